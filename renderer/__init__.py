@@ -1,0 +1,18 @@
+"""Vectorized numpy renderer of the Chapter-9 scene (two spheres, two point
+lights, checker floor, bump-mapped sphere A) with a numeric (central
+difference) and a symbolic (exact gradient) pipeline.
+
+Public API (DESIGN.md)::
+
+    from renderer import Scene, PointLight, render
+    frame = render(Scene(), width=256, height=256, gradient="exact")
+"""
+
+from .ledger import Ledger, compare, to_srgb
+from .render import CHAMBER_NAMES, GRADIENTS, Frame, render
+from .scene import HEIGHT_FIELDS, MODELS, PointLight, Scene
+
+__all__ = [
+    "Scene", "PointLight", "render", "Frame", "Ledger", "compare", "to_srgb",
+    "GRADIENTS", "HEIGHT_FIELDS", "MODELS", "CHAMBER_NAMES",
+]

@@ -1,0 +1,142 @@
+"""Height fields h(u, v) on sphere A's chart, written once in sympy.
+
+Seed §2 and §3 define three fields on the chart (u, v) in [0, 1]^2:
+
+* sine   h = sin(pi k_u u) sin(pi k_v v)         smooth everywhere (the control)
+* ridges h = |sin(pi k_u u) sin(pi k_v v)|       creased where either factor is 0
+* rings  h = sin(2 pi k_v v)                     latitude bands, no u-dependence
+
+`HEIGHT_EXPRS` holds the sympy expressions; everything numeric is generated
+from them by ``sympy.lambdify``: the height itself (`height`, evaluated by the
+central-difference pipeline) and its exact gradient (`exact_gradient`, sympy's
+derivative with common subexpressions shared).  Nothing here is typed twice.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+import sympy as sp
+
+__all__ = [
+    "u", "v", "k_u", "k_v", "HEIGHT_EXPRS", "GRADIENT_EXPRS",
+    "height", "exact_gradient", "kink_band", "KINK_BAND_HALF_WIDTH",
+]
+
+#: Chart coordinates and frequencies.  Real, so that d|f|/du = sign(f) f'.
+u, v, k_u, k_v = sp.symbols("u v k_u k_v", real=True)
+
+_s1 = sp.sin(sp.pi * k_u * u)
+_s2 = sp.sin(sp.pi * k_v * v)
+
+#: The three height fields of seed §2, the single source of truth.
+HEIGHT_EXPRS = {
+    "sine": _s1 * _s2,
+    "ridges": sp.Abs(_s1 * _s2),
+    "rings": sp.sin(2 * sp.pi * k_v * v),
+}
+
+#: (h_u, h_v) for each field: sympy's derivatives of `HEIGHT_EXPRS`.
+GRADIENT_EXPRS = {
+    name: (sp.diff(h, u), sp.diff(h, v)) for name, h in HEIGHT_EXPRS.items()
+}
+
+#: Half-width of the seed's crease band: a ridges pixel is flagged when
+#: |sin(pi k_u u)| < 0.03 or |sin(pi k_v v)| < 0.03 (seed Cell 1, ``height1``).
+KINK_BAND_HALF_WIDTH = 0.03
+
+
+@lru_cache(maxsize=None)
+def _height_fn(name):
+    return sp.lambdify((u, v, k_u, k_v), HEIGHT_EXPRS[name], modules="numpy")
+
+
+@lru_cache(maxsize=None)
+def _ridge_factors_fn():
+    return sp.lambdify((u, v, k_u, k_v), [_s1, _s2], modules="numpy")
+
+
+@lru_cache(maxsize=None)
+def _gradient_fn(name):
+    return sp.lambdify((u, v, k_u, k_v), list(GRADIENT_EXPRS[name]), modules="numpy", cse=True)
+
+
+def _check_name(name):
+    if name not in HEIGHT_EXPRS:
+        raise ValueError(f"height_field must be one of {tuple(HEIGHT_EXPRS)}, got {name!r}")
+
+
+def height(name, uu, vv, ku, kv):
+    """Evaluate the height field ``name`` at chart points.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : ndarray of float64, broadcastable
+        Chart coordinates (dimensionless, nominally in [0, 1]).
+    ku, kv : float
+        Frequencies k_u, k_v.
+
+    Returns
+    -------
+    ndarray of float64 with the broadcast shape of ``uu`` and ``vv``.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a known field.
+    """
+    _check_name(name)
+    h = _height_fn(name)(uu, vv, ku, kv)
+    return np.broadcast_to(np.asarray(h, dtype=np.float64), np.broadcast(uu, vv).shape)
+
+
+def exact_gradient(name, uu, vv, ku, kv):
+    """The exact chart gradient (h_u, h_v), generated from the sympy field.
+
+    For "ridges" the derivative of |f| is sign(f) f', so on the zero lines
+    (where the field is not differentiable) both components are 0, as the
+    seed's ``grad_exact`` also returns (seed Cell 3).
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : ndarray of float64, broadcastable
+    ku, kv : float
+
+    Returns
+    -------
+    (h_u, h_v) : tuple of two float64 ndarrays of the broadcast shape.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a known field.
+    """
+    _check_name(name)
+    shape = np.broadcast(uu, vv).shape
+    hu, hv = _gradient_fn(name)(uu, vv, ku, kv)
+    return (np.broadcast_to(np.asarray(hu, dtype=np.float64), shape),
+            np.broadcast_to(np.asarray(hv, dtype=np.float64), shape))
+
+
+def kink_band(name, uu, vv, ku, kv):
+    """The seed's crease flag: True within the band around the ridges' zero lines.
+
+    Only the "ridges" field has creases; for the other fields the result is
+    all False.  The band is |sin(pi k_u u)| < 0.03 or |sin(pi k_v v)| < 0.03
+    (seed Cell 1).
+
+    Returns
+    -------
+    ndarray of bool with the broadcast shape of ``uu`` and ``vv``.
+    """
+    _check_name(name)
+    shape = np.broadcast(uu, vv).shape
+    if name != "ridges":
+        return np.zeros(shape, dtype=bool)
+    s1, s2 = _ridge_factors_fn()(uu, vv, ku, kv)
+    return np.broadcast_to(
+        (np.abs(s1) < KINK_BAND_HALF_WIDTH) | (np.abs(s2) < KINK_BAND_HALF_WIDTH), shape
+    )

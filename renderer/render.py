@@ -1,0 +1,290 @@
+"""The two pipelines: one render function, differing only in the gradient.
+
+Data flow for a tile of pixels (see DESIGN.md):
+
+camera -> intersections -> chamber code -> hit points and geometric normals
+-> sphere A only: chart (u, v), tangent frame, gradient, perturbed normal
+-> shading (ambient + per light: geometric shadow predicate, Lambert, Blinn or
+Phong).  Everything before the gradient depends on geometry alone.
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import fields
+from .geometry import chart, image_plane, segment_hits_sphere, sphere_hit, tangent_frame
+from .scene import Scene
+
+__all__ = [
+    "Frame", "render", "central_gradient", "GRADIENTS", "MAX_SIDE", "CHAMBER_NAMES",
+    "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR",
+]
+
+#: Accepted values of ``render(..., gradient=...)``.
+GRADIENTS = ("exact", "central")
+#: Largest accepted image side, in pixels.
+MAX_SIDE = 8192
+#: Pixels per tile: bounds the working memory of a render at any resolution.
+TILE_PIXELS = 1 << 16
+
+BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
+#: Chamber codes of `Frame.chamber`.
+CHAMBER_NAMES = {BACKGROUND: "background", SPHERE_A: "sphere A", SPHERE_B: "sphere B",
+                 FLOOR: "floor"}
+
+#: Checker albedo levels of the floor's two colours (seed Cell 1).
+FLOOR_LIGHT, FLOOR_DARK = 0.85, 0.15
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One rendered frame.
+
+    Attributes
+    ----------
+    image : (H, W, 3) float64
+        Linear RGB, clipped to [0, 1].
+    chamber : (H, W) uint8
+        0 background, 1 sphere A, 2 sphere B, 3 floor: the object of the
+        nearest positive hit.
+    kink : (H, W) bool
+        The seed's crease band on sphere A (ridges only; all False otherwise).
+    grad : (H, W, 2) float64
+        (h_u, h_v) used on sphere A by this frame's pipeline; 0 elsewhere.
+    scene : Scene
+    gradient : {"exact", "central"}
+    """
+
+    image: np.ndarray
+    chamber: np.ndarray
+    kink: np.ndarray
+    grad: np.ndarray
+    scene: Scene
+    gradient: str
+
+
+def _check_size(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer number of pixels, got {value!r}")
+    if not 1 <= value <= MAX_SIDE:
+        raise ValueError(f"{name} must be between 1 and {MAX_SIDE} pixels, got {value!r}")
+    return int(value)
+
+
+def central_gradient(name, uu, vv, ku, kv, eps):
+    """Central-difference chart gradient, the numeric pipeline's one difference.
+
+    h_u = (h(u + eps, v) - h(u - eps, v)) / (2 eps) with u wrapped modulo 1
+    (the chart is periodic in u).  v is clamped to [0, 1]; where a clamp
+    happens the quotient is one-sided, divided by the clamped distance
+    v_+ - v_-; elsewhere by 2 eps (seed Cell 1, ``grad_numeric``).  Four
+    evaluations of h per point.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : (n,) float64 chart coordinates in [0, 1]
+    ku, kv : float
+    eps : float > 0, the step in chart units
+
+    Returns
+    -------
+    (h_u, h_v) : two (n,) float64 arrays.
+    """
+    up = np.mod(uu + eps, 1.0)
+    um = np.mod(uu - eps, 1.0)
+    hu = (fields.height(name, up, vv, ku, kv) - fields.height(name, um, vv, ku, kv)) / (2.0 * eps)
+    vp = np.minimum(1.0, vv + eps)
+    vm = np.maximum(0.0, vv - eps)
+    clamped = (vv + eps > 1.0) | (vv - eps < 0.0)
+    den = np.where(clamped, vp - vm, 2.0 * eps)
+    hv = (fields.height(name, uu, vp, ku, kv) - fields.height(name, uu, vm, ku, kv)) / den
+    return hu, hv
+
+
+def _dot(a, b):
+    return np.einsum("ij,ij->i", a, b)
+
+
+def _normalize(a):
+    n = np.sqrt(_dot(a, a))
+    return a / np.where(n > 0.0, n, 1.0)[:, None]
+
+
+def _shade(scene, P, N, Ns, albedo, spheres, floor_blocks):
+    """Ambient plus, per light, Lambert and Blinn/Phong (seed Cell 1, ``shade1``).
+
+    A light reaches P only if the geometric normal N faces it (attached
+    shadow) and no blocker sphere, nor the floor plane, cuts the segment to it
+    (cast shadow).  Both predicates use geometry alone; the shading normal Ns
+    (perturbed on sphere A) enters only the Lambert and specular factors, and
+    the specular lobe is gated by Ns . w > 0.
+    """
+    n = P.shape[0]
+    E = np.array([0.0, 0.0, scene.camera_z])
+    col = np.empty((n, 3))
+    col[:] = scene.ka * np.asarray(scene.ambient)
+    v_hat = _normalize(E[None, :] - P)
+    for light in scene.lights:
+        color = np.asarray(light.color)
+        if not color.any():
+            continue
+        Lp = np.asarray(light.position)
+        w = Lp[None, :] - P
+        lit = _dot(N, w) > 0.0
+        if floor_blocks:
+            lit &= ~(((P[:, 2] > 0.0) & (Lp[2] < 0.0)) | ((P[:, 2] < 0.0) & (Lp[2] > 0.0)))
+        for center, radius in spheres:
+            idx = np.flatnonzero(lit)
+            if idx.size:
+                lit[idx] = ~segment_hits_sphere(P[idx], Lp, center, radius)
+        idx = np.flatnonzero(lit)
+        if idx.size == 0:
+            continue
+        Nsi = Ns[idx]
+        w_hat = _normalize(w[idx])
+        vi = v_hat[idx]
+        mu = _dot(Nsi, w_hat)
+        if scene.model == "blinn":
+            spec_cos = _dot(Nsi, _normalize(w_hat + vi))
+        else:
+            r = 2.0 * mu[:, None] * Nsi - w_hat
+            spec_cos = _dot(r, vi)
+        spec = np.where(mu > 0.0, np.maximum(spec_cos, 0.0) ** scene.shininess, 0.0)
+        alb = albedo if albedo.ndim == 1 else albedo[idx]
+        col[idx] += color[None, :] * (scene.kd * alb * np.maximum(mu, 0.0)[:, None]
+                                      + scene.ks * spec[:, None])
+    return col
+
+
+def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
+    """Render the rays (X, Y) into the flat output views (one entry per ray)."""
+    e = scene.camera_z
+    origin = (0.0, 0.0, 0.0)
+    t = np.full(X.shape, np.inf)
+    code = np.zeros(X.shape, dtype=np.uint8)
+
+    # Nearest positive hit; ties go to A, then B, then the floor (seed order).
+    tA = sphere_hit(X, Y, e, origin, scene.radius_a)
+    closer = tA < t
+    t[closer], code[closer] = tA[closer], SPHERE_A
+    if scene.sphere_b:
+        tB = sphere_hit(X, Y, e, scene.center_b, scene.radius_b)
+        closer = tB < t
+        t[closer], code[closer] = tB[closer], SPHERE_B
+    if scene.floor:
+        # The floor z = 0 is the image plane: every ray meets it at t = 1.
+        closer = 1.0 < t
+        t[closer], code[closer] = 1.0, FLOOR
+    chamber[:] = code
+
+    sphere_a = (np.zeros(3), scene.radius_a)
+    sphere_b = (np.asarray(scene.center_b), scene.radius_b)
+
+    for kind in (SPHERE_A, SPHERE_B, FLOOR):
+        idx = np.flatnonzero(code == kind)
+        if idx.size == 0:
+            continue
+        ti = t[idx]
+        P = np.stack([ti * X[idx], ti * Y[idx], e * (1.0 - ti)], axis=-1)
+        if kind == SPHERE_A:
+            N = P / scene.radius_a
+            uu, vv, sin_phi = chart(N[:, 0], N[:, 1], N[:, 2])
+            if gradient == "exact":
+                hu, hv = fields.exact_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v)
+            else:
+                hu, hv = central_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v,
+                                          scene.eps)
+            grad[idx, 0], grad[idx, 1] = hu, hv
+            kink[idx] = fields.kink_band(scene.height_field, uu, vv, scene.k_u, scene.k_v)
+            if scene.beta == 0.0:
+                Ns = N                      # beta = 0 is the un-bumped scene, exactly
+            else:
+                e_theta, e_phi = tangent_frame(N[:, 0], N[:, 1], N[:, 2], sin_phi)
+                M = N + scene.beta * (hu[:, None] * e_theta + hv[:, None] * e_phi)
+                Ns = _normalize(M)
+            albedo = np.asarray(scene.albedo_a)
+            spheres = [sphere_b] if scene.sphere_b else []
+        elif kind == SPHERE_B:
+            N = (P - sphere_b[0][None, :]) / scene.radius_b
+            Ns = N
+            albedo = np.asarray(scene.albedo_b)
+            spheres = [sphere_a]
+        else:
+            N = np.zeros_like(P)
+            N[:, 2] = 1.0
+            Ns = N
+            light_square = np.sin(np.pi * P[:, 0]) * np.sin(np.pi * P[:, 1]) >= 0.0
+            base = np.where(light_square, FLOOR_LIGHT, FLOOR_DARK)
+            albedo = np.stack([base * (1.0 - scene.floor_tint),
+                               base * (1.0 - scene.floor_tint), base], axis=-1)
+            spheres = [sphere_a] + ([sphere_b] if scene.sphere_b else [])
+        floor_blocks = scene.floor and kind != FLOOR
+        image[idx] = _shade(scene, P, N, Ns, albedo, spheres, floor_blocks)
+    np.clip(image, 0.0, 1.0, out=image)
+
+
+def render(scene, width, height, *, gradient="exact"):
+    """Render the Chapter-9 scene.
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene (see `Scene`).
+    width, height : int
+        Image size in pixels, each in [1, 8192].
+    gradient : {"exact", "central"}, keyword-only
+        "exact": the symbolic pipeline, the gradient of h generated from its
+        sympy expression.  "central": the numeric pipeline, central differences
+        of the same h with step ``scene.eps`` (u wraps, v clamps).
+
+    Returns
+    -------
+    Frame
+        ``image`` (H, W, 3) float64 linear RGB in [0, 1]; ``chamber`` (H, W)
+        uint8; ``kink`` (H, W) bool; ``grad`` (H, W, 2) float64.
+
+    Raises
+    ------
+    TypeError
+        ``scene`` is not a Scene, or ``width``/``height`` is not an integer.
+    ValueError
+        ``width``/``height`` outside [1, 8192], or an unknown ``gradient``.
+
+    Notes
+    -----
+    The image is computed in tiles of at most 65,536 pixels, so the working
+    memory beyond the outputs is bounded at any resolution.  Source: seed
+    Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
+    corrections listed in the book's errata.
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
+    width = _check_size("width", width)
+    height = _check_size("height", height)
+    if not isinstance(gradient, str) or gradient not in GRADIENTS:
+        raise ValueError(f"gradient must be one of {GRADIENTS}, got {gradient!r}")
+
+    image = np.zeros((height, width, 3))
+    chamber = np.zeros((height, width), dtype=np.uint8)
+    kink = np.zeros((height, width), dtype=bool)
+    grad = np.zeros((height, width, 2))
+    x, y = image_plane(scene.radius_a, scene.camera_z, width, height)
+    rows = max(1, TILE_PIXELS // width)
+    flat_image = image.reshape(-1, 3)
+    flat_chamber = chamber.reshape(-1)
+    flat_kink = kink.reshape(-1)
+    flat_grad = grad.reshape(-1, 2)
+    for j0 in range(0, height, rows):
+        j1 = min(height, j0 + rows)
+        X = np.tile(x, j1 - j0)
+        Y = np.repeat(y[j0:j1], width)
+        sl = slice(j0 * width, j1 * width)
+        _render_tile(scene, gradient, X, Y, flat_image[sl], flat_chamber[sl],
+                     flat_kink[sl], flat_grad[sl])
+    return Frame(image=image, chamber=chamber, kink=kink, grad=grad, scene=scene,
+                 gradient=gradient)

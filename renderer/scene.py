@@ -1,0 +1,220 @@
+"""The Chapter-9 scene: a frozen, validated description of what is rendered.
+
+Every field is checked once, here, when the scene is built; the render code
+downstream can then trust its inputs.  Seed names are given in brackets in the
+`Scene` docstring (seed §2 and Cell 1, the ``SC9`` dictionary).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, field, fields
+
+__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS"]
+
+#: Names accepted for ``Scene.height_field`` (seed §2).
+HEIGHT_FIELDS = ("sine", "ridges", "rings")
+#: Names accepted for ``Scene.model`` (seed Cell 1, ``shade1``).
+MODELS = ("blinn", "phong")
+
+
+def _real(owner: str, name: str, value, *, low=None, low_open=False, high=None):
+    """Return ``value`` as a finite float, or raise naming ``owner.name``."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(
+            f"{owner}.{name} must be a real number, got {type(value).__name__} {value!r}"
+        )
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{owner}.{name} must be finite, got {value!r}")
+    if low is not None and (x <= low if low_open else x < low):
+        rel = ">" if low_open else ">="
+        raise ValueError(f"{owner}.{name} must be {rel} {low}, got {value!r}")
+    if high is not None and x > high:
+        raise ValueError(f"{owner}.{name} must be <= {high}, got {value!r}")
+    return x
+
+
+def _vec3(owner: str, name: str, value, *, nonneg=False, high=None):
+    """Return ``value`` as a tuple of three finite floats, or raise."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
+        raise TypeError(
+            f"{owner}.{name} must be a sequence of 3 real numbers, got {value!r}"
+        )
+    if len(value) != 3:
+        raise ValueError(
+            f"{owner}.{name} must have exactly 3 components, got {len(value)}: {value!r}"
+        )
+    low = 0.0 if nonneg else None
+    return tuple(
+        _real(owner, f"{name}[{i}]", c, low=low, high=high) for i, c in enumerate(value)
+    )
+
+
+def _flag(owner: str, name: str, value):
+    if not isinstance(value, bool):
+        raise TypeError(f"{owner}.{name} must be True or False, got {value!r}")
+    return value
+
+
+def _choice(owner: str, name: str, value, accepted):
+    if not isinstance(value, str):
+        raise TypeError(f"{owner}.{name} must be a string, one of {accepted}, got {value!r}")
+    if value not in accepted:
+        raise ValueError(f"{owner}.{name} must be one of {accepted}, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class PointLight:
+    """A point light (seed Cell 1, ``SC9['lights']``).
+
+    Parameters
+    ----------
+    position : sequence of 3 floats
+        World position of the light (same units as the scene radii).
+    color : sequence of 3 floats, each >= 0
+        Linear-RGB radiant intensity.  A light whose colour is (0, 0, 0)
+        contributes nothing.
+
+    Raises
+    ------
+    TypeError, ValueError
+        If a component is not a finite real number, or a colour is negative.
+    """
+
+    position: tuple = (5.0, 5.0, 10.0)
+    color: tuple = (1.0, 1.0, 1.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "position", _vec3("PointLight", "position", self.position))
+        object.__setattr__(self, "color", _vec3("PointLight", "color", self.color, nonneg=True))
+
+
+_DEFAULT_LIGHTS = (
+    PointLight((5.0, 5.0, 10.0), (1.0, 1.0, 1.0)),
+    PointLight((-6.0, 2.0, 8.0), (0.9, 0.65, 0.25)),
+)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """The Chapter-9 scene; the defaults are the seed's (Cell 1, ``SC9``).
+
+    Geometry.  Sphere A (radius ``radius_a`` [R]) is centred at the origin and
+    carries the bump.  The pinhole camera sits at ``(0, 0, camera_z)`` [e] and
+    looks down the -z axis at the image plane z = 0, which is also the floor
+    plane.  Sphere B has centre ``center_b`` [Cb] and radius ``radius_b`` [R2]
+    and is drawn when ``sphere_b`` [b_on]; the checker floor when ``floor``
+    [floor_on].
+
+    Shading.  ``lights`` [lights] is a tuple of `PointLight`.  ``ambient``
+    [ambient] times ``ka`` is added everywhere; ``kd``, ``ks`` and
+    ``shininess`` [shin] weight Lambert and ``model`` ("blinn" or "phong")
+    terms.  ``albedo_a`` [matA] and ``albedo_b`` [matB] are the sphere
+    albedos; ``floor_tint`` [alpha] in [0, 1] removes that fraction of red and
+    green from the floor's checker squares.
+
+    Bump.  ``height_field`` [hf] is one of "sine", "ridges", "rings" with
+    frequencies ``k_u`` [ku] and ``k_v`` [kv] (seed §2); ``beta`` [beta] >= 0 is
+    the bump amplitude; ``eps`` [eps] > 0 is the central-difference step of the
+    numeric pipeline, in chart units (u and v both run over [0, 1]).
+
+    Raises
+    ------
+    TypeError
+        A field has the wrong type (a string for a number, a number for a flag).
+    ValueError
+        A field is out of range: not finite, a radius <= 0, the camera inside or
+        on sphere A or sphere B, ``eps`` <= 0, ``beta`` < 0, an unknown
+        ``model`` or ``height_field`` name.  The message names the field, the
+        value and what is accepted.
+
+    Examples
+    --------
+    >>> Scene(height_field="sine", beta=1.5).beta
+    1.5
+    """
+
+    radius_a: float = 1.0
+    camera_z: float = 4.0
+    center_b: tuple = (0.5, 0.5, 1.3)
+    radius_b: float = 0.32
+    sphere_b: bool = True
+    floor: bool = True
+    lights: tuple = field(default=_DEFAULT_LIGHTS)
+    ambient: tuple = (0.15, 0.15, 0.16)
+    albedo_a: tuple = (0.63, 0.19, 0.16)
+    albedo_b: tuple = (0.33, 0.44, 0.62)
+    ka: float = 0.1
+    kd: float = 0.7
+    ks: float = 0.5
+    shininess: float = 32.0
+    model: str = "blinn"
+    floor_tint: float = 0.25
+    height_field: str = "ridges"
+    k_u: float = 8.0
+    k_v: float = 4.0
+    beta: float = 0.35
+    eps: float = 1e-3
+
+    def __post_init__(self):
+        set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
+        S = "Scene"
+        set_("radius_a", _real(S, "radius_a", self.radius_a, low=0.0, low_open=True))
+        set_("camera_z", _real(S, "camera_z", self.camera_z))
+        if not self.camera_z > self.radius_a:
+            raise ValueError(
+                f"Scene.camera_z must be > radius_a = {self.radius_a} (camera outside "
+                f"sphere A), got {self.camera_z!r}"
+            )
+        set_("center_b", _vec3(S, "center_b", self.center_b))
+        set_("radius_b", _real(S, "radius_b", self.radius_b, low=0.0, low_open=True))
+        # Camera outside sphere B: the nearest hit is then always a front face.
+        d2 = self.center_b[0] ** 2 + self.center_b[1] ** 2 + (self.camera_z - self.center_b[2]) ** 2
+        if not d2 > self.radius_b**2:
+            raise ValueError(
+                f"Scene.radius_b = {self.radius_b!r} puts the camera (0, 0, {self.camera_z}) "
+                f"inside or on sphere B centred at {self.center_b}; the camera must be outside"
+            )
+        set_("sphere_b", _flag(S, "sphere_b", self.sphere_b))
+        set_("floor", _flag(S, "floor", self.floor))
+        lights = self.lights
+        if isinstance(lights, PointLight):
+            raise TypeError("Scene.lights must be a sequence of PointLight, got a single PointLight")
+        if not isinstance(lights, (tuple, list)):
+            raise TypeError(f"Scene.lights must be a tuple of PointLight, got {lights!r}")
+        for i, light in enumerate(lights):
+            if not isinstance(light, PointLight):
+                raise TypeError(f"Scene.lights[{i}] must be a PointLight, got {light!r}")
+        set_("lights", tuple(lights))
+        set_("ambient", _vec3(S, "ambient", self.ambient, nonneg=True))
+        set_("albedo_a", _vec3(S, "albedo_a", self.albedo_a, nonneg=True, high=1.0))
+        set_("albedo_b", _vec3(S, "albedo_b", self.albedo_b, nonneg=True, high=1.0))
+        for name in ("ka", "kd", "ks"):
+            set_(name, _real(S, name, getattr(self, name), low=0.0))
+        set_("shininess", _real(S, "shininess", self.shininess, low=0.0, low_open=True))
+        set_("model", _choice(S, "model", self.model, MODELS))
+        set_("floor_tint", _real(S, "floor_tint", self.floor_tint, low=0.0, high=1.0))
+        set_("height_field", _choice(S, "height_field", self.height_field, HEIGHT_FIELDS))
+        set_("k_u", _real(S, "k_u", self.k_u, low=0.0, low_open=True))
+        set_("k_v", _real(S, "k_v", self.k_v, low=0.0, low_open=True))
+        set_("beta", _real(S, "beta", self.beta, low=0.0))
+        set_("eps", _real(S, "eps", self.eps, low=0.0, low_open=True))
+
+    def replace(self, **changes) -> "Scene":
+        """Return a copy with ``changes`` applied (and validated).
+
+        Raises
+        ------
+        TypeError
+            If a keyword is not a Scene field.
+        """
+        names = {f.name for f in fields(self)}
+        unknown = sorted(set(changes) - names)
+        if unknown:
+            raise TypeError(f"Scene has no field(s) {unknown}; fields are {sorted(names)}")
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        values.update(changes)
+        return Scene(**values)
