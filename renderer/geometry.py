@@ -75,16 +75,19 @@ def sphere_hit(x, y, camera_z, center, radius):
     b = x * ocx + y * ocy - camera_z * ocz
     c = ocx * ocx + ocy * ocy + ocz * ocz - radius * radius
     disc = b * b - a * c
-    hit = disc >= 0.0
-    sq = np.sqrt(np.where(hit, disc, 0.0))
-    q = -(b + np.copysign(sq, b))
+    t = np.full(disc.shape, np.inf)
+    idx = np.flatnonzero(disc >= 0.0)
+    if idx.size == 0:
+        return t
+    bi = b[idx]
+    q = -(bi + np.copysign(np.sqrt(disc[idx]), bi))
     with np.errstate(divide="ignore", invalid="ignore"):
-        t0 = q / a
+        t0 = q / a[idx]
         t1 = c / q
     near = np.fmin(t0, t1)
     far = np.fmax(t0, t1)
-    t = np.where(near > 0.0, near, np.where(far > 0.0, far, np.inf))
-    return np.where(hit, t, np.inf)
+    t[idx] = np.where(near > 0.0, near, np.where(far > 0.0, far, np.inf))
+    return t
 
 
 def chart(Nx, Ny, Nz):
@@ -118,47 +121,52 @@ def tangent_frame(Nx, Ny, Nz, sin_phi):
 
     Returns
     -------
-    e_theta, e_phi : (n, 3) float64
+    e_theta, e_phi : triples of (n,) float64 arrays (x, y, z components)
     """
     regular = sin_phi > POLE_SIN_PHI
-    s = np.where(regular, sin_phi, 1.0)
-    zero = np.zeros_like(Nx)
-    e_theta = np.stack([np.where(regular, -Ny / s, 1.0),
-                        np.where(regular, Nx / s, 0.0), zero], axis=-1)
-    e_phi = np.stack([np.where(regular, Nz * Nx / s, 0.0),
-                      np.where(regular, Nz * Ny / s, 1.0),
-                      np.where(regular, -sin_phi, 0.0)], axis=-1)
+    inv = 1.0 / np.where(regular, sin_phi, 1.0)
+    e_theta = (np.where(regular, -Ny * inv, 1.0), np.where(regular, Nx * inv, 0.0),
+               np.zeros_like(Nx))
+    zx = Nz * inv
+    e_phi = (np.where(regular, zx * Nx, 0.0), np.where(regular, zx * Ny, 1.0),
+             np.where(regular, -sin_phi, 0.0))
     return e_theta, e_phi
 
 
-def segment_hits_sphere(P, L, center, radius):
-    """Shadow predicate: does the open segment from P to the light L meet a sphere?
+def segment_hits_sphere(wx, wy, wz, w2, L, center, radius):
+    """Shadow predicate: does the segment from a point P to the light L meet a sphere?
 
-    Solves |P + s (L - P) - C|^2 = r^2 for s with the stable root pair and
-    reports a blocker when a root lies in the open interval (0, 1) (seed Cell
-    1, ``shadowed1``; "sign logic").  Depends on geometry only.
+    With u = P - L (the caller passes w = L - P = -u and w2 = |w|^2) and
+    d = C - L, the segment is L + tau u, tau in (0, 1), and meets the sphere
+    where tau^2 |u|^2 - 2 tau (u . d) + |d|^2 - r^2 = 0.  For a light and a
+    point both outside the sphere the roots share a sign and the point lies
+    outside the root interval, so a root falls in (0, 1) exactly when
+
+        (u . d)^2 >= |u|^2 (|d|^2 - r^2)   (the ray from L meets the sphere),
+        0 < u . d < |u|^2                  (ahead of L, and the chord ends before P).
+
+    A light inside the sphere is blocked from every outside point.  This is the
+    seed's quadratic "sign logic" test (seed Cell 1, ``shadowed1``) solved once
+    per light instead of once per point; it depends on geometry only.
 
     Parameters
     ----------
-    P : (n, 3) float64   surface points
-    L : (3,) float64     light position
-    center : (3,) float64, radius : float
+    wx, wy, wz : (n,) float64   components of L - P
+    w2 : (n,) float64           |L - P|^2
+    L : sequence of 3 floats    light position
+    center : sequence of 3 floats, radius : float
 
     Returns
     -------
     (n,) bool
     """
-    seg = L[None, :] - P
-    pc = P - center[None, :]
-    a = np.einsum("ij,ij->i", seg, seg)
-    b = np.einsum("ij,ij->i", pc, seg)
-    c = np.einsum("ij,ij->i", pc, pc) - radius * radius
-    disc = b * b - a * c
-    ok = (disc >= 0.0) & (a > 0.0)
-    sq = np.sqrt(np.where(ok, disc, 0.0))
-    q = -(b + np.copysign(sq, b))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s0 = q / a
-        s1 = c / q
-    inside = ((s0 > 0.0) & (s0 < 1.0)) | ((s1 > 0.0) & (s1 < 1.0))
-    return ok & inside
+    dx, dy, dz = L[0] - center[0], L[1] - center[1], L[2] - center[2]
+    k = dx * dx + dy * dy + dz * dz - radius * radius
+    if k <= 0.0:
+        return np.ones(wx.shape, dtype=bool)
+    g = wx * dx + wy * dy + wz * dz          # = u . d
+    blocked = (g > 0.0) & (g < w2)
+    idx = np.flatnonzero(blocked)
+    gi = g[idx]
+    blocked[idx] = gi * gi >= w2[idx] * k
+    return blocked

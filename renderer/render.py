@@ -29,7 +29,7 @@ GRADIENTS = ("exact", "central")
 #: Largest accepted image side, in pixels.
 MAX_SIDE = 8192
 #: Pixels per tile: bounds the working memory of a render at any resolution.
-TILE_PIXELS = 1 << 16
+TILE_PIXELS = 1 << 14
 
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
 #: Chamber codes of `Frame.chamber`.
@@ -106,70 +106,73 @@ def central_gradient(name, uu, vv, ku, kv, eps):
     return hu, hv
 
 
-def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
-
-
-def _normalize(a):
-    n = np.sqrt(_dot(a, a))
-    return a / np.where(n > 0.0, n, 1.0)[:, None]
+def _dot(ax, ay, az, bx, by, bz):
+    return ax * bx + ay * by + az * bz
 
 
 def _shade(scene, P, N, Ns, albedo, spheres, floor_blocks):
     """Ambient plus, per light, Lambert and Blinn/Phong (seed Cell 1, ``shade1``).
 
-    A light reaches P only if the geometric normal N faces it (attached
-    shadow) and no blocker sphere, nor the floor plane, cuts the segment to it
-    (cast shadow).  Both predicates use geometry alone; the shading normal Ns
-    (perturbed on sphere A) enters only the Lambert and specular factors, and
-    the specular lobe is gated by Ns . w > 0.
+    P, N, Ns are triples of (n,) float64 arrays (x, y, z components); albedo
+    is a triple of floats or of (n,) arrays.  A light reaches P only if the
+    geometric normal N faces it (attached shadow) and no blocker sphere, nor
+    the floor plane, cuts the segment to it (cast shadow).  Both predicates
+    use geometry alone; the shading normal Ns (perturbed on sphere A) enters
+    only the Lambert and specular factors, and the specular lobe is gated by
+    Ns . w > 0.  Returns a triple of (n,) arrays.
     """
-    n = P.shape[0]
-    E = np.array([0.0, 0.0, scene.camera_z])
-    col = np.empty((n, 3))
-    col[:] = scene.ka * np.asarray(scene.ambient)
-    v_hat = _normalize(E[None, :] - P)
+    Px, Py, Pz = P
+    Nx, Ny, Nz = N
+    Sx, Sy, Sz = Ns
+    n = Px.shape[0]
+    out = [np.full(n, scene.ka * a) for a in scene.ambient]
+    # Unit vector to the eye.
+    vx, vy, vz = -Px, -Py, scene.camera_z - Pz
+    inv = 1.0 / np.sqrt(_dot(vx, vy, vz, vx, vy, vz))
+    vx, vy, vz = vx * inv, vy * inv, vz * inv
     for light in scene.lights:
-        color = np.asarray(light.color)
-        if not color.any():
+        if not any(light.color):
             continue
-        Lp = np.asarray(light.position)
-        w = Lp[None, :] - P
-        lit = _dot(N, w) > 0.0
+        Lx, Ly, Lz = light.position
+        wx, wy, wz = Lx - Px, Ly - Py, Lz - Pz
+        lit = _dot(Nx, Ny, Nz, wx, wy, wz) > 0.0
         if floor_blocks:
-            lit &= ~(((P[:, 2] > 0.0) & (Lp[2] < 0.0)) | ((P[:, 2] < 0.0) & (Lp[2] > 0.0)))
+            lit &= ~(((Pz > 0.0) & (Lz < 0.0)) | ((Pz < 0.0) & (Lz > 0.0)))
+        w2 = _dot(wx, wy, wz, wx, wy, wz)
         for center, radius in spheres:
             idx = np.flatnonzero(lit)
             if idx.size:
-                lit[idx] = ~segment_hits_sphere(P[idx], Lp, center, radius)
-        idx = np.flatnonzero(lit)
-        if idx.size == 0:
+                lit[idx] = ~segment_hits_sphere(wx[idx], wy[idx], wz[idx], w2[idx],
+                                                light.position, center, radius)
+        if not lit.any():
             continue
-        Nsi = Ns[idx]
-        w_hat = _normalize(w[idx])
-        vi = v_hat[idx]
-        mu = _dot(Nsi, w_hat)
+        inv = 1.0 / np.sqrt(w2)
+        wx, wy, wz = wx * inv, wy * inv, wz * inv
+        mu = _dot(Sx, Sy, Sz, wx, wy, wz)
         if scene.model == "blinn":
-            spec_cos = _dot(Nsi, _normalize(w_hat + vi))
+            hx, hy, hz = wx + vx, wy + vy, wz + vz
+            hn = np.sqrt(_dot(hx, hy, hz, hx, hy, hz))
+            spec_cos = _dot(Sx, Sy, Sz, hx, hy, hz) / np.where(hn > 0.0, hn, 1.0)
         else:
-            r = 2.0 * mu[:, None] * Nsi - w_hat
-            spec_cos = _dot(r, vi)
-        spec = np.where(mu > 0.0, np.maximum(spec_cos, 0.0) ** scene.shininess, 0.0)
-        alb = albedo if albedo.ndim == 1 else albedo[idx]
-        col[idx] += color[None, :] * (scene.kd * alb * np.maximum(mu, 0.0)[:, None]
-                                      + scene.ks * spec[:, None])
-    return col
+            two_mu = 2.0 * mu
+            spec_cos = _dot(two_mu * Sx - wx, two_mu * Sy - wy, two_mu * Sz - wz, vx, vy, vz)
+        front = lit & (mu > 0.0)
+        spec = np.where(front, np.maximum(spec_cos, 0.0), 0.0) ** scene.shininess
+        diffuse = np.where(front, mu, 0.0) * scene.kd
+        spec *= scene.ks
+        for c in range(3):
+            out[c] += light.color[c] * (diffuse * albedo[c] + spec)
+    return out
 
 
 def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
     """Render the rays (X, Y) into the flat output views (one entry per ray)."""
     e = scene.camera_z
-    origin = (0.0, 0.0, 0.0)
     t = np.full(X.shape, np.inf)
     code = np.zeros(X.shape, dtype=np.uint8)
 
     # Nearest positive hit; ties go to A, then B, then the floor (seed order).
-    tA = sphere_hit(X, Y, e, origin, scene.radius_a)
+    tA = sphere_hit(X, Y, e, (0.0, 0.0, 0.0), scene.radius_a)
     closer = tA < t
     t[closer], code[closer] = tA[closer], SPHERE_A
     if scene.sphere_b:
@@ -182,18 +185,18 @@ def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
         t[closer], code[closer] = 1.0, FLOOR
     chamber[:] = code
 
-    sphere_a = (np.zeros(3), scene.radius_a)
-    sphere_b = (np.asarray(scene.center_b), scene.radius_b)
+    sphere_a = ((0.0, 0.0, 0.0), scene.radius_a)
+    sphere_b = (scene.center_b, scene.radius_b)
 
     for kind in (SPHERE_A, SPHERE_B, FLOOR):
         idx = np.flatnonzero(code == kind)
         if idx.size == 0:
             continue
         ti = t[idx]
-        P = np.stack([ti * X[idx], ti * Y[idx], e * (1.0 - ti)], axis=-1)
+        P = (ti * X[idx], ti * Y[idx], e * (1.0 - ti))
         if kind == SPHERE_A:
-            N = P / scene.radius_a
-            uu, vv, sin_phi = chart(N[:, 0], N[:, 1], N[:, 2])
+            N = tuple(c / scene.radius_a for c in P)
+            uu, vv, sin_phi = chart(*N)
             if gradient == "exact":
                 hu, hv = fields.exact_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v)
             else:
@@ -204,28 +207,30 @@ def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
             if scene.beta == 0.0:
                 Ns = N                      # beta = 0 is the un-bumped scene, exactly
             else:
-                e_theta, e_phi = tangent_frame(N[:, 0], N[:, 1], N[:, 2], sin_phi)
-                M = N + scene.beta * (hu[:, None] * e_theta + hv[:, None] * e_phi)
-                Ns = _normalize(M)
-            albedo = np.asarray(scene.albedo_a)
+                e_theta, e_phi = tangent_frame(*N, sin_phi)
+                bu, bv = scene.beta * hu, scene.beta * hv
+                M = tuple(n_ + bu * a + bv * b for n_, a, b in zip(N, e_theta, e_phi))
+                inv = 1.0 / np.sqrt(_dot(*M, *M))
+                Ns = tuple(m * inv for m in M)
+            albedo = scene.albedo_a
             spheres = [sphere_b] if scene.sphere_b else []
         elif kind == SPHERE_B:
-            N = (P - sphere_b[0][None, :]) / scene.radius_b
+            N = tuple((p - c) / scene.radius_b for p, c in zip(P, scene.center_b))
             Ns = N
-            albedo = np.asarray(scene.albedo_b)
+            albedo = scene.albedo_b
             spheres = [sphere_a]
         else:
-            N = np.zeros_like(P)
-            N[:, 2] = 1.0
-            Ns = N
-            light_square = np.sin(np.pi * P[:, 0]) * np.sin(np.pi * P[:, 1]) >= 0.0
+            zero = np.zeros_like(ti)
+            N = Ns = (zero, zero, zero + 1.0)
+            light_square = np.sin(np.pi * P[0]) * np.sin(np.pi * P[1]) >= 0.0
             base = np.where(light_square, FLOOR_LIGHT, FLOOR_DARK)
-            albedo = np.stack([base * (1.0 - scene.floor_tint),
-                               base * (1.0 - scene.floor_tint), base], axis=-1)
+            rg = base * (1.0 - scene.floor_tint)
+            albedo = (rg, rg, base)
             spheres = [sphere_a] + ([sphere_b] if scene.sphere_b else [])
         floor_blocks = scene.floor and kind != FLOOR
-        image[idx] = _shade(scene, P, N, Ns, albedo, spheres, floor_blocks)
-    np.clip(image, 0.0, 1.0, out=image)
+        col = _shade(scene, P, N, Ns, albedo, spheres, floor_blocks)
+        for c in range(3):
+            image[idx, c] = np.clip(col[c], 0.0, 1.0)
 
 
 def render(scene, width, height, *, gradient="exact"):
@@ -257,7 +262,7 @@ def render(scene, width, height, *, gradient="exact"):
 
     Notes
     -----
-    The image is computed in tiles of at most 65,536 pixels, so the working
+    The image is computed in tiles of at most 16,384 pixels, so the working
     memory beyond the outputs is bounded at any resolution.  Source: seed
     Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
     corrections listed in the book's errata.
