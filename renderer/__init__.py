@@ -9,10 +9,10 @@ Public API (DESIGN.md)::
 """
 
 from .ledger import Ledger, compare, to_srgb
-from .render import CHAMBER_NAMES, GRADIENTS, Frame, render
+from .render import CHAMBER_NAMES, GRADIENTS, Frame, GBuffer, gbuffer, render
 from .scene import HEIGHT_FIELDS, MODELS, PointLight, Scene
 
 __all__ = [
-    "Scene", "PointLight", "render", "Frame", "Ledger", "compare", "to_srgb",
+    "Scene", "PointLight", "render", "Frame", "GBuffer", "gbuffer", "Ledger", "compare", "to_srgb",
     "GRADIENTS", "HEIGHT_FIELDS", "MODELS", "CHAMBER_NAMES",
 ]

@@ -20,7 +20,7 @@ from .geometry import chart, image_plane, segment_hits_sphere, sphere_hit, tange
 from .scene import Scene
 
 __all__ = [
-    "Frame", "render", "central_gradient", "GRADIENTS", "MAX_SIDE", "CHAMBER_NAMES",
+    "Frame", "render", "GBuffer", "gbuffer", "central_gradient", "GRADIENTS", "MAX_SIDE", "CHAMBER_NAMES",
     "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR",
 ]
 
@@ -165,13 +165,12 @@ def _shade(scene, P, N, Ns, albedo, spheres, floor_blocks):
     return out
 
 
-def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
-    """Render the rays (X, Y) into the flat output views (one entry per ray)."""
+def _nearest_hit(scene, X, Y):
+    """Ray parameter and chamber code of the nearest positive hit of each ray."""
     e = scene.camera_z
     t = np.full(X.shape, np.inf)
     code = np.zeros(X.shape, dtype=np.uint8)
-
-    # Nearest positive hit; ties go to A, then B, then the floor (seed order).
+    # Ties go to A, then B, then the floor (the seed's order of tests).
     tA = sphere_hit(X, Y, e, (0.0, 0.0, 0.0), scene.radius_a)
     closer = tA < t
     t[closer], code[closer] = tA[closer], SPHERE_A
@@ -183,11 +182,30 @@ def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
         # The floor z = 0 is the image plane: every ray meets it at t = 1.
         closer = 1.0 < t
         t[closer], code[closer] = 1.0, FLOOR
-    chamber[:] = code
+    return t, code
 
+
+@dataclass
+class _Surface:
+    """Shading inputs of the pixels of one object (triples are x, y, z arrays)."""
+
+    kind: int
+    idx: np.ndarray
+    P: tuple
+    N: tuple
+    Ns: tuple
+    albedo: tuple
+    spheres: list
+    uv: tuple = None
+    grad: tuple = None
+    kink: np.ndarray = None
+
+
+def _surfaces(scene, gradient, X, Y, t, code):
+    """Yield a `_Surface` per object hit by at least one of the rays."""
+    e = scene.camera_z
     sphere_a = ((0.0, 0.0, 0.0), scene.radius_a)
     sphere_b = (scene.center_b, scene.radius_b)
-
     for kind in (SPHERE_A, SPHERE_B, FLOOR):
         idx = np.flatnonzero(code == kind)
         if idx.size == 0:
@@ -202,35 +220,109 @@ def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
             else:
                 hu, hv = central_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v,
                                           scene.eps)
-            grad[idx, 0], grad[idx, 1] = hu, hv
-            kink[idx] = fields.kink_band(scene.height_field, uu, vv, scene.k_u, scene.k_v)
+            kink = fields.kink_band(scene.height_field, uu, vv, scene.k_u, scene.k_v)
             if scene.beta == 0.0:
                 Ns = N                      # beta = 0 is the un-bumped scene, exactly
             else:
+                # Perturbed normal N' = M / |M|, M = N + beta (h_u e_theta + h_v e_phi).
                 e_theta, e_phi = tangent_frame(*N, sin_phi)
                 bu, bv = scene.beta * hu, scene.beta * hv
                 M = tuple(n_ + bu * a + bv * b for n_, a, b in zip(N, e_theta, e_phi))
                 inv = 1.0 / np.sqrt(_dot(*M, *M))
                 Ns = tuple(m * inv for m in M)
-            albedo = scene.albedo_a
-            spheres = [sphere_b] if scene.sphere_b else []
+            yield _Surface(kind, idx, P, N, Ns, scene.albedo_a,
+                           [sphere_b] if scene.sphere_b else [],
+                           uv=(uu, vv), grad=(hu, hv), kink=kink)
         elif kind == SPHERE_B:
             N = tuple((p - c) / scene.radius_b for p, c in zip(P, scene.center_b))
-            Ns = N
-            albedo = scene.albedo_b
-            spheres = [sphere_a]
+            yield _Surface(kind, idx, P, N, N, scene.albedo_b, [sphere_a])
         else:
             zero = np.zeros_like(ti)
-            N = Ns = (zero, zero, zero + 1.0)
+            N = (zero, zero, zero + 1.0)
+            # Checker: light squares where sin(pi x) sin(pi y) >= 0 (seed Cell 1).
             light_square = np.sin(np.pi * P[0]) * np.sin(np.pi * P[1]) >= 0.0
             base = np.where(light_square, FLOOR_LIGHT, FLOOR_DARK)
             rg = base * (1.0 - scene.floor_tint)
-            albedo = (rg, rg, base)
-            spheres = [sphere_a] + ([sphere_b] if scene.sphere_b else [])
-        floor_blocks = scene.floor and kind != FLOOR
-        col = _shade(scene, P, N, Ns, albedo, spheres, floor_blocks)
+            yield _Surface(kind, idx, P, N, N, (rg, rg, base),
+                           [sphere_a] + ([sphere_b] if scene.sphere_b else []))
+
+
+def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
+    """Render the rays (X, Y) into the flat output views (one entry per ray)."""
+    t, code = _nearest_hit(scene, X, Y)
+    chamber[:] = code
+    for surf in _surfaces(scene, gradient, X, Y, t, code):
+        if surf.kind == SPHERE_A:
+            grad[surf.idx, 0], grad[surf.idx, 1] = surf.grad
+            kink[surf.idx] = surf.kink
+        floor_blocks = scene.floor and surf.kind != FLOOR
+        col = _shade(scene, surf.P, surf.N, surf.Ns, surf.albedo, surf.spheres, floor_blocks)
         for c in range(3):
-            image[idx, c] = np.clip(col[c], 0.0, 1.0)
+            image[surf.idx, c] = np.clip(col[c], 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class GBuffer:
+    """Per-pixel geometry of a frame, for checks and figures (not shaded).
+
+    Attributes
+    ----------
+    chamber : (H, W) uint8        as `Frame.chamber`
+    t : (H, W) float64            ray parameter of the nearest hit (inf: none)
+    P : (H, W, 3) float64         hit point (0 where chamber is 0)
+    N : (H, W, 3) float64         geometric unit normal (0 where chamber is 0)
+    Ns : (H, W, 3) float64        shading normal (perturbed on sphere A)
+    uv : (H, W, 2) float64        sphere-A chart (u, v); 0 elsewhere
+    grad : (H, W, 2) float64      (h_u, h_v) on sphere A; 0 elsewhere
+    x, y : (W,), (H,) float64     image-plane coordinates of the pixel centres
+    """
+
+    chamber: np.ndarray
+    t: np.ndarray
+    P: np.ndarray
+    N: np.ndarray
+    Ns: np.ndarray
+    uv: np.ndarray
+    grad: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+
+
+def gbuffer(scene, width, height, *, gradient="exact"):
+    """Per-pixel hit points, normals and chart of a frame (see `GBuffer`).
+
+    Same arguments, validation and errors as `render`; computed by the same
+    code path as `render` up to (not including) shading.
+    """
+    scene, width, height, gradient = _check_args(scene, width, height, gradient)
+    x, y = image_plane(scene.radius_a, scene.camera_z, width, height)
+    X = np.tile(x, height)
+    Y = np.repeat(y, width)
+    t, code = _nearest_hit(scene, X, Y)
+    n = width * height
+    P, N, Ns = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    uv, grad = np.zeros((n, 2)), np.zeros((n, 2))
+    for surf in _surfaces(scene, gradient, X, Y, t, code):
+        P[surf.idx] = np.stack(surf.P, axis=-1)
+        N[surf.idx] = np.stack(surf.N, axis=-1)
+        Ns[surf.idx] = np.stack(surf.Ns, axis=-1)
+        if surf.kind == SPHERE_A:
+            uv[surf.idx] = np.stack(surf.uv, axis=-1)
+            grad[surf.idx] = np.stack(surf.grad, axis=-1)
+    shape = (height, width)
+    return GBuffer(code.reshape(shape), t.reshape(shape), P.reshape(shape + (3,)),
+                   N.reshape(shape + (3,)), Ns.reshape(shape + (3,)), uv.reshape(shape + (2,)),
+                   grad.reshape(shape + (2,)), x, y)
+
+
+def _check_args(scene, width, height, gradient):
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
+    width = _check_size("width", width)
+    height = _check_size("height", height)
+    if not isinstance(gradient, str) or gradient not in GRADIENTS:
+        raise ValueError(f"gradient must be one of {GRADIENTS}, got {gradient!r}")
+    return scene, width, height, gradient
 
 
 def render(scene, width, height, *, gradient="exact"):
@@ -267,13 +359,7 @@ def render(scene, width, height, *, gradient="exact"):
     Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
     corrections listed in the book's errata.
     """
-    if not isinstance(scene, Scene):
-        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
-    width = _check_size("width", width)
-    height = _check_size("height", height)
-    if not isinstance(gradient, str) or gradient not in GRADIENTS:
-        raise ValueError(f"gradient must be one of {GRADIENTS}, got {gradient!r}")
-
+    scene, width, height, gradient = _check_args(scene, width, height, gradient)
     image = np.zeros((height, width, 3))
     chamber = np.zeros((height, width), dtype=np.uint8)
     kink = np.zeros((height, width), dtype=bool)
