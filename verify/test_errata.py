@@ -1,0 +1,69 @@
+"""The errata of the seed's code: each measured defect is real in the seed's
+variant and absent from the renderer.  If a measurement stops showing its
+defect, the book's errata section would be false: this fails first."""
+
+import numpy as np
+import pytest
+
+from proofs.seed_errata import ERRATA, measure_all
+from renderer import Scene, gbuffer
+
+MEASURED = measure_all()
+
+
+def test_every_erratum_is_measured_and_reported():
+    assert [e.id for e in ERRATA] == list(MEASURED)
+    for e in ERRATA:
+        text = e.report(MEASURED[e.id])
+        assert text and "{" not in text
+
+
+def test_sphere_b_seed_variant_is_off_the_surface():
+    m = MEASURED["sphere-b-quadratic"]
+    assert m["off_surface_relative"] > 1.0            # seed: points far off sphere B
+    assert m["seed_pixels_b"] > 5 * m["true_pixels_b"]
+    # The renderer's own sphere-B hit points are on the surface.
+    scene = Scene()
+    g = gbuffer(scene, 128, 128)
+    b = g.chamber == 2
+    dist = np.linalg.norm(g.P[b] - np.asarray(scene.center_b), axis=-1)
+    assert np.max(np.abs(dist - scene.radius_b)) <= 1e-12 * scene.radius_b
+
+
+def test_terminator_leak_exists_in_seed_rule_only():
+    m = MEASURED["terminator-leak"]
+    assert m["leak_pixels_default"] > 0 and m["leak_diffuse_max_default"] > 1 / 255
+    # The renderer: with one light and no ambient, every sphere-A pixel whose
+    # geometric normal faces away from the light is exactly black.
+    from renderer import render
+    light = Scene().lights[0]
+    scene = Scene(lights=(light,), ka=0.0, beta=1.5)
+    g = gbuffer(scene, 128, 128)
+    image = render(scene, 128, 128).image
+    a = g.chamber == 1
+    away = a & (np.einsum("hwc,hwc->hw", g.N, np.asarray(light.position) - g.P) <= 0)
+    bumped_toward = away & (np.einsum("hwc,hwc->hw", g.Ns, np.asarray(light.position) - g.P) > 0)
+    assert bumped_toward.sum() > 0          # pixels the seed's rule would light
+    assert np.all(image[away] == 0.0)
+
+
+def test_acos_pole_loses_digits_atan2_does_not():
+    m = MEASURED["acos-pole"]
+    assert m["max_rel_error_acos"] > 1e-3
+    assert m["max_rel_error_atan2"] < 1e-14
+
+
+def test_fallback_orientation_is_reflected():
+    m = MEASURED["fallback-orientation"]
+    assert m["orientation_fallback"] == 1.0
+    assert m["orientation_regular_max"] == pytest.approx(-1.0, abs=1e-12)
+
+
+def test_v_border_branch_fires_in_interior():
+    m = MEASURED["v-border-branch"]
+    assert 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"]
+
+
+def test_report_rejects_a_missing_measurement():
+    with pytest.raises(KeyError):
+        ERRATA[0].report({})
