@@ -95,9 +95,12 @@ def height(name, uu, vv, ku, kv):
 def exact_gradient(name, uu, vv, ku, kv):
     """The exact chart gradient (h_u, h_v), generated from the sympy field.
 
-    For "ridges" the derivative of |f| is sign(f) f', so on the zero lines
-    (where the field is not differentiable) both components are 0, as the
-    seed's ``grad_exact`` also returns (seed Cell 3).
+    For "ridges" the derivative of |f| is sign(f) f'.  The field is not
+    differentiable on its zero lines u = m/k_u, v = m/k_v; there the result is
+    0 only where the float64 sine is exactly 0 (e.g. the seam u = 0).  On a
+    line such as u = 1/8 with k_u = 8, sin(pi) rounds to 1.2e-16, the sign is
+    taken from that residue, and the result is one of the two one-sided
+    derivatives.  The `kink_band` flag marks these pixels.
 
     Parameters
     ----------
