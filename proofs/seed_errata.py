@@ -65,15 +65,12 @@ def _sphere_b_seed_vs_true(size=SIZE):
     t = (-b[hit] - np.sqrt(disc[hit])) / a[hit]
     P = np.stack([t * X[hit], t * Y[hit], e * (1 - t)], axis=-1)
     off = np.abs(np.linalg.norm(P - C, axis=-1) - r)
-    # Chamber of the seed's scene: nearest of A (correct in the seed), seed-B, floor.
+    # Chamber of the seed's scene: nearest of A (which the seed intersects
+    # correctly), the seed's sphere B, and the floor at t = 1.
     g = gbuffer(scene, size, size)
     tB_seed = np.full(X.shape, np.inf)
     tB_seed[hit] = t
-    tA = np.where(g.chamber.ravel() == SPHERE_A, g.t.ravel(), np.inf)
-    tA_all = np.where(np.isfinite(tA), tA, np.inf)
-    # Rays that hit A but are shown as B by the corrected renderer still hit A:
-    # recompute A independently of the occlusion by B.
-    gA = gbuffer(scene.replace(sphere_b=False), size, size)
+    gA = gbuffer(scene.replace(sphere_b=False), size, size)      # A unoccluded by B
     tA_all = np.where(gA.chamber.ravel() == SPHERE_A, gA.t.ravel(), np.inf)
     seed_code = np.full(X.shape, FLOOR, dtype=np.uint8)
     seed_code[tA_all <= np.minimum(tB_seed, 1.0)] = SPHERE_A
