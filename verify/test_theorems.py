@@ -1,0 +1,41 @@
+"""`pytest verify`: one test per theorem, and one per wrong variant.
+
+A theorem passes when its check returns proved or verified; the ledger of
+verdicts is printed at the end of the run (see conftest.py).  Each wrong
+variant (a flipped sign, a dropped factor, a wrong exponent) must be refuted:
+the checker has teeth.
+"""
+
+import pytest
+
+from proofs.registry import THEOREMS, get
+from verify.conftest import LEDGER
+
+VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
+
+
+@pytest.mark.parametrize("theorem_id", list(THEOREMS))
+def test_theorem_holds(theorem_id):
+    verdict = THEOREMS[theorem_id].check()
+    LEDGER[theorem_id] = verdict
+    assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
+    if verdict.status == "verified":
+        assert verdict.digits >= 30 and verdict.points >= 20
+
+
+@pytest.mark.parametrize("theorem_id, description, variant", VARIANTS,
+                         ids=[f"{i}: {d}" for i, d, _ in VARIANTS])
+def test_wrong_variant_is_refuted(theorem_id, description, variant):
+    verdict = variant()
+    assert verdict.status == "refuted", f"{theorem_id}, {description}: {verdict.evidence}"
+
+
+def test_every_theorem_has_a_variant_and_a_statement():
+    for t in THEOREMS.values():
+        assert t.wrong_variants, t.id
+        assert t.statement and t.steps, t.id
+
+
+def test_registry_names_unknown_ids():
+    with pytest.raises(KeyError, match="no theorem 'no-such'"):
+        get("no-such")
