@@ -156,7 +156,8 @@ class Theorem:
     id : str            stable identifier (cited by the book and verify/)
     title : str
     statement : str     LaTeX
-    steps : tuple       (caption, lhs, rhs) triples of sympy objects (rhs may be None):
+    steps : tuple       (caption, lhs, rhs) triples of sympy objects or LaTeX strings
+                        (rhs may be None):
                         the argument a reader sees, rendered as lhs = rhs
     check : callable    () -> Verdict
     wrong_variants : tuple of (description, callable () -> Verdict); each must be refuted
@@ -193,6 +194,7 @@ def identities_theorem(id, title, statement, identities, variants, *, steps=(), 
 def step_latex(step) -> str:
     """LaTeX of one (caption, lhs, rhs) step: ``lhs = rhs`` (or ``lhs``)."""
     _, lhs, rhs = step
+    tex = lambda e: e if isinstance(e, str) else sp.latex(e)  # noqa: E731 - str is LaTeX already
     if rhs is None:
-        return sp.latex(lhs)
-    return f"{sp.latex(lhs)} = {sp.latex(rhs)}"
+        return tex(lhs)
+    return f"{tex(lhs)} = {tex(rhs)}"

@@ -65,8 +65,8 @@ OPTIMAL_STEP = Theorem(
     statement=r"The error model $E(\varepsilon) = \varepsilon^2\lvert h'''\rvert/6 + "
               r"\mathrm{u}\lvert h\rvert/\varepsilon$ ($\mathrm{u}$ the unit roundoff) has its "
               r"minimum at $\varepsilon^\ast = (3\mathrm{u}\lvert h\rvert/\lvert h'''\rvert)^{1/3}$.",
-    steps=((r"E'(\varepsilon)", sp.diff(ERROR_MODEL, eps), None),
-           (r"\varepsilon^\ast", sp.Symbol(r"\varepsilon^\ast"), EPS_STAR)),
+    steps=((r"derivative", r"E'(\varepsilon)", sp.diff(ERROR_MODEL, eps)),
+           (r"\varepsilon^\ast", r"\varepsilon^\ast", EPS_STAR)),
     check=lambda: _optimum(EPS_STAR),
     wrong_variants=(("exponent 1/2 instead of 1/3",
                      lambda: _optimum((3 * u_round * H / H3) ** sp.Rational(1, 2))),),

@@ -65,8 +65,9 @@ FRAME_ORIENTATION = Theorem(
     id="frame-orientation", title="Orientation of the tangent frame",
     statement=r"$(e_\theta \times e_\varphi)\cdot N = -1$: the pair $(e_\theta, e_\varphi)$ is "
               r"left-handed about the outward normal, $e_\theta\times e_\varphi = -N$.",
-    steps=((r"cross product", e_theta.cross(e_phi).applyfunc(sp.simplify), -N),
-           (r"orientation", sp.Symbol(r"(e_\theta\times e_\varphi)\cdot N"), _orientation_value())),
+    steps=((r"cross product", r"e_\theta\times e_\varphi", e_theta.cross(e_phi).applyfunc(sp.simplify)),
+           (r"outward normal", "N", N),
+           (r"orientation", r"(e_\theta\times e_\varphi)\cdot N", _orientation_value())),
     check=_check_orientation,
     wrong_variants=(("the seed's reading: aligned with N (+1)",
                      lambda: _orientation(e_theta, e_phi, 1)),),

@@ -49,9 +49,9 @@ RIDGES_KINKS = identities_theorem(
     _identities(JUMP_U, JUMP_V),
     [("jump without the factor 2", _identities(sp.pi * k_u * sp.Abs(s2), JUMP_V)),
      ("jump with the roles of k_u and k_v swapped", _identities(2 * sp.pi * k_v * sp.Abs(s2), JUMP_V))],
-    steps=((r"h_u^{\pm}\ \text{at}\ u = 1/k_u", sp.Tuple(*one_sided(h, u, 1 / k_u)), None),
-           (r"h_u^+ - h_u^-", sp.Symbol(r"h_u^+ - h_u^-"), JUMP_U),
-           (r"h_v^+ - h_v^-", sp.Symbol(r"h_v^+ - h_v^-"), JUMP_V)),
+    steps=((r"one-sided", r"(h_u^+, h_u^-)\big|_{u = 1/k_u}", sp.Tuple(*one_sided(h, u, 1 / k_u))),
+           (r"h_u^+ - h_u^-", r"h_u^+ - h_u^-", JUMP_U),
+           (r"h_v^+ - h_v^-", r"h_v^+ - h_v^-", JUMP_V)),
     pages=("s3", "s7"),
 )
 

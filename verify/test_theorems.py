@@ -39,3 +39,13 @@ def test_every_theorem_has_a_variant_and_a_statement():
 def test_registry_names_unknown_ids():
     with pytest.raises(KeyError, match="no theorem 'no-such'"):
         get("no-such")
+
+
+def test_book_block_refuses_a_failing_theorem(monkeypatch):
+    """A theorem that does not hold fails the build (the cell raises)."""
+    from proofs import book
+    from proofs.core import Verdict
+    monkeypatch.setitem(book._VERDICTS, "optimal-step", Verdict("refuted", "forced for the test"))
+    with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
+        book.theorem_block("optimal-step")
+    assert "PROVED" in book.theorem_block("frame-orthonormal")
