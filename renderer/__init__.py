@@ -10,9 +10,9 @@ Public API (DESIGN.md)::
 
 from .ledger import Ledger, compare, to_srgb
 from .render import CHAMBER_NAMES, GRADIENTS, Frame, GBuffer, gbuffer, render
-from .scene import HEIGHT_FIELDS, MODELS, PointLight, Scene
+from .scene import BUMPS, HEIGHT_FIELDS, MODELS, PointLight, Scene
 
 __all__ = [
     "Scene", "PointLight", "render", "Frame", "GBuffer", "gbuffer", "Ledger", "compare", "to_srgb",
-    "GRADIENTS", "HEIGHT_FIELDS", "MODELS", "CHAMBER_NAMES",
+    "GRADIENTS", "HEIGHT_FIELDS", "MODELS", "BUMPS", "CHAMBER_NAMES",
 ]

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import fields
-from .geometry import chart, image_plane, segment_hits_sphere, sphere_hit, tangent_frame
+from .geometry import (POLE_SIN_PHI, chart, image_plane, segment_hits_sphere, sphere_hit,
+                       tangent_frame)
 from .scene import Scene
 
 __all__ = [
@@ -226,7 +227,14 @@ def _surfaces(scene, gradient, X, Y, t, code):
             else:
                 # Perturbed normal N' = M / |M|, M = N + beta (h_u e_theta + h_v e_phi).
                 e_theta, e_phi = tangent_frame(*N, sin_phi)
-                bu, bv = scene.beta * hu, scene.beta * hv
+                if scene.bump == "chart":
+                    bu, bv = scene.beta * hu, scene.beta * hv
+                else:
+                    # Normal of P = (R + beta h) N: h_theta = h_u / 2 pi, h_phi = h_v / pi.
+                    h = fields.height(scene.height_field, uu, vv, scene.k_u, scene.k_v)
+                    w = -scene.beta / (scene.radius_a + scene.beta * h)
+                    s_phi = np.maximum(sin_phi, POLE_SIN_PHI)
+                    bu, bv = w * hu / (2.0 * np.pi * s_phi), w * hv / np.pi
                 M = tuple(n_ + bu * a + bv * b for n_, a, b in zip(N, e_theta, e_phi))
                 inv = 1.0 / np.sqrt(_dot(*M, *M))
                 Ns = tuple(m * inv for m in M)

@@ -11,12 +11,15 @@ import math
 import numbers
 from dataclasses import dataclass, field, fields
 
-__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS"]
+__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
 
 #: Names accepted for ``Scene.height_field`` (seed §2).
 HEIGHT_FIELDS = ("sine", "ridges", "rings")
 #: Names accepted for ``Scene.model`` (seed Cell 1, ``shade1``).
 MODELS = ("blinn", "phong")
+#: Names accepted for ``Scene.bump``: the seed's chart formula, or the normal
+#: of the displaced surface P = (R + beta h) N (theorem bump-vs-displacement).
+BUMPS = ("chart", "surface")
 
 
 def _real(owner: str, name: str, value, *, low=None, low_open=False, high=None):
@@ -120,6 +123,11 @@ class Scene:
     frequencies ``k_u`` [ku] and ``k_v`` [kv] (seed §2); ``beta`` [beta] >= 0 is
     the bump amplitude; ``eps`` [eps] > 0 is the central-difference step of the
     numeric pipeline, in chart units (u and v both run over [0, 1]).
+    ``bump`` selects the perturbed normal: "chart" (default) is the seed's
+    N' = normalize(N + beta (h_u e_theta + h_v e_phi)); "surface" is the exact
+    normal of the displaced sphere P = (R + beta h) N,
+    N' = normalize(N - beta / (R + beta h) (h_u / (2 pi sin phi) e_theta + h_v / pi e_phi)),
+    which needs beta < radius_a (|h| <= 1 keeps R + beta h > 0).
 
     Raises
     ------
@@ -158,6 +166,7 @@ class Scene:
     k_v: float = 4.0
     beta: float = 0.35
     eps: float = 1e-3
+    bump: str = "chart"
 
     def __post_init__(self):
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -202,6 +211,12 @@ class Scene:
         set_("k_v", _real(S, "k_v", self.k_v, low=0.0, low_open=True))
         set_("beta", _real(S, "beta", self.beta, low=0.0))
         set_("eps", _real(S, "eps", self.eps, low=0.0, low_open=True))
+        set_("bump", _choice(S, "bump", self.bump, BUMPS))
+        if self.bump == "surface" and not self.beta < self.radius_a:
+            raise ValueError(
+                f"Scene.beta must be < radius_a = {self.radius_a} when bump='surface' (the "
+                f"displaced radius R + beta h must stay positive), got {self.beta!r}"
+            )
 
     def replace(self, **changes) -> "Scene":
         """Return a copy with ``changes`` applied (and validated).

@@ -170,7 +170,13 @@ def render_pixel(scene, i, j, width, height, gradient="exact"):
                 ep = [N[2] * N[0] / sin_phi, N[2] * N[1] / sin_phi, -sin_phi]
             else:
                 et, ep = [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]
-            Ns = unit([N[k] + scene.beta * (grad[0] * et[k] + grad[1] * ep[k]) for k in range(3)])
+            if scene.bump == "chart":
+                a_u, a_v = scene.beta * grad[0], scene.beta * grad[1]
+            else:   # exact normal of the displaced sphere (R + beta h) N
+                w = -scene.beta / (scene.radius_a + scene.beta * h_value(f, u, v, ku, kv))
+                a_u = w * grad[0] / (2 * PI * max(sin_phi, POLE))
+                a_v = w * grad[1] / PI
+            Ns = unit([N[k] + a_u * et[k] + a_v * ep[k] for k in range(3)])
         rgb = shade(scene, P, N, Ns, scene.albedo_a, [B] if scene.sphere_b else [], scene.floor)
     elif code == 2:
         N = [(P[k] - scene.center_b[k]) / scene.radius_b for k in range(3)]

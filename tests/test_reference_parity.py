@@ -44,6 +44,16 @@ def test_matches_scalar_reference(field, model, gradient, sphere_b, floor, beta)
     assert d_grad <= 1e-12
 
 
+@pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
+@pytest.mark.parametrize("gradient", ["exact", "central"])
+@pytest.mark.parametrize("beta", [0.35, 0.9])
+def test_surface_bump_matches_scalar_reference(field, gradient, beta):
+    scene = Scene(height_field=field, bump="surface", beta=beta)
+    chamber, kink, d_image, d_grad = compare_with_reference(scene, gradient)
+    assert (chamber, kink) == (0, 0)
+    assert d_image <= 1e-12 and d_grad <= 1e-12
+
+
 def test_reference_parity_has_teeth(monkeypatch):
     """The comparison rejects wrong variants of the scene and of the reference."""
     scene = Scene(beta=0.35)

@@ -48,6 +48,7 @@ BAD_VALUES = [
     ("height_field", "bumps", ValueError, "height_field"), ("height_field", None, TypeError, "height_field"),
     ("k_u", 0.0, ValueError, "k_u"), ("k_v", -2.0, ValueError, "k_v"), ("k_u", math.inf, ValueError, "k_u"),
     ("beta", -0.1, ValueError, "beta"), ("beta", math.nan, ValueError, "beta"),
+    ("bump", "displacement", ValueError, "bump"), ("bump", None, TypeError, "bump"),
     ("eps", 0.0, ValueError, "eps"), ("eps", -1e-3, ValueError, "eps"), ("eps", math.inf, ValueError, "eps"),
 ]
 
@@ -56,6 +57,12 @@ BAD_VALUES = [
 def test_scene_rejects_bad_field(field, value, exc, fragment):
     with pytest.raises(exc, match=fragment):
         Scene(**{field: value})
+
+
+def test_surface_bump_needs_beta_below_radius():
+    with pytest.raises(ValueError, match="beta must be < radius_a"):
+        Scene(bump="surface", beta=1.0)
+    assert Scene(bump="surface", beta=0.99).bump == "surface"
 
 
 def test_message_names_value_and_accepted_range():

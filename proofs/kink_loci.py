@@ -1,0 +1,129 @@
+"""The kink loci of the ridges field, seen by the camera: rays and circles.
+
+The camera sits on the z-axis, so the z-axis projects to the image-plane
+origin.  A point R N(theta, phi) of sphere A projects to
+
+    (x, y) = rho(phi) (cos theta, sin theta),  rho(phi) = e R sin(phi) / (e - R cos(phi)),
+
+so in polar coordinates (rho, alpha) about the origin, alpha = theta: the chart
+u = (theta + pi) / 2 pi depends only on the angle, and v = phi / pi only on the
+radius (rho is increasing on the visible cap cos(phi) > R / e).  The zero line
+u = m / k_u is the ray alpha_m = 2 pi m / k_u - pi; the zero line v = m / k_v
+is the circle rho_m = rho(pi m / k_v), visible when cos(pi m / k_v) > R / e.
+"""
+
+import numpy as np
+import sympy as sp
+
+from renderer import Scene, gbuffer, render
+
+from .core import Identity, Theorem, Verdict, check_identities
+
+theta, phi = sp.symbols("theta phi", real=True)
+R, e = sp.symbols("R e", positive=True)
+P = R * sp.Matrix([sp.sin(phi) * sp.cos(theta), sp.sin(phi) * sp.sin(theta), sp.cos(phi)])
+#: Projection from the eye (0, 0, e) onto the image plane z = 0.
+x_img = P[0] * e / (e - P[2])
+y_img = P[1] * e / (e - P[2])
+RHO = e * R * sp.sin(phi) / (e - R * sp.cos(phi))
+DRHO = e * R * (e * sp.cos(phi) - R) / (e - R * sp.cos(phi)) ** 2
+DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 1.2), R: (0.5, 1.0), e: (2.0, 6.0)}
+
+
+def ray_angles(k_u):
+    """Image-plane angles alpha_m of the rays u = m / k_u, m = 0 .. ceil(k_u) - 1."""
+    m = np.arange(int(np.ceil(k_u)))
+    return 2 * np.pi * m / k_u - np.pi
+
+
+def circle_radii(radius_a, camera_z, k_v):
+    """(phi_m, rho_m, visible) for the circles v = m / k_v with 0 < phi_m < pi."""
+    m = np.arange(1, int(np.ceil(k_v)))
+    phi_m = np.pi * m / k_v
+    rho = camera_z * radius_a * np.sin(phi_m) / (camera_z - radius_a * np.cos(phi_m))
+    return phi_m, rho, np.cos(phi_m) > radius_a / camera_z
+
+
+def phi_of_rho(rho, radius_a, camera_z):
+    """Invert rho(phi) on the visible cap: phi = asin(rho e / (R sqrt(e^2 + rho^2))) - atan2(rho, e)."""
+    s = np.clip(rho * camera_z / (radius_a * np.hypot(camera_z, rho)), -1.0, 1.0)
+    return np.arcsin(s) - np.arctan2(rho, camera_z)
+
+
+def predicted_band(scene, width, height):
+    """The crease band predicted from the closed forms, on the pixels of sphere A."""
+    g = gbuffer(scene, width, height)
+    X, Y = np.meshgrid(g.x, g.y)
+    alpha = np.arctan2(Y, X)
+    rho = np.hypot(X, Y)
+    u = (alpha + np.pi) / (2 * np.pi)
+    v = phi_of_rho(rho, scene.radius_a, scene.camera_z) / np.pi
+    band = ((np.abs(np.sin(np.pi * scene.k_u * u)) < 0.03)
+            | (np.abs(np.sin(np.pi * scene.k_v * v)) < 0.03))
+    return band & (g.chamber == 1), g.chamber == 1
+
+
+def band_mismatch(scene=None, size=256):
+    """Pixels where the rendered kink band and the closed-form band disagree."""
+    scene = scene or Scene()
+    predicted, on_a = predicted_band(scene, size, size)
+    rendered = render(scene, size, size).kink
+    return int(np.count_nonzero(predicted != rendered)), int(np.count_nonzero(rendered)), int(on_a.sum())
+
+
+def _projection_identities(rho, drho):
+    return [Identity("x", x_img, rho * sp.cos(theta), DOMAIN),
+            Identity("y", y_img, rho * sp.sin(theta), DOMAIN),
+            Identity(r"d\rho/d\varphi", sp.diff(RHO, phi), drho, DOMAIN)]
+
+
+def _check(kind, rho=RHO, drho=DRHO, scene=None):
+    symbolic = check_identities(_projection_identities(rho, drho))
+    if not symbolic.holds:
+        return symbolic
+    scene = scene or Scene()
+    mismatched, band, on_a = band_mismatch(scene)
+    if kind == "rays":
+        loci = ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
+        what = f"{len(ray_angles(scene.k_u))} rays at alpha = {loci} (all visible)"
+    else:
+        phis, rhos, vis = circle_radii(scene.radius_a, scene.camera_z, scene.k_v)
+        what = "; ".join(f"phi={p:.4f}: rho={r:.4f} ({'visible' if s else 'hidden'})"
+                         for p, r, s in zip(phis, rhos, vis))
+    if mismatched > 0:
+        return Verdict("refuted", f"{mismatched} of {on_a} sphere-A pixels: rendered band differs "
+                       f"from the closed form")
+    return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the closed-form band equals the "
+                   f"rendered kink band on all {on_a} sphere-A pixels ({band} in the band) at 256x256")
+
+
+KINK_LOCI_RAYS = Theorem(
+    id="kink-loci-rays", title="The u-creases are rays",
+    statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the "
+              r"$z$-axis, $\alpha = \theta$, so $u = (\alpha + \pi)/2\pi$ depends on the angle alone "
+              r"and the crease $u = m/k_u$ is the ray $\alpha_m = 2\pi m/k_u - \pi$.",
+    steps=(("projection", r"(x, y)", sp.Matrix([x_img, y_img]).applyfunc(sp.simplify)),
+           ("polar form", r"(x, y)", sp.Matrix([RHO * sp.cos(theta), RHO * sp.sin(theta)]))),
+    check=lambda: _check("rays"),
+    wrong_variants=(("projection with a flipped sign: e + R cos(phi) in the denominator",
+                     lambda: _check("rays", rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi)))),),
+    pages=("s3", "s4"),
+    seed_says="§3: the zero lines u = m/k_u are rays 'by Chapter 5's longitude theorem'.",
+)
+
+KINK_LOCI_CIRCLES = Theorem(
+    id="kink-loci-circles", title="The v-creases are circles",
+    statement=r"$v = \varphi/\pi$ depends on the radius alone: $\rho(\varphi) = "
+              r"\dfrac{eR\sin\varphi}{e - R\cos\varphi}$ with $\rho'(\varphi) = "
+              r"\dfrac{eR(e\cos\varphi - R)}{(e - R\cos\varphi)^2} > 0$ on the visible cap "
+              r"$\cos\varphi > R/e$. The crease $v = m/k_v$ is the circle of radius "
+              r"$\rho(\pi m/k_v)$, visible when $\cos(\pi m/k_v) > R/e$.",
+    steps=(("radius", r"\rho(\varphi)", RHO), ("monotone", r"\rho'(\varphi)", DRHO)),
+    check=lambda: _check("circles"),
+    wrong_variants=(("derivative with the factor e cos(phi) - R replaced by e - R cos(phi)",
+                     lambda: _check("circles", drho=e * R / (e - R * sp.cos(phi)))),),
+    pages=("s3", "s4"),
+    seed_says="§3: the zero lines v = m/k_v are circles 'by its corollary'.",
+)
+
+THEOREMS = (KINK_LOCI_RAYS, KINK_LOCI_CIRCLES)

@@ -1,0 +1,320 @@
+"""Scalar per-pixel oracle for the vectorized renderer: `math` only, slow on purpose.
+
+Written from the seed's equations (Cell 1 ``render_numeric_bump`` and
+``shade1``, Cell 3 ``grad_exact``, and the formulas of §3) with the project's
+corrections:
+
+* sphere B's ray quadratic uses the constant term c = |E - C|^2 - r^2 (the
+  seed's Cell 1 writes |C|^2 - r^2, which places the hit points off the sphere);
+* the nearest *positive* root is taken for every sphere;
+* the chart's polar angle is atan2(hypot(N_x, N_y), N_z) rather than acos(N_z);
+* a light reaches a point only if the geometric normal faces it, no blocker
+  sphere meets the segment, and (for sphere points, floor on) the floor plane
+  does not separate the point from the light.
+
+Nothing here imports renderer code: the only contact with the renderer is
+reading attribute values off a ``renderer.Scene``.  The structure is
+deliberately different from ``renderer/`` (one pixel at a time, plain tuples,
+textbook quadratic formula) so that a shared mistake is unlikely.
+
+Each stage is a module-level function so that a test can swap one stage for a
+wrong variant (``monkeypatch.setattr``) and check that parity notices.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR",
+    "pixel_point", "ray_point", "nearest_positive_root", "sphere_a_t", "sphere_b_t",
+    "nearest_hit", "chart_a", "tangent_frame_a", "height_value", "grad_exact",
+    "grad_central", "in_kink_band", "perturb", "segment_blocked", "shade",
+    "render_pixel", "render_reference",
+]
+
+BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
+TWO_PI = 2.0 * math.pi
+POLE_SIN_PHI = 1e-4      # seed Cell 1, tangent_frame: fallback below this sin(phi)
+KINK_HALF_WIDTH = 0.03   # seed Cell 1, height1: the crease band
+
+
+# --- small 3-vector helpers on tuples ----------------------------------------------
+
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def scale(s, a):
+    return (s * a[0], s * a[1], s * a[2])
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def normalize(a):
+    n = math.sqrt(dot(a, a))
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
+# --- camera ---------------------------------------------------------------------------
+
+def pixel_point(scene, i, j, width, height):
+    """Image-plane point (x, y) of pixel centre (i, j) (seed Cell 1's window)."""
+    e, R = scene.camera_z, scene.radius_a
+    half = 1.25 * e * R / math.sqrt(e * e - R * R)
+    x = half * (2.0 * (i + 0.5) / width - 1.0)
+    y = half * (1.0 - 2.0 * (j + 0.5) / height) - 0.15 * half
+    return x, y
+
+
+def ray_point(t, x, y, e):
+    """P(t) = (t x, t y, e (1 - t)): t = 0 is the eye, t = 1 the floor z = 0."""
+    return (t * x, t * y, e * (1.0 - t))
+
+
+# --- intersections ----------------------------------------------------------------------
+
+def nearest_positive_root(a, b, c):
+    """Smallest root t > 0 of a t^2 + b t + c = 0 (a > 0), or inf."""
+    disc = b * b - 4.0 * a * c
+    if disc < 0.0:
+        return math.inf
+    root = math.sqrt(disc)
+    for t in ((-b - root) / (2.0 * a), (-b + root) / (2.0 * a)):   # ascending
+        if t > 0.0:
+            return t
+    return math.inf
+
+
+def ray_sphere_t(x, y, e, C, r):
+    """Nearest positive t with |P(t) - C| = r.
+
+    P(t) = E + t d, d = (x, y, -e), E = (0, 0, e):
+    a = |d|^2, b = 2 d . (E - C), c = |E - C|^2 - r^2.
+    """
+    d = (x, y, -e)
+    oc = sub((0.0, 0.0, e), C)
+    return nearest_positive_root(dot(d, d), 2.0 * dot(d, oc), dot(oc, oc) - r * r)
+
+
+def sphere_a_t(x, y, scene):
+    return ray_sphere_t(x, y, scene.camera_z, (0.0, 0.0, 0.0), scene.radius_a)
+
+
+def sphere_b_t(x, y, scene):
+    return ray_sphere_t(x, y, scene.camera_z, scene.center_b, scene.radius_b)
+
+
+def nearest_hit(x, y, scene):
+    """(t, chamber code) of the nearest positive hit; ties go A, then B, then floor."""
+    best_t, best_code = math.inf, BACKGROUND
+    candidates = [(sphere_a_t(x, y, scene), SPHERE_A)]
+    if scene.sphere_b:
+        candidates.append((sphere_b_t(x, y, scene), SPHERE_B))
+    if scene.floor:
+        candidates.append((1.0, FLOOR))
+    for t, code in candidates:        # strict '<' keeps the earlier object on a tie
+        if t < best_t:
+            best_t, best_code = t, code
+    return best_t, best_code
+
+
+# --- sphere A: chart and tangent frame ------------------------------------------------
+
+def chart_a(N):
+    """(u, v, sin phi) of a unit normal: u from the azimuth, v from the polar angle."""
+    sin_phi = math.hypot(N[0], N[1])
+    u = (math.atan2(N[1], N[0]) + math.pi) / TWO_PI
+    v = math.atan2(sin_phi, N[2]) / math.pi
+    return u, v, sin_phi
+
+
+def tangent_frame_a(N, sin_phi):
+    """(e_theta, e_phi) of seed §3, with the seed's fixed basis near the poles."""
+    if sin_phi > POLE_SIN_PHI:
+        e_th = (-N[1] / sin_phi, N[0] / sin_phi, 0.0)
+        e_ph = (N[2] * N[0] / sin_phi, N[2] * N[1] / sin_phi, -sin_phi)
+    else:
+        e_th, e_ph = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
+    return e_th, e_ph
+
+
+# --- height fields and their gradients (hand-written, seed §2 and §3) ---------------
+
+def height_value(field, u, v, ku, kv):
+    """h(u, v) of seed §2."""
+    if field == "sine":
+        return math.sin(math.pi * ku * u) * math.sin(math.pi * kv * v)
+    if field == "ridges":
+        return abs(math.sin(math.pi * ku * u) * math.sin(math.pi * kv * v))
+    if field == "rings":
+        return math.sin(TWO_PI * kv * v)
+    raise ValueError(f"unknown height field {field!r}")
+
+
+def sign(x):
+    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+
+def grad_exact(field, u, v, ku, kv):
+    """Closed-form (h_u, h_v) of seed §3."""
+    s1, c1 = math.sin(math.pi * ku * u), math.cos(math.pi * ku * u)
+    s2, c2 = math.sin(math.pi * kv * v), math.cos(math.pi * kv * v)
+    if field == "sine":
+        return math.pi * ku * c1 * s2, math.pi * kv * s1 * c2
+    if field == "ridges":
+        sigma = sign(s1 * s2)          # 0 on the zero lines, as the seed's grad_exact
+        return math.pi * ku * c1 * s2 * sigma, math.pi * kv * s1 * c2 * sigma
+    if field == "rings":
+        return 0.0, TWO_PI * kv * math.cos(TWO_PI * kv * v)
+    raise ValueError(f"unknown height field {field!r}")
+
+
+def grad_central(field, u, v, ku, kv, eps):
+    """Central differences of h: u wraps modulo 1, v clamps to [0, 1] (one-sided there)."""
+    h = lambda uu, vv: height_value(field, uu, vv, ku, kv)  # noqa: E731
+    hu = (h((u + eps) % 1.0, v) - h((u - eps) % 1.0, v)) / (2.0 * eps)
+    v_plus, v_minus = min(1.0, v + eps), max(0.0, v - eps)
+    clamped = v + eps > 1.0 or v - eps < 0.0
+    step = (v_plus - v_minus) if clamped else 2.0 * eps
+    hv = (h(u, v_plus) - h(u, v_minus)) / step
+    return hu, hv
+
+
+def in_kink_band(field, u, v, ku, kv):
+    """The seed's crease flag (ridges only)."""
+    if field != "ridges":
+        return False
+    return (abs(math.sin(math.pi * ku * u)) < KINK_HALF_WIDTH
+            or abs(math.sin(math.pi * kv * v)) < KINK_HALF_WIDTH)
+
+
+def perturb(N, e_th, e_ph, hu, hv, beta):
+    """N' = M / |M|, M = N + beta (h_u e_theta + h_v e_phi); N itself when beta = 0."""
+    if beta == 0.0:
+        return N
+    g = add(scale(hu, e_th), scale(hv, e_ph))
+    return normalize(add(N, scale(beta, g)))
+
+
+# --- shading ---------------------------------------------------------------------------
+
+def segment_blocked(P, L, C, r):
+    """Seed Cell 1's sign logic: does P + s (L - P) meet the sphere for some s in (0, 1)?"""
+    w = sub(L, P)
+    pc = sub(P, C)
+    a = dot(w, w)
+    if a == 0.0:
+        return False
+    b = dot(pc, w)                     # half the linear coefficient
+    c = dot(pc, pc) - r * r
+    disc = b * b - a * c
+    if disc < 0.0:
+        return False
+    root = math.sqrt(disc)
+    s1, s2 = (-b - root) / a, (-b + root) / a
+    return 0.0 < s1 < 1.0 or 0.0 < s2 < 1.0
+
+
+def floor_separates(P, L):
+    """The plane z = 0 lies strictly between P and L."""
+    return (P[2] > 0.0 and L[2] < 0.0) or (P[2] < 0.0 and L[2] > 0.0)
+
+
+def shade(scene, P, N, N_shade, albedo, blockers, floor_blocks):
+    """Ambient plus, per visible light, Lambert and Blinn or Phong; clipped to [0, 1]."""
+    E = (0.0, 0.0, scene.camera_z)
+    v_hat = normalize(sub(E, P))
+    col = [scene.ka * a for a in scene.ambient]
+    for light in scene.lights:
+        L, color = light.position, light.color
+        if color[0] == 0.0 and color[1] == 0.0 and color[2] == 0.0:
+            continue
+        w = sub(L, P)
+        # Visibility: attached shadow on the true normal, then the cast shadows.
+        if not dot(N, w) > 0.0:
+            continue
+        if any(segment_blocked(P, L, C, r) for C, r in blockers):
+            continue
+        if floor_blocks and floor_separates(P, L):
+            continue
+        # Reflectance with the shading normal.
+        w_hat = normalize(w)
+        mu = dot(N_shade, w_hat)
+        if mu <= 0.0:
+            continue                    # neither diffuse nor specular
+        if scene.model == "blinn":
+            spec = max(0.0, dot(N_shade, normalize(add(w_hat, v_hat)))) ** scene.shininess
+        else:
+            reflected = sub(scale(2.0 * mu, N_shade), w_hat)
+            spec = max(0.0, dot(reflected, v_hat)) ** scene.shininess
+        for k in range(3):
+            col[k] += color[k] * (scene.kd * albedo[k] * mu + scene.ks * spec)
+    return tuple(min(1.0, max(0.0, c)) for c in col)
+
+
+# --- one pixel, one frame ---------------------------------------------------------------
+
+def render_pixel(scene, i, j, width, height, gradient):
+    """(rgb, chamber, kink, (h_u, h_v)) of pixel (i, j)."""
+    e = scene.camera_z
+    x, y = pixel_point(scene, i, j, width, height)
+    t, code = nearest_hit(x, y, scene)
+    if code == BACKGROUND:
+        return (0.0, 0.0, 0.0), code, False, (0.0, 0.0)
+    P = ray_point(t, x, y, e)
+    sphere_a = ((0.0, 0.0, 0.0), scene.radius_a)
+    sphere_b = (scene.center_b, scene.radius_b)
+    if code == SPHERE_A:
+        # Chart, gradient, frame, perturbed normal.
+        N = scale(1.0 / scene.radius_a, P)
+        u, v, sin_phi = chart_a(N)
+        args = (scene.height_field, u, v, scene.k_u, scene.k_v)
+        hu, hv = grad_exact(*args) if gradient == "exact" else grad_central(*args, scene.eps)
+        e_th, e_ph = tangent_frame_a(N, sin_phi)
+        N_shade = perturb(N, e_th, e_ph, hu, hv, scene.beta)
+        blockers = [sphere_b] if scene.sphere_b else []
+        rgb = shade(scene, P, N, N_shade, scene.albedo_a, blockers, scene.floor)
+        return rgb, code, in_kink_band(*args), (hu, hv)
+    if code == SPHERE_B:
+        N = scale(1.0 / scene.radius_b, sub(P, scene.center_b))
+        rgb = shade(scene, P, N, N, scene.albedo_b, [sphere_a], scene.floor)
+        return rgb, code, False, (0.0, 0.0)
+    # Floor: checker albedo, blocked by both spheres, never by itself.
+    base = 0.85 if math.sin(math.pi * P[0]) * math.sin(math.pi * P[1]) >= 0.0 else 0.15
+    rg = base * (1.0 - scene.floor_tint)
+    blockers = [sphere_a] + ([sphere_b] if scene.sphere_b else [])
+    rgb = shade(scene, P, (0.0, 0.0, 1.0), (0.0, 0.0, 1.0), (rg, rg, base), blockers, False)
+    return rgb, code, False, (0.0, 0.0)
+
+
+def render_reference(scene, width, height, *, gradient="exact"):
+    """Render pixel by pixel.
+
+    Returns
+    -------
+    image : (H, W, 3) float64, chamber : (H, W) uint8, kink : (H, W) bool,
+    grad : (H, W, 2) float64 -- numpy containers filled one pixel at a time.
+    """
+    if gradient not in ("exact", "central"):
+        raise ValueError(f"unknown gradient {gradient!r}")
+    image = np.zeros((height, width, 3))
+    chamber = np.zeros((height, width), dtype=np.uint8)
+    kink = np.zeros((height, width), dtype=bool)
+    grad = np.zeros((height, width, 2))
+    for j in range(height):
+        for i in range(width):
+            rgb, code, flag, g = render_pixel(scene, i, j, width, height, gradient)
+            image[j, i] = rgb
+            chamber[j, i] = code
+            kink[j, i] = flag
+            grad[j, i] = g
+    return image, chamber, kink, grad
