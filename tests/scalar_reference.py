@@ -31,7 +31,7 @@ __all__ = [
     "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR",
     "pixel_point", "ray_point", "nearest_positive_root", "sphere_a_t", "sphere_b_t",
     "nearest_hit", "chart_a", "tangent_frame_a", "height_value", "grad_exact",
-    "grad_central", "in_kink_band", "perturb", "segment_blocked", "shade",
+    "grad_central", "in_kink_band", "perturb", "perturb_surface", "segment_blocked", "shade",
     "render_pixel", "render_reference",
 ]
 
@@ -198,11 +198,30 @@ def in_kink_band(field, u, v, ku, kv):
 
 
 def perturb(N, e_th, e_ph, hu, hv, beta):
-    """N' = M / |M|, M = N + beta (h_u e_theta + h_v e_phi); N itself when beta = 0."""
+    """Seed §3: N' = M / |M|, M = N + beta (h_u e_theta + h_v e_phi); N itself at beta = 0."""
     if beta == 0.0:
         return N
     g = add(scale(hu, e_th), scale(hv, e_ph))
     return normalize(add(N, scale(beta, g)))
+
+
+def perturb_surface(N, e_th, e_ph, hu, hv, h, beta, R, sin_phi):
+    """Normal of the displaced sphere r = rho N, rho = R + beta h (Scene.bump = "surface").
+
+    Derived by hand: with theta = 2 pi u - pi and phi = pi v, r_theta = rho_theta N
+    + rho sin(phi) e_theta and r_phi = rho_phi N + rho e_phi, and e_phi x e_theta = N,
+    so r_phi x r_theta is parallel to N - (rho_theta / (rho sin phi)) e_theta
+    - (rho_phi / rho) e_phi, with rho_theta = beta h_u / (2 pi), rho_phi = beta h_v / pi.
+    Below the pole cut-off sin(phi) is held at the cut-off, as the frame falls
+    back to the fixed basis there (renderer's documented choice).
+    """
+    if beta == 0.0:
+        return N
+    rho = R + beta * h
+    s = max(sin_phi, POLE_SIN_PHI)
+    a_th = beta * hu / (TWO_PI * s * rho)
+    a_ph = beta * hv / (math.pi * rho)
+    return normalize(sub(N, add(scale(a_th, e_th), scale(a_ph, e_ph))))
 
 
 # --- shading ---------------------------------------------------------------------------
@@ -280,7 +299,13 @@ def render_pixel(scene, i, j, width, height, gradient):
         args = (scene.height_field, u, v, scene.k_u, scene.k_v)
         hu, hv = grad_exact(*args) if gradient == "exact" else grad_central(*args, scene.eps)
         e_th, e_ph = tangent_frame_a(N, sin_phi)
-        N_shade = perturb(N, e_th, e_ph, hu, hv, scene.beta)
+        if scene.bump == "chart":
+            N_shade = perturb(N, e_th, e_ph, hu, hv, scene.beta)
+        elif scene.bump == "surface":
+            N_shade = perturb_surface(N, e_th, e_ph, hu, hv, height_value(*args), scene.beta,
+                                      scene.radius_a, sin_phi)
+        else:
+            raise ValueError(f"unknown bump {scene.bump!r}")
         blockers = [sphere_b] if scene.sphere_b else []
         rgb = shade(scene, P, N, N_shade, scene.albedo_a, blockers, scene.floor)
         return rgb, code, in_kink_band(*args), (hu, hv)

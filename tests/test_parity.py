@@ -1,0 +1,270 @@
+"""Parity: the vectorized `renderer.render` against the scalar oracle `scalar_reference`.
+
+Every height field x both models x both pipelines x sphere B on/off x floor
+on/off x beta in {0, 0.35, 1.5}, on three small frames chosen for what they hit:
+
+* 24 x 20: even width, non-square;
+* 17 x 13: odd width (column 8 lies on x = 0), odd height;
+* 17 x 20: x = 0 at column 8 and y = 3.6e-17 at row 8, so pixel (8, 8) lands on
+  sphere A's pole: sin(phi) = 4e-17, the frame fallback and the one-sided v
+  difference (v = 1.3e-17 < eps) are exercised.
+
+Checks per frame: identical chamber codes, identical crease flags,
+|dI| <= 1e-12 per channel (the issue's tolerance), and the gradient within the
+tolerance of `grad_tolerance` (justified there).  Each kind of check is shown
+to reject a wrong variant at the end of the file.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+import renderer.render as render_module
+from renderer import PointLight, Scene, render
+from tests import scalar_reference as ref
+
+SIZES = ((24, 20), (17, 13), (17, 20))
+IMAGE_TOL = 1e-12          # per channel, required by the issue
+FIELDS = ("sine", "ridges", "rings")
+MODELS = ("blinn", "phong")
+GRADIENTS = ("exact", "central")
+LIGHT_2 = PointLight((-6.0, 2.0, 8.0), (0.9, 0.65, 0.25))     # the seed's second light
+
+
+def grad_tolerance(scene, gradient, grad_ref):
+    """Allowed |grad_renderer - grad_reference|, per component.
+
+    Both routes evaluate the same closed forms, so 1e-12 (1 + |g|) covers
+    rounding for the exact pipeline (measured worst: 9.4e-14 relative).
+
+    The central pipeline needs an absolute slack on top.  The two routes
+    compute the chart (u, v) of a hit point differently (textbook vs
+    cancellation-free quadratic for t; glibc's atan2/hypot vs numpy's SIMD
+    versions, which differ by an ulp on ~8% of inputs on this machine), and
+    the results differ by up to 3 ulp (3.3e-16, measured; given the *same*
+    (u, v) the central quotients agree bit for bit, measured).  The common
+    shift cancels in h(u + eps) - h(u - eps), but u + eps and u - eps are each
+    rounded afresh, so the two samples can sit up to 2^-52 apart per side.
+    h is Lipschitz with constant LIP = pi max(k_u, 2 k_v) in each chart
+    variable, so the quotient can move by 2 LIP 2^-52 / (2 eps) = LIP 2^-52 / eps
+    (5.6e-12 at the defaults).  Measured worst on these frames: 1.0e-12
+    absolute (4.6e-13 relative), so the slack holds with a factor ~5 to spare,
+    and 1e-12 relative alone would pass here only by a factor ~2 without a
+    guarantee (at 40 x 33 the absolute gap reaches 1.8e-12).
+    """
+    tol = 1e-12 * (1.0 + np.abs(grad_ref))
+    if gradient == "central":
+        lip = math.pi * max(scene.k_u, 2.0 * scene.k_v)
+        tol = tol + lip * 2.0**-52 / scene.eps
+    return tol
+
+
+def parity_failures(scene, width, height, gradient, *, frame=None):
+    """Compare one render with the reference; return a list of failure strings (empty: parity)."""
+    if frame is None:
+        frame = render(scene, width, height, gradient=gradient)
+    image, chamber, kink, grad = ref.render_reference(scene, width, height, gradient=gradient)
+    failures = []
+    n = int(np.count_nonzero(frame.chamber != chamber))
+    if n:
+        failures.append(f"chamber differs at {n} pixels")
+    n = int(np.count_nonzero(frame.kink != kink))
+    if n:
+        failures.append(f"kink differs at {n} pixels")
+    d_image = float(np.abs(frame.image - image).max())
+    if not d_image <= IMAGE_TOL:                       # also catches NaN
+        failures.append(f"max |dI| = {d_image:.3e} > {IMAGE_TOL}")
+    excess = np.abs(frame.grad - grad) - grad_tolerance(scene, gradient, grad)
+    if not np.all(excess <= 0.0):
+        failures.append(f"grad differs beyond tolerance by up to {np.nanmax(excess):.3e}")
+    return failures
+
+
+# --- the full matrix --------------------------------------------------------------------
+
+MATRIX = list(itertools.product(FIELDS, MODELS, GRADIENTS, (True, False), (True, False),
+                                (0.0, 0.35, 1.5)))
+
+
+@pytest.mark.parametrize("field, model, gradient, sphere_b, floor, beta", MATRIX)
+def test_matches_reference(field, model, gradient, sphere_b, floor, beta):
+    scene = Scene(height_field=field, model=model, sphere_b=sphere_b, floor=floor, beta=beta)
+    for width, height in SIZES:
+        assert parity_failures(scene, width, height, gradient) == [], (width, height)
+
+
+@pytest.mark.parametrize("field, model, gradient, beta",
+                         list(itertools.product(FIELDS, MODELS, GRADIENTS, (0.35, 0.9))))
+def test_matches_reference_displaced_surface_normal(field, model, gradient, beta):
+    """Scene.bump = "surface": the displaced sphere's normal, derived by hand in the reference."""
+    scene = Scene(height_field=field, model=model, beta=beta, bump="surface")
+    for width, height in SIZES:
+        assert parity_failures(scene, width, height, gradient) == [], (width, height)
+
+
+# Scenes that exercise what the default scene does not.
+VARIANTS = {
+    # Sphere points are lit from below the floor plane only if the plane does not separate them.
+    "light below the floor": dict(lights=(PointLight((5.0, 5.0, 10.0)),
+                                          PointLight((3.0, -2.0, -4.0), (0.5, 0.6, 0.7)))),
+    "black light skipped": dict(lights=(PointLight((5.0, 5.0, 10.0), (0.0, 0.0, 0.0)), LIGHT_2)),
+    "no lights": dict(lights=()),
+    "light inside sphere B": dict(lights=(PointLight((0.5, 0.5, 1.3)), LIGHT_2)),
+    # k_u = 7: the pole pixel of 17 x 20 has h_v != 0, so the fallback frame matters.
+    "pole with nonzero gradient": dict(k_u=7.0, beta=1.5),
+    "non-integer frequencies": dict(k_u=3.3, k_v=7.1, beta=1.0),
+    "large eps": dict(eps=0.4),
+    "eps 0.05": dict(eps=0.05),
+    "camera close, sphere B moved": dict(camera_z=2.5, radius_a=0.8, center_b=(-0.6, 0.2, 0.9),
+                                         radius_b=0.4),
+    "saturated (clipping)": dict(kd=3.0, ks=2.0, shininess=1.0, floor_tint=1.0),
+    "sphere B through the floor": dict(center_b=(0.9, -0.3, 0.2), radius_b=0.5, floor_tint=0.0),
+}
+
+
+@pytest.mark.parametrize("gradient", GRADIENTS)
+@pytest.mark.parametrize("field", FIELDS)
+@pytest.mark.parametrize("name", sorted(VARIANTS))
+def test_matches_reference_scene_variants(name, field, gradient):
+    scene = Scene(height_field=field, **VARIANTS[name])
+    for width, height in SIZES:
+        assert parity_failures(scene, width, height, gradient) == [], (width, height)
+
+
+def test_frame_sizes_reach_the_pole():
+    """The 17 x 20 frame does put a pixel on the pole, as the module docstring claims."""
+    width, height = 17, 20
+    x, y = ref.pixel_point(Scene(), 8, 8, width, height)
+    assert x == 0.0 and abs(y) < 1e-16
+    _, _, _, grad = ref.render_reference(Scene(**VARIANTS["pole with nonzero gradient"]),
+                                         width, height)
+    assert abs(grad[8, 8, 1]) > 1.0
+
+
+@pytest.mark.parametrize("gradient", GRADIENTS)
+def test_tiling_is_invisible(monkeypatch, gradient):
+    """Tiles of one row give the same frame, bit for bit, and it matches the reference."""
+    scene = Scene(beta=1.5)
+    whole = render(scene, 17, 13, gradient=gradient)
+    monkeypatch.setattr(render_module, "TILE_PIXELS", 20)      # 17-wide rows: 1 row per tile
+    tiled = render(scene, 17, 13, gradient=gradient)
+    for a, b in ((whole.image, tiled.image), (whole.chamber, tiled.chamber),
+                 (whole.kink, tiled.kink), (whole.grad, tiled.grad)):
+        assert np.array_equal(a, b)
+    assert parity_failures(scene, 17, 13, gradient, frame=tiled) == []
+
+
+def test_light_on_a_blocker_surface_does_not_shadow_the_outside():
+    """A light exactly on sphere B's surface: the seed's sign logic (a root in the
+    open interval (0, 1)) lights a floor point whose segment only touches B at
+    the light.  Here L = (0.5, 0.5, 1.25) is B's lowest point (C = (0.5, 0.5, 1.5),
+    r = 0.25, |L - C|^2 - r^2 = 0 exactly in float64), the tangent plane at L is
+    z = 1.25 and every floor point lies below it, so no floor segment enters B.
+    The image must be continuous in the light position: moving the light 1e-9
+    below B (outside it) changes the image by O(1e-9), not by O(1).
+    """
+    base = dict(center_b=(0.5, 0.5, 1.5), radius_b=0.25, height_field="sine")
+    on = Scene(lights=(PointLight((0.5, 0.5, 1.25)),), **base)
+    near = Scene(lights=(PointLight((0.5, 0.5, 1.25 - 1e-9)),), **base)
+    a, b = render(on, 24, 20), render(near, 24, 20)
+    floor = a.chamber == 3
+    assert floor.any()
+    # The reference with the light 1e-9 away agrees with the renderer there...
+    assert parity_failures(near, 24, 20, "exact", frame=b) == []
+    # ...and the renderer must not jump when the light touches the sphere.
+    jump = float(np.abs(a.image - b.image)[floor].max())
+    assert jump <= 1e-6, f"floor image jumps by {jump:.3f} when the light touches sphere B"
+
+
+# --- teeth: each check rejects a wrong variant ------------------------------------------
+
+@pytest.mark.parametrize("change, gradient, kind", [
+    (dict(beta=0.36), "exact", "|dI|"),
+    (dict(k_u=8.25), "exact", "grad"),
+    (dict(model="phong"), "exact", "|dI|"),
+    (dict(floor_tint=0.26), "exact", "|dI|"),
+    (dict(albedo_a=(0.63, 0.19, 0.17)), "exact", "|dI|"),
+    (dict(lights=(PointLight((5.0, 5.0, 10.5)), LIGHT_2)), "exact", "|dI|"),
+    (dict(eps=1.1e-3), "central", "grad"),
+    (dict(center_b=(0.5, 0.45, 1.3)), "exact", "chamber"),
+    (dict(height_field="sine"), "exact", "kink"),
+    (dict(bump="surface"), "exact", "|dI|"),
+])
+def test_parity_rejects_a_scene_that_differs_in_one_field(change, gradient, kind):
+    scene = Scene()
+    wrong = render(scene.replace(**change), 24, 20, gradient=gradient)
+    failures = parity_failures(scene, 24, 20, gradient, frame=wrong)
+    assert any(kind in f for f in failures), failures
+
+
+def _seed_sphere_b_t(x, y, scene):
+    """The seed's Cell 1 sphere-B hit: constant term |C|^2 - r^2 instead of |E - C|^2 - r^2."""
+    e, C, r = scene.camera_z, scene.center_b, scene.radius_b
+    a = x * x + y * y + e * e
+    b_half = -C[0] * x - C[1] * y - (e - C[2]) * e
+    c_seed = C[0] ** 2 + C[1] ** 2 + C[2] ** 2 - r * r
+    disc = b_half * b_half - a * c_seed
+    return (-b_half - math.sqrt(disc)) / a if disc >= 0 else math.inf
+
+
+def test_parity_rejects_the_seeds_sphere_b_quadratic(monkeypatch):
+    monkeypatch.setattr(ref, "sphere_b_t", _seed_sphere_b_t)
+    failures = parity_failures(Scene(), 24, 20, "exact")
+    assert any("chamber" in f for f in failures), failures
+
+
+def test_parity_rejects_a_reference_without_the_floor_plane_shadow(monkeypatch):
+    monkeypatch.setattr(ref, "floor_separates", lambda P, L: False)
+    scene = Scene(**VARIANTS["light below the floor"])
+    assert any("|dI|" in f for f in parity_failures(scene, 24, 20, "exact"))
+
+
+def test_parity_rejects_the_seeds_terminator_rule(monkeypatch):
+    """The seed tests the light against the perturbed normal only (no geometric attached shadow)."""
+    shade = ref.shade
+    monkeypatch.setattr(ref, "shade", lambda scene, P, N, Ns, *rest: shade(scene, P, Ns, Ns, *rest))
+    assert any("|dI|" in f for f in parity_failures(Scene(beta=1.5), 24, 20, "exact"))
+
+
+def test_parity_rejects_a_different_pole_fallback(monkeypatch):
+    frame = ref.tangent_frame_a
+
+    def swapped(N, sin_phi):
+        if sin_phi > ref.POLE_SIN_PHI:
+            return frame(N, sin_phi)
+        return (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)
+
+    monkeypatch.setattr(ref, "tangent_frame_a", swapped)
+    scene = Scene(**VARIANTS["pole with nonzero gradient"])
+    assert any("|dI|" in f for f in parity_failures(scene, 17, 20, "exact"))
+
+
+def test_parity_rejects_a_two_sided_quotient_at_the_pole(monkeypatch):
+    """Dividing by 2 eps even where v was clamped (v = 1.3e-17 at the pole pixel)."""
+    def two_sided(field, u, v, ku, kv, eps):
+        h = lambda uu, vv: ref.height_value(field, uu, vv, ku, kv)  # noqa: E731
+        hu = (h((u + eps) % 1.0, v) - h((u - eps) % 1.0, v)) / (2.0 * eps)
+        hv = (h(u, min(1.0, v + eps)) - h(u, max(0.0, v - eps))) / (2.0 * eps)
+        return hu, hv
+
+    monkeypatch.setattr(ref, "grad_central", two_sided)
+    scene = Scene(**VARIANTS["pole with nonzero gradient"])
+    assert any("grad" in f for f in parity_failures(scene, 17, 20, "central"))
+
+
+def test_parity_rejects_a_wider_kink_band(monkeypatch):
+    monkeypatch.setattr(ref, "KINK_HALF_WIDTH", 0.05)
+    assert any("kink" in f for f in parity_failures(Scene(), 24, 20, "exact"))
+
+
+def test_grad_tolerance_is_tight_enough_to_catch_a_half_step_error():
+    """The central slack (5.6e-12 at the defaults) is far below any real pipeline error:
+    the reference's central gradient at eps differs from the renderer's at 1.001 eps."""
+    scene = Scene()
+    frame = render(scene.replace(eps=1.001e-3), 24, 20, gradient="central")
+    failures = parity_failures(scene, 24, 20, "central", frame=frame)
+    assert any("grad" in f for f in failures), failures
