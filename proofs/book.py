@@ -54,10 +54,11 @@ def theorem_block(theorem_id, *, label_prefix="thm-"):
 
 def ledger_table():
     """Markdown table of every theorem: id, verdict, evidence, the pages using it."""
-    rows = ["| theorem | verdict | evidence | used on |", "|---|---|---|---|"]
+    rows = ["| theorem | verdict | evidence | the draft says | used on |", "|---|---|---|---|---|"]
     for theorem_id, t in THEOREMS.items():
         v = verdict(theorem_id)
         pages = ", ".join(f"{{ref}}`{p}`" for p in t.pages)
         rows.append(f"| {{prf:ref}}`{t.title} <thm-{theorem_id}>` (`{theorem_id}`) | "
-                    f"{BADGES[v.status]} | {v.evidence.replace('|', '/')} | {pages} |")
+                    f"{BADGES[v.status]} | {v.evidence.replace('|', '/')} | "
+                    f"{t.seed_says.replace('|', '/') or '—'} | {pages} |")
     return "\n".join(rows)

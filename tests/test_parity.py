@@ -17,13 +17,13 @@ to reject a wrong variant at the end of the file.
 
 from __future__ import annotations
 
+import importlib
 import itertools
 import math
 
 import numpy as np
 import pytest
 
-import renderer.render as render_module
 from renderer import PointLight, Scene, render
 from tests import scalar_reference as ref
 
@@ -32,6 +32,8 @@ IMAGE_TOL = 1e-12          # per channel, required by the issue
 FIELDS = ("sine", "ridges", "rings")
 MODELS = ("blinn", "phong")
 GRADIENTS = ("exact", "central")
+# The module, not the function `renderer.render` that shadows it as a package attribute.
+render_module = importlib.import_module("renderer.render")
 LIGHT_2 = PointLight((-6.0, 2.0, 8.0), (0.9, 0.65, 0.25))     # the seed's second light
 
 
@@ -257,7 +259,7 @@ def test_parity_rejects_a_two_sided_quotient_at_the_pole(monkeypatch):
 
 
 def test_parity_rejects_a_wider_kink_band(monkeypatch):
-    monkeypatch.setattr(ref, "KINK_HALF_WIDTH", 0.05)
+    monkeypatch.setattr(ref, "KINK_HALF_WIDTH", 0.1)
     assert any("kink" in f for f in parity_failures(Scene(), 24, 20, "exact"))
 
 
