@@ -145,7 +145,9 @@ def segment_hits_sphere(wx, wy, wz, w2, L, center, radius):
         (u . d)^2 >= |u|^2 (|d|^2 - r^2)   (the ray from L meets the sphere),
         0 < u . d < |u|^2                  (ahead of L, and the chord ends before P).
 
-    A light inside the sphere is blocked from every outside point.  This is the
+    A light inside the sphere is blocked from every outside point; a light on
+    the sphere is blocked where the chord from it, tau = 2 (u . d) / |u|^2, ends
+    before P.  This is the
     seed's quadratic "sign logic" test (seed Cell 1, ``shadowed1``) solved once
     per light instead of once per point; it depends on geometry only.
 
@@ -162,9 +164,12 @@ def segment_hits_sphere(wx, wy, wz, w2, L, center, radius):
     """
     dx, dy, dz = L[0] - center[0], L[1] - center[1], L[2] - center[2]
     k = dx * dx + dy * dy + dz * dz - radius * radius
-    if k <= 0.0:
+    if k < 0.0:
         return np.ones(wx.shape, dtype=bool)
     g = wx * dx + wy * dy + wz * dz          # = u . d
+    if k == 0.0:
+        # Light on the sphere: roots tau = 0 (the light, excluded) and tau = 2 g / |u|^2.
+        return (g > 0.0) & (2.0 * g < w2)
     blocked = (g > 0.0) & (g < w2)
     idx = np.flatnonzero(blocked)
     gi = g[idx]
