@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from renderer import Scene, render  # noqa: E402
-from tests.reference_renderer import render_reference  # noqa: E402
+from tests.scalar_reference import render_reference  # noqa: E402
 
 SIZES = (128, 256, 512, 1024)
 PIPELINES = ("exact", "central")

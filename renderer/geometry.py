@@ -74,7 +74,13 @@ def sphere_hit(x, y, camera_z, center, radius):
     a = x * x + y * y + camera_z * camera_z
     b = x * ocx + y * ocy - camera_z * ocz
     c = ocx * ocx + ocy * ocy + ocz * ocz - radius * radius
-    disc = b * b - a * c
+    # Discriminant from the distance of the centre to the ray's line,
+    # b^2 - a c = a (r^2 - |oc - (b / a) d|^2): no cancellation of two large
+    # squares when the camera is far away (Haines et al., Ray Tracing Gems,
+    # ch. 7, "Precision improvements for ray/sphere intersection").
+    f = b / a
+    lx, ly, lz = ocx - f * x, ocy - f * y, ocz + f * camera_z
+    disc = a * (radius * radius - (lx * lx + ly * ly + lz * lz))
     t = np.full(disc.shape, np.inf)
     idx = np.flatnonzero(disc >= 0.0)
     if idx.size == 0:

@@ -11,7 +11,18 @@ import math
 import numbers
 from dataclasses import dataclass, field, fields
 
+import numpy as np
+
 __all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
+
+#: Largest accepted magnitude of a length or coordinate (scene units): squares of
+#: lengths are formed everywhere, and 1e6 keeps them far from overflow.
+MAX_LENGTH = 1e6
+#: Smallest accepted radius (scene units), far from underflow of R^2.
+MIN_RADIUS = 1e-6
+#: Largest accepted frequency k_u, k_v and amplitude beta.
+MAX_FREQUENCY = 1e6
+MAX_BETA = 1e6
 
 #: Names accepted for ``Scene.height_field`` (seed §2).
 HEIGHT_FIELDS = ("sine", "ridges", "rings")
@@ -39,9 +50,9 @@ def _real(owner: str, name: str, value, *, low=None, low_open=False, high=None):
     return x
 
 
-def _vec3(owner: str, name: str, value, *, nonneg=False, high=None):
+def _vec3(owner: str, name: str, value, *, nonneg=False, high=None, low=None):
     """Return ``value`` as a tuple of three finite floats, or raise."""
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__"):
+    if not isinstance(value, (tuple, list, np.ndarray)):
         raise TypeError(
             f"{owner}.{name} must be a sequence of 3 real numbers, got {value!r}"
         )
@@ -49,7 +60,7 @@ def _vec3(owner: str, name: str, value, *, nonneg=False, high=None):
         raise ValueError(
             f"{owner}.{name} must have exactly 3 components, got {len(value)}: {value!r}"
         )
-    low = 0.0 if nonneg else None
+    low = 0.0 if nonneg else low
     return tuple(
         _real(owner, f"{name}[{i}]", c, low=low, high=high) for i, c in enumerate(value)
     )
@@ -91,7 +102,8 @@ class PointLight:
     color: tuple = (1.0, 1.0, 1.0)
 
     def __post_init__(self):
-        object.__setattr__(self, "position", _vec3("PointLight", "position", self.position))
+        object.__setattr__(self, "position", _vec3("PointLight", "position", self.position,
+                                                   low=-MAX_LENGTH, high=MAX_LENGTH))
         object.__setattr__(self, "color", _vec3("PointLight", "color", self.color, nonneg=True))
 
 
@@ -134,7 +146,8 @@ class Scene:
     TypeError
         A field has the wrong type (a string for a number, a number for a flag).
     ValueError
-        A field is out of range: not finite, a radius <= 0, the camera inside or
+        A field is out of range: not finite, a radius below 1e-6, a length or
+        coordinate above 1e6 in magnitude, k_u, k_v or beta above 1e6, the camera inside or
         on sphere A or sphere B, ``eps`` <= 0, ``beta`` < 0, an unknown
         ``model`` or ``height_field`` name.  The message names the field, the
         value and what is accepted.
@@ -171,15 +184,15 @@ class Scene:
     def __post_init__(self):
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         S = "Scene"
-        set_("radius_a", _real(S, "radius_a", self.radius_a, low=0.0, low_open=True))
-        set_("camera_z", _real(S, "camera_z", self.camera_z))
+        set_("radius_a", _real(S, "radius_a", self.radius_a, low=MIN_RADIUS, high=MAX_LENGTH))
+        set_("camera_z", _real(S, "camera_z", self.camera_z, high=MAX_LENGTH))
         if not self.camera_z > self.radius_a:
             raise ValueError(
                 f"Scene.camera_z must be > radius_a = {self.radius_a} (camera outside "
                 f"sphere A), got {self.camera_z!r}"
             )
-        set_("center_b", _vec3(S, "center_b", self.center_b))
-        set_("radius_b", _real(S, "radius_b", self.radius_b, low=0.0, low_open=True))
+        set_("center_b", _vec3(S, "center_b", self.center_b, low=-MAX_LENGTH, high=MAX_LENGTH))
+        set_("radius_b", _real(S, "radius_b", self.radius_b, low=MIN_RADIUS, high=MAX_LENGTH))
         # Camera outside sphere B: the nearest hit is then always a front face.
         d2 = self.center_b[0] ** 2 + self.center_b[1] ** 2 + (self.camera_z - self.center_b[2]) ** 2
         if not d2 > self.radius_b**2:
@@ -207,9 +220,9 @@ class Scene:
         set_("model", _choice(S, "model", self.model, MODELS))
         set_("floor_tint", _real(S, "floor_tint", self.floor_tint, low=0.0, high=1.0))
         set_("height_field", _choice(S, "height_field", self.height_field, HEIGHT_FIELDS))
-        set_("k_u", _real(S, "k_u", self.k_u, low=0.0, low_open=True))
-        set_("k_v", _real(S, "k_v", self.k_v, low=0.0, low_open=True))
-        set_("beta", _real(S, "beta", self.beta, low=0.0))
+        set_("k_u", _real(S, "k_u", self.k_u, low=0.0, low_open=True, high=MAX_FREQUENCY))
+        set_("k_v", _real(S, "k_v", self.k_v, low=0.0, low_open=True, high=MAX_FREQUENCY))
+        set_("beta", _real(S, "beta", self.beta, low=0.0, high=MAX_BETA))
         set_("eps", _real(S, "eps", self.eps, low=0.0, low_open=True))
         set_("bump", _choice(S, "bump", self.bump, BUMPS))
         if self.bump == "surface" and not self.beta < self.radius_a:

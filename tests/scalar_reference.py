@@ -12,6 +12,9 @@ corrections:
   sphere meets the segment, and (for sphere points, floor on) the floor plane
   does not separate the point from the light.
 
+It also covers the project's ``Scene.bump = "surface"`` option (the normal of
+the displaced sphere), derived by hand in `perturb_surface`.
+
 Nothing here imports renderer code: the only contact with the renderer is
 reading attribute values off a ``renderer.Scene``.  The structure is
 deliberately different from ``renderer/`` (one pixel at a time, plain tuples,

@@ -11,8 +11,9 @@ on/off x beta in {0, 0.35, 1.5}, on three small frames chosen for what they hit:
 
 Checks per frame: identical chamber codes, identical crease flags,
 |dI| <= 1e-12 per channel (the issue's tolerance), and the gradient within the
-tolerance of `grad_tolerance` (justified there).  Each kind of check is shown
-to reject a wrong variant at the end of the file.
+tolerance of `grad_tolerance` (justified there).  The only exemption is a ray
+tangent to a sphere (`grazing_mask`: at most two pixels, checked at 1e-6).
+Each kind of check is shown to reject a wrong variant at the end of the file.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def grad_tolerance(scene, gradient, grad_ref):
     """Allowed |grad_renderer - grad_reference|, per component.
 
     Both routes evaluate the same closed forms, so 1e-12 (1 + |g|) covers
-    rounding for the exact pipeline (measured worst: 9.4e-14 relative).
+    rounding for the exact pipeline (measured worst on these frames: 4.7e-14 relative).
 
     The central pipeline needs an absolute slack on top.  The two routes
     compute the chart (u, v) of a hit point differently (textbook vs
@@ -53,16 +54,59 @@ def grad_tolerance(scene, gradient, grad_ref):
     rounded afresh, so the two samples can sit up to 2^-52 apart per side.
     h is Lipschitz with constant LIP = pi max(k_u, 2 k_v) in each chart
     variable, so the quotient can move by 2 LIP 2^-52 / (2 eps) = LIP 2^-52 / eps
-    (5.6e-12 at the defaults).  Measured worst on these frames: 1.0e-12
-    absolute (4.6e-13 relative), so the slack holds with a factor ~5 to spare,
+    (5.6e-12 at the defaults).  Measured worst on these frames: 1.45e-12
+    absolute (4.6e-13 relative), so the slack holds with a factor ~4 to spare,
     and 1e-12 relative alone would pass here only by a factor ~2 without a
-    guarantee (at 40 x 33 the absolute gap reaches 1.8e-12).
+    guarantee (at 40 x 33 the absolute gap reaches 1.8e-12, at 64 x 64 the
+    relative one 9.8e-13).
     """
     tol = 1e-12 * (1.0 + np.abs(grad_ref))
     if gradient == "central":
         lip = math.pi * max(scene.k_u, 2.0 * scene.k_v)
         tol = tol + lip * 2.0**-52 / scene.eps
     return tol
+
+
+# Tangent rays.  A ray that touches a sphere has discriminant D = 0, and where
+# D is within rounding of 0 the root t is determined only to about
+# sqrt(eps_machine): two correct implementations that round D differently then
+# disagree at 1e-8, not 1e-12.  The 17 x 20 frame has two such pixels by
+# construction, (0, 8) and (16, 8): x = 0 and y = +-0.8 half = +-e R / sqrt(e^2 - R^2),
+# sphere A's silhouette radius.  (The two codes happen to round D identically
+# today; a cancellation-free discriminant in the renderer would not.)
+GRAZING_REL_T = 1e-12      # eps * condition number of t above which a hit counts as tangent;
+                           # measured <= 8e-14 on every other pixel of these frames
+MAX_GRAZING = 2            # per frame: the exemption cannot swallow a silhouette
+GRAZING_TOL = 1e-6         # |dI| still bounded there, and the chart point within this
+                           # distance; h's gradient then moves by at most its second
+                           # derivative bound (pi max(k_u, 2 k_v))^2 times that.  Measured
+                           # gap today: 0; with a cancellation-free discriminant in the
+                           # renderer (tried locally): |dI| < 1e-6, |d grad| = 2.7e-6 (rings).
+
+
+def grazing_mask(scene, width, height, chamber):
+    """Pixels whose sphere hit is ill-conditioned by input rounding alone.
+
+    For a t^2 + 2 b t + c = 0 a relative error eps in b^2 and a c moves D by
+    eps (b^2 + |a c|) and t by that over 2 a sqrt(D); relative to t this is
+    eps * kappa with kappa = (b^2 + |a c|) / (a sqrt(D) t).
+    """
+    mask = np.zeros(chamber.shape, dtype=bool)
+    e = scene.camera_z
+    spheres = {ref.SPHERE_A: ((0.0, 0.0, 0.0), scene.radius_a),
+               ref.SPHERE_B: (scene.center_b, scene.radius_b)}
+    for j, i in zip(*np.nonzero(np.isin(chamber, list(spheres)))):
+        C, r = spheres[int(chamber[j, i])]
+        x, y = ref.pixel_point(scene, i, j, width, height)
+        d, oc = (x, y, -e), ref.sub((0.0, 0.0, e), C)
+        a, b, c = ref.dot(d, d), ref.dot(d, oc), ref.dot(oc, oc) - r * r
+        D = b * b - a * c
+        if D <= 0.0:
+            mask[j, i] = True
+            continue
+        t = (-b - math.sqrt(D)) / a
+        mask[j, i] = 2.0**-52 * (b * b + abs(a * c)) / (a * math.sqrt(D) * t) > GRAZING_REL_T
+    return mask
 
 
 def parity_failures(scene, width, height, gradient, *, frame=None):
@@ -77,12 +121,21 @@ def parity_failures(scene, width, height, gradient, *, frame=None):
     n = int(np.count_nonzero(frame.kink != kink))
     if n:
         failures.append(f"kink differs at {n} pixels")
-    d_image = float(np.abs(frame.image - image).max())
-    if not d_image <= IMAGE_TOL:                       # also catches NaN
-        failures.append(f"max |dI| = {d_image:.3e} > {IMAGE_TOL}")
-    excess = np.abs(frame.grad - grad) - grad_tolerance(scene, gradient, grad)
-    if not np.all(excess <= 0.0):
-        failures.append(f"grad differs beyond tolerance by up to {np.nanmax(excess):.3e}")
+    tangent = grazing_mask(scene, width, height, chamber)
+    if np.count_nonzero(tangent) > MAX_GRAZING:
+        failures.append(f"{np.count_nonzero(tangent)} tangent pixels > {MAX_GRAZING}")
+    d_image = np.abs(frame.image - image).max(axis=-1)
+    excess = (np.abs(frame.grad - grad) - grad_tolerance(scene, gradient, grad)).max(axis=-1)
+    for where, image_tol, what in ((~tangent, IMAGE_TOL, ""), (tangent, GRAZING_TOL, " (tangent)")):
+        if not where.any():
+            continue
+        worst = float(d_image[where].max())
+        if not worst <= image_tol:                       # also catches NaN
+            failures.append(f"max |dI|{what} = {worst:.3e} > {image_tol}")
+        lip = math.pi * max(scene.k_u, 2.0 * scene.k_v)
+        worst = float(excess[where].max())
+        if not worst <= (0.0 if what == "" else GRAZING_TOL * lip * lip):
+            failures.append(f"grad{what} differs beyond tolerance by up to {worst:.3e}")
     return failures
 
 
@@ -270,3 +323,19 @@ def test_grad_tolerance_is_tight_enough_to_catch_a_half_step_error():
     frame = render(scene.replace(eps=1.001e-3), 24, 20, gradient="central")
     failures = parity_failures(scene, 24, 20, "central", frame=frame)
     assert any("grad" in f for f in failures), failures
+
+
+def test_tangent_exemption_covers_only_the_two_tangent_pixels():
+    for width, height in SIZES:
+        image, chamber, _, _ = ref.render_reference(Scene(), width, height)
+        got = np.argwhere(grazing_mask(Scene(), width, height, chamber)).tolist()
+        assert got == ([[0, 8], [16, 8]] if (width, height) == (17, 20) else [])
+
+
+def test_parity_still_checks_the_tangent_pixels():
+    """A wrong colour (1e-3) at an exempted pixel is still rejected."""
+    scene = Scene()
+    frame = render(scene, 17, 20)
+    assert parity_failures(scene, 17, 20, "exact", frame=frame) == []
+    frame.image[0, 8] += 1e-3
+    assert any("(tangent)" in f for f in parity_failures(scene, 17, 20, "exact", frame=frame))

@@ -1,0 +1,389 @@
+"""Geometric invariants of rendered frames, checked against independent solves.
+
+Hit points are rebuilt here from the pixel grid (written out below from the
+seed's Cell 1 window) and the chamber map: t comes from
+`renderer.geometry.sphere_hit` for the spheres and is 1 for the floor, and t
+itself is checked against an mpmath solve of the ray quadratic at 40 digits.
+Then: every hit point lies on its surface, floor points have z == 0, normals
+are unit vectors, the chamber is the nearest positive hit, nothing is NaN,
+and the image lies in [0, 1].  The seed's sphere-B quadratic (constant term
+|C_B|^2 - R_2^2, seed Cell 1) is shown to fail the on-surface invariant.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mpmath
+import numpy as np
+import pytest
+
+from renderer import PointLight, Scene, gbuffer, render
+from renderer.geometry import sphere_hit, tangent_frame
+
+SIZE = 128
+SURFACE_TOL = 1e-12        # relative to the radius
+UNIT_TOL = 1e-12
+# 40 digits: the float64 inputs are exact binary numbers, and the discriminant
+# of a ray grazing a sphere loses at most ~16 of them to cancellation; 40 leaves
+# more than 20 correct digits in t, far beyond the float64 error compared against.
+MP_DPS = 40
+
+SCENES = {
+    "default": Scene(),
+    "no sphere B": Scene(sphere_b=False),
+    "no floor": Scene(floor=False),
+    "bumpy sine, phong": Scene(height_field="sine", beta=1.5, model="phong"),
+    "camera close, sphere B moved": Scene(camera_z=2.5, radius_a=0.8, center_b=(-0.6, 0.2, 0.9),
+                                          radius_b=0.4),
+    "sphere B through the floor": Scene(center_b=(0.9, -0.3, 0.2), radius_b=0.5,
+                                        lights=(PointLight((3.0, -2.0, -4.0)),)),
+    "displaced-surface normal": Scene(height_field="rings", beta=0.9, bump="surface"),
+}
+
+
+# --- independent pieces -----------------------------------------------------------------
+
+def pixel_grid(scene, width, height):
+    """Image-plane (X, Y), shape (height, width): seed Cell 1's window."""
+    e, R = scene.camera_z, scene.radius_a
+    half = 1.25 * e * R / math.sqrt(e * e - R * R)
+    x = half * (2.0 * (np.arange(width) + 0.5) / width - 1.0)
+    y = half * (1.0 - 2.0 * (np.arange(height) + 0.5) / height) - 0.15 * half
+    return np.meshgrid(x, y)
+
+
+def hit_points(scene, X, Y, chamber):
+    """(t, P) per pixel from the chamber map: t from the sphere hit, 1 on the floor."""
+    e = scene.camera_z
+    t = np.full(X.shape, np.nan)
+    spheres = {1: ((0.0, 0.0, 0.0), scene.radius_a), 2: (scene.center_b, scene.radius_b)}
+    for code, (C, r) in spheres.items():
+        m = chamber == code
+        if m.any():
+            t[m] = sphere_hit(X[m], Y[m], e, C, r)
+    t[chamber == 3] = 1.0
+    P = np.stack([t * X, t * Y, e * (1.0 - t)], axis=-1)
+    return t, P
+
+
+def mp_nearest(scene, x, y, dps=MP_DPS):
+    """(t, chamber, t_tol) of the nearest positive hit, by mpmath at ``dps`` digits.
+
+    t_tol is the forward error bound of a float64 solve of the same ray:
+    with a t^2 + 2 b t + c = 0, rounding b^2 and a c perturbs the discriminant
+    D = b^2 - a c by about eps (b^2 + |a c|), which moves the root by that over
+    2 a sqrt(D) (large for grazing rays, where D -> 0); the rest of the
+    arithmetic adds a few eps t.  t_tol = 4 eps (t + (b^2 + |a c|) / (a sqrt D)),
+    eps = 2^-52.  (Measured: float64 errors reach 0.56 of the bracket, 0.14 of t_tol.)
+    """
+    eps = 2.0**-52
+    with mpmath.workdps(dps):
+        x, y, e = mpmath.mpf(x), mpmath.mpf(y), mpmath.mpf(scene.camera_z)
+
+        def sphere(C, r):
+            ox, oy, oz = -mpmath.mpf(C[0]), -mpmath.mpf(C[1]), e - mpmath.mpf(C[2])
+            a = x * x + y * y + e * e
+            b = x * ox + y * oy - e * oz                   # half the linear coefficient
+            c = ox * ox + oy * oy + oz * oz - mpmath.mpf(r) ** 2
+            disc = b * b - a * c
+            if disc < 0:
+                return mpmath.inf, 0.0
+            root = mpmath.sqrt(disc)
+            for t in sorted(((-b - root) / a, (-b + root) / a)):
+                if t > 0:
+                    tol = 4 * eps * (t + (b * b + abs(a * c)) / (a * root))
+                    return t, float(tol)
+            return mpmath.inf, 0.0
+
+        best = (mpmath.inf, 0, 0.0)
+        cands = [(*sphere((0.0, 0.0, 0.0), scene.radius_a), 1)]
+        if scene.sphere_b:
+            cands.append((*sphere(scene.center_b, scene.radius_b), 2))
+        if scene.floor:
+            cands.append((mpmath.mpf(1), 0.0, 3))      # t = 1 exactly in both
+        for t, tol, code in cands:
+            if t < best[0]:
+                best = (t, code, tol)
+        return float(best[0]), best[1], best[2]
+
+
+def sample_pixels(chamber, rng, n_random=300):
+    """Every pixel next to a chamber boundary (where a wrong solve shows first),
+    plus a random sample."""
+    c = chamber
+    edge = np.zeros(c.shape, dtype=bool)
+    edge[:, 1:] |= c[:, 1:] != c[:, :-1]
+    edge[:, :-1] |= c[:, 1:] != c[:, :-1]
+    edge[1:, :] |= c[1:, :] != c[:-1, :]
+    edge[:-1, :] |= c[1:, :] != c[:-1, :]
+    pick = np.zeros(c.size, dtype=bool)
+    pick[rng.choice(c.size, size=min(n_random, c.size), replace=False)] = True
+    return np.argwhere(edge | pick.reshape(c.shape))
+
+
+# --- the checks (each returns its evidence; the tests below assert on it) ----------------
+
+def off_surface(P, C, r):
+    """max | |P - C| - r | / r over points P (n, 3)."""
+    if P.shape[0] == 0:
+        return 0.0
+    return float(np.abs(np.linalg.norm(P - np.asarray(C), axis=-1) - r).max() / r)
+
+
+def off_unit(V):
+    return float(np.abs(np.linalg.norm(V, axis=-1) - 1.0).max()) if V.shape[0] else 0.0
+
+
+def chamber_mismatches(scene, X, Y, chamber, t, pixels):
+    """[(j, i, ours, mp)] where the chamber or t disagrees with the mpmath solve."""
+    bad = []
+    for j, i in pixels:
+        t_mp, code_mp, t_tol = mp_nearest(scene, X[j, i], Y[j, i])
+        if code_mp != chamber[j, i]:
+            bad.append((j, i, int(chamber[j, i]), code_mp))
+        elif code_mp != 0 and not abs(t[j, i] - t_mp) <= t_tol:
+            bad.append((j, i, float(t[j, i]), t_mp))
+    return bad
+
+
+def all_finite(*arrays):
+    return all(bool(np.all(np.isfinite(a))) for a in arrays)
+
+
+def in_unit_interval(image):
+    return bool(np.all((image >= 0.0) & (image <= 1.0)))
+
+
+# --- tests ------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module", params=sorted(SCENES))
+def case(request):
+    scene = SCENES[request.param]
+    g = gbuffer(scene, SIZE, SIZE, gradient="exact")
+    X, Y = pixel_grid(scene, SIZE, SIZE)
+    t, P = hit_points(scene, X, Y, g.chamber)
+    return scene, g, X, Y, t, P
+
+
+def test_grid_and_hit_points_agree_with_gbuffer(case):
+    scene, g, X, Y, t, P = case
+    assert np.array_equal(g.x, X[0]) and np.array_equal(g.y, Y[:, 0])
+    hit = g.chamber > 0
+    assert np.array_equal(g.t[hit], t[hit])
+    assert np.abs(g.P[hit] - P[hit]).max() <= 1e-15 * (1 + np.abs(P[hit]).max())
+
+
+def test_sphere_a_hits_are_on_sphere_a(case):
+    scene, g, X, Y, t, P = case
+    a = g.chamber == 1
+    assert a.sum() > 100
+    assert off_surface(P[a], (0, 0, 0), scene.radius_a) <= SURFACE_TOL
+
+
+def test_sphere_b_hits_are_on_sphere_b(case):
+    scene, g, X, Y, t, P = case
+    b = g.chamber == 2
+    assert b.any() == scene.sphere_b
+    assert off_surface(P[b], scene.center_b, scene.radius_b) <= SURFACE_TOL
+
+
+def test_floor_points_are_on_the_plane(case):
+    scene, g, X, Y, t, P = case
+    f = g.chamber == 3
+    assert f.any() == scene.floor
+    # t = 1 exactly, so z = e (1 - 1) is exactly 0.
+    assert np.all(P[f][:, 2] == 0.0) and np.all(g.P[f][:, 2] == 0.0)
+
+
+def test_normals_are_unit(case):
+    scene, g, X, Y, t, P = case
+    hit = g.chamber > 0
+    assert off_unit(g.N[hit]) <= UNIT_TOL
+    assert off_unit(g.Ns[hit]) <= UNIT_TOL
+    # The geometric normal is the independent one: (P - C) / r, or +z on the floor.
+    for code, C, r in ((1, (0, 0, 0), scene.radius_a), (2, scene.center_b, scene.radius_b)):
+        m = g.chamber == code
+        if m.any():
+            assert np.abs(g.N[m] - (P[m] - np.asarray(C)) / r).max() <= 1e-15 / r * 4
+    assert np.all(g.N[g.chamber == 3] == (0.0, 0.0, 1.0))
+
+
+def test_chamber_is_the_nearest_positive_hit(case):
+    scene, g, X, Y, t, P = case
+    pixels = sample_pixels(g.chamber, np.random.default_rng(20261121))
+    assert len(pixels) > 300
+    assert chamber_mismatches(scene, X, Y, g.chamber, t, pixels) == []
+
+
+@pytest.mark.parametrize("gradient", ("exact", "central"))
+def test_no_nan_and_image_in_unit_interval(case, gradient):
+    scene = case[0]
+    frame = render(scene, SIZE, SIZE, gradient=gradient)
+    g = gbuffer(scene, SIZE, SIZE, gradient=gradient)
+    assert all_finite(frame.image, frame.grad, g.t[g.chamber > 0], g.P, g.N, g.Ns, g.uv, g.grad)
+    assert in_unit_interval(frame.image)
+    assert np.array_equal(frame.chamber, g.chamber)
+    assert np.all(frame.image[frame.chamber == 0] == 0.0)
+
+
+# --- the seed's sphere-B quadratic, and teeth for each check -----------------------------
+
+def seed_sphere_b(scene, X, Y):
+    """t of the seed's Cell 1 sphere-B hit (c = |C_B|^2 - R_2^2, taken as written)."""
+    e, C, r = scene.camera_z, np.asarray(scene.center_b), scene.radius_b
+    a = X * X + Y * Y + e * e
+    b_half = -C[0] * X - C[1] * Y - (e - C[2]) * e
+    disc = b_half * b_half - a * (C @ C - r * r)
+    with np.errstate(invalid="ignore"):
+        return np.where(disc >= 0.0, (-b_half - np.sqrt(disc)) / a, np.inf)
+
+
+def seed_chamber(scene, X, Y):
+    """The seed's chamber: tm = min(tA, tB, 1), first of A, B, floor to equal it."""
+    e, R = scene.camera_z, scene.radius_a
+    a = X * X + Y * Y + e * e
+    disc_a = e * e * R * R - (e * e - R * R) * (X * X + Y * Y)
+    with np.errstate(invalid="ignore"):
+        tA = np.where(disc_a >= 0.0, (e * e - np.sqrt(disc_a)) / a, np.inf)
+    tB = seed_sphere_b(scene, X, Y)
+    tm = np.minimum(np.minimum(tA, tB), 1.0)
+    return np.where(tm == tA, 1, np.where(tm == tB, 2, 3)).astype(np.uint8), tB
+
+
+def test_seed_sphere_b_points_are_off_the_sphere():
+    """Measured at 128^2: the seed's 'hit points' sit up to 2.07 units (6.5 R_2) off sphere B."""
+    scene = Scene()
+    X, Y = pixel_grid(scene, SIZE, SIZE)
+    tB = seed_sphere_b(scene, X, Y)
+    hit = np.isfinite(tB)
+    P = np.stack([tB * X, tB * Y, scene.camera_z * (1.0 - tB)], axis=-1)[hit]
+    err = off_surface(P, scene.center_b, scene.radius_b)
+    assert err > 1e10 * SURFACE_TOL          # rejected, by ten orders of magnitude
+    assert 6.0 < err < 7.0                   # 2.07 / 0.32 = 6.46 radii (measured)
+
+
+def test_seed_sphere_b_flips_the_chamber_of_most_of_the_frame():
+    """At the seed's own 256^2 the seed's sphere B covers every pixel; the corrected
+    sphere covers 6635, so 58901 of 65536 pixels change chamber (measured)."""
+    scene, n = Scene(), 256
+    X, Y = pixel_grid(scene, n, n)
+    seed, _ = seed_chamber(scene, X, Y)
+    ours = render(scene, n, n).chamber
+    flips = int(np.count_nonzero(seed != ours))
+    assert np.all(seed == 2)
+    assert int(np.count_nonzero(ours == 2)) == 6635
+    assert flips == 58901
+
+
+def test_seed_sphere_b_is_a_larger_sphere_about_the_same_centre():
+    """Why the seed's B covers the frame: c = |C|^2 - r^2 is the constant term of the
+    sphere about C_B with r'^2 = |E - C_B|^2 - |C_B|^2 + r^2, i.e. r' = 2.39, not 0.32."""
+    scene = Scene()
+    X, Y = pixel_grid(scene, 64, 64)
+    C, e, r = np.asarray(scene.center_b), scene.camera_z, scene.radius_b
+    r_seed = math.sqrt(float((C - (0, 0, e)) @ (C - (0, 0, e)) - C @ C + r * r))
+    assert 2.38 < r_seed < 2.39
+    t_seed = seed_sphere_b(scene, X, Y)
+    t_big = sphere_hit(X.ravel(), Y.ravel(), e, scene.center_b, r_seed).reshape(X.shape)
+    assert np.abs(t_seed - t_big).max() <= 1e-14
+
+
+def test_chamber_check_rejects_the_seeds_chamber():
+    scene = Scene()
+    X, Y = pixel_grid(scene, SIZE, SIZE)
+    code, tB = seed_chamber(scene, X, Y)
+    t = np.where(code == 2, tB, np.nan)
+    pixels = sample_pixels(code, np.random.default_rng(1), n_random=50)
+    assert len(chamber_mismatches(scene, X, Y, code, t, pixels)) > 40
+
+
+def test_t_check_rejects_the_far_root():
+    """Right chamber, wrong root: the far intersection of sphere A fails the t comparison."""
+    scene = Scene(sphere_b=False, floor=False)
+    g = gbuffer(scene, 32, 32)
+    X, Y = pixel_grid(scene, 32, 32)
+    e, R = scene.camera_z, scene.radius_a
+    a = X * X + Y * Y + e * e
+    disc = e * e * R * R - (e * e - R * R) * (X * X + Y * Y)
+    with np.errstate(invalid="ignore"):
+        far = np.where(g.chamber == 1, (e * e + np.sqrt(disc)) / a, np.nan)
+    # Twenty pixels nearest the middle of sphere A's disc (rays far from grazing).
+    order = np.argsort(np.where(g.chamber == 1, X * X + (Y - Y[g.chamber == 1].mean()) ** 2,
+                                np.inf), axis=None)
+    pixels = np.column_stack(np.unravel_index(order[:20], X.shape))
+    assert len(chamber_mismatches(scene, X, Y, g.chamber, far, pixels)) == 20
+    assert chamber_mismatches(scene, X, Y, g.chamber, g.t, pixels) == []
+
+
+def test_unit_check_rejects_the_unnormalized_perturbed_normal():
+    scene = Scene(beta=0.35)
+    g = gbuffer(scene, 64, 64)
+    a = g.chamber == 1
+    N, (hu, hv) = g.N[a], g.grad[a].T
+    e_th, e_ph = tangent_frame(N[:, 0], N[:, 1], N[:, 2], np.hypot(N[:, 0], N[:, 1]))
+    M = N + scene.beta * (hu[:, None] * np.stack(e_th, -1) + hv[:, None] * np.stack(e_ph, -1))
+    assert off_unit(M) > 1e-2
+    assert off_unit(M / np.linalg.norm(M, axis=-1, keepdims=True)) <= UNIT_TOL
+
+
+def test_surface_check_rejects_a_point_one_part_in_1e11_off():
+    P = np.array([[0.6, 0.0, 0.8]]) * (1.0 + 1e-11)
+    assert off_surface(P, (0, 0, 0), 1.0) > SURFACE_TOL
+    assert off_surface(np.array([[0.6, 0.0, 0.8]]), (0, 0, 0), 1.0) <= SURFACE_TOL
+
+
+def test_finite_and_range_checks_reject_bad_values():
+    image = np.full((4, 4, 3), 0.5)
+    assert all_finite(image) and in_unit_interval(image)
+    for bad in (np.nan, np.inf, 1.0 + 2**-52, -1e-300):
+        wrong = image.copy()
+        wrong[2, 1, 0] = bad
+        assert not (all_finite(wrong) and in_unit_interval(wrong))
+
+
+# --- valid scenes outside the seed's range -------------------------------------------------
+
+def scene_or_rejection(kwargs, field):
+    """The Scene, or None if validation rejects it with a ValueError naming ``field``."""
+    try:
+        return Scene(**kwargs)
+    except ValueError as exc:
+        assert str(exc).startswith(f"Scene.{field} "), f"ValueError names another field: {exc}"
+        return None
+
+
+@pytest.mark.parametrize("camera_z", [1e6, 1e9])
+def test_chamber_is_the_nearest_positive_hit_for_a_distant_camera(camera_z):
+    """A camera_z that Scene accepts must render the right chamber.  The window
+    is scaled to sphere A's silhouette, so A fills the same disc at any
+    distance.  The discriminant b^2 - a c of the ray quadratic is a difference
+    of two numbers of size e^4 whose true value is of size e^2 R^2, so it
+    cancels once e^2 >> 1 / eps_machine (pbrt-v4 and Ray Tracing Gems ch. 7
+    use the cancellation-free form r^2 - |o - (o.d) d|^2 for this reason)."""
+    scene = scene_or_rejection(dict(camera_z=camera_z, sphere_b=False), "camera_z")
+    if scene is None:
+        return
+    n = 48
+    frame = render(scene, n, n)
+    X, Y = pixel_grid(scene, n, n)
+    # The mpmath discriminant cancels the same ~4 log10(e) digits; 40 + 40 keeps 40.
+    wrong = [(j, i) for j in range(n) for i in range(n)
+             if mp_nearest(scene, X[j, i], Y[j, i], dps=80)[1] != frame.chamber[j, i]]
+    assert wrong == [], f"{len(wrong)} of {n * n} pixels have the wrong chamber: {wrong[:4]}"
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(beta=1e200), "beta"), (dict(k_u=1e200), "k_u"),
+    (dict(beta=1e6), "beta"), (dict(k_u=1e6, height_field="sine"), "k_u"),
+])
+def test_perturbed_normal_is_unit_for_huge_inputs(kwargs, field):
+    """If Scene accepts the value, N' = M / |M| must stay a unit vector (the limit
+    beta -> inf is the direction of the gradient); |M|^2 must not overflow."""
+    scene = scene_or_rejection(kwargs, field)
+    if scene is None:
+        return
+    with np.errstate(all="ignore"):
+        g = gbuffer(scene, 32, 32)
+    err = off_unit(g.Ns[g.chamber == 1])
+    assert err <= UNIT_TOL, f"| |N'| - 1 | reaches {err}"
