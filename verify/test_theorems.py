@@ -49,3 +49,19 @@ def test_book_block_refuses_a_failing_theorem(monkeypatch):
     with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
         book.theorem_block("optimal-step")
     assert "PROVED" in book.theorem_block("frame-orthonormal")
+
+
+def test_undecided_identity_is_verified_numerically(monkeypatch):
+    """When sympy cannot decide, a true identity is 'verified' at >= 20 points and
+    >= 30 digits with its worst residual stated, and a false one is still refuted."""
+    import sympy as sp
+
+    from proofs import core
+    monkeypatch.setattr(core, "_exactly_zero", lambda expr: False)   # sympy "cannot decide"
+    x = sp.Symbol("x", real=True)
+    true = core.Identity("double angle", sp.sin(2 * x), 2 * sp.sin(x) * sp.cos(x), {x: (-3, 3)})
+    verdict = core.check_identities([true])
+    assert verdict.status == "verified"
+    assert verdict.points >= 20 and verdict.digits >= 30 and verdict.residual < 1e-25
+    false = core.Identity("wrong angle", sp.sin(2 * x), sp.sin(x) * sp.cos(x), {x: (-3, 3)})
+    assert core.check_identities([false]).status == "refuted"
