@@ -254,7 +254,7 @@ ERRATA = (
         title="The specular lobe is added where the surface faces away from the light",
         seed=r"$k_s \max(0, N'\cdot h)^{n}$ added for every unshadowed light",
         correction=r"the lobe is zero where $N'\cdot\hat w \le 0$",
-        exposed_by="tests/test_parity.py",
+        exposed_by="verify/test_errata.py (lobe where the bumped normal faces away)",
         measure=_specular_ungated,
         finding=(
             "In the default frame {pixels} (pixel, light) pairs on the spheres face away "
@@ -286,7 +286,7 @@ ERRATA = (
         title="The polar angle loses digits near the pole",
         seed=r"$\varphi = \arccos N_z$ and $\sin\varphi = \sqrt{1 - N_z^2}$",
         correction=r"$\varphi = \operatorname{atan2}(\operatorname{hypot}(N_x, N_y), N_z)$ and $\sin\varphi = \operatorname{hypot}(N_x, N_y)$",
-        exposed_by="proofs/seed_errata.py (mpmath reference)",
+        exposed_by="verify/test_errata.py (mpmath reference)",
         measure=_acos_pole,
         finding=(
             "For float64 unit normals with sin(phi) between 1e-8 and 1e-2, the relative "
@@ -300,7 +300,7 @@ ERRATA = (
         title="The pole fallback frame has the opposite orientation",
         seed=r"fallback $e_\theta = (1,0,0)$, $e_\varphi = (0,1,0)$",
         correction="kept as the seed has it (the convention is the seed's); measured and disclosed",
-        exposed_by="proofs/seed_errata.py",
+        exposed_by="verify/test_errata.py",
         measure=_fallback_orientation,
         finding=(
             "(e_theta x e_phi) . N lies in [{orientation_regular_min:.16f}, "

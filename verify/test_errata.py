@@ -67,3 +67,29 @@ def test_v_border_branch_fires_in_interior():
 def test_report_rejects_a_missing_measurement():
     with pytest.raises(KeyError):
         ERRATA[0].report({})
+
+
+def test_specular_lobe_is_gated_by_the_shading_normal():
+    """Erratum specular-ungated: with only a specular term (kd = 0, low shininess),
+    pixels lit geometrically but whose bumped normal faces away from the light
+    are exactly black; the seed's rule would add ks (N'.h)^n there."""
+    from renderer import render
+    light = Scene().lights[0]
+    scene = Scene(lights=(light,), ka=0.0, kd=0.0, ks=1.0, shininess=1.0, beta=1.5,
+                  sphere_b=False)
+    g = gbuffer(scene, 128, 128)
+    image = render(scene, 128, 128).image
+    L = np.asarray(light.position)
+    w = L - g.P
+    w_hat = w / np.linalg.norm(w, axis=-1, keepdims=True)
+    v = np.array([0.0, 0.0, scene.camera_z]) - g.P
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    h = w_hat + v
+    h /= np.linalg.norm(h, axis=-1, keepdims=True)
+    a = g.chamber == 1
+    lit = np.einsum("hwc,hwc->hw", g.N, w) > 0
+    away = np.einsum("hwc,hwc->hw", g.Ns, w_hat) <= 0
+    seed_lobe = np.maximum(np.einsum("hwc,hwc->hw", g.Ns, h), 0) ** scene.shininess
+    target = a & lit & away & (seed_lobe > 1e-3)
+    assert target.sum() > 0                      # the seed would light these visibly
+    assert np.all(image[target] == 0.0)
