@@ -1,0 +1,151 @@
+"""The finite-difference U-curve, measured exactly (seed §3, Cells 2 and 7).
+
+For a height field, a chart point (u, v), a component (h_u or h_v) and a grid
+of steps eps, `measure` returns
+
+* the float64 central difference exactly as the renderer computes it (same
+  code path: `renderer.render.central_gradient`);
+* its error against the true derivative evaluated with mpmath at 50 digits;
+* that error split exactly into *truncation*, the same difference quotient
+  taken in exact arithmetic at the float64 abscissae the renderer actually
+  used (u +/- eps rounded and wrapped, v +/- eps rounded and clamped) and the
+  same denominator, minus the true derivative; and *roundoff*, the rest
+  (the rounding of the two values of h and of the subtraction and division);
+* the model eps^2 |h'''| / 6 + u_round |h| / eps (u_round = 2^-53, the unit
+  roundoff), its minimiser eps* = (3 u_round |h| / |h'''|)^(1/3), and the
+  measured minimiser.
+
+Working precision: 50 digits, so that the reference's own error (~1e-50) is
+far below the float64 quantities measured (>= 1e-17).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from renderer import fields
+from renderer.render import central_gradient
+
+__all__ = ["UCurve", "measure", "UNIT_ROUNDOFF", "DIGITS"]
+
+#: Unit roundoff of IEEE double precision (round to nearest).
+UNIT_ROUNDOFF = 2.0**-53
+#: mpmath working precision of the references, in decimal digits.
+DIGITS = 50
+
+
+@dataclass(frozen=True)
+class UCurve:
+    """Result of `measure` (arrays are float64, one entry per step)."""
+
+    field: str
+    u: float
+    v: float
+    component: str
+    eps: np.ndarray
+    error: np.ndarray          # |float64 FD - true derivative|
+    truncation: np.ndarray     # exact-arithmetic FD at the float64 abscissae - true (signed)
+    roundoff: np.ndarray       # float64 FD - exact-arithmetic FD (signed)
+    model: np.ndarray          # eps^2 |h'''| / 6 + u_round |h| / eps
+    derivative: float          # the true derivative, rounded to float64
+    third_derivative: float
+    eps_opt_predicted: float
+    eps_opt_measured: float
+    error_at_measured_opt: float
+
+
+@lru_cache(maxsize=None)
+def _mp_functions(field, component, ku, kv):
+    h = fields.HEIGHT_EXPRS[field].subs({fields.k_u: ku, fields.k_v: kv})
+    var = fields.u if component == "u" else fields.v
+    # Exact rational frequencies so that mpmath does not inherit float64 rounding.
+    h = h.subs({fields.k_u: sp.nsimplify(ku), fields.k_v: sp.nsimplify(kv)})
+    args = (fields.u, fields.v)
+    # d sign(f) / du = 2 DiracDelta(f) f' vanishes off the crease: drop it.
+    smooth = lambda e: e.replace(lambda x: isinstance(x, sp.DiracDelta), lambda x: 0)  # noqa: E731
+    return (sp.lambdify(args, h, modules="mpmath"),
+            sp.lambdify(args, smooth(sp.diff(h, var)), modules="mpmath"),
+            sp.lambdify(args, smooth(sp.diff(h, var, 3)), modules="mpmath"))
+
+
+def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=4.0):
+    """Measure the central-difference U-curve at one chart point.
+
+    Parameters
+    ----------
+    field : {"sine", "ridges", "rings"}
+    u, v : float in [0, 1]
+        Chart point (the seed's default is (0.31, 0.47)).
+    component : {"u", "v"}
+        Which partial derivative.
+    eps : array_like of float > 0, optional
+        Steps; default 200 log-spaced from 1e-1 to 1e-15.
+    k_u, k_v : float > 0
+
+    Returns
+    -------
+    UCurve
+
+    Raises
+    ------
+    ValueError
+        Naming the argument, for an unknown field or component, a chart
+        point outside [0, 1], or a non-positive or non-finite step.
+
+    Notes
+    -----
+    At a crease of the ridges field the difference quotient does not converge;
+    the "true derivative" is then sympy's sign(s1 s2) (s1 s2)' evaluated at
+    the float64 point, i.e. one of the two one-sided derivatives, and
+    `truncation` does not vanish as eps -> 0.
+    """
+    if field not in fields.HEIGHT_EXPRS:
+        raise ValueError(f"field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {field!r}")
+    if component not in ("u", "v"):
+        raise ValueError(f"component must be 'u' or 'v', got {component!r}")
+    for name, value in (("u", u), ("v", v)):
+        if not (isinstance(value, (int, float)) and 0.0 <= value <= 1.0):
+            raise ValueError(f"{name} must be a number in [0, 1], got {value!r}")
+    for name, value in (("k_u", k_u), ("k_v", k_v)):
+        if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    steps = np.logspace(-1, -15, 200) if eps is None else np.asarray(eps, dtype=np.float64).ravel()
+    if steps.size == 0 or not np.all(np.isfinite(steps)) or np.any(steps <= 0):
+        raise ValueError("eps must be a non-empty array of finite steps > 0")
+
+    u, v, k_u, k_v = float(u), float(v), float(k_u), float(k_v)
+    h_mp, dh_mp, d3h_mp = _mp_functions(field, component, k_u, k_v)
+    uu, vv = np.array([u]), np.array([v])
+    with mpmath.workdps(DIGITS):
+        U, V = mpmath.mpf(u), mpmath.mpf(v)
+        true = dh_mp(U, V)
+        h0 = h_mp(U, V)
+        h3 = d3h_mp(U, V)
+        error, trunc, roundoff = [], [], []
+        for e in steps:
+            fd = central_gradient(field, uu, vv, k_u, k_v, float(e))[0 if component == "u" else 1][0]
+            # The abscissae and the denominator, exactly as float64 made them.
+            if component == "u":
+                a_plus, a_minus = np.mod(u + e, 1.0), np.mod(u - e, 1.0)
+                den = 2.0 * e
+                f_plus, f_minus = h_mp(mpmath.mpf(a_plus), V), h_mp(mpmath.mpf(a_minus), V)
+            else:
+                a_plus, a_minus = min(1.0, v + e), max(0.0, v - e)
+                den = (a_plus - a_minus) if (v + e > 1.0 or v - e < 0.0) else 2.0 * e
+                f_plus, f_minus = h_mp(U, mpmath.mpf(a_plus)), h_mp(U, mpmath.mpf(a_minus))
+            exact_fd = (f_plus - f_minus) / mpmath.mpf(den)
+            trunc.append(float(exact_fd - true))
+            roundoff.append(float(mpmath.mpf(fd) - exact_fd))
+            error.append(float(abs(mpmath.mpf(fd) - true)))
+    error = np.array(error)
+    h0f, h3f = float(h0), float(h3)
+    model = steps**2 * abs(h3f) / 6 + UNIT_ROUNDOFF * abs(h0f) / steps
+    predicted = (3 * UNIT_ROUNDOFF * abs(h0f) / abs(h3f)) ** (1 / 3) if h3f != 0 else float("inf")
+    best = int(np.argmin(error))
+    return UCurve(field, u, v, component, steps, error, np.array(trunc), np.array(roundoff), model,
+                  float(true), h3f, predicted, float(steps[best]), float(error[best]))

@@ -1,0 +1,53 @@
+"""The U-curve reference (proofs/ucurve.py): the split is exact, each part
+behaves as its theory says, and the checks reject wrong variants."""
+
+import numpy as np
+import pytest
+
+from proofs.ucurve import UNIT_ROUNDOFF, measure
+
+CURVE = measure()                                   # sine, (0.31, 0.47), h_u, k = (8, 4)
+
+
+def test_split_is_exact():
+    # error = |truncation + roundoff| up to the float64 rounding of each part.
+    total = np.abs(CURVE.truncation + CURVE.roundoff)
+    assert np.allclose(total, CURVE.error, rtol=1e-12, atol=0)
+
+
+def test_truncation_follows_eps_squared_h3_over_6_at_large_steps():
+    big = (CURVE.eps > 1e-4) & (CURVE.eps < 1e-2)
+    predicted = CURVE.eps[big] ** 2 * CURVE.third_derivative / 6
+    assert np.allclose(CURVE.truncation[big], predicted, rtol=2e-2)
+    # A wrong coefficient (1/3) is rejected by the same comparison.
+    assert not np.allclose(CURVE.truncation[big], 2 * predicted, rtol=2e-2)
+
+
+def test_roundoff_is_bounded_by_a_few_ulps_over_eps():
+    # |roundoff| <= c u |h'| ... bounded by (2 ulp(h) + ulp of the quotient) / (2 eps).
+    bound = 4 * UNIT_ROUNDOFF * (1 + abs(CURVE.derivative)) / CURVE.eps
+    assert np.all(np.abs(CURVE.roundoff) <= bound)
+    assert np.any(np.abs(CURVE.roundoff) > 1e-3 * bound)   # and it is not identically tiny
+
+
+def test_measured_optimum_near_predicted():
+    ratio = CURVE.eps_opt_measured / CURVE.eps_opt_predicted
+    assert 0.05 < ratio < 20
+    assert CURVE.error_at_measured_opt < 1e-9
+    assert CURVE.error[CURVE.eps < 1e-13].min() > 100 * CURVE.error_at_measured_opt
+
+
+def test_crease_does_not_converge():
+    crease = measure("ridges", u=0.125)                   # u = 1/k_u
+    assert np.all(crease.error > 9.0)                     # no step gets within 9 of a derivative
+    smooth = measure("ridges", u=0.1)
+    assert smooth.error_at_measured_opt < 1e-8
+
+
+@pytest.mark.parametrize("kwargs, fragment", [
+    (dict(field="bumps"), "field"), (dict(component="w"), "component"), (dict(u=1.5), "u"),
+    (dict(eps=[1e-3, -1e-3]), "eps"), (dict(eps=[]), "eps"), (dict(k_u=0.0), "k_u"),
+])
+def test_bad_arguments_are_named(kwargs, fragment):
+    with pytest.raises(ValueError, match=fragment):
+        measure(**kwargs)
