@@ -1,0 +1,93 @@
+"""Stress tests: where floating point hurts (issue 4, item 4, in part).
+
+Each test states what it found; the numbers are asserted against bounds that a
+wrong renderer would break.
+"""
+
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from renderer import Scene, gbuffer, render
+from renderer.geometry import POLE_SIN_PHI, tangent_frame
+
+
+def fallback_pixels(scene, width, height):
+    g = gbuffer(scene, width, height)
+    a = g.chamber == 1
+    return int(np.count_nonzero(a & (np.hypot(g.N[..., 0], g.N[..., 1]) <= POLE_SIN_PHI)))
+
+
+def test_pole_fallback_engages_only_where_a_pixel_centre_hits_the_pole():
+    # Pixel centres land on x = 0 for odd widths and on y = 0 when (j + 1/2)/H = 0.425,
+    # e.g. H = 20, j = 8: then the centre ray meets the pole (to rounding).
+    assert fallback_pixels(Scene(), 21, 20) == 1
+    for w, h in ((256, 256), (255, 255), (128, 96), (512, 512)):
+        assert fallback_pixels(Scene(), w, h) == 0
+    for gradient in ("exact", "central"):
+        frame = render(Scene(height_field="sine", beta=1.5), 21, 20, gradient=gradient)
+        assert np.isfinite(frame.image).all() and np.isfinite(frame.grad).all()
+
+
+def test_size_of_the_jump_across_the_fallback():
+    """N' from the fallback basis against the regular frame just outside the
+    threshold, for the same gradient: the jump is O(beta |grad|), not small."""
+    phi = 1.0001 * POLE_SIN_PHI
+    N = np.array([[np.sin(phi)], [0.0], [np.cos(phi)]])
+    reg = tangent_frame(*N, np.array([np.sin(phi)]))
+    fb = tangent_frame(*N, np.array([0.0]))
+    g = np.array([1.0, 0.5])
+    beta = 0.35
+    n_reg = N[:, 0] + beta * (g[0] * np.ravel(reg[0]) + g[1] * np.ravel(reg[1]))
+    n_fb = N[:, 0] + beta * (g[0] * np.ravel(fb[0]) + g[1] * np.ravel(fb[1]))
+    jump = np.linalg.norm(n_reg / np.linalg.norm(n_reg) - n_fb / np.linalg.norm(n_fb))
+    assert jump > 0.1             # a real discontinuity (confessed in §7), not rounding
+
+
+@pytest.mark.parametrize("kwargs", [
+    dict(beta=1e6), dict(beta=1e6, height_field="sine"), dict(k_u=1e3, k_v=1e3),
+    dict(camera_z=1.0 + 1e-9), dict(camera_z=1.0 + 1e-9, center_b=(3.0, 3.0, 0.5)),
+    dict(eps=1e-300), dict(eps=5e-324), dict(eps=0.75), dict(eps=1e6),
+])
+@pytest.mark.parametrize("gradient", ["exact", "central"])
+def test_extreme_valid_scenes_render_finite_unit_normals(kwargs, gradient):
+    scene = Scene(**kwargs)
+    frame = render(scene, 48, 40, gradient=gradient)
+    assert np.isfinite(frame.image).all() and frame.image.min() >= 0 and frame.image.max() <= 1
+    g = gbuffer(scene, 48, 40, gradient=gradient)
+    hit = g.chamber > 0
+    assert np.abs(np.linalg.norm(g.Ns[hit], axis=-1) - 1).max() < 1e-12
+
+
+def test_one_by_one_and_thin_frames():
+    for w, h in ((1, 1), (1, 300), (300, 1)):
+        frame = render(Scene(), w, h)
+        assert frame.image.shape == (h, w, 3) and np.isfinite(frame.image).all()
+
+
+def test_4096_frame_in_bounded_memory():
+    """Working memory beyond the outputs stays bounded (tiles of 16,384 pixels)."""
+    w = h = 4096
+    outputs = w * h * (3 * 8 + 1 + 1 + 2 * 8)
+    tracemalloc.start()
+    frame = render(Scene(), w, h)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert np.isfinite(frame.image).all()
+    assert peak - outputs < 64 * 2**20, f"working memory {(peak - outputs) / 2**20:.0f} MiB"
+
+
+def test_grazing_rays_at_the_silhouette_stay_on_the_surface():
+    """Rays within a hair of sphere A's silhouette: hit points still on the sphere."""
+    from renderer.geometry import sphere_hit
+    e, R = 4.0, 1.0
+    rho_sil = e * R / np.sqrt(e * e - R * R)
+    theta = np.linspace(0, 2 * np.pi, 1000)
+    rho = rho_sil * (1 - np.logspace(-16, -6, 1000))
+    x, y = rho * np.cos(theta), rho * np.sin(theta)
+    t = sphere_hit(x, y, e, (0.0, 0.0, 0.0), R)
+    hit = np.isfinite(t)
+    assert hit.mean() > 0.99
+    P = np.stack([t[hit] * x[hit], t[hit] * y[hit], e * (1 - t[hit])], axis=-1)
+    assert np.abs(np.linalg.norm(P, axis=-1) - R).max() < 1e-12
