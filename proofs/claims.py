@@ -6,8 +6,9 @@ recomputes the evidence at build time and returns (measured, verdict); the
 verdict is one of HOLDS, FAILS ("does not hold") and CORRECTED ("holds with a
 correction").  `pytest verify` fails when a computed verdict differs from the
 registered one, so a verdict cannot change silently: the register must be
-edited with it.  Timing claims are measured in the benchmarks, not here (a
-verdict must not depend on machine load).
+edited with it.  The one timing claim rests on the gradient stage, where
+the margin (about 2.5x) is far outside machine noise; the whole-frame ratio
+is reported beside it but decides nothing.
 """
 
 from __future__ import annotations
@@ -158,6 +159,34 @@ def _evals():
             CORRECTED if (central_per_pixel, exact_per_pixel) == (4, 0) else FAILS)
 
 
+def _timing():
+    """Gradient stage and whole frame, exact vs central: min of repeated runs.
+
+    The verdict rests on the gradient stage, where the margin is wide; the whole
+    frame's ratio is reported but is within machine noise of 1.
+    """
+    import time
+    g = gbuffer(Scene(), 128, 128)
+    uv = g.uv[g.chamber == SPHERE_A]
+    u, v = uv[:, 0].copy(), uv[:, 1].copy()
+
+    def best(fn, n=25):
+        times = []
+        for _ in range(n):
+            t0 = time.perf_counter()
+            fn()
+            times.append(time.perf_counter() - t0)
+        return min(times)
+
+    t_exact = best(lambda: fields.exact_gradient("ridges", u, v, 8.0, 4.0))
+    t_central = best(lambda: central_gradient("ridges", u, v, 8.0, 4.0, 1e-3))
+    f_exact = best(lambda: render(Scene(), 128, 128), 7)
+    f_central = best(lambda: render(Scene(), 128, 128, gradient="central"), 7)
+    stage = t_central / t_exact
+    return (f"gradient stage: central/exact = {stage:.1f}x; whole 128^2 frame: "
+            f"{f_central / f_exact:.2f}x (min of repeated runs)", HOLDS if stage > 1.5 else FAILS)
+
+
 def _cell5_fd():
     rng = np.random.default_rng(5)
     worst = 0.0
@@ -274,6 +303,8 @@ CLAIMS = (
           "mean |ΔI| on / off the crease band at ε = 1e-3", FAILS, _kink_order_of_magnitude),
     Claim("four-evals-vs-one", "Cell 4, Expect; §6", "4 evals vs 1",
           "instrumented count of h evaluations", CORRECTED, _evals),
+    Claim("symbolic-not-slower", "Cell 4, Expect", "the symbolic column at or under the numeric",
+          "min-of-N timings of the gradient stage and of the frame", HOLDS, _timing),
     Claim("cell5-fd-1e-9", "Cell 5, Expect", "~1e-9 worst component on the normal derivative",
           "the seed's forward-difference check over 2,000 trials", FAILS, _cell5_fd),
     Claim("dn-verified-1e-12", "§3, §6", "∂N′/∂β … verified to 10⁻¹²",

@@ -91,3 +91,55 @@ def test_grazing_rays_at_the_silhouette_stay_on_the_surface():
     assert hit.mean() > 0.99
     P = np.stack([t[hit] * x[hit], t[hit] * y[hit], e * (1 - t[hit])], axis=-1)
     assert np.abs(np.linalg.norm(P, axis=-1) - R).max() < 1e-12
+
+
+@pytest.mark.parametrize("m", range(0, 9))
+def test_points_exactly_on_the_u_creases(m):
+    """u = m / k_u as float64 represents it, v off the v-creases: what each
+    pipeline returns and what the kink flag says."""
+    from renderer import fields
+    from renderer.render import central_gradient
+    ku, kv = 8.0, 4.0
+    u, v = np.array([m / ku]), np.array([0.47])
+    one_sided = np.pi * ku * abs(np.sin(np.pi * kv * 0.47))          # |h_u| on either side
+    exact = fields.exact_gradient("ridges", u, v, ku, kv)[0][0]
+    fd = central_gradient("ridges", u, v, ku, kv, 1e-4)[0][0]
+    assert fields.kink_band("ridges", u, v, ku, kv)[0]                # flagged
+    # The exact form returns 0 where the float sine is exactly 0, else one side.
+    assert exact == 0.0 or abs(abs(exact) - one_sided) < 1e-9 * one_sided
+    # The central quotient straddles the kink and averages the two sides: ~0.
+    assert abs(fd) < 1e-6 * one_sided
+
+
+@pytest.mark.parametrize("m", range(1, 4))
+def test_points_exactly_on_the_v_creases(m):
+    from renderer import fields
+    from renderer.render import central_gradient
+    ku, kv = 8.0, 4.0
+    u, v = np.array([0.31]), np.array([m / kv])
+    one_sided = np.pi * kv * abs(np.sin(np.pi * ku * 0.31))
+    exact = fields.exact_gradient("ridges", u, v, ku, kv)[1][0]
+    fd = central_gradient("ridges", u, v, ku, kv, 1e-4)[1][0]
+    assert fields.kink_band("ridges", u, v, ku, kv)[0]
+    assert exact == 0.0 or abs(abs(exact) - one_sided) < 1e-9 * one_sided
+    assert abs(fd) < 1e-6 * one_sided
+
+
+def test_shading_goes_continuously_to_zero_at_the_terminator():
+    """Sphere B (no bump), one light, Lambert only: every pixel equals
+    kd albedo color max(0, N.w_hat) or 0 (cast shadow); none is lit with
+    N.w <= 0, and pixels within 1e-3 of the terminator are within 1e-3 of black."""
+    light = Scene().lights[0]
+    scene = Scene(lights=(light,), ka=0.0, ks=0.0, beta=0.0)
+    g = gbuffer(scene, 200, 200)
+    image = render(scene, 200, 200).image
+    b = g.chamber == 2
+    w = np.asarray(light.position) - g.P[b]
+    cos = np.einsum("ij,ij->i", g.N[b], w / np.linalg.norm(w, axis=-1, keepdims=True))
+    lambert = scene.kd * np.asarray(scene.albedo_b)[None, :] * np.maximum(cos, 0)[:, None]
+    got = image[b]
+    lit = np.any(got > 0, axis=-1)
+    assert np.allclose(got[lit], lambert[lit], rtol=0, atol=1e-15)
+    assert not np.any(lit & (cos <= 0))
+    near = (cos > 0) & (cos < 1e-3)
+    assert np.all(got[near] < 1e-3)
