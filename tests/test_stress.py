@@ -143,3 +143,28 @@ def test_shading_goes_continuously_to_zero_at_the_terminator():
     assert not np.any(lit & (cos <= 0))
     near = (cos > 0) & (cos < 1e-3)
     assert np.all(got[near] < 1e-3)
+
+
+def test_grazing_rays_at_sphere_b_silhouette_stay_on_the_surface():
+    """Rays through points just inside sphere B's silhouette circle (the tangent
+    points seen from the eye): hit points on the sphere to 1e-12 relative."""
+    from renderer.geometry import sphere_hit
+    scene = Scene()
+    e = scene.camera_z
+    C, r = np.asarray(scene.center_b), scene.radius_b
+    E = np.array([0.0, 0.0, e])
+    axis = E - C
+    dist2 = axis @ axis
+    centre = C + r * r * axis / dist2                        # silhouette circle centre
+    radius = r * np.sqrt(1 - r * r / dist2)
+    a = np.cross(axis, [1.0, 0.0, 0.0]); a /= np.linalg.norm(a)
+    b = np.cross(axis, a); b /= np.linalg.norm(b)
+    alpha = np.linspace(0, 2 * np.pi, 500)
+    shrink = 1 - np.logspace(-15, -6, 500)
+    Q = centre + (radius * shrink)[:, None] * (np.cos(alpha)[:, None] * a + np.sin(alpha)[:, None] * b)
+    x, y = Q[:, 0] * e / (e - Q[:, 2]), Q[:, 1] * e / (e - Q[:, 2])
+    t = sphere_hit(x, y, e, scene.center_b, r)
+    hit = np.isfinite(t)
+    assert hit.mean() > 0.95
+    P = np.stack([t[hit] * x[hit], t[hit] * y[hit], e * (1 - t[hit])], axis=-1)
+    assert np.abs(np.linalg.norm(P - C, axis=-1) - r).max() < 1e-12 * r
