@@ -271,6 +271,25 @@ def _creases_part():
     return f"{share:.0%} of pixels with |dI| > 1e-3 lie in the crease band", HOLDS if share > 0.95 else FAILS
 
 
+def _rings_pinch():
+    """rings: h_v = 2 pi k_v cos(2 pi k_v v) is nonzero at the pole while e_phi turns
+    with theta, so N' points in opposite directions on opposite sides of the pole."""
+    from renderer.geometry import tangent_frame
+    phi = 1e-3
+    out = []
+    for theta in (0.0, np.pi):
+        N = np.array([[np.sin(phi) * np.cos(theta)], [np.sin(phi) * np.sin(theta)], [np.cos(phi)]])
+        u = np.array([(theta + np.pi) / (2 * np.pi)])
+        v = np.array([phi / np.pi])
+        _, hv = fields.exact_gradient("rings", u, v, 8.0, 4.0)
+        _, e_phi = tangent_frame(*N, np.array([np.sin(phi)]))
+        M = N[:, 0] + 0.35 * hv[0] * np.ravel(e_phi)
+        out.append(M / np.linalg.norm(M))
+    angle = float(np.degrees(np.arccos(np.clip(out[0] @ out[1], -1, 1))))
+    return (f"N' on opposite sides of the pole (sin phi = 1e-3, rings, beta = 0.35) differ by "
+            f"{angle:.0f} degrees", HOLDS if angle > 90 else FAILS)
+
+
 def _beta_zero_slider():
     a = render(Scene(beta=0.0), 96, 96).image
     b = render(Scene(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
@@ -327,6 +346,8 @@ CLAIMS = (
           "RMS |ΔI| on A for the sine field over ε", HOLDS, _sweep_best),
     Claim("try-creases", "§4 Try this (2)", "the white creases are exactly where the two pipelines part",
           "share of large differences inside the crease band", HOLDS, _creases_part),
+    Claim("try-pinch", "§4 Try this (3)", "rings + magnify the pole: the pinch returns",
+          "angle between N' just either side of the pole", HOLDS, _rings_pinch),
     Claim("try-beta0", "§4 Try this (4)", "bump β to 0: both panels return Chapter 5",
           "β = 0 renders across fields and pipelines, bit for bit", HOLDS, _beta_zero_slider),
 )
