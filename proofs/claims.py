@@ -29,6 +29,13 @@ HOLDS, FAILS, CORRECTED = "holds", "does not hold", "holds with a correction"
 
 @dataclass(frozen=True)
 class Claim:
+    """One checkable claim of the seed.
+
+    ``where`` is the seed section or cell, ``quote`` the claim in the seed's
+    words (short), ``measurement`` how it is tested, ``registered`` the verdict
+    on record, and ``measure()`` returns (measured text, computed verdict).
+    """
+
     id: str
     where: str
     quote: str

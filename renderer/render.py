@@ -300,7 +300,9 @@ def gbuffer(scene, width, height, *, gradient="exact"):
     """Per-pixel hit points, normals and chart of a frame (see `GBuffer`).
 
     Same arguments, validation and errors as `render`; computed by the same
-    code path as `render` up to (not including) shading.
+    code path as `render` up to (not including) shading.  Unlike `render` it
+    is not tiled: its arrays (about 150 bytes per pixel) are built whole, so
+    it is meant for checks and figures, not for very large frames.
     """
     scene, width, height, gradient = _check_args(scene, width, height, gradient)
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height)
