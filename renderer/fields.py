@@ -10,6 +10,12 @@ Seed §2 and §3 define three fields on the chart (u, v) in [0, 1]^2:
 from them by ``sympy.lambdify``: the height itself (`height`, evaluated by the
 central-difference pipeline) and its exact gradient (`exact_gradient`, sympy's
 derivative with common subexpressions shared).  Nothing here is typed twice.
+
+The height itself is evaluated with `renderer.detmath.sin`, not numpy's sine:
+the central-difference quotient amplifies the last bit of h by 1/eps, and the
+deterministic sine gives the same bits here and in the §4 simulator's
+JavaScript (see `renderer.detmath`).  The exact gradient is not amplified and
+uses numpy's sin and cos.
 """
 
 from __future__ import annotations
@@ -18,6 +24,8 @@ from functools import lru_cache
 
 import numpy as np
 import sympy as sp
+
+from . import detmath
 
 __all__ = [
     "u", "v", "k_u", "k_v", "HEIGHT_EXPRS", "GRADIENT_EXPRS",
@@ -47,14 +55,18 @@ GRADIENT_EXPRS = {
 KINK_BAND_HALF_WIDTH = 0.03
 
 
+#: lambdify's modules for the height and the crease factors: sin is deterministic.
+HEIGHT_MODULES = [{"sin": detmath.sin}, "numpy"]
+
+
 @lru_cache(maxsize=None)
 def _height_fn(name):
-    return sp.lambdify((u, v, k_u, k_v), HEIGHT_EXPRS[name], modules="numpy")
+    return sp.lambdify((u, v, k_u, k_v), HEIGHT_EXPRS[name], modules=HEIGHT_MODULES)
 
 
 @lru_cache(maxsize=None)
 def _ridge_factors_fn():
-    return sp.lambdify((u, v, k_u, k_v), [_s1, _s2], modules="numpy")
+    return sp.lambdify((u, v, k_u, k_v), [_s1, _s2], modules=HEIGHT_MODULES)
 
 
 @lru_cache(maxsize=None)

@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from . import detmath
+
 __all__ = [
     "POLE_SIN_PHI", "WINDOW_OFFSET", "WINDOW_MARGIN",
     "image_plane", "sphere_hit", "chart", "tangent_frame", "segment_hits_sphere",
@@ -26,7 +28,7 @@ WINDOW_OFFSET = 0.15
 WINDOW_MARGIN = 1.25
 
 
-def image_plane(radius_a, camera_z, width, height):
+def image_plane(radius_a, camera_z, width, height, zoom=1.0):
     """Pixel centres on the image plane z = 0.
 
     The half-width of the window is 1.25 times the radius e R / sqrt(e^2 - R^2)
@@ -34,7 +36,11 @@ def image_plane(radius_a, camera_z, width, height):
     of that half-width (seed Cell 1).  Column i and row j map to
 
         x_i = half (2 (i + 1/2) / width - 1),
-        y_j = half (1 - 2 (j + 1/2) / height) - 0.15 half.
+        y_j = half (1 - 2 (j + 1/2) / height) - 0.15 half,
+
+    both divided by ``zoom`` (>= 1): the window is magnified about the optical
+    axis x = y = 0, where sphere A's pole is seen (the §4 simulator's "magnify
+    the pole").  ``zoom = 1`` is the seed's window, bit for bit.
 
     Returns
     -------
@@ -44,8 +50,8 @@ def image_plane(radius_a, camera_z, width, height):
     half = WINDOW_MARGIN * camera_z * radius_a / math.sqrt(camera_z**2 - radius_a**2)
     i = np.arange(width, dtype=np.float64)
     j = np.arange(height, dtype=np.float64)
-    x = half * (2.0 * (i + 0.5) / width - 1.0)
-    y = half * (1.0 - 2.0 * (j + 0.5) / height) - WINDOW_OFFSET * half
+    x = half * (2.0 * (i + 0.5) / width - 1.0) / zoom
+    y = (half * (1.0 - 2.0 * (j + 0.5) / height) - WINDOW_OFFSET * half) / zoom
     return x, y
 
 
@@ -101,17 +107,20 @@ def chart(Nx, Ny, Nz):
 
     u = (theta + pi) / (2 pi) with theta = atan2(N_y, N_x), and v = phi / pi with
     phi the polar angle from +z.  phi is computed as atan2(sin phi, N_z) with
-    sin phi = hypot(N_x, N_y): the seed's acos(N_z) loses half the digits near
-    the pole, where acos has an infinite derivative.
+    sin phi = sqrt(N_x^2 + N_y^2): the seed's acos(N_z) loses half the digits
+    near the pole, where acos has an infinite derivative.  atan2 is
+    `renderer.detmath.atan2` and the square root is taken of the sum of
+    squares (not hypot), so that (u, v) are the same bits in the §4
+    simulator's JavaScript: the central differences amplify their last bit.
 
     Returns
     -------
     u, v : float64 arrays in [0, 1], the shape of the inputs.
-    sin_phi : float64 array, hypot(N_x, N_y).
+    sin_phi : float64 array, sqrt(N_x^2 + N_y^2).
     """
-    sin_phi = np.hypot(Nx, Ny)
-    uu = (np.arctan2(Ny, Nx) + np.pi) / (2.0 * np.pi)
-    vv = np.arctan2(sin_phi, Nz) / np.pi
+    sin_phi = np.sqrt(Nx * Nx + Ny * Ny)
+    uu = (detmath.atan2(Ny, Nx) + np.pi) / (2.0 * np.pi)
+    vv = detmath.atan2(sin_phi, Nz) / np.pi
     return uu, vv, sin_phi
 
 

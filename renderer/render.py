@@ -21,7 +21,7 @@ from .geometry import (POLE_SIN_PHI, chart, image_plane, segment_hits_sphere, sp
 from .scene import Scene
 
 __all__ = [
-    "Frame", "render", "GBuffer", "gbuffer", "central_gradient", "GRADIENTS", "MAX_SIDE", "CHAMBER_NAMES",
+    "Frame", "render", "GBuffer", "gbuffer", "central_gradient", "GRADIENTS", "MAX_SIDE", "MAX_ZOOM", "CHAMBER_NAMES",
     "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR",
 ]
 
@@ -29,6 +29,8 @@ __all__ = [
 GRADIENTS = ("exact", "central")
 #: Largest accepted image side, in pixels.
 MAX_SIDE = 8192
+#: Largest accepted magnification of the image window (`render`'s ``zoom``).
+MAX_ZOOM = 1e6
 #: Pixels per tile: bounds the working memory of a render at any resolution.
 TILE_PIXELS = 1 << 14
 
@@ -296,7 +298,7 @@ class GBuffer:
     y: np.ndarray
 
 
-def gbuffer(scene, width, height, *, gradient="exact"):
+def gbuffer(scene, width, height, *, gradient="exact", zoom=1.0):
     """Per-pixel hit points, normals and chart of a frame (see `GBuffer`).
 
     Same arguments, validation and errors as `render`; computed by the same
@@ -304,8 +306,8 @@ def gbuffer(scene, width, height, *, gradient="exact"):
     is not tiled: its arrays (about 150 bytes per pixel) are built whole, so
     it is meant for checks and figures, not for very large frames.
     """
-    scene, width, height, gradient = _check_args(scene, width, height, gradient)
-    x, y = image_plane(scene.radius_a, scene.camera_z, width, height)
+    scene, width, height, gradient, zoom = _check_args(scene, width, height, gradient, zoom)
+    x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     X = np.tile(x, height)
     Y = np.repeat(y, width)
     t, code = _nearest_hit(scene, X, Y)
@@ -325,17 +327,21 @@ def gbuffer(scene, width, height, *, gradient="exact"):
                    grad.reshape(shape + (2,)), x, y)
 
 
-def _check_args(scene, width, height, gradient):
+def _check_args(scene, width, height, gradient, zoom):
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
     width = _check_size("width", width)
     height = _check_size("height", height)
     if not isinstance(gradient, str) or gradient not in GRADIENTS:
         raise ValueError(f"gradient must be one of {GRADIENTS}, got {gradient!r}")
-    return scene, width, height, gradient
+    if isinstance(zoom, bool) or not isinstance(zoom, numbers.Real):
+        raise TypeError(f"zoom must be a real number, got {type(zoom).__name__} {zoom!r}")
+    if not 1.0 <= zoom <= MAX_ZOOM:
+        raise ValueError(f"zoom must be between 1 and {MAX_ZOOM:g}, got {zoom!r}")
+    return scene, width, height, gradient, float(zoom)
 
 
-def render(scene, width, height, *, gradient="exact"):
+def render(scene, width, height, *, gradient="exact", zoom=1.0):
     """Render the Chapter-9 scene.
 
     Parameters
@@ -348,6 +354,9 @@ def render(scene, width, height, *, gradient="exact"):
         "exact": the symbolic pipeline, the gradient of h generated from its
         sympy expression.  "central": the numeric pipeline, central differences
         of the same h with step ``scene.eps`` (u wraps, v clamps).
+    zoom : float in [1, 1e6], keyword-only
+        Magnification of the image window about the optical axis, where sphere
+        A's pole is seen (see `renderer.geometry.image_plane`); 1 is the seed's view.
 
     Returns
     -------
@@ -360,7 +369,8 @@ def render(scene, width, height, *, gradient="exact"):
     TypeError
         ``scene`` is not a Scene, or ``width``/``height`` is not an integer.
     ValueError
-        ``width``/``height`` outside [1, 8192], or an unknown ``gradient``.
+        ``width``/``height`` outside [1, 8192], an unknown ``gradient``, or
+        ``zoom`` outside [1, 1e6] (TypeError if it is not a real number).
 
     Notes
     -----
@@ -369,12 +379,12 @@ def render(scene, width, height, *, gradient="exact"):
     Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
     corrections listed in the book's errata.
     """
-    scene, width, height, gradient = _check_args(scene, width, height, gradient)
+    scene, width, height, gradient, zoom = _check_args(scene, width, height, gradient, zoom)
     image = np.zeros((height, width, 3))
     chamber = np.zeros((height, width), dtype=np.uint8)
     kink = np.zeros((height, width), dtype=bool)
     grad = np.zeros((height, width, 2))
-    x, y = image_plane(scene.radius_a, scene.camera_z, width, height)
+    x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     rows = max(1, TILE_PIXELS // width)
     flat_image = image.reshape(-1, 3)
     flat_chamber = chamber.reshape(-1)

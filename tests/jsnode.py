@@ -1,0 +1,93 @@
+"""Running the simulator's JavaScript under node, for the parity tests.
+
+`require_tool` skips a test when a tool is missing on a developer's machine,
+and fails it when the environment variable CI is "true": in CI nothing that
+checks the simulator may silently skip.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from renderer import Scene, jsgen
+
+DRIVERS = Path(__file__).with_name("js")
+#: Where tests leave artifacts (tables, screenshots) for the closing notes.
+ARTIFACTS = Path(os.environ.get("SYMRENDER_ARTIFACTS", Path(__file__).parents[1] / "test-artifacts"))
+
+
+def in_ci():
+    return os.environ.get("CI", "").lower() == "true"
+
+
+def require_tool(path_or_name, why):
+    """Return the tool's path; skip (locally) or fail (CI=true) if it is missing."""
+    found = shutil.which(path_or_name) or (Path(path_or_name).exists() and str(path_or_name))
+    if found:
+        return found
+    message = f"{path_or_name} not found: {why}"
+    if in_ci():
+        pytest.fail(message + " (CI=true: this test may not skip)")
+    pytest.skip(message)
+
+
+def write_modules(directory, transform=None):
+    """Write the ES modules to ``directory``; ``transform(name, text)`` may alter one (wrong variants)."""
+    paths = jsgen.write_modules(directory)
+    if transform is not None:
+        for name, path in paths.items():
+            text = path.read_text(encoding="utf-8")
+            new = transform(name, text)
+            if new != text:
+                path.write_text(new, encoding="utf-8")
+    return Path(directory)
+
+
+def scene_json(scene: Scene, base: Scene = Scene()):
+    """The fields of ``scene`` that differ from ``base``, as the driver expects them."""
+    out = {}
+    for name in scene.__dataclass_fields__:
+        value = getattr(scene, name)
+        if value == getattr(base, name):
+            continue
+        if name == "lights":
+            value = [{"position": list(l.position), "color": list(l.color)} for l in value]
+        elif isinstance(value, tuple):
+            value = list(value)
+        out[name] = value
+    return out
+
+
+def run_render_cases(module_dir, cases, out_dir):
+    """Render ``cases`` (dicts: id, scene: Scene, width, height, gradient, zoom) in node.
+
+    Returns {id: ms} and leaves the frames in ``out_dir`` (read them with `read_frame`).
+    """
+    node = require_tool("node", "the JS parity tests run the renderer core under node")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    payload = [dict(c, scene=scene_json(c["scene"])) for c in cases]
+    cases_path = out_dir / "cases.json"
+    cases_path.write_text(json.dumps(payload), encoding="utf-8")
+    proc = subprocess.run([node, str(DRIVERS / "parity_driver.mjs"), str(module_dir), str(cases_path),
+                           str(out_dir)], capture_output=True, text=True, timeout=600)
+    if proc.returncode != 0:
+        raise RuntimeError(f"node parity driver failed:\n{proc.stderr}")
+    return {rec["id"]: rec["ms"] for rec in map(json.loads, proc.stdout.splitlines())}
+
+
+def read_frame(out_dir, prefix, width, height):
+    """(image (H, W, 3), grad (H, W, 2), chamber (H, W) uint8, kink (H, W) bool) written by node."""
+    out_dir = Path(out_dir)
+    image = np.fromfile(out_dir / f"{prefix}.image.f64", dtype="<f8").reshape(height, width, 3)
+    grad = np.fromfile(out_dir / f"{prefix}.grad.f64", dtype="<f8").reshape(height, width, 2)
+    chamber = np.fromfile(out_dir / f"{prefix}.chamber.u8", dtype=np.uint8).reshape(height, width)
+    kink = np.fromfile(out_dir / f"{prefix}.kink.u8", dtype=np.uint8).reshape(height, width).astype(bool)
+    return image, grad, chamber, kink
