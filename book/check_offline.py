@@ -40,6 +40,10 @@ class _Fetches(HTMLParser):
                 self.urls.append((tag + " style", m.group(1)))
 
 
+def tag_is_script(kind: str) -> bool:
+    return kind == "script"
+
+
 def problems(root: Path) -> list[str]:
     out = []
     pages = sorted(root.rglob("*.html"))
@@ -54,6 +58,15 @@ def problems(root: Path) -> list[str]:
         for kind, url in parser.urls:
             if REMOTE.match(url):
                 out.append(f"{page.relative_to(root)}: {kind} loads {url}")
+            elif tag_is_script(kind) and not url.startswith("data:") and "{{" not in url:
+                # A local script that is missing breaks the page as surely as a CDN.
+                local = (page.parent / url.split("?")[0].split("#")[0]).resolve()
+                if not local.is_file():
+                    out.append(f"{page.relative_to(root)}: script {url} is not in the site")
+    for js in sorted(root.rglob("_static/sim/*.js")):
+        for m in re.finditer(r"""(?:import\s*\(|from\s+|fetch\s*\(|src\s*=)\s*['"](https?:)?//""",
+                             js.read_text(encoding="utf-8")):
+            out.append(f"{js.relative_to(root)}: loads {m.group(0)}")
     for css in sorted(root.rglob("*.css")):
         for m in CSS_URL.finditer(css.read_text(encoding="utf-8", errors="replace")):
             if REMOTE.match(m.group(1)):
@@ -75,7 +88,7 @@ def main(argv):
     for line in found:
         print("offline check:", line, file=sys.stderr)
     if found:
-        print(f"offline check FAILED: {len(found)} network resource(s)", file=sys.stderr)
+        print(f"offline check FAILED: {len(found)} problem(s)", file=sys.stderr)
         return 1
     print(f"offline check: {len(list(root.rglob('*.html')))} pages load nothing from the network")
     return 0

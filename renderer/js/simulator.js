@@ -139,6 +139,7 @@ class Simulator {
       if (c.kind === "checkbox") {
         return el("label", { class: "sim-check" }, [input, el("span", { text: c.label })]);
       }
+      if (c.kind === "select") return el("label", {}, [el("span", { text: c.label }), input]);
       const out = el("output", { id: `sim-${c.name}-value`, for: `sim-${c.name}` });
       this.outputs[c.name] = out;
       return el("label", {}, [el("span", {}, [c.label + " ", out]), input]);

@@ -1,0 +1,264 @@
+"""The §4 simulator in a real browser: Debian's Chromium, driven by Playwright.
+
+The built page is loaded from disk (file://), as a reader without a network
+opens it, and every request that is not for a local file is blocked and
+recorded.  The test checks: no console errors, MathJax typeset from the site,
+canvases that are not blank, the ledger's RMS at eps = 1e-3 and 1e-6 equal to
+what the Python renderer predicts, the hover readout's (u, v) equal to
+Python's for a given pixel, and every control reachable and movable from the
+keyboard.  It saves a screenshot and the timings to test-artifacts/.
+
+The book is built into a temporary directory for the test unless
+SYMRENDER_BOOK_HTML names a freshly built site (.ci/run builds the book first
+and passes it).  With CI=true a missing Chromium or Playwright fails the test.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from renderer import Scene, compare, gbuffer, render
+
+from .jsnode import ARTIFACTS, in_ci, require_tool
+
+CHROMIUM = "/usr/bin/chromium"
+ROOT = Path(__file__).parents[1]
+SIZE = 256
+# Flags for a machine with no network (see the environment notes): without the
+# background-networking ones Chromium keeps trying to reach Google's hosts.
+CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+CONTROLS = ["sim-height_field", "sim-k_u", "sim-k_v", "sim-beta", "sim-log_eps", "sim-model",
+            "sim-resolution", "sim-view", "sim-zoom", "sim-sphere_b"]
+BUTTONS = ["sim-preset-try1", "sim-preset-try2", "sim-preset-try3", "sim-preset-try4", "sim-reset"]
+
+
+@pytest.fixture(scope="module")
+def book_html(tmp_path_factory):
+    given = os.environ.get("SYMRENDER_BOOK_HTML")
+    if given:
+        path = Path(given)
+        if not (path / "s4_simulator.html").is_file():
+            pytest.fail(f"SYMRENDER_BOOK_HTML={given} holds no s4_simulator.html")
+        return path
+    out = tmp_path_factory.mktemp("book")
+    jb = Path(sys.executable).with_name("jupyter-book")
+    subprocess.run([str(jb), "build", str(ROOT / "book"), "--path-output", str(out), "--warningiserror",
+                    "--keep-going", "--quiet"], check=True, timeout=1800)
+    return out / "_build" / "html"
+
+
+@pytest.fixture(scope="module")
+def browser():
+    require_tool(CHROMIUM, "the browser test drives Debian's Chromium (apt-get install chromium)")
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        if in_ci():
+            pytest.fail("playwright is not installed (CI=true: this test may not skip)")
+        pytest.skip("playwright is not installed")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+class Session:
+    """One page of the built book, with the network blocked and errors recorded."""
+
+    def __init__(self, browser, url):
+        self.context = browser.new_context(viewport={"width": 1200, "height": 1400})
+        self.blocked, self.errors = [], []
+
+        def route(r):
+            if r.request.url.startswith("file://"):
+                r.continue_()
+            else:
+                self.blocked.append(r.request.url)
+                r.abort()
+
+        self.context.route("**/*", route)
+        self.page = self.context.new_page()
+        self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.page.goto(url)
+        self.page.wait_for_selector("[data-symrender-sim][data-updates]", timeout=30_000)
+
+    def updates(self):
+        return int(self.page.get_attribute("[data-symrender-sim]", "data-updates"))
+
+    def wait_update(self, before):
+        self.page.wait_for_function(
+            f"Number(document.querySelector('[data-symrender-sim]').dataset.updates) > {before}",
+            timeout=30_000)
+
+    def ledger(self, name):
+        return float(self.page.get_attribute(f"#sim-{name}", "data-value"))
+
+    def set_eps(self, exponent):
+        before = self.updates()
+        self.page.fill("#sim-log_eps", str(exponent))
+        self.wait_update(before)
+
+    def close(self):
+        self.context.close()
+
+
+@pytest.fixture(scope="module")
+def session(browser, book_html):
+    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    yield s
+    s.close()
+
+
+def test_page_loads_offline_without_errors(session):
+    page = session.page
+    page.wait_for_function("document.querySelectorAll('mjx-container').length > 0", timeout=30_000)
+    assert page.locator("mjx-container").count() > 5
+    srcs = page.eval_on_selector_all("script[src]", "els => els.map(e => e.src)")
+    assert any(s.startswith("file://") and s.endswith("_static/mathjax/tex-chtml.js") for s in srcs)
+    assert session.errors == []
+    assert session.blocked == [], f"the page tried the network: {session.blocked}"
+
+
+def test_canvases_are_not_blank(session):
+    stats = session.page.evaluate("""() => ['numeric', 'symbolic', 'difference'].map(name => {
+        const c = document.getElementById('sim-canvas-' + name);
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let lit = 0; const colours = new Set();
+        for (let k = 0; k < d.length; k += 4) {
+            if (d[k] || d[k + 1] || d[k + 2]) lit++;
+            colours.add((d[k] << 16) | (d[k + 1] << 8) | d[k + 2]);
+        }
+        return {name, width: c.width, lit, colours: colours.size};
+    })""")
+    by = {s["name"]: s for s in stats}
+    for name in ("numeric", "symbolic"):
+        assert by[name]["width"] == SIZE
+        assert by[name]["lit"] > 0.5 * SIZE * SIZE and by[name]["colours"] > 1000, by[name]
+    assert by["difference"]["lit"] > 100, by["difference"]   # ridges at eps = 1e-3 differ visibly
+
+
+def _python_rms(eps):
+    scene = Scene(eps=eps)
+    return compare(render(scene, SIZE, SIZE, gradient="central"), render(scene, SIZE, SIZE)).rms
+
+
+def test_eps_slider_moves_the_ledger_as_python_predicts(session):
+    got = {}
+    for exponent in (-3, -6):
+        session.set_eps(exponent)
+        assert session.page.text_content("#sim-log_eps-value") == f"1.0e{exponent}"
+        got[exponent] = (session.ledger("rms"), session.ledger("max"), session.ledger("flips"))
+    want = {-3: _python_rms(1e-3), -6: _python_rms(1e-6)}
+    for e in (-3, -6):
+        # |rms_js - rms_py| <= rms of the per-pixel gap, which the parity tests
+        # bound by 2.2e-16; rel = 1e-6 is loose at 1e-3 and still tight at 1e-6.
+        assert got[e][0] == pytest.approx(want[e], rel=1e-6, abs=0.0), (e, got[e][0], want[e])
+        assert got[e][2] == 0
+    assert got[-3][0] / got[-6][0] == pytest.approx(want[-3] / want[-6], rel=1e-6, abs=0.0)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    (ARTIFACTS / "browser_ledger.json").write_text(json.dumps(
+        {"eps=1e-3": {"rms": got[-3][0], "max": got[-3][1], "python_rms": want[-3]},
+         "eps=1e-6": {"rms": got[-6][0], "max": got[-6][1], "python_rms": want[-6]}}, indent=1))
+
+
+def test_hover_readout_gives_pythons_chart(session):
+    """Mouse events carry whole CSS pixels, so the test aims at a pixel, reads
+    which pixel the readout reports (within one of the aim), and compares that
+    pixel's (u, v) with Python's, bit for bit."""
+    session.set_eps(-3)
+    gb = gbuffer(Scene(), SIZE, SIZE)
+    rows, cols = np.nonzero(gb.chamber == 1)
+    pick = [(int(cols[k]), int(rows[k])) for k in (len(rows) // 5, len(rows) // 3, len(rows) // 2,
+                                                   4 * len(rows) // 5)]
+    canvas = session.page.locator("#sim-canvas-symbolic")
+    # Centre it in the viewport: the theme's sticky header covers the top of the page.
+    canvas.evaluate("c => c.scrollIntoView({block: 'center'})")
+    box = canvas.bounding_box()
+    checked = set()
+    for i, j in pick:
+        session.page.mouse.move(box["x"] + (i + 0.5) * box["width"] / SIZE,
+                                box["y"] + (j + 0.5) * box["height"] / SIZE)
+        session.page.wait_for_function(
+            f"Math.abs(Number(document.getElementById('sim-readout').dataset.i) - {i}) <= 1 && "
+            f"Math.abs(Number(document.getElementById('sim-readout').dataset.j) - {j}) <= 1", timeout=10_000)
+        ri = int(session.page.get_attribute("#sim-readout", "data-i"))
+        rj = int(session.page.get_attribute("#sim-readout", "data-j"))
+        assert gb.chamber[rj, ri] == int(session.page.get_attribute("#sim-readout", "data-chamber")) == 1
+        u = float(session.page.get_attribute("#sim-readout", "data-u"))
+        v = float(session.page.get_attribute("#sim-readout", "data-v"))
+        assert (u, v) == (gb.uv[rj, ri, 0], gb.uv[rj, ri, 1]), (ri, rj)
+        checked.add((ri, rj))
+    assert len(checked) == len(pick)
+    assert "(u, v)" in session.page.text_content("#sim-readout")
+
+
+def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_html):
+    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    try:
+        page = s.page
+        page.focus("#sim-canvas-numeric")
+        seen = []
+        for _ in range(40):
+            page.keyboard.press("Tab")
+            seen.append(page.evaluate("document.activeElement.id"))
+        missing = [c for c in CONTROLS + BUTTONS if c not in seen]
+        assert not missing, f"not reachable with Tab: {missing}"
+        # Move each control with the keys a keyboard user has.
+        for cid in CONTROLS:
+            page.focus(f"#{cid}")
+            kind = page.evaluate(f"document.getElementById('{cid}').type")
+            value = lambda: page.evaluate(  # noqa: E731
+                f"(e => e.type === 'checkbox' ? e.checked : e.value)(document.getElementById('{cid}'))")
+            before, n = value(), s.updates()
+            key = {"range": "ArrowLeft" if cid == "sim-log_eps" else "ArrowRight",
+                   "checkbox": "Space"}.get(kind, "ArrowDown")
+            if cid == "sim-resolution":
+                key = "ArrowUp"          # 256 -> 128: keeps the test quick
+            page.keyboard.press(key)
+            s.wait_update(n)
+            assert value() != before, (cid, kind, key)
+        for bid in BUTTONS:
+            page.focus(f"#{bid}")
+            n = s.updates()
+            page.keyboard.press("Enter")
+            s.wait_update(n)
+        assert page.input_value("#sim-height_field") == "ridges"     # reset was last
+        # The probe moves with the arrow keys on a focused canvas.
+        page.focus("#sim-canvas-symbolic")
+        page.keyboard.press("ArrowRight")
+        assert page.get_attribute("#sim-readout", "data-i") is not None
+        assert s.errors == [] and s.blocked == []
+    finally:
+        s.close()
+
+
+def test_update_time_is_measured_and_a_screenshot_saved(browser, book_html):
+    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    try:
+        for k in range(16):
+            s.set_eps(-3 if k % 2 else -3.1)
+        timings = s.page.evaluate(
+            "document.querySelector('[data-symrender-sim]').symrender.timings")
+        ms = [t["ms"] for t in timings if t["resolution"] == SIZE][1:]     # drop the first (JIT warm-up)
+        assert len(ms) >= 15 and all(np.isfinite(ms))
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        s.page.set_viewport_size({"width": 1200, "height": 1600})
+        s.page.locator("#sim").scroll_into_view_if_needed()
+        s.page.screenshot(path=str(ARTIFACTS / "s4_simulator.png"), full_page=False)
+        report = {"updates": len(ms), "median_ms": statistics.median(ms), "min_ms": min(ms),
+                  "max_ms": max(ms), "size": SIZE}
+        (ARTIFACTS / "browser_timing.json").write_text(json.dumps(report, indent=1))
+        print("simulator update at 256^2 (both pipelines + difference):", report)
+        assert s.errors == [] and s.blocked == []
+    finally:
+        s.close()
