@@ -262,3 +262,18 @@ def test_update_time_is_measured_and_a_screenshot_saved(browser, book_html):
         assert s.errors == [] and s.blocked == []
     finally:
         s.close()
+
+
+def test_the_session_catches_network_use_and_errors(browser, tmp_path):
+    """The checks above can fail: a page that reaches for the network and logs an
+    error is caught (and its request never leaves the machine)."""
+    page = tmp_path / "bad.html"
+    page.write_text('<html><body><div data-symrender-sim data-updates="1"></div>'
+                    '<script src="https://cdn.example.invalid/x.js"></script>'
+                    '<script>console.error("boom"); undefinedFunction();</script></body></html>')
+    s = Session(browser, page.as_uri())
+    try:
+        assert any("cdn.example.invalid" in url for url in s.blocked)
+        assert any("boom" in e for e in s.errors) and any("undefinedFunction" in e for e in s.errors)
+    finally:
+        s.close()
