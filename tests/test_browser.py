@@ -90,7 +90,7 @@ class Session:
         self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
         self.page.on("pageerror", lambda e: self.errors.append(str(e)))
         self.page.goto(url)
-        self.page.wait_for_selector("[data-symrender-sim][data-updates]", timeout=30_000)
+        self.page.wait_for_selector("[data-symrender-sim][data-updates]", state="attached", timeout=30_000)
 
     def updates(self):
         return int(self.page.get_attribute("[data-symrender-sim]", "data-updates"))
