@@ -57,28 +57,25 @@ _PI_LO = 1.2246467991473531772e-16
 _PI_O_2 = 1.5707963267948965580e+00
 
 
-def _kernel_sin(x, y):
+def _kernels(x, y):
+    """k_sin.c and k_cos.c on the reduced argument x + y, sharing z = x^2 and z^2."""
     z = x * x
     w = z * z
     r = _S2 + z * (_S3 + z * _S4) + z * w * (_S5 + z * _S6)
     v = z * x
-    return x - ((z * (0.5 * y - v * r) - y) - v * _S1)
-
-
-def _kernel_cos(x, y):
-    z = x * x
-    w = z * z
+    s = x - ((z * (0.5 * y - v * r) - y) - v * _S1)
     r = z * (_C1 + z * (_C2 + z * _C3)) + w * w * (_C4 + z * (_C5 + z * _C6))
     hz = 0.5 * z
     w = 1.0 - hz
-    return w + (((1.0 - w) - hz) + (z * r - x * y))
+    c = w + (((1.0 - w) - hz) + (z * r - x * y))
+    return s, c
 
 
 def sin(x):
     """Deterministic sine of float64 ``x`` (array or scalar), in radians.
 
     Returns float64 of the shape of ``x``.  Bit-identical to
-    ``detmath.sin`` of renderer/js/detmath.js.  NaN for inf or NaN.
+    ``det_sin`` of renderer/js/detmath.js.  NaN for inf or NaN.
     """
     x = np.asarray(x, dtype=np.float64)
     with np.errstate(invalid="ignore"):           # inf and NaN give NaN, quietly
@@ -89,31 +86,40 @@ def sin(x):
         w = fn * _PIO2_2T - ((t - r) - w)
         y0 = r - w
         y1 = (r - y0) - w
-        q = np.mod(fn, 4.0)
-        s = _kernel_sin(y0, y1)
-        c = _kernel_cos(y0, y1)
-    out = np.where(q == 0.0, s, np.where(q == 1.0, c, np.where(q == 2.0, -s, np.where(q == 3.0, -c, np.nan))))
+        # Quadrant q = fn mod 4, exactly (fn is an integer): sin, cos, -sin, -cos.
+        q = fn - 4.0 * np.floor(fn * 0.25)
+        s, c = _kernels(y0, y1)
+        out = np.where((q == 1.0) | (q == 3.0), c, s)
+        out = np.where(q >= 2.0, -out, out)
     return out if out.ndim else float(out)
+
+
+# The interval reduction of s_atan.c, t -> (a t + b) / (c t + d), one row per
+# interval: [0, 7/16) none, [7/16, 11/16) (2t - 1)/(2 + t), [11/16, 19/16)
+# (t - 1)/(t + 1), [19/16, 39/16) (t - 1.5)/(1 + 1.5 t), beyond -1/t.  With
+# these coefficients each row performs exactly the operations of the C source
+# (multiplying by 1, adding 0), so the result is the same bits.
+_ATAN_BREAKS = np.array([0.4375, 0.6875, 1.1875, 2.4375])
+_ATAN_MOBIUS = np.array([[1.0, 0.0, 0.0, 1.0], [2.0, -1.0, 1.0, 2.0], [1.0, -1.0, 1.0, 1.0],
+                         [1.0, -1.5, 1.5, 1.0], [0.0, -1.0, 1.0, 0.0]])
+_ATANHI_ROW = np.concatenate([[0.0], _ATANHI])
+_ATANLO_ROW = np.concatenate([[0.0], _ATANLO])
 
 
 def _atan_nonneg(t):
     """atan of t >= 0 (s_atan.c, with the interval reduction)."""
-    idx = np.select([t < 0.4375, t < 0.6875, t < 1.1875, t < 2.4375], [-1, 0, 1, 2], 3)
+    row = np.searchsorted(_ATAN_BREAKS, t, side="right")
+    a, b, c, d = _ATAN_MOBIUS[row].T
     with np.errstate(divide="ignore", invalid="ignore"):
-        tr = np.select(
-            [idx == 0, idx == 1, idx == 2, idx == 3],
-            [(2.0 * t - 1.0) / (2.0 + t), (t - 1.0) / (t + 1.0),
-             (t - 1.5) / (1.0 + 1.5 * t), -1.0 / t],
-            t,
-        )
+        tr = (a * t + b) / (c * t + d)
+    tr = np.where(t == np.inf, -0.0, tr)          # -1/inf, where 0 * inf would give NaN
     z = tr * tr
     w = z * z
-    a = _AT
-    s1 = z * (a[0] + w * (a[2] + w * (a[4] + w * (a[6] + w * (a[8] + w * a[10])))))
-    s2 = w * (a[1] + w * (a[3] + w * (a[5] + w * (a[7] + w * a[9]))))
-    k = np.maximum(idx, 0)
-    reduced = _ATANHI[k] - ((tr * (s1 + s2) - _ATANLO[k]) - tr)
-    return np.where(idx < 0, tr - tr * (s1 + s2), reduced)
+    at = _AT
+    s1 = z * (at[0] + w * (at[2] + w * (at[4] + w * (at[6] + w * (at[8] + w * at[10])))))
+    s2 = w * (at[1] + w * (at[3] + w * (at[5] + w * (at[7] + w * at[9]))))
+    reduced = _ATANHI_ROW[row] - ((tr * (s1 + s2) - _ATANLO_ROW[row]) - tr)
+    return np.where(row == 0, tr - tr * (s1 + s2), reduced)
 
 
 def atan2(y, x):
@@ -125,7 +131,7 @@ def atan2(y, x):
     y = np.asarray(y, dtype=np.float64)
     x = np.asarray(x, dtype=np.float64)
     y, x = np.broadcast_arrays(y, x)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         ratio = np.abs(y / x)
     z = _atan_nonneg(np.where(np.isnan(ratio), 0.0, ratio))
     ny = np.signbit(y)
