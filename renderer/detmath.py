@@ -100,8 +100,9 @@ def sin(x):
 # these coefficients each row performs exactly the operations of the C source
 # (multiplying by 1, adding 0), so the result is the same bits.
 _ATAN_BREAKS = np.array([0.4375, 0.6875, 1.1875, 2.4375])
-_ATAN_MOBIUS = np.array([[1.0, 0.0, 0.0, 1.0], [2.0, -1.0, 1.0, 2.0], [1.0, -1.0, 1.0, 1.0],
-                         [1.0, -1.5, 1.5, 1.0], [0.0, -1.0, 1.0, 0.0]])
+_ATAN_MOBIUS = tuple(np.array(col) for col in zip(
+    (1.0, 0.0, 0.0, 1.0), (2.0, -1.0, 1.0, 2.0), (1.0, -1.0, 1.0, 1.0), (1.0, -1.5, 1.5, 1.0),
+    (0.0, -1.0, 1.0, 0.0)))
 _ATANHI_ROW = np.concatenate([[0.0], _ATANHI])
 _ATANLO_ROW = np.concatenate([[0.0], _ATANLO])
 
@@ -109,7 +110,7 @@ _ATANLO_ROW = np.concatenate([[0.0], _ATANLO])
 def _atan_nonneg(t):
     """atan of t >= 0 (s_atan.c, with the interval reduction)."""
     row = np.searchsorted(_ATAN_BREAKS, t, side="right")
-    a, b, c, d = _ATAN_MOBIUS[row].T
+    a, b, c, d = (np.take(col, row) for col in _ATAN_MOBIUS)
     with np.errstate(divide="ignore", invalid="ignore"):
         tr = (a * t + b) / (c * t + d)
     tr = np.where(t == np.inf, -0.0, tr)          # -1/inf, where 0 * inf would give NaN
@@ -118,7 +119,7 @@ def _atan_nonneg(t):
     at = _AT
     s1 = z * (at[0] + w * (at[2] + w * (at[4] + w * (at[6] + w * (at[8] + w * at[10])))))
     s2 = w * (at[1] + w * (at[3] + w * (at[5] + w * (at[7] + w * at[9]))))
-    reduced = _ATANHI_ROW[row] - ((tr * (s1 + s2) - _ATANLO_ROW[row]) - tr)
+    reduced = np.take(_ATANHI_ROW, row) - ((tr * (s1 + s2) - np.take(_ATANLO_ROW, row)) - tr)
     return np.where(row == 0, tr - tr * (s1 + s2), reduced)
 
 

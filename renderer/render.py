@@ -54,9 +54,9 @@ class Frame:
     chamber : (H, W) uint8
         0 background, 1 sphere A, 2 sphere B, 3 floor: the object of the
         nearest positive hit.
-    kink : (H, W) bool
+    kink : (H, W) bool, or None if not requested
         The seed's crease band on sphere A (ridges only; all False otherwise).
-    grad : (H, W, 2) float64
+    grad : (H, W, 2) float64, or None if not requested
         (h_u, h_v) used on sphere A by this frame's pipeline; 0 elsewhere.
     scene : Scene
     gradient : {"exact", "central"}
@@ -113,19 +113,80 @@ def _dot(ax, ay, az, bx, by, bz):
     return ax * bx + ay * by + az * bz
 
 
-def _shade(scene, P, N, Ns, albedo, spheres, floor_blocks):
-    """Ambient plus, per light, Lambert and Blinn/Phong (seed Cell 1, ``shade1``).
+@dataclass
+class _Light:
+    """One light as seen from the points of a surface (geometry only).
 
-    P, N, Ns are triples of (n,) float64 arrays (x, y, z components); albedo
-    is a triple of floats or of (n,) arrays.  A light reaches P only if the
-    geometric normal N faces it (attached shadow) and no blocker sphere, nor
-    the floor plane, cuts the segment to it (cast shadow).  Both predicates
-    use geometry alone; the shading normal Ns (perturbed on sphere A) enters
-    only the Lambert and specular factors, and the specular lobe is gated by
-    Ns . w > 0.  Returns a triple of (n,) arrays.
+    ``w`` is the unit vector to the light, ``attached`` says where the geometric
+    normal faces it and no floor plane separates it, and ``lit`` (once shadow
+    rays have been traced) where it also reaches the point.
+    """
+
+    color: tuple
+    position: tuple
+    w: tuple
+    w_raw: tuple
+    w2: np.ndarray
+    attached: np.ndarray
+    lit: np.ndarray = None
+
+
+def _lights(scene, P, N, floor_blocks, skip, flat=False):
+    """The lights that can contribute (zero colour is skipped), seen from P.
+
+    ``flat`` says N is exactly (0, 0, 1) (the floor): then N . w is w_z, the
+    same number the dot product gives (0 w_x + 0 w_y + w_z), in one operation.
     """
     Px, Py, Pz = P
-    Nx, Ny, Nz = N
+    out = []
+    for light in scene.lights:
+        if skip and not any(light.color):
+            continue
+        Lx, Ly, Lz = light.position
+        wx, wy, wz = Lx - Px, Ly - Py, Lz - Pz
+        attached = (wz > 0.0) if flat else (_dot(*N, wx, wy, wz) > 0.0)
+        if floor_blocks:
+            attached &= ~(((Pz > 0.0) & (Lz < 0.0)) | ((Pz < 0.0) & (Lz > 0.0)))
+        w2 = _dot(wx, wy, wz, wx, wy, wz)
+        inv = 1.0 / np.sqrt(w2)
+        out.append(_Light(light.color, light.position, (wx * inv, wy * inv, wz * inv), (wx, wy, wz),
+                          w2, attached))
+    return out
+
+
+def _trace_shadows(light, spheres, test):
+    """Set ``light.lit``: attached and no blocker sphere on the segment to the light.
+
+    Shadow rays are traced only where ``test`` is True (every pixel when it is
+    None); elsewhere the pixel keeps ``attached``, which the caller guarantees
+    cannot change its colour.
+    """
+    lit = light.attached.copy()
+    idx = np.flatnonzero(lit if test is None else test)
+    wx, wy, wz = light.w_raw
+    for center, radius in spheres:
+        if idx.size == 0:
+            break
+        blocked = segment_hits_sphere(wx[idx], wy[idx], wz[idx], light.w2[idx], light.position,
+                                      center, radius)
+        lit[idx[blocked]] = False
+        idx = idx[~blocked]
+    light.lit = lit
+
+
+def _shade(scene, P, Ns, albedo, lights, flat=False):
+    """Ambient plus, per light, Lambert and Blinn/Phong (seed Cell 1, ``shade1``).
+
+    ``lights`` come from `_lights` with ``lit`` set: a light reaches P only if
+    the geometric normal faces it (attached shadow) and no blocker sphere, nor
+    the floor plane, cuts the segment to it (cast shadow), both predicates of
+    geometry alone.  The shading normal Ns (perturbed on sphere A) enters only
+    the Lambert and specular factors, and both are gated by Ns . w > 0.
+    Returns a triple of (n,) arrays (clipping is the caller's).  ``flat``:
+    Ns is exactly (0, 0, 1), and its dot products are read off the z
+    components (the same numbers, as in `_lights`).
+    """
+    Px, Py, Pz = P
     Sx, Sy, Sz = Ns
     n = Px.shape[0]
     out = [np.full(n, scene.ka * a) for a in scene.ambient]
@@ -133,33 +194,19 @@ def _shade(scene, P, N, Ns, albedo, spheres, floor_blocks):
     vx, vy, vz = -Px, -Py, scene.camera_z - Pz
     inv = 1.0 / np.sqrt(_dot(vx, vy, vz, vx, vy, vz))
     vx, vy, vz = vx * inv, vy * inv, vz * inv
-    for light in scene.lights:
-        if not any(light.color):
+    for light in lights:
+        wx, wy, wz = light.w
+        mu = wz if flat else _dot(Sx, Sy, Sz, wx, wy, wz)
+        front = light.lit & (mu > 0.0)
+        if not front.any():
             continue
-        Lx, Ly, Lz = light.position
-        wx, wy, wz = Lx - Px, Ly - Py, Lz - Pz
-        lit = _dot(Nx, Ny, Nz, wx, wy, wz) > 0.0
-        if floor_blocks:
-            lit &= ~(((Pz > 0.0) & (Lz < 0.0)) | ((Pz < 0.0) & (Lz > 0.0)))
-        w2 = _dot(wx, wy, wz, wx, wy, wz)
-        for center, radius in spheres:
-            idx = np.flatnonzero(lit)
-            if idx.size:
-                lit[idx] = ~segment_hits_sphere(wx[idx], wy[idx], wz[idx], w2[idx],
-                                                light.position, center, radius)
-        if not lit.any():
-            continue
-        inv = 1.0 / np.sqrt(w2)
-        wx, wy, wz = wx * inv, wy * inv, wz * inv
-        mu = _dot(Sx, Sy, Sz, wx, wy, wz)
         if scene.model == "blinn":
             hx, hy, hz = wx + vx, wy + vy, wz + vz
             hn = np.sqrt(_dot(hx, hy, hz, hx, hy, hz))
-            spec_cos = _dot(Sx, Sy, Sz, hx, hy, hz) / np.where(hn > 0.0, hn, 1.0)
+            spec_cos = (hz if flat else _dot(Sx, Sy, Sz, hx, hy, hz)) / np.where(hn > 0.0, hn, 1.0)
         else:
             two_mu = 2.0 * mu
             spec_cos = _dot(two_mu * Sx - wx, two_mu * Sy - wy, two_mu * Sz - wz, vx, vy, vz)
-        front = lit & (mu > 0.0)
         spec = np.where(front, np.maximum(spec_cos, 0.0), 0.0) ** scene.shininess
         diffuse = np.where(front, mu, 0.0) * scene.kd
         spec *= scene.ks
@@ -168,8 +215,12 @@ def _shade(scene, P, N, Ns, albedo, spheres, floor_blocks):
     return out
 
 
-def _nearest_hit(scene, X, Y):
-    """Ray parameter and chamber code of the nearest positive hit of each ray."""
+def _nearest_hit(scene, X, Y, skip=True):
+    """Ray parameter and chamber code of the nearest positive hit of each ray.
+
+    With ``skip`` an object that is off is not intersected; without, it is
+    intersected and its hits discarded (the reference path for the tests).
+    """
     e = scene.camera_z
     t = np.full(X.shape, np.inf)
     code = np.zeros(X.shape, dtype=np.uint8)
@@ -177,75 +228,60 @@ def _nearest_hit(scene, X, Y):
     tA = sphere_hit(X, Y, e, (0.0, 0.0, 0.0), scene.radius_a)
     closer = tA < t
     t[closer], code[closer] = tA[closer], SPHERE_A
-    if scene.sphere_b:
+    if scene.sphere_b or not skip:
         tB = sphere_hit(X, Y, e, scene.center_b, scene.radius_b)
-        closer = tB < t
+        closer = (tB < t) & scene.sphere_b
         t[closer], code[closer] = tB[closer], SPHERE_B
-    if scene.floor:
+    if scene.floor or not skip:
         # The floor z = 0 is the image plane: every ray meets it at t = 1.
-        closer = 1.0 < t
+        closer = (1.0 < t) & scene.floor
         t[closer], code[closer] = 1.0, FLOOR
     return t, code
 
 
 @dataclass
 class _Surface:
-    """Shading inputs of the pixels of one object (triples are x, y, z arrays)."""
+    """Geometry of the pixels of one object (triples are x, y, z arrays).
+
+    On sphere A also the chart (u, v), sin(phi) and, once computed, the tangent
+    frame, the gradient and the kink flag.
+    """
 
     kind: int
     idx: np.ndarray
     P: tuple
     N: tuple
-    Ns: tuple
     albedo: tuple
     spheres: list
+    floor_blocks: bool
     uv: tuple = None
+    sin_phi: np.ndarray = None
+    frame: tuple = None
     grad: tuple = None
     kink: np.ndarray = None
 
 
-def _surfaces(scene, gradient, X, Y, t, code):
-    """Yield a `_Surface` per object hit by at least one of the rays."""
+def _surfaces(scene, X, Y, t, code, skip=True):
+    """A `_Surface` per object hit by at least one ray (geometry only, no gradient)."""
     e = scene.camera_z
     sphere_a = ((0.0, 0.0, 0.0), scene.radius_a)
     sphere_b = (scene.center_b, scene.radius_b)
+    out = []
     for kind in (SPHERE_A, SPHERE_B, FLOOR):
         idx = np.flatnonzero(code == kind)
         if idx.size == 0:
             continue
         ti = t[idx]
         P = (ti * X[idx], ti * Y[idx], e * (1.0 - ti))
+        floor_blocks = scene.floor and kind != FLOOR
         if kind == SPHERE_A:
             N = tuple(c / scene.radius_a for c in P)
             uu, vv, sin_phi = chart(*N)
-            if gradient == "exact":
-                hu, hv = fields.exact_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v)
-            else:
-                hu, hv = central_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v,
-                                          scene.eps)
-            kink = fields.kink_band(scene.height_field, uu, vv, scene.k_u, scene.k_v)
-            if scene.beta == 0.0:
-                Ns = N                      # beta = 0 is the un-bumped scene, exactly
-            else:
-                # Perturbed normal N' = M / |M|, M = N + beta (h_u e_theta + h_v e_phi).
-                e_theta, e_phi = tangent_frame(*N, sin_phi)
-                if scene.bump == "chart":
-                    bu, bv = scene.beta * hu, scene.beta * hv
-                else:
-                    # Normal of P = (R + beta h) N: h_theta = h_u / 2 pi, h_phi = h_v / pi.
-                    h = fields.height(scene.height_field, uu, vv, scene.k_u, scene.k_v)
-                    w = -scene.beta / (scene.radius_a + scene.beta * h)
-                    s_phi = np.maximum(sin_phi, POLE_SIN_PHI)
-                    bu, bv = w * hu / (2.0 * np.pi * s_phi), w * hv / np.pi
-                M = tuple(n_ + bu * a + bv * b for n_, a, b in zip(N, e_theta, e_phi))
-                inv = 1.0 / np.sqrt(_dot(*M, *M))
-                Ns = tuple(m * inv for m in M)
-            yield _Surface(kind, idx, P, N, Ns, scene.albedo_a,
-                           [sphere_b] if scene.sphere_b else [],
-                           uv=(uu, vv), grad=(hu, hv), kink=kink)
+            out.append(_Surface(kind, idx, P, N, scene.albedo_a, [sphere_b] if scene.sphere_b else [],
+                                floor_blocks, uv=(uu, vv), sin_phi=sin_phi))
         elif kind == SPHERE_B:
             N = tuple((p - c) / scene.radius_b for p, c in zip(P, scene.center_b))
-            yield _Surface(kind, idx, P, N, N, scene.albedo_b, [sphere_a])
+            out.append(_Surface(kind, idx, P, N, scene.albedo_b, [sphere_a], floor_blocks))
         else:
             zero = np.zeros_like(ti)
             N = (zero, zero, zero + 1.0)
@@ -253,22 +289,101 @@ def _surfaces(scene, gradient, X, Y, t, code):
             light_square = np.sin(np.pi * P[0]) * np.sin(np.pi * P[1]) >= 0.0
             base = np.where(light_square, FLOOR_LIGHT, FLOOR_DARK)
             rg = base * (1.0 - scene.floor_tint)
-            yield _Surface(kind, idx, P, N, N, (rg, rg, base),
-                           [sphere_a] + ([sphere_b] if scene.sphere_b else []))
+            out.append(_Surface(kind, idx, P, N, (rg, rg, base),
+                                [sphere_a] + ([sphere_b] if scene.sphere_b else []), floor_blocks))
+    if not skip:
+        # Reference path: the chart everywhere, kept on sphere A only.
+        for surf in out:
+            if surf.kind != SPHERE_A:
+                chart(*tuple(c / scene.radius_a for c in surf.P))
+    return out
 
 
-def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad):
+def _gradient(scene, surf, gradient, eps):
+    """(h_u, h_v) on sphere A by the pipeline ``gradient`` with step ``eps``."""
+    uu, vv = surf.uv
+    if gradient == "exact":
+        return fields.exact_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v)
+    return central_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v, eps)
+
+
+def _shading_normal(scene, surf, grad):
+    """N' on sphere A from the gradient (seed §3; `Scene.bump`)."""
+    if scene.beta == 0.0:
+        return surf.N                       # beta = 0 is the un-bumped scene, exactly
+    hu, hv = grad
+    N = surf.N
+    if surf.frame is None:
+        surf.frame = tangent_frame(*N, surf.sin_phi)
+    e_theta, e_phi = surf.frame
+    if scene.bump == "chart":
+        bu, bv = scene.beta * hu, scene.beta * hv
+    else:
+        # Normal of P = (R + beta h) N: h_theta = h_u / 2 pi, h_phi = h_v / pi.
+        uu, vv = surf.uv
+        h = fields.height(scene.height_field, uu, vv, scene.k_u, scene.k_v)
+        w = -scene.beta / (scene.radius_a + scene.beta * h)
+        s_phi = np.maximum(surf.sin_phi, POLE_SIN_PHI)
+        bu, bv = w * hu / (2.0 * np.pi * s_phi), w * hv / np.pi
+    M = tuple(n_ + bu * a + bv * b for n_, a, b in zip(N, e_theta, e_phi))
+    inv = 1.0 / np.sqrt(_dot(*M, *M))
+    return tuple(m * inv for m in M)
+
+
+def _prepare_a(scene, surf, gradient, want_grad, want_kink, skip):
+    """Gradient, kink flag and shading normal of sphere A's pixels.
+
+    With ``skip`` the gradient is computed only if beta != 0 or the caller wants
+    it, and the kink flag only if the caller wants it.
+    """
+    need_grad = want_grad or scene.beta != 0.0 or not skip
+    if need_grad:
+        surf.grad = _gradient(scene, surf, gradient, scene.eps)
+    if want_kink or not skip:
+        surf.kink = fields.kink_band(scene.height_field, *surf.uv, scene.k_u, scene.k_v)
+    if not skip and surf.frame is None:
+        surf.frame = tangent_frame(*surf.N, surf.sin_phi)
+    return _shading_normal(scene, surf, surf.grad)
+
+
+def _shade_surface(scene, surf, Ns, skip):
+    """Clipped colour of one surface's pixels: lights, shadow rays, shading."""
+    flat = skip and surf.kind == FLOOR
+    lights = _lights(scene, surf.P, surf.N, surf.floor_blocks, skip, flat)
+    for light in lights:
+        if skip:
+            # Shadow rays only where the light could add something: attached and
+            # in front of the shading normal (Ns . w > 0 gates both terms).  Off
+            # sphere A, Ns = N and attached already implies it.
+            test = (light.attached & (_dot(*Ns, *light.w) > 0.0) if surf.kind == SPHERE_A
+                    else light.attached)
+        else:
+            test = None
+        _trace_shadows(light, surf.spheres, test)
+        if not skip and not scene.sphere_b and surf.kind != SPHERE_B:
+            # Reference path: trace the switched-off sphere B too, and ignore it.
+            segment_hits_sphere(*light.w_raw, light.w2, light.position, scene.center_b,
+                                scene.radius_b)
+    col = _shade(scene, surf.P, Ns, surf.albedo, lights, flat)
+    return [np.clip(c, 0.0, 1.0) for c in col]
+
+
+def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad, skip):
     """Render the rays (X, Y) into the flat output views (one entry per ray)."""
-    t, code = _nearest_hit(scene, X, Y)
+    t, code = _nearest_hit(scene, X, Y, skip)
     chamber[:] = code
-    for surf in _surfaces(scene, gradient, X, Y, t, code):
+    for surf in _surfaces(scene, X, Y, t, code, skip):
         if surf.kind == SPHERE_A:
-            grad[surf.idx, 0], grad[surf.idx, 1] = surf.grad
-            kink[surf.idx] = surf.kink
-        floor_blocks = scene.floor and surf.kind != FLOOR
-        col = _shade(scene, surf.P, surf.N, surf.Ns, surf.albedo, surf.spheres, floor_blocks)
+            Ns = _prepare_a(scene, surf, gradient, grad is not None, kink is not None, skip)
+            if grad is not None:
+                grad[surf.idx, 0], grad[surf.idx, 1] = surf.grad
+            if kink is not None:
+                kink[surf.idx] = surf.kink
+        else:
+            Ns = surf.N
+        col = _shade_surface(scene, surf, Ns, skip)
         for c in range(3):
-            image[surf.idx, c] = np.clip(col[c], 0.0, 1.0)
+            image[surf.idx, c] = col[c]
 
 
 @dataclass(frozen=True)
@@ -314,13 +429,15 @@ def gbuffer(scene, width, height, *, gradient="exact", zoom=1.0):
     n = width * height
     P, N, Ns = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     uv, grad = np.zeros((n, 2)), np.zeros((n, 2))
-    for surf in _surfaces(scene, gradient, X, Y, t, code):
+    for surf in _surfaces(scene, X, Y, t, code):
         P[surf.idx] = np.stack(surf.P, axis=-1)
         N[surf.idx] = np.stack(surf.N, axis=-1)
-        Ns[surf.idx] = np.stack(surf.Ns, axis=-1)
         if surf.kind == SPHERE_A:
+            Ns[surf.idx] = np.stack(_prepare_a(scene, surf, gradient, True, False, True), axis=-1)
             uv[surf.idx] = np.stack(surf.uv, axis=-1)
             grad[surf.idx] = np.stack(surf.grad, axis=-1)
+        else:
+            Ns[surf.idx] = N[surf.idx]
     shape = (height, width)
     return GBuffer(code.reshape(shape), t.reshape(shape), P.reshape(shape + (3,)),
                    N.reshape(shape + (3,)), Ns.reshape(shape + (3,)), uv.reshape(shape + (2,)),
@@ -341,7 +458,7 @@ def _check_args(scene, width, height, gradient, zoom):
     return scene, width, height, gradient, float(zoom)
 
 
-def render(scene, width, height, *, gradient="exact", zoom=1.0):
+def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=True, skip=True):
     """Render the Chapter-9 scene.
 
     Parameters
@@ -357,12 +474,23 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0):
     zoom : float in [1, 1e6], keyword-only
         Magnification of the image window about the optical axis, where sphere
         A's pole is seen (see `renderer.geometry.image_plane`); 1 is the seed's view.
+    kink, grad : bool, keyword-only
+        Whether to compute ``Frame.kink`` and ``Frame.grad``; when False the
+        field is None and its work is skipped (the image does not need them).
+    skip : bool, keyword-only
+        True (default): do only the work the outputs need: objects that are off
+        are neither intersected nor shadow blockers, zero-colour lights are
+        skipped, shadow rays are traced only where the light could add
+        something, and at beta = 0 no gradient is computed unless ``grad``.
+        False runs the reference path that skips none of it; the tests show the
+        two give the same bits.
 
     Returns
     -------
     Frame
         ``image`` (H, W, 3) float64 linear RGB in [0, 1]; ``chamber`` (H, W)
-        uint8; ``kink`` (H, W) bool; ``grad`` (H, W, 2) float64.
+        uint8; ``kink`` (H, W) bool; ``grad`` (H, W, 2) float64 (each of the last
+        two None when not requested).
 
     Raises
     ------
@@ -382,20 +510,20 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0):
     scene, width, height, gradient, zoom = _check_args(scene, width, height, gradient, zoom)
     image = np.zeros((height, width, 3))
     chamber = np.zeros((height, width), dtype=np.uint8)
-    kink = np.zeros((height, width), dtype=bool)
-    grad = np.zeros((height, width, 2))
+    kink_out = np.zeros((height, width), dtype=bool) if kink else None
+    grad_out = np.zeros((height, width, 2)) if grad else None
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     rows = max(1, TILE_PIXELS // width)
     flat_image = image.reshape(-1, 3)
     flat_chamber = chamber.reshape(-1)
-    flat_kink = kink.reshape(-1)
-    flat_grad = grad.reshape(-1, 2)
+    flat_kink = kink_out.reshape(-1) if kink else None
+    flat_grad = grad_out.reshape(-1, 2) if grad else None
     for j0 in range(0, height, rows):
         j1 = min(height, j0 + rows)
         X = np.tile(x, j1 - j0)
         Y = np.repeat(y[j0:j1], width)
         sl = slice(j0 * width, j1 * width)
         _render_tile(scene, gradient, X, Y, flat_image[sl], flat_chamber[sl],
-                     flat_kink[sl], flat_grad[sl])
-    return Frame(image=image, chamber=chamber, kink=kink, grad=grad, scene=scene,
+                     flat_kink[sl] if kink else None, flat_grad[sl] if grad else None, skip)
+    return Frame(image=image, chamber=chamber, kink=kink_out, grad=grad_out, scene=scene,
                  gradient=gradient)
