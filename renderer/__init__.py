@@ -11,8 +11,9 @@ Public API (DESIGN.md)::
 from .ledger import Ledger, compare, to_srgb
 from .render import CHAMBER_NAMES, GRADIENTS, Frame, GBuffer, gbuffer, render
 from .scene import BUMPS, HEIGHT_FIELDS, MODELS, PointLight, Scene
+from .sweep import Sweep, sweep
 
 __all__ = [
     "Scene", "PointLight", "render", "Frame", "GBuffer", "gbuffer", "Ledger", "compare", "to_srgb",
-    "GRADIENTS", "HEIGHT_FIELDS", "MODELS", "BUMPS", "CHAMBER_NAMES",
+    "GRADIENTS", "HEIGHT_FIELDS", "MODELS", "BUMPS", "CHAMBER_NAMES", "Sweep", "sweep",
 ]

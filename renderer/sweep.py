@@ -1,0 +1,145 @@
+"""An eps sweep that computes everything but sphere A's shading once.
+
+Everything above the gradient in the pipeline depends on geometry alone (the
+theorem "bump moves no boundary", proved in proofs/no_boundary.py and checked
+by verify/ with independent full renders).  So for a sweep over the step eps
+of the numeric pipeline, the rays, the chamber codes, the hit points, the
+shadow rays and the shading of every object other than sphere A are computed
+once per tile; per eps only sphere A's central-difference gradient, perturbed
+normal and colour are recomputed.  The symbolic frame is rendered alongside in
+the same pass.  tests/test_skips.py shows every frame equal, bit for bit, to a
+separate `render` call.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import image_plane
+from .ledger import compare
+from .render import (FLOOR, SPHERE_A, TILE_PIXELS, Frame, _check_args, _gradient, _lights,
+                     _nearest_hit, _prepare_a, _shade, _shading_normal, _surfaces, _trace_shadows)
+
+__all__ = ["Sweep", "sweep", "MAX_STEPS"]
+
+#: Most steps one sweep accepts (each holds a frame in memory).
+MAX_STEPS = 64
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Frames and census of an eps sweep.
+
+    Attributes
+    ----------
+    eps : tuple of float            the steps, in the order given
+    numeric : tuple of Frame        central-difference frames, one per step
+    symbolic : Frame                the exact-gradient frame
+    census : tuple of Ledger        ``compare(numeric[i], symbolic)`` per step
+    """
+
+    eps: tuple
+    numeric: tuple
+    symbolic: Frame
+    census: tuple
+
+
+def _check_steps(eps_values):
+    if isinstance(eps_values, (str, bytes)) or not hasattr(eps_values, "__iter__"):
+        raise TypeError(f"eps_values must be a sequence of positive numbers, got {eps_values!r}")
+    steps = []
+    for i, e in enumerate(eps_values):
+        if isinstance(e, bool) or not isinstance(e, numbers.Real) or not math.isfinite(e) or e <= 0:
+            raise ValueError(f"eps_values[{i}] must be a finite number > 0, got {e!r}")
+        steps.append(float(e))
+    if not 1 <= len(steps) <= MAX_STEPS:
+        raise ValueError(f"eps_values must hold 1 to {MAX_STEPS} steps, got {len(steps)}")
+    return tuple(steps)
+
+
+def sweep(scene, eps_values, width, height, *, zoom=1.0):
+    """Render the symbolic frame and one numeric frame per step, sharing the geometry.
+
+    Parameters
+    ----------
+    scene : Scene
+        ``scene.eps`` is ignored; the steps come from ``eps_values``.
+    eps_values : sequence of float > 0 (1 to 64 of them), chart units
+    width, height : int in [1, 8192]
+    zoom : float in [1, 1e6], keyword-only (see `render`)
+
+    Returns
+    -------
+    Sweep
+        Each ``numeric[i]`` equals ``render(scene.replace(eps=eps_values[i]),
+        width, height, gradient="central", zoom=zoom)`` bit for bit, and
+        ``symbolic`` equals the exact render; ``census[i]`` is their `Ledger`.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As `render`, and for an empty or over-long ``eps_values`` or a step
+        that is not a finite positive number (the message names its index).
+
+    Notes
+    -----
+    Memory: one frame (about 57 bytes per pixel) per step plus one.  Source:
+    seed §4 (the simulator's ε slider) and Cell 2; the licence is the theorem
+    "bump moves no boundary" (seed §3).
+    """
+    scene, width, height, _, zoom = _check_args(scene, width, height, "exact", zoom)
+    steps = _check_steps(eps_values)
+    scenes = [scene.replace(eps=e) for e in steps]
+
+    def blank(gradient, s):
+        return Frame(image=np.zeros((height, width, 3)), chamber=np.zeros((height, width), np.uint8),
+                     kink=np.zeros((height, width), bool), grad=np.zeros((height, width, 2)),
+                     scene=s, gradient=gradient)
+
+    symbolic = blank("exact", scene)
+    numeric = [blank("central", s) for s in scenes]
+    frames = [symbolic] + numeric
+    flat = [(f.image.reshape(-1, 3), f.chamber.reshape(-1), f.kink.reshape(-1), f.grad.reshape(-1, 2))
+            for f in frames]
+    x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
+    rows = max(1, TILE_PIXELS // width)
+    for j0 in range(0, height, rows):
+        j1 = min(height, j0 + rows)
+        X = np.tile(x, j1 - j0)
+        Y = np.repeat(y[j0:j1], width)
+        sl = slice(j0 * width, j1 * width)
+        t, code = _nearest_hit(scene, X, Y)
+        for image, chamber, _, _ in flat:
+            chamber[sl] = code
+        for surf in _surfaces(scene, X, Y, t, code):
+            flat_kind = surf.kind == FLOOR
+            lights = _lights(scene, surf.P, surf.N, surf.floor_blocks, True, flat_kind)
+            for light in lights:
+                # Every attached pixel, once: the shading normal varies with eps.
+                _trace_shadows(light, surf.spheres, light.attached)
+            rows_idx = surf.idx + j0 * width
+            if surf.kind != SPHERE_A:
+                col = [np.clip(c, 0.0, 1.0)
+                       for c in _shade(scene, surf.P, surf.N, surf.albedo, lights, flat_kind)]
+                for image, _, _, _ in flat:
+                    for c in range(3):
+                        image[rows_idx, c] = col[c]
+                continue
+            # Sphere A: the exact frame, then one re-shade per step.
+            Ns = _prepare_a(scene, surf, "exact", True, True, True)
+            kink = surf.kink
+            for k, (s, (image, _, kink_out, grad_out)) in enumerate(zip([scene] + scenes, flat)):
+                if k > 0:
+                    surf.grad = _gradient(s, surf, "central", s.eps)
+                    Ns = _shading_normal(s, surf, surf.grad)
+                col = _shade(s, surf.P, Ns, surf.albedo, lights)
+                for c in range(3):
+                    image[rows_idx, c] = np.clip(col[c], 0.0, 1.0)
+                grad_out[rows_idx, 0], grad_out[rows_idx, 1] = surf.grad
+                kink_out[rows_idx] = kink
+    census = tuple(compare(f, symbolic) for f in numeric)
+    return Sweep(eps=steps, numeric=tuple(numeric), symbolic=symbolic, census=census)

@@ -1,0 +1,172 @@
+"""Each skip of the renderer is output-identical, bit for bit, to the path that
+does not skip (issue 6, item 3), and each skip really skips: instrumentation
+counts the work, and the same counters show the reference path doing it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import importlib
+
+from renderer import PointLight, Scene, fields, render, sweep
+
+#: The module renderer.render (the package re-exports the function under that name).
+R = importlib.import_module("renderer.render")
+
+SIZE = (48, 40)
+SCENES = {
+    "default": Scene(),
+    "sine-phong": Scene(height_field="sine", model="phong", eps=1e-6),
+    "rings-noB": Scene(height_field="rings", sphere_b=False),
+    "nofloor": Scene(floor=False),
+    "noB-nofloor-beta0": Scene(sphere_b=False, floor=False, beta=0.0),
+    "zero-light": Scene(lights=(PointLight((5.0, 5.0, 10.0), (1.0, 1.0, 1.0)),
+                                PointLight((-6.0, 2.0, 8.0), (0.0, 0.0, 0.0)),
+                                PointLight((0.0, 3.0, -2.0), (0.4, 0.4, 0.4)))),
+    "surface-bump": Scene(height_field="sine", bump="surface", beta=0.5),
+}
+
+
+def _same(a, b):
+    for name in ("image", "chamber", "kink", "grad"):
+        x, y = getattr(a, name), getattr(b, name)
+        if x is None or y is None:
+            continue
+        if not np.array_equal(x, y):
+            return False
+    return True
+
+
+@pytest.mark.parametrize("name", sorted(SCENES))
+@pytest.mark.parametrize("gradient", ["exact", "central"])
+def test_skipping_path_equals_reference_path(name, gradient):
+    scene = SCENES[name]
+    fast = render(scene, *SIZE, gradient=gradient)
+    ref = render(scene, *SIZE, gradient=gradient, skip=False)
+    assert _same(fast, ref)
+    lean = render(scene, *SIZE, gradient=gradient, kink=False, grad=False)
+    assert lean.kink is None and lean.grad is None
+    assert np.array_equal(lean.image, ref.image) and np.array_equal(lean.chamber, ref.chamber)
+
+
+def test_the_identity_check_rejects_a_different_image():
+    a = render(SCENES["default"], *SIZE)
+    b = render(SCENES["default"].replace(eps=2e-3), *SIZE, gradient="central")
+    c = render(SCENES["default"], *SIZE, gradient="central")
+    assert _same(a, a) and not _same(a, c) and not _same(b, c)
+
+
+class Counter:
+    """Wrap a function; record the arguments' sizes and the positions/centres passed."""
+
+    def __init__(self, fn, key=None, points_arg=0):
+        self.fn, self.key, self.calls, self.points, self.keys = fn, key, 0, 0, []
+        self.points_arg = points_arg
+
+    def __call__(self, *args, **kwargs):
+        self.calls += 1
+        self.points += int(np.size(args[self.points_arg]))
+        if self.key is not None:
+            self.keys.append(self.key(*args))
+        return self.fn(*args, **kwargs)
+
+
+@pytest.fixture
+def count(monkeypatch):
+    def install(module, name, key=None, points_arg=0):
+        c = Counter(getattr(module, name), key, points_arg)
+        monkeypatch.setattr(module, name, c)
+        return c
+    return install
+
+
+def test_objects_that_are_off_are_neither_intersected_nor_blockers(count):
+    scene = SCENES["noB-nofloor-beta0"].replace(beta=0.35)
+    hits = count(R, "sphere_hit", key=lambda x, y, e, center, r: tuple(center))
+    shadows = count(R, "segment_hits_sphere", key=lambda *a: tuple(a[5]))
+    render(scene, *SIZE)
+    assert tuple(scene.center_b) not in hits.keys + shadows.keys
+    render(scene, *SIZE, skip=False)              # the reference path does the work
+    assert tuple(scene.center_b) in hits.keys and tuple(scene.center_b) in shadows.keys
+
+
+def test_zero_colour_lights_are_skipped(count):
+    scene = SCENES["zero-light"]
+    dark = scene.lights[1].position
+    shadows = count(R, "segment_hits_sphere", key=lambda *a: tuple(a[4]))
+    render(scene, *SIZE)
+    assert dark not in shadows.keys
+    render(scene, *SIZE, skip=False)
+    assert dark in shadows.keys
+
+
+def test_shadow_rays_only_where_they_can_change_the_pixel(count):
+    scene = Scene(height_field="sine", beta=1.5)       # strong bump: many N' facing away
+    shadows = count(R, "segment_hits_sphere")
+    fast = render(scene, *SIZE)
+    traced_fast = shadows.points
+    shadows.points = 0
+    ref = render(scene, *SIZE, skip=False)
+    assert traced_fast < shadows.points and _same(fast, ref)
+
+
+def test_beta_zero_computes_no_gradient(count):
+    scene = SCENES["default"].replace(beta=0.0)
+    exact = count(fields, "exact_gradient")
+    central = count(R, "central_gradient")
+    frame_ = count(R, "tangent_frame")
+    a = render(scene, *SIZE, grad=False, kink=False)
+    b = render(scene, *SIZE, gradient="central", grad=False, kink=False)
+    assert exact.calls == central.calls == frame_.calls == 0
+    assert np.array_equal(a.image, render(scene, *SIZE, skip=False).image)
+    assert np.array_equal(b.image, render(scene, *SIZE, gradient="central", skip=False).image)
+    render(scene, *SIZE)                              # asked for grad: computed
+    assert exact.calls > 0
+
+
+def test_kink_and_grad_only_when_asked(count):
+    kinks = count(fields, "kink_band")
+    render(SCENES["default"], *SIZE, kink=False)
+    assert kinks.calls == 0
+    render(SCENES["default"], *SIZE)
+    assert kinks.calls > 0
+
+
+def test_gradient_frame_and_normal_only_on_sphere_a(count):
+    scene = SCENES["default"]
+    exact = count(fields, "exact_gradient", points_arg=1)
+    frame_ = count(R, "tangent_frame")
+    f = render(scene, *SIZE)
+    on_a = int(np.count_nonzero(f.chamber == R.SPHERE_A))
+    assert exact.points == on_a and frame_.points == on_a
+
+
+@pytest.mark.parametrize("name", ["default", "sine-phong", "rings-noB", "noB-nofloor-beta0", "zero-light"])
+def test_sweep_equals_independent_renders(name):
+    scene = SCENES[name]
+    steps = (1e-1, 1e-3, 1e-6, 1e-10)
+    sw = sweep(scene, steps, *SIZE)
+    assert _same(sw.symbolic, render(scene, *SIZE))
+    for eps, frame in zip(steps, sw.numeric):
+        assert _same(frame, render(scene.replace(eps=eps), *SIZE, gradient="central"))
+    assert all(led.flips == 0 for led in sw.census)
+
+
+def test_sweep_shades_geometry_once(count):
+    hits = count(R, "sphere_hit")
+    sweep(SCENES["default"], (1e-1, 1e-2, 1e-3, 1e-4), *SIZE)
+    once = hits.calls
+    hits.calls = 0
+    render(SCENES["default"], *SIZE, gradient="central")
+    assert once == hits.calls                       # one render's worth, not four
+
+
+@pytest.mark.parametrize("bad, match", [
+    ((), "1 to 64"), ([1e-3, 0.0], r"eps_values\[1\]"), ([float("nan")], r"eps_values\[0\]"),
+    ("1e-3", "sequence"), ([True], r"eps_values\[0\]"), ([1e-3] * 65, "1 to 64"),
+])
+def test_sweep_rejects_bad_steps(bad, match):
+    with pytest.raises((TypeError, ValueError), match=match):
+        sweep(Scene(), bad, 8, 8)
