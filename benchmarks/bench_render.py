@@ -1,9 +1,18 @@
-"""Render speed: medians for both pipelines at 128^2 ... 1024^2, peak memory at
-1024^2, and the speed-up over the scalar per-pixel reference of tests/ at 128^2,
-all measured side by side in one run (these machines are noisy: the spread
-min-max is printed with every median).
+"""Render speed and scaling, measured side by side in one run.
 
-Usage: python benchmarks/bench_render.py [--repeats N] [--json FILE]
+* time (median, min-max) of both pipelines from 64^2 to 4096^2, and peak
+  working memory (tracemalloc, beyond the returned frame) at each size;
+* the speed-up over the scalar per-pixel reference of tests/ at 64^2;
+* an 8-step eps sweep at 256^2 (both pipelines and the census), against the
+  same frames rendered independently;
+* the gradient stage alone over sphere A's pixels: exact against one central
+  difference at the same pixels.
+
+These machines are noisy: every median is printed with its min-max, and the
+things compared are interleaved in one loop.  Results go to
+benchmarks/results/render.md (and .json).
+
+Usage: python benchmarks/bench_render.py [--repeats N] [--max-size S] [--out DIR]
 """
 
 from __future__ import annotations
@@ -16,84 +25,124 @@ import time
 import tracemalloc
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from renderer import Scene, render  # noqa: E402
+from renderer import Scene, compare, fields, gbuffer, render, sweep  # noqa: E402
+from renderer.render import central_gradient  # noqa: E402
 from tests.scalar_reference import render_reference  # noqa: E402
 
-SIZES = (128, 256, 512, 1024)
+SIZES = (64, 128, 256, 512, 1024, 2048, 4096)
 PIPELINES = ("exact", "central")
+STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10)
 
 
-def _times(fn, repeats):
-    out = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
+def _stats(samples):
+    return dict(median=statistics.median(samples), min=min(samples), max=max(samples), runs=len(samples))
+
+
+def _interleaved(fns, repeats):
+    """{name: stats} of the callables in ``fns``, run round-robin ``repeats`` times after a warm-up."""
+    for fn in fns.values():
         fn()
-        out.append(time.perf_counter() - t0)
-    return out
+    samples = {k: [] for k in fns}
+    for _ in range(repeats):
+        for k, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            samples[k].append(time.perf_counter() - t0)
+    return {k: _stats(v) for k, v in samples.items()}
+
+
+def _peak_working_bytes(fn):
+    tracemalloc.start()
+    out = fn()
+    current, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    del out
+    return peak, current
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=15, help="timed runs per cell (default 15)")
-    ap.add_argument("--json", type=Path, help="also write the results to this JSON file")
+    ap.add_argument("--repeats", type=int, default=15, help="timed runs per cell at <= 256^2 (default 15)")
+    ap.add_argument("--max-size", type=int, default=4096, help="largest side (default 4096)")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error(f"--repeats must be >= 1, got {args.repeats}")
-
     scene = Scene()
-    results = {}
-    for size in SIZES:
-        for pipe in PIPELINES:
-            render(scene, size, size, gradient=pipe)          # warm-up
-        reps = max(3, args.repeats // (1 if size <= 256 else 3))
-        samples = {p: [] for p in PIPELINES}
-        for _ in range(reps):                                  # interleave the pipelines
-            for pipe in PIPELINES:
-                samples[pipe] += _times(lambda: render(scene, size, size, gradient=pipe), 1)
-        for pipe in PIPELINES:
-            s = samples[pipe]
-            results[f"{pipe}@{size}"] = dict(median=statistics.median(s), min=min(s), max=max(s),
-                                             runs=len(s))
+    res = {"scaling": {}, "memory": {}}
 
-    peak = {}
-    for pipe in PIPELINES:
-        tracemalloc.start()
-        frame = render(scene, 1024, 1024, gradient=pipe)
-        _, peak_bytes = tracemalloc.get_traced_memory()
-        tracemalloc.stop()
-        del frame
-        peak[pipe] = peak_bytes
+    for size in [s for s in SIZES if s <= args.max_size]:
+        reps = args.repeats if size <= 256 else max(3, args.repeats // 3) if size <= 1024 else 3
+        fns = {p: (lambda p=p: render(scene, size, size, gradient=p)) for p in PIPELINES}
+        fns["exact, image only"] = lambda: render(scene, size, size, kink=False, grad=False)
+        for k, st in _interleaved(fns, reps).items():
+            res["scaling"][f"{k}@{size}"] = st
+        peak, held = _peak_working_bytes(lambda: render(scene, size, size, kink=False, grad=False))
+        res["memory"][size] = dict(peak=peak, output=held, per_pixel=peak / size**2)
 
-    # Scalar reference against the vectorized renderer at 128^2, same run.
-    ref = {}
-    for pipe in PIPELINES:
-        s = _times(lambda: render_reference(scene, 128, 128, gradient=pipe), 3)
-        ref[pipe] = dict(median=statistics.median(s), min=min(s), max=max(s), runs=len(s))
+    ref = _interleaved({"reference exact": lambda: render_reference(scene, 64, 64, gradient="exact"),
+                        "numpy exact": lambda: render(scene, 64, 64),
+                        "reference central": lambda: render_reference(scene, 64, 64, gradient="central"),
+                        "numpy central": lambda: render(scene, 64, 64, gradient="central")}, 3)
+    res["reference"] = ref
 
-    print(f"{'pipeline':>8} {'size':>6} {'median ms':>10} {'min-max ms':>16} {'runs':>5}")
-    for size in SIZES:
-        for pipe in PIPELINES:
-            r = results[f"{pipe}@{size}"]
-            print(f"{pipe:>8} {size:>4}^2 {1e3 * r['median']:>10.2f} "
-                  f"{1e3 * r['min']:>7.2f}-{1e3 * r['max']:<8.2f} {r['runs']:>5}")
-    print()
-    for pipe in PIPELINES:
-        print(f"peak traced memory, {pipe} 1024^2: {peak[pipe] / 2**20:.1f} MiB "
-              f"(outputs alone: {1024 * 1024 * (3 * 8 + 1 + 1 + 2 * 8) / 2**20:.1f} MiB)")
-    print()
-    for pipe in PIPELINES:
-        vec = results[f"{pipe}@128"]["median"]
-        print(f"scalar reference {pipe} 128^2: median {ref[pipe]['median']:.2f} s "
-              f"({ref[pipe]['min']:.2f}-{ref[pipe]['max']:.2f}); vectorized {1e3 * vec:.2f} ms; "
-              f"speed-up x{ref[pipe]['median'] / vec:.0f}")
-    if args.json:
-        args.json.write_text(json.dumps(dict(render=results, peak_bytes=peak, reference=ref),
-                                        indent=2))
-    return 0
+    def independent():
+        frames = [render(scene.replace(eps=e), 256, 256, gradient="central") for e in STEPS]
+        sym = render(scene, 256, 256)
+        return [compare(f, sym) for f in frames]
+
+    res["sweep"] = _interleaved({"sweep()": lambda: sweep(scene, STEPS, 256, 256),
+                                 "independent renders": independent}, 5)
+
+    gb = gbuffer(scene, 256, 256)
+    on_a = gb.chamber == 1
+    uu, vv = gb.uv[on_a, 0].copy(), gb.uv[on_a, 1].copy()
+    stage = {}
+    for field in ("sine", "ridges", "rings"):
+        st = _interleaved({
+            "exact": lambda f=field: fields.exact_gradient(f, uu, vv, 8.0, 4.0),
+            "central": lambda f=field: central_gradient(f, uu, vv, 8.0, 4.0, 1e-3)}, 25)
+        stage[field] = st | {"pixels": int(uu.size)}
+    res["gradient_stage"] = stage
+
+    lines = ["## Scaling (default scene; ms, median and min-max)", "",
+             "| size | exact | central | exact, image only | peak working MiB | bytes/pixel |",
+             "|---|---|---|---|---|---|"]
+    for size in [s for s in SIZES if s <= args.max_size]:
+        cells = []
+        for k in ("exact", "central", "exact, image only"):
+            r = res["scaling"][f"{k}@{size}"]
+            cells.append(f"{1e3 * r['median']:.1f} ({1e3 * r['min']:.1f}-{1e3 * r['max']:.1f})")
+        m = res["memory"][size]
+        lines.append(f"| {size}² | " + " | ".join(cells) + f" | {m['peak'] / 2**20:.0f} | {m['per_pixel']:.0f} |")
+    lines += ["", "## Scalar per-pixel reference at 64² (same run)", "", "| pipeline | reference ms | numpy ms | speed-up |",
+              "|---|---|---|---|"]
+    for p in PIPELINES:
+        a, b = ref[f"reference {p}"]["median"], ref[f"numpy {p}"]["median"]
+        lines.append(f"| {p} | {1e3 * a:.0f} | {1e3 * b:.2f} | ×{a / b:.0f} |")
+    sw = res["sweep"]
+    lines += ["", "## 8-step ε sweep at 256², both pipelines and the census", "",
+              "| path | median ms | min-max ms |", "|---|---|---|"]
+    for k, r in sw.items():
+        lines.append(f"| {k} | {1e3 * r['median']:.0f} | {1e3 * r['min']:.0f}-{1e3 * r['max']:.0f} |")
+    lines += ["", "## Gradient stage over sphere A's pixels at 256² (µs)", "",
+              "| field | pixels | exact | one central difference | exact / central |", "|---|---|---|---|---|"]
+    for field, st in stage.items():
+        e, c = st["exact"]["median"], st["central"]["median"]
+        lines.append(f"| {field} | {st['pixels']} | {1e6 * e:.0f} ({1e6 * st['exact']['min']:.0f}-"
+                     f"{1e6 * st['exact']['max']:.0f}) | {1e6 * c:.0f} ({1e6 * st['central']['min']:.0f}-"
+                     f"{1e6 * st['central']['max']:.0f}) | {e / c:.2f} |")
+    text = "\n".join(lines) + "\n"
+    print(text)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "render.md").write_text(text, encoding="utf-8")
+    (args.out / "render.json").write_text(json.dumps(res, indent=1, default=float), encoding="utf-8")
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()
