@@ -2,7 +2,7 @@
 // readout, wired to the renderer in render.js.  Only this module touches the
 // DOM; the renderer core runs the same under node (tests/test_js_parity.py).
 import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, SPHERE_A, CHAMBER_NAMES } from "./constants.js";
-import { render, probe_pixel } from "./render.js";
+import { render_pair, probe_pixel } from "./render.js";
 import { compare, to_srgb } from "./ledger.js";
 
 // The step of the numeric pipeline as shown on the slider: 10^x rounded to two
@@ -195,8 +195,8 @@ class Simulator {
     const s = this.state;
     const scene = scene_of(s);
     const t0 = performance.now();
-    const numeric = render(scene, s.resolution, s.resolution, "central", s.zoom);
-    const symbolic = render(scene, s.resolution, s.resolution, "exact", s.zoom);
+    // One pass for both pipelines: the geometry is shared (bump moves no boundary).
+    const { numeric, symbolic } = render_pair(scene, s.resolution, s.resolution, s.zoom);
     const ledger = compare(numeric, symbolic);
     this.draw(numeric, symbolic);
     const ms = performance.now() - t0;
