@@ -1,0 +1,822 @@
+"""Run time against error for the ways of computing the chart gradient (issue 6, item 1).
+
+For each height field, over the sphere-A pixels of a 256 x 256 default-scene
+frame, this module measures five ways of computing (h_u, h_v):
+
+* ``exact``: the generated sympy gradient, `renderer.fields.exact_gradient`;
+* ``central``: the renderer's central difference,
+  `renderer.render.central_gradient`, at each step of a sweep;
+* ``forward``: the one-sided difference (h(u + eps) - h(u)) / eps, at each
+  step of a sweep (`forward_gradient`);
+* ``complex step``: Im h(u + i eps) / eps (Squire and Trapp 1998), with h the
+  sympy expression evaluated in complex numpy by ``sympy.lambdify``
+  (`complex_step_gradient`).  It needs h to be analytic; `ANALYTIC` says for
+  which fields it is, decided from the expression.  The ridges field is
+  |f|, which is not: lambdify's ``abs`` of a complex number is its modulus,
+  a real number, so the plain complex step returns 0.  The usual repair
+  (Martins, Sturdza and Alonso 2003) continues |f| as f sign(Re f); that
+  variant is measured too, as ``complex step, |z| continued``;
+* ``richardson``: `scipy.differentiate.derivative`, an adaptive
+  finite-difference differentiator that raises the order of accuracy by
+  combining nested steps (Richardson's idea, as in numdifftools and
+  DERIVEST), vectorised over pixels (`richardson_gradient`).
+
+For each method and field it records the time per frame (median, minimum and
+maximum over repeats, methods interleaved), the evaluations of h per pixel
+(counted by instrumentation, `count_evaluations`), and the largest and RMS
+error of the two components against an mpmath reference of the exact
+gradient (`reference_gradient`).  On the ridges field the derivative does not
+exist on the crease lines, so errors there are measured off the seed's crease
+band (`renderer.fields.kink_band`); the timings still cover every pixel.
+
+`FAST` is the configuration the book runs when it is built; `FULL` the one the
+benchmark runs for a release (every pixel in the reference, more steps, more
+repeats).  `pareto_front`, `pareto_figure` and `markdown_table` present a
+`Measurement`.
+
+References
+----------
+.. [1] W. Squire and G. Trapp, "Using complex variables to estimate
+   derivatives of real functions", SIAM Review 40(1), 110-112, 1998.
+.. [2] J. R. R. A. Martins, P. Sturdza and J. J. Alonso, "The complex-step
+   derivative approximation", ACM Trans. Math. Softw. 29(3), 245-262, 2003.
+.. [3] SciPy 1.17, ``scipy.differentiate.derivative``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import platform
+import sys
+import time
+from dataclasses import asdict, dataclass, field as dc_field
+from functools import lru_cache
+
+import mpmath
+import numpy as np
+import sympy as sp
+from scipy.differentiate import derivative
+
+from renderer import Scene, fields, gbuffer
+from renderer.render import SPHERE_A, central_gradient
+
+__all__ = [
+    "FIELDS", "ANALYTIC", "Config", "FAST", "FULL", "Counter", "MethodResult", "Measurement",
+    "is_analytic", "chart_points", "forward_gradient", "complex_step_gradient",
+    "richardson_gradient", "reference_gradient", "count_evaluations", "methods", "measure",
+    "pareto_front", "pareto_figure", "markdown_table", "to_json",
+]
+
+FIELDS = ("sine", "ridges", "rings")
+
+#: sympy functions that are not holomorphic in their argument: an expression
+#: containing one of them cannot be differentiated by the complex step.
+_NON_ANALYTIC = (sp.Abs, sp.sign, sp.re, sp.im, sp.conjugate, sp.arg, sp.Heaviside,
+                 sp.Piecewise, sp.Max, sp.Min, sp.floor, sp.ceiling)
+
+
+def is_analytic(expr):
+    """Whether the sympy expression ``expr`` is built from holomorphic functions only.
+
+    True when ``expr`` contains none of Abs, sign, re, im, conjugate, arg,
+    Heaviside, Piecewise, Max, Min, floor, ceiling: then its lambdified
+    complex evaluation is the analytic continuation the complex step needs.
+    This is a syntactic test (sufficient, not necessary): |x|^2 written with
+    Abs would be reported as not analytic.
+    """
+    return not expr.has(*_NON_ANALYTIC)
+
+
+#: For each field: may the complex step be used?  Computed from `fields.HEIGHT_EXPRS`.
+ANALYTIC = {name: is_analytic(expr) for name, expr in fields.HEIGHT_EXPRS.items()}
+
+
+@dataclass(frozen=True)
+class Config:
+    """What `measure` runs.
+
+    Attributes
+    ----------
+    name : str
+    central_steps, forward_steps, complex_steps : tuple of float
+        The steps eps (chart units) of each sweep.
+    repeats : int
+        Timed runs of every method (each run: all pixels of the frame) ...
+    richardson_repeats : int
+        ... except ``richardson``, ten to twenty times slower than the rest,
+        which is timed this many times.
+    reference_pixels : int or None
+        Pixels per field at which errors are measured against mpmath (a
+        seeded sample of the pixels where the gradient exists); None for all.
+    digits : int
+        mpmath working precision of the reference, in decimal digits.
+    size : int
+        Frame side in pixels.
+    seed : int
+        Seed of the pixel sample and of the order in which methods run.
+    """
+
+    name: str
+    central_steps: tuple
+    forward_steps: tuple
+    complex_steps: tuple
+    repeats: int
+    richardson_repeats: int
+    reference_pixels: int | None
+    digits: int = 34
+    size: int = 256
+    seed: int = 6
+
+
+#: Book build: about 1 s for all three fields on this 2-core machine (budget 1.5 s).
+#: Steps: the renderer's default 1e-3, near each quotient's optimum (central
+#: 1e-6, forward 1e-8), and one past the central optimum, where rounding rules.
+FAST = Config("fast", central_steps=(1e-3, 1e-6, 1e-9), forward_steps=(1e-3, 1e-8),
+              complex_steps=(1e-20,), repeats=3, richardson_repeats=1, reference_pixels=100)
+#: Release: every pixel in the reference, twelve steps per sweep, more repeats.
+FULL = Config("full", central_steps=tuple(10.0 ** -np.arange(1, 13)),
+              forward_steps=tuple(10.0 ** -np.arange(1, 13)),
+              complex_steps=(1e-2, 1e-4, 1e-6, 1e-8, 1e-20, 1e-100), repeats=15, richardson_repeats=15,
+              reference_pixels=None, digits=40)
+
+
+# --- chart points --------------------------------------------------------------------------
+
+def chart_points(field="ridges", size=256):
+    """Chart coordinates (u, v) of the sphere-A pixels of a default-scene frame.
+
+    Parameters
+    ----------
+    field : {"sine", "ridges", "rings"}
+        The scene's height field (the chart does not depend on it: it is
+        computed from the geometry before any gradient).
+    size : int
+        Frame side in pixels.
+
+    Returns
+    -------
+    (u, v) : two (n,) float64 arrays, contiguous, in row-major pixel order.
+    """
+    g = gbuffer(Scene(height_field=field), size, size)
+    uv = g.uv[g.chamber == SPHERE_A]
+    return np.ascontiguousarray(uv[:, 0]), np.ascontiguousarray(uv[:, 1])
+
+
+# --- the methods ---------------------------------------------------------------------------
+
+def forward_gradient(name, uu, vv, ku, kv, eps):
+    """One-sided (forward) difference chart gradient.
+
+    h_u = (h(u + eps, v) - h(u, v)) / eps with u + eps wrapped modulo 1 (the
+    chart is periodic in u), and h_v the same in v, except where v + eps > 1,
+    where the step is taken backwards, (h(u, v) - h(u, v - eps)) / eps.  The
+    quotient is divided by the nominal step, as `central_gradient` does.
+    h(u, v) is shared by both components: three evaluations of h per point.
+    Truncation error O(eps); h is `renderer.fields.height`.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : (n,) float64 chart coordinates in [0, 1]
+    ku, kv : float
+    eps : float > 0, the step in chart units
+
+    Returns
+    -------
+    (h_u, h_v) : two (n,) float64 arrays.
+
+    Raises
+    ------
+    ValueError
+        If ``eps`` is not a positive finite number or ``name`` is unknown.
+    """
+    if not (np.isfinite(eps) and eps > 0):
+        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
+    h0 = fields.height(name, uu, vv, ku, kv)
+    hu = (fields.height(name, np.mod(uu + eps, 1.0), vv, ku, kv) - h0) / eps
+    back = vv + eps > 1.0
+    step = np.where(back, -eps, eps)
+    hv = (fields.height(name, uu, vv + step, ku, kv) - h0) / step
+    return hu, hv
+
+
+def _abs_continued(z):
+    """|x| continued off the real axis as z sign(Re z) (Martins et al. 2003, sec. 3)."""
+    return np.where(np.real(z) < 0, -z, z)
+
+
+@lru_cache(maxsize=None)
+def _complex_height_fn(name, continued):
+    modules = [{"Abs": _abs_continued}, "numpy"] if continued else "numpy"
+    # With "Abs" in a user namespace, lambdify prints Abs(...) and calls that function.
+    return sp.lambdify((fields.u, fields.v, fields.k_u, fields.k_v), fields.HEIGHT_EXPRS[name],
+                       modules=modules)
+
+
+def _complex_height(name, uu, vv, ku, kv, continued):
+    """h at complex chart points, from the sympy expression (hook for `count_evaluations`)."""
+    return _complex_height_fn(name, continued)(uu, vv, ku, kv)
+
+
+def complex_step_gradient(name, uu, vv, ku, kv, eps, *, continued=False):
+    """Complex-step chart gradient, h_u = Im h(u + i eps, v) / eps, h_v likewise.
+
+    h is the sympy expression of `renderer.fields.HEIGHT_EXPRS` evaluated in
+    complex128 numpy by ``sympy.lambdify``.  No difference is taken, so there
+    is no cancellation and eps may be tiny (1e-20 is usual); the truncation
+    error is O(eps^2).  Two complex evaluations of h per point.  Valid only
+    where h is analytic (`ANALYTIC`): for "ridges" numpy's abs of a complex
+    number is its modulus, a real number, and the result is 0.  With
+    ``continued=True`` the expression's Abs is evaluated as z sign(Re z)
+    [Martins et al. 2003], which gives the one-sided derivative of |f|.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : (n,) float64 chart coordinates
+    ku, kv : float
+    eps : float > 0, the imaginary step in chart units
+    continued : bool, keyword-only
+
+    Returns
+    -------
+    (h_u, h_v) : two (n,) float64 arrays.
+
+    Raises
+    ------
+    ValueError
+        If ``eps`` is not a positive finite number or ``name`` is unknown.
+    """
+    if not (np.isfinite(eps) and eps > 0):
+        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
+    if name not in fields.HEIGHT_EXPRS:
+        raise ValueError(f"height_field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {name!r}")
+    shape = np.broadcast(uu, vv).shape
+    hu = np.imag(_complex_height(name, uu + 1j * eps, vv, ku, kv, continued)) / eps
+    hv = np.imag(_complex_height(name, uu, vv + 1j * eps, ku, kv, continued)) / eps
+    return np.broadcast_to(hu, shape), np.broadcast_to(hv, shape)
+
+
+#: scipy.differentiate.derivative's settings.  The first step is half a radian of
+#: phase at the highest frequency of the default scene (pi k_u = 8 pi);
+#: atol lets it stop where a component is exactly 0 (rings: h_u = 0), which its
+#: default (the smallest normal float) never does.
+RICHARDSON = dict(initial_step=0.02, order=8, step_factor=2.0, maxiter=10,
+                  tolerances=dict(atol=1e-12))
+
+
+def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
+    """Chart gradient by `scipy.differentiate.derivative` (settings `RICHARDSON`).
+
+    Both components are computed in one vectorised call: the 2n abscissae are
+    u (moving u) followed by v (moving v).  h is `renderer.fields.height`,
+    evaluated at whatever steps scipy chooses (the chart formula is defined for
+    every real u and v, so no wrapping or clamping).  Elements whose
+    iteration did not converge (scipy status != 0) keep scipy's last estimate.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : (n,) float64 chart coordinates
+    ku, kv : float
+    info : dict or None, keyword-only
+        If given, receives ``"not_converged"`` (int, elements with status != 0),
+        ``"iterations"`` (float, mean iterations per element) and ``"nfev"``
+        (int, scipy's own count of points evaluated, summed over elements).
+
+    Returns
+    -------
+    (h_u, h_v) : two (n,) float64 arrays.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is unknown.
+    """
+    if name not in fields.HEIGHT_EXPRS:
+        raise ValueError(f"height_field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {name!r}")
+    uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
+    n = uu.size
+    x = np.concatenate([uu.ravel(), vv.ravel()])
+    other = np.concatenate([vv.ravel(), uu.ravel()])
+    moves_v = np.repeat(np.array([False, True]), n)
+
+    def h(x, other, moves_v):
+        return fields.height(name, np.where(moves_v, other, x), np.where(moves_v, x, other), ku, kv)
+
+    res = derivative(h, x, args=(other, moves_v), **RICHARDSON)
+    if info is not None:
+        info["not_converged"] = int(np.count_nonzero(res.status != 0))
+        info["iterations"] = float(np.mean(res.nit))
+        info["nfev"] = int(np.sum(res.nfev))
+    return res.df[:n].reshape(uu.shape), res.df[n:].reshape(uu.shape)
+
+
+# --- the reference -------------------------------------------------------------------------
+
+@lru_cache(maxsize=None)
+def _reference_fn(name, ku, kv):
+    # Exact rational frequencies, so that mpmath does not inherit float64 rounding.
+    # First derivatives of |f| carry sign(f), no DiracDelta: usable as they are.
+    ks = {fields.k_u: sp.nsimplify(ku), fields.k_v: sp.nsimplify(kv)}
+    exprs = [g.subs(ks) for g in fields.GRADIENT_EXPRS[name]]
+    return sp.lambdify((fields.u, fields.v), exprs, modules="mpmath", cse=True)
+
+
+def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
+    """The exact gradient at float64 chart points, evaluated by mpmath.
+
+    sympy's derivative of the field (`renderer.fields.GRADIENT_EXPRS`) is
+    evaluated with mpmath at ``digits`` decimal digits, at the chart points
+    exactly as float64 represents them, and returned as a double-double: the
+    value rounded to float64 (``hi``) and the rounding residual (``lo``).  An
+    error |x - ref| of a float64 estimate x is then ``|(x - hi) - lo|``, exact
+    up to one rounding of the error itself.  Working precision: 34 digits
+    put the reference's own error (~1e-33 relative) sixteen orders below the
+    float64 spacing it judges; ``lo`` needs only 32.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : (n,) float64
+    ku, kv : float (converted to exact rationals)
+    digits : int, keyword-only
+
+    Returns
+    -------
+    (hi, lo) : two (2, n) float64 arrays; row 0 is h_u, row 1 is h_v.
+    """
+    if name not in fields.HEIGHT_EXPRS:
+        raise ValueError(f"height_field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {name!r}")
+    fn = _reference_fn(name, float(ku), float(kv))
+    uu, vv = np.broadcast_arrays(np.ravel(uu), np.ravel(vv))
+    hi = np.empty((2, uu.size))
+    lo = np.empty((2, uu.size))
+    with mpmath.workdps(digits):
+        for j, (a, b) in enumerate(zip(uu.tolist(), vv.tolist())):
+            for c, val in enumerate(fn(mpmath.mpf(a), mpmath.mpf(b))):
+                hi[c, j] = float(val)
+                lo[c, j] = float(val - hi[c, j])
+    return hi, lo
+
+
+# --- instrumentation -----------------------------------------------------------------------
+
+@dataclass
+class Counter:
+    """Points evaluated, by kind: real h, complex h, and the generated gradient."""
+
+    h: int = 0
+    h_complex: int = 0
+    gradient: int = 0
+
+
+@contextlib.contextmanager
+def count_evaluations():
+    """Count the points at which h and the generated gradient are evaluated.
+
+    Within the block, `renderer.fields.height`, `renderer.fields.exact_gradient`
+    and this module's complex evaluation of h are replaced by wrappers that add
+    the number of points of each call (the broadcast size of (u, v)) to a
+    `Counter`, which the block receives.  The originals are restored on exit,
+    also on error.  Code that captured the originals before the block (e.g.
+    ``from renderer.fields import height``) is not counted.
+
+    Yields
+    ------
+    Counter
+    """
+    counter = Counter()
+    here = sys.modules[__name__]
+    originals = (fields.height, fields.exact_gradient, here._complex_height)
+
+    def height(name, uu, vv, ku, kv):
+        counter.h += int(np.broadcast(uu, vv).size)
+        return originals[0](name, uu, vv, ku, kv)
+
+    def exact_gradient(name, uu, vv, ku, kv):
+        counter.gradient += int(np.broadcast(uu, vv).size)
+        return originals[1](name, uu, vv, ku, kv)
+
+    def complex_height(name, uu, vv, ku, kv, continued):
+        counter.h_complex += int(np.broadcast(uu, vv).size)
+        return originals[2](name, uu, vv, ku, kv, continued)
+
+    fields.height, fields.exact_gradient, here._complex_height = height, exact_gradient, complex_height
+    try:
+        yield counter
+    finally:
+        fields.height, fields.exact_gradient, here._complex_height = originals
+
+
+# --- the measurement -----------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class MethodResult:
+    """One method on one field.
+
+    Times are seconds per frame (all sphere-A pixels, both components);
+    evaluations are per pixel; errors are absolute, in units of h per chart
+    unit, over both components at the reference pixels.
+    """
+
+    field: str
+    method: str                 # "exact", "central", "forward", "complex step", ...
+    eps: float | None           # the step, or None
+    valid: bool                 # False: the method's premise fails on this field
+    times: tuple                # seconds, one per repeat
+    h_evals: float              # real evaluations of h per pixel (counted)
+    h_complex_evals: float      # complex evaluations of h per pixel (counted)
+    gradient_evals: float       # evaluations of the generated gradient per pixel (counted)
+    max_error: float
+    rms_error: float
+    note: str = ""
+
+    @property
+    def label(self):
+        """The method and its step, e.g. ``central 1e-06``."""
+        return self.method if self.eps is None else f"{self.method} {self.eps:.0e}"
+
+    @property
+    def median(self):
+        """Median time per frame, seconds."""
+        return float(np.median(self.times))
+
+    @property
+    def t_min(self):
+        """Fastest run, seconds."""
+        return float(min(self.times))
+
+    @property
+    def t_max(self):
+        """Slowest run, seconds."""
+        return float(max(self.times))
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """All results of one `measure` run.
+
+    ``pixels`` is the number of sphere-A pixels timed per frame;
+    ``reference_pixels`` maps each field to the number of pixels whose error
+    was measured, ``excluded_pixels`` to the number of the frame's pixels on
+    the crease band, where no error is measured (0 for sine and rings);
+    ``h_times`` to the times (seconds) of one evaluation of h at all pixels,
+    timed among the methods as a unit of cost; ``seconds`` is the wall time
+    of the run.
+    """
+
+    config: Config
+    results: tuple
+    pixels: int
+    reference_pixels: dict
+    excluded_pixels: dict
+    h_times: dict
+    seconds: float
+    k_u: float
+    k_v: float
+    machine: dict = dc_field(default_factory=dict)
+
+    def of(self, field):
+        """The results for one field, in the order they were defined."""
+        return [r for r in self.results if r.field == field]
+
+    def get(self, field, label):
+        """The result with this field and label; KeyError if absent."""
+        for r in self.results:
+            if r.field == field and r.label == label:
+                return r
+        raise KeyError((field, label))
+
+
+def methods(name, config, ku, kv):
+    """The methods measured on field ``name``: a list of (method, eps, valid, fn, note).
+
+    ``fn(u, v)`` returns (h_u, h_v); ``valid`` is False where the method's
+    premise fails (complex step on a field that is not analytic).
+    """
+    out = [("exact", None, True, lambda u, v: fields.exact_gradient(name, u, v, ku, kv), "")]
+    for eps in config.central_steps:
+        out.append(("central", eps, True,
+                    lambda u, v, eps=eps: central_gradient(name, u, v, ku, kv, eps), ""))
+    for eps in config.forward_steps:
+        out.append(("forward", eps, True,
+                    lambda u, v, eps=eps: forward_gradient(name, u, v, ku, kv, eps), ""))
+    analytic = ANALYTIC[name]
+    for eps in config.complex_steps:
+        note = "" if analytic else "h is not analytic: Im |f(u + i eps)| = 0"
+        out.append(("complex step", eps, analytic,
+                    lambda u, v, eps=eps: complex_step_gradient(name, u, v, ku, kv, eps), note))
+    if not analytic and fields.HEIGHT_EXPRS[name].has(sp.Abs):
+        eps = min(config.complex_steps)
+        out.append(("complex step, |z| continued", eps, True,
+                    lambda u, v, eps=eps: complex_step_gradient(name, u, v, ku, kv, eps, continued=True),
+                    "|f| evaluated as f sign(Re f); one-sided on the crease"))
+    out.append(("richardson", None, True, lambda u, v: richardson_gradient(name, u, v, ku, kv),
+                "scipy.differentiate.derivative, order 8"))
+    return out
+
+
+def _errors(approx, hi, lo):
+    err = np.abs((np.stack(approx) - hi) - lo)
+    return float(err.max()), float(np.sqrt(np.mean(err**2)))
+
+
+def measure(config=FAST, *, fields_=FIELDS, uv=None):
+    """Time, count and check every method on every field (see the module docstring).
+
+    Parameters
+    ----------
+    config : Config
+        `FAST` (book build) or `FULL` (release).
+    fields_ : sequence of field names, keyword-only
+    uv : (u, v) pair of (n,) float64 arrays or None, keyword-only
+        Chart points of the sphere-A pixels, shared by all fields (they do
+        not depend on the field); None computes them with `chart_points`
+        for each field.
+
+    Returns
+    -------
+    Measurement
+
+    Raises
+    ------
+    RuntimeError
+        If the instrumentation counted no evaluation of h for the central
+        difference (the renderer no longer calls `renderer.fields.height`;
+        the counts would be meaningless).
+
+    Notes
+    -----
+    Per field: one instrumented run of every method at the reference pixels
+    gives the errors and the counts (for the plain difference quotients the
+    count per pixel does not depend on the pixel; for scipy's adaptive
+    iteration it does, and a sample's mean is reported in `FAST`); then
+    ``config.repeats`` rounds time every method on all pixels, uninstrumented,
+    in an order shuffled each round so that drifts of the machine's speed
+    fall on all methods alike.
+    """
+    t_start = time.perf_counter()
+    rng = np.random.default_rng(config.seed)
+    scene = Scene()
+    ku, kv = float(scene.k_u), float(scene.k_v)
+    results, n_ref, n_excl, h_times = [], {}, {}, {}
+    pixels = None
+    for name in fields_:
+        u, v = chart_points(name, config.size) if uv is None else uv
+        pixels = u.size
+        # The error sample: pixels where the gradient exists (off the ridges' crease band).
+        off = np.flatnonzero(~fields.kink_band(name, u, v, ku, kv))
+        n_excl[name] = int(u.size - off.size)
+        if config.reference_pixels is not None and config.reference_pixels < off.size:
+            pick = np.sort(rng.choice(off, size=config.reference_pixels, replace=False))
+        else:
+            pick = off
+        n_ref[name] = int(pick.size)
+        ru, rv = u[pick].copy(), v[pick].copy()
+        hi, lo = reference_gradient(name, ru, rv, ku, kv, digits=config.digits)
+
+        specs = methods(name, config, ku, kv)
+        checked = []
+        for method, eps, valid, fn, note in specs:
+            info = {}
+            with count_evaluations() as counter:
+                if method == "richardson":
+                    approx = richardson_gradient(name, ru, rv, ku, kv, info=info)
+                else:
+                    approx = fn(ru, rv)
+            if method == "central" and counter.h == 0:
+                raise RuntimeError("central_gradient no longer calls renderer.fields.height; "
+                                   "the evaluation counts would be meaningless")
+            if info.get("not_converged"):
+                note = (note + "; " if note else "") + \
+                    f"{info['not_converged']} of {2 * ru.size} components not converged"
+            checked.append((method, eps, valid, fn, note, counter, _errors(approx, hi, lo)))
+
+        # Timing: every method on all pixels, uninstrumented, interleaved.
+        # The last entry times one evaluation of h alone, as a unit of cost.
+        timed = [spec[3] for spec in specs] + [lambda u, v: fields.height(name, u, v, ku, kv)]
+        times = [[] for _ in timed]
+        quota = [config.richardson_repeats if spec[0] == "richardson" else config.repeats
+                 for spec in specs] + [config.repeats]
+        for _ in range(max(quota)):
+            for k in rng.permutation(len(timed)):
+                if len(times[k]) == quota[k]:
+                    continue
+                t0 = time.perf_counter()
+                timed[k](u, v)
+                times[k].append(time.perf_counter() - t0)
+        h_times[name] = tuple(times.pop())
+        for (method, eps, valid, _, note, counter, (emax, erms)), ts in zip(checked, times):
+            results.append(MethodResult(
+                name, method, eps, valid, tuple(ts), counter.h / ru.size, counter.h_complex / ru.size,
+                counter.gradient / ru.size, emax, erms, note))
+    machine = {"python": platform.python_version(), "numpy": np.__version__,
+               "scipy": sys.modules["scipy"].__version__, "cpus": os.cpu_count(),
+               "processor": platform.processor() or platform.machine()}
+    return Measurement(config, tuple(results), int(pixels), n_ref, n_excl, h_times,
+                       time.perf_counter() - t_start, ku, kv, machine)
+
+
+# --- presentation --------------------------------------------------------------------------
+
+def _non_dominated(times, errors):
+    """Indices of the points not dominated in (time, error), both minimised.
+
+    A point is dominated when another is no worse in both coordinates and
+    strictly better in one.  Equal points do not dominate each other.
+    """
+    t = np.asarray(times, dtype=np.float64)
+    e = np.asarray(errors, dtype=np.float64)
+    if t.shape != e.shape or t.ndim != 1:
+        raise ValueError("times and errors must be 1-D sequences of the same length")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(e))):
+        raise ValueError("times and errors must be finite")
+    keep = []
+    for i in range(t.size):
+        dominated = np.any((t <= t[i]) & (e <= e[i]) & ((t < t[i]) | (e < e[i])))
+        if not dominated:
+            keep.append(i)
+    return keep
+
+
+def pareto_front(results, *, error="max"):
+    """The results not dominated in (median time, error), sorted by time.
+
+    Parameters
+    ----------
+    results : sequence of MethodResult
+        Usually one field's results (`Measurement.of`).
+    error : {"max", "rms"}, keyword-only
+        Which error is minimised with the time.
+
+    Returns
+    -------
+    list of MethodResult, fastest first.
+
+    Raises
+    ------
+    ValueError
+        If ``error`` is not "max" or "rms", or a time or error is not finite.
+    """
+    if error not in ("max", "rms"):
+        raise ValueError(f"error must be 'max' or 'rms', got {error!r}")
+    results = list(results)
+    errs = [r.max_error if error == "max" else r.rms_error for r in results]
+    keep = _non_dominated([r.median for r in results], errs)
+    return sorted((results[i] for i in keep), key=lambda r: r.median)
+
+
+_STYLE = {"exact": ("#1b5e20", "*", 12), "central": ("#7a1f1f", "o", 5), "forward": ("#b26b00", "s", 5),
+          "complex step": ("#1f4e7a", "D", 6), "complex step, |z| continued": ("#5b7fa6", "d", 7),
+          "richardson": ("#6a1b9a", "^", 8)}
+
+
+def _floor(e):
+    # An error of exactly 0 cannot sit on a log axis; plotted at 1e-18 (marked in the legend).
+    return max(e, 1e-18)
+
+
+def pareto_figure(measurement, *, error="max"):
+    """Log-log plot of time per frame against error, one panel per field.
+
+    Each point is a method at its median time, with a horizontal bar from the
+    fastest to the slowest run; difference sweeps are joined in order of eps;
+    the Pareto front is the grey staircase.  Methods whose premise fails on a
+    field are drawn hollow.
+
+    Parameters
+    ----------
+    measurement : Measurement
+    error : {"max", "rms"}, keyword-only
+
+    Returns
+    -------
+    matplotlib.figure.Figure (not shown; the caller shows or saves it).
+    """
+    from matplotlib.figure import Figure
+    names = list(dict.fromkeys(r.field for r in measurement.results))
+    fig = Figure(figsize=(4.0 * len(names), 3.9), layout="constrained")
+    axes = fig.subplots(1, len(names), sharey=True, squeeze=False)[0]
+    pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
+    for ax, name in zip(axes, names):
+        rs = measurement.of(name)
+        front = pareto_front(rs, error=error)
+        ft = [1e3 * r.median for r in front]
+        fe = [_floor(pick(r)) for r in front]
+        t_end = 2e3 * max(r.t_max for r in rs)
+        ax.step(ft + [t_end], fe + [fe[-1]], where="post", color="0.75", lw=4,
+                zorder=0, label="Pareto front" if name == names[0] else None)
+        for method in dict.fromkeys(r.method for r in rs):
+            group = [r for r in rs if r.method == method]
+            color, marker, ms = _STYLE.get(method, ("k", "x", 5))
+            t = np.array([1e3 * r.median for r in group])
+            e = np.array([_floor(pick(r)) for r in group])
+            if len(group) > 1:
+                ax.plot(t, e, color=color, lw=0.8, alpha=0.6)
+            for r, ti, ei in zip(group, t, e):
+                ax.errorbar(ti, ei, xerr=[[ti - 1e3 * r.t_min], [1e3 * r.t_max - ti]], color=color,
+                            lw=0.8, capsize=0)
+                ax.plot(ti, ei, marker=marker, ms=ms, color=color, ls="none",
+                        mfc=color if r.valid else "white")
+            ax.plot([], [], marker=marker, color=color, ls="-" if len(group) > 1 else "none",
+                    label=method if name == names[0] or method.endswith("continued") else None)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlim(0.5 * min(1e3 * r.t_min for r in rs), 2 * max(1e3 * r.t_max for r in rs))
+        ax.set_title(name + ("" if ANALYTIC[name] else " (not analytic; errors off the crease band)"),
+                     fontsize=9)
+        ax.set_xlabel("time per frame (ms), median and min-max")
+        ax.grid(alpha=0.3, which="both", lw=0.3)
+    axes[0].set_ylabel(f"{error} |error| of (h_u, h_v)")
+    fig.legend(loc="outside lower center", ncols=7, fontsize=8, frameon=False)
+    return fig
+
+
+def _fmt_ms(r):
+    return f"{1e3 * r.median:.2f} ({1e3 * r.t_min:.2f}–{1e3 * r.t_max:.2f})"
+
+
+def _fmt_evals(r):
+    parts = []
+    if r.h_evals:
+        parts.append(f"{r.h_evals:.4g} h")
+    if r.h_complex_evals:
+        parts.append(f"{r.h_complex_evals:.4g} complex h")
+    if r.gradient_evals:
+        parts.append(f"{r.gradient_evals:.4g} ∇h")
+    return ", ".join(parts) or "0"
+
+
+def markdown_table(measurement, *, rows="all", error="max", include=()):
+    """The measurement as a Markdown table, one row per (field, method).
+
+    Parameters
+    ----------
+    measurement : Measurement
+    rows : {"all", "front", "best"}, keyword-only
+        "all": every result; "front": the Pareto front of each field;
+        "best": per field, the exact gradient and, of every other method, the
+        step with the smallest error (plus any result on the front).
+    error : {"max", "rms"}, keyword-only
+        The error that defines the front and "best".
+    include : sequence of str, keyword-only
+        Labels (`MethodResult.label`, e.g. ``"central 1e-03"``) shown in
+        every field even when ``rows`` would leave them out.
+
+    Returns
+    -------
+    str (GitHub-flavoured Markdown; ``|`` inside cells is escaped).
+
+    Raises
+    ------
+    ValueError
+        If ``rows`` is not one of the three choices.
+    """
+    if rows not in ("all", "front", "best"):
+        raise ValueError(f"rows must be 'all', 'front' or 'best', got {rows!r}")
+    head = ("field", "method", "evaluations per pixel", "time per frame, ms: median (min–max)",
+            "max error", "RMS error", "on the front", "note")
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    key = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
+    for name in dict.fromkeys(r.field for r in measurement.results):
+        rs = measurement.of(name)
+        front = pareto_front(rs, error=error)
+        if rows == "front":
+            chosen = list(front)
+        elif rows == "best":
+            chosen = []
+            for method in dict.fromkeys(r.method for r in rs):
+                group = [r for r in rs if r.method == method]
+                chosen.append(min(group, key=key))
+        else:
+            chosen = list(rs)
+        for r in front + [r for r in rs if r.label in include]:
+            if r not in chosen:
+                chosen.append(r)
+        chosen.sort(key=rs.index)
+        for r in chosen:
+            note = r.note if r.valid else ("**not valid**: " + r.note)
+            cells = (name, r.label, _fmt_evals(r), _fmt_ms(r), f"{r.max_error:.2e}", f"{r.rms_error:.2e}",
+                     "yes" if r in front else "", note)
+            lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+    return "\n".join(lines)
+
+
+def to_json(measurement):
+    """The measurement as a JSON string (times in seconds, every repeat kept)."""
+    out = {"config": asdict(measurement.config), "pixels": measurement.pixels,
+           "h_alone_seconds": {k: list(v) for k, v in measurement.h_times.items()},
+           "reference_pixels": measurement.reference_pixels,
+           "excluded_pixels_crease_band": measurement.excluded_pixels,
+           "seconds": measurement.seconds, "k_u": measurement.k_u, "k_v": measurement.k_v,
+           "machine": measurement.machine, "results": []}
+    for name in dict.fromkeys(r.field for r in measurement.results):
+        front = pareto_front(measurement.of(name))
+        for r in measurement.of(name):
+            d = asdict(r)
+            d.update(label=r.label, median=r.median, t_min=r.t_min, t_max=r.t_max, on_front=r in front)
+            out["results"].append(d)
+    return json.dumps(out, indent=1)

@@ -1,0 +1,274 @@
+"""The gradient methods of proofs/gradient_methods.py: their orders against an
+mpmath closed form, the complex step's analyticity premise, the evaluation
+counter, and the Pareto front.  Each check is shown to reject a wrong variant.
+"""
+
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+from proofs import gradient_methods as gm
+from renderer import fields
+from renderer.render import central_gradient
+
+KU, KV = 8.0, 4.0
+#: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as proofs/accuracy.py).
+SPACING = float(np.spacing(np.pi * max(KU, 2 * KV)))
+#: Over many pixels a float64 evaluation of the gradient is off by up to ~40 spacings: the
+#: phase pi k u (up to 8 pi) is rounded, and the rounding is multiplied by the slope, up to
+#: 8 pi.  verify/test_accuracy.py allows 64 spacings for the exact gradient; so do we.
+FLOAT64_EVAL = 64 * SPACING
+
+
+def sine_gradient_mp(u, v, ku=KU, kv=KV):
+    """(h_u, h_v) of h = sin(pi k_u u) sin(pi k_v v), written by hand (seed §3) and
+    evaluated by mpmath at 40 digits at the float64 point: independent of sympy's
+    derivative and of every method under test."""
+    with mpmath.workdps(40):
+        u, v, pi = mpmath.mpf(float(u)), mpmath.mpf(float(v)), mpmath.pi
+        return (pi * ku * mpmath.cos(pi * ku * u) * mpmath.sin(pi * kv * v),
+                pi * kv * mpmath.sin(pi * ku * u) * mpmath.cos(pi * kv * v))
+
+
+def abs_errors(grad, ref):
+    """|float64 - reference| of both components, computed at 40 digits."""
+    with mpmath.workdps(40):
+        return np.array([float(abs(mpmath.mpf(float(np.ravel(g)[0])) - r)) for g, r in zip(grad, ref)])
+
+
+U0, V0 = np.array([0.31]), np.array([0.47])          # the draft's smooth point (Cell 2)
+REF0 = sine_gradient_mp(U0[0], V0[0])
+
+
+def fitted_order(method, steps):
+    """Slope of log(error) against log(eps), per component."""
+    errs = np.array([abs_errors(method(e), REF0) for e in steps])
+    return np.polyfit(np.log(steps), np.log(errs), 1)[0]
+
+
+CENTRAL = lambda e: central_gradient("sine", U0, V0, KU, KV, e)          # noqa: E731
+FORWARD = lambda e: gm.forward_gradient("sine", U0, V0, KU, KV, e)        # noqa: E731
+COMPLEX = lambda e: gm.complex_step_gradient("sine", U0, V0, KU, KV, e)   # noqa: E731
+STEPS = (1e-2, 1e-3, 1e-4)            # truncation-dominated for all three at this point
+
+
+def second_order(slopes):
+    return bool(np.all(np.abs(slopes - 2.0) < 0.1))
+
+
+def first_order(slopes):
+    return bool(np.all(np.abs(slopes - 1.0) < 0.1))
+
+
+# --- orders against mpmath ---------------------------------------------------------------
+
+def test_central_difference_is_second_order():
+    assert second_order(fitted_order(CENTRAL, STEPS))
+
+
+def test_forward_difference_is_first_order_and_fails_the_second_order_check():
+    slopes = fitted_order(FORWARD, STEPS)
+    assert first_order(slopes)
+    assert not second_order(slopes)       # the criterion above rejects a one-sided quotient
+
+
+def test_complex_step_is_second_order_then_at_machine_precision():
+    assert second_order(fitted_order(COMPLEX, STEPS))
+    # No subtraction: at eps = 1e-20 the truncation term (~1e-40 relative) is gone and
+    # what is left is the rounding of a few products, within 4 spacings of 8 pi.
+    assert np.all(abs_errors(COMPLEX(1e-20), REF0) <= 4 * SPACING)
+    # A difference quotient at the same step sees u + eps == u: it returns 0, wrong by
+    # the whole derivative (|h_u| = 0.58, |h_v| = 11.7 here).
+    assert np.all(abs_errors(CENTRAL(1e-20), REF0) > 0.5)
+
+
+def test_exact_and_richardson_against_mpmath():
+    assert np.all(abs_errors(fields.exact_gradient("sine", U0, V0, KU, KV), REF0) <= 4 * SPACING)
+    err = abs_errors(gm.richardson_gradient("sine", U0, V0, KU, KV), REF0)
+    assert np.all(err < 1e-11)             # order-8 stencils, stopped at rtol ~ 1.5e-8
+    assert np.all(err > 4 * SPACING)       # ... but not exact: it differences h
+
+
+def test_reference_gradient_is_the_mpmath_value_as_a_double_double():
+    hi, lo = gm.reference_gradient("sine", U0, V0, KU, KV)
+    with mpmath.workdps(40):
+        for c in range(2):
+            assert hi[c, 0] == float(REF0[c])                      # rounded to nearest
+            residual = mpmath.mpf(hi[c, 0]) + mpmath.mpf(lo[c, 0]) - REF0[c]
+            assert abs(residual) < mpmath.mpf(10) ** -30           # hi + lo carries ~32 digits
+    # A wrong reference (the generated float64 gradient in place of mpmath) has lo = 0.
+    assert np.any(lo != 0.0)
+
+
+def test_forward_difference_steps_backwards_at_the_top_of_the_chart():
+    u, v = np.array([0.31]), np.array([1.0 - 1e-5])
+    hu, hv = gm.forward_gradient("sine", u, v, KU, KV, 1e-3)
+    ref = sine_gradient_mp(u[0], v[0])
+    # A step past v = 1 would still be O(eps) here (h is defined beyond the chart);
+    # check the rule itself: the quotient equals the backward one.
+    h0 = fields.height("sine", u, v, KU, KV)
+    back = (fields.height("sine", u, v - 1e-3, KU, KV) - h0) / -1e-3
+    assert hv[0] == back[0]
+    assert abs(hv[0] - float(ref[1])) < 10 * 1e-3 * (np.pi * KV) ** 2       # |h_vv| eps / 2 bound
+
+
+@pytest.mark.parametrize("eps", [0.0, -1e-3, np.inf, np.nan])
+def test_steps_are_validated(eps):
+    with pytest.raises(ValueError, match="eps must be a positive finite number"):
+        gm.forward_gradient("sine", U0, V0, KU, KV, eps)
+    with pytest.raises(ValueError, match="eps must be a positive finite number"):
+        gm.complex_step_gradient("sine", U0, V0, KU, KV, eps)
+
+
+def test_unknown_field_is_rejected():
+    for fn in (lambda: gm.complex_step_gradient("bumps", U0, V0, KU, KV, 1e-20),
+               lambda: gm.richardson_gradient("bumps", U0, V0, KU, KV),
+               lambda: gm.reference_gradient("bumps", U0, V0, KU, KV)):
+        with pytest.raises(ValueError, match="height_field must be one of"):
+            fn()
+
+
+# --- the complex step's premise ------------------------------------------------------------
+
+def test_analyticity_flag_is_read_from_the_expressions():
+    assert gm.ANALYTIC == {"sine": True, "ridges": False, "rings": True}
+    x = sp.Symbol("x", real=True)
+    assert gm.is_analytic(sp.sin(x) * sp.exp(x))
+    assert not gm.is_analytic(sp.Abs(sp.sin(x)))
+    assert not gm.is_analytic(sp.sign(x) * x)
+
+
+def test_complex_step_on_ridges_is_wrong_near_a_crease_so_the_flag_matters():
+    # Just off the crease u = 1/k_u (float64 1/8 exactly), where the derivative exists.
+    u, v = np.array([1.0 / KU + 1e-6]), np.array([0.47])
+    hi, lo = gm.reference_gradient("ridges", u, v, KU, KV)
+    true_hu = hi[0, 0]
+    assert abs(true_hu) > 1.0                          # a steep slope, not a flat spot
+    hu_plain, _ = gm.complex_step_gradient("ridges", u, v, KU, KV, 1e-20)
+    # Im |f(u + i eps)| = 0: the plain complex step returns 0, wrong by the whole slope.
+    assert hu_plain[0] == 0.0
+    assert abs(hu_plain[0] - true_hu) > 1.0
+    # Had the flag called ridges analytic, this result would be trusted as exact; it is
+    # flagged instead.
+    def complex_step_valid(field):
+        return {(m, e): ok for m, e, ok, _, _ in gm.methods(field, gm.FAST, KU, KV)}[("complex step", 1e-20)]
+    assert complex_step_valid("ridges") is False and complex_step_valid("sine") is True
+    # With |z| continued as z sign(Re z) the complex step is right off the crease.
+    hu_cont, _ = gm.complex_step_gradient("ridges", u, v, KU, KV, 1e-20, continued=True)
+    assert abs((hu_cont[0] - hi[0, 0]) - lo[0, 0]) <= 4 * SPACING
+
+
+# --- the counter ---------------------------------------------------------------------------
+
+def test_counter_counts_points_per_method():
+    u, v = gm.chart_points()
+    u, v = u[:257], v[:257]
+    n = u.size
+    expected = {
+        "central": (lambda: central_gradient("sine", u, v, KU, KV, 1e-3), (4 * n, 0, 0)),
+        "forward": (lambda: gm.forward_gradient("sine", u, v, KU, KV, 1e-3), (3 * n, 0, 0)),
+        "complex": (lambda: gm.complex_step_gradient("sine", u, v, KU, KV, 1e-20), (0, 2 * n, 0)),
+        "exact": (lambda: fields.exact_gradient("sine", u, v, KU, KV), (0, 0, n)),
+    }
+    for name, (fn, want) in expected.items():
+        with gm.count_evaluations() as c:
+            fn()
+        assert (c.h, c.h_complex, c.gradient) == want, name
+
+
+def test_counter_agrees_with_scipys_own_count_for_richardson():
+    u, v = gm.chart_points()
+    u, v = u[:300], v[:300]
+    info = {}
+    with gm.count_evaluations() as c:
+        gm.richardson_gradient("ridges", u, v, KU, KV, info=info)
+    assert c.h == info["nfev"]             # scipy counts its validation call too
+    assert c.h > 4 * u.size                # more than a central difference's four
+
+
+def test_counter_restores_the_originals_even_on_error():
+    before = (fields.height, fields.exact_gradient)
+    with pytest.raises(ZeroDivisionError):
+        with gm.count_evaluations():
+            assert fields.height is not before[0]
+            1 / 0
+    assert (fields.height, fields.exact_gradient) == before
+
+
+def test_measure_refuses_counts_when_the_instrumentation_is_bypassed(monkeypatch):
+    u, v = gm.chart_points()
+    u, v = u[:40].copy(), v[:40].copy()
+    height = fields.height                 # captured: the counter cannot see calls to it
+
+    def bypassing(name, uu, vv, ku, kv, eps):
+        return ((height(name, uu + eps, vv, ku, kv) - height(name, uu - eps, vv, ku, kv)) / (2 * eps),
+                (height(name, uu, vv + eps, ku, kv) - height(name, uu, vv - eps, ku, kv)) / (2 * eps))
+
+    monkeypatch.setattr(gm, "central_gradient", bypassing)
+    with pytest.raises(RuntimeError, match="no longer calls renderer.fields.height"):
+        gm.measure(TINY, fields_=("sine",), uv=(u, v))
+
+
+# --- the Pareto front ----------------------------------------------------------------------
+
+def result(label, t, err):
+    return gm.MethodResult("sine", label, None, True, (t,), 0.0, 0.0, 0.0, err, err)
+
+
+def test_pareto_front_rejects_a_dominated_point():
+    fast_exact = result("a", 1.0, 1e-14)
+    slow_coarse = result("b", 2.0, 1e-9)          # slower and less accurate than a
+    fastest = result("c", 0.5, 1e-3)
+    tie_time = result("d", 1.0, 1e-12)            # same time as a, worse error: dominated
+    twin = result("e", 1.0, 1e-14)                # equal to a: neither dominates the other
+    front = gm.pareto_front([fast_exact, slow_coarse, fastest, tie_time, twin])
+    assert [r.method for r in front] == ["c", "a", "e"]
+    assert slow_coarse not in front and tie_time not in front
+
+
+def test_pareto_front_validates_its_input():
+    with pytest.raises(ValueError, match="error must be 'max' or 'rms'"):
+        gm.pareto_front([result("a", 1.0, 1.0)], error="mean")
+    with pytest.raises(ValueError, match="must be finite"):
+        gm.pareto_front([result("a", 1.0, np.nan), result("b", 2.0, 1.0)])
+
+
+# --- the whole measurement, small ----------------------------------------------------------
+
+TINY = gm.Config("tiny", central_steps=(1e-3, 1e-6), forward_steps=(1e-8,), complex_steps=(1e-20,),
+                 repeats=2, richardson_repeats=1, reference_pixels=30)
+
+
+def test_chart_points_do_not_depend_on_the_field():
+    # This licenses measure(uv=...) sharing one set of chart points across fields.
+    a, b = gm.chart_points("sine"), gm.chart_points("rings")
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    assert a[0].size > 20000
+
+
+def test_measure_small_run_and_its_presentations():
+    u, v = gm.chart_points()
+    step = max(1, u.size // 2000)
+    m = gm.measure(TINY, uv=(u[::step].copy(), v[::step].copy()))
+    assert m.reference_pixels == {"sine": 30, "ridges": 30, "rings": 30}
+    assert m.excluded_pixels["sine"] == 0 and m.excluded_pixels["ridges"] > 0
+    exact = m.get("sine", "exact")
+    assert exact.max_error <= FLOAT64_EVAL and len(exact.times) == 2
+    assert m.get("sine", "central 1e-03").h_evals == 4.0
+    assert len(m.get("sine", "richardson").times) == 1
+    plain = m.get("ridges", "complex step 1e-20")
+    assert not plain.valid and plain.max_error > 1.0
+    assert m.get("ridges", "complex step, |z| continued 1e-20").max_error <= FLOAT64_EVAL
+    assert m.get("sine", "central 1e-06").max_error > 1e4 * FLOAT64_EVAL
+    table = gm.markdown_table(m, rows="best", include=("central 1e-03",))
+    assert "central 1e-03" in table and "**not valid**" in table
+    # "best": per field one row per method (5 on sine and rings, 6 on ridges) + central 1e-03.
+    assert len(table.splitlines()) == 2 + (5 + 1) + (6 + 1) + (5 + 1)
+    with pytest.raises(ValueError, match="rows must be"):
+        gm.markdown_table(m, rows="some")
+    fig = gm.pareto_figure(m)
+    assert len(fig.axes) == 3
+    assert '"label": "exact"' in gm.to_json(m)
