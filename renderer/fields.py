@@ -29,7 +29,8 @@ from . import detmath
 
 __all__ = [
     "u", "v", "k_u", "k_v", "HEIGHT_EXPRS", "GRADIENT_EXPRS",
-    "height", "exact_gradient", "kink_band", "KINK_BAND_HALF_WIDTH",
+    "height", "exact_gradient", "kink_band", "KINK_BAND_HALF_WIDTH", "CentralStencil",
+    "central_stencil",
 ]
 
 #: Chart coordinates and frequencies.  Real, so that d|f|/du = sign(f) f'.
@@ -155,3 +156,66 @@ def kink_band(name, uu, vv, ku, kv):
     return np.broadcast_to(
         (np.abs(s1) < KINK_BAND_HALF_WIDTH) | (np.abs(s2) < KINK_BAND_HALF_WIDTH), shape
     )
+
+
+#: The shifted chart points of the central-difference stencil.
+u_p, u_m, v_p, v_m = sp.symbols("u_p u_m v_p v_m", real=True)
+
+
+class CentralStencil:
+    """The four values h(u+, v), h(u-, v), h(u, v+), h(u, v-) of a central
+    difference, generated from the sympy field as one function.
+
+    sympy's common-subexpression elimination runs over the four shifted
+    expressions together, so a factor that does not move with the shift is
+    computed once: for sine and ridges sin(pi k_v v) serves h(u+-eps, v) and
+    sin(pi k_u u) serves h(u, v+-eps) (6 sines instead of 8); for rings
+    h(u+-eps, v) is one value (3 instead of 4).  The subexpressions free of the
+    shifted points (``base``) do not depend on eps either, so an eps sweep
+    computes them once (`renderer.sweep`).  Every value is the same bits as
+    `height` at the same point: the same operations on the same numbers
+    (tests/test_fields.py checks it; the JavaScript evaluates h four times and
+    matches too).
+    """
+
+    def __init__(self, name):
+        _check_name(name)
+        h = HEIGHT_EXPRS[name]
+        quad = [h.subs(u, u_p), h.subs(u, u_m), h.subs(v, v_p), h.subs(v, v_m)]
+        replacements, reduced = sp.cse(quad)
+        base, rest = [], []
+        for sym, expr in replacements:
+            if expr.free_symbols <= {u, v, k_u, k_v} | {b for b, _ in base}:
+                base.append((sym, expr))
+            else:
+                rest.append((sym, expr))
+        self.name = name
+        self.base_symbols = tuple(b for b, _ in base)
+        self._base = sp.lambdify((u, v, k_u, k_v), list(self.base_symbols), modules=HEIGHT_MODULES,
+                                 cse=lambda exprs: (base, exprs))
+        self._shifted = sp.lambdify((u_p, u_m, v_p, v_m, u, v, k_u, k_v, *self.base_symbols), reduced,
+                                    modules=HEIGHT_MODULES, cse=lambda exprs: (rest, exprs))
+
+    def base(self, uu, vv, ku, kv):
+        """The eps-free subexpressions at the stencil's centre (a list of arrays)."""
+        return self._base(uu, vv, ku, kv)
+
+    def values(self, up, um, vp, vm, uu, vv, ku, kv, base=None):
+        """[h(u+, v), h(u-, v), h(u, v+), h(u, v-)], each broadcast to the centre's shape."""
+        if base is None:
+            base = self.base(uu, vv, ku, kv)
+        shape = np.broadcast(uu, vv).shape
+        return [np.broadcast_to(np.asarray(x, dtype=np.float64), shape)
+                for x in self._shifted(up, um, vp, vm, uu, vv, ku, kv, *base)]
+
+
+@lru_cache(maxsize=None)
+def central_stencil(name):
+    """The `CentralStencil` of field ``name`` (built once).
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a known field.
+    """
+    return CentralStencil(name)

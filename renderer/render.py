@@ -78,14 +78,16 @@ def _check_size(name, value):
     return int(value)
 
 
-def central_gradient(name, uu, vv, ku, kv, eps):
+def central_gradient(name, uu, vv, ku, kv, eps, base=None):
     """Central-difference chart gradient, the numeric pipeline's one difference.
 
     h_u = (h(u + eps, v) - h(u - eps, v)) / (2 eps) with u wrapped modulo 1
     (the chart is periodic in u).  v is clamped to [0, 1]; where a clamp
     happens the quotient is one-sided, divided by the clamped distance
     v_+ - v_-; elsewhere by 2 eps (seed Cell 1, ``grad_numeric``).  Four
-    evaluations of h per point.
+    values of h per point, from `renderer.fields.central_stencil` (the same
+    bits as four calls of `fields.height`, with the factors that do not move
+    shared).
 
     Parameters
     ----------
@@ -93,6 +95,9 @@ def central_gradient(name, uu, vv, ku, kv, eps):
     uu, vv : (n,) float64 chart coordinates in [0, 1]
     ku, kv : float
     eps : float > 0, the step in chart units
+    base : list of arrays, optional
+        ``central_stencil(name).base(uu, vv, ku, kv)``, computed once by a
+        caller that differentiates the same points with several steps.
 
     Returns
     -------
@@ -100,12 +105,13 @@ def central_gradient(name, uu, vv, ku, kv, eps):
     """
     up = np.mod(uu + eps, 1.0)
     um = np.mod(uu - eps, 1.0)
-    hu = (fields.height(name, up, vv, ku, kv) - fields.height(name, um, vv, ku, kv)) / (2.0 * eps)
     vp = np.minimum(1.0, vv + eps)
     vm = np.maximum(0.0, vv - eps)
+    h_up, h_um, h_vp, h_vm = fields.central_stencil(name).values(up, um, vp, vm, uu, vv, ku, kv, base)
+    hu = (h_up - h_um) / (2.0 * eps)
     clamped = (vv + eps > 1.0) | (vv - eps < 0.0)
     den = np.where(clamped, vp - vm, 2.0 * eps)
-    hv = (fields.height(name, uu, vp, ku, kv) - fields.height(name, uu, vm, ku, kv)) / den
+    hv = (h_vp - h_vm) / den
     return hu, hv
 
 
@@ -299,12 +305,12 @@ def _surfaces(scene, X, Y, t, code, skip=True):
     return out
 
 
-def _gradient(scene, surf, gradient, eps):
+def _gradient(scene, surf, gradient, eps, base=None):
     """(h_u, h_v) on sphere A by the pipeline ``gradient`` with step ``eps``."""
     uu, vv = surf.uv
     if gradient == "exact":
         return fields.exact_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v)
-    return central_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v, eps)
+    return central_gradient(scene.height_field, uu, vv, scene.k_u, scene.k_v, eps, base)
 
 
 def _shading_normal(scene, surf, grad):

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import fields
 from .geometry import image_plane
 from .ledger import compare
 from .render import (FLOOR, SPHERE_A, TILE_PIXELS, Frame, _check_args, _gradient, _lights,
@@ -132,9 +133,11 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0):
             # Sphere A: the exact frame, then one re-shade per step.
             Ns = _prepare_a(scene, surf, "exact", True, True, True)
             kink = surf.kink
+            # The stencil's eps-free factors, once for all steps.
+            base = fields.central_stencil(scene.height_field).base(*surf.uv, scene.k_u, scene.k_v)
             for k, (s, (image, _, kink_out, grad_out)) in enumerate(zip([scene] + scenes, flat)):
                 if k > 0:
-                    surf.grad = _gradient(s, surf, "central", s.eps)
+                    surf.grad = _gradient(s, surf, "central", s.eps, base)
                     Ns = _shading_normal(s, surf, surf.grad)
                 col = _shade(s, surf.P, Ns, surf.albedo, lights)
                 for c in range(3):
