@@ -138,13 +138,17 @@ def tangent_frame(Nx, Ny, Nz, sin_phi):
     -------
     e_theta, e_phi : triples of (n,) float64 arrays (x, y, z components)
     """
-    regular = sin_phi > POLE_SIN_PHI
-    inv = 1.0 / np.where(regular, sin_phi, 1.0)
-    e_theta = (np.where(regular, -Ny * inv, 1.0), np.where(regular, Nx * inv, 0.0),
-               np.zeros_like(Nx))
-    zx = Nz * inv
-    e_phi = (np.where(regular, zx * Nx, 0.0), np.where(regular, zx * Ny, 1.0),
-             np.where(regular, -sin_phi, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / sin_phi
+        zx = Nz * inv
+        e_theta = (-Ny * inv, Nx * inv, np.zeros_like(Nx))
+        e_phi = (zx * Nx, zx * Ny, -sin_phi)
+    # The few pixels at the pole get the fixed basis (indexing, not np.where
+    # over every pixel).
+    pole = np.flatnonzero(~(sin_phi > POLE_SIN_PHI))
+    if pole.size:
+        for arr, value in zip(e_theta + e_phi, (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)):
+            arr[pole] = value
     return e_theta, e_phi
 
 
