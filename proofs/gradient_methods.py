@@ -366,23 +366,43 @@ def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
 
 @dataclass
 class Counter:
-    """Points evaluated, by kind: real h, complex h, and the generated gradient."""
+    """Values computed, by kind: real h, complex h, and the generated gradient (points)."""
 
     h: int = 0
     h_complex: int = 0
     gradient: int = 0
 
 
+class _CountingStencil:
+    """Wraps a `renderer.fields.CentralStencil`: counts the values of h it returns."""
+
+    def __init__(self, inner, counter):
+        self._inner = inner
+        self._counter = counter
+
+    def __getattr__(self, attr):
+        return getattr(self._inner, attr)
+
+    def values(self, *args, **kwargs):
+        out = self._inner.values(*args, **kwargs)
+        self._counter.h += sum(int(np.size(x)) for x in out)
+        return out
+
+
 @contextlib.contextmanager
 def count_evaluations():
-    """Count the points at which h and the generated gradient are evaluated.
+    """Count the values of h and of the generated gradient that are computed.
 
     Within the block, `renderer.fields.height`, `renderer.fields.exact_gradient`
     and this module's complex evaluation of h are replaced by wrappers that add
     the number of points of each call (the broadcast size of (u, v)) to a
-    `Counter`, which the block receives.  The originals are restored on exit,
-    also on error.  Code that captured the originals before the block (e.g.
-    ``from renderer.fields import height``) is not counted.
+    `Counter`, which the block receives.  Where the renderer computes the four
+    values of a central difference in one call (``fields.central_stencil``,
+    which shares the factors that do not move with the step), that call is
+    wrapped too and adds the number of values of h it returns.  The originals
+    are restored on exit, also on error.  Code that captured the originals
+    before the block (e.g. ``from renderer.fields import height``) is not
+    counted.
 
     Yields
     ------
@@ -391,6 +411,7 @@ def count_evaluations():
     counter = Counter()
     here = sys.modules[__name__]
     originals = (fields.height, fields.exact_gradient, here._complex_height)
+    stencil = getattr(fields, "central_stencil", None)
 
     def height(name, uu, vv, ku, kv):
         counter.h += int(np.broadcast(uu, vv).size)
@@ -405,10 +426,14 @@ def count_evaluations():
         return originals[2](name, uu, vv, ku, kv, continued)
 
     fields.height, fields.exact_gradient, here._complex_height = height, exact_gradient, complex_height
+    if stencil is not None:
+        fields.central_stencil = lambda name: _CountingStencil(stencil(name), counter)
     try:
         yield counter
     finally:
         fields.height, fields.exact_gradient, here._complex_height = originals
+        if stencil is not None:
+            fields.central_stencil = stencil
 
 
 # --- the measurement -----------------------------------------------------------------------
@@ -544,19 +569,19 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     Raises
     ------
     RuntimeError
-        If the instrumentation counted no evaluation of h for the central
-        difference (the renderer no longer calls `renderer.fields.height`;
-        the counts would be meaningless).
+        If the instrumentation counted no value of h for the central
+        difference (the renderer no longer computes h through
+        `renderer.fields`; the counts would be meaningless).
 
     Notes
     -----
-    Per field: one instrumented run of every method at the reference pixels
+    Per field, one instrumented run of every method at the reference pixels
     gives the errors and the counts (for the plain difference quotients the
     count per pixel does not depend on the pixel; for scipy's adaptive
-    iteration it does, and a sample's mean is reported in `FAST`); then
-    ``config.repeats`` rounds time every method on all pixels, uninstrumented,
-    in an order shuffled each round so that drifts of the machine's speed
-    fall on all methods alike.
+    iteration it does, and a sample's mean is reported in `FAST`).  Then
+    ``config.repeats`` rounds time every (field, method) pair on all pixels,
+    uninstrumented, in an order shuffled each round, so that drifts of the
+    machine's speed fall on all of them alike.
     """
     t_start = time.perf_counter()
     rng = np.random.default_rng(config.seed)
@@ -564,6 +589,7 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     ku, kv = float(scene.k_u), float(scene.k_v)
     results, n_ref, n_excl, h_times = [], {}, {}, {}
     pixels = None
+    checked, timed = [], []
     for name in fields_:
         u, v = chart_points(name, config.size) if uv is None else uv
         pixels = u.size
@@ -578,9 +604,8 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
         ru, rv = u[pick].copy(), v[pick].copy()
         hi, lo = reference_gradient(name, ru, rv, ku, kv, digits=config.digits)
 
-        specs = methods(name, config, ku, kv)
-        checked = []
-        for method, eps, valid, fn, note in specs:
+        # Errors and counts: one instrumented run of every method at the reference pixels.
+        for method, eps, valid, fn, note in methods(name, config, ku, kv):
             info = {}
             with count_evaluations() as counter:
                 if method == "richardson":
@@ -588,31 +613,34 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
                 else:
                     approx = fn(ru, rv)
             if method == "central" and counter.h == 0:
-                raise RuntimeError("central_gradient no longer calls renderer.fields.height; "
-                                   "the evaluation counts would be meaningless")
+                raise RuntimeError("central_gradient no longer calls renderer.fields.height or "
+                                   "fields.central_stencil; the evaluation counts would be meaningless")
             if info.get("not_converged"):
                 note = (note + "; " if note else "") + \
                     f"{info['not_converged']} of {2 * ru.size} components not converged"
-            checked.append((method, eps, valid, fn, note, counter, _errors(approx, hi, lo)))
+            checked.append((name, method, eps, valid, note, counter, ru.size, _errors(approx, hi, lo)))
+            timed.append((fn, u, v, config.richardson_repeats if method == "richardson" else config.repeats))
+        # One evaluation of h alone, timed with the methods as a unit of cost.
+        timed.append((lambda uu, vv, name=name: fields.height(name, uu, vv, ku, kv), u, v, config.repeats))
 
-        # Timing: every method on all pixels, uninstrumented, interleaved.
-        # The last entry times one evaluation of h alone, as a unit of cost.
-        timed = [spec[3] for spec in specs] + [lambda u, v: fields.height(name, u, v, ku, kv)]
-        times = [[] for _ in timed]
-        quota = [config.richardson_repeats if spec[0] == "richardson" else config.repeats
-                 for spec in specs] + [config.repeats]
-        for _ in range(max(quota)):
-            for k in rng.permutation(len(timed)):
-                if len(times[k]) == quota[k]:
-                    continue
-                t0 = time.perf_counter()
-                timed[k](u, v)
-                times[k].append(time.perf_counter() - t0)
-        h_times[name] = tuple(times.pop())
-        for (method, eps, valid, _, note, counter, (emax, erms)), ts in zip(checked, times):
-            results.append(MethodResult(
-                name, method, eps, valid, tuple(ts), counter.h / ru.size, counter.h_complex / ru.size,
-                counter.gradient / ru.size, emax, erms, note))
+    # Timing: every (field, method) on all pixels, uninstrumented, in an order shuffled
+    # every round, so that changes in the machine's load fall on all of them alike.
+    times = [[] for _ in timed]
+    for _ in range(max(q for *_, q in timed)):
+        for k in rng.permutation(len(timed)):
+            fn, uu, vv, quota = timed[k]
+            if len(times[k]) == quota:
+                continue
+            t0 = time.perf_counter()
+            fn(uu, vv)
+            times[k].append(time.perf_counter() - t0)
+    it = iter(times)            # same order as `timed`: per field, its methods, then h
+    for name in fields_:
+        for entry in [c for c in checked if c[0] == name]:
+            _, method, eps, valid, note, counter, n, (emax, erms) = entry
+            results.append(MethodResult(name, method, eps, valid, tuple(next(it)), counter.h / n,
+                                        counter.h_complex / n, counter.gradient / n, emax, erms, note))
+        h_times[name] = tuple(next(it))
     machine = {"python": platform.python_version(), "numpy": np.__version__,
                "scipy": sys.modules["scipy"].__version__, "cpus": os.cpu_count(),
                "processor": platform.processor() or platform.machine()}
@@ -683,9 +711,10 @@ def pareto_figure(measurement, *, error="max"):
     """Log-log plot of time per frame against error, one panel per field.
 
     Each point is a method at its median time, with a horizontal bar from the
-    fastest to the slowest run; difference sweeps are joined in order of eps;
-    the Pareto front is the grey staircase.  Methods whose premise fails on a
-    field are drawn hollow.
+    fastest to the slowest run; difference sweeps are joined in order of eps
+    (steps labelled when a sweep has at most six); the Pareto front is the
+    grey staircase.  Methods whose premise fails on a field are drawn hollow.
+    An error of exactly 0 would be drawn at 1e-18.
 
     Parameters
     ----------
@@ -698,40 +727,45 @@ def pareto_figure(measurement, *, error="max"):
     """
     from matplotlib.figure import Figure
     names = list(dict.fromkeys(r.field for r in measurement.results))
-    fig = Figure(figsize=(4.0 * len(names), 3.9), layout="constrained")
+    fig = Figure(figsize=(3.4 * len(names), 3.7))
+    fig.subplots_adjust(left=0.07, right=0.99, top=0.92, bottom=0.24, wspace=0.06)
     axes = fig.subplots(1, len(names), sharey=True, squeeze=False)[0]
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
+    handles = {}
     for ax, name in zip(axes, names):
         rs = measurement.of(name)
         front = pareto_front(rs, error=error)
         ft = [1e3 * r.median for r in front]
         fe = [_floor(pick(r)) for r in front]
-        t_end = 2e3 * max(r.t_max for r in rs)
-        ax.step(ft + [t_end], fe + [fe[-1]], where="post", color="0.75", lw=4,
-                zorder=0, label="Pareto front" if name == names[0] else None)
+        t_lo, t_hi = 0.5e3 * min(r.t_min for r in rs), 2e3 * max(r.t_max for r in rs)
+        handles["Pareto front"], = ax.step(ft + [t_hi], fe + [fe[-1]], where="post", color="0.75",
+                                           lw=4, zorder=0)
         for method in dict.fromkeys(r.method for r in rs):
             group = [r for r in rs if r.method == method]
             color, marker, ms = _STYLE.get(method, ("k", "x", 5))
             t = np.array([1e3 * r.median for r in group])
             e = np.array([_floor(pick(r)) for r in group])
-            if len(group) > 1:
-                ax.plot(t, e, color=color, lw=0.8, alpha=0.6)
-            for r, ti, ei in zip(group, t, e):
-                ax.errorbar(ti, ei, xerr=[[ti - 1e3 * r.t_min], [1e3 * r.t_max - ti]], color=color,
-                            lw=0.8, capsize=0)
-                ax.plot(ti, ei, marker=marker, ms=ms, color=color, ls="none",
-                        mfc=color if r.valid else "white")
-            ax.plot([], [], marker=marker, color=color, ls="-" if len(group) > 1 else "none",
-                    label=method if name == names[0] or method.endswith("continued") else None)
+            ax.hlines(e, [1e3 * r.t_min for r in group], [1e3 * r.t_max for r in group], color=color,
+                      lw=0.8)
+            ok = np.array([r.valid for r in group])
+            line, = ax.plot(t, e, color=color, lw=0.8 if len(group) > 1 else 0, alpha=0.7,
+                            marker=marker, ms=ms, markevery=list(np.flatnonzero(ok)))
+            ax.plot(t[~ok], e[~ok], ls="none", marker=marker, ms=ms, color=color, mfc="white")
+            handles.setdefault(method, line)
+            if 1 < len(group) <= 6:
+                for r, ti, ei in zip(group, t, e):
+                    ax.annotate(f"{r.eps:.0e}", (ti, ei), xytext=(-5, -2), textcoords="offset points",
+                                fontsize=6, color=color, ha="right")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlim(0.5 * min(1e3 * r.t_min for r in rs), 2 * max(1e3 * r.t_max for r in rs))
-        ax.set_title(name + ("" if ANALYTIC[name] else " (not analytic; errors off the crease band)"),
-                     fontsize=9)
-        ax.set_xlabel("time per frame (ms), median and min-max")
-        ax.grid(alpha=0.3, which="both", lw=0.3)
-    axes[0].set_ylabel(f"{error} |error| of (h_u, h_v)")
-    fig.legend(loc="outside lower center", ncols=7, fontsize=8, frameon=False)
+        ax.set_xlim(t_lo, t_hi)
+        ax.set_title(name + ("" if ANALYTIC[name] else " (not analytic; off the crease band)"), fontsize=9)
+        ax.set_xlabel("time per frame, ms", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3, lw=0.3)
+    axes[0].set_ylabel(f"{error} |error| of (h_u, h_v)", fontsize=8)
+    fig.legend(list(handles.values()), list(handles), loc="lower center", ncols=4, fontsize=7,
+               frameon=False)
     return fig
 
 
