@@ -19,14 +19,14 @@ into the page's cache key.  This script shows, by building, that
   the two pages' sources touched so Sphinx even re-reads them, is served from
   the cache, stale.
 
-Everything happens in a scratch copy (``git clone`` of this repository's HEAD,
-or with --worktree its working tree) with PYTHONPATH set to the copy, so the
+Everything happens in a scratch copy (``git clone`` of this repository at HEAD
+or --rev, or with --worktree its working tree) with PYTHONPATH set to the copy, so the
 copy's renderer/ and proofs/ are the ones imported (checked); this checkout is
 never touched.  Each build is the Makefile's ``book`` target
 (``make -o .venv/.installed BIN=<this venv>/bin book``: the venv is used as
 installed, not re-installed).  Results go to benchmarks/results/book_build.md.
 
-Usage: python benchmarks/bench_book.py [--worktree] [--no-control] [--keep] [--out FILE]
+Usage: python benchmarks/bench_book.py [--rev REV | --worktree] [--no-control] [--keep] [--out FILE]
 """
 
 from __future__ import annotations
@@ -148,9 +148,10 @@ def _edit(path, old, new):
     path.write_text(text.replace(old, new, 1), encoding="utf-8")
 
 
-def _scratch_copy(dest, worktree):
+def _scratch_copy(dest, worktree, rev):
     if not worktree:
         subprocess.run(["git", "clone", "--quiet", str(ROOT), str(dest)], check=True)
+        subprocess.run(["git", "checkout", "--quiet", rev], cwd=dest, check=True)
         return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=dest, check=True,
                               capture_output=True, text=True).stdout.strip()
     files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=ROOT, check=True,
@@ -166,7 +167,8 @@ def _scratch_copy(dest, worktree):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--worktree", action="store_true", help="copy the working tree instead of cloning HEAD")
+    parser.add_argument("--rev", default="HEAD", help="the commit to clone (default HEAD)")
+    parser.add_argument("--worktree", action="store_true", help="copy the working tree instead of a commit")
     parser.add_argument("--no-control", action="store_true", help="skip the build without nb_deps")
     parser.add_argument("--keep", action="store_true", help="keep the scratch copy")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "book_build.md")
@@ -175,7 +177,7 @@ def main(argv=None):
     scratch = Path(tempfile.mkdtemp(prefix="bench_book_"))
     repo = scratch / "repo"
     repo.mkdir()
-    source = _scratch_copy(repo, args.worktree)
+    source = _scratch_copy(repo, args.worktree, args.rev)
     book = Book(repo)
     imported = book.check_imports()
     rows, failures = [], []
