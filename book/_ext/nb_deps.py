@@ -43,7 +43,6 @@ import hashlib
 import json
 import re
 from contextlib import suppress
-from fnmatch import fnmatch
 from importlib.util import find_spec
 from pathlib import Path
 from typing import Iterable, Mapping
