@@ -116,7 +116,7 @@ def imported_names(tree: ast.AST, *, package: str = "") -> set[str]:
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 parts = package.split(".") if package else []
-                if node.level - 1 > len(parts) or not parts:
+                if node.level - 1 >= len(parts):
                     continue                       # beyond the top package: not ours
                 base = ".".join(parts[:len(parts) - (node.level - 1)])
                 module = f"{base}.{node.module}" if node.module else base
