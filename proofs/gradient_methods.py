@@ -540,7 +540,7 @@ def methods(name, config, ku, kv):
                     lambda u, v, eps=eps: complex_step_gradient(name, u, v, ku, kv, eps, continued=True),
                     "|f| evaluated as f sign(Re f); one-sided on the crease"))
     out.append(("richardson", None, True, lambda u, v: richardson_gradient(name, u, v, ku, kv),
-                "scipy.differentiate.derivative, order 8"))
+                f"scipy.differentiate.derivative, order {RICHARDSON['order']}"))
     return out
 
 
@@ -584,6 +584,7 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     machine's speed fall on all of them alike.
     """
     t_start = time.perf_counter()
+    load_start = os.getloadavg() if hasattr(os, "getloadavg") else None
     rng = np.random.default_rng(config.seed)
     scene = Scene()
     ku, kv = float(scene.k_u), float(scene.k_v)
@@ -643,7 +644,8 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
         h_times[name] = tuple(next(it))
     machine = {"python": platform.python_version(), "numpy": np.__version__,
                "scipy": sys.modules["scipy"].__version__, "cpus": os.cpu_count(),
-               "processor": platform.processor() or platform.machine()}
+               "processor": platform.processor() or platform.machine(),
+               "load_average_1_5_15_min_at_start": load_start}
     return Measurement(config, tuple(results), int(pixels), n_ref, n_excl, h_times,
                        time.perf_counter() - t_start, ku, kv, machine)
 
