@@ -1,7 +1,7 @@
 """Render speed and scaling, measured side by side in one run.
 
 * time (median, min-max) of both pipelines from 64^2 to 4096^2, and peak
-  working memory (tracemalloc, beyond the returned frame) at each size;
+  memory (tracemalloc) at each size, with the part beyond the returned frame;
 * the speed-up over the scalar per-pixel reference of tests/ at 64^2;
 * an 8-step eps sweep at 256^2 (both pipelines and the census), against the
   same frames rendered independently;
@@ -111,15 +111,16 @@ def main(argv=None):
     res["gradient_stage"] = stage
 
     lines = ["## Scaling (default scene; ms, median and min-max)", "",
-             "| size | exact | central | exact, image only | peak working MiB | bytes/pixel |",
-             "|---|---|---|---|---|---|"]
+             "| size | exact | central | exact, image only | output MiB | peak MiB | peak beyond the output, MiB |",
+             "|---|---|---|---|---|---|---|"]
     for size in [s for s in SIZES if s <= args.max_size]:
         cells = []
         for k in ("exact", "central", "exact, image only"):
             r = res["scaling"][f"{k}@{size}"]
             cells.append(f"{1e3 * r['median']:.1f} ({1e3 * r['min']:.1f}-{1e3 * r['max']:.1f})")
         m = res["memory"][size]
-        lines.append(f"| {size}² | " + " | ".join(cells) + f" | {m['peak'] / 2**20:.0f} | {m['per_pixel']:.0f} |")
+        lines.append(f"| {size}² | " + " | ".join(cells) + f" | {m['output'] / 2**20:.1f} | "
+                     f"{m['peak'] / 2**20:.1f} | {(m['peak'] - m['output']) / 2**20:.1f} |")
     lines += ["", "## Scalar per-pixel reference at 64² (same run)", "", "| pipeline | reference ms | numpy ms | speed-up |",
               "|---|---|---|---|"]
     for p in PIPELINES:
