@@ -22,8 +22,9 @@ import numpy as np
 from . import fields
 from .geometry import image_plane
 from .ledger import compare
-from .render import (FLOOR, SPHERE_A, TILE_PIXELS, Frame, _check_args, _gradient, _lights,
-                     _nearest_hit, _prepare_a, _shade, _shading_normal, _surfaces, _trace_shadows)
+from .render import (FLOOR, SPHERE_A, TILE_PIXELS, Frame, _check_args, _check_workers, _gradient,
+                     _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal,
+                     _surfaces, _trace_shadows)
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS"]
 
@@ -62,7 +63,7 @@ def _check_steps(eps_values):
     return tuple(steps)
 
 
-def sweep(scene, eps_values, width, height, *, zoom=1.0):
+def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
     """Render the symbolic frame and one numeric frame per step, sharing the geometry.
 
     Parameters
@@ -72,6 +73,7 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0):
     eps_values : sequence of float > 0 (1 to 64 of them), chart units
     width, height : int in [1, 8192]
     zoom : float in [1, 1e6], keyword-only (see `render`)
+    workers : int >= 1, keyword-only (see `render`)
 
     Returns
     -------
@@ -93,6 +95,7 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0):
     "bump moves no boundary" (seed §3).
     """
     scene, width, height, _, zoom = _check_args(scene, width, height, "exact", zoom)
+    workers = _check_workers(workers)
     steps = _check_steps(eps_values)
     scenes = [scene.replace(eps=e) for e in steps]
 
@@ -108,7 +111,7 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0):
             for f in frames]
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     rows = max(1, TILE_PIXELS // width)
-    for j0 in range(0, height, rows):
+    def tile(j0):
         j1 = min(height, j0 + rows)
         X = np.tile(x, j1 - j0)
         Y = np.repeat(y[j0:j1], width)
@@ -144,5 +147,6 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0):
                     image[rows_idx, c] = np.clip(col[c], 0.0, 1.0)
                 grad_out[rows_idx, 0], grad_out[rows_idx, 1] = surf.grad
                 kink_out[rows_idx] = kink
+    _run_tiles([lambda j0=j0: tile(j0) for j0 in range(0, height, rows)], workers)
     census = tuple(compare(f, symbolic) for f in numeric)
     return Sweep(eps=steps, numeric=tuple(numeric), symbolic=symbolic, census=census)

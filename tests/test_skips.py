@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import importlib
+import threading
 
 from renderer import PointLight, Scene, fields, render, sweep
 
@@ -64,12 +65,14 @@ class Counter:
     def __init__(self, fn, key=None, points_arg=0):
         self.fn, self.key, self.calls, self.points, self.keys = fn, key, 0, 0, []
         self.points_arg = points_arg
+        self.lock = threading.Lock()          # tiles render on several threads
 
     def __call__(self, *args, **kwargs):
-        self.calls += 1
-        self.points += int(np.size(args[self.points_arg]))
-        if self.key is not None:
-            self.keys.append(self.key(*args))
+        with self.lock:
+            self.calls += 1
+            self.points += int(np.size(args[self.points_arg]))
+            if self.key is not None:
+                self.keys.append(self.key(*args))
         return self.fn(*args, **kwargs)
 
 
@@ -170,3 +173,19 @@ def test_sweep_shades_geometry_once(count):
 def test_sweep_rejects_bad_steps(bad, match):
     with pytest.raises((TypeError, ValueError), match=match):
         sweep(Scene(), bad, 8, 8)
+
+
+@pytest.mark.parametrize("workers", [2, 3])
+def test_threads_give_the_same_bits(workers):
+    scene = SCENES["default"]
+    big = (200, 170)                                  # several tiles
+    assert _same(render(scene, *big, workers=1), render(scene, *big, workers=workers))
+    a = sweep(scene, (1e-2, 1e-6), *big, workers=1)
+    b = sweep(scene, (1e-2, 1e-6), *big, workers=workers)
+    assert all(_same(x, y) for x, y in zip(a.numeric + (a.symbolic,), b.numeric + (b.symbolic,)))
+
+
+@pytest.mark.parametrize("bad", [0, -1, 65, 1.5, True, "2"])
+def test_bad_workers_are_refused(bad):
+    with pytest.raises(ValueError, match="workers"):
+        render(Scene(), 8, 8, workers=bad)
