@@ -38,19 +38,25 @@ TILE_PIXELS = 1 << 14
 #: Threads that render tiles side by side (numpy releases the GIL inside its
 #: loops).  Tiles write disjoint slices, so the image does not depend on it.
 WORKERS = max(1, min(4, os.cpu_count() or 1))
-_POOL = None
+_POOL, _POOL_SIZE = None, 0
 
 
 def _run_tiles(jobs, workers):
-    """Run the tile jobs (callables), on ``workers`` threads when there are several."""
-    global _POOL
+    """Run the tile jobs (callables), on ``workers`` threads when there are several.
+
+    An exception in a job propagates to the caller (the first one, after all
+    submitted jobs have finished or failed).
+    """
+    global _POOL, _POOL_SIZE
     if workers <= 1 or len(jobs) <= 1:
         for job in jobs:
             job()
         return
-    if _POOL is None or _POOL._max_workers < workers:
+    if _POOL is None or _POOL_SIZE < workers:
         _POOL = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="symrender-tile")
-    for future in [_POOL.submit(job) for job in jobs]:
+        _POOL_SIZE = workers
+    futures = [_POOL.submit(job) for job in jobs]
+    for future in futures:
         future.result()
 
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
