@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from renderer import Scene, compare, fields, gbuffer, render, sweep  # noqa: E402
-from renderer.render import central_gradient  # noqa: E402
+from renderer.render import WORKERS, central_gradient  # noqa: E402
 from tests.scalar_reference import render_reference  # noqa: E402
 
 SIZES = (64, 128, 256, 512, 1024, 2048, 4096)
@@ -80,6 +80,8 @@ def main(argv=None):
         reps = args.repeats if size <= 256 else max(3, args.repeats // 3) if size <= 1024 else 3
         fns = {p: (lambda p=p: render(scene, size, size, gradient=p)) for p in PIPELINES}
         fns["exact, image only"] = lambda: render(scene, size, size, kink=False, grad=False)
+        if size <= 1024:
+            fns["exact, 1 thread"] = lambda: render(scene, size, size, workers=1)
         for k, st in _interleaved(fns, reps).items():
             res["scaling"][f"{k}@{size}"] = st
         peak, held = _peak_working_bytes(lambda: render(scene, size, size, kink=False, grad=False))
@@ -111,13 +113,16 @@ def main(argv=None):
     res["gradient_stage"] = stage
 
     lines = ["## Scaling (default scene; ms, median and min-max)", "",
-             "| size | exact | central | exact, image only | output MiB | peak MiB | peak beyond the output, MiB |",
-             "|---|---|---|---|---|---|---|"]
+             f"Tiles render on {WORKERS} threads unless stated.", "",
+             "| size | exact | central | exact, image only | exact, 1 thread | output MiB | peak MiB | "
+             "peak beyond the output, MiB |",
+             "|---|---|---|---|---|---|---|---|"]
     for size in [s for s in SIZES if s <= args.max_size]:
         cells = []
-        for k in ("exact", "central", "exact, image only"):
-            r = res["scaling"][f"{k}@{size}"]
-            cells.append(f"{1e3 * r['median']:.1f} ({1e3 * r['min']:.1f}-{1e3 * r['max']:.1f})")
+        for k in ("exact", "central", "exact, image only", "exact, 1 thread"):
+            r = res["scaling"].get(f"{k}@{size}")
+            cells.append("—" if r is None else
+                         f"{1e3 * r['median']:.1f} ({1e3 * r['min']:.1f}-{1e3 * r['max']:.1f})")
         m = res["memory"][size]
         lines.append(f"| {size}² | " + " | ".join(cells) + f" | {m['output'] / 2**20:.1f} | "
                      f"{m['peak'] / 2**20:.1f} | {(m['peak'] - m['output']) / 2**20:.1f} |")

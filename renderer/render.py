@@ -44,8 +44,7 @@ _POOL, _POOL_SIZE = None, 0
 def _run_tiles(jobs, workers):
     """Run the tile jobs (callables), on ``workers`` threads when there are several.
 
-    An exception in a job propagates to the caller (the first one, after all
-    submitted jobs have finished or failed).
+    An exception raised in a job is raised again here, in the caller.
     """
     global _POOL, _POOL_SIZE
     if workers <= 1 or len(jobs) <= 1:
