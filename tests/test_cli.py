@@ -326,7 +326,9 @@ def test_huge_size_refused_before_allocating(tmp_path, capsys, monkeypatch):
 
 def test_sweep_formats_match_renderer_sweep(capsys):
     steps = cli.parse_eps("1e-1:1e-6:6")
-    np.testing.assert_array_equal(steps, np.logspace(-1, -6, 6))
+    np.testing.assert_allclose(steps, np.logspace(-1, -6, 6), rtol=1e-15)
+    assert steps == (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)  # decades exactly (15-digit rounding)
+    assert cli.parse_eps("1e-3, 2e-4") == (1e-3, 2e-4)
     ref = sweep(Scene(), steps, 40, 32).census
     rc, out, err = run(["sweep", "--eps", "1e-1:1e-6:6", "--size", "40x32", "--format", "csv"], capsys)
     assert rc == 0 and err == ""
@@ -365,7 +367,7 @@ def test_ucurve_table_matches_measure(tmp_path, capsys):
     rc, out, err = run(["ucurve", "--field", "sine", "--u", "0.31", "--v", "0.47", "--component", "u",
                         "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
     assert rc == 0 and err == ""
-    uc = measure("sine", 0.31, 0.47, "u", eps=np.logspace(-1, -12, 12))
+    uc = measure("sine", 0.31, 0.47, "u", eps=cli.parse_eps("1e-1:1e-12:12", max_steps=100))
     rows = [line.split() for line in out.splitlines() if line.split()[0][:1].isdigit()]
     assert len(rows) == 12
     for r, e, t, ro, er in zip(rows, uc.eps, uc.truncation, uc.roundoff, uc.error):
@@ -392,6 +394,21 @@ def test_verify_runs_the_proof_checker(capsys):
     assert rc == 0 and "theorem ledger" in out and "frame-orthonormal" in out and "proved" in out
     # pytest's "no tests collected" (5) comes through.
     assert run(["verify", "-k", "no_such_test_anywhere"], capsys)[0] == 5
+
+
+class ClosedPipe(io.StringIO):
+    def write(self, text):
+        raise BrokenPipeError(32, "Broken pipe")
+
+
+def test_broken_pipe_is_quiet(capsys, monkeypatch):
+    monkeypatch.setattr(sys, "stdout", ClosedPipe())
+    rc = main(["sweep", "--size", "8x8", "--eps", "1e-2"])
+    assert rc == 1 and capsys.readouterr().err == ""
+    # Wrong variant: any other OSError on output is still reported.
+    monkeypatch.setattr(ClosedPipe, "write", lambda self, t: (_ for _ in ()).throw(OSError(5, "I/O error")))
+    rc = main(["sweep", "--size", "8x8", "--eps", "1e-2"])
+    assert rc == 2 and capsys.readouterr().err == "symrender: error: I/O error\n"
 
 
 def test_verify_passes_the_exit_code_through(capsys, monkeypatch):
