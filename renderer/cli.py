@@ -8,6 +8,7 @@ Subcommands (``symrender <command> --help`` for each)::
                       [--format text|csv|json]
     symrender ucurve  --field sine --u 0.31 --v 0.47 --component u [--eps ...] [--plot out.png]
     symrender verify  [-k EXPR]
+    symrender figures --out DIR [--pages s1,s4] | --check DIR [--ignore ID-PATTERN ...]
 
 Errors.  Every input error (a bad argument, a malformed or unknown scene key, a
 value `Scene` refuses, a size over the limits, an output path that cannot be
@@ -33,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import hashlib
 import io
 import json
 import math
@@ -566,6 +568,228 @@ def _cmd_verify(args, out):
     return proc.returncode
 
 
+# ---------------------------------------------------------------- figures
+
+
+def _book_pages(book):
+    """Page names of the book in table-of-contents order (book/_toc.yml)."""
+    import yaml
+    toc = yaml.safe_load((book / "_toc.yml").read_text())
+    pages = [toc["root"]]
+    for ch in toc.get("chapters", []):
+        pages.append(ch["file"])
+    return pages
+
+
+def _code_version(root):
+    """The code a run used: git commit (and whether the tree differs from it)
+    and a SHA-256 over the sources that make figures (renderer/, proofs/, book
+    pages), so a manifest says which code it came from without timestamps."""
+    digest = hashlib.sha256()
+    files = sorted([*root.glob("renderer/**/*.py"), *root.glob("renderer/js/*.js"),
+                    *root.glob("proofs/*.py"), *root.glob("book/*.md"), *root.glob("book/_toc.yml")])
+    for f in files:
+        digest.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+    version = {"source_sha256": digest.hexdigest(), "git_commit": None, "git_dirty": None}
+    try:
+        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True)
+        if head.returncode == 0:
+            version["git_commit"] = head.stdout.strip()
+            st = subprocess.run(["git", "status", "--porcelain", "--", "renderer", "proofs", "book"],
+                                cwd=root, capture_output=True, text=True)
+            version["git_dirty"] = bool(st.stdout.strip()) if st.returncode == 0 else None
+    except OSError:
+        pass
+    return version
+
+
+def _png_pixels(data):
+    """Decode PNG bytes to an (H, W, 4) uint8 RGBA array."""
+    import matplotlib.image
+    rgba = matplotlib.image.imread(io.BytesIO(data), format="png")
+    if rgba.dtype != np.uint8:
+        rgba = np.round(np.clip(rgba, 0, 1) * 255).astype(np.uint8)
+    if rgba.ndim == 2:
+        rgba = np.repeat(rgba[..., None], 3, axis=2)
+    if rgba.shape[2] == 3:
+        rgba = np.concatenate([rgba, np.full(rgba.shape[:2] + (1,), 255, np.uint8)], axis=2)
+    return rgba
+
+
+def _page_figures(book, page):
+    """Execute one book page (a MyST notebook) in a fresh kernel; yield
+    (figure id, code-cell ordinal, cell source, PNG bytes) for every PNG it
+    displays or glues.
+
+    Raises
+    ------
+    UsageError
+        If a cell fails (the page's exception, in one line).
+    """
+    import base64
+
+    import nbclient
+    from myst_nb.core.read import read_myst_markdown_notebook
+
+    path = book / f"{page}.md"
+    nb = read_myst_markdown_notebook(path.read_text(encoding="utf-8"), path=path)
+    client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
+                                     resources={"metadata": {"path": str(book)}})
+    try:
+        client.execute(stderr=subprocess.DEVNULL)
+    except nbclient.exceptions.CellExecutionError as exc:
+        raise UsageError(f"figures: page {page} failed: {exc.ename}: {exc.evalue}") from None
+    ordinal = 0
+    for cell in nb.cells:
+        if cell.cell_type != "code":
+            continue
+        ordinal += 1
+        j = 0
+        for o in cell.get("outputs", []):
+            data = o.get("data", {})
+            key = next((k for k in data if k == "image/png" or k.endswith("record/image/png")), None)
+            if key is None:
+                continue
+            glue = (o.get("metadata", {}).get("scrapbook", {}) or {}).get("name")
+            j += 1
+            fid = f"{page}-{glue}" if glue else f"{page}-cell{ordinal:02d}-{j}"
+            yield fid, ordinal, cell.source, base64.b64decode(data[key])
+
+
+def _resolve_pages(pages):
+    """The book's pages to run: all (None) or the named ones, by name or by
+    section prefix (s4 -> s4_simulator)."""
+    book = _repo_root() / "book"
+    if not (book / "_toc.yml").is_file():
+        raise UsageError(f"figures needs a source checkout: {str(book / '_toc.yml')!r} not found")
+    all_pages = _book_pages(book)
+    if pages is None:
+        return all_pages
+    resolved = []
+    for p in pages:  # a page by name or by its section prefix: s4 -> s4_simulator
+        match = [q for q in all_pages if q == p or q.startswith(f"{p}_")]
+        if len(match) != 1:
+            raise UsageError(f"--pages: unknown page {p!r}; pages are {', '.join(all_pages)}")
+        resolved.append(match[0])
+    return resolved
+
+
+def _render_figures(out_dir, pages):
+    """Execute the book's ``pages`` and write every figure into ``out_dir``
+    (PNG, re-encoded from its pixels without metadata) plus ``manifest.json``.
+    Returns the manifest (a dict)."""
+    root = _repo_root()
+    book = root / "book"
+    figures = []
+    for page in _progress(pages, desc="figures", unit="page"):
+        for fid, ordinal, source, png in _page_figures(book, page):
+            rgba = _png_pixels(png)
+            name = f"{fid}.png"
+            atomic_write(out_dir / name, _png_bytes_writer(rgba))
+            data = (out_dir / name).read_bytes()
+            figures.append({"id": fid, "page": page, "code_cell": ordinal, "file": name,
+                            "width": int(rgba.shape[1]), "height": int(rgba.shape[0]),
+                            "sha256": hashlib.sha256(data).hexdigest(),
+                            "cell_sha256": hashlib.sha256(source.encode()).hexdigest()})
+    manifest = {"code_version": _code_version(root), "pages": list(pages), "figures": figures}
+    text = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
+    atomic_write(out_dir / "manifest.json", lambda f: f.write(text.encode()))
+    return manifest
+
+
+def _write_figures_staged(out_dir, pages):
+    """Run `_render_figures` into a staging directory beside ``out_dir``, then
+    move the result in (the whole directory if ``out_dir`` is new, else file by
+    file with manifest.json last).  A failed or interrupted run removes the
+    staging directory and leaves ``out_dir`` as it was."""
+    import shutil
+    staging = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}.", suffix=".part"))
+    try:
+        manifest = _render_figures(staging, pages)
+        os.chmod(staging, 0o777 & ~_umask())
+        if not out_dir.exists():
+            os.replace(staging, out_dir)
+        else:
+            names = sorted(p.name for p in staging.iterdir() if p.name != "manifest.json")
+            for name in [*names, "manifest.json"]:
+                os.replace(staging / name, out_dir / name)
+        return manifest
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+def _load_manifest(old_dir):
+    path = Path(old_dir) / "manifest.json"
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        figures = {f["id"]: f for f in doc["figures"]}
+        pages = list(doc["pages"])
+    except OSError as exc:
+        raise UsageError(f"--check: cannot read {str(path)!r}: {exc.strerror or exc}") from None
+    except (ValueError, KeyError, TypeError) as exc:
+        raise UsageError(f"--check: {str(path)!r} is not a symrender manifest ({exc})") from None
+    return doc, figures, pages
+
+
+def _cmd_figures(args, out):
+    import fnmatch
+    pages = None if args.pages is None else [p.strip() for p in args.pages.split(",") if p.strip()]
+    if args.check is None:
+        out_dir = Path(args.out)
+        if out_dir.exists() and not out_dir.is_dir():
+            raise UsageError(f"--out {args.out!r} is not a directory")
+        if not out_dir.parent.is_dir():
+            raise UsageError(f"--out {args.out!r}: directory {str(out_dir.parent)!r} does not exist")
+        pages = _resolve_pages(pages)
+        manifest = _write_figures_staged(out_dir, pages)
+        for f in manifest["figures"]:
+            print(f"{f['id']:40s} {f['width']:4d}x{f['height']:<4d} {f['sha256'][:16]}", file=out)
+        v = manifest["code_version"]
+        print(f"wrote {len(manifest['figures'])} figures and manifest.json to {out_dir} "
+              f"(code {v['git_commit'] or 'no git'}{' + local changes' if v['git_dirty'] else ''}, "
+              f"sources {v['source_sha256'][:16]})", file=out)
+        return 0
+    old_doc, old, old_pages = _load_manifest(args.check)
+    pages = _resolve_pages(old_pages if pages is None else pages)
+    with tempfile.TemporaryDirectory(prefix="symrender-figures-") as tmp:
+        tmp = Path(tmp)
+        new_doc = _render_figures(tmp, pages)
+        new = {f["id"]: f for f in new_doc["figures"]}
+        changed = 0
+        ignored = lambda fid: any(fnmatch.fnmatchcase(fid, pat) for pat in args.ignore)  # noqa: E731
+        for fid in sorted(set(old) | set(new), key=lambda i: (i not in new, i)):
+            tag = " (ignored)" if ignored(fid) else ""
+            if fid not in new:
+                print(f"removed    {fid}{tag}", file=out)
+            elif fid not in old:
+                print(f"added      {fid}{tag}", file=out)
+            elif old[fid]["sha256"] == new[fid]["sha256"]:
+                print(f"unchanged  {fid}", file=out)
+                continue
+            else:
+                try:
+                    a = _png_pixels((Path(args.check) / old[fid]["file"]).read_bytes())
+                except OSError:
+                    a = None
+                b = _png_pixels((tmp / new[fid]["file"]).read_bytes())
+                if a is None:
+                    how = "previous file missing"
+                elif a.shape != b.shape:
+                    how = f"size {a.shape[1]}x{a.shape[0]} -> {b.shape[1]}x{b.shape[0]}"
+                else:
+                    d = np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=2)
+                    how = f"max |dI| = {d.max() / 255:.4f} ({np.count_nonzero(d):,} pixels differ)"
+                print(f"changed    {fid}: {how}{tag}", file=out)
+            if not tag:
+                changed += 1
+    ov, nv = old_doc.get("code_version", {}), new_doc["code_version"]
+    print(f"code: previous {str(ov.get('git_commit'))[:12]} sources {str(ov.get('source_sha256'))[:16]}; "
+          f"now {str(nv['git_commit'])[:12]}{' + local changes' if nv['git_dirty'] else ''} "
+          f"sources {nv['source_sha256'][:16]}", file=out)
+    print(f"{changed} figure(s) changed" if changed else "no figure changed", file=out)
+    return 1 if changed else 0
+
+
 # ---------------------------------------------------------------- argument parser
 
 
@@ -650,10 +874,27 @@ def build_parser():
                        description="Runs `python -m pytest verify` from the repository root; exits with "
                                    "pytest's code.")
     v.add_argument("-k", metavar="EXPR", help="pytest -k expression (select theorems)")
+
+    f = sub.add_parser("figures", help="execute the book's pages; write every figure and a manifest, "
+                                       "or --check against a previous manifest",
+                       description="Execute each page of the book (book/_toc.yml order) in a fresh kernel "
+                                   "and write every PNG figure it displays or glues into DIR, re-encoded "
+                                   "without metadata, with manifest.json (figure id, page, code cell, "
+                                   "content hash, code version). --check DIR runs afresh and reports each "
+                                   "figure that changed and by how much (max |dI|), exiting 1 on a change.")
+    what = f.add_mutually_exclusive_group(required=True)
+    what.add_argument("--out", metavar="DIR", help="directory to write the figures and manifest.json into")
+    what.add_argument("--check", metavar="DIR", help="a previous --out directory to compare a fresh run with")
+    f.add_argument("--pages", metavar="s1,s4,...", help="only these pages (default: all; --check: those "
+                                                         "of the manifest)")
+    f.add_argument("--ignore", action="append", default=[], metavar="ID-PATTERN",
+                   help="with --check: report but do not fail on figures matching this pattern "
+                        "(e.g. timing plots); repeatable")
     return p
 
 
-_COMMANDS = {"render": _cmd_render, "sweep": _cmd_sweep, "ucurve": _cmd_ucurve, "verify": _cmd_verify}
+_COMMANDS = {"render": _cmd_render, "sweep": _cmd_sweep, "ucurve": _cmd_ucurve, "verify": _cmd_verify,
+             "figures": _cmd_figures}
 
 
 def _one_line(msg):
@@ -666,7 +907,8 @@ def main(argv=None) -> int:
     Returns 0 on success, 2 on any input error (one line ``symrender: error:
     ...`` on stderr, nothing written), 1 on an unanticipated error (one line
     ``symrender: internal error: ...``), 130 on Ctrl-C, 1 silently when stdout
-    is closed early (a broken pipe), and pytest's code for
+    is closed early (a broken pipe), 1 when ``figures --check`` finds a
+    changed figure, and pytest's code for
     ``verify``.  ``--help`` prints to stdout and returns 0.  Never raises.
     """
     argv = sys.argv[1:] if argv is None else list(argv)

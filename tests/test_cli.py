@@ -416,7 +416,7 @@ def test_verify_passes_the_exit_code_through(capsys, monkeypatch):
     assert run(["verify"], capsys)[0] == 3
 
 
-@pytest.mark.parametrize("command", ["render", "sweep", "ucurve", "verify"])
+@pytest.mark.parametrize("command", ["render", "sweep", "ucurve", "verify", "figures"])
 def test_help_on_each_subcommand(capsys, command):
     rc, out, err = run([command, "--help"], capsys)
     assert rc == 0 and out.startswith(f"usage: symrender {command}") and err == ""
@@ -529,3 +529,103 @@ def test_fuzz_reached_both_outcomes():
         pytest.skip("run together with test_fuzz_main")
     print(f"fuzz: {len(FUZZ_CODES)} runs, {FUZZ_CODES.count(0)} exit 0, {FUZZ_CODES.count(2)} exit 2")
     assert FUZZ_CODES.count(0) >= 10 and FUZZ_CODES.count(2) >= 10, (len(FUZZ_CODES), FUZZ_CODES.count(0))
+
+
+# ------------------------------------------------------------------ figures
+
+
+@pytest.fixture(scope="module")
+def s1_figures(tmp_path_factory):
+    """`symrender figures --out` of the real §1 page (one figure), run once."""
+    d = tmp_path_factory.mktemp("figs")
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = main(["figures", "--out", str(d / "a"), "--pages", "s1"])
+    assert rc == 0, err.getvalue()
+    return d / "a", out.getvalue()
+
+
+def copy_dir(src, dst):
+    import shutil
+    shutil.copytree(src, dst)
+    return dst
+
+
+def test_figures_writes_pngs_and_manifest(s1_figures, tmp_path, capsys):
+    a, stdout = s1_figures
+    doc = json.loads((a / "manifest.json").read_text())
+    assert [f["id"] for f in doc["figures"]] == ["s1_what_changes-cell01-1"]
+    fig = doc["figures"][0]
+    data = (a / fig["file"]).read_bytes()
+    import hashlib
+    assert hashlib.sha256(data).hexdigest() == fig["sha256"] and varying_chunks(data) == []
+    assert read_png(a / fig["file"]).shape == (fig["height"], fig["width"], 3)
+    assert len(doc["code_version"]["source_sha256"]) == 64 and "timestamp" not in json.dumps(doc)
+    assert "wrote 1 figures" in stdout
+    # A second run gives byte-identical files, the manifest included.
+    rc, _, _ = run(["figures", "--out", str(tmp_path / "b"), "--pages", "s1_what_changes"], capsys)
+    assert rc == 0
+    assert sorted(p.name for p in a.iterdir()) == sorted(p.name for p in (tmp_path / "b").iterdir())
+    for p in a.iterdir():
+        assert p.read_bytes() == (tmp_path / "b" / p.name).read_bytes(), p.name
+
+
+def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
+    a, _ = s1_figures
+    rc, out, err = run(["figures", "--check", str(a)], capsys)
+    assert rc == 0 and "unchanged  s1_what_changes-cell01-1" in out and "no figure changed" in out
+    # Wrong variant: one pixel changed by 51/255 in the previous run's file.
+    old = copy_dir(a, tmp_path / "old")
+    doc = json.loads((old / "manifest.json").read_text())
+    f = old / doc["figures"][0]["file"]
+    px = read_png(f)
+    px[10, 10] = np.where(px[10, 10] >= 128, px[10, 10].astype(int) - 51, px[10, 10].astype(int) + 51)
+    cli.write_png(f, px / 255.0)
+    doc["figures"][0]["sha256"] = "0" * 64
+    (old / "manifest.json").write_text(json.dumps(doc))
+    rc, out, _ = run(["figures", "--check", str(old)], capsys)
+    assert rc == 1 and "changed    s1_what_changes-cell01-1: max |dI| = 0.2000 (1 pixels differ)" in out
+    rc, out, _ = run(["figures", "--check", str(old), "--ignore", "s1_*"], capsys)
+    assert rc == 0 and "(ignored)" in out
+    # A figure the previous manifest does not have is reported as added.
+    doc["figures"] = []
+    (old / "manifest.json").write_text(json.dumps(doc))
+    rc, out, _ = run(["figures", "--check", str(old)], capsys)
+    assert rc == 1 and "added      s1_what_changes-cell01-1" in out
+
+
+def fake_book(root, cell):
+    (root / "book").mkdir(parents=True)
+    (root / "book" / "_toc.yml").write_text("format: jb-book\nroot: index\nchapters:\n  - file: s1_bad\n")
+    head = "---\nkernelspec:\n  display_name: Python 3\n  language: python\n  name: python3\n---\n\n# T\n\n"
+    (root / "book" / "index.md").write_text(head)
+    (root / "book" / "s1_bad.md").write_text(head + "```{code-cell} ipython3\n" + cell + "\n```\n")
+
+
+def test_figures_failing_page_is_one_line(tmp_path, capsys, monkeypatch):
+    fake_book(tmp_path / "repo", "x = 1 / 0")
+    monkeypatch.setattr(cli, "_repo_root", lambda: tmp_path / "repo")
+    out_dir = tmp_path / "out"
+    rc, stdout, err = run(["figures", "--out", str(out_dir)], capsys)
+    assert failure_problems(rc, err, [], []) == []
+    assert "page s1_bad failed: ZeroDivisionError" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["repo"]  # no out dir, no staging dir
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["figures"], "--out"),
+    (["figures", "--out", "DIR/a", "--check", "DIR/a"], "--check"),
+    (["figures", "--check", "DIR/none"], "--check"),
+    (["figures", "--check", "DIR"], "--check"),
+    (["figures", "--out", "DIR/a", "--pages", "s99"], "--pages"),
+    (["figures", "--out", "DIR/no/such"], "--out"),
+    (["figures", "--out", "DIR/file.txt"], "--out"),
+])
+def test_figures_bad_input(tmp_path, capsys, argv, word):
+    (tmp_path / "file.txt").write_text("x")
+    (tmp_path / "manifest.json").write_text("{not json")
+    argv = [a.replace("DIR", str(tmp_path)) for a in argv]
+    before = sorted(p.name for p in tmp_path.iterdir())
+    rc, stdout, err = run(argv, capsys)
+    assert failure_problems(rc, err, before, sorted(p.name for p in tmp_path.iterdir())) == []
+    assert word in err
