@@ -16,7 +16,7 @@ written) prints ONE line ``symrender: error: ...`` on stderr naming the bad
 argument, writes no file and returns 2.  A Python traceback is never printed;
 an error the command line did not anticipate (a bug) prints one line
 ``symrender: internal error: ...`` and returns 1.  ``verify`` returns pytest's
-exit code.
+exit code; ``figures --check`` returns 1 when a figure changed.
 
 Reproducibility.  PNG files carry no timestamp, software tag or other varying
 metadata, so two runs on the same code give byte-identical files; they are
@@ -783,8 +783,9 @@ def _cmd_figures(args, out):
             if not tag:
                 changed += 1
     ov, nv = old_doc.get("code_version", {}), new_doc["code_version"]
-    print(f"code: previous {str(ov.get('git_commit'))[:12]} sources {str(ov.get('source_sha256'))[:16]}; "
-          f"now {str(nv['git_commit'])[:12]}{' + local changes' if nv['git_dirty'] else ''} "
+    commit = lambda c: (c or "no git")[:12]  # noqa: E731
+    print(f"code: previous {commit(ov.get('git_commit'))} sources {str(ov.get('source_sha256'))[:16]}; "
+          f"now {commit(nv['git_commit'])}{' + local changes' if nv['git_dirty'] else ''} "
           f"sources {nv['source_sha256'][:16]}", file=out)
     print(f"{changed} figure(s) changed" if changed else "no figure changed", file=out)
     return 1 if changed else 0
