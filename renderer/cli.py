@@ -347,7 +347,8 @@ def _check_output(path, flag):
         raise UsageError(f"{flag} {str(path)!r} is a directory")
     parent = target.parent
     if not parent.is_dir():
-        raise UsageError(f"{flag} {str(path)!r}: directory {str(parent)!r} does not exist")
+        what = "is not a directory" if parent.exists() else "does not exist"
+        raise UsageError(f"{flag} {str(path)!r}: {str(parent)!r} {what}")
     if not os.access(parent, os.W_OK):
         raise UsageError(f"{flag} {str(path)!r}: directory {str(parent)!r} is not writable")
 

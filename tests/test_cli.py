@@ -267,7 +267,7 @@ BAD = [
     (["render", "--scene", "DIR/missing.toml", "-o", "OUT"], None, "--scene"),
     (["render", "--size", "8x8", "-o", "DIR/no/such/dir/o.png"], None, "does not exist"),
     (["render", "--size", "8x8", "-o", "DIR"], None, "directory"),
-    (["render", "--size", "8x8", "-o", "DIR/file.txt/o.png"], None, "-o"),
+    (["render", "--size", "8x8", "-o", "DIR/file.txt/o.png"], None, "is not a directory"),
     (["render", "--view", "sideways", "-o", "OUT"], None, "--view"),
     (["render", "--size", "8x8"], None, "-o"),
     (["sweep", "--eps", "0:1:3"], None, "--eps"),
