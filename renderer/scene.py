@@ -39,7 +39,11 @@ def _real(owner: str, name: str, value, *, low=None, low_open=False, high=None):
         raise TypeError(
             f"{owner}.{name} must be a real number, got {type(value).__name__} {value!r}"
         )
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:                      # an integer beyond float64's range
+        raise ValueError(f"{owner}.{name} must be finite, got an integer of "
+                         f"{len(str(abs(int(value))))} digits") from None
     if not math.isfinite(x):
         raise ValueError(f"{owner}.{name} must be finite, got {value!r}")
     if low is not None and (x <= low if low_open else x < low):

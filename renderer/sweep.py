@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,7 +64,7 @@ def _check_steps(eps_values):
     return tuple(steps)
 
 
-def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
+def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=None):
     """Render the symbolic frame and one numeric frame per step, sharing the geometry.
 
     Parameters
@@ -74,6 +75,9 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
     width, height : int in [1, 8192]
     zoom : float in [1, 1e6], keyword-only (see `render`)
     workers : int >= 1, keyword-only (see `render`)
+    progress : callable(done, total), keyword-only, optional
+        Called after each tile with the pixels done so far and the total
+        (for a progress bar); it must not raise.
 
     Returns
     -------
@@ -147,6 +151,16 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
                     image[rows_idx, c] = np.clip(col[c], 0.0, 1.0)
                 grad_out[rows_idx, 0], grad_out[rows_idx, 1] = surf.grad
                 kink_out[rows_idx] = kink
-    _run_tiles([lambda j0=j0: tile(j0) for j0 in range(0, height, rows)], workers)
+    done = {"pixels": 0}
+    lock = threading.Lock()
+
+    def tile_and_report(j0):
+        tile(j0)
+        if progress is not None:
+            with lock:
+                done["pixels"] += (min(height, j0 + rows) - j0) * width
+                progress(done["pixels"], width * height)
+
+    _run_tiles([lambda j0=j0: tile_and_report(j0) for j0 in range(0, height, rows)], workers)
     census = tuple(compare(f, symbolic) for f in numeric)
     return Sweep(eps=steps, numeric=tuple(numeric), symbolic=symbolic, census=census)

@@ -360,3 +360,8 @@ def test_boundary_check_has_teeth():
     scene = Scene()
     moved = render(scene.replace(radius_b=0.33), 16, 16)
     assert boundary_violations(moved, render(geometry_only(scene), 16, 16)) > 0
+
+
+def test_an_integer_beyond_float_range_names_the_field():
+    with pytest.raises(ValueError, match=r"^Scene\.beta must be finite, got an integer of 401 digits"):
+        Scene(beta=10**400)

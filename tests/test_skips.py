@@ -189,3 +189,13 @@ def test_threads_give_the_same_bits(workers):
 def test_bad_workers_are_refused(bad):
     with pytest.raises(ValueError, match="workers"):
         render(Scene(), 8, 8, workers=bad)
+
+
+def test_sweep_reports_progress_per_tile_and_gives_the_same_bits():
+    calls = []
+    scene = SCENES["default"]
+    a = sweep(scene, (1e-3, 1e-6), 200, 170, progress=lambda done, total: calls.append((done, total)))
+    b = sweep(scene, (1e-3, 1e-6), 200, 170)
+    assert len(calls) > 1 and calls[-1] == (200 * 170, 200 * 170)
+    assert [d for d, _ in calls] == sorted(d for d, _ in calls)
+    assert all(_same(x, y) for x, y in zip(a.numeric, b.numeric))
