@@ -178,9 +178,8 @@ def _toml_value(key, text):
 def _check_ints(source, name, value):
     """Refuse a TOML integer too large for a float, naming the key.
 
-    `Scene` converts numbers with float(), which raises an OverflowError that
-    names no field for an integer beyond about 1.8e308 (TOML integers are
-    unbounded in tomllib); this check gives the named error instead.
+    TOML integers are unbounded in tomllib; one beyond about 1.8e308 is refused
+    here, with the file (or --set) and the key path, before `Scene` sees it.
     """
     if isinstance(value, int) and not isinstance(value, bool):
         try:
