@@ -606,10 +606,15 @@ def _png_pixels(data):
     return rgba
 
 
+#: A book code cell with this tag draws measured run times: its figures are
+#: recorded with "varies" in the manifest, and --check reports them without failing.
+VARIES_TAG = "measured-timing"
+
+
 def _page_figures(book, page):
     """Execute one book page (a MyST notebook) in a fresh kernel; yield
-    (figure id, code-cell ordinal, cell source, PNG bytes) for every PNG it
-    displays or glues.
+    (figure id, code-cell ordinal, cell source, PNG bytes, cell tags) for every
+    PNG it displays or glues.
 
     Raises
     ------
@@ -643,7 +648,8 @@ def _page_figures(book, page):
             glue = (o.get("metadata", {}).get("scrapbook", {}) or {}).get("name")
             j += 1
             fid = f"{page}-{glue}" if glue else f"{page}-cell{ordinal:02d}-{j}"
-            yield fid, ordinal, cell.source, base64.b64decode(data[key])
+            tags = tuple(cell.get("metadata", {}).get("tags", ()))
+            yield fid, ordinal, cell.source, base64.b64decode(data[key]), tags
 
 
 def _resolve_pages(pages):
@@ -672,15 +678,19 @@ def _render_figures(out_dir, pages):
     book = root / "book"
     figures = []
     for page in _progress(pages, desc="figures", unit="page"):
-        for fid, ordinal, source, png in _page_figures(book, page):
+        for fid, ordinal, source, png, tags in _page_figures(book, page):
             rgba = _png_pixels(png)
             name = f"{fid}.png"
             atomic_write(out_dir / name, _png_bytes_writer(rgba))
             data = (out_dir / name).read_bytes()
-            figures.append({"id": fid, "page": page, "code_cell": ordinal, "file": name,
-                            "width": int(rgba.shape[1]), "height": int(rgba.shape[0]),
-                            "sha256": hashlib.sha256(data).hexdigest(),
-                            "cell_sha256": hashlib.sha256(source.encode()).hexdigest()})
+            entry = {"id": fid, "page": page, "code_cell": ordinal, "file": name,
+                     "width": int(rgba.shape[1]), "height": int(rgba.shape[0]),
+                     "sha256": hashlib.sha256(data).hexdigest(),
+                     "cell_sha256": hashlib.sha256(source.encode()).hexdigest()}
+            if VARIES_TAG in tags:
+                # A plot of measured run times: it cannot repeat bit for bit.
+                entry["varies"] = "measured timing"
+            figures.append(entry)
     manifest = {"code_version": _code_version(root), "pages": list(pages), "figures": figures}
     text = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
     atomic_write(out_dir / "manifest.json", lambda f: f.write(text.encode()))
@@ -748,7 +758,8 @@ def _cmd_figures(args, out):
         changed = 0
         ignored = lambda fid: any(fnmatch.fnmatchcase(fid, pat) for pat in args.ignore)  # noqa: E731
         for fid in sorted(set(old) | set(new), key=lambda i: (i not in new, i)):
-            tag = " (ignored)" if ignored(fid) else ""
+            varies = (old.get(fid) or {}).get("varies") or (new.get(fid) or {}).get("varies")
+            tag = " (ignored)" if ignored(fid) else f" ({varies}: varies by run)" if varies else ""
             if fid not in new:
                 print(f"removed    {fid}{tag}", file=out)
             elif fid not in old:

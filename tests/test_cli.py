@@ -629,3 +629,31 @@ def test_figures_bad_input(tmp_path, capsys, argv, word):
     rc, stdout, err = run(argv, capsys)
     assert failure_problems(rc, err, before, sorted(p.name for p in tmp_path.iterdir())) == []
     assert word in err
+
+
+def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_figures, tmp_path,
+                                                                               capsys, monkeypatch):
+    a, _ = s1_figures
+    old = copy_dir(a, tmp_path / "old")
+    doc = json.loads((old / "manifest.json").read_text())
+    f = old / doc["figures"][0]["file"]
+    px = read_png(f)
+    px[5, 5] = 255 - px[5, 5]
+    cli.write_png(f, px / 255.0)
+    doc["figures"][0]["sha256"] = "0" * 64
+    doc["figures"][0]["varies"] = "measured timing"
+    (old / "manifest.json").write_text(json.dumps(doc))
+    rc, out, _ = run(["figures", "--check", str(old)], capsys)
+    assert rc == 0 and "measured timing: varies by run" in out and "no figure changed" in out
+    # Without the mark the same difference fails the check (the mark is what lets it pass).
+    del doc["figures"][0]["varies"]
+    (old / "manifest.json").write_text(json.dumps(doc))
+    rc, out, _ = run(["figures", "--check", str(old)], capsys)
+    assert rc == 1
+    # A cell tagged measured-timing is marked in the manifest; an untagged one is not.
+    png = (a / json.loads((a / "manifest.json").read_text())["figures"][0]["file"]).read_bytes()
+    monkeypatch.setattr(cli, "_page_figures", lambda book, page: iter([
+        ("p-cell01-1", 1, "plot()", png, (cli.VARIES_TAG,)), ("p-cell02-1", 2, "plot()", png, ())]))
+    manifest = cli._render_figures(tmp_path / "new", ["p"]) if (tmp_path / "new").mkdir() is None else None
+    marks = {f["id"]: f.get("varies") for f in manifest["figures"]}
+    assert marks == {"p-cell01-1": "measured timing", "p-cell02-1": None}
