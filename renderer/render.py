@@ -11,7 +11,6 @@ Phong).  Everything before the gradient depends on geometry alone.
 from __future__ import annotations
 
 import numbers
-import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -35,9 +34,12 @@ MAX_SIDE = 8192
 MAX_ZOOM = 1e6
 #: Pixels per tile: bounds the working memory of a render at any resolution.
 TILE_PIXELS = 1 << 14
-#: Threads that render tiles side by side (numpy releases the GIL inside its
-#: loops).  Tiles write disjoint slices, so the image does not depend on it.
-WORKERS = max(1, min(4, os.cpu_count() or 1))
+#: Default number of threads rendering tiles side by side.  numpy releases the
+#: GIL inside its loops, but on this project's 2-core machines two threads gained
+#: only 0-7 % (benchmarks/results/render.md), so the default is one; pass
+#: ``workers=`` to use more.  Tiles write disjoint slices: the image does not
+#: depend on the number.
+WORKERS = 1
 _POOL, _POOL_SIZE = None, 0
 
 
@@ -534,8 +536,8 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
         False runs the reference path that skips none of it; the tests show the
         two give the same bits.
     workers : int >= 1, keyword-only
-        Threads rendering tiles side by side (default `WORKERS`, the CPU count
-        up to 4).  The image is the same bits for any number.
+        Threads rendering tiles side by side (default `WORKERS`, 1).  The
+        image is the same bits for any number.
 
     Returns
     -------
