@@ -196,13 +196,20 @@ def _lights(scene, P, N, floor_blocks, skip, flat=False):
 def _trace_shadows(light, spheres, test):
     """Set ``light.lit``: attached and no blocker sphere on the segment to the light.
 
-    Shadow rays are traced only where ``test`` is True (every pixel when it is
-    None); elsewhere the pixel keeps ``attached``, which the caller guarantees
-    cannot change its colour.
+    Shadow rays are traced only where ``test`` is True, and a ray stops at the
+    first blocker it meets; elsewhere the pixel keeps ``attached``, which the
+    caller guarantees cannot change its colour.  ``test=None`` is the reference
+    path: every pixel against every blocker.
     """
     lit = light.attached.copy()
-    idx = np.flatnonzero(lit if test is None else test)
     wx, wy, wz = light.w_raw
+    if test is None:
+        # Reference path: every pixel against every blocker.
+        for center, radius in spheres:
+            lit &= ~segment_hits_sphere(wx, wy, wz, light.w2, light.position, center, radius)
+        light.lit = lit
+        return
+    idx = np.flatnonzero(test)
     for center, radius in spheres:
         if idx.size == 0:
             break
