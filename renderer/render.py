@@ -36,7 +36,7 @@ MAX_ZOOM = 1e6
 TILE_PIXELS = 1 << 14
 #: Default number of threads rendering tiles side by side.  numpy releases the
 #: GIL inside its loops, but on this project's 2-core machines two threads gained
-#: only 0-7 % (benchmarks/results/render.md), so the default is one; pass
+#: only 0-14 % (benchmarks/results/render.md), so the default is one; pass
 #: ``workers=`` to use more.  Tiles write disjoint slices: the image does not
 #: depend on the number.
 WORKERS = 1
