@@ -49,6 +49,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import files
 from .ledger import compare, to_srgb
 from .render import MAX_SIDE, SPHERE_A, render
 from .scene import HEIGHT_FIELDS, PointLight, Scene
@@ -274,15 +275,10 @@ def load_scene(path=None, sets=()):
 # ---------------------------------------------------------------- output helpers
 
 
-def _umask():
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def atomic_write(path, write):
     """Write a file atomically: ``write(fileobj)`` into a temporary file in the
-    target directory, then `os.replace` it onto ``path``.
+    target directory, then `os.replace` it onto ``path`` (`renderer.files`),
+    after checking the path as a command-line argument.
 
     On any exception (including KeyboardInterrupt) the temporary file is
     removed and the exception propagates; ``path`` is then untouched (absent
@@ -301,20 +297,7 @@ def atomic_write(path, write):
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
         raise UsageError(f"output {str(path)!r}: directory {str(parent)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{target.name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, target)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
+    files.atomic_write(target, write)
 
 
 def _png_bytes_writer(rgb8):
@@ -706,7 +689,7 @@ def _write_figures_staged(out_dir, pages):
     staging = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}.", suffix=".part"))
     try:
         manifest = _render_figures(staging, pages)
-        os.chmod(staging, 0o777 & ~_umask())
+        os.chmod(staging, 0o777 & ~files.umask())
         if not out_dir.exists():
             os.replace(staging, out_dir)
         else:

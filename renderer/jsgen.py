@@ -24,14 +24,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import os
 import re
-import tempfile
 from pathlib import Path
 
 import sympy as sp
 
 from . import fields, geometry, scene
+from .files import atomic_write
 from .render import (BACKGROUND, CHAMBER_NAMES, FLOOR, FLOOR_DARK, FLOOR_LIGHT, GRADIENTS,
                      SPHERE_A, SPHERE_B)
 
@@ -157,14 +156,7 @@ def _sources():
 
 def _atomic_write(path: Path, text: str):
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    atomic_write(path, lambda f: f.write(text.encode("utf-8")))
 
 
 def write_modules(directory):

@@ -65,3 +65,11 @@ def test_bundle_rejects_an_unhandled_export_form():
     bad = jsgen._sources()["ledger"] + "\nexport default compare;\n"
     with pytest.raises(jsgen.BundleError, match="export default"):
         jsgen.bundle_source(_sources(ledger=bad))
+
+
+def test_generated_files_get_the_usual_permissions(tmp_path):
+    """mkstemp creates 0600 files; a generated script must be readable like any other."""
+    from renderer.files import umask
+    path = jsgen.write_bundle(tmp_path / "sim.js")
+    assert path.stat().st_mode & 0o777 == 0o666 & ~umask()
+    assert (path.stat().st_mode & 0o777) != 0o600 or umask() == 0o066
