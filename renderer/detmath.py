@@ -107,20 +107,25 @@ _ATANHI_ROW = np.concatenate([[0.0], _ATANHI])
 _ATANLO_ROW = np.concatenate([[0.0], _ATANLO])
 
 
-def _atan_nonneg(t):
-    """atan of t >= 0 (s_atan.c, with the interval reduction)."""
+def _atan_nonneg(t, finite=False):
+    """atan of t >= 0 (s_atan.c, with the interval reduction).
+
+    ``finite``: the caller knows t has no inf (skips the -1/inf fix-up).
+    """
     row = np.searchsorted(_ATAN_BREAKS, t, side="right")
     a, b, c, d = (np.take(col, row) for col in _ATAN_MOBIUS)
     with np.errstate(divide="ignore", invalid="ignore"):
         tr = (a * t + b) / (c * t + d)
-    tr = np.where(t == np.inf, -0.0, tr)          # -1/inf, where 0 * inf would give NaN
+    if not finite:
+        tr = np.where(t == np.inf, -0.0, tr)      # -1/inf, where 0 * inf would give NaN
     z = tr * tr
     w = z * z
     at = _AT
     s1 = z * (at[0] + w * (at[2] + w * (at[4] + w * (at[6] + w * (at[8] + w * at[10])))))
     s2 = w * (at[1] + w * (at[3] + w * (at[5] + w * (at[7] + w * at[9]))))
-    reduced = np.take(_ATANHI_ROW, row) - ((tr * (s1 + s2) - np.take(_ATANLO_ROW, row)) - tr)
-    return np.where(row == 0, tr - tr * (s1 + s2), reduced)
+    p = tr * (s1 + s2)
+    reduced = np.take(_ATANHI_ROW, row) - ((p - np.take(_ATANLO_ROW, row)) - tr)
+    return np.where(row == 0, tr - p, reduced)
 
 
 def atan2(y, x):
@@ -134,6 +139,14 @@ def atan2(y, x):
     y, x = np.broadcast_arrays(y, x)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         ratio = np.abs(y / x)
+    if np.isfinite(ratio).all() and (x != 0.0).all():
+        # The common case, no NaN, no axis, no origin: e_atan2.c's quadrant
+        # rule is the sign of y on z (x > 0) or on pi - (z - pi_lo) (x < 0).
+        # z >= +0 is never -0, and (z - pi_lo) - pi = -(pi - (z - pi_lo))
+        # exactly, so copysign gives the general path's bits (below).
+        z = _atan_nonneg(ratio, finite=True)
+        out = np.copysign(np.where(np.signbit(x), _PI - (z - _PI_LO), z), y)
+        return out if out.ndim else float(out)
     z = _atan_nonneg(np.where(np.isnan(ratio), 0.0, ratio))
     ny = np.signbit(y)
     nx = np.signbit(x)
