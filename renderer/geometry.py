@@ -17,6 +17,7 @@ from . import detmath
 __all__ = [
     "POLE_SIN_PHI", "WINDOW_OFFSET", "WINDOW_MARGIN",
     "image_plane", "sphere_hit", "chart", "tangent_frame", "segment_hits_sphere",
+    "projected_bounds", "BOUNDS_MARGIN",
 ]
 
 #: Below this value of sin(phi) the chart frame is replaced by a fixed basis
@@ -55,6 +56,52 @@ def image_plane(radius_a, camera_z, width, height, zoom=1.0):
     return x, y
 
 
+#: Relative widening of `projected_bounds`' box: rays or shadow rays this far
+#: outside the exact cone miss the sphere by a margin about 1e8 times larger
+#: than the rounding error of `sphere_hit` and `segment_hits_sphere`.
+BOUNDS_MARGIN = 1e-7
+
+
+def projected_bounds(apex, center, radius):
+    """Box on the plane z = 0 holding the central projection of a sphere from ``apex``.
+
+    A line through the apex A meets the sphere (C, r) exactly when it lies in
+    the cone tangent to the sphere, and the cone cuts z = 0 in a conic.  Its
+    extent in x is fixed by the two tangent planes through A that contain the
+    y direction: the plane x - A_x = m (A_z - z) is at distance r from C when
+
+        m^2 (D^2 - r^2) - 2 m c D + c^2 - r^2 = 0,  c = C_x - A_x, D = A_z - C_z,
+
+    so x = A_x + m A_z at the two roots m = (c D +- r sqrt(c^2 + D^2 - r^2)) /
+    (D^2 - r^2); likewise in y.  Used to intersect only the rays (apex = the
+    eye) or trace only the floor's shadow rays (apex = a light) that can meet
+    the sphere; the box is widened by `BOUNDS_MARGIN` of its size and distance.
+
+    Parameters
+    ----------
+    apex, center : sequences of 3 floats (scene units); radius : float > 0
+
+    Returns
+    -------
+    (x_min, x_max, y_min, y_max) : four floats, or None when the sphere is not
+    wholly below the apex (A_z - C_z <= r): then the projection is unbounded or
+    the cone opens upward, and the caller must test every point.
+    """
+    D = apex[2] - center[2]
+    den = D * D - radius * radius
+    if not (D > radius and den > 0.0 and apex[2] > 0.0):
+        return None
+    out = []
+    for axis in (0, 1):
+        c = center[axis] - apex[axis]
+        root = radius * math.sqrt(c * c + den)
+        lo, hi = (c * D - root) / den, (c * D + root) / den
+        a, b = apex[axis] + lo * apex[2], apex[axis] + hi * apex[2]
+        pad = BOUNDS_MARGIN * (abs(a) + abs(b) + (hi - lo) * apex[2] + abs(apex[axis]) + apex[2])
+        out += [a - pad, b + pad]
+    return tuple(out)
+
+
 def sphere_hit(x, y, camera_z, center, radius):
     """Nearest positive ray parameter t of rays from the eye through (x, y, 0).
 
@@ -65,15 +112,18 @@ def sphere_hit(x, y, camera_z, center, radius):
 
     Parameters
     ----------
-    x, y : (n,) float64
-        Image-plane coordinates of the rays.
+    x, y : float64 arrays of broadcastable shapes
+        Image-plane coordinates of the rays: (n,) and (n,), or a row of
+        columns (m,) and a column of rows (k, 1) for a (k, m) block of pixels
+        (each value is then computed once per row or column; the results are
+        the same bits as for the flattened block).
     camera_z : float
     center : sequence of 3 floats
     radius : float > 0
 
     Returns
     -------
-    t : (n,) float64
+    t : float64 array of the broadcast shape of x and y
         Nearest root with t > 0, or inf where the ray misses.
     """
     ocx, ocy, ocz = 0.0 - center[0], 0.0 - center[1], camera_z - center[2]
@@ -91,14 +141,14 @@ def sphere_hit(x, y, camera_z, center, radius):
     idx = np.flatnonzero(disc >= 0.0)
     if idx.size == 0:
         return t
-    bi = b[idx]
-    q = -(bi + np.copysign(np.sqrt(disc[idx]), bi))
+    bi = b.reshape(-1)[idx]
+    q = -(bi + np.copysign(np.sqrt(disc.reshape(-1)[idx]), bi))
     with np.errstate(divide="ignore", invalid="ignore"):
-        t0 = q / a[idx]
+        t0 = q / a.reshape(-1)[idx]
         t1 = c / q
     near = np.fmin(t0, t1)
     far = np.fmax(t0, t1)
-    t[idx] = np.where(near > 0.0, near, np.where(far > 0.0, far, np.inf))
+    t.reshape(-1)[idx] = np.where(near > 0.0, near, np.where(far > 0.0, far, np.inf))
     return t
 
 
@@ -119,8 +169,10 @@ def chart(Nx, Ny, Nz):
     sin_phi : float64 array, sqrt(N_x^2 + N_y^2).
     """
     sin_phi = np.sqrt(Nx * Nx + Ny * Ny)
-    uu = (detmath.atan2(Ny, Nx) + np.pi) / (2.0 * np.pi)
-    vv = detmath.atan2(sin_phi, Nz) / np.pi
+    # Both angles in one call (half the array operations' overhead).
+    theta, phi = detmath.atan2(np.stack((Ny, sin_phi)), np.stack((Nx, Nz)))
+    uu = (theta + np.pi) / (2.0 * np.pi)
+    vv = phi / np.pi
     return uu, vv, sin_phi
 
 

@@ -11,14 +11,15 @@ Phong).  Everything before the gradient depends on geometry alone.
 from __future__ import annotations
 
 import numbers
+import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import fields
-from .geometry import (POLE_SIN_PHI, chart, image_plane, segment_hits_sphere, sphere_hit,
-                       tangent_frame)
+from .geometry import (POLE_SIN_PHI, chart, image_plane, projected_bounds, segment_hits_sphere,
+                       sphere_hit, tangent_frame)
 from .scene import Scene
 
 __all__ = [
@@ -32,15 +33,28 @@ GRADIENTS = ("exact", "central")
 MAX_SIDE = 8192
 #: Largest accepted magnification of the image window (`render`'s ``zoom``).
 MAX_ZOOM = 1e6
-#: Pixels per tile: bounds the working memory of a render at any resolution.
-TILE_PIXELS = 1 << 14
-#: Default number of threads rendering tiles side by side.  numpy releases the
-#: GIL inside its loops, but on this project's 2-core machines two threads gained
-#: only 0-14 % (benchmarks/results/render.md), so the default is one; pass
-#: ``workers=`` to use more.  Tiles write disjoint slices: the image does not
-#: depend on the number.
-WORKERS = 1
-_POOL, _POOL_SIZE = None, 0
+#: Pixels per tile: bounds the working memory of a render at any resolution
+#: (about 0.4 KiB of temporaries per pixel of a tile, per thread).
+TILE_PIXELS = 1 << 15
+#: Default number of threads rendering tiles side by side: the machine's cores,
+#: at most 4.  numpy releases the GIL inside its loops, and with tiles of
+#: 32,768 pixels two threads render a 256^2 frame 1.2-1.5 times as fast as
+#: one on this project's 2-core machines (benchmarks/results/render.md).
+#: Tiles write disjoint slices: the image is the same bits for any number.
+WORKERS = max(1, min(4, os.cpu_count() or 1))
+#: Frames smaller than this many pixels are rendered on one thread (the
+#: threads' overhead would exceed their gain).
+MIN_SPLIT_PIXELS = 1 << 13
+_POOLS = {}
+
+
+def _tile_rows(width, height, workers):
+    """Rows per tile: at most `TILE_PIXELS` pixels, and at least ``workers`` tiles
+    when the frame has `MIN_SPLIT_PIXELS` pixels or more."""
+    rows = max(1, TILE_PIXELS // width)
+    if workers > 1 and width * height >= MIN_SPLIT_PIXELS:
+        rows = min(rows, -(-height // workers))
+    return rows
 
 
 def _run_tiles(jobs, workers):
@@ -48,15 +62,15 @@ def _run_tiles(jobs, workers):
 
     An exception raised in a job is raised again here, in the caller.
     """
-    global _POOL, _POOL_SIZE
     if workers <= 1 or len(jobs) <= 1:
         for job in jobs:
             job()
         return
-    if _POOL is None or _POOL_SIZE < workers:
-        _POOL = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="symrender-tile")
-        _POOL_SIZE = workers
-    futures = [_POOL.submit(job) for job in jobs]
+    pool = _POOLS.get(workers)
+    if pool is None:
+        pool = _POOLS.setdefault(workers, ThreadPoolExecutor(max_workers=workers,
+                                                             thread_name_prefix="symrender-tile"))
+    futures = [pool.submit(job) for job in jobs]
     for future in futures:
         future.result()
 
@@ -132,8 +146,15 @@ def central_gradient(name, uu, vv, ku, kv, eps, base=None):
     -------
     (h_u, h_v) : two (n,) float64 arrays.
     """
-    up = np.mod(uu + eps, 1.0)
-    um = np.mod(uu - eps, 1.0)
+    up, um = uu + eps, uu - eps
+    if eps < 1.0:
+        # u in [0, 1]: u + eps in [0, 2) and u - eps in (-1, 1), where the
+        # wrap is one exact subtraction or addition, the bits of np.mod
+        # (x - 1 is exact on [1, 2]; np.mod adds 1 to a negative fmod, which is x).
+        up = np.where(up >= 1.0, up - 1.0, up)
+        um = np.where(um < 0.0, um + 1.0, um)
+    else:
+        up, um = np.mod(up, 1.0), np.mod(um, 1.0)
     vp = np.minimum(1.0, vv + eps)
     vm = np.maximum(0.0, vv - eps)
     h_up, h_um, h_vp, h_vm = fields.central_stencil(name).values(up, um, vp, vm, uu, vv, ku, kv, base)
@@ -193,13 +214,16 @@ def _lights(scene, P, N, floor_blocks, skip, flat=False):
     return out
 
 
-def _trace_shadows(light, spheres, test):
+def _trace_shadows(light, spheres, test, floor_points=None):
     """Set ``light.lit``: attached and no blocker sphere on the segment to the light.
 
-    Shadow rays are traced only where ``test`` is True, and a ray stops at the
-    first blocker it meets; elsewhere the pixel keeps ``attached``, which the
-    caller guarantees cannot change its colour.  ``test=None`` is the reference
-    path: every pixel against every blocker.
+    Shadow rays are traced only where ``test`` is True, and a ray is not traced
+    again once a blocker has stopped it; elsewhere the pixel keeps
+    ``attached``, which the caller guarantees cannot change its colour.
+    ``floor_points = (x, y)``: the points are (x, y, 0) on the floor, and
+    against each sphere only those inside the box of its shadow on z = 0
+    (`projected_bounds` from the light) are traced; the others' segments miss
+    it.  ``test=None`` is the reference path: every pixel against every blocker.
     """
     lit = light.attached.copy()
     wx, wy, wz = light.w_raw
@@ -209,18 +233,23 @@ def _trace_shadows(light, spheres, test):
             lit &= ~segment_hits_sphere(wx, wy, wz, light.w2, light.position, center, radius)
         light.lit = lit
         return
-    idx = np.flatnonzero(test)
     for center, radius in spheres:
+        trace = test & lit
+        if floor_points is not None:
+            box = projected_bounds(light.position, center, radius)
+            if box is not None:
+                px, py = floor_points
+                trace &= (px >= box[0]) & (px <= box[1]) & (py >= box[2]) & (py <= box[3])
+        idx = np.flatnonzero(trace)
         if idx.size == 0:
-            break
+            continue
         blocked = segment_hits_sphere(wx[idx], wy[idx], wz[idx], light.w2[idx], light.position,
                                       center, radius)
         lit[idx[blocked]] = False
-        idx = idx[~blocked]
     light.lit = lit
 
 
-def _shade(scene, P, Ns, albedo, lights, flat=False):
+def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None):
     """Ambient plus, per light, Lambert and Blinn/Phong (seed Cell 1, ``shade1``).
 
     ``lights`` come from `_lights` with ``lit`` set: a light reaches P only if
@@ -230,7 +259,8 @@ def _shade(scene, P, Ns, albedo, lights, flat=False):
     the Lambert and specular factors, and both are gated by Ns . w > 0.
     Returns a triple of (n,) arrays (clipping is the caller's).  ``flat``:
     Ns is exactly (0, 0, 1), and its dot products are read off the z
-    components (the same numbers, as in `_lights`).
+    components (the same numbers, as in `_lights`).  ``mus``: Ns . w per
+    light, when the caller has computed them already.
     """
     Px, Py, Pz = P
     Sx, Sy, Sz = Ns
@@ -240,9 +270,9 @@ def _shade(scene, P, Ns, albedo, lights, flat=False):
     vx, vy, vz = -Px, -Py, scene.camera_z - Pz
     inv = 1.0 / np.sqrt(_dot(vx, vy, vz, vx, vy, vz))
     vx, vy, vz = vx * inv, vy * inv, vz * inv
-    for light in lights:
+    for k, light in enumerate(lights):
         wx, wy, wz = light.w
-        mu = wz if flat else _dot(Sx, Sy, Sz, wx, wy, wz)
+        mu = wz if flat else mus[k] if mus is not None else _dot(Sx, Sy, Sz, wx, wy, wz)
         front = light.lit & (mu > 0.0)
         if not front.any():
             continue
@@ -264,23 +294,60 @@ def _shade(scene, P, Ns, albedo, lights, flat=False):
     return out
 
 
-def _nearest_hit(scene, X, Y, skip=True):
+def _grid_block(grid, bounds):
+    """The block of a tile's pixels whose image-plane point lies in ``bounds``.
+
+    ``grid = (x, y)``: the tile's rays are ``X = tile(x, len(y))``, ``Y =
+    repeat(y, len(x))`` (row-major; x increases along a row, y decreases down
+    the rows).  Returns ``(rows, cols)`` slices of the (len(y), len(x)) grid,
+    or None when no pixel is in the box.
+    """
+    x, y = grid
+    x_min, x_max, y_min, y_max = bounds
+    c0, c1 = np.searchsorted(x, x_min, side="left"), np.searchsorted(x, x_max, side="right")
+    # y decreases down the rows: search its negation.
+    r0, r1 = np.searchsorted(-y, -y_max, side="left"), np.searchsorted(-y, -y_min, side="right")
+    if c0 >= c1 or r0 >= r1:
+        return None
+    return slice(r0, r1), slice(c0, c1)
+
+
+def _nearest_hit(scene, X, Y, skip=True, grid=None):
     """Ray parameter and chamber code of the nearest positive hit of each ray.
 
-    With ``skip`` an object that is off is not intersected; without, it is
-    intersected and its hits discarded (the reference path for the tests).
+    With ``skip`` an object that is off is not intersected, and when the
+    tile's ``grid`` is given (see `_grid_block`) a sphere is intersected only
+    by the rays inside the box of its projection (`projected_bounds`): the rays
+    outside miss it.  Without ``skip`` every ray meets every object and the
+    hits of objects that are off are discarded (the reference path for the
+    tests).
     """
     e = scene.camera_z
     t = np.full(X.shape, np.inf)
     code = np.zeros(X.shape, dtype=np.uint8)
+    eye = (0.0, 0.0, e)
     # Ties go to A, then B, then the floor (the seed's order of tests).
-    tA = sphere_hit(X, Y, e, (0.0, 0.0, 0.0), scene.radius_a)
-    closer = tA < t
-    t[closer], code[closer] = tA[closer], SPHERE_A
+    spheres = [(SPHERE_A, (0.0, 0.0, 0.0), scene.radius_a, True)]
     if scene.sphere_b or not skip:
-        tB = sphere_hit(X, Y, e, scene.center_b, scene.radius_b)
-        closer = (tB < t) & scene.sphere_b
-        t[closer], code[closer] = tB[closer], SPHERE_B
+        spheres.append((SPHERE_B, scene.center_b, scene.radius_b, scene.sphere_b))
+    for kind, center, radius, on in spheres:
+        bounds = projected_bounds(eye, center, radius) if skip and grid is not None else None
+        if bounds is None:
+            ts = sphere_hit(X, Y, e, center, radius)
+            tv, cv = t, code
+        else:
+            block = _grid_block(grid, bounds)
+            if block is None:
+                continue                              # no ray of this tile can meet it
+            rows, cols = block
+            x, y = grid
+            ts = sphere_hit(x[cols], y[rows, None], e, center, radius)
+            tv = t.reshape(y.shape[0], x.shape[0])[rows, cols]
+            cv = code.reshape(y.shape[0], x.shape[0])[rows, cols]
+        if not on:
+            continue
+        closer = ts < tv
+        tv[closer], cv[closer] = ts[closer], kind
     if scene.floor or not skip:
         # The floor z = 0 is the image plane: every ray meets it at t = 1.
         closer = (1.0 < t) & scene.floor
@@ -310,8 +377,13 @@ class _Surface:
     kink: np.ndarray = None
 
 
-def _surfaces(scene, X, Y, t, code, skip=True):
-    """A `_Surface` per object hit by at least one ray (geometry only, no gradient)."""
+def _surfaces(scene, X, Y, t, code, skip=True, grid=None):
+    """A `_Surface` per object hit by at least one ray (geometry only, no gradient).
+
+    With ``skip`` and the tile's ``grid`` (see `_grid_block`) the floor's
+    checker factors sin(pi x) and sin(pi y) are computed once per column and
+    per row: a floor point is exactly its pixel centre (x, y, 0), as t = 1.
+    """
     e = scene.camera_z
     sphere_a = ((0.0, 0.0, 0.0), scene.radius_a)
     sphere_b = (scene.center_b, scene.radius_b)
@@ -335,7 +407,11 @@ def _surfaces(scene, X, Y, t, code, skip=True):
             zero = np.zeros_like(ti)
             N = (zero, zero, zero + 1.0)
             # Checker: light squares where sin(pi x) sin(pi y) >= 0 (seed Cell 1).
-            light_square = np.sin(np.pi * P[0]) * np.sin(np.pi * P[1]) >= 0.0
+            if skip and grid is not None:
+                gx, gy = grid
+                light_square = (np.sin(np.pi * gx) * np.sin(np.pi * gy)[:, None] >= 0.0).reshape(-1)[idx]
+            else:
+                light_square = np.sin(np.pi * P[0]) * np.sin(np.pi * P[1]) >= 0.0
             base = np.where(light_square, FLOOR_LIGHT, FLOOR_DARK)
             rg = base * (1.0 - scene.floor_tint)
             out.append(_Surface(kind, idx, P, N, (rg, rg, base),
@@ -399,29 +475,35 @@ def _shade_surface(scene, surf, Ns, skip):
     """Clipped colour of one surface's pixels: lights, shadow rays, shading."""
     flat = skip and surf.kind == FLOOR
     lights = _lights(scene, surf.P, surf.N, surf.floor_blocks, skip, flat)
-    for light in lights:
+    mus = None
+    if skip and surf.kind == SPHERE_A:
+        # Ns . w, for the shadow-ray test here and for the shading.
+        mus = [_dot(*Ns, *light.w) for light in lights]
+    for k, light in enumerate(lights):
         if skip:
             # Shadow rays only where the light could add something: attached and
             # in front of the shading normal (Ns . w > 0 gates both terms).  Off
             # sphere A, Ns = N and attached already implies it.
-            test = (light.attached & (_dot(*Ns, *light.w) > 0.0) if surf.kind == SPHERE_A
-                    else light.attached)
+            test = light.attached & (mus[k] > 0.0) if mus is not None else light.attached
+            _trace_shadows(light, surf.spheres, test, surf.P[:2] if surf.kind == FLOOR else None)
         else:
-            test = None
-        _trace_shadows(light, surf.spheres, test)
+            _trace_shadows(light, surf.spheres, None)
         if not skip and not scene.sphere_b and surf.kind != SPHERE_B:
             # Reference path: trace the switched-off sphere B too, and ignore it.
             segment_hits_sphere(*light.w_raw, light.w2, light.position, scene.center_b,
                                 scene.radius_b)
-    col = _shade(scene, surf.P, Ns, surf.albedo, lights, flat)
+    col = _shade(scene, surf.P, Ns, surf.albedo, lights, flat, mus)
     return [np.clip(c, 0.0, 1.0) for c in col]
 
 
-def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad, skip):
-    """Render the rays (X, Y) into the flat output views (one entry per ray)."""
-    t, code = _nearest_hit(scene, X, Y, skip)
+def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad, skip, grid=None):
+    """Render the rays (X, Y) into the flat output views (one entry per ray).
+
+    ``grid``: the tile's pixel-centre columns and rows (see `_grid_block`).
+    """
+    t, code = _nearest_hit(scene, X, Y, skip, grid)
     chamber[:] = code
-    for surf in _surfaces(scene, X, Y, t, code, skip):
+    for surf in _surfaces(scene, X, Y, t, code, skip, grid):
         if surf.kind == SPHERE_A:
             Ns = _prepare_a(scene, surf, gradient, grad is not None, kink is not None, skip)
             if grad is not None:
@@ -474,11 +556,11 @@ def gbuffer(scene, width, height, *, gradient="exact", zoom=1.0):
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     X = np.tile(x, height)
     Y = np.repeat(y, width)
-    t, code = _nearest_hit(scene, X, Y)
+    t, code = _nearest_hit(scene, X, Y, grid=(x, y))
     n = width * height
     P, N, Ns = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     uv, grad = np.zeros((n, 2)), np.zeros((n, 2))
-    for surf in _surfaces(scene, X, Y, t, code):
+    for surf in _surfaces(scene, X, Y, t, code, grid=(x, y)):
         P[surf.idx] = np.stack(surf.P, axis=-1)
         N[surf.idx] = np.stack(surf.N, axis=-1)
         if surf.kind == SPHERE_A:
@@ -543,8 +625,8 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
         False runs the reference path that skips none of it; the tests show the
         two give the same bits.
     workers : int >= 1, keyword-only
-        Threads rendering tiles side by side (default `WORKERS`, 1).  The
-        image is the same bits for any number.
+        Threads rendering tiles side by side (default `WORKERS`: the
+        machine's cores, at most 4).  The image is the same bits for any number.
 
     Returns
     -------
@@ -563,8 +645,9 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
 
     Notes
     -----
-    The image is computed in tiles of at most 16,384 pixels, so the working
-    memory beyond the outputs is bounded at any resolution.  Source: seed
+    The image is computed in tiles of at most 32,768 pixels, so the working
+    memory beyond the outputs is bounded at any resolution (about 13 MiB per
+    thread).  Source: seed
     Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
     corrections listed in the book's errata.
     """
@@ -575,7 +658,7 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     kink_out = np.zeros((height, width), dtype=bool) if kink else None
     grad_out = np.zeros((height, width, 2)) if grad else None
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
-    rows = max(1, TILE_PIXELS // width)
+    rows = _tile_rows(width, height, workers)
     flat_image = image.reshape(-1, 3)
     flat_chamber = chamber.reshape(-1)
     flat_kink = kink_out.reshape(-1) if kink else None
@@ -587,7 +670,8 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
         Y = np.repeat(y[j0:j1], width)
         sl = slice(j0 * width, j1 * width)
         _render_tile(scene, gradient, X, Y, flat_image[sl], flat_chamber[sl],
-                     flat_kink[sl] if kink else None, flat_grad[sl] if grad else None, skip)
+                     flat_kink[sl] if kink else None, flat_grad[sl] if grad else None, skip,
+                     (x, y[j0:j1]))
 
     _run_tiles([lambda j0=j0: tile(j0) for j0 in range(0, height, rows)], workers)
     return Frame(image=image, chamber=chamber, kink=kink_out, grad=grad_out, scene=scene,

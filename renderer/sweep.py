@@ -23,9 +23,9 @@ import numpy as np
 from . import fields
 from .geometry import image_plane
 from .ledger import compare
-from .render import (FLOOR, SPHERE_A, TILE_PIXELS, Frame, _check_args, _check_workers, _gradient,
+from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient,
                      _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal,
-                     _surfaces, _trace_shadows)
+                     _surfaces, _tile_rows, _trace_shadows)
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS"]
 
@@ -114,16 +114,16 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     flat = [(f.image.reshape(-1, 3), f.chamber.reshape(-1), f.kink.reshape(-1), f.grad.reshape(-1, 2))
             for f in frames]
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
-    rows = max(1, TILE_PIXELS // width)
+    rows = _tile_rows(width, height, workers)
     def tile(j0):
         j1 = min(height, j0 + rows)
         X = np.tile(x, j1 - j0)
         Y = np.repeat(y[j0:j1], width)
         sl = slice(j0 * width, j1 * width)
-        t, code = _nearest_hit(scene, X, Y)
+        t, code = _nearest_hit(scene, X, Y, grid=(x, y[j0:j1]))
         for image, chamber, _, _ in flat:
             chamber[sl] = code
-        for surf in _surfaces(scene, X, Y, t, code):
+        for surf in _surfaces(scene, X, Y, t, code, grid=(x, y[j0:j1])):
             flat_kind = surf.kind == FLOOR
             lights = _lights(scene, surf.P, surf.N, surf.floor_blocks, True, flat_kind)
             for light in lights:
