@@ -249,7 +249,34 @@ def _trace_shadows(light, spheres, test, floor_points=None):
     light.lit = lit
 
 
-def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None):
+def _view(scene, P, lights):
+    """The shading terms that depend on geometry alone, not on the normal.
+
+    Returns ``(halves, v)``: v is the unit vector from P to the eye and
+    ``halves[k]``, for Blinn, the half vector h = w_k + v of light k with
+    max(|h|, tiny); None for Phong.  Computed once per surface: an eps sweep
+    shades sphere A with a new normal per step on the same view
+    (`renderer.sweep`).
+    """
+    Px, Py, Pz = P
+    vx, vy, vz = -Px, -Py, scene.camera_z - Pz
+    inv = 1.0 / np.sqrt(_dot(vx, vy, vz, vx, vy, vz))
+    v = (vx * inv, vy * inv, vz * inv)
+    halves = []
+    for light in lights:
+        if scene.model == "blinn":
+            wx, wy, wz = light.w
+            hx, hy, hz = wx + v[0], wy + v[1], wz + v[2]
+            # |h| = 0 only where w = -v, which no front pixel has; the floor
+            # keeps that quotient finite (it is masked below).
+            hn = np.maximum(np.sqrt(_dot(hx, hy, hz, hx, hy, hz)), _TINY)
+            halves.append(((hx, hy, hz), hn))
+        else:
+            halves.append(None)
+    return halves, v
+
+
+def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None, view=None):
     """Ambient plus, per light, Lambert and Blinn/Phong (seed Cell 1, ``shade1``).
 
     ``lights`` come from `_lights` with ``lit`` set: a light reaches P only if
@@ -260,16 +287,12 @@ def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None):
     Returns a triple of (n,) arrays (clipping is the caller's).  ``flat``:
     Ns is exactly (0, 0, 1), and its dot products are read off the z
     components (the same numbers, as in `_lights`).  ``mus``: Ns . w per
-    light, when the caller has computed them already.
+    light, when the caller has computed them already; ``view``: `_view` of
+    (P, lights), likewise.
     """
-    Px, Py, Pz = P
     Sx, Sy, Sz = Ns
-    n = Px.shape[0]
-    out = [np.full(n, scene.ka * a) for a in scene.ambient]
-    # Unit vector to the eye.
-    vx, vy, vz = -Px, -Py, scene.camera_z - Pz
-    inv = 1.0 / np.sqrt(_dot(vx, vy, vz, vx, vy, vz))
-    vx, vy, vz = vx * inv, vy * inv, vz * inv
+    halves, (vx, vy, vz) = _view(scene, P, lights) if view is None else view
+    out = [None, None, None]
     for k, light in enumerate(lights):
         wx, wy, wz = light.w
         mu = wz if flat else mus[k] if mus is not None else _dot(Sx, Sy, Sz, wx, wy, wz)
@@ -277,10 +300,7 @@ def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None):
         if not front.any():
             continue
         if scene.model == "blinn":
-            hx, hy, hz = wx + vx, wy + vy, wz + vz
-            # |h| = 0 only where w = -v, which no front pixel has; the floor
-            # keeps that quotient finite (it is masked below).
-            hn = np.maximum(np.sqrt(_dot(hx, hy, hz, hx, hy, hz)), _TINY)
+            (hx, hy, hz), hn = halves[k]
             spec_cos = (hz if flat else _dot(Sx, Sy, Sz, hx, hy, hz)) / hn
         else:
             two_mu = 2.0 * mu
@@ -289,9 +309,15 @@ def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None):
         spec = (np.maximum(spec_cos, 0.0) * front) ** scene.shininess
         diffuse = (mu * front) * scene.kd
         spec *= scene.ks
+        term = None
         for c in range(3):
-            out[c] += light.color[c] * (diffuse * albedo[c] + spec)
-    return out
+            if c == 0 or albedo[c] is not albedo[c - 1]:
+                term = diffuse * albedo[c] + spec
+            # A colour of exactly 1 multiplies by 1: the product is the term itself.
+            add = term if light.color[c] == 1.0 else light.color[c] * term
+            out[c] = add + out[c] if out[c] is not None else add + scene.ka * scene.ambient[c]
+    n = P[0].shape[0]
+    return [np.full(n, scene.ka * a) if o is None else o for o, a in zip(out, scene.ambient)]
 
 
 def _grid_block(grid, bounds):
@@ -472,7 +498,7 @@ def _prepare_a(scene, surf, gradient, want_grad, want_kink, skip):
 
 
 def _shade_surface(scene, surf, Ns, skip):
-    """Clipped colour of one surface's pixels: lights, shadow rays, shading."""
+    """Colour of one surface's pixels (not clipped): lights, shadow rays, shading."""
     flat = skip and surf.kind == FLOOR
     lights = _lights(scene, surf.P, surf.N, surf.floor_blocks, skip, flat)
     mus = None
@@ -492,8 +518,16 @@ def _shade_surface(scene, surf, Ns, skip):
             # Reference path: trace the switched-off sphere B too, and ignore it.
             segment_hits_sphere(*light.w_raw, light.w2, light.position, scene.center_b,
                                 scene.radius_b)
-    col = _shade(scene, surf.P, Ns, surf.albedo, lights, flat, mus)
-    return [np.clip(c, 0.0, 1.0) for c in col]
+    return _shade(scene, surf.P, Ns, surf.albedo, lights, flat, mus)
+
+
+def _store_rgb(image, idx, col):
+    """Clip the colour triple ``col`` to [0, 1] and write it to rows ``idx`` of
+    the (n, 3) ``image`` view (one row scatter, not three strided ones)."""
+    rgb = np.empty((idx.shape[0], 3))
+    for c in range(3):
+        np.clip(col[c], 0.0, 1.0, out=rgb[:, c])
+    image[idx] = rgb
 
 
 def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad, skip, grid=None):
@@ -512,9 +546,7 @@ def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad, skip, grid=N
                 kink[surf.idx] = surf.kink
         else:
             Ns = surf.N
-        col = _shade_surface(scene, surf, Ns, skip)
-        for c in range(3):
-            image[surf.idx, c] = col[c]
+        _store_rgb(image, surf.idx, _shade_surface(scene, surf, Ns, skip))
 
 
 @dataclass(frozen=True)

@@ -24,8 +24,8 @@ from . import fields
 from .geometry import image_plane
 from .ledger import compare
 from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient,
-                     _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal,
-                     _surfaces, _tile_rows, _trace_shadows)
+                     _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal, _view,
+                     _store_rgb, _surfaces, _tile_rows, _trace_shadows)
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS"]
 
@@ -128,27 +128,24 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
             lights = _lights(scene, surf.P, surf.N, surf.floor_blocks, True, flat_kind)
             for light in lights:
                 # Every attached pixel, once: the shading normal varies with eps.
-                _trace_shadows(light, surf.spheres, light.attached)
+                _trace_shadows(light, surf.spheres, light.attached, surf.P[:2] if flat_kind else None)
             rows_idx = surf.idx + j0 * width
             if surf.kind != SPHERE_A:
-                col = [np.clip(c, 0.0, 1.0)
-                       for c in _shade(scene, surf.P, surf.N, surf.albedo, lights, flat_kind)]
+                col = _shade(scene, surf.P, surf.N, surf.albedo, lights, flat_kind)
                 for image, _, _, _ in flat:
-                    for c in range(3):
-                        image[rows_idx, c] = col[c]
+                    _store_rgb(image, rows_idx, col)
                 continue
             # Sphere A: the exact frame, then one re-shade per step.
             Ns = _prepare_a(scene, surf, "exact", True, True, True)
             kink = surf.kink
             # The stencil's eps-free factors, once for all steps.
             base = fields.central_stencil(scene.height_field).base(*surf.uv, scene.k_u, scene.k_v)
+            view = _view(scene, surf.P, lights)
             for k, (s, (image, _, kink_out, grad_out)) in enumerate(zip([scene] + scenes, flat)):
                 if k > 0:
                     surf.grad = _gradient(s, surf, "central", s.eps, base)
                     Ns = _shading_normal(s, surf, surf.grad)
-                col = _shade(s, surf.P, Ns, surf.albedo, lights)
-                for c in range(3):
-                    image[rows_idx, c] = np.clip(col[c], 0.0, 1.0)
+                _store_rgb(image, rows_idx, _shade(s, surf.P, Ns, surf.albedo, lights, view=view))
                 grad_out[rows_idx, 0], grad_out[rows_idx, 1] = surf.grad
                 kink_out[rows_idx] = kink
     done = {"pixels": 0}
