@@ -38,8 +38,9 @@ MAX_ZOOM = 1e6
 TILE_PIXELS = 1 << 15
 #: Default number of threads rendering tiles side by side: the machine's cores,
 #: at most 4.  numpy releases the GIL inside its loops, and with tiles of
-#: 32,768 pixels two threads render a 256^2 frame 1.2-1.5 times as fast as
-#: one on this project's 2-core machines (benchmarks/results/render.md).
+#: 32,768 pixels two threads render a frame 1.3 (256^2) to 1.6 (512^2,
+#: 1024^2) times as fast as one on this project's 2-core machines
+#: (benchmarks/results/render.md).
 #: Tiles write disjoint slices: the image is the same bits for any number.
 WORKERS = max(1, min(4, os.cpu_count() or 1))
 #: Frames smaller than this many pixels are rendered on one thread (the
