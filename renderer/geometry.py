@@ -84,9 +84,22 @@ def projected_bounds(apex, center, radius):
     Returns
     -------
     (x_min, x_max, y_min, y_max) : four floats, or None when the sphere is not
-    wholly below the apex (A_z - C_z <= r): then the projection is unbounded or
-    the cone opens upward, and the caller must test every point.
+    wholly below the apex (A_z - C_z <= r) or the apex is not above z = 0:
+    then the projection is unbounded or the cone opens upward, and the caller
+    must test every point.
+
+    Raises
+    ------
+    ValueError
+        If ``radius`` is not a finite number > 0.
+
+    Source: derived here from the planes through the apex tangent to the
+    sphere (the cone of seed Cell 1's rays and shadow rays, not in the seed);
+    tests/test_culling.py checks it against `sphere_hit` and
+    `segment_hits_sphere` on random spheres.
     """
+    if not (math.isfinite(radius) and radius > 0.0):
+        raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
     D = apex[2] - center[2]
     den = D * D - radius * radius
     if not (D > radius and den > 0.0 and apex[2] > 0.0):

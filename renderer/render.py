@@ -312,6 +312,8 @@ def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None, view=None):
         spec *= scene.ks
         term = None
         for c in range(3):
+            # The floor passes one array as its red and green albedo (rg, rg, b):
+            # the same object gives the same term, computed once.
             if c == 0 or albedo[c] is not albedo[c - 1]:
                 term = diffuse * albedo[c] + spec
             # A colour of exactly 1 multiplies by 1: the product is the term itself.

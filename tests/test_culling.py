@@ -93,6 +93,12 @@ def test_the_check_rejects_a_box_two_percent_too_small():
     assert (light_blocks(L, center, r, x, y) & ~inside(box, x, y)).any()
 
 
+@pytest.mark.parametrize("radius", [0.0, -0.5, float("nan"), float("inf")])
+def test_bad_radius_is_refused(radius):
+    with pytest.raises(ValueError, match="radius"):
+        projected_bounds((0.0, 0.0, 4.0), (0.0, 0.0, 0.0), radius)
+
+
 def test_no_box_when_the_sphere_reaches_the_apex_plane():
     assert projected_bounds((0.0, 0.0, 4.0), (0.0, 0.0, 3.5), 0.5) is None   # touches z = 4
     assert projected_bounds((0.0, 0.0, 4.0), (0.0, 0.0, 5.0), 0.5) is None   # above the apex

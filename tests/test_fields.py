@@ -244,6 +244,25 @@ def test_u_wraps_at_the_seam():
     assert np.all(np.abs(got - fields.exact_gradient("sine", u, v, 8.0, 4.0)[0]) < 1e-2)
 
 
+@pytest.mark.parametrize("eps", [1e-10, 1e-3, 0.25, 0.999, 1.0, 3.5])
+def test_u_wrap_gives_the_bits_of_np_mod(eps):
+    """central_gradient wraps u +- eps by one add (eps < 1) or by np.mod: the
+    quotient must be the same bits as four calls of `fields.height` at
+    np.mod-wrapped points.  Without the wrap the bits differ, so the check can fail."""
+    u, v = _border_points()
+    u = np.concatenate([u, np.random.default_rng(7).uniform(0.0, 1.0, 500), [eps % 1.0, 1.0 - eps % 1.0]])
+    v = np.resize(v, u.shape)
+    v = np.where((v + eps > 1.0) | (v - eps < 0.0), 0.5, v)      # h_u only; keep v unclamped
+    hu = central_gradient("sine", u, v, 8.0, 4.0, eps)[0]
+
+    def quotient(up, um):
+        return (fields.height("sine", up, v, 8.0, 4.0) - fields.height("sine", um, v, 8.0, 4.0)) / (2.0 * eps)
+
+    want = quotient(np.mod(u + eps, 1.0), np.mod(u - eps, 1.0))
+    assert np.array_equal(hu.view(np.int64), want.view(np.int64))
+    assert not np.array_equal(quotient(u + eps, u - eps).view(np.int64), want.view(np.int64))
+
+
 def _border_points():
     v = np.array([0.0, 5e-324, 1e-300, 2**-60, 0.5, 1 - 2**-53, 1.0, 0.999, 1e-3])
     u = np.array([0.0, 1e-300, 0.5, 1 - 2**-53, 1.0, 0.3, 0.125, 0.7, 0.99])
