@@ -6,7 +6,10 @@
 * an 8-step eps sweep at 256^2 (both pipelines and the census), against the
   same frames rendered independently;
 * the gradient stage alone over sphere A's pixels: exact against one central
-  difference at the same pixels.
+  difference at the same pixels;
+* the allocator settings of renderer.heap: 256^2 frames and their minor page
+  faults in child processes with the settings and without them
+  (SYMRENDER_KEEP_HEAP=0), the two kinds of child alternating.
 
 These machines are noisy: every median is printed with its min-max, and the
 things compared are interleaved in one loop.  Results go to
@@ -19,7 +22,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import resource
 import statistics
+import subprocess
 import sys
 import time
 import tracemalloc
@@ -65,7 +71,55 @@ def _peak_working_bytes(fn):
     return peak, current
 
 
+HEAP_CASES = {"exact, 1 thread": dict(workers=1), "exact": {}, "central": dict(gradient="central")}
+
+
+def _heap_child(repeats):
+    """Run in a child process: per case, the median of ``repeats`` warm 256^2
+    frames (s) and the minor page faults per frame; printed as JSON."""
+    from renderer.heap import keep_heap
+    scene = Scene()
+    out = {}
+    for name, kw in HEAP_CASES.items():
+        fn = lambda kw=kw: render(scene, 256, 256, **kw)   # noqa: E731
+        fn()
+        fn()
+        before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+        times = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            fn()
+            times.append(time.perf_counter() - t0)
+        faults = (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before) / repeats
+        out[name] = dict(median=statistics.median(times), faults=faults)
+    out["applied"] = keep_heap()
+    print(json.dumps(out))
+
+
+def _heap_rounds(rounds, repeats):
+    """Children with the heap kept and left alone, alternating: {setting: {case: stats}}."""
+    samples = {"kept": [], "left alone": []}
+    for _ in range(rounds):
+        for setting in samples:
+            env = dict(os.environ)
+            env.pop("SYMRENDER_KEEP_HEAP", None)
+            if setting == "left alone":
+                env["SYMRENDER_KEEP_HEAP"] = "0"
+            run = subprocess.run([sys.executable, __file__, "--heap-child", str(repeats)], env=env,
+                                 check=True, capture_output=True, text=True)
+            samples[setting].append(json.loads(run.stdout.strip().splitlines()[-1]))
+    res = {}
+    for setting, runs in samples.items():
+        res[setting] = {"applied": all(r["applied"] for r in runs)}
+        for name in HEAP_CASES:
+            res[setting][name] = _stats([r[name]["median"] for r in runs]) | {
+                "faults": statistics.median(r[name]["faults"] for r in runs)}
+    return res
+
+
 def main(argv=None):
+    if argv is None and sys.argv[1:2] == ["--heap-child"]:
+        return _heap_child(int(sys.argv[2]))
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=15, help="timed runs per cell at <= 256^2 (default 15)")
     ap.add_argument("--max-size", type=int, default=4096, help="largest side (default 4096)")
@@ -112,6 +166,7 @@ def main(argv=None):
             "central": lambda f=field: central_gradient(f, uu, vv, 8.0, 4.0, 1e-3)}, 25)
         stage[field] = st | {"pixels": int(uu.size)}
     res["gradient_stage"] = stage
+    res["heap"] = heap = _heap_rounds(3, args.repeats)
 
     lines = ["## Scaling (default scene; ms, median and min-max)", "",
              f"Tiles render on {WORKERS} thread(s) (the default here) unless stated.", "",
@@ -144,6 +199,17 @@ def main(argv=None):
         lines.append(f"| {field} | {st['pixels']} | {1e6 * e:.0f} ({1e6 * st['exact']['min']:.0f}-"
                      f"{1e6 * st['exact']['max']:.0f}) | {1e6 * c:.0f} ({1e6 * st['central']['min']:.0f}-"
                      f"{1e6 * st['central']['max']:.0f}) | {e / c:.2f} |")
+    lines += ["", "## Allocator settings (renderer.heap) at 256²", "",
+              "Three child processes of each kind, alternating; each gives the median of "
+              f"{args.repeats} warm frames.  Shown: the median of the three medians (min-max), "
+              "and the minor page faults per frame.", "",
+              "| case | heap kept, ms | faults/frame | left alone, ms | faults/frame | left alone / kept |",
+              "|---|---|---|---|---|---|"]
+    for name in HEAP_CASES:
+        k, a = heap["kept"][name], heap["left alone"][name]
+        lines.append(f"| {name} | {1e3 * k['median']:.1f} ({1e3 * k['min']:.1f}-{1e3 * k['max']:.1f}) | "
+                     f"{k['faults']:.0f} | {1e3 * a['median']:.1f} ({1e3 * a['min']:.1f}-{1e3 * a['max']:.1f}) | "
+                     f"{a['faults']:.0f} | {a['median'] / k['median']:.2f} |")
     lines += ["", "## Issue 6 targets (medians of this run)", "", "| target | measured | met |", "|---|---|---|"]
     sc = res["scaling"]
     checks = []

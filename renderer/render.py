@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import fields
+from .heap import keep_heap
 from .geometry import (POLE_SIN_PHI, chart, image_plane, projected_bounds, segment_hits_sphere,
                        sphere_hit, tangent_frame)
 from .scene import Scene
@@ -35,7 +36,7 @@ MAX_SIDE = 8192
 MAX_ZOOM = 1e6
 #: Pixels per tile: bounds the working memory of a render at any resolution
 #: (about 0.4 KiB of temporaries per pixel of a tile, per thread).
-TILE_PIXELS = 1 << 15
+TILE_PIXELS = 1 << 16
 #: Default number of threads rendering tiles side by side: the machine's cores,
 #: at most 4.  numpy releases the GIL inside its loops, and with tiles of
 #: 32,768 pixels two threads render a frame 1.3 (256^2) to 1.6 (512^2,
@@ -588,6 +589,7 @@ def gbuffer(scene, width, height, *, gradient="exact", zoom=1.0):
     it is meant for checks and figures, not for very large frames.
     """
     scene, width, height, gradient, zoom = _check_args(scene, width, height, gradient, zoom)
+    keep_heap()
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     X = np.tile(x, height)
     Y = np.repeat(y, width)
@@ -687,6 +689,7 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     corrections listed in the book's errata.
     """
     scene, width, height, gradient, zoom = _check_args(scene, width, height, gradient, zoom)
+    keep_heap()
     workers = _check_workers(workers)
     image = np.zeros((height, width, 3))
     chamber = np.zeros((height, width), dtype=np.uint8)

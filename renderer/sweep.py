@@ -22,6 +22,7 @@ import numpy as np
 
 from . import fields
 from .geometry import image_plane
+from .heap import keep_heap
 from .ledger import compare
 from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient,
                      _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal, _view,
@@ -99,6 +100,7 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     "bump moves no boundary" (seed §3).
     """
     scene, width, height, _, zoom = _check_args(scene, width, height, "exact", zoom)
+    keep_heap()
     workers = _check_workers(workers)
     steps = _check_steps(eps_values)
     scenes = [scene.replace(eps=e) for e in steps]
