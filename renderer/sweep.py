@@ -26,7 +26,8 @@ from .heap import keep_heap
 from .ledger import compare
 from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient,
                      _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal, _view,
-                     _store_rgb, _surfaces, _tile_rows, _trace_shadows)
+                     _put_rows, _store_rgb, _surfaces, _tile_rows,
+                     _trace_shadows)
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS"]
 
@@ -148,7 +149,7 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
                     surf.grad = _gradient(s, surf, "central", s.eps, base)
                     Ns = _shading_normal(s, surf, surf.grad)
                 _store_rgb(image, rows_idx, _shade(s, surf.P, Ns, surf.albedo, lights, view=view))
-                grad_out[rows_idx, 0], grad_out[rows_idx, 1] = surf.grad
+                _put_rows(grad_out, rows_idx, np.stack(surf.grad, axis=-1))
                 kink_out[rows_idx] = kink
     done = {"pixels": 0}
     lock = threading.Lock()
