@@ -182,6 +182,67 @@ def test_kink_band_of_ridges_is_the_seed_band():
     assert np.any(render(Scene(height_field="ridges"), 48, 48).kink)
 
 
+def _det_band(u, v, ku, kv):
+    """The crease flag decided with the deterministic sine everywhere (the definition)."""
+    s1, s2 = fields._ridge_factors_fn()(u, v, ku, kv)
+    return (np.abs(s1) < fields.KINK_BAND_HALF_WIDTH) | (np.abs(s2) < fields.KINK_BAND_HALF_WIDTH)
+
+
+def _edge_points(ku, kv, spread=40):
+    """Chart points whose factors lie within a few ulps of the band's edge
+    |sin| = 0.03: u = (m pi +- asin 0.03) / (pi k_u), stepped ulp by ulp."""
+    a = np.arcsin(fields.KINK_BAND_HALF_WIDTH)
+    steps = np.arange(-spread, spread + 1)
+    out_u, out_v = [], []
+    for m in range(3):
+        for root in (m * np.pi + a, m * np.pi - a):
+            if root <= 0:
+                continue
+            for k, dest, other in ((ku, out_u, out_v), (kv, out_v, out_u)):
+                centre = root / (np.pi * k)
+                pts = centre + steps * np.spacing(centre)
+                dest.append(pts)
+                other.append(np.full(pts.size, 0.5 / k + 0.1))     # far from the other edge
+    return np.concatenate(out_u), np.concatenate(out_v)
+
+
+@pytest.mark.parametrize("ku, kv", K_PAIRS)
+def test_kink_band_first_pass_gives_the_deterministic_flag(ku, kv):
+    """numpy's sine decides only away from the band's edge: the flag is the
+    deterministic sine's, on random points and on points ulps from the edge."""
+    u, v = chart_points(np.random.default_rng(99))
+    eu, ev = _edge_points(ku, kv)
+    u, v = np.concatenate([u, eu]), np.concatenate([v, ev])
+    flag = fields.kink_band("ridges", u, v, ku, kv)
+    assert np.array_equal(flag, _det_band(u, v, ku, kv))
+    assert 0 < np.count_nonzero(flag) < flag.size
+
+
+def test_kink_band_survives_a_worse_sine_and_the_margin_is_what_saves_it(monkeypatch):
+    """A first-pass sine off by 1e-13 (far worse than numpy's) still gives the
+    deterministic flag; without the margin the same sine flips edge points, so
+    the check above can fail."""
+    ku, kv = 8.0, 4.0
+    u, v = _edge_points(ku, kv)
+    want = _det_band(u, v, ku, kv)
+    monkeypatch.setattr(fields, "_fast_sine", lambda x: np.sin(x) * (1.0 + 1e-13 / 0.03))
+    assert np.array_equal(fields.kink_band("ridges", u, v, ku, kv), want)
+    monkeypatch.setattr(fields, "KINK_SINE_MARGIN", 0.0)
+    assert not np.array_equal(fields.kink_band("ridges", u, v, ku, kv), want)
+
+
+def test_kink_band_outside_the_fast_range():
+    """NaN chart values, and arguments beyond the deterministic sine's accurate
+    range, are decided by the deterministic sine alone."""
+    u = np.array([0.1, np.nan, 0.3, np.inf])
+    v = np.array([0.2, 0.2, np.nan, 0.4])
+    assert np.array_equal(fields.kink_band("ridges", u, v, 8.0, 4.0), _det_band(u, v, 8.0, 4.0))
+    big = np.random.default_rng(100).random(500)
+    assert np.array_equal(fields.kink_band("ridges", big, big, 3e6, 4.0), _det_band(big, big, 3e6, 4.0))
+    scalar = fields.kink_band("ridges", 0.0, 0.3, 8.0, 4.0)
+    assert scalar.shape == () and bool(scalar)
+
+
 # --- central differences at the chart borders ---------------------------------------------
 
 @pytest.mark.parametrize("field", FIELDS)
