@@ -58,16 +58,58 @@ _PI_O_2 = 1.5707963267948965580e+00
 
 
 def _kernels(x, y):
-    """k_sin.c and k_cos.c on the reduced argument x + y, sharing z = x^2 and z^2."""
+    """k_sin.c and k_cos.c on the reduced argument x + y, sharing z = x^2 and z^2.
+
+    Computed in place on a few temporaries (a quarter faster than one new
+    array per operation); each line's comment is the expression of the C
+    source it evaluates, in the same order.  ``x``, ``y``: float64 arrays of
+    one shape (at least 1-d), not written to.
+    """
+    mul = np.multiply
     z = x * x
     w = z * z
-    r = _S2 + z * (_S3 + z * _S4) + z * w * (_S5 + z * _S6)
-    v = z * x
-    s = x - ((z * (0.5 * y - v * r) - y) - v * _S1)
-    r = z * (_C1 + z * (_C2 + z * _C3)) + w * w * (_C4 + z * (_C5 + z * _C6))
-    hz = 0.5 * z
-    w = 1.0 - hz
-    c = w + (((1.0 - w) - hz) + (z * r - x * y))
+    # r = S2 + z*(S3 + z*S4) + (z*w)*(S5 + z*S6)
+    r = z * _S4
+    r += _S3
+    r *= z
+    r += _S2
+    a = z * _S6
+    a += _S5
+    b = z * w
+    a *= b
+    r += a
+    # s = x - ((z*(0.5*y - v*r) - y) - v*S1), v = z*x
+    v = mul(z, x, out=b)
+    r *= v
+    s = mul(y, 0.5, out=a)
+    s -= r
+    s *= z
+    s -= y
+    v *= _S1
+    s -= v
+    np.subtract(x, s, out=s)
+    # r = z*(C1 + z*(C2 + z*C3)) + (w*w)*(C4 + z*(C5 + z*C6))
+    mul(z, _C3, out=r)
+    r += _C2
+    r *= z
+    r += _C1
+    r *= z
+    b = mul(z, _C6, out=v)
+    b += _C5
+    b *= z
+    b += _C4
+    w *= w
+    b *= w
+    r += b
+    # c = (1 - hz) + (((1 - (1 - hz)) - hz) + (z*r - x*y)), hz = 0.5*z
+    hz = mul(z, 0.5, out=w)
+    one_hz = np.subtract(1.0, hz)
+    r *= z
+    r -= mul(x, y, out=b)
+    c = np.subtract(1.0, one_hz, out=z)
+    c -= hz
+    c += r
+    c += one_hz                                   # IEEE addition commutes exactly
     return s, c
 
 
@@ -78,20 +120,34 @@ def sin(x):
     ``det_sin`` of renderer/js/detmath.js.  NaN for inf or NaN.
     """
     x = np.asarray(x, dtype=np.float64)
+    scalar = x.ndim == 0
+    x = x.reshape(1) if scalar else x
     with np.errstate(invalid="ignore"):           # inf and NaN give NaN, quietly
-        fn = np.floor(x * _INVPIO2 + 0.5)
-        t = x - fn * _PIO2_1
-        w = fn * _PIO2_2
-        r = t - w
-        w = fn * _PIO2_2T - ((t - r) - w)
-        y0 = r - w
-        y1 = (r - y0) - w
+        # Cody-Waite reduction, x = fn pi/2 + (y0 + y1) (e_rem_pio2.c, medium path),
+        # in place; the comments are the C expressions.
+        fn = x * _INVPIO2                         # fn = floor(x * invpio2 + 0.5)
+        fn += 0.5
+        np.floor(fn, out=fn)
+        t = fn * _PIO2_1                          # t = x - fn * pio2_1
+        np.subtract(x, t, out=t)
+        w = fn * _PIO2_2                          # w = fn * pio2_2
+        r = t - w                                 # r = t - w
+        a = t - r                                 # w = fn * pio2_2t - ((t - r) - w)
+        a -= w
+        w2 = fn * _PIO2_2T
+        w2 -= a
+        y0 = np.subtract(r, w2, out=t)            # y0 = r - w
+        y1 = np.subtract(r, y0, out=r)            # y1 = (r - y0) - w
+        y1 -= w2
         # Quadrant q = fn mod 4, exactly (fn is an integer): sin, cos, -sin, -cos.
-        q = fn - 4.0 * np.floor(fn * 0.25)
+        q = np.multiply(fn, 0.25, out=a)
+        np.floor(q, out=q)
+        q *= 4.0
+        np.subtract(fn, q, out=q)
         s, c = _kernels(y0, y1)
         out = np.where((q == 1.0) | (q == 3.0), c, s)
         out = np.where(q >= 2.0, -out, out)
-    return out if out.ndim else float(out)
+    return float(out[0]) if scalar else out
 
 
 # The interval reduction of s_atan.c, t -> (a t + b) / (c t + d), one row per
