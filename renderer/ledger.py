@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .render import SPHERE_A, Frame
+from .render import SPHERE_A, Frame, _take_rows
 
 __all__ = ["Ledger", "compare", "to_srgb"]
 
@@ -52,9 +52,15 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
     idx = np.flatnonzero(on_a)
     channels = numeric.image.shape[-1]
     # |dI| on sphere A only, pixels in raster order (the order of d[on_a]).
-    da = np.abs(numeric.image.reshape(-1, channels)[idx] - symbolic.image.reshape(-1, channels)[idx])
+    da = _take_rows(numeric.image.reshape(-1, channels), idx)
+    da -= _take_rows(symbolic.image.reshape(-1, channels), idx)
+    np.abs(da, out=da)
     band = symbolic.kink.reshape(-1)[idx]
-    mean = lambda m: float(da[m].mean()) if m.any() else float("nan")  # noqa: E731
+
+    def mean(m):
+        rows = np.flatnonzero(m)
+        return float(_take_rows(da, rows).mean()) if rows.size else float("nan")
+
     return Ledger(
         max_abs=float(da.max()) if da.size else 0.0,
         rms=float(np.sqrt(np.mean(da**2))) if da.size else 0.0,

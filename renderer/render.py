@@ -536,6 +536,14 @@ def _put_rows(dest, idx, rows):
     np.put(dest.view(record).reshape(-1), idx, rows.view(record).reshape(-1))
 
 
+def _take_rows(src, idx):
+    """``src[idx]`` for a C-contiguous (n, k) ``src``: one `np.take` of k-float
+    records on a void view (the same bytes as 2-D fancy indexing, faster)."""
+    record = np.dtype((np.void, src.dtype.itemsize * src.shape[1]))
+    rows = np.take(src.view(record).reshape(-1), idx)
+    return rows.view(src.dtype).reshape(idx.shape[0], src.shape[1])
+
+
 def _store_rgb(image, idx, col):
     """Clip the colour triple ``col`` to [0, 1] and write it to rows ``idx`` of
     the (n, 3) ``image`` view (one row scatter, not three strided ones)."""

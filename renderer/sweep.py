@@ -162,5 +162,12 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
                 progress(done["pixels"], width * height)
 
     _run_tiles([lambda j0=j0: tile_and_report(j0) for j0 in range(0, height, rows)], workers)
-    census = tuple(compare(f, symbolic) for f in numeric)
+    # The ledgers, side by side on the same threads.
+    census = [None] * len(numeric)
+
+    def ledger(i):
+        census[i] = compare(numeric[i], symbolic)
+
+    _run_tiles([lambda i=i: ledger(i) for i in range(len(numeric))], workers)
+    census = tuple(census)
     return Sweep(eps=steps, numeric=tuple(numeric), symbolic=symbolic, census=census)
