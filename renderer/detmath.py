@@ -168,20 +168,44 @@ def _atan_nonneg(t, finite=False):
 
     ``finite``: the caller knows t has no inf (skips the -1/inf fix-up).
     """
-    row = np.searchsorted(_ATAN_BREAKS, t, side="right")
+    if t.ndim == 0:                               # in-place steps need an array
+        return _atan_nonneg(t.reshape(1), finite).reshape(())
+    # The interval of t: the number of breaks <= t (t is never NaN here).
+    row = (t >= _ATAN_BREAKS[0]).view(np.uint8)
+    for brk in _ATAN_BREAKS[1:]:
+        row = row + (t >= brk).view(np.uint8)
     a, b, c, d = (np.take(col, row) for col in _ATAN_MOBIUS)
     with np.errstate(divide="ignore", invalid="ignore"):
-        tr = (a * t + b) / (c * t + d)
+        a *= t                                    # tr = (a t + b) / (c t + d)
+        a += b
+        c *= t
+        c += d
+        tr = np.divide(a, c, out=a)
     if not finite:
         tr = np.where(t == np.inf, -0.0, tr)      # -1/inf, where 0 * inf would give NaN
     z = tr * tr
     w = z * z
     at = _AT
-    s1 = z * (at[0] + w * (at[2] + w * (at[4] + w * (at[6] + w * (at[8] + w * at[10])))))
-    s2 = w * (at[1] + w * (at[3] + w * (at[5] + w * (at[7] + w * at[9]))))
-    p = tr * (s1 + s2)
-    reduced = np.take(_ATANHI_ROW, row) - ((p - np.take(_ATANLO_ROW, row)) - tr)
-    return np.where(row == 0, tr - p, reduced)
+    # s1 = z*(at0 + w*(at2 + w*(at4 + w*(at6 + w*(at8 + w*at10))))), Horner in place
+    s1 = w * at[10]
+    for coef in (at[8], at[6], at[4], at[2]):
+        s1 += coef
+        s1 *= w
+    s1 += at[0]
+    s1 *= z
+    # s2 = w*(at1 + w*(at3 + w*(at5 + w*(at7 + w*at9))))
+    s2 = np.multiply(w, at[9], out=b)
+    for coef in (at[7], at[5], at[3], at[1]):
+        s2 += coef
+        s2 *= w
+    s1 += s2                                      # p = tr * (s1 + s2)
+    p = np.multiply(s1, tr, out=s1)
+    # row 0: tr - p; else atanhi - ((p - atanlo) - tr)
+    reduced = np.take(_ATANLO_ROW, row)
+    np.subtract(p, reduced, out=reduced)
+    reduced -= tr
+    np.subtract(np.take(_ATANHI_ROW, row), reduced, out=reduced)
+    return np.where(row == 0, np.subtract(tr, p, out=p), reduced)
 
 
 def atan2(y, x):

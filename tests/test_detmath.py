@@ -150,3 +150,39 @@ def test_in_place_sine_gives_the_plain_expressions_bits():
         before = a.copy()
         assert detmath.sin(a).tobytes() == _plain_sin(a).tobytes() and np.array_equal(a, before)
     assert isinstance(detmath.sin(2.5), float) and detmath.sin(2.5) == float(_plain_sin(np.array(2.5)))
+
+
+def _plain_atan_nonneg(t, distribute=False):
+    """s_atan.c on t >= 0 as plain expressions (one new array per operation),
+    the interval found by searchsorted.  ``distribute`` is a wrong variant:
+    tr (s1 + s2) computed as tr s1 + tr s2."""
+    row = np.searchsorted(detmath._ATAN_BREAKS, t, side="right")
+    a, b, c, d = (np.take(col, row) for col in detmath._ATAN_MOBIUS)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tr = (a * t + b) / (c * t + d)
+    tr = np.where(t == np.inf, -0.0, tr)
+    z = tr * tr
+    w = z * z
+    at = detmath._AT
+    s1 = z * (at[0] + w * (at[2] + w * (at[4] + w * (at[6] + w * (at[8] + w * at[10])))))
+    s2 = w * (at[1] + w * (at[3] + w * (at[5] + w * (at[7] + w * at[9]))))
+    p = tr * s1 + tr * s2 if distribute else tr * (s1 + s2)
+    reduced = np.take(detmath._ATANHI_ROW, row) - ((p - np.take(detmath._ATANLO_ROW, row)) - tr)
+    return np.where(row == 0, tr - p, reduced)
+
+
+def test_in_place_atan_gives_the_plain_expressions_bits():
+    """`detmath._atan_nonneg` finds the interval by comparisons and works in
+    place: the same bits as the plain expressions, break points included; the
+    check rejects a variant that distributes one product over a sum."""
+    rng = np.random.default_rng(9)
+    breaks = detmath._ATAN_BREAKS
+    t = np.concatenate([np.abs(rng.normal(size=200000)),
+                        rng.uniform(0.0, 1.0, 200000) * 10.0 ** rng.integers(-300, 300, 200000),
+                        breaks, np.nextafter(breaks, 0.0), np.nextafter(breaks, 9.0),
+                        [0.0, 5e-324, 1e308, np.inf]])
+    want = _plain_atan_nonneg(t)
+    assert detmath._atan_nonneg(t).tobytes() == want.tobytes()
+    finite = t[np.isfinite(t)]
+    assert detmath._atan_nonneg(finite, finite=True).tobytes() == _plain_atan_nonneg(finite).tobytes()
+    assert _plain_atan_nonneg(t, distribute=True).tobytes() != want.tobytes()
