@@ -46,7 +46,7 @@ TILE_PIXELS = 1 << 16
 WORKERS = max(1, min(4, os.cpu_count() or 1))
 #: Frames smaller than this many pixels are rendered on one thread (the
 #: threads' overhead would exceed their gain).
-MIN_SPLIT_PIXELS = 1 << 13
+MIN_SPLIT_PIXELS = 1 << 16
 _POOLS = {}
 
 

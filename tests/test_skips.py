@@ -178,7 +178,8 @@ def test_sweep_rejects_bad_steps(bad, match):
 @pytest.mark.parametrize("workers", [2, 3])
 def test_threads_give_the_same_bits(workers):
     scene = SCENES["default"]
-    big = (200, 170)                                  # several tiles
+    big = (300, 240)                        # above MIN_SPLIT_PIXELS: one tile per thread
+    assert big[0] * big[1] >= R.MIN_SPLIT_PIXELS
     assert _same(render(scene, *big, workers=1), render(scene, *big, workers=workers))
     a = sweep(scene, (1e-2, 1e-6), *big, workers=1)
     b = sweep(scene, (1e-2, 1e-6), *big, workers=workers)
@@ -194,8 +195,8 @@ def test_bad_workers_are_refused(bad):
 def test_sweep_reports_progress_per_tile_and_gives_the_same_bits():
     calls = []
     scene = SCENES["default"]
-    a = sweep(scene, (1e-3, 1e-6), 200, 170, progress=lambda done, total: calls.append((done, total)))
-    b = sweep(scene, (1e-3, 1e-6), 200, 170)
-    assert len(calls) > 1 and calls[-1] == (200 * 170, 200 * 170)
+    a = sweep(scene, (1e-3, 1e-6), 300, 240, progress=lambda done, total: calls.append((done, total)))
+    b = sweep(scene, (1e-3, 1e-6), 300, 240)
+    assert len(calls) > 1 and calls[-1] == (300 * 240, 300 * 240)
     assert [d for d, _ in calls] == sorted(d for d, _ in calls)
     assert all(_same(x, y) for x, y in zip(a.numeric, b.numeric))
