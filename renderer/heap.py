@@ -40,7 +40,7 @@ __all__ = ["keep_heap", "MMAP_THRESHOLD", "TRIM_THRESHOLD", "ENV_VAR"]
 #: above it, every tile temporary is far below.
 MMAP_THRESHOLD = 32 << 20
 #: Free memory the top of a heap may hold before it is returned (bytes): several
-#: tiles' working sets (about 13 MiB each, `renderer.render.TILE_PIXELS`).
+#: tiles' working sets (about 26 MiB each, `renderer.render.TILE_PIXELS`).
 TRIM_THRESHOLD = 64 << 20
 #: Environment variable: "0" leaves the allocator alone.
 ENV_VAR = "SYMRENDER_KEEP_HEAP"

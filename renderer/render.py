@@ -38,14 +38,15 @@ MAX_ZOOM = 1e6
 #: (about 0.4 KiB of temporaries per pixel of a tile, per thread).
 TILE_PIXELS = 1 << 16
 #: Default number of threads rendering tiles side by side: the machine's cores,
-#: at most 4.  numpy releases the GIL inside its loops, and with tiles of
-#: 32,768 pixels two threads render a frame 1.3 (256^2) to 1.6 (512^2,
-#: 1024^2) times as fast as one on this project's 2-core machines
-#: (benchmarks/results/render.md).
+#: at most 4.  numpy releases the GIL inside its loops, but each of the few
+#: thousand array operations of a tile takes it back, and on this project's
+#: 2-core machines two threads render a frame 1.5 (256^2) to 1.7 (1024^2)
+#: times as fast as one (benchmarks/results/render.md).
 #: Tiles write disjoint slices: the image is the same bits for any number.
 WORKERS = max(1, min(4, os.cpu_count() or 1))
-#: Frames smaller than this many pixels are rendered on one thread (the
-#: threads' overhead would exceed their gain).
+#: Frames smaller than this many pixels are rendered on one thread: below it
+#: the threads' contention for the GIL costs more than they gain (here two
+#: threads took 6.0 ms for a 128^2 frame, one 4.3 ms; about even at 224^2).
 MIN_SPLIT_PIXELS = 1 << 16
 _POOLS = {}
 
@@ -701,9 +702,10 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
 
     Notes
     -----
-    The image is computed in tiles of at most 32,768 pixels, so the working
-    memory beyond the outputs is bounded at any resolution (about 13 MiB per
-    thread).  Source: seed
+    The image is computed in tiles of at most 65,536 pixels, so the working
+    memory beyond the outputs is bounded at any resolution (about 26 MiB per
+    thread).  The first call keeps freed memory in the process heap
+    (`renderer.heap`; ``SYMRENDER_KEEP_HEAP=0`` opts out).  Source: seed
     Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
     corrections listed in the book's errata.
     """

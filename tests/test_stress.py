@@ -67,7 +67,7 @@ def test_one_by_one_and_thin_frames():
 
 
 def test_4096_frame_in_bounded_memory():
-    """Working memory beyond the outputs stays bounded (tiles of 16,384 pixels)."""
+    """Working memory beyond the outputs stays bounded (tiles of `TILE_PIXELS` pixels)."""
     w = h = 4096
     outputs = w * h * (3 * 8 + 1 + 1 + 2 * 8)
     tracemalloc.start()
