@@ -213,6 +213,62 @@ def _fast_sine_applies(uu, vv, ku, kv):
 u_p, u_m, v_p, v_m = sp.symbols("u_p u_m v_p v_m", real=True)
 
 
+#: Largest number of points whose sines `_SineBatch` stacks into one call.
+#: Measured here (benchmarks/results/render.md): stacking four sines of
+#: 15,000 points (a 256^2 tile on each of two threads) made the central frame
+#: 0.94 times as long; four of 30,000 on one thread made it 1.09 times as
+#: long (the stacked temporaries no longer fit the core's cache).
+SINE_BATCH_MAX = 24576
+
+
+class _SineBatch:
+    """A list of assignments and outputs evaluated with all their sines in one call.
+
+    The sines of ``assignments`` (``(symbol, expr)`` pairs in order) and of
+    ``outputs`` are taken out: first the assignments free of sines and every
+    sine's argument are evaluated (``_args``), then `detmath.sin` once on the
+    stacked arguments, then the rest with each sine replaced by its row
+    (``_rest``).  For up to `SINE_BATCH_MAX` points, one call on a (k, n)
+    array instead of k calls on (n,) arrays: the same elementwise operations,
+    so the same bits, with a k-th of the array operations (each of which
+    takes the GIL back when tiles render on several threads).  Source: a rewrite of sympy's cse output; the sines'
+    arguments and the other expressions print exactly as before.
+    """
+
+    def __init__(self, inputs, assignments, outputs):
+        sines = []
+        for expr in [e for _, e in assignments] + list(outputs):
+            for atom in sorted(expr.atoms(sp.sin), key=sp.default_sort_key):
+                if atom not in sines:
+                    sines.append(atom)
+        pre = [(sym, e) for sym, e in assignments if not e.has(sp.sin)]
+        known = set(inputs) | {sym for sym, _ in pre}
+        if any(not s.args[0].free_symbols <= known for s in sines):
+            raise ValueError("a sine's argument depends on another sine")   # not in these fields
+        rows = sp.symbols(f"_sin0:{len(sines)}", real=True)
+        swap = dict(zip(sines, rows))
+        post = [(sym, e.xreplace(swap)) for sym, e in assignments if e.has(sp.sin)]
+        pre_symbols = [sym for sym, _ in pre]
+        self.count = len(sines)
+        self._args = sp.lambdify(inputs, pre_symbols + [s.args[0] for s in sines], modules="numpy",
+                                 cse=lambda exprs: (pre, exprs))
+        self._rest = sp.lambdify(tuple(inputs) + tuple(pre_symbols) + rows,
+                                 [e.xreplace(swap) for e in outputs], modules="numpy",
+                                 cse=lambda exprs: (post, exprs))
+        self._n_pre = len(pre)
+
+    def __call__(self, *values):
+        out = self._args(*values)
+        pre, args = out[:self._n_pre], out[self._n_pre:]
+        if args:
+            args = np.broadcast_arrays(*args)
+            if args[0].size <= SINE_BATCH_MAX:
+                args = list(detmath.sin(np.stack(args)))
+            else:
+                args = [detmath.sin(a) for a in args]
+        return self._rest(*values, *pre, *args)
+
+
 class CentralStencil:
     """The four values h(u+, v), h(u-, v), h(u, v+), h(u, v-) of a central
     difference, generated from the sympy field as one function.
@@ -223,7 +279,8 @@ class CentralStencil:
     sin(pi k_u u) serves h(u, v+-eps) (6 sines instead of 8); for rings
     h(u+-eps, v) is one value (3 instead of 4).  The subexpressions free of the
     shifted points (``base``) do not depend on eps either, so an eps sweep
-    computes them once (`renderer.sweep`).  Every value is the same bits as
+    computes them once (`renderer.sweep`).  The sines of each part are
+    computed in one call (`_SineBatch`).  Every value is the same bits as
     `height` at the same point: the same operations on the same numbers
     (tests/test_fields.py checks it; the JavaScript evaluates h four times and
     matches too).
@@ -242,10 +299,9 @@ class CentralStencil:
                 rest.append((sym, expr))
         self.name = name
         self.base_symbols = tuple(b for b, _ in base)
-        self._base = sp.lambdify((u, v, k_u, k_v), list(self.base_symbols), modules=HEIGHT_MODULES,
-                                 cse=lambda exprs: (base, exprs))
-        self._shifted = sp.lambdify((u_p, u_m, v_p, v_m, u, v, k_u, k_v, *self.base_symbols), reduced,
-                                    modules=HEIGHT_MODULES, cse=lambda exprs: (rest, exprs))
+        self._base = _SineBatch((u, v, k_u, k_v), base, list(self.base_symbols))
+        self._shifted = _SineBatch((u_p, u_m, v_p, v_m, u, v, k_u, k_v, *self.base_symbols), rest,
+                                   reduced)
 
     def base(self, uu, vv, ku, kv):
         """The eps-free subexpressions at the stencil's centre (a list of arrays)."""

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import sympy as sp
 
 from renderer import Scene, fields, render
 from renderer.render import central_gradient
@@ -322,6 +323,26 @@ def test_u_wrap_gives_the_bits_of_np_mod(eps):
     want = quotient(np.mod(u + eps, 1.0), np.mod(u - eps, 1.0))
     assert np.array_equal(hu.view(np.int64), want.view(np.int64))
     assert not np.array_equal(quotient(u + eps, u - eps).view(np.int64), want.view(np.int64))
+
+
+@pytest.mark.parametrize("field", FIELDS)
+@pytest.mark.parametrize("n", [1, 1000, fields.SINE_BATCH_MAX, fields.SINE_BATCH_MAX + 1])
+def test_stencil_values_are_the_bits_of_height(field, n):
+    """The stencil (sines stacked into one call up to SINE_BATCH_MAX points,
+    one call per sine beyond) gives `fields.height`'s bits at the four shifted
+    points; values computed with numpy's sine instead differ, so the check can fail."""
+    rng = np.random.default_rng(n)
+    u, v = rng.random(n), rng.random(n)
+    eps = 1e-3
+    up, um, vp, vm = np.mod(u + eps, 1.0), np.mod(u - eps, 1.0), np.minimum(1.0, v + eps), np.maximum(0.0, v - eps)
+    got = fields.central_stencil(field).values(up, um, vp, vm, u, v, 3.3, 7.1)
+    points = ((up, v), (um, v), (u, vp), (u, vm))
+    for g, (pu, pv) in zip(got, points):
+        assert g.tobytes() == fields.height(field, pu, pv, 3.3, 7.1).tobytes()
+    if n >= 1000:
+        numpy_h = sp.lambdify((fields.u, fields.v, fields.k_u, fields.k_v), fields.HEIGHT_EXPRS[field], "numpy")
+        assert any(g.tobytes() != np.broadcast_to(numpy_h(pu, pv, 3.3, 7.1), g.shape).tobytes()
+                   for g, (pu, pv) in zip(got, points))
 
 
 def _border_points():
