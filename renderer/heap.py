@@ -1,14 +1,15 @@
 """Keep freed memory in the process's heap, so a render's temporaries are reused.
 
-A 256^2 tile allocates and frees a few hundred numpy temporaries of 50 to
-260 KB each.  With glibc's default settings the freed memory at the top of
+A tile of a 256^2 frame allocates and frees a few hundred numpy temporaries of
+50 to 520 KB each.  With glibc's default settings the freed memory at the top of
 the heap is handed back to the kernel as soon as more than a few times the
 largest freed block lies free there (``M_TRIM_THRESHOLD``), and blocks above
 the mmap threshold are mapped and unmapped on every allocation.  Either way
 the next tile's temporaries are fresh pages, and each page costs a page fault
-when first written: about 6,100 minor faults per 256^2 frame on one thread
+when first written: about 7,400 minor faults per 256^2 frame on one thread
 here, a third of its run time (benchmarks/results/render.md; `tests/test_heap.py`
-counts them).
+counts them).  Frames of 1024^2 and more gain nothing measurable: their large
+output arrays already raise glibc's own thresholds.
 
 `keep_heap` raises both thresholds once per process through glibc's
 ``mallopt(3)``: blocks up to `MMAP_THRESHOLD` come from the heap, and the heap

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import fields
-from .heap import keep_heap
 from .geometry import (POLE_SIN_PHI, chart, image_plane, projected_bounds, segment_hits_sphere,
                        sphere_hit, tangent_frame)
+from .heap import keep_heap
 from .scene import Scene
 
 __all__ = [
@@ -40,13 +40,14 @@ TILE_PIXELS = 1 << 16
 #: Default number of threads rendering tiles side by side: the machine's cores,
 #: at most 4.  numpy releases the GIL inside its loops, but each of the few
 #: thousand array operations of a tile takes it back, and on this project's
-#: 2-core machines two threads render a frame 1.5 (256^2) to 1.7 (1024^2)
+#: 2-core machines two threads render a frame 1.5 (256^2) to 1.6 (1024^2)
 #: times as fast as one (benchmarks/results/render.md).
 #: Tiles write disjoint slices: the image is the same bits for any number.
 WORKERS = max(1, min(4, os.cpu_count() or 1))
 #: Frames smaller than this many pixels are rendered on one thread: below it
-#: the threads' contention for the GIL costs more than they gain (here two
-#: threads took 6.0 ms for a 128^2 frame, one 4.3 ms; about even at 224^2).
+#: the threads' contention for the GIL costs more than they gain (measured
+#: here when this was set: two threads took 6.0 ms for a 128^2 frame against
+#: 4.3 ms on one, and were about even at 224^2).
 MIN_SPLIT_PIXELS = 1 << 16
 _POOLS = {}
 

@@ -26,8 +26,7 @@ from .heap import keep_heap
 from .ledger import compare
 from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient,
                      _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal, _view,
-                     _put_rows, _store_rgb, _surfaces, _tile_rows,
-                     _trace_shadows)
+                     _put_rows, _store_rgb, _surfaces, _tile_rows, _trace_shadows)
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS"]
 

@@ -64,7 +64,7 @@ def test_warm_render_faults_in_no_fresh_pages(probes):
 
     The wrong variant (the allocator left alone) is checked too, so this test
     can fail: there every 256^2 frame faults in thousands of pages (about
-    6,100 here), the temporaries' memory handed back and taken again.
+    7,400 here), the temporaries' memory handed back and taken again.
     """
     kept, alone = probes["kept"]["faults"], probes["left alone"]["faults"]
     if GLIBC:
