@@ -214,10 +214,11 @@ u_p, u_m, v_p, v_m = sp.symbols("u_p u_m v_p v_m", real=True)
 
 
 #: Largest number of points whose sines `_SineBatch` stacks into one call.
-#: Measured here (benchmarks/results/render.md): stacking four sines of
-#: 15,000 points (a 256^2 tile on each of two threads) made the central frame
-#: 0.94 times as long; four of 30,000 on one thread made it 1.09 times as
-#: long (the stacked temporaries no longer fit the core's cache).
+#: Measured here side by side when it was set (steady-state A/B runs, not a
+#: committed benchmark): stacking four sines of 15,000 points (a 256^2 tile on
+#: each of two threads) made the central frame 0.94-0.95 times as long; four of
+#: 30,000 on one thread made it 1.09 times as long (the stacked temporaries no
+#: longer fit the core's cache).
 SINE_BATCH_MAX = 24576
 
 
@@ -231,8 +232,9 @@ class _SineBatch:
     (``_rest``).  For up to `SINE_BATCH_MAX` points, one call on a (k, n)
     array instead of k calls on (n,) arrays: the same elementwise operations,
     so the same bits, with a k-th of the array operations (each of which
-    takes the GIL back when tiles render on several threads).  Source: a rewrite of sympy's cse output; the sines'
-    arguments and the other expressions print exactly as before.
+    takes the GIL back when tiles render on several threads).  Source: a
+    rewrite of sympy's cse output; the sines' arguments and the other
+    expressions print exactly as before.
     """
 
     def __init__(self, inputs, assignments, outputs):
@@ -249,7 +251,6 @@ class _SineBatch:
         swap = dict(zip(sines, rows))
         post = [(sym, e.xreplace(swap)) for sym, e in assignments if e.has(sp.sin)]
         pre_symbols = [sym for sym, _ in pre]
-        self.count = len(sines)
         self._args = sp.lambdify(inputs, pre_symbols + [s.args[0] for s in sines], modules="numpy",
                                  cse=lambda exprs: (pre, exprs))
         self._rest = sp.lambdify(tuple(inputs) + tuple(pre_symbols) + rows,
