@@ -8,10 +8,12 @@
 * the gradient stage alone over sphere A's pixels: exact against one central
   difference at the same pixels;
 * the steady state: each target case (and 256^2 on one thread) repeated back
-  to back in child processes, with the allocator settings of renderer.heap
-  and without them (SYMRENDER_KEEP_HEAP=0), the two kinds of child
-  alternating, with the minor page faults per run; the issue-6 targets are
-  judged on these.
+  to back in child processes of three kinds, alternating: the defaults (tiles
+  on the calling thread and worker processes, renderer.workers; the
+  allocator settings of renderer.heap), threads only
+  (SYMRENDER_WORKER_PROCESSES=0), and the heap left alone
+  (SYMRENDER_KEEP_HEAP=0), with the minor page faults per run; the issue-6
+  targets are judged on the defaults.
 
 These machines are noisy: every median is printed with its min-max, and the
 things compared are interleaved in one loop.  Results go to
@@ -37,6 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from renderer import Scene, compare, fields, gbuffer, render, sweep  # noqa: E402
+from renderer import workers as worker_processes  # noqa: E402
 from renderer.render import WORKERS, central_gradient  # noqa: E402
 from tests.scalar_reference import render_reference  # noqa: E402
 
@@ -89,7 +92,7 @@ def _steady_child(repeats):
     after the other (s), and the minor page faults per run; printed as JSON."""
     from renderer.heap import keep_heap
     scene = Scene()
-    out = {}
+    out = {"worker processes": worker_processes.wait_ready()}
     for name, (size, kw, share) in STEADY_CASES.items():
         if kw == "sweep":
             fn = lambda size=size: sweep(scene, STEPS, size, size)   # noqa: E731
@@ -110,22 +113,29 @@ def _steady_child(repeats):
     print(json.dumps(out))
 
 
+#: Children of each kind.
+STEADY_ROUNDS = 3
+#: The kinds of steady-state child: name -> environment variable set to "0".
+STEADY_SETTINGS = {"defaults": None, "threads only": worker_processes.ENV_VAR,
+                   "heap left alone": "SYMRENDER_KEEP_HEAP"}
+
+
 def _steady_rounds(rounds, repeats):
-    """Children with the heap kept and left alone, alternating:
+    """Children of each kind in `STEADY_SETTINGS`, alternating:
     {setting: {case: stats of the children's medians, with faults per run}}."""
-    samples = {"kept": [], "left alone": []}
+    samples = {k: [] for k in STEADY_SETTINGS}
     for _ in range(rounds):
-        for setting in samples:
-            env = dict(os.environ)
-            env.pop("SYMRENDER_KEEP_HEAP", None)
-            if setting == "left alone":
-                env["SYMRENDER_KEEP_HEAP"] = "0"
+        for setting, var in STEADY_SETTINGS.items():
+            env = {k: v for k, v in os.environ.items() if k not in STEADY_SETTINGS.values()}
+            if var is not None:
+                env[var] = "0"
             run = subprocess.run([sys.executable, __file__, "--steady-child", str(repeats)], env=env,
                                  check=True, capture_output=True, text=True)
             samples[setting].append(json.loads(run.stdout.strip().splitlines()[-1]))
     res = {}
     for setting, runs in samples.items():
-        res[setting] = {"applied": all(r["applied"] for r in runs)}
+        res[setting] = {"applied": all(r["applied"] for r in runs),
+                        "worker processes": min(r["worker processes"] for r in runs)}
         for name in STEADY_CASES:
             res[setting][name] = _stats([r[name]["median"] for r in runs]) | {
                 "faults": statistics.median(r[name]["faults"] for r in runs)}
@@ -143,7 +153,7 @@ def main(argv=None):
     if args.repeats < 1:
         ap.error(f"--repeats must be >= 1, got {args.repeats}")
     scene = Scene()
-    res = {"scaling": {}, "memory": {}}
+    res = {"scaling": {}, "memory": {}, "worker processes": worker_processes.wait_ready()}
 
     for size in [s for s in SIZES if s <= args.max_size]:
         reps = args.repeats if size <= 256 else max(3, args.repeats // 3) if size <= 1024 else 3
@@ -181,10 +191,14 @@ def main(argv=None):
             "central": lambda f=field: central_gradient(f, uu, vv, 8.0, 4.0, 1e-3)}, 25)
         stage[field] = st | {"pixels": int(uu.size)}
     res["gradient_stage"] = stage
-    res["steady"] = steady = _steady_rounds(3, args.repeats)
+    res["steady"] = steady = _steady_rounds(STEADY_ROUNDS, args.repeats)
 
     lines = ["## Scaling (default scene; ms, median and min-max)", "",
-             f"Tiles render on {WORKERS} thread(s) (the default here) unless stated.", "",
+             f"Tiles render on the calling thread and {res['worker processes']} worker process(es) "
+             f"(`renderer.workers`; {WORKERS} workers, the default here) unless stated.  Peak memory is "
+             "this process's (tracemalloc); a worker process holds one tile's temporaries and "
+             f"{worker_processes.SLOTS} tile slots of {worker_processes.PIXEL_BYTES} bytes per pixel "
+             "(5.3 MiB).", "",
              "| size | exact | central | exact, image only | exact, 1 thread | output MiB | peak MiB | "
              "peak beyond the output, MiB |",
              "|---|---|---|---|---|---|---|---|"]
@@ -214,22 +228,28 @@ def main(argv=None):
         lines.append(f"| {field} | {st['pixels']} | {1e6 * e:.0f} ({1e6 * st['exact']['min']:.0f}-"
                      f"{1e6 * st['exact']['max']:.0f}) | {1e6 * c:.0f} ({1e6 * st['central']['min']:.0f}-"
                      f"{1e6 * st['central']['max']:.0f}) | {e / c:.2f} |")
-    lines += ["", "## Steady state, and the allocator settings (renderer.heap)", "",
+    def cell(st):
+        return f"{1e3 * st['median']:.1f} ({1e3 * st['min']:.1f}-{1e3 * st['max']:.1f})"
+
+    d, t, h = (steady[k] for k in STEADY_SETTINGS)
+    lines += ["", "## Steady state: worker processes, threads, and the allocator settings", "",
               "Each case repeated back to back in a child process (the tables above "
               "alternate their cases in one process, which here runs each 15-30 % slower). "
-              "Three children with the heap kept and three with it left alone "
-              "(SYMRENDER_KEEP_HEAP=0), alternating; shown: the median of the children's "
-              "medians (min-max) and the minor page faults per run.", "",
-              "| case | heap kept, ms | faults/run | left alone, ms | faults/run | left alone / kept |",
-              "|---|---|---|---|---|---|"]
+              f"{len(STEADY_SETTINGS)} kinds of child, {STEADY_ROUNDS} of each, alternating: the defaults (the calling thread and "
+              f"{d['worker processes']} worker process(es), `renderer.workers`; the heap kept, "
+              "`renderer.heap`), threads only (SYMRENDER_WORKER_PROCESSES=0) and the heap left alone "
+              "(SYMRENDER_KEEP_HEAP=0).  Shown: the median of the children's medians (min-max), "
+              "and the minor page faults per run of this process (a worker's are its own).", "",
+              "| case | defaults, ms | faults/run | threads only, ms | threads / defaults | "
+              "heap left alone, ms | faults/run | left alone / defaults |",
+              "|---|---|---|---|---|---|---|---|"]
     for name in STEADY_CASES:
-        k, a = steady["kept"][name], steady["left alone"][name]
-        lines.append(f"| {name} | {1e3 * k['median']:.1f} ({1e3 * k['min']:.1f}-{1e3 * k['max']:.1f}) | "
-                     f"{k['faults']:.0f} | {1e3 * a['median']:.1f} ({1e3 * a['min']:.1f}-{1e3 * a['max']:.1f}) | "
-                     f"{a['faults']:.0f} | {a['median'] / k['median']:.2f} |")
-    lines += ["", "## Issue 6 targets (steady state, heap kept: the table above)", "",
+        lines.append(f"| {name} | {cell(d[name])} | {d[name]['faults']:.0f} | {cell(t[name])} | "
+                     f"{t[name]['median'] / d[name]['median']:.2f} | {cell(h[name])} | "
+                     f"{h[name]['faults']:.0f} | {h[name]['median'] / d[name]['median']:.2f} |")
+    lines += ["", "## Issue 6 targets (steady state, defaults: the table above)", "",
               "| target | measured, median (min-max of the children) | met |", "|---|---|---|"]
-    kept = steady["kept"]
+    kept = d
     checks = [(f"{p} 256², ≤ 15 ms", kept[f"{p} 256²"], 0.015) for p in PIPELINES]
     checks += [(f"{p} 1024², ≤ 250 ms", kept[f"{p} 1024²"], 0.25) for p in PIPELINES]
     checks.append(("8-step ε sweep at 256², both pipelines and the census, ≤ 80 ms",

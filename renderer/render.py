@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import fields
+from . import workers as _workers
 from .geometry import (POLE_SIN_PHI, chart, image_plane, projected_bounds, segment_hits_sphere,
                        sphere_hit, tangent_frame)
 from .heap import keep_heap
@@ -37,11 +38,12 @@ MAX_ZOOM = 1e6
 #: Pixels per tile: bounds the working memory of a render at any resolution
 #: (about 0.4 KiB of temporaries per pixel of a tile, per thread).
 TILE_PIXELS = 1 << 16
-#: Default number of threads rendering tiles side by side: the machine's cores,
-#: at most 4.  numpy releases the GIL inside its loops, but each of the few
-#: thousand array operations of a tile takes it back, and on this project's
-#: 2-core machines two threads render a frame 1.5 (256^2) to 1.6 (1024^2)
-#: times as fast as one (benchmarks/results/render.md).
+#: Default number of workers rendering tiles side by side: the machine's cores,
+#: at most 4.  The calling thread is one; the others are worker processes
+#: (`renderer.workers`) once they have started, threads until then.  numpy
+#: releases the GIL inside its loops, but each of the few thousand array
+#: operations of a tile takes it back, so threads contend for it; processes
+#: do not (benchmarks/results/render.md, "Steady state").
 #: Tiles write disjoint slices: the image is the same bits for any number.
 WORKERS = max(1, min(4, os.cpu_count() or 1))
 #: Frames smaller than this many pixels are rendered on one thread: below it
@@ -78,10 +80,65 @@ def _run_tiles(jobs, workers):
     for future in futures:
         future.result()
 
+
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
 #: Chamber codes of `Frame.chamber`.
 CHAMBER_NAMES = {BACKGROUND: "background", SPHERE_A: "sphere A", SPHERE_B: "sphere B",
                  FLOOR: "floor"}
+
+#: Relative cost of a pixel by the object it shows, for balancing the tiles of
+#: a frame between workers (`_tile_bounds`), with sphere A's cost per pipeline.
+#: Measured here on one thread at 256^2 (default scene), in ns per pixel: the
+#: camera ray and its intersections about 30 for every pixel; then the floor
+#: about 110, sphere B 150, sphere A 290 (exact) or 485 (central); the
+#: background next to nothing.  In units of a floor pixel:
+RAY_COST = 0.3
+PIXEL_COST = {BACKGROUND: 0.05, FLOOR: 1.0, SPHERE_B: 1.4}
+SPHERE_A_COST = {"exact": 2.7, "central": 4.4}
+#: Rows and columns of the coarse grid of rays that estimates the cost.
+COST_SAMPLES = 64
+
+
+def _tile_bounds(scene, x, y, workers, a_cost):
+    """Row ranges ``[(j0, j1), ...]`` of a frame's tiles, in order, covering it.
+
+    Equal bands of `_tile_rows` rows, except where the frame splits into just
+    one tile per worker (``workers`` >= 2, at least `MIN_SPLIT_PIXELS` pixels,
+    at most ``workers`` * `TILE_PIXELS`): then the ``workers`` tiles have about
+    equal cost, so that the workers finish together.  The cost of a row is
+    estimated from the objects that a coarse grid of at most `COST_SAMPLES`^2
+    rays meets (`PIXEL_COST`; sphere A weighs ``a_cost``).  In the default
+    scene sphere B is in the top half, whose rows cost about 1.3 times as much
+    as the bottom half's: an even split leaves one worker waiting.  With more
+    tiles than workers the pool hands them out as workers free up.  Each pixel
+    is computed the same way in any tile, so the bounds change no bit.
+    """
+    width, height = x.shape[0], y.shape[0]
+    rows = _tile_rows(width, height, workers)
+    bands = [(j0, min(height, j0 + rows)) for j0 in range(0, height, rows)]
+    if workers <= 1 or len(bands) != min(workers, height):
+        return bands
+    sr, sc = max(1, height // COST_SAMPLES), max(1, width // COST_SAMPLES)
+    ys, xs = y[sr // 2::sr], x[sc // 2::sc]
+    _, code = _nearest_hit(scene, np.tile(xs, ys.shape[0]), np.repeat(ys, xs.shape[0]), grid=(xs, ys))
+    table = np.zeros(256)
+    for kind, cost in PIXEL_COST.items():
+        table[kind] = cost
+    table[SPHERE_A] = a_cost
+    sample = table[code].reshape(ys.shape[0], xs.shape[0]).sum(axis=1) + RAY_COST * xs.shape[0]
+    cum = np.cumsum(sample[np.minimum(np.arange(height) // sr, ys.shape[0] - 1)])
+    n = len(bands)
+    cuts = [0]
+    for k in range(1, n):
+        # The first row boundary with at least k/n of the cost above it, and
+        # at least one row per tile.
+        j = int(np.searchsorted(cum, cum[-1] * k / n)) + 1
+        cuts.append(min(max(j, cuts[-1] + 1), height - (n - k)))
+    cuts.append(height)
+    if max(j1 - j0 for j0, j1 in zip(cuts, cuts[1:])) * width > TILE_PIXELS:
+        return bands                        # the memory bound comes first
+    return list(zip(cuts, cuts[1:]))
+
 
 #: Floor under |h| in Blinn's half-vector quotient (|h| = 0 only off the lit side).
 _TINY = 1e-300
@@ -682,9 +739,15 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
         something, and at beta = 0 no gradient is computed unless ``grad``.
         False runs the reference path that skips none of it; the tests show the
         two give the same bits.
-    workers : int >= 1, keyword-only
-        Threads rendering tiles side by side (default `WORKERS`: the
-        machine's cores, at most 4).  The image is the same bits for any number.
+    workers : int in [1, 64], keyword-only
+        Workers rendering tiles side by side (default `WORKERS`: the
+        machine's cores, at most 4): the calling thread, and ``workers - 1``
+        worker processes, at most one per further core (`renderer.workers`:
+        started in the background by the second render of a frame of at
+        least `MIN_SPLIT_PIXELS` pixels), or threads until they are ready or
+        when ``SYMRENDER_WORKER_PROCESSES=0``.  A frame of one tile per
+        worker is split so that the tiles cost about the same
+        (`_tile_bounds`).  The image is the same bits for any number.
 
     Returns
     -------
@@ -705,7 +768,7 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     -----
     The image is computed in tiles of at most 65,536 pixels, so the working
     memory beyond the outputs is bounded at any resolution (about 26 MiB per
-    thread).  The first call keeps freed memory in the process heap
+    worker, and 5.3 MiB of tile slots shared with each worker process).  The first call keeps freed memory in the process heap
     (`renderer.heap`; ``SYMRENDER_KEEP_HEAP=0`` opts out).  Source: seed
     Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
     corrections listed in the book's errata.
@@ -718,14 +781,12 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     kink_out = np.zeros((height, width), dtype=bool) if kink else None
     grad_out = np.zeros((height, width, 2)) if grad else None
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
-    rows = _tile_rows(width, height, workers)
     flat_image = image.reshape(-1, 3)
     flat_chamber = chamber.reshape(-1)
     flat_kink = kink_out.reshape(-1) if kink else None
     flat_grad = grad_out.reshape(-1, 2) if grad else None
 
-    def tile(j0):
-        j1 = min(height, j0 + rows)
+    def tile(j0, j1):
         X = np.tile(x, j1 - j0)
         Y = np.repeat(y[j0:j1], width)
         sl = slice(j0 * width, j1 * width)
@@ -733,6 +794,10 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
                      flat_kink[sl] if kink else None, flat_grad[sl] if grad else None, skip,
                      (x, y[j0:j1]))
 
-    _run_tiles([lambda j0=j0: tile(j0) for j0 in range(0, height, rows)], workers)
+    bounds = _tile_bounds(scene, x, y, workers, SPHERE_A_COST[gradient])
+    if not (workers > 1 and len(bounds) > 1 and _workers.run_tiles(
+            bounds, tile, (scene, gradient, width, height, zoom, kink, grad, skip),
+            (flat_image, flat_chamber, flat_kink, flat_grad), width, workers - 1, TILE_PIXELS)):
+        _run_tiles([lambda b=b: tile(*b) for b in bounds], workers)
     return Frame(image=image, chamber=chamber, kink=kink_out, grad=grad_out, scene=scene,
                  gradient=gradient)

@@ -176,7 +176,8 @@ def test_sweep_rejects_bad_steps(bad, match):
 
 
 @pytest.mark.parametrize("workers", [2, 3])
-def test_threads_give_the_same_bits(workers):
+def test_threads_give_the_same_bits(workers, monkeypatch):
+    monkeypatch.setenv("SYMRENDER_WORKER_PROCESSES", "0")     # threads only (tests/test_workers.py)
     scene = SCENES["default"]
     big = (300, 240)                        # above MIN_SPLIT_PIXELS: one tile per thread
     assert big[0] * big[1] >= R.MIN_SPLIT_PIXELS
