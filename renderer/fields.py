@@ -156,12 +156,16 @@ def exact_gradient(name, uu, vv, ku, kv):
             np.broadcast_to(np.asarray(hv, dtype=np.float64), shape))
 
 
-def kink_band(name, uu, vv, ku, kv):
+def kink_band(name, uu, vv, ku, kv, factors=None):
     """The seed's crease flag: True within the band around the ridges' zero lines.
 
     Only the "ridges" field has creases; for the other fields the result is
     all False.  The band is |sin(pi k_u u)| < 0.03 or |sin(pi k_v v)| < 0.03
     (seed Cell 1).
+
+    ``factors``: optionally the two sines sin(pi k_u u), sin(pi k_v v) at the
+    same points, already computed by `renderer.detmath.sin` (the central
+    stencil's, `CentralStencil.ridge_factors`); the flag is then read off them.
 
     The factors are computed first with numpy's sine (about six times as fast
     as `renderer.detmath.sin`).  Only where one of them lies within
@@ -178,6 +182,8 @@ def kink_band(name, uu, vv, ku, kv):
     shape = np.broadcast(uu, vv).shape
     if name != "ridges":
         return np.zeros(shape, dtype=bool)
+    if factors is not None:
+        return np.broadcast_to(np.asarray(_band(*factors)), shape)
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     if uu.size == 0 or not _fast_sine_applies(uu, vv, ku, kv):
         return np.asarray(_band(*_ridge_factors_fn()(uu, vv, ku, kv)))
@@ -300,6 +306,14 @@ class CentralStencil:
                 rest.append((sym, expr))
         self.name = name
         self.base_symbols = tuple(b for b, _ in base)
+        # Where the ridges' two factors sin(pi k_u u), sin(pi k_v v) are among
+        # the base values (as for sine and ridges): their positions.
+        full, expanded = {}, []
+        for sym, expr in base:
+            full[sym] = expr.xreplace(full)
+            expanded.append(full[sym])
+        self._factor_rows = (tuple(expanded.index(f) for f in (_s1, _s2))
+                             if _s1 in expanded and _s2 in expanded else None)
         self._base = _SineBatch((u, v, k_u, k_v), base, list(self.base_symbols))
         self._shifted = _SineBatch((u_p, u_m, v_p, v_m, u, v, k_u, k_v, *self.base_symbols), rest,
                                    reduced)
@@ -307,6 +321,14 @@ class CentralStencil:
     def base(self, uu, vv, ku, kv):
         """The eps-free subexpressions at the stencil's centre (a list of arrays)."""
         return self._base(uu, vv, ku, kv)
+
+    def ridge_factors(self, base):
+        """(sin(pi k_u u), sin(pi k_v v)) out of ``base`` (the list `base`
+        returned), or None if this field's base does not hold them.  The same
+        bits as `kink_band`'s deterministic factors (tests/test_fields.py)."""
+        if self._factor_rows is None:
+            return None
+        return tuple(base[i] for i in self._factor_rows)
 
     def values(self, up, um, vp, vm, uu, vv, ku, kv, base=None):
         """[h(u+, v), h(u-, v), h(u, v+), h(u, v-)], each broadcast to the centre's shape."""

@@ -544,17 +544,25 @@ def _shading_normal(scene, surf, grad):
     return tuple(m * inv for m in M)
 
 
-def _prepare_a(scene, surf, gradient, want_grad, want_kink, skip):
+def _prepare_a(scene, surf, gradient, want_grad, want_kink, skip, base=None):
     """Gradient, kink flag and shading normal of sphere A's pixels.
 
     With ``skip`` the gradient is computed only if beta != 0 or the caller wants
-    it, and the kink flag only if the caller wants it.
+    it, and the kink flag only if the caller wants it.  ``base``: the central
+    stencil's eps-free values at the chart points (`fields.CentralStencil.base`),
+    if the caller has them; the central pipeline computes them here.  With
+    ``skip`` the kink flag is then read off the two sines among them, the
+    deterministic sines `fields.kink_band` would compute again.
     """
     need_grad = want_grad or scene.beta != 0.0 or not skip
+    stencil = fields.central_stencil(scene.height_field)
+    if base is None and gradient == "central" and need_grad:
+        base = stencil.base(*surf.uv, scene.k_u, scene.k_v)
     if need_grad:
-        surf.grad = _gradient(scene, surf, gradient, scene.eps)
+        surf.grad = _gradient(scene, surf, gradient, scene.eps, base)
     if want_kink or not skip:
-        surf.kink = fields.kink_band(scene.height_field, *surf.uv, scene.k_u, scene.k_v)
+        factors = stencil.ridge_factors(base) if skip and base is not None else None
+        surf.kink = fields.kink_band(scene.height_field, *surf.uv, scene.k_u, scene.k_v, factors)
     if not skip and surf.frame is None:
         surf.frame = tangent_frame(*surf.N, surf.sin_phi)
     return _shading_normal(scene, surf, surf.grad)

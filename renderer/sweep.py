@@ -137,11 +137,12 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
                 for image, _, _, _ in flat:
                     _store_rgb(image, rows_idx, col)
                 continue
-            # Sphere A: the exact frame, then one re-shade per step.
-            Ns = _prepare_a(scene, surf, "exact", True, True, True)
-            kink = surf.kink
-            # The stencil's eps-free factors, once for all steps.
+            # Sphere A: the stencil's eps-free factors, once for all steps (and
+            # the kink flag read off them), the exact frame, then one re-shade
+            # per step.
             base = fields.central_stencil(scene.height_field).base(*surf.uv, scene.k_u, scene.k_v)
+            Ns = _prepare_a(scene, surf, "exact", True, True, True, base)
+            kink = surf.kink
             view = _view(scene, surf.P, lights)
             for k, (s, (image, _, kink_out, grad_out)) in enumerate(zip([scene] + scenes, flat)):
                 if k > 0:

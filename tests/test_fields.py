@@ -244,6 +244,36 @@ def test_kink_band_outside_the_fast_range():
     assert scalar.shape == () and bool(scalar)
 
 
+def _stencil_factors(u, v, ku, kv, field="ridges"):
+    st = fields.central_stencil(field)
+    return st.ridge_factors(st.base(u, v, ku, kv))
+
+
+@pytest.mark.parametrize("field", ["sine", "ridges"])
+@pytest.mark.parametrize("ku, kv", K_PAIRS)
+def test_stencil_factors_are_the_bits_of_the_deterministic_factors(field, ku, kv):
+    """The central stencil's two base sines are the deterministic sines the
+    kink flag is defined by, bit for bit (the central pipeline and the sweep
+    read the flag off them), on random points and ulps from the band's edge."""
+    u, v = chart_points(np.random.default_rng(7))
+    eu, ev = _edge_points(ku, kv)
+    u, v = np.concatenate([u, eu]), np.concatenate([v, ev])
+    s1, s2 = _stencil_factors(u, v, ku, kv, field)
+    d1, d2 = fields._ridge_factors_fn()(u, v, ku, kv)
+    assert np.array_equal(s1, d1) and np.array_equal(s2, d2)
+    flag = fields.kink_band("ridges", u, v, ku, kv, (s1, s2))
+    assert np.array_equal(flag, _det_band(u, v, ku, kv))
+    assert fields.central_stencil("rings").ridge_factors([]) is None
+
+
+def test_factor_check_rejects_a_regrouped_argument():
+    """The same sine with its argument grouped pi (k u) instead of (pi k) u
+    differs in the last bit somewhere: the check above can fail."""
+    u, v = chart_points(np.random.default_rng(7))
+    s1, _ = _stencil_factors(u, v, 3.3, 7.1)          # (k = 8 would be exact either way)
+    assert not np.array_equal(s1, fields.detmath.sin(np.pi * (3.3 * u)))
+
+
 # --- central differences at the chart borders ---------------------------------------------
 
 @pytest.mark.parametrize("field", FIELDS)
