@@ -114,7 +114,7 @@ def _steady_child(repeats):
 
 
 #: Children of each kind.
-STEADY_ROUNDS = 3
+STEADY_ROUNDS = 5
 #: The kinds of steady-state child: name -> environment variable set to "0".
 STEADY_SETTINGS = {"defaults": None, "threads only": worker_processes.ENV_VAR,
                    "heap left alone": "SYMRENDER_KEEP_HEAP"}
