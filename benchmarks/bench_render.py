@@ -40,7 +40,7 @@ sys.path.insert(0, str(ROOT))
 
 from renderer import Scene, compare, fields, gbuffer, render, sweep  # noqa: E402
 from renderer import workers as worker_processes  # noqa: E402
-from renderer.render import WORKERS, central_gradient  # noqa: E402
+from renderer.render import TILE_PIXELS, WORKERS, central_gradient  # noqa: E402
 from tests.scalar_reference import render_reference  # noqa: E402
 
 SIZES = (64, 128, 256, 512, 1024, 2048, 4096)
@@ -198,7 +198,7 @@ def main(argv=None):
              f"(`renderer.workers`; {WORKERS} workers, the default here) unless stated.  Peak memory is "
              "this process's (tracemalloc); a worker process holds one tile's temporaries and "
              f"{worker_processes.SLOTS} tile slots of {worker_processes.PIXEL_BYTES} bytes per pixel "
-             "(5.3 MiB).", "",
+             f"({worker_processes.SLOTS * TILE_PIXELS * worker_processes.PIXEL_BYTES / 2**20:.2f} MiB).", "",
              "| size | exact | central | exact, image only | exact, 1 thread | output MiB | peak MiB | "
              "peak beyond the output, MiB |",
              "|---|---|---|---|---|---|---|---|"]

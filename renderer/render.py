@@ -555,13 +555,13 @@ def _prepare_a(scene, surf, gradient, want_grad, want_kink, skip, base=None):
     deterministic sines `fields.kink_band` would compute again.
     """
     need_grad = want_grad or scene.beta != 0.0 or not skip
-    stencil = fields.central_stencil(scene.height_field)
     if base is None and gradient == "central" and need_grad:
-        base = stencil.base(*surf.uv, scene.k_u, scene.k_v)
+        base = fields.central_stencil(scene.height_field).base(*surf.uv, scene.k_u, scene.k_v)
     if need_grad:
         surf.grad = _gradient(scene, surf, gradient, scene.eps, base)
     if want_kink or not skip:
-        factors = stencil.ridge_factors(base) if skip and base is not None else None
+        factors = (fields.central_stencil(scene.height_field).ridge_factors(base)
+                   if skip and base is not None else None)
         surf.kink = fields.kink_band(scene.height_field, *surf.uv, scene.k_u, scene.k_v, factors)
     if not skip and surf.frame is None:
         surf.frame = tangent_frame(*surf.N, surf.sin_phi)
@@ -776,8 +776,9 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     -----
     The image is computed in tiles of at most 65,536 pixels, so the working
     memory beyond the outputs is bounded at any resolution (about 26 MiB per
-    worker, and 5.3 MiB of tile slots shared with each worker process).  The first call keeps freed memory in the process heap
-    (`renderer.heap`; ``SYMRENDER_KEEP_HEAP=0`` opts out).  Source: seed
+    worker, and 5.25 MiB of tile slots shared with each worker process).  The
+    first call keeps freed memory in the process heap (`renderer.heap`;
+    ``SYMRENDER_KEEP_HEAP=0`` opts out).  Source: seed
     Cells 1 and 3 (``render_numeric_bump``, ``render_symbolic_bump``), with the
     corrections listed in the book's errata.
     """

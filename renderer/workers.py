@@ -3,10 +3,11 @@
 Why processes: numpy releases the GIL inside each array operation, but a tile
 of a 256^2 frame is a few thousand operations of 10 to 30 microseconds, and
 each one takes the GIL back.  Two threads then spend much of their time
-handing the GIL to each other: here two threads rendered a 256^2 frame only
-1.2 to 1.35 times as fast as one, while the calling thread and one worker
-process, each with its own interpreter, render it about 1.5 times as fast as
-one thread (benchmarks/results/render.md, "Steady state").
+handing the GIL to each other.  The calling thread and a worker process, each
+with its own interpreter, do not: at 256^2 the threads-only frame takes 1.16
+(exact) and 1.27 (central) times as long as with one worker process, in the
+same run (benchmarks/results/render.md, "Steady state"; at 1024^2, where
+tiles are larger and threads contend less, 1.04 and 1.12).
 
 How: a worker is a child interpreter (``python -m renderer._worker``, started
 with `subprocess` in a session of its own, so no ``__main__`` module is
@@ -242,6 +243,11 @@ def run_tiles(bounds, local, job, outputs, width, count, tile_pixels):
     bool
         False, having rendered nothing, when no worker is ready (workers are
         off, not started yet, or starting): the caller renders on threads.
+
+    Raises
+    ------
+    Whatever ``local`` raises, also for a tile a failed worker gave back
+    (a worker's own failure is a `RuntimeWarning`, not an error).
     """
     if not _lock.acquire(blocking=False):
         return False                           # another thread's render holds the workers
@@ -274,7 +280,7 @@ def _run(workers, bounds, local, job, outputs, width):
                 w.conn.send((_state["job"], slot, job, j0, j1))
             except OSError as exc:
                 pending.append(k)
-                raise _Broken(w, exc) from exc
+                raise _Broken(exc) from exc
             outstanding[_state["job"]] = (w, slot, k)
 
     def collect(block):
@@ -290,13 +296,13 @@ def _run(workers, bounds, local, job, outputs, width):
                 try:
                     job_id, error = conn.recv()
                 except (OSError, EOFError) as exc:
-                    raise _Broken(w, exc) from exc
+                    raise _Broken(exc) from exc
                 if job_id not in outstanding:
                     continue                   # an answer to an interrupted render
                 w, slot, k = outstanding.pop(job_id)
                 if error is not None:
                     pending.append(k)
-                    raise _Broken(w, error)
+                    raise _Broken(error)
                 _copy_out(w, slot, bounds[k], outputs, width)
                 _state["tiles"] += 1
                 free.append((w, slot))
@@ -321,9 +327,10 @@ def _run(workers, bounds, local, job, outputs, width):
 
 
 class _Broken(Exception):
-    def __init__(self, worker, reason):
+    """A worker failed; ``reason`` is the last line of its error."""
+
+    def __init__(self, reason):
         super().__init__(str(reason))
-        self.worker = worker
         self.reason = str(reason).strip().splitlines()[-1] if str(reason).strip() else repr(reason)
 
 
