@@ -14,6 +14,7 @@ import numbers
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -99,25 +100,15 @@ SPHERE_A_COST = {"exact": 2.7, "central": 4.4}
 COST_SAMPLES = 64
 
 
-def _tile_bounds(scene, x, y, workers, a_cost):
-    """Row ranges ``[(j0, j1), ...]`` of a frame's tiles, in order, covering it.
+@lru_cache(maxsize=64)
+def _row_costs(scene, width, height, zoom, a_cost):
+    """Cumulative estimated cost of a frame's rows: float64 (height,), read-only.
 
-    Equal bands of `_tile_rows` rows, except where the frame splits into just
-    one tile per worker (``workers`` >= 2, at least `MIN_SPLIT_PIXELS` pixels,
-    at most ``workers`` * `TILE_PIXELS`): then the ``workers`` tiles have about
-    equal cost, so that the workers finish together.  The cost of a row is
-    estimated from the objects that a coarse grid of at most `COST_SAMPLES`^2
-    rays meets (`PIXEL_COST`; sphere A weighs ``a_cost``).  In the default
-    scene sphere B is in the top half, whose rows cost about 1.3 times as much
-    as the bottom half's: an even split leaves one worker waiting.  With more
-    tiles than workers the pool hands them out as workers free up.  Each pixel
-    is computed the same way in any tile, so the bounds change no bit.
+    Estimated from the objects that a coarse grid of at most `COST_SAMPLES`^2
+    rays meets (`PIXEL_COST`; sphere A weighs ``a_cost``) plus `RAY_COST` per
+    ray.  Cached: a scene rendered again at the same size costs nothing here.
     """
-    width, height = x.shape[0], y.shape[0]
-    rows = _tile_rows(width, height, workers)
-    bands = [(j0, min(height, j0 + rows)) for j0 in range(0, height, rows)]
-    if workers <= 1 or len(bands) != min(workers, height):
-        return bands
+    x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     sr, sc = max(1, height // COST_SAMPLES), max(1, width // COST_SAMPLES)
     ys, xs = y[sr // 2::sr], x[sc // 2::sc]
     _, code = _nearest_hit(scene, np.tile(xs, ys.shape[0]), np.repeat(ys, xs.shape[0]), grid=(xs, ys))
@@ -127,6 +118,28 @@ def _tile_bounds(scene, x, y, workers, a_cost):
     table[SPHERE_A] = a_cost
     sample = table[code].reshape(ys.shape[0], xs.shape[0]).sum(axis=1) + RAY_COST * xs.shape[0]
     cum = np.cumsum(sample[np.minimum(np.arange(height) // sr, ys.shape[0] - 1)])
+    cum.flags.writeable = False
+    return cum
+
+
+def _tile_bounds(scene, width, height, zoom, workers, a_cost):
+    """Row ranges ``[(j0, j1), ...]`` of a frame's tiles, in order, covering it.
+
+    Equal bands of `_tile_rows` rows, except where the frame splits into just
+    one tile per worker (``workers`` >= 2, at least `MIN_SPLIT_PIXELS` pixels,
+    at most ``workers`` * `TILE_PIXELS`): then the tiles are cut at
+    estimated cost (`_row_costs`), so that the workers finish together.  In
+    the default scene sphere B is in the top half, whose rows cost about 1.3
+    times as much as the bottom half's: an even split leaves one worker
+    waiting.  With more tiles than workers the pool hands them out as workers
+    free up.  Each pixel is computed the same way in any tile, so the bounds
+    change no bit.
+    """
+    rows = _tile_rows(width, height, workers)
+    bands = [(j0, min(height, j0 + rows)) for j0 in range(0, height, rows)]
+    if workers <= 1 or len(bands) != min(workers, height):
+        return bands
+    cum = _row_costs(scene, width, height, zoom, a_cost)
     n = len(bands)
     cuts = [0]
     for k in range(1, n):
@@ -337,6 +350,24 @@ def _view(scene, P, lights):
     return halves, v
 
 
+def _power(base, exponent):
+    """``base ** exponent`` for a float64 array ``base`` and a float exponent
+    > 0, with ``pow`` called only where ``base`` is not +0.
+
+    The specular base is exactly +0 wherever the light is masked off or the
+    cosine is negative (half of sphere A's pixels in the default scene), and
+    libm's ``pow`` takes a slow path at 0: skipping those makes the specular
+    power about twice as fast.  pow(+0, p) is +0 for every p > 0 (C99 F.9.4.4),
+    which the skipped entries hold; -0, NaN and the rest go through ``pow``.
+    The same bits as ``base ** exponent`` (tests/test_skips.py).
+    """
+    mask = base != 0.0
+    mask |= np.signbit(base)
+    out = np.zeros_like(base)
+    np.power(base, exponent, out=out, where=mask)
+    return out
+
+
 def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None, view=None):
     """Ambient plus, per light, Lambert and Blinn/Phong (seed Cell 1, ``shade1``).
 
@@ -367,7 +398,7 @@ def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None, view=None):
             two_mu = 2.0 * mu
             spec_cos = _dot(two_mu * Sx - wx, two_mu * Sy - wy, two_mu * Sz - wz, vx, vy, vz)
         # Masks by multiplication (x * False = 0): the same sums as np.where, faster.
-        spec = (np.maximum(spec_cos, 0.0) * front) ** scene.shininess
+        spec = _power(np.maximum(spec_cos, 0.0) * front, scene.shininess)
         diffuse = (mu * front) * scene.kd
         spec *= scene.ks
         term = None
@@ -803,7 +834,7 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
                      flat_kink[sl] if kink else None, flat_grad[sl] if grad else None, skip,
                      (x, y[j0:j1]))
 
-    bounds = _tile_bounds(scene, x, y, workers, SPHERE_A_COST[gradient])
+    bounds = _tile_bounds(scene, width, height, zoom, workers, SPHERE_A_COST[gradient])
     if not (workers > 1 and len(bounds) > 1 and _workers.run_tiles(
             bounds, tile, (scene, gradient, width, height, zoom, kink, grad, skip),
             (flat_image, flat_chamber, flat_kink, flat_grad), width, workers - 1, TILE_PIXELS)):

@@ -201,3 +201,33 @@ def test_sweep_reports_progress_per_tile_and_gives_the_same_bits():
     assert len(calls) > 1 and calls[-1] == (300 * 240, 300 * 240)
     assert [d for d, _ in calls] == sorted(d for d, _ in calls)
     assert all(_same(x, y) for x, y in zip(a.numeric, b.numeric))
+
+
+_POWER_BASES = np.concatenate([
+    np.random.default_rng(7).random(1000), np.zeros(100), -np.zeros(10),
+    [np.nan, np.inf, 5e-324, 1e-300, 1e300, 1.0], np.random.default_rng(8).random(100) * 1e-12])
+
+
+def _bits(x):
+    return np.asarray(x, dtype=np.float64).view(np.uint64)
+
+
+@pytest.mark.parametrize("exponent", [32.0, 0.5, 1.0, 2.0, 3.0, 7.5, 1e-3, 200.0])
+def test_specular_power_skips_zero_bases_with_the_same_bits(exponent):
+    # render._power calls pow only where the base is not +0 (libm's slow
+    # path); -0, NaN, inf, subnormals and the rest give the bits of **.
+    with np.errstate(all="ignore"):
+        expected = _POWER_BASES ** exponent
+        got = R._power(_POWER_BASES.copy(), exponent)
+    assert np.array_equal(_bits(got), _bits(expected))
+
+
+def test_the_power_check_sees_a_lost_negative_zero():
+    # A variant that also skips -0 writes +0 where pow(-0, 3) is -0.
+    def variant(base, exponent):
+        out = np.zeros_like(base)
+        np.power(base, exponent, out=out, where=base != 0.0)
+        return out
+    with np.errstate(all="ignore"):
+        assert not np.array_equal(_bits(variant(_POWER_BASES, 3.0)), _bits(_POWER_BASES ** 3.0))
+        assert np.array_equal(_bits(variant(_POWER_BASES, 32.0)), _bits(_POWER_BASES ** 32.0))

@@ -220,8 +220,7 @@ def test_workers_start_on_the_second_render_and_die_with_their_parent():
 @pytest.mark.parametrize("workers", [2, 3])
 def test_tile_bounds_cover_the_frame_within_the_memory_bound(size, workers):
     scene = Scene()
-    x, y = R.image_plane(scene.radius_a, scene.camera_z, *size, 1.0)
-    bounds = R._tile_bounds(scene, x, y, workers, R.SPHERE_A_COST["central"])
+    bounds = R._tile_bounds(scene, *size, 1.0, workers, R.SPHERE_A_COST["central"])
     cuts = [j0 for j0, _ in bounds] + [bounds[-1][1]]
     assert cuts[0] == 0 and cuts[-1] == size[1] and all(a < b for a, b in zip(cuts, cuts[1:]))
     assert all((j1 - j0) * size[0] <= R.TILE_PIXELS for j0, j1 in bounds)
@@ -242,9 +241,8 @@ def _tile_costs(scene, bounds, size, a_cost):
 @pytest.mark.parametrize("gradient", ["exact", "central"])
 def test_one_tile_per_worker_splits_the_cost_not_the_rows(scene, gradient):
     size = (256, 256)
-    x, y = R.image_plane(scene.radius_a, scene.camera_z, *size, 1.0)
     a_cost = R.SPHERE_A_COST[gradient]
-    bounds = R._tile_bounds(scene, x, y, 2, a_cost)
+    bounds = R._tile_bounds(scene, *size, 1.0, 2, a_cost)
     top, bottom = _tile_costs(scene, bounds, size, a_cost)
     assert abs(top - bottom) < 0.03 * (top + bottom)
     # The even split of the rows is what the balance replaces: off by more.
@@ -253,5 +251,4 @@ def test_one_tile_per_worker_splits_the_cost_not_the_rows(scene, gradient):
 
 
 def test_more_tiles_than_workers_are_equal_bands():
-    x, y = R.image_plane(1.0, 4.0, 512, 512, 1.0)
-    assert R._tile_bounds(Scene(), x, y, 2, 4.4) == [(0, 128), (128, 256), (256, 384), (384, 512)]
+    assert R._tile_bounds(Scene(), 512, 512, 1.0, 2, 4.4) == [(0, 128), (128, 256), (256, 384), (384, 512)]
