@@ -4,10 +4,10 @@ Why processes: numpy releases the GIL inside each array operation, but a tile
 of a 256^2 frame is a few thousand operations of 10 to 30 microseconds, and
 each one takes the GIL back.  Two threads then spend much of their time
 handing the GIL to each other.  The calling thread and a worker process, each
-with its own interpreter, do not: at 256^2 the threads-only frame takes 1.16
-(exact) and 1.27 (central) times as long as with one worker process, in the
+with its own interpreter, do not: at 256^2 the threads-only frame takes 1.10
+(exact) and 1.20 (central) times as long as with one worker process, in the
 same run (benchmarks/results/render.md, "Steady state"; at 1024^2, where
-tiles are larger and threads contend less, 1.04 and 1.12).
+tiles are larger and threads contend less, 0.98 and 1.05: about even).
 
 How: a worker is a child interpreter (``python -m renderer._worker``, started
 with `subprocess` in a session of its own, so no ``__main__`` module is
