@@ -14,7 +14,6 @@ import numbers
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
@@ -100,14 +99,27 @@ SPHERE_A_COST = {"exact": 2.7, "central": 4.4}
 COST_SAMPLES = 64
 
 
-@lru_cache(maxsize=64)
+#: Cache of `_row_costs`, by the scene's geometry and the frame (at most
+#: `ROW_COST_CACHE` entries; cleared when full).
+_ROW_COSTS = {}
+ROW_COST_CACHE = 64
+
+
 def _row_costs(scene, width, height, zoom, a_cost):
     """Cumulative estimated cost of a frame's rows: float64 (height,), read-only.
 
     Estimated from the objects that a coarse grid of at most `COST_SAMPLES`^2
     rays meets (`PIXEL_COST`; sphere A weighs ``a_cost``) plus `RAY_COST` per
-    ray.  Cached: a scene rendered again at the same size costs nothing here.
+    ray.  Cached by what the estimate reads: the spheres, the floor and the
+    camera of ``scene`` (not its lights, field or eps), ``width``, ``height``
+    (int), ``zoom`` (float) and ``a_cost``.  A scene rendered again with the
+    same geometry, size and pipeline costs nothing here.
     """
+    key = (scene.radius_a, scene.camera_z, scene.center_b, scene.radius_b, scene.sphere_b,
+           scene.floor, width, height, zoom, a_cost)
+    cum = _ROW_COSTS.get(key)
+    if cum is not None:
+        return cum
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     sr, sc = max(1, height // COST_SAMPLES), max(1, width // COST_SAMPLES)
     ys, xs = y[sr // 2::sr], x[sc // 2::sc]
@@ -119,21 +131,27 @@ def _row_costs(scene, width, height, zoom, a_cost):
     sample = table[code].reshape(ys.shape[0], xs.shape[0]).sum(axis=1) + RAY_COST * xs.shape[0]
     cum = np.cumsum(sample[np.minimum(np.arange(height) // sr, ys.shape[0] - 1)])
     cum.flags.writeable = False
+    cum = cum.view()                        # a view of a read-only array cannot be made writeable
+    if len(_ROW_COSTS) >= ROW_COST_CACHE:
+        _ROW_COSTS.clear()
+    _ROW_COSTS[key] = cum
     return cum
 
 
 def _tile_bounds(scene, width, height, zoom, workers, a_cost):
     """Row ranges ``[(j0, j1), ...]`` of a frame's tiles, in order, covering it.
 
-    Equal bands of `_tile_rows` rows, except where the frame splits into just
-    one tile per worker (``workers`` >= 2, at least `MIN_SPLIT_PIXELS` pixels,
-    at most ``workers`` * `TILE_PIXELS`): then the tiles are cut at
-    estimated cost (`_row_costs`), so that the workers finish together.  In
-    the default scene sphere B is in the top half, whose rows cost about 1.3
-    times as much as the bottom half's: an even split leaves one worker
-    waiting.  With more tiles than workers the pool hands them out as workers
-    free up.  Each pixel is computed the same way in any tile, so the bounds
-    change no bit.
+    ``width``, ``height``: int pixels; ``zoom``: float (as validated by
+    `render`); ``workers``: int >= 1; ``a_cost``: sphere A's weight
+    (`SPHERE_A_COST`).  Equal bands of `_tile_rows` rows, except where the
+    frame splits into just one tile per worker (``workers`` >= 2, at least
+    `MIN_SPLIT_PIXELS` pixels, at most ``workers`` * `TILE_PIXELS`): then the
+    tiles are cut at estimated cost (`_row_costs`), so that the workers finish
+    together.  In the default scene sphere B is in the top half, whose rows
+    cost about 1.3 times as much as the bottom half's: an even split leaves
+    one worker waiting.  With more tiles than workers the pool hands them out
+    as workers free up.  Each pixel is computed the same way in any tile, so
+    the bounds change no bit.
     """
     rows = _tile_rows(width, height, workers)
     bands = [(j0, min(height, j0 + rows)) for j0 in range(0, height, rows)]
@@ -351,15 +369,19 @@ def _view(scene, P, lights):
 
 
 def _power(base, exponent):
-    """``base ** exponent`` for a float64 array ``base`` and a float exponent
-    > 0, with ``pow`` called only where ``base`` is not +0.
+    """``base ** exponent`` for a float64 array ``base`` (any values) and a
+    float ``exponent`` > 0 (`Scene.shininess`, validated there), with the
+    power computed only where ``base`` is not +0.
 
     The specular base is exactly +0 wherever the light is masked off or the
     cosine is negative (half of sphere A's pixels in the default scene), and
-    libm's ``pow`` takes a slow path at 0: skipping those makes the specular
-    power about twice as fast.  pow(+0, p) is +0 for every p > 0 (C99 F.9.4.4),
-    which the skipped entries hold; -0, NaN and the rest go through ``pow``.
-    The same bits as ``base ** exponent`` (tests/test_skips.py).
+    numpy's float64 power loop (Intel SVML on AVX-512 machines, libm
+    elsewhere) is about four times as slow at 0 as at other bases, measured
+    here: skipping those makes the specular power about twice as fast.  The
+    skipped entries hold +0, which is pow(+0, p) for every p > 0; -0, NaN,
+    inf and the rest go through the same loop as ``**`` with a scalar
+    exponent.  The same bits as ``base ** exponent`` (tests/test_skips.py
+    checks it, with the bases that could differ).  Returns a new (n,) array.
     """
     mask = base != 0.0
     mask |= np.signbit(base)

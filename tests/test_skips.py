@@ -203,9 +203,18 @@ def test_sweep_reports_progress_per_tile_and_gives_the_same_bits():
     assert all(_same(x, y) for x, y in zip(a.numeric, b.numeric))
 
 
-_POWER_BASES = np.concatenate([
-    np.random.default_rng(7).random(1000), np.zeros(100), -np.zeros(10),
-    [np.nan, np.inf, 5e-324, 1e-300, 1e300, 1.0], np.random.default_rng(8).random(100) * 1e-12])
+def _power_bases():
+    """Bases for the specular power check: random values in [0, 1], the
+    specular range, with +0 and -0 scattered among them, every special value
+    (+-inf, NaN of either sign, subnormals, huge, negative), shuffled."""
+    rng = np.random.default_rng(7)
+    special = [np.nan, -np.nan, np.inf, -np.inf, 5e-324, -5e-324, 1e-300, 1e300, 1.0, -1.0, -2.5]
+    base = np.concatenate([rng.random(1000), np.zeros(300), -np.zeros(30), special,
+                           rng.random(100) * 1e-12])
+    return rng.permutation(base)
+
+
+_POWER_BASES = _power_bases()
 
 
 def _bits(x):
@@ -219,7 +228,9 @@ def test_specular_power_skips_zero_bases_with_the_same_bits(exponent):
     with np.errstate(all="ignore"):
         expected = _POWER_BASES ** exponent
         got = R._power(_POWER_BASES.copy(), exponent)
+        strided = R._power(_POWER_BASES[::3], exponent)
     assert np.array_equal(_bits(got), _bits(expected))
+    assert np.array_equal(_bits(strided), _bits(expected[::3]))
 
 
 def test_the_power_check_sees_a_lost_negative_zero():

@@ -252,3 +252,23 @@ def test_one_tile_per_worker_splits_the_cost_not_the_rows(scene, gradient):
 
 def test_more_tiles_than_workers_are_equal_bands():
     assert R._tile_bounds(Scene(), 512, 512, 1.0, 2, 4.4) == [(0, 128), (128, 256), (256, 384), (384, 512)]
+
+
+def test_row_cost_estimate_is_cached_by_geometry_and_read_only():
+    R._ROW_COSTS.clear()
+    scene = Scene()
+    first = R._row_costs(scene, 256, 256, 1.0, 4.4)
+    # Lights, field and eps are not read by the estimate: the same entry.
+    assert R._row_costs(scene.replace(eps=1e-6, height_field="sine"), 256, 256, 1.0, 4.4) is first
+    # Geometry, size, zoom and pipeline are: new entries, with other costs.
+    for other in [(scene.replace(center_b=(-0.6, -0.7, 1.2)), 256, 256, 1.0, 4.4),
+                  (scene.replace(sphere_b=False), 256, 256, 1.0, 4.4),
+                  (scene, 256, 256, 2.0, 4.4), (scene, 256, 256, 1.0, 2.7)]:
+        cum = R._row_costs(*other)
+        assert cum is not first and not np.array_equal(cum, first)
+    with pytest.raises(ValueError):
+        first[0] = 0.0
+    with pytest.raises(ValueError):
+        first.flags.writeable = True
+    R._ROW_COSTS.clear()
+    assert np.array_equal(R._row_costs(scene, 256, 256, 1.0, 4.4), first)
