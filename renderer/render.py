@@ -381,7 +381,8 @@ def _power(base, exponent):
     skipped entries hold +0, which is pow(+0, p) for every p > 0; -0, NaN,
     inf and the rest go through the same loop as ``**`` with a scalar
     exponent.  The same bits as ``base ** exponent`` (tests/test_skips.py
-    checks it, with the bases that could differ).  Returns a new (n,) array.
+    checks it, with the bases that could differ).  Returns a new float64
+    array of the shape of ``base``.
     """
     mask = base != 0.0
     mask |= np.signbit(base)
