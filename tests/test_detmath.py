@@ -60,7 +60,9 @@ def test_atan2_signed_zeros_and_limits_match_c(y, x):
 def test_atan2_fast_path_gives_the_general_paths_bits(args):
     """Finite ratios off the axes take a shorter path; one NaN in the array
     forces the general path on the same arguments, which must give the same bits.
-    numpy's arctan2 (a different algorithm) does not, so the check can fail."""
+    The general path with the quotient formed as y * (1 / x) instead of y / x
+    (one more rounding, a different result for some arguments in any IEEE
+    arithmetic) does not, so the check can fail."""
     a, b = args
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         keep = (b != 0.0) & np.isfinite(np.abs(a / b))
@@ -68,7 +70,9 @@ def test_atan2_fast_path_gives_the_general_paths_bits(args):
     fast = detmath.atan2(y, x)
     general = detmath.atan2(np.append(y, np.nan), np.append(x, 1.0))[:-1]
     assert np.array_equal(fast.view(np.int64), general.view(np.int64))
-    assert not np.array_equal(np.arctan2(y, x).view(np.int64), general.view(np.int64))
+    with np.errstate(divide="ignore"):
+        regrouped = detmath.atan2(np.append(y * (1.0 / x), np.nan), np.append(np.ones_like(x), 1.0))[:-1]
+    assert not np.array_equal(regrouped.view(np.int64), general.view(np.int64))
 
 
 def test_nan_propagates():
@@ -91,14 +95,15 @@ def test_javascript_twin_gives_the_same_bits(args, tmp_path):
     subprocess.run([node, str(DRIVERS / "detmath_driver.mjs"), str(modules), str(tmp_path / "args.f64"),
                     str(tmp_path / "out.f64")], check=True, timeout=120)
     out = np.fromfile(tmp_path / "out.f64", dtype="<f8").reshape(-1, 4)
-    js_sin, js_atan2, v8_sin, v8_atan2 = out.T
+    js_sin, js_atan2 = out.T[:2]         # columns 3-4: V8's own Math.sin, Math.atan2
     py_sin, py_atan2 = detmath.sin(a), detmath.atan2(a, b)
     assert np.array_equal(js_sin.view(np.int64), py_sin.view(np.int64))
     assert np.array_equal(js_atan2.view(np.int64), py_atan2.view(np.int64))
-    # The same comparison rejects the library functions this module replaces:
-    # V8's sine and atan2 differ from numpy's in the last bit for some arguments.
-    assert np.count_nonzero(v8_sin != np.sin(a)) > 0
-    assert np.count_nonzero(v8_atan2 != np.arctan2(a, b)) > 0
+    # The comparison sees a single last-bit change.  (Whether V8's own Math.sin
+    # differs from numpy's is the libraries' accident on this CPU: not asserted.)
+    nudged = py_sin.copy()
+    nudged[len(a) // 2] = np.nextafter(nudged[len(a) // 2], np.inf)
+    assert not np.array_equal(js_sin.view(np.int64), nudged.view(np.int64))
 
 
 def _plain_sin(x, reassociate=False):

