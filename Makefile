@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: book test bench clean
+.PHONY: book test test-baseline-simd bench clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -19,6 +19,16 @@ book: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest verify tests
+
+# The numerics-heavy tests again with numpy's optional SIMD features (those
+# found on this CPU beyond its baseline) disabled: the same checks must hold
+# on the dispatch path of a machine without them.
+NUMERIC_TESTS := verify tests/test_parity.py tests/test_fields.py tests/test_detmath.py \
+                 tests/test_gradient_methods.py tests/test_any_scene.py tests/test_stress.py
+test-baseline-simd: $(STAMP)
+	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')"; \
+	echo "NPY_DISABLE_CPU_FEATURES=\"$$features\""; \
+	NPY_DISABLE_CPU_FEATURES="$$features" $(BIN)/python -m pytest $(NUMERIC_TESTS) -p no:cacheprovider
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_render.py

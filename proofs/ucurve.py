@@ -22,6 +22,7 @@ far below the float64 quantities measured (>= 1e-17).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import lru_cache
 
 import mpmath
@@ -31,7 +32,7 @@ import sympy as sp
 from renderer import fields
 from renderer.render import central_gradient
 
-__all__ = ["UCurve", "measure", "UNIT_ROUNDOFF", "DIGITS"]
+__all__ = ["UCurve", "measure", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS"]
 
 #: Unit roundoff of IEEE double precision (round to nearest).
 UNIT_ROUNDOFF = 2.0**-53
@@ -39,9 +40,50 @@ UNIT_ROUNDOFF = 2.0**-53
 DIGITS = 50
 
 
+def non_differentiable(field, u, v, component, k_u, k_v):
+    """Why h_u (``component="u"``) or h_v of ``field`` has no derivative at the
+    chart point (u, v), or None where it has one.
+
+    Two cases (seed §3 and §7): the pole v = 0 or v = 1, where the chart is
+    singular (every u names the same point of the sphere, so a chart
+    derivative there is not a derivative of a function on the sphere); and a
+    crease of the ridges field h = |sin(pi k_u u) sin(pi k_v v)|, the line
+    u = m / k_u (or v = m / k_v) for an integer m, across which the slope
+    jumps from -s to +s.  A point within one ulp of a crease counts as on
+    it: no float64 step can tell its two sides apart.  Where both factors
+    vanish, h is 0 along the component's line and the partial derivative
+    exists (it is 0).  Exact rational arithmetic on the float64 inputs.
+    """
+    if v in (0.0, 1.0):
+        return (f"v = {v!r} is a pole of the chart: every u names the same point of the sphere, "
+                f"so the field is not differentiable there as a function on the sphere")
+    if field != "ridges":
+        return None
+
+    def near_crease(x, k):
+        m = round(Fraction(k) * Fraction(x))
+        return m, abs(Fraction(x) - m / Fraction(k)) <= Fraction(float(np.spacing(x)))
+
+    (mu, on_u), (mv, on_v) = near_crease(u, k_u), near_crease(v, k_v)
+    if component == "u" and on_u and not on_v:
+        return (f"u = {u!r} lies on the crease u = {mu}/k_u of the ridges field (k_u = {k_u:g}): "
+                f"h is not differentiable in u there (its slope jumps sign)")
+    if component == "v" and on_v and not on_u:
+        return (f"v = {v!r} lies on the crease v = {mv}/k_v of the ridges field (k_v = {k_v:g}): "
+                f"h is not differentiable in v there (its slope jumps sign)")
+    return None
+
+
 @dataclass(frozen=True)
 class UCurve:
-    """Result of `measure` (arrays are float64, one entry per step)."""
+    """Result of `measure` (arrays are float64, one entry per step).
+
+    Where the derivative does not exist (``reason`` is not None, see
+    `non_differentiable`), ``error`` and ``truncation`` are measured against
+    the one-sided derivative from the interior side named in ``reason``'s
+    place (from above, or from below at 1), and ``derivative`` and the three
+    optimum fields are NaN: there is no true derivative and no optimal step.
+    """
 
     field: str
     u: float
@@ -57,6 +99,7 @@ class UCurve:
     eps_opt_predicted: float
     eps_opt_measured: float
     error_at_measured_opt: float
+    reason: str | None = None  # why h has no derivative here (`non_differentiable`), or None
 
 
 @lru_cache(maxsize=None)
@@ -99,10 +142,11 @@ def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=
 
     Notes
     -----
-    At a crease of the ridges field the difference quotient does not converge;
-    the "true derivative" is then sympy's sign(s1 s2) (s1 s2)' evaluated at
-    the float64 point, i.e. one of the two one-sided derivatives, and
-    `truncation` does not vanish as eps -> 0.
+    At a crease of the ridges field, or at a pole, there is no derivative
+    (`non_differentiable`): the result's ``reason`` says why, the reference
+    is the one-sided derivative from the side of larger u or v (smaller, at
+    1), ``truncation`` does not vanish as eps -> 0, and the derivative and
+    the optimal step are NaN.
     """
     if field not in fields.HEIGHT_EXPRS:
         raise ValueError(f"field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {field!r}")
@@ -119,11 +163,19 @@ def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=
         raise ValueError("eps must be a non-empty array of finite steps > 0")
 
     u, v, k_u, k_v = float(u), float(v), float(k_u), float(k_v)
+    reason = non_differentiable(field, u, v, component, k_u, k_v)
     h_mp, dh_mp, d3h_mp = _mp_functions(field, component, k_u, k_v)
     uu, vv = np.array([u]), np.array([v])
     with mpmath.workdps(DIGITS):
         U, V = mpmath.mpf(u), mpmath.mpf(v)
-        true = dh_mp(U, V)
+        if reason is None:
+            true = dh_mp(U, V)
+        else:
+            # The one-sided derivative: the derivative 1e-40 inside, where
+            # the field is smooth and within ~1e-39 of the one-sided limit.
+            x = u if component == "u" else v
+            side = mpmath.mpf(10) ** -(DIGITS - 10) * (-1 if x == 1.0 else 1)
+            true = dh_mp(U + side, V) if component == "u" else dh_mp(U, V + side)
         h0 = h_mp(U, V)
         h3 = d3h_mp(U, V)
         error, trunc, roundoff = [], [], []
@@ -147,5 +199,9 @@ def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=
     model = steps**2 * abs(h3f) / 6 + UNIT_ROUNDOFF * abs(h0f) / steps
     predicted = (3 * UNIT_ROUNDOFF * abs(h0f) / abs(h3f)) ** (1 / 3) if h3f != 0 else float("inf")
     best = int(np.argmin(error))
+    nan = float("nan")
+    if reason is not None:
+        return UCurve(field, u, v, component, steps, error, np.array(trunc), np.array(roundoff),
+                      np.full(steps.shape, nan), nan, nan, nan, nan, nan, reason)
     return UCurve(field, u, v, component, steps, error, np.array(trunc), np.array(roundoff), model,
                   float(true), h3f, predicted, float(steps[best]), float(error[best]))

@@ -39,11 +39,24 @@ class Ledger:
 def compare(numeric: Frame, symbolic: Frame) -> Ledger:
     """Ledger of two frames of the same size.
 
+    The crease band is read from ``symbolic.kink``, so ``symbolic`` must be
+    rendered with ``kink=True`` (the default).
+
     Raises
     ------
+    TypeError
+        If either argument is not a `Frame`.
     ValueError
-        If the frames differ in shape.
+        If the frames differ in shape, or ``symbolic`` was rendered with
+        ``kink=False`` (the message says to render it with ``kink=True``).
     """
+    for name, frame in (("numeric", numeric), ("symbolic", symbolic)):
+        if not isinstance(frame, Frame):
+            raise TypeError(f"{name} must be a renderer Frame, got {type(frame).__name__}")
+    if symbolic.kink is None:
+        raise ValueError("symbolic has no crease band (rendered with kink=False); the ledger's "
+                         "on/off-band means need it: render the symbolic frame with kink=True "
+                         "(the default)")
     if numeric.image.shape != symbolic.image.shape:
         raise ValueError(
             f"frames must have the same shape, got {numeric.image.shape} and {symbolic.image.shape}"

@@ -10,6 +10,7 @@ Phong).  Everything before the gradient depends on geometry alone.
 
 from __future__ import annotations
 
+import functools
 import numbers
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -169,6 +170,24 @@ def _tile_bounds(scene, width, height, zoom, workers, a_cost):
     if max(j1 - j0 for j0, j1 in zip(cuts, cuts[1:])) * width > TILE_PIXELS:
         return bands                        # the memory bound comes first
     return list(zip(cuts, cuts[1:]))
+
+
+def quiet_underflow(fn):
+    """Run ``fn`` with numpy's underflow flag ignored (and every other
+    floating-point error left as the caller set it).
+
+    A product or power that underflows (a vanishing highlight pow(0.01, 1e4),
+    a tiny beta times a gradient) rounds to a subnormal or to 0, which is the
+    correctly rounded result and invisible in any image; invalid operations,
+    division by zero and overflow stay errors or warnings, as the caller
+    chose.  Worker threads start with numpy's defaults, which already ignore
+    underflow.
+    """
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        with np.errstate(under="ignore"):
+            return fn(*args, **kwargs)
+    return wrapper
 
 
 #: Floor under |h| in Blinn's half-vector quotient (|h| = 0 only off the lit side).
@@ -420,8 +439,10 @@ def _shade(scene, P, Ns, albedo, lights, flat=False, mus=None, view=None):
         else:
             two_mu = 2.0 * mu
             spec_cos = _dot(two_mu * Sx - wx, two_mu * Sy - wy, two_mu * Sz - wz, vx, vy, vz)
+        # The cosine clamped to [0, 1] before the power: rounding can put it a
+        # few ulps above 1, and at a large exponent 1 + 2^-52 would grow.
         # Masks by multiplication (x * False = 0): the same sums as np.where, faster.
-        spec = _power(np.maximum(spec_cos, 0.0) * front, scene.shininess)
+        spec = _power(np.clip(spec_cos, 0.0, 1.0) * front, scene.shininess)
         diffuse = (mu * front) * scene.kd
         spec *= scene.ks
         term = None
@@ -720,6 +741,7 @@ class GBuffer:
     y: np.ndarray
 
 
+@quiet_underflow
 def gbuffer(scene, width, height, *, gradient="exact", zoom=1.0):
     """Per-pixel hit points, normals and chart of a frame (see `GBuffer`).
 
@@ -760,6 +782,15 @@ def _check_workers(workers):
     return int(workers)
 
 
+def check_flag(name, value):
+    """Return ``value`` as a bool if it is one (Python's or numpy's), else
+    raise TypeError naming the keyword ``name`` (as `_check_size` does for
+    sizes): ``kink="no"`` or ``grad=0`` would otherwise be read by truth value."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {type(value).__name__} {value!r}")
+    return bool(value)
+
+
 def _check_args(scene, width, height, gradient, zoom):
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
@@ -774,6 +805,7 @@ def _check_args(scene, width, height, gradient, zoom):
     return scene, width, height, gradient, float(zoom)
 
 
+@quiet_underflow
 def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=True, skip=True,
            workers=None):
     """Render the Chapter-9 scene.
@@ -821,7 +853,8 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     Raises
     ------
     TypeError
-        ``scene`` is not a Scene, or ``width``/``height`` is not an integer.
+        ``scene`` is not a Scene, ``width``/``height`` is not an integer, or
+        ``kink``, ``grad`` or ``skip`` is not a bool.
     ValueError
         ``width``/``height`` outside [1, 8192], an unknown ``gradient``, or
         ``zoom`` outside [1, 1e6] (TypeError if it is not a real number).
@@ -837,6 +870,7 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     corrections listed in the book's errata.
     """
     scene, width, height, gradient, zoom = _check_args(scene, width, height, gradient, zoom)
+    kink, grad, skip = (check_flag(n, f) for n, f in (("kink", kink), ("grad", grad), ("skip", skip)))
     keep_heap()
     workers = _check_workers(workers)
     image = np.zeros((height, width, 3))

@@ -20,9 +20,28 @@ __all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
 MAX_LENGTH = 1e6
 #: Smallest accepted radius (scene units), far from underflow of R^2.
 MIN_RADIUS = 1e-6
-#: Largest accepted frequency k_u, k_v and amplitude beta.
-MAX_FREQUENCY = 1e6
-MAX_BETA = 1e6
+#: Largest accepted frequency k_u, k_v (periods over the chart): 1000 periods
+#: over u are more than a pixel each even at 8192 pixels across, and keep the
+#: phase pi k u far inside the accurate range of the deterministic sine.
+MAX_FREQUENCY = 1e3
+#: Largest accepted bump amplitude beta: at 100 the chart bump tilts every
+#: normal with |grad h| >= 0.01 by more than 45 degrees; beyond it the image no
+#: longer changes in any way that means something.
+MAX_BETA = 100.0
+#: Accepted central-difference steps eps (chart units).  Below 1e-16 the step
+#: no longer moves every chart point (half an ulp of u just below 1 is 2^-54,
+#: about 5.6e-17, so u + 1e-16 != u still holds on all of [0, 1)); at 0.5 the
+#: two samples u +- eps wrap onto the same point of the periodic u, and 0.25
+#: keeps them at least a quarter period apart.
+MIN_EPS, MAX_EPS = 1e-16, 0.25
+#: Largest accepted light colour or ambient component (linear RGB): 1000
+#: times the default white light already saturates every lit pixel.
+MAX_INTENSITY = 1e3
+#: Accepted Blinn/Phong exponents: n >= 1 keeps the lobe inside the cosine
+#: lobe (n < 1 widens it towards a step at the horizon); at 1e4 the Blinn
+#: highlight's half-width is about 0.7 degrees, narrower than a pixel of the
+#: default 256^2 frame.
+MIN_SHININESS, MAX_SHININESS = 1.0, 1e4
 
 #: Names accepted for ``Scene.height_field`` (seed §2).
 HEIGHT_FIELDS = ("sine", "ridges", "rings")
@@ -46,11 +65,15 @@ def _real(owner: str, name: str, value, *, low=None, low_open=False, high=None):
                          f"{len(str(abs(int(value))))} digits") from None
     if not math.isfinite(x):
         raise ValueError(f"{owner}.{name} must be finite, got {value!r}")
-    if low is not None and (x <= low if low_open else x < low):
-        rel = ">" if low_open else ">="
-        raise ValueError(f"{owner}.{name} must be {rel} {low}, got {value!r}")
-    if high is not None and x > high:
-        raise ValueError(f"{owner}.{name} must be <= {high}, got {value!r}")
+    below = low is not None and (x <= low if low_open else x < low)
+    if below or (high is not None and x > high):
+        if low is not None and high is not None:
+            accepted = f"in {'(' if low_open else '['}{low:g}, {high:g}]"
+        elif low is not None:
+            accepted = f"{'>' if low_open else '>='} {low:g}"
+        else:
+            accepted = f"<= {high:g}"
+        raise ValueError(f"{owner}.{name} must be {accepted}, got {value!r}")
     return x
 
 
@@ -92,14 +115,15 @@ class PointLight:
     ----------
     position : sequence of 3 floats
         World position of the light (same units as the scene radii).
-    color : sequence of 3 floats, each >= 0
+    color : sequence of 3 floats, each in [0, 1e3]
         Linear-RGB radiant intensity.  A light whose colour is (0, 0, 0)
         contributes nothing.
 
     Raises
     ------
     TypeError, ValueError
-        If a component is not a finite real number, or a colour is negative.
+        If a component is not a finite real number, a position component is
+        above 1e6 in magnitude, or a colour component is outside [0, 1e3].
     """
 
     position: tuple = (5.0, 5.0, 10.0)
@@ -108,7 +132,8 @@ class PointLight:
     def __post_init__(self):
         object.__setattr__(self, "position", _vec3("PointLight", "position", self.position,
                                                    low=-MAX_LENGTH, high=MAX_LENGTH))
-        object.__setattr__(self, "color", _vec3("PointLight", "color", self.color, nonneg=True))
+        object.__setattr__(self, "color", _vec3("PointLight", "color", self.color, nonneg=True,
+                                                high=MAX_INTENSITY))
 
 
 _DEFAULT_LIGHTS = (
@@ -150,11 +175,16 @@ class Scene:
     TypeError
         A field has the wrong type (a string for a number, a number for a flag).
     ValueError
-        A field is out of range: not finite, a radius below 1e-6, a length or
-        coordinate above 1e6 in magnitude, k_u, k_v or beta above 1e6, the camera inside or
-        on sphere A or sphere B, ``eps`` <= 0, ``beta`` < 0, an unknown
-        ``model`` or ``height_field`` name.  The message names the field, the
-        value and what is accepted.
+        A field is out of its range, each chosen to mean something (see the
+        module constants for why): every number finite; radii in [1e-6, 1e6]
+        and coordinates in [-1e6, 1e6] (scene units); the camera outside
+        sphere A and sphere B; ``ka``, ``kd``, ``ks``, ``floor_tint`` and
+        albedos in [0, 1]; ``ambient`` and light colours in [0, 1e3];
+        ``shininess`` in [1, 1e4]; ``k_u``, ``k_v`` in (0, 1e3]; ``beta`` in
+        [0, 100] (and < ``radius_a`` for ``bump="surface"``); ``eps`` in
+        [1e-16, 0.25] chart units; ``model``, ``height_field`` and ``bump``
+        one of their names.  The message names the field, the value and what
+        is accepted.
 
     Examples
     --------
@@ -215,19 +245,19 @@ class Scene:
             if not isinstance(light, PointLight):
                 raise TypeError(f"Scene.lights[{i}] must be a PointLight, got {light!r}")
         set_("lights", tuple(lights))
-        set_("ambient", _vec3(S, "ambient", self.ambient, nonneg=True))
+        set_("ambient", _vec3(S, "ambient", self.ambient, nonneg=True, high=MAX_INTENSITY))
         set_("albedo_a", _vec3(S, "albedo_a", self.albedo_a, nonneg=True, high=1.0))
         set_("albedo_b", _vec3(S, "albedo_b", self.albedo_b, nonneg=True, high=1.0))
         for name in ("ka", "kd", "ks"):
-            set_(name, _real(S, name, getattr(self, name), low=0.0))
-        set_("shininess", _real(S, "shininess", self.shininess, low=0.0, low_open=True))
+            set_(name, _real(S, name, getattr(self, name), low=0.0, high=1.0))
+        set_("shininess", _real(S, "shininess", self.shininess, low=MIN_SHININESS, high=MAX_SHININESS))
         set_("model", _choice(S, "model", self.model, MODELS))
         set_("floor_tint", _real(S, "floor_tint", self.floor_tint, low=0.0, high=1.0))
         set_("height_field", _choice(S, "height_field", self.height_field, HEIGHT_FIELDS))
         set_("k_u", _real(S, "k_u", self.k_u, low=0.0, low_open=True, high=MAX_FREQUENCY))
         set_("k_v", _real(S, "k_v", self.k_v, low=0.0, low_open=True, high=MAX_FREQUENCY))
         set_("beta", _real(S, "beta", self.beta, low=0.0, high=MAX_BETA))
-        set_("eps", _real(S, "eps", self.eps, low=0.0, low_open=True))
+        set_("eps", _real(S, "eps", self.eps, low=MIN_EPS, high=MAX_EPS))
         set_("bump", _choice(S, "bump", self.bump, BUMPS))
         if self.bump == "surface" and not self.beta < self.radius_a:
             raise ValueError(

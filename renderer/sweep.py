@@ -13,6 +13,8 @@ separate `render` call.
 
 from __future__ import annotations
 
+import collections.abc
+import itertools
 import math
 import numbers
 import threading
@@ -24,9 +26,10 @@ from . import fields
 from .geometry import image_plane
 from .heap import keep_heap
 from .ledger import compare
-from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient,
+from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient, quiet_underflow,
                      _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal, _view,
                      _put_rows, _store_rgb, _surfaces, _tile_rows, _trace_shadows)
+from .scene import MAX_EPS, MIN_EPS
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS"]
 
@@ -53,18 +56,34 @@ class Sweep:
 
 
 def _check_steps(eps_values):
+    """The steps as a tuple of floats, read one at a time: at most
+    `MAX_STEPS` + 1 items are taken from an iterator, so an endless or
+    over-long one is refused without being consumed whole.
+
+    Raises TypeError for a non-iterable, a string, or an unordered collection
+    (a set or a mapping: the census is reported in the order of the steps);
+    ValueError for no steps, more than `MAX_STEPS`, or a step outside
+    [`MIN_EPS`, `MAX_EPS`] (naming its index)."""
     if isinstance(eps_values, (str, bytes)) or not hasattr(eps_values, "__iter__"):
         raise TypeError(f"eps_values must be a sequence of positive numbers, got {eps_values!r}")
+    if isinstance(eps_values, (collections.abc.Set, collections.abc.Mapping,
+                               collections.abc.KeysView, collections.abc.ValuesView)):
+        raise TypeError(f"eps_values must be ordered (a list, tuple, array or iterator), got a "
+                        f"{type(eps_values).__name__}: the census follows the order of the steps")
     steps = []
-    for i, e in enumerate(eps_values):
-        if isinstance(e, bool) or not isinstance(e, numbers.Real) or not math.isfinite(e) or e <= 0:
-            raise ValueError(f"eps_values[{i}] must be a finite number > 0, got {e!r}")
+    for i, e in enumerate(itertools.islice(eps_values, MAX_STEPS + 1)):
+        if isinstance(e, (bool, np.bool_)) or not isinstance(e, numbers.Real) or not math.isfinite(e) \
+                or not MIN_EPS <= e <= MAX_EPS:
+            raise ValueError(f"eps_values[{i}] must be a number in [{MIN_EPS:g}, {MAX_EPS:g}], got {e!r}")
         steps.append(float(e))
-    if not 1 <= len(steps) <= MAX_STEPS:
-        raise ValueError(f"eps_values must hold 1 to {MAX_STEPS} steps, got {len(steps)}")
+    if not steps:
+        raise ValueError(f"eps_values must hold 1 to {MAX_STEPS} steps, got none")
+    if len(steps) > MAX_STEPS:
+        raise ValueError(f"eps_values must hold 1 to {MAX_STEPS} steps, got more than {MAX_STEPS}")
     return tuple(steps)
 
 
+@quiet_underflow
 def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=None):
     """Render the symbolic frame and one numeric frame per step, sharing the geometry.
 
@@ -72,7 +91,7 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     ----------
     scene : Scene
         ``scene.eps`` is ignored; the steps come from ``eps_values``.
-    eps_values : sequence of float > 0 (1 to 64 of them), chart units
+    eps_values : ordered iterable of float in [1e-16, 0.25] (1 to 64 of them), chart units
     width, height : int in [1, 8192]
     zoom : float in [1, 1e6], keyword-only (see `render`)
     workers : int >= 1, keyword-only (see `render`)
@@ -90,8 +109,9 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     Raises
     ------
     TypeError, ValueError
-        As `render`, and for an empty or over-long ``eps_values`` or a step
-        that is not a finite positive number (the message names its index).
+        As `render`; for an empty or over-long ``eps_values`` (an iterator is
+        read no further than step 65), an unordered one (a set or a mapping),
+        or a step outside [1e-16, 0.25] (the message names its index).
 
     Notes
     -----

@@ -172,11 +172,12 @@ VARIANTS = {
     # k_u = 7: the pole pixel of 17 x 20 has h_v != 0, so the fallback frame matters.
     "pole with nonzero gradient": dict(k_u=7.0, beta=1.5),
     "non-integer frequencies": dict(k_u=3.3, k_v=7.1, beta=1.0),
-    "large eps": dict(eps=0.4),
+    "large eps": dict(eps=0.25),
     "eps 0.05": dict(eps=0.05),
     "camera close, sphere B moved": dict(camera_z=2.5, radius_a=0.8, center_b=(-0.6, 0.2, 0.9),
                                          radius_b=0.4),
-    "saturated (clipping)": dict(kd=3.0, ks=2.0, shininess=1.0, floor_tint=1.0),
+    "saturated (clipping)": dict(kd=1.0, ks=1.0, shininess=1.0, floor_tint=1.0,
+                                 lights=(PointLight((5.0, 5.0, 10.0), (3.0, 3.0, 3.0)), LIGHT_2)),
     "sphere B through the floor": dict(center_b=(0.9, -0.3, 0.2), radius_b=0.5, floor_tint=0.0),
 }
 

@@ -16,7 +16,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from renderer import PointLight, Scene, render
+from renderer import PointLight, Scene, compare, render, sweep
 
 NAN, INF = float("nan"), float("inf")
 
@@ -100,6 +100,12 @@ BAD += [
     ("ka", -0.1, ValueError), ("kd", -1e-9, ValueError), ("ks", -1.0, ValueError),
     ("shininess", 0.0, ValueError), ("shininess", -32.0, ValueError),
     ("k_u", 0.0, ValueError), ("k_u", -8.0, ValueError), ("k_v", 0.0, ValueError),
+    # above the meaningful ranges (each stated in the message)
+    ("eps", 1e300, ValueError), ("eps", 5e-324, ValueError), ("eps", 0.26, ValueError),
+    ("eps", 9e-17, ValueError), ("kd", 1e308, ValueError), ("ks", 1e308, ValueError),
+    ("ka", 1.01, ValueError), ("shininess", 1e20, ValueError), ("shininess", 0.5, ValueError),
+    ("beta", 100.5, ValueError), ("k_u", 1001.0, ValueError), ("k_v", 1e6, ValueError),
+    ("ambient", (1e308, 0.0, 0.0), ValueError),
     # colours and albedos
     ("ambient", (0.15, -0.01, 0.16), ValueError),
     ("albedo_a", (0.63, 1.01, 0.16), ValueError), ("albedo_a", (-0.1, 0.19, 0.16), ValueError),
@@ -122,6 +128,15 @@ BAD += [
                          ids=[f"{f}={v!r}" for f, v, _ in BAD])
 def test_bad_field_is_rejected_naming_it(field, value, error):
     with pytest.raises(error, match=names(field)):
+        Scene(**{field: value})
+
+
+@pytest.mark.parametrize("field, value, accepted", [
+    ("eps", 1e300, "in [1e-16, 0.25]"), ("kd", 1e308, "in [0, 1]"),
+    ("shininess", 1e20, "in [1, 10000]"), ("beta", 1e3, "in [0, 100]"), ("k_u", 0.0, "in (0, 1000]"),
+])
+def test_range_errors_state_the_accepted_range(field, value, accepted):
+    with pytest.raises(ValueError, match=re.escape(f"Scene.{field} must be {accepted}, got {value!r}")):
         Scene(**{field: value})
 
 
@@ -161,7 +176,9 @@ def test_bad_point_light_is_rejected_naming_the_field(field, value, error):
 @pytest.mark.parametrize("kwargs", [
     dict(beta=0.0), dict(floor_tint=0.0), dict(floor_tint=1.0), dict(ka=0.0, kd=0.0, ks=0.0),
     dict(albedo_a=(1.0, 1.0, 1.0)), dict(albedo_b=(0.0, 0.0, 0.0)), dict(ambient=(0.0, 0.0, 0.0)),
-    dict(eps=5e-324), dict(eps=0.5), dict(eps=7.0), dict(shininess=5e-324), dict(k_u=5e-324),
+    dict(eps=1e-16), dict(eps=0.25), dict(shininess=1.0), dict(shininess=1e4), dict(k_u=5e-324),
+    dict(k_v=1e3), dict(beta=100.0), dict(ka=1.0, kd=1.0, ks=1.0), dict(ambient=(1e3, 0.0, 1e3)),
+    dict(lights=(PointLight((1e6, -1e6, 0.0), (1e3, 1e3, 0.0)),)),
     dict(camera_z=1.0 + 2**-52), dict(radius_a=1e-3), dict(radius_b=1e-3),
     dict(center_b=np.array([0.5, 0.5, 1.3])), dict(center_b=[0.5, 0.5, 1.3]),
     dict(beta=np.float64(0.5)), dict(k_u=np.int64(3)), dict(k_v=7),
@@ -327,7 +344,7 @@ def valid_scenes(draw):
         k_u=draw(st.floats(0.5, 20.0, exclude_min=True, exclude_max=True)),
         k_v=draw(st.floats(0.5, 20.0, exclude_min=True, exclude_max=True)),
         beta=draw(st.floats(0.0, beta_max)),
-        eps=draw(st.floats(1e-8, 0.4)),
+        eps=draw(st.floats(1e-8, 0.25)),
         sphere_b=draw(st.booleans()),
         floor=draw(st.booleans()),
         bump=bump,
@@ -365,3 +382,57 @@ def test_boundary_check_has_teeth():
 def test_an_integer_beyond_float_range_names_the_field():
     with pytest.raises(ValueError, match=r"^Scene\.beta must be finite, got an integer of 401 digits"):
         Scene(beta=10**400)
+
+
+# --- flags, sweep steps and compare's inputs -----------------------------------------------
+
+@pytest.mark.parametrize("flag", ["kink", "grad", "skip"])
+@pytest.mark.parametrize("value", ["no", 0, 1, None, 1.0, [True]])
+def test_boolean_flags_are_type_checked(flag, value):
+    with pytest.raises(TypeError, match=rf"^{flag} must be True or False, got "):
+        render(Scene(), 4, 4, **{flag: value})
+
+
+def test_numpy_bools_are_accepted_as_flags():
+    frame = render(Scene(), 4, 4, kink=np.bool_(False), grad=np.True_)
+    assert frame.kink is None and frame.grad is not None
+
+
+def test_sweep_reads_an_endless_iterator_only_one_step_past_the_limit():
+    from renderer.sweep import MAX_STEPS
+    taken = []
+
+    def endless():
+        while True:
+            taken.append(1)
+            yield 1e-3
+
+    with pytest.raises(ValueError, match=f"must hold 1 to {MAX_STEPS} steps, got more than {MAX_STEPS}"):
+        sweep(Scene(), endless(), 4, 4)
+    assert len(taken) == MAX_STEPS + 1
+    # An iterator within the limit is read whole and used in order.
+    sw = sweep(Scene(), iter([1e-2, 1e-3]), 4, 4)
+    assert [f.scene.eps for f in sw.numeric] == [1e-2, 1e-3]
+
+
+@pytest.mark.parametrize("steps", [{1e-3, 1e-4}, frozenset({1e-3}), {1e-3: "a"}, {1e-3: 1}.keys()])
+def test_sweep_refuses_unordered_steps(steps):
+    with pytest.raises(TypeError, match="eps_values must be ordered"):
+        sweep(Scene(), steps, 4, 4)
+
+
+@pytest.mark.parametrize("step", [0.0, 5e-324, 1e300, 0.3, np.nan, True])
+def test_sweep_steps_outside_the_scene_range_are_refused_by_index(step):
+    with pytest.raises(ValueError, match=r"eps_values\[1\] must be a number in \[1e-16, 0.25\]"):
+        sweep(Scene(), [1e-3, step], 4, 4)
+
+
+def test_compare_without_a_crease_band_says_what_to_pass():
+    numeric = render(Scene(), 8, 8, gradient="central")
+    symbolic = render(Scene(), 8, 8, kink=False)
+    with pytest.raises(ValueError, match="render the symbolic frame with kink=True"):
+        compare(numeric, symbolic)
+    # With the band, the same frames compare.
+    assert compare(numeric, render(Scene(), 8, 8)).pixels_a > 0
+    with pytest.raises(TypeError, match="numeric must be a renderer Frame"):
+        compare(numeric.image, symbolic)

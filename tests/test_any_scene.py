@@ -1,0 +1,128 @@
+"""Every scene `Scene` accepts renders a finite image in [0, 1], with no
+floating-point error: a property over the whole accepted range of every field
+(hypothesis draws the ends of each range often), rendered under
+``np.errstate(all="raise")`` with warnings turned into errors.
+
+The frames are small, so they render on the calling thread, where the
+caller's floating-point state applies (numpy's error state is per thread).
+The checker is shown to reject a renderer that lets a NaN through.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from renderer import BUMPS, HEIGHT_FIELDS, MODELS, PointLight, Scene, gbuffer, render, sweep
+from renderer import scene as S
+from renderer.render import MAX_ZOOM
+
+#: Scenes tried by the property in this process (reported by the last test).
+TRIED = {"scenes": 0, "rendered": 0}
+
+
+def _length(low=-S.MAX_LENGTH, high=S.MAX_LENGTH):
+    return st.floats(low, high, allow_nan=False)
+
+
+def _vec(elements):
+    return st.tuples(elements, elements, elements)
+
+
+@st.composite
+def accepted_scenes(draw):
+    """Any combination of field values inside the stated ranges; combinations
+    that `Scene` refuses (camera inside a sphere, surface bump with beta >= R)
+    are discarded."""
+    intensity = st.floats(0.0, S.MAX_INTENSITY)
+    radius = st.floats(S.MIN_RADIUS, S.MAX_LENGTH)
+    kw = dict(
+        radius_a=draw(st.one_of(st.just(1.0), radius)),
+        camera_z=draw(st.one_of(st.just(4.0), _length(0.0))),
+        center_b=draw(st.one_of(st.just((0.5, 0.5, 1.3)), _vec(_length()))),
+        radius_b=draw(st.one_of(st.just(0.32), radius)),
+        sphere_b=draw(st.booleans()),
+        floor=draw(st.booleans()),
+        lights=tuple(draw(st.lists(st.builds(PointLight, _vec(_length()), _vec(intensity)), max_size=3))),
+        ambient=draw(_vec(intensity)),
+        albedo_a=draw(_vec(st.floats(0.0, 1.0))),
+        albedo_b=draw(_vec(st.floats(0.0, 1.0))),
+        ka=draw(st.floats(0.0, 1.0)), kd=draw(st.floats(0.0, 1.0)), ks=draw(st.floats(0.0, 1.0)),
+        shininess=draw(st.floats(S.MIN_SHININESS, S.MAX_SHININESS)),
+        model=draw(st.sampled_from(MODELS)),
+        floor_tint=draw(st.floats(0.0, 1.0)),
+        height_field=draw(st.sampled_from(HEIGHT_FIELDS)),
+        k_u=draw(st.floats(0.0, S.MAX_FREQUENCY, exclude_min=True)),
+        k_v=draw(st.floats(0.0, S.MAX_FREQUENCY, exclude_min=True)),
+        beta=draw(st.floats(0.0, S.MAX_BETA)),
+        eps=draw(st.floats(S.MIN_EPS, S.MAX_EPS)),
+        bump=draw(st.sampled_from(BUMPS)),
+    )
+    TRIED["scenes"] += 1
+    try:
+        return Scene(**kw)
+    except ValueError:
+        assume(False)
+
+
+def check_frame(render_fn, scene, width, height, gradient, zoom):
+    """Render under errstate(all="raise") with warnings as errors; return the
+    frame after checking that its image is finite and in [0, 1]."""
+    with np.errstate(all="raise"), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        frame = render_fn(scene, width, height, gradient=gradient, zoom=zoom)
+    assert np.all(np.isfinite(frame.image)), "non-finite pixels"
+    assert frame.image.min() >= 0.0 and frame.image.max() <= 1.0
+    assert np.all(np.isfinite(frame.grad))
+    return frame
+
+
+@settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                    HealthCheck.filter_too_much])
+@given(scene=accepted_scenes(), size=st.tuples(st.integers(1, 12), st.integers(1, 12)),
+       gradient=st.sampled_from(("exact", "central")),
+       zoom=st.one_of(st.just(1.0), st.floats(1.0, MAX_ZOOM)))
+def test_every_accepted_scene_renders_finite_without_floating_point_errors(scene, size, gradient, zoom):
+    check_frame(render, scene, *size, gradient, zoom)
+    TRIED["rendered"] += 1
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                   HealthCheck.filter_too_much])
+@given(scene=accepted_scenes(), steps=st.lists(st.floats(S.MIN_EPS, S.MAX_EPS), min_size=1, max_size=3))
+def test_every_accepted_scene_sweeps_and_buffers_finite(scene, steps):
+    with np.errstate(all="raise"), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sw = sweep(scene, steps, 8, 6)
+        g = gbuffer(scene, 8, 6)
+    for frame in (sw.symbolic, *sw.numeric):
+        assert np.all(np.isfinite(frame.image)) and frame.image.min() >= 0.0 and frame.image.max() <= 1.0
+    hit = g.chamber > 0
+    assert np.all(np.isfinite(g.Ns[hit])) and np.all(np.isfinite(g.P[hit]))
+
+
+def test_the_checker_rejects_a_nan_pixel_and_a_floating_point_error():
+    def leaks_nan(scene, width, height, **kw):
+        frame = render(scene, width, height, **kw)
+        frame.image[0, 0, 0] = np.nan
+        return frame
+
+    def divides_by_zero(scene, width, height, **kw):
+        np.float64(1.0) / np.zeros(1)
+        return render(scene, width, height, **kw)
+
+    with pytest.raises(AssertionError, match="non-finite"):
+        check_frame(leaks_nan, Scene(), 4, 4, "exact", 1.0)
+    with pytest.raises(FloatingPointError):
+        check_frame(divides_by_zero, Scene(), 4, 4, "exact", 1.0)
+
+
+def test_the_property_tried_many_scenes():
+    """Runs after the property above (file order): it tried and rendered a
+    substantial number of distinct accepted scenes, not a handful."""
+    print(f"\naccepted-scene property: {TRIED['scenes']} scenes drawn, {TRIED['rendered']} rendered")
+    assert TRIED["rendered"] >= 300
