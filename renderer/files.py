@@ -1,12 +1,29 @@
-"""Atomic file writes, shared by the command line and the JavaScript generator."""
+"""Safe file writes and bounded reads, shared by the command line and the
+JavaScript generator.
+
+Writes never rename over anything but a regular file: a path that is absent or
+a regular file is replaced atomically (a temporary file beside it, then
+`os.replace`); a character device, FIFO or socket (``/dev/null``), or a
+symbolic link whose target exists (``/dev/stdout``), is written through and
+stays what it was; anything else (a directory, a dangling link, a block
+device, a path ending in ``/``) is refused.  Reads take regular files only,
+up to a stated size, with a bounded read.
+"""
 
 from __future__ import annotations
 
+import io
 import os
+import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write", "umask"]
+__all__ = ["atomic_write", "write_bytes", "output_route", "read_regular", "RefusedPath", "umask"]
+
+
+class RefusedPath(ValueError):
+    """A path this module will not write to or read from; the message names it
+    and says what is accepted."""
 
 
 def umask():
@@ -16,33 +33,207 @@ def umask():
     return mask
 
 
-def atomic_write(path, write):
-    """Write a file atomically: ``write(fileobj)`` (a binary file object) into a
-    temporary file in the target directory, then `os.replace` it onto ``path``.
+def _named(exc, path):
+    """``exc`` (an OSError) re-raised naming ``path`` instead of whatever file
+    the failing call was given (a temporary file, a descriptor)."""
+    return OSError(exc.errno, exc.strerror or str(exc), os.fspath(path))
 
-    On any exception (including KeyboardInterrupt) the temporary file is
-    removed and the exception propagates; ``path`` is then untouched (absent if
-    it did not exist).  The file gets the usual 0666 & ~umask permissions, not
-    mkstemp's 0600.
+
+def output_route(path):
+    """How `write_bytes` would write ``path``, without writing anything.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    str
+        ``"replace"`` if ``path`` is absent or a regular file (not a symbolic
+        link): a temporary file in its directory is renamed onto it.
+        ``"through"`` if it is a character device, a FIFO or a socket, or a
+        symbolic link whose target exists and is not a directory: it is opened
+        for writing and written, and stays what it was.
 
     Raises
     ------
+    RefusedPath
+        An empty path, a path ending in ``/`` (or in a ``.`` or ``..``
+        component), a directory, a block device, or a symbolic link whose
+        target does not exist or is a directory.
     OSError
-        If the directory does not exist or cannot be written.
+        If ``path`` cannot be examined (other than being absent), naming it.
+    """
+    text = os.fspath(path)
+    if not text:
+        raise RefusedPath("'' is an empty path (give a file name)")
+    if text.endswith(("/", "/.", "/..")) or text in (".", ".."):
+        raise RefusedPath(f"{text!r} names a directory (give a file name without a trailing '/')")
+    try:
+        st = os.lstat(text)
+    except FileNotFoundError:
+        return "replace"
+    except OSError as exc:
+        raise _named(exc, text) from None
+    if stat.S_ISREG(st.st_mode):
+        return "replace"
+    if stat.S_ISLNK(st.st_mode):
+        try:
+            st = os.stat(text)
+        except FileNotFoundError:
+            raise RefusedPath(f"{text!r} is a symbolic link to {os.readlink(text)!r}, which does not "
+                              "exist (accepted: a link to an existing file or device)") from None
+        except OSError as exc:
+            raise _named(exc, text) from None
+        if stat.S_ISDIR(st.st_mode):
+            raise RefusedPath(f"{text!r} is a symbolic link to a directory (give a file name)")
+    if stat.S_ISDIR(st.st_mode):
+        raise RefusedPath(f"{text!r} is a directory (give a file name)")
+    if stat.S_ISBLK(st.st_mode):
+        raise RefusedPath(f"{text!r} is a block device (accepted: a regular file, a character "
+                          "device, a FIFO, a socket, or a link to one)")
+    return "through"
+
+
+def _write_all(fd, data):
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def write_bytes(path, data):
+    """Write ``data`` to ``path`` by the route of `output_route`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    data : bytes-like
+        The whole content, prepared before the target is opened.
+
+    Replaced files are written atomically: on any exception (including
+    KeyboardInterrupt) the temporary file is removed and ``path`` is untouched
+    (absent if it did not exist); the file gets 0666 & ~umask permissions, not
+    mkstemp's 0600.  Written-through targets are opened without ``O_CREAT``
+    (a regular file behind a link is truncated first) and never unlinked.
+
+    Raises
+    ------
+    RefusedPath
+        As `output_route`.
+    OSError
+        If the directory or the target cannot be written; the error names
+        ``path``, never the temporary file.
     """
     target = Path(path)
+    if output_route(path) == "through":
+        try:
+            regular = stat.S_ISREG(os.stat(path).st_mode)
+            fd = os.open(path, os.O_WRONLY | os.O_CLOEXEC | getattr(os, "O_NOCTTY", 0)
+                         | (os.O_TRUNC if regular else 0))
+            try:
+                _write_all(fd, data)
+                if regular:
+                    os.fsync(fd)
+            finally:
+                os.close(fd)
+        except OSError as exc:
+            raise _named(exc, path) from None
+        return
     parent = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{target.name}.", suffix=".part")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{target.name[:64]}.", suffix=".part")
+    except OSError as exc:
+        raise _named(exc, path) from None
     try:
         with os.fdopen(fd, "wb") as f:
-            write(f)
+            f.write(data)
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp, 0o666 & ~umask())
         os.replace(tmp, target)
-    except BaseException:
+    except BaseException as exc:
         try:
             os.unlink(tmp)
         except FileNotFoundError:
             pass
+        if isinstance(exc, OSError):
+            raise _named(exc, path) from None
         raise
+
+
+def atomic_write(path, write):
+    """Write a file from ``write(fileobj)`` (a callable given a binary file
+    object): the bytes are prepared in memory first, then written by
+    `write_bytes` (atomically for a regular file, through a device, FIFO or
+    link).  An exception in ``write`` writes nothing.
+
+    Raises
+    ------
+    RefusedPath, OSError
+        As `write_bytes`; whatever ``write`` raises propagates.
+    """
+    buf = io.BytesIO()
+    write(buf)
+    write_bytes(path, buf.getbuffer())
+
+
+def read_regular(path, limit, *, follow=True):
+    """Read a whole regular file of at most ``limit`` bytes.
+
+    The file is opened with ``O_NONBLOCK`` (a FIFO does not block the open)
+    and, if ``follow`` is false, ``O_NOFOLLOW`` (a symbolic link is refused);
+    its type and size are checked on the open descriptor, and at most
+    ``limit + 1`` bytes are read, so a file that grows is refused too.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    limit : int
+        Most bytes accepted.
+    follow : bool
+        Whether a symbolic link is followed (default) or refused.
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    RefusedPath
+        Not a regular file (a directory, device, FIFO or socket; a symbolic
+        link when ``follow`` is false), or larger than ``limit`` bytes.
+    OSError
+        If it cannot be opened or read, naming ``path``.
+    """
+    text = os.fspath(path)
+    flags = os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC | (0 if follow else os.O_NOFOLLOW)
+    try:
+        fd = os.open(text, flags)
+    except OSError as exc:
+        if not follow and os.path.islink(text):
+            raise RefusedPath(f"{text!r} is a symbolic link (accepted: a regular file)") from None
+        raise _named(exc, text) from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = ("a directory" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
+                    else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode)
+                    else "not a regular file")
+            raise RefusedPath(f"{text!r} is {kind} (accepted: a regular file)")
+        too_big = RefusedPath(f"{text!r} is larger than {limit:,} bytes (the most accepted)")
+        if st.st_size > limit:
+            raise too_big
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = os.read(fd, limit + 1 - size)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        if size > limit:
+            raise too_big
+        return b"".join(chunks)
+    except OSError as exc:
+        raise _named(exc, text) from None
+    finally:
+        os.close(fd)
