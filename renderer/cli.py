@@ -1,4 +1,4 @@
-"""``symrender``: the command line for authors and releases (issue 7).
+"""``symrender``: the command line for authors and releases.
 
 Subcommands (``symrender <command> --help`` for each)::
 
@@ -16,12 +16,32 @@ written) prints ONE line ``symrender: error: ...`` on stderr naming the bad
 argument, writes no file and returns 2.  A Python traceback is never printed;
 an error the command line did not anticipate (a bug) prints one line
 ``symrender: internal error: ...`` and returns 1.  ``verify`` returns pytest's
-exit code; ``figures --check`` returns 1 when a figure changed.
+exit code; ``figures --check`` returns 1 when a figure changed beyond
+`CHECK_TOLERANCE_LEVELS` / `CHECK_TOLERANCE_FRACTION`.
+
+Interrupts.  Ctrl-C at any moment of a command, its imports of numpy, sympy
+and matplotlib included, prints ONE line ``symrender: interrupted`` on stderr
+and returns 130, after the clean-up has run: no output file, temporary file
+or staging directory is left, and no child process (the notebook kernel of
+``figures``, which jupyter_client starts in a session of its own, is shut
+down; the pytest child of ``verify`` gets the same Ctrl-C and is waited for;
+the render worker processes are stopped).  A second Ctrl-C is ignored, so it
+cannot cut the clean-up short.  ``import renderer.cli`` loads neither numpy
+nor the renderer, which `main` imports under its SIGINT handling; only a
+Ctrl-C while Python itself starts, before `main` runs (under 0.1 s here), is
+reported by Python (see `main`).
 
 Reproducibility.  PNG files carry no timestamp, software tag or other varying
-metadata, so two runs on the same code give byte-identical files; they are
-written atomically (a temporary file in the target directory, then
-`os.replace`), so an interrupted or failed run leaves no file behind.
+metadata, so two runs on the same code give byte-identical files.  The bytes
+are prepared in memory, then written by `renderer.files.write_bytes`: a new or
+regular file atomically (a temporary file in the target directory, then
+`os.replace`), so an interrupted or failed run leaves no file behind; a
+character device, FIFO or socket (``/dev/null``), or a link to an existing
+file or device (``/dev/stdout``), is written through and keeps its kind; a
+directory, a dangling link, a block device or a path ending in ``/`` is
+refused.  ``-o -`` (``--plot -``) writes the PNG to standard output, the
+report to standard error, and is refused on a terminal.  Files read (scene
+files, a ``--check`` directory) are bounded regular files.
 
 Limits (refused before anything is allocated): each side of ``--size`` in
 [1, 8192] (`renderer.render.MAX_SIDE`); ``render`` holds two frames, so at most
@@ -40,20 +60,33 @@ import json
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
 import tomllib
-from dataclasses import fields as dataclass_fields
 from pathlib import Path
 
-import numpy as np
-
 from . import files
-from .ledger import compare, to_srgb
-from .render import MAX_SIDE, SPHERE_A, render
-from .scene import HEIGHT_FIELDS, PointLight, Scene
-from .sweep import MAX_STEPS, sweep
+
+# numpy, sympy, matplotlib and the renderer's modules are imported where they
+# are first used (the functions below import renderer.scene, .render, .ledger
+# and .sweep), never by ``import renderer.cli``: the console script imports
+# this module before `main` runs, and a Ctrl-C during a heavy import at that
+# point would print a traceback.  In `main` it is handled.
+
+
+class _Numpy:
+    """Stands for the numpy module until the first ``np.<name>``, which
+    imports numpy and puts the module itself in this one's globals."""
+
+    def __getattr__(self, name):
+        import numpy
+        globals()["np"] = numpy
+        return getattr(numpy, name)
+
+
+np = _Numpy()
 
 __all__ = ["main", "load_scene", "parse_size", "parse_eps", "write_png", "atomic_write",
            "MAX_PIXELS", "FRAME_PIXEL_BUDGET", "MAX_UCURVE_STEPS"]
@@ -69,20 +102,57 @@ MAX_UCURVE_STEPS = 10_000
 
 VIEWS = ("shaded", "difference", "bump", "kink")
 FORMATS = ("text", "csv", "json")
-_SCENE_FIELDS = tuple(f.name for f in dataclass_fields(Scene))
-_LIGHT_FIELDS = tuple(f.name for f in dataclass_fields(PointLight))
 _BARE_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*\Z")
+
+
+def _field_names():
+    """(`Scene` field names, `PointLight` field names), in declaration order."""
+    from dataclasses import fields as dataclass_fields
+
+    from .scene import PointLight, Scene
+    return (tuple(f.name for f in dataclass_fields(Scene)),
+            tuple(f.name for f in dataclass_fields(PointLight)))
 
 
 class UsageError(Exception):
     """A bad argument or input: printed as one line, exit code 2."""
 
 
+_NEGATIVE_VALUE = re.compile(r"-[0-9.]")
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse that raises `UsageError` instead of printing usage and exiting."""
+    """argparse that raises `UsageError` instead of printing usage and exiting,
+    and that takes a value starting with ``-`` and a digit or ``.`` as the
+    value of the option before it (``--size -5x5``, ``--eps -1e-3``), so that
+    such values reach the command's own checks and messages."""
 
     def error(self, message):
         raise UsageError(message)
+
+    def parse_known_args(self, args=None, namespace=None):
+        if args is not None:
+            takes_value = {o for a in self._actions if a.nargs is None for o in a.option_strings}
+            args, joined = list(args), []
+            while args:
+                token = args.pop(0)
+                if token == "--":
+                    joined += [token, *args]
+                    break
+                if token in takes_value and args and _NEGATIVE_VALUE.match(args[0]):
+                    token = f"{token}={args.pop(0)}"
+                joined.append(token)
+            args = joined
+        return super().parse_known_args(args, namespace)
+
+
+def _version():
+    """The installed version of the project, or a note when it is not installed."""
+    from importlib import metadata
+    try:
+        return metadata.version("symbolic-rendering-ch9")
+    except metadata.PackageNotFoundError:
+        return "unknown (not installed)"
 
 
 # ---------------------------------------------------------------- parsing helpers
@@ -94,18 +164,21 @@ def parse_size(text):
     Raises
     ------
     UsageError
-        Naming ``--size`` and the text, for anything else (negative or zero
-        sides, a side above 8192, not of the form WxH).  The pixel limits of a
-        command are checked separately, still before any allocation.
+        Naming ``--size`` and the text: not of the form WxH with integer
+        sides, or a side outside [1, 8192] (negative, zero or huge sides are
+        reported with the range).  The pixel limits of a command are checked
+        separately, still before any allocation.
     """
-    m = re.fullmatch(r"\s*(\d{1,9})\s*[xX]\s*(\d{1,9})\s*", str(text))
+    from .render import MAX_SIDE
+    m = re.fullmatch(r"\s*([-+]?\d+)\s*[xX]\s*([-+]?\d+)\s*", str(text))
     if not m:
-        raise UsageError(f"--size must be WxH with positive integers (e.g. 256x256), got {text!r}")
-    w, h = int(m.group(1)), int(m.group(2))
-    for name, side in (("width", w), ("height", h)):
-        if not 1 <= side <= MAX_SIDE:
+        raise UsageError(f"--size must be WxH with integer sides in [1, {MAX_SIDE}] (e.g. 256x256), "
+                         f"got {text!r}")
+    for name, digits in (("width", m.group(1)), ("height", m.group(2))):
+        # Decided on the digits, so a huge side is never converted to an int.
+        if not (len(digits.lstrip("+")) <= 6 and 1 <= int(digits) <= MAX_SIDE):
             raise UsageError(f"--size {name} must be between 1 and {MAX_SIDE} pixels, got {text!r}")
-    return w, h
+    return int(m.group(1)), int(m.group(2))
 
 
 def _check_budget(width, height, frames, what):
@@ -119,57 +192,88 @@ def _check_budget(width, height, frames, what):
             f"{what} accepts at most {FRAME_PIXEL_BUDGET:,} (use a smaller size or fewer steps)")
 
 
-def _positive_float(text, name):
+def _positive_float(text, name, bounds=None):
     try:
         x = float(text)
     except ValueError:
         raise UsageError(f"{name}: {text!r} is not a number") from None
+    if bounds is not None and not (math.isfinite(x) and bounds[0] <= x <= bounds[1]):
+        raise UsageError(f"{name}: each step must be in [{bounds[0]:g}, {bounds[1]:g}] "
+                         f"(chart units), got {text.strip()!r}")
     if not (math.isfinite(x) and x > 0):
         raise UsageError(f"{name}: each step must be a finite number > 0, got {text!r}")
     return x
 
 
-def parse_eps(text, *, name="--eps", max_steps=MAX_STEPS):
+def parse_eps(text, *, name="--eps", max_steps=None, bounds=None):
     """Parse steps: ``"a:b:n"`` (n log-spaced from a to b) or ``"e1,e2,..."``.
+
+    Parameters
+    ----------
+    text : str
+    name : str
+        The option named in errors.
+    max_steps : int or None
+        Most steps accepted; None means `renderer.sweep.MAX_STEPS`.
+    bounds : (float, float) or None
+        If given, the closed range every step must lie in (chart units), as
+        ``(renderer.scene.MIN_EPS, renderer.scene.MAX_EPS)`` for a sweep.
 
     Returns
     -------
-    tuple of float, each finite and > 0, chart units; 1 to ``max_steps`` of them.
+    tuple of float, each finite and > 0 (and within ``bounds``), chart units;
+    1 to ``max_steps`` of them.
 
     Raises
     ------
     UsageError
         Naming ``name``, for a malformed text, a step that is not a finite
-        positive number, or a count outside [1, max_steps].
+        positive number or lies outside ``bounds`` (the range is named), or a
+        count outside [1, max_steps].
     """
+    if max_steps is None:
+        from .sweep import MAX_STEPS as max_steps
     text = str(text).strip()
     if ":" in text:
         parts = text.split(":")
         if len(parts) != 3:
             raise UsageError(f"{name} must be a:b:n (n log-spaced steps from a to b) or a comma "
                              f"list, got {text!r}")
-        a, b = (_positive_float(p, name) for p in parts[:2])
-        if not re.fullmatch(r"\s*\d{1,6}\s*", parts[2]):
-            raise UsageError(f"{name}: the count n in a:b:n must be a positive integer, got {parts[2]!r}")
-        n = int(parts[2])
-        if not 1 <= n <= max_steps:
-            raise UsageError(f"{name}: the count n must be between 1 and {max_steps}, got {n}")
+        a, b = (_positive_float(p, name, bounds) for p in parts[:2])
+        count = parts[2].strip()
+        if not re.fullmatch(r"[-+]?\d+", count):
+            raise UsageError(f"{name}: the count n in a:b:n must be an integer in [1, {max_steps}], "
+                             f"got {parts[2]!r}")
+        if not (len(count.lstrip("+")) <= 6 and 1 <= int(count) <= max_steps):
+            raise UsageError(f"{name}: the count n must be between 1 and {max_steps}, got {count}")
         # Rounded to 15 significant digits so that decades print as 1e-05, not
         # 9.999999999999999e-06 (a relative change below 1e-15).
-        steps = tuple(float(f"{e:.15g}") for e in np.logspace(math.log10(a), math.log10(b), n))
+        steps = tuple(float(f"{e:.15g}") for e in np.logspace(math.log10(a), math.log10(b), int(count)))
+        if bounds is not None:  # rounding could step just outside the range
+            steps = tuple(min(max(e, bounds[0]), bounds[1]) for e in steps)
     else:
         items = [p for p in text.split(",")]
         if not 1 <= len(items) <= max_steps:
             raise UsageError(f"{name} must hold 1 to {max_steps} steps, got {len(items)}")
-        steps = tuple(_positive_float(p, name) for p in items)
+        steps = tuple(_positive_float(p, name, bounds) for p in items)
     return steps
+
+
+#: Largest scene file `load_scene` reads (bytes); a scene is a few hundred.
+MAX_SCENE_BYTES = 1 << 20
+#: Deepest nesting of arrays and tables accepted in a scene value (a light's
+#: position inside its table inside the lights array is 3 levels).
+MAX_NESTING = 8
 
 
 def _toml_value(key, text):
     """The value of ``--set key=text``: TOML, or a bare word taken as a string."""
     try:
         return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+    except RecursionError:
+        raise UsageError(f"--set {key}: the value is nested too deeply (at most {MAX_NESTING} "
+                         "levels of arrays and tables)") from None
+    except ValueError:  # TOMLDecodeError, or an integer of over 4300 digits
         if _BARE_WORD.match(text):
             return text
         raise UsageError(f"--set {key}: cannot parse {text!r} as a TOML value "
@@ -177,31 +281,39 @@ def _toml_value(key, text):
 
 
 def _check_ints(source, name, value):
-    """Refuse a TOML integer too large for a float, naming the key.
+    """Refuse, naming the key path, a TOML integer too large for a float or a
+    value nested deeper than `MAX_NESTING` levels.
 
-    TOML integers are unbounded in tomllib; one beyond about 1.8e308 is refused
-    here, with the file (or --set) and the key path, before `Scene` sees it.
+    TOML integers are unbounded in tomllib; one beyond about 1.8e308 is
+    refused here, with the file (or --set) and the key path, before `Scene`
+    sees it.  The walk is iterative and stops at the nesting limit.
     """
-    if isinstance(value, int) and not isinstance(value, bool):
-        try:
-            float(value)
-        except OverflowError:
-            raise UsageError(f"{source}: {name} = {str(value)[:20]}... is too large for a number "
-                             f"(more than {len(str(value))} digits)") from None
-    elif isinstance(value, list):
-        for i, item in enumerate(value):
-            _check_ints(source, f"{name}[{i}]", item)
-    elif isinstance(value, dict):
-        for k, item in value.items():
-            _check_ints(source, f"{name}.{k}", item)
+    stack = [(name, value, 0)]
+    while stack:
+        where, item, depth = stack.pop()
+        if isinstance(item, (list, dict)):
+            if depth >= MAX_NESTING:
+                raise UsageError(f"{source}: {where} is nested too deeply (at most {MAX_NESTING} "
+                                 "levels of arrays and tables)")
+            pairs = item.items() if isinstance(item, dict) else enumerate(item)
+            stack.extend((f"{where}.{k}" if isinstance(item, dict) else f"{where}[{k}]", v, depth + 1)
+                         for k, v in reversed(list(pairs)))
+        elif isinstance(item, int) and not isinstance(item, bool):
+            try:
+                float(item)
+            except OverflowError:
+                raise UsageError(f"{source}: {where} = {str(item)[:20]}... is too large for a number "
+                                 f"(more than {len(str(item))} digits)") from None
 
 
 def _scene_mapping(data, source):
     """Turn a TOML mapping into `Scene` keyword arguments, refusing unknown keys."""
+    from .scene import PointLight
+    scene_fields, light_fields = _field_names()
     out = {}
     for key, value in data.items():
-        if key not in _SCENE_FIELDS:
-            raise UsageError(f"{source}: unknown scene field {key!r}; fields are {', '.join(_SCENE_FIELDS)}")
+        if key not in scene_fields:
+            raise UsageError(f"{source}: unknown scene field {key!r}; fields are {', '.join(scene_fields)}")
         _check_ints(source, key, value)
         if key == "lights":
             if not isinstance(value, list):
@@ -212,14 +324,35 @@ def _scene_mapping(data, source):
                 if not isinstance(table, dict):
                     raise UsageError(f"{source}: lights[{i}] must be a table with position and "
                                      f"color, got {table!r}")
-                unknown = sorted(set(table) - set(_LIGHT_FIELDS))
+                unknown = sorted(set(table) - set(light_fields))
                 if unknown:
                     raise UsageError(f"{source}: unknown light field {unknown[0]!r} in lights[{i}]; "
-                                     f"fields are {', '.join(_LIGHT_FIELDS)}")
+                                     f"fields are {', '.join(light_fields)}")
+                missing = [k for k in light_fields if k not in table]
+                if missing:
+                    raise UsageError(f"{source}: lights[{i}] has no {missing[0]!r}; each light needs "
+                                     f"{' and '.join(light_fields)}")
                 lights.append(PointLight(**table))
             value = tuple(lights)
         out[key] = value
     return out
+
+
+def _read_scene_text(path):
+    """The text of a scene file: a regular file of at most `MAX_SCENE_BYTES`,
+    UTF-8 with an optional byte-order mark."""
+    if not str(path):
+        raise UsageError("--scene: the path is empty (give a TOML file)")
+    try:
+        raw = files.read_regular(path, MAX_SCENE_BYTES)
+    except files.RefusedPath as exc:
+        raise UsageError(f"--scene {exc}") from None
+    except OSError as exc:
+        raise UsageError(f"--scene: cannot read {str(path)!r}: {exc.strerror or exc}") from None
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise UsageError(f"--scene {path}: not UTF-8 text") from None
 
 
 def load_scene(path=None, sets=()):
@@ -229,8 +362,11 @@ def load_scene(path=None, sets=()):
     ----------
     path : str or None
         A TOML file whose top-level keys are `Scene` field names; ``lights``
-        is an array of tables ``[[lights]]`` with ``position`` and ``color``.
-        Missing fields keep the Scene's defaults (the seed's, Cell 1).
+        is an array of tables ``[[lights]]``, each with ``position`` and
+        ``color``.  Missing fields keep the Scene's defaults (the seed's,
+        Cell 1).  It must be a regular file (a symbolic link to one is
+        followed) of at most `MAX_SCENE_BYTES` = 1 MiB, UTF-8 (a leading
+        byte-order mark is accepted).
     sets : sequence of str
         ``key=value`` overrides applied after the file; ``value`` is parsed
         as TOML (``beta=0.5``, ``floor=false``, ``center_b=[0.5, 0.5, 1.3]``),
@@ -243,22 +379,25 @@ def load_scene(path=None, sets=()):
     Raises
     ------
     UsageError
-        Unreadable file, malformed TOML, an unknown key (named), or a
-        malformed ``--set``.
+        An empty path; a file that is missing, unreadable, not a regular
+        file (a directory, FIFO or device) or over 1 MiB; malformed TOML; a
+        value nested more than `MAX_NESTING` levels; an unknown key (named);
+        a light without ``position`` or ``color`` (named as ``lights[i]``);
+        or a malformed ``--set``.
     TypeError, ValueError
         From `Scene`/`PointLight` validation (the message names the field).
     """
+    from .scene import Scene
+    scene_fields = _field_names()[0]
     data = {}
     if path is not None:
+        text = _read_scene_text(path)
         try:
-            raw = Path(path).read_bytes()
-        except OSError as exc:
-            raise UsageError(f"--scene: cannot read {path!r}: {exc.strerror or exc}") from None
-        try:
-            data = tomllib.loads(raw.decode("utf-8"))
-        except UnicodeDecodeError:
-            raise UsageError(f"--scene {path}: not UTF-8 text") from None
-        except tomllib.TOMLDecodeError as exc:
+            data = tomllib.loads(text)
+        except RecursionError:
+            raise UsageError(f"--scene {path}: nested too deeply (at most {MAX_NESTING} levels of "
+                             "arrays and tables)") from None
+        except ValueError as exc:  # TOMLDecodeError, or an integer of over 4300 digits
             raise UsageError(f"--scene {path}: malformed TOML: {exc}") from None
         data = _scene_mapping(data, f"--scene {path}")
     for item in sets:
@@ -266,8 +405,8 @@ def load_scene(path=None, sets=()):
         key = key.strip()
         if not sep or not key:
             raise UsageError(f"--set must be key=value, got {item!r}")
-        if key not in _SCENE_FIELDS:
-            raise UsageError(f"--set: unknown scene field {key!r}; fields are {', '.join(_SCENE_FIELDS)}")
+        if key not in scene_fields:
+            raise UsageError(f"--set: unknown scene field {key!r}; fields are {', '.join(scene_fields)}")
         data.update(_scene_mapping({key: _toml_value(key, text.strip())}, "--set"))
     return Scene(**data)
 
@@ -275,29 +414,64 @@ def load_scene(path=None, sets=()):
 # ---------------------------------------------------------------- output helpers
 
 
-def atomic_write(path, write):
-    """Write a file atomically: ``write(fileobj)`` into a temporary file in the
-    target directory, then `os.replace` it onto ``path`` (`renderer.files`),
-    after checking the path as a command-line argument.
+#: The output path that means standard output (``-o -``, ``--plot -``).
+STDOUT = "-"
 
-    On any exception (including KeyboardInterrupt) the temporary file is
-    removed and the exception propagates; ``path`` is then untouched (absent
-    if it did not exist).  The file gets the usual 0666 & ~umask permissions.
+
+def _stdout_bytes():
+    """The binary stream under ``sys.stdout``, refused when it is a terminal."""
+    stream = sys.stdout
+    if stream.isatty():
+        raise UsageError("output '-' is standard output, which is a terminal; redirect it to a "
+                         "file or a pipe, or give a file name")
+    if getattr(stream, "buffer", None) is None:
+        raise UsageError("output '-': standard output does not take bytes here; give a file name")
+    return stream.buffer
+
+
+def atomic_write(path, write):
+    """Write an output file from ``write(fileobj)`` (a callable given a binary
+    file object), after checking the path as a command-line argument.
+
+    The bytes are prepared in memory first (an exception in ``write`` writes
+    nothing), then written by `renderer.files.write_bytes`: a path that is
+    absent or a regular file is replaced atomically (a temporary file in its
+    directory, then `os.replace`; on any exception, KeyboardInterrupt
+    included, ``path`` is untouched and no temporary file is left); a
+    character device, FIFO or socket (``/dev/null``), or a symbolic link to
+    an existing file or device (``/dev/stdout``), is written through and
+    stays what it was.  ``path`` ``-`` writes the bytes to standard output.
+    New files get 0666 & ~umask permissions.
 
     Raises
     ------
     UsageError
-        If ``path`` is a directory or its directory does not exist.
+        If ``path`` is empty, ends in ``/``, is a directory, a block device or
+        a dangling symbolic link, or its directory does not exist; or if it
+        is ``-`` and standard output is a terminal.
     OSError
-        If the directory cannot be written.
+        If the directory or the target cannot be written (naming ``path``).
     """
-    target = Path(path)
-    if target.is_dir():
-        raise UsageError(f"output {str(path)!r} is a directory")
-    parent = target.parent if str(target.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"output {str(path)!r}: directory {str(parent)!r} does not exist")
-    files.atomic_write(target, write)
+    if path == STDOUT:
+        stream = _stdout_bytes()
+        buf = io.BytesIO()
+        write(buf)
+        sys.stdout.flush()
+        stream.write(buf.getbuffer())
+        stream.flush()
+        return
+    try:
+        route = files.output_route(path)
+    except files.RefusedPath as exc:
+        raise UsageError(f"output {exc}") from None
+    if route == "replace":
+        parent = Path(path).parent
+        if not parent.is_dir():
+            raise UsageError(f"output {str(path)!r}: directory {str(parent)!r} does not exist")
+    try:
+        files.atomic_write(path, write)
+    except files.RefusedPath as exc:  # changed since checked
+        raise UsageError(f"output {exc}") from None
 
 
 def _png_bytes_writer(rgb8):
@@ -311,7 +485,8 @@ def _png_bytes_writer(rgb8):
 
 def write_png(path, rgb):
     """Write an (H, W, 3) float image with values in [0, 1] (already display-
-    encoded) as an 8-bit PNG, atomically and without varying metadata.
+    encoded) as an 8-bit PNG without varying metadata, by `atomic_write`
+    (``-`` is standard output).
 
     Raises
     ------
@@ -323,11 +498,28 @@ def write_png(path, rgb):
 
 
 def _check_output(path, flag):
-    """Fail fast, before rendering, on an output path that cannot be written."""
-    target = Path(path)
-    if target.is_dir():
-        raise UsageError(f"{flag} {str(path)!r} is a directory")
-    parent = target.parent
+    """Fail fast, before any work, on an output path that cannot be written:
+    ``-`` on a terminal; an empty path, a trailing ``/``, a directory, a
+    block device or a dangling link; a new or regular file whose directory is
+    missing or not writable; a device, FIFO or link that is not writable
+    (its directory need not be writable)."""
+    if path == STDOUT:
+        try:
+            _stdout_bytes()
+        except UsageError as exc:
+            raise UsageError(f"{flag} {str(exc).removeprefix('output ')}") from None
+        return
+    try:
+        route = files.output_route(path)
+    except files.RefusedPath as exc:
+        raise UsageError(f"{flag} {exc}") from None
+    except NotADirectoryError:
+        route = "replace"  # a parent that is not a directory: named below
+    if route == "through":
+        if not os.access(path, os.W_OK):
+            raise UsageError(f"{flag} {str(path)!r} is not writable")
+        return
+    parent = Path(path).parent
     if not parent.is_dir():
         what = "is not a directory" if parent.exists() else "does not exist"
         raise UsageError(f"{flag} {str(path)!r}: {str(parent)!r} {what}")
@@ -375,6 +567,8 @@ def view_image(view, selected, numeric, symbolic):
     black elsewhere.  kink: the selected image sRGB-encoded and dimmed to 40 %,
     the exact frame's crease band painted white.
     """
+    from .ledger import to_srgb
+    from .render import SPHERE_A
     if view == "shaded":
         return to_srgb(selected.image)
     if view == "difference":
@@ -393,9 +587,13 @@ def view_image(view, selected, numeric, symbolic):
 
 
 def _cmd_render(args, out):
+    from .ledger import compare
+    from .render import render
     width, height = args.size
     _check_budget(width, height, 2, "render")
     _check_output(args.output, "-o")
+    if args.output == STDOUT:  # the PNG takes stdout; the report goes to stderr
+        out = sys.stderr
     scene = load_scene(args.scene, args.set)
     frames = {}
     for g in _progress(("central", "exact"), desc="render", unit="frame"):
@@ -403,7 +601,8 @@ def _cmd_render(args, out):
     numeric, symbolic = frames["central"], frames["exact"]
     selected = frames[args.gradient]
     write_png(args.output, view_image(args.view, selected, numeric, symbolic))
-    print(f"wrote {args.output} ({width}x{height}, view {args.view}, gradient {args.gradient})", file=out)
+    where = "standard output" if args.output == STDOUT else args.output
+    print(f"wrote {where} ({width}x{height}, view {args.view}, gradient {args.gradient})", file=out)
     print("\n".join(_ledger_lines(compare(numeric, symbolic))), file=out)
     return 0
 
@@ -414,6 +613,7 @@ _CENSUS_COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink"
 def _run_sweep(scene, steps, width, height):
     """`renderer.sweep` over ``steps``, with a progress bar over its tiles when
     stderr is a terminal."""
+    from .sweep import sweep
     if not _show_progress():
         return list(sweep(scene, steps, width, height).census)
     with _progress(total=width * height, desc="sweep", unit="px", unit_scale=True) as bar:
@@ -469,9 +669,11 @@ def _measure_ucurve(args):
     error = cat("error")
     best = int(np.argmin(error))
     p0 = parts[0]
+    reason = getattr(p0, "reason", None)
+    opt = (float("nan"),) * 2 if reason is not None else (float(steps[best]), float(error[best]))
     return UCurve(p0.field, p0.u, p0.v, p0.component, steps, error, cat("truncation"), cat("roundoff"),
-                  cat("model"), p0.derivative, p0.third_derivative, p0.eps_opt_predicted,
-                  float(steps[best]), float(error[best]))
+                  cat("model"), p0.derivative, p0.third_derivative, p0.eps_opt_predicted, *opt,
+                  **({"reason": reason} if reason is not None else {}))
 
 
 def _ucurve_plot_writer(uc):
@@ -490,7 +692,8 @@ def _ucurve_plot_writer(uc):
                 ax.axvline(uc.eps_opt_predicted, color="0.6", lw=0.8, label="predicted eps*")
             ax.set_xlabel("eps (chart units)")
             ax.set_ylabel(f"|error| of h_{uc.component}")
-            ax.set_title(f"U-curve: {uc.field} at (u, v) = ({uc.u:g}, {uc.v:g})")
+            ax.set_title(f"U-curve: {uc.field} at (u, v) = ({uc.u:g}, {uc.v:g})"
+                         + (" (not differentiable there)" if uc.reason else ""))
             ax.legend(fontsize=7)
             fig.tight_layout()
             fig.savefig(f, format="png", metadata={"Software": None})
@@ -500,32 +703,77 @@ def _ucurve_plot_writer(uc):
 def _cmd_ucurve(args, out):
     if args.plot is not None:
         _check_output(args.plot, "--plot")
+        if args.plot == STDOUT:  # the plot takes stdout; the table goes to stderr
+            out = sys.stderr
     for name in ("u", "v"):
         x = getattr(args, name)
         if not (math.isfinite(x) and 0.0 <= x <= 1.0):
             raise UsageError(f"--{name} must be a number in [0, 1], got {x!r}")
+    from .scene import MAX_FREQUENCY
     for name in ("k_u", "k_v"):
         x = getattr(args, name)
-        if not (math.isfinite(x) and 0.0 < x <= 1e6):
-            raise UsageError(f"--{name.replace('_', '-')} must be a finite number in (0, 1e6], got {x!r}")
+        if not (math.isfinite(x) and 0.0 < x <= MAX_FREQUENCY):
+            raise UsageError(f"--{name.replace('_', '-')} must be a finite number in "
+                             f"(0, {MAX_FREQUENCY:g}], got {x!r}")
     uc = _measure_ucurve(args)
     print(f"U-curve: {uc.field}, h_{uc.component} at (u, v) = ({uc.u:g}, {uc.v:g}), "
           f"k = ({args.k_u:g}, {args.k_v:g}); reference mpmath 50 digits", file=out)
-    print(f"true derivative {uc.derivative:.17g}; |h'''| = {abs(uc.third_derivative):.6g}", file=out)
-    print(f"{'eps':>9}  {'truncation':>11}  {'roundoff':>11}  {'|error|':>10}  {'model':>10}", file=out)
-    for i in range(uc.eps.size):
-        print(f"{uc.eps[i]:9.2e}  {uc.truncation[i]:11.3e}  {uc.roundoff[i]:11.3e}  "
-              f"{uc.error[i]:10.3e}  {uc.model[i]:10.3e}", file=out)
-    print(f"eps* predicted {uc.eps_opt_predicted:.3e}; measured minimum {uc.error_at_measured_opt:.3e} "
-          f"at eps {uc.eps_opt_measured:.3e}", file=out)
+    if uc.reason is not None:
+        # No derivative: no "true derivative", no model and no optimal step to print.
+        print(f"not differentiable: {uc.reason}", file=out)
+        print("error, truncation: against the one-sided derivative from the side of larger "
+              f"{uc.component} (smaller at 1); no true derivative and no optimal step exist here", file=out)
+        print(f"{'eps':>9}  {'truncation':>11}  {'roundoff':>11}  {'|error|':>10}", file=out)
+        for i in range(uc.eps.size):
+            print(f"{uc.eps[i]:9.2e}  {uc.truncation[i]:11.3e}  {uc.roundoff[i]:11.3e}  "
+                  f"{uc.error[i]:10.3e}", file=out)
+    else:
+        print(f"true derivative {uc.derivative:.17g}; |h'''| = {abs(uc.third_derivative):.6g}", file=out)
+        print(f"{'eps':>9}  {'truncation':>11}  {'roundoff':>11}  {'|error|':>10}  {'model':>10}", file=out)
+        for i in range(uc.eps.size):
+            print(f"{uc.eps[i]:9.2e}  {uc.truncation[i]:11.3e}  {uc.roundoff[i]:11.3e}  "
+                  f"{uc.error[i]:10.3e}  {uc.model[i]:10.3e}", file=out)
+        print(f"eps* predicted {uc.eps_opt_predicted:.3e}; measured minimum {uc.error_at_measured_opt:.3e} "
+              f"at eps {uc.eps_opt_measured:.3e}", file=out)
     if args.plot is not None:
         atomic_write(args.plot, _ucurve_plot_writer(uc))
-        print(f"wrote {args.plot}", file=out)
+        print(f"wrote {'standard output' if args.plot == STDOUT else args.plot}", file=out)
     return 0
 
 
 def _repo_root():
     return Path(__file__).resolve().parent.parent
+
+
+def _sigint_noted():
+    """Context manager for `_cmd_verify`: while pytest runs, a SIGINT that
+    `main` would raise as KeyboardInterrupt is only noted (the list it yields
+    gets an entry); afterwards SIGINT is ignored if one was noted, as after
+    `main`'s first, and the caller raises the interrupt.
+
+    pytest runs in symrender's process group, so a Ctrl-C at the terminal
+    reaches it as well: it stops its tests, tears down (its render workers
+    stop with it) and exits with 2, and symrender waits for that.  Raising
+    at once instead would make `subprocess.run` kill pytest a quarter
+    second later, cutting its clean-up short.  (A SIGINT sent to symrender
+    alone does not stop pytest: the run then ends first.)  Outside `main`'s
+    handling it changes nothing.
+    """
+    import contextlib
+
+    @contextlib.contextmanager
+    def noting():
+        noted = []
+        if signal.getsignal(signal.SIGINT) is not _interrupt_once:
+            yield noted
+            return
+        signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum))
+        try:
+            yield noted
+        finally:
+            signal.signal(signal.SIGINT, signal.SIG_IGN if noted else _interrupt_once)
+
+    return noting()
 
 
 def _cmd_verify(args, out):
@@ -536,7 +784,10 @@ def _cmd_verify(args, out):
     if args.k is not None:
         cmd += ["-k", args.k]
     out.flush()
-    proc = subprocess.run(cmd, cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    with _sigint_noted() as noted:
+        proc = subprocess.run(cmd, cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if noted:
+        raise KeyboardInterrupt
     out.write(proc.stdout)
     return proc.returncode
 
@@ -594,15 +845,89 @@ def _png_pixels(data):
 VARIES_TAG = "measured-timing"
 
 
+def _kernel_loop():
+    """A new asyncio event loop on which nbclient cannot take SIGINT over.
+
+    `nbclient.NotebookClient.async_execute` installs a SIGINT handler on the
+    running loop that shuts the kernel down and lets the run go on (to fail
+    later with a dead kernel).  This loop refuses signal handlers with
+    RuntimeError, which nbclient takes as "no signal handlers here", so a
+    Ctrl-C stays `main`'s: a KeyboardInterrupt out of ``run_until_complete``.
+    """
+    import asyncio
+
+    class Loop(asyncio.SelectorEventLoop):
+        def add_signal_handler(self, sig, callback, *args):
+            raise RuntimeError("symrender handles signals itself")
+
+    return Loop()
+
+
+def _close_loop(loop):
+    """Cancel the tasks still pending on ``loop`` (nbclient's pollers of a
+    cancelled cell), let them finish, and close it, as `asyncio.run` does."""
+    import asyncio
+    try:
+        pending = asyncio.all_tasks(loop)
+        for task in pending:
+            task.cancel()
+        if pending:
+            loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
+        loop.run_until_complete(loop.shutdown_asyncgens())
+    finally:
+        loop.close()
+
+
+def _stop_kernel(loop, run, client):
+    """After a Ctrl-C during ``run`` (the task of ``client.async_execute``):
+    end the run and shut its kernel down, whatever the moment.
+
+    Cancelling the run unwinds nbclient's kernel context, whose clean-up
+    (jupyter_client's graceful shutdown) interrupts the kernel and asks it to
+    shut down, so that its own clean-up runs (it stops its render workers);
+    a kernel still busy (say, drawing a figure) after half of
+    ``shutdown_wait_time`` (5 s) gets SIGTERM, after all of it SIGKILL.  A
+    Ctrl-C while the kernel was still starting comes before nbclient arms
+    that clean-up; then it is run here.  SIGINT is ignored meanwhile (`main`).
+    """
+    import atexit
+    if not run.done():
+        run.cancel()
+        try:
+            loop.run_until_complete(run)
+        except BaseException:  # noqa: BLE001 - CancelledError, or the run's own failure
+            pass
+    if client.km is not None:
+        try:
+            loop.run_until_complete(client._async_cleanup_kernel())
+        except Exception:  # noqa: BLE001 - kill it then
+            km = client.km
+            if km is not None and getattr(km, "provisioner", None) is not None:
+                try:
+                    loop.run_until_complete(km.provisioner.kill())
+                except Exception:  # noqa: BLE001 - nothing more to try
+                    pass
+    # nbclient registers its clean-up with atexit and unregisters it only on
+    # its normal way out; at exit it would fail on the manager already gone.
+    atexit.unregister(client._cleanup_kernel)
+
+
 def _page_figures(book, page):
     """Execute one book page (a MyST notebook) in a fresh kernel; yield
     (figure id, code-cell ordinal, cell source, PNG bytes, cell tags) for every
     PNG it displays or glues.
 
+    The kernel (ipykernel, started by jupyter_client in a session of its
+    own, so a terminal's Ctrl-C does not reach it) runs on an event loop of
+    its own (`_kernel_loop`); on a KeyboardInterrupt it is shut down before
+    the interrupt goes on (`_stop_kernel`).
+
     Raises
     ------
     UsageError
         If a cell fails (the page's exception, in one line).
+    KeyboardInterrupt
+        After the kernel has been shut down.
     """
     import base64
 
@@ -613,10 +938,18 @@ def _page_figures(book, page):
     nb = read_myst_markdown_notebook(path.read_text(encoding="utf-8"), path=path)
     client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
                                      resources={"metadata": {"path": str(book)}})
+    loop = _kernel_loop()
     try:
-        client.execute(stderr=subprocess.DEVNULL)
-    except nbclient.exceptions.CellExecutionError as exc:
-        raise UsageError(f"figures: page {page} failed: {exc.ename}: {exc.evalue}") from None
+        run = loop.create_task(client.async_execute(stderr=subprocess.DEVNULL))
+        try:
+            loop.run_until_complete(run)
+        except KeyboardInterrupt:
+            _stop_kernel(loop, run, client)
+            raise
+        except nbclient.exceptions.CellExecutionError as exc:
+            raise UsageError(f"figures: page {page} failed: {exc.ename}: {exc.evalue}") from None
+    finally:
+        _close_loop(loop)
     ordinal = 0
     for cell in nb.cells:
         if cell.cell_type != "code":
@@ -638,10 +971,7 @@ def _page_figures(book, page):
 def _resolve_pages(pages):
     """The book's pages to run: all (None) or the named ones, by name or by
     section prefix (s4 -> s4_simulator)."""
-    book = _repo_root() / "book"
-    if not (book / "_toc.yml").is_file():
-        raise UsageError(f"figures needs a source checkout: {str(book / '_toc.yml')!r} not found")
-    all_pages = _book_pages(book)
+    all_pages = _known_pages()
     if pages is None:
         return all_pages
     resolved = []
@@ -663,9 +993,9 @@ def _render_figures(out_dir, pages):
     for page in _progress(pages, desc="figures", unit="page"):
         for fid, ordinal, source, png, tags in _page_figures(book, page):
             rgba = _png_pixels(png)
-            name = f"{fid}.png"
-            atomic_write(out_dir / name, _png_bytes_writer(rgba))
-            data = (out_dir / name).read_bytes()
+            name = _figure_file_name(fid, {f["file"] for f in figures})
+            data = _png_bytes(rgba)
+            files.write_bytes(out_dir / name, data)
             entry = {"id": fid, "page": page, "code_cell": ordinal, "file": name,
                      "width": int(rgba.shape[1]), "height": int(rgba.shape[0]),
                      "sha256": hashlib.sha256(data).hexdigest(),
@@ -676,7 +1006,7 @@ def _render_figures(out_dir, pages):
             figures.append(entry)
     manifest = {"code_version": _code_version(root), "pages": list(pages), "figures": figures}
     text = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
-    atomic_write(out_dir / "manifest.json", lambda f: f.write(text.encode()))
+    files.write_bytes(out_dir / "manifest.json", text.encode())
     return manifest
 
 
@@ -686,38 +1016,245 @@ def _write_figures_staged(out_dir, pages):
     file with manifest.json last).  A failed or interrupted run removes the
     staging directory and leaves ``out_dir`` as it was."""
     import shutil
-    staging = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}.", suffix=".part"))
+    try:
+        staging = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name[:64]}.", suffix=".part"))
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(out_dir)) from None
     try:
         manifest = _render_figures(staging, pages)
-        os.chmod(staging, 0o777 & ~files.umask())
-        if not out_dir.exists():
-            os.replace(staging, out_dir)
-        else:
-            names = sorted(p.name for p in staging.iterdir() if p.name != "manifest.json")
-            for name in [*names, "manifest.json"]:
-                os.replace(staging / name, out_dir / name)
+        try:
+            os.chmod(staging, 0o777 & ~files.umask())
+            if not out_dir.exists():
+                os.replace(staging, out_dir)
+            else:
+                names = sorted(p.name for p in staging.iterdir() if p.name != "manifest.json")
+                for name in [*names, "manifest.json"]:
+                    os.replace(staging / name, out_dir / name)
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, str(out_dir)) from None
         return manifest
     finally:
         shutil.rmtree(staging, ignore_errors=True)
 
 
-def _load_manifest(old_dir):
+#: Largest manifest.json that ``figures --check`` reads (bytes); the whole
+#: book's manifest is a few KiB.
+MAX_MANIFEST_BYTES = 1 << 20
+#: Largest previous figure file that ``--check`` reads (bytes); a book figure
+#: is some tens of KiB, and an 8192^2 RGBA PNG that does not compress at all
+#: is 256 MiB, far beyond any figure worth comparing.
+MAX_FIGURE_BYTES = 64 << 20
+#: Largest side (pixels) of a figure a manifest may declare.
+MAX_FIGURE_SIDE = 8192
+#: A figure file: a plain name inside the directory.
+_FIGURE_FILE = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]*\.png\Z")
+_SHA256 = re.compile(r"[0-9a-f]{64}\Z")
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+#: Figures whose previous and fresh pixels differ by at most this many 8-bit
+#: levels in every channel, on at most `CHECK_TOLERANCE_FRACTION` of their
+#: pixels, are reported "within tolerance" and do not fail ``--check``.
+#: Bit-identity cannot hold across machines: numpy picks a SIMD loop for
+#: pow, exp, sin and log at run time (SSE4.2, AVX2 or AVX-512 here), and the
+#: loops round differently in the last bit.  A figure that plots such values
+#: (the U-curve's step grid from logspace, a roundoff measured in float64)
+#: then moves its lines by a small fraction of a pixel; the antialiased edge
+#: pixels and, along a dashed or dotted line, the phase of every dash change
+#: by some levels.  The bounds are about twice the largest difference
+#: measured between dispatch paths of the same code (README, ``--check``).
+CHECK_TOLERANCE_LEVELS = 32
+#: See `CHECK_TOLERANCE_LEVELS`: the most pixels, as a fraction of the
+#: figure, that may differ for it to count as within tolerance.
+CHECK_TOLERANCE_FRACTION = 0.02
+
+
+def _figure_file_name(fid, taken):
+    """A plain file name for figure ``fid`` (characters outside [A-Za-z0-9._-]
+    become ``_``), distinct from the names in ``taken``."""
+    base = re.sub(r"[^A-Za-z0-9._-]", "_", fid).lstrip(".").replace("..", "_") or "figure"
+    name, k = f"{base}.png", 1
+    while name in taken:
+        k += 1
+        name = f"{base}-{k}.png"
+    return name
+
+
+def _png_bytes(rgb8):
+    """PNG bytes of an (H, W, 3 or 4) uint8 image, without metadata."""
+    buf = io.BytesIO()
+    _png_bytes_writer(rgb8)(buf)
+    return buf.getvalue()
+
+
+def _known_pages():
+    book = _repo_root() / "book"
+    if not (book / "_toc.yml").is_file():
+        raise UsageError(f"figures needs a source checkout: {str(book / '_toc.yml')!r} not found")
+    return _book_pages(book)
+
+
+def _manifest_error(path, what):
+    return UsageError(f"--check: {str(path)!r} is not a valid symrender manifest: {what}")
+
+
+def _validate_manifest(doc, path, known_pages):
+    """Check a parsed manifest's structure; return ``(figures by id, pages)``."""
+    bad = lambda what: _manifest_error(path, what)  # noqa: E731
+    if not isinstance(doc, dict):
+        raise bad(f"a JSON object is needed, got {type(doc).__name__}")
+    pages = doc.get("pages")
+    if not (isinstance(pages, list) and pages and all(isinstance(p, str) for p in pages)):
+        raise bad('"pages" must be a non-empty list of page names')
+    unknown = [p for p in pages if p not in known_pages]
+    if unknown:
+        raise bad(f"unknown page {unknown[0][:80]!r} in \"pages\"; pages are {', '.join(known_pages)}")
+    version = doc.get("code_version", {})
+    if not (isinstance(version, dict)
+            and all(isinstance(version.get(k), (str, type(None))) for k in ("git_commit", "source_sha256"))):
+        raise bad('"code_version" must be an object with string git_commit and source_sha256')
+    entries = doc.get("figures")
+    if not isinstance(entries, list):
+        raise bad('"figures" must be a list')
+    figures, names = {}, set()
+    for i, f in enumerate(entries):
+        if not isinstance(f, dict):
+            raise bad(f"figures[{i}] must be an object")
+        for key in ("id", "file", "sha256"):
+            if not isinstance(f.get(key), str) or not f[key]:
+                raise bad(f"figures[{i}].{key} must be a non-empty string")
+        for key in ("width", "height"):
+            v = f.get(key)
+            if type(v) is not int or not 1 <= v <= MAX_FIGURE_SIDE:
+                raise bad(f"figures[{i}].{key} must be an integer in [1, {MAX_FIGURE_SIDE}], got {v!r:.40}")
+        name = f["file"]
+        if not _FIGURE_FILE.match(name) or ".." in name:
+            raise bad(f"figures[{i}].file {name[:80]!r} must be a plain file name in the directory "
+                      "(letters, digits, '.', '_', '-', ending .png; no '/' or '..')")
+        if not _SHA256.match(f["sha256"]):
+            raise bad(f"figures[{i}].sha256 must be 64 lowercase hex digits")
+        if not isinstance(f.get("varies", ""), str):
+            raise bad(f"figures[{i}].varies must be a string")
+        if f["id"] in figures:
+            raise bad(f"figure id {f['id'][:80]!r} appears twice")
+        if name in names:
+            raise bad(f"file {name!r} is listed twice")
+        figures[f["id"]] = f
+        names.add(name)
+    return figures, pages
+
+
+def _read_figure(old_dir, entry):
+    """The bytes of a previous figure file, checked against its manifest entry:
+    a regular file (not a link) of at most `MAX_FIGURE_BYTES`, with the
+    manifest's SHA-256, a PNG whose header declares the manifest's size."""
+    path = Path(old_dir) / entry["file"]
+    try:
+        data = files.read_regular(path, MAX_FIGURE_BYTES, follow=False)
+    except files.RefusedPath as exc:
+        raise UsageError(f"--check: figure {entry['id']!r}: {exc}") from None
+    except OSError as exc:
+        raise UsageError(f"--check: figure {entry['id']!r}: cannot read {str(path)!r}: "
+                         f"{exc.strerror or exc}") from None
+    if hashlib.sha256(data).hexdigest() != entry["sha256"]:
+        raise UsageError(f"--check: {str(path)!r} does not match its sha256 in manifest.json "
+                         "(the directory was changed after it was written)")
+    size = (int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big"))
+    if data[:8] != _PNG_SIGNATURE or data[12:16] != b"IHDR" or size != (entry["width"], entry["height"]):
+        raise UsageError(f"--check: {str(path)!r} is not a {entry['width']}x{entry['height']} PNG, "
+                         "as manifest.json says")
+    return data
+
+
+def _decode_figure(data, what):
+    """`_png_pixels` of a checked figure; a corrupt PNG is a usage error."""
+    try:
+        return _png_pixels(data)
+    except Exception as exc:  # PIL and matplotlib raise many kinds on bad data
+        raise UsageError(f"--check: {what} is not a readable PNG ({type(exc).__name__})") from None
+
+
+def _load_manifest(old_dir, known_pages):
+    """Read and validate ``old_dir/manifest.json`` and every figure file it lists
+    before any page runs.
+
+    Returns
+    -------
+    (doc, figures, pages) : the manifest (dict), its figure entries by id, its page names.
+
+    Raises
+    ------
+    UsageError
+        If manifest.json is not a regular file (a link, FIFO or device) of
+        at most `MAX_MANIFEST_BYTES`, not UTF-8 JSON, or not a manifest: an
+        object with a non-empty list of known ``pages`` and a list of
+        ``figures``, each with a unique string ``id``, a plain ``file`` name
+        inside ``old_dir``, a 64-hex-digit ``sha256`` and integer ``width``,
+        ``height`` in [1, 8192]; or if a listed file is not a regular file of
+        at most `MAX_FIGURE_BYTES`, does not match its sha256, or is not a
+        PNG of the stated size.
+    """
+    if not str(old_dir):
+        raise UsageError("--check: the directory path is empty")
     path = Path(old_dir) / "manifest.json"
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-        figures = {f["id"]: f for f in doc["figures"]}
-        pages = list(doc["pages"])
+        raw = files.read_regular(path, MAX_MANIFEST_BYTES, follow=False)
+    except files.RefusedPath as exc:
+        raise UsageError(f"--check: {exc}") from None
     except OSError as exc:
         raise UsageError(f"--check: cannot read {str(path)!r}: {exc.strerror or exc}") from None
-    except (ValueError, KeyError, TypeError) as exc:
-        raise UsageError(f"--check: {str(path)!r} is not a symrender manifest ({exc})") from None
+    try:
+        doc = json.loads(raw.decode("utf-8"))
+    except (ValueError, RecursionError) as exc:  # bad UTF-8, bad JSON, nesting too deep
+        raise _manifest_error(path, f"not JSON ({_one_line(exc)[:120]})") from None
+    figures, pages = _validate_manifest(doc, path, known_pages)
+    for entry in figures.values():
+        _read_figure(old_dir, entry)
+    for entry in figures.values():
+        _decode_figure(_read_figure(old_dir, entry), repr(str(Path(old_dir) / entry["file"])))
     return doc, figures, pages
+
+
+def compare_figure(old_png, new_png):
+    """Compare a previous figure with a fresh one.
+
+    Parameters
+    ----------
+    old_png, new_png : bytes
+        PNG files (any size; decoded to 8-bit RGBA).
+
+    Returns
+    -------
+    verdict : {"unchanged", "within tolerance", "changed"}
+        ``"unchanged"`` if the bytes are equal; ``"within tolerance"`` if the
+        sizes agree and every channel differs by at most
+        `CHECK_TOLERANCE_LEVELS` of 255 on at most `CHECK_TOLERANCE_FRACTION`
+        of the pixels; else ``"changed"``.
+    how : str
+        The size change, or the largest per-channel difference (as a fraction
+        of full scale) and the number of pixels that differ; empty when unchanged.
+    """
+    if old_png == new_png:
+        return "unchanged", ""
+    a, b = _png_pixels(old_png), _png_pixels(new_png)
+    if a.shape != b.shape:
+        return "changed", f"size {a.shape[1]}x{a.shape[0]} -> {b.shape[1]}x{b.shape[0]}"
+    d = np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=2)
+    levels, count = int(d.max()), int(np.count_nonzero(d))
+    how = f"max |dI| = {levels / 255:.4f} ({count:,} pixels differ)"
+    within = levels <= CHECK_TOLERANCE_LEVELS and count <= CHECK_TOLERANCE_FRACTION * d.size
+    return ("within tolerance" if within else "changed"), how
 
 
 def _cmd_figures(args, out):
     import fnmatch
-    pages = None if args.pages is None else [p.strip() for p in args.pages.split(",") if p.strip()]
+    pages = None
+    if args.pages is not None:
+        pages = [p.strip() for p in args.pages.split(",") if p.strip()]
+        if not pages:
+            raise UsageError(f"--pages names no page ({args.pages!r}); give names like s1,s4")
     if args.check is None:
+        if not args.out or args.out == STDOUT:
+            raise UsageError(f"--out {args.out!r}: give a directory to write the figures into")
         out_dir = Path(args.out)
         if out_dir.exists() and not out_dir.is_dir():
             raise UsageError(f"--out {args.out!r} is not a directory")
@@ -732,7 +1269,7 @@ def _cmd_figures(args, out):
               f"(code {v['git_commit'] or 'no git'}{' + local changes' if v['git_dirty'] else ''}, "
               f"sources {v['source_sha256'][:16]})", file=out)
         return 0
-    old_doc, old, old_pages = _load_manifest(args.check)
+    old_doc, old, old_pages = _load_manifest(args.check, _known_pages())
     pages = _resolve_pages(old_pages if pages is None else pages)
     with tempfile.TemporaryDirectory(prefix="symrender-figures-") as tmp:
         tmp = Path(tmp)
@@ -751,18 +1288,11 @@ def _cmd_figures(args, out):
                 print(f"unchanged  {fid}", file=out)
                 continue
             else:
-                try:
-                    a = _png_pixels((Path(args.check) / old[fid]["file"]).read_bytes())
-                except OSError:
-                    a = None
-                b = _png_pixels((tmp / new[fid]["file"]).read_bytes())
-                if a is None:
-                    how = "previous file missing"
-                elif a.shape != b.shape:
-                    how = f"size {a.shape[1]}x{a.shape[0]} -> {b.shape[1]}x{b.shape[0]}"
-                else:
-                    d = np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=2)
-                    how = f"max |dI| = {d.max() / 255:.4f} ({np.count_nonzero(d):,} pixels differ)"
+                verdict, how = compare_figure(_read_figure(args.check, old[fid]),
+                                              (tmp / new[fid]["file"]).read_bytes())
+                if verdict == "within tolerance":
+                    print(f"within tolerance {fid}: {how}", file=out)
+                    continue
                 print(f"changed    {fid}: {how}{tag}", file=out)
             if not tag:
                 changed += 1
@@ -785,10 +1315,10 @@ def _size_arg(text):
         raise argparse.ArgumentTypeError(str(exc).removeprefix("--size ")) from None
 
 
-def _eps_arg(max_steps):
+def _eps_arg(max_steps, bounds=None):
     def parse(text):
         try:
-            return parse_eps(text, name="", max_steps=max_steps)
+            return parse_eps(text, name="", max_steps=max_steps, bounds=bounds)
         except UsageError as exc:
             raise argparse.ArgumentTypeError(str(exc).lstrip(": ")) from None
     return parse
@@ -803,10 +1333,14 @@ def _float_arg(text):
 
 def build_parser():
     """The argparse parser of ``symrender`` (one subparser per command)."""
+    from .render import MAX_SIDE
+    from .scene import HEIGHT_FIELDS
+    from .sweep import MAX_STEPS
     limits = (f"Limits: each side 1..{MAX_SIDE}; render at most {MAX_PIXELS:,} pixels (4096^2); "
               f"sweep at most (steps + 1) * W * H <= {FRAME_PIXEL_BUDGET:,}; refused before allocating.")
     p = _Parser(prog="symrender", description="Render, sweep, measure and verify the Chapter-9 scene.",
                 epilog=limits)
+    p.add_argument("--version", action="version", version=f"symrender {_version()}")
     sub = p.add_subparsers(dest="command", metavar="command", required=True, parser_class=_Parser)
 
     def scene_opts(sp):
@@ -833,9 +1367,11 @@ def build_parser():
                                    "eps, max and RMS |dI| on A, flips, mean |dI| on and off the kink band.",
                        epilog=limits)
     scene_opts(s)
-    s.add_argument("--eps", type=_eps_arg(MAX_STEPS), default=parse_eps("1e-1:1e-8:8"), metavar="a:b:n|e1,e2,..",
-                   help=f"n log-spaced steps from a to b, or a comma list; 1..{MAX_STEPS} steps "
-                        "(default 1e-1:1e-8:8)")
+    from .scene import MAX_EPS, MIN_EPS
+    s.add_argument("--eps", type=_eps_arg(MAX_STEPS, (MIN_EPS, MAX_EPS)), default=parse_eps("1e-1:1e-8:8"),
+                   metavar="a:b:n|e1,e2,..",
+                   help=f"n log-spaced steps from a to b, or a comma list; 1..{MAX_STEPS} steps, each in "
+                        f"[{MIN_EPS:g}, {MAX_EPS:g}] (default 1e-1:1e-8:8)")
     s.add_argument("--size", type=_size_arg, default=(256, 256), metavar="WxH",
                    help="image size (default 256x256); (steps + 1) * W * H <= "
                         f"{FRAME_PIXEL_BUDGET:,}")
@@ -866,7 +1402,11 @@ def build_parser():
                                    "and write every PNG figure it displays or glues into DIR, re-encoded "
                                    "without metadata, with manifest.json (figure id, page, code cell, "
                                    "content hash, code version). --check DIR runs afresh and reports each "
-                                   "figure that changed and by how much (max |dI|), exiting 1 on a change.")
+                                   "figure that changed and by how much (max |dI|), exiting 1 on a change "
+                                   f"of more than {CHECK_TOLERANCE_LEVELS}/255 in a channel or on more "
+                                   f"than {CHECK_TOLERANCE_FRACTION:.0%} of a figure's pixels (the "
+                                   "tolerance across numpy's SIMD paths); a malformed or "
+                                   "tampered DIR is refused before any page runs.")
     what = f.add_mutually_exclusive_group(required=True)
     what.add_argument("--out", metavar="DIR", help="directory to write the figures and manifest.json into")
     what.add_argument("--check", metavar="DIR", help="a previous --out directory to compare a fresh run with")
@@ -886,17 +1426,107 @@ def _one_line(msg):
     return " ".join(str(msg).split())
 
 
+def _interrupt_once(signum, frame):
+    """`main`'s SIGINT handler: raise KeyboardInterrupt once, then ignore
+    SIGINT, so that a second Ctrl-C cannot cut the clean-up short."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    raise KeyboardInterrupt
+
+
+def _stop_rendering():
+    """Before the program exits: stop the renderer's worker processes, if it
+    was used (the tiles still queued on its threads were cancelled when the
+    interrupt reached the render, `renderer.render._run_tiles`)."""
+    workers = sys.modules.get(f"{__package__}.workers")
+    if workers is not None:
+        workers.shutdown()
+
+
 def main(argv=None) -> int:
     """Run ``symrender`` with ``argv`` (default ``sys.argv[1:]``); return the exit code.
 
-    Returns 0 on success, 2 on any input error (one line ``symrender: error:
-    ...`` on stderr, nothing written), 1 on an unanticipated error (one line
-    ``symrender: internal error: ...``), 130 on Ctrl-C, 1 silently when stdout
-    is closed early (a broken pipe), 1 when ``figures --check`` finds a
-    changed figure, and pytest's code for
-    ``verify``.  ``--help`` prints to stdout and returns 0.  Never raises.
+    Parameters
+    ----------
+    argv : list of str or None
+        The arguments after the program name.  None means ``sys.argv[1:]``
+        and running as the program (the console script, ``python -m
+        renderer``): see Ctrl-C below.
+
+    Returns
+    -------
+    int
+        0 on success, 2 on any input error (one line ``symrender: error:
+        ...`` on stderr, nothing written), 1 on an unanticipated error (one
+        line ``symrender: internal error: ...``), 130 on Ctrl-C, 1 silently
+        when stdout is closed early (a broken pipe), 1 when ``figures
+        --check`` finds a changed figure, and pytest's code for ``verify``.
+        ``--help`` prints to stdout and returns 0.  Never raises.
+
+    Notes
+    -----
+    Ctrl-C.  `main` takes SIGINT over on entry (unless it is ignored, as in a
+    background job): the first SIGINT raises KeyboardInterrupt wherever the
+    command is, its imports of numpy, sympy and matplotlib included, and
+    SIGINT is ignored from then on, so that a second Ctrl-C cannot cut the
+    clean-up short: the partial output file or staging directory is
+    removed, the notebook kernel of ``figures`` shut down (`_stop_kernel`).
+    While ``verify``'s pytest runs, a SIGINT is noted and pytest, which got
+    the same Ctrl-C, is waited for (`_sigint_noted`).  Then one line
+    ``symrender: interrupted`` on stderr and 130.
+
+    Called with an argument list (in-process use), `main` restores the
+    previous SIGINT handler when it returns.  Run as the program, it stops
+    the renderer's worker processes before it returns (`_stop_rendering`;
+    queued tiles were cancelled by the interrupted render), and leaves
+    SIGINT ignored, as the process is
+    about to exit: a Ctrl-C during the interpreter's exit would print an
+    "Exception ignored" traceback.
+
+    What `main` cannot cover is Python's own start-up before it runs (the
+    interpreter, site, and this module's standard-library imports: under
+    0.1 s here; importing this module loads neither numpy nor the
+    renderer): a Ctrl-C then gets Python's report.
     """
-    argv = sys.argv[1:] if argv is None else list(argv)
+    as_program = argv is None
+    reported = []
+
+    def interrupted():
+        if not reported:
+            reported.append(True)
+            print("symrender: interrupted", file=sys.stderr)
+        return 130
+
+    restore = None  # the SIGINT handler to put back, once main's is in place
+    try:
+        try:
+            try:
+                previous = signal.getsignal(signal.SIGINT)
+                if previous is not signal.SIG_IGN:
+                    signal.signal(signal.SIGINT, _interrupt_once)
+                    restore = signal.default_int_handler if previous is None else previous
+            except ValueError:  # not the main thread: signals are left alone
+                pass
+            code = _run(sys.argv[1:] if as_program else list(argv), interrupted)
+        except KeyboardInterrupt:  # before the handler was in place, or while an error was reported
+            code = interrupted()
+        if as_program:
+            try:
+                if restore is not None:
+                    signal.signal(signal.SIGINT, signal.SIG_IGN)
+            except KeyboardInterrupt:  # the first one, just before it was ignored
+                code = interrupted()
+            try:
+                _stop_rendering()
+            except Exception:  # noqa: BLE001 - the command's result stands
+                pass
+        return code
+    finally:
+        if restore is not None and not as_program:
+            signal.signal(signal.SIGINT, restore)
+
+
+def _run(argv, interrupted):
+    """`main` without its signal handling."""
     out = sys.stdout
     try:
         try:
@@ -924,8 +1554,7 @@ def main(argv=None) -> int:
         print("symrender: error: out of memory (use a smaller --size)", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("symrender: interrupted", file=sys.stderr)
-        return 130
+        return interrupted()
     except Exception as exc:  # a bug: still one line, no traceback
         print(f"symrender: internal error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
         return 1

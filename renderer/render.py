@@ -67,7 +67,9 @@ def _tile_rows(width, height, workers):
 def _run_tiles(jobs, workers):
     """Run the tile jobs (callables), on ``workers`` threads when there are several.
 
-    An exception raised in a job is raised again here, in the caller.
+    An exception raised in a job is raised again here, in the caller; then,
+    as on KeyboardInterrupt while waiting, the jobs not yet started are
+    cancelled.
     """
     if workers <= 1 or len(jobs) <= 1:
         for job in jobs:
@@ -78,8 +80,13 @@ def _run_tiles(jobs, workers):
         pool = _POOLS.setdefault(workers, ThreadPoolExecutor(max_workers=workers,
                                                              thread_name_prefix="symrender-tile"))
     futures = [pool.submit(job) for job in jobs]
-    for future in futures:
-        future.result()
+    try:
+        for future in futures:
+            future.result()
+    except BaseException:                   # an error or Ctrl-C: drop the tiles not yet started
+        for future in futures:
+            future.cancel()
+        raise
 
 
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3

@@ -1,4 +1,4 @@
-"""Tests of the ``symrender`` command line (renderer/cli.py, issue 7).
+"""Tests of the ``symrender`` command line (renderer/cli.py).
 
 Every subcommand runs on real input through ``main([...])``; the installed
 console script and ``python -m renderer`` run once each.  Outputs are checked
@@ -11,10 +11,12 @@ to reject a wrong variant.
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import csv
 import io
 import json
+import os
 import struct
 import subprocess
 import sys
@@ -284,6 +286,32 @@ BAD = [
     (["ucurve", "--plot", "DIR/no/such/p.png"], None, "--plot"),
     (["frobnicate"], None, "frobnicate"),
     ([], None, "command"),
+    # Negative and huge numbers reach the command's own checks and get the range.
+    (["render", "--size", "-5x5", "-o", "OUT"], None, "between 1 and 8192"),
+    (["render", "--size", "99999999999x5", "-o", "OUT"], None, "between 1 and 8192"),
+    (["render", "--size", "5x" + "9" * 5000, "-o", "OUT"], None, "between 1 and 8192"),
+    (["sweep", "--eps", "1e-1:1e-8:99999999999"], None, "between 1 and 64"),
+    (["sweep", "--eps", "-1e-3"], None, "[1e-16, 0.25]"),
+    (["sweep", "--eps", "0.5"], None, "[1e-16, 0.25]"),
+    (["sweep", "--eps", "1e-1:1e-20:4"], None, "[1e-16, 0.25]"),
+    (["ucurve", "--u", "-0.5"], None, "[0, 1]"),
+    (["ucurve", "--k-u", "-3"], None, "(0, 1000]"),
+    (["ucurve", "--k-v", "5000"], None, "(0, 1000]"),
+    # Empty and directory-like paths.
+    (["render", "--size", "8x8", "-o", ""], None, "empty"),
+    (["render", "--size", "8x8", "-o", "OUT/"], None, "trailing '/'"),
+    (["ucurve", "--plot", ""], None, "empty"),
+    (["render", "--scene", "", "-o", "OUT"], None, "empty"),
+    (["render", "--scene", "DIR", "-o", "OUT"], None, "directory"),
+    (["render", "--scene", "/dev/zero", "-o", "OUT"], None, "regular file"),
+    # Lights need both keys; nesting is bounded; huge integers are named.
+    (["render", "--scene", "TOML", "-o", "OUT"], "[[lights]]\n", "lights[0] has no 'position'"),
+    (["render", "--scene", "TOML", "-o", "OUT"], "[[lights]]\nposition = [1, 2, 3]\n", "lights[0] has no 'color'"),
+    (["render", "--set", "lights=[{color=[1, 1, 1]}]", "-o", "OUT"], None, "lights[0] has no 'position'"),
+    (["render", "--scene", "TOML", "-o", "OUT"], "a = " + "[" * 5000 + "]" * 5000 + "\n", "nested too deeply"),
+    (["render", "--set", "center_b=" + "[" * 5000 + "]" * 5000, "-o", "OUT"], None, "nested too deeply"),
+    (["render", "--set", "center_b=" + "[" * 20 + "]" * 20, "-o", "OUT"], None, "center_b[0]"),
+    (["render", "--scene", "TOML", "-o", "OUT"], "beta = " + "9" * 5000 + "\n", "--scene"),
 ]
 
 
@@ -307,8 +335,10 @@ def test_huge_size_refused_before_allocating(tmp_path, capsys, monkeypatch):
     def no_render(*a, **k):
         raise AssertionError("render called")
 
-    monkeypatch.setattr(cli, "render", no_render)
-    monkeypatch.setattr(cli, "sweep", no_render)
+    import importlib
+    for module, name in ((importlib.import_module("renderer.render"), "render"),
+                         (importlib.import_module("renderer.sweep"), "sweep"), (cli, "render"), (cli, "sweep")):
+        monkeypatch.setattr(module, name, no_render, raising=module is not cli)
     for argv in (["render", "--size", "100000x100000", "-o", str(tmp_path / "o.png")],
                  ["render", "--size", "8192x8192", "-o", str(tmp_path / "o.png")],
                  ["sweep", "--size", "4096x4096"]):
@@ -319,6 +349,187 @@ def test_huge_size_refused_before_allocating(tmp_path, capsys, monkeypatch):
     # Wrong variant: a size within the limits does reach render.
     rc, _, err = run(["render", "--size", "8x8", "-o", str(tmp_path / "o.png")], capsys)
     assert rc == 1 and "render called" in err and not (tmp_path / "o.png").exists()
+
+
+# ------------------------------------------------------------------ argument edge cases
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["render", "--size", "-5x5", "-o", "OUT"], "--size: width must be between 1 and 8192"),
+    (["ucurve", "--u", "-0.5"], "--u must be a number in [0, 1]"),
+    (["ucurve", "--k-u", "-3"], "--k-u must be a finite number in (0, 1000]"),
+    (["sweep", "--eps", "-1e-3"], "each step must be in [1e-16, 0.25]"),
+    (["sweep", "--eps", "-.5"], "each step must be in [1e-16, 0.25]"),
+])
+def test_negative_values_reach_our_checks(tmp_path, capsys, argv, word):
+    argv = [a.replace("OUT", str(tmp_path / "o.png")) for a in argv]
+    rc, _, err = run(argv, capsys)
+    assert rc == 2 and word in err and "expected one argument" not in err
+    # Wrong variant: plain argparse takes "-5x5" and "-1e-3" for options.
+    plain = argparse.ArgumentParser(exit_on_error=False)
+    plain.add_argument("--size")
+    with pytest.raises(argparse.ArgumentError, match="expected one argument"):
+        plain.parse_args(["--size", "-5x5"])
+
+
+def test_a_value_after_double_dash_is_left_alone():
+    p = cli._Parser(prog="t")
+    p.add_argument("--u")
+    p.add_argument("rest", nargs="*")
+    assert p.parse_args(["--u", "-1", "--", "--u", "-2"]) == argparse.Namespace(u="-1", rest=["--u", "-2"])
+
+
+def test_version(capsys, monkeypatch):
+    from importlib import metadata
+    rc, out, err = run(["--version"], capsys)
+    assert rc == 0 and err == "" and out == f"symrender {metadata.version('symbolic-rendering-ch9')}\n"
+
+    def not_installed(name):
+        raise metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(metadata, "version", not_installed)
+    rc, out, _ = run(["--version"], capsys)
+    assert rc == 0 and out == "symrender unknown (not installed)\n"
+
+
+# ------------------------------------------------------------------ standard output
+
+
+class BinaryStdout(io.TextIOWrapper):
+    """A non-terminal stdout whose bytes can be read back."""
+
+    def __init__(self, tty=False):
+        super().__init__(io.BytesIO(), encoding="utf-8")
+        self.tty = tty
+
+    def isatty(self):
+        return self.tty
+
+    def data(self):
+        self.flush()
+        return self.buffer.getvalue()
+
+
+def test_output_dash_writes_the_png_to_stdout_and_the_report_to_stderr(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "o.png"
+    rc, stdout, _ = run(["render", "--size", SMALL, "--view", "kink", "-o", str(out)], capsys)
+    assert rc == 0
+    fake = BinaryStdout()
+    monkeypatch.setattr(sys, "stdout", fake)
+    rc = main(["render", "--size", SMALL, "--view", "kink", "-o", "-"])
+    err = capsys.readouterr().err
+    assert rc == 0 and fake.data() == out.read_bytes()  # the PNG and nothing else
+    assert "wrote standard output" in err and stdout.splitlines()[1:] == err.splitlines()[1:]
+    assert list(tmp_path.iterdir()) == [out]
+
+
+def test_plot_dash_writes_the_plot_to_stdout_and_the_table_to_stderr(tmp_path, capsys, monkeypatch):
+    plot = tmp_path / "u.png"
+    rc, table, _ = run(["ucurve", "--eps", "1e-1:1e-6:6", "--plot", str(plot)], capsys)
+    assert rc == 0
+    fake = BinaryStdout()
+    monkeypatch.setattr(sys, "stdout", fake)
+    rc = main(["ucurve", "--eps", "1e-1:1e-6:6", "--plot", "-"])
+    err = capsys.readouterr().err
+    assert rc == 0 and fake.data() == plot.read_bytes()
+    assert err.splitlines()[:-1] == table.splitlines()[:-1] and err.endswith("wrote standard output\n")
+
+
+@pytest.mark.parametrize("argv", [["render", "--size", "8x8", "-o", "-"], ["ucurve", "--plot", "-"]])
+def test_dash_on_a_terminal_is_refused(capsys, monkeypatch, argv):
+    fake = BinaryStdout(tty=True)
+    monkeypatch.setattr(sys, "stdout", fake)
+    rc = main(argv)
+    err = capsys.readouterr().err
+    assert failure_problems(rc, err, [], []) == [] and "terminal" in err and fake.data() == b""
+    # The same run with stdout not a terminal writes (the refusal is about the terminal).
+    fake.tty = False
+    if argv[0] == "render":
+        assert main(argv) == 0 and fake.data().startswith(b"\x89PNG")
+
+
+def test_stdout_and_dev_stdout_in_a_real_process(tmp_path):
+    """Through a real pipe: ``-o -`` gives the PNG alone on stdout; ``-o
+    /dev/stdout`` (a link) writes through it; a pseudo-terminal is refused."""
+    cmd = [sys.executable, "-m", "renderer", "render", "--size", "8x8", "-o"]
+    ref = tmp_path / "ref.png"
+    assert main(["render", "--size", "8x8", "-o", str(ref)]) == 0
+    dash = subprocess.run([*cmd, "-"], capture_output=True)
+    assert dash.returncode == 0 and dash.stdout == ref.read_bytes() and b"ledger" in dash.stderr
+    dev = subprocess.run([*cmd, "/dev/stdout"], capture_output=True)
+    assert dev.returncode == 0 and dev.stdout.startswith(ref.read_bytes()) and dev.stderr == b""
+    primary, secondary = os.openpty()
+    try:
+        tty = subprocess.run([*cmd, "-"], stdout=secondary, stderr=subprocess.PIPE)
+    finally:
+        os.close(secondary)
+        os.close(primary)
+    assert tty.returncode == 2 and tty.stderr.count(b"\n") == 1 and b"terminal" in tty.stderr
+
+
+def test_device_output_needs_no_writable_directory(tmp_path, capsys, monkeypatch):
+    """As a user who cannot write /dev: a writable device passes the early
+    check; a new file in a directory that is not writable does not."""
+    real_access = os.access
+    monkeypatch.setattr(cli.os, "access",
+                        lambda p, mode: False if os.path.isdir(p) else real_access(p, mode))
+    assert cli._check_output("/dev/null", "-o") is None
+    with pytest.raises(cli.UsageError, match="not writable"):
+        cli._check_output(str(tmp_path / "o.png"), "-o")
+
+
+# ------------------------------------------------------------------ scene files
+
+
+def test_scene_file_with_a_byte_order_mark(tmp_path):
+    text = 'beta = 0.8\nheight_field = "rings"\n'
+    plain, bom = tmp_path / "a.toml", tmp_path / "b.toml"
+    plain.write_text(text, encoding="utf-8")
+    bom.write_text(text, encoding="utf-8-sig")
+    assert bom.read_bytes().startswith(b"\xef\xbb\xbf")
+    assert cli.load_scene(str(bom)) == cli.load_scene(str(plain)) == Scene(beta=0.8, height_field="rings")
+
+
+def test_scene_fifo_is_refused_without_blocking(tmp_path, capsys):
+    fifo = tmp_path / "scene.toml"
+    os.mkfifo(fifo)
+    t0 = time.monotonic()
+    rc, _, err = run(["render", "--scene", str(fifo), "-o", str(tmp_path / "o.png")], capsys)
+    assert time.monotonic() - t0 < 2.0
+    assert failure_problems(rc, err, [], []) == [] and "FIFO" in err and "regular file" in err
+
+
+def test_scene_file_size_cap(tmp_path, capsys):
+    big = tmp_path / "big.toml"
+    with open(big, "wb") as f:
+        f.truncate(2 << 30)
+    t0 = time.monotonic()
+    rc, _, err = run(["render", "--scene", str(big), "-o", str(tmp_path / "o.png")], capsys)
+    assert rc == 2 and "larger than 1,048,576 bytes" in err and time.monotonic() - t0 < 1.0
+    # A file at the cap is read (padded with a comment).
+    ok = tmp_path / "ok.toml"
+    ok.write_bytes(b"beta = 0.5\n#" + b"x" * (cli.MAX_SCENE_BYTES - 13) + b"\n")
+    assert ok.stat().st_size == cli.MAX_SCENE_BYTES and cli.load_scene(str(ok)).beta == 0.5
+
+
+def test_check_ints_walks_deep_values_without_recursion():
+    deep = 1
+    for _ in range(100_000):
+        deep = [deep]
+    with pytest.raises(cli.UsageError, match=r"x\[0\]\[0\].* is nested too deeply"):
+        cli._check_ints("--set", "x", deep)
+    cli._check_ints("--set", "x", [[[1, 2]], {"a": [3]}])  # shallow values pass
+    with pytest.raises(cli.UsageError, match=r"x\[1\]\.a\[0\] = 1000"):
+        cli._check_ints("--set", "x", [[[1, 2]], {"a": [10 ** 400]}])
+
+    # Wrong variant: the recursive walk this replaced overflows the stack.
+    def recursive(value):
+        if isinstance(value, list):
+            for item in value:
+                recursive(item)
+
+    with pytest.raises(RecursionError):
+        recursive(deep)
 
 
 # ------------------------------------------------------------------ sweep
@@ -376,6 +587,24 @@ def test_ucurve_table_matches_measure(tmp_path, capsys):
     assert varying_chunks(first) == []
     rc, _, _ = run(["ucurve", "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
     assert rc == 0 and plot.read_bytes() == first
+
+
+@pytest.mark.parametrize("argv, where", [
+    (["--field", "ridges", "--u", "0.125"], "crease u = 1/k_u"),
+    (["--field", "sine", "--v", "0"], "pole"),
+])
+def test_ucurve_says_where_the_field_is_not_differentiable(argv, where, tmp_path, capsys):
+    plot = tmp_path / "u.png"
+    rc, out, err = run(["ucurve", *argv, "--eps", "1e-2:1e-10:5", "--plot", str(plot)], capsys)
+    assert rc == 0 and err == ""
+    assert "not differentiable: " in out and where in out
+    # Neither a "true derivative" nor an optimum is printed; the table still is.
+    assert not any(line.startswith(("true derivative", "eps* predicted")) for line in out.splitlines())
+    assert len([line for line in out.splitlines() if line.split()[0][:1].isdigit()]) == 5
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # At a smooth point of the same field the derivative and optimum are printed.
+    rc, out, _ = run(["ucurve", "--field", "ridges", "--u", "0.1", "--eps", "1e-2:1e-10:5"], capsys)
+    assert rc == 0 and "true derivative" in out and "eps* predicted" in out and "not differentiable" not in out
 
 
 def test_ucurve_in_chunks_for_progress_equals_one_measure(capsys, monkeypatch):
@@ -545,6 +774,11 @@ def s1_figures(tmp_path_factory):
     return d / "a", out.getvalue()
 
 
+def sha256_of(path):
+    import hashlib
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
 def copy_dir(src, dst):
     import shutil
     shutil.copytree(src, dst)
@@ -581,7 +815,7 @@ def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
     px = read_png(f)
     px[10, 10] = np.where(px[10, 10] >= 128, px[10, 10].astype(int) - 51, px[10, 10].astype(int) + 51)
     cli.write_png(f, px / 255.0)
-    doc["figures"][0]["sha256"] = "0" * 64
+    doc["figures"][0]["sha256"] = sha256_of(f)
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
     assert rc == 1 and "changed    s1_what_changes-cell01-1: max |dI| = 0.2000 (1 pixels differ)" in out
@@ -620,6 +854,11 @@ def test_figures_failing_page_is_one_line(tmp_path, capsys, monkeypatch):
     (["figures", "--out", "DIR/a", "--pages", "s99"], "--pages"),
     (["figures", "--out", "DIR/no/such"], "--out"),
     (["figures", "--out", "DIR/file.txt"], "--out"),
+    (["figures", "--out", ""], "--out"),
+    (["figures", "--out", "-"], "--out"),
+    (["figures", "--check", ""], "--check"),
+    (["figures", "--out", "DIR/a", "--pages", ""], "--pages"),
+    (["figures", "--out", "DIR/a", "--pages", ","], "--pages"),
 ])
 def test_figures_bad_input(tmp_path, capsys, argv, word):
     (tmp_path / "file.txt").write_text("x")
@@ -640,7 +879,7 @@ def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_
     px = read_png(f)
     px[5, 5] = 255 - px[5, 5]
     cli.write_png(f, px / 255.0)
-    doc["figures"][0]["sha256"] = "0" * 64
+    doc["figures"][0]["sha256"] = sha256_of(f)
     doc["figures"][0]["varies"] = "measured timing"
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
@@ -657,3 +896,255 @@ def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_
     manifest = cli._render_figures(tmp_path / "new", ["p"]) if (tmp_path / "new").mkdir() is None else None
     marks = {f["id"]: f.get("varies") for f in manifest["figures"]}
     assert marks == {"p-cell01-1": "measured timing", "p-cell02-1": None}
+
+
+# ------------------------------------------------------------------ --check: manifest validation
+
+
+def figure_pixels(h=40, w=50):
+    """A deterministic RGB test image with no flat regions."""
+    y, x = np.mgrid[0:h, 0:w]
+    return np.stack([(7 * x + 3 * y) % 256, (5 * x * y) % 256, (x ^ y) * 4 % 256], axis=2).astype(np.uint8)
+
+
+def write_check_dir(d, px=None, **entry):
+    """A previous ``--out`` directory with one synthetic figure; returns the manifest."""
+    import hashlib
+    d.mkdir(exist_ok=True)
+    data = cli._png_bytes(figure_pixels() if px is None else px)
+    (d / "fig.png").write_bytes(data)
+    h, w = (px if px is not None else figure_pixels()).shape[:2]
+    page = cli._known_pages()[1]
+    doc = {"code_version": {"git_commit": None, "git_dirty": None, "source_sha256": "0" * 64},
+           "pages": [page],
+           "figures": [{"id": f"{page}-cell01-1", "page": page, "code_cell": 1, "file": "fig.png",
+                        "sha256": hashlib.sha256(data).hexdigest(), "width": w, "height": h, **entry}]}
+    (d / "manifest.json").write_text(json.dumps(doc))
+    return doc
+
+
+def fake_run(monkeypatch, new_pngs):
+    """Replace page execution by writing ``new_pngs`` (id -> PNG bytes) as the fresh run."""
+    def render_figures(out_dir, pages):
+        import hashlib
+        figs = []
+        for fid, data in new_pngs.items():
+            (out_dir / f"{fid}.png").write_bytes(data)
+            figs.append({"id": fid, "file": f"{fid}.png", "sha256": hashlib.sha256(data).hexdigest()})
+        return {"code_version": {"git_commit": None, "git_dirty": False, "source_sha256": "1" * 64},
+                "pages": pages, "figures": figs}
+    monkeypatch.setattr(cli, "_render_figures", render_figures)
+
+
+def no_run(out_dir, pages):
+    raise AssertionError("pages were executed")
+
+
+def tamper(name):
+    """Mutations of a valid check directory ``d`` with manifest ``doc``."""
+    def apply(d, doc):
+        f = doc["figures"][0]
+        if name == "dev-zero":
+            f["file"] = "/dev/zero"
+        elif name == "dotdot":
+            f["file"] = "../../x"
+        elif name == "dotdot-png":
+            f["file"] = "../x.png"
+        elif name == "subdir":
+            f["file"] = "sub/fig.png"
+        elif name == "nul":
+            f["file"] = "fig\0.png"
+        elif name == "double-dot-name":
+            f["file"] = "..png"
+        elif name == "bad-json":
+            return "{not json"
+        elif name == "deep-json":
+            return "[" * 100_000 + "]" * 100_000
+        elif name == "not-utf8":
+            return b'{"pages": ["\xff"]}'
+        elif name == "list":
+            return "[]"
+        elif name == "no-pages":
+            del doc["pages"]
+        elif name == "empty-pages":
+            doc["pages"] = []
+        elif name == "unknown-page":
+            doc["pages"] = ["s99_nope"]
+        elif name == "page-int":
+            doc["pages"] = [1]
+        elif name == "figures-dict":
+            doc["figures"] = {"a": f}
+        elif name == "figure-str":
+            doc["figures"] = ["fig.png"]
+        elif name == "id-int":
+            f["id"] = 3
+        elif name == "no-file":
+            del f["file"]
+        elif name == "sha-short":
+            f["sha256"] = f["sha256"][:63]
+        elif name == "sha-upper":
+            f["sha256"] = f["sha256"].upper()
+        elif name == "width-str":
+            f["width"] = str(f["width"])
+        elif name == "width-bool":
+            f["width"] = True
+        elif name == "width-zero":
+            f["width"] = 0
+        elif name == "height-huge":
+            f["height"] = 8193
+        elif name == "height-float":
+            f["height"] = float(f["height"])
+        elif name == "varies-int":
+            f["varies"] = 1
+        elif name == "code-version-list":
+            doc["code_version"] = []
+        elif name == "duplicate-id":
+            doc["figures"].append(dict(f, file="fig2.png"))
+        elif name == "duplicate-file":
+            doc["figures"].append(dict(f, id="other"))
+        elif name == "sha-mismatch":
+            f["sha256"] = "0" * 64
+        elif name == "file-changed":
+            (d / "fig.png").write_bytes(cli._png_bytes(255 - figure_pixels()))
+        elif name == "missing-file":
+            (d / "fig.png").unlink()
+        elif name == "link-to-dev-zero":
+            (d / "fig.png").unlink()
+            (d / "fig.png").symlink_to("/dev/zero")
+        elif name == "fifo-figure":
+            (d / "fig.png").unlink()
+            os.mkfifo(d / "fig.png")
+        elif name in ("corrupt-png", "bomb-header"):
+            import hashlib
+            data = bytearray((d / "fig.png").read_bytes())
+            if name == "corrupt-png":
+                data[41:-12] = bytes(len(data) - 53)  # IDAT contents zeroed, header kept
+            else:
+                data[16:24] = struct.pack(">II", 100_000, 100_000)
+            (d / "fig.png").write_bytes(bytes(data))
+            f["sha256"] = hashlib.sha256(bytes(data)).hexdigest()
+        elif name == "manifest-link":
+            (d / "manifest.json").unlink()
+            (d / "manifest.json").symlink_to("/dev/zero")
+            return None
+        elif name == "manifest-sparse":
+            with open(d / "manifest.json", "wb") as fh:
+                fh.truncate(2 << 30)
+            return None
+        elif name == "manifest-fifo":
+            (d / "manifest.json").unlink()
+            os.mkfifo(d / "manifest.json")
+            return None
+        elif name == "manifest-dir":
+            (d / "manifest.json").unlink()
+            (d / "manifest.json").mkdir()
+            return None
+        else:
+            raise KeyError(name)
+        return json.dumps(doc)
+    return apply
+
+
+TAMPERED = ["dev-zero", "dotdot", "dotdot-png", "subdir", "nul", "double-dot-name", "bad-json", "deep-json",
+            "not-utf8", "list", "no-pages", "empty-pages", "unknown-page", "page-int", "figures-dict",
+            "figure-str", "id-int", "no-file", "sha-short", "sha-upper", "width-str", "width-bool",
+            "width-zero", "height-huge", "height-float", "varies-int", "code-version-list", "duplicate-id",
+            "duplicate-file", "sha-mismatch", "file-changed", "missing-file", "link-to-dev-zero",
+            "fifo-figure", "corrupt-png", "bomb-header", "manifest-link", "manifest-sparse",
+            "manifest-fifo", "manifest-dir"]
+
+
+def test_check_accepts_the_untampered_directory(tmp_path, capsys, monkeypatch):
+    """The control for the refusals below: the same directory, untouched, is
+    validated and compared (so each refusal is the tampering's doing)."""
+    d = tmp_path / "old"
+    doc = write_check_dir(d)
+    fake_run(monkeypatch, {doc["figures"][0]["id"]: (d / "fig.png").read_bytes()})
+    rc, out, err = run(["figures", "--check", str(d)], capsys)
+    assert rc == 0 and err == "" and f"unchanged  {doc['figures'][0]['id']}" in out
+
+
+@pytest.mark.parametrize("name", TAMPERED)
+def test_check_refuses_a_tampered_directory_before_running_pages(tmp_path, capsys, monkeypatch, name):
+    d = tmp_path / "old"
+    doc = write_check_dir(d)
+    text = tamper(name)(d, doc)
+    if text is not None:
+        (d / "manifest.json").write_bytes(text if isinstance(text, bytes) else text.encode())
+    monkeypatch.setattr(cli, "_render_figures", no_run)
+    decoded = []
+    if name == "bomb-header":  # refused on the header, before any decoding
+        monkeypatch.setattr(cli, "_png_pixels", lambda data: decoded.append(1) or no_run(None, None))
+    reads = []
+    if name == "manifest-sparse":
+        real_read = os.read
+        monkeypatch.setattr(cli.files.os, "read", lambda fd, n: reads.append(n) or real_read(fd, n))
+    t0 = time.monotonic()
+    rc, out, err = run(["figures", "--check", str(d)], capsys)
+    elapsed = time.monotonic() - t0
+    assert failure_problems(rc, err, [], []) == [], err
+    assert err.startswith("symrender: error: --check") and out == ""
+    assert elapsed < 1.0 and decoded == [] and reads == []
+
+
+def test_check_names_what_is_wrong(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(cli, "_render_figures", no_run)
+    expect = {"dev-zero": "plain file name", "dotdot": "plain file name", "duplicate-id": "appears twice",
+              "sha-mismatch": "does not match its sha256", "link-to-dev-zero": "symbolic link",
+              "corrupt-png": "not a readable PNG", "bomb-header": "is not a 50x40 PNG",
+              "manifest-sparse": "larger than 1,048,576 bytes", "manifest-link": "symbolic link",
+              "manifest-fifo": "FIFO", "bad-json": "not JSON", "width-bool": "width must be an integer"}
+    for i, (name, words) in enumerate(expect.items()):
+        d = tmp_path / f"old{i}"
+        text = tamper(name)(d, write_check_dir(d))
+        if text is not None:
+            (d / "manifest.json").write_text(text)
+        rc, _, err = run(["figures", "--check", str(d)], capsys)
+        assert rc == 2 and words in err, (name, err)
+
+
+# ------------------------------------------------------------------ --check: tolerance
+
+
+def test_compare_figure_tolerance_on_synthetic_pngs():
+    base = figure_pixels()
+    n = base.shape[0] * base.shape[1]
+    allowed = int(cli.CHECK_TOLERANCE_FRACTION * n)
+    levels = cli.CHECK_TOLERANCE_LEVELS
+    assert allowed >= 1
+    png = cli._png_bytes(base)
+
+    def changed(count, by):
+        px = base.astype(int)
+        flat = px.reshape(-1, 3)
+        idx = np.arange(count) * (n // max(count, 1))
+        flat[idx, 1] = np.where(flat[idx, 1] >= 128, flat[idx, 1] - by, flat[idx, 1] + by)
+        return cli._png_bytes(px.astype(np.uint8))
+
+    assert cli.compare_figure(png, png) == ("unchanged", "")
+    verdict, how = cli.compare_figure(png, changed(allowed, levels))
+    assert verdict == "within tolerance" and f"({allowed:,} pixels differ)" in how
+    assert cli.compare_figure(png, changed(1, 1))[0] == "within tolerance"
+    # Wrong variants: one level more, one pixel more, another size.
+    verdict, how = cli.compare_figure(png, changed(1, levels + 1))
+    assert verdict == "changed" and how == f"max |dI| = {(levels + 1) / 255:.4f} (1 pixels differ)"
+    assert cli.compare_figure(png, changed(allowed + 1, 1))[0] == "changed"
+    assert cli.compare_figure(png, cli._png_bytes(base[:-1]))[0] == "changed"
+    assert cli.compare_figure(png, changed(1, 127))[0] == "changed"
+
+
+def test_check_passes_within_tolerance_and_fails_beyond(tmp_path, capsys, monkeypatch):
+    d = tmp_path / "old"
+    doc = write_check_dir(d)
+    fid = doc["figures"][0]["id"]
+    px = figure_pixels().astype(int)
+    near, far = px.copy(), px.copy()
+    near[3, 4] += np.where(near[3, 4] < 255, 1, -1)
+    far[3, 4] += np.where(far[3, 4] < 128, cli.CHECK_TOLERANCE_LEVELS + 1, -cli.CHECK_TOLERANCE_LEVELS - 1)
+    fake_run(monkeypatch, {fid: cli._png_bytes(near.astype(np.uint8))})
+    rc, out, _ = run(["figures", "--check", str(d)], capsys)
+    assert rc == 0 and f"within tolerance {fid}: max |dI| = 0.0039 (1 pixels differ)" in out
+    assert "no figure changed" in out
+    fake_run(monkeypatch, {fid: cli._png_bytes(far.astype(np.uint8))})
+    rc, out, _ = run(["figures", "--check", str(d)], capsys)
+    assert rc == 1 and f"changed    {fid}: max |dI|" in out and "1 figure(s) changed" in out

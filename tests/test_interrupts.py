@@ -1,0 +1,375 @@
+"""Ctrl-C at any moment of a ``symrender`` command (renderer/cli.py, `main`).
+
+Each test starts the installed console script in a session of its own (as a
+shell starts a foreground job), waits for a chosen moment, and sends SIGINT
+to the child's whole process group, as a terminal's Ctrl-C does.  Then it
+asks for: exit code 130; stderr exactly one line ``symrender: interrupted``
+(no traceback); the output directory as it was (no output file, no ``.part``
+staging directory, no temporary file); and no process left behind, neither in
+the child's session nor anywhere else.  The notebook kernel (jupyter_client)
+and the render workers (renderer/workers.py) start sessions of their own, so
+a session check alone would miss them: every run carries a marker in its
+environment, which all its descendants inherit, and any live process with
+that marker after the run is a leftover.
+
+The moments: during the start-up imports (numpy, sympy, the renderer, then
+matplotlib; several delays from the moment numpy's extension is mapped);
+during ``render`` of a large frame once a render worker process exists;
+during ``sweep``; during ``verify`` while its pytest child runs; during
+``figures`` while the notebook kernel starts, and while it runs the page's
+cell, with one Ctrl-C and with two 50 ms apart.  In-process: `main` ignores a
+second Ctrl-C during the clean-up and restores the previous handler.  The
+checkers are shown to fail on a leaked process (in the session, and in a
+session of its own) and on a traceback.
+
+Linux only (/proc).  About 25 s in all.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+
+ROOT = Path(__file__).resolve().parent.parent
+SYMRENDER = Path(sys.executable).with_name("symrender")
+MARKER = "SYMRENDER_INTERRUPT_TEST"
+INTERRUPTED = "symrender: interrupted\n"
+
+
+# ------------------------------------------------------------------ processes
+
+
+def _stat(pid):
+    """(state, session id) of a process (proc(5)), or None if it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            text = f.read().decode(errors="replace")
+    except OSError:
+        return None
+    rest = text[text.rindex(")") + 2:].split()   # after "pid (comm) "
+    return rest[0], int(rest[3])
+
+
+def _cmdline(pid):
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            return f.read().replace(b"\0", b" ").decode(errors="replace").strip()
+    except OSError:
+        return ""
+
+
+def _has_marker(pid, token):
+    try:
+        with open(f"/proc/{pid}/environ", "rb") as f:
+            return f"{MARKER}={token}".encode() in f.read().split(b"\0")
+    except OSError:
+        return False
+
+
+def live_processes(session, token):
+    """Live processes (zombies excluded) in ``session`` or carrying the run's
+    marker ``token`` in their environment: a list of (pid, command line)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit() or int(entry) == os.getpid():
+            continue
+        pid = int(entry)
+        st = _stat(pid)
+        if st is None or st[0] in "ZX":
+            continue
+        if st[1] == session or _has_marker(pid, token):
+            found.append((pid, _cmdline(pid)))
+    return found
+
+
+class Run:
+    """``symrender *args`` in a new session with piped output, marked in its
+    environment so that every descendant can be found."""
+
+    def __init__(self, *args, cwd, env=None):
+        self.token = uuid.uuid4().hex
+        environ = dict(os.environ, **(env or {}))
+        environ[MARKER] = self.token
+        environ.pop("SYMRENDER_WORKER_PROCESSES", None)   # the default: workers on
+        self.started = time.monotonic()
+        self.proc = subprocess.Popen([str(SYMRENDER), *map(str, args)], cwd=cwd, env=environ,
+                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, start_new_session=True)
+
+    def descendants(self, needle):
+        """Live marked processes, other than the command itself, whose command
+        line contains ``needle``."""
+        return [(pid, cmd) for pid, cmd in live_processes(self.proc.pid, self.token)
+                if pid != self.proc.pid and needle in cmd]
+
+    def wait_until(self, condition, timeout, what):
+        """Poll ``condition()`` every 10 ms; fail if the command ends first or
+        ``timeout`` s pass."""
+        deadline = time.monotonic() + timeout
+        while not condition():
+            if self.proc.poll() is not None:
+                out, err = self.proc.communicate()
+                pytest.fail(f"symrender ended (code {self.proc.returncode}) before {what}: "
+                            f"{err.decode()[-2000:]!r}")
+            if time.monotonic() > deadline:
+                self.interrupt()
+                self.finish()
+                pytest.fail(f"no {what} within {timeout} s")
+            time.sleep(0.01)
+
+    def maps(self, needle):
+        """True once a file whose path contains ``needle`` is mapped into the command."""
+        try:
+            with open(f"/proc/{self.proc.pid}/maps") as f:
+                return needle in f.read()
+        except OSError:
+            return False
+
+    def interrupt(self):
+        """Ctrl-C at a terminal: SIGINT to the whole foreground process group."""
+        os.killpg(self.proc.pid, signal.SIGINT)
+
+    def finish(self, timeout=60):
+        """Wait for the command; return (exit code, stdout, stderr, seconds
+        from start)."""
+        try:
+            out, err = self.proc.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+            out, err = self.proc.communicate()
+            pytest.fail(f"symrender did not exit within {timeout} s of the interrupt; stderr "
+                        f"{err.decode()[-2000:]!r}")
+        return self.proc.returncode, out.decode(), err.decode(), time.monotonic() - self.started
+
+    def leftovers(self, grace=5.0):
+        return leftovers(self.proc.pid, self.token, grace)
+
+
+def leftovers(session, token, grace):
+    """Processes of a run (its session, or its marker ``token``) still alive
+    after up to ``grace`` seconds (polled)."""
+    deadline = time.monotonic() + grace
+    while True:
+        left = live_processes(session, token)
+        if not left or time.monotonic() > deadline:
+            return left
+        time.sleep(0.05)
+
+
+def interrupt_problems(rc, err, before, after, left):
+    """What is wrong with an interrupted run: an exit code other than 130,
+    stderr other than the one line, a traceback, a file added to the output
+    directory, a process left behind."""
+    problems = []
+    if rc != 130:
+        problems.append(f"exit code {rc}")
+    if err != INTERRUPTED:
+        problems.append(f"stderr is not the one line: {err[-3000:]!r}")
+    if "Traceback" in err:
+        problems.append("traceback")
+    if sorted(set(after) - set(before)):
+        problems.append(f"files left: {sorted(set(after) - set(before))}")
+    if left:
+        problems.append(f"processes left: {left}")
+    return problems
+
+
+def listing(directory):
+    return sorted(p.name for p in Path(directory).iterdir())
+
+
+def check(run, directory, before, grace=5.0):
+    rc, out, err, seconds = run.finish()
+    problems = interrupt_problems(rc, err, before, listing(directory), run.leftovers(grace))
+    assert problems == [], problems
+    return seconds
+
+
+# ------------------------------------------------------------------ the checkers can fail
+
+
+def test_checker_rejects_wrong_variants():
+    assert interrupt_problems(130, INTERRUPTED, [], [], []) == []
+    assert interrupt_problems(1, INTERRUPTED, [], [], [])
+    assert interrupt_problems(-2, "", [], [], [])
+    assert interrupt_problems(130, "", [], [], [])
+    assert interrupt_problems(130, INTERRUPTED * 2, [], [], [])
+    tb = "Traceback (most recent call last):\n  File ...\nKeyboardInterrupt\n" + INTERRUPTED
+    assert "traceback" in interrupt_problems(130, tb, [], [], [])
+    assert interrupt_problems(130, INTERRUPTED, [], [".figs.x1.part"], [])
+    assert interrupt_problems(130, INTERRUPTED, [], [], [(123, "python -m ipykernel_launcher")])
+
+
+def test_orphan_check_catches_a_leaked_process():
+    """A command that exits 130 but leaves a ``sleep`` behind, one in its own
+    session and one in a new session, is caught; once they are killed the
+    check passes."""
+    token = uuid.uuid4().hex
+    leak = ("import subprocess, sys; "
+            "subprocess.Popen(['sleep', '30']); "
+            "subprocess.Popen(['sleep', '31'], start_new_session=True); "
+            "sys.exit(130)")
+    proc = subprocess.Popen([sys.executable, "-c", leak], env=dict(os.environ, **{MARKER: token}),
+                            start_new_session=True)
+    assert proc.wait() == 130
+    left = leftovers(proc.pid, token, grace=0.5)
+    try:
+        assert sorted(cmd for _, cmd in left) == ["sleep 30", "sleep 31"], left
+        assert interrupt_problems(130, INTERRUPTED, [], [], left) == [f"processes left: {left}"]
+    finally:
+        for pid, _ in left:
+            os.kill(pid, signal.SIGKILL)
+    assert leftovers(proc.pid, token, grace=5.0) == []
+
+
+# ------------------------------------------------------------------ start-up
+
+
+@pytest.mark.parametrize("library, delay", [("_multiarray_umath", 0.0), ("_multiarray_umath", 0.1),
+                                            ("_multiarray_umath", 0.25), ("kiwisolver", 0.0)])
+def test_interrupt_during_start_up_imports(tmp_path, library, delay):
+    """SIGINT while ``render`` imports numpy, sympy and the renderer (about
+    0.5 s here), and later matplotlib: ``delay`` s after numpy's extension
+    module, or matplotlib's kiwisolver, has been mapped.  The one line, 130,
+    nothing written.
+
+    The clock starts inside `main`, not at the spawn: before `main` runs,
+    Python itself starts (interpreter, site, the console script's ``import
+    renderer.cli``, which loads no numpy; about 80 ms here), and a SIGINT
+    then is Python's to report."""
+    run = Run("render", "--size", "64x64", "-o", "out.png", cwd=tmp_path)
+    run.wait_until(lambda: run.maps(library), 10, f"{library} being imported")
+    time.sleep(delay)
+    run.interrupt()
+    check(run, tmp_path, [])
+
+
+def test_importing_the_command_line_loads_no_numpy():
+    code = ("import sys, renderer.cli; "
+            "print(sorted(m for m in ('numpy', 'sympy', 'matplotlib') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+
+
+# ------------------------------------------------------------------ commands at work
+
+
+def test_interrupt_during_render_with_worker_processes(tmp_path):
+    """A 2048^2 render: the second frame starts render worker processes; SIGINT
+    once one exists.  No PNG, no temporary file, no worker left."""
+    run = Run("render", "--size", "2048x2048", "-o", "big.png", cwd=tmp_path)
+    run.wait_until(lambda: run.descendants("renderer._worker"), 60, "render worker process")
+    time.sleep(0.3)
+    run.interrupt()
+    check(run, tmp_path, [])
+
+
+def test_interrupt_during_sweep(tmp_path):
+    run = Run("sweep", "--size", "2048x2048", "--eps", "1e-1:1e-6:6", "--format", "csv", cwd=tmp_path)
+    run.wait_until(lambda: run.maps("_multiarray_umath"), 10, "numpy being imported")
+    time.sleep(2.0)                      # the imports take about 1 s, the sweep about 10 s
+    assert run.proc.poll() is None, "the sweep ended before the interrupt; make it larger"
+    run.interrupt()
+    check(run, tmp_path, [])
+
+
+def test_interrupt_during_verify(tmp_path):
+    """``verify`` runs pytest as a child; Ctrl-C ends it too."""
+    run = Run("verify", cwd=tmp_path)
+    run.wait_until(lambda: run.descendants("pytest verify"), 20, "pytest child")
+    time.sleep(1.5)
+    run.interrupt()
+    check(run, tmp_path, [])
+
+
+@pytest.mark.parametrize("moment, presses", [("kernel starting", 1), ("kernel running", 1),
+                                             ("kernel running", 2)])
+def test_interrupt_while_the_notebook_kernel_runs(tmp_path, moment, presses):
+    """``figures --out figs --pages s1``: SIGINT (once, or twice 50 ms apart)
+    as soon as the kernel process exists (it is still starting: nbclient has
+    not armed its clean-up yet), or while it runs the page's cell.  No figs/,
+    no .figs.*.part staging directory, no kernel, no worker process and no
+    kernel connection file left."""
+    run = Run("figures", "--out", tmp_path / "figs", "--pages", "s1", cwd=tmp_path)
+    run.wait_until(lambda: run.descendants("ipykernel"), 30, "ipykernel process")
+    if moment == "kernel running":
+        time.sleep(1.0)                  # the kernel starts (0.5 s), then runs the cell (2 s)
+    kernels = run.descendants("ipykernel")
+    assert kernels, "the kernel ended before the interrupt"
+    connection = Path(kernels[0][1].split(" -f ")[1].split()[0])
+    run.interrupt()
+    if presses == 2:
+        time.sleep(0.05)
+        run.interrupt()
+    check(run, tmp_path, [])
+    assert not connection.exists(), f"kernel connection file left: {connection}"
+
+
+# ------------------------------------------------------------------ in-process and start-up path
+
+
+def test_main_in_process_restores_the_handler_and_ignores_a_second_ctrl_c(capsys, monkeypatch):
+    """main([...]) in this process: a SIGINT during the command gives 130 and
+    the one line; a second SIGINT during its clean-up is ignored (no second
+    line, the clean-up finishes); the previous handler is back afterwards."""
+    import renderer.cli as cli
+
+    cleaned = []
+
+    def command(args, out):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(1.0)                       # the KeyboardInterrupt comes here
+            pytest.fail("no KeyboardInterrupt")
+        finally:
+            os.kill(os.getpid(), signal.SIGINT)   # a second Ctrl-C during the clean-up
+            time.sleep(0.05)
+            cleaned.append(True)
+
+    before = signal.getsignal(signal.SIGINT)
+    monkeypatch.setitem(cli._COMMANDS, "verify", command)
+    assert cli.main(["verify"]) == 130
+    assert cleaned == [True]
+    assert capsys.readouterr().err == INTERRUPTED
+    assert signal.getsignal(signal.SIGINT) is before
+    # Without a Ctrl-C: the handler is back too.
+    assert cli.main(["sweep", "--size", "8x8", "--eps", "1e-2"]) == 0
+    assert signal.getsignal(signal.SIGINT) is before
+    capsys.readouterr()
+
+
+def test_package_exports_lazily():
+    """``import renderer`` loads no numpy; the public names, the submodules
+    and dir() work as with eager imports, and ``renderer.render`` stays the
+    function after the module renderer.render is imported."""
+    code = """
+import importlib, sys, types
+import renderer
+assert "numpy" not in sys.modules and "renderer.render" not in sys.modules
+module = importlib.import_module("renderer.render")
+assert isinstance(module, types.ModuleType) and renderer.render is module.render
+from renderer import Scene, render, sweep, fields, compare
+import renderer.sweep
+assert renderer.sweep is importlib.import_module("renderer.sweep").sweep and callable(sweep)
+assert isinstance(fields, types.ModuleType) and renderer.detmath.__name__ == "renderer.detmath"
+assert set(renderer.__all__) <= set(dir(renderer))
+assert render(Scene(), 8, 8).image.shape == (8, 8, 3)
+try:
+    renderer.no_such_name
+except AttributeError:
+    pass
+else:
+    raise AssertionError("no AttributeError")
+print("ok")
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert proc.stdout == "ok\n", proc.stderr
