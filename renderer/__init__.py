@@ -20,6 +20,17 @@ attributes ``render`` and ``sweep`` are the functions (the modules are
 import importlib as _importlib
 import sys as _sys
 import types as _types
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    # Where each lazy name comes from, as import statements that static tools
+    # read: type checkers, and the book's dependency finder (book/_ext/nb_deps.py),
+    # which must see that ``from renderer import Scene`` loads renderer/scene.py.
+    # tests/test_interrupts.py checks that these match _EXPORTS.
+    from .ledger import Ledger, compare, to_srgb
+    from .render import CHAMBER_NAMES, GRADIENTS, Frame, GBuffer, gbuffer, render
+    from .scene import BUMPS, HEIGHT_FIELDS, MODELS, PointLight, Scene
+    from .sweep import Sweep, sweep
 
 #: Public name -> the submodule that defines it.
 _EXPORTS = {

@@ -373,3 +373,29 @@ print("ok")
 """
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert proc.stdout == "ok\n", proc.stderr
+
+
+def _type_checking_imports(source):
+    """{name: submodule} of the ``from .x import ...`` statements under
+    ``if TYPE_CHECKING:`` in a module's source."""
+    import ast
+    found = {}
+    for node in ast.parse(source).body:
+        if isinstance(node, ast.If) and getattr(node.test, "id", None) == "TYPE_CHECKING":
+            for stmt in node.body:
+                if isinstance(stmt, ast.ImportFrom) and stmt.level == 1:
+                    found.update({alias.name: stmt.module for alias in stmt.names})
+    return found
+
+
+def test_lazy_names_are_declared_as_static_imports():
+    """The book's dependency finder reads import statements; the lazy table
+    must be exactly what the TYPE_CHECKING imports say, or a page that uses
+    ``from renderer import Scene`` would not be re-run when scene.py changes."""
+    import renderer
+    source = (ROOT / "renderer" / "__init__.py").read_text(encoding="utf-8")
+    assert _type_checking_imports(source) == renderer._EXPORTS
+    assert set(renderer._EXPORTS) == set(renderer.__all__)
+    # A table entry without its import statement is caught.
+    wrong = source.replace("    from .sweep import Sweep, sweep\n", "")
+    assert _type_checking_imports(wrong) != renderer._EXPORTS
