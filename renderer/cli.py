@@ -888,25 +888,41 @@ def _stop_kernel(loop, run, client):
     a kernel still busy (say, drawing a figure) after half of
     ``shutdown_wait_time`` (5 s) gets SIGTERM, after all of it SIGKILL.  A
     Ctrl-C while the kernel was still starting comes before nbclient arms
-    that clean-up; then it is run here.  SIGINT is ignored meanwhile (`main`).
+    that clean-up; then the kernel is killed here.  SIGINT is ignored
+    meanwhile (`main`).
     """
     import atexit
+    import warnings
+    # A Ctrl-C while the kernel starts can land between nbclient creating a
+    # coroutine and awaiting it; the abandoned coroutine would be reported
+    # when it is collected at exit, after our one line.  It is abandoned on
+    # purpose here.
+    warnings.filterwarnings("ignore", message="coroutine .* was never awaited", category=RuntimeWarning)
     if not run.done():
         run.cancel()
         try:
             loop.run_until_complete(run)
         except BaseException:  # noqa: BLE001 - CancelledError, or the run's own failure
             pass
-    if client.km is not None:
+    km = client.km
+    if km is not None:
+        # The kernel is killed by its manager (which also removes the
+        # connection file), not through nbclient's clean-up: that one stops
+        # the client's channels and terminates their zmq context, and a
+        # context whose channels were still being set up can block that
+        # forever (seen here: zmq's term() never returned, also from the
+        # client's __del__).  The client's context is left to the process,
+        # which `main` ends with os._exit after an interrupt.
         try:
-            loop.run_until_complete(client._async_cleanup_kernel())
-        except Exception:  # noqa: BLE001 - kill it then
-            km = client.km
-            if km is not None and getattr(km, "provisioner", None) is not None:
+            loop.run_until_complete(km.shutdown_kernel(now=True))
+        except Exception:  # noqa: BLE001 - kill the process then
+            if getattr(km, "provisioner", None) is not None:
                 try:
                     loop.run_until_complete(km.provisioner.kill())
                 except Exception:  # noqa: BLE001 - nothing more to try
                     pass
+        finally:
+            km.cleanup_connection_file()
     # nbclient registers its clean-up with atexit and unregisters it only on
     # its normal way out; at exit it would fail on the manager already gone.
     atexit.unregister(client._cleanup_kernel)
@@ -1478,9 +1494,11 @@ def main(argv=None) -> int:
     previous SIGINT handler when it returns.  Run as the program, it stops
     the renderer's worker processes before it returns (`_stop_rendering`;
     queued tiles were cancelled by the interrupted render), and leaves
-    SIGINT ignored, as the process is
-    about to exit: a Ctrl-C during the interpreter's exit would print an
-    "Exception ignored" traceback.
+    SIGINT ignored, as the process is about to exit: a Ctrl-C during the
+    interpreter's exit would print an "Exception ignored" traceback.  After
+    an interrupt it ends the process with ``os._exit(130)`` once its own
+    clean-up has run, without the interpreter's finalizers: that of a
+    half-started kernel client can block forever in zmq's term().
 
     What `main` cannot cover is Python's own start-up before it runs (the
     interpreter, site, and this module's standard-library imports: under
@@ -1519,6 +1537,16 @@ def main(argv=None) -> int:
                 _stop_rendering()
             except Exception:  # noqa: BLE001 - the command's result stands
                 pass
+            if code == 130:
+                # Our clean-up has run (outputs removed, kernel killed); the
+                # interpreter's own finalizers are not waited for: one of a
+                # half-started kernel client (zmq's term()) can block forever.
+                for stream in (sys.stdout, sys.stderr):
+                    try:
+                        stream.flush()
+                    except (OSError, ValueError):
+                        pass
+                os._exit(130)
         return code
     finally:
         if restore is not None and not as_program:
