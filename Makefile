@@ -26,7 +26,8 @@ test: $(STAMP)
 NUMERIC_TESTS := verify tests/test_parity.py tests/test_fields.py tests/test_detmath.py \
                  tests/test_gradient_methods.py tests/test_any_scene.py tests/test_stress.py
 test-baseline-simd: $(STAMP)
-	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')"; \
+	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')" \
+	  || { echo "test-baseline-simd: cannot list numpy's CPU features" >&2; exit 1; }; \
 	echo "NPY_DISABLE_CPU_FEATURES=\"$$features\""; \
 	NPY_DISABLE_CPU_FEATURES="$$features" $(BIN)/python -m pytest $(NUMERIC_TESTS) -p no:cacheprovider
 

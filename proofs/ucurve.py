@@ -53,6 +53,20 @@ def non_differentiable(field, u, v, component, k_u, k_v):
     it: no float64 step can tell its two sides apart.  Where both factors
     vanish, h is 0 along the component's line and the partial derivative
     exists (it is 0).  Exact rational arithmetic on the float64 inputs.
+
+    Parameters
+    ----------
+    field : {"sine", "ridges", "rings"}
+    u, v : float
+        The chart point (`measure` accepts [0, 1]).
+    component : {"u", "v"}
+    k_u, k_v : float > 0
+
+    Returns
+    -------
+    str or None
+        The reason, naming the point and the crease or pole; None where the
+        derivative exists.
     """
     if v in (0.0, 1.0):
         return (f"v = {v!r} is a pole of the chart: every u names the same point of the sphere, "
@@ -62,7 +76,7 @@ def non_differentiable(field, u, v, component, k_u, k_v):
 
     def near_crease(x, k):
         m = round(Fraction(k) * Fraction(x))
-        return m, abs(Fraction(x) - m / Fraction(k)) <= Fraction(float(np.spacing(x)))
+        return m, abs(Fraction(x) - m / Fraction(k)) <= Fraction(abs(float(np.spacing(x))))
 
     (mu, on_u), (mv, on_v) = near_crease(u, k_u), near_crease(v, k_v)
     if component == "u" and on_u and not on_v:

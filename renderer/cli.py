@@ -28,18 +28,18 @@ down; the pytest child of ``verify`` gets the same Ctrl-C and is waited for;
 the render worker processes are stopped).  A second Ctrl-C is ignored, so it
 cannot cut the clean-up short.  ``import renderer.cli`` loads neither numpy
 nor the renderer, which `main` imports under its SIGINT handling; only a
-Ctrl-C while Python itself starts, before `main` runs (under 0.1 s here), is
-reported by Python (see `main`).
+Ctrl-C while Python itself starts, before `main` runs, is reported by
+Python (see `main`).
 
 Reproducibility.  PNG files carry no timestamp, software tag or other varying
 metadata, so two runs on the same code give byte-identical files.  The bytes
 are prepared in memory, then written by `renderer.files.write_bytes`: a new or
 regular file atomically (a temporary file in the target directory, then
-`os.replace`), so an interrupted or failed run leaves no file behind; a
-character device, FIFO or socket (``/dev/null``), or a link to an existing
-file or device (``/dev/stdout``), is written through and keeps its kind; a
-directory, a dangling link, a block device or a path ending in ``/`` is
-refused.  ``-o -`` (``--plot -``) writes the PNG to standard output, the
+`os.replace`), so an interrupted or failed run leaves no file behind, and
+so is the final target of a link to a regular file; a character device or
+FIFO (``/dev/null``), or a link to one (``/dev/stdout`` on a pipe), is
+written through and keeps its kind; a directory, a dangling link, a block
+device, a socket or a path ending in ``/`` is refused.  ``-o -`` (``--plot -``) writes the PNG to standard output, the
 report to standard error, and is refused on a terminal.  Files read (scene
 files, a ``--check`` directory) are bounded regular files.
 
@@ -176,7 +176,7 @@ def parse_size(text):
                          f"got {text!r}")
     for name, digits in (("width", m.group(1)), ("height", m.group(2))):
         # Decided on the digits, so a huge side is never converted to an int.
-        if not (len(digits.lstrip("+")) <= 6 and 1 <= int(digits) <= MAX_SIDE):
+        if not (len(digits.lstrip("+").lstrip("0")) <= 6 and 1 <= int(digits) <= MAX_SIDE):
             raise UsageError(f"--size {name} must be between 1 and {MAX_SIDE} pixels, got {text!r}")
     return int(m.group(1)), int(m.group(2))
 
@@ -437,17 +437,17 @@ def atomic_write(path, write):
     nothing), then written by `renderer.files.write_bytes`: a path that is
     absent or a regular file is replaced atomically (a temporary file in its
     directory, then `os.replace`; on any exception, KeyboardInterrupt
-    included, ``path`` is untouched and no temporary file is left); a
-    character device, FIFO or socket (``/dev/null``), or a symbolic link to
-    an existing file or device (``/dev/stdout``), is written through and
-    stays what it was.  ``path`` ``-`` writes the bytes to standard output.
+    included, ``path`` is untouched and no temporary file is left), and so
+    is the final target of a symbolic link to a regular file; a character
+    device or FIFO (``/dev/null``), or a link to one (``/dev/stdout`` on a
+    pipe), is written through and stays what it was.  ``path`` ``-`` writes the bytes to standard output.
     New files get 0666 & ~umask permissions.
 
     Raises
     ------
     UsageError
-        If ``path`` is empty, ends in ``/``, is a directory, a block device or
-        a dangling symbolic link, or its directory does not exist; or if it
+        If ``path`` is empty, ends in ``/``, is a directory, a block device, a
+        socket or a dangling symbolic link, or its directory does not exist; or if it
         is ``-`` and standard output is a terminal.
     OSError
         If the directory or the target cannot be written (naming ``path``).
@@ -464,8 +464,8 @@ def atomic_write(path, write):
         route = files.output_route(path)
     except files.RefusedPath as exc:
         raise UsageError(f"output {exc}") from None
-    if route == "replace":
-        parent = Path(path).parent
+    if route != "through":
+        parent = Path(os.path.realpath(path) if route == "link" else path).parent
         if not parent.is_dir():
             raise UsageError(f"output {str(path)!r}: directory {str(parent)!r} does not exist")
     try:
@@ -500,9 +500,10 @@ def write_png(path, rgb):
 def _check_output(path, flag):
     """Fail fast, before any work, on an output path that cannot be written:
     ``-`` on a terminal; an empty path, a trailing ``/``, a directory, a
-    block device or a dangling link; a new or regular file whose directory is
-    missing or not writable; a device, FIFO or link that is not writable
-    (its directory need not be writable)."""
+    block device, a socket or a dangling link; a new or regular file (or
+    the regular file a link leads to) whose directory is missing or not
+    writable; a device or FIFO that is not writable (its directory need not
+    be writable)."""
     if path == STDOUT:
         try:
             _stdout_bytes()
@@ -519,7 +520,7 @@ def _check_output(path, flag):
         if not os.access(path, os.W_OK):
             raise UsageError(f"{flag} {str(path)!r} is not writable")
         return
-    parent = Path(path).parent
+    parent = Path(os.path.realpath(path) if route == "link" else path).parent
     if not parent.is_dir():
         what = "is not a directory" if parent.exists() else "does not exist"
         raise UsageError(f"{flag} {str(path)!r}: {str(parent)!r} {what}")
@@ -1071,13 +1072,15 @@ _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 #: levels in every channel, on at most `CHECK_TOLERANCE_FRACTION` of their
 #: pixels, are reported "within tolerance" and do not fail ``--check``.
 #: Bit-identity cannot hold across machines: numpy picks a SIMD loop for
-#: pow, exp, sin and log at run time (SSE4.2, AVX2 or AVX-512 here), and the
-#: loops round differently in the last bit.  A figure that plots such values
-#: (the U-curve's step grid from logspace, a roundoff measured in float64)
-#: then moves its lines by a small fraction of a pixel; the antialiased edge
-#: pixels and, along a dashed or dotted line, the phase of every dash change
-#: by some levels.  The bounds are about twice the largest difference
-#: measured between dispatch paths of the same code (README, ``--check``).
+#: pow, exp, sin and log at run time from what the CPU offers, and the loops
+#: round differently in the last bit.  A figure that plots such values (the
+#: U-curve's step grid from logspace, a roundoff measured in float64) then
+#: moves its lines by a small fraction of a pixel; only the antialiased edge
+#: pixels change, and, along a dashed or dotted line, the phase of every dash,
+#: each by part of the line's contrast.  A real change of a figure (a curve
+#: that moves by a pixel, a different image) changes more pixels or more
+#: levels than that.  `make test-baseline-simd` and ``figures --check`` across
+#: ``NPY_DISABLE_CPU_FEATURES`` settings show the differences that occur.
 CHECK_TOLERANCE_LEVELS = 32
 #: See `CHECK_TOLERANCE_LEVELS`: the most pixels, as a fraction of the
 #: figure, that may differ for it to count as within tolerance.
@@ -1501,9 +1504,9 @@ def main(argv=None) -> int:
     half-started kernel client can block forever in zmq's term().
 
     What `main` cannot cover is Python's own start-up before it runs (the
-    interpreter, site, and this module's standard-library imports: under
-    0.1 s here; importing this module loads neither numpy nor the
-    renderer): a Ctrl-C then gets Python's report.
+    interpreter, site, and this module's standard-library imports;
+    importing this module loads neither numpy nor the renderer): a Ctrl-C
+    then gets Python's report.
     """
     as_program = argv is None
     reported = []

@@ -3,10 +3,11 @@ JavaScript generator.
 
 Writes never rename over anything but a regular file: a path that is absent or
 a regular file is replaced atomically (a temporary file beside it, then
-`os.replace`); a character device, FIFO or socket (``/dev/null``), or a
-symbolic link whose target exists (``/dev/stdout``), is written through and
-stays what it was; anything else (a directory, a dangling link, a block
-device, a path ending in ``/``) is refused.  Reads take regular files only,
+`os.replace`), and so is the final target of a symbolic link to a regular
+file (the link stays a link); a character device or FIFO (``/dev/null``), or
+a link to one (``/dev/stdout`` on a pipe), is written through and stays what
+it was; anything else (a directory, a dangling link, a block device, a
+socket, a path ending in ``/``) is refused.  Reads take regular files only,
 up to a stated size, with a bounded read.
 """
 
@@ -51,16 +52,17 @@ def output_route(path):
     str
         ``"replace"`` if ``path`` is absent or a regular file (not a symbolic
         link): a temporary file in its directory is renamed onto it.
-        ``"through"`` if it is a character device, a FIFO or a socket, or a
-        symbolic link whose target exists and is not a directory: it is opened
-        for writing and written, and stays what it was.
+        ``"link"`` if it is a symbolic link to a regular file: the same, onto
+        the link's final target (the link stays a link).  ``"through"`` if it
+        is a character device or a FIFO, or a link to one: it is opened for
+        writing and written, and stays what it was.
 
     Raises
     ------
     RefusedPath
         An empty path, a path ending in ``/`` (or in a ``.`` or ``..``
-        component), a directory, a block device, or a symbolic link whose
-        target does not exist or is a directory.
+        component), a directory, a block device, a socket, or a symbolic
+        link whose target does not exist or is one of those.
     OSError
         If ``path`` cannot be examined (other than being absent), naming it.
     """
@@ -89,9 +91,12 @@ def output_route(path):
             raise RefusedPath(f"{text!r} is a symbolic link to a directory (give a file name)")
     if stat.S_ISDIR(st.st_mode):
         raise RefusedPath(f"{text!r} is a directory (give a file name)")
-    if stat.S_ISBLK(st.st_mode):
-        raise RefusedPath(f"{text!r} is a block device (accepted: a regular file, a character "
-                          "device, a FIFO, a socket, or a link to one)")
+    if stat.S_ISBLK(st.st_mode) or stat.S_ISSOCK(st.st_mode):
+        kind = "a block device" if stat.S_ISBLK(st.st_mode) else "a socket"
+        raise RefusedPath(f"{text!r} is {kind} (accepted: a new or regular file, a character "
+                          "device, a FIFO, or a link to one of those)")
+    if stat.S_ISREG(st.st_mode):
+        return "link"
     return "through"
 
 
@@ -113,8 +118,9 @@ def write_bytes(path, data):
     Replaced files are written atomically: on any exception (including
     KeyboardInterrupt) the temporary file is removed and ``path`` is untouched
     (absent if it did not exist); the file gets 0666 & ~umask permissions, not
-    mkstemp's 0600.  Written-through targets are opened without ``O_CREAT``
-    (a regular file behind a link is truncated first) and never unlinked.
+    mkstemp's 0600; a link to a regular file is followed to its final target,
+    which is replaced the same way.  Written-through targets (devices,
+    FIFOs) are opened without ``O_CREAT`` and never unlinked.
 
     Raises
     ------
@@ -125,20 +131,19 @@ def write_bytes(path, data):
         ``path``, never the temporary file.
     """
     target = Path(path)
-    if output_route(path) == "through":
+    route = output_route(path)
+    if route == "through":
         try:
-            regular = stat.S_ISREG(os.stat(path).st_mode)
-            fd = os.open(path, os.O_WRONLY | os.O_CLOEXEC | getattr(os, "O_NOCTTY", 0)
-                         | (os.O_TRUNC if regular else 0))
+            fd = os.open(path, os.O_WRONLY | os.O_CLOEXEC | getattr(os, "O_NOCTTY", 0))
             try:
                 _write_all(fd, data)
-                if regular:
-                    os.fsync(fd)
             finally:
                 os.close(fd)
         except OSError as exc:
             raise _named(exc, path) from None
         return
+    if route == "link":
+        target = Path(os.path.realpath(path))
     parent = target.parent if str(target.parent) else Path(".")
     try:
         fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{target.name[:64]}.", suffix=".part")
@@ -164,8 +169,8 @@ def write_bytes(path, data):
 def atomic_write(path, write):
     """Write a file from ``write(fileobj)`` (a callable given a binary file
     object): the bytes are prepared in memory first, then written by
-    `write_bytes` (atomically for a regular file, through a device, FIFO or
-    link).  An exception in ``write`` writes nothing.
+    `write_bytes` (atomically for a regular file or the file a link leads
+    to, through a device or FIFO).  An exception in ``write`` writes nothing.
 
     Raises
     ------

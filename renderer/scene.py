@@ -25,7 +25,7 @@ MIN_RADIUS = 1e-6
 #: phase pi k u far inside the accurate range of the deterministic sine.
 MAX_FREQUENCY = 1e3
 #: Largest accepted bump amplitude beta: at 100 the chart bump tilts every
-#: normal with |grad h| >= 0.01 by more than 45 degrees; beyond it the image no
+#: normal with |grad h| >= 0.01 by 45 degrees or more; beyond it the image no
 #: longer changes in any way that means something.
 MAX_BETA = 100.0
 #: Accepted central-difference steps eps (chart units).  Below 1e-16 the step
@@ -39,8 +39,8 @@ MIN_EPS, MAX_EPS = 1e-16, 0.25
 MAX_INTENSITY = 1e3
 #: Accepted Blinn/Phong exponents: n >= 1 keeps the lobe inside the cosine
 #: lobe (n < 1 widens it towards a step at the horizon); at 1e4 the Blinn
-#: highlight's half-width is about 0.7 degrees, narrower than a pixel of the
-#: default 256^2 frame.
+#: highlight's half-width, acos(2^(-1/n)) between N and the half vector, is
+#: about 0.7 degrees, already close to a mirror's.
 MIN_SHININESS, MAX_SHININESS = 1.0, 1e4
 
 #: Names accepted for ``Scene.height_field`` (seed §2).
