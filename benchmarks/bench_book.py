@@ -284,7 +284,7 @@ def _report(rows, source, failures, imported):
     for kind, seconds, executed, written, expected, ok, note in rows:
         head.append(f"| {kind} | {seconds:.1f} | {', '.join(executed) or '—'} | {', '.join(written) or '—'} | "
                     f"{', '.join(expected) or '—'} | {ok} | {note} |")
-    head += ["", "Targets (issue 6): cold ≤ 120 s, warm with nothing changed ≤ 15 s.", ""]
+    head += ["", "Targets: cold ≤ 120 s, warm with nothing changed ≤ 15 s.", ""]
     head.append("All checks passed." if not failures else "FAILED:\n\n" + "\n".join(f"- {f}" for f in failures))
     return "\n".join(head) + "\n"
 

@@ -1,5 +1,5 @@
 """Image-wide accuracy of the gradients and of the perturbed normal's
-beta-derivative, against mpmath references (issue 4, items 2 and 3).
+beta-derivative, against mpmath references.
 
 Working precision 50 digits: the references' own error is far below the
 float64 quantities they judge.

@@ -11,7 +11,7 @@ A check returns a `Verdict`:
 Each theorem also carries *wrong variants* (a flipped sign, a dropped factor,
 a wrong exponent) that the same checker must refute: the checker has teeth.
 (SymPy's ``sympy/vector`` tests and mpmath's precision discipline are the
-models; see STYLE.md.)
+models.)
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Run time against error for the ways of computing the chart gradient (issue 6, item 1).
+"""Run time against error for the ways of computing the chart gradient.
 
 For each height field, over the sphere-A pixels of a 256 x 256 default-scene
 frame, this module measures five ways of computing (h_u, h_v):

@@ -2,7 +2,7 @@
 lights, checker floor, bump-mapped sphere A) with a numeric (central
 difference) and a symbolic (exact gradient) pipeline.
 
-Public API (DESIGN.md)::
+Public API::
 
     from renderer import Scene, PointLight, render
     frame = render(Scene(), width=256, height=256, gradient="exact")

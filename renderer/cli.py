@@ -460,14 +460,7 @@ def atomic_write(path, write):
         stream.write(buf.getbuffer())
         stream.flush()
         return
-    try:
-        route = files.output_route(path)
-    except files.RefusedPath as exc:
-        raise UsageError(f"output {exc}") from None
-    if route != "through":
-        parent = Path(os.path.realpath(path) if route == "link" else path).parent
-        if not parent.is_dir():
-            raise UsageError(f"output {str(path)!r}: directory {str(parent)!r} does not exist")
+    _check_output(path, "output")
     try:
         files.atomic_write(path, write)
     except files.RefusedPath as exc:  # changed since checked

@@ -1,6 +1,6 @@
 """The two pipelines: one render function, differing only in the gradient.
 
-Data flow for a tile of pixels (see DESIGN.md):
+Data flow for a tile of pixels:
 
 camera -> intersections -> chamber code -> hit points and geometric normals
 -> sphere A only: chart (u, v), tangent frame, gradient, perturbed normal

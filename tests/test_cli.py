@@ -963,22 +963,17 @@ def no_run(out_dir, pages):
     raise AssertionError("pages were executed")
 
 
+#: Tamperings that name a figure file outside the directory or not a plain name.
+BAD_FILE_NAMES = {"dev-zero": "/dev/zero", "dotdot": "../../x", "dotdot-png": "../x.png",
+                  "subdir": "sub/fig.png", "nul": "fig\0.png", "double-dot-name": "..png"}
+
+
 def tamper(name):
     """Mutations of a valid check directory ``d`` with manifest ``doc``."""
     def apply(d, doc):
         f = doc["figures"][0]
-        if name == "dev-zero":
-            f["file"] = "/dev/zero"
-        elif name == "dotdot":
-            f["file"] = "../../x"
-        elif name == "dotdot-png":
-            f["file"] = "../x.png"
-        elif name == "subdir":
-            f["file"] = "sub/fig.png"
-        elif name == "nul":
-            f["file"] = "fig\0.png"
-        elif name == "double-dot-name":
-            f["file"] = "..png"
+        if name in BAD_FILE_NAMES:
+            f["file"] = BAD_FILE_NAMES[name]
         elif name == "bad-json":
             return "{not json"
         elif name == "deep-json":

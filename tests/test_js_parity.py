@@ -1,6 +1,6 @@
 """The §4 simulator's JavaScript renderer against Python's `render`, under node.
 
-Acceptance (issue 5): identical chamber codes and |dI| <= 1e-9 per channel, for
+Acceptance: identical chamber codes and |dI| <= 1e-9 per channel, for
 every field, both models, both pipelines, beta = 0, sphere B on and off, and eps
 from 1e-1 down to 1e-10.  The central pipeline is held to more than that: its
 gradient must be the same bits, because both sides difference the same values of

@@ -1,7 +1,7 @@
 """Input validation of `Scene`, `PointLight` and `render`, the seed's defaults, and a
 property test over valid scenes.
 
-DESIGN.md: invalid input raises ValueError (TypeError for a wrong type) naming
+The contract: invalid input raises ValueError (TypeError for a wrong type) naming
 the field, the value and what is accepted.  Each case below matches the
 field's name at the start of the message ("Scene.<field>" or
 "PointLight.<field>"), so an error that names another field does not pass.
@@ -27,7 +27,7 @@ SC9 = dict(R=1.0, e=4.0, Cb=(0.5, 0.5, 1.3), R2=0.32, b_on=True, floor_on=True,
            ambient=(0.15, 0.15, 0.16), matA=(0.63, 0.19, 0.16), matB=(0.33, 0.44, 0.62),
            ka=0.1, kd=0.7, ks=0.5, shin=32.0, model='blinn',
            alpha=0.25, hf='ridges', ku=8.0, kv=4.0, beta=0.35, eps=1e-3)
-# Scene field <- seed name (DESIGN.md, "Scene fields").
+# Scene field <- seed name (the `Scene` docstring gives both).
 SEED_NAMES = dict(radius_a="R", camera_z="e", center_b="Cb", radius_b="R2", sphere_b="b_on",
                   floor="floor_on", ambient="ambient", albedo_a="matA", albedo_b="matB",
                   ka="ka", kd="kd", ks="ks", shininess="shin", model="model",
@@ -246,7 +246,7 @@ def scene_or_rejection(kwargs, field):
     (dict(center_b=(1e160, 0.0, 0.0)), "center_b"),
 ])
 def test_huge_finite_values_raise_value_error_not_overflow(kwargs, field):
-    """DESIGN.md: invalid input raises ValueError naming the field.  (A finite value
+    """Invalid input raises ValueError naming the field.  (A finite value
     whose square overflows made Scene() raise OverflowError from `x ** 2`.)"""
     try:
         scene_or_rejection(kwargs, field)
@@ -260,7 +260,7 @@ def test_huge_finite_values_raise_value_error_not_overflow(kwargs, field):
     (dict(beta=1e308), "beta"),
 ])
 def test_a_scene_that_validates_renders_finite_outputs(kwargs, field):
-    """'Nothing returns NaN silently' (DESIGN.md): a Scene is either rejected by
+    """Nothing returns NaN silently: a Scene is either rejected by
     validation, naming the field, or renders without an exception and with a
     finite image and gradient."""
     scene = scene_or_rejection(kwargs, field)

@@ -1,5 +1,5 @@
 """Each skip of the renderer is output-identical, bit for bit, to the path that
-does not skip (issue 6, item 3), and each skip really skips: instrumentation
+does not skip, and each skip really skips: instrumentation
 counts the work, and the same counters show the reference path doing it.
 """
 

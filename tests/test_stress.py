@@ -1,4 +1,4 @@
-"""Stress tests: where floating point hurts (issue 4, item 4, in part).
+"""Stress tests: where floating point hurts.
 
 Each test states what it found; the numbers are asserted against bounds that a
 wrong renderer would break.

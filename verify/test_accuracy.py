@@ -1,6 +1,5 @@
 """Image-wide accuracy against mpmath (proofs/accuracy.py), with teeth."""
 
-import numpy as np
 import pytest
 
 from proofs.accuracy import gradient_accuracy, image_beta_order, normal_beta_derivative_residual
