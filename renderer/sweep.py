@@ -1,14 +1,13 @@
 """An eps sweep that computes everything but sphere A's shading once.
 
-Everything above the gradient in the pipeline depends on geometry alone (the
-theorem "bump moves no boundary", proved in proofs/no_boundary.py and checked
-by verify/ with independent full renders).  So for a sweep over the step eps
-of the numeric pipeline, the rays, the chamber codes, the hit points, the
-shadow rays and the shading of every object other than sphere A are computed
-once per tile; per eps only sphere A's central-difference gradient, perturbed
-normal and colour are recomputed.  The symbolic frame is rendered alongside in
-the same pass.  tests/test_skips.py shows every frame equal, bit for bit, to a
-separate `render` call.
+Everything above the gradient depends on geometry alone (the theorem "bump
+moves no boundary", proved in proofs/no_boundary.py and checked by verify/
+with independent full renders).  So for a sweep over the step eps of the
+numeric pipeline the kernel (`renderer.kernel.sweep_rows`) computes, per
+pixel, the ray, the chamber, the hit point, the shadow rays and the colour of
+every object but sphere A once, and re-shades sphere A per step; the exact
+frame is rendered in the same pass.  tests/test_skips.py shows every frame
+equal, bit for bit, to a separate `render` call.
 """
 
 from __future__ import annotations
@@ -17,18 +16,13 @@ import collections.abc
 import itertools
 import math
 import numbers
-import threading
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import fields
-from .geometry import image_plane
-from .heap import keep_heap
+from . import kernel
 from .ledger import compare
-from .render import (FLOOR, SPHERE_A, Frame, _check_args, _check_workers, _gradient, quiet_underflow,
-                     _lights, _nearest_hit, _prepare_a, _run_tiles, _shade, _shading_normal, _view,
-                     _put_rows, _store_rgb, _surfaces, _tile_rows, _trace_shadows)
+from .render import Frame, check_args, image_plane, threads
 from .scene import MAX_EPS, MIN_EPS
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS"]
@@ -83,7 +77,6 @@ def _check_steps(eps_values):
     return tuple(steps)
 
 
-@quiet_underflow
 def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=None):
     """Render the symbolic frame and one numeric frame per step, sharing the geometry.
 
@@ -94,10 +87,10 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     eps_values : ordered iterable of float in [1e-16, 0.25] (1 to 64 of them), chart units
     width, height : int in [1, 8192]
     zoom : float in [1, 1e6], keyword-only (see `render`)
-    workers : int >= 1, keyword-only (see `render`)
+    workers : int in [1, 64] or None, keyword-only (see `render`)
     progress : callable(done, total), keyword-only, optional
-        Called after each tile with the pixels done so far and the total
-        (for a progress bar); it must not raise.
+        Called with the pixels done and the total, (W H, W H), once the
+        frames are rendered (kept for callers that show a progress bar).
 
     Returns
     -------
@@ -115,79 +108,20 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
 
     Notes
     -----
-    Memory: one frame (about 57 bytes per pixel) per step plus one.  Source:
-    seed §4 (the simulator's ε slider) and Cell 2; the licence is the theorem
-    "bump moves no boundary" (seed §3).
+    Memory: one frame (57 bytes per pixel) per step plus one.  Source: seed
+    §4 (the simulator's ε slider) and Cell 2.
     """
-    scene, width, height, _, zoom = _check_args(scene, width, height, "exact", zoom)
-    keep_heap()
-    workers = _check_workers(workers)
+    scene, width, height, _, zoom = check_args(scene, width, height, "exact", zoom)
     steps = _check_steps(eps_values)
-    scenes = [scene.replace(eps=e) for e in steps]
-
-    def blank(gradient, s):
-        return Frame(image=np.zeros((height, width, 3)), chamber=np.zeros((height, width), np.uint8),
-                     kink=np.zeros((height, width), bool), grad=np.zeros((height, width, 2)),
-                     scene=s, gradient=gradient)
-
-    symbolic = blank("exact", scene)
-    numeric = [blank("central", s) for s in scenes]
-    frames = [symbolic] + numeric
-    flat = [(f.image.reshape(-1, 3), f.chamber.reshape(-1), f.kink.reshape(-1), f.grad.reshape(-1, 2))
-            for f in frames]
+    n = len(steps) + 1
+    images, grads = np.zeros((n, height, width, 3)), np.zeros((n, height, width, 2))
+    chamber, kink = np.zeros((height, width), np.uint8), np.zeros((height, width), bool)
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
-    rows = _tile_rows(width, height, workers)
-    def tile(j0):
-        j1 = min(height, j0 + rows)
-        X = np.tile(x, j1 - j0)
-        Y = np.repeat(y[j0:j1], width)
-        sl = slice(j0 * width, j1 * width)
-        t, code = _nearest_hit(scene, X, Y, grid=(x, y[j0:j1]))
-        for image, chamber, _, _ in flat:
-            chamber[sl] = code
-        for surf in _surfaces(scene, X, Y, t, code, grid=(x, y[j0:j1])):
-            flat_kind = surf.kind == FLOOR
-            lights = _lights(scene, surf.P, surf.N, surf.floor_blocks, True, flat_kind)
-            for light in lights:
-                # Every attached pixel, once: the shading normal varies with eps.
-                _trace_shadows(light, surf.spheres, light.attached, surf.P[:2] if flat_kind else None)
-            rows_idx = surf.idx + j0 * width
-            if surf.kind != SPHERE_A:
-                col = _shade(scene, surf.P, surf.N, surf.albedo, lights, flat_kind)
-                for image, _, _, _ in flat:
-                    _store_rgb(image, rows_idx, col)
-                continue
-            # Sphere A: the stencil's eps-free factors, once for all steps (and
-            # the kink flag read off them), the exact frame, then one re-shade
-            # per step.
-            base = fields.central_stencil(scene.height_field).base(*surf.uv, scene.k_u, scene.k_v)
-            Ns = _prepare_a(scene, surf, "exact", True, True, True, base)
-            kink = surf.kink
-            view = _view(scene, surf.P, lights)
-            for k, (s, (image, _, kink_out, grad_out)) in enumerate(zip([scene] + scenes, flat)):
-                if k > 0:
-                    surf.grad = _gradient(s, surf, "central", s.eps, base)
-                    Ns = _shading_normal(s, surf, surf.grad)
-                _store_rgb(image, rows_idx, _shade(s, surf.P, Ns, surf.albedo, lights, view=view))
-                _put_rows(grad_out, rows_idx, np.stack(surf.grad, axis=-1))
-                kink_out[rows_idx] = kink
-    done = {"pixels": 0}
-    lock = threading.Lock()
-
-    def tile_and_report(j0):
-        tile(j0)
-        if progress is not None:
-            with lock:
-                done["pixels"] += (min(height, j0 + rows) - j0) * width
-                progress(done["pixels"], width * height)
-
-    _run_tiles([lambda j0=j0: tile_and_report(j0) for j0 in range(0, height, rows)], workers)
-    # The ledgers, side by side on the same threads.
-    census = [None] * len(numeric)
-
-    def ledger(i):
-        census[i] = compare(numeric[i], symbolic)
-
-    _run_tiles([lambda i=i: ledger(i) for i in range(len(numeric))], workers)
-    census = tuple(census)
-    return Sweep(eps=steps, numeric=tuple(numeric), symbolic=symbolic, census=census)
+    with threads(workers):
+        kernel.sweep_rows(kernel.params(scene), x, y, np.array(steps), images, chamber, kink, grads)
+    frames = [Frame(images[f], chamber.copy(), kink.copy(), grads[f], scene.replace(eps=e) if f else scene,
+                    "central" if f else "exact") for f, e in enumerate((scene.eps,) + steps)]
+    if progress is not None:
+        progress(width * height, width * height)
+    census = tuple(compare(frame, frames[0]) for frame in frames[1:])
+    return Sweep(eps=steps, numeric=tuple(frames[1:]), symbolic=frames[0], census=census)

@@ -1,7 +1,7 @@
-"""Tests of the ``symrender`` command line (renderer/cli.py).
+"""Tests of the ``symrender`` command line (proofs/cli.py).
 
 Every subcommand runs on real input through ``main([...])``; the installed
-console script and ``python -m renderer`` run once each.  Outputs are checked
+console script and ``python -m proofs`` run once each.  Outputs are checked
 against an independent route (the library called directly), PNGs are checked
 byte for byte and chunk by chunk, the atomic write is interrupted on purpose,
 and bad inputs (hand-picked and hypothesis-generated) must each give exit
@@ -29,9 +29,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import renderer.cli as cli
+import proofs.cli as cli
+from proofs.cli import main
 from renderer import PointLight, Scene, compare, render, sweep, to_srgb
-from renderer.cli import main
 
 SMALL = "48x40"
 
@@ -451,7 +451,7 @@ def test_dash_on_a_terminal_is_refused(capsys, monkeypatch, argv):
 def test_stdout_and_dev_stdout_in_a_real_process(tmp_path):
     """Through a real pipe: ``-o -`` gives the PNG alone on stdout; ``-o
     /dev/stdout`` (a link) writes through it; a pseudo-terminal is refused."""
-    cmd = [sys.executable, "-m", "renderer", "render", "--size", "8x8", "-o"]
+    cmd = [sys.executable, "-m", "proofs", "render", "--size", "8x8", "-o"]
     ref = tmp_path / "ref.png"
     assert main(["render", "--size", "8x8", "-o", str(ref)]) == 0
     dash = subprocess.run([*cmd, "-"], capture_output=True)
@@ -685,7 +685,7 @@ def test_console_script_and_module(tmp_path):
     proc = subprocess.run([str(exe), "render", "--size", "16x12", "-o", str(out)],
                           capture_output=True, text=True)
     assert proc.returncode == 0 and "ledger" in proc.stdout and out.exists()
-    proc = subprocess.run([sys.executable, "-m", "renderer", "render", "--size", "0x0", "-o", str(out)],
+    proc = subprocess.run([sys.executable, "-m", "proofs", "render", "--size", "0x0", "-o", str(out)],
                           capture_output=True, text=True)
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
 

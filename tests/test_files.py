@@ -18,8 +18,8 @@ import threading
 
 import pytest
 
+from proofs.cli import main
 from renderer import files
-from renderer.cli import main
 
 from .test_cli import returns_without_blocking
 

@@ -1,4 +1,4 @@
-"""Ctrl-C at any moment of a ``symrender`` command (renderer/cli.py, `main`).
+"""Ctrl-C at any moment of a ``symrender`` command (proofs/cli.py, `main`).
 
 Each test starts the installed console script in a session of its own (as a
 shell starts a foreground job), waits for a chosen moment, and sends SIGINT
@@ -18,7 +18,9 @@ during ``render`` of a large frame once a render worker process exists;
 during ``sweep``; during ``verify`` while its pytest child runs; during
 ``figures`` while the notebook kernel starts, and while it runs the page's
 cell, with one Ctrl-C and with two 50 ms apart.  In-process: `main` ignores a
-second Ctrl-C during the clean-up and restores the previous handler.  The
+second Ctrl-C during the clean-up and restores the previous handler.
+``import proofs.cli`` (what the console script does before `main` runs)
+loads none of numpy, sympy, matplotlib or the renderer.  The
 checkers are shown to fail on a leaked process (in the session, and in a
 session of its own) and on a traceback.
 
@@ -244,7 +246,7 @@ def test_interrupt_during_start_up_imports(tmp_path, library, delay):
 
     The clock starts inside `main`, not at the spawn: before `main` runs,
     Python itself starts (interpreter, site, the console script's ``import
-    renderer.cli``, which loads no numpy), and a SIGINT
+    proofs.cli``, which loads no numpy), and a SIGINT
     then is Python's to report."""
     run = Run("render", "--size", "64x64", "-o", "out.png", cwd=tmp_path)
     run.wait_until(lambda: run.maps(library), 10, f"{library} being imported")
@@ -254,10 +256,18 @@ def test_interrupt_during_start_up_imports(tmp_path, library, delay):
 
 
 def test_importing_the_command_line_loads_no_numpy():
-    code = ("import sys, renderer.cli; "
-            "print(sorted(m for m in ('numpy', 'sympy', 'matplotlib') if m in sys.modules))")
+    """``import proofs.cli`` loads neither numpy, sympy nor matplotlib, nor any
+    of the renderer (importing the package ``renderer`` loads numpy): the
+    command line starts at once, and `main` does the heavy imports where it
+    handles a Ctrl-C.  Wrong variant: once the command line touches numpy
+    (through its lazy ``np``), the same check sees it."""
+    code = ("import sys, proofs.cli as cli\n"
+            "heavy = ('numpy', 'sympy', 'matplotlib', 'renderer', 'renderer.render')\n"
+            "print(sorted(m for m in heavy if m in sys.modules))\n"
+            "cli.np.float64\n"
+            "print(sorted(m for m in heavy if m in sys.modules))\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.strip() == "[]"
+    assert out.splitlines() == ["[]", "['numpy']"], out
 
 
 # ------------------------------------------------------------------ commands at work
@@ -321,7 +331,7 @@ def test_main_in_process_restores_the_handler_and_ignores_a_second_ctrl_c(capsys
     """main([...]) in this process: a SIGINT during the command gives 130 and
     the one line; a second SIGINT during its clean-up is ignored (no second
     line, the clean-up finishes); the previous handler is back afterwards."""
-    import renderer.cli as cli
+    import proofs.cli as cli
 
     cleaned = []
 
@@ -346,56 +356,3 @@ def test_main_in_process_restores_the_handler_and_ignores_a_second_ctrl_c(capsys
     assert signal.getsignal(signal.SIGINT) is before
     capsys.readouterr()
 
-
-def test_package_exports_lazily():
-    """``import renderer`` loads no numpy; the public names, the submodules
-    and dir() work as with eager imports, and ``renderer.render`` stays the
-    function after the module renderer.render is imported."""
-    code = """
-import importlib, sys, types
-import renderer
-assert "numpy" not in sys.modules and "renderer.render" not in sys.modules
-module = importlib.import_module("renderer.render")
-assert isinstance(module, types.ModuleType) and renderer.render is module.render
-from renderer import Scene, render, sweep, fields, compare
-import renderer.sweep
-assert renderer.sweep is importlib.import_module("renderer.sweep").sweep and callable(sweep)
-assert isinstance(fields, types.ModuleType) and renderer.detmath.__name__ == "renderer.detmath"
-assert set(renderer.__all__) <= set(dir(renderer))
-assert render(Scene(), 8, 8).image.shape == (8, 8, 3)
-try:
-    renderer.no_such_name
-except AttributeError:
-    pass
-else:
-    raise AssertionError("no AttributeError")
-print("ok")
-"""
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
-    assert proc.stdout == "ok\n", proc.stderr
-
-
-def _type_checking_imports(source):
-    """{name: submodule} of the ``from .x import ...`` statements under
-    ``if TYPE_CHECKING:`` in a module's source."""
-    import ast
-    found = {}
-    for node in ast.parse(source).body:
-        if isinstance(node, ast.If) and getattr(node.test, "id", None) == "TYPE_CHECKING":
-            for stmt in node.body:
-                if isinstance(stmt, ast.ImportFrom) and stmt.level == 1:
-                    found.update({alias.name: stmt.module for alias in stmt.names})
-    return found
-
-
-def test_lazy_names_are_declared_as_static_imports():
-    """The book's dependency finder reads import statements; the lazy table
-    must be exactly what the TYPE_CHECKING imports say, or a page that uses
-    ``from renderer import Scene`` would not be re-run when scene.py changes."""
-    import renderer
-    source = (ROOT / "renderer" / "__init__.py").read_text(encoding="utf-8")
-    assert _type_checking_imports(source) == renderer._EXPORTS
-    assert set(renderer._EXPORTS) == set(renderer.__all__)
-    # A table entry without its import statement is caught.
-    wrong = source.replace("    from .sweep import Sweep, sweep\n", "")
-    assert _type_checking_imports(wrong) != renderer._EXPORTS

@@ -26,7 +26,7 @@ or staging directory is left, and no child process (the notebook kernel of
 ``figures``, which jupyter_client starts in a session of its own, is shut
 down; the pytest child of ``verify`` gets the same Ctrl-C and is waited for;
 the render worker processes are stopped).  A second Ctrl-C is ignored, so it
-cannot cut the clean-up short.  ``import renderer.cli`` loads neither numpy
+cannot cut the clean-up short.  ``import proofs.cli`` loads neither numpy
 nor the renderer, which `main` imports under its SIGINT handling; only a
 Ctrl-C while Python itself starts, before `main` runs, is reported by
 Python (see `main`).
@@ -67,26 +67,31 @@ import tempfile
 import tomllib
 from pathlib import Path
 
-from . import files
-
-# numpy, sympy, matplotlib and the renderer's modules are imported where they
-# are first used (the functions below import renderer.scene, .render, .ledger
-# and .sweep), never by ``import renderer.cli``: the console script imports
-# this module before `main` runs, and a Ctrl-C during a heavy import at that
-# point would print a traceback.  In `main` it is handled.
-
-
-class _Numpy:
-    """Stands for the numpy module until the first ``np.<name>``, which
-    imports numpy and puts the module itself in this one's globals."""
-
-    def __getattr__(self, name):
-        import numpy
-        globals()["np"] = numpy
-        return getattr(numpy, name)
+# numpy, sympy, matplotlib and the renderer (any ``renderer`` module, even
+# renderer.files: importing the package loads numpy) are imported where they
+# are first used (the functions below import renderer.scene, .render, .ledger,
+# .sweep and proofs.ucurve), never by ``import proofs.cli``: the console script
+# imports this module before `main` runs, and a Ctrl-C during a heavy import at
+# that point would print a traceback.  In `main` it is handled.
 
 
-np = _Numpy()
+class _Module:
+    """Stands for the module ``module`` under the global name ``name`` until
+    the first ``<name>.<attribute>``, which imports the module and puts the
+    module itself in this one's globals."""
+
+    def __init__(self, name, module):
+        self._name, self._module = name, module
+
+    def __getattr__(self, attribute):
+        import importlib
+        module = importlib.import_module(self._module)
+        globals()[self._name] = module
+        return getattr(module, attribute)
+
+
+np = _Module("np", "numpy")
+files = _Module("files", "renderer.files")
 
 __all__ = ["main", "load_scene", "parse_size", "parse_eps", "write_png", "atomic_write",
            "MAX_PIXELS", "FRAME_PIXEL_BUDGET", "MAX_UCURVE_STEPS"]
@@ -109,7 +114,7 @@ def _field_names():
     """(`Scene` field names, `PointLight` field names), in declaration order."""
     from dataclasses import fields as dataclass_fields
 
-    from .scene import PointLight, Scene
+    from renderer.scene import PointLight, Scene
     return (tuple(f.name for f in dataclass_fields(Scene)),
             tuple(f.name for f in dataclass_fields(PointLight)))
 
@@ -169,7 +174,7 @@ def parse_size(text):
         reported with the range).  The pixel limits of a command are checked
         separately, still before any allocation.
     """
-    from .render import MAX_SIDE
+    from renderer.render import MAX_SIDE
     m = re.fullmatch(r"\s*([-+]?\d+)\s*[xX]\s*([-+]?\d+)\s*", str(text))
     if not m:
         raise UsageError(f"--size must be WxH with integer sides in [1, {MAX_SIDE}] (e.g. 256x256), "
@@ -232,7 +237,7 @@ def parse_eps(text, *, name="--eps", max_steps=None, bounds=None):
         count outside [1, max_steps].
     """
     if max_steps is None:
-        from .sweep import MAX_STEPS as max_steps
+        from renderer.sweep import MAX_STEPS as max_steps
     text = str(text).strip()
     if ":" in text:
         parts = text.split(":")
@@ -308,7 +313,7 @@ def _check_ints(source, name, value):
 
 def _scene_mapping(data, source):
     """Turn a TOML mapping into `Scene` keyword arguments, refusing unknown keys."""
-    from .scene import PointLight
+    from renderer.scene import PointLight
     scene_fields, light_fields = _field_names()
     out = {}
     for key, value in data.items():
@@ -387,7 +392,7 @@ def load_scene(path=None, sets=()):
     TypeError, ValueError
         From `Scene`/`PointLight` validation (the message names the field).
     """
-    from .scene import Scene
+    from renderer.scene import Scene
     scene_fields = _field_names()[0]
     data = {}
     if path is not None:
@@ -561,8 +566,8 @@ def view_image(view, selected, numeric, symbolic):
     black elsewhere.  kink: the selected image sRGB-encoded and dimmed to 40 %,
     the exact frame's crease band painted white.
     """
-    from .ledger import to_srgb
-    from .render import SPHERE_A
+    from renderer.ledger import to_srgb
+    from renderer.render import SPHERE_A
     if view == "shaded":
         return to_srgb(selected.image)
     if view == "difference":
@@ -581,8 +586,8 @@ def view_image(view, selected, numeric, symbolic):
 
 
 def _cmd_render(args, out):
-    from .ledger import compare
-    from .render import render
+    from renderer.ledger import compare
+    from renderer.render import render
     width, height = args.size
     _check_budget(width, height, 2, "render")
     _check_output(args.output, "-o")
@@ -607,7 +612,7 @@ _CENSUS_COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink"
 def _run_sweep(scene, steps, width, height):
     """`renderer.sweep` over ``steps``, with a progress bar over its tiles when
     stderr is a terminal."""
-    from .sweep import sweep
+    from renderer.sweep import sweep
     if not _show_progress():
         return list(sweep(scene, steps, width, height).census)
     with _progress(total=width * height, desc="sweep", unit="px", unit_scale=True) as bar:
@@ -649,7 +654,7 @@ def _cmd_sweep(args, out):
 
 
 def _measure_ucurve(args):
-    from proofs.ucurve import UCurve, measure
+    from .ucurve import UCurve, measure
     steps = np.asarray(args.eps, dtype=np.float64)
     kw = dict(field=args.field, u=args.u, v=args.v, component=args.component, k_u=args.k_u, k_v=args.k_v)
     if not _show_progress() or steps.size < 50:
@@ -703,7 +708,7 @@ def _cmd_ucurve(args, out):
         x = getattr(args, name)
         if not (math.isfinite(x) and 0.0 <= x <= 1.0):
             raise UsageError(f"--{name} must be a number in [0, 1], got {x!r}")
-    from .scene import MAX_FREQUENCY
+    from renderer.scene import MAX_FREQUENCY
     for name in ("k_u", "k_v"):
         x = getattr(args, name)
         if not (math.isfinite(x) and 0.0 < x <= MAX_FREQUENCY):
@@ -1345,9 +1350,9 @@ def _float_arg(text):
 
 def build_parser():
     """The argparse parser of ``symrender`` (one subparser per command)."""
-    from .render import MAX_SIDE
-    from .scene import HEIGHT_FIELDS
-    from .sweep import MAX_STEPS
+    from renderer.render import MAX_SIDE
+    from renderer.scene import HEIGHT_FIELDS
+    from renderer.sweep import MAX_STEPS
     limits = (f"Limits: each side 1..{MAX_SIDE}; render at most {MAX_PIXELS:,} pixels (4096^2); "
               f"sweep at most (steps + 1) * W * H <= {FRAME_PIXEL_BUDGET:,}; refused before allocating.")
     p = _Parser(prog="symrender", description="Render, sweep, measure and verify the Chapter-9 scene.",
@@ -1379,7 +1384,7 @@ def build_parser():
                                    "eps, max and RMS |dI| on A, flips, mean |dI| on and off the kink band.",
                        epilog=limits)
     scene_opts(s)
-    from .scene import MAX_EPS, MIN_EPS
+    from renderer.scene import MAX_EPS, MIN_EPS
     s.add_argument("--eps", type=_eps_arg(MAX_STEPS, (MIN_EPS, MAX_EPS)), default=parse_eps("1e-1:1e-8:8"),
                    metavar="a:b:n|e1,e2,..",
                    help=f"n log-spaced steps from a to b, or a comma list; 1..{MAX_STEPS} steps, each in "
@@ -1449,7 +1454,7 @@ def _stop_rendering():
     """Before the program exits: stop the renderer's worker processes, if it
     was used (the tiles still queued on its threads were cancelled when the
     interrupt reached the render, `renderer.render._run_tiles`)."""
-    workers = sys.modules.get(f"{__package__}.workers")
+    workers = sys.modules.get("renderer.workers")
     if workers is not None:
         workers.shutdown()
 
@@ -1462,7 +1467,7 @@ def main(argv=None) -> int:
     argv : list of str or None
         The arguments after the program name.  None means ``sys.argv[1:]``
         and running as the program (the console script, ``python -m
-        renderer``): see Ctrl-C below.
+        proofs``): see Ctrl-C below.
 
     Returns
     -------
