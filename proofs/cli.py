@@ -25,7 +25,8 @@ and returns 130, after the clean-up has run: no output file, temporary file
 or staging directory is left, and no child process (the notebook kernel of
 ``figures``, which jupyter_client starts in a session of its own, is shut
 down; the pytest child of ``verify`` gets the same Ctrl-C and is waited for;
-the render worker processes are stopped).  A second Ctrl-C is ignored, so it
+a render under way finishes first: it runs compiled,
+without Python's signal checks).  A second Ctrl-C is ignored, so it
 cannot cut the clean-up short.  ``import proofs.cli`` loads neither numpy
 nor the renderer, which `main` imports under its SIGINT handling; only a
 Ctrl-C while Python itself starts, before `main` runs, is reported by
@@ -595,7 +596,8 @@ def _cmd_render(args, out):
         out = sys.stderr
     scene = load_scene(args.scene, args.set)
     frames = {}
-    for g in _progress(("central", "exact"), desc="render", unit="frame"):
+    wanted = ("central", "exact") + (() if args.gradient in ("central", "exact") else (args.gradient,))
+    for g in _progress(wanted, desc="render", unit="frame"):
         frames[g] = render(scene, width, height, gradient=g)
     numeric, symbolic = frames["central"], frames["exact"]
     selected = frames[args.gradient]
@@ -610,7 +612,7 @@ _CENSUS_COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink"
 
 
 def _run_sweep(scene, steps, width, height):
-    """`renderer.sweep` over ``steps``, with a progress bar over its tiles when
+    """`renderer.sweep` over ``steps``, with a progress bar when
     stderr is a terminal."""
     from renderer.sweep import sweep
     if not _show_progress():
@@ -751,8 +753,7 @@ def _sigint_noted():
     `main`'s first, and the caller raises the interrupt.
 
     pytest runs in symrender's process group, so a Ctrl-C at the terminal
-    reaches it as well: it stops its tests, tears down (its render workers
-    stop with it) and exits with 2, and symrender waits for that.  Raising
+    reaches it as well: it stops its tests, tears down and exits with 2, and symrender waits for that.  Raising
     at once instead would make `subprocess.run` kill pytest a quarter
     second later, cutting its clean-up short.  (A SIGINT sent to symrender
     alone does not stop pytest: the run then ends first.)  Outside `main`'s
@@ -883,7 +884,7 @@ def _stop_kernel(loop, run, client):
 
     Cancelling the run unwinds nbclient's kernel context, whose clean-up
     (jupyter_client's graceful shutdown) interrupts the kernel and asks it to
-    shut down, so that its own clean-up runs (it stops its render workers);
+    shut down, so that its own clean-up runs;
     a kernel still busy (say, drawing a figure) after half of
     ``shutdown_wait_time`` (5 s) gets SIGTERM, after all of it SIGKILL.  A
     Ctrl-C while the kernel was still starting comes before nbclient arms
@@ -1373,7 +1374,7 @@ def build_parser():
     scene_opts(r)
     r.add_argument("--size", type=_size_arg, default=(256, 256), metavar="WxH",
                    help=f"image size, each side 1..{MAX_SIDE}, W*H <= {MAX_PIXELS:,} (default 256x256)")
-    r.add_argument("--gradient", choices=("exact", "central"), default="exact",
+    r.add_argument("--gradient", choices=("exact", "central", "footprint"), default="exact",
                    help="pipeline shown by the shaded, bump and kink views (default exact)")
     r.add_argument("--view", choices=VIEWS, default="shaded",
                    help="shaded image; difference clip(100|dI|); bump |grad h|; kink band over dimmed image")
@@ -1450,15 +1451,6 @@ def _interrupt_once(signum, frame):
     raise KeyboardInterrupt
 
 
-def _stop_rendering():
-    """Before the program exits: stop the renderer's worker processes, if it
-    was used (the tiles still queued on its threads were cancelled when the
-    interrupt reached the render, `renderer.render._run_tiles`)."""
-    workers = sys.modules.get("renderer.workers")
-    if workers is not None:
-        workers.shutdown()
-
-
 def main(argv=None) -> int:
     """Run ``symrender`` with ``argv`` (default ``sys.argv[1:]``); return the exit code.
 
@@ -1492,10 +1484,8 @@ def main(argv=None) -> int:
     ``symrender: interrupted`` on stderr and 130.
 
     Called with an argument list (in-process use), `main` restores the
-    previous SIGINT handler when it returns.  Run as the program, it stops
-    the renderer's worker processes before it returns (`_stop_rendering`;
-    queued tiles were cancelled by the interrupted render), and leaves
-    SIGINT ignored, as the process is about to exit: a Ctrl-C during the
+    previous SIGINT handler when it returns.  Run as the program, it leaves
+    SIGINT ignored when it returns, as the process is about to exit: a Ctrl-C during the
     interpreter's exit would print an "Exception ignored" traceback.  After
     an interrupt it ends the process with ``os._exit(130)`` once its own
     clean-up has run, without the interpreter's finalizers: that of a
@@ -1534,10 +1524,6 @@ def main(argv=None) -> int:
                     signal.signal(signal.SIGINT, signal.SIG_IGN)
             except KeyboardInterrupt:  # the first one, just before it was ignored
                 code = interrupted()
-            try:
-                _stop_rendering()
-            except Exception:  # noqa: BLE001 - the command's result stands
-                pass
             if code == 130:
                 # Our clean-up has run (outputs removed, kernel killed); the
                 # interpreter's own finalizers are not waited for: one of a

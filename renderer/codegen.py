@@ -93,6 +93,7 @@ def python_source():
         call = f"{name}({', '.join(lead + [f'{a}[i]' for a in args])})"
         out.append(f"\n\n{_NJIT}\ndef {name}_array({', '.join(lead + args)}, out):\n"
                    f"    \"\"\"`{name}` at each index i of 1-D float64 arrays; out: ({k}, n) float64.\"\"\"\n"
+                   f"    if out.shape[0] != {k}:\n        raise ValueError(\"out must have {k} rows\")\n"
                    f"    for i in range(out.shape[1]):\n        {targets} = {call}\n")
     return "".join(out)
 

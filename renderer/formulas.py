@@ -159,15 +159,16 @@ def _footprint():
 #: 0.0005 where that is 0), here also where it is undefined, and at most 0.25.
 FOOTPRINT = _footprint()
 
-#: What the generator prints: name -> (arguments, outputs, per-field?).  A
-#: per-field entry maps each field to its outputs and becomes one function
-#: with the field's code (`FIELD_CODES`) as first argument.
+#: What the generator prints: name -> (arguments, outputs).  A per-field entry
+#: maps each field to its outputs and becomes one function with the field's
+#: code (`FIELD_CODES`) as first argument.  The gradients also return the
+#: crease flag, whose sines they share (sympy's cse finds them).
 _UV = (u, v, k_u, k_v)
 _N = (N_x, N_y, N_z)
 FUNCTIONS = {
     "height": (_UV, {n: (f,) for n, f in HEIGHT.items()}),
-    "exact_gradient": (_UV, GRADIENT),
-    "central_gradient": (_UV + (eps_u, eps_v), CENTRAL),
+    "exact_gradient": (_UV, {n: GRADIENT[n] + (KINK_BAND[n],) for n in HEIGHT}),
+    "central_gradient": (_UV + (eps_u, eps_v), {n: CENTRAL[n] + (KINK_BAND[n],) for n in HEIGHT}),
     "kink_band": (_UV, {n: (f,) for n, f in KINK_BAND.items()}),
     "chart": (_N, CHART),
     "tangent_frame": (_N + (sin_phi,), TANGENT_FRAME),

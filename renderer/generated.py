@@ -24,6 +24,8 @@ def height(field, u, v, k_u, k_v):
 @njit(cache=True, error_model="numpy")
 def height_array(field, u, v, k_u, k_v, out):
     """`height` at each index i of 1-D float64 arrays; out: (1, n) float64."""
+    if out.shape[0] != 1:
+        raise ValueError("out must have 1 rows")
     for i in range(out.shape[1]):
         out[0, i] = height(field, u[i], v[i], k_u[i], k_v[i])
 
@@ -35,7 +37,7 @@ def exact_gradient(field, u, v, k_u, k_v):
         x1 = u*x0
         x2 = math.pi*k_v
         x3 = v*x2
-        return (x0*math.sin(x3)*math.cos(x1), x2*math.sin(x1)*math.cos(x3))
+        return (x0*math.sin(x3)*math.cos(x1), x2*math.sin(x1)*math.cos(x3), False)
     if field == 1:  # ridges
         x0 = math.pi*k_v
         x1 = v*x0
@@ -44,18 +46,20 @@ def exact_gradient(field, u, v, k_u, k_v):
         x4 = u*x3
         x5 = math.sin(x4)
         x6 = (0.0 if x2*x5 == 0 else math.copysign(1, x2*x5))
-        return (x2*x3*x6*math.cos(x4), x0*x5*x6*math.cos(x1))
+        return (x2*x3*x6*math.cos(x4), x0*x5*x6*math.cos(x1), (abs(x2) < 0.03) or (abs(x5) < 0.03))
     if field == 2:  # rings
         x0 = 2*math.pi*k_v
-        return (0.0, x0*math.cos(v*x0))
+        return (0.0, x0*math.cos(v*x0), False)
     raise ValueError("unknown field code")
 
 
 @njit(cache=True, error_model="numpy")
 def exact_gradient_array(field, u, v, k_u, k_v, out):
-    """`exact_gradient` at each index i of 1-D float64 arrays; out: (2, n) float64."""
+    """`exact_gradient` at each index i of 1-D float64 arrays; out: (3, n) float64."""
+    if out.shape[0] != 3:
+        raise ValueError("out must have 3 rows")
     for i in range(out.shape[1]):
-        out[0, i], out[1, i] = exact_gradient(field, u[i], v[i], k_u[i], k_v[i])
+        out[0, i], out[1, i], out[2, i] = exact_gradient(field, u[i], v[i], k_u[i], k_v[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -69,7 +73,7 @@ def central_gradient(field, u, v, k_u, k_v, eps_u, eps_v):
         x1 = math.pi*k_v
         x2 = math.sin(v*x1)
         x3 = math.sin(u*x0)
-        return ((1/2)*(-x2*math.sin(u_m*x0) + x2*math.sin(u_p*x0))/eps_u, (-x3*math.sin(v_m*x1) + x3*math.sin(v_p*x1))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
+        return ((1/2)*(-x2*math.sin(u_m*x0) + x2*math.sin(u_p*x0))/eps_u, (-x3*math.sin(v_m*x1) + x3*math.sin(v_p*x1))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), False)
     if field == 1:  # ridges
         u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
         u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
@@ -79,22 +83,24 @@ def central_gradient(field, u, v, k_u, k_v, eps_u, eps_v):
         x1 = math.pi*k_v
         x2 = math.sin(v*x1)
         x3 = math.sin(u*x0)
-        return ((1/2)*(-abs(x2*math.sin(u_m*x0)) + abs(x2*math.sin(u_p*x0)))/eps_u, (-abs(x3*math.sin(v_m*x1)) + abs(x3*math.sin(v_p*x1)))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
+        return ((1/2)*(-abs(x2*math.sin(u_m*x0)) + abs(x2*math.sin(u_p*x0)))/eps_u, (-abs(x3*math.sin(v_m*x1)) + abs(x3*math.sin(v_p*x1)))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), (abs(x2) < 0.03) or (abs(x3) < 0.03))
     if field == 2:  # rings
         u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
         u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
         v_p = min(1, eps_v + v)
         v_m = max(0, -eps_v + v)
         x0 = 2*math.pi*k_v
-        return (0.0, (-math.sin(v_m*x0) + math.sin(v_p*x0))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
+        return (0.0, (-math.sin(v_m*x0) + math.sin(v_p*x0))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), False)
     raise ValueError("unknown field code")
 
 
 @njit(cache=True, error_model="numpy")
 def central_gradient_array(field, u, v, k_u, k_v, eps_u, eps_v, out):
-    """`central_gradient` at each index i of 1-D float64 arrays; out: (2, n) float64."""
+    """`central_gradient` at each index i of 1-D float64 arrays; out: (3, n) float64."""
+    if out.shape[0] != 3:
+        raise ValueError("out must have 3 rows")
     for i in range(out.shape[1]):
-        out[0, i], out[1, i] = central_gradient(field, u[i], v[i], k_u[i], k_v[i], eps_u[i], eps_v[i])
+        out[0, i], out[1, i], out[2, i] = central_gradient(field, u[i], v[i], k_u[i], k_v[i], eps_u[i], eps_v[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -111,6 +117,8 @@ def kink_band(field, u, v, k_u, k_v):
 @njit(cache=True, error_model="numpy")
 def kink_band_array(field, u, v, k_u, k_v, out):
     """`kink_band` at each index i of 1-D float64 arrays; out: (1, n) float64."""
+    if out.shape[0] != 1:
+        raise ValueError("out must have 1 rows")
     for i in range(out.shape[1]):
         out[0, i] = kink_band(field, u[i], v[i], k_u[i], k_v[i])
 
@@ -125,6 +133,8 @@ def chart(N_x, N_y, N_z):
 @njit(cache=True, error_model="numpy")
 def chart_array(N_x, N_y, N_z, out):
     """`chart` at each index i of 1-D float64 arrays; out: (3, n) float64."""
+    if out.shape[0] != 3:
+        raise ValueError("out must have 3 rows")
     for i in range(out.shape[1]):
         out[0, i], out[1, i], out[2, i] = chart(N_x[i], N_y[i], N_z[i])
 
@@ -141,6 +151,8 @@ def tangent_frame(N_x, N_y, N_z, sin_phi):
 @njit(cache=True, error_model="numpy")
 def tangent_frame_array(N_x, N_y, N_z, sin_phi, out):
     """`tangent_frame` at each index i of 1-D float64 arrays; out: (6, n) float64."""
+    if out.shape[0] != 6:
+        raise ValueError("out must have 6 rows")
     for i in range(out.shape[1]):
         out[0, i], out[1, i], out[2, i], out[3, i], out[4, i], out[5, i] = tangent_frame(N_x[i], N_y[i], N_z[i], sin_phi[i])
 
@@ -159,6 +171,8 @@ def perturbed_normal_chart(N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, h_
 @njit(cache=True, error_model="numpy")
 def perturbed_normal_chart_array(N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, h_u, h_v, beta, out):
     """`perturbed_normal_chart` at each index i of 1-D float64 arrays; out: (3, n) float64."""
+    if out.shape[0] != 3:
+        raise ValueError("out must have 3 rows")
     for i in range(out.shape[1]):
         out[0, i], out[1, i], out[2, i] = perturbed_normal_chart(N_x[i], N_y[i], N_z[i], et_x[i], et_y[i], et_z[i], ep_x[i], ep_y[i], ep_z[i], h_u[i], h_v[i], beta[i])
 
@@ -178,6 +192,8 @@ def perturbed_normal_surface(N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, 
 @njit(cache=True, error_model="numpy")
 def perturbed_normal_surface_array(N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, h_u, h_v, beta, h, R, sin_phi, out):
     """`perturbed_normal_surface` at each index i of 1-D float64 arrays; out: (3, n) float64."""
+    if out.shape[0] != 3:
+        raise ValueError("out must have 3 rows")
     for i in range(out.shape[1]):
         out[0, i], out[1, i], out[2, i] = perturbed_normal_surface(N_x[i], N_y[i], N_z[i], et_x[i], et_y[i], et_z[i], ep_x[i], ep_y[i], ep_z[i], h_u[i], h_v[i], beta[i], h[i], R[i], sin_phi[i])
 
@@ -209,5 +225,7 @@ def footprint(x, y, dx, dy, camera_z, P_x, P_y, P_z, N_x, N_y, N_z, et_x, et_y, 
 @njit(cache=True, error_model="numpy")
 def footprint_array(x, y, dx, dy, camera_z, P_x, P_y, P_z, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, R, sin_phi, out):
     """`footprint` at each index i of 1-D float64 arrays; out: (2, n) float64."""
+    if out.shape[0] != 2:
+        raise ValueError("out must have 2 rows")
     for i in range(out.shape[1]):
         out[0, i], out[1, i] = footprint(x[i], y[i], dx[i], dy[i], camera_z[i], P_x[i], P_y[i], P_z[i], N_x[i], N_y[i], N_z[i], et_x[i], et_y[i], et_z[i], ep_x[i], ep_y[i], ep_z[i], R[i], sin_phi[i])

@@ -44,13 +44,12 @@ FLOOR_LIGHT, FLOOR_DARK = 0.85, 0.15
 #: Floor under |h| in Blinn's half-vector quotient (|h| = 0 only where w = -v).
 TINY = 1e-300
 
-#: The scene as the kernel reads it (`params`): floats, bools, int codes and
-#: the lights as an (n, 6) float64 array of position and colour.
-Params = namedtuple("Params", "camera_z radius_a center_b radius_b sphere_b floor lights ambient "
-                              "albedo_a albedo_b ka kd ks shininess phong floor_tint field k_u k_v "
-                              "beta surface")
+#: The scene as the pixel code reads it: floats, bools, triples, int codes
+#: (the lights are a separate array, see `params`).
+Params = namedtuple("Params", "camera_z radius_a center_b radius_b sphere_b floor ambient albedo_a "
+                              "albedo_b ka kd ks shininess phong floor_tint field k_u k_v beta surface")
 
-FORMULAS_DIGEST = "e8a03aa67b22655643b57341607433b2ab38e335efd147aa2ba29fae3d88ebf2"  # of generated.py, written by renderer/codegen.py
+FORMULAS_DIGEST = "d182f0a360428cc958e81d6c6f081962ce53a4a1eb859912cac481b216a4d55c"  # of generated.py, written by renderer/codegen.py
 
 
 # ---- the kernel's own steps: intersection, shadows, shading ---------------------
@@ -100,9 +99,8 @@ def segment_blocked(wx, wy, wz, w2, L, cx, cy, cz, r):
 @njit(cache=True, error_model="numpy")
 def nearest_hit(s, x, y, skip):
     """(t, chamber) of the nearest positive hit; ties go to A, then B, then the floor."""
-    t, code = sphere_hit(x, y, s.camera_z, 0.0, 0.0, 0.0, s.radius_a), BACKGROUND
-    if t < math.inf:
-        code = SPHERE_A
+    t = sphere_hit(x, y, s.camera_z, 0.0, 0.0, 0.0, s.radius_a)
+    code = SPHERE_A if t < math.inf else BACKGROUND
     if s.sphere_b or not skip:
         tb = sphere_hit(x, y, s.camera_z, s.center_b[0], s.center_b[1], s.center_b[2], s.radius_b)
         if s.sphere_b and tb < t:
@@ -113,99 +111,121 @@ def nearest_hit(s, x, y, skip):
 
 
 @njit(cache=True, error_model="numpy")
-def surface(s, x, y, t, code):
-    """Hit point P, geometric normal N and albedo of a hit (geometry only)."""
+def surface(s, x, y, t, code, checker):
+    """Hit point P, geometric normal N and albedo of a hit (geometry only).
+
+    ``checker`` = sin(pi x) sin(pi y): a floor hit is the pixel centre (x, y, 0)
+    itself (t = 1), so the caller takes the sines once per column and row."""
     P = (t * x, t * y, s.camera_z * (1.0 - t))
     if code == SPHERE_A:
         r = s.radius_a
-        return P, (P[0] / r, P[1] / r, P[2] / r), (s.albedo_a[0], s.albedo_a[1], s.albedo_a[2])
+        return P, (P[0] / r, P[1] / r, P[2] / r), s.albedo_a
     if code == SPHERE_B:
         c, r = s.center_b, s.radius_b
-        return P, ((P[0] - c[0]) / r, (P[1] - c[1]) / r, (P[2] - c[2]) / r), (s.albedo_b[0], s.albedo_b[1],
-                                                                             s.albedo_b[2])
+        return P, ((P[0] - c[0]) / r, (P[1] - c[1]) / r, (P[2] - c[2]) / r), s.albedo_b
     # Checker: light squares where sin(pi x) sin(pi y) >= 0 (seed Cell 1).
-    base = FLOOR_LIGHT if math.sin(math.pi * P[0]) * math.sin(math.pi * P[1]) >= 0.0 else FLOOR_DARK
+    base = FLOOR_LIGHT if checker >= 0.0 else FLOOR_DARK
     rg = base * (1.0 - s.floor_tint)
     return P, (0.0, 0.0, 1.0), (rg, rg, base)
 
 
 @njit(cache=True, error_model="numpy")
-def attached(s, L, P, N, code):
-    """The geometric normal faces the light and the floor plane does not
-    separate P from it (floor on, P not on the floor)."""
-    facing = N[0] * (L[0] - P[0]) + N[1] * (L[1] - P[1]) + N[2] * (L[2] - P[2]) > 0.0
-    if s.floor and code != FLOOR:
-        if (L[2] < 0.0 and P[2] > 0.0) or (L[2] > 0.0 and P[2] < 0.0):
-            return False
-    return facing
+def light(lights, k):
+    """Position and colour of light k, as two triples (scalar reads: no array views)."""
+    return (lights[k, 0], lights[k, 1], lights[k, 2]), (lights[k, 3], lights[k, 4], lights[k, 5])
 
 
 @njit(cache=True, error_model="numpy")
-def occluded(s, L, P, code, skip):
-    """A blocker sphere (B for A, A for B, both for the floor) cuts the segment P-L."""
+def reach(s, L, P, N, code, skip, gate, Ns):
+    """Unit vector w from P to the light L and whether the light reaches P:
+    the geometric normal faces it (attached shadow), the floor plane does not
+    separate them (floor on, P off the floor), and no blocker sphere (B for A,
+    A for B, both for the floor) cuts the segment (cast shadow).  Geometry
+    only.  With ``gate`` the shadow ray is not traced where Ns . w <= 0, where
+    `light_term` adds nothing (then False is returned); with ``skip`` sphere B
+    is tested only if it is on."""
     wx, wy, wz = L[0] - P[0], L[1] - P[1], L[2] - P[2]
+    if not N[0] * wx + N[1] * wy + N[2] * wz > 0.0:
+        return (0.0, 0.0, 0.0), False
+    if s.floor and code != FLOOR and ((L[2] < 0.0 and P[2] > 0.0) or (L[2] > 0.0 and P[2] < 0.0)):
+        return (0.0, 0.0, 0.0), False
     w2 = wx * wx + wy * wy + wz * wz
-    hit = False
-    if code != SPHERE_A:
-        hit = segment_blocked(wx, wy, wz, w2, L, 0.0, 0.0, 0.0, s.radius_a)
+    inv = 1.0 / math.sqrt(w2)
+    w = (wx * inv, wy * inv, wz * inv)
+    if gate and not Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0:
+        return w, False
+    if code != SPHERE_A and segment_blocked(wx, wy, wz, w2, L, 0.0, 0.0, 0.0, s.radius_a):
+        return w, False
     if code != SPHERE_B and (s.sphere_b or not skip):
         c = s.center_b
-        hit_b = segment_blocked(wx, wy, wz, w2, L, c[0], c[1], c[2], s.radius_b)
-        hit = hit or (s.sphere_b and hit_b)
-    return hit
+        if segment_blocked(wx, wy, wz, w2, L, c[0], c[1], c[2], s.radius_b) and s.sphere_b:
+            return w, False
+    return w, True
 
 
 @njit(cache=True, error_model="numpy")
-def light_term(s, k, P, Ns, albedo, rgb):
-    """Add light k's Lambert and Blinn/Phong terms at P with shading normal Ns to rgb."""
-    L, col = s.lights[k, :3], s.lights[k, 3:]
-    wx, wy, wz = L[0] - P[0], L[1] - P[1], L[2] - P[2]
-    inv = 1.0 / math.sqrt(wx * wx + wy * wy + wz * wz)
-    wx, wy, wz = wx * inv, wy * inv, wz * inv
-    mu = Ns[0] * wx + Ns[1] * wy + Ns[2] * wz
-    if not mu > 0.0:
-        return
+def view_vector(s, P):
+    """Unit vector from P to the eye (0, 0, camera_z)."""
     vx, vy, vz = -P[0], -P[1], s.camera_z - P[2]
     inv = 1.0 / math.sqrt(vx * vx + vy * vy + vz * vz)
-    vx, vy, vz = vx * inv, vy * inv, vz * inv
-    if s.phong:
-        m2 = 2.0 * mu
-        spec_cos = (m2 * Ns[0] - wx) * vx + (m2 * Ns[1] - wy) * vy + (m2 * Ns[2] - wz) * vz
-    else:
-        hx, hy, hz = wx + vx, wy + vy, wz + vz
-        hn = max(math.sqrt(hx * hx + hy * hy + hz * hz), TINY)
-        spec_cos = (Ns[0] * hx + Ns[1] * hy + Ns[2] * hz) / hn
-    # Clamped before the power: rounding can put the cosine an ulp above 1.
-    spec = min(max(spec_cos, 0.0), 1.0) ** s.shininess * s.ks
-    diffuse = mu * s.kd
-    for c in range(3):
-        rgb[c] += col[c] * (diffuse * albedo[c] + spec)
+    return vx * inv, vy * inv, vz * inv
 
 
 @njit(cache=True, error_model="numpy")
-def shade(s, P, N, Ns, albedo, code, skip, rgb):
-    """Ambient plus every light that reaches P (seed Cell 1, ``shade1``), clipped to [0, 1]."""
-    for c in range(3):
-        rgb[c] = s.ka * s.ambient[c]
-    for k in range(s.lights.shape[0]):
-        L = s.lights[k, :3]
-        if not attached(s, L, P, N, code):
-            continue
-        if skip:
-            # No shadow ray where the light adds nothing: Ns . w <= 0.
-            wx, wy, wz = L[0] - P[0], L[1] - P[1], L[2] - P[2]
-            if not Ns[0] * wx + Ns[1] * wy + Ns[2] * wz > 0.0:
-                continue
-        if not occluded(s, L, P, code, skip):
-            light_term(s, k, P, Ns, albedo, rgb)
-    for c in range(3):
-        rgb[c] = min(max(rgb[c], 0.0), 1.0)
+def specular_axis(s, w, view):
+    """The geometry of the highlight, independent of the shading normal Ns:
+    (a, w . v) with the specular cosine Ns . a (Blinn: a = the unit half
+    vector (w + v) / |w + v|) or 2 (Ns . w)(Ns . a) - w . v (Phong: a = v,
+    the reflected light (2 (Ns . w) Ns - w) . v)."""
+    if s.phong:
+        return view, w[0] * view[0] + w[1] * view[1] + w[2] * view[2]
+    hx, hy, hz = w[0] + view[0], w[1] + view[1], w[2] + view[2]
+    inv = 1.0 / max(math.sqrt(hx * hx + hy * hy + hz * hz), TINY)   # |h| = 0 only where w = -v
+    return (hx * inv, hy * inv, hz * inv), 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def light_term(s, color, w, axis, wv, Ns, albedo):
+    """A light's Lambert and Blinn/Phong terms (r, g, b) at a point it reaches:
+    ``w`` the unit vector to the light, (``axis``, ``wv``) its `specular_axis`."""
+    mu = Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2]
+    if not mu > 0.0:
+        return 0.0, 0.0, 0.0
+    spec_cos = Ns[0] * axis[0] + Ns[1] * axis[1] + Ns[2] * axis[2]
+    if s.phong:
+        spec_cos = 2.0 * mu * spec_cos - wv
+    # Clamped before the power: rounding can put the cosine an ulp above 1.
+    base = min(max(spec_cos, 0.0), 1.0)
+    # An integral exponent (the seed's 32) by repeated squaring (numba's
+    # float ** int) rather than libm's pow, which took a sixth of the frame.
+    n = int(s.shininess)
+    spec = (base ** n if n == s.shininess else base ** s.shininess) * s.ks
+    diffuse = mu * s.kd
+    return (color[0] * (diffuse * albedo[0] + spec), color[1] * (diffuse * albedo[1] + spec),
+            color[2] * (diffuse * albedo[2] + spec))
+
+
+@njit(cache=True, error_model="numpy")
+def shade(s, lights, P, N, Ns, albedo, code, skip):
+    """Ambient plus every light that reaches P (seed Cell 1, ``shade1``): (r, g, b) clipped to [0, 1]."""
+    r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
+    view = (0.0, 0.0, 0.0)
+    for k in range(lights.shape[0]):
+        L, color = light(lights, k)
+        w, lit = reach(s, L, P, N, code, skip, skip, Ns)
+        if lit:
+            if view[2] == 0.0:          # > 0 once computed: P is below the eye
+                view = view_vector(s, P)
+            axis, wv = specular_axis(s, w, view)
+            dr, dg, db = light_term(s, color, w, axis, wv, Ns, albedo)
+            r, g, b = r + dr, g + dg, b + db
+    return min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0), min(max(b, 0.0), 1.0)
 
 
 @njit(cache=True, error_model="numpy")
 def gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi):
-    """(h_u, h_v) by ``method``: exact, central with step eps, or central with
-    the pixel's footprint as step (pixel spacing dx, dy on the image plane)."""
+    """(h_u, h_v, crease flag) by ``method``: exact, central with step eps, or
+    central with the pixel's footprint as steps (pixel spacing dx, dy)."""
     if method == EXACT:
         return exact_gradient(s.field, u, v, s.k_u, s.k_v)
     if method == CENTRAL:
@@ -229,7 +249,7 @@ def shading_normal(s, N, frame, hu, hv, u, v, sin_phi):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def render_rows(s, xs, ys, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
+def render_rows(prm, lights, xs, ys, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
                 image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out):
     """Render every pixel (rows in parallel) into the preallocated outputs.
 
@@ -237,95 +257,135 @@ def render_rows(s, xs, ys, dx, dy, method, eps, skip, want_kink, want_grad, want
     chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2) when wanted;
     t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) when ``want_geo`` (the GBuffer).
     """
+    sin_x = np.sin(np.pi * xs)
     for j in prange(ys.shape[0]):
-        rgb = np.zeros(3)
+        s, sin_y = unpack(prm), math.sin(math.pi * ys[j])
         for i in range(xs.shape[0]):
             x, y = xs[i], ys[j]
             t, code = nearest_hit(s, x, y, skip)
             chamber[j, i] = code
+            if want_geo:
+                t_out[j, i] = t
             if code == BACKGROUND:
-                if want_geo:
-                    t_out[j, i] = t
                 continue
-            P, N, albedo = surface(s, x, y, t, code)
+            P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
             Ns = N
             if code == SPHERE_A:
                 u, v, sin_phi = chart(N[0], N[1], N[2])
                 frame = tangent_frame(N[0], N[1], N[2], sin_phi)
                 if want_grad or want_geo or s.beta != 0.0 or not skip:
-                    hu, hv = gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
+                    hu, hv, flag = gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
                     Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
                     if want_grad:
                         grad[j, i, 0], grad[j, i, 1] = hu, hv
-                    if want_geo:
-                        uv_out[j, i, 0], uv_out[j, i, 1] = u, v
-                if want_kink or not skip:
+                elif want_kink:
                     flag = kink_band(s.field, u, v, s.k_u, s.k_v)
-                    if want_kink:
-                        kink[j, i] = flag
-            shade(s, P, N, Ns, albedo, code, skip, rgb)
-            image[j, i, 0], image[j, i, 1], image[j, i, 2] = rgb[0], rgb[1], rgb[2]
-            if want_geo:
-                t_out[j, i] = t
-                for c in range(3):
+                if want_kink:
+                    kink[j, i] = flag
+                if want_geo:
+                    uv_out[j, i, 0], uv_out[j, i, 1] = u, v
+            image[j, i, 0], image[j, i, 1], image[j, i, 2] = shade(s, lights, P, N, Ns, albedo, code, skip)
+            for c in range(3):
+                if want_geo:
                     P_out[j, i, c], N_out[j, i, c], Ns_out[j, i, c] = P[c], N[c], Ns[c]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def sweep_rows(s, xs, ys, steps, images, chamber, kink, grads):
+def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
     """The exact frame (index 0) and one central frame per step (1, 2, ...).
 
     Per pixel the geometry, the crease flag and the shadow rays are computed
     once (they do not depend on the gradient); sphere A is re-shaded per step.
     images (S+1, H, W, 3), grads (S+1, H, W, 2); chamber, kink (H, W).
     """
-    n = s.lights.shape[0]
+    n, sin_x = lights.shape[0], np.sin(np.pi * xs)
     for j in prange(ys.shape[0]):
-        rgb = np.zeros(3)
-        reach = np.zeros(n, dtype=np.bool_)
+        s, sin_y = unpack(prm), math.sin(math.pi * ys[j])
+        # Per light: the unit vector w to it, its specular axis and w . v, and
+        # whether it reaches the pixel (1.0) or not (0.0).
+        geo = np.zeros((n, 8))
         for i in range(xs.shape[0]):
             x, y = xs[i], ys[j]
             t, code = nearest_hit(s, x, y, True)
             chamber[j, i] = code
             if code == BACKGROUND:
                 continue
-            P, N, albedo = surface(s, x, y, t, code)
+            P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
             if code != SPHERE_A:
-                shade(s, P, N, N, albedo, code, True, rgb)
+                rgb = shade(s, lights, P, N, N, albedo, code, True)
                 for f in range(images.shape[0]):
-                    for c in range(3):
-                        images[f, j, i, c] = rgb[c]
+                    images[f, j, i, 0], images[f, j, i, 1], images[f, j, i, 2] = rgb
                 continue
             u, v, sin_phi = chart(N[0], N[1], N[2])
             frame = tangent_frame(N[0], N[1], N[2], sin_phi)
-            kink[j, i] = kink_band(s.field, u, v, s.k_u, s.k_v)
+            view = view_vector(s, P)
             for k in range(n):
-                L = s.lights[k, :3]
-                reach[k] = attached(s, L, P, N, code) and not occluded(s, L, P, code, True)
+                # Every shadow ray of an attached light, once (Ns varies with the step).
+                w, lit = reach(s, light(lights, k)[0], P, N, code, True, False, N)
+                axis, wv = specular_axis(s, w, view)
+                geo[k, 0], geo[k, 1], geo[k, 2], geo[k, 3], geo[k, 4], geo[k, 5] = w + axis
+                geo[k, 6], geo[k, 7] = wv, 1.0 if lit else 0.0
             for f in range(images.shape[0]):
                 if f == 0:
-                    hu, hv = exact_gradient(s.field, u, v, s.k_u, s.k_v)
+                    hu, hv, flag = exact_gradient(s.field, u, v, s.k_u, s.k_v)
+                    kink[j, i] = flag
                 else:
-                    hu, hv = central_gradient(s.field, u, v, s.k_u, s.k_v, steps[f - 1], steps[f - 1])
+                    hu, hv, flag = central_gradient(s.field, u, v, s.k_u, s.k_v, steps[f - 1], steps[f - 1])
                 Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
-                for c in range(3):
-                    rgb[c] = s.ka * s.ambient[c]
+                r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
                 for k in range(n):
-                    if reach[k]:
-                        light_term(s, k, P, Ns, albedo, rgb)
-                for c in range(3):
-                    images[f, j, i, c] = min(max(rgb[c], 0.0), 1.0)
+                    if geo[k, 7] != 0.0:
+                        dr, dg, db = light_term(s, light(lights, k)[1], (geo[k, 0], geo[k, 1], geo[k, 2]),
+                                                (geo[k, 3], geo[k, 4], geo[k, 5]), geo[k, 6], Ns, albedo)
+                        r, g, b = r + dr, g + dg, b + db
+                images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0)
+                images[f, j, i, 2] = min(max(b, 0.0), 1.0)
                 grads[f, j, i, 0], grads[f, j, i, 1] = hu, hv
 
 
+@njit(cache=True, error_model="numpy")
+def ledger_sums(num_image, sym_image, num_chamber, sym_chamber, band):
+    """One pass over two frames for `renderer.compare`: over the pixels on
+    sphere A in both, max |dI|, the sum of |dI|^2, the pixel count, the sum
+    and count of |dI| on and off the crease ``band`` (channel values); and the
+    number of pixels whose chamber differs.  Images (H, W, C) float64,
+    chambers (H, W) uint8, band (H, W) bool."""
+    top, sq, pixels, on, n_on, off, n_off, flips = 0.0, 0.0, 0, 0.0, 0, 0.0, 0, 0
+    for j in range(num_chamber.shape[0]):
+        for i in range(num_chamber.shape[1]):
+            a, b = num_chamber[j, i], sym_chamber[j, i]
+            flips += a != b
+            if a != SPHERE_A or b != SPHERE_A:
+                continue
+            pixels += 1
+            for c in range(num_image.shape[2]):
+                d = abs(num_image[j, i, c] - sym_image[j, i, c])
+                top, sq = max(top, d), sq + d * d
+                if band[j, i]:
+                    on, n_on = on + d, n_on + 1
+                else:
+                    off, n_off = off + d, n_off + 1
+    return top, sq, pixels, on, n_on, off, n_off, flips
+
+
 def params(scene, skip=True):
-    """The kernel's `Params` of a validated `renderer.Scene`.  With ``skip``
-    the lights of zero colour are left out (they add exactly 0)."""
+    """The kernel's arguments for a validated `renderer.Scene`: the `Params`
+    flattened to a float64 array (`unpack` reads it back inside the kernel)
+    and the lights as an (n, 6) float64 array of position and colour.  With
+    ``skip`` the lights of zero colour are left out (they add exactly 0)."""
+    p = Params(scene.camera_z, scene.radius_a, scene.center_b, scene.radius_b, scene.sphere_b, scene.floor,
+               scene.ambient, scene.albedo_a, scene.albedo_b, scene.ka, scene.kd, scene.ks, scene.shininess,
+               scene.model == "phong", scene.floor_tint, FIELD_CODES[scene.height_field], scene.k_u,
+               scene.k_v, scene.beta, scene.bump == "surface")
+    flat = [c for f in p for c in (f if isinstance(f, tuple) else (f,))]
     lights = [tuple(l.position) + tuple(l.color) for l in scene.lights if any(l.color) or not skip]
-    vec = lambda a: np.array(a, dtype=np.float64)  # noqa: E731
-    return Params(float(scene.camera_z), float(scene.radius_a), vec(scene.center_b),
-                  float(scene.radius_b), bool(scene.sphere_b), bool(scene.floor),
-                  vec(lights).reshape(-1, 6), vec(scene.ambient), vec(scene.albedo_a), vec(scene.albedo_b),
-                  float(scene.ka), float(scene.kd), float(scene.ks), float(scene.shininess),
-                  scene.model == "phong", float(scene.floor_tint), FIELD_CODES[scene.height_field],
-                  float(scene.k_u), float(scene.k_v), float(scene.beta), scene.bump == "surface")
+    return np.array(flat, dtype=np.float64), np.array(lights, dtype=np.float64).reshape(-1, 6)
+
+
+@njit(cache=True, error_model="numpy")
+def unpack(a):
+    """The `Params` of the flat array `params` made (scalars and triples:
+    numba's parallel loops take arrays, the pixel code reads fields)."""
+    return Params(a[0], a[1], (a[2], a[3], a[4]), a[5], a[6] != 0.0, a[7] != 0.0, (a[8], a[9], a[10]),
+                  (a[11], a[12], a[13]), (a[14], a[15], a[16]), a[17], a[18], a[19], a[20], a[21] != 0.0,
+                  a[22], int(a[23]), a[24], a[25], a[26], a[27] != 0.0)

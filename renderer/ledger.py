@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from .render import SPHERE_A, Frame
+from .kernel import ledger_sums
+from .render import Frame
 
 __all__ = ["Ledger", "compare", "to_srgb"]
 
@@ -61,23 +63,17 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
         raise ValueError(
             f"frames must have the same shape, got {numeric.image.shape} and {symbolic.image.shape}"
         )
-    on_a = (numeric.chamber == SPHERE_A) & (symbolic.chamber == SPHERE_A)
-    # |dI| on sphere A only, pixels in raster order.
-    da = np.abs(numeric.image[on_a] - symbolic.image[on_a])
-    band = symbolic.kink[on_a]
-
-    def mean(m):
-        return float(da[m].mean()) if m.any() else float("nan")
-
-    with np.errstate(under="ignore"):       # a tiny |dI| squared rounds to 0, as it should
-        rms = float(np.sqrt(np.mean(da**2))) if da.size else 0.0
+    arrays = [np.ascontiguousarray(a) for a in (numeric.image, symbolic.image, numeric.chamber,
+                                                   symbolic.chamber, symbolic.kink)]
+    top, sq, pixels, on, n_on, off, n_off, flips = ledger_sums(*arrays)
+    entries = n_on + n_off
     return Ledger(
-        max_abs=float(da.max()) if da.size else 0.0,
-        rms=rms,
-        flips=int(np.count_nonzero(numeric.chamber != symbolic.chamber)),
-        pixels_a=int(da.shape[0]),
-        mean_abs_kink=mean(band),
-        mean_abs_off_kink=mean(~band),
+        max_abs=float(top),
+        rms=math.sqrt(sq / entries) if entries else 0.0,
+        flips=int(flips),
+        pixels_a=int(pixels),
+        mean_abs_kink=on / n_on if n_on else math.nan,
+        mean_abs_off_kink=off / n_off if n_off else math.nan,
     )
 
 

@@ -48,7 +48,7 @@ def exact_gradient(name, u, v, k_u, k_v):
     """(h_u, h_v), sympy's derivative (`renderer.formulas.GRADIENT`); for ridges
     sign(f) f' (one of the one-sided derivatives on a crease, 0 where the
     float64 factor is exactly 0).  Two float64 arrays of the broadcast shape."""
-    return tuple(_evaluate(G.exact_gradient_array, 2, (_field(name),), (u, v, k_u, k_v)))
+    return tuple(_evaluate(G.exact_gradient_array, 3, (_field(name),), (u, v, k_u, k_v))[:2])
 
 
 def central_gradient(name, u, v, k_u, k_v, eps, eps_v=None):
@@ -68,7 +68,7 @@ def central_gradient(name, u, v, k_u, k_v, eps, eps_v=None):
         e = np.asarray(e, dtype=np.float64)
         if not np.all((e > 0.0) & (e < 1.0)):
             raise ValueError(f"{label} must be in (0, 1), got {e if e.ndim else float(e)!r}")
-    return tuple(_evaluate(G.central_gradient_array, 2, (_field(name),), (u, v, k_u, k_v, eps, eps_v)))
+    return tuple(_evaluate(G.central_gradient_array, 3, (_field(name),), (u, v, k_u, k_v, eps, eps_v))[:2])
 
 
 def kink_band(name, u, v, k_u, k_v):

@@ -159,7 +159,7 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     # Pixel spacing on the image plane, the footprint's ray differentials.
     dx, dy = (x[1] - x[0] if width > 1 else 2 * abs(x[0])), (y[0] - y[1] if height > 1 else 2 * abs(y[0]))
     with threads(workers):
-        kernel.render_rows(kernel.params(scene, skip), x, y, float(dx), float(dy), GRADIENTS.index(gradient),
+        kernel.render_rows(*kernel.params(scene, skip), x, y, float(dx), float(dy), GRADIENTS.index(gradient),
                            float(scene.eps), skip, want_kink, want_grad, want_geo, *out.values(), *geo.values())
     return x, y, out, geo
 

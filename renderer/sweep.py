@@ -118,7 +118,7 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     chamber, kink = np.zeros((height, width), np.uint8), np.zeros((height, width), bool)
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     with threads(workers):
-        kernel.sweep_rows(kernel.params(scene), x, y, np.array(steps), images, chamber, kink, grads)
+        kernel.sweep_rows(*kernel.params(scene), x, y, np.array(steps), images, chamber, kink, grads)
     frames = [Frame(images[f], chamber.copy(), kink.copy(), grads[f], scene.replace(eps=e) if f else scene,
                     "central" if f else "exact") for f, e in enumerate((scene.eps,) + steps)]
     if progress is not None:
