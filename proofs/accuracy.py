@@ -14,8 +14,9 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, fields, gbuffer, render
-from renderer.render import SPHERE_A, central_gradient
+from renderer import Scene, gbuffer, pointwise, render
+from renderer import formulas as F
+from renderer.render import SPHERE_A
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
            "image_beta_order", "DIGITS"]
@@ -40,9 +41,8 @@ class GradientAccuracy:
 @lru_cache(maxsize=None)
 def _reference(field, ku, kv):
     # First derivatives carry sign(.) but no DiracDelta: usable as they are.
-    exprs = [g.subs({fields.k_u: sp.nsimplify(ku), fields.k_v: sp.nsimplify(kv)})
-             for g in fields.GRADIENT_EXPRS[field]]
-    return sp.lambdify((fields.u, fields.v), exprs, modules="mpmath")
+    exprs = [g.subs({F.k_u: sp.nsimplify(ku), F.k_v: sp.nsimplify(kv)}) for g in F.GRADIENT[field]]
+    return sp.lambdify((F.u, F.v), exprs, modules="mpmath")
 
 
 def _sample(scene, size, count, seed):
@@ -82,9 +82,10 @@ def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=8
         return GradientAccuracy(field, method, len(uu), float(err.max()), float(np.sqrt((err**2).mean())),
                                 float(ulps.max()), float(np.sqrt((ulps**2).mean())))
 
-    out = [summarize("exact", *fields.exact_gradient(field, uu, vv, k_u, k_v))]
+    # Through the module attribute, so that a test can put a wrong gradient there.
+    out = [summarize("exact", *pointwise.exact_gradient(field, uu, vv, k_u, k_v))]
     for eps in steps:
-        out.append(summarize(f"central eps={eps:.0e}", *central_gradient(field, uu, vv, k_u, k_v, eps)))
+        out.append(summarize(f"central eps={eps:.0e}", *pointwise.central_gradient(field, uu, vv, k_u, k_v, eps)))
     return out
 
 

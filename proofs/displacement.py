@@ -18,6 +18,12 @@ and G_phi = -pi R h_phi, which is integrable only if
 field (h_theta = 0) it holds: the seed's rings bump is the first-order normal
 of the sphere displaced by G = -pi R h.  For sine and ridges it fails, so the
 seed's bump is the normal of no displaced sphere.
+
+The renderer's bump="surface" is checked twice: its coefficients
+(`renderer.formulas.BUMP["surface"]`, off the pole cut-off) equal the
+bracket's in chart terms, with the chart's rates du/dtheta and dv/dphi taken
+from `renderer.formulas.CHART` (theorem `chart`); and its rendered normals
+equal the displaced surface's, evaluated by mpmath.
 """
 
 import random
@@ -26,9 +32,11 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, fields, gbuffer
+from renderer import Scene, gbuffer
+from renderer import formulas as F
 
 from .core import Identity, Theorem, Verdict, check_identities
+from .frame import CHART_RATES
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, beta = sp.symbols("R beta", positive=True)
@@ -39,8 +47,27 @@ e_phi = sp.diff(N, phi)
 P = (R + beta * H(theta, phi)) * N
 CROSS = sp.diff(P, phi).cross(sp.diff(P, theta))
 H_t, H_p = sp.diff(H(theta, phi), theta), sp.diff(H(theta, phi), phi)
-BRACKET = N - beta / (R + beta * H(theta, phi)) * (H_t / sp.sin(phi) * e_theta + H_p * e_phi)
+#: The tangential coefficients of the displaced normal: BRACKET = N + c_theta e_theta + c_phi e_phi.
+COEFFS = (-beta / (R + beta * H(theta, phi)) * H_t / sp.sin(phi), -beta / (R + beta * H(theta, phi)) * H_p)
+BRACKET = N + COEFFS[0] * e_theta + COEFFS[1] * e_phi
 CLAIM = (R + beta * H(theta, phi)) ** 2 * sp.sin(phi) * BRACKET
+
+#: The same coefficients in chart terms: H(theta, phi) = h(u, v) with the chart's rates
+#: (theorem `chart`), H_theta = h_u du/dtheta and H_phi = h_v dv/dphi; in the renderer's symbols.
+CHART_COEFFS = tuple(c.subs({H_t: F.h_u * CHART_RATES[0], H_p: F.h_v * CHART_RATES[1]})
+                     .subs({H(theta, phi): F.h, sp.sin(phi): F.sin_phi, beta: F.beta, R: F.R})
+                     for c in COEFFS)
+#: The renderer's coefficients of bump="surface" (`renderer.formulas.BUMP`) away from
+#: the pole cut-off, where its floor max(sin phi, POLE_SIN_PHI) is sin phi.
+_FLOOR = sp.Max(F.sin_phi, F.POLE_SIN_PHI)
+KERNEL_COEFFS = tuple(b.subs(_FLOOR, F.sin_phi) for b in F.BUMP["surface"])
+KERNEL_DOMAIN = {F.beta: (0.0, 2.0), F.R: (0.5, 2.0), F.h: (-1.0, 1.0), F.h_u: (-30.0, 30.0),
+                 F.h_v: (-30.0, 30.0), F.sin_phi: (0.001, 1.0)}
+
+
+def _kernel_identities(coeffs):
+    return [Identity(r"b_u\ (	ext{surface})", coeffs[0], CHART_COEFFS[0], KERNEL_DOMAIN),
+            Identity(r"b_v\ (	ext{surface})", coeffs[1], CHART_COEFFS[1], KERNEL_DOMAIN)]
 
 a, b = sp.symbols("a b", real=True)
 INSTANCE = {H: sp.Lambda((theta, phi), sp.sin(a * theta) * sp.cos(b * phi) + sp.sin(phi))}
@@ -50,8 +77,7 @@ DOMAIN = {theta: (-3.0, 3.0), phi: (0.1, 3.0), R: (0.5, 2.0), beta: (0.0, 0.3),
 
 def integrability_obstruction(field):
     """2 cos(phi) h_theta + (2 sin(phi) - 1) h_theta_phi for a field, in (theta, phi)."""
-    h = fields.HEIGHT_EXPRS[field].subs({fields.u: (theta + sp.pi) / (2 * sp.pi),
-                                          fields.v: phi / sp.pi})
+    h = F.HEIGHT[field].subs({F.u: (theta + sp.pi) / (2 * sp.pi), F.v: phi / sp.pi})
     h_t = sp.diff(h, theta)
     return sp.simplify(2 * sp.cos(phi) * h_t + (2 * sp.sin(phi) - 1) * sp.diff(h_t, phi))
 
@@ -66,9 +92,8 @@ def surface_normal_residual(points=40, seed=7):
     g = gbuffer(scene, 128, 128)
     idx = np.flatnonzero(g.chamber.ravel() == 1)
     rng = random.Random(seed)
-    h_expr = fields.HEIGHT_EXPRS["sine"].subs({fields.k_u: scene.k_u, fields.k_v: scene.k_v,
-                                                fields.u: (theta + sp.pi) / (2 * sp.pi),
-                                                fields.v: phi / sp.pi})
+    h_expr = F.HEIGHT["sine"].subs({F.k_u: scene.k_u, F.k_v: scene.k_v,
+                                    F.u: (theta + sp.pi) / (2 * sp.pi), F.v: phi / sp.pi})
     cross = sp.diff((scene.radius_a + scene.beta * h_expr) * N, phi).cross(
         sp.diff((scene.radius_a + scene.beta * h_expr) * N, theta))
     fn = sp.lambdify((theta, phi), list(cross), modules="mpmath")
@@ -83,8 +108,12 @@ def surface_normal_residual(points=40, seed=7):
     return worst
 
 
-def _check(claim):
-    symbolic = check_identities([Identity("P_phi x P_theta", CROSS, claim, DOMAIN, INSTANCE)])
+def _check(claim, kernel=KERNEL_COEFFS):
+    if any(b.has(_FLOOR) for b in kernel):
+        return Verdict("refuted", "the surface bump's pole floor max(sin_phi, POLE_SIN_PHI) was not "
+                       "found in renderer.formulas.BUMP['surface']")
+    symbolic = check_identities([Identity("P_phi x P_theta", CROSS, claim, DOMAIN, INSTANCE)]
+                                + _kernel_identities(kernel))
     if not symbolic.holds:
         return symbolic
     obstruction = {f: integrability_obstruction(f) for f in ("sine", "ridges", "rings")}
@@ -95,7 +124,8 @@ def _check(claim):
         return Verdict("refuted", f"renderer's bump='surface' normal differs from the displaced "
                        f"surface's by {worst:.2e}")
     return Verdict(symbolic.status,
-                   f"{symbolic.evidence}; obstruction is 0 for rings, nonzero for sine and ridges "
+                   f"{symbolic.evidence} (the cross product, and renderer.formulas.BUMP['surface'] "
+                   f"against its chart form); obstruction is 0 for rings, nonzero for sine and ridges "
                    f"(the seed's bump is the normal of no displaced sphere for those); "
                    f"renderer's bump='surface' within {worst:.1e} of the displaced normal "
                    f"(mpmath, 40 pixels)")
@@ -108,16 +138,21 @@ BUMP_VS_DISPLACEMENT = Theorem(
               r"H_\varphi e_\varphi\bigr)\bigr]$. In chart terms the displaced normal's tangential "
               r"part is $-\tfrac{\beta}{R+\beta h}\bigl(\tfrac{h_u}{2\pi\sin\varphi}e_\theta + "
               r"\tfrac{h_v}{\pi}e_\varphi\bigr)$, against the seed's $+\beta(h_u e_\theta + h_v e_\varphi)$: "
-              r"opposite sign, and the chart's metric factors missing. The seed's bump is, to first "
+              r"opposite sign, and the chart's metric factors missing; the renderer's "
+              r"`bump='surface'` (`renderer.formulas.BUMP['surface']`) is the displaced normal's. "
+              r"The seed's bump is, to first "
               r"order, the normal of the sphere displaced by $G = -\pi R h$ for the rings field, and "
               r"of no displaced sphere for the sine and ridges fields.",
     steps=(("cross product", r"P_\varphi \times P_\theta", CLAIM),
            ("obstruction (sine)", r"2\cos\varphi\,h_\theta + (2\sin\varphi - 1)h_{\theta\varphi}",
             integrability_obstruction("sine")),
            ("obstruction (rings)", r"2\cos\varphi\,h_\theta + (2\sin\varphi - 1)h_{\theta\varphi}",
-            integrability_obstruction("rings"))),
+            integrability_obstruction("rings")),
+           ("the renderer's surface bump", r"(b_u, b_v)", sp.Tuple(*KERNEL_COEFFS))),
     check=lambda: _check(CLAIM),
-    wrong_variants=(("the seed's reading: the bump is the displaced normal (+ sign, no metric)",
+    wrong_variants=(("the renderer's chart bump (the seed's) as the displaced normal's coefficients",
+                     lambda: _check(CLAIM, kernel=F.BUMP["chart"])),
+                    ("the seed's reading: the bump is the displaced normal (+ sign, no metric)",
                      lambda: _check((R + beta * H(theta, phi)) ** 2 * sp.sin(phi)
                                     * (N + beta * (2 * sp.pi * H_t * e_theta + sp.pi * H_p * e_phi)))),),
     pages=("s3", "s7"),

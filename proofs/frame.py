@@ -1,18 +1,42 @@
-"""The tangent frame of sphere A (seed §3, Cell 2)."""
+"""The chart and the tangent frame of sphere A, as the renderer holds them (seed §3, Cell 2).
+
+The theorems are about `renderer.formulas`: its chart ``CHART`` (u, v, sin phi
+of a unit normal) and the regular branch of its ``TANGENT_FRAME`` (the
+branch taken where sin phi > ``POLE_SIN_PHI``).  The independent side is the
+unit sphere in spherical coordinates, N(theta, phi), and its derivatives
+dN/dtheta and dN/dphi, written here.
+"""
 
 import sympy as sp
 
-from .core import Identity, Theorem, Verdict, check_identities, identities_theorem
+from renderer import formulas as F
+
+from .core import Identity, Theorem, Verdict, check_identities
 
 theta, phi = sp.symbols("theta phi", real=True)
+#: The unit normal in spherical coordinates (the independent side).
 N = sp.Matrix([sp.sin(phi) * sp.cos(theta), sp.sin(phi) * sp.sin(theta), sp.cos(phi)])
-Nx, Ny, Nz = N
-sin_phi = sp.sin(phi)
-#: §3's frame, written from the components of N as the seed prints it.
-e_theta = sp.Matrix([-Ny, Nx, 0]) / sin_phi
-e_phi = sp.Matrix([Nz * Nx, Nz * Ny, -sin_phi**2]) / sin_phi
-#: Sampling domain: away from the poles, where sin(phi) > 0.
-DOMAIN = {theta: (-3.14, 3.14), phi: (0.01, 3.13)}
+#: The renderer's symbols at N(theta, phi).  sin_phi is the kernel's sqrt(N_x^2 + N_y^2)
+#: (`formulas.CHART`), which is sin(phi) for 0 < phi < pi (theorem `chart`).
+ON_SPHERE = {F.N_x: N[0], F.N_y: N[1], F.N_z: N[2], F.sin_phi: sp.sin(phi)}
+#: Sampling domain: away from the poles, where sin(phi) > 0, and off the seam theta = +-pi.
+DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 3.13)}
+#: LaTeX names of the renderer's symbols.
+NAMES = {F.sin_phi: r"\sin\varphi"}
+
+
+def regular_branch(component):
+    """The first (regular) branch of a component of `formulas.TANGENT_FRAME`.  A
+    component whose two branches are equal (e_theta's z, 0 in both) is not a
+    Piecewise: sympy folded it, and it is its own regular branch."""
+    return component.args[0].expr if isinstance(component, sp.Piecewise) else component
+
+
+#: The renderer's frame where sin(phi) > POLE_SIN_PHI, in terms of N_x, N_y, N_z, sin_phi.
+REGULAR = tuple(regular_branch(c) for c in F.TANGENT_FRAME)
+#: ... and at N(theta, phi).
+e_theta = sp.Matrix(REGULAR[:3]).subs(ON_SPHERE)
+e_phi = sp.Matrix(REGULAR[3:]).subs(ON_SPHERE)
 
 
 def _frame_identities(et, ep):
@@ -22,22 +46,57 @@ def _frame_identities(et, ep):
         Identity(r"e_\theta\cdot e_\varphi", et.dot(ep), sp.Integer(0), DOMAIN),
         Identity(r"e_\theta\cdot N", et.dot(N), sp.Integer(0), DOMAIN),
         Identity(r"e_\varphi\cdot N", ep.dot(N), sp.Integer(0), DOMAIN),
-        Identity(r"e_\theta", et, sp.diff(N, theta) / sin_phi, DOMAIN),
+        Identity(r"e_\theta", et, sp.diff(N, theta) / sp.sin(phi), DOMAIN),
         Identity(r"e_\varphi", ep, sp.diff(N, phi), DOMAIN),
     ]
 
 
-FRAME_ORTHONORMAL = identities_theorem(
-    "frame-orthonormal", "The tangent frame is orthonormal and tangent",
-    r"For $0 < \varphi < \pi$, $e_\theta = (-N_y, N_x, 0)/\sin\varphi$ and "
-    r"$e_\varphi = (N_z N_x, N_z N_y, -\sin^2\varphi)/\sin\varphi$ are unit vectors, orthogonal to "
-    r"each other and to $N$, and equal $\frac{1}{\sin\varphi}\partial N/\partial\theta$ and "
-    r"$\partial N/\partial\varphi$.",
-    _frame_identities(e_theta, e_phi),
-    [("e_phi with its 1/sin(phi) dropped",
-      _frame_identities(e_theta, sp.Matrix([Nz * Nx, Nz * Ny, -sin_phi**2]))),
-     ("e_theta with a flipped sign",
-      [Identity(r"e_\theta", -e_theta, sp.diff(N, theta) / sin_phi, DOMAIN)])],
+def _branch_structure():
+    """Refuted unless every component of TANGENT_FRAME is Piecewise((regular,
+    sin_phi > POLE_SIN_PHI), (fallback, True)) with FALLBACK_FRAME's values."""
+    for k, (c, fallback) in enumerate(zip(F.TANGENT_FRAME, F.FALLBACK_FRAME)):
+        if not isinstance(c, sp.Piecewise):
+            ok = c.is_number and c - fallback == 0         # both branches equal: folded by sympy
+        else:
+            ok = (len(c.args) == 2 and c.args[0].cond == (F.sin_phi > F.POLE_SIN_PHI)
+                  and c.args[1].cond == sp.true and c.args[1].expr - fallback == 0)
+        if not ok:
+            return Verdict("refuted", f"TANGENT_FRAME[{k}] is not (regular, sin_phi > POLE_SIN_PHI), "
+                           f"(fallback, True): {c}")
+    return None
+
+
+def _check_frame(et, ep):
+    bad = _branch_structure()
+    if bad is not None:
+        return bad
+    verdict = check_identities(_frame_identities(et, ep))
+    if not verdict.holds:
+        return verdict
+    return Verdict(verdict.status, f"renderer.formulas.TANGENT_FRAME, regular branch at N(theta, phi): "
+                   f"{verdict.evidence}", verdict.residual, verdict.digits, verdict.points)
+
+
+def vector_latex(components):
+    """LaTeX of a row vector of the renderer's expressions (sin_phi as sin(varphi)).
+    The z-component 0 of e_theta is a sympy Float; shown as 0."""
+    return sp.latex(sp.Matrix(components).T.applyfunc(lambda c: sp.Integer(0) if c.is_zero else c),
+                    symbol_names=NAMES)
+
+
+FRAME_ORTHONORMAL = Theorem(
+    id="frame-orthonormal", title="The tangent frame is orthonormal and tangent",
+    statement=(r"For $0 < \varphi < \pi$ the renderer's frame (`renderer.formulas.TANGENT_FRAME`, "
+               rf"regular branch) $e_\theta = {vector_latex(REGULAR[:3])}$ and "
+               rf"$e_\varphi = {vector_latex(REGULAR[3:])}$ "
+               r"are unit vectors, orthogonal to each other and to $N$, and equal "
+               r"$\frac{1}{\sin\varphi}\partial N/\partial\theta$ and $\partial N/\partial\varphi$."),
+    steps=tuple((i.label, i.lhs, i.rhs) for i in _frame_identities(e_theta, e_phi)),
+    check=lambda: _check_frame(e_theta, e_phi),
+    wrong_variants=(("e_phi multiplied by sin(phi)", lambda: _check_frame(e_theta, e_phi * sp.sin(phi))),
+                    ("e_theta with a flipped sign",
+                     lambda: check_identities([Identity(r"e_\theta", -e_theta, sp.diff(N, theta) / sp.sin(phi),
+                                                        DOMAIN)]))),
     pages=("s3",),
 )
 
@@ -51,13 +110,20 @@ def _orientation_value():
     return sp.simplify(e_theta.cross(e_phi).dot(N))
 
 
+def _fallback_orientation():
+    """(e_theta x e_phi) . N of the pole fallback at the north pole N = (0, 0, 1)."""
+    et, ep = sp.Matrix(F.FALLBACK_FRAME[:3]), sp.Matrix(F.FALLBACK_FRAME[3:])
+    return et.cross(ep).dot(sp.Matrix([0, 0, 1]))
+
+
 def _check_orientation() -> Verdict:
     value = _orientation_value()
     verdict = _orientation(e_theta, e_phi, value)
     if value not in (1, -1):
         return Verdict("refuted", f"(e_theta x e_phi) . N simplifies to {value}, not a sign")
     return Verdict(verdict.status, f"(e_theta x e_phi) . N = {value} exactly: the frame is "
-                   f"{'right' if value == 1 else 'left'}-handed about the outward normal; "
+                   f"{'right' if value == 1 else 'left'}-handed about the outward normal (the pole "
+                   f"fallback's is {int(_fallback_orientation()):+d} at the north pole); "
                    + verdict.evidence, verdict.residual, verdict.digits, verdict.points)
 
 
@@ -75,4 +141,57 @@ FRAME_ORIENTATION = Theorem(
     seed_says="Cell 2 prints (e_theta x e_phi) . N and labels the frame 'unit, aligned with N'.",
 )
 
-THEOREMS = (FRAME_ORTHONORMAL, FRAME_ORIENTATION)
+
+# ------------------------------------------------------------------------------- the chart
+#: The renderer's chart (u, v, sin phi) at N(theta, phi).
+CHART_AT = tuple(c.subs({F.N_x: N[0], F.N_y: N[1], F.N_z: N[2]}) for c in F.CHART)
+#: The chart's rates du/dtheta and dv/dphi, from `formulas.CHART` with its own sin phi
+#: (CHART[2]) written as the symbol sin_phi and then as sin(phi): the factors that turn
+#: chart derivatives h_u, h_v into angular ones.
+CHART_RATES = (sp.simplify(sp.diff(CHART_AT[0], theta)),
+               sp.simplify(sp.diff(F.CHART[1].subs(F.CHART[2], F.sin_phi).subs(ON_SPHERE), phi)))
+
+
+def _chart_identities(u_claim, v_claim):
+    return [
+        Identity("u", CHART_AT[0], u_claim, DOMAIN),
+        Identity("v", CHART_AT[1], v_claim, DOMAIN),
+        Identity(r"\sin\varphi", CHART_AT[2], sp.sin(phi), DOMAIN),
+        Identity(r"\partial u/\partial\theta", CHART_RATES[0], 1 / (2 * sp.pi), DOMAIN),
+        Identity(r"\partial v/\partial\varphi", CHART_RATES[1], 1 / sp.pi, DOMAIN),
+    ]
+
+
+U_OF_THETA, V_OF_PHI = (theta + sp.pi) / (2 * sp.pi), phi / sp.pi
+ANGLE_NAMES = {phi: r"\varphi"}
+
+
+def _check_chart(identities):
+    verdict = check_identities(identities)
+    if not verdict.holds:
+        return verdict
+    return Verdict(verdict.status, f"renderer.formulas.CHART at N(theta, phi): {verdict.evidence}",
+                   verdict.residual, verdict.digits, verdict.points)
+
+
+_swapped = [Identity("v", sp.atan2(N[2], sp.sqrt(N[0]**2 + N[1]**2)) / sp.pi, V_OF_PHI, DOMAIN)]
+
+CHART_INVERSE = Theorem(
+    id="chart", title="The chart is the spherical angles",
+    statement=(r"For $-\pi < \theta < \pi$ and $0 < \varphi < \pi$ the renderer's chart "
+               r"(`renderer.formulas.CHART`) of $N(\theta, \varphi)$ is "
+               rf"$u = {sp.latex(F.CHART[0])} = {sp.latex(U_OF_THETA)}$, "
+               rf"$v = {sp.latex(F.CHART[1])} = {sp.latex(V_OF_PHI, symbol_names=ANGLE_NAMES)}$ and "
+               rf"${sp.latex(F.CHART[2])} = \sin\varphi$; so $\partial u/\partial\theta = 1/2\pi$ and "
+               r"$\partial v/\partial\varphi = 1/\pi$, the factors between chart and angular "
+               r"derivatives of $h$."),
+    steps=tuple((i.label, i.lhs, i.rhs) for i in _chart_identities(U_OF_THETA, V_OF_PHI)),
+    check=lambda: _check_chart(_chart_identities(U_OF_THETA, V_OF_PHI)),
+    wrong_variants=(("u without the offset pi: theta / 2 pi",
+                     lambda: _check_chart(_chart_identities(theta / (2 * sp.pi), V_OF_PHI))),
+                    ("v with the arguments of atan2 swapped", lambda: _check_chart(_swapped))),
+    pages=("s3",),
+    seed_says="Cell 1 (chartA1): u = (theta + pi) / 2 pi, v = acos(N_z) / pi.",
+)
+
+THEOREMS = (CHART_INVERSE, FRAME_ORTHONORMAL, FRAME_ORIENTATION)

@@ -3,9 +3,10 @@
 For each height field, over the sphere-A pixels of a 256 x 256 default-scene
 frame, this module measures five ways of computing (h_u, h_v):
 
-* ``exact``: the generated sympy gradient, `renderer.fields.exact_gradient`;
-* ``central``: the renderer's central difference,
-  `renderer.render.central_gradient`, at each step of a sweep;
+* ``exact``: the kernel's generated gradient (sympy's derivative,
+  `renderer.formulas.GRADIENT`), `renderer.pointwise.exact_gradient`;
+* ``central``: the kernel's central difference (`renderer.formulas.CENTRAL`),
+  `renderer.pointwise.central_gradient`, at each step of a sweep;
 * ``forward``: the one-sided difference (h(u + eps) - h(u)) / eps, at each
   step of a sweep (`forward_gradient`);
 * ``complex step``: Im h(u + i eps) / eps (Squire and Trapp 1998), with h the
@@ -22,12 +23,21 @@ frame, this module measures five ways of computing (h_u, h_v):
   DERIVEST), vectorised over pixels (`richardson_gradient`).
 
 For each method and field it records the time per frame (median, minimum and
-maximum over repeats, methods interleaved), the evaluations of h per pixel
-(counted by instrumentation, `count_evaluations`), and the largest and RMS
-error of the two components against an mpmath reference of the exact
-gradient (`reference_gradient`).  On the ridges field the derivative does not
-exist on the crease lines, so errors there are measured off the seed's crease
-band (`renderer.fields.kink_band`); the timings still cover every pixel.
+maximum over repeats, methods interleaved), the work per pixel (`evaluations`:
+the values of h, or evaluations of the generated gradient, and the sines and
+cosines they cost, counted from the sympy objects the kernel is generated
+from, since compiled code cannot be instrumented; scipy counts its own
+evaluations), and the largest and RMS error of the two components against an
+mpmath reference of the exact gradient (`reference_gradient`).  On the ridges
+field the derivative does not exist on the crease lines, so errors there are
+measured off the seed's crease band (`renderer.pointwise.kink_band`); the
+timings still cover every pixel.
+
+The exact and central gradients and h itself are the kernel's compiled
+functions; forward differences call the compiled h three times from numpy;
+the complex step evaluates h in complex numpy (lambdify), and Richardson
+calls the compiled h from scipy's iteration.  So the times compare the
+methods as they are available here, not as each could best be compiled.
 
 `FAST` is the configuration the book runs when it is built; `FULL` the one the
 benchmark runs for a release (every pixel in the reference, more steps, more
@@ -45,7 +55,6 @@ References
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import platform
@@ -59,14 +68,15 @@ import numpy as np
 import sympy as sp
 from scipy.differentiate import derivative
 
-from renderer import Scene, fields, gbuffer
-from renderer.render import SPHERE_A, central_gradient
+from renderer import Scene, gbuffer, pointwise
+from renderer import formulas as F
+from renderer.render import SPHERE_A
 
 __all__ = [
-    "FIELDS", "ANALYTIC", "Config", "FAST", "FULL", "Counter", "MethodResult", "Measurement",
+    "FIELDS", "ANALYTIC", "Config", "FAST", "FULL", "Evaluations", "MethodResult", "Measurement",
     "is_analytic", "chart_points", "forward_gradient", "complex_step_gradient",
-    "richardson_gradient", "reference_gradient", "count_evaluations", "methods", "measure",
-    "pareto_front", "pareto_figure", "markdown_table", "to_json",
+    "richardson_gradient", "reference_gradient", "trig_calls", "stencil_values", "evaluations",
+    "methods", "measure", "pareto_front", "pareto_figure", "markdown_table", "to_json",
 ]
 
 FIELDS = ("sine", "ridges", "rings")
@@ -89,8 +99,8 @@ def is_analytic(expr):
     return not expr.has(*_NON_ANALYTIC)
 
 
-#: For each field: may the complex step be used?  Computed from `fields.HEIGHT_EXPRS`.
-ANALYTIC = {name: is_analytic(expr) for name, expr in fields.HEIGHT_EXPRS.items()}
+#: For each field: may the complex step be used?  Computed from `renderer.formulas.HEIGHT`.
+ANALYTIC = {name: is_analytic(expr) for name, expr in F.HEIGHT.items()}
 
 
 @dataclass(frozen=True)
@@ -130,7 +140,8 @@ class Config:
     seed: int = 6
 
 
-#: Book build: about 1 s for all three fields on this 2-core machine (budget 1.5 s).
+#: Book build (§5, Cell 4, which reports the time it took): a few hundred reference pixels
+#: at 34 digits and one Richardson run per field keep it to about a second.
 #: Steps: the renderer's default 1e-3, near each quotient's optimum (central
 #: 1e-6, forward 1e-8), and one past the central optimum, where rounding rules.
 FAST = Config("fast", central_steps=(1e-3, 1e-6, 1e-9), forward_steps=(1e-3, 1e-8),
@@ -172,9 +183,9 @@ def forward_gradient(name, uu, vv, ku, kv, eps):
     h_u = (h(u + eps, v) - h(u, v)) / eps with u + eps wrapped modulo 1 (the
     chart is periodic in u), and h_v the same in v, except where v + eps > 1,
     where the step is taken backwards, (h(u, v) - h(u, v - eps)) / eps.  The
-    quotient is divided by the nominal step, as `central_gradient` does.
+    quotient is divided by the nominal step, as the kernel's central difference does.
     h(u, v) is shared by both components: three evaluations of h per point.
-    Truncation error O(eps); h is `renderer.fields.height`.
+    Truncation error O(eps); h is the kernel's, `renderer.pointwise.height`.
 
     Parameters
     ----------
@@ -194,11 +205,11 @@ def forward_gradient(name, uu, vv, ku, kv, eps):
     """
     if not (np.isfinite(eps) and eps > 0):
         raise ValueError(f"eps must be a positive finite number, got {eps!r}")
-    h0 = fields.height(name, uu, vv, ku, kv)
-    hu = (fields.height(name, np.mod(uu + eps, 1.0), vv, ku, kv) - h0) / eps
+    h0 = pointwise.height(name, uu, vv, ku, kv)
+    hu = (pointwise.height(name, np.mod(uu + eps, 1.0), vv, ku, kv) - h0) / eps
     back = vv + eps > 1.0
     step = np.where(back, -eps, eps)
-    hv = (fields.height(name, uu, vv + step, ku, kv) - h0) / step
+    hv = (pointwise.height(name, uu, vv + step, ku, kv) - h0) / step
     return hu, hv
 
 
@@ -211,19 +222,18 @@ def _abs_continued(z):
 def _complex_height_fn(name, continued):
     modules = [{"Abs": _abs_continued}, "numpy"] if continued else "numpy"
     # With "Abs" in a user namespace, lambdify prints Abs(...) and calls that function.
-    return sp.lambdify((fields.u, fields.v, fields.k_u, fields.k_v), fields.HEIGHT_EXPRS[name],
-                       modules=modules)
+    return sp.lambdify((F.u, F.v, F.k_u, F.k_v), F.HEIGHT[name], modules=modules)
 
 
 def _complex_height(name, uu, vv, ku, kv, continued):
-    """h at complex chart points, from the sympy expression (hook for `count_evaluations`)."""
+    """h at complex chart points, from the sympy expression."""
     return _complex_height_fn(name, continued)(uu, vv, ku, kv)
 
 
 def complex_step_gradient(name, uu, vv, ku, kv, eps, *, continued=False):
     """Complex-step chart gradient, h_u = Im h(u + i eps, v) / eps, h_v likewise.
 
-    h is the sympy expression of `renderer.fields.HEIGHT_EXPRS` evaluated in
+    h is the sympy expression of `renderer.formulas.HEIGHT` evaluated in
     complex128 numpy by ``sympy.lambdify``.  No difference is taken, so there
     is no cancellation and eps may be tiny (1e-20 is usual); the truncation
     error is O(eps^2).  Two complex evaluations of h per point.  Valid only
@@ -251,8 +261,7 @@ def complex_step_gradient(name, uu, vv, ku, kv, eps, *, continued=False):
     """
     if not (np.isfinite(eps) and eps > 0):
         raise ValueError(f"eps must be a positive finite number, got {eps!r}")
-    if name not in fields.HEIGHT_EXPRS:
-        raise ValueError(f"height_field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {name!r}")
+    _check_name(name)
     shape = np.broadcast(uu, vv).shape
     hu = np.imag(_complex_height(name, uu + 1j * eps, vv, ku, kv, continued)) / eps
     hv = np.imag(_complex_height(name, uu, vv + 1j * eps, ku, kv, continued)) / eps
@@ -271,7 +280,7 @@ def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
     """Chart gradient by `scipy.differentiate.derivative` (settings `RICHARDSON`).
 
     Both components are computed in one vectorised call: the 2n abscissae are
-    u (moving u) followed by v (moving v).  h is `renderer.fields.height`,
+    u (moving u) followed by v (moving v).  h is `renderer.pointwise.height`,
     evaluated at whatever steps scipy chooses (the chart formula is defined for
     every real u and v, so no wrapping or clamping).  Elements whose
     iteration did not converge (scipy status != 0) keep scipy's last estimate.
@@ -295,8 +304,7 @@ def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
     ValueError
         If ``name`` is unknown.
     """
-    if name not in fields.HEIGHT_EXPRS:
-        raise ValueError(f"height_field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {name!r}")
+    _check_name(name)
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     n = uu.size
     x = np.concatenate([uu.ravel(), vv.ravel()])
@@ -304,7 +312,7 @@ def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
     moves_v = np.repeat(np.array([False, True]), n)
 
     def h(x, other, moves_v):
-        return fields.height(name, np.where(moves_v, other, x), np.where(moves_v, x, other), ku, kv)
+        return pointwise.height(name, np.where(moves_v, other, x), np.where(moves_v, x, other), ku, kv)
 
     res = derivative(h, x, args=(other, moves_v), **RICHARDSON)
     if info is not None:
@@ -320,15 +328,15 @@ def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
 def _reference_fn(name, ku, kv):
     # Exact rational frequencies, so that mpmath does not inherit float64 rounding.
     # First derivatives of |f| carry sign(f), no DiracDelta: usable as they are.
-    ks = {fields.k_u: sp.nsimplify(ku), fields.k_v: sp.nsimplify(kv)}
-    exprs = [g.subs(ks) for g in fields.GRADIENT_EXPRS[name]]
-    return sp.lambdify((fields.u, fields.v), exprs, modules="mpmath", cse=True)
+    ks = {F.k_u: sp.nsimplify(ku), F.k_v: sp.nsimplify(kv)}
+    exprs = [g.subs(ks) for g in F.GRADIENT[name]]
+    return sp.lambdify((F.u, F.v), exprs, modules="mpmath", cse=True)
 
 
 def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
     """The exact gradient at float64 chart points, evaluated by mpmath.
 
-    sympy's derivative of the field (`renderer.fields.GRADIENT_EXPRS`) is
+    sympy's derivative of the field (`renderer.formulas.GRADIENT`) is
     evaluated with mpmath at ``digits`` decimal digits, at the chart points
     exactly as float64 represents them, and returned as a double-double: the
     value rounded to float64 (``hi``) and the rounding residual (``lo``).  An
@@ -348,8 +356,7 @@ def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
     -------
     (hi, lo) : two (2, n) float64 arrays; row 0 is h_u, row 1 is h_v.
     """
-    if name not in fields.HEIGHT_EXPRS:
-        raise ValueError(f"height_field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {name!r}")
+    _check_name(name)
     fn = _reference_fn(name, float(ku), float(kv))
     uu, vv = np.broadcast_arrays(np.ravel(uu), np.ravel(vv))
     hi = np.empty((2, uu.size))
@@ -362,78 +369,87 @@ def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
     return hi, lo
 
 
-# --- instrumentation -----------------------------------------------------------------------
+# --- the work per pixel -------------------------------------------------------------------
 
-@dataclass
-class Counter:
-    """Values computed, by kind: real h, complex h, and the generated gradient (points)."""
-
-    h: int = 0
-    h_complex: int = 0
-    gradient: int = 0
+def _check_name(name):
+    if name not in F.HEIGHT:
+        raise ValueError(f"height_field must be one of {tuple(F.HEIGHT)}, got {name!r}")
 
 
-class _CountingStencil:
-    """Wraps a `renderer.fields.CentralStencil`: counts the values of h it returns."""
+def trig_calls(exprs):
+    """Sines and cosines evaluated per point by the code generated from ``exprs``.
 
-    def __init__(self, inner, counter):
-        self._inner = inner
-        self._counter = counter
-
-    def __getattr__(self, attr):
-        return getattr(self._inner, attr)
-
-    def values(self, *args, **kwargs):
-        out = self._inner.values(*args, **kwargs)
-        self._counter.h += sum(int(np.size(x)) for x in out)
-        return out
-
-
-@contextlib.contextmanager
-def count_evaluations():
-    """Count the values of h and of the generated gradient that are computed.
-
-    Within the block, `renderer.fields.height`, `renderer.fields.exact_gradient`
-    and this module's complex evaluation of h are replaced by wrappers that add
-    the number of points of each call (the broadcast size of (u, v)) to a
-    `Counter`, which the block receives.  Where the renderer computes the four
-    values of a central difference in one call (``fields.central_stencil``,
-    which shares the factors that do not move with the step), that call is
-    wrapped too and adds the number of values of h it returns.  The originals
-    are restored on exit, also on error.  Code that captured the originals
-    before the block (e.g. ``from renderer.fields import height``) is not
-    counted.
-
-    Yields
-    ------
-    Counter
+    ``renderer.codegen`` prints a function's outputs after one common-subexpression
+    elimination over all of them (``sympy.cse``); a sine or cosine left in the
+    eliminated code is computed once per point, so this counts the sin and cos
+    nodes of the replacements and the reduced outputs.  The numba kernel calls
+    exactly these (tests/test_gradient_methods.py compares the count with the
+    text of renderer/generated.py).
     """
-    counter = Counter()
-    here = sys.modules[__name__]
-    originals = (fields.height, fields.exact_gradient, here._complex_height)
-    stencil = getattr(fields, "central_stencil", None)
+    subs, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols("x"))
+    return sum(isinstance(node, (sp.sin, sp.cos))
+               for e in [x for _, x in subs] + list(reduced) for node in sp.preorder_traversal(e))
 
-    def height(name, uu, vv, ku, kv):
-        counter.h += int(np.broadcast(uu, vv).size)
-        return originals[0](name, uu, vv, ku, kv)
 
-    def exact_gradient(name, uu, vv, ku, kv):
-        counter.gradient += int(np.broadcast(uu, vv).size)
-        return originals[1](name, uu, vv, ku, kv)
+def stencil_values(name):
+    """Values of h per point in the kernel's central difference of field ``name``:
+    the stencil points (`formulas.STENCIL_POINTS`) that `formulas.CENTRAL` reads.
+    4 for sine and ridges; 2 for rings, whose u-difference sympy reduced to 0."""
+    _check_name(name)
+    used = set().union(*(c.free_symbols for c in F.CENTRAL[name]))
+    return sum(p in used for p, _ in F.STENCIL_POINTS)
 
-    def complex_height(name, uu, vv, ku, kv, continued):
-        counter.h_complex += int(np.broadcast(uu, vv).size)
-        return originals[2](name, uu, vv, ku, kv, continued)
 
-    fields.height, fields.exact_gradient, here._complex_height = height, exact_gradient, complex_height
-    if stencil is not None:
-        fields.central_stencil = lambda name: _CountingStencil(stencil(name), counter)
-    try:
-        yield counter
-    finally:
-        fields.height, fields.exact_gradient, here._complex_height = originals
-        if stencil is not None:
-            fields.central_stencil = stencil
+@dataclass(frozen=True)
+class Evaluations:
+    """Work per pixel: real values of h, complex values of h, evaluations of the
+    generated gradient, and the real sines and cosines all of them cost."""
+
+    h: float = 0.0
+    h_complex: float = 0.0
+    gradient: float = 0.0
+    trig: float = 0.0
+
+
+def evaluations(name, method, *, h_per_pixel=None):
+    """The work per pixel of ``method`` on field ``name``, from the sympy objects.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    method : str
+        "exact", "central", "forward", "complex step", "complex step, |z|
+        continued", "richardson" or "h" (one evaluation of h alone).
+    h_per_pixel : float, keyword-only
+        For "richardson" only: the values of h per pixel scipy reported (its
+        iteration adapts, so the count is measured, not derived).
+
+    Returns
+    -------
+    Evaluations
+
+    Raises
+    ------
+    ValueError
+        An unknown field or method, or ``h_per_pixel`` missing for "richardson".
+    """
+    _check_name(name)
+    per_h = trig_calls((F.HEIGHT[name],))
+    if method == "exact":
+        return Evaluations(gradient=1.0, trig=float(trig_calls(F.GRADIENT[name])))
+    if method == "central":
+        return Evaluations(h=float(stencil_values(name)), trig=float(trig_calls(F.CENTRAL[name])))
+    if method == "forward":
+        return Evaluations(h=3.0, trig=3.0 * per_h)
+    if method in ("complex step", "complex step, |z| continued"):
+        return Evaluations(h_complex=2.0)
+    if method == "h":
+        return Evaluations(h=1.0, trig=float(per_h))
+    if method == "richardson":
+        if h_per_pixel is None:
+            raise ValueError("richardson's evaluations are measured: pass h_per_pixel")
+        return Evaluations(h=float(h_per_pixel), trig=float(h_per_pixel) * per_h)
+    raise ValueError(f"unknown method {method!r}")
 
 
 # --- the measurement -----------------------------------------------------------------------
@@ -452,12 +468,13 @@ class MethodResult:
     eps: float | None           # the step, or None
     valid: bool                 # False: the method's premise fails on this field
     times: tuple                # seconds, one per repeat
-    h_evals: float              # real evaluations of h per pixel (counted)
-    h_complex_evals: float      # complex evaluations of h per pixel (counted)
-    gradient_evals: float       # evaluations of the generated gradient per pixel (counted)
+    h_evals: float              # real evaluations of h per pixel (`evaluations`)
+    h_complex_evals: float      # complex evaluations of h per pixel
+    gradient_evals: float       # evaluations of the generated gradient per pixel
     max_error: float
     rms_error: float
     note: str = ""
+    trig_evals: float = 0.0     # real sines and cosines per pixel
 
     @property
     def label(self):
@@ -522,10 +539,10 @@ def methods(name, config, ku, kv):
     ``fn(u, v)`` returns (h_u, h_v); ``valid`` is False where the method's
     premise fails (complex step on a field that is not analytic).
     """
-    out = [("exact", None, True, lambda u, v: fields.exact_gradient(name, u, v, ku, kv), "")]
+    out = [("exact", None, True, lambda u, v: pointwise.exact_gradient(name, u, v, ku, kv), "")]
     for eps in config.central_steps:
         out.append(("central", eps, True,
-                    lambda u, v, eps=eps: central_gradient(name, u, v, ku, kv, eps), ""))
+                    lambda u, v, eps=eps: pointwise.central_gradient(name, u, v, ku, kv, eps), ""))
     for eps in config.forward_steps:
         out.append(("forward", eps, True,
                     lambda u, v, eps=eps: forward_gradient(name, u, v, ku, kv, eps), ""))
@@ -534,7 +551,7 @@ def methods(name, config, ku, kv):
         note = "" if analytic else "h is not analytic: Im |f(u + i eps)| = 0"
         out.append(("complex step", eps, analytic,
                     lambda u, v, eps=eps: complex_step_gradient(name, u, v, ku, kv, eps), note))
-    if not analytic and fields.HEIGHT_EXPRS[name].has(sp.Abs):
+    if not analytic and F.HEIGHT[name].has(sp.Abs):
         eps = min(config.complex_steps)
         out.append(("complex step, |z| continued", eps, True,
                     lambda u, v, eps=eps: complex_step_gradient(name, u, v, ku, kv, eps, continued=True),
@@ -550,7 +567,7 @@ def _errors(approx, hi, lo):
 
 
 def measure(config=FAST, *, fields_=FIELDS, uv=None):
-    """Time, count and check every method on every field (see the module docstring).
+    """Time and check every method on every field, with its work per pixel (see the module docstring).
 
     Parameters
     ----------
@@ -566,21 +583,13 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     -------
     Measurement
 
-    Raises
-    ------
-    RuntimeError
-        If the instrumentation counted no value of h for the central
-        difference (the renderer no longer computes h through
-        `renderer.fields`; the counts would be meaningless).
-
     Notes
     -----
-    Per field, one instrumented run of every method at the reference pixels
-    gives the errors and the counts (for the plain difference quotients the
-    count per pixel does not depend on the pixel; for scipy's adaptive
-    iteration it does, and a sample's mean is reported in `FAST`).  Then
-    ``config.repeats`` rounds time every (field, method) pair on all pixels,
-    uninstrumented, in an order shuffled each round, so that drifts of the
+    Per field, one run of every method at the reference pixels gives the
+    errors; the work per pixel is `evaluations` (for scipy's adaptive
+    iteration, its own count at those pixels, a sample's mean in `FAST`).
+    Then ``config.repeats`` rounds time every (field, method) pair on all
+    pixels, in an order shuffled each round, so that drifts of the
     machine's speed fall on all of them alike.
     """
     t_start = time.perf_counter()
@@ -595,7 +604,7 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
         u, v = chart_points(name, config.size) if uv is None else uv
         pixels = u.size
         # The error sample: pixels where the gradient exists (off the ridges' crease band).
-        off = np.flatnonzero(~fields.kink_band(name, u, v, ku, kv))
+        off = np.flatnonzero(~pointwise.kink_band(name, u, v, ku, kv))
         n_excl[name] = int(u.size - off.size)
         if config.reference_pixels is not None and config.reference_pixels < off.size:
             pick = np.sort(rng.choice(off, size=config.reference_pixels, replace=False))
@@ -605,26 +614,24 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
         ru, rv = u[pick].copy(), v[pick].copy()
         hi, lo = reference_gradient(name, ru, rv, ku, kv, digits=config.digits)
 
-        # Errors and counts: one instrumented run of every method at the reference pixels.
+        # Errors: one run of every method at the reference pixels; the work per pixel.
         for method, eps, valid, fn, note in methods(name, config, ku, kv):
-            info = {}
-            with count_evaluations() as counter:
-                if method == "richardson":
-                    approx = richardson_gradient(name, ru, rv, ku, kv, info=info)
-                else:
-                    approx = fn(ru, rv)
-            if method == "central" and counter.h == 0:
-                raise RuntimeError("central_gradient no longer calls renderer.fields.height or "
-                                   "fields.central_stencil; the evaluation counts would be meaningless")
-            if info.get("not_converged"):
-                note = (note + "; " if note else "") + \
-                    f"{info['not_converged']} of {2 * ru.size} components not converged"
-            checked.append((name, method, eps, valid, note, counter, ru.size, _errors(approx, hi, lo)))
+            if method == "richardson":
+                info = {}
+                approx = richardson_gradient(name, ru, rv, ku, kv, info=info)
+                work = evaluations(name, method, h_per_pixel=info["nfev"] / ru.size)
+                if info["not_converged"]:
+                    note = (note + "; " if note else "") + \
+                        f"{info['not_converged']} of {2 * ru.size} components not converged"
+            else:
+                approx = fn(ru, rv)
+                work = evaluations(name, method)
+            checked.append((name, method, eps, valid, note, work, _errors(approx, hi, lo)))
             timed.append((fn, u, v, config.richardson_repeats if method == "richardson" else config.repeats))
         # One evaluation of h alone, timed with the methods as a unit of cost.
-        timed.append((lambda uu, vv, name=name: fields.height(name, uu, vv, ku, kv), u, v, config.repeats))
+        timed.append((lambda uu, vv, name=name: pointwise.height(name, uu, vv, ku, kv), u, v, config.repeats))
 
-    # Timing: every (field, method) on all pixels, uninstrumented, in an order shuffled
+    # Timing: every (field, method) on all pixels, in an order shuffled
     # every round, so that changes in the machine's load fall on all of them alike.
     times = [[] for _ in timed]
     for _ in range(max(q for *_, q in timed)):
@@ -638,9 +645,9 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     it = iter(times)            # same order as `timed`: per field, its methods, then h
     for name in fields_:
         for entry in [c for c in checked if c[0] == name]:
-            _, method, eps, valid, note, counter, n, (emax, erms) = entry
-            results.append(MethodResult(name, method, eps, valid, tuple(next(it)), counter.h / n,
-                                        counter.h_complex / n, counter.gradient / n, emax, erms, note))
+            _, method, eps, valid, note, work, (emax, erms) = entry
+            results.append(MethodResult(name, method, eps, valid, tuple(next(it)), work.h, work.h_complex,
+                                        work.gradient, emax, erms, note, work.trig))
         h_times[name] = tuple(next(it))
     machine = {"python": platform.python_version(), "numpy": np.__version__,
                "scipy": sys.modules["scipy"].__version__, "cpus": os.cpu_count(),
@@ -788,7 +795,8 @@ def _fmt_evals(r):
         parts.append(f"{r.h_complex_evals:.4g} complex h")
     if r.gradient_evals:
         parts.append(f"{r.gradient_evals:.4g} ∇h")
-    return ", ".join(parts) or "0"
+    text = ", ".join(parts) or "0"
+    return f"{text} ({r.trig_evals:.4g} sin/cos)" if r.trig_evals else text
 
 
 def markdown_table(measurement, *, rows="all", error="max", include=()):

@@ -1,17 +1,23 @@
 """The exact gradients of the three height fields (seed §3) and the renderer's
-generated code for them."""
+generated code for them.
+
+The theorems are about `renderer.formulas.GRADIENT` (sympy's derivatives of
+`renderer.formulas.HEIGHT`) and its compiled evaluation
+(`renderer.pointwise.exact_gradient`, the kernel's generated function); the
+closed forms they are checked against are typed here from seed §3.
+"""
 
 import random
 
 import mpmath
-import numpy as np
 import sympy as sp
 
-from renderer import fields
+from renderer import formulas as F
+from renderer import pointwise
 
 from .core import DIGITS, POINTS, Identity, Theorem, Verdict, check_identities
 
-u, v, k_u, k_v = fields.u, fields.v, fields.k_u, fields.k_v
+u, v, k_u, k_v = F.u, F.v, F.k_u, F.k_v
 s1, s2 = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
 c1, c2 = sp.cos(sp.pi * k_u * u), sp.cos(sp.pi * k_v * v)
 sigma = sp.sign(s1 * s2)
@@ -51,11 +57,11 @@ def generated_code_residual(name, closed_form, *, seed=0, points=POINTS):
             if name == "ridges" and min(abs(mpmath.sin(mpmath.pi * ku * uu)),
                                         abs(mpmath.sin(mpmath.pi * kv * vv))) < 1e-9:
                 continue
-            got = fields.exact_gradient(name, np.array([uu]), np.array([vv]), ku, kv)
+            got = pointwise.exact_gradient(name, uu, vv, ku, kv)        # 0-d arrays
             ref = fn(mpmath.mpf(uu), mpmath.mpf(vv), mpmath.mpf(ku), mpmath.mpf(kv))
             scale = mpmath.pi * max(ku, 2 * kv)
             for g, r in zip(got, ref):
-                worst = max(worst, float(abs(mpmath.mpf(float(g[0])) - r) / scale))
+                worst = max(worst, float(abs(mpmath.mpf(float(g)) - r) / scale))
             taken += 1
     return worst
 
@@ -66,16 +72,17 @@ GENERATED_TOLERANCE = 1e-13
 
 def _gradient_check(name, closed_form):
     def check():
-        identities = [Identity(f"h_u ({name})", fields.GRADIENT_EXPRS[name][0], closed_form[0], DOMAIN),
-                      Identity(f"h_v ({name})", fields.GRADIENT_EXPRS[name][1], closed_form[1], DOMAIN)]
+        identities = [Identity(f"h_u ({name})", F.GRADIENT[name][0], closed_form[0], DOMAIN),
+                      Identity(f"h_v ({name})", F.GRADIENT[name][1], closed_form[1], DOMAIN)]
         symbolic = check_identities(identities)
         if not symbolic.holds:
             return symbolic
         worst = generated_code_residual(name, closed_form)
         if worst > GENERATED_TOLERANCE:
-            return Verdict("refuted", f"generated numpy gradient differs from the closed form by "
+            return Verdict("refuted", f"generated (compiled) gradient differs from the closed form by "
                            f"{worst:.2e} (relative to pi max(k_u, 2 k_v))", worst, DIGITS, POINTS)
-        return Verdict(symbolic.status, f"{symbolic.evidence}; generated numpy code within "
+        return Verdict(symbolic.status, f"renderer.formulas.GRADIENT: {symbolic.evidence}; "
+                       f"the kernel's generated code within "
                        f"{worst:.1e} of mpmath ({DIGITS} digits, {POINTS} points)",
                        worst, DIGITS, POINTS)
     return check
@@ -86,11 +93,11 @@ def _theorem(name):
     description, wrong = WRONG[name]
     return Theorem(
         id=f"gradient-{name}", title=f"The gradient of the {name} field",
-        statement=(rf"For $h = {sp.latex(fields.HEIGHT_EXPRS[name])}$: "
+        statement=(rf"For $h = {sp.latex(F.HEIGHT[name])}$: "
                    rf"$h_u = {sp.latex(hu)}$ and $h_v = {sp.latex(hv)}$, and the renderer's "
                    r"generated code evaluates them to float64 accuracy."),
-        steps=((r"h_u", sp.Derivative(fields.HEIGHT_EXPRS[name], u), fields.GRADIENT_EXPRS[name][0]),
-               (r"h_v", sp.Derivative(fields.HEIGHT_EXPRS[name], v), fields.GRADIENT_EXPRS[name][1])),
+        steps=((r"h_u", sp.Derivative(F.HEIGHT[name], u), F.GRADIENT[name][0]),
+               (r"h_v", sp.Derivative(F.HEIGHT[name], v), F.GRADIENT[name][1])),
         check=_gradient_check(name, PRINTED[name]),
         wrong_variants=((description, _gradient_check(name, wrong)),),
         pages=("s3", "s5"),

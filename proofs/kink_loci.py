@@ -15,7 +15,7 @@ is the circle rho_m = rho(pi m / k_v), visible when cos(pi m / k_v) > R / e.
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, gbuffer, render
+from renderer import Scene, gbuffer, pointwise, render
 
 from .core import Identity, Theorem, Verdict, check_identities
 
@@ -51,15 +51,20 @@ def phi_of_rho(rho, radius_a, camera_z):
 
 
 def predicted_band(scene, width, height):
-    """The crease band predicted from the closed forms, on the pixels of sphere A."""
+    """The crease band predicted from the closed forms, on the pixels of sphere A.
+
+    (u, v) come from the pixel's image-plane polar coordinates by the closed
+    forms above, not from the renderer's ray and chart; the band is then the
+    renderer's crease flag at those (u, v) (`renderer.pointwise.kink_band`,
+    `renderer.formulas.KINK_BAND`).
+    """
     g = gbuffer(scene, width, height)
     X, Y = np.meshgrid(g.x, g.y)
     alpha = np.arctan2(Y, X)
     rho = np.hypot(X, Y)
     u = (alpha + np.pi) / (2 * np.pi)
     v = phi_of_rho(rho, scene.radius_a, scene.camera_z) / np.pi
-    band = ((np.abs(np.sin(np.pi * scene.k_u * u)) < 0.03)
-            | (np.abs(np.sin(np.pi * scene.k_v * v)) < 0.03))
+    band = pointwise.kink_band("ridges", u, v, scene.k_u, scene.k_v)
     return band & (g.chamber == 1), g.chamber == 1
 
 

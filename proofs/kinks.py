@@ -1,17 +1,27 @@
-"""Where the ridges field is not differentiable, and by how much (seed §3)."""
+"""Where the ridges field is not differentiable, and by how much (seed §3).
+
+The theorem is about the renderer's ridges field and crease flag,
+`renderer.formulas.HEIGHT["ridges"]`, `RIDGE_FACTORS` and `KINK_BAND`; the
+jumps it states are written here by hand, from seed §3.
+"""
 
 import sympy as sp
 
-from renderer import fields
+from renderer import formulas as F
 
 from .core import Identity, identities_theorem
 
-u, v = fields.u, fields.v
+u, v = F.u, F.v
+#: The frequencies are positive in the scene (Scene validates k_u, k_v > 0): the
+#: one-sided limits below need it.
 k_u, k_v = sp.symbols("k_u k_v", positive=True)
+POSITIVE = {F.k_u: k_u, F.k_v: k_v}
 delta = sp.Symbol("delta", positive=True)
 x = sp.Symbol("x", real=True, nonzero=True)
-s1, s2 = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
-h = sp.Abs(s1 * s2)
+#: The renderer's ridges field and its two factors.
+h = F.HEIGHT["ridges"].subs(POSITIVE)
+FACTORS = tuple(s.subs(POSITIVE) for s in F.RIDGE_FACTORS)
+BAND = F.KINK_BAND["ridges"].subs(POSITIVE)
 DOMAIN = {u: (0.0, 1.0), v: (0.0, 1.0), k_u: (0.5, 12.0), k_v: (0.5, 12.0)}
 #: Zero lines checked: u = m / k_u and v = m / k_v for these m.
 LINES = (0, 1, 2, 3)
@@ -25,33 +35,49 @@ def one_sided(expr, var, at):
     return sp.simplify(right), sp.simplify(left)
 
 
+def _flag(condition):
+    """1 where the crease flag's condition holds, 0 where it does not."""
+    return sp.Piecewise((sp.Integer(1), condition), (sp.Integer(0), True))
+
+
 def _identities(jump_u, jump_v):
     ids = [Identity(r"\frac{d}{dx}\lvert x\rvert,\ x \ne 0", sp.diff(sp.Abs(x), x), sp.sign(x),
-                    {x: (-3.0, 3.0)})]
+                    {x: (-3.0, 3.0)}),
+           Identity(r"h = \lvert s_1 s_2\rvert", h, sp.Abs(FACTORS[0] * FACTORS[1]), DOMAIN)]
     for m in LINES:
-        r, l = one_sided(h, u, sp.Integer(m) / k_u)
-        ids.append(Identity(rf"h_u^+ - h_u^-\ \text{{at}}\ u = {m}/k_u", r - l, jump_u, DOMAIN))
-        r, l = one_sided(h, v, sp.Integer(m) / k_v)
-        ids.append(Identity(rf"h_v^+ - h_v^-\ \text{{at}}\ v = {m}/k_v", r - l, jump_v, DOMAIN))
+        for var, k, factor, jump in ((u, k_u, FACTORS[0], jump_u), (v, k_v, FACTORS[1], jump_v)):
+            line = sp.Integer(m) / k
+            r, l = one_sided(h, var, line)
+            ids += [Identity(rf"h_{var}^+ - h_{var}^-\ \text{{at}}\ {var} = {m}/k_{var}", r - l, jump, DOMAIN),
+                    Identity(rf"s\ \text{{at}}\ {var} = {m}/k_{var}", factor.subs(var, line), sp.Integer(0),
+                             DOMAIN),
+                    Identity(rf"\text{{crease flag at}}\ {var} = {m}/k_{var}", _flag(BAND.subs(var, line)),
+                             sp.Integer(1), DOMAIN)]
     return ids
 
 
-JUMP_U = 2 * sp.pi * k_u * sp.Abs(s2)
-JUMP_V = 2 * sp.pi * k_v * sp.Abs(s1)
+#: The jumps, written by hand (seed §3): independent of the renderer's expressions.
+s1_hand, s2_hand = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
+JUMP_U = 2 * sp.pi * k_u * sp.Abs(s2_hand)
+JUMP_V = 2 * sp.pi * k_v * sp.Abs(s1_hand)
 
 RIDGES_KINKS = identities_theorem(
     "ridges-kinks", "The creases of the ridges field",
-    r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ is "
+    r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
+    r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
+    r"(`RIDGE_FACTORS`) is "
     r"differentiable wherever $s_1 s_2 \ne 0$, with gradient $\operatorname{sign}(s_1 s_2)\,\nabla(s_1 s_2)$. "
     r"On the zero line $u = m/k_u$ the one-sided derivatives in $u$ differ by "
     r"$2\pi k_u \lvert\sin\pi k_v v\rvert$, and on $v = m/k_v$ those in $v$ by "
-    r"$2\pi k_v \lvert\sin\pi k_u u\rvert$: a crease wherever the other factor is nonzero.",
+    r"$2\pi k_v \lvert\sin\pi k_u u\rvert$: a crease wherever the other factor is nonzero. "
+    r"The renderer's crease flag (`KINK_BAND`) is set on every zero line.",
     _identities(JUMP_U, JUMP_V),
-    [("jump without the factor 2", _identities(sp.pi * k_u * sp.Abs(s2), JUMP_V)),
-     ("jump with the roles of k_u and k_v swapped", _identities(2 * sp.pi * k_v * sp.Abs(s2), JUMP_V))],
+    [("jump without the factor 2", _identities(sp.pi * k_u * sp.Abs(s2_hand), JUMP_V)),
+     ("jump with the roles of k_u and k_v swapped", _identities(2 * sp.pi * k_v * sp.Abs(s2_hand), JUMP_V))],
     steps=((r"one-sided", r"(h_u^+, h_u^-)\big|_{u = 1/k_u}", sp.Tuple(*one_sided(h, u, 1 / k_u))),
            (r"h_u^+ - h_u^-", r"h_u^+ - h_u^-", JUMP_U),
-           (r"h_v^+ - h_v^-", r"h_v^+ - h_v^-", JUMP_V)),
+           (r"h_v^+ - h_v^-", r"h_v^+ - h_v^-", JUMP_V),
+           (r"crease flag", r"\text{KINK\_BAND}", BAND)),
     pages=("s3", "s7"),
 )
 

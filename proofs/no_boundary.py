@@ -13,6 +13,7 @@ import numpy as np
 import sympy as sp
 
 from renderer import Scene, render
+from renderer import formulas as F
 
 from .core import Theorem, Verdict
 
@@ -20,8 +21,8 @@ x, y, e, R, t, s = sp.symbols("x y e R t s", real=True)
 Cb = sp.Matrix(sp.symbols("C_x C_y C_z", real=True))
 r_b = sp.Symbol("r_B", positive=True)
 L = sp.Matrix(sp.symbols("L_x L_y L_z", real=True))
-beta, eps, k_u, k_v, u, v = sp.symbols("beta varepsilon k_u k_v u v", real=True)
-BUMP_SYMBOLS = {beta, eps, k_u, k_v}
+#: The bump's parameters, as the renderer's formulas name them (`renderer.formulas`).
+BUMP_SYMBOLS = {F.beta, F.eps_u, F.eps_v, F.k_u, F.k_v}
 
 E = sp.Matrix([0, 0, e])
 d = sp.Matrix([x, y, -e])
@@ -47,14 +48,15 @@ PREDICATES = {
 }
 
 
-def _seed_attached_predicate():
-    """The seed's rule: the light counts where N' . (L - P) > 0, N' the bumped normal."""
-    h_u = sp.pi * k_u * sp.cos(sp.pi * k_u * u) * sp.sin(sp.pi * k_v * v)
-    h_v = sp.pi * k_v * sp.sin(sp.pi * k_u * u) * sp.cos(sp.pi * k_v * v)
-    e_t = sp.Matrix(sp.symbols("et_x et_y et_z", real=True))
-    e_p = sp.Matrix(sp.symbols("ep_x ep_y ep_z", real=True))
-    M = N_A + beta * (h_u * e_t + h_v * e_p)
-    return {"attached (seed): N' . (L - P)": (M / sp.sqrt(M.dot(M))).dot(L - P_A)}
+def _seed_attached_predicate(gradient="exact"):
+    """The seed's rule: the light counts where N' . (L - P) > 0, with N' the
+    renderer's chart-mode perturbed normal (`formulas.PERTURBED_NORMAL`) at
+    sphere A's hit point, fed the sine field's exact gradient (`formulas.GRADIENT`)
+    or central difference (`formulas.CENTRAL`)."""
+    grad = F.GRADIENT["sine"] if gradient == "exact" else F.CENTRAL["sine"]
+    at_hit = {F.N_x: N_A[0], F.N_y: N_A[1], F.N_z: N_A[2], F.h_u: grad[0], F.h_v: grad[1]}
+    N_prime = sp.Matrix(F.PERTURBED_NORMAL["chart"]).subs(at_hit)
+    return {f"attached (seed, {gradient} gradient): N' . (L - P)": N_prime.dot(L - P_A)}
 
 
 BETAS = (0.0, 0.35, 1.5, 10.0)
@@ -99,7 +101,9 @@ NO_BOUNDARY = Theorem(
                  sp.Tuple(*sorted(expr.free_symbols, key=str))) for name, expr in PREDICATES.items()),
     check=lambda: _check(PREDICATES),
     wrong_variants=(("the seed's attached-shadow rule, with the bumped normal",
-                     lambda: _check({**PREDICATES, **_seed_attached_predicate()})),),
+                     lambda: _check({**PREDICATES, **_seed_attached_predicate()})),
+                    ("the seed's rule with the central-difference gradient",
+                     lambda: _check({**PREDICATES, **_seed_attached_predicate("central")}))),
     pages=("s1", "s3", "s4"),
     seed_says="§3: the chamber masks are functions of geometry alone; the seed's shading code "
               "nonetheless lets lights past the geometric terminator (errata E2).",

@@ -18,8 +18,8 @@ from typing import Callable
 import numpy as np
 
 from renderer import Scene, gbuffer
-from renderer.geometry import chart, image_plane, tangent_frame
-from renderer.render import FLOOR, SPHERE_A, SPHERE_B
+from renderer.pointwise import chart, tangent_frame
+from renderer.render import FLOOR, SPHERE_A, SPHERE_B, image_plane
 
 __all__ = ["Erratum", "ERRATA", "measure_all"]
 
@@ -269,7 +269,7 @@ ERRATA = (
         title="The one-sided v-difference fires in the interior",
         seed=r"one-sided quotient whenever $\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border",
         correction=r"one-sided only where $v \pm \varepsilon$ leaves $[0, 1]$; elsewhere divide by $2\varepsilon$",
-        exposed_by="tests/test_fields.py",
+        exposed_by="verify/test_theorems.py (central-difference-truncation: interior points take the 2 eps branch)",
         measure=_v_border_branch,
         finding=(
             "At eps = 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "

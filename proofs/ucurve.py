@@ -3,12 +3,13 @@
 For a height field, a chart point (u, v), a component (h_u or h_v) and a grid
 of steps eps, `measure` returns
 
-* the float64 central difference exactly as the renderer computes it (same
-  code path: `renderer.render.central_gradient`);
+* the float64 central difference exactly as the renderer computes it (the
+  kernel's compiled function, through `renderer.pointwise.central_gradient`);
 * its error against the true derivative evaluated with mpmath at 50 digits;
 * that error split exactly into *truncation*, the same difference quotient
   taken in exact arithmetic at the float64 abscissae the renderer actually
-  used (u +/- eps rounded and wrapped, v +/- eps rounded and clamped) and the
+  used (u +/- eps rounded and wrapped, v +/- eps rounded and clamped: the
+  kernel's `renderer.formulas.STENCIL_POINTS`, evaluated in float64) and the
   same denominator, minus the true derivative; and *roundoff*, the rest
   (the rounding of the two values of h and of the subtraction and division);
 * the model eps^2 |h'''| / 6 + u_round |h| / eps (u_round = 2^-53, the unit
@@ -29,8 +30,8 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from renderer import fields
-from renderer.render import central_gradient
+from renderer import formulas as F
+from renderer import pointwise
 
 __all__ = ["UCurve", "measure", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS"]
 
@@ -118,16 +119,33 @@ class UCurve:
 
 @lru_cache(maxsize=None)
 def _mp_functions(field, component, ku, kv):
-    h = fields.HEIGHT_EXPRS[field].subs({fields.k_u: ku, fields.k_v: kv})
-    var = fields.u if component == "u" else fields.v
+    var = F.u if component == "u" else F.v
     # Exact rational frequencies so that mpmath does not inherit float64 rounding.
-    h = h.subs({fields.k_u: sp.nsimplify(ku), fields.k_v: sp.nsimplify(kv)})
-    args = (fields.u, fields.v)
+    h = F.HEIGHT[field].subs({F.k_u: sp.nsimplify(ku), F.k_v: sp.nsimplify(kv)})
+    args = (F.u, F.v)
     # d sign(f) / du = 2 DiracDelta(f) f' vanishes off the crease: drop it.
     smooth = lambda e: e.replace(lambda x: isinstance(x, sp.DiracDelta), lambda x: 0)  # noqa: E731
     return (sp.lambdify(args, h, modules="mpmath"),
             sp.lambdify(args, smooth(sp.diff(h, var)), modules="mpmath"),
             sp.lambdify(args, smooth(sp.diff(h, var, 3)), modules="mpmath"))
+
+
+@lru_cache(maxsize=None)
+def _stencil():
+    """(u_p, u_m, v_p, v_m, den_u, den_v) as float64 functions of (u, v, eps_u, eps_v):
+    the kernel's stencil points (`formulas.STENCIL_POINTS`) and the denominators of
+    `formulas.CENTRAL`, read off its sine field (CENTRAL = (h(+) - h(-)) / den)."""
+    points = dict(F.STENCIL_POINTS)
+    dens = []
+    for k, var in enumerate((F.u, F.v)):
+        plus, minus = ((F.u_p, F.u_m), (F.v_p, F.v_m))[k]
+        h = F.HEIGHT["sine"]
+        den = sp.simplify((h.subs(var, plus) - h.subs(var, minus)) / F.CENTRAL["sine"][k])
+        if not den.free_symbols <= {F.u, F.v, F.eps_u, F.eps_v, plus, minus}:
+            raise RuntimeError(f"formulas.CENTRAL is not (h(+) - h(-)) / den: den = {den}")
+        dens.append(den.subs(points))
+    args = (F.u, F.v, F.eps_u, F.eps_v)
+    return sp.lambdify(args, [points[p] for p in (F.u_p, F.u_m, F.v_p, F.v_m)] + dens, modules="math")
 
 
 def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=4.0):
@@ -162,8 +180,8 @@ def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=
     1), ``truncation`` does not vanish as eps -> 0, and the derivative and
     the optimal step are NaN.
     """
-    if field not in fields.HEIGHT_EXPRS:
-        raise ValueError(f"field must be one of {tuple(fields.HEIGHT_EXPRS)}, got {field!r}")
+    if field not in F.HEIGHT:
+        raise ValueError(f"field must be one of {tuple(F.HEIGHT)}, got {field!r}")
     if component not in ("u", "v"):
         raise ValueError(f"component must be 'u' or 'v', got {component!r}")
     for name, value in (("u", u), ("v", v)):
@@ -179,7 +197,7 @@ def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=
     u, v, k_u, k_v = float(u), float(v), float(k_u), float(k_v)
     reason = non_differentiable(field, u, v, component, k_u, k_v)
     h_mp, dh_mp, d3h_mp = _mp_functions(field, component, k_u, k_v)
-    uu, vv = np.array([u]), np.array([v])
+    stencil = _stencil()
     with mpmath.workdps(DIGITS):
         U, V = mpmath.mpf(u), mpmath.mpf(v)
         if reason is None:
@@ -194,16 +212,16 @@ def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=
         h3 = d3h_mp(U, V)
         error, trunc, roundoff = [], [], []
         for e in steps:
-            fd = central_gradient(field, uu, vv, k_u, k_v, float(e))[0 if component == "u" else 1][0]
+            e = float(e)
+            fd = float(pointwise.central_gradient(field, u, v, k_u, k_v, e)[0 if component == "u" else 1])
             # The abscissae and the denominator, exactly as float64 made them.
+            u_p, u_m, v_p, v_m, den_u, den_v = stencil(u, v, e, e)
             if component == "u":
-                a_plus, a_minus = np.mod(u + e, 1.0), np.mod(u - e, 1.0)
-                den = 2.0 * e
-                f_plus, f_minus = h_mp(mpmath.mpf(a_plus), V), h_mp(mpmath.mpf(a_minus), V)
+                den = den_u
+                f_plus, f_minus = h_mp(mpmath.mpf(u_p), V), h_mp(mpmath.mpf(u_m), V)
             else:
-                a_plus, a_minus = min(1.0, v + e), max(0.0, v - e)
-                den = (a_plus - a_minus) if (v + e > 1.0 or v - e < 0.0) else 2.0 * e
-                f_plus, f_minus = h_mp(U, mpmath.mpf(a_plus)), h_mp(U, mpmath.mpf(a_minus))
+                den = den_v
+                f_plus, f_minus = h_mp(U, mpmath.mpf(v_p)), h_mp(U, mpmath.mpf(v_m))
             exact_fd = (f_plus - f_minus) / mpmath.mpf(den)
             trunc.append(float(exact_fd - true))
             roundoff.append(float(mpmath.mpf(fd) - exact_fd))

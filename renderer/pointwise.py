@@ -28,7 +28,8 @@ def _evaluate(loop, k, lead, args):
     """``loop`` over the broadcast ``args``: k arrays of the broadcast shape."""
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in args))
     shape = arrays[0].shape
-    flat = [np.ascontiguousarray(a).reshape(-1) for a in arrays]
+    # Copies: numba warns on the read-only views broadcast_arrays returns.
+    flat = [np.array(a, dtype=np.float64).reshape(-1) for a in arrays]
     out = np.empty((k, flat[0].size))
     loop(*lead, *flat, out)
     return [row.reshape(shape) for row in out]

@@ -1,9 +1,13 @@
 """The gradient methods of proofs/gradient_methods.py: their orders against an
-mpmath closed form, the complex step's analyticity premise, the evaluation
-counter, and the Pareto front.  Each check is shown to reject a wrong variant.
+mpmath closed form, the complex step's analyticity premise, the work per pixel
+counted from the formulas, and the Pareto front.  Each check is shown to
+reject a wrong variant.
 """
 
 from __future__ import annotations
+
+import inspect
+import re
 
 import mpmath
 import numpy as np
@@ -11,8 +15,9 @@ import pytest
 import sympy as sp
 
 from proofs import gradient_methods as gm
-from renderer import fields
-from renderer.render import central_gradient
+from renderer import formulas as F
+from renderer import generated as G
+from renderer import pointwise
 
 KU, KV = 8.0, 4.0
 #: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as proofs/accuracy.py).
@@ -49,7 +54,7 @@ def fitted_order(method, steps):
     return np.polyfit(np.log(steps), np.log(errs), 1)[0]
 
 
-CENTRAL = lambda e: central_gradient("sine", U0, V0, KU, KV, e)          # noqa: E731
+CENTRAL = lambda e: pointwise.central_gradient("sine", U0, V0, KU, KV, e)          # noqa: E731
 FORWARD = lambda e: gm.forward_gradient("sine", U0, V0, KU, KV, e)        # noqa: E731
 COMPLEX = lambda e: gm.complex_step_gradient("sine", U0, V0, KU, KV, e)   # noqa: E731
 STEPS = (1e-2, 1e-3, 1e-4)            # truncation-dominated for all three at this point
@@ -86,7 +91,7 @@ def test_complex_step_is_second_order_then_at_machine_precision():
 
 
 def test_exact_and_richardson_against_mpmath():
-    assert np.all(abs_errors(fields.exact_gradient("sine", U0, V0, KU, KV), REF0) <= 4 * SPACING)
+    assert np.all(abs_errors(pointwise.exact_gradient("sine", U0, V0, KU, KV), REF0) <= 4 * SPACING)
     err = abs_errors(gm.richardson_gradient("sine", U0, V0, KU, KV), REF0)
     # Order-8 stencils, stopped at rtol ~ 1.5e-8.  How much smaller than 1e-11
     # the error comes out is the last bits of the library's sine and of
@@ -111,8 +116,8 @@ def test_forward_difference_steps_backwards_at_the_top_of_the_chart():
     ref = sine_gradient_mp(u[0], v[0])
     # A step past v = 1 would still be O(eps) here (h is defined beyond the chart);
     # check the rule itself: the quotient equals the backward one.
-    h0 = fields.height("sine", u, v, KU, KV)
-    back = (fields.height("sine", u, v - 1e-3, KU, KV) - h0) / -1e-3
+    h0 = pointwise.height("sine", u, v, KU, KV)
+    back = (pointwise.height("sine", u, v - 1e-3, KU, KV) - h0) / -1e-3
     assert hv[0] == back[0]
     assert abs(hv[0] - float(ref[1])) < 10 * 1e-3 * (np.pi * KV) ** 2       # |h_vv| eps / 2 bound
 
@@ -163,55 +168,63 @@ def test_complex_step_on_ridges_is_wrong_near_a_crease_so_the_flag_matters():
     assert abs((hu_cont[0] - hi[0, 0]) - lo[0, 0]) <= 4 * SPACING
 
 
-# --- the counter ---------------------------------------------------------------------------
+# --- the work per pixel ------------------------------------------------------------------
 
-def test_counter_counts_points_per_method():
-    u, v = gm.chart_points()
-    u, v = u[:257], v[:257]
-    n = u.size
+def generated_trig_calls(function, field):
+    """math.sin and math.cos calls in the branch of ``field`` of a function of
+    renderer/generated.py: the code numba compiles, read as text."""
+    source = inspect.getsource(function.py_func)
+    branch = source.split(f"if field == {F.FIELD_CODES[field]}:")[1].split("if field ==")[0]
+    return len(re.findall(r"math\.(?:sin|cos)\(", branch))
+
+
+@pytest.mark.parametrize("field", gm.FIELDS)
+def test_trig_count_is_the_generated_codes(field):
+    # Two routes: sympy's cse over the formulas, and the text numba compiles.
+    assert gm.trig_calls(F.CENTRAL[field]) == generated_trig_calls(G.central_gradient, field)
+    assert gm.trig_calls(F.GRADIENT[field]) == generated_trig_calls(G.exact_gradient, field)
+    assert gm.trig_calls((F.HEIGHT[field],)) == generated_trig_calls(G.height, field)
+
+
+def test_trig_count_rejects_counting_without_the_shared_factors():
+    # Counting the stencil's four values of h as written (no cse) gives 8 sines for the
+    # sine field; the generated code shares sin(pi k_v v) and sin(pi k_u u) and calls 6.
+    as_written = sum(isinstance(n, sp.sin) for c in F.CENTRAL["sine"] for n in sp.preorder_traversal(c))
+    assert as_written == 8 != generated_trig_calls(G.central_gradient, "sine") == 6
+
+
+def test_work_per_pixel_of_each_method():
     expected = {
-        "central": (lambda: central_gradient("sine", u, v, KU, KV, 1e-3), (4 * n, 0, 0)),
-        "forward": (lambda: gm.forward_gradient("sine", u, v, KU, KV, 1e-3), (3 * n, 0, 0)),
-        "complex": (lambda: gm.complex_step_gradient("sine", u, v, KU, KV, 1e-20), (0, 2 * n, 0)),
-        "exact": (lambda: fields.exact_gradient("sine", u, v, KU, KV), (0, 0, n)),
+        ("sine", "central"): gm.Evaluations(h=4, trig=6),
+        ("ridges", "central"): gm.Evaluations(h=4, trig=6),
+        ("rings", "central"): gm.Evaluations(h=2, trig=2),      # the u-difference of rings is 0
+        ("sine", "exact"): gm.Evaluations(gradient=1, trig=4),
+        ("rings", "exact"): gm.Evaluations(gradient=1, trig=1),
+        ("sine", "forward"): gm.Evaluations(h=3, trig=6),
+        ("sine", "complex step"): gm.Evaluations(h_complex=2),
+        ("ridges", "h"): gm.Evaluations(h=1, trig=2),
     }
-    for name, (fn, want) in expected.items():
-        with gm.count_evaluations() as c:
-            fn()
-        assert (c.h, c.h_complex, c.gradient) == want, name
+    for (field, method), want in expected.items():
+        assert gm.evaluations(field, method) == want, (field, method)
+    assert gm.evaluations("sine", "richardson", h_per_pixel=22.5) == gm.Evaluations(h=22.5, trig=45)
+    with pytest.raises(ValueError, match="pass h_per_pixel"):
+        gm.evaluations("sine", "richardson")
+    with pytest.raises(ValueError, match="unknown method"):
+        gm.evaluations("sine", "backward")
 
 
-def test_counter_agrees_with_scipys_own_count_for_richardson():
+def test_stencil_values_are_the_points_the_stencil_reads():
+    assert [gm.stencil_values(f) for f in gm.FIELDS] == [4, 4, 2]
+    # A stencil that read h only at u +- eps would be counted as 2, not 4.
+    assert sum(p in F.CENTRAL["sine"][0].free_symbols for p, _ in F.STENCIL_POINTS) == 2
+
+
+def test_scipy_counts_richardsons_evaluations():
     u, v = gm.chart_points()
     u, v = u[:300], v[:300]
     info = {}
-    with gm.count_evaluations() as c:
-        gm.richardson_gradient("ridges", u, v, KU, KV, info=info)
-    assert c.h == info["nfev"]             # scipy counts its validation call too
-    assert c.h > 4 * u.size                # more than a central difference's four
-
-
-def test_counter_restores_the_originals_even_on_error():
-    before = (fields.height, fields.exact_gradient)
-    with pytest.raises(ZeroDivisionError):
-        with gm.count_evaluations():
-            assert fields.height is not before[0]
-            1 / 0
-    assert (fields.height, fields.exact_gradient) == before
-
-
-def test_measure_refuses_counts_when_the_instrumentation_is_bypassed(monkeypatch):
-    u, v = gm.chart_points()
-    u, v = u[:40].copy(), v[:40].copy()
-    height = fields.height                 # captured: the counter cannot see calls to it
-
-    def bypassing(name, uu, vv, ku, kv, eps):
-        return ((height(name, uu + eps, vv, ku, kv) - height(name, uu - eps, vv, ku, kv)) / (2 * eps),
-                (height(name, uu, vv + eps, ku, kv) - height(name, uu, vv - eps, ku, kv)) / (2 * eps))
-
-    monkeypatch.setattr(gm, "central_gradient", bypassing)
-    with pytest.raises(RuntimeError, match="no longer calls renderer.fields.height"):
-        gm.measure(TINY, fields_=("sine",), uv=(u, v))
+    gm.richardson_gradient("ridges", u, v, KU, KV, info=info)
+    assert info["nfev"] > 4 * 2 * u.size     # more than a central difference's four, per component
 
 
 # --- the Pareto front ----------------------------------------------------------------------
@@ -260,6 +273,8 @@ def test_measure_small_run_and_its_presentations():
     exact = m.get("sine", "exact")
     assert exact.max_error <= FLOAT64_EVAL and len(exact.times) == 2
     assert m.get("sine", "central 1e-03").h_evals == 4.0
+    assert m.get("sine", "central 1e-03").trig_evals == 6.0 and m.get("rings", "exact").trig_evals == 1.0
+    assert m.get("sine", "richardson").h_evals > 4.0
     assert len(m.get("sine", "richardson").times) == 1
     plain = m.get("ridges", "complex step 1e-20")
     assert not plain.valid and plain.max_error > 1.0

@@ -16,9 +16,9 @@ def test_exact_gradient_is_float64_accurate_and_central_is_not(field):
 
 
 def test_gradient_accuracy_detects_a_wrong_pipeline(monkeypatch):
-    from renderer import fields
-    original = fields.exact_gradient
-    monkeypatch.setattr(fields, "exact_gradient",
+    from renderer import pointwise
+    original = pointwise.exact_gradient
+    monkeypatch.setattr(pointwise, "exact_gradient",
                         lambda *a: tuple(1.000001 * g for g in original(*a)))
     assert gradient_accuracy("sine", count=200)[0].max_ulps > 1e6
 
