@@ -27,6 +27,7 @@ import sys
 from pathlib import Path
 
 import sympy as sp
+from sympy.printing.jscode import JavascriptCodePrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from . import formulas as F
@@ -48,9 +49,24 @@ def _py(expr):
     return _PY.doprint(expr)
 
 
+class _JavascriptPrinter(JavascriptCodePrinter):
+    """sympy's JavaScript printer, but with JavaScript's booleans: sympy 1.14
+    prints sympy.true and sympy.false as Python's True and False, which are
+    undefined names in JavaScript (the crease flag of a field without creases)."""
+
+    def _print_BooleanTrue(self, expr):
+        return "true"
+
+    def _print_BooleanFalse(self, expr):
+        return "false"
+
+
+_JS = _JavascriptPrinter()
+
+
 def _js(expr):
     # sympy prints a Piecewise over several lines; one line reads better.
-    return " ".join(line.strip() for line in sp.jscode(expr).splitlines())
+    return " ".join(line.strip() for line in _JS.doprint(expr).splitlines())
 
 
 def _body(name, outputs, printer, indent):

@@ -66,7 +66,7 @@ def scene_json(scene: Scene, base: Scene = Scene()):
 
 
 def run_render_cases(module_dir, cases, out_dir):
-    """Render ``cases`` (dicts: id, scene: Scene, width, height, gradient, zoom) in node.
+    """Render ``cases`` (dicts: id, scene: Scene, width, height, gradient, zoom[, numeric]) in node.
 
     Returns {id: ms} and leaves the frames in ``out_dir`` (read them with `read_frame`).
     """
@@ -84,10 +84,13 @@ def run_render_cases(module_dir, cases, out_dir):
 
 
 def read_frame(out_dir, prefix, width, height):
-    """(image (H, W, 3), grad (H, W, 2), chamber (H, W) uint8, kink (H, W) bool) written by node."""
+    """(image (H, W, 3), grad (H, W, 2), chamber (H, W) uint8, kink (H, W) bool,
+    uv (H, W, 2)) of a frame written by node; grad and uv are 0 off sphere A."""
     out_dir = Path(out_dir)
-    image = np.fromfile(out_dir / f"{prefix}.image.f64", dtype="<f8").reshape(height, width, 3)
-    grad = np.fromfile(out_dir / f"{prefix}.grad.f64", dtype="<f8").reshape(height, width, 2)
-    chamber = np.fromfile(out_dir / f"{prefix}.chamber.u8", dtype=np.uint8).reshape(height, width)
-    kink = np.fromfile(out_dir / f"{prefix}.kink.u8", dtype=np.uint8).reshape(height, width).astype(bool)
-    return image, grad, chamber, kink
+    read = lambda name, dtype: np.fromfile(out_dir / f"{prefix}.{name}", dtype=dtype)  # noqa: E731
+    image = read("image.f64", "<f8").reshape(height, width, 3)
+    grad = read("grad.f64", "<f8").reshape(height, width, 2)
+    chamber = read("chamber.u8", np.uint8).reshape(height, width)
+    kink = read("kink.u8", np.uint8).reshape(height, width).astype(bool)
+    uv = read("uv.f64", "<f8").reshape(height, width, 2)
+    return image, grad, chamber, kink, uv

@@ -3,10 +3,11 @@
 The built page is loaded from disk (file://), as a reader without a network
 opens it, and every request that is not for a local file is blocked and
 recorded.  The test checks: no console errors, MathJax typeset from the site,
-canvases that are not blank, the ledger's RMS at eps = 1e-3 and 1e-6 equal to
-what the Python renderer predicts, the hover readout's (u, v) equal to
-Python's for a given pixel, and every control reachable and movable from the
-keyboard.  It saves a screenshot and the timings to test-artifacts/.
+canvases that are not blank, the ledger's RMS and max at eps = 1e-3 and 1e-6
+within the bounds that the JavaScript-vs-Python error model
+(tests/test_js_parity.py) puts around the Python renderer's, the hover
+readout's (u, v) within the model's chart bound of Python's for a given
+pixel, and every control reachable and movable from the keyboard.  It saves a screenshot and the timings to test-artifacts/.
 
 The book is built into a temporary directory for the test unless
 SYMRENDER_BOOK_HTML names a freshly built site (.ci/run builds the book first
@@ -28,6 +29,7 @@ import pytest
 from renderer import Scene, compare, gbuffer, render
 
 from .jsnode import ARTIFACTS, in_ci, require_tool
+from .test_js_parity import CHART_TOL, image_bound
 
 CHROMIUM = "/usr/bin/chromium"
 ROOT = Path(__file__).parents[1]
@@ -36,7 +38,7 @@ SIZE = 256
 # background-networking ones Chromium keeps trying to reach Google's hosts.
 CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
-CONTROLS = ["sim-height_field", "sim-k_u", "sim-k_v", "sim-beta", "sim-log_eps", "sim-model",
+CONTROLS = ["sim-height_field", "sim-k_u", "sim-k_v", "sim-beta", "sim-numeric", "sim-log_eps", "sim-model",
             "sim-resolution", "sim-view", "sim-zoom", "sim-sphere_b"]
 BUTTONS = ["sim-preset-try1", "sim-preset-try2", "sim-preset-try3", "sim-preset-try4", "sim-reset"]
 
@@ -124,7 +126,9 @@ def test_page_loads_offline_without_errors(session):
     page.wait_for_function("document.querySelectorAll('mjx-container').length > 0", timeout=30_000)
     assert page.locator("mjx-container").count() > 5
     srcs = page.eval_on_selector_all("script[src]", "els => els.map(e => e.src)")
-    assert any(s.startswith("file://") and s.endswith("_static/mathjax/tex-chtml.js") for s in srcs)
+    # Sphinx may append a ?v=<checksum> query to a static file's address.
+    paths = [s.split("?")[0] for s in srcs]
+    assert any(s.startswith("file://") and s.endswith("_static/mathjax/tex-chtml.js") for s in paths)
     assert session.errors == []
     assert session.blocked == [], f"the page tried the network: {session.blocked}"
 
@@ -147,9 +151,18 @@ def test_canvases_are_not_blank(session):
     assert by["difference"]["lit"] > 100, by["difference"]   # ridges at eps = 1e-3 differ visibly
 
 
-def _python_rms(eps):
+def _python_ledger(eps):
+    """Python's ledger at eps, and bounds of how far the simulator's RMS and max may lie from it.
+
+    Per pixel and channel the two |I_numeric - I_symbolic| differ by at most
+    b = b_central + b_exact (`image_bound` of each pipeline), so the maxima
+    differ by at most max b and, the RMS being a norm, the RMS by at most the
+    RMS of b over the same pixels (sphere A in both frames)."""
     scene = Scene(eps=eps)
-    return compare(render(scene, SIZE, SIZE, gradient="central"), render(scene, SIZE, SIZE)).rms
+    led = compare(render(scene, SIZE, SIZE, gradient="central"), render(scene, SIZE, SIZE))
+    b = image_bound(scene, SIZE, SIZE, "central") + image_bound(scene, SIZE, SIZE, "exact")
+    on_a = render(scene, SIZE, SIZE, kink=False, grad=False).chamber == 1
+    return led, float(np.sqrt(np.mean(b[on_a] ** 2))), float(b[on_a].max())
 
 
 def test_eps_slider_moves_the_ledger_as_python_predicts(session):
@@ -158,23 +171,27 @@ def test_eps_slider_moves_the_ledger_as_python_predicts(session):
         session.set_eps(exponent)
         assert session.page.text_content("#sim-log_eps-value") == f"1.0e{exponent}"
         got[exponent] = (session.ledger("rms"), session.ledger("max"), session.ledger("flips"))
-    want = {-3: _python_rms(1e-3), -6: _python_rms(1e-6)}
-    for e in (-3, -6):
-        # |rms_js - rms_py| <= rms of the per-pixel gap, which the parity tests
-        # bound by 2.2e-16; rel = 1e-6 is loose at 1e-3 and still tight at 1e-6.
-        assert got[e][0] == pytest.approx(want[e], rel=1e-6, abs=0.0), (e, got[e][0], want[e])
-        assert got[e][2] == 0
-    assert got[-3][0] / got[-6][0] == pytest.approx(want[-3] / want[-6], rel=1e-6, abs=0.0)
+    report = {}
+    for e, eps in ((-3, 1e-3), (-6, 1e-6)):
+        led, rms_bound, max_bound = _python_ledger(eps)
+        rms, top, flips = got[e]
+        assert abs(rms - led.rms) <= rms_bound, (e, rms, led.rms, rms_bound)
+        assert abs(top - led.max_abs) <= max_bound, (e, top, led.max_abs, max_bound)
+        assert flips == led.flips == 0
+        report[f"eps={eps:g}"] = {"rms": rms, "max": top, "python_rms": led.rms, "python_max": led.max_abs,
+                                  "rms_bound": rms_bound, "max_bound": max_bound}
+    # The slider moves the ledger down the truncation slope: by three orders
+    # of magnitude or more from 1e-3 to 1e-6.
+    assert got[-6][0] < 1e-3 * got[-3][0]
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
-    (ARTIFACTS / "browser_ledger.json").write_text(json.dumps(
-        {"eps=1e-3": {"rms": got[-3][0], "max": got[-3][1], "python_rms": want[-3]},
-         "eps=1e-6": {"rms": got[-6][0], "max": got[-6][1], "python_rms": want[-6]}}, indent=1))
+    (ARTIFACTS / "browser_ledger.json").write_text(json.dumps(report, indent=1))
 
 
 def test_hover_readout_gives_pythons_chart(session):
     """Mouse events carry whole CSS pixels, so the test aims at a pixel, reads
     which pixel the readout reports (within one of the aim), and compares that
-    pixel's (u, v) with Python's, bit for bit."""
+    pixel's (u, v) with Python's, within the error model's chart bound (the
+    browser's atan2 may round the last bit differently)."""
     session.set_eps(-3)
     gb = gbuffer(Scene(), SIZE, SIZE)
     rows, cols = np.nonzero(gb.chamber == 1)
@@ -196,7 +213,7 @@ def test_hover_readout_gives_pythons_chart(session):
         assert gb.chamber[rj, ri] == int(session.page.get_attribute("#sim-readout", "data-chamber")) == 1
         u = float(session.page.get_attribute("#sim-readout", "data-u"))
         v = float(session.page.get_attribute("#sim-readout", "data-v"))
-        assert (u, v) == (gb.uv[rj, ri, 0], gb.uv[rj, ri, 1]), (ri, rj)
+        assert abs(u - gb.uv[rj, ri, 0]) <= CHART_TOL and abs(v - gb.uv[rj, ri, 1]) <= CHART_TOL, (ri, rj)
         checked.add((ri, rj))
     assert len(checked) == len(pick)
     assert "(u, v)" in session.page.text_content("#sim-readout")

@@ -1,68 +1,198 @@
-"""renderer.jsgen: the generated modules come from sympy, and the bundle is joined safely."""
+"""renderer.jsgen: the generated modules come from their sources, and the bundle is joined safely."""
 
 from __future__ import annotations
 
+import importlib.util
+import json
+import math
+import os
+import re
 import subprocess
+from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
-import sympy as sp
 
-from renderer import fields, jsgen
+from renderer import codegen, generated, jsgen
+from renderer import formulas as F
 
 from .jsnode import require_tool
 
-
-def test_fields_js_is_printed_from_the_sympy_expressions():
-    text = jsgen.fields_js()
-    for name, (hu, hv) in fields.GRADIENT_EXPRS.items():
-        replacements, (ru, rv) = sp.cse([hu, hv])
-        assert f"out[0] = {sp.jscode(ru)};" in text, name
-        assert f"out[1] = {sp.jscode(rv)};" in text, name
-    assert "det_sin(Math.PI*k_u*u)*det_sin(Math.PI*k_v*v)" in text
-    assert "Math.sin(" not in text.split("function gradient_sine")[0]   # h uses the deterministic sine
+ROOT = Path(__file__).parents[1]
 
 
-def test_constants_js_carries_the_python_defaults():
+def _node():
+    return require_tool("node", "the generated JavaScript is run under node")
+
+
+# ---- the generated modules -------------------------------------------------------------
+
+def test_formulas_js_is_the_generators_output():
+    """formulas.js is renderer.codegen's JavaScript, unaltered, and the bundle carries it."""
+    assert jsgen.formulas_js() == codegen.js_source()
+    assert jsgen.sources()["formulas"] == codegen.js_source()
+    bundle = jsgen.bundle_source()
+    body = codegen.js_source().replace("export ", "")
+    assert body in bundle
+
+
+def test_the_book_uses_the_regenerated_bundle(tmp_path):
+    """book/_ext/simulator_assets.py writes exactly `bundle_source` into the site's static files."""
+    spec = importlib.util.spec_from_file_location("simulator_assets", ROOT / "book" / "_ext" / "simulator_assets.py")
+    assets = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(assets)
+    app = SimpleNamespace(outdir=str(tmp_path / "_build" / "html"))
+    config = SimpleNamespace(html_static_path=["_static"])
+    assets._generate(app, config)
+    static = Path(config.html_static_path[-1])
+    assert (static / "sim" / "simulator.js").read_text(encoding="utf-8") == jsgen.bundle_source()
+
+
+def test_a_built_book_carries_the_regenerated_bundle():
+    """The simulator script of a built site (SYMRENDER_BOOK_HTML) is today's bundle."""
+    html = os.environ.get("SYMRENDER_BOOK_HTML")
+    if not html:
+        pytest.skip("SYMRENDER_BOOK_HTML names no built site")
+    script = Path(html) / "_static" / "sim" / "simulator.js"
+    assert script.read_text(encoding="utf-8") == jsgen.bundle_source(), \
+        f"{script} is stale: rebuild the book"
+
+
+#: A value for every argument name of `formulas.FUNCTIONS` (a unit normal, its
+#: frame, a chart point away from creases and poles, a pixel of the default camera).
+_N = (0.3, -0.4, math.sqrt(1 - 0.25))
+_S = math.hypot(_N[0], _N[1])
+ARGS = dict(u=0.31, v=0.58, k_u=8.0, k_v=4.0, eps_u=1e-3, eps_v=2e-3, N_x=_N[0], N_y=_N[1], N_z=_N[2],
+            sin_phi=_S, et_x=-_N[1] / _S, et_y=_N[0] / _S, et_z=0.0, ep_x=_N[2] * _N[0] / _S,
+            ep_y=_N[2] * _N[1] / _S, ep_z=-_S, h_u=3.0, h_v=-2.0, beta=0.35, h=0.4, R=1.0, x=0.07,
+            y=-0.1, dx=0.011, dy=0.012, camera_z=4.0, P_x=_N[0], P_y=_N[1], P_z=_N[2])
+
+
+def _js_values(tmp_path, calls):
+    """Run formulas.js under node: {key: (name, [args])} -> {key: value or [values]}."""
+    module = tmp_path / "formulas.js"
+    module.write_text(jsgen.formulas_js(), encoding="utf-8")
+    driver = tmp_path / "driver.mjs"
+    driver.write_text(
+        f'import * as F from "{module.as_uri()}";\n'
+        f"const calls = {json.dumps(calls)};\n"
+        "const out = {};\n"
+        "for (const [key, [name, args]] of Object.entries(calls)) {\n"
+        "  const r = F[name](...args, new Float64Array(8));\n"
+        "  out[key] = typeof r === 'object' ? Array.from(r) : r;\n"
+        "}\n"
+        "console.log(JSON.stringify(out));\n", encoding="utf-8")
+    proc = subprocess.run([_node(), str(driver)], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout)
+
+
+def test_every_generated_function_runs_in_javascript_and_agrees_with_python(tmp_path):
+    """Every function of formulas.js, every field's branch, runs under node (no
+    Python name such as False printed into it) and returns what renderer/generated.py
+    returns, to rounding: a handful of libm-vs-V8 ulps, amplified by at most
+    1/eps = 1e3 in the central quotient, stays far inside 1e-9 relative."""
+    calls, expect = {}, {}
+    for name, (args, outputs) in F.FUNCTIONS.items():
+        values = [ARGS[str(a)] for a in args]
+        fields = F.FIELD_CODES.items() if isinstance(outputs, dict) else [(None, None)]
+        for field, code in fields:
+            lead = [] if code is None else [code]
+            key = f"{name}[{field}]" if field else name
+            calls[key] = (name, lead + values)
+            expect[key] = getattr(generated, name)(*lead, *values)
+    got = _js_values(tmp_path, calls)
+    assert set(got) == set(calls)
+    for key, want in expect.items():
+        want = list(want) if isinstance(want, tuple) else [want]
+        have = got[key] if isinstance(got[key], list) else [got[key]]
+        have = have[:len(want)]
+        for w, h in zip(want, have):
+            if isinstance(w, bool) or type(w).__name__ == "bool_":
+                # A flag: a boolean, or 1/0 where it is written into an `out` array.
+                assert h in (0, 1) and bool(h) == bool(w), (key, h, w)
+            else:
+                assert math.isclose(h, w, rel_tol=1e-9, abs_tol=1e-12), (key, h, w)
+
+
+def test_constants_js_carries_the_python_values():
     text = jsgen.constants_js()
     assert '"height_field": "ridges"' in text and '"eps": 0.001' in text
-    assert "export const POLE_SIN_PHI = 0.0001;" in text
+    assert 'export const GRADIENTS = ["exact", "central", "footprint"];' in text
+    assert "export const TINY = 1e-300;" in text
+    assert "export const FLOOR_LIGHT = 0.85;" in text and "export const FLOOR_DARK = 0.15;" in text
 
+
+def test_the_modules_are_exactly_the_hand_written_files_and_the_generated_ones():
+    """renderer/js holds the hand-written modules of MODULE_ORDER, nothing else (no stale detmath.js)."""
+    on_disk = {p.stem for p in jsgen.JS_DIR.glob("*.js")}
+    assert on_disk == set(jsgen.MODULE_ORDER) - set(jsgen.GENERATED)
+    assert set(jsgen.GENERATED) <= set(jsgen.MODULE_ORDER)
+
+
+# ---- nothing hand-written retypes a formula --------------------------------------------
+
+#: Calls that only formulas.js may make (the chart's atan2, the seed's acos, the gradients' cos).
+_FORMULA_CALLS = ("Math.atan2", "Math.acos", "Math.cos", "Math.sign")
+#: The constants of renderer/formulas.py.
+_FORMULA_CONSTANTS = {float(c) for c in (F.POLE_SIN_PHI, F.KINK_BAND_HALF_WIDTH, F.FOOTPRINT_FALLBACK,
+                                        F.FOOTPRINT_MAX)}
+_NUMBER = re.compile(r"(?<![\w.])(\d+\.?\d*(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?)")
+
+
+def retyped_formulas(text):
+    """Calls and numeric literals in ``text`` that belong to renderer/formulas.py."""
+    code = "\n".join(line.split("//")[0] for line in text.splitlines())
+    found = [c for c in _FORMULA_CALLS if c in code]
+    found += [n for n in _NUMBER.findall(code) if float(n) in _FORMULA_CONSTANTS]
+    return found
+
+
+def test_the_renderer_core_retypes_no_formula():
+    text = (jsgen.JS_DIR / "render.js").read_text(encoding="utf-8")
+    assert retyped_formulas(text) == []
+    # The check rejects a hand-written chart, pole cut-off or crease band.
+    assert retyped_formulas(text + "\nconst theta = Math.atan2(N[1], N[0]);\n") == ["Math.atan2"]
+    assert retyped_formulas(text + "\nif (sin_phi > 1e-4) {}\n") == ["1e-4"]
+    assert retyped_formulas(text + "\nconst band = Math.abs(f) < 0.03;\n") == ["0.03"]
+
+
+# ---- the bundle --------------------------------------------------------------------------
 
 def test_bundle_is_valid_javascript(tmp_path):
-    node = require_tool("node", "node --check parses the bundle")
     path = jsgen.write_bundle(tmp_path / "simulator.js")
-    subprocess.run([node, "--check", str(path)], check=True, timeout=60)
+    subprocess.run([_node(), "--check", str(path)], check=True, timeout=60)
     text = path.read_text()
     assert "import " not in text.replace("// ", "") and "\nexport " not in text
     assert "http://" not in text and "https://" not in text
 
 
 def _sources(**changes):
-    src = dict(jsgen._sources())
+    src = dict(jsgen.sources())
     src.update(changes)
     return src
 
 
 def test_bundle_rejects_an_import_of_a_name_not_exported():
-    bad = jsgen._sources()["ledger"].replace("import { SPHERE_A }", "import { SPHERE_A, NOT_THERE }")
+    bad = jsgen.sources()["ledger"].replace("import { SPHERE_A }", "import { SPHERE_A, NOT_THERE }")
     with pytest.raises(jsgen.BundleError, match="NOT_THERE"):
         jsgen.bundle_source(_sources(ledger=bad))
 
 
 def test_bundle_rejects_a_forward_import():
-    bad = 'import { render } from "./render.js";\n' + jsgen._sources()["geometry"]
+    bad = 'import { render } from "./render.js";\n' + jsgen.sources()["formulas"]
     with pytest.raises(jsgen.BundleError, match="not an earlier module"):
-        jsgen.bundle_source(_sources(geometry=bad))
+        jsgen.bundle_source(_sources(formulas=bad))
 
 
 def test_bundle_rejects_a_name_declared_twice():
-    bad = jsgen._sources()["ledger"] + "\nfunction _dot(a, b) { return a * b; }\n"
-    with pytest.raises(jsgen.BundleError, match="_dot"):
+    bad = jsgen.sources()["ledger"] + "\nfunction copysign(a, b) { return a; }\n"
+    with pytest.raises(jsgen.BundleError, match="copysign"):
         jsgen.bundle_source(_sources(ledger=bad))
 
 
 def test_bundle_rejects_an_unhandled_export_form():
-    bad = jsgen._sources()["ledger"] + "\nexport default compare;\n"
+    bad = jsgen.sources()["ledger"] + "\nexport default compare;\n"
     with pytest.raises(jsgen.BundleError, match="export default"):
         jsgen.bundle_source(_sources(ledger=bad))
 

@@ -10,7 +10,7 @@ extension puts the code a page runs into that key:
    imports, imports inside functions, ``importlib.import_module`` with a
    literal name), closes the set over the imports of the project's own
    modules (parent packages' ``__init__.py`` included, since importing
-   ``renderer.geometry`` runs ``renderer/__init__.py``, which imports its
+   ``renderer.kernel`` runs ``renderer/__init__.py``, which imports its
    submodules), adds the data files a module reads at run time
    (``DATA_FILES``), and hashes the contents of those files.
 2. On ``source-read`` the page's source gains a last code cell, tagged
@@ -25,7 +25,8 @@ extension puts the code a page runs into that key:
    page whose digests differ is re-read (and so re-executed, or matched in
    the cache under its new key).  The second digest, ``asset_digest``, covers
    the static files a page loads that are generated from project code at build
-   time (``ASSETS``: §4's simulator script, printed by ``renderer.jsgen``).
+   time (``ASSETS``: §4's simulator script, bundled by ``renderer.jsgen``
+   from renderer/js/*.js and the formulas ``renderer.codegen`` prints).
    It is not part of the cache key: when only the simulator's sources change,
    §4 is re-read and re-written from the cache, which makes Sphinx copy the new
    script into the site (with no page to write, Sphinx copies no static file).

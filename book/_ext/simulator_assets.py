@@ -1,9 +1,10 @@
 """Sphinx extension: generate the §4 simulator's script when the book is built.
 
 On ``config-inited`` it writes ``sim/simulator.js`` (renderer.jsgen's bundle of
-renderer/js/*.js with the fields printed from sympy) into a build-side
-directory and adds that directory to ``html_static_path``, so the site serves
-``_static/sim/simulator.js``.  Nothing generated is written into book/.
+renderer/js/*.js with the formulas that renderer.codegen prints from
+renderer/formulas.py) into a build-side directory and adds that directory to
+``html_static_path``, so the site serves ``_static/sim/simulator.js``.
+Nothing generated is written into book/.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 // The §4 live simulator: controls, three canvases, the ledger and the hover
 // readout, wired to the renderer in render.js.  Only this module touches the
 // DOM; the renderer core runs the same under node (tests/test_js_parity.py).
-import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, SPHERE_A, CHAMBER_NAMES } from "./constants.js";
+import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, SPHERE_A, CHAMBER_NAMES } from "./constants.js";
 import { render_pair, probe_pixel } from "./render.js";
 import { compare, to_srgb } from "./ledger.js";
 
@@ -11,8 +11,17 @@ export function eps_of(log_eps) {
   return Number(Math.pow(10, log_eps).toPrecision(2));
 }
 
+// The numeric pipelines the left canvas can show: every gradient method but the exact one.
+const NUMERIC = GRADIENTS.filter((g) => g !== "exact");
+
+// What the left canvas shows, per numeric pipeline.
+const NUMERIC_CAPTION = {
+  central: "numeric: central differences, step ε",
+  footprint: "numeric: central differences, step = the pixel's footprint",
+};
+
 const DEFAULT_STATE = {
-  height_field: DEFAULT_SCENE.height_field, k_u: DEFAULT_SCENE.k_u, k_v: DEFAULT_SCENE.k_v,
+  numeric: "central", height_field: DEFAULT_SCENE.height_field, k_u: DEFAULT_SCENE.k_u, k_v: DEFAULT_SCENE.k_v,
   beta: DEFAULT_SCENE.beta, log_eps: Math.log10(DEFAULT_SCENE.eps), model: DEFAULT_SCENE.model,
   resolution: 256, view: "shaded", zoom: 1, sphere_b: DEFAULT_SCENE.sphere_b,
 };
@@ -23,6 +32,7 @@ const CONTROLS = [
   { name: "k_u", label: "k_u", kind: "range", min: 1, max: 24, step: 1 },
   { name: "k_v", label: "k_v", kind: "range", min: 1, max: 24, step: 1 },
   { name: "beta", label: "β (bump amplitude)", kind: "range", min: 0, max: 2, step: 0.01 },
+  { name: "numeric", label: "numeric gradient", kind: "select", options: NUMERIC },
   { name: "log_eps", label: "ε (finite-difference step)", kind: "range", min: -14, max: -1, step: 0.1,
     show: (x) => eps_of(x).toExponential(1) },
   { name: "model", label: "shading model", kind: "select", options: MODELS },
@@ -96,7 +106,7 @@ class Simulator {
     }
     this.canvases = {};
     const figs = [
-      ["numeric", "numeric: central differences, step ε"],
+      ["numeric", NUMERIC_CAPTION.central],
       ["symbolic", "symbolic: the exact gradient"],
       ["difference", "|difference| × 10²"],
     ].map(([name, caption]) => {
@@ -196,7 +206,7 @@ class Simulator {
     const scene = scene_of(s);
     const t0 = performance.now();
     // One pass for both pipelines: the geometry is shared (bump moves no boundary).
-    const { numeric, symbolic } = render_pair(scene, s.resolution, s.resolution, s.zoom);
+    const { numeric, symbolic } = render_pair(scene, s.resolution, s.resolution, s.zoom, s.numeric);
     const ledger = compare(numeric, symbolic);
     this.draw(numeric, symbolic);
     const ms = performance.now() - t0;
@@ -260,9 +270,10 @@ class Simulator {
       }
       ctx.putImageData(img, 0, 0);
     }
-    const cap = { shaded: ["numeric: central differences, step ε", "symbolic: the exact gradient", "|ΔI| × 10²"],
-                  bump: ["bump view: |∇h|, numeric", "bump view: |∇h|, exact", "|Δ|∇h|| × 10² (relative to max)"],
-                  kink: ["kink view: crease band (white), numeric", "kink view: crease band (white), exact", "|ΔI| × 10², band in blue"] }[view];
+    const pipe = this.state.numeric;
+    const cap = { shaded: [NUMERIC_CAPTION[pipe] ?? `numeric: ${pipe}`, "symbolic: the exact gradient", "|ΔI| × 10²"],
+                  bump: [`bump view: |∇h|, numeric (${pipe})`, "bump view: |∇h|, exact", "|Δ|∇h|| × 10² (relative to max)"],
+                  kink: [`kink view: crease band (white), numeric (${pipe})`, "kink view: crease band (white), exact", "|ΔI| × 10², band in blue"] }[view];
     ["numeric", "symbolic", "difference"].forEach((name, i) => {
       this.root.querySelector(`#sim-caption-${name}`).textContent = cap[i];
     });
@@ -291,7 +302,7 @@ class Simulator {
     const res = s.resolution;
     if (i >= res || j >= res) { i = res >> 1; j = res >> 1; }
     this.probe = { i, j };
-    const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom);
+    const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom, s.numeric);
     const a = pr.symbolic, b = pr.numeric;
     const vec = (v) => v ? "(" + v.map((x) => x.toPrecision(10)).join(", ") + ")" : "—";
     const lines = [
@@ -302,7 +313,9 @@ class Simulator {
     if (a.chamber === SPHERE_A) {
       lines.push(`(u, v)        ${vec(a.uv)}`);
       lines.push(`∇h exact      ${vec(a.grad)}`);
-      lines.push(`∇h central    ${vec(b.grad)}   (ε = ${eps_of(s.log_eps).toExponential(1)})`);
+      const steps = b.steps[0] === b.steps[1] ? `ε = ${b.steps[0].toExponential(1)}`
+        : `ε_u = ${b.steps[0].toExponential(2)}, ε_v = ${b.steps[1].toExponential(2)}`;
+      lines.push(`${("∇h " + b.gradient).padEnd(14)}${vec(b.grad)}   (${steps})`);
       lines.push(`kink band     ${a.kink ? "yes: the gradient is undefined on the crease" : "no"}`);
     }
     lines.push(`RGB symbolic  ${vec(a.rgb)}`);
