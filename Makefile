@@ -23,7 +23,7 @@ test: $(STAMP)
 # The numerics-heavy tests again with numpy's optional SIMD features (those
 # found on this CPU beyond its baseline) disabled: the same checks must hold
 # on the dispatch path of a machine without them.
-NUMERIC_TESTS := verify tests/test_parity.py tests/test_fields.py tests/test_detmath.py \
+NUMERIC_TESTS := verify tests/test_parity.py tests/test_codegen.py \
                  tests/test_gradient_methods.py tests/test_any_scene.py tests/test_stress.py
 test-baseline-simd: $(STAMP)
 	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')" \

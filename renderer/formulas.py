@@ -29,7 +29,7 @@ __all__ = [
     "KINK_BAND_HALF_WIDTH", "N_x", "N_y", "N_z", "sin_phi", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL", "FOOTPRINT",
-    "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FUNCTIONS", "FIELD_CODES",
+    "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FUNCTIONS", "FIELD_CODES",
 ]
 
 # ---------------------------------------------------------------- height fields
@@ -130,6 +130,10 @@ P = sp.symbols("P_x P_y P_z", real=True)
 #: pbrt-v4's fallback step where the footprint is 0 (or undefined), and the
 #: largest step the stencil accepts (u +- eps stays a quarter period apart).
 FOOTPRINT_FALLBACK, FOOTPRINT_MAX = sp.Float(0.0005), sp.Float(0.25)
+#: pbrt-v4 clamps |du/dx| to 1e8 and zeroes a non-finite one (at the pole
+#: sin phi = 0, or a ray grazing the tangent plane); here a footprint that is
+#: not below 1e8 (or is NaN) takes the fallback step.
+FOOTPRINT_LIMIT = sp.Float(1e8)
 
 
 def _ray_differential(sx, sy):
@@ -150,13 +154,17 @@ def _footprint():
         d = [sum(a * c for a, c in zip(axis, _ray_differential(*s))) / scale
              for s in ((dx, 0), (0, dy))]
         half = (sp.Abs(d[0]) + sp.Abs(d[1])) / 2
-        steps.append(sp.Piecewise((sp.Min(half, FOOTPRINT_MAX), half > 0), (FOOTPRINT_FALLBACK, True)))
+        steps.append(sp.Piecewise((sp.Min(half, FOOTPRINT_MAX), sp.And(half > 0, half < FOOTPRINT_LIMIT)),
+                                  (FOOTPRINT_FALLBACK, True)))
     return tuple(steps)
 
 
-#: (eps_u, eps_v): half the sum of |du/dx| and |du/dy| (likewise v), the pixel's
-#: footprint in the chart (pbrt-v4, ``BumpMap``: du = 0.5 (|dudx| + |dudy|),
-#: 0.0005 where that is 0), here also where it is undefined, and at most 0.25.
+#: (eps_u, eps_v): half the sum of |du/dx| and |du/dy| (likewise v), the
+#: pixel's footprint in the chart (pbrt-v4, ``BumpMap``: du = 0.5 (|dudx| +
+#: |dudy|), 0.0005 where that is 0), the fallback also where it is not below
+#: `FOOTPRINT_LIMIT`, and at most 0.25.  The neighbours are the next column
+#: (x + dx) and, dy being the row spacing, the row above (y + dy); pbrt takes
+#: the row below, the same footprint to first order.
 FOOTPRINT = _footprint()
 
 #: What the generator prints: name -> (arguments, outputs).  A per-field entry

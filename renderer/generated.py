@@ -219,7 +219,7 @@ def footprint(x, y, dx, dy, camera_z, P_x, P_y, P_z, N_x, N_y, N_z, et_x, et_y, 
     x16 = x10*abs(x0*(et_x*x14 + et_y*x13 + et_z*x15)) + x10*abs(x0*(et_x*x6 + et_y*x7 + et_z*x8))
     x17 = (1/2)*x9
     x18 = x17*abs(x0*(ep_x*x14 + ep_y*x13 + ep_z*x15)) + x17*abs(x0*(ep_x*x6 + ep_y*x7 + ep_z*x8))
-    return (((min(0.25, x16)) if (x16 > 0) else (0.0005)), ((min(0.25, x18)) if (x18 > 0) else (0.0005)))
+    return (((min(0.25, x16)) if (x16 > 0) and (x16 < 100000000.0) else (0.0005)), ((min(0.25, x18)) if (x18 > 0) and (x18 < 100000000.0) else (0.0005)))
 
 
 @njit(cache=True, error_model="numpy")

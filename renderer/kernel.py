@@ -49,7 +49,7 @@ TINY = 1e-300
 Params = namedtuple("Params", "camera_z radius_a center_b radius_b sphere_b floor ambient albedo_a "
                               "albedo_b ka kd ks shininess phong floor_tint field k_u k_v beta surface")
 
-FORMULAS_DIGEST = "d182f0a360428cc958e81d6c6f081962ce53a4a1eb859912cac481b216a4d55c"  # of generated.py, written by renderer/codegen.py
+FORMULAS_DIGEST = "1cac1a54653fd61cea517a329222bbaa404eb11ce40ab300e89cc9001ae83961"  # of generated.py, written by renderer/codegen.py
 
 
 # ---- the kernel's own steps: intersection, shadows, shading ---------------------

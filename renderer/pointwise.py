@@ -52,23 +52,28 @@ def exact_gradient(name, u, v, k_u, k_v):
     return tuple(_evaluate(G.exact_gradient_array, 3, (_field(name),), (u, v, k_u, k_v))[:2])
 
 
+#: Smallest step `central_gradient` accepts: the generated quotient multiplies
+#: by 1 / (2 eps), which overflows for eps below about 2.8e-309.
+MIN_STEP = 1e-300
+
+
 def central_gradient(name, u, v, k_u, k_v, eps, eps_v=None):
     """Central differences (h_u, h_v) with step ``eps`` (and ``eps_v`` in v, default eps).
 
     u wraps modulo 1, v clamps to [0, 1] with a one-sided quotient where it
     clamps (`renderer.formulas.CENTRAL`, seed Cell 1 ``grad_numeric``).  ``u``,
-    ``v`` in [0, 1]; steps in (0, 1), scalars or arrays (broadcast).
+    ``v`` in [0, 1]; steps in [`MIN_STEP`, 1), scalars or arrays (broadcast).
 
     Raises
     ------
     ValueError
-        An unknown ``name``, or a step outside (0, 1) or not finite.
+        An unknown ``name``, or a step outside [`MIN_STEP`, 1) or not finite.
     """
     eps_v = eps if eps_v is None else eps_v
     for label, e in (("eps", eps), ("eps_v", eps_v)):
         e = np.asarray(e, dtype=np.float64)
-        if not np.all((e > 0.0) & (e < 1.0)):
-            raise ValueError(f"{label} must be in (0, 1), got {e if e.ndim else float(e)!r}")
+        if not np.all((e >= MIN_STEP) & (e < 1.0)):
+            raise ValueError(f"{label} must be in [{MIN_STEP:g}, 1), got {e if e.ndim else float(e)!r}")
     return tuple(_evaluate(G.central_gradient_array, 3, (_field(name),), (u, v, k_u, k_v, eps, eps_v))[:2])
 
 

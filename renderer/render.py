@@ -156,10 +156,14 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     geo_shape = (height, width) if want_geo else (1, 1)
     geo = dict(t=np.full(geo_shape, np.inf), P=np.zeros(geo_shape + (3,)), N=np.zeros(geo_shape + (3,)),
                Ns=np.zeros(geo_shape + (3,)), uv=np.zeros(geo_shape + (2,)))
-    # Pixel spacing on the image plane, the footprint's ray differentials.
-    dx, dy = (x[1] - x[0] if width > 1 else 2 * abs(x[0])), (y[0] - y[1] if height > 1 else 2 * abs(y[0]))
+    # Pixel spacing on the image plane (the footprint's ray differentials);
+    # a frame one pixel wide or high spans the whole window, 2 half / zoom.
+    e, r = scene.camera_z, scene.radius_a
+    window = 2.0 * WINDOW_MARGIN * e * r / math.sqrt(e**2 - r**2) / zoom
+    dx = float(x[1] - x[0]) if width > 1 else window
+    dy = float(y[0] - y[1]) if height > 1 else window
     with threads(workers):
-        kernel.render_rows(*kernel.params(scene, skip), x, y, float(dx), float(dy), GRADIENTS.index(gradient),
+        kernel.render_rows(*kernel.params(scene, skip), x, y, dx, dy, GRADIENTS.index(gradient),
                            float(scene.eps), skip, want_kink, want_grad, want_geo, *out.values(), *geo.values())
     return x, y, out, geo
 

@@ -13,7 +13,11 @@ corrections:
   does not separate the point from the light.
 
 It also covers the project's ``Scene.bump = "surface"`` option (the normal of
-the displaced sphere), derived by hand in `perturb_surface`.
+the displaced sphere), derived by hand in `perturb_surface`, and the third
+pipeline ``gradient="footprint"`` (central differences whose steps are the
+pixel's footprint in the chart), written in `footprint_steps` from pbrt-v4's
+rule (``SurfaceInteraction::ComputeDifferentials`` and ``BumpMap``) with
+pbrt's least-squares solve, not the renderer's projections.
 
 Nothing here imports renderer code: the only contact with the renderer is
 reading attribute values off a ``renderer.Scene``.  The structure is
@@ -35,6 +39,7 @@ __all__ = [
     "pixel_point", "ray_point", "nearest_positive_root", "sphere_a_t", "sphere_b_t",
     "nearest_hit", "chart_a", "tangent_frame_a", "height_value", "grad_exact",
     "grad_central", "in_kink_band", "perturb", "perturb_surface", "segment_blocked", "shade",
+    "tangent_plane_offset", "footprint_steps", "footprint_neighbours", "sphere_a_colour",
     "render_pixel", "render_reference",
 ]
 
@@ -42,6 +47,10 @@ BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
 TWO_PI = 2.0 * math.pi
 POLE_SIN_PHI = 1e-4      # seed Cell 1, tangent_frame: fallback below this sin(phi)
 KINK_HALF_WIDTH = 0.03   # seed Cell 1, height1: the crease band
+FOOTPRINT_FALLBACK = 0.0005   # pbrt-v4, BumpMap: the step where the footprint is 0
+FOOTPRINT_LIMIT = 1e8         # pbrt-v4 clamps |du/dx| to this; beyond it, the fallback
+FOOTPRINT_MAX = 0.25          # the project's cap (u +- eps stays a quarter period apart)
+GRADIENTS = ("exact", "central", "footprint")
 
 
 # --- small 3-vector helpers on tuples ----------------------------------------------
@@ -181,13 +190,15 @@ def grad_exact(field, u, v, ku, kv):
     raise ValueError(f"unknown height field {field!r}")
 
 
-def grad_central(field, u, v, ku, kv, eps):
-    """Central differences of h: u wraps modulo 1, v clamps to [0, 1] (one-sided there)."""
+def grad_central(field, u, v, ku, kv, eps, eps_v=None):
+    """Central differences of h with steps eps (in u) and eps_v (in v, default
+    eps): u wraps modulo 1, v clamps to [0, 1] (one-sided there)."""
+    eps_v = eps if eps_v is None else eps_v
     h = lambda uu, vv: height_value(field, uu, vv, ku, kv)  # noqa: E731
     hu = (h((u + eps) % 1.0, v) - h((u - eps) % 1.0, v)) / (2.0 * eps)
-    v_plus, v_minus = min(1.0, v + eps), max(0.0, v - eps)
-    clamped = v + eps > 1.0 or v - eps < 0.0
-    step = (v_plus - v_minus) if clamped else 2.0 * eps
+    v_plus, v_minus = min(1.0, v + eps_v), max(0.0, v - eps_v)
+    clamped = v + eps_v > 1.0 or v - eps_v < 0.0
+    step = (v_plus - v_minus) if clamped else 2.0 * eps_v
     hv = (h(u, v_plus) - h(u, v_minus)) / step
     return hu, hv
 
@@ -225,6 +236,52 @@ def perturb_surface(N, e_th, e_ph, hu, hv, h, beta, R, sin_phi):
     a_th = beta * hu / (TWO_PI * s * rho)
     a_ph = beta * hv / (math.pi * rho)
     return normalize(sub(N, add(scale(a_th, e_th), scale(a_ph, e_ph))))
+
+
+# --- the pixel footprint (pbrt-v4) -------------------------------------------------------
+
+def tangent_plane_offset(scene, P, N, x, y):
+    """Where the eye ray through the image-plane point (x, y) meets the tangent
+    plane at P, minus P (pbrt-v4, ComputeDifferentials: d = -N . P,
+    t = (-N . o - d) / (N . dir), p = o + t dir)."""
+    o, direction = (0.0, 0.0, scene.camera_z), (x, y, -scene.camera_z)
+    t = (-dot(N, o) + dot(N, P)) / dot(N, direction)
+    return sub(add(o, scale(t, direction)), P)
+
+
+def footprint_steps(scene, P, N, e_th, e_ph, sin_phi, right, up):
+    """(eps_u, eps_v) of pbrt-v4's bump mapping at a pixel of sphere A.
+
+    ``right``, ``up``: image-plane centres of the neighbouring pixels one
+    column right and one row up (the renderer's ray differentials,
+    `renderer.formulas.FOOTPRINT`; pbrt's own y differential goes one raster
+    row down, the same to first order).  dp/dx and dp/dy are where the
+    neighbours' rays meet the tangent plane at P, minus P; (du/dx, dv/dx)
+    solve the normal equations of dp/dx = du/dx dP/du + dv/dx dP/dv with
+    dP/du = 2 pi R sin(phi) e_theta and dP/dv = pi R e_phi (pbrt's 2 x 2
+    least squares); then du = (|du/dx| + |du/dy|) / 2, the fallback 0.0005
+    where that is 0 (pbrt-v4, BumpMap) or not below 1e8 (pbrt clamps a
+    derivative to 1e8 and zeroes a non-finite one), at most 0.25 (the
+    project's cap).  Where dP/du = 0 (sin phi = 0 exactly) u's footprint is
+    unbounded, so the fallback, and v's solve is one-dimensional.
+    """
+    R = scene.radius_a
+    dpdu, dpdv = scale(TWO_PI * R * sin_phi, e_th), scale(math.pi * R, e_ph)
+    a00, a01, a11 = dot(dpdu, dpdu), dot(dpdu, dpdv), dot(dpdv, dpdv)
+    det = a00 * a11 - a01 * a01
+    derivatives = []
+    for neighbour in (right, up):
+        dp = tangent_plane_offset(scene, P, N, *neighbour)
+        b0, b1 = dot(dpdu, dp), dot(dpdv, dp)
+        if det:
+            derivatives.append(((a11 * b0 - a01 * b1) / det, (a00 * b1 - a01 * b0) / det))
+        else:
+            derivatives.append((math.inf, b1 / a11))
+    (dudx, dvdx), (dudy, dvdy) = derivatives
+    steps = []
+    for half in (0.5 * (abs(dudx) + abs(dudy)), 0.5 * (abs(dvdx) + abs(dvdy))):
+        steps.append(min(half, FOOTPRINT_MAX) if 0.0 < half < FOOTPRINT_LIMIT else FOOTPRINT_FALLBACK)
+    return tuple(steps)
 
 
 # --- shading ---------------------------------------------------------------------------
@@ -285,6 +342,24 @@ def shade(scene, P, N, N_shade, albedo, blockers, floor_blocks):
 
 # --- one pixel, one frame ---------------------------------------------------------------
 
+def footprint_neighbours(scene, i, j, width, height):
+    """Image-plane centres of the pixels one column right and one row up of (i, j)."""
+    return pixel_point(scene, i + 1, j, width, height), pixel_point(scene, i, j - 1, width, height)
+
+
+def sphere_a_colour(scene, P, N, e_th, e_ph, sin_phi, u, v, hu, hv):
+    """Shade a point of sphere A with gradient (h_u, h_v): perturbed normal, then lights."""
+    if scene.bump == "chart":
+        N_shade = perturb(N, e_th, e_ph, hu, hv, scene.beta)
+    elif scene.bump == "surface":
+        h = height_value(scene.height_field, u, v, scene.k_u, scene.k_v)
+        N_shade = perturb_surface(N, e_th, e_ph, hu, hv, h, scene.beta, scene.radius_a, sin_phi)
+    else:
+        raise ValueError(f"unknown bump {scene.bump!r}")
+    blockers = [(scene.center_b, scene.radius_b)] if scene.sphere_b else []
+    return shade(scene, P, N, N_shade, scene.albedo_a, blockers, scene.floor)
+
+
 def render_pixel(scene, i, j, width, height, gradient):
     """(rgb, chamber, kink, (h_u, h_v)) of pixel (i, j)."""
     e = scene.camera_z
@@ -296,21 +371,19 @@ def render_pixel(scene, i, j, width, height, gradient):
     sphere_a = ((0.0, 0.0, 0.0), scene.radius_a)
     sphere_b = (scene.center_b, scene.radius_b)
     if code == SPHERE_A:
-        # Chart, gradient, frame, perturbed normal.
+        # Chart, frame, gradient, perturbed normal.
         N = scale(1.0 / scene.radius_a, P)
         u, v, sin_phi = chart_a(N)
         args = (scene.height_field, u, v, scene.k_u, scene.k_v)
-        hu, hv = grad_exact(*args) if gradient == "exact" else grad_central(*args, scene.eps)
         e_th, e_ph = tangent_frame_a(N, sin_phi)
-        if scene.bump == "chart":
-            N_shade = perturb(N, e_th, e_ph, hu, hv, scene.beta)
-        elif scene.bump == "surface":
-            N_shade = perturb_surface(N, e_th, e_ph, hu, hv, height_value(*args), scene.beta,
-                                      scene.radius_a, sin_phi)
+        if gradient == "exact":
+            hu, hv = grad_exact(*args)
+        elif gradient == "central":
+            hu, hv = grad_central(*args, scene.eps)
         else:
-            raise ValueError(f"unknown bump {scene.bump!r}")
-        blockers = [sphere_b] if scene.sphere_b else []
-        rgb = shade(scene, P, N, N_shade, scene.albedo_a, blockers, scene.floor)
+            neighbours = footprint_neighbours(scene, i, j, width, height)
+            hu, hv = grad_central(*args, *footprint_steps(scene, P, N, e_th, e_ph, sin_phi, *neighbours))
+        rgb = sphere_a_colour(scene, P, N, e_th, e_ph, sin_phi, u, v, hu, hv)
         return rgb, code, in_kink_band(*args), (hu, hv)
     if code == SPHERE_B:
         N = scale(1.0 / scene.radius_b, sub(P, scene.center_b))
@@ -332,7 +405,7 @@ def render_reference(scene, width, height, *, gradient="exact"):
     image : (H, W, 3) float64, chamber : (H, W) uint8, kink : (H, W) bool,
     grad : (H, W, 2) float64 -- numpy containers filled one pixel at a time.
     """
-    if gradient not in ("exact", "central"):
+    if gradient not in GRADIENTS:
         raise ValueError(f"unknown gradient {gradient!r}")
     image = np.zeros((height, width, 3))
     chamber = np.zeros((height, width), dtype=np.uint8)

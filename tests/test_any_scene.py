@@ -1,11 +1,17 @@
-"""Every scene `Scene` accepts renders a finite image in [0, 1], with no
-floating-point error: a property over the whole accepted range of every field
-(hypothesis draws the ends of each range often), rendered under
-``np.errstate(all="raise")`` with warnings turned into errors.
+"""Every scene `Scene` accepts renders finite outputs in range: a property
+over the whole accepted range of every field (hypothesis draws the ends of
+each range often), for the three gradient methods.
 
-The frames are small, so they render on the calling thread, where the
-caller's floating-point state applies (numpy's error state is per thread).
-The checker is shown to reject a renderer that lets a NaN through.
+What is checked where: the compiled kernel (`renderer.kernel`, numba with
+``error_model="numpy"``) computes in IEEE arithmetic and signals nothing (no
+numpy error state, no ZeroDivisionError), so for the pixels the property
+rests on the outputs: the image finite and in [0, 1] (a NaN in the shading
+sum survives the kernel's clamp, so it shows), the gradient finite, the
+chamber a known code, the crease flag only on sphere A.  The numpy code
+around the kernel (the window, the parameters, a sweep's ledger) runs under
+``np.errstate(all="raise")`` with warnings turned into errors, so an
+overflow there is an error.  The checker is shown to reject a frame with a
+NaN, an out-of-range chamber, a stray crease flag and a floating-point error.
 """
 
 from __future__ import annotations
@@ -17,7 +23,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from renderer import BUMPS, HEIGHT_FIELDS, MODELS, PointLight, Scene, gbuffer, render, sweep
+from renderer import BUMPS, GRADIENTS, HEIGHT_FIELDS, MODELS, PointLight, Scene, gbuffer, render, sweep
 from renderer import scene as S
 from renderer.render import MAX_ZOOM
 
@@ -66,20 +72,23 @@ def accepted_scenes(draw):
 
 def check_frame(render_fn, scene, width, height, gradient, zoom):
     """Render under errstate(all="raise") with warnings as errors; return the
-    frame after checking that its image is finite and in [0, 1]."""
+    frame after checking its outputs (see the module docstring)."""
     with np.errstate(all="raise"), warnings.catch_warnings():
         warnings.simplefilter("error")
         frame = render_fn(scene, width, height, gradient=gradient, zoom=zoom)
     assert np.all(np.isfinite(frame.image)), "non-finite pixels"
-    assert frame.image.min() >= 0.0 and frame.image.max() <= 1.0
-    assert np.all(np.isfinite(frame.grad))
+    assert frame.image.min() >= 0.0 and frame.image.max() <= 1.0, "pixels outside [0, 1]"
+    assert np.all(np.isfinite(frame.grad)), "non-finite gradient"
+    assert np.all(np.isin(frame.chamber, (0, 1, 2, 3))), "unknown chamber code"
+    assert not np.any(frame.kink & (frame.chamber != 1)), "crease flag off sphere A"
+    assert not np.any(frame.grad[frame.chamber != 1]), "gradient off sphere A"
     return frame
 
 
 @settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow,
                                                                     HealthCheck.filter_too_much])
 @given(scene=accepted_scenes(), size=st.tuples(st.integers(1, 12), st.integers(1, 12)),
-       gradient=st.sampled_from(("exact", "central")),
+       gradient=st.sampled_from(GRADIENTS),
        zoom=st.one_of(st.just(1.0), st.floats(1.0, MAX_ZOOM)))
 def test_every_accepted_scene_renders_finite_without_floating_point_errors(scene, size, gradient, zoom):
     check_frame(render, scene, *size, gradient, zoom)
@@ -92,25 +101,41 @@ def test_every_accepted_scene_sweeps_and_buffers_finite(scene, steps):
     with np.errstate(all="raise"), warnings.catch_warnings():
         warnings.simplefilter("error")
         sw = sweep(scene, steps, 8, 6)
-        g = gbuffer(scene, 8, 6)
+        buffers = [gbuffer(scene, 8, 6, gradient=gradient) for gradient in GRADIENTS]
     for frame in (sw.symbolic, *sw.numeric):
         assert np.all(np.isfinite(frame.image)) and frame.image.min() >= 0.0 and frame.image.max() <= 1.0
-    hit = g.chamber > 0
-    assert np.all(np.isfinite(g.Ns[hit])) and np.all(np.isfinite(g.P[hit]))
+        assert np.all(np.isfinite(frame.grad))
+    for g in buffers:
+        hit = g.chamber > 0
+        assert np.all(np.isfinite(g.Ns[hit])) and np.all(np.isfinite(g.P[hit])) and np.all(np.isfinite(g.uv))
 
 
-def test_the_checker_rejects_a_nan_pixel_and_a_floating_point_error():
-    def leaks_nan(scene, width, height, **kw):
+def _corrupting(name, index, value):
+    """A wrong renderer: the frame with one entry of one output replaced."""
+    def render_fn(scene, width, height, **kw):
         frame = render(scene, width, height, **kw)
-        frame.image[0, 0, 0] = np.nan
+        getattr(frame, name)[index] = value
         return frame
+    return render_fn
 
+
+@pytest.mark.parametrize("name, index, value, message", [
+    ("image", (0, 0, 0), np.nan, "non-finite pixels"),
+    ("image", (1, 1, 2), 1.0 + 2**-52, r"outside \[0, 1\]"),
+    ("grad", (2, 2, 1), np.inf, "non-finite gradient"),
+    ("chamber", (3, 0), 4, "unknown chamber"),
+    ("kink", (3, 0), True, "crease flag off sphere A"),      # (3, 0) is the floor at 4 x 4
+])
+def test_the_checker_rejects_a_wrong_output(name, index, value, message):
+    assert render(Scene(), 4, 4).chamber[3, 0] != 1
+    with pytest.raises(AssertionError, match=message):
+        check_frame(_corrupting(name, index, value), Scene(), 4, 4, "exact", 1.0)
+
+
+def test_the_checker_rejects_a_floating_point_error():
     def divides_by_zero(scene, width, height, **kw):
         np.float64(1.0) / np.zeros(1)
         return render(scene, width, height, **kw)
 
-    with pytest.raises(AssertionError, match="non-finite"):
-        check_frame(leaks_nan, Scene(), 4, 4, "exact", 1.0)
     with pytest.raises(FloatingPointError):
         check_frame(divides_by_zero, Scene(), 4, 4, "exact", 1.0)
-

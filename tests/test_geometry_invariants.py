@@ -1,8 +1,8 @@
 """Geometric invariants of rendered frames, checked against independent solves.
 
 Hit points are rebuilt here from the pixel grid (written out below from the
-seed's Cell 1 window) and the chamber map: t comes from
-`renderer.geometry.sphere_hit` for the spheres and is 1 for the floor, and t
+seed's Cell 1 window) and the chamber map: t comes from the kernel's
+`renderer.kernel.sphere_hit` for the spheres and is 1 for the floor, and t
 itself is checked against an mpmath solve of the ray quadratic at 40 digits.
 Then: every hit point lies on its surface, floor points have z == 0, normals
 are unit vectors, the chamber is the nearest positive hit, nothing is NaN,
@@ -18,8 +18,8 @@ import mpmath
 import numpy as np
 import pytest
 
-from renderer import PointLight, Scene, gbuffer, render
-from renderer.geometry import sphere_hit, tangent_frame
+from renderer import GRADIENTS, PointLight, Scene, gbuffer, kernel, pointwise, render
+from renderer.render import image_plane
 
 SIZE = 128
 SURFACE_TOL = 1e-12        # relative to the radius
@@ -43,6 +43,11 @@ SCENES = {
 
 
 # --- independent pieces -----------------------------------------------------------------
+
+def sphere_hit(X, Y, e, center, r):
+    """`kernel.sphere_hit` (a scalar function) at each image-plane point of X, Y."""
+    return np.array([kernel.sphere_hit(x, y, e, *map(float, center), r) for x, y in zip(np.ravel(X), np.ravel(Y))]
+                    ).reshape(np.shape(X))
 
 def pixel_grid(scene, width, height):
     """Image-plane (X, Y), shape (height, width): seed Cell 1's window."""
@@ -169,6 +174,8 @@ def case(request):
 def test_grid_and_hit_points_agree_with_gbuffer(case):
     scene, g, X, Y, t, P = case
     assert np.array_equal(g.x, X[0]) and np.array_equal(g.y, Y[:, 0])
+    x, y = image_plane(scene.radius_a, scene.camera_z, SIZE, SIZE)
+    assert np.array_equal(x, X[0]) and np.array_equal(y, Y[:, 0])
     hit = g.chamber > 0
     assert np.array_equal(g.t[hit], t[hit])
     assert np.abs(g.P[hit] - P[hit]).max() <= 1e-15 * (1 + np.abs(P[hit]).max())
@@ -216,7 +223,7 @@ def test_chamber_is_the_nearest_positive_hit(case):
     assert chamber_mismatches(scene, X, Y, g.chamber, t, pixels) == []
 
 
-@pytest.mark.parametrize("gradient", ("exact", "central"))
+@pytest.mark.parametrize("gradient", GRADIENTS)
 def test_no_nan_and_image_in_unit_interval(case, gradient):
     scene = case[0]
     frame = render(scene, SIZE, SIZE, gradient=gradient)
@@ -285,7 +292,7 @@ def test_seed_sphere_b_is_a_larger_sphere_about_the_same_centre():
     r_seed = math.sqrt(float((C - (0, 0, e)) @ (C - (0, 0, e)) - C @ C + r * r))
     assert 2.38 < r_seed < 2.39
     t_seed = seed_sphere_b(scene, X, Y)
-    t_big = sphere_hit(X.ravel(), Y.ravel(), e, scene.center_b, r_seed).reshape(X.shape)
+    t_big = sphere_hit(X, Y, e, scene.center_b, r_seed)
     assert np.abs(t_seed - t_big).max() <= 1e-14
 
 
@@ -321,7 +328,7 @@ def test_unit_check_rejects_the_unnormalized_perturbed_normal():
     g = gbuffer(scene, 64, 64)
     a = g.chamber == 1
     N, (hu, hv) = g.N[a], g.grad[a].T
-    e_th, e_ph = tangent_frame(N[:, 0], N[:, 1], N[:, 2], np.hypot(N[:, 0], N[:, 1]))
+    e_th, e_ph = pointwise.tangent_frame(N[:, 0], N[:, 1], N[:, 2], np.hypot(N[:, 0], N[:, 1]))
     M = N + scene.beta * (hu[:, None] * np.stack(e_th, -1) + hv[:, None] * np.stack(e_ph, -1))
     assert off_unit(M) > 1e-2
     assert off_unit(M / np.linalg.norm(M, axis=-1, keepdims=True)) <= UNIT_TOL

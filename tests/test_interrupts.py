@@ -7,15 +7,15 @@ asks for: exit code 130; stderr exactly one line ``symrender: interrupted``
 (no traceback); the output directory as it was (no output file, no ``.part``
 staging directory, no temporary file); and no process left behind, neither in
 the child's session nor anywhere else.  The notebook kernel (jupyter_client)
-and the render workers (renderer/workers.py) start sessions of their own, so
+starts a session of its own, so
 a session check alone would miss them: every run carries a marker in its
 environment, which all its descendants inherit, and any live process with
 that marker after the run is a leftover.
 
 The moments: during the start-up imports (numpy, sympy, the renderer, then
 matplotlib; several delays from the moment numpy's extension is mapped);
-during ``render`` of a large frame once a render worker process exists;
-during ``sweep``; during ``verify`` while its pytest child runs; during
+during ``render`` of a large frame and during ``sweep`` (once numba is
+loaded); during ``verify`` while its pytest child runs; during
 ``figures`` while the notebook kernel starts, and while it runs the page's
 cell, with one Ctrl-C and with two 50 ms apart.  In-process: `main` ignores a
 second Ctrl-C during the clean-up and restores the previous handler.
@@ -101,7 +101,6 @@ class Run:
         self.token = uuid.uuid4().hex
         environ = dict(os.environ, **(env or {}))
         environ[MARKER] = self.token
-        environ.pop("SYMRENDER_WORKER_PROCESSES", None)   # the default: workers on
         self.started = time.monotonic()
         self.proc = subprocess.Popen([str(SYMRENDER), *map(str, args)], cwd=cwd, env=environ,
                                      stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -273,20 +272,22 @@ def test_importing_the_command_line_loads_no_numpy():
 # ------------------------------------------------------------------ commands at work
 
 
-def test_interrupt_during_render_with_worker_processes(tmp_path):
-    """A 2048^2 render: the second frame starts render worker processes; SIGINT
-    once one exists.  No PNG, no temporary file, no worker left."""
-    run = Run("render", "--size", "2048x2048", "-o", "big.png", cwd=tmp_path)
-    run.wait_until(lambda: run.descendants("renderer._worker"), 60, "render worker process")
-    time.sleep(0.3)
+def test_interrupt_during_render(tmp_path):
+    """Two 4096^2 frames: SIGINT once the compiled kernel's library is loaded.
+    A render under way finishes first (compiled code does not check for
+    signals); then no PNG and no temporary file."""
+    run = Run("render", "--size", "4096x4096", "-o", "big.png", cwd=tmp_path)
+    run.wait_until(lambda: run.maps("llvmlite"), 20, "numba being loaded")
+    time.sleep(0.5)
+    assert run.proc.poll() is None, "the render ended before the interrupt; make it larger"
     run.interrupt()
     check(run, tmp_path, [])
 
 
 def test_interrupt_during_sweep(tmp_path):
     run = Run("sweep", "--size", "2048x2048", "--eps", "1e-1:1e-6:6", "--format", "csv", cwd=tmp_path)
-    run.wait_until(lambda: run.maps("_multiarray_umath"), 10, "numpy being imported")
-    time.sleep(2.0)                      # past the imports, well inside the sweep
+    run.wait_until(lambda: run.maps("llvmlite"), 20, "numba being loaded")
+    time.sleep(0.5)
     assert run.proc.poll() is None, "the sweep ended before the interrupt; make it larger"
     run.interrupt()
     check(run, tmp_path, [])

@@ -98,6 +98,7 @@ from mpmath import mp, mpf
 
 from renderer import GRADIENTS, PointLight, Scene, gbuffer, pointwise, render
 from renderer import formulas as F
+from renderer.render import WINDOW_MARGIN
 
 from .jsnode import ARTIFACTS, read_frame, run_render_cases, write_modules
 
@@ -279,8 +280,10 @@ def python_side(scene, width, height, gradient, zoom):
     if gradient == "footprint":
         e_theta, e_phi = pointwise.tangent_frame(N[:, 0], N[:, 1], N[:, 2], sin_phi)
         x, y = gb.x, gb.y
-        dx = x[1] - x[0] if width > 1 else 2 * abs(x[0])
-        dy = y[0] - y[1] if height > 1 else 2 * abs(y[0])
+        window = 2.0 * WINDOW_MARGIN * scene.camera_z * scene.radius_a / math.sqrt(
+            scene.camera_z**2 - scene.radius_a**2) / zoom
+        dx = x[1] - x[0] if width > 1 else window
+        dy = y[0] - y[1] if height > 1 else window
         X, Y = np.broadcast_to(x, on_a.shape)[on_a], np.broadcast_to(y[:, None], on_a.shape)[on_a]
         P = gb.P[on_a]
         steps = np.stack(pointwise.footprint(X, Y, dx, dy, scene.camera_z, P.T, N.T, e_theta, e_phi,
@@ -471,8 +474,8 @@ WRONG_VARIANTS = {
                                           "light_term(s, s.lights[k].color, px.w, px.axis, wv, px.N,", "image",
                                           ["default-exact"]),
     "footprint with the column spacing for rows": (
-        "render", "const dy = height > 1 ? y[0] - y[1] : 2 * Math.abs(y[0]);",
-        "const dy = width > 1 ? x[1] - x[0] : 2 * Math.abs(x[0]);", "grad", ["default-footprint"]),
+        "render", "const dy = height > 1 ? y[0] - y[1] : window;",
+        "const dy = width > 1 ? x[1] - x[0] : window;", "grad", ["default-footprint"]),
     "central step 0.1 % off": ("render", "px.steps[0] = eps; px.steps[1] = eps;",
                                "px.steps[0] = 1.001 * eps; px.steps[1] = 1.001 * eps;", "grad",
                                ["sine-phong-eps1e-1"]),

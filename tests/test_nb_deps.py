@@ -289,8 +289,10 @@ print(json.dumps(out))
 def loaded_by_book_pages():
     """Per page, the project files Python loads when it runs the page's import statements."""
     pages = sorted(str(p) for p in (ROOT / "book").glob("s*.md"))
-    result = subprocess.run([sys.executable, "-c", _LOADED, str(ROOT), *pages], check=True,
+    result = subprocess.run([sys.executable, "-c", _LOADED, str(ROOT), *pages],
                             capture_output=True, text=True, timeout=600, cwd=ROOT)
+    # A page whose imports fail (a module renamed or removed) is named in the traceback.
+    assert result.returncode == 0, f"running the book pages' imports failed:\n{result.stderr[-3000:]}"
     return {Path(k): {Path(f).resolve() for f in v} for k, v in json.loads(result.stdout).items()}
 
 
@@ -309,3 +311,15 @@ def test_book_check_rejects_a_finder_without_the_transitive_closure(loaded_by_bo
     packages = {"renderer": ROOT / "renderer", "proofs": ROOT / "proofs"}
     monkeypatch.setattr(nb_deps, "_imports_of_file", lambda file, package: frozenset())
     assert not _covers(loaded_by_book_pages, packages)
+
+
+def test_the_simulator_bundle_follows_the_formulas_it_is_printed_from(monkeypatch):
+    """renderer.jsgen prints formulas.js from renderer/formulas.py through
+    renderer/codegen.py and joins renderer/js/*.js: a page importing it
+    depends on all of them (so the §4 asset is rebuilt when a formula changes)."""
+    packages = {"renderer": ROOT / "renderer", "proofs": ROOT / "proofs"}
+    files = {f.relative_to(ROOT).as_posix() for f in nb_deps.dependencies(page("import renderer.jsgen"), packages)}
+    assert {"renderer/formulas.py", "renderer/codegen.py", "renderer/jsgen.py", "renderer/js/render.js"} <= files
+    monkeypatch.setattr(nb_deps, "DATA_FILES", {})          # the wrong variant misses the hand-written modules
+    files = {f.relative_to(ROOT).as_posix() for f in nb_deps.dependencies(page("import renderer.jsgen"), packages)}
+    assert "renderer/js/render.js" not in files and "renderer/formulas.py" in files

@@ -1,7 +1,8 @@
-"""Parity: the vectorized `renderer.render` against the scalar oracle `scalar_reference`.
+"""Parity: `renderer.render` against the scalar oracle `scalar_reference`.
 
-Every height field x both models x both pipelines x sphere B on/off x floor
-on/off x beta in {0, 0.35, 1.5}, on three small frames chosen for what they hit:
+Every height field x both models x the three pipelines (exact, central,
+footprint) x sphere B on/off x floor on/off x beta in {0, 0.35, 1.5}, on
+three small frames chosen for what they hit:
 
 * 24 x 20: even width, non-square;
 * 17 x 13: odd width (column 8 lies on x = 0), odd height;
@@ -11,14 +12,18 @@ on/off x beta in {0, 0.35, 1.5}, on three small frames chosen for what they hit:
 
 Checks per frame: identical chamber codes, identical crease flags,
 |dI| <= 1e-12 per channel (the issue's tolerance), and the gradient within the
-tolerance of `grad_tolerance` (justified there).  The only exemption is a ray
-tangent to a sphere (`grazing_mask`: at most two pixels, checked at 1e-6).
-Each kind of check is shown to reject a wrong variant at the end of the file.
+tolerance of `grad_tolerance` (justified there).  The footprint pipeline's
+step is computed by both routes from the pixel's geometry, so its gradient
+carries the step's rounding too: `footprint_bound` bounds that, and the
+image tolerance of that pipeline grows by what the gradient tolerance can
+move the reference's own shading (`footprint_allowances`).  The only
+exemption is a ray tangent to a sphere (`grazing_mask`: at most two pixels,
+checked at 1e-6).  Each kind of check is shown to reject a wrong variant at
+the end of the file.
 """
 
 from __future__ import annotations
 
-import importlib
 import itertools
 import math
 
@@ -32,13 +37,17 @@ SIZES = ((24, 20), (17, 13), (17, 20))
 IMAGE_TOL = 1e-12          # per channel, required by the issue
 FIELDS = ("sine", "ridges", "rings")
 MODELS = ("blinn", "phong")
-GRADIENTS = ("exact", "central")
-# The module, not the function `renderer.render` that shadows it as a package attribute.
-render_module = importlib.import_module("renderer.render")
+GRADIENTS = ("exact", "central", "footprint")
 LIGHT_2 = PointLight((-6.0, 2.0, 8.0), (0.9, 0.65, 0.25))     # the seed's second light
+U = 2.0**-53               # unit roundoff
 
 
-def grad_tolerance(scene, gradient, grad_ref):
+def lipschitz(scene):
+    """Bound on |h_u| and |h_v| of every field: pi max(k_u, 2 k_v)."""
+    return math.pi * max(scene.k_u, 2.0 * scene.k_v)
+
+
+def grad_tolerance(scene, gradient, grad_ref, steps=None, delta=None):
     """Allowed |grad_renderer - grad_reference|, per component.
 
     Both routes evaluate the same closed forms, so 1e-12 (1 + |g|) covers
@@ -46,24 +55,28 @@ def grad_tolerance(scene, gradient, grad_ref):
 
     The central pipeline needs an absolute slack on top.  The two routes
     compute the chart (u, v) of a hit point differently (textbook vs
-    cancellation-free quadratic for t; glibc's atan2/hypot vs numpy's SIMD
-    versions, which differ by an ulp on ~8% of inputs on this machine), and
-    the results differ by up to 3 ulp (3.3e-16, measured; given the *same*
-    (u, v) the central quotients agree bit for bit, measured).  The common
-    shift cancels in h(u + eps) - h(u - eps), but u + eps and u - eps are each
-    rounded afresh, so the two samples can sit up to 2^-52 apart per side.
-    h is Lipschitz with constant LIP = pi max(k_u, 2 k_v) in each chart
-    variable, so the quotient can move by 2 LIP 2^-52 / (2 eps) = LIP 2^-52 / eps
-    (5.6e-12 at the defaults).  Measured worst on these frames: 1.45e-12
-    absolute (4.6e-13 relative), so the slack holds with a factor ~4 to spare,
-    and 1e-12 relative alone would pass here only by a factor ~2 without a
-    guarantee (at 40 x 33 the absolute gap reaches 1.8e-12, at 64 x 64 the
-    relative one 9.8e-13).
+    cancellation-free quadratic for t, and their own atan2/hypot sequences),
+    and the results differ by a few ulp.  The common shift cancels in
+    h(u + eps) - h(u - eps), but u + eps and u - eps are each rounded
+    afresh, so the two samples can sit up to 2^-52 apart per side.  h is
+    Lipschitz with constant LIP = pi max(k_u, 2 k_v) in each chart variable,
+    so the quotient can move by 2 LIP 2^-52 / (2 eps) = LIP 2^-52 / eps
+    (5.6e-12 at the defaults).
+
+    The footprint pipeline is the central one with steps ``steps`` (H, W, 2),
+    the reference's, per component; the renderer's own steps differ from
+    them by at most the relative ``delta`` (H, W, 2) of `footprint_bound`.
+    With g(eps) = (h(u + eps) - h(u - eps)) / (2 eps),
+    eps g'(eps) = (h'(u + eps) + h'(u - eps)) / 2 - g, at most 2 LIP in size
+    (also for the one-sided quotient at the v border), so a relative change
+    delta of the step moves the quotient by at most 2 LIP delta.
     """
     tol = 1e-12 * (1.0 + np.abs(grad_ref))
+    lip = lipschitz(scene)
     if gradient == "central":
-        lip = math.pi * max(scene.k_u, 2.0 * scene.k_v)
         tol = tol + lip * 2.0**-52 / scene.eps
+    elif gradient == "footprint":
+        tol = tol + lip * 2.0**-52 / steps + 2.0 * lip * delta
     return tol
 
 
@@ -72,41 +85,145 @@ def grad_tolerance(scene, gradient, grad_ref):
 # sqrt(eps_machine): two correct implementations that round D differently then
 # disagree at 1e-8, not 1e-12.  The 17 x 20 frame has two such pixels by
 # construction, (0, 8) and (16, 8): x = 0 and y = +-0.8 half = +-e R / sqrt(e^2 - R^2),
-# sphere A's silhouette radius.  (The two codes happen to round D identically
-# today; a cancellation-free discriminant in the renderer would not.)
+# sphere A's silhouette radius.
 GRAZING_REL_T = 1e-12      # eps * condition number of t above which a hit counts as tangent;
                            # measured <= 8e-14 on every other pixel of these frames
 MAX_GRAZING = 2            # per frame: the exemption cannot swallow a silhouette
 GRAZING_TOL = 1e-6         # |dI| still bounded there, and the chart point within this
                            # distance; h's gradient then moves by at most its second
-                           # derivative bound (pi max(k_u, 2 k_v))^2 times that.  Measured
-                           # gap today: 0; with a cancellation-free discriminant in the
-                           # renderer (tried locally): |dI| < 1e-6, |d grad| = 2.7e-6 (rings).
+                           # derivative bound (pi max(k_u, 2 k_v))^2 times that.
 
 
-def grazing_mask(scene, width, height, chamber):
-    """Pixels whose sphere hit is ill-conditioned by input rounding alone.
+def hit_condition(scene, x, y, C, r):
+    """Condition number kappa of the nearest root t of the ray through (x, y) on a sphere.
 
     For a t^2 + 2 b t + c = 0 a relative error eps in b^2 and a c moves D by
     eps (b^2 + |a c|) and t by that over 2 a sqrt(D); relative to t this is
-    eps * kappa with kappa = (b^2 + |a c|) / (a sqrt(D) t).
+    eps * kappa with kappa = (b^2 + |a c|) / (a sqrt(D) t).  inf if D <= 0.
     """
-    mask = np.zeros(chamber.shape, dtype=bool)
     e = scene.camera_z
+    d, oc = (x, y, -e), ref.sub((0.0, 0.0, e), C)
+    a, b, c = ref.dot(d, d), ref.dot(d, oc), ref.dot(oc, oc) - r * r
+    D = b * b - a * c
+    if D <= 0.0:
+        return math.inf
+    t = (-b - math.sqrt(D)) / a
+    return (b * b + abs(a * c)) / (a * math.sqrt(D) * t)
+
+
+def grazing_mask(scene, width, height, chamber):
+    """Pixels whose sphere hit is ill-conditioned by input rounding alone."""
+    mask = np.zeros(chamber.shape, dtype=bool)
     spheres = {ref.SPHERE_A: ((0.0, 0.0, 0.0), scene.radius_a),
                ref.SPHERE_B: (scene.center_b, scene.radius_b)}
     for j, i in zip(*np.nonzero(np.isin(chamber, list(spheres)))):
-        C, r = spheres[int(chamber[j, i])]
         x, y = ref.pixel_point(scene, i, j, width, height)
-        d, oc = (x, y, -e), ref.sub((0.0, 0.0, e), C)
-        a, b, c = ref.dot(d, d), ref.dot(d, oc), ref.dot(oc, oc) - r * r
-        D = b * b - a * c
-        if D <= 0.0:
-            mask[j, i] = True
-            continue
-        t = (-b - math.sqrt(D)) / a
-        mask[j, i] = 2.0**-52 * (b * b + abs(a * c)) / (a * math.sqrt(D) * t) > GRAZING_REL_T
+        mask[j, i] = 2.0**-52 * hit_condition(scene, x, y, *spheres[int(chamber[j, i])]) > GRAZING_REL_T
     return mask
+
+
+def _norm(a):
+    return math.sqrt(ref.dot(a, a))
+
+
+def footprint_bound(scene, i, j, width, height):
+    """(steps, delta): the reference's footprint steps (eps_u, eps_v) at a
+    sphere-A pixel, and bounds on |eps_renderer - eps_reference| / eps.
+
+    The step is (|a_x| + |a_y|) / (2 L) with a_k = e . dp_k, where dp_k =
+    E + t_k d_k - P is the k-th neighbour's ray d_k on the tangent plane at P
+    (t_k = N . (P - E) / N . d_k), e = e_theta and L = 2 pi R sin(phi) for u,
+    e = e_phi and L = pi R for v.  The two routes differ in
+
+    * the hit point: P, and N = P / R, agree to dP = 4 u (1 + kappa) |P - E|
+      + 4 u |P| (kappa the condition of the hit, `hit_condition`), dN = dP / R
+      + 2 u;
+    * the neighbour's centre (x + dx against x_{i+1}): dd = 2 u (|x_k| + |y_k|);
+    * their own roundings: dp_k is a difference of terms of size
+      A_k = |E| + |t_k| |d_k| + |P|, and t_k a quotient of two dot products
+      of conditions kappa_k = |d_k| / |N . d_k| + |P - E| / |N . (P - E)|.
+
+    First order, from the derivatives of dp_k in P, N and d_k:
+    |d dp_k| <= 4 u (A_k + |t_k| |d_k| kappa_k) + s_k dP
+    + |d_k| (|P - E| + |t_k| |d_k|) / |N . d_k| dN + |t_k| s_k dd,
+    s_k = 1 + |d_k| / |N . d_k|; the frame (e over sin(phi)) and L (u only)
+    add 2 (dN + u) / sin(phi) relatively.  Then delta = 4 (sum_k |d a_k| /
+    sum_k |a_k| + frame terms + u): 4 covers the few roundings each step
+    takes in either route.  A step both routes cap at 0.25 (its uncapped
+    value shrunk by delta still above) has delta = 0; inf where the routes
+    may take different frames (sin(phi) within rounding of the pole cut-off).
+    """
+    e, R = scene.camera_z, scene.radius_a
+    x, y = ref.pixel_point(scene, i, j, width, height)
+    t, _ = ref.nearest_hit(x, y, scene)
+    P = ref.ray_point(t, x, y, e)
+    N = ref.scale(1.0 / R, P)
+    _, _, sin_phi = ref.chart_a(N)
+    e_th, e_ph = ref.tangent_frame_a(N, sin_phi)
+    neighbours = ref.footprint_neighbours(scene, i, j, width, height)
+    steps = ref.footprint_steps(scene, P, N, e_th, e_ph, sin_phi, *neighbours)
+    PE = ref.sub(P, (0.0, 0.0, e))
+    dP = 4 * U * (1.0 + hit_condition(scene, x, y, (0.0, 0.0, 0.0), R)) * _norm(PE) + 4 * U * _norm(P)
+    dN = dP / R + 2 * U
+    errors, offsets = [], []
+    for xk, yk in neighbours:
+        d = (xk, yk, -e)
+        nd, dk = abs(ref.dot(N, d)), _norm(d)
+        tk = abs(ref.dot(N, PE) / ref.dot(N, d))
+        kappa = dk / nd + _norm(PE) / abs(ref.dot(N, PE))
+        slope = 1.0 + dk / nd
+        errors.append(4 * U * (e + tk * dk + _norm(P) + tk * dk * kappa) + slope * dP
+                      + dk * (_norm(PE) + tk * dk) / nd * dN + tk * slope * 2 * U * (abs(xk) + abs(yk)))
+        offsets.append(ref.tangent_plane_offset(scene, P, N, xk, yk))
+    near_cut = abs(sin_phi - ref.POLE_SIN_PHI) <= 4 * (dN + U)
+    regular = sin_phi > ref.POLE_SIN_PHI
+    frame = 2 * (dN + U) / sin_phi if regular else 0.0
+    delta = []
+    for axis, (vec, L, extra) in enumerate(((e_th, 2 * math.pi * R * sin_phi, frame), (e_ph, math.pi * R, 0.0))):
+        a = sum(abs(ref.dot(vec, dp)) for dp in offsets)
+        change = sum(errors) + frame * sum(_norm(dp) for dp in offsets)
+        bound = 4 * (change / a + frame + extra + U) if a > 0 else math.inf
+        uncapped = a / (2 * L) if L > 0 else math.inf
+        if near_cut:
+            bound = math.inf
+        elif uncapped * (1 - bound) > ref.FOOTPRINT_MAX:
+            bound = 0.0                     # both routes take the cap
+        delta.append(bound)
+    return steps, tuple(delta)
+
+
+#: Above this relative step bound a pixel's footprint is too ill-conditioned to
+#: compare (a ray grazing the tangent plane); as many as tangent pixels may be.
+WIDE_DELTA = 1e-6
+
+
+def footprint_allowances(scene, width, height, chamber, grad_ref):
+    """(grad tolerance, extra image tolerance, pixels with delta > WIDE_DELTA) of the footprint pipeline.
+
+    The image allowance is how far the reference's own shading of the pixel
+    moves when its gradient moves by the gradient tolerance (the largest
+    change over the four corners of the tolerance box, first order).
+    """
+    steps, delta = np.ones(grad_ref.shape), np.zeros(grad_ref.shape)
+    extra = np.zeros(chamber.shape)
+    on_a = np.argwhere(chamber == ref.SPHERE_A)
+    for j, i in on_a:
+        steps[j, i], delta[j, i] = footprint_bound(scene, i, j, width, height)
+    tol = grad_tolerance(scene, "footprint", grad_ref, steps, delta)
+    for j, i in on_a:
+        if not np.all(np.isfinite(tol[j, i])):
+            extra[j, i] = math.inf
+            continue
+        x, y = ref.pixel_point(scene, i, j, width, height)
+        P = ref.ray_point(ref.nearest_hit(x, y, scene)[0], x, y, scene.camera_z)
+        N = ref.scale(1.0 / scene.radius_a, P)
+        u, v, sin_phi = ref.chart_a(N)
+        e_th, e_ph = ref.tangent_frame_a(N, sin_phi)
+        colour = lambda g: np.array(ref.sphere_a_colour(scene, P, N, e_th, e_ph, sin_phi, u, v, *g))  # noqa: E731
+        base = colour(grad_ref[j, i])
+        extra[j, i] = max(float(np.abs(colour(grad_ref[j, i] + np.array(s) * tol[j, i]) - base).max())
+                          for s in itertools.product((-1.0, 1.0), repeat=2))
+    return tol, extra, int(np.count_nonzero((delta > WIDE_DELTA).any(axis=-1)))
 
 
 def parity_failures(scene, width, height, gradient, *, frame=None):
@@ -124,15 +241,21 @@ def parity_failures(scene, width, height, gradient, *, frame=None):
     tangent = grazing_mask(scene, width, height, chamber)
     if np.count_nonzero(tangent) > MAX_GRAZING:
         failures.append(f"{np.count_nonzero(tangent)} tangent pixels > {MAX_GRAZING}")
+    if gradient == "footprint":
+        tol, extra, wide = footprint_allowances(scene, width, height, chamber, grad)
+        if wide > MAX_GRAZING:
+            failures.append(f"{wide} pixels with an ill-conditioned footprint > {MAX_GRAZING}")
+    else:
+        tol, extra = grad_tolerance(scene, gradient, grad), np.zeros(chamber.shape)
     d_image = np.abs(frame.image - image).max(axis=-1)
-    excess = (np.abs(frame.grad - grad) - grad_tolerance(scene, gradient, grad)).max(axis=-1)
+    excess = (np.abs(frame.grad - grad) - tol).max(axis=-1)
+    lip = lipschitz(scene)
     for where, image_tol, what in ((~tangent, IMAGE_TOL, ""), (tangent, GRAZING_TOL, " (tangent)")):
         if not where.any():
             continue
-        worst = float(d_image[where].max())
+        worst = float((d_image - extra)[where].max())
         if not worst <= image_tol:                       # also catches NaN
-            failures.append(f"max |dI|{what} = {worst:.3e} > {image_tol}")
-        lip = math.pi * max(scene.k_u, 2.0 * scene.k_v)
+            failures.append(f"max |dI|{what} beyond the allowance = {worst:.3e} > {image_tol}")
         worst = float(excess[where].max())
         if not worst <= (0.0 if what == "" else GRAZING_TOL * lip * lip):
             failures.append(f"grad{what} differs beyond tolerance by up to {worst:.3e}")
@@ -201,19 +324,6 @@ def test_frame_sizes_reach_the_pole():
     assert abs(grad[8, 8, 1]) > 1.0
 
 
-@pytest.mark.parametrize("gradient", GRADIENTS)
-def test_tiling_is_invisible(monkeypatch, gradient):
-    """Tiles of one row give the same frame, bit for bit, and it matches the reference."""
-    scene = Scene(beta=1.5)
-    whole = render(scene, 17, 13, gradient=gradient)
-    monkeypatch.setattr(render_module, "TILE_PIXELS", 20)      # 17-wide rows: 1 row per tile
-    tiled = render(scene, 17, 13, gradient=gradient)
-    for a, b in ((whole.image, tiled.image), (whole.chamber, tiled.chamber),
-                 (whole.kink, tiled.kink), (whole.grad, tiled.grad)):
-        assert np.array_equal(a, b)
-    assert parity_failures(scene, 17, 13, gradient, frame=tiled) == []
-
-
 def test_light_on_a_blocker_surface_does_not_shadow_the_outside():
     """A light exactly on sphere B's surface: the seed's sign logic (a root in the
     open interval (0, 1)) lights a floor point whose segment only touches B at
@@ -249,6 +359,8 @@ def test_light_on_a_blocker_surface_does_not_shadow_the_outside():
     (dict(center_b=(0.5, 0.45, 1.3)), "exact", "chamber"),
     (dict(height_field="sine"), "exact", "kink"),
     (dict(bump="surface"), "exact", "|dI|"),
+    (dict(k_v=4.25), "footprint", "grad"),
+    (dict(beta=0.36), "footprint", "|dI|"),
 ])
 def test_parity_rejects_a_scene_that_differs_in_one_field(change, gradient, kind):
     scene = Scene()
@@ -340,3 +452,40 @@ def test_parity_still_checks_the_tangent_pixels():
     assert parity_failures(scene, 17, 20, "exact", frame=frame) == []
     frame.image[0, 8] += 1e-3
     assert any("(tangent)" in f for f in parity_failures(scene, 17, 20, "exact", frame=frame))
+
+
+# --- teeth of the footprint pipeline's checks ----------------------------------------------
+
+def _pbrt_raster_row(scene, i, j, width, height):
+    """pbrt-v4's y differential: the next raster row, one row *down* (j + 1)."""
+    return ref.pixel_point(scene, i + 1, j, width, height), ref.pixel_point(scene, i, j + 1, width, height)
+
+
+def test_footprint_parity_rejects_the_other_neighbouring_row(monkeypatch):
+    """The neighbour below instead of above: the same rule to first order in the
+    pixel spacing, a different step at second order, which the tolerance sees."""
+    monkeypatch.setattr(ref, "footprint_neighbours", _pbrt_raster_row)
+    failures = parity_failures(Scene(), 24, 20, "footprint")
+    assert any("grad" in f for f in failures), failures
+
+
+def test_footprint_parity_rejects_a_step_without_pbrts_half(monkeypatch):
+    steps = ref.footprint_steps
+    monkeypatch.setattr(ref, "footprint_steps",
+                        lambda *a: tuple(min(2 * s, ref.FOOTPRINT_MAX) for s in steps(*a)))
+    failures = parity_failures(Scene(), 24, 20, "footprint")
+    assert any("grad" in f for f in failures) and any("|dI|" in f for f in failures), failures
+
+
+def test_footprint_parity_rejects_the_central_pipelines_frame():
+    frame = render(Scene(), 24, 20, gradient="central")
+    assert any("grad" in f for f in parity_failures(Scene(), 24, 20, "footprint", frame=frame))
+
+
+def test_footprint_exemption_is_limited_to_a_few_pixels(monkeypatch):
+    """A footprint too ill-conditioned to compare (delta > WIDE_DELTA) is
+    allowed on at most MAX_GRAZING pixels: with no pixel well-conditioned
+    enough the check fails instead of passing vacuously."""
+    assert parity_failures(Scene(), 17, 20, "footprint") == []
+    monkeypatch.setitem(globals(), "WIDE_DELTA", -1.0)
+    assert any("ill-conditioned footprint" in f for f in parity_failures(Scene(), 17, 20, "footprint"))

@@ -16,7 +16,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from renderer import PointLight, Scene, compare, render, sweep
+from renderer import GRADIENTS, PointLight, Scene, compare, gbuffer, render, sweep
 
 NAN, INF = float("nan"), float("inf")
 
@@ -267,7 +267,7 @@ def test_a_scene_that_validates_renders_finite_outputs(kwargs, field):
     if scene is None:
         return
     with np.errstate(all="ignore"):
-        for gradient in ("exact", "central"):
+        for gradient in GRADIENTS:
             frame = render(scene, 8, 8, gradient=gradient)
             bad = {name: int(np.count_nonzero(~np.isfinite(a)))
                    for name, a in (("image", frame.image), ("grad", frame.grad))}
@@ -299,10 +299,30 @@ def test_render_rejects_bad_sizes(width, height, error, name):
         render(Scene(), width, height)
 
 
-@pytest.mark.parametrize("gradient", ["Exact", "symbolic", "numeric", "", None, 1, ("exact",)])
+@pytest.mark.parametrize("gradient", ["Exact", "symbolic", "numeric", "Footprint", "pbrt", "", None, 1,
+                                      ("exact",)])
 def test_render_rejects_unknown_gradient(gradient):
-    with pytest.raises(ValueError, match=r"^gradient\b"):
+    with pytest.raises(ValueError, match=r"^gradient must be one of \('exact', 'central', 'footprint'\)"):
         render(Scene(), 4, 4, gradient=gradient)
+    with pytest.raises(ValueError, match=r"^gradient\b"):
+        gbuffer(Scene(), 4, 4, gradient=gradient)
+
+
+@pytest.mark.parametrize("gradient", GRADIENTS)
+def test_render_accepts_every_gradient_and_records_it(gradient):
+    frame = render(Scene(), 4, 4, gradient=gradient)
+    assert frame.gradient == gradient and gbuffer(Scene(), 4, 4, gradient=gradient).grad.shape == (4, 4, 2)
+
+
+@pytest.mark.parametrize("workers", [0, -1, 65, 1.5, True, "2", np.float64(2.0)])
+def test_render_rejects_a_bad_thread_count_naming_it(workers):
+    with pytest.raises(ValueError, match=r"^workers must be an integer from 1 to 64, got "):
+        render(Scene(), 4, 4, workers=workers)
+
+
+@pytest.mark.parametrize("workers", [1, 64, np.int64(2), None])
+def test_render_accepts_thread_counts_in_range(workers):
+    assert render(Scene(), 4, 4, workers=workers).image.shape == (4, 4, 3)
 
 
 def test_render_rejects_a_non_scene():
@@ -363,7 +383,7 @@ def boundary_violations(frame, other):
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(scene=valid_scenes(), gradient=st.sampled_from(("exact", "central")))
+@given(scene=valid_scenes(), gradient=st.sampled_from(GRADIENTS))
 def test_valid_scenes_render_in_unit_interval_and_bump_moves_no_boundary(scene, gradient):
     frame = render(scene, 16, 16, gradient=gradient)
     assert np.all(np.isfinite(frame.image)) and np.all(np.isfinite(frame.grad))

@@ -1,169 +1,250 @@
-"""Each skip of the renderer is output-identical, bit for bit, to the path that
-does not skip, and each skip really skips: instrumentation
-counts the work, and the same counters show the reference path doing it.
+"""The kernel's skips change no bit, and the sweep's frames are `render`'s.
+
+`renderer.kernel` skips work the outputs do not need (its docstring lists
+the skips): an object that is off is not intersected; a shadow ray is traced
+only where Ns . w > 0; at beta = 0 no gradient unless grad is an output; the
+crease flag only when it is an output; `kernel.params` drops lights of zero
+colour.  ``render(..., skip=False)`` is the reference path that does all of
+it.  Checked here, each against a wrong variant:
+
+* over a grid of scenes x gradient methods x output flags, the two paths
+  give the same bytes (image, chamber, kink, grad);
+* the grid does exercise every skip: the kernel's own Python source
+  (numba's ``py_func``), run interpreted with its steps counted, skips on
+  the grid's scenes and does the work with ``skip=False``;
+* every frame of `sweep` is the bytes of a separate `render` call, and its
+  census is `compare` of those renders;
+* the number of threads changes no bit.
 """
 
 from __future__ import annotations
 
+import collections
+import dataclasses
+import numba
 import numpy as np
 import pytest
 
-import importlib
-import threading
+from renderer import GRADIENTS, PointLight, Scene, compare, kernel, render, sweep
 
-from renderer import PointLight, Scene, fields, render, sweep
-
-#: The module renderer.render (the package re-exports the function under that name).
-R = importlib.import_module("renderer.render")
-
-SIZE = (48, 40)
+SIZE = (40, 32)
+LIGHT_1, LIGHT_2 = Scene().lights
+DARK = PointLight((-2.0, 6.0, 9.0), (0.0, 0.0, 0.0))
 SCENES = {
     "default": Scene(),
-    "sine-phong": Scene(height_field="sine", model="phong", eps=1e-6),
-    "rings-noB": Scene(height_field="rings", sphere_b=False),
-    "nofloor": Scene(floor=False),
-    "noB-nofloor-beta0": Scene(sphere_b=False, floor=False, beta=0.0),
-    "zero-light": Scene(lights=(PointLight((5.0, 5.0, 10.0), (1.0, 1.0, 1.0)),
-                                PointLight((-6.0, 2.0, 8.0), (0.0, 0.0, 0.0)),
-                                PointLight((0.0, 3.0, -2.0), (0.4, 0.4, 0.4)))),
-    "surface-bump": Scene(height_field="sine", bump="surface", beta=0.5),
+    "sphere B off": Scene(sphere_b=False),
+    "floor off": Scene(floor=False),
+    "B and floor off": Scene(sphere_b=False, floor=False, height_field="sine"),
+    "zero-colour light": Scene(lights=(LIGHT_1, DARK, LIGHT_2)),
+    "beta 0": Scene(beta=0.0),
+    "beta 0, sine, phong": Scene(beta=0.0, height_field="sine", model="phong"),
+    # Lights behind sphere A and below the floor: attached shadows and the floor plane.
+    "lights behind": Scene(lights=(PointLight((0.5, -1.0, -6.0)), PointLight((3.0, -2.0, -4.0), (0.5, 0.6, 0.7)))),
+    # A strong bump turns many N' away from lights the geometric normal faces.
+    "strong bump": Scene(height_field="sine", beta=1.5),
+    "surface bump, phong": Scene(height_field="sine", bump="surface", beta=0.6, model="phong"),
+    "rings, eps 0.05": Scene(height_field="rings", eps=0.05),
 }
+FLAGS = ((True, True), (False, False), (True, False), (False, True))
 
 
-def _same(a, b):
+def differences(a, b):
+    """Names of the outputs of two frames that differ in any byte (None must match None)."""
+    out = []
     for name in ("image", "chamber", "kink", "grad"):
         x, y = getattr(a, name), getattr(b, name)
-        if x is None or y is None:
-            continue
-        if not np.array_equal(x, y):
-            return False
-    return True
+        if (x is None) != (y is None):
+            out.append(name)
+        elif x is not None and (x.dtype, x.shape, x.tobytes()) != (y.dtype, y.shape, y.tobytes()):
+            out.append(name)
+    return out
+
+
+@pytest.mark.parametrize("gradient", GRADIENTS)
+@pytest.mark.parametrize("name", sorted(SCENES))
+def test_skipping_path_gives_the_reference_paths_bytes(name, gradient):
+    scene = SCENES[name]
+    images = []
+    for kink, grad in FLAGS:
+        fast = render(scene, *SIZE, gradient=gradient, kink=kink, grad=grad)
+        full = render(scene, *SIZE, gradient=gradient, kink=kink, grad=grad, skip=False)
+        assert differences(fast, full) == [], (kink, grad)
+        assert (fast.kink is None, fast.grad is None) == (not kink, not grad)
+        images.append(fast.image.tobytes())
+    assert len(set(images)) == 1                           # the flags change no pixel
+
+
+def _dropping_a_lit_light(real):
+    """A wrong `kernel.params`: with skip, it drops the first light, which has colour."""
+    def params(scene, skip=True):
+        return real(scene.replace(lights=scene.lights[1:]) if skip else scene, skip)
+    return params
+
+
+def test_the_check_rejects_a_skip_that_drops_a_lit_light(monkeypatch):
+    monkeypatch.setattr(kernel, "params", _dropping_a_lit_light(kernel.params))
+    fast, full = render(Scene(), *SIZE), render(Scene(), *SIZE, skip=False)
+    assert "image" in differences(fast, full)
+
+
+def _changed(frame, name, index, value):
+    array = getattr(frame, name).copy()
+    array[index] = value
+    return dataclasses.replace(frame, **{name: array})
+
+
+def test_the_check_rejects_one_changed_bit():
+    frame = render(Scene(), *SIZE)
+    j, i = np.argwhere(frame.chamber == 1)[0]
+    (bj, bi), = np.argwhere(frame.chamber != 1)[:1]         # grad is +0 off sphere A
+    assert differences(frame, frame) == []
+    assert differences(frame, _changed(frame, "image", (j, i, 0), np.nextafter(frame.image[j, i, 0], 2))) == ["image"]
+    assert differences(frame, _changed(frame, "grad", (bj, bi, 0), -0.0)) == ["grad"]    # -0 == 0, not the same bits
+    assert differences(frame, _changed(frame, "kink", (j, i), not frame.kink[j, i])) == ["kink"]
+    assert differences(frame, dataclasses.replace(frame, grad=None)) == ["grad"]
+
+
+# --- the grid exercises every skip --------------------------------------------------------
+
+@pytest.fixture
+def interpreted(monkeypatch):
+    """Run `renderer.kernel` as plain Python: every compiled function of the
+    module (its steps and the generated formulas it calls) replaced by its
+    ``py_func``, with the arguments of every call recorded by name."""
+    calls = collections.defaultdict(list)
+    for name, obj in list(vars(kernel).items()):
+        if isinstance(obj, numba.core.dispatcher.Dispatcher):
+            def step(*args, _fn=obj.py_func, _name=name):
+                calls[_name].append(args)
+                return _fn(*args)
+            monkeypatch.setattr(kernel, name, step)
+    assert {"render_rows", "sphere_hit", "segment_blocked", "exact_gradient", "central_gradient",
+            "footprint", "kink_band"} <= set(vars(kernel)) and calls == {}
+    return calls
+
+
+def _work(calls, scene):
+    """Counts of the work each skip avoids, from the recorded calls."""
+    b = (*scene.center_b, scene.radius_b)
+    dark = {tuple(l.position) for l in scene.lights if not any(l.color)}
+    return dict(
+        b_rays=sum(tuple(a[-4:]) == b for a in calls["sphere_hit"]),
+        b_blocks=sum(tuple(a[-4:]) == b for a in calls["segment_blocked"]),
+        shadow_rays=len(calls["segment_blocked"]),
+        dark_rays=sum(tuple(a[4]) in dark for a in calls["segment_blocked"]),
+        gradients=sum(len(calls[n]) for n in ("exact_gradient", "central_gradient", "footprint")),
+        creases=sum(len(calls[n]) for n in ("exact_gradient", "central_gradient", "footprint", "kink_band")),
+    )
+
+
+def run(interpreted, scene, **kw):
+    interpreted.clear()
+    frame = render(scene, 16, 12, **kw)
+    return _work(interpreted, scene), frame
+
+
+@pytest.mark.parametrize("name, counter, flags", [
+    ("sphere B off", "b_rays", {}), ("sphere B off", "b_blocks", {}),
+    ("B and floor off", "b_rays", {}),
+    ("zero-colour light", "dark_rays", {}),
+    ("beta 0", "gradients", dict(grad=False)),
+    ("beta 0", "creases", dict(grad=False, kink=False)),
+    ("beta 0, sine, phong", "creases", dict(grad=False, kink=False, gradient="footprint")),
+])
+def test_the_skip_does_none_of_the_work_the_reference_path_does(interpreted, name, counter, flags):
+    scene = SCENES[name]
+    fast, _ = run(interpreted, scene, **flags)
+    full, _ = run(interpreted, scene, skip=False, **flags)
+    assert fast[counter] == 0 < full[counter]
+
+
+@pytest.mark.parametrize("name", ["strong bump", "surface bump, phong"])
+def test_shadow_rays_are_traced_only_where_the_light_can_add_light(interpreted, name):
+    fast, _ = run(interpreted, SCENES[name])
+    full, _ = run(interpreted, SCENES[name], skip=False)
+    assert 0 < fast["shadow_rays"] < full["shadow_rays"]
+
+
+def test_zero_colour_lights_are_dropped_from_the_kernels_lights():
+    scene = SCENES["zero-colour light"]
+
+    def lights(skip):
+        arrays = [a for a in kernel.params(scene, skip) if np.ndim(a) == 2]
+        assert len(arrays) == 1
+        return arrays[0]
+
+    assert lights(True).tolist() == [[*l.position, *l.color] for l in (LIGHT_1, LIGHT_2)]
+    assert lights(False).shape == (3, 6)
+
+
+def test_gradient_and_crease_work_is_done_when_asked(interpreted):
+    """The counters see work when the outputs need it, so a zero above means a skip."""
+    scene = SCENES["beta 0"]
+    asked, frame = run(interpreted, scene)
+    a = int(np.count_nonzero(frame.chamber == 1))
+    assert asked["gradients"] == a > 0
+    only_kink, _ = run(interpreted, scene, grad=False)
+    assert only_kink["creases"] == a and only_kink["gradients"] == 0
+
+
+def test_the_counters_see_a_skip_that_is_not_taken(interpreted, monkeypatch):
+    """The same counters reject a kernel told never to skip (every call gets skip=False)."""
+    real = kernel.render_rows
+    monkeypatch.setattr(kernel, "render_rows", lambda *a: real(*_never_skip(a)))
+    work, _ = run(interpreted, SCENES["sphere B off"])
+    assert work["b_rays"] > 0
+
+
+def _never_skip(args):
+    """render_rows' arguments with its ``skip`` flag (the first bool after the pixel centres) False."""
+    args = list(args)
+    at = next(i for i, a in enumerate(args) if isinstance(a, (bool, np.bool_)))
+    args[at] = False
+    return args
+
+
+# --- the sweep's frames are separate renders -----------------------------------------------
+
+STEPS = (1e-1, 1e-3, 1e-6, 1e-10, 1e-16, 0.25)
+
+
+def ledger_bytes(led):
+    return np.array(dataclasses.astuple(led), dtype=np.float64).tobytes()
+
+
+def sweep_differences(scene, sw, size=SIZE):
+    """What differs between a sweep and separate renders of the same frames."""
+    bad = []
+    exact = render(scene, *size)
+    if differences(sw.symbolic, exact) or (sw.symbolic.scene, sw.symbolic.gradient) != (scene, "exact"):
+        bad.append("symbolic")
+    for i, (eps, frame, led) in enumerate(zip(sw.eps, sw.numeric, sw.census)):
+        alone = render(scene.replace(eps=eps), *size, gradient="central")
+        if differences(frame, alone) or (frame.scene, frame.gradient) != (alone.scene, "central"):
+            bad.append(f"numeric[{i}]")
+        if ledger_bytes(led) != ledger_bytes(compare(alone, exact)):
+            bad.append(f"census[{i}]")
+    return bad
 
 
 @pytest.mark.parametrize("name", sorted(SCENES))
-@pytest.mark.parametrize("gradient", ["exact", "central"])
-def test_skipping_path_equals_reference_path(name, gradient):
+def test_sweep_frames_are_separate_renders(name):
     scene = SCENES[name]
-    fast = render(scene, *SIZE, gradient=gradient)
-    ref = render(scene, *SIZE, gradient=gradient, skip=False)
-    assert _same(fast, ref)
-    lean = render(scene, *SIZE, gradient=gradient, kink=False, grad=False)
-    assert lean.kink is None and lean.grad is None
-    assert np.array_equal(lean.image, ref.image) and np.array_equal(lean.chamber, ref.chamber)
+    sw = sweep(scene, STEPS, *SIZE)
+    assert sw.eps == STEPS and len(sw.numeric) == len(sw.census) == len(STEPS)
+    assert sweep_differences(scene, sw) == []
 
 
-def test_the_identity_check_rejects_a_different_image():
-    a = render(SCENES["default"], *SIZE)
-    b = render(SCENES["default"].replace(eps=2e-3), *SIZE, gradient="central")
-    c = render(SCENES["default"], *SIZE, gradient="central")
-    assert _same(a, a) and not _same(a, c) and not _same(b, c)
-
-
-class Counter:
-    """Wrap a function; record the arguments' sizes and the positions/centres passed."""
-
-    def __init__(self, fn, key=None, points_arg=0):
-        self.fn, self.key, self.calls, self.points, self.keys = fn, key, 0, 0, []
-        self.points_arg = points_arg
-        self.lock = threading.Lock()          # tiles render on several threads
-
-    def __call__(self, *args, **kwargs):
-        with self.lock:
-            self.calls += 1
-            self.points += int(np.size(args[self.points_arg]))
-            if self.key is not None:
-                self.keys.append(self.key(*args))
-        return self.fn(*args, **kwargs)
-
-
-@pytest.fixture
-def count(monkeypatch):
-    def install(module, name, key=None, points_arg=0):
-        c = Counter(getattr(module, name), key, points_arg)
-        monkeypatch.setattr(module, name, c)
-        return c
-    return install
-
-
-def test_objects_that_are_off_are_neither_intersected_nor_blockers(count):
-    scene = SCENES["noB-nofloor-beta0"].replace(beta=0.35)
-    hits = count(R, "sphere_hit", key=lambda x, y, e, center, r: tuple(center))
-    shadows = count(R, "segment_hits_sphere", key=lambda *a: tuple(a[5]))
-    render(scene, *SIZE)
-    assert tuple(scene.center_b) not in hits.keys + shadows.keys
-    render(scene, *SIZE, skip=False)              # the reference path does the work
-    assert tuple(scene.center_b) in hits.keys and tuple(scene.center_b) in shadows.keys
-
-
-def test_zero_colour_lights_are_skipped(count):
-    scene = SCENES["zero-light"]
-    dark = scene.lights[1].position
-    shadows = count(R, "segment_hits_sphere", key=lambda *a: tuple(a[4]))
-    render(scene, *SIZE)
-    assert dark not in shadows.keys
-    render(scene, *SIZE, skip=False)
-    assert dark in shadows.keys
-
-
-def test_shadow_rays_only_where_they_can_change_the_pixel(count):
-    scene = Scene(height_field="sine", beta=1.5)       # strong bump: many N' facing away
-    shadows = count(R, "segment_hits_sphere")
-    fast = render(scene, *SIZE)
-    traced_fast = shadows.points
-    shadows.points = 0
-    ref = render(scene, *SIZE, skip=False)
-    assert traced_fast < shadows.points and _same(fast, ref)
-
-
-def test_beta_zero_computes_no_gradient(count):
-    scene = SCENES["default"].replace(beta=0.0)
-    exact = count(fields, "exact_gradient")
-    central = count(R, "central_gradient")
-    frame_ = count(R, "tangent_frame")
-    a = render(scene, *SIZE, grad=False, kink=False)
-    b = render(scene, *SIZE, gradient="central", grad=False, kink=False)
-    assert exact.calls == central.calls == frame_.calls == 0
-    assert np.array_equal(a.image, render(scene, *SIZE, skip=False).image)
-    assert np.array_equal(b.image, render(scene, *SIZE, gradient="central", skip=False).image)
-    render(scene, *SIZE)                              # asked for grad: computed
-    assert exact.calls > 0
-
-
-def test_kink_and_grad_only_when_asked(count):
-    kinks = count(fields, "kink_band")
-    render(SCENES["default"], *SIZE, kink=False)
-    assert kinks.calls == 0
-    render(SCENES["default"], *SIZE)
-    assert kinks.calls > 0
-
-
-def test_gradient_frame_and_normal_only_on_sphere_a(count):
-    scene = SCENES["default"]
-    exact = count(fields, "exact_gradient", points_arg=1)
-    frame_ = count(R, "tangent_frame")
-    f = render(scene, *SIZE)
-    on_a = int(np.count_nonzero(f.chamber == R.SPHERE_A))
-    assert exact.points == on_a and frame_.points == on_a
-
-
-@pytest.mark.parametrize("name", ["default", "sine-phong", "rings-noB", "noB-nofloor-beta0", "zero-light"])
-def test_sweep_equals_independent_renders(name):
-    scene = SCENES[name]
-    steps = (1e-1, 1e-3, 1e-6, 1e-10)
-    sw = sweep(scene, steps, *SIZE)
-    assert _same(sw.symbolic, render(scene, *SIZE))
-    for eps, frame in zip(steps, sw.numeric):
-        assert _same(frame, render(scene.replace(eps=eps), *SIZE, gradient="central"))
-    assert all(led.flips == 0 for led in sw.census)
-
-
-def test_sweep_shades_geometry_once(count):
-    hits = count(R, "sphere_hit")
-    sweep(SCENES["default"], (1e-1, 1e-2, 1e-3, 1e-4), *SIZE)
-    once = hits.calls
-    hits.calls = 0
-    render(SCENES["default"], *SIZE, gradient="central")
-    assert once == hits.calls                       # one render's worth, not four
+def test_the_sweep_check_rejects_a_frame_of_another_step_and_a_wrong_census():
+    scene = Scene()
+    sw = sweep(scene, (1e-3, 1e-1), *SIZE)
+    other = render(scene.replace(eps=1.001e-3), *SIZE, gradient="central")
+    wrong = dataclasses.replace(sw, numeric=(other, sw.numeric[1]))
+    assert sweep_differences(scene, wrong) == ["numeric[0]"]
+    swapped = dataclasses.replace(sw, census=sw.census[::-1])
+    assert sweep_differences(scene, swapped) == ["census[0]", "census[1]"]
+    moved = dataclasses.replace(sw, symbolic=_changed(sw.symbolic, "image", (20, 20, 1), 0.5))
+    assert sweep_differences(scene, moved) == ["symbolic"]
 
 
 @pytest.mark.parametrize("bad, match", [
@@ -175,70 +256,37 @@ def test_sweep_rejects_bad_steps(bad, match):
         sweep(Scene(), bad, 8, 8)
 
 
-@pytest.mark.parametrize("workers", [2, 3])
-def test_threads_give_the_same_bits(workers, monkeypatch):
-    monkeypatch.setenv("SYMRENDER_WORKER_PROCESSES", "0")     # threads only (tests/test_workers.py)
-    scene = SCENES["default"]
-    big = (300, 240)                        # above MIN_SPLIT_PIXELS: one tile per thread
-    assert big[0] * big[1] >= R.MIN_SPLIT_PIXELS
-    assert _same(render(scene, *big, workers=1), render(scene, *big, workers=workers))
-    a = sweep(scene, (1e-2, 1e-6), *big, workers=1)
-    b = sweep(scene, (1e-2, 1e-6), *big, workers=workers)
-    assert all(_same(x, y) for x, y in zip(a.numeric + (a.symbolic,), b.numeric + (b.symbolic,)))
+def test_sweep_reports_progress_once():
+    calls = []
+    sweep(Scene(), (1e-3,), 12, 10, progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(120, 120)]
+
+
+# --- threads ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("gradient", GRADIENTS)
+def test_the_number_of_threads_changes_no_bit(gradient):
+    scene, size = Scene(beta=1.2), (96, 80)
+    before = numba.get_num_threads()
+    one = render(scene, *size, gradient=gradient, workers=1)
+    assert numba.get_num_threads() == before                # restored
+    for workers in (None, 2, 3):
+        assert differences(one, render(scene, *size, gradient=gradient, workers=workers)) == [], workers
+    a, b = sweep(scene, (1e-2, 1e-6), *size, workers=1), sweep(scene, (1e-2, 1e-6), *size)
+    assert all(differences(x, y) == [] for x, y in zip(a.numeric + (a.symbolic,), b.numeric + (b.symbolic,)))
+    assert [ledger_bytes(x) for x in a.census] == [ledger_bytes(x) for x in b.census]
 
 
 @pytest.mark.parametrize("bad", [0, -1, 65, 1.5, True, "2"])
 def test_bad_workers_are_refused(bad):
     with pytest.raises(ValueError, match="workers"):
         render(Scene(), 8, 8, workers=bad)
+    with pytest.raises(ValueError, match="workers"):
+        sweep(Scene(), (1e-3,), 8, 8, workers=bad)
 
 
-def test_sweep_reports_progress_per_tile_and_gives_the_same_bits():
-    calls = []
-    scene = SCENES["default"]
-    a = sweep(scene, (1e-3, 1e-6), 300, 240, progress=lambda done, total: calls.append((done, total)))
-    b = sweep(scene, (1e-3, 1e-6), 300, 240)
-    assert len(calls) > 1 and calls[-1] == (300 * 240, 300 * 240)
-    assert [d for d, _ in calls] == sorted(d for d, _ in calls)
-    assert all(_same(x, y) for x, y in zip(a.numeric, b.numeric))
-
-
-def _power_bases():
-    """Bases for the specular power check: random values in [0, 1], the
-    specular range, with +0 and -0 scattered among them, every special value
-    (+-inf, NaN of either sign, subnormals, huge, negative), shuffled."""
-    rng = np.random.default_rng(7)
-    special = [np.nan, -np.nan, np.inf, -np.inf, 5e-324, -5e-324, 1e-300, 1e300, 1.0, -1.0, -2.5]
-    base = np.concatenate([rng.random(1000), np.zeros(300), -np.zeros(30), special,
-                           rng.random(100) * 1e-12])
-    return rng.permutation(base)
-
-
-_POWER_BASES = _power_bases()
-
-
-def _bits(x):
-    return np.asarray(x, dtype=np.float64).view(np.uint64)
-
-
-@pytest.mark.parametrize("exponent", [32.0, 0.5, 1.0, 2.0, 3.0, 7.5, 1e-3, 200.0])
-def test_specular_power_skips_zero_bases_with_the_same_bits(exponent):
-    # render._power calls pow only where the base is not +0 (libm's slow
-    # path); -0, NaN, inf, subnormals and the rest give the bits of **.
-    with np.errstate(all="ignore"):
-        expected = _POWER_BASES ** exponent
-        got = R._power(_POWER_BASES.copy(), exponent)
-        strided = R._power(_POWER_BASES[::3], exponent)
-    assert np.array_equal(_bits(got), _bits(expected))
-    assert np.array_equal(_bits(strided), _bits(expected[::3]))
-
-
-def test_the_power_check_sees_a_lost_negative_zero():
-    # A variant that also skips -0 writes +0 where pow(-0, 3) is -0.
-    def variant(base, exponent):
-        out = np.zeros_like(base)
-        np.power(base, exponent, out=out, where=base != 0.0)
-        return out
-    with np.errstate(all="ignore"):
-        assert not np.array_equal(_bits(variant(_POWER_BASES, 3.0)), _bits(_POWER_BASES ** 3.0))
-        assert np.array_equal(_bits(variant(_POWER_BASES, 32.0)), _bits(_POWER_BASES ** 32.0))
+def test_a_refused_thread_count_leaves_numbas_count_alone():
+    before = numba.get_num_threads()
+    with pytest.raises(ValueError):
+        render(Scene(), 8, 8, workers=0)
+    assert numba.get_num_threads() == before

@@ -4,13 +4,18 @@ Each test states what it found; the numbers are asserted against bounds that a
 wrong renderer would break.
 """
 
-import tracemalloc
+import json
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from renderer import Scene, gbuffer, render
-from renderer.geometry import POLE_SIN_PHI, tangent_frame
+from renderer import GRADIENTS, Scene, gbuffer, kernel, pointwise, render
+from renderer.formulas import POLE_SIN_PHI
+
+POLE_SIN_PHI = float(POLE_SIN_PHI)
 
 
 def fallback_pixels(scene, width, height):
@@ -25,7 +30,7 @@ def test_pole_fallback_engages_only_where_a_pixel_centre_hits_the_pole():
     assert fallback_pixels(Scene(), 21, 20) == 1
     for w, h in ((256, 256), (255, 255), (128, 96), (512, 512)):
         assert fallback_pixels(Scene(), w, h) == 0
-    for gradient in ("exact", "central"):
+    for gradient in GRADIENTS:
         frame = render(Scene(height_field="sine", beta=1.5), 21, 20, gradient=gradient)
         assert np.isfinite(frame.image).all() and np.isfinite(frame.grad).all()
 
@@ -35,8 +40,8 @@ def test_size_of_the_jump_across_the_fallback():
     threshold, for the same gradient: the jump is O(beta |grad|), not small."""
     phi = 1.0001 * POLE_SIN_PHI
     N = np.array([[np.sin(phi)], [0.0], [np.cos(phi)]])
-    reg = tangent_frame(*N, np.array([np.sin(phi)]))
-    fb = tangent_frame(*N, np.array([0.0]))
+    reg = pointwise.tangent_frame(*N, np.array([np.sin(phi)]))
+    fb = pointwise.tangent_frame(*N, np.array([0.0]))
     g = np.array([1.0, 0.5])
     beta = 0.35
     n_reg = N[:, 0] + beta * (g[0] * np.ravel(reg[0]) + g[1] * np.ravel(reg[1]))
@@ -50,7 +55,7 @@ def test_size_of_the_jump_across_the_fallback():
     dict(camera_z=1.0 + 1e-9), dict(camera_z=1.0 + 1e-9, center_b=(3.0, 3.0, 0.5)),
     dict(eps=1e-16), dict(eps=1e-16, height_field="sine"), dict(eps=0.25), dict(shininess=1e4),
 ])
-@pytest.mark.parametrize("gradient", ["exact", "central"])
+@pytest.mark.parametrize("gradient", GRADIENTS)
 def test_extreme_valid_scenes_render_finite_unit_normals(kwargs, gradient):
     scene = Scene(**kwargs)
     frame = render(scene, 48, 40, gradient=gradient)
@@ -66,27 +71,54 @@ def test_one_by_one_and_thin_frames():
         assert frame.image.shape == (h, w, 3) and np.isfinite(frame.image).all()
 
 
+_MEMORY = r"""
+import json, resource, sys
+import numpy as np
+from renderer import Scene, render
+
+def peak():
+    # ru_maxrss is in KiB on Linux (bytes on macOS).
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * (1 if sys.platform == "darwin" else 1024)
+
+render(Scene(), 8, 8)                       # the compiled kernel loaded
+n, scratch = int(sys.argv[1]), sys.argv[2] == "1"
+before = peak()
+frame = render(Scene(), n, n)
+if scratch:                                 # the wrong variant: one frame-sized scratch image
+    work = np.ones((n, n, 3))
+    work += 1.0
+outputs = sum(a.nbytes for a in (frame.image, frame.chamber, frame.kink, frame.grad))
+print(json.dumps(peak() - before - outputs))
+"""
+#: Working memory allowed beyond the outputs: far below one frame-sized
+#: float64 image at 4096^2 (384 MiB), far above a few hundred bytes per thread.
+WORKING_MEMORY = 32 * 2**20
+
+
+def _peak_growth(n, scratch):
+    """Peak resident memory a fresh process gains rendering an n x n frame, beyond its outputs."""
+    result = subprocess.run([sys.executable, "-c", _MEMORY, str(n), "1" if scratch else "0"], check=True,
+                            capture_output=True, text=True, timeout=600, cwd=Path(__file__).parents[1])
+    return json.loads(result.stdout)
+
+
 def test_4096_frame_in_bounded_memory():
-    """Working memory beyond the outputs stays bounded (tiles of `TILE_PIXELS` pixels)."""
-    w = h = 4096
-    outputs = w * h * (3 * 8 + 1 + 1 + 2 * 8)
-    tracemalloc.start()
-    frame = render(Scene(), w, h)
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    assert np.isfinite(frame.image).all()
-    assert peak - outputs < 64 * 2**20, f"working memory {(peak - outputs) / 2**20:.0f} MiB"
+    """The outputs are allocated once and the kernel writes each pixel into
+    them: the process's peak grows by the outputs (42 bytes per pixel with
+    kink and grad) and little more.  A render that kept one scratch image
+    of the frame's size would be refused by the same measurement."""
+    assert _peak_growth(4096, scratch=False) < WORKING_MEMORY
+    assert _peak_growth(4096, scratch=True) > WORKING_MEMORY
 
 
 def test_grazing_rays_at_the_silhouette_stay_on_the_surface():
     """Rays within a hair of sphere A's silhouette: hit points still on the sphere."""
-    from renderer.geometry import sphere_hit
     e, R = 4.0, 1.0
     rho_sil = e * R / np.sqrt(e * e - R * R)
     theta = np.linspace(0, 2 * np.pi, 1000)
     rho = rho_sil * (1 - np.logspace(-16, -6, 1000))
     x, y = rho * np.cos(theta), rho * np.sin(theta)
-    t = sphere_hit(x, y, e, (0.0, 0.0, 0.0), R)
+    t = np.array([kernel.sphere_hit(a, b, e, 0.0, 0.0, 0.0, R) for a, b in zip(x, y)])
     hit = np.isfinite(t)
     assert hit.mean() > 0.99
     P = np.stack([t[hit] * x[hit], t[hit] * y[hit], e * (1 - t[hit])], axis=-1)
@@ -97,14 +129,12 @@ def test_grazing_rays_at_the_silhouette_stay_on_the_surface():
 def test_points_exactly_on_the_u_creases(m):
     """u = m / k_u as float64 represents it, v off the v-creases: what each
     pipeline returns and what the kink flag says."""
-    from renderer import fields
-    from renderer.render import central_gradient
     ku, kv = 8.0, 4.0
     u, v = np.array([m / ku]), np.array([0.47])
     one_sided = np.pi * ku * abs(np.sin(np.pi * kv * 0.47))          # |h_u| on either side
-    exact = fields.exact_gradient("ridges", u, v, ku, kv)[0][0]
-    fd = central_gradient("ridges", u, v, ku, kv, 1e-4)[0][0]
-    assert fields.kink_band("ridges", u, v, ku, kv)[0]                # flagged
+    exact = pointwise.exact_gradient("ridges", u, v, ku, kv)[0][0]
+    fd = pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4)[0][0]
+    assert pointwise.kink_band("ridges", u, v, ku, kv)[0]             # flagged
     # The exact form returns 0 where the float sine is exactly 0, else one side.
     assert exact == 0.0 or abs(abs(exact) - one_sided) < 1e-9 * one_sided
     # The central quotient straddles the kink and averages the two sides: ~0.
@@ -113,14 +143,12 @@ def test_points_exactly_on_the_u_creases(m):
 
 @pytest.mark.parametrize("m", range(1, 4))
 def test_points_exactly_on_the_v_creases(m):
-    from renderer import fields
-    from renderer.render import central_gradient
     ku, kv = 8.0, 4.0
     u, v = np.array([0.31]), np.array([m / kv])
     one_sided = np.pi * kv * abs(np.sin(np.pi * ku * 0.31))
-    exact = fields.exact_gradient("ridges", u, v, ku, kv)[1][0]
-    fd = central_gradient("ridges", u, v, ku, kv, 1e-4)[1][0]
-    assert fields.kink_band("ridges", u, v, ku, kv)[0]
+    exact = pointwise.exact_gradient("ridges", u, v, ku, kv)[1][0]
+    fd = pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4)[1][0]
+    assert pointwise.kink_band("ridges", u, v, ku, kv)[0]
     assert exact == 0.0 or abs(abs(exact) - one_sided) < 1e-9 * one_sided
     assert abs(fd) < 1e-6 * one_sided
 
@@ -148,7 +176,6 @@ def test_shading_goes_continuously_to_zero_at_the_terminator():
 def test_grazing_rays_at_sphere_b_silhouette_stay_on_the_surface():
     """Rays through points just inside sphere B's silhouette circle (the tangent
     points seen from the eye): hit points on the sphere to 1e-12 relative."""
-    from renderer.geometry import sphere_hit
     scene = Scene()
     e = scene.camera_z
     C, r = np.asarray(scene.center_b), scene.radius_b
@@ -163,7 +190,7 @@ def test_grazing_rays_at_sphere_b_silhouette_stay_on_the_surface():
     shrink = 1 - np.logspace(-15, -6, 500)
     Q = centre + (radius * shrink)[:, None] * (np.cos(alpha)[:, None] * a + np.sin(alpha)[:, None] * b)
     x, y = Q[:, 0] * e / (e - Q[:, 2]), Q[:, 1] * e / (e - Q[:, 2])
-    t = sphere_hit(x, y, e, scene.center_b, r)
+    t = np.array([kernel.sphere_hit(a, b, e, *scene.center_b, r) for a, b in zip(x, y)])
     hit = np.isfinite(t)
     assert hit.mean() > 0.95
     P = np.stack([t[hit] * x[hit], t[hit] * y[hit], e * (1 - t[hit])], axis=-1)

@@ -31,14 +31,14 @@ const EXACT = GRADIENTS.indexOf("exact"), CENTRAL = GRADIENTS.indexOf("central")
 
 // Pixel centres on the image plane z = 0 (seed Cell 1's window), magnified by
 // `zoom` about the optical axis.  Returns { x: Float64Array(width),
-// y: Float64Array(height) }; row 0 is the top.
+// y: Float64Array(height), window: its width 2 half / zoom }; row 0 is the top.
 export function image_plane(radius_a, camera_z, width, height, zoom = 1.0) {
   const half = WINDOW_MARGIN * camera_z * radius_a / Math.sqrt(camera_z * camera_z - radius_a * radius_a);
   const x = new Float64Array(width);
   const y = new Float64Array(height);
   for (let i = 0; i < width; i++) x[i] = half * (2.0 * (i + 0.5) / width - 1.0) / zoom;
   for (let j = 0; j < height; j++) y[j] = (half * (1.0 - 2.0 * (j + 0.5) / height) - WINDOW_OFFSET * half) / zoom;
-  return { x, y };
+  return { x, y, window: 2.0 * half / zoom };
 }
 
 // ---- the kernel's own steps: intersection, shadows, shading ------------------------
@@ -309,9 +309,9 @@ function check_args(width, height, gradient, zoom) {
 // ray differentials, as render.py `_run` passes them) and the floor checker's
 // sines sin(pi x) per column and sin(pi y) per row.
 function camera(scene, width, height, zoom) {
-  const { x, y } = image_plane(scene.radius_a, scene.camera_z, width, height, zoom);
-  const dx = width > 1 ? x[1] - x[0] : 2 * Math.abs(x[0]);
-  const dy = height > 1 ? y[0] - y[1] : 2 * Math.abs(y[0]);
+  const { x, y, window } = image_plane(scene.radius_a, scene.camera_z, width, height, zoom);
+  const dx = width > 1 ? x[1] - x[0] : window;
+  const dy = height > 1 ? y[0] - y[1] : window;
   return { x, y, dx, dy, sin_x: x.map((xi) => Math.sin(Math.PI * xi)), sin_y: y.map((yj) => Math.sin(Math.PI * yj)) };
 }
 
