@@ -72,17 +72,19 @@ def test_one_by_one_and_thin_frames():
 
 
 _MEMORY = r"""
-import json, resource, sys
+import json, sys
 import numpy as np
 from renderer import Scene, render
 
-def peak():
-    # ru_maxrss is in KiB on Linux (bytes on macOS).
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * (1 if sys.platform == "darwin" else 1024)
+def status(key):
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) * 1024 for line in f if line.startswith(key + ":"))
 
-render(Scene(), 8, 8)                       # the compiled kernel loaded
+render(Scene(), 8, 8)                       # the compiled kernel loaded (or compiled)
 n, scratch = int(sys.argv[1]), sys.argv[2] == "1"
-before = peak()
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")                            # reset the peak (VmHWM) to the current resident set:
+before = status("VmRSS")                    # a compilation's peak before this point does not count
 frame = render(Scene(), n, n)
 if scratch:                                 # the wrong variant: one frame-sized scratch image
     work = np.ones((n, n, 3))
@@ -91,7 +93,7 @@ arrays = (frame.image, frame.chamber, frame.kink, frame.grad)
 for a in arrays:                            # make every page of the outputs resident (zeros the
     a.view(np.uint8).reshape(-1)[::4096] = 0    # kernel never wrote are not), so they are all counted
 outputs = sum(a.nbytes for a in arrays)
-print(json.dumps(peak() - before - outputs))
+print(json.dumps(status("VmHWM") - before - outputs))
 """
 #: Working memory allowed beyond the outputs: far below one frame-sized
 #: float64 image at 4096^2 (384 MiB), far above a few hundred bytes per thread.
