@@ -21,15 +21,18 @@ test: $(STAMP)
 	$(BIN)/python -m pytest verify tests
 
 # The numerics-heavy tests again with numpy's optional SIMD features (those
-# found on this CPU beyond its baseline) disabled: the same checks must hold
-# on the dispatch path of a machine without them.
+# found on this CPU beyond its baseline) disabled, and the kernel compiled by
+# numba for a generic x86-64 CPU (into a cache of its own): the same checks
+# must hold on the code paths of a machine without them.
 NUMERIC_TESTS := verify tests/test_parity.py tests/test_codegen.py \
                  tests/test_gradient_methods.py tests/test_any_scene.py tests/test_stress.py
 test-baseline-simd: $(STAMP)
 	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')" \
 	  || { echo "test-baseline-simd: cannot list numpy's CPU features" >&2; exit 1; }; \
 	echo "NPY_DISABLE_CPU_FEATURES=\"$$features\""; \
-	NPY_DISABLE_CPU_FEATURES="$$features" $(BIN)/python -m pytest $(NUMERIC_TESTS) -p no:cacheprovider
+	cache="$$(mktemp -d)"; trap 'rm -rf "$$cache"' EXIT; \
+	NPY_DISABLE_CPU_FEATURES="$$features" NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR="$$cache" \
+	  $(BIN)/python -m pytest $(NUMERIC_TESTS) -p no:cacheprovider
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_render.py

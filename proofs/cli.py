@@ -612,15 +612,9 @@ _CENSUS_COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink"
 
 
 def _run_sweep(scene, steps, width, height):
-    """`renderer.sweep` over ``steps``, with a progress bar when
-    stderr is a terminal."""
+    """The census of `renderer.sweep` over ``steps``."""
     from renderer.sweep import sweep
-    if not _show_progress():
-        return list(sweep(scene, steps, width, height).census)
-    with _progress(total=width * height, desc="sweep", unit="px", unit_scale=True) as bar:
-        def report(done, total):
-            bar.update(done - bar.n)
-        return list(sweep(scene, steps, width, height, progress=report).census)
+    return list(sweep(scene, steps, width, height).census)
 
 
 def _cmd_sweep(args, out):

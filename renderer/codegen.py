@@ -103,7 +103,8 @@ def python_source():
             out.extend(line + "\n" for line in lines)
             out.append(f"{ind}return {value}\n")
         if per_field:
-            out.append("    raise ValueError(\"unknown field code\")\n")
+            accepted = ", ".join(f"{i} ({n})" for n, i in F.FIELD_CODES.items())
+            out.append(f"    raise ValueError(\"field must be one of {accepted}\")\n")
         k = len(next(iter(outputs.values())) if per_field else outputs)
         targets = ", ".join(f"out[{c}, i]" for c in range(k))
         call = f"{name}({', '.join(lead + [f'{a}[i]' for a in args])})"

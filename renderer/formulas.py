@@ -2,9 +2,10 @@
 
 This module is the single source of the renderer's mathematics.  Nothing
 imports it at render time: `renderer.codegen` prints each entry of
-`FUNCTIONS` as a scalar Python function that numba compiles (the generated
-block of renderer/kernel.py) and as a JavaScript function of the §4 simulator
-(renderer/js/formulas.js); tests/test_codegen.py regenerates both and compares.
+`FUNCTIONS` as a scalar Python function that numba compiles
+(renderer/generated.py, which the kernel calls) and as a JavaScript function
+of the §4 simulator (``formulas.js``, generated when the simulator is
+bundled); tests/test_codegen.py regenerates both and compares.
 proofs/ proves its theorems about these same objects.
 
 What lives here (seed §2, §3 and Cell 1, with the project's corrections):
@@ -169,14 +170,13 @@ FOOTPRINT = _footprint()
 
 #: What the generator prints: name -> (arguments, outputs).  A per-field entry
 #: maps each field to its outputs and becomes one function with the field's
-#: code (`FIELD_CODES`) as first argument.  The gradients also return the
-#: crease flag, whose sines they share (sympy's cse finds them).
+#: code (`FIELD_CODES`) as first argument.
 _UV = (u, v, k_u, k_v)
 _N = (N_x, N_y, N_z)
 FUNCTIONS = {
     "height": (_UV, {n: (f,) for n, f in HEIGHT.items()}),
-    "exact_gradient": (_UV, {n: GRADIENT[n] + (KINK_BAND[n],) for n in HEIGHT}),
-    "central_gradient": (_UV + (eps_u, eps_v), {n: CENTRAL[n] + (KINK_BAND[n],) for n in HEIGHT}),
+    "exact_gradient": (_UV, GRADIENT),
+    "central_gradient": (_UV + (eps_u, eps_v), CENTRAL),
     "kink_band": (_UV, {n: (f,) for n, f in KINK_BAND.items()}),
     "chart": (_N, CHART),
     "tangent_frame": (_N + (sin_phi,), TANGENT_FRAME),

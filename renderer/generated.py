@@ -18,7 +18,7 @@ def height(field, u, v, k_u, k_v):
         return abs(math.sin(math.pi*k_u*u)*math.sin(math.pi*k_v*v))
     if field == 2:  # rings
         return math.sin(2*math.pi*k_v*v)
-    raise ValueError("unknown field code")
+    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
 
 
 @njit(cache=True, error_model="numpy")
@@ -37,7 +37,7 @@ def exact_gradient(field, u, v, k_u, k_v):
         x1 = u*x0
         x2 = math.pi*k_v
         x3 = v*x2
-        return (x0*math.sin(x3)*math.cos(x1), x2*math.sin(x1)*math.cos(x3), False)
+        return (x0*math.sin(x3)*math.cos(x1), x2*math.sin(x1)*math.cos(x3))
     if field == 1:  # ridges
         x0 = math.pi*k_v
         x1 = v*x0
@@ -46,20 +46,20 @@ def exact_gradient(field, u, v, k_u, k_v):
         x4 = u*x3
         x5 = math.sin(x4)
         x6 = (0.0 if x2*x5 == 0 else math.copysign(1, x2*x5))
-        return (x2*x3*x6*math.cos(x4), x0*x5*x6*math.cos(x1), (abs(x2) < 0.03) or (abs(x5) < 0.03))
+        return (x2*x3*x6*math.cos(x4), x0*x5*x6*math.cos(x1))
     if field == 2:  # rings
         x0 = 2*math.pi*k_v
-        return (0.0, x0*math.cos(v*x0), False)
-    raise ValueError("unknown field code")
+        return (0.0, x0*math.cos(v*x0))
+    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
 
 
 @njit(cache=True, error_model="numpy")
 def exact_gradient_array(field, u, v, k_u, k_v, out):
-    """`exact_gradient` at each index i of 1-D float64 arrays; out: (3, n) float64."""
-    if out.shape[0] != 3:
-        raise ValueError("out must have 3 rows")
+    """`exact_gradient` at each index i of 1-D float64 arrays; out: (2, n) float64."""
+    if out.shape[0] != 2:
+        raise ValueError("out must have 2 rows")
     for i in range(out.shape[1]):
-        out[0, i], out[1, i], out[2, i] = exact_gradient(field, u[i], v[i], k_u[i], k_v[i])
+        out[0, i], out[1, i] = exact_gradient(field, u[i], v[i], k_u[i], k_v[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -73,7 +73,7 @@ def central_gradient(field, u, v, k_u, k_v, eps_u, eps_v):
         x1 = math.pi*k_v
         x2 = math.sin(v*x1)
         x3 = math.sin(u*x0)
-        return ((1/2)*(-x2*math.sin(u_m*x0) + x2*math.sin(u_p*x0))/eps_u, (-x3*math.sin(v_m*x1) + x3*math.sin(v_p*x1))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), False)
+        return ((1/2)*(-x2*math.sin(u_m*x0) + x2*math.sin(u_p*x0))/eps_u, (-x3*math.sin(v_m*x1) + x3*math.sin(v_p*x1))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
     if field == 1:  # ridges
         u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
         u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
@@ -83,24 +83,24 @@ def central_gradient(field, u, v, k_u, k_v, eps_u, eps_v):
         x1 = math.pi*k_v
         x2 = math.sin(v*x1)
         x3 = math.sin(u*x0)
-        return ((1/2)*(-abs(x2*math.sin(u_m*x0)) + abs(x2*math.sin(u_p*x0)))/eps_u, (-abs(x3*math.sin(v_m*x1)) + abs(x3*math.sin(v_p*x1)))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), (abs(x2) < 0.03) or (abs(x3) < 0.03))
+        return ((1/2)*(-abs(x2*math.sin(u_m*x0)) + abs(x2*math.sin(u_p*x0)))/eps_u, (-abs(x3*math.sin(v_m*x1)) + abs(x3*math.sin(v_p*x1)))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
     if field == 2:  # rings
         u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
         u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
         v_p = min(1, eps_v + v)
         v_m = max(0, -eps_v + v)
         x0 = 2*math.pi*k_v
-        return (0.0, (-math.sin(v_m*x0) + math.sin(v_p*x0))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), False)
-    raise ValueError("unknown field code")
+        return (0.0, (-math.sin(v_m*x0) + math.sin(v_p*x0))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
+    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
 
 
 @njit(cache=True, error_model="numpy")
 def central_gradient_array(field, u, v, k_u, k_v, eps_u, eps_v, out):
-    """`central_gradient` at each index i of 1-D float64 arrays; out: (3, n) float64."""
-    if out.shape[0] != 3:
-        raise ValueError("out must have 3 rows")
+    """`central_gradient` at each index i of 1-D float64 arrays; out: (2, n) float64."""
+    if out.shape[0] != 2:
+        raise ValueError("out must have 2 rows")
     for i in range(out.shape[1]):
-        out[0, i], out[1, i], out[2, i] = central_gradient(field, u[i], v[i], k_u[i], k_v[i], eps_u[i], eps_v[i])
+        out[0, i], out[1, i] = central_gradient(field, u[i], v[i], k_u[i], k_v[i], eps_u[i], eps_v[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -111,7 +111,7 @@ def kink_band(field, u, v, k_u, k_v):
         return (abs(math.sin(math.pi*k_u*u)) < 0.03) or (abs(math.sin(math.pi*k_v*v)) < 0.03)
     if field == 2:  # rings
         return False
-    raise ValueError("unknown field code")
+    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
 
 
 @njit(cache=True, error_model="numpy")

@@ -12,24 +12,34 @@ segment) then Lambert and Blinn/Phong with the shading normal.
 
 Everything up to the gradient depends on geometry alone (theorem "bump moves
 no boundary"), which licenses `sweep_rows`: geometry and shadow rays once per
-pixel, sphere A re-shaded per step.  The formulas of sphere A are the
-generated block below (`renderer.codegen` prints `renderer.formulas`); they
-live in this file because numba's cache is keyed on the file of a compiled
-function.  Compiled on first use and cached beside this file (``__pycache__``,
-or numba's user cache directory when that is not writable).
+pixel, sphere A re-shaded per step.  The formulas of sphere A come from
+renderer/generated.py (`renderer.codegen` prints `renderer.formulas`).
+Compiled on first use and cached beside this file (``__pycache__``, or
+numba's user cache directory when that is not writable).  numba's cache
+checks only the file of the function it compiled, so this file holds the
+SHA-256 of generated.py (`FORMULAS_DIGEST`, written by the generator) and
+refuses to load beside a generated.py that does not match it.
+
+Threads: numba's ``workqueue`` layer (unless NUMBA_THREADING_LAYER chooses
+another), which survives a fork; it may not be entered by two threads at
+once, so `renderer.render` runs the kernel under a lock.
 
 ``skip``: True does only the work the outputs need (an object that is off is
-not intersected; a shadow ray is traced only where the light could add light;
-at beta = 0 no gradient unless it is an output; the crease flag only when it
-is an output).  False does all of it and discards what is unused: the
-reference path of tests/test_skips.py, which shows both give the same bits.
+not intersected; a shadow ray is traced only where the light could add
+light; at beta = 0 no gradient unless it is an output, as beta times any
+gradient is 0; the crease flag only when it is an output).  False does all
+of it and discards what is unused: the reference path of
+tests/test_skips.py, which shows both give the same bits.
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections import namedtuple
+from pathlib import Path
 
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -49,7 +59,13 @@ TINY = 1e-300
 Params = namedtuple("Params", "camera_z radius_a center_b radius_b sphere_b floor ambient albedo_a "
                               "albedo_b ka kd ks shininess phong floor_tint field k_u k_v beta surface")
 
-FORMULAS_DIGEST = "1cac1a54653fd61cea517a329222bbaa404eb11ce40ab300e89cc9001ae83961"  # of generated.py, written by renderer/codegen.py
+if numba.config.THREADING_LAYER == "default":       # not chosen by NUMBA_THREADING_LAYER
+    numba.config.THREADING_LAYER = "workqueue"
+
+FORMULAS_DIGEST = "a6abdbc422bd2f4c02e0569318eafc99bde9dd2d9e35d33afdbb8231b53f9994"  # of generated.py, written by renderer/codegen.py
+if hashlib.sha256(Path(__file__).with_name("generated.py").read_bytes()).hexdigest() != FORMULAS_DIGEST:
+    raise ImportError("renderer/generated.py does not match the digest kernel.py holds: it was edited by "
+                      "hand or not regenerated; run python -m renderer.codegen")
 
 
 # ---- the kernel's own steps: intersection, shadows, shading ---------------------
@@ -197,7 +213,7 @@ def light_term(s, color, w, axis, wv, Ns, albedo):
     # Clamped before the power: rounding can put the cosine an ulp above 1.
     base = min(max(spec_cos, 0.0), 1.0)
     # An integral exponent (the seed's 32) by repeated squaring (numba's
-    # float ** int) rather than libm's pow, which took a sixth of the frame.
+    # float ** int), faster than libm's pow.
     n = int(s.shininess)
     spec = (base ** n if n == s.shininess else base ** s.shininess) * s.ks
     diffuse = mu * s.kd
@@ -224,8 +240,8 @@ def shade(s, lights, P, N, Ns, albedo, code, skip):
 
 @njit(cache=True, error_model="numpy")
 def gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi):
-    """(h_u, h_v, crease flag) by ``method``: exact, central with step eps, or
-    central with the pixel's footprint as steps (pixel spacing dx, dy)."""
+    """(h_u, h_v) by ``method``: exact, central with step eps, or central with
+    the pixel's footprint as steps (pixel spacing dx, dy)."""
     if method == EXACT:
         return exact_gradient(s.field, u, v, s.k_u, s.k_v)
     if method == CENTRAL:
@@ -237,9 +253,7 @@ def gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi):
 
 @njit(cache=True, error_model="numpy")
 def shading_normal(s, N, frame, hu, hv, u, v, sin_phi):
-    """N' of sphere A (`formulas.PERTURBED_NORMAL`); N itself at beta = 0."""
-    if s.beta == 0.0:
-        return N
+    """N' of sphere A (`formulas.PERTURBED_NORMAL`)."""
     et0, et1, et2, ep0, ep1, ep2 = frame
     if s.surface:
         h = height(s.field, u, v, s.k_u, s.k_v)
@@ -255,7 +269,8 @@ def render_rows(prm, lights, xs, ys, dx, dy, method, eps, skip, want_kink, want_
 
     xs (W,), ys (H,): pixel centres on the image plane; image (H, W, 3),
     chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2) when wanted;
-    t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) when ``want_geo`` (the GBuffer).
+    t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) when ``want_geo`` (the GBuffer);
+    the caller allocates them with these shapes (nothing is checked here).
     """
     sin_x = np.sin(np.pi * xs)
     for j in prange(ys.shape[0]):
@@ -273,15 +288,16 @@ def render_rows(prm, lights, xs, ys, dx, dy, method, eps, skip, want_kink, want_
             if code == SPHERE_A:
                 u, v, sin_phi = chart(N[0], N[1], N[2])
                 frame = tangent_frame(N[0], N[1], N[2], sin_phi)
+                hu, hv = 0.0, 0.0
                 if want_grad or want_geo or s.beta != 0.0 or not skip:
-                    hu, hv, flag = gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
-                    Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
+                    hu, hv = gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
                     if want_grad:
                         grad[j, i, 0], grad[j, i, 1] = hu, hv
-                elif want_kink:
+                Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
+                if want_kink or not skip:
                     flag = kink_band(s.field, u, v, s.k_u, s.k_v)
-                if want_kink:
-                    kink[j, i] = flag
+                    if want_kink:
+                        kink[j, i] = flag
                 if want_geo:
                     uv_out[j, i, 0], uv_out[j, i, 1] = u, v
             image[j, i, 0], image[j, i, 1], image[j, i, 2] = shade(s, lights, P, N, Ns, albedo, code, skip)
@@ -297,6 +313,7 @@ def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
     Per pixel the geometry, the crease flag and the shadow rays are computed
     once (they do not depend on the gradient); sphere A is re-shaded per step.
     images (S+1, H, W, 3), grads (S+1, H, W, 2); chamber, kink (H, W).
+    The caller allocates the outputs with these shapes (nothing is checked here).
     """
     n, sin_x = lights.shape[0], np.sin(np.pi * xs)
     for j in prange(ys.shape[0]):
@@ -318,6 +335,7 @@ def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
                 continue
             u, v, sin_phi = chart(N[0], N[1], N[2])
             frame = tangent_frame(N[0], N[1], N[2], sin_phi)
+            kink[j, i] = kink_band(s.field, u, v, s.k_u, s.k_v)
             view = view_vector(s, P)
             for k in range(n):
                 # Every shadow ray of an attached light, once (Ns varies with the step).
@@ -327,10 +345,9 @@ def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
                 geo[k, 6], geo[k, 7] = wv, 1.0 if lit else 0.0
             for f in range(images.shape[0]):
                 if f == 0:
-                    hu, hv, flag = exact_gradient(s.field, u, v, s.k_u, s.k_v)
-                    kink[j, i] = flag
+                    hu, hv = exact_gradient(s.field, u, v, s.k_u, s.k_v)
                 else:
-                    hu, hv, flag = central_gradient(s.field, u, v, s.k_u, s.k_v, steps[f - 1], steps[f - 1])
+                    hu, hv = central_gradient(s.field, u, v, s.k_u, s.k_v, steps[f - 1], steps[f - 1])
                 Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
                 r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
                 for k in range(n):
@@ -341,31 +358,6 @@ def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
                 images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0)
                 images[f, j, i, 2] = min(max(b, 0.0), 1.0)
                 grads[f, j, i, 0], grads[f, j, i, 1] = hu, hv
-
-
-@njit(cache=True, error_model="numpy")
-def ledger_sums(num_image, sym_image, num_chamber, sym_chamber, band):
-    """One pass over two frames for `renderer.compare`: over the pixels on
-    sphere A in both, max |dI|, the sum of |dI|^2, the pixel count, the sum
-    and count of |dI| on and off the crease ``band`` (channel values); and the
-    number of pixels whose chamber differs.  Images (H, W, C) float64,
-    chambers (H, W) uint8, band (H, W) bool."""
-    top, sq, pixels, on, n_on, off, n_off, flips = 0.0, 0.0, 0, 0.0, 0, 0.0, 0, 0
-    for j in range(num_chamber.shape[0]):
-        for i in range(num_chamber.shape[1]):
-            a, b = num_chamber[j, i], sym_chamber[j, i]
-            flips += a != b
-            if a != SPHERE_A or b != SPHERE_A:
-                continue
-            pixels += 1
-            for c in range(num_image.shape[2]):
-                d = abs(num_image[j, i, c] - sym_image[j, i, c])
-                top, sq = max(top, d), sq + d * d
-                if band[j, i]:
-                    on, n_on = on + d, n_on + 1
-                else:
-                    off, n_off = off + d, n_off + 1
-    return top, sq, pixels, on, n_on, off, n_off, flips
 
 
 def params(scene, skip=True):

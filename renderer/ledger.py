@@ -7,8 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .kernel import ledger_sums
-from .render import Frame
+from numba import njit
+
+from .render import SPHERE_A, Frame
 
 __all__ = ["Ledger", "compare", "to_srgb"]
 
@@ -49,8 +50,10 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
     TypeError
         If either argument is not a `Frame`.
     ValueError
-        If the frames differ in shape, or ``symbolic`` was rendered with
-        ``kink=False`` (the message says to render it with ``kink=True``).
+        If the frames differ in shape, an image, chamber or (symbolic) kink
+        array is not (H, W, 3) float64, (H, W) uint8, (H, W) bool, or
+        ``symbolic`` was rendered with ``kink=False`` (the message says to
+        render it with ``kink=True``).
     """
     for name, frame in (("numeric", numeric), ("symbolic", symbolic)):
         if not isinstance(frame, Frame):
@@ -63,6 +66,17 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
         raise ValueError(
             f"frames must have the same shape, got {numeric.image.shape} and {symbolic.image.shape}"
         )
+    shape = numeric.image.shape[:2]
+    for name, frame in (("numeric", numeric), ("symbolic", symbolic)):
+        for field, array, dims, dtype in (("image", frame.image, shape + (3,), np.float64),
+                                          ("chamber", frame.chamber, shape, np.uint8),
+                                          ("kink", frame.kink, shape, np.bool_)):
+            if field == "kink" and name == "numeric":
+                continue                      # only the symbolic frame's band is read
+            if not isinstance(array, np.ndarray) or array.shape != dims or array.dtype != dtype:
+                got = (f"{array.dtype} {array.shape}" if isinstance(array, np.ndarray)
+                       else type(array).__name__)
+                raise ValueError(f"{name}.{field} must be a {np.dtype(dtype)} array of shape {dims}, got {got}")
     arrays = [np.ascontiguousarray(a) for a in (numeric.image, symbolic.image, numeric.chamber,
                                                    symbolic.chamber, symbolic.kink)]
     top, sq, pixels, on, n_on, off, n_off, flips = ledger_sums(*arrays)
@@ -75,6 +89,31 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
         mean_abs_kink=on / n_on if n_on else math.nan,
         mean_abs_off_kink=off / n_off if n_off else math.nan,
     )
+
+
+@njit(cache=True, error_model="numpy")
+def ledger_sums(num_image, sym_image, num_chamber, sym_chamber, band):
+    """One pass over two frames for `renderer.compare`: over the pixels on
+    sphere A in both, max |dI|, the sum of |dI|^2, the pixel count, the sum
+    and count of |dI| on and off the crease ``band`` (channel values); and the
+    number of pixels whose chamber differs.  Images (H, W, C) float64,
+    chambers (H, W) uint8, band (H, W) bool."""
+    top, sq, pixels, on, n_on, off, n_off, flips = 0.0, 0.0, 0, 0.0, 0, 0.0, 0, 0
+    for j in range(num_chamber.shape[0]):
+        for i in range(num_chamber.shape[1]):
+            a, b = num_chamber[j, i], sym_chamber[j, i]
+            flips += a != b
+            if a != SPHERE_A or b != SPHERE_A:
+                continue
+            pixels += 1
+            for c in range(num_image.shape[2]):
+                d = abs(num_image[j, i, c] - sym_image[j, i, c])
+                top, sq = max(top, d), sq + d * d
+                if band[j, i]:
+                    on, n_on = on + d, n_on + 1
+                else:
+                    off, n_off = off + d, n_off + 1
+    return top, sq, pixels, on, n_on, off, n_off, flips
 
 
 def to_srgb(linear):

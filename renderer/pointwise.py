@@ -5,7 +5,14 @@ renderer/generated.py holds beside the kernel's scalar function, and reshapes:
 the same machine code as a render, so a value here is the bits the renderer
 uses at the same point (tests/test_codegen.py checks it against `render`).
 
-Fields are named as in `renderer.Scene.height_field`: "sine", "ridges", "rings".
+Fields are named as in `renderer.Scene.height_field`: "sine", "ridges",
+"rings".  Arguments are scalars or float64 arrays that broadcast together
+(chart coordinates u, v in chart units, positions in scene units); results
+are float64 arrays of the broadcast shape.  Every function raises ValueError
+for an unknown field, TypeError for an argument that is not real numbers,
+and ValueError for a value that is not finite or arguments that do not
+broadcast, naming the argument (and the first bad value's flat index).
+Source: the formulas of seed §2-§3 as corrected in `renderer.formulas`.
 """
 
 from __future__ import annotations
@@ -24,15 +31,56 @@ def _field(name):
     return G.FIELD_CODES[name]
 
 
-def _evaluate(loop, k, lead, args):
-    """``loop`` over the broadcast ``args``: k arrays of the broadcast shape."""
-    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in args))
+def _evaluate(loop, k, lead, names, args):
+    """``loop`` over the broadcast ``args``: k arrays of the broadcast shape.
+
+    Each argument must hold finite real numbers; TypeError or ValueError
+    names the argument (``names``), the first bad value and its index."""
+    arrays = [_real(name, a) for name, a in zip(names, args)]
+    try:
+        arrays = np.broadcast_arrays(*arrays)
+    except ValueError:
+        shapes = ", ".join(f"{n} {a.shape}" for n, a in zip(names, arrays))
+        raise ValueError(f"the arguments must broadcast to one shape, got {shapes}") from None
     shape = arrays[0].shape
     # Copies: numba warns on the read-only views broadcast_arrays returns.
     flat = [np.array(a, dtype=np.float64).reshape(-1) for a in arrays]
     out = np.empty((k, flat[0].size))
     loop(*lead, *flat, out)
     return [row.reshape(shape) for row in out]
+
+
+def _real(name, value, low=None, high=None, high_open=False):
+    """``value`` as a float64 array of finite numbers (in [low, high] or
+    [low, high)); TypeError or ValueError naming ``name``, the first bad
+    value and its flat index."""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be real numbers (a scalar or an array), got "
+                        f"{type(value).__name__} {value!r:.60}") from None
+    ok = np.isfinite(a)
+    if low is not None:
+        ok &= (a >= low) & ((a < high) if high_open else (a <= high))
+    bad = np.flatnonzero(~ok)
+    if bad.size:
+        accepted = "finite" if low is None else f"in [{low:g}, {high:g}{')' if high_open else ']'}"
+        raise ValueError(f"{name} must be {accepted}, got {float(a.reshape(-1)[bad[0]])!r} at flat index {bad[0]}")
+    return a
+
+
+def _triple(name, value):
+    """``value`` as three components (x, y, z), or ValueError naming ``name``."""
+    try:
+        parts = tuple(value)
+    except TypeError:
+        parts = ()
+    if len(parts) != 3:
+        raise ValueError(f"{name} must have three components (x, y, z), got {value!r:.60}")
+    return parts
+
+
+_UV = ("u", "v", "k_u", "k_v")
 
 
 def height(name, u, v, k_u, k_v):
@@ -42,14 +90,14 @@ def height(name, u, v, k_u, k_v):
     ``k_v`` frequencies.  Returns a float64 array of the broadcast shape.
     Raises ValueError for an unknown ``name``.
     """
-    return _evaluate(G.height_array, 1, (_field(name),), (u, v, k_u, k_v))[0]
+    return _evaluate(G.height_array, 1, (_field(name),), _UV, (u, v, k_u, k_v))[0]
 
 
 def exact_gradient(name, u, v, k_u, k_v):
     """(h_u, h_v), sympy's derivative (`renderer.formulas.GRADIENT`); for ridges
     sign(f) f' (one of the one-sided derivatives on a crease, 0 where the
     float64 factor is exactly 0).  Two float64 arrays of the broadcast shape."""
-    return tuple(_evaluate(G.exact_gradient_array, 3, (_field(name),), (u, v, k_u, k_v))[:2])
+    return tuple(_evaluate(G.exact_gradient_array, 2, (_field(name),), _UV, (u, v, k_u, k_v)))
 
 
 #: Smallest step `central_gradient` accepts: the generated quotient multiplies
@@ -66,31 +114,32 @@ def central_gradient(name, u, v, k_u, k_v, eps, eps_v=None):
 
     Raises
     ------
-    ValueError
-        An unknown ``name``, or a step outside [`MIN_STEP`, 1) or not finite.
+    TypeError, ValueError
+        As every function here; also a u or v outside [0, 1], a step outside
+        [`MIN_STEP`, 1).
     """
     eps_v = eps if eps_v is None else eps_v
-    for label, e in (("eps", eps), ("eps_v", eps_v)):
-        e = np.asarray(e, dtype=np.float64)
-        if not np.all((e >= MIN_STEP) & (e < 1.0)):
-            raise ValueError(f"{label} must be in [{MIN_STEP:g}, 1), got {e if e.ndim else float(e)!r}")
-    return tuple(_evaluate(G.central_gradient_array, 3, (_field(name),), (u, v, k_u, k_v, eps, eps_v))[:2])
+    # The stencil wraps u and clamps v on [0, 1], for steps below 1.
+    u, v = _real("u", u, 0.0, 1.0), _real("v", v, 0.0, 1.0)
+    eps, eps_v = _real("eps", eps, MIN_STEP, 1.0, True), _real("eps_v", eps_v, MIN_STEP, 1.0, True)
+    return tuple(_evaluate(G.central_gradient_array, 2, (_field(name),), _UV + ("eps", "eps_v"),
+                           (u, v, k_u, k_v, eps, eps_v)))
 
 
 def kink_band(name, u, v, k_u, k_v):
     """The seed's crease flag (`renderer.formulas.KINK_BAND`): bool array of the broadcast shape."""
-    return _evaluate(G.kink_band_array, 1, (_field(name),), (u, v, k_u, k_v))[0] != 0.0
+    return _evaluate(G.kink_band_array, 1, (_field(name),), _UV, (u, v, k_u, k_v))[0] != 0.0
 
 
 def chart(N_x, N_y, N_z):
     """(u, v, sin phi) of unit normals of sphere A (`renderer.formulas.CHART`)."""
-    return tuple(_evaluate(G.chart_array, 3, (), (N_x, N_y, N_z)))
+    return tuple(_evaluate(G.chart_array, 3, (), ("N_x", "N_y", "N_z"), (N_x, N_y, N_z)))
 
 
 def tangent_frame(N_x, N_y, N_z, sin_phi):
     """(e_theta, e_phi), each a triple of arrays, with the pole fallback
     (`renderer.formulas.TANGENT_FRAME`)."""
-    c = _evaluate(G.tangent_frame_array, 6, (), (N_x, N_y, N_z, sin_phi))
+    c = _evaluate(G.tangent_frame_array, 6, (), ("N_x", "N_y", "N_z", "sin_phi"), (N_x, N_y, N_z, sin_phi))
     return tuple(c[:3]), tuple(c[3:])
 
 
@@ -100,5 +149,9 @@ def footprint(x, y, dx, dy, camera_z, P, N, e_theta, e_phi, radius, sin_phi):
     ``x``, ``y``: pixel centres on the image plane; ``dx``, ``dy``: the pixel
     spacing; ``P``, ``N``, ``e_theta``, ``e_phi``: triples of arrays.
     """
-    return tuple(_evaluate(G.footprint_array, 2, (), (x, y, dx, dy, camera_z, *P, *N, *e_theta, *e_phi,
-                                                      radius, sin_phi)))
+    P, N, e_theta, e_phi = (_triple(n, t) for n, t in (("P", P), ("N", N), ("e_theta", e_theta),
+                                                        ("e_phi", e_phi)))
+    names = ("x", "y", "dx", "dy", "camera_z", "P_x", "P_y", "P_z", "N_x", "N_y", "N_z", "et_x", "et_y", "et_z",
+             "ep_x", "ep_y", "ep_z", "radius", "sin_phi")
+    return tuple(_evaluate(G.footprint_array, 2, (), names, (x, y, dx, dy, camera_z, *P, *N, *e_theta, *e_phi,
+                                                             radius, sin_phi)))

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import threading
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -22,7 +23,7 @@ from .kernel import BACKGROUND, FLOOR, SPHERE_A, SPHERE_B
 from .scene import Scene
 
 __all__ = [
-    "Frame", "render", "GBuffer", "gbuffer", "image_plane", "GRADIENTS", "MAX_SIDE", "MAX_ZOOM",
+    "Frame", "render", "GBuffer", "gbuffer", "image_plane", "window_width", "GRADIENTS", "MAX_SIDE", "MAX_ZOOM",
     "CHAMBER_NAMES", "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR", "WINDOW_MARGIN", "WINDOW_OFFSET",
 ]
 
@@ -53,10 +54,16 @@ def image_plane(radius_a, camera_z, width, height, zoom=1.0):
     -------
     x : (width,) float64, y : (height,) float64   scene units; row 0 is the top.
     """
-    half = WINDOW_MARGIN * camera_z * radius_a / math.sqrt(camera_z**2 - radius_a**2)
+    half = window_width(radius_a, camera_z, 1.0) / 2.0
     x = half * (2.0 * (np.arange(width) + 0.5) / width - 1.0) / zoom
     y = (half * (1.0 - 2.0 * (np.arange(height) + 0.5) / height) - WINDOW_OFFSET * half) / zoom
     return x, y
+
+
+def window_width(radius_a, camera_z, zoom=1.0):
+    """Width (and height) of the image window in scene units: twice 1.25 times
+    sphere A's silhouette radius e R / sqrt(e^2 - R^2) on z = 0, over ``zoom``."""
+    return 2.0 * WINDOW_MARGIN * camera_z * radius_a / math.sqrt(camera_z**2 - radius_a**2) / zoom
 
 
 @dataclass(frozen=True)
@@ -123,7 +130,9 @@ def check_args(scene, width, height, gradient, zoom):
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
     width, height = _check_size("width", width), _check_size("height", height)
-    if not isinstance(gradient, str) or gradient not in GRADIENTS:
+    if not isinstance(gradient, str):
+        raise TypeError(f"gradient must be a string, one of {GRADIENTS}, got {type(gradient).__name__} {gradient!r}")
+    if gradient not in GRADIENTS:
         raise ValueError(f"gradient must be one of {GRADIENTS}, got {gradient!r}")
     if isinstance(zoom, bool) or not isinstance(zoom, numbers.Real):
         raise TypeError(f"zoom must be a real number, got {type(zoom).__name__} {zoom!r}")
@@ -132,20 +141,32 @@ def check_args(scene, width, height, gradient, zoom):
     return scene, width, height, gradient, float(zoom)
 
 
+#: One kernel call at a time: numba's workqueue threading layer (see
+#: `renderer.kernel`) may not be entered from two threads at once.
+_KERNEL_LOCK = threading.Lock()
+
+
+def check_workers(workers):
+    """``workers`` (None or an int in [1, 64]); TypeError or ValueError naming it."""
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, numbers.Integral)):
+        raise TypeError(f"workers must be None or an integer, got {type(workers).__name__} {workers!r}")
+    if workers is not None and not 1 <= workers <= 64:
+        raise ValueError(f"workers must be an integer from 1 to 64, got {workers!r}")
+    return workers
+
+
 @contextmanager
 def threads(workers):
-    """Run numba's parallel loops on ``workers`` threads (None: all of
-    numba's, the machine's cores) inside the block; the count is per thread
-    and restored after.  Raises ValueError unless 1 <= workers <= 64."""
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, numbers.Integral)
-                                or not 1 <= workers <= 64):
-        raise ValueError(f"workers must be an integer from 1 to 64, got {workers!r}")
-    before = numba.get_num_threads()
-    numba.set_num_threads(min(int(workers or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
-    try:
-        yield
-    finally:
-        numba.set_num_threads(before)
+    """Run the kernel inside the block, alone (`_KERNEL_LOCK`), its rows on
+    ``workers`` threads (None: numba's count, the machine's cores; at most
+    that many), and restore numba's thread count after."""
+    with _KERNEL_LOCK:
+        before = numba.get_num_threads()
+        numba.set_num_threads(min(int(workers or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
+        try:
+            yield
+        finally:
+            numba.set_num_threads(before)
 
 
 def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_geo, workers):
@@ -157,9 +178,8 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     geo = dict(t=np.full(geo_shape, np.inf), P=np.zeros(geo_shape + (3,)), N=np.zeros(geo_shape + (3,)),
                Ns=np.zeros(geo_shape + (3,)), uv=np.zeros(geo_shape + (2,)))
     # Pixel spacing on the image plane (the footprint's ray differentials);
-    # a frame one pixel wide or high spans the whole window, 2 half / zoom.
-    e, r = scene.camera_z, scene.radius_a
-    window = 2.0 * WINDOW_MARGIN * e * r / math.sqrt(e**2 - r**2) / zoom
+    # a frame one pixel wide or high spans the whole window.
+    window = window_width(scene.radius_a, scene.camera_z, zoom)
     dx = float(x[1] - x[0]) if width > 1 else window
     dy = float(y[0] - y[1]) if height > 1 else window
     with threads(workers):
@@ -201,7 +221,8 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     Raises
     ------
     TypeError
-        ``scene`` is not a Scene; a size or ``zoom`` of the wrong type; a flag not a bool.
+        ``scene`` is not a Scene; a size, ``gradient``, ``zoom`` or ``workers``
+        of the wrong type; a flag not a bool.
     ValueError
         A size outside [1, 8192], an unknown ``gradient``, ``zoom`` outside
         [1, 1e6], ``workers`` outside [1, 64].
@@ -214,16 +235,24 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     """
     scene, width, height, gradient, zoom = check_args(scene, width, height, gradient, zoom)
     kink, grad, skip = (check_flag(n, f) for n, f in (("kink", kink), ("grad", grad), ("skip", skip)))
+    check_workers(workers)
     _, _, out, _ = _run(scene, width, height, gradient, zoom, skip, kink, grad, False, workers)
     return Frame(out["image"], out["chamber"], out["kink"] if kink else None, out["grad"] if grad else None,
                  scene, gradient)
 
 
 def gbuffer(scene, width, height, *, gradient="exact", zoom=1.0):
-    """Per-pixel hit points, normals and chart of a frame (`GBuffer`).
+    """Per-pixel hit points, normals and chart of a frame.
 
-    Same arguments, validation and errors as `render`, and the same kernel
-    pass: the geometry is that of the rendered frame, not recomputed.
+    Same arguments, validation and errors (TypeError, ValueError) as
+    `render`, and the same kernel pass: the geometry is that of the rendered
+    frame, not recomputed.
+
+    Returns
+    -------
+    GBuffer
+        chamber (H, W) uint8; t (H, W) float64; P, N, Ns (H, W, 3) float64
+        (scene units; unit normals); uv, grad (H, W, 2) float64; x (W,), y (H,).
     """
     scene, width, height, gradient, zoom = check_args(scene, width, height, gradient, zoom)
     x, y, out, geo = _run(scene, width, height, gradient, zoom, True, False, True, True, None)

@@ -22,13 +22,17 @@ import numpy as np
 
 from . import kernel
 from .ledger import compare
-from .render import Frame, check_args, image_plane, threads
+from .render import Frame, check_args, check_workers, image_plane, threads
 from .scene import MAX_EPS, MIN_EPS
 
-__all__ = ["Sweep", "sweep", "MAX_STEPS"]
+__all__ = ["Sweep", "sweep", "MAX_STEPS", "MAX_SWEEP_PIXELS"]
 
 #: Most steps one sweep accepts (each holds a frame in memory).
 MAX_STEPS = 64
+#: Most pixels one sweep holds in all its frames, (steps + 1) x width x
+#: height: two 4096^2 frames' worth (each pixel 42 bytes: image, grad,
+#: chamber, kink), bounding its memory.
+MAX_SWEEP_PIXELS = 2 * 4096 * 4096
 
 
 @dataclass(frozen=True)
@@ -77,7 +81,7 @@ def _check_steps(eps_values):
     return tuple(steps)
 
 
-def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=None):
+def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
     """Render the symbolic frame and one numeric frame per step, sharing the geometry.
 
     Parameters
@@ -88,9 +92,6 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     width, height : int in [1, 8192]
     zoom : float in [1, 1e6], keyword-only (see `render`)
     workers : int in [1, 64] or None, keyword-only (see `render`)
-    progress : callable(done, total), keyword-only, optional
-        Called with the pixels done and the total, (W H, W H), once the
-        frames are rendered (kept for callers that show a progress bar).
 
     Returns
     -------
@@ -104,16 +105,22 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
     TypeError, ValueError
         As `render`; for an empty or over-long ``eps_values`` (an iterator is
         read no further than step 65), an unordered one (a set or a mapping),
-        or a step outside [1e-16, 0.25] (the message names its index).
+        or a step outside [1e-16, 0.25] (the message names its index); or
+        more than `MAX_SWEEP_PIXELS` pixels in all frames (ValueError).
 
     Notes
     -----
-    Memory: one frame (57 bytes per pixel) per step plus one.  Source: seed
-    §4 (the simulator's ε slider) and Cell 2.
+    Memory: one frame per step plus one (its image, grad, chamber and kink);
+    at most `MAX_SWEEP_PIXELS` pixels in all.  Source: seed §4 (the
+    simulator's ε slider) and Cell 2.
     """
     scene, width, height, _, zoom = check_args(scene, width, height, "exact", zoom)
     steps = _check_steps(eps_values)
+    check_workers(workers)
     n = len(steps) + 1
+    if n * width * height > MAX_SWEEP_PIXELS:
+        raise ValueError(f"a sweep holds (steps + 1) x width x height <= {MAX_SWEEP_PIXELS:,} pixels in memory, "
+                         f"got {n} x {width} x {height} = {n * width * height:,}")
     images, grads = np.zeros((n, height, width, 3)), np.zeros((n, height, width, 2))
     chamber, kink = np.zeros((height, width), np.uint8), np.zeros((height, width), bool)
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
@@ -121,7 +128,5 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None, progress=
         kernel.sweep_rows(*kernel.params(scene), x, y, np.array(steps), images, chamber, kink, grads)
     frames = [Frame(images[f], chamber.copy(), kink.copy(), grads[f], scene.replace(eps=e) if f else scene,
                     "central" if f else "exact") for f, e in enumerate((scene.eps,) + steps)]
-    if progress is not None:
-        progress(width * height, width * height)
     census = tuple(compare(frame, frames[0]) for frame in frames[1:])
     return Sweep(eps=steps, numeric=tuple(frames[1:]), symbolic=frames[0], census=census)

@@ -37,10 +37,10 @@ import numpy as np
 __all__ = [
     "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR",
     "pixel_point", "ray_point", "nearest_positive_root", "sphere_a_t", "sphere_b_t",
-    "nearest_hit", "chart_a", "tangent_frame_a", "height_value", "grad_exact",
-    "grad_central", "in_kink_band", "perturb", "perturb_surface", "segment_blocked", "shade",
-    "tangent_plane_offset", "footprint_steps", "footprint_neighbours", "sphere_a_colour",
-    "render_pixel", "render_reference",
+    "nearest_hit", "chart_a", "tangent_frame_a", "chart_tangents", "height_value", "grad_exact",
+    "stencil_u", "stencil_v", "grad_central", "in_kink_band", "chart_bump_vector", "perturb",
+    "perturb_surface", "segment_blocked", "shade", "tangent_plane_offset", "footprint_steps",
+    "footprint_neighbours", "sphere_a_colour", "render_pixel", "render_reference",
 ]
 
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
@@ -159,6 +159,12 @@ def tangent_frame_a(N, sin_phi):
     return e_th, e_ph
 
 
+def chart_tangents(R, sin_phi, e_th, e_ph):
+    """(dP/du, dP/dv) of sphere A: with theta = 2 pi u - pi and phi = pi v,
+    P = R N gives dP/dtheta = R sin(phi) e_theta and dP/dphi = R e_phi."""
+    return scale(TWO_PI * R * sin_phi, e_th), scale(math.pi * R, e_ph)
+
+
 # --- height fields and their gradients (hand-written, seed §2 and §3) ---------------
 
 def height_value(field, u, v, ku, kv):
@@ -190,15 +196,27 @@ def grad_exact(field, u, v, ku, kv):
     raise ValueError(f"unknown height field {field!r}")
 
 
+def stencil_u(u, eps):
+    """(u + eps, u - eps), each wrapped modulo 1 (the chart is periodic in u)."""
+    return (u + eps) % 1.0, (u - eps) % 1.0
+
+
+def stencil_v(v, eps_v):
+    """(v_plus, v_minus, divisor): v +- eps_v clamped to [0, 1]; where either
+    clamps, the divisor is the clamped distance (a one-sided quotient), else 2 eps_v."""
+    v_plus, v_minus = min(1.0, v + eps_v), max(0.0, v - eps_v)
+    clamped = v + eps_v > 1.0 or v - eps_v < 0.0
+    return v_plus, v_minus, (v_plus - v_minus) if clamped else 2.0 * eps_v
+
+
 def grad_central(field, u, v, ku, kv, eps, eps_v=None):
     """Central differences of h with steps eps (in u) and eps_v (in v, default
     eps): u wraps modulo 1, v clamps to [0, 1] (one-sided there)."""
     eps_v = eps if eps_v is None else eps_v
     h = lambda uu, vv: height_value(field, uu, vv, ku, kv)  # noqa: E731
-    hu = (h((u + eps) % 1.0, v) - h((u - eps) % 1.0, v)) / (2.0 * eps)
-    v_plus, v_minus = min(1.0, v + eps_v), max(0.0, v - eps_v)
-    clamped = v + eps_v > 1.0 or v - eps_v < 0.0
-    step = (v_plus - v_minus) if clamped else 2.0 * eps_v
+    u_plus, u_minus = stencil_u(u, eps)
+    hu = (h(u_plus, v) - h(u_minus, v)) / (2.0 * eps)
+    v_plus, v_minus, step = stencil_v(v, eps_v)
     hv = (h(u, v_plus) - h(u, v_minus)) / step
     return hu, hv
 
@@ -211,12 +229,17 @@ def in_kink_band(field, u, v, ku, kv):
             or abs(math.sin(math.pi * kv * v)) < KINK_HALF_WIDTH)
 
 
+def chart_bump_vector(N, e_th, e_ph, hu, hv, beta):
+    """Seed §3's M = N + beta (h_u e_theta + h_v e_phi), before normalisation."""
+    g = add(scale(hu, e_th), scale(hv, e_ph))
+    return add(N, scale(beta, g))
+
+
 def perturb(N, e_th, e_ph, hu, hv, beta):
-    """Seed §3: N' = M / |M|, M = N + beta (h_u e_theta + h_v e_phi); N itself at beta = 0."""
+    """Seed §3: N' = M / |M| (`chart_bump_vector`); N itself at beta = 0."""
     if beta == 0.0:
         return N
-    g = add(scale(hu, e_th), scale(hv, e_ph))
-    return normalize(add(N, scale(beta, g)))
+    return normalize(chart_bump_vector(N, e_th, e_ph, hu, hv, beta))
 
 
 def perturb_surface(N, e_th, e_ph, hu, hv, h, beta, R, sin_phi):
@@ -265,8 +288,7 @@ def footprint_steps(scene, P, N, e_th, e_ph, sin_phi, right, up):
     project's cap).  Where dP/du = 0 (sin phi = 0 exactly) u's footprint is
     unbounded, so the fallback, and v's solve is one-dimensional.
     """
-    R = scene.radius_a
-    dpdu, dpdv = scale(TWO_PI * R * sin_phi, e_th), scale(math.pi * R, e_ph)
+    dpdu, dpdv = chart_tangents(scene.radius_a, sin_phi, e_th, e_ph)
     a00, a01, a11 = dot(dpdu, dpdu), dot(dpdu, dpdv), dot(dpdv, dpdv)
     det = a00 * a11 - a01 * a01
     derivatives = []

@@ -585,13 +585,6 @@ def test_sweep_formats_match_renderer_sweep(capsys):
     assert f"{ref[0].max_abs:.3e}" in lines[2]
 
 
-def test_sweep_in_chunks_for_progress_equals_one_sweep(capsys, monkeypatch):
-    rc, plain, _ = run(["sweep", "--eps", "1e-1:1e-8:17", "--size", "24x20", "--format", "csv"], capsys)
-    monkeypatch.setattr(cli, "_show_progress", lambda: True)
-    rc2, chunked, _ = run(["sweep", "--eps", "1e-1:1e-8:17", "--size", "24x20", "--format", "csv"], capsys)
-    assert rc == rc2 == 0 and plain == chunked
-
-
 # ------------------------------------------------------------------ ucurve
 
 

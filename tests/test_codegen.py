@@ -47,6 +47,7 @@ from renderer import GRADIENTS, Scene, codegen, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer import generated as G
 
+from . import scalar_reference
 from .jsnode import require_tool
 
 #: Unit roundoff of float64.
@@ -200,14 +201,16 @@ def excess(got, want):
 
 # ---- samples: the inputs of each generated function ------------------------------------
 
+def _sin_phi(N):
+    """sin(phi) of unit normals N (n, 3), by `renderer.pointwise.chart` (inputs only)."""
+    return pointwise.chart(*N.T)[2]
+
+
 def _frame(N):
-    """(e_theta, e_phi) rows for unit normals N (n, 3), with the pole fallback (inputs only)."""
-    s = np.hypot(N[:, 0], N[:, 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        et = np.stack([-N[:, 1] / s, N[:, 0] / s, 0 * s], -1)
-        ep = np.stack([N[:, 2] * N[:, 0] / s, N[:, 2] * N[:, 1] / s, -s], -1)
-    pole = s <= float(F.POLE_SIN_PHI)
-    et[pole], ep[pole] = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
+    """(sin phi, e_theta, e_phi) rows for unit normals N (n, 3), with the pole
+    fallback, by `renderer.pointwise` (inputs only)."""
+    s = _sin_phi(N)
+    et, ep = (np.stack(e, -1) for e in pointwise.tangent_frame(*N.T, s))
     return s, et, ep
 
 
@@ -246,7 +249,7 @@ def sample(name, rng, n=160):
         return [tuple(p) for p in _normals(rng, n)]
     if name == "tangent_frame":
         N = _normals(rng, n)
-        return [tuple(p) + (s,) for p, s in zip(N, np.hypot(N[:, 0], N[:, 1]))]
+        return [tuple(p) + (s,) for p, s in zip(N, _sin_phi(N))]
     if name.startswith("perturbed_normal"):
         N = _normals(rng, n)
         s, et, ep = _frame(N)
@@ -580,9 +583,7 @@ def pointwise_pixels(scene, g, gradient, *, dy_sign=1.0):
                                      e_th, e_ph, scene.radius_a, sin_phi)
         hu, hv = pointwise.central_gradient(field, u, v, ku, kv, eu, ev)
     kink = pointwise.kink_band(field, u, v, ku, kv)
-    if scene.beta == 0.0:
-        Ns = N
-    elif scene.bump == "chart":
+    if scene.bump == "chart":
         Ns = np.column_stack(each(G.perturbed_normal_chart, *N.T, *e_th, *e_ph, hu, hv, np.full(u.shape, scene.beta)))
     else:
         h = pointwise.height(field, u, v, ku, kv)
@@ -633,29 +634,46 @@ def test_the_pointwise_check_rejects_another_pipeline(gradient, wrong):
 
 # ---- the height fields (formerly tests/test_fields.py) ------------------------------------
 
-def seed_gradient(field):
-    """(h_u, h_v) of seed §3, typed from the seed, as sympy expressions."""
-    u, v, ku, kv, pi = F.u, F.v, F.k_u, F.k_v, sp.pi
-    s1, c1, s2, c2 = sp.sin(pi * ku * u), sp.cos(pi * ku * u), sp.sin(pi * kv * v), sp.cos(pi * kv * v)
-    if field == "sine":
-        return pi * ku * c1 * s2, pi * kv * s1 * c2
-    if field == "ridges":
-        sigma = sp.sign(s1 * s2)
-        return pi * ku * c1 * s2 * sigma, pi * kv * s1 * c2 * sigma
-    return sp.Integer(0), 2 * pi * kv * sp.cos(2 * pi * kv * v)
+def closed_form_excess(exprs, field, points):
+    """`excess` of seed §3's closed form (h_u, h_v), as tests/scalar_reference.py
+    types it (`grad_exact`, float64), over the mpmath value of ``exprs`` (sympy
+    expressions in u, v, k_u, k_v; a shorter tuple compares its first
+    components) at each chart point; an ambiguous sign is left out."""
+    out = []
+    for point in points:
+        point = tuple(map(float, point))
+        with mpmath.workdps(MP_DPS):
+            env = {s: (mpmath.mpf(x), mpmath.mpf(0)) for s, x in zip((F.u, F.v, F.k_u, F.k_v), point)}
+            for expr, got in zip(exprs, scalar_reference.grad_exact(field, *point)):
+                try:
+                    out.append(excess(got, evaluate(sp.sympify(expr), env)))
+                except Ambiguous:
+                    pass
+    return np.array(out)
+
+
+def _closed_form_points(n=200, seed=102):
+    return list(zip(*_chart_points(np.random.default_rng(seed), n)))
 
 
 @pytest.mark.parametrize("field", FIELDS)
 def test_sympys_gradient_is_the_seeds_closed_form(field):
-    """Proved: simplify(sympy's derivative - seed §3) == 0."""
-    for got, want in zip(F.GRADIENT[field], seed_gradient(field)):
-        assert sp.simplify(got - want) == 0
+    """sympy's derivative (`formulas.GRADIENT`) agrees with seed §3's closed
+    form, written independently in tests/scalar_reference.py, at seeded chart
+    points: the float64 closed form lies within the forward error bound of
+    the mpmath value (numerical, at points, not a proof)."""
+    points = _closed_form_points()
+    ex = closed_form_excess(F.GRADIENT[field], field, points)
+    assert len(ex) >= (1 - MAX_AMBIGUOUS) * 2 * len(points)
+    assert ex.max() <= 0.0
 
 
 def test_closed_form_check_rejects_swapped_frequencies():
-    hu, _ = seed_gradient("sine")
-    assert sp.simplify(F.GRADIENT["sine"][0] - hu.xreplace({F.k_u: F.k_v, F.k_v: F.k_u})) != 0
-    assert sp.simplify(F.GRADIENT["ridges"][0] - seed_gradient("sine")[0]) != 0
+    points = _closed_form_points()
+    swapped = F.GRADIENT["sine"][0].xreplace({F.k_u: F.k_v, F.k_v: F.k_u})
+    assert np.mean(closed_form_excess((swapped,), "sine", points) > 0) > 0.5
+    # ridges' h_u in place of sine's: wrong wherever the sign factor is -1.
+    assert np.mean(closed_form_excess((F.GRADIENT["ridges"][0],), "sine", points) > 0) > 0.2
 
 
 EPS_SWEEP = np.logspace(-2, -4, 9)
@@ -703,12 +721,12 @@ def test_one_sided_quotient_at_the_pole_converges_at_first_order():
     assert abs(order - 1.0) <= 0.2
 
 
-def hand_height(field, u, v, ku, kv):
-    if field == "sine":
-        return np.sin(np.pi * ku * u) * np.sin(np.pi * kv * v)
-    if field == "ridges":
-        return np.abs(np.sin(np.pi * ku * u) * np.sin(np.pi * kv * v))
-    return np.sin(2 * np.pi * kv * v) + 0.0 * u
+def reference_quotient(field, u, v, ku, kv, eps, component):
+    """tests/scalar_reference.py's central quotient (its own heights and stencil,
+    seed Cell 1) at each u (array) and v (array or scalar): the independent value."""
+    v = np.broadcast_to(v, np.shape(u))
+    return np.array([scalar_reference.grad_central(field, float(a), float(b), ku, kv, eps)[component]
+                     for a, b in zip(u, v)])
 
 
 def quotient_tolerance(ku, kv, eps):
@@ -723,11 +741,13 @@ def quotient_tolerance(ku, kv, eps):
 def test_v_clamp_is_one_sided_at_the_poles(field, eps):
     ku, kv = 3.3, 7.1
     u = np.random.default_rng(98).random(50)
-    h = lambda vv: hand_height(field, u, np.full_like(u, vv), ku, kv)  # noqa: E731
     at0 = pointwise.central_gradient(field, u, np.zeros_like(u), ku, kv, eps)[1]
     at1 = pointwise.central_gradient(field, u, np.ones_like(u), ku, kv, eps)[1]
-    one_sided_0 = (h(eps) - h(0.0)) / eps
-    one_sided_1 = (h(1.0) - h(1.0 - eps)) / (1.0 - (1.0 - eps))
+    # The reference's stencil at the borders: (v+, v-, divisor), one-sided.
+    assert scalar_reference.stencil_v(0.0, eps) == (eps, 0.0, eps)
+    assert scalar_reference.stencil_v(1.0, eps) == (1.0, 1.0 - eps, 1.0 - (1.0 - eps))
+    one_sided_0 = reference_quotient(field, u, 0.0, ku, kv, eps, 1)
+    one_sided_1 = reference_quotient(field, u, 1.0, ku, kv, eps, 1)
     tol = quotient_tolerance(ku, kv, eps)
     assert np.all(np.abs(at0 - one_sided_0) <= tol) and np.all(np.abs(at1 - one_sided_1) <= tol)
     # The two-sided quotient over the clamped points (divided by 2 eps) is half that: rejected.
@@ -740,12 +760,13 @@ def test_v_clamp_just_inside_the_border():
     eps, v0, ku, kv = 1e-2, 2.5e-3, 8.0, 4.0
     u = np.random.default_rng(99).random(50)
     got = pointwise.central_gradient("sine", u, v0, ku, kv, eps)[1]
-    want = (hand_height("sine", u, v0 + eps, ku, kv) - hand_height("sine", u, 0.0, ku, kv)) / (v0 + eps)
+    assert scalar_reference.stencil_v(v0, eps) == (v0 + eps, 0.0, v0 + eps)
+    want = reference_quotient("sine", u, v0, ku, kv, eps, 1)
     assert np.all(np.abs(got - want) <= quotient_tolerance(ku, kv, eps))
     assert np.all(np.abs(got - want * (v0 + eps) / (2 * eps)) > quotient_tolerance(ku, kv, eps))
 
 
-def test_u_wraps_at_the_seam():
+def test_u_wraps_at_the_seam(monkeypatch):
     """u near 0 and 1: the quotient reaches across the seam (u - eps + 1).  With
     k_u = 3.3 the field is not periodic in u, so a quotient that did not wrap
     (h(u - eps) at u - eps < 0) differs by O(1)."""
@@ -754,26 +775,30 @@ def test_u_wraps_at_the_seam():
     v = rng.uniform(0.1, 0.9, 60)
     u = np.concatenate([rng.uniform(0, eps, 30), rng.uniform(1 - eps, 1, 30)])
     got = pointwise.central_gradient("sine", u, v, ku, kv, eps)[0]
-    want = (hand_height("sine", np.mod(u + eps, 1.0), v, ku, kv)
-            - hand_height("sine", np.mod(u - eps, 1.0), v, ku, kv)) / (2 * eps)
-    unwrapped = (hand_height("sine", u + eps, v, ku, kv) - hand_height("sine", u - eps, v, ku, kv)) / (2 * eps)
+    want = reference_quotient("sine", u, v, ku, kv, eps, 0)
+    # The wrong variant: the reference's quotient with its u stencil not wrapped.
+    monkeypatch.setattr(scalar_reference, "stencil_u", lambda uu, e: (uu + e, uu - e))
+    unwrapped = reference_quotient("sine", u, v, ku, kv, eps, 0)
     tol = quotient_tolerance(ku, kv, eps)
     assert np.all(np.abs(got - want) <= tol)
     assert np.all(np.abs(unwrapped - want) > 1e6 * tol)
 
 
-def test_interior_v_difference_divides_by_two_eps():
+def test_interior_v_difference_divides_by_two_eps(monkeypatch):
     """Erratum v-border-branch: away from the border the quotient is over 2 eps,
     even where rounding makes fl(v + eps) - fl(v - eps) differ from 2 eps (the
     seed's test `vp - vm < 2 eps` would switch to that distance there)."""
     u, v, eps = 0.31, 0.47, 1e-9
     assert (v + eps) - (v - eps) != 2 * eps                  # the seed's branch would fire
     _, hv = pointwise.central_gradient("sine", u, v, 8.0, 4.0, eps)
-    h = lambda vv: float(pointwise.height("sine", u, vv, 8.0, 4.0))  # noqa: E731
-    difference = h(v + eps) - h(v - eps)
-    tol = 4 * U * abs(difference) / (2 * eps)              # the quotient's own roundings
-    assert abs(hv - difference / (2 * eps)) <= tol
-    assert abs(hv - difference / ((v + eps) - (v - eps))) > 1e3 * tol
+    # The reference's quotient over the renderer's own samples of h (`pointwise.height`),
+    # so that only the stencil can differ: its divisor is 2 eps here.
+    assert scalar_reference.stencil_v(v, eps)[2] == 2 * eps
+    monkeypatch.setattr(scalar_reference, "height_value", lambda *a: float(pointwise.height(*a)))
+    want = scalar_reference.grad_central("sine", u, v, 8.0, 4.0, eps)[1]
+    tol = 4 * U * abs(want)                                  # the quotient's own roundings
+    assert abs(hv - want) <= tol
+    assert abs(hv - want * (2 * eps) / ((v + eps) - (v - eps))) > 1e3 * tol
 
 
 @pytest.mark.parametrize("eps", [1e-3, 0.37, 1e-16])

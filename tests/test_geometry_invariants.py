@@ -21,6 +21,8 @@ import pytest
 from renderer import GRADIENTS, PointLight, Scene, gbuffer, kernel, pointwise, render
 from renderer.render import image_plane
 
+from . import scalar_reference as ref
+
 SIZE = 128
 SURFACE_TOL = 1e-12        # relative to the radius
 UNIT_TOL = 1e-12
@@ -328,8 +330,11 @@ def test_unit_check_rejects_the_unnormalized_perturbed_normal():
     g = gbuffer(scene, 64, 64)
     a = g.chamber == 1
     N, (hu, hv) = g.N[a], g.grad[a].T
-    e_th, e_ph = pointwise.tangent_frame(N[:, 0], N[:, 1], N[:, 2], np.hypot(N[:, 0], N[:, 1]))
-    M = N + scene.beta * (hu[:, None] * np.stack(e_th, -1) + hv[:, None] * np.stack(e_ph, -1))
+    _, _, sin_phi = pointwise.chart(N[:, 0], N[:, 1], N[:, 2])
+    e_th, e_ph = (np.stack(e, -1) for e in pointwise.tangent_frame(N[:, 0], N[:, 1], N[:, 2], sin_phi))
+    # The seed's M = N + beta (h_u e_theta + h_v e_phi) before N' = M / |M| (tests/scalar_reference.py).
+    M = np.array([ref.chart_bump_vector(tuple(n), tuple(t), tuple(p), gu, gv, scene.beta)
+                  for n, t, p, gu, gv in zip(N, e_th, e_ph, hu, hv)])
     assert off_unit(M) > 1e-2
     assert off_unit(M / np.linalg.norm(M, axis=-1, keepdims=True)) <= UNIT_TOL
 

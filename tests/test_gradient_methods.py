@@ -1,7 +1,7 @@
-"""The gradient methods of proofs/gradient_methods.py: their orders against an
-mpmath closed form, the complex step's analyticity premise, the work per pixel
-counted from the formulas, and the Pareto front.  Each check is shown to
-reject a wrong variant.
+"""The gradient methods of proofs/gradient_methods.py: their orders against
+sympy's derivative evaluated by mpmath, the complex step's analyticity
+premise, the work per pixel counted from the formulas, and the Pareto front.
+Each check is shown to reject a wrong variant.
 """
 
 from __future__ import annotations
@@ -28,14 +28,17 @@ SPACING = float(np.spacing(np.pi * max(KU, 2 * KV)))
 FLOAT64_EVAL = 64 * SPACING
 
 
+#: The sine field's (h_u, h_v), `formulas.GRADIENT["sine"]`, as an mpmath function.
+_SINE_GRADIENT_MP = sp.lambdify((F.u, F.v, F.k_u, F.k_v), F.GRADIENT["sine"], "mpmath")
+
+
 def sine_gradient_mp(u, v, ku=KU, kv=KV):
-    """(h_u, h_v) of h = sin(pi k_u u) sin(pi k_v v), written by hand (seed §3) and
-    evaluated by mpmath at 40 digits at the float64 point: independent of sympy's
-    derivative and of every method under test."""
+    """(h_u, h_v) of the sine field: sympy's derivative (`formulas.GRADIENT`,
+    checked against seed §3's closed form in tests/test_codegen.py) evaluated
+    by mpmath at 40 digits at the float64 point: no float64 rounding of any
+    method under test."""
     with mpmath.workdps(40):
-        u, v, pi = mpmath.mpf(float(u)), mpmath.mpf(float(v)), mpmath.pi
-        return (pi * ku * mpmath.cos(pi * ku * u) * mpmath.sin(pi * kv * v),
-                pi * kv * mpmath.sin(pi * ku * u) * mpmath.cos(pi * kv * v))
+        return tuple(+x for x in _SINE_GRADIENT_MP(*(mpmath.mpf(float(a)) for a in (u, v, ku, kv))))
 
 
 def abs_errors(grad, ref):

@@ -58,7 +58,9 @@ worst-case sum, rounded up):
    bump, M = N - b_u e_theta - b_v e_phi with b_u = q h_u / (2 max(sin phi,
    POLE_SIN_PHI)), b_v = q h_v, q = beta / (pi (R + beta h)): the same with
    q / (2 s) and q for beta, plus (|b_u| + |b_v|)(beta DH / (R + beta h) + 12u).
-   At beta = 0, Ns = N on both sides: dNs = 0.
+   (The coefficients and their slopes in h_u, h_v and h are formulas.BUMP's,
+   evaluated, not retyped.)  At beta = 0, M = N and only the roundings
+   remain: both sides normalise N, by different printers (b).
 8. Image, per light of colour c, at Python's mu = Ns . w and specular cosine
    (Blinn Ns . h / |h|, Phong 2 mu (Ns . v) - w . v): mu moves by dmu = dNs +
    6u, the cosine by dcos = m dNs + 24u (m = 1 Blinn, 4 Phong).  The lobe x^n
@@ -71,8 +73,8 @@ worst-case sum, rounded up):
    whose mu is within dmu + 8u of 0 (a "terminator" pixel: on for one side
    only) its whole contribution, c (kd (|mu| + dmu) + ks b^n).  Plus 4u
    (lights + 1)(ka ambient + sum_l c (kd + ks)) for the sums' roundings and a
-   non-integral pow, everywhere (off sphere A and at beta = 0 only this: Ns =
-   N there).  Clipping is 1-Lipschitz.
+   non-integral pow, everywhere (off sphere A only this: Ns = N there).
+   Clipping is 1-Lipschitz.
 9. Crease flag |sin a| < 0.03: can differ only where ||sin a| - 0.03| <=
    ARG + 2 ulp(0.03) for a ridge factor and (u, v) differ ("band-edge"
    pixels, exempt from the flag check).
@@ -94,6 +96,7 @@ import math
 
 import numpy as np
 import pytest
+import sympy as sp
 from mpmath import mp, mpf
 
 from renderer import GRADIENTS, PointLight, Scene, gbuffer, pointwise, render
@@ -108,6 +111,25 @@ MAX_EXEMPT = 2                  # exempt pixels of one kind per frame
 SPHERE_A = 1
 POLE_SIN_PHI = float(F.POLE_SIN_PHI)
 KINK_BAND_HALF_WIDTH = float(F.KINK_BAND_HALF_WIDTH)
+
+
+def _bump_functions():
+    """Per bump mode, numpy functions of (beta, R, h, h_u, h_v, sin phi) giving
+    the coefficients (b_u, b_v) of M = N + b_u e_theta + b_v e_phi
+    (`formulas.BUMP`) and their derivatives in h_u, h_v and h (sympy's), for
+    the error model of step 7."""
+    args = (F.beta, F.R, F.h, F.h_u, F.h_v, F.sin_phi)
+    out = {}
+    for mode, coefficients in F.BUMP.items():
+        exprs = [sp.sympify(b) for b in coefficients]
+        parts = {"b": exprs, **{str(x): [sp.diff(b, x) for b in exprs] for x in (F.h_u, F.h_v, F.h)}}
+        out[mode] = {key: sp.lambdify(args, tuple(e), "numpy") for key, e in parts.items()}
+    return out
+
+
+BUMP = _bump_functions()
+#: The arguments a_u, a_v of the ridges' two sines (`formulas.RIDGE_FACTORS`), as numpy functions.
+RIDGE_ARGUMENTS = [sp.lambdify((F.u, F.v, F.k_u, F.k_v), factor.args[0], "numpy") for factor in F.RIDGE_FACTORS]
 
 #: (id, scene, width, height, gradient, zoom); non-square sizes catch a transposed
 #: image, odd widths put a pixel column exactly on x = 0 (the seam's meridian).
@@ -173,20 +195,16 @@ def grad_tolerance(scene, gradient, g, uv, steps):
 
 def normal_tolerance(scene, g, dg, h, sin_phi):
     """Step 7: allowed |dNs| given Python's gradient ``g``, its bound ``dg``,
-    h and sin(phi) per pixel."""
-    beta = scene.beta
-    if beta == 0.0:
-        return np.zeros(g.shape[:-1])
-    ag = np.abs(g)
-    if scene.bump == "chart":
-        dM = beta * (dg[..., 0] + dg[..., 1]) + 12.0 * U * (1.0 + beta * (ag[..., 0] + ag[..., 1]))
-    else:
-        radius = scene.radius_a + beta * h
-        q = beta / (math.pi * radius)
-        s = np.maximum(sin_phi, POLE_SIN_PHI)
-        b = q * ag[..., 0] / (2.0 * s) + q * ag[..., 1]
-        dM = (q * (dg[..., 0] / (2.0 * s) + dg[..., 1]) + b * (beta * height_tol(scene) / radius + 12.0 * U)
-              + 12.0 * U * (1.0 + b))
+    h and sin(phi) per pixel.  The coefficients (b_u, b_v) of M and their
+    slopes in h_u, h_v and h are `formulas.BUMP` of the scene's mode, evaluated."""
+    f = BUMP[scene.bump]
+    at = (scene.beta, scene.radius_a, h, g[..., 0], g[..., 1], sin_phi)
+    size = lambda values: sum(np.abs(np.broadcast_to(c, h.shape)) for c in values)  # noqa: E731
+    b = size(f["b"](*at))
+    dM = (size(f["h_u"](*at)) * dg[..., 0] + size(f["h_v"](*at)) * dg[..., 1] + size(f["h"](*at)) * height_tol(scene)
+          + 12.0 * U * (1.0 + b))
+    if scene.bump == "surface":
+        dM = dM + 12.0 * U * b              # the roundings of b's own factors
     return 4.0 * dM + 8.0 * U
 
 
@@ -243,8 +261,9 @@ def image_tolerance(scene, on_a, P, Ns, d_ns):
 
 def ridge_arguments(scene, uv):
     """The float arguments a_u = (pi k_u) u, a_v = (pi k_v) v of the ridges' two
-    sines, rounded as formulas.js and generated.py round them."""
-    return (math.pi * scene.k_u) * uv[..., 0], (math.pi * scene.k_v) * uv[..., 1]
+    sines (`formulas.RIDGE_FACTORS`), rounded as formulas.js and generated.py
+    round them: pi k first."""
+    return tuple(a(uv[..., 0], uv[..., 1], scene.k_u, scene.k_v) for a in RIDGE_ARGUMENTS)
 
 
 def crease_margins(args):

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from renderer import codegen, generated, jsgen
+from renderer import codegen, generated, jsgen, pointwise
 from renderer import formulas as F
 
 from .jsnode import require_tool
@@ -60,12 +60,14 @@ def test_a_built_book_carries_the_regenerated_bundle():
 
 #: A value for every argument name of `formulas.FUNCTIONS` (a unit normal, its
 #: frame, a chart point away from creases and poles, a pixel of the default camera).
+#: sin(phi) and the frame come from `renderer.pointwise`.
 _N = (0.3, -0.4, math.sqrt(1 - 0.25))
-_S = math.hypot(_N[0], _N[1])
+_S = float(pointwise.chart(*_N)[2])
+_ET, _EP = (tuple(map(float, e)) for e in pointwise.tangent_frame(*_N, _S))
 ARGS = dict(u=0.31, v=0.58, k_u=8.0, k_v=4.0, eps_u=1e-3, eps_v=2e-3, N_x=_N[0], N_y=_N[1], N_z=_N[2],
-            sin_phi=_S, et_x=-_N[1] / _S, et_y=_N[0] / _S, et_z=0.0, ep_x=_N[2] * _N[0] / _S,
-            ep_y=_N[2] * _N[1] / _S, ep_z=-_S, h_u=3.0, h_v=-2.0, beta=0.35, h=0.4, R=1.0, x=0.07,
-            y=-0.1, dx=0.011, dy=0.012, camera_z=4.0, P_x=_N[0], P_y=_N[1], P_z=_N[2])
+            sin_phi=_S, et_x=_ET[0], et_y=_ET[1], et_z=_ET[2], ep_x=_EP[0], ep_y=_EP[1], ep_z=_EP[2],
+            h_u=3.0, h_v=-2.0, beta=0.35, h=0.4, R=1.0, x=0.07, y=-0.1, dx=0.011, dy=0.012, camera_z=4.0,
+            P_x=_N[0], P_y=_N[1], P_z=_N[2])
 
 
 def _js_values(tmp_path, calls):

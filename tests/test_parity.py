@@ -132,8 +132,9 @@ def footprint_bound(scene, i, j, width, height):
 
     The step is (|a_x| + |a_y|) / (2 L) with a_k = e . dp_k, where dp_k =
     E + t_k d_k - P is the k-th neighbour's ray d_k on the tangent plane at P
-    (t_k = N . (P - E) / N . d_k), e = e_theta and L = 2 pi R sin(phi) for u,
-    e = e_phi and L = pi R for v.  The two routes differ in
+    (t_k = N . (P - E) / N . d_k), e = e_theta and L = |dP/du| = 2 pi R sin(phi)
+    for u, e = e_phi and L = |dP/dv| = pi R for v (`scalar_reference.chart_tangents`).
+    The two routes differ in
 
     * the hit point: P, and N = P / R, agree to dP = 4 u (1 + kappa) |P - E|
       + 4 u |P| (kappa the condition of the hit, `hit_condition`), dN = dP / R
@@ -178,8 +179,9 @@ def footprint_bound(scene, i, j, width, height):
     near_cut = abs(sin_phi - ref.POLE_SIN_PHI) <= 4 * (dN + U)
     regular = sin_phi > ref.POLE_SIN_PHI
     frame = 2 * (dN + U) / sin_phi if regular else 0.0
+    dpdu, dpdv = ref.chart_tangents(R, sin_phi, e_th, e_ph)
     delta = []
-    for axis, (vec, L, extra) in enumerate(((e_th, 2 * math.pi * R * sin_phi, frame), (e_ph, math.pi * R, 0.0))):
+    for axis, (vec, L, extra) in enumerate(((e_th, _norm(dpdu), frame), (e_ph, _norm(dpdv), 0.0))):
         a = sum(abs(ref.dot(vec, dp)) for dp in offsets)
         change = sum(errors) + frame * sum(_norm(dp) for dp in offsets)
         bound = 4 * (change / a + frame + extra + U) if a > 0 else math.inf
@@ -413,13 +415,8 @@ def test_parity_rejects_a_different_pole_fallback(monkeypatch):
 
 def test_parity_rejects_a_two_sided_quotient_at_the_pole(monkeypatch):
     """Dividing by 2 eps even where v was clamped (v = 1.3e-17 at the pole pixel)."""
-    def two_sided(field, u, v, ku, kv, eps):
-        h = lambda uu, vv: ref.height_value(field, uu, vv, ku, kv)  # noqa: E731
-        hu = (h((u + eps) % 1.0, v) - h((u - eps) % 1.0, v)) / (2.0 * eps)
-        hv = (h(u, min(1.0, v + eps)) - h(u, max(0.0, v - eps))) / (2.0 * eps)
-        return hu, hv
-
-    monkeypatch.setattr(ref, "grad_central", two_sided)
+    stencil = ref.stencil_v
+    monkeypatch.setattr(ref, "stencil_v", lambda v, eps: stencil(v, eps)[:2] + (2.0 * eps,))
     scene = Scene(**VARIANTS["pole with nonzero gradient"])
     assert any("grad" in f for f in parity_failures(scene, 17, 20, "central"))
 

@@ -299,12 +299,19 @@ def test_render_rejects_bad_sizes(width, height, error, name):
         render(Scene(), width, height)
 
 
-@pytest.mark.parametrize("gradient", ["Exact", "symbolic", "numeric", "Footprint", "pbrt", "", None, 1,
-                                      ("exact",)])
+@pytest.mark.parametrize("gradient", ["Exact", "symbolic", "numeric", "Footprint", "pbrt", ""])
 def test_render_rejects_unknown_gradient(gradient):
     with pytest.raises(ValueError, match=r"^gradient must be one of \('exact', 'central', 'footprint'\)"):
         render(Scene(), 4, 4, gradient=gradient)
     with pytest.raises(ValueError, match=r"^gradient\b"):
+        gbuffer(Scene(), 4, 4, gradient=gradient)
+
+
+@pytest.mark.parametrize("gradient", [None, 1, ("exact",)])
+def test_render_rejects_a_gradient_that_is_not_a_string(gradient):
+    with pytest.raises(TypeError, match=r"^gradient must be a string, one of \('exact', 'central', 'footprint'\)"):
+        render(Scene(), 4, 4, gradient=gradient)
+    with pytest.raises(TypeError, match=r"^gradient\b"):
         gbuffer(Scene(), 4, 4, gradient=gradient)
 
 
@@ -314,9 +321,15 @@ def test_render_accepts_every_gradient_and_records_it(gradient):
     assert frame.gradient == gradient and gbuffer(Scene(), 4, 4, gradient=gradient).grad.shape == (4, 4, 2)
 
 
-@pytest.mark.parametrize("workers", [0, -1, 65, 1.5, True, "2", np.float64(2.0)])
-def test_render_rejects_a_bad_thread_count_naming_it(workers):
+@pytest.mark.parametrize("workers", [0, -1, 65])
+def test_render_rejects_a_thread_count_out_of_range_naming_it(workers):
     with pytest.raises(ValueError, match=r"^workers must be an integer from 1 to 64, got "):
+        render(Scene(), 4, 4, workers=workers)
+
+
+@pytest.mark.parametrize("workers", [1.5, True, "2", np.float64(2.0)])
+def test_render_rejects_a_thread_count_that_is_not_an_integer(workers):
+    with pytest.raises(TypeError, match=r"^workers must be None or an integer, got "):
         render(Scene(), 4, 4, workers=workers)
 
 

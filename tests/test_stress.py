@@ -15,13 +15,16 @@ import pytest
 from renderer import GRADIENTS, Scene, gbuffer, kernel, pointwise, render
 from renderer.formulas import POLE_SIN_PHI
 
+from . import scalar_reference as ref
+
 POLE_SIN_PHI = float(POLE_SIN_PHI)
 
 
 def fallback_pixels(scene, width, height):
     g = gbuffer(scene, width, height)
     a = g.chamber == 1
-    return int(np.count_nonzero(a & (np.hypot(g.N[..., 0], g.N[..., 1]) <= POLE_SIN_PHI)))
+    _, _, sin_phi = pointwise.chart(g.N[..., 0], g.N[..., 1], g.N[..., 2])
+    return int(np.count_nonzero(a & (sin_phi <= POLE_SIN_PHI)))
 
 
 def test_pole_fallback_engages_only_where_a_pixel_centre_hits_the_pole():
@@ -37,16 +40,21 @@ def test_pole_fallback_engages_only_where_a_pixel_centre_hits_the_pole():
 
 def test_size_of_the_jump_across_the_fallback():
     """N' from the fallback basis against the regular frame just outside the
-    threshold, for the same gradient: the jump is O(beta |grad|), not small."""
+    threshold, for the same gradient: the jump is O(beta |grad|), not small.
+    N' is tests/scalar_reference.py's seed §3 formula (`perturb`, chart bump)."""
     phi = 1.0001 * POLE_SIN_PHI
     N = np.array([[np.sin(phi)], [0.0], [np.cos(phi)]])
-    reg = pointwise.tangent_frame(*N, np.array([np.sin(phi)]))
+    _, _, sin_phi = pointwise.chart(*N)
+    reg = pointwise.tangent_frame(*N, sin_phi)
     fb = pointwise.tangent_frame(*N, np.array([0.0]))
-    g = np.array([1.0, 0.5])
-    beta = 0.35
-    n_reg = N[:, 0] + beta * (g[0] * np.ravel(reg[0]) + g[1] * np.ravel(reg[1]))
-    n_fb = N[:, 0] + beta * (g[0] * np.ravel(fb[0]) + g[1] * np.ravel(fb[1]))
-    jump = np.linalg.norm(n_reg / np.linalg.norm(n_reg) - n_fb / np.linalg.norm(n_fb))
+    assert sin_phi[0] > POLE_SIN_PHI                   # the regular frame, just outside the cut-off
+    hu, hv, beta = 1.0, 0.5, 0.35
+
+    def shading_normal(frame):
+        e_th, e_ph = (tuple(float(c[0]) for c in e) for e in frame)
+        return np.array(ref.perturb(tuple(N[:, 0]), e_th, e_ph, hu, hv, beta))
+
+    jump = np.linalg.norm(shading_normal(reg) - shading_normal(fb))
     assert jump > 0.1             # a real discontinuity (confessed in §7), not rounding
 
 
@@ -136,7 +144,9 @@ def test_points_exactly_on_the_u_creases(m):
     pipeline returns and what the kink flag says."""
     ku, kv = 8.0, 4.0
     u, v = np.array([m / ku]), np.array([0.47])
-    one_sided = np.pi * ku * abs(np.sin(np.pi * kv * 0.47))          # |h_u| on either side
+    # |h_u| on either side: ridges is |sine|, so its one-sided h_u are +- sine's there
+    # (tests/scalar_reference.py's closed form of seed §3).
+    one_sided = abs(ref.grad_exact("sine", u[0], v[0], ku, kv)[0])
     exact = pointwise.exact_gradient("ridges", u, v, ku, kv)[0][0]
     fd = pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4)[0][0]
     assert pointwise.kink_band("ridges", u, v, ku, kv)[0]             # flagged
@@ -150,7 +160,7 @@ def test_points_exactly_on_the_u_creases(m):
 def test_points_exactly_on_the_v_creases(m):
     ku, kv = 8.0, 4.0
     u, v = np.array([0.31]), np.array([m / kv])
-    one_sided = np.pi * kv * abs(np.sin(np.pi * ku * 0.31))
+    one_sided = abs(ref.grad_exact("sine", u[0], v[0], ku, kv)[1])   # as for u above
     exact = pointwise.exact_gradient("ridges", u, v, ku, kv)[1][0]
     fd = pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4)[1][0]
     assert pointwise.kink_band("ridges", u, v, ku, kv)[0]

@@ -9,7 +9,7 @@
 // cast shadows) then `light_term`, Lambert and Blinn/Phong with the shading
 // normal.
 //
-// Every formula of sphere A (chart, tangent frame, gradients and crease flag,
+// Every formula of sphere A (chart, tangent frame, gradients, crease flag,
 // footprint, perturbed normals) is imported from formulas.js, which
 // renderer/codegen.py prints from renderer/formulas.py: the same sympy objects
 // the kernel's generated.py is printed from.  What is written here is what
@@ -19,7 +19,7 @@
 // intersected, no shadow ray where the light adds nothing); tests/test_skips.py
 // shows it gives the bits of the path that skips nothing.  The kernel's tuples
 // are preallocated arrays of a `Pixel` record, so the pixel loop allocates nothing.
-import { FIELD_CODES, height, exact_gradient, central_gradient, chart, tangent_frame,
+import { FIELD_CODES, height, exact_gradient, central_gradient, kink_band, chart, tangent_frame,
          perturbed_normal_chart, perturbed_normal_surface, footprint } from "./formulas.js";
 import { GRADIENTS, MAX_SIDE, MAX_ZOOM, WINDOW_MARGIN, WINDOW_OFFSET, BACKGROUND, SPHERE_A, SPHERE_B,
          FLOOR, FLOOR_LIGHT, FLOOR_DARK, TINY } from "./constants.js";
@@ -200,7 +200,7 @@ function shade(s, px) {
   for (let c = 0; c < 3; c++) rgb[c] = Math.min(Math.max(rgb[c], 0.0), 1.0);
 }
 
-// (h_u, h_v, crease flag) into px.grad by `method`: exact, central with step
+// (h_u, h_v) into px.grad by `method`: exact, central with step
 // eps, or central with the pixel's footprint as steps (pixel spacing dx, dy
 // on the image plane); the steps into px.steps (NaN for exact).
 function gradient(s, method, eps, x, y, dx, dy, px) {
@@ -220,10 +220,9 @@ function gradient(s, method, eps, x, y, dx, dy, px) {
   central_gradient(s.field, u, v, s.k_u, s.k_v, px.steps[0], px.steps[1], px.grad);
 }
 
-// N' of sphere A into px.Ns (formulas.py `PERTURBED_NORMAL`); N itself at beta = 0.
+// N' of sphere A into px.Ns (formulas.py `PERTURBED_NORMAL`).
 function shading_normal(s, px) {
   const N = px.N, f = px.frame, hu = px.grad[0], hv = px.grad[1];
-  if (s.beta === 0.0) { px.Ns.set(N); return; }
   if (s.surface) {
     const u = px.uvs[0], v = px.uvs[1], sin_phi = px.uvs[2];
     const h = height(s.field, u, v, s.k_u, s.k_v);
@@ -244,7 +243,8 @@ class Pixel {
     this.albedo = new Float64Array(3); this.rgb = new Float64Array(3);
     this.uvs = new Float64Array(3);        // chart: u, v, sin(phi)
     this.frame = new Float64Array(6);      // tangent_frame: e_theta, e_phi
-    this.grad = new Float64Array(3);       // gradient: h_u, h_v, crease flag (1 or 0)
+    this.grad = new Float64Array(2);       // gradient: h_u, h_v
+    this.kink = false;                     // the crease flag
     this.steps = new Float64Array(2);      // the central steps (eps_u, eps_v); NaN for exact
     this.w = new Float64Array(3); this.axis = new Float64Array(3); this.view = new Float64Array(3);
   }
@@ -280,6 +280,7 @@ function geometry(s, x, y, checker, px) {
   const N = px.N;
   chart(N[0], N[1], N[2], px.uvs);
   tangent_frame(N[0], N[1], N[2], px.uvs[2], px.frame);
+  px.kink = kink_band(s.field, px.uvs[0], px.uvs[1], s.k_u, s.k_v);
 }
 
 // The rest of pixel (x, y) after `geometry`: on sphere A the gradient and the
@@ -331,7 +332,7 @@ function store(frame, k, px) {
   if (px.code === SPHERE_A) {
     frame.grad[2 * k] = px.grad[0]; frame.grad[2 * k + 1] = px.grad[1];
     frame.uv[2 * k] = px.uvs[0]; frame.uv[2 * k + 1] = px.uvs[1];
-    frame.kink[k] = px.grad[2] !== 0.0 ? 1 : 0;
+    frame.kink[k] = px.kink ? 1 : 0;
   }
 }
 
@@ -397,7 +398,7 @@ export function probe_pixel(scene, width, height, i, j, zoom = 1.0, numeric = "c
     return { gradient, chamber: px.code, P: px.code === BACKGROUND ? null : Array.from(px.P),
              uv: on_a ? [px.uvs[0], px.uvs[1]] : null, grad: on_a ? [px.grad[0], px.grad[1]] : null,
              steps: on_a && gradient !== "exact" ? Array.from(px.steps) : null,
-             kink: on_a && px.grad[2] !== 0.0, rgb: Array.from(px.rgb) };
+             kink: on_a && px.kink, rgb: Array.from(px.rgb) };
   };
   return { i, j, X: x[i], Y: y[j], numeric: record(numeric), symbolic: record("exact") };
 }
