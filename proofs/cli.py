@@ -103,7 +103,7 @@ MAX_PIXELS = 4096 * 4096
 #: Most frame-pixels a command holds at once: render holds 2 frames, a sweep of
 #: n steps holds n + 1.
 FRAME_PIXEL_BUDGET = 2 * MAX_PIXELS
-#: Most steps of one U-curve (each step is a 50-digit mpmath evaluation, ~1 ms).
+#: Most steps of one U-curve (each step is a 50-digit mpmath evaluation).
 MAX_UCURVE_STEPS = 10_000
 
 VIEWS = ("shaded", "difference", "bump", "kink")

@@ -22,7 +22,7 @@ MAX_LENGTH = 1e6
 MIN_RADIUS = 1e-6
 #: Largest accepted frequency k_u, k_v (periods over the chart): 1000 periods
 #: over u are more than a pixel each even at 8192 pixels across, and keep the
-#: phase pi k u far inside the accurate range of the deterministic sine.
+#: phase pi k u small enough that a sine's argument reduction loses nothing.
 MAX_FREQUENCY = 1e3
 #: Largest accepted bump amplitude beta: at 100 the chart bump tilts every
 #: normal with |grad h| >= 0.01 by 45 degrees or more; beyond it the image no

@@ -24,8 +24,8 @@ objects of `renderer.formulas`, and the bits the renderer uses.
     tampered line of the printed source) printed through the same
     `codegen.python_source` are rejected by the checks of (d).
 
-The height-field tests formerly in tests/test_fields.py follow: the seed's
-closed forms, the central difference's order and its border rules.
+The height-field tests follow: the seed's closed forms, the central
+difference's order and its border rules.
 """
 
 from __future__ import annotations
@@ -632,7 +632,7 @@ def test_the_pointwise_check_rejects_another_pipeline(gradient, wrong):
     assert pixel_differences(scene.replace(**wrong), size, kw.pop("gradient", gradient), frame, g, **kw)
 
 
-# ---- the height fields (formerly tests/test_fields.py) ------------------------------------
+# ---- the height fields ------------------------------------
 
 def closed_form_excess(exprs, field, points):
     """`excess` of seed §3's closed form (h_u, h_v), as tests/scalar_reference.py

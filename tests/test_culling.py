@@ -1,8 +1,7 @@
 """The kernel's ray-sphere and shadow-segment tests against closed forms, and
 the culling they decide.
 
-The culling boxes of the old tiled renderer are gone: the kernel now culls
-by skipping what is off (tests/test_skips.py).  What decides every hit and
+The kernel culls by skipping what is off (tests/test_skips.py).  What decides every hit and
 every shadow is two scalar functions of `renderer.kernel`, checked here on
 random rays, spheres and segments against an independent route:
 

@@ -308,7 +308,7 @@ def test_interrupt_while_the_notebook_kernel_runs(tmp_path, moment, presses):
     """``figures --out figs --pages s1``: SIGINT (once, or twice 50 ms apart)
     as soon as the kernel process exists (it is still starting: nbclient has
     not armed its clean-up yet), or while it runs the page's cell.  No figs/,
-    no .figs.*.part staging directory, no kernel, no worker process and no
+    no .figs.*.part staging directory, no kernel and no
     kernel connection file left."""
     run = Run("figures", "--out", tmp_path / "figs", "--pages", "s1", cwd=tmp_path)
     run.wait_until(lambda: run.descendants("ipykernel"), 30, "ipykernel process")

@@ -126,7 +126,7 @@ def test_constants_js_carries_the_python_values():
 
 
 def test_the_modules_are_exactly_the_hand_written_files_and_the_generated_ones():
-    """renderer/js holds the hand-written modules of MODULE_ORDER, nothing else (no stale detmath.js)."""
+    """renderer/js holds the hand-written modules of MODULE_ORDER, nothing else (no stale module)."""
     on_disk = {p.stem for p in jsgen.JS_DIR.glob("*.js")}
     assert on_disk == set(jsgen.MODULE_ORDER) - set(jsgen.GENERATED)
     assert set(jsgen.GENERATED) <= set(jsgen.MODULE_ORDER)
