@@ -12,17 +12,13 @@ segment) then Lambert and Blinn/Phong with the shading normal.
 
 Everything up to the gradient depends on geometry alone (theorem "bump moves
 no boundary"), which licenses `sweep_rows`: geometry and shadow rays once per
-pixel, sphere A re-shaded per step.  The formulas of sphere A come from
+pixel, sphere A re-shaded per step.  Sphere A's formulas come from
 renderer/generated.py (`renderer.codegen` prints `renderer.formulas`).
-Compiled on first use and cached beside this file (``__pycache__``, or
-numba's user cache directory when that is not writable).  numba's cache
-checks only the file of the function it compiled, so this file holds the
-SHA-256 of generated.py (`FORMULAS_DIGEST`, written by the generator) and
-refuses to load beside a generated.py that does not match it.
-
-Threads: numba's ``workqueue`` layer (unless NUMBA_THREADING_LAYER chooses
-another), which survives a fork; it may not be entered by two threads at
-once, so `renderer.render` runs the kernel under a lock.
+Compiled on first use, cached in ``__pycache__`` (or numba's user cache).
+numba's cache checks only the file of the function it compiled, so this
+file holds generated.py's SHA-256 (`FORMULAS_DIGEST`, written by the
+generator) and refuses to load beside a generated.py that does not match.
+Threads: see `_threading_layer`; `renderer.render` runs one call at a time.
 
 ``skip``: True does only the work the outputs need (an object that is off is
 not intersected; a shadow ray is traced only where the light could add
@@ -34,8 +30,11 @@ tests/test_skips.py, which shows both give the same bits.
 
 from __future__ import annotations
 
+import ctypes
 import hashlib
+import importlib
 import math
+import sys
 from collections import namedtuple
 from pathlib import Path
 
@@ -59,8 +58,26 @@ TINY = 1e-300
 Params = namedtuple("Params", "camera_z radius_a center_b radius_b sphere_b floor ambient albedo_a "
                               "albedo_b ka kd ks shininess phong floor_tint field k_u k_v beta surface")
 
-if numba.config.THREADING_LAYER == "default":       # not chosen by NUMBA_THREADING_LAYER
-    numba.config.THREADING_LAYER = "workqueue"
+
+
+def _threading_layer():
+    """numba's threading layer, unless NUMBA_THREADING_LAYER chose one: TBB (pip
+    puts its library in <prefix>/lib, off the loader's path) survives a fork
+    and several threads; numba's default, GNU OpenMP, kills a child forked
+    after a render.  Without TBB the ``workqueue`` layer, fork-safe, slower."""
+    if numba.config.THREADING_LAYER != "default":
+        return
+    library = Path(sys.prefix, "lib", "libtbb.so.12")
+    try:
+        if library.exists():
+            ctypes.CDLL(str(library), mode=ctypes.RTLD_GLOBAL)
+        importlib.import_module("numba.np.ufunc.tbbpool")      # loads only beside a usable TBB
+        numba.config.THREADING_LAYER = "tbb"
+    except (ImportError, OSError):
+        numba.config.THREADING_LAYER = "workqueue"
+
+
+_threading_layer()
 
 FORMULAS_DIGEST = "a6abdbc422bd2f4c02e0569318eafc99bde9dd2d9e35d33afdbb8231b53f9994"  # of generated.py, written by renderer/codegen.py
 if hashlib.sha256(Path(__file__).with_name("generated.py").read_bytes()).hexdigest() != FORMULAS_DIGEST:

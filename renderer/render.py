@@ -141,8 +141,8 @@ def check_args(scene, width, height, gradient, zoom):
     return scene, width, height, gradient, float(zoom)
 
 
-#: One kernel call at a time: numba's workqueue threading layer (see
-#: `renderer.kernel`) may not be entered from two threads at once.
+#: One kernel call at a time: numba's fallback threading layer, workqueue, may
+#: not be entered from two threads at once (`renderer.kernel._threading_layer`).
 _KERNEL_LOCK = threading.Lock()
 
 

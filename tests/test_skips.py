@@ -311,7 +311,7 @@ sys.exit(os.waitstatus_to_exitcode(status))
 def test_a_forked_child_renders_after_its_parent():
     """numba's GNU OpenMP threading layer kills a child forked after a
     parallel region ("fork() called from a process already using GNU
-    OpenMP"); the workqueue layer the kernel chooses does not."""
+    OpenMP"); the TBB layer the kernel chooses does not."""
     run = subprocess.run([sys.executable, "-c", _FORK], capture_output=True, text=True, timeout=300,
                          env={k: v for k, v in os.environ.items() if k != "NUMBA_THREADING_LAYER"})
     assert run.returncode == 0, run.stderr[-2000:]
