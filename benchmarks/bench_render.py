@@ -1,267 +1,248 @@
-"""Render speed and scaling, measured side by side in one run.
+"""Render time, start-up time and memory of the working tree's renderer against a baseline commit.
 
-* time (median, min-max) of both pipelines from 64^2 to 4096^2, and peak
-  memory (tracemalloc) at each size, with the part beyond the returned frame;
-* the speed-up over the scalar per-pixel reference of tests/ at 64^2;
-* an 8-step eps sweep at 256^2 (both pipelines and the census), against the
-  same frames rendered independently;
-* the gradient stage alone over sphere A's pixels: exact against one central
-  difference at the same pixels;
-* the steady state: each target case (and 256^2 on one thread) repeated back
-  to back in child processes of three kinds, alternating: the defaults (tiles
-  on the calling thread and worker processes, renderer.workers; the
-  allocator settings of renderer.heap), threads only
-  (SYMRENDER_WORKER_PROCESSES=0), and the heap left alone
-  (SYMRENDER_KEEP_HEAP=0), with the minor page faults per run; the issue-6
-  targets are judged on the defaults.
+The baseline (``--baseline``, default a35b7d1) is checked out into a temporary
+detached git worktree, removed at the end.  All measurements run in child
+processes, new and baseline alternating, each with ``PYTHONPATH=<its tree>``
+and the tree first on ``sys.path``; each child checks that ``renderer`` came
+from its tree.  Only the public API is used (Scene, render, sweep).
 
-These machines are noisy: every median is printed with its min-max, and the
-things compared are interleaved in one loop.  Results go to
-benchmarks/results/render.md (and .json).
+* Steady state, default ``Scene()``: 256² and 1024², exact and central, and an
+  8-step ε sweep at 256² (the census inside ``sweep``); per round, case and
+  renderer one child, two warm-up calls, then timed calls; samples pooled.
+* Fresh process: the parent's wall time around a child that imports renderer
+  and renders 256² exact (and ``python -c pass``); the first run (numba cache
+  as found) apart from the later ones (warm cache); the new renderer with an
+  empty ``NUMBA_CACHE_DIR`` (cold compile); where numba put its cache files.
+* Memory beyond the output at 4096² exact, a fresh child each time: growth of
+  ``ru_maxrss`` over the render (after a 64² warm-up) less the Frame's arrays'
+  resident pages (those never written, zeros, are found by writing them after);
+  tracemalloc's peak beyond the output for reference (numpy's allocations).
 
-Usage: python benchmarks/bench_render.py [--repeats N] [--max-size S] [--out DIR]
+Results: benchmarks/results/render.md (table) and render.json (raw samples).
+Usage: python benchmarks/bench_render.py [--repeats N] [--baseline REV] [--out DIR] [--quick]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
-import resource
+import platform
+import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
-import tracemalloc
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from renderer import Scene, compare, fields, gbuffer, render, sweep  # noqa: E402
-from renderer import workers as worker_processes  # noqa: E402
-from renderer.render import TILE_PIXELS, WORKERS, central_gradient  # noqa: E402
-from tests.scalar_reference import render_reference  # noqa: E402
-
-SIZES = (64, 128, 256, 512, 1024, 2048, 4096)
-PIPELINES = ("exact", "central")
 STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10)
+#: Steady-state cases: name -> (side, gradient or "sweep", target in seconds).
+CASES = {"exact 256²": (256, "exact", 0.004), "central 256²": (256, "central", 0.004),
+         "exact 1024²": (1024, "exact", 0.060), "central 1024²": (1024, "central", 0.060),
+         "8-step ε sweep 256²": (256, "sweep", 0.020)}
+FRESH_TARGET, MEMORY_TARGET = 1.5, 16 * 2**20
+#: A fresh process: import the tree's renderer, render 256² once, say where renderer came from.
+FRESH = ("import sys; sys.path.insert(0, sys.argv[1]); import renderer; from renderer import Scene, render; "
+         "render(Scene(), 256, 256); print(renderer.__file__)")
+TREES = ("new", "baseline")
 
 
-def _stats(samples):
-    return dict(median=statistics.median(samples), min=min(samples), max=max(samples), runs=len(samples))
-
-
-def _interleaved(fns, repeats):
-    """{name: stats} of the callables in ``fns``, run round-robin ``repeats`` times after a warm-up."""
-    for fn in fns.values():
-        fn()
-    samples = {k: [] for k in fns}
-    for _ in range(repeats):
-        for k, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            samples[k].append(time.perf_counter() - t0)
-    return {k: _stats(v) for k, v in samples.items()}
-
-
-def _peak_working_bytes(fn):
-    tracemalloc.start()
-    out = fn()
-    current, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    del out
-    return peak, current
-
-
-# Cases measured in child processes, each repeated back to back (a user's
-# steady state): the issue-6 targets, and the heap settings on and off.
-# name: (size, render keywords or "sweep", repeats as a fraction of --repeats)
-STEADY_CASES = {
-    "exact 256², 1 thread": (256, dict(workers=1), 1.0),
-    "exact 256²": (256, {}, 1.0),
-    "central 256²": (256, dict(gradient="central"), 1.0),
-    "exact 1024²": (1024, {}, 1 / 3),
-    "central 1024²": (1024, dict(gradient="central"), 1 / 3),
-    "8-step ε sweep 256²": (256, "sweep", 1 / 2),
-}
-
-
-def _steady_child(repeats):
-    """Run in a child process: per case, the median of its warm runs, one case
-    after the other (s), and the minor page faults per run; printed as JSON."""
-    from renderer.heap import keep_heap
+def _child(mode, root, arg):
+    """In a child process: one measurement of the renderer in ``root``, printed as JSON."""
+    sys.path.insert(0, root)
+    import renderer
+    from renderer import Scene, render, sweep
+    out = {"file": os.path.realpath(renderer.__file__)}
+    if not out["file"].startswith(os.path.realpath(root) + os.sep):
+        sys.exit(f"renderer was imported from {out['file']}, not from {root}")
     scene = Scene()
-    out = {"worker processes": worker_processes.wait_ready()}
-    for name, (size, kw, share) in STEADY_CASES.items():
-        if kw == "sweep":
-            fn = lambda size=size: sweep(scene, STEPS, size, size)   # noqa: E731
-        else:
-            fn = lambda size=size, kw=kw: render(scene, size, size, **kw)   # noqa: E731
-        fn()
-        fn()
-        runs = max(3, round(repeats * share))
-        before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
-        times = []
-        for _ in range(runs):
+    nbytes = lambda f: sum(a.nbytes for a in (f.image, f.chamber, f.kink, f.grad) if a is not None)  # noqa: E731
+    if mode == "steady":
+        name, reps = arg.rsplit(":", 1)
+        side, kind, _ = CASES[name]
+        fn = ((lambda: sweep(scene, STEPS, side, side).census) if kind == "sweep"
+              else lambda: render(scene, side, side, gradient=kind))
+        fn(), fn()
+        out["samples"] = []
+        for _ in range(int(reps)):
             t0 = time.perf_counter()
             fn()
-            times.append(time.perf_counter() - t0)
-        faults = (resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before) / runs
-        out[name] = dict(median=statistics.median(times), faults=faults)
-    out["applied"] = keep_heap()
+            out["samples"].append(time.perf_counter() - t0)
+    elif mode == "maxrss":
+        import resource
+        rss = lambda: 1024 * sum(int(ln.split()[1]) for ln in open("/proc/self/status") if ln[:6] == "VmRSS:")  # noqa
+        maxrss = lambda: 1024 * resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # noqa: E731
+        render(scene, 64, 64)
+        before, slack = maxrss(), max(0, maxrss() - rss())  # slack: growth the high-water mark cannot show
+        frame = render(scene, 4096, 4096)
+        after, held = maxrss(), rss()
+        for a in (a for a in (frame.image, frame.chamber, frame.kink, frame.grad) if a is not None):
+            if a.flags.c_contiguous:  # write one byte per page: the output's pages never touched (zeros)
+                a.reshape(-1).view("u1")[::resource.getpagesize()] |= 0
+        untouched = rss() - held
+        out.update(raw=after - before - nbytes(frame), beyond=after - before - (nbytes(frame) - untouched),
+                   output=nbytes(frame), untouched=untouched, slack=slack)
+    elif mode == "tracemalloc":  # and the versions of what the renderer loaded
+        import tracemalloc
+        render(scene, 64, 64)
+        tracemalloc.start()
+        frame = render(scene, 4096, 4096)
+        nb = sys.modules.get("numba")
+        out.update(beyond=tracemalloc.get_traced_memory()[1] - nbytes(frame), python=platform.python_version(),
+                   numpy=sys.modules["numpy"].__version__, numba=nb and nb.__version__,
+                   numba_cache_dir=nb and (nb.config.CACHE_DIR or None))
     print(json.dumps(out))
 
 
-#: Children of each kind.
-STEADY_ROUNDS = 5
-#: The kinds of steady-state child: name -> environment variable set to "0".
-STEADY_SETTINGS = {"defaults": None, "threads only": worker_processes.ENV_VAR,
-                   "heap left alone": "SYMRENDER_KEEP_HEAP"}
+def _process(root, argv, **env):
+    """Wall time (s) of a child process run in ``root`` with PYTHONPATH=root, and its last line of output."""
+    t0 = time.perf_counter()
+    run = subprocess.run([sys.executable, *argv], env={**os.environ, "PYTHONPATH": str(root), **env}, cwd=root,
+                         capture_output=True, text=True)
+    dt = time.perf_counter() - t0
+    if run.returncode:
+        raise SystemExit(f"failed in {root}: {argv[-3:]}\n{run.stderr[-4000:]}")
+    return dt, (run.stdout.strip().splitlines() or [""])[-1]
 
 
-def _steady_rounds(rounds, repeats):
-    """Children of each kind in `STEADY_SETTINGS`, alternating:
-    {setting: {case: stats of the children's medians, with faults per run}}."""
-    samples = {k: [] for k in STEADY_SETTINGS}
+def _stats(samples):
+    return dict(median=statistics.median(samples), min=min(samples), max=max(samples), runs=len(samples),
+                samples=samples)
+
+
+def _git(*args, cwd=ROOT):
+    return subprocess.run(["git", *args], cwd=cwd, check=True, capture_output=True, text=True).stdout.strip()
+
+
+def _nb_files(tree):
+    return sorted(str(p.relative_to(tree)) for ext in ("nbi", "nbc") for p in (tree / "renderer").rglob(f"*.{ext}"))
+
+
+def measure(trees, repeats, quick):
+    """All the measurements, new and baseline alternating: a dict for render.json."""
+    res = {"numba cache files before": len(_nb_files(trees["new"]))}
+    def child(tree, mode, arg=""):
+        return json.loads(_process(trees[tree], [__file__, "--child", mode, str(trees[tree]), arg])[1])
+    fresh_runs, cold_runs, mem_runs, rounds = (3, 1, 1, 2) if quick else (5, 3, 3, 3)
+    # Fresh processes first, so that the first run meets the numba cache as it was found.
+    fresh = {k: [] for k in (*TREES, "python -c pass")}
+    for _ in range(fresh_runs):
+        for tree in TREES:
+            dt, where = _process(trees[tree], ["-c", FRESH, str(trees[tree])])
+            if not os.path.realpath(where).startswith(str(trees[tree]) + os.sep):
+                raise SystemExit(f"{tree}: renderer was imported from {where}")
+            fresh[tree].append(dt)
+        fresh["python -c pass"].append(_process(ROOT, ["-c", "pass"])[0])
+    res["fresh"] = {k: {"first": _stats(s[:1]), "warm": _stats(s[1:])} for k, s in fresh.items()}
+    cold, written = [], []
+    for _ in range(cold_runs):
+        with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache:
+            cold.append(_process(trees["new"], ["-c", FRESH, str(trees["new"])], NUMBA_CACHE_DIR=cache)[0])
+            written.append(sum(1 for p in Path(cache).rglob("*") if p.suffix in (".nbi", ".nbc")))
+    res["cold"] = _stats(cold) | {"cache files written": written}
+    samples = {t: {c: [] for c in CASES} for t in TREES}
     for _ in range(rounds):
-        for setting, var in STEADY_SETTINGS.items():
-            env = {k: v for k, v in os.environ.items() if k not in STEADY_SETTINGS.values()}
-            if var is not None:
-                env[var] = "0"
-            run = subprocess.run([sys.executable, __file__, "--steady-child", str(repeats)], env=env,
-                                 check=True, capture_output=True, text=True)
-            samples[setting].append(json.loads(run.stdout.strip().splitlines()[-1]))
-    res = {}
-    for setting, runs in samples.items():
-        res[setting] = {"applied": all(r["applied"] for r in runs),
-                        "worker processes": min(r["worker processes"] for r in runs)}
-        for name in STEADY_CASES:
-            res[setting][name] = _stats([r[name]["median"] for r in runs]) | {
-                "faults": statistics.median(r[name]["faults"] for r in runs)}
+        for case in CASES:
+            for tree in TREES:
+                samples[tree][case] += child(tree, "steady", f"{case}:{math.ceil(repeats / rounds)}")["samples"]
+    res["steady"] = {t: {c: _stats(s) for c, s in cs.items()} for t, cs in samples.items()}
+    mem = [{t: child(t, "maxrss") for t in TREES} for _ in range(mem_runs)]  # alternating
+    res["memory"] = {t: _stats([m[t]["beyond"] for m in mem]) | {k: [m[t][k] for m in mem] for k in mem[0][t]}
+                     for t in TREES}
+    res["tracemalloc"] = {t: child(t, "tracemalloc") for t in TREES}
+    res["numba cache files after"] = _nb_files(trees["new"])
     return res
 
 
+def _cell(st, scale, fmt, unit):
+    if st is None:
+        return "—"
+    spread = f" ({st['min'] * scale:{fmt}}–{st['max'] * scale:{fmt}})" if st["runs"] > 1 else ""
+    return f"{st['median'] * scale:{fmt}}{spread}{unit}"
+
+
+def report(res, info):
+    """The Markdown page."""
+    (new, base), fresh, mem = (res["steady"][t] for t in TREES), res["fresh"], res["memory"]
+    rows = [(name, new[name], base[name], 1e3, ".1f", " ms", target) for name, (_, _, target) in CASES.items()]
+    rows += [("fresh import + first 256² render, warm cache (runs 2–)", fresh["new"]["warm"],
+              fresh["baseline"]["warm"], 1, ".2f", " s", FRESH_TARGET),
+             ("the same, first run (cache as found)", fresh["new"]["first"], fresh["baseline"]["first"], 1, ".2f",
+              " s", None),
+             ("the same, empty NUMBA_CACHE_DIR (cold compile)", res["cold"], None, 1, ".2f", " s", None),
+             ("bare interpreter, python -c pass", fresh["python -c pass"]["warm"], None, 1e3, ".0f", " ms", None),
+             ("peak memory beyond the output, 4096² exact (ru_maxrss)", mem["new"], mem["baseline"], 2**-20, ".1f",
+              " MiB", MEMORY_TARGET)]
+    v = res["tracemalloc"]["new"]
+    lines = ["## Render benchmark: the working tree against the baseline", "",
+             f"* new: `{info['new']}`", f"* baseline: `{info['baseline']}`",
+             f"* machine: {info['cpu']}, {info['cores']}; Python {v['python']}, numpy {v['numpy']}, "
+             f"numba {v['numba'] or 'not loaded by the renderer'}", "",
+             f"Median (min–max).  Steady state: {new['exact 256²']['runs']} timed calls per case and renderer, "
+             "from alternating child processes, after warm-up.  Targets are judged on the new renderer's median.",
+             "", "| case | new median (min–max) | baseline median (min–max) | ratio baseline/new | target |",
+             "|---|---|---|---|---|"]
+    for name, st_new, st_base, scale, fmt, unit, target in rows:
+        ratio = f"{st_base['median'] / st_new['median']:.2f}" if st_base else "—"
+        goal = "—" if target is None else f"≤ {target * scale:g}{unit}: " + (
+            "met" if st_new["median"] <= target else "not met")
+        lines.append(f"| {name} | {_cell(st_new, scale, fmt, unit)} | {_cell(st_base, scale, fmt, unit)} | "
+                     f"{ratio} | {goal} |")
+    files, mib = res["numba cache files after"], lambda t, k: f"{max(mem[t][k]) / 2**20:.1f} MiB ({t})"
+    lines += ["", "* Fresh process: the parent's wall time around the child, interpreter start included.  "
+              "Cold compile: a new empty NUMBA_CACHE_DIR per run "
+              f"({', '.join(map(str, res['cold']['cache files written']))} *.nbi/*.nbc files written into it).",
+              f"* numba cache: numba.config.CACHE_DIR is {v.get('numba_cache_dir') or 'not set'}; *.nbi/*.nbc "
+              f"files under the new tree's renderer/: {res['numba cache files before']} before the first run, "
+              f"{len(files)} after, in {', '.join(sorted({str(Path(f).parent) for f in files})) or '—'}.",
+              f"* Memory: the 4096² Frame's arrays are {mem['new']['output'][0] / 2**20:.1f} MiB, of which pages "
+              f"never written (zeros, not resident) at most {mib('new', 'untouched')} and "
+              f"{mib('baseline', 'untouched')}; they are not subtracted (the ru_maxrss growth less all the output "
+              f"would be, median, {statistics.median(mem['new']['raw']) / 2**20:.1f} MiB (new) and "
+              f"{statistics.median(mem['baseline']['raw']) / 2**20:.1f} MiB (baseline)).  ru_maxrss counts the "
+              "rendering process only, not worker processes it may start; before the render it stood at most "
+              f"{mib('new', 'slack')} and {mib('baseline', 'slack')} above the resident set (growth it cannot "
+              "show).  tracemalloc's peak beyond the output (numpy's allocations only): "
+              + ", ".join(f"{t} {res['tracemalloc'][t]['beyond'] / 2**20:.1f} MiB" for t in TREES) + "."]
+    return "\n".join(lines) + "\n"
+
+
 def main(argv=None):
-    if argv is None and sys.argv[1:2] == ["--steady-child"]:
-        return _steady_child(int(sys.argv[2]))
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["--child"]:
+        return _child(*argv[1:4])
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=15, help="timed runs per cell at <= 256^2 (default 15)")
-    ap.add_argument("--max-size", type=int, default=4096, help="largest side (default 4096)")
-    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results")
+    ap.add_argument("--repeats", type=int, default=None, help="timed calls per steady-state case (default 15)")
+    ap.add_argument("--baseline", default="a35b7d1", help="the baseline commit (default a35b7d1)")
+    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results", help="benchmarks/results/")
+    ap.add_argument("--quick", action="store_true", help="fewer repeats and runs, for a smoke run")
+    ap.add_argument("--new-tree", type=Path, default=ROOT, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    if args.repeats < 1:
-        ap.error(f"--repeats must be >= 1, got {args.repeats}")
-    scene = Scene()
-    res = {"scaling": {}, "memory": {}, "worker processes": worker_processes.wait_ready()}
-
-    for size in [s for s in SIZES if s <= args.max_size]:
-        reps = args.repeats if size <= 256 else max(3, args.repeats // 3) if size <= 1024 else 3
-        fns = {p: (lambda p=p: render(scene, size, size, gradient=p)) for p in PIPELINES}
-        fns["exact, image only"] = lambda: render(scene, size, size, kink=False, grad=False)
-        if size <= 1024:
-            fns["exact, 1 thread"] = lambda: render(scene, size, size, workers=1)
-        for k, st in _interleaved(fns, reps).items():
-            res["scaling"][f"{k}@{size}"] = st
-        peak, held = _peak_working_bytes(lambda: render(scene, size, size, kink=False, grad=False))
-        res["memory"][size] = dict(peak=peak, output=held, per_pixel=peak / size**2)
-
-    ref = _interleaved({"reference exact": lambda: render_reference(scene, 64, 64, gradient="exact"),
-                        "numpy exact": lambda: render(scene, 64, 64),
-                        "reference central": lambda: render_reference(scene, 64, 64, gradient="central"),
-                        "numpy central": lambda: render(scene, 64, 64, gradient="central")}, 3)
-    res["reference"] = ref
-
-    def independent():
-        frames = [render(scene.replace(eps=e), 256, 256, gradient="central") for e in STEPS]
-        sym = render(scene, 256, 256)
-        return [compare(f, sym) for f in frames]
-
-    res["sweep"] = _interleaved({"sweep()": lambda: sweep(scene, STEPS, 256, 256),
-                                 "sweep(), 1 thread": lambda: sweep(scene, STEPS, 256, 256, workers=1),
-                                 "independent renders": independent}, 7)
-
-    gb = gbuffer(scene, 256, 256)
-    on_a = gb.chamber == 1
-    uu, vv = gb.uv[on_a, 0].copy(), gb.uv[on_a, 1].copy()
-    stage = {}
-    for field in ("sine", "ridges", "rings"):
-        st = _interleaved({
-            "exact": lambda f=field: fields.exact_gradient(f, uu, vv, 8.0, 4.0),
-            "central": lambda f=field: central_gradient(f, uu, vv, 8.0, 4.0, 1e-3)}, 25)
-        stage[field] = st | {"pixels": int(uu.size)}
-    res["gradient_stage"] = stage
-    res["steady"] = steady = _steady_rounds(STEADY_ROUNDS, args.repeats)
-
-    lines = ["## Scaling (default scene; ms, median and min-max)", "",
-             f"Tiles render on the calling thread and {res['worker processes']} worker process(es) "
-             f"(`renderer.workers`; {WORKERS} workers, the default here) unless stated.  Peak memory is "
-             "this process's (tracemalloc); a worker process holds one tile's temporaries and "
-             f"{worker_processes.SLOTS} tile slots of {worker_processes.PIXEL_BYTES} bytes per pixel "
-             f"({worker_processes.SLOTS * TILE_PIXELS * worker_processes.PIXEL_BYTES / 2**20:.2f} MiB).", "",
-             "| size | exact | central | exact, image only | exact, 1 thread | output MiB | peak MiB | "
-             "peak beyond the output, MiB |",
-             "|---|---|---|---|---|---|---|---|"]
-    for size in [s for s in SIZES if s <= args.max_size]:
-        cells = []
-        for k in ("exact", "central", "exact, image only", "exact, 1 thread"):
-            r = res["scaling"].get(f"{k}@{size}")
-            cells.append("—" if r is None else
-                         f"{1e3 * r['median']:.1f} ({1e3 * r['min']:.1f}-{1e3 * r['max']:.1f})")
-        m = res["memory"][size]
-        lines.append(f"| {size}² | " + " | ".join(cells) + f" | {m['output'] / 2**20:.1f} | "
-                     f"{m['peak'] / 2**20:.1f} | {(m['peak'] - m['output']) / 2**20:.1f} |")
-    lines += ["", "## Scalar per-pixel reference at 64² (same run)", "", "| pipeline | reference ms | numpy ms | speed-up |",
-              "|---|---|---|---|"]
-    for p in PIPELINES:
-        a, b = ref[f"reference {p}"]["median"], ref[f"numpy {p}"]["median"]
-        lines.append(f"| {p} | {1e3 * a:.0f} | {1e3 * b:.2f} | ×{a / b:.0f} |")
-    sw = res["sweep"]
-    lines += ["", "## 8-step ε sweep at 256², both pipelines and the census", "",
-              "| path | median ms | min-max ms |", "|---|---|---|"]
-    for k, r in sw.items():
-        lines.append(f"| {k} | {1e3 * r['median']:.0f} | {1e3 * r['min']:.0f}-{1e3 * r['max']:.0f} |")
-    lines += ["", "## Gradient stage over sphere A's pixels at 256² (µs)", "",
-              "| field | pixels | exact | one central difference | exact / central |", "|---|---|---|---|---|"]
-    for field, st in stage.items():
-        e, c = st["exact"]["median"], st["central"]["median"]
-        lines.append(f"| {field} | {st['pixels']} | {1e6 * e:.0f} ({1e6 * st['exact']['min']:.0f}-"
-                     f"{1e6 * st['exact']['max']:.0f}) | {1e6 * c:.0f} ({1e6 * st['central']['min']:.0f}-"
-                     f"{1e6 * st['central']['max']:.0f}) | {e / c:.2f} |")
-    def cell(st):
-        return f"{1e3 * st['median']:.1f} ({1e3 * st['min']:.1f}-{1e3 * st['max']:.1f})"
-
-    d, t, h = (steady[k] for k in STEADY_SETTINGS)
-    lines += ["", "## Steady state: worker processes, threads, and the allocator settings", "",
-              "Each case repeated back to back in a child process (the tables above "
-              "alternate their cases in one process, which here runs each 15-30 % slower). "
-              f"{len(STEADY_SETTINGS)} kinds of child, {STEADY_ROUNDS} of each, alternating: the defaults (the calling thread and "
-              f"{d['worker processes']} worker process(es), `renderer.workers`; the heap kept, "
-              "`renderer.heap`), threads only (SYMRENDER_WORKER_PROCESSES=0) and the heap left alone "
-              "(SYMRENDER_KEEP_HEAP=0).  Shown: the median of the children's medians (min-max), "
-              "and the minor page faults per run of this process (a worker's are its own).", "",
-              "| case | defaults, ms | faults/run | threads only, ms | threads / defaults | "
-              "heap left alone, ms | faults/run | left alone / defaults |",
-              "|---|---|---|---|---|---|---|---|"]
-    for name in STEADY_CASES:
-        lines.append(f"| {name} | {cell(d[name])} | {d[name]['faults']:.0f} | {cell(t[name])} | "
-                     f"{t[name]['median'] / d[name]['median']:.2f} | {cell(h[name])} | "
-                     f"{h[name]['faults']:.0f} | {h[name]['median'] / d[name]['median']:.2f} |")
-    lines += ["", "## Issue 6 targets (steady state, defaults: the table above)", "",
-              "| target | measured, median (min-max of the children) | met |", "|---|---|---|"]
-    kept = d
-    checks = [(f"{p} 256², ≤ 15 ms", kept[f"{p} 256²"], 0.015) for p in PIPELINES]
-    checks += [(f"{p} 1024², ≤ 250 ms", kept[f"{p} 1024²"], 0.25) for p in PIPELINES]
-    checks.append(("8-step ε sweep at 256², both pipelines and the census, ≤ 80 ms",
-                   kept["8-step ε sweep 256²"], 0.08))
-    for name, st, limit in checks:
-        lines.append(f"| {name} | {1e3 * st['median']:.1f} ({1e3 * st['min']:.1f}-{1e3 * st['max']:.1f}) ms | "
-                     f"{'yes' if st['median'] <= limit else 'no'} |")
-    text = "\n".join(lines) + "\n"
+    repeats = args.repeats or (4 if args.quick else 15)
+    if repeats < 1:
+        ap.error(f"--repeats must be >= 1, got {repeats}")
+    new = args.new_tree.resolve()
+    dirty = " + uncommitted changes in renderer/" if _git("status", "--porcelain", "--", "renderer", cwd=new) else ""
+    cpu = [ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")]
+    info = {"new": f"{new} at {_git('rev-parse', 'HEAD', cwd=new)}{dirty}", "cpu": (cpu or ["unknown CPU"])[0],
+            "cores": f"{os.cpu_count()} logical CPUs ({len(os.sched_getaffinity(0))} usable)"}
+    base = (tmp := Path(os.path.realpath(tempfile.mkdtemp(prefix="bench-render-")))) / "baseline"
+    _git("worktree", "add", "--detach", str(base), args.baseline)
+    try:
+        info["baseline"] = f"{args.baseline} = {_git('rev-parse', 'HEAD', cwd=base)}"
+        res = measure({"new": new, "baseline": base}, repeats, args.quick)
+    finally:
+        _git("worktree", "remove", "--force", str(base))
+        shutil.rmtree(tmp, ignore_errors=True)
+    res["info"] = info
+    text = report(res, info)
     print(text)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "render.md").write_text(text, encoding="utf-8")
-    (args.out / "render.json").write_text(json.dumps(res, indent=1, default=float), encoding="utf-8")
+    (args.out / "render.json").write_text(json.dumps(res, indent=1), encoding="utf-8")
 
 
 if __name__ == "__main__":
