@@ -66,8 +66,8 @@ KERNEL_DOMAIN = {F.beta: (0.0, 2.0), F.R: (0.5, 2.0), F.h: (-1.0, 1.0), F.h_u: (
 
 
 def _kernel_identities(coeffs):
-    return [Identity(r"b_u\ (	ext{surface})", coeffs[0], CHART_COEFFS[0], KERNEL_DOMAIN),
-            Identity(r"b_v\ (	ext{surface})", coeffs[1], CHART_COEFFS[1], KERNEL_DOMAIN)]
+    return [Identity(r"b_u\ (\text{surface})", coeffs[0], CHART_COEFFS[0], KERNEL_DOMAIN),
+            Identity(r"b_v\ (\text{surface})", coeffs[1], CHART_COEFFS[1], KERNEL_DOMAIN)]
 
 a, b = sp.symbols("a b", real=True)
 INSTANCE = {H: sp.Lambda((theta, phi), sp.sin(a * theta) * sp.cos(b * phi) + sp.sin(phi))}

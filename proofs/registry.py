@@ -1,10 +1,10 @@
 """All theorems of the chapter, by id."""
 
-from . import displacement, finite_difference, frame, gradients, kink_loci, kinks, no_boundary, normal
+from . import blinn, displacement, finite_difference, frame, gradients, kink_loci, kinks, no_boundary, normal
 
 #: id -> Theorem, in the order the chapter uses them.
 THEOREMS = {t.id: t for mod in (frame, gradients, kinks, kink_loci, no_boundary, normal,
-                                        finite_difference, displacement)
+                                        finite_difference, displacement, blinn)
             for t in mod.THEOREMS}
 
 
