@@ -116,27 +116,31 @@ def _fallback_orientation():
     return et.cross(ep).dot(sp.Matrix([0, 0, 1]))
 
 
-def _check_orientation() -> Verdict:
-    value = _orientation_value()
-    verdict = _orientation(e_theta, e_phi, value)
-    if value not in (1, -1):
-        return Verdict("refuted", f"(e_theta x e_phi) . N simplifies to {value}, not a sign")
-    return Verdict(verdict.status, f"(e_theta x e_phi) . N = {value} exactly: the frame is "
-                   f"{'right' if value == 1 else 'left'}-handed about the outward normal (the pole "
+#: What the theorem claims (e_theta x e_phi) . N is: the check compares the
+#: frame with this constant, not with its own simplification.
+CLAIMED_ORIENTATION = -1
+
+
+def _check_orientation(claimed=CLAIMED_ORIENTATION) -> Verdict:
+    verdict = _orientation(e_theta, e_phi, claimed)
+    if not verdict.holds:
+        return verdict
+    return Verdict(verdict.status, f"(e_theta x e_phi) . N = {claimed:+d}, the claimed value: the frame is "
+                   f"{'right' if claimed == 1 else 'left'}-handed about the outward normal (the pole "
                    f"fallback's is {int(_fallback_orientation()):+d} at the north pole); "
                    + verdict.evidence, verdict.residual, verdict.digits, verdict.points)
 
 
 FRAME_ORIENTATION = Theorem(
     id="frame-orientation", title="Orientation of the tangent frame",
-    statement=r"$(e_\theta \times e_\varphi)\cdot N = -1$: the pair $(e_\theta, e_\varphi)$ is "
+    statement=rf"$(e_\theta \times e_\varphi)\cdot N = {CLAIMED_ORIENTATION}$: the pair $(e_\theta, e_\varphi)$ is "
               r"left-handed about the outward normal, $e_\theta\times e_\varphi = -N$.",
     steps=((r"cross product", r"e_\theta\times e_\varphi", e_theta.cross(e_phi).applyfunc(sp.simplify)),
            (r"outward normal", "N", N),
            (r"orientation", r"(e_\theta\times e_\varphi)\cdot N", _orientation_value())),
     check=_check_orientation,
-    wrong_variants=(("the seed's reading: aligned with N (+1)",
-                     lambda: _orientation(e_theta, e_phi, 1)),),
+    wrong_variants=(("the seed's reading: aligned with N (+1)", lambda: _check_orientation(1)),
+                    ("the frame with e_theta and e_phi swapped", lambda: _orientation(e_phi, e_theta, -1))),
     pages=("s3", "s5"),
     seed_says="Cell 2 prints (e_theta x e_phi) . N and labels the frame 'unit, aligned with N'.",
 )
