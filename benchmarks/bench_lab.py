@@ -1,7 +1,7 @@
 """Time the computations of §5's lab cells: every code cell of book/s5_lab.md,
 run in order in one IPython shell (figures drawn with the Agg backend, not
 encoded), several times in fresh subprocesses; median and min-max per cell and
-in total.  Issue 6's target for the eight lab cells together is 3 s.
+in total, against a target of 3 s for the eight lab cells together.
 
 Usage: python benchmarks/bench_lab.py [--runs N] [--out DIR]
 """

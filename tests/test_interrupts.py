@@ -272,23 +272,18 @@ def test_importing_the_command_line_loads_no_numpy():
 # ------------------------------------------------------------------ commands at work
 
 
-def test_interrupt_during_render(tmp_path):
-    """Two 4096^2 frames: SIGINT once the compiled kernel's library is loaded.
-    A render under way finishes first (compiled code does not check for
-    signals); then no PNG and no temporary file."""
-    run = Run("render", "--size", "4096x4096", "-o", "big.png", cwd=tmp_path)
+@pytest.mark.parametrize("args", [
+    ("render", "--size", "4096x4096", "-o", "big.png"),                          # two 4096^2 frames
+    ("sweep", "--size", "2048x2048", "--eps", "1e-1:1e-6:6", "--format", "csv"),
+], ids=["render", "sweep"])
+def test_interrupt_during_render_or_sweep(tmp_path, args):
+    """SIGINT once the compiled kernel's library is loaded.  A render under
+    way finishes first (compiled code does not check for signals); then no
+    PNG and no temporary file."""
+    run = Run(*args, cwd=tmp_path)
     run.wait_until(lambda: run.maps("llvmlite"), 20, "numba being loaded")
     time.sleep(0.5)
-    assert run.proc.poll() is None, "the render ended before the interrupt; make it larger"
-    run.interrupt()
-    check(run, tmp_path, [])
-
-
-def test_interrupt_during_sweep(tmp_path):
-    run = Run("sweep", "--size", "2048x2048", "--eps", "1e-1:1e-6:6", "--format", "csv", cwd=tmp_path)
-    run.wait_until(lambda: run.maps("llvmlite"), 20, "numba being loaded")
-    time.sleep(0.5)
-    assert run.proc.poll() is None, "the sweep ended before the interrupt; make it larger"
+    assert run.proc.poll() is None, f"{args[0]} ended before the interrupt; make it larger"
     run.interrupt()
     check(run, tmp_path, [])
 
