@@ -62,7 +62,7 @@ def exact_gradient_array(field, u, v, k_u, k_v, out):
         out[0, i], out[1, i] = exact_gradient(field, u[i], v[i], k_u[i], k_v[i])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def central_gradient(field, u, v, k_u, k_v, eps_u, eps_v):
     if field == 0:  # sine
         u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))

@@ -2,30 +2,27 @@
 
 One pixel at a time, in the order of the data flow (seed Cell 1,
 ``render_numeric_bump``; the §4 simulator's renderer/js/render.js and the
-scalar reference of tests/ take the same steps):
-
-camera ray -> `nearest_hit` (chamber) -> `surface` (hit point, normal,
-albedo) -> on sphere A: `chart`, `tangent_frame`, `gradient`,
-`shading_normal` -> `shade`: ambient + per light, `reach` (the normal faces
-the light, the floor plane does not separate them, no blocker sphere on the
-segment) then Lambert and Blinn/Phong with the shading normal.
+scalar reference of tests/ take the same steps): camera ray -> `nearest_hit`
+(chamber) -> `surface` (hit point, normal, albedo) -> on sphere A: `chart`,
+`tangent_frame`, `gradient`, `shading_normal` -> `shade`: ambient + per
+light, `reach` (the normal faces the light, the floor plane does not
+separate them, no blocker sphere on the segment) then Lambert and
+Blinn/Phong with the shading normal.
 
 Everything up to the gradient depends on geometry alone (theorem "bump moves
 no boundary"), which licenses `sweep_rows`: geometry and shadow rays once per
 pixel, sphere A re-shaded per step.  Sphere A's formulas come from
 renderer/generated.py (`renderer.codegen` prints `renderer.formulas`).
-Compiled on first use, cached in ``__pycache__`` (or numba's user cache).
-numba's cache checks only the file of the function it compiled, so this
-file holds generated.py's SHA-256 (`FORMULAS_DIGEST`, written by the
-generator) and refuses to load beside a generated.py that does not match.
+Compiled on first use, cached in ``__pycache__`` (or numba's user cache);
+as that cache checks only the file of the function it compiled, this file
+holds generated.py's SHA-256 (`FORMULAS_DIGEST`) and refuses any other.
 Threads: see `_threading_layer`; `renderer.render` runs one call at a time.
 
 ``skip``: True does only the work the outputs need (an object that is off is
-not intersected; a shadow ray is traced only where the light could add
-light; at beta = 0 no gradient unless it is an output, as beta times any
-gradient is 0; the crease flag only when it is an output).  False does all
-of it and discards what is unused: the reference path of
-tests/test_skips.py, which shows both give the same bits.
+not intersected; a shadow ray only where the light could add light; at
+beta = 0 no gradient unless it is an output, as beta times any gradient is
+0).  False does all of it and discards what is unused: the reference path
+of tests/test_skips.py, which shows both give the same bits.
 """
 
 from __future__ import annotations
@@ -59,7 +56,6 @@ Params = namedtuple("Params", "camera_z radius_a center_b radius_b sphere_b floo
                               "albedo_b ka kd ks shininess phong floor_tint field k_u k_v beta surface")
 
 
-
 def _threading_layer():
     """numba's threading layer, unless NUMBA_THREADING_LAYER chose one: TBB (pip
     puts its library in <prefix>/lib, off the loader's path) survives a fork
@@ -79,18 +75,15 @@ def _threading_layer():
 
 _threading_layer()
 
-FORMULAS_DIGEST = "a6abdbc422bd2f4c02e0569318eafc99bde9dd2d9e35d33afdbb8231b53f9994"  # of generated.py, written by renderer/codegen.py
+FORMULAS_DIGEST = "f1242c2779f566abdd5b06780eac20c047d2c7d070b352427ab8e3bfa15efac8"  # of generated.py, written by renderer/codegen.py
 if hashlib.sha256(Path(__file__).with_name("generated.py").read_bytes()).hexdigest() != FORMULAS_DIGEST:
     raise ImportError("renderer/generated.py does not match the digest kernel.py holds: it was edited by "
                       "hand or not regenerated; run python -m renderer.codegen")
 
 
-# ---- the kernel's own steps: intersection, shadows, shading ---------------------
-
 @njit(cache=True, error_model="numpy")
 def sphere_hit(x, y, e, cx, cy, cz, r):
     """Nearest t > 0 of the ray E + t (x, y, -e), E = (0, 0, e), on a sphere, or inf.
-
     Stable roots q = -(b + sign(b) sqrt(disc)), t = q / a, c / q (pbrt-v4); the
     discriminant from the centre's distance to the ray's line (Haines et al.,
     Ray Tracing Gems, ch. 7), free of the cancellation of b^2 - a c.
@@ -113,7 +106,6 @@ def sphere_hit(x, y, e, cx, cy, cz, r):
 @njit(cache=True, error_model="numpy")
 def segment_blocked(wx, wy, wz, w2, L, cx, cy, cz, r):
     """Does the segment from P to the light L meet the sphere (C, r)?  w = L - P.
-
     With d = C - L and g = -(w . d): a root of |L + tau (P - L) - C| = r lies in
     (0, 1) exactly when g^2 >= |w|^2 (|d|^2 - r^2) and 0 < g < |w|^2 (light
     outside the sphere); a light inside is blocked from every outside point;
@@ -129,7 +121,7 @@ def segment_blocked(wx, wy, wz, w2, L, cx, cy, cz, r):
     return g > 0.0 and g < w2 and g * g >= w2 * k
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def nearest_hit(s, x, y, skip):
     """(t, chamber) of the nearest positive hit; ties go to A, then B, then the floor."""
     t = sphere_hit(x, y, s.camera_z, 0.0, 0.0, 0.0, s.radius_a)
@@ -162,13 +154,7 @@ def surface(s, x, y, t, code, checker):
     return P, (0.0, 0.0, 1.0), (rg, rg, base)
 
 
-@njit(cache=True, error_model="numpy")
-def light(lights, k):
-    """Position and colour of light k, as two triples (scalar reads: no array views)."""
-    return (lights[k, 0], lights[k, 1], lights[k, 2]), (lights[k, 3], lights[k, 4], lights[k, 5])
-
-
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def reach(s, L, P, N, code, skip, gate, Ns):
     """Unit vector w from P to the light L and whether the light reaches P:
     the geometric normal faces it (attached shadow), the floor plane does not
@@ -238,13 +224,13 @@ def light_term(s, color, w, axis, wv, Ns, albedo):
             color[2] * (diffuse * albedo[2] + spec))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def shade(s, lights, P, N, Ns, albedo, code, skip):
     """Ambient plus every light that reaches P (seed Cell 1, ``shade1``): (r, g, b) clipped to [0, 1]."""
     r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
     view = (0.0, 0.0, 0.0)
     for k in range(lights.shape[0]):
-        L, color = light(lights, k)
+        L, color = (lights[k, 0], lights[k, 1], lights[k, 2]), (lights[k, 3], lights[k, 4], lights[k, 5])
         w, lit = reach(s, L, P, N, code, skip, skip, Ns)
         if lit:
             if view[2] == 0.0:          # > 0 once computed: P is below the eye
@@ -255,17 +241,18 @@ def shade(s, lights, P, N, Ns, albedo, code, skip):
     return min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0), min(max(b, 0.0), 1.0)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi):
-    """(h_u, h_v) by ``method``: exact, central with step eps, or central with
-    the pixel's footprint as steps (pixel spacing dx, dy)."""
+    """(h_u, h_v, crease flag) by ``method``: exact, central with step eps, or
+    central with the pixel's footprint as steps (pixel spacing dx, dy).  The
+    flag is taken beside the gradient, so that LLVM shares their sines."""
     if method == EXACT:
-        return exact_gradient(s.field, u, v, s.k_u, s.k_v)
-    if method == CENTRAL:
-        return central_gradient(s.field, u, v, s.k_u, s.k_v, eps, eps)
-    eu, ev = footprint(x, y, dx, dy, s.camera_z, P[0], P[1], P[2], N[0], N[1], N[2],
-                       frame[0], frame[1], frame[2], frame[3], frame[4], frame[5], s.radius_a, sin_phi)
-    return central_gradient(s.field, u, v, s.k_u, s.k_v, eu, ev)
+        return exact_gradient(s.field, u, v, s.k_u, s.k_v) + (kink_band(s.field, u, v, s.k_u, s.k_v),)
+    eu = ev = eps
+    if method == FOOTPRINT:
+        eu, ev = footprint(x, y, dx, dy, s.camera_z, P[0], P[1], P[2], N[0], N[1], N[2],
+                           frame[0], frame[1], frame[2], frame[3], frame[4], frame[5], s.radius_a, sin_phi)
+    return central_gradient(s.field, u, v, s.k_u, s.k_v, eu, ev) + (kink_band(s.field, u, v, s.k_u, s.k_v),)
 
 
 @njit(cache=True, error_model="numpy")
@@ -282,8 +269,7 @@ def shading_normal(s, N, frame, hu, hv, u, v, sin_phi):
 @njit(cache=True, error_model="numpy", parallel=True)
 def render_rows(prm, lights, xs, ys, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
                 image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out):
-    """Render every pixel (rows in parallel) into the preallocated outputs.
-
+    """Render every pixel (rows in parallel) into the preallocated outputs:
     xs (W,), ys (H,): pixel centres on the image plane; image (H, W, 3),
     chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2) when wanted;
     t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) when ``want_geo`` (the GBuffer);
@@ -291,90 +277,104 @@ def render_rows(prm, lights, xs, ys, dx, dy, method, eps, skip, want_kink, want_
     """
     sin_x = np.sin(np.pi * xs)
     for j in prange(ys.shape[0]):
-        s, sin_y = unpack(prm), math.sin(math.pi * ys[j])
-        for i in range(xs.shape[0]):
-            x, y = xs[i], ys[j]
-            t, code = nearest_hit(s, x, y, skip)
-            chamber[j, i] = code
+        render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
+                   image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out)
+
+
+# A row is a function of its own: numba's parallel loop cannot take the
+# steps inlined (inline="always", 1.3x: LLVM leaves them as calls).
+@njit(cache=True, error_model="numpy")
+def render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
+               image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out):
+    """Row j of `render_rows`."""
+    s, y, sin_y = unpack(prm), ys[j], math.sin(math.pi * ys[j])
+    for i in range(xs.shape[0]):
+        x = xs[i]
+        t, code = nearest_hit(s, x, y, skip)
+        chamber[j, i] = code
+        if want_geo:
+            t_out[j, i] = t
+        if code == BACKGROUND:
+            continue
+        P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
+        Ns = N
+        if code == SPHERE_A:
+            u, v, sin_phi = chart(N[0], N[1], N[2])
+            frame = tangent_frame(N[0], N[1], N[2], sin_phi)
+            hu, hv, flag = 0.0, 0.0, False
+            if want_grad or want_geo or s.beta != 0.0 or not skip:
+                hu, hv, flag = gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
+            elif want_kink:
+                flag = kink_band(s.field, u, v, s.k_u, s.k_v)
+            Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
+            if want_grad:
+                grad[j, i, 0], grad[j, i, 1] = hu, hv
+            if want_kink:
+                kink[j, i] = flag
             if want_geo:
-                t_out[j, i] = t
-            if code == BACKGROUND:
-                continue
-            P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
-            Ns = N
-            if code == SPHERE_A:
-                u, v, sin_phi = chart(N[0], N[1], N[2])
-                frame = tangent_frame(N[0], N[1], N[2], sin_phi)
-                hu, hv = 0.0, 0.0
-                if want_grad or want_geo or s.beta != 0.0 or not skip:
-                    hu, hv = gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
-                    if want_grad:
-                        grad[j, i, 0], grad[j, i, 1] = hu, hv
-                Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
-                if want_kink or not skip:
-                    flag = kink_band(s.field, u, v, s.k_u, s.k_v)
-                    if want_kink:
-                        kink[j, i] = flag
-                if want_geo:
-                    uv_out[j, i, 0], uv_out[j, i, 1] = u, v
-            image[j, i, 0], image[j, i, 1], image[j, i, 2] = shade(s, lights, P, N, Ns, albedo, code, skip)
-            for c in range(3):
-                if want_geo:
-                    P_out[j, i, c], N_out[j, i, c], Ns_out[j, i, c] = P[c], N[c], Ns[c]
+                uv_out[j, i, 0], uv_out[j, i, 1] = u, v
+        image[j, i, 0], image[j, i, 1], image[j, i, 2] = shade(s, lights, P, N, Ns, albedo, code, skip)
+        for c in range(3 if want_geo else 0):
+            P_out[j, i, c], N_out[j, i, c], Ns_out[j, i, c] = P[c], N[c], Ns[c]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
     """The exact frame (index 0) and one central frame per step (1, 2, ...).
-
     Per pixel the geometry, the crease flag and the shadow rays are computed
     once (they do not depend on the gradient); sphere A is re-shaded per step.
     images (S+1, H, W, 3), grads (S+1, H, W, 2); chamber, kink (H, W).
     The caller allocates the outputs with these shapes (nothing is checked here).
     """
-    n, sin_x = lights.shape[0], np.sin(np.pi * xs)
+    sin_x = np.sin(np.pi * xs)
     for j in prange(ys.shape[0]):
-        s, sin_y = unpack(prm), math.sin(math.pi * ys[j])
-        # Per light: the unit vector w to it, its specular axis and w . v, and
-        # whether it reaches the pixel (1.0) or not (0.0).
-        geo = np.zeros((n, 8))
-        for i in range(xs.shape[0]):
-            x, y = xs[i], ys[j]
-            t, code = nearest_hit(s, x, y, True)
-            chamber[j, i] = code
-            if code == BACKGROUND:
-                continue
-            P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
-            if code != SPHERE_A:
-                rgb = shade(s, lights, P, N, N, albedo, code, True)
-                for f in range(images.shape[0]):
-                    images[f, j, i, 0], images[f, j, i, 1], images[f, j, i, 2] = rgb
-                continue
-            u, v, sin_phi = chart(N[0], N[1], N[2])
-            frame = tangent_frame(N[0], N[1], N[2], sin_phi)
-            kink[j, i] = kink_band(s.field, u, v, s.k_u, s.k_v)
-            view = view_vector(s, P)
-            for k in range(n):
-                # Every shadow ray of an attached light, once (Ns varies with the step).
-                w, lit = reach(s, light(lights, k)[0], P, N, code, True, False, N)
-                axis, wv = specular_axis(s, w, view)
-                geo[k, 0], geo[k, 1], geo[k, 2], geo[k, 3], geo[k, 4], geo[k, 5] = w + axis
-                geo[k, 6], geo[k, 7] = wv, 1.0 if lit else 0.0
+        sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads)
+
+
+@njit(cache=True, error_model="numpy")
+def sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads):
+    """Row j of `sweep_rows`."""
+    s, y, sin_y, n = unpack(prm), ys[j], math.sin(math.pi * ys[j]), lights.shape[0]
+    # Per light: the unit vector w to it, its specular axis and w . v, and
+    # whether it reaches the pixel (1.0) or not (0.0).
+    geo = np.zeros((n, 8))
+    for i in range(xs.shape[0]):
+        x = xs[i]
+        t, code = nearest_hit(s, x, y, True)
+        chamber[j, i] = code
+        if code == BACKGROUND:
+            continue
+        P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
+        if code != SPHERE_A:
+            rgb = shade(s, lights, P, N, N, albedo, code, True)
             for f in range(images.shape[0]):
-                if f == 0:
-                    hu, hv = exact_gradient(s.field, u, v, s.k_u, s.k_v)
-                else:
-                    hu, hv = central_gradient(s.field, u, v, s.k_u, s.k_v, steps[f - 1], steps[f - 1])
-                Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
-                r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
-                for k in range(n):
-                    if geo[k, 7] != 0.0:
-                        dr, dg, db = light_term(s, light(lights, k)[1], (geo[k, 0], geo[k, 1], geo[k, 2]),
-                                                (geo[k, 3], geo[k, 4], geo[k, 5]), geo[k, 6], Ns, albedo)
-                        r, g, b = r + dr, g + dg, b + db
-                images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0)
-                images[f, j, i, 2] = min(max(b, 0.0), 1.0)
-                grads[f, j, i, 0], grads[f, j, i, 1] = hu, hv
+                images[f, j, i, 0], images[f, j, i, 1], images[f, j, i, 2] = rgb
+            continue
+        u, v, sin_phi = chart(N[0], N[1], N[2])
+        frame = tangent_frame(N[0], N[1], N[2], sin_phi)
+        view = view_vector(s, P)
+        for k in range(n):
+            # Every shadow ray of an attached light, once (Ns varies with the step).
+            w, lit = reach(s, (lights[k, 0], lights[k, 1], lights[k, 2]), P, N, code, True, False, N)
+            axis, wv = specular_axis(s, w, view)
+            geo[k, 0], geo[k, 1], geo[k, 2], geo[k, 3], geo[k, 4], geo[k, 5] = w + axis
+            geo[k, 6], geo[k, 7] = wv, 1.0 if lit else 0.0
+        for f in range(images.shape[0]):
+            method, eps = (EXACT, 0.0) if f == 0 else (CENTRAL, steps[f - 1])
+            hu, hv, flag = gradient(s, method, eps, u, v, x, y, 0.0, 0.0, P, N, frame, sin_phi)
+            if f == 0:
+                kink[j, i] = flag
+            Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
+            r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
+            for k in range(n):
+                if geo[k, 7] != 0.0:
+                    color = (lights[k, 3], lights[k, 4], lights[k, 5])
+                    dr, dg, db = light_term(s, color, (geo[k, 0], geo[k, 1], geo[k, 2]),
+                                            (geo[k, 3], geo[k, 4], geo[k, 5]), geo[k, 6], Ns, albedo)
+                    r, g, b = r + dr, g + dg, b + db
+            images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0)
+            images[f, j, i, 2] = min(max(b, 0.0), 1.0)
+            grads[f, j, i, 0], grads[f, j, i, 1] = hu, hv
 
 
 def params(scene, skip=True):

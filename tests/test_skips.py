@@ -2,10 +2,10 @@
 
 `renderer.kernel` skips work the outputs do not need (its docstring lists
 the skips): an object that is off is not intersected; a shadow ray is traced
-only where Ns . w > 0; at beta = 0 no gradient unless grad is an output; the
-crease flag only when it is an output; `kernel.params` drops lights of zero
-colour.  ``render(..., skip=False)`` is the reference path that does all of
-it.  Checked here, each against a wrong variant:
+only where Ns . w > 0; at beta = 0 no gradient unless grad is an output, and
+no crease flag unless kink is; `kernel.params` drops lights of zero colour.
+``render(..., skip=False)`` is the reference path that does all of it.
+Checked here, each against a wrong variant:
 
 * over a grid of scenes x gradient methods x output flags, the two paths
   give the same bytes (image, chamber, kink, grad);
