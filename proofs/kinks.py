@@ -9,7 +9,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Identity, identities_theorem
+from .core import Identity, Theorem, check_identities
 
 u, v = F.u, F.v
 #: The frequencies are positive in the scene (Scene validates k_u, k_v > 0): the
@@ -61,19 +61,22 @@ s1_hand, s2_hand = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
 JUMP_U = 2 * sp.pi * k_u * sp.Abs(s2_hand)
 JUMP_V = 2 * sp.pi * k_v * sp.Abs(s1_hand)
 
-RIDGES_KINKS = identities_theorem(
-    "ridges-kinks", "The creases of the ridges field",
-    r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
-    r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
-    r"(`RIDGE_FACTORS`) is "
-    r"differentiable wherever $s_1 s_2 \ne 0$, with gradient $\operatorname{sign}(s_1 s_2)\,\nabla(s_1 s_2)$. "
-    r"On the zero line $u = m/k_u$ the one-sided derivatives in $u$ differ by "
-    r"$2\pi k_u \lvert\sin\pi k_v v\rvert$, and on $v = m/k_v$ those in $v$ by "
-    r"$2\pi k_v \lvert\sin\pi k_u u\rvert$: a crease wherever the other factor is nonzero. "
-    r"The renderer's crease flag (`KINK_BAND`) is set on every zero line.",
-    _identities(JUMP_U, JUMP_V),
-    [("jump without the factor 2", _identities(sp.pi * k_u * sp.Abs(s2_hand), JUMP_V)),
-     ("jump with the roles of k_u and k_v swapped", _identities(2 * sp.pi * k_v * sp.Abs(s2_hand), JUMP_V))],
+RIDGES_KINKS = Theorem(
+    id="ridges-kinks", title="The creases of the ridges field",
+    statement=r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
+              r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
+              r"(`RIDGE_FACTORS`) is "
+              r"differentiable wherever $s_1 s_2 \ne 0$, with gradient $\operatorname{sign}(s_1 s_2)\,\nabla(s_1 s_2)$. "
+              r"On the zero line $u = m/k_u$ the one-sided derivatives in $u$ differ by "
+              r"$2\pi k_u \lvert\sin\pi k_v v\rvert$, and on $v = m/k_v$ those in $v$ by "
+              r"$2\pi k_v \lvert\sin\pi k_u u\rvert$: a crease wherever the other factor is nonzero. "
+              r"The renderer's crease flag (`KINK_BAND`) is set on every zero line.",
+    # The identities take one-sided limits: built when checked, not on import.
+    check=lambda: check_identities(_identities(JUMP_U, JUMP_V)),
+    wrong_variants=(
+        ("jump without the factor 2", lambda: check_identities(_identities(sp.pi * k_u * sp.Abs(s2_hand), JUMP_V))),
+        ("jump with the roles of k_u and k_v swapped",
+         lambda: check_identities(_identities(2 * sp.pi * k_v * sp.Abs(s2_hand), JUMP_V)))),
     steps=((r"one-sided", r"(h_u^+, h_u^-)\big|_{u = 1/k_u}", sp.Tuple(*one_sided(h, u, 1 / k_u))),
            (r"h_u^+ - h_u^-", r"h_u^+ - h_u^-", JUMP_U),
            (r"h_v^+ - h_v^-", r"h_v^+ - h_v^-", JUMP_V),
