@@ -4,33 +4,55 @@ A code cell displays ``Markdown(theorem_block("frame-orthonormal"))``; myst-nb
 parses the output as MyST (``nb_render_markdown_format: myst``), so the
 statement and the argument shown are the proof object's, and the badge is the
 verdict its check returned during this build.  A theorem that does not hold
-raises, and the cell error fails the build.
+raises, and the cell error fails the build.  Each theorem's check runs once
+per build: its entry is a measurement of `proofs.store`, which later pages
+(§6's ledger) read.
 """
 
 from __future__ import annotations
 
+from . import store
 from .core import step_latex
-from .registry import THEOREMS, get
 
-__all__ = ["theorem_block", "ledger_table", "TheoremFailed"]
+__all__ = ["theorem_block", "ledger_table", "ledger", "TheoremFailed"]
 
 BADGES = {"proved": "PROVED", "verified": "VERIFIED numerically", "refuted": "REFUTED"}
-_VERDICTS = {}
 
 
 class TheoremFailed(AssertionError):
     """A theorem the book relies on did not hold during the build."""
 
 
-def verdict(theorem_id):
-    """The theorem's verdict, computed once per build (per kernel)."""
-    if theorem_id not in _VERDICTS:
-        _VERDICTS[theorem_id] = get(theorem_id).check()
-    return _VERDICTS[theorem_id]
+def _entry(t):
+    v = t.check()
+    steps = "\n".join(f"- $\\displaystyle {step_latex(step)}$" for step in t.steps)
+    evidence = v.evidence.replace("$", "")
+    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement}\n\n"
+             f"**{BADGES[v.status]}** (`{t.id}`): {evidence}\n:::\n\n"
+             f":::{{prf:proof}}\n{steps}\n\nThe check: every identity above is decided by sympy "
+             f"(or, failing that, evaluated with mpmath), and a wrong variant "
+             f"({t.wrong_variants[0][0]}) is refuted by the same check.\n:::\n")
+    return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
+                pages=list(t.pages), block=block)
 
 
-def theorem_block(theorem_id, *, label_prefix="thm-"):
-    """MyST markdown: a prf:theorem with statement and badge, and a prf:proof with the steps.
+def _ledger():
+    from .registry import THEOREMS
+    return {theorem_id: _entry(t) for theorem_id, t in THEOREMS.items()}
+
+
+def ledger():
+    """{theorem id: entry} for every theorem, in the registry's order; an entry
+    holds the title, the verdict (``status``, ``evidence``), what the draft
+    says, the pages and the MyST ``block``.  One measurement of the build
+    (`proofs.store`): every check runs once, in the first page that needs
+    any, and the later pages read the verdicts it reached."""
+    return store.measured("theorem-ledger", _ledger)
+
+
+def theorem_block(theorem_id):
+    """MyST markdown: a prf:theorem (label ``thm-<id>``) with statement and
+    badge, and a prf:proof with the steps.
 
     Raises
     ------
@@ -39,26 +61,21 @@ def theorem_block(theorem_id, *, label_prefix="thm-"):
     KeyError
         If the id is unknown.
     """
-    t = get(theorem_id)
-    v = verdict(theorem_id)
-    if not v.holds:
-        raise TheoremFailed(f"{theorem_id} is {v.status}: {v.evidence}")
-    steps = "\n".join(f"- $\\displaystyle {step_latex(step)}$" for step in t.steps)
-    evidence = v.evidence.replace("$", "")
-    return (f":::{{prf:theorem}} {t.title}\n:label: {label_prefix}{theorem_id}\n\n{t.statement}\n\n"
-            f"**{BADGES[v.status]}** (`{theorem_id}`): {evidence}\n:::\n\n"
-            f":::{{prf:proof}}\n{steps}\n\nThe check: every identity above is decided by sympy "
-            f"(or, failing that, evaluated with mpmath), and a wrong variant "
-            f"({t.wrong_variants[0][0]}) is refuted by the same check.\n:::\n")
+    entries = ledger()
+    if theorem_id not in entries:
+        raise KeyError(f"no theorem {theorem_id!r}")
+    entry = entries[theorem_id]
+    if entry["status"] not in ("proved", "verified"):
+        raise TheoremFailed(f"{theorem_id} is {entry['status']}: {entry['evidence']}")
+    return entry["block"]
 
 
 def ledger_table():
     """Markdown table of every theorem: id, verdict, evidence, the pages using it."""
     rows = ["| theorem | verdict | evidence | the draft says | used on |", "|---|---|---|---|---|"]
-    for theorem_id, t in THEOREMS.items():
-        v = verdict(theorem_id)
-        pages = ", ".join(f"{{ref}}`{p}`" for p in t.pages)
-        rows.append(f"| {{prf:ref}}`{t.title} <thm-{theorem_id}>` (`{theorem_id}`) | "
-                    f"{BADGES[v.status]} | {v.evidence.replace('|', '/')} | "
-                    f"{t.seed_says.replace('|', '/') or '—'} | {pages} |")
+    for theorem_id, e in ledger().items():
+        pages = ", ".join(f"{{ref}}`{p}`" for p in e["pages"])
+        rows.append(f"| {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`) | "
+                    f"{BADGES[e['status']]} | {e['evidence'].replace('|', '/')} | "
+                    f"{e['seed_says'].replace('|', '/') or '—'} | {pages} |")
     return "\n".join(rows)

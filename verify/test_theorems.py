@@ -6,6 +6,8 @@ variant (a flipped sign, a dropped factor, a wrong exponent) must be refuted:
 the checker has teeth.
 """
 
+import dataclasses
+
 import pytest
 
 from proofs.registry import THEOREMS, get
@@ -43,12 +45,19 @@ def test_registry_names_unknown_ids():
 
 def test_book_block_refuses_a_failing_theorem(monkeypatch):
     """A theorem that does not hold fails the build (the cell raises)."""
-    from proofs import book
+    from proofs import book, registry
     from proofs.core import Verdict
-    monkeypatch.setitem(book._VERDICTS, "optimal-step", Verdict("refuted", "forced for the test"))
+    refuted = dataclasses.replace(get("optimal-step"), check=lambda: Verdict("refuted", "forced for the test"))
+    monkeypatch.setattr(registry, "THEOREMS", {"optimal-step": refuted,
+                                               "frame-orthonormal": get("frame-orthonormal")})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
     with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
         book.theorem_block("optimal-step")
     assert "PROVED" in book.theorem_block("frame-orthonormal")
+    assert "REFUTED" in book.ledger_table()
+    with pytest.raises(KeyError, match="no theorem 'no-such'"):
+        book.theorem_block("no-such")
 
 
 def test_undecided_identity_is_verified_numerically(monkeypatch):

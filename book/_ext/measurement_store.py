@@ -1,0 +1,24 @@
+"""Sphinx extension: the pages of one build share one store of measurements.
+
+Sets ``SYMRENDER_STORE`` (`proofs.store.ENV`) to ``<build dir>/.measurements``
+unless it is set already; the kernels myst-nb starts for the pages inherit it,
+so a quantity shown on several pages (a theorem's verdict) is computed by the
+first page that needs it and read by the others (`proofs.store.measured`).
+``make clean`` removes it with the rest of the build.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from proofs.store import ENV
+
+
+def _set_store(app, config):
+    os.environ.setdefault(ENV, str(Path(app.outdir).parent / ".measurements"))
+
+
+def setup(app):
+    app.connect("config-inited", _set_store)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}

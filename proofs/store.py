@@ -1,0 +1,116 @@
+"""The build's measurements: each computed once, then read by every page that shows it.
+
+The book's pages run in separate kernels, one after another.  A quantity two
+pages show (a theorem's verdict, say) is computed by the first page that asks
+for it and written to the store; later pages read the same value instead of
+computing their own, so the pages cannot disagree and the build pays once.
+
+The store is a directory named by the environment variable ``SYMRENDER_STORE``
+(the book's build sets it to ``book/_build/.measurements``, see
+book/_ext/measurement_store.py); without it, values are kept for the life of
+the process only.  Each measurement is one JSON file, ``<name>.json``, holding
+its parameters, its value and the digest of what it was computed from: every
+file of renderer/ and proofs/ and the versions of the numerical libraries.  A
+stored value whose parameters or digest differ is computed again, so an edit
+to the code never shows a stale number.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import tempfile
+from importlib import metadata
+from pathlib import Path
+
+__all__ = ["ENV", "measured", "source_digest"]
+
+#: Environment variable naming the store's directory.
+ENV = "SYMRENDER_STORE"
+#: The packages whose files a measurement may depend on, and the libraries whose versions it may.
+PACKAGES = ("renderer", "proofs")
+LIBRARIES = ("numpy", "sympy", "mpmath", "numba", "llvmlite")
+_NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,99}")
+_MEMORY = {}
+_DIGEST = []
+
+
+def source_digest():
+    """SHA-256 (hex str) of every file of renderer/ and proofs/ (their paths and
+    bytes, __pycache__ left out) and the versions of `LIBRARIES`; computed
+    once per process."""
+    if not _DIGEST:
+        h = hashlib.sha256()
+        root = Path(__file__).resolve().parents[1]
+        for package in PACKAGES:
+            for path in sorted((root / package).rglob("*")):
+                if path.is_file() and "__pycache__" not in path.parts:
+                    h.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes() + b"\0")
+        for name in LIBRARIES:
+            h.update(f"{name}=={metadata.version(name)}\0".encode())
+        _DIGEST.append(h.hexdigest())
+    return _DIGEST[0]
+
+
+def measured(name, compute, **params):
+    """The value of the measurement ``name``: ``compute(**params)`` once per build.
+
+    Parameters
+    ----------
+    name : str
+        Lower-case letters, digits, ``_ . -``; at most 100 characters (it names a file).
+    compute : callable
+        Called with ``params`` when the store has no value for them; must return
+        a value JSON can hold (numbers, strings, lists, dicts with str keys):
+        it is returned as it reads back from JSON (tuples become lists).
+    **params
+        JSON-able parameters (scene, resolution, ...), stored beside the value.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is not of that form.
+    TypeError
+        The value or the parameters are not JSON-able (nothing is written).
+    """
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise ValueError(f"name must be 1-100 characters of a-z 0-9 _ . - starting with a letter or digit, "
+                         f"got {name!r}")
+    key = json.dumps(params, sort_keys=True)
+    if (name, key) in _MEMORY:
+        return _MEMORY[name, key]
+    directory = os.environ.get(ENV)
+    path = Path(directory, f"{name}.json") if directory else None
+    record = _read(path)
+    if record is not None and record.get("digest") == source_digest() and record.get("params") == json.loads(key):
+        value = record["value"]
+    else:
+        value = json.loads(json.dumps(compute(**params)))
+        if path is not None:
+            _write(path, {"name": name, "params": json.loads(key), "digest": source_digest(), "value": value})
+    _MEMORY[name, key] = value
+    return value
+
+
+def _read(path):
+    if path is None or not path.is_file():
+        return None
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None                      # unreadable: computed again and replaced
+
+
+def _write(path, record):
+    """Write ``record`` to ``path`` atomically (a temporary file, then a rename)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            json.dump(record, f)             # key order kept: a dict reads back as written
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise

@@ -1,0 +1,113 @@
+"""`proofs.store`: a measurement is computed once per build and read back by later pages.
+
+The pages of the book run in separate processes; here a second process is
+played by clearing the store's in-process memory (`_MEMORY`).  Each check is
+shown failing on a wrong variant of the store.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from proofs import store
+
+
+@pytest.fixture
+def fresh(tmp_path, monkeypatch):
+    """An empty store directory and an empty process memory; returns a counter of computations."""
+    monkeypatch.setenv(store.ENV, str(tmp_path))
+    monkeypatch.setattr(store, "_MEMORY", {})
+    calls = []
+
+    def compute(**params):
+        calls.append(params)
+        return {"value": 0.1 + 0.2, "params": params}
+    return tmp_path, calls, compute
+
+
+def _new_process(monkeypatch):
+    monkeypatch.setattr(store, "_MEMORY", {})
+
+
+def test_a_second_process_reads_the_first_ones_value(fresh, monkeypatch):
+    directory, calls, compute = fresh
+    first = store.measured("u-curve", compute, size=256)
+    _new_process(monkeypatch)
+    second = store.measured("u-curve", compute, size=256)
+    assert first == second == {"value": 0.1 + 0.2, "params": {"size": 256}}   # floats round-trip exactly
+    assert len(calls) == 1
+    record = json.loads((directory / "u-curve.json").read_text())
+    assert record["params"] == {"size": 256} and record["digest"] == store.source_digest()
+
+
+def test_other_parameters_or_another_digest_compute_again(fresh, monkeypatch):
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    _new_process(monkeypatch)
+    store.measured("u-curve", compute, size=128)
+    assert len(calls) == 2
+    _new_process(monkeypatch)
+    monkeypatch.setattr(store, "_DIGEST", ["a different source tree"])
+    store.measured("u-curve", compute, size=128)
+    assert len(calls) == 3
+
+
+def test_the_digest_follows_the_source_files(tmp_path, monkeypatch):
+    """A changed byte in any file of renderer/ or proofs/ changes the digest."""
+    for package in store.PACKAGES:
+        (tmp_path / package).mkdir()
+        (tmp_path / package / "a.py").write_text("x = 1\n")
+    monkeypatch.setattr(store, "__file__", str(tmp_path / "proofs" / "store.py"))
+    monkeypatch.setattr(store, "_DIGEST", [])
+    before = store.source_digest()
+    (tmp_path / "renderer" / "a.py").write_text("x = 2\n")
+    monkeypatch.setattr(store, "_DIGEST", [])
+    assert store.source_digest() != before
+
+
+def test_the_check_rejects_a_store_that_ignores_the_digest(fresh, monkeypatch):
+    """A wrong store that trusts any record of the right name and parameters
+    serves the old value after an edit: the count the test above asserts
+    (computed again) would not be reached."""
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    _new_process(monkeypatch)
+    monkeypatch.setattr(store, "_DIGEST", ["edited"])
+    monkeypatch.setattr(store, "_read", lambda path: {**json.loads(path.read_text()), "digest": "edited"})
+    store.measured("u-curve", compute, size=256)
+    assert len(calls) == 1
+
+
+def test_an_unreadable_record_is_computed_again(fresh, monkeypatch):
+    directory, calls, compute = fresh
+    (directory / "u-curve.json").write_text("{not json")
+    assert store.measured("u-curve", compute)["value"] == 0.1 + 0.2
+    assert len(calls) == 1 and json.loads((directory / "u-curve.json").read_text())["value"]
+
+
+def test_without_a_store_values_live_in_the_process(monkeypatch):
+    monkeypatch.delenv(store.ENV, raising=False)
+    monkeypatch.setattr(store, "_MEMORY", {})
+    calls = []
+    for _ in range(2):
+        store.measured("count", lambda: calls.append(1) or len(calls))
+    assert calls == [1]
+
+
+@pytest.mark.parametrize("name", ["", "Upper", "../escape", "a/b", "x" * 101, 7])
+def test_bad_names_are_refused(name, fresh):
+    _, calls, compute = fresh
+    with pytest.raises(ValueError, match="name must be"):
+        store.measured(name, compute)
+    assert calls == []
+
+
+def test_a_value_json_cannot_hold_writes_nothing(fresh):
+    directory, _, _ = fresh
+    with pytest.raises(TypeError):
+        store.measured("bad", lambda: {1, 2})
+    with pytest.raises(TypeError):
+        store.measured("bad", lambda: 1, scene=object())
+    assert list(directory.iterdir()) == []
