@@ -24,6 +24,7 @@ class TheoremFailed(AssertionError):
 
 
 def _entry(t):
+    from .registry import pinned_failure
     v = t.check()
     steps = "\n".join(f"- $\\displaystyle {step_latex(step)}$" for step in t.steps)
     evidence = v.evidence.replace("$", "")
@@ -33,7 +34,7 @@ def _entry(t):
              f"(or, failing that, evaluated with mpmath), and a wrong variant "
              f"({t.wrong_variants[0][0]}) is refuted by the same check.\n:::\n")
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
-                pages=list(t.pages), block=block)
+                pages=list(t.pages), block=block, changed=pinned_failure(t.id, v.status, v.residual))
 
 
 def _ledger():
@@ -57,23 +58,36 @@ def theorem_block(theorem_id):
     Raises
     ------
     TheoremFailed
-        If the theorem's check does not return proved or verified.
+        If the theorem's check does not return proved or verified, or not
+        the verdict `proofs.registry.PINNED` holds for it.
     KeyError
         If the id is unknown.
     """
     entries = ledger()
     if theorem_id not in entries:
         raise KeyError(f"no theorem {theorem_id!r}")
-    entry = entries[theorem_id]
+    _refuse(theorem_id, entries[theorem_id])
+    return entries[theorem_id]["block"]
+
+
+def _refuse(theorem_id, entry):
     if entry["status"] not in ("proved", "verified"):
         raise TheoremFailed(f"{theorem_id} is {entry['status']}: {entry['evidence']}")
-    return entry["block"]
+    if entry["changed"]:
+        raise TheoremFailed(f"{entry['changed']} (proofs.registry.PINNED): {entry['evidence']}")
 
 
 def ledger_table():
-    """Markdown table of every theorem: id, verdict, evidence, the pages using it."""
+    """Markdown table of every theorem: id, verdict, evidence, the pages using it.
+
+    Raises
+    ------
+    TheoremFailed
+        As `theorem_block`, for the first theorem whose verdict fails or changed.
+    """
     rows = ["| theorem | verdict | evidence | the draft says | used on |", "|---|---|---|---|---|"]
     for theorem_id, e in ledger().items():
+        _refuse(theorem_id, e)
         pages = ", ".join(f"{{ref}}`{p}`" for p in e["pages"])
         rows.append(f"| {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`) | "
                     f"{BADGES[e['status']]} | {e['evidence'].replace('|', '/')} | "

@@ -1,4 +1,4 @@
-"""All theorems of the chapter, by id."""
+"""All theorems of the chapter, by id, and the verdict each must reach."""
 
 from . import blinn, displacement, finite_difference, frame, gradients, kink_loci, kinks, no_boundary, normal
 
@@ -6,6 +6,37 @@ from . import blinn, displacement, finite_difference, frame, gradients, kink_loc
 THEOREMS = {t.id: t for mod in (frame, gradients, kinks, kink_loci, no_boundary, normal,
                                         finite_difference, displacement, blinn)
             for t in mod.THEOREMS}
+
+#: The verdict each theorem must reach: "proved" (sympy decided every
+#: identity) or ("verified", bound): sympy left some undecided and mpmath
+#: found no residual above ``bound`` at the check's seeded points and digits.
+#: `pinned_failure` compares a verdict with it; `pytest verify` and the book
+#: build fail on any difference, so a verdict cannot change unnoticed.
+PINNED = {
+    "chart": ("verified", 1e-25), "frame-orthonormal": "proved", "frame-orientation": "proved",
+    "gradient-sine": "proved", "gradient-ridges": "proved", "gradient-rings": "proved",
+    "ridges-kinks": "proved", "kink-loci-rays": "proved", "kink-loci-circles": "proved",
+    "no-boundary": "proved", "normal-beta-derivative": "proved", "beta-zero-regression": "proved",
+    "central-difference-truncation": "proved", "optimal-step": "proved", "bump-vs-displacement": "proved",
+    "blinn-perturbation": "proved",
+}
+
+
+def pinned_failure(theorem_id, status, residual=None):
+    """Why the verdict (``status``, ``residual``) differs from `PINNED`, or None if it does not.
+
+    Raises
+    ------
+    KeyError
+        If the theorem has no pinned verdict.
+    """
+    pin = PINNED[theorem_id]
+    want, bound = (pin, None) if isinstance(pin, str) else pin
+    if status != want:
+        return f"{theorem_id} is {status}, pinned {want}"
+    if bound is not None and not (residual is not None and residual <= bound):
+        return f"{theorem_id} is verified with residual {residual}, pinned at most {bound:g}"
+    return None
 
 
 def get(theorem_id):

@@ -10,7 +10,7 @@ import dataclasses
 
 import pytest
 
-from proofs.registry import THEOREMS, get
+from proofs.registry import PINNED, THEOREMS, get, pinned_failure
 from verify.conftest import LEDGER
 
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
@@ -21,8 +21,25 @@ def test_theorem_holds(theorem_id):
     verdict = THEOREMS[theorem_id].check()
     LEDGER[theorem_id] = verdict
     assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
+    assert pinned_failure(theorem_id, verdict.status, verdict.residual) is None
     if verdict.status == "verified":
         assert verdict.digits >= 30 and verdict.points >= 20
+
+
+def test_every_theorem_has_a_pinned_verdict():
+    assert set(PINNED) == set(THEOREMS)
+
+
+@pytest.mark.parametrize("pin, status, residual, why", [
+    ("proved", "verified", 1e-30, "is verified, pinned proved"),
+    (("verified", 1e-25), "proved", None, "is proved, pinned verified"),
+    (("verified", 1e-25), "verified", 1e-20, "residual 1e-20, pinned at most 1e-25"),
+    (("verified", 1e-25), "verified", None, "residual None"),
+])
+def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
+    monkeypatch.setitem(PINNED, "chart", pin)
+    assert why in pinned_failure("chart", status, residual)
+    assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30))) is None
 
 
 @pytest.mark.parametrize("theorem_id, description, variant", VARIANTS,
@@ -55,9 +72,22 @@ def test_book_block_refuses_a_failing_theorem(monkeypatch):
     with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
         book.theorem_block("optimal-step")
     assert "PROVED" in book.theorem_block("frame-orthonormal")
-    assert "REFUTED" in book.ledger_table()
+    with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
+        book.ledger_table()
     with pytest.raises(KeyError, match="no theorem 'no-such'"):
         book.theorem_block("no-such")
+
+
+def test_book_block_refuses_a_changed_verdict(monkeypatch):
+    """A theorem that holds but not with its pinned verdict also fails the build."""
+    from proofs import book, registry
+    monkeypatch.setattr(registry, "THEOREMS", {"frame-orthonormal": get("frame-orthonormal")})
+    monkeypatch.setitem(registry.PINNED, "frame-orthonormal", ("verified", 1e-25))
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    for show in (lambda: book.theorem_block("frame-orthonormal"), book.ledger_table):
+        with pytest.raises(book.TheoremFailed, match="frame-orthonormal is proved, pinned verified"):
+            show()
 
 
 def test_undecided_identity_is_verified_numerically(monkeypatch):
