@@ -23,7 +23,7 @@ import numpy as np
 from renderer import Scene, compare, gbuffer, pointwise, render
 from renderer.render import SPHERE_A
 
-__all__ = ["Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED", "evaluate"]
+__all__ = ["Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED", "evaluate", "checked", "ClaimChanged"]
 
 HOLDS, FAILS, CORRECTED = "holds", "does not hold", "holds with a correction"
 
@@ -132,6 +132,22 @@ def _census_slope():
             HOLDS if s_rms > 1.8 else CORRECTED if s_off > 1.8 else FAILS)
 
 
+def _cell3_runs():
+    """The draft's Cell 3 reduces |num - sym| over the pixels both maps put on
+    sphere A; with its sphere B (erratum sphere-b-quadratic) no pixel is on A."""
+    from .seed_errata import seed_chamber
+    code = seed_chamber(256)
+    on_a = (code & 3) == SPHERE_A
+    num, sym = _frames(size=256)
+    same = np.ones(code.shape, bool)          # its code_e == code_sym: two maps of one scene
+    try:
+        np.abs(num.image - sym.image)[same & on_a].max()
+    except ValueError as error:
+        return (f"its sphere A covers {np.count_nonzero(on_a)} of {code.size} pixels, so the first row "
+                f"of the sweep stops with ValueError: {error}", FAILS)
+    return "the sweep's first row is computed", HOLDS
+
+
 def _census_flips():
     flips = sum(compare(*_frames(eps=e)).flips for e in (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6))
     return f"{flips} flips over 6 steps", HOLDS if flips == 0 else FAILS
@@ -153,6 +169,70 @@ def _evals():
             f"({central.trig:g} sines after sharing), exact {exact.h:g} (one evaluation of the "
             f"generated gradient: {exact.trig:g} sines and cosines)",
             CORRECTED if (central.h, exact.h) == (4, 0) else FAILS)
+
+
+def _cell4_counter():
+    """The draft's Cell 4 counting, in its structure: a counter wraps h, but the
+    gradients it times call the unwrapped h, so both counts stay 0."""
+    class Counter:
+        n = 0
+
+    def h(u, v):
+        return float(pointwise.height("ridges", np.array([u]), np.array([v]), 8.0, 4.0)[0])
+
+    def h_counted(u, v):
+        Counter.n += 1
+        return h(u, v)
+
+    def central(u, v, height, eps=1e-3):
+        return ((height(u + eps, v) - height(u - eps, v)) / (2 * eps),
+                (height(u, v + eps) - height(u, v - eps)) / (2 * eps))
+
+    counts = []
+    for gradient in (lambda: central(0.3, 0.4, h), lambda: pointwise.exact_gradient("ridges", 0.3, 0.4, 8.0, 4.0),
+                     lambda: central(0.3, 0.4, h_counted)):
+        Counter.n = 0
+        gradient()
+        counts.append(Counter.n)
+    numeric, exact, wired = counts
+    return (f"the counter prints {numeric} and {exact}: the wrapper is never called; wired into the "
+            f"central gradient it counts {wired}", HOLDS if (numeric, exact) == (4, 1) else FAILS)
+
+
+def _stacking():
+    """Bump under a pixel filter: a 4 x 4 box filter (a 512² render averaged to
+    128²) against one sample per pixel, on sphere-A pixels whose 16 samples
+    are all on A, with the bump and without it."""
+    err = {}
+    for beta in (0.35, 0.0):
+        scene = Scene(beta=beta)
+        fine, one = render(scene, 512, 512).image, render(scene, 128, 128)
+        box = fine.reshape(128, 4, 128, 4, 3).mean(axis=(1, 3))
+        all_a = (render(scene, 512, 512, kink=False, grad=False).chamber == SPHERE_A).reshape(128, 4, 128, 4).all(axis=(1, 3))
+        d = (box - one.image)[all_a & (one.chamber == SPHERE_A)]
+        err[beta] = float(np.sqrt(np.mean(d ** 2)))
+    ratio = err[0.35] / err[0.0]
+    return (f"the bump adds no integral (the pixel filter's integrand changes), but one sample per pixel "
+            f"misses the filtered value by RMS {err[0.35]:.1e} on sphere A with the bump against "
+            f"{err[0.0]:.1e} without: {ratio:.0f}x, so the same filter needs more samples",
+            CORRECTED if ratio > 2 else HOLDS)
+
+
+def _blinn_exact():
+    """Blinn's normal against the displaced sphere's, both in slopes (proofs/blinn.py):
+    equal to first order in beta (theorem blinn-perturbation); the second order differs."""
+    import sympy as sp
+
+    from renderer import formulas as F
+
+    from .blinn import BLINN, SURFACE, phi, theta
+    at = {F.R: 1.0, F.beta: 0.35, F.h: 0.5, F.h_u: 3.0, F.h_v: -2.0, phi: 1.1, theta: 0.4}
+    gap = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE))
+    first = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE).diff(F.beta).subs(F.beta, 0))
+    return (f"derived from the surface, but only to first order in beta: at beta = 0.35 (h = 0.5, "
+            f"h_u = 3, h_v = -2, phi = 1.1) his slopes differ from the displaced sphere's by {gap:.2e} "
+            f"(first-order terms: {first:.0e})", CORRECTED if gap > 1e-6 and first < 1e-12 else
+            HOLDS if gap <= 1e-12 else FAILS)
 
 
 def _timing():
@@ -308,11 +388,20 @@ CLAIMS = (
           "fitted slope of the census over ε = 1e-1 … 1e-6 (ridges, 256²)", CORRECTED, _census_slope),
     Claim("census-flips", "Cell 3, Expect", "flips = 0 everywhere", "census over six steps", HOLDS,
           _census_flips),
+    Claim("cell3-runs", "Cell 3", "the census as an epsilon sweep … print the table",
+          "the draft's reduction over its own chamber map (its sphere B), 256²", FAILS, _cell3_runs),
     Claim("kink-order-of-magnitude", "Cell 3, Expect",
           "the kink-loci error an order of magnitude above the smooth interior",
           "mean |ΔI| on / off the crease band at ε = 1e-3", FAILS, _kink_order_of_magnitude),
     Claim("four-evals-vs-one", "Cell 4, Expect; §6", "4 evals vs 1",
           "values of h in the kernel's formulas (sympy objects)", CORRECTED, _evals),
+    Claim("cell4-counter", "Cell 4", "h-evals per numeric gradient … per symbolic gradient",
+          "the draft's counting scheme, run: a counter around h, gradients calling h", FAILS, _cell4_counter),
+    Claim("stacking", "§6, Stacking", "bump composes under Ch. 6's filter … no new integral, ever",
+          "4 x 4 box filter against one sample per pixel, with and without the bump (128²)", CORRECTED,
+          _stacking),
+    Claim("blinn-exact", "§8", "Blinn computed his perturbation exactly",
+          "Blinn's slopes against the displaced sphere's, exact at beta = 0.35", CORRECTED, _blinn_exact),
     Claim("symbolic-not-slower", "Cell 4, Expect", "the symbolic column at or under the numeric",
           "min-of-N timings of the gradient stage and of the frame", HOLDS, _timing),
     Claim("cell5-fd-1e-9", "Cell 5, Expect", "~1e-9 worst component on the normal derivative",
@@ -347,3 +436,25 @@ CLAIMS = (
 def evaluate():
     """[(claim, measured text, computed verdict)] for every claim."""
     return [(c, *c.measure()) for c in CLAIMS]
+
+
+class ClaimChanged(AssertionError):
+    """A claim's computed verdict is not the one registered for it."""
+
+
+def checked(results=None):
+    """`evaluate`'s results (or ``results``), after checking every computed
+    verdict against the registered one: the book shows the register only
+    through this, so its build fails as `pytest verify` does.
+
+    Raises
+    ------
+    ClaimChanged
+        Naming every claim whose verdict changed, with its measurement.
+    """
+    results = evaluate() if results is None else results
+    changed = [f"{c.id}: registered {c.registered!r}, computed {v!r} ({m})"
+               for c, m, v in results if v != c.registered]
+    if changed:
+        raise ClaimChanged("; ".join(changed) + " (edit the register in proofs/claims.py with the change)")
+    return results

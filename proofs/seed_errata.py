@@ -21,7 +21,7 @@ from renderer import Scene, gbuffer
 from renderer.pointwise import chart, tangent_frame
 from renderer.render import FLOOR, SPHERE_A, SPHERE_B, image_plane
 
-__all__ = ["Erratum", "ERRATA", "measure_all"]
+__all__ = ["Erratum", "ERRATA", "measure_all", "reproduced", "ErratumVanished", "seed_chamber"]
 
 #: Resolution of the measurements (the seed's own 256 x 256 frames).
 SIZE = 256
@@ -39,6 +39,10 @@ class Erratum:
     exposed_by: str    # the test that fails on the seed's variant
     measure: Callable[[], dict] = field(repr=False)
     finding: str = ""  # str.format template over the measured dict
+    #: When the defect counts as still there, in words (the book shows it) and
+    #: as a test of the measured dict (`reproduced` applies it).
+    criterion: str = ""
+    present: Callable[[dict], bool] = field(default=lambda m: False, repr=False)
 
     def report(self, measured=None):
         """The finding with the measured numbers filled in (measures if not given)."""
@@ -76,14 +80,28 @@ def _sphere_b_seed_vs_true(size=SIZE):
     seed_code[tA_all <= np.minimum(tB_seed, 1.0)] = SPHERE_A
     seed_code[(tB_seed < tA_all) & (tB_seed < 1.0)] = SPHERE_B
     true_code = g.chamber.ravel()
+    _SEED_CHAMBER[size] = seed_code.reshape(size, size)
     return {
         "off_surface_max": float(off.max()),
         "off_surface_relative": float(off.max() / r),
+        "seed_pixels_a": int(np.count_nonzero(seed_code == SPHERE_A)),
         "seed_pixels_b": int(np.count_nonzero(seed_code == SPHERE_B)),
         "true_pixels_b": int(np.count_nonzero(true_code == SPHERE_B)),
         "chamber_flips": int(np.count_nonzero(seed_code != true_code)),
         "pixels": size * size,
     }
+
+
+#: The draft's chamber map per frame size, kept by `_sphere_b_seed_vs_true` (see `seed_chamber`).
+_SEED_CHAMBER = {}
+
+
+def seed_chamber(size=SIZE):
+    """(size, size) uint8: the chamber map of the draft's scene, its sphere B
+    intersected with the draft's quadratic (erratum sphere-b-quadratic)."""
+    if size not in _SEED_CHAMBER:
+        _sphere_b_seed_vs_true(size)
+    return _SEED_CHAMBER[size]
 
 
 def _light_terms(scene, size=SIZE, gradient="exact"):
@@ -222,6 +240,8 @@ ERRATA = (
         correction=r"$c = |E - C_B|^2 - r_B^2$ for the ray from the eye $E$, roots by the stable pair $q/a,\ c/q$",
         exposed_by="tests/test_geometry_invariants.py (hit points on the surface)",
         measure=_sphere_b_seed_vs_true,
+        criterion="the draft's hit points lie over one radius off sphere B, which covers over 5 times the true pixels",
+        present=lambda m: m["off_surface_relative"] > 1.0 and m["seed_pixels_b"] > 5 * m["true_pixels_b"],
         finding=(
             "In the default {pixels}-pixel frame the draft's sphere B is hit by every ray: "
                 "it covers {seed_pixels_b} pixels where the true sphere covers {true_pixels_b}, "
@@ -239,6 +259,8 @@ ERRATA = (
         correction=r"a light reaches $P$ only if $N\cdot w > 0$ (geometric) and no blocker cuts the segment; $N'$ then only weights Lambert and the lobe",
         exposed_by="tests/test_parity.py (scalar reference with geometric shadow predicate)",
         measure=_terminator_leak,
+        criterion="the draft's rule lights a pair beyond the terminator at the default beta, by more than one 8-bit level",
+        present=lambda m: m["leak_pixels_default"] > 0 and m["leak_diffuse_max_default"] > 1 / 255,
         finding=(
             "At the default beta the draft's rule lights {leak_pixels_default} (pixel, light) pairs "
                 "on sphere A whose geometric normal faces away from the light (Lambert term up to "
@@ -256,6 +278,8 @@ ERRATA = (
         correction=r"the lobe is zero where $N'\cdot\hat w \le 0$",
         exposed_by="verify/test_errata.py (lobe where the bumped normal faces away)",
         measure=_specular_ungated,
+        criterion="some pair facing away from its light receives a nonzero lobe",
+        present=lambda m: m["pixels"] > 0 and m["max_specular_added"] > 0,
         finding=(
             "In the default frame {pixels} (pixel, light) pairs on the spheres face away "
                 "from the light yet receive a lobe; the largest such contribution is "
@@ -271,6 +295,8 @@ ERRATA = (
         correction=r"one-sided only where $v \pm \varepsilon$ leaves $[0, 1]$; elsewhere divide by $2\varepsilon$",
         exposed_by="verify/test_theorems.py (central-difference-truncation: interior points take the 2 eps branch)",
         measure=_v_border_branch,
+        criterion="the branch fires at some interior pixels at eps = 1e-3, and at more at 1e-9",
+        present=lambda m: 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"],
         finding=(
             "At eps = 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
                 "sphere-A pixels, changing the quotient by at most {rel_change_1e-3:.1e} "
@@ -288,6 +314,8 @@ ERRATA = (
         correction=r"$\varphi = \operatorname{atan2}(\operatorname{hypot}(N_x, N_y), N_z)$ and $\sin\varphi = \operatorname{hypot}(N_x, N_y)$",
         exposed_by="verify/test_errata.py (mpmath reference)",
         measure=_acos_pole,
+        criterion="acos loses more than 1e-3 (relative) while atan2 stays within 1e-14",
+        present=lambda m: m["max_rel_error_acos"] > 1e-3 and m["max_rel_error_atan2"] < 1e-14,
         finding=(
             "For float64 unit normals with sin(phi) between 1e-8 and 1e-2, the relative "
                 "error of acos(N_z) reaches {max_rel_error_acos:.1e} (against mpmath at 40 "
@@ -302,6 +330,9 @@ ERRATA = (
         correction="kept as the seed has it (the convention is the seed's); measured and disclosed",
         exposed_by="verify/test_errata.py",
         measure=_fallback_orientation,
+        criterion="the fallback's orientation is +1, the regular frame's -1 to 1e-12",
+        present=lambda m: (m["orientation_fallback"] == 1.0
+                         and max(abs(m["orientation_regular_min"] + 1), abs(m["orientation_regular_max"] + 1)) <= 1e-12),
         finding=(
             "(e_theta x e_phi) . N lies in [{orientation_regular_min:.16f}, "
                 "{orientation_regular_max:.16f}] on the regular frame and is "
@@ -315,3 +346,25 @@ ERRATA = (
 def measure_all():
     """Return {erratum id: measured dict} for every record in `ERRATA`."""
     return {e.id: e.measure() for e in ERRATA}
+
+
+class ErratumVanished(AssertionError):
+    """An erratum's measurement no longer shows its defect: the book's errata would be false."""
+
+
+def reproduced(measured=None):
+    """`measure_all`'s dict (or ``measured``), after checking that every
+    erratum's defect is still there by its `Erratum.criterion`; the book's
+    errata section is built from this, so its build fails on a vanished one.
+
+    Raises
+    ------
+    ErratumVanished
+        Naming every erratum whose measurement fails its criterion.
+    """
+    measured = measure_all() if measured is None else measured
+    gone = [f"{e.id}: not ({e.criterion}); measured {measured[e.id]}" for e in ERRATA
+            if not e.present(measured[e.id])]
+    if gone:
+        raise ErratumVanished("; ".join(gone))
+    return measured

@@ -6,7 +6,7 @@ until the register (proofs/claims.py) is edited with it.
 
 import pytest
 
-from proofs.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Claim, evaluate
+from proofs.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Claim, ClaimChanged, checked, evaluate
 
 RESULTS = {c.id: (measured, verdict) for c, measured, verdict in evaluate()}
 
@@ -27,6 +27,17 @@ def test_register_mismatch_is_detected():
     wrong = Claim("x", "§0", "q", "m", HOLDS, lambda: ("measured 2", FAILS))
     _, verdict = wrong.measure()
     assert verdict != wrong.registered
+
+
+def test_the_books_table_refuses_a_flipped_verdict():
+    """The book's register goes through `checked`: one flipped verdict fails the build."""
+    results = [(c, RESULTS[c.id][0], RESULTS[c.id][1]) for c in CLAIMS]
+    assert checked(results) == results
+    flipped = list(results)
+    c, m, v = flipped[3]
+    flipped[3] = (c, m, HOLDS if v != HOLDS else FAILS)
+    with pytest.raises(ClaimChanged, match=f"{c.id}: registered"):
+        checked(flipped)
 
 
 def test_register_records_false_claims_too():

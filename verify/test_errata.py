@@ -5,7 +5,7 @@ defect, the book's errata section would be false: this fails first."""
 import numpy as np
 import pytest
 
-from proofs.seed_errata import ERRATA, measure_all
+from proofs.seed_errata import ERRATA, ErratumVanished, measure_all, reproduced
 from renderer import Scene, gbuffer
 
 MEASURED = measure_all()
@@ -62,6 +62,26 @@ def test_fallback_orientation_is_reflected():
 def test_v_border_branch_fires_in_interior():
     m = MEASURED["v-border-branch"]
     assert 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"]
+
+
+def test_every_erratum_is_present_by_its_criterion():
+    assert reproduced(MEASURED) is MEASURED
+    assert all(e.criterion and e.present(MEASURED[e.id]) for e in ERRATA)
+
+
+@pytest.mark.parametrize("erratum_id, key, fixed", [
+    ("sphere-b-quadratic", "off_surface_relative", 0.0),
+    ("terminator-leak", "leak_pixels_default", 0),
+    ("specular-ungated", "pixels", 0),
+    ("v-border-branch", "fraction_interior_1e-3", 0.0),
+    ("acos-pole", "max_rel_error_acos", 1e-16),
+    ("fallback-orientation", "orientation_fallback", -1.0),
+])
+def test_a_vanished_erratum_fails_the_book(erratum_id, key, fixed):
+    """The measurement of a corrected draft (its defect gone) is refused by name."""
+    gone = {**MEASURED, erratum_id: {**MEASURED[erratum_id], key: fixed}}
+    with pytest.raises(ErratumVanished, match=erratum_id):
+        reproduced(gone)
 
 
 def test_report_rejects_a_missing_measurement():
