@@ -22,9 +22,12 @@ x = sp.Symbol("x", real=True, nonzero=True)
 h = F.HEIGHT["ridges"].subs(POSITIVE)
 FACTORS = tuple(s.subs(POSITIVE) for s in F.RIDGE_FACTORS)
 BAND = F.KINK_BAND["ridges"].subs(POSITIVE)
-DOMAIN = {u: (0.0, 1.0), v: (0.0, 1.0), k_u: (0.5, 12.0), k_v: (0.5, 12.0)}
-#: Zero lines checked: u = m / k_u and v = m / k_v for these m.
-LINES = (0, 1, 2, 3)
+#: Every zero line at once: u = m / k_u and v = m / k_v for a symbolic integer m.
+m = sp.Symbol("m", integer=True)
+#: The other factor's value on the line, nonzero (where it is 0, h vanishes
+#: along the whole line and there is no crease).
+c = sp.Symbol("c", real=True, nonzero=True)
+DOMAIN = {u: (0.0, 1.0), v: (0.0, 1.0), k_u: (0.5, 12.0), k_v: (0.5, 12.0), c: (-1.0, 1.0)}
 
 
 def one_sided(expr, var, at):
@@ -44,15 +47,14 @@ def _identities(jump_u, jump_v):
     ids = [Identity(r"\frac{d}{dx}\lvert x\rvert,\ x \ne 0", sp.diff(sp.Abs(x), x), sp.sign(x),
                     {x: (-3.0, 3.0)}),
            Identity(r"h = \lvert s_1 s_2\rvert", h, sp.Abs(FACTORS[0] * FACTORS[1]), DOMAIN)]
-    for m in LINES:
-        for var, k, factor, jump in ((u, k_u, FACTORS[0], jump_u), (v, k_v, FACTORS[1], jump_v)):
-            line = sp.Integer(m) / k
-            r, l = one_sided(h, var, line)
-            ids += [Identity(rf"h_{var}^+ - h_{var}^-\ \text{{at}}\ {var} = {m}/k_{var}", r - l, jump, DOMAIN),
-                    Identity(rf"s\ \text{{at}}\ {var} = {m}/k_{var}", factor.subs(var, line), sp.Integer(0),
-                             DOMAIN),
-                    Identity(rf"\text{{crease flag at}}\ {var} = {m}/k_{var}", _flag(BAND.subs(var, line)),
-                             sp.Integer(1), DOMAIN)]
+    for var, k, factor, other, hand, jump in ((u, k_u, FACTORS[0], FACTORS[1], s2_hand, jump_u),
+                                              (v, k_v, FACTORS[1], FACTORS[0], s1_hand, jump_v)):
+        line = m / k
+        r, l = one_sided(h.subs(other, c), var, line)
+        ids += [Identity(rf"h_{var}^+ - h_{var}^-\ \text{{at}}\ {var} = m/k_{var}", r - l, jump.subs(hand, c), DOMAIN),
+                Identity(rf"s\ \text{{at}}\ {var} = m/k_{var}", factor.subs(var, line), sp.Integer(0), DOMAIN),
+                Identity(rf"\text{{crease flag at}}\ {var} = m/k_{var}", _flag(BAND.subs(var, line)),
+                         sp.Integer(1), DOMAIN)]
     return ids
 
 
@@ -67,7 +69,7 @@ RIDGES_KINKS = Theorem(
               r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
               r"(`RIDGE_FACTORS`) is "
               r"differentiable wherever $s_1 s_2 \ne 0$, with gradient $\operatorname{sign}(s_1 s_2)\,\nabla(s_1 s_2)$. "
-              r"On the zero line $u = m/k_u$ the one-sided derivatives in $u$ differ by "
+              r"On every zero line $u = m/k_u$ ($m$ any integer) the one-sided derivatives in $u$ differ by "
               r"$2\pi k_u \lvert\sin\pi k_v v\rvert$, and on $v = m/k_v$ those in $v$ by "
               r"$2\pi k_v \lvert\sin\pi k_u u\rvert$: a crease wherever the other factor is nonzero. "
               r"The renderer's crease flag (`KINK_BAND`) is set on every zero line.",
@@ -77,7 +79,8 @@ RIDGES_KINKS = Theorem(
         ("jump without the factor 2", lambda: check_identities(_identities(sp.pi * k_u * sp.Abs(s2_hand), JUMP_V))),
         ("jump with the roles of k_u and k_v swapped",
          lambda: check_identities(_identities(2 * sp.pi * k_v * sp.Abs(s2_hand), JUMP_V)))),
-    steps=((r"one-sided", r"(h_u^+, h_u^-)\big|_{u = 1/k_u}", sp.Tuple(*one_sided(h, u, 1 / k_u))),
+    steps=((r"one-sided", r"(h_u^+, h_u^-)\big|_{u = m/k_u,\ \sin\pi k_v v = c \ne 0}",
+            sp.Tuple(*one_sided(h.subs(FACTORS[1], c), u, m / k_u))),
            (r"h_u^+ - h_u^-", r"h_u^+ - h_u^-", JUMP_U),
            (r"h_v^+ - h_v^-", r"h_v^+ - h_v^-", JUMP_V),
            (r"crease flag", r"\text{KINK\_BAND}", BAND)),
