@@ -33,7 +33,7 @@ import sympy as sp
 from renderer import formulas as F
 from renderer import pointwise
 
-__all__ = ["UCurve", "measure", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS"]
+__all__ = ["UCurve", "measure", "fit_model", "default_optimum", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS"]
 
 #: Unit roundoff of IEEE double precision (round to nearest).
 UNIT_ROUNDOFF = 2.0**-53
@@ -115,6 +115,70 @@ class UCurve:
     eps_opt_measured: float
     error_at_measured_opt: float
     reason: str | None = None  # why h has no derivative here (`non_differentiable`), or None
+    #: The model A eps^2 + B / eps fitted to the measured error (`fit_model`),
+    #: its optimum (B / 2A)^(1/3) and the model's error there: the statistics
+    #: the book shows, as they move little with the grid of steps (the argmin
+    #: of a noisy curve jumps between its dips).
+    truncation_coeff: float = float("nan")
+    roundoff_coeff: float = float("nan")
+    eps_opt_fitted: float = float("nan")
+    error_at_fitted_opt: float = float("nan")
+
+
+def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
+    """(A, B) of the model A eps^2 + B / eps fitted to a measured U-curve.
+
+    Least squares on the logarithms (every decade of error weighs the same;
+    Gauss-Newton from ``start``, in log A and log B, until a step moves
+    neither by more than 1e-12); steps with zero error are left out.
+
+    Parameters
+    ----------
+    eps, error : 1-D float64 arrays of one length, eps > 0
+    start : (float, float) > 0
+        First guess, e.g. (|third derivative| / 6, u |h|).
+
+    Raises
+    ------
+    ValueError
+        Fewer than 2 steps with nonzero error, or a fit that does not converge in 100 steps.
+    """
+    eps, error = np.asarray(eps, dtype=np.float64), np.asarray(error, dtype=np.float64)
+    keep = error > 0
+    if np.count_nonzero(keep) < 2:
+        raise ValueError("error must have at least 2 nonzero entries to fit a two-term model")
+    e, err = eps[keep], error[keep]
+    p = np.log(np.asarray(start, dtype=np.float64))
+    for _ in range(100):
+        trunc, rnd = np.exp(p[0]) * e**2, np.exp(p[1]) / e
+        model = trunc + rnd
+        step = np.linalg.lstsq(np.stack([trunc / model, rnd / model], axis=1), np.log(model / err), rcond=None)[0]
+        p -= step
+        if np.max(np.abs(step)) < 1e-12:
+            return float(np.exp(p[0])), float(np.exp(p[1]))
+    raise ValueError("the U-curve model fit did not converge in 100 Gauss-Newton steps")
+
+
+def default_optimum():
+    """The U-curve optimum the book shows, one measurement of the build
+    (`proofs.store`): `measure`'s default curve (sine, (u, v) = (0.31, 0.47),
+    h_u, k_u = 8, k_v = 4, 200 steps from 1e-1 to 1e-15), as a dict: the
+    fitted optimum ``eps`` and the model's ``error`` there, the measured
+    errors ``band`` (min, max) within a factor 2 of it, the coefficients
+    ``A`` and ``B``, the model's prediction ``eps_predicted`` and, for
+    comparison, the curve's ``argmin`` and ``min``, and a ``label``."""
+    from .store import measured
+    return measured("ucurve.default-optimum", _default_optimum)
+
+
+def _default_optimum():
+    c = measure()
+    near = c.error[(c.eps >= c.eps_opt_fitted / 2) & (c.eps <= 2 * c.eps_opt_fitted)]
+    return dict(eps=c.eps_opt_fitted, error=c.error_at_fitted_opt, band=[float(near.min()), float(near.max())],
+                A=c.truncation_coeff, B=c.roundoff_coeff, eps_predicted=c.eps_opt_predicted,
+                argmin=c.eps_opt_measured, min=c.error_at_measured_opt,
+                label=f"sine, (u, v) = ({c.u}, {c.v}), h_u, k_u = 8, k_v = 4, {c.eps.size} steps "
+                      f"from {c.eps.max():.0e} to {c.eps.min():.0e}")
 
 
 @lru_cache(maxsize=None)
@@ -235,5 +299,11 @@ def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=
     if reason is not None:
         return UCurve(field, u, v, component, steps, error, np.array(trunc), np.array(roundoff),
                       np.full(steps.shape, nan), nan, nan, nan, nan, nan, reason)
+    try:
+        A, B = fit_model(steps, error, start=(max(abs(h3f), 1e-300) / 6, UNIT_ROUNDOFF * max(abs(h0f), 1e-300)))
+    except ValueError:              # an exact quotient (h_u of rings: zero error) has no U to fit
+        A = B = nan
+    eps_fit = (B / (2 * A)) ** (1 / 3)
     return UCurve(field, u, v, component, steps, error, np.array(trunc), np.array(roundoff), model,
-                  float(true), h3f, predicted, float(steps[best]), float(error[best]))
+                  float(true), h3f, predicted, float(steps[best]), float(error[best]), None,
+                  A, B, float(eps_fit), float(A * eps_fit**2 + B / eps_fit))

@@ -73,3 +73,32 @@ def test_differentiable_points_are_not_flagged(kwargs):
 def test_bad_arguments_are_named(kwargs, fragment):
     with pytest.raises(ValueError, match=fragment):
         measure(**kwargs)
+
+
+def test_the_fitted_model_recovers_a_synthetic_curve_and_the_truncation_coefficient():
+    from proofs.ucurve import fit_model
+    eps = np.logspace(-1, -15, 200)
+    A, B = fit_model(eps, 61.0 * eps**2 + 1e-17 / eps)
+    assert A == pytest.approx(61.0, rel=1e-9) and B == pytest.approx(1e-17, rel=1e-9)
+    # On the measured curve, A is |h'''| / 6 (the truncation term), not twice or half of it.
+    assert CURVE.truncation_coeff == pytest.approx(abs(CURVE.third_derivative) / 6, rel=0.1)
+    assert CURVE.truncation_coeff != pytest.approx(abs(CURVE.third_derivative) / 3, rel=0.1)
+
+
+def test_the_fitted_optimum_does_not_jump_with_the_grid_where_the_argmin_does():
+    """Four grids of steps: the argmin of the measured curve moves by a factor
+    of more than 3 between them, the fitted optimum by less than 20 %."""
+    grids = [np.logspace(-1, -15, 200), np.logspace(-1, -12, 60), np.logspace(-1, -14, 120),
+             np.logspace(-1, -13, 37)]
+    curves = [measure(eps=g) for g in grids]
+    argmins = [c.eps_opt_measured for c in curves]
+    fitted = [c.eps_opt_fitted for c in curves]
+    assert max(argmins) / min(argmins) > 3
+    assert max(fitted) / min(fitted) < 1.2
+    # and it sits on the measured curve: within a factor 3 of the model's prediction
+    assert 1 / 3 < CURVE.eps_opt_fitted / CURVE.eps_opt_predicted < 3
+
+
+def test_an_exact_quotient_has_no_fitted_optimum():
+    flat = measure("rings", u=0.3, v=0.31)          # h_u = 0 for rings: every quotient is exact
+    assert np.all(flat.error == 0) and np.isnan(flat.eps_opt_fitted)

@@ -1,0 +1,73 @@
+"""book/check_glue.py: a name glued on several pages must show one value.
+
+Pages are notebooks cached with jupyter-cache, as the book's build caches
+them; each check is shown failing on a wrong variant."""
+
+from __future__ import annotations
+
+import importlib.util
+import time
+from pathlib import Path
+
+import nbformat
+import pytest
+from jupyter_cache import get_cache
+from jupyter_cache.base import CacheBundleIn
+
+_SPEC = importlib.util.spec_from_file_location("check_glue", Path(__file__).parents[1] / "book" / "check_glue.py")
+check_glue = importlib.util.module_from_spec(_SPEC)
+_SPEC.loader.exec_module(check_glue)
+
+
+def _page(page="", **values):
+    """An executed notebook whose one cell glues ``values`` (as myst_nb.glue writes them)."""
+    outputs = [nbformat.v4.new_output("display_data", data={check_glue.MIME + "text/plain": repr(v)},
+                                      metadata={"scrapbook": {"name": k, "mime_prefix": check_glue.MIME}})
+               for k, v in values.items()]
+    cell = nbformat.v4.new_code_cell(f"# {page} {sorted(values.items())}", outputs=outputs)
+    return nbformat.v4.new_notebook(cells=[cell])
+
+
+def _cache(tmp_path, pages):
+    cache = get_cache(str(tmp_path / "cache"))
+    for uri, nb in pages:
+        cache.cache_notebook_bundle(CacheBundleIn(nb, uri), check_validity=False)
+        time.sleep(0.01)
+    return tmp_path / "cache"
+
+
+def test_one_value_per_shared_name_passes(tmp_path, capsys):
+    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(ucurve_eps_opt=4.3e-7, c2_cube=16000.0)),
+                              ("/b/s7_pitfalls.md", _page(ucurve_eps_opt=4.3e-7))])
+    assert check_glue.glued(cache)["ucurve_eps_opt"] == {"s5_lab": "4.3e-07", "s7_pitfalls": "4.3e-07"}
+    assert check_glue.main([str(cache)]) == 0
+    assert "1 shown on several pages" in capsys.readouterr().out
+
+
+def test_two_values_under_one_name_fail_naming_pages_and_values(tmp_path, capsys):
+    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(ucurve_eps_opt=3.9e-7)),
+                              ("/b/s7_pitfalls.md", _page(ucurve_eps_opt=1.0e-7))])
+    assert check_glue.main([str(cache)]) == 1
+    assert "ucurve_eps_opt: s5_lab = 3.9e-07, s7_pitfalls = 1e-07" in capsys.readouterr().err
+
+
+def test_only_the_record_a_page_used_last_counts(tmp_path):
+    """A stale execution of a page (an earlier version, still cached) is not the page."""
+    cache = _cache(tmp_path, [("/b/s7_pitfalls.md", _page(ucurve_eps_opt=1.0e-7)),
+                              ("/b/s7_pitfalls.md", _page(ucurve_eps_opt=4.3e-7)),
+                              ("/b/s5_lab.md", _page("s5", ucurve_eps_opt=4.3e-7))])
+    assert check_glue.conflicts(check_glue.glued(cache)) == []
+    # A wrong variant that reads every record sees the stale value and fails.
+    records = get_cache(str(cache)).list_cache_records()
+    every = {}
+    for r in records:
+        nb = (cache / "executed" / r.hashkey / "base.ipynb").read_text()
+        for name, value in check_glue.page_glue(nbformat.reads(nb, 4)).items():
+            every.setdefault(name, {})[f"{Path(r.uri).stem}#{r.pk}"] = value
+    assert check_glue.conflicts(every)
+
+
+def test_no_cache_is_an_error(tmp_path):
+    assert check_glue.main([str(tmp_path)]) == 2
+    with pytest.raises(FileNotFoundError):
+        check_glue.glued(tmp_path)
