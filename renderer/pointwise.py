@@ -18,11 +18,15 @@ Source: the formulas of seed §2-§3 as corrected in `renderer.formulas`.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from . import generated as G
+from . import kernel
+from .render import GBuffer, check_flag
+from .scene import Scene
 
 __all__ = ["height", "exact_gradient", "central_gradient", "kink_band", "chart", "tangent_frame",
-           "footprint"]
+           "footprint", "reach"]
 
 
 def _field(name):
@@ -155,3 +159,56 @@ def footprint(x, y, dx, dy, camera_z, P, N, e_theta, e_phi, radius, sin_phi):
              "ep_x", "ep_y", "ep_z", "radius", "sin_phi")
     return tuple(_evaluate(G.footprint_array, 2, (), names, (x, y, dx, dy, camera_z, *P, *N, *e_theta, *e_phi,
                                                              radius, sin_phi)))
+
+
+
+def reach(scene, gbuffer, *, gate=False):
+    """Which light reaches each pixel's hit point, by the kernel's own predicate.
+
+    `renderer.kernel.reach` (the normal faces the light, the floor plane does
+    not separate them, no blocker sphere cuts the segment) evaluated on the
+    hit points and normals of ``gbuffer``, for every light of ``scene`` in
+    order (lights of zero colour included): the masks the renderer shades
+    with.  With ``gate`` also Ns . w > 0, the gate by which the kernel skips
+    shadow rays where the light adds nothing (Ns: the bumped normal).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene ``gbuffer`` was made from.
+    gbuffer : GBuffer
+        From `renderer.gbuffer`.
+    gate : bool, keyword-only
+
+    Returns
+    -------
+    (n_lights, H, W) bool array (False where chamber is 0).
+
+    Raises
+    ------
+    TypeError
+        ``scene`` not a Scene, ``gbuffer`` not a GBuffer, ``gate`` not a bool.
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
+    if not isinstance(gbuffer, GBuffer):
+        raise TypeError(f"gbuffer must be a renderer.GBuffer, got {type(gbuffer).__name__}")
+    prm, lights = kernel.params(scene, skip=False)
+    out = np.zeros((lights.shape[0],) + gbuffer.chamber.shape, dtype=bool)
+    _reach_rows(prm, lights, gbuffer.chamber, gbuffer.P, gbuffer.N, gbuffer.Ns, check_flag("gate", gate), out)
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def _reach_rows(prm, lights, chamber, P, N, Ns, gate, out):
+    s = kernel.unpack(prm)
+    for j in range(chamber.shape[0]):
+        for i in range(chamber.shape[1]):
+            code = chamber[j, i]
+            if code == kernel.BACKGROUND:
+                continue
+            p, n, ns = (P[j, i, 0], P[j, i, 1], P[j, i, 2]), (N[j, i, 0], N[j, i, 1], N[j, i, 2]), \
+                (Ns[j, i, 0], Ns[j, i, 1], Ns[j, i, 2])
+            for k in range(lights.shape[0]):
+                out[k, j, i] = kernel.reach(s, (lights[k, 0], lights[k, 1], lights[k, 2]), p, n, code,
+                                            True, gate, ns)[1]

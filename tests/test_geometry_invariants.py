@@ -399,3 +399,37 @@ def test_perturbed_normal_is_unit_for_huge_inputs(kwargs, field):
         g = gbuffer(scene, 32, 32)
     err = off_unit(g.Ns[g.chamber == 1])
     assert err <= UNIT_TOL, f"| |N'| - 1 | reaches {err}"
+
+
+# --- the kernel's reach predicate, as pointwise.reach exposes it ---------------------------
+
+@pytest.mark.parametrize("scene", [Scene(beta=0.0), Scene(beta=0.0, height_field="sine", sphere_b=False),
+                                   Scene(beta=0.0, lights=(PointLight((0.5, -1.0, -6.0)), PointLight((3.0, 2.0, 5.0))))],
+                         ids=["default", "no sphere B", "a light below the floor"])
+def test_reach_masks_are_where_a_lone_diffuse_light_lights_the_image(scene):
+    """With one light, no ambient and no lobe, at beta = 0 (Ns = N), a pixel is
+    lit exactly where `pointwise.reach` says the light reaches it."""
+    g = gbuffer(scene, 64, 48)
+    masks = pointwise.reach(scene, g)
+    assert masks.shape == (len(scene.lights), 48, 64) and masks.any()
+    for k, light in enumerate(scene.lights):
+        alone = scene.replace(lights=(light,), ka=0.0, ks=0.0)
+        lit = render(alone, 64, 48).image.max(axis=-1) > 0
+        assert np.array_equal(lit, masks[k])
+    # The check has teeth: the mask of the other light does not match.
+    if len(scene.lights) > 1:
+        lone = render(scene.replace(lights=scene.lights[:1], ka=0.0, ks=0.0), 64, 48).image.max(axis=-1) > 0
+        assert not np.array_equal(lone, masks[1])
+
+
+def test_reach_gate_adds_the_shading_normal_and_bad_arguments_are_named():
+    scene = Scene(beta=1.5, height_field="sine")
+    g = gbuffer(scene, 64, 48)
+    plain, gated = pointwise.reach(scene, g), pointwise.reach(scene, g, gate=True)
+    assert np.all(gated <= plain) and np.count_nonzero(plain & ~gated) > 0
+    with pytest.raises(TypeError, match="scene must be"):
+        pointwise.reach(object(), g)
+    with pytest.raises(TypeError, match="gbuffer must be"):
+        pointwise.reach(scene, render(scene, 8, 8))
+    with pytest.raises(TypeError, match="gate"):
+        pointwise.reach(scene, g, gate=1)
