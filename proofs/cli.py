@@ -54,6 +54,7 @@ takes about 57 bytes per pixel: about 1.9 GB at the limit).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import hashlib
 import io
@@ -650,7 +651,7 @@ def _cmd_sweep(args, out):
 
 
 def _measure_ucurve(args):
-    from .ucurve import UCurve, measure
+    from .ucurve import UNIT_ROUNDOFF, UCurve, fit_model, measure
     steps = np.asarray(args.eps, dtype=np.float64)
     kw = dict(field=args.field, u=args.u, v=args.v, component=args.component, k_u=args.k_u, k_v=args.k_v)
     if not _show_progress() or steps.size < 50:
@@ -666,9 +667,14 @@ def _measure_ucurve(args):
     p0 = parts[0]
     reason = getattr(p0, "reason", None)
     opt = (float("nan"),) * 2 if reason is not None else (float(steps[best]), float(error[best]))
+    fit = (float("nan"),) * 4
+    if reason is None:
+        with contextlib.suppress(ValueError):
+            A, B = fit_model(steps, error, start=(max(abs(p0.third_derivative), 1e-300) / 6, UNIT_ROUNDOFF))
+            e_fit = (B / (2 * A)) ** (1 / 3)
+            fit = (A, B, e_fit, A * e_fit**2 + B / e_fit)
     return UCurve(p0.field, p0.u, p0.v, p0.component, steps, error, cat("truncation"), cat("roundoff"),
-                  cat("model"), p0.derivative, p0.third_derivative, p0.eps_opt_predicted, *opt,
-                  **({"reason": reason} if reason is not None else {}))
+                  cat("model"), p0.derivative, p0.third_derivative, p0.eps_opt_predicted, *opt, reason, *fit)
 
 
 def _ucurve_plot_writer(uc):

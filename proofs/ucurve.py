@@ -141,7 +141,8 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
     Raises
     ------
     ValueError
-        Fewer than 2 steps with nonzero error, or a fit that does not converge in 100 steps.
+        Fewer than 2 steps with nonzero error; or no fit: no convergence in 100
+        steps, or an optimum (B / 2A)^(1/3) outside the steps (they see one side of it).
     """
     eps, error = np.asarray(eps, dtype=np.float64), np.asarray(error, dtype=np.float64)
     keep = error > 0
@@ -149,14 +150,24 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
         raise ValueError("error must have at least 2 nonzero entries to fit a two-term model")
     e, err = eps[keep], error[keep]
     p = np.log(np.asarray(start, dtype=np.float64))
-    for _ in range(100):
-        trunc, rnd = np.exp(p[0]) * e**2, np.exp(p[1]) / e
-        model = trunc + rnd
-        step = np.linalg.lstsq(np.stack([trunc / model, rnd / model], axis=1), np.log(model / err), rcond=None)[0]
-        p -= step
-        if np.max(np.abs(step)) < 1e-12:
-            return float(np.exp(p[0])), float(np.exp(p[1]))
-    raise ValueError("the U-curve model fit did not converge in 100 Gauss-Newton steps")
+    with np.errstate(all="ignore"):
+        for _ in range(100):
+            trunc, rnd = np.exp(p[0]) * e**2, np.exp(p[1]) / e
+            model = trunc + rnd
+            jac = np.stack([trunc / model, rnd / model], axis=1)
+            if not (np.all(np.isfinite(jac)) and np.all(model > 0)):
+                break                        # a term vanished or blew up: the steps see one side only
+            step = np.linalg.lstsq(jac, np.log(model / err), rcond=None)[0]
+            p -= step
+            if not np.all(np.abs(p) < 700):
+                break
+            if np.max(np.abs(step)) < 1e-12:
+                A, B = float(np.exp(p[0])), float(np.exp(p[1]))
+                if e.min() <= (B / (2 * A)) ** (1 / 3) <= e.max():
+                    return A, B
+                break                        # an optimum outside the steps: they see one side only
+    raise ValueError("the U-curve model did not fit (steps on one side of the optimum only, or no "
+                     "convergence in 100 Gauss-Newton steps)")
 
 
 def default_optimum():
