@@ -66,15 +66,27 @@ def _branch_structure():
     return None
 
 
-def _check_frame(et, ep):
+def _check_frame(et, ep, corrupt=None):
     bad = _branch_structure()
     if bad is not None:
         return bad
     verdict = check_identities(_frame_identities(et, ep))
     if not verdict.holds:
         return verdict
+    # The renderer's shading normals, which the frame builds (proofs/pixels.py).
+    from .pixels import TOLERANCE, normal_error
+    worst, count = 0.0, 0
+    for field in ("sine", "ridges", "rings"):
+        for bump in ("chart", "surface"):
+            err, n = normal_error(field, bump, corrupt)
+            worst, count = max(worst, err), count + n
+    if worst > TOLERANCE["normal"]:
+        return Verdict("refuted", f"the renderer's N' differs from PERTURBED_NORMAL in this frame by {worst:.1e} "
+                       f"at some of {count} sphere-A pixels")
     return Verdict(verdict.status, f"renderer.formulas.TANGENT_FRAME, regular branch at N(theta, phi): "
-                   f"{verdict.evidence}", verdict.residual, verdict.digits, verdict.points)
+                   f"{verdict.evidence}; the renderer's N' (GBuffer.Ns, both bump modes, 3 fields) at {count} "
+                   f"seeded sphere-A pixels (pole ring and fallback included) within {worst:.1e} of mpmath's "
+                   "PERTURBED_NORMAL in this frame", verdict.residual, verdict.digits, verdict.points)
 
 
 def vector_latex(components):
@@ -96,7 +108,9 @@ FRAME_ORTHONORMAL = Theorem(
     wrong_variants=(("e_phi multiplied by sin(phi)", lambda: _check_frame(e_theta, e_phi * sp.sin(phi))),
                     ("e_theta with a flipped sign",
                      lambda: check_identities([Identity(r"e_\theta", -e_theta, sp.diff(N, theta) / sp.sin(phi),
-                                                        DOMAIN)]))),
+                                                        DOMAIN)])),
+                    ("the kernel's N' built with h_u and h_v swapped",
+                     lambda: _check_frame(e_theta, e_phi, corrupt=lambda g: g[:, ::-1]))),
     pages=("s3",),
 )
 
@@ -170,12 +184,23 @@ U_OF_THETA, V_OF_PHI = (theta + sp.pi) / (2 * sp.pi), phi / sp.pi
 ANGLE_NAMES = {phi: r"\varphi"}
 
 
-def _check_chart(identities):
+def _check_chart(identities, corrupt=None):
     verdict = check_identities(identities)
     if not verdict.holds:
         return verdict
-    return Verdict(verdict.status, f"renderer.formulas.CHART at N(theta, phi): {verdict.evidence}",
-                   verdict.residual, verdict.digits, verdict.points)
+    # The renderer's own chart (GBuffer.uv) at its own N (proofs/pixels.py).
+    from .pixels import TOLERANCE, chart_error
+    worst, count = 0.0, 0
+    for field in ("sine", "ridges", "rings"):
+        err, n = chart_error(field, corrupt)
+        worst, count = max(worst, err), count + n
+    if worst > TOLERANCE["chart"]:
+        return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
+                       f"{count} sphere-A pixels")
+    return Verdict(verdict.status, f"renderer.formulas.CHART at N(theta, phi): {verdict.evidence}; the "
+                   f"renderer's (u, v) (GBuffer.uv) at {count} seeded sphere-A pixels (pole ring and fallback "
+                   f"included) within {worst:.1e} of mpmath's CHART at its N", verdict.residual, verdict.digits,
+                   verdict.points)
 
 
 _swapped = [Identity("v", sp.atan2(N[2], sp.sqrt(N[0]**2 + N[1]**2)) / sp.pi, V_OF_PHI, DOMAIN)]
@@ -193,7 +218,9 @@ CHART_INVERSE = Theorem(
     check=lambda: _check_chart(_chart_identities(U_OF_THETA, V_OF_PHI)),
     wrong_variants=(("u without the offset pi: theta / 2 pi",
                      lambda: _check_chart(_chart_identities(theta / (2 * sp.pi), V_OF_PHI))),
-                    ("v with the arguments of atan2 swapped", lambda: _check_chart(_swapped))),
+                    ("v with the arguments of atan2 swapped", lambda: _check_chart(_swapped)),
+                    ("the kernel's u and v swapped",
+                     lambda: _check_chart(_chart_identities(U_OF_THETA, V_OF_PHI), corrupt=lambda a: a[:, ::-1]))),
     pages=("s3",),
     seed_says="Cell 1 (chartA1): u = (theta + pi) / 2 pi, v = acos(N_z) / pi.",
 )

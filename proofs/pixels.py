@@ -1,0 +1,135 @@
+"""The renderer's own per-pixel outputs against mpmath, for the theorems' checks.
+
+A theorem about `renderer.formulas` says what the kernel should compute; this
+module asks what it did.  For seeded random sphere-A pixels of G-buffers of
+the default scene (`renderer.gbuffer`: a full frame, two frames zoomed onto the
+pole, one of them inside the frame's fallback radius, and the pixels next to a
+crease of the ridges field), the renderer's chart (u, v), gradient (exact and
+central) and shading normal N' (both bump modes) are compared with the same
+sympy objects evaluated by mpmath at 30 digits, from the renderer's own inputs
+at that pixel (N for the chart; u, v for the gradient; N, its frame and the
+gradient for N').  A wrong formula in the kernel's glue code (arguments
+swapped, a component dropped, a wrong step) refutes the theorem that uses it.
+
+Tolerances (absolute): `TOLERANCE`, a few float64 roundings of each output at
+its scale; the central difference also carries the rounding of h divided by
+the step (4 u |h| / eps) and of its abscissae (|h_u| u / eps).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from renderer import Scene, gbuffer
+from renderer import formulas as F
+from renderer.render import SPHERE_A
+
+__all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "TOLERANCE", "PER_FIELD"]
+
+#: Pixels drawn per field from each source (full frame, pole ring, crease neighbours): >= 200 in all.
+PER_FIELD = 240
+DIGITS = 30
+UNIT = 2.0**-53
+#: Absolute tolerances of the outputs at their scale (chart units; gradient per k; unit normal).
+TOLERANCE = {"chart": 16 * UNIT, "gradient": 64 * UNIT, "normal": 64 * UNIT}
+
+
+@lru_cache(maxsize=None)
+def _frames(field, gradient, bump):
+    """G-buffers of the default scene (``field``, ``gradient``, ``bump``): 128², and
+    the pole at zoom 300 and 3e4 (sin phi down to ~1e-3 and ~1e-5)."""
+    scene = Scene(height_field=field, bump=bump, beta=0.35 if bump == "chart" else 0.3)
+    return scene, [gbuffer(scene, 128, 128, gradient=gradient),
+                   gbuffer(scene, 48, 48, gradient=gradient, zoom=300.0),
+                   gbuffer(scene, 48, 48, gradient=gradient, zoom=3e4)]
+
+
+def pixels(field, gradient="exact", bump="chart", seed=0):
+    """The sampled sphere-A pixels as a dict of arrays (one row per pixel):
+    N, Ns (k, 3), uv, grad (k, 2), from the full frame, the two pole frames
+    and (ridges) the crease band of the full frame; and the `Scene`."""
+    scene, frames = _frames(field, gradient, bump)
+    rng = np.random.default_rng(seed)
+    picked = {name: [] for name in ("N", "Ns", "uv", "grad")}
+    for k, g in enumerate(frames):
+        on_a = g.chamber == SPHERE_A
+        where = [np.flatnonzero(on_a)]
+        if k == 0 and field == "ridges":
+            u, v = g.uv[..., 0] * scene.k_u, g.uv[..., 1] * scene.k_v
+            near = on_a & ((np.abs(u - np.rint(u)) < 0.05) | (np.abs(v - np.rint(v)) < 0.05))
+            where.append(np.flatnonzero(near))
+        for idx in where:
+            take = rng.choice(idx, size=min(PER_FIELD // 3, idx.size), replace=False)
+            for name in picked:
+                a = getattr(g, name)
+                picked[name].append(a.reshape(-1, a.shape[-1])[take])
+    return scene, {name: np.concatenate(rows) for name, rows in picked.items()}
+
+
+@lru_cache(maxsize=None)
+def _mp(expr, args):
+    return sp.lambdify(args, expr, modules="mpmath")
+
+
+def _eval(exprs, args, rows):
+    """Each expression of ``exprs`` at each row of float64 ``rows`` (columns = ``args``), in mpmath."""
+    fns = [_mp(e, tuple(args)) for e in exprs]
+    out = np.empty((rows.shape[0], len(exprs)))
+    with mpmath.workdps(DIGITS):
+        for i, row in enumerate(rows):
+            point = [mpmath.mpf(float(x)) for x in row]
+            out[i] = [float(f(*point)) for f in fns]
+    return out
+
+
+def chart_error(field, corrupt=None):
+    """Worst |uv - CHART(N)| over the sampled pixels (``corrupt``: a function applied to
+    the renderer's uv first, to show the check failing on a wrong kernel)."""
+    _, px = pixels(field)
+    uv = px["uv"] if corrupt is None else corrupt(px["uv"])
+    ref = _eval(F.CHART[:2], (F.N_x, F.N_y, F.N_z), px["N"])
+    return float(np.max(np.abs(uv - ref))), uv.shape[0]
+
+
+def gradient_error(field, gradient, corrupt=None):
+    """Worst |grad - reference| / bound over the sampled pixels: the exact gradient
+    against `formulas.GRADIENT`, central against `formulas.CENTRAL` (stencil
+    included) at the scene's eps, both at the renderer's own (u, v); and the count.
+    A value <= 1 is within tolerance."""
+    scene, px = pixels(field, gradient)
+    grad = px["grad"] if corrupt is None else corrupt(px["grad"])
+    consts = {F.k_u: scene.k_u, F.k_v: scene.k_v}
+    if gradient == "exact":
+        exprs = [e.subs(consts) for e in F.GRADIENT[field]]
+        ref = _eval(exprs, (F.u, F.v), px["uv"])
+        bound = TOLERANCE["gradient"] * np.pi * max(scene.k_u, 2 * scene.k_v)
+    else:
+        stencil = dict(F.STENCIL_POINTS)
+        exprs = [e.subs(stencil).subs({F.eps_u: scene.eps, F.eps_v: scene.eps, **consts})
+                 for e in F.CENTRAL[field]]
+        ref = _eval(exprs, (F.u, F.v), px["uv"])
+        scale = np.pi * max(scene.k_u, 2 * scene.k_v)
+        bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / scene.eps
+    return float(np.max(np.abs(grad - ref)) / bound), grad.shape[0]
+
+
+def normal_error(field, bump, corrupt=None):
+    """Worst |Ns - PERTURBED_NORMAL[bump]| over the sampled pixels, the formula fed the
+    renderer's N, the frame of N (`formulas.TANGENT_FRAME`, fallback included), its
+    gradient and h at its (u, v); and the count.  ``corrupt`` is applied to the
+    gradient (k, 2) the reference is fed: a kernel that used it so would differ."""
+    scene, px = pixels(field, "exact", bump)
+    Ns = px["Ns"]
+    sin_phi = F.CHART[2]
+    frame = [c.subs(F.sin_phi, sin_phi) for c in F.TANGENT_FRAME]
+    normal = sp.Matrix(F.PERTURBED_NORMAL[bump]).subs(
+        {**dict(zip(F.e_theta + F.e_phi, frame)), F.sin_phi: sin_phi, F.R: scene.radius_a, F.beta: scene.beta,
+         F.h: F.HEIGHT[field].subs({F.k_u: scene.k_u, F.k_v: scene.k_v})}, simultaneous=True)
+    args = (F.N_x, F.N_y, F.N_z, F.h_u, F.h_v, F.u, F.v)
+    grad = px["grad"] if corrupt is None else corrupt(px["grad"])
+    ref = _eval(list(normal), args, np.hstack([px["N"], grad, px["uv"]]))
+    return float(np.max(np.abs(Ns - ref))), Ns.shape[0]
