@@ -1,0 +1,230 @@
+"""Mutation audit: does the proof checker catch realistic bugs, and do the tests?
+
+Each semantic mutant in `MUTANTS` is one edit of the kind a person makes (a
+swapped pair, a dropped factor, a moved threshold, a check that always
+passes), applied alone to a scratch copy of this working tree (the files git
+tracks, plus untracked ones not ignored).  After the edit, ``python -m
+renderer.codegen`` regenerates the kernel's formulas when the edit is in
+renderer/formulas.py, so that the mutant reaches the renderer as a real
+change would.  Then ``pytest verify -x`` runs; a mutant it does not kill goes
+on to ``pytest tests -x``.  Outcome per mutant: killed by verify, killed by
+tests, or survived (listed with the reason it is acceptable, `ACCEPTED`, or
+flagged).  Not run in CI: it takes about a minute per mutant killed by
+verify and several per mutant that reaches the tests.
+
+``--mutmut`` also runs mutmut (``pip install mutmut``) over proofs/ with
+``pytest verify`` as its test command and reports its kill rate; mutmut
+cannot mutate the numba kernel (its trampolines are Python calls, which
+compiled code cannot make) nor formulas.py's module-level sympy, which is why
+the semantic mutants cover those.
+
+Results: benchmarks/results/mutation_audit.md.
+Usage: python benchmarks/mutation_audit.py [--only ID ...] [--mutmut] [--out FILE]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PYTHON = sys.executable
+TIMEOUT = 1800
+
+#: (id, file, old text, new text, what the bug is). Each old text occurs once in its file.
+MUTANTS = [
+    ("normal-swap", "renderer/formulas.py", '"chart": (beta * h_u, beta * h_v),',
+     '"chart": (beta * h_v, beta * h_u),', "h_u and h_v swapped in the perturbed normal"),
+    ("u-not-wrapped", "renderer/formulas.py", "(u_p, sp.Piecewise((u + eps_u - 1, u + eps_u >= 1), (u + eps_u, True))),",
+     "(u_p, u + eps_u),", "u not wrapped in the central difference"),
+    ("v-border-2eps", "renderer/formulas.py",
+     "_den_v = sp.Piecewise((v_p - v_m, sp.Or(v + eps_v > 1, v - eps_v < 0)), (2 * eps_v, True))",
+     "_den_v = 2 * eps_v", "the v border divided by 2 eps"),
+    ("pole-3e-4", "renderer/formulas.py", "POLE_SIN_PHI = sp.Float(1e-4)", "POLE_SIN_PHI = sp.Float(3e-4)",
+     "the pole threshold moved from 1e-4 to 3e-4"),
+    ("chart-offset", "renderer/formulas.py", "CHART = ((sp.atan2(N_y, N_x) + sp.pi) / (2 * sp.pi),",
+     "CHART = ((sp.atan2(N_y, N_x) - sp.pi) / (2 * sp.pi),", "u offset by -pi instead of +pi"),
+    ("chart-acos", "renderer/formulas.py", "sp.atan2(sp.sqrt(N_x**2 + N_y**2), N_z) / sp.pi,",
+     "sp.acos(N_z) / sp.pi,", "v from acos(N_z) (the draft's chart)"),
+    ("fallback-frame", "renderer/formulas.py", "FALLBACK_FRAME = (1, 0, 0, 0, 1, 0)",
+     "FALLBACK_FRAME = (0, 1, 0, 1, 0, 0)", "the pole fallback frame's axes swapped"),
+    ("ephi-sign", "renderer/formulas.py", "N_z * N_x / sin_phi, N_z * N_y / sin_phi, -sin_phi)",
+     "-N_z * N_x / sin_phi, -N_z * N_y / sin_phi, sin_phi)", "e_phi with the opposite sign"),
+    ("surface-2", "renderer/formulas.py", '"surface": (_w * h_u / (2 * sp.pi * sp.Max(sin_phi, POLE_SIN_PHI)), _w * h_v / sp.pi),',
+     '"surface": (_w * h_u / (sp.pi * sp.Max(sin_phi, POLE_SIN_PHI)), _w * h_v / sp.pi),',
+     "the surface bump without the factor 2 of du/dtheta"),
+    ("kink-width", "renderer/formulas.py", "KINK_BAND_HALF_WIDTH = sp.Float(0.03)",
+     "KINK_BAND_HALF_WIDTH = sp.Float(0.3)", "the crease band ten times wider"),
+    ("footprint-half", "renderer/formulas.py", "half = (sp.Abs(d[0]) + sp.Abs(d[1])) / 2",
+     "half = sp.Abs(d[0]) + sp.Abs(d[1])", "the footprint without pbrt's factor 1/2"),
+    ("sphere-b-no-shadow", "renderer/kernel.py", "    if code != SPHERE_B and (s.sphere_b or not skip):",
+     "    if code == FLOOR and (s.sphere_b or not skip):", "sphere B no longer shadows sphere A"),
+    ("light-inside", "renderer/kernel.py", "    if k < 0.0:\n        return True",
+     "    if k < 0.0:\n        return False", "a light inside a sphere is not blocked"),
+    ("far-root", "renderer/kernel.py", "    return near if near > 0.0 else (far if far > 0.0 else math.inf)",
+     "    return far if far > 0.0 else math.inf", "the far root of the ray quadratic"),
+    ("phong-factor", "renderer/kernel.py", "        spec_cos = 2.0 * mu * spec_cos - wv",
+     "        spec_cos = mu * spec_cos - wv", "Phong's reflection without the factor 2"),
+    ("no-ambient-ka", "renderer/kernel.py",
+     "    r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]\n    view = (0.0, 0.0, 0.0)",
+     "    r, g, b = s.ambient[0], s.ambient[1], s.ambient[2]\n    view = (0.0, 0.0, 0.0)",
+     "ambient not scaled by ka (render; the sweep keeps it)"),
+    ("central-eps-v", "renderer/kernel.py", "    eu = ev = eps\n", "    eu, ev = eps, 2 * eps\n",
+     "the central difference in v with step 2 eps"),
+    ("kink-inverted", "renderer/kernel.py", "            if want_kink:\n                kink[j, i] = flag",
+     "            if want_kink:\n                kink[j, i] = not flag", "the crease flag written inverted"),
+    ("beta0-shortcut", "renderer/kernel.py", "    et0, et1, et2, ep0, ep1, ep2 = frame\n",
+     "    et0, et1, et2, ep0, ep1, ep2 = frame\n    if s.beta == 0.0:\n        return N\n",
+     "the beta = 0 shortcut put back (N' = N without normalising)"),
+    ("gate-always", "renderer/pointwise.py", "check_flag(\"gate\", gate), out)", "True, out)",
+     "pointwise.reach always gated by the bumped normal"),
+    ("ledger-all-pixels", "renderer/ledger.py", "            if a != SPHERE_A or b != SPHERE_A:\n                continue\n",
+     "", "the ledger sums over every pixel, not sphere A"),
+    ("check-always-proved", "proofs/core.py", "    for simplifier in (sp.expand,",
+     "    return True\n    for simplifier in (sp.expand,", "the identity checker decides every identity true"),
+    ("unit-roundoff", "proofs/ucurve.py", "UNIT_ROUNDOFF = 2.0**-53", "UNIT_ROUNDOFF = 2.0**-52",
+     "the unit roundoff 2^-52 instead of 2^-53"),
+    ("reference-digits", "proofs/ucurve.py", "DIGITS = 50", "DIGITS = 15",
+     "the U-curve's reference at 15 digits, float64's own"),
+    ("statement-drift", "proofs/frame.py", r'r"$\partial v/\partial\varphi = 1/\pi$, the factors',
+     r'r"$\partial v/\partial\varphi = 1/2\pi$, the factors',
+     "a theorem's LaTeX statement changed while its check is not"),
+    ("claim-threshold", "proofs/claims.py", "HOLDS if 3 <= ratio <= 30 else FAILS",
+     "HOLDS if 3 <= ratio <= 30000 else FAILS", "a claim's pass range widened until it holds"),
+    ("erratum-criterion", "proofs/seed_errata.py", 'present=lambda m: m["max_rel_error_acos"] > 1e-3 and',
+     'present=lambda m: m["max_rel_error_acos"] > -1 and', "an erratum's presence criterion made vacuous"),
+    ("blinn-orientation", "proofs/blinn.py", "ORIENTATION = sp.simplify(N_BLINN.dot(N) / NORM_N)",
+     "ORIENTATION = -sp.simplify(N_BLINN.dot(N) / NORM_N)", "Blinn's normal taken outward (F = +beta h)"),
+    ("pixels-tolerance", "proofs/pixels.py", 'TOLERANCE = {"chart": 16 * UNIT, "gradient": 64 * UNIT, "normal": 64 * UNIT}',
+     'TOLERANCE = {"chart": 1.0, "gradient": 1.0, "normal": 1.0}', "the renderer-output tolerances made vacuous"),
+]
+
+#: Survivors that are acceptable, with the reason (a mutant not listed here that survives is flagged).
+ACCEPTED = {
+    "statement-drift": "the statement is prose beside the checked identities; printing it from the checked "
+                       "sympy objects (open) would catch it",
+    "pixels-tolerance": "only loosens a check: every renderer output still matches, so nothing can fail",
+    "claim-threshold": "the register's pass ranges are code, not data shown in the table (open)",
+}
+
+
+def _tree_files():
+    out = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=ROOT, capture_output=True,
+                         text=True, check=True).stdout.split("\n")
+    return [f for f in out if f and not f.startswith(("book/_build", "benchmarks/results"))]
+
+
+def _scratch():
+    """A scratch copy of the working tree; returns its path."""
+    d = Path(tempfile.mkdtemp(prefix="mutation-audit-"))
+    for f in _tree_files():
+        src = ROOT / f
+        if src.is_file():
+            (d / f).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, d / f)
+    return d
+
+
+def _run(cmd, cwd):
+    env = dict(os.environ, PYTHONPATH=str(cwd), NUMBA_CACHE_DIR=str(cwd / ".numba_cache"))
+    env.pop("SYMRENDER_STORE", None)
+    try:
+        return subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=TIMEOUT).returncode
+    except subprocess.TimeoutExpired:
+        return "timeout"
+
+
+def check_mutants():
+    """Every mutant's old text occurs exactly once in its file (ValueError naming the mutant if not)."""
+    for mid, path, old, _, _ in MUTANTS:
+        count = (ROOT / path).read_text(encoding="utf-8").count(old)
+        if count != 1:
+            raise ValueError(f"mutant {mid}: its text occurs {count} times in {path}, expected once")
+
+
+def audit(mutant, work):
+    """Apply one mutant in the scratch copy ``work``, run the checks, restore; returns the outcome."""
+    mid, path, old, new, _ = mutant
+    target = work / path
+    original = target.read_text(encoding="utf-8")
+    try:
+        target.write_text(original.replace(old, new, 1), encoding="utf-8")
+        if path == "renderer/formulas.py":
+            if _run([PYTHON, "-m", "renderer.codegen"], work) != 0:
+                return "killed by the generator"
+        t0 = time.time()
+        if _run([PYTHON, "-m", "pytest", "verify", "-x", "-q", "-p", "no:cacheprovider"], work) != 0:
+            return f"verify ({time.time() - t0:.0f} s)"
+        if _run([PYTHON, "-m", "pytest", "tests", "-x", "-q", "-p", "no:cacheprovider"], work) != 0:
+            return f"tests ({time.time() - t0:.0f} s)"
+        return "survived"
+    finally:
+        target.write_text(original, encoding="utf-8")
+        if path == "renderer/formulas.py":
+            _run([PYTHON, "-m", "renderer.codegen"], work)
+
+
+def run_mutmut(work):
+    """mutmut over proofs/ with pytest verify; (killed, total) or None if mutmut is missing."""
+    if shutil.which("mutmut", path=str(Path(PYTHON).parent)) is None:
+        return None
+    (work / "setup.cfg").write_text("[mutmut]\npaths_to_mutate=proofs/\ntests_dir=verify/\n"
+                                    "pytest_add_cli_args_test_selection=verify\n", encoding="utf-8")
+    _run([str(Path(PYTHON).parent / "mutmut"), "run"], work)
+    out = subprocess.run([str(Path(PYTHON).parent / "mutmut"), "results", "--all", "true"], cwd=work,
+                         capture_output=True, text=True).stdout
+    statuses = [line.rsplit(":", 1)[-1].strip() for line in out.splitlines() if ":" in line]
+    return sum(s == "killed" for s in statuses), len(statuses)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="*", help="mutant ids to run (default: all)")
+    parser.add_argument("--mutmut", action="store_true", help="also run mutmut over proofs/")
+    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "mutation_audit.md"))
+    args = parser.parse_args(argv)
+    check_mutants()
+    chosen = [m for m in MUTANTS if not args.only or m[0] in args.only]
+    work = _scratch()
+    rows, started = [], time.time()
+    try:
+        for m in chosen:
+            outcome = audit(m, work)
+            print(f"{m[0]:24s} {outcome}", flush=True)
+            rows.append((m, outcome))
+        mm = run_mutmut(work) if args.mutmut else None
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    by_verify = sum(o.startswith(("verify", "killed by the generator")) for _, o in rows)
+    by_any = sum(o != "survived" for _, o in rows)
+    n = len(rows)
+    lines = ["# Mutation audit", "",
+             f"`python benchmarks/mutation_audit.py` on {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC, "
+             f"{os.cpu_count()} CPUs, Python {platform.python_version()}, {time.time() - started:.0f} s.",
+             "Each mutant applied alone to a scratch copy of the working tree; formulas regenerated; "
+             "`pytest verify -x`, then (if it survives) `pytest tests -x`.", "",
+             "| mutant | the bug | killed by |", "|---|---|---|"]
+    for (mid, path, _, _, what), outcome in rows:
+        note = f" ({ACCEPTED[mid]})" if outcome == "survived" and mid in ACCEPTED else \
+            (" (**flagged**: not an accepted survivor)" if outcome == "survived" else "")
+        lines.append(f"| `{mid}` (`{path}`) | {what} | {outcome}{note} |")
+    lines += ["", f"Kill rate: `pytest verify` alone {by_verify}/{n} ({100 * by_verify / max(n, 1):.0f} %); "
+              f"verify + tests {by_any}/{n} ({100 * by_any / max(n, 1):.0f} %). Targets: 90 % and 98 %."]
+    if args.mutmut:
+        lines.append(f"mutmut over proofs/ with pytest verify: {mm[0]}/{mm[1]} killed." if mm else
+                     "mutmut: not installed (pip install mutmut).")
+    Path(args.out).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print("\n".join(lines[-2:]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
