@@ -23,7 +23,7 @@ import numpy as np
 from renderer import Scene, compare, gbuffer, pointwise, render
 from renderer.render import SPHERE_A
 
-__all__ = ["Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED", "evaluate", "checked", "ClaimChanged",
+__all__ = ["Claim", "CLAIMS", "CRITERIA", "HOLDS", "FAILS", "CORRECTED", "evaluate", "checked", "ClaimChanged",
            "crease_band_ratio"]
 
 HOLDS, FAILS, CORRECTED = "holds", "does not hold", "holds with a correction"
@@ -450,6 +450,46 @@ CLAIMS = (
     Claim("try-beta0", "§4 Try this (4)", "bump β to 0: both panels return Chapter 5",
           "β = 0 renders across fields and pipelines, bit for bit", HOLDS, _beta_zero_slider),
 )
+
+
+#: Each claim's decision rule, as its measure function applies it; the book shows
+#: it beside the measurement (x: the measured quantity).
+CRITERIA = {
+    "h3-scale": "holds if 1,000 <= (π k_u)³ <= 4,000",
+    "truncation-until-1e-6": "holds if the model's optimum lies within half a decade of 1e-6",
+    "roundoff-drowns-1e-9": "holds if the relative error at ε = 1e-9 exceeds 1e-2",
+    "cell2-minimum": "holds if the fitted optimum lies within half a decade of 1e-6; with a correction if "
+                     "within 1e-8 … 1e-5",
+    "frame-aligned": "holds if (e_θ × e_φ)·N = +1",
+    "flips-zero": "holds if no geometry value and no reach-mask pixel differs",
+    "shadow-curves-unchanged": "with a correction if the draft's rule lights any pair past the terminator, "
+                               "else holds",
+    "cell1-ripples": "does not hold if the draft's sphere B covers every pixel",
+    "census-slope": "holds if the RMS slope exceeds 1.8; with a correction if only the off-band slope does",
+    "census-flips": "holds if no step has a flip",
+    "cell3-runs": "holds if the draft's reduction completes",
+    "kink-order-of-magnitude": "holds if 3 <= on/off ratio <= 30",
+    "four-evals-vs-one": "with a correction if central uses 4 values of h and exact none",
+    "cell4-counter": "holds if the counter prints 4 and 1",
+    "stacking": "with a correction if the bump raises the one-sample error over 2×, else holds",
+    "blinn-exact": "with a correction if the gap exceeds 1e-6 with first-order terms below 1e-12; "
+                   "holds if the gap is below 1e-12",
+    "symbolic-not-slower": "holds if the central gradient stage takes over 1.5× the exact one",
+    "cell5-fd-1e-9": "holds if 1e-10 < worst component < 1e-8",
+    "dn-verified-1e-12": "with a correction if the closed form's residual is below 1e-12",
+    "beta-quadratic": "holds if the median and RMS orders exceed 1.8 (median below 2.3); with a correction "
+                      "if only the median's does",
+    "beta0-1e-16": "holds if max |ΔI| <= 1e-15",
+    "bump-nonzero": "holds if mean |ΔI| > 1e-2",
+    "cell6-truncation": "holds if 50 < max |ΔI| ratio < 200 (a hundredfold per decade)",
+    "noise-below-1e-11": "holds if the relative error exceeds 0.1",
+    "crease-fd-zero": "with a correction if |FD| < 1e-6 while the exact value is not 0; holds if both are ~0",
+    "pole-pixels": "does not hold if no pixel uses the fallback",
+    "try-sweep": "holds if the best step lies in 1e-7 … 1e-5",
+    "try-creases": "holds if over 95 % lie in the band",
+    "try-pinch": "holds if the angle exceeds 90°",
+    "try-beta0": "holds if the renders are equal bit for bit",
+}
 
 
 def evaluate():

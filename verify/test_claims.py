@@ -40,6 +40,11 @@ def test_the_books_table_refuses_a_flipped_verdict():
         checked(flipped)
 
 
+def test_every_claim_states_its_decision_rule():
+    from proofs.claims import CRITERIA
+    assert set(CRITERIA) == {c.id for c in CLAIMS} and all(CRITERIA.values())
+
+
 def test_register_records_false_claims_too():
     verdicts = [c.registered for c in CLAIMS]
     assert verdicts.count(FAILS) >= 5 and verdicts.count(HOLDS) >= 5
