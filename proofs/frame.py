@@ -170,13 +170,17 @@ CHART_RATES = (sp.simplify(sp.diff(CHART_AT[0], theta)),
                sp.simplify(sp.diff(F.CHART[1].subs(F.CHART[2], F.sin_phi).subs(ON_SPHERE), phi)))
 
 
+#: The rates the statement claims (printed from these objects).
+RATES_CLAIMED = (1 / (2 * sp.pi), 1 / sp.pi)
+
+
 def _chart_identities(u_claim, v_claim):
     return [
         Identity("u", CHART_AT[0], u_claim, DOMAIN),
         Identity("v", CHART_AT[1], v_claim, DOMAIN),
         Identity(r"\sin\varphi", CHART_AT[2], sp.sin(phi), DOMAIN),
-        Identity(r"\partial u/\partial\theta", CHART_RATES[0], 1 / (2 * sp.pi), DOMAIN),
-        Identity(r"\partial v/\partial\varphi", CHART_RATES[1], 1 / sp.pi, DOMAIN),
+        Identity(r"\partial u/\partial\theta", CHART_RATES[0], RATES_CLAIMED[0], DOMAIN),
+        Identity(r"\partial v/\partial\varphi", CHART_RATES[1], RATES_CLAIMED[1], DOMAIN),
     ]
 
 
@@ -211,8 +215,8 @@ CHART_INVERSE = Theorem(
                r"(`renderer.formulas.CHART`) of $N(\theta, \varphi)$ is "
                rf"$u = {sp.latex(F.CHART[0])} = {sp.latex(U_OF_THETA)}$, "
                rf"$v = {sp.latex(F.CHART[1])} = {sp.latex(V_OF_PHI, symbol_names=ANGLE_NAMES)}$ and "
-               rf"${sp.latex(F.CHART[2])} = \sin\varphi$; so $\partial u/\partial\theta = 1/2\pi$ and "
-               r"$\partial v/\partial\varphi = 1/\pi$, the factors between chart and angular "
+               rf"${sp.latex(F.CHART[2])} = \sin\varphi$; so $\partial u/\partial\theta = {sp.latex(RATES_CLAIMED[0])}$ "
+               rf"and $\partial v/\partial\varphi = {sp.latex(RATES_CLAIMED[1])}$, the factors between chart and angular "
                r"derivatives of $h$."),
     steps=tuple((i.label, i.lhs, i.rhs) for i in _chart_identities(U_OF_THETA, V_OF_PHI)),
     check=lambda: _check_chart(_chart_identities(U_OF_THETA, V_OF_PHI)),
