@@ -15,7 +15,8 @@ is the circle rho_m = rho(pi m / k_v), visible when cos(pi m / k_v) > R / e.
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, gbuffer, pointwise, render
+from renderer import Scene, gbuffer, render
+from renderer import formulas as F
 
 from .core import Identity, Theorem, Verdict, check_identities
 
@@ -50,30 +51,35 @@ def phi_of_rho(rho, radius_a, camera_z):
     return np.arcsin(s) - np.arctan2(rho, camera_z)
 
 
-def predicted_band(scene, width, height):
-    """The crease band predicted from the closed forms, on the pixels of sphere A.
+#: The crease flag's two parts (`formulas.KINK_BAND`: a factor of `RIDGE_FACTORS`
+#: below `KINK_BAND_HALF_WIDTH`), as functions of (u, k_u) and (v, k_v).
+_PART = [sp.lambdify((var, k), sp.Abs(f) < F.KINK_BAND_HALF_WIDTH, modules="numpy")
+         for var, k, f in ((F.u, F.k_u, F.RIDGE_FACTORS[0]), (F.v, F.k_v, F.RIDGE_FACTORS[1]))]
 
-    (u, v) come from the pixel's image-plane polar coordinates by the closed
-    forms above, not from the renderer's ray and chart; the band is then the
-    renderer's crease flag at those (u, v) (`renderer.pointwise.kink_band`,
-    `renderer.formulas.KINK_BAND`).
-    """
+
+def predicted_parts(scene, width, height, shift=(0.0, 0.0)):
+    """The two parts of the crease band predicted from the closed forms alone,
+    on sphere A's pixels: the rays (u from the image angle) and the circles (v
+    from the image radius); ``shift`` (in u, v) moves them, for wrong variants.
+    Returns (u part, v part, on A), (H, W) bool arrays."""
     g = gbuffer(scene, width, height)
     X, Y = np.meshgrid(g.x, g.y)
-    alpha = np.arctan2(Y, X)
-    rho = np.hypot(X, Y)
-    u = (alpha + np.pi) / (2 * np.pi)
-    v = phi_of_rho(rho, scene.radius_a, scene.camera_z) / np.pi
-    band = pointwise.kink_band("ridges", u, v, scene.k_u, scene.k_v)
-    return band & (g.chamber == 1), g.chamber == 1
+    u = (np.arctan2(Y, X) + np.pi) / (2 * np.pi) + shift[0]
+    v = phi_of_rho(np.hypot(X, Y), scene.radius_a, scene.camera_z) / np.pi + shift[1]
+    on_a = g.chamber == 1
+    return _PART[0](u, scene.k_u) & on_a, _PART[1](v, scene.k_v) & on_a, on_a
 
 
-def band_mismatch(scene=None, size=256):
-    """Pixels where the rendered kink band and the closed-form band disagree."""
+def part_mismatch(kind, scene=None, size=256, shift=(0.0, 0.0)):
+    """(mismatched, in the part, compared): where the other part's closed form is off, the
+    rendered kink flag against this part's closed form (rays: u; circles: v)."""
     scene = scene or Scene()
-    predicted, on_a = predicted_band(scene, size, size)
+    u_part, v_part, on_a = predicted_parts(scene, size, size, shift)
+    mine, other = (u_part, v_part) if kind == "rays" else (v_part, u_part)
     rendered = render(scene, size, size).kink
-    return int(np.count_nonzero(predicted != rendered)), int(np.count_nonzero(rendered)), int(on_a.sum())
+    where = on_a & ~other
+    return (int(np.count_nonzero((rendered != mine) & where)), int(np.count_nonzero(mine & where)),
+            int(np.count_nonzero(where)))
 
 
 def _projection_identities(rho, drho):
@@ -82,12 +88,12 @@ def _projection_identities(rho, drho):
             Identity(r"d\rho/d\varphi", sp.diff(RHO, phi), drho, DOMAIN)]
 
 
-def _check(kind, rho=RHO, drho=DRHO, scene=None):
+def _check(kind, rho=RHO, drho=DRHO, scene=None, shift=(0.0, 0.0)):
     symbolic = check_identities(_projection_identities(rho, drho))
     if not symbolic.holds:
         return symbolic
     scene = scene or Scene()
-    mismatched, band, on_a = band_mismatch(scene)
+    mismatched, band, on_a = part_mismatch(kind, scene, shift=shift)
     if kind == "rays":
         loci = ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
         what = f"{len(ray_angles(scene.k_u))} rays at alpha = {loci} (all visible)"
@@ -95,11 +101,13 @@ def _check(kind, rho=RHO, drho=DRHO, scene=None):
         phis, rhos, vis = circle_radii(scene.radius_a, scene.camera_z, scene.k_v)
         what = "; ".join(f"phi={p:.4f}: rho={r:.4f} ({'visible' if s else 'hidden'})"
                          for p, r, s in zip(phis, rhos, vis))
+    part = "u-creases from the image angle" if kind == "rays" else "v-creases from the image radius"
     if mismatched > 0:
-        return Verdict("refuted", f"{mismatched} of {on_a} sphere-A pixels: rendered band differs "
-                       f"from the closed form")
-    return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the closed-form band equals the "
-                   f"rendered kink band on all {on_a} sphere-A pixels ({band} in the band) at 256x256")
+        return Verdict("refuted", f"{mismatched} of {on_a} sphere-A pixels: the rendered crease flag differs "
+                       f"from the {part}")
+    return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the {part} (closed form alone) equal the "
+                   f"rendered crease flag on all {on_a} sphere-A pixels off the other family ({band} on a "
+                   "crease) at 256x256")
 
 
 KINK_LOCI_RAYS = Theorem(
@@ -111,7 +119,9 @@ KINK_LOCI_RAYS = Theorem(
            ("polar form", r"(x, y)", sp.Matrix([RHO * sp.cos(theta), RHO * sp.sin(theta)]))),
     check=lambda: _check("rays"),
     wrong_variants=(("projection with a flipped sign: e + R cos(phi) in the denominator",
-                     lambda: _check("rays", rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi)))),),
+                     lambda: _check("rays", rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi)))),
+                    ("the rays turned by half a period (u + 1/2k_u)",
+                     lambda: _check("rays", shift=(0.5 / Scene().k_u, 0.0)))),
     pages=("s3", "s4"),
     seed_says="§3: the zero lines u = m/k_u are rays 'by Chapter 5's longitude theorem'.",
 )
@@ -126,7 +136,9 @@ KINK_LOCI_CIRCLES = Theorem(
     steps=(("radius", r"\rho(\varphi)", RHO), ("monotone", r"\rho'(\varphi)", DRHO)),
     check=lambda: _check("circles"),
     wrong_variants=(("derivative with the factor e cos(phi) - R replaced by e - R cos(phi)",
-                     lambda: _check("circles", drho=e * R / (e - R * sp.cos(phi)))),),
+                     lambda: _check("circles", drho=e * R / (e - R * sp.cos(phi)))),
+                    ("the circles moved by half a period (v + 1/2k_v)",
+                     lambda: _check("circles", shift=(0.0, 0.5 / Scene().k_v)))),
     pages=("s3", "s4"),
     seed_says="§3: the zero lines v = m/k_v are circles 'by its corollary'.",
 )
