@@ -83,16 +83,17 @@ def _gradient_check(name, closed_form, corrupt=None):
                            f"{worst:.2e} (relative to pi max(k_u, 2 k_v))", worst, DIGITS, POINTS)
         # The renderer's own gradients (GBuffer.grad) at its own (u, v) (proofs/pixels.py).
         from .pixels import gradient_error
-        rendered = {method: gradient_error(name, method, corrupt) for method in ("exact", "central")}
+        rendered = {method: gradient_error(name, method, corrupt) for method in ("exact", "central", "footprint")}
         if max(r for r, _ in rendered.values()) > 1:
             return Verdict("refuted", "the renderer's gradient leaves its tolerance by "
                            + ", ".join(f"{m} {r:.2g}x" for m, (r, _) in rendered.items()))
         return Verdict(symbolic.status, f"renderer.formulas.GRADIENT: {symbolic.evidence}; "
                        f"the kernel's generated code within "
-                       f"{worst:.1e} of mpmath ({DIGITS} digits, {POINTS} points); the renderer's exact and "
-                       f"central gradients (GBuffer.grad) at {rendered['exact'][1]} seeded sphere-A pixels within "
-                       f"{rendered['exact'][0]:.2f} and {rendered['central'][0]:.2f} of their tolerances against "
-                       "GRADIENT and CENTRAL (stencil included) at its (u, v)", worst, DIGITS, POINTS)
+                       f"{worst:.1e} of mpmath ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
+                       f"footprint gradients (GBuffer.grad) at {rendered['exact'][1]} seeded sphere-A pixels within "
+                       f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
+                       "of their tolerances against GRADIENT, CENTRAL (stencil included) and CENTRAL with "
+                       "FOOTPRINT's steps at its (u, v)", worst, DIGITS, POINTS)
     return check
 
 

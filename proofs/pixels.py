@@ -50,23 +50,27 @@ def _frames(field, gradient, bump):
 
 def pixels(field, gradient="exact", bump="chart", seed=0):
     """The sampled sphere-A pixels as a dict of arrays (one row per pixel):
-    N, Ns (k, 3), uv, grad (k, 2), from the full frame, the two pole frames
-    and (ridges) the crease band of the full frame; and the `Scene`."""
+    N, Ns, P (k, 3), uv, grad (k, 2), xy (k, 4: the pixel centre x, y and
+    the spacings dx, dy), from the full frame, the two pole frames and
+    (ridges) the crease band of the full frame; and the `Scene`."""
     scene, frames = _frames(field, gradient, bump)
     rng = np.random.default_rng(seed)
-    picked = {name: [] for name in ("N", "Ns", "uv", "grad")}
+    picked = {name: [] for name in ("N", "Ns", "uv", "grad", "P", "xy")}
     for k, g in enumerate(frames):
-        on_a = g.chamber == SPHERE_A
+        X, Y = np.meshgrid(g.x, g.y)
+        spacing = (g.x[1] - g.x[0], g.y[0] - g.y[1])
+        g = dict(N=g.N, Ns=g.Ns, uv=g.uv, grad=g.grad, P=g.P, chamber=g.chamber,
+                 xy=np.stack([X, Y, np.full(X.shape, spacing[0]), np.full(X.shape, spacing[1])], axis=-1))
+        on_a = g["chamber"] == SPHERE_A
         where = [np.flatnonzero(on_a)]
         if k == 0 and field == "ridges":
-            u, v = g.uv[..., 0] * scene.k_u, g.uv[..., 1] * scene.k_v
+            u, v = g["uv"][..., 0] * scene.k_u, g["uv"][..., 1] * scene.k_v
             near = on_a & ((np.abs(u - np.rint(u)) < 0.05) | (np.abs(v - np.rint(v)) < 0.05))
             where.append(np.flatnonzero(near))
         for idx in where:
             take = rng.choice(idx, size=min(PER_FIELD // 3, idx.size), replace=False)
             for name in picked:
-                a = getattr(g, name)
-                picked[name].append(a.reshape(-1, a.shape[-1])[take])
+                picked[name].append(g[name].reshape(-1, g[name].shape[-1])[take])
     return scene, {name: np.concatenate(rows) for name, rows in picked.items()}
 
 
@@ -107,6 +111,17 @@ def gradient_error(field, gradient, corrupt=None):
         exprs = [e.subs(consts) for e in F.GRADIENT[field]]
         ref = _eval(exprs, (F.u, F.v), px["uv"])
         bound = TOLERANCE["gradient"] * np.pi * max(scene.k_u, 2 * scene.k_v)
+    elif gradient == "footprint":
+        # The steps from formulas.FOOTPRINT at the pixel (its frame from TANGENT_FRAME), then CENTRAL.
+        sin_phi = F.CHART[2]
+        frame = dict(zip(F.e_theta + F.e_phi, [c.subs(F.sin_phi, sin_phi) for c in F.TANGENT_FRAME]))
+        steps = _eval([e.subs(frame).subs({F.sin_phi: sin_phi, F.R: scene.radius_a, F.camera_z: scene.camera_z})
+                       for e in F.FOOTPRINT], (F.N_x, F.N_y, F.N_z) + tuple(F.P) + (F.x, F.y, F.dx, F.dy),
+                      np.hstack([px["N"], px["P"], px["xy"]]))
+        exprs = [e.subs(dict(F.STENCIL_POINTS)).subs(consts) for e in F.CENTRAL[field]]
+        ref = _eval(exprs, (F.u, F.v, F.eps_u, F.eps_v), np.hstack([px["uv"], steps]))
+        scale = np.pi * max(scene.k_u, 2 * scene.k_v)
+        bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / float(steps.min())
     else:
         stencil = dict(F.STENCIL_POINTS)
         exprs = [e.subs(stencil).subs({F.eps_u: scene.eps, F.eps_v: scene.eps, **consts})
