@@ -93,16 +93,54 @@ def interior_branch_mismatches(samples=2000, seed=11):
     return bad
 
 
-def _check_truncation(claimed, denominator=2):
+def _border_rule(u, v, eps):
+    """The stencil at the chart's borders, written from the rule (seed Cell 1,
+    ``grad_numeric``): u wraps (the chart is periodic in u), v clamps to [0, 1]
+    and the v-quotient is then one-sided, over the clamped distance."""
+    u_p = u + eps - 1 if u + eps >= 1 else u + eps
+    u_m = u - eps + 1 if u - eps < 0 else u - eps
+    v_p, v_m = min(1.0, v + eps), max(0.0, v - eps)
+    return u_p, u_m, v_p, v_m, (v_p - v_m) if (v + eps > 1 or v - eps < 0) else 2 * eps
+
+
+def border_mismatches(samples=2000, seed=12, rule=_border_rule):
+    """Seeded points within a step of the borders (u near 0 or 1, v near 0 or 1) at
+    which `formulas.STENCIL_POINTS`, or the v-denominator of `formulas.CENTRAL`
+    (read off its sine field), differ from ``rule``; evaluated in float64."""
+    args = (F.u, F.v, F.eps_u, F.eps_v)
+    points = sp.lambdify(args, [e for _, e in F.STENCIL_POINTS], modules="math")
+    h = F.HEIGHT["sine"].subs({F.k_u: 3, F.k_v: 2})
+    central_v = sp.lambdify(args, F.CENTRAL["sine"][1].subs({F.k_u: 3, F.k_v: 2}).subs(dict(F.STENCIL_POINTS)),
+                            modules="math")
+    h_of = sp.lambdify((F.u, F.v), h, modules="math")
+    rng = random.Random(seed)
+    bad = 0
+    for _ in range(samples):
+        step = 10.0 ** rng.uniform(-6, -1)
+        u_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0 - 1e-12), rng.uniform(0, 1)))
+        v_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0), rng.uniform(0, 1)))
+        want = rule(u_, v_, step)
+        got = points(u_, v_, step, step)
+        quotient = (h_of(u_, want[2]) - h_of(u_, want[3])) / want[4]
+        bad += list(got) != list(want[:4]) or abs(central_v(u_, v_, step, step) - quotient) > 1e-9 * (1 + abs(quotient))
+    return bad
+
+
+def _check_truncation(claimed, denominator=2, rule=_border_rule):
     verdict = check_identities([_series_identity(claimed)] + _kernel_identities(denominator))
     if not verdict.holds:
         return verdict
     bad = interior_branch_mismatches()
     if bad:
         return Verdict("refuted", f"at {bad} interior points the kernel's stencil is not its interior branch")
+    border = border_mismatches(rule=rule)
+    if border:
+        return Verdict("refuted", f"at {border} of 2,000 points near the borders the stencil does not wrap u, "
+                       "clamp v and divide by the clamped distance")
     return Verdict(verdict.status, f"{verdict.evidence} (the series, and the 6 components of "
                    f"renderer.formulas.CENTRAL at interior points); the stencil takes its interior "
-                   f"branch at 2,000 seeded interior points", verdict.residual, verdict.digits, verdict.points)
+                   f"branch at 2,000 seeded interior points, and at 2,000 points near the borders wraps u, "
+                   f"clamps v and divides by the clamped distance", verdict.residual, verdict.digits, verdict.points)
 
 
 CENTRAL_DIFFERENCE_TRUNCATION = Theorem(
@@ -110,7 +148,8 @@ CENTRAL_DIFFERENCE_TRUNCATION = Theorem(
     statement=(r"$\dfrac{h(x+\varepsilon) - h(x-\varepsilon)}{2\varepsilon} = h' + \dfrac{\varepsilon^2}{6}h''' + "
                r"\dfrac{\varepsilon^4}{120}h^{(5)} + O(\varepsilon^6)$. Away from the seam and the poles "
                r"this quotient is the renderer's stencil (`renderer.formulas.CENTRAL`), in $u$ and in $v$, "
-               r"for every height field."),
+               r"for every height field; at the borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient "
+               r"in $v$ then one-sided over the clamped distance."),
     steps=(("series", r"\frac{h(x+\varepsilon) - h(x-\varepsilon)}{2\varepsilon}", CLAIMED),
            ("stencil", r"\text{CENTRAL[sine]}_u", kernel_quotient("sine", 0).subs(F.eps_u, eps))),
     check=lambda: _check_truncation(CLAIMED),
@@ -120,7 +159,9 @@ CENTRAL_DIFFERENCE_TRUNCATION = Theorem(
                      lambda: _check_truncation(CLAIMED - eps**2 / 6 * sp.diff(f(x), x, 3)
                                                + eps**3 / 6 * sp.diff(f(x), x, 3))),
                     ("the stencil read as a quotient over eps, not 2 eps",
-                     lambda: _check_truncation(CLAIMED, denominator=1))),
+                     lambda: _check_truncation(CLAIMED, denominator=1)),
+                    ("a v border divided by 2 eps",
+                     lambda: _check_truncation(CLAIMED, rule=lambda u_, v_, e_: _border_rule(u_, v_, e_)[:4] + (2 * e_,)))),
     pages=("s3",),
 )
 

@@ -51,9 +51,16 @@ def _frame_identities(et, ep):
     ]
 
 
+#: The cut-off below which the frame is the fallback (seed Cell 1, ``tangent_frame``: sin phi > 1e-4).
+SEED_POLE_SIN_PHI = 1e-4
+
+
 def _branch_structure():
     """Refuted unless every component of TANGENT_FRAME is Piecewise((regular,
-    sin_phi > POLE_SIN_PHI), (fallback, True)) with FALLBACK_FRAME's values."""
+    sin_phi > POLE_SIN_PHI), (fallback, True)) with FALLBACK_FRAME's values,
+    and POLE_SIN_PHI is the seed's cut-off."""
+    if F.POLE_SIN_PHI != SEED_POLE_SIN_PHI:
+        return Verdict("refuted", f"POLE_SIN_PHI is {F.POLE_SIN_PHI}, the seed's cut-off is {SEED_POLE_SIN_PHI}")
     for k, (c, fallback) in enumerate(zip(F.TANGENT_FRAME, F.FALLBACK_FRAME)):
         if not isinstance(c, sp.Piecewise):
             ok = c.is_number and c - fallback == 0         # both branches equal: folded by sympy

@@ -9,7 +9,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Identity, Theorem, check_identities
+from .core import Identity, Theorem, Verdict, check_identities
 
 u, v = F.u, F.v
 #: The frequencies are positive in the scene (Scene validates k_u, k_v > 0): the
@@ -58,6 +58,16 @@ def _identities(jump_u, jump_v):
     return ids
 
 
+#: The crease flag's half-width (seed Cell 1, ``height1``: |s1| < 0.03 or |s2| < 0.03).
+SEED_HALF_WIDTH = 0.03
+
+
+def _check(jump_u, jump_v):
+    if F.KINK_BAND_HALF_WIDTH != SEED_HALF_WIDTH:
+        return Verdict("refuted", f"KINK_BAND_HALF_WIDTH is {F.KINK_BAND_HALF_WIDTH}, the seed's is {SEED_HALF_WIDTH}")
+    return check_identities(_identities(jump_u, jump_v))
+
+
 #: The jumps, written by hand (seed §3): independent of the renderer's expressions.
 s1_hand, s2_hand = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
 JUMP_U = 2 * sp.pi * k_u * sp.Abs(s2_hand)
@@ -74,11 +84,10 @@ RIDGES_KINKS = Theorem(
               r"$2\pi k_v \lvert\sin\pi k_u u\rvert$: a crease wherever the other factor is nonzero. "
               r"The renderer's crease flag (`KINK_BAND`) is set on every zero line.",
     # The identities take one-sided limits: built when checked, not on import.
-    check=lambda: check_identities(_identities(JUMP_U, JUMP_V)),
+    check=lambda: _check(JUMP_U, JUMP_V),
     wrong_variants=(
-        ("jump without the factor 2", lambda: check_identities(_identities(sp.pi * k_u * sp.Abs(s2_hand), JUMP_V))),
-        ("jump with the roles of k_u and k_v swapped",
-         lambda: check_identities(_identities(2 * sp.pi * k_v * sp.Abs(s2_hand), JUMP_V)))),
+        ("jump without the factor 2", lambda: _check(sp.pi * k_u * sp.Abs(s2_hand), JUMP_V)),
+        ("jump with the roles of k_u and k_v swapped", lambda: _check(2 * sp.pi * k_v * sp.Abs(s2_hand), JUMP_V))),
     steps=((r"one-sided", r"(h_u^+, h_u^-)\big|_{u = m/k_u,\ \sin\pi k_v v = c \ne 0}",
             sp.Tuple(*one_sided(h.subs(FACTORS[1], c), u, m / k_u))),
            (r"h_u^+ - h_u^-", r"h_u^+ - h_u^-", JUMP_U),
