@@ -17,7 +17,7 @@ import itertools
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, gbuffer, pointwise
+from renderer import PointLight, Scene, gbuffer, pointwise
 from renderer import formulas as F
 
 from .core import Theorem, Verdict
@@ -92,7 +92,62 @@ def render_flips(size=64, gate=False):
     return frames, values, masks
 
 
-def _check(predicates, gate=False):
+#: Scenes for comparing the renderer's reach masks with the predicates: the default, lights
+#: behind sphere A and below the floor, and a light inside sphere B.
+REACH_SCENES = (Scene(), Scene(lights=(PointLight((0.5, -1.0, -6.0)), PointLight((3.0, -2.0, -4.0)))),
+                Scene(lights=(PointLight((0.5, 0.5, 1.3)), PointLight((5.0, 5.0, 10.0)))))
+
+
+def predicate_masks(scene, g, margin=1e-9):
+    """(masks (n_lights, H, W) bool, decided (n_lights, H, W) bool): the statement's predicates
+    evaluated at the G-buffer's hit points in float64, written here from their definitions:
+    attached N . (L - P) > 0; the floor plane z = 0 not between P and L (floor on, P off
+    it); no blocker sphere (B for A, A for B, both for the floor) with a root of
+    |P + s (L - P) - C|^2 = r^2 in (0, 1).  ``decided`` is False where a root, the
+    discriminant or the attached product lies within ``margin`` of its threshold."""
+    P, N, code = g.P, g.N, g.chamber
+    blockers = [(np.zeros(3), scene.radius_a, code != 1)]
+    if scene.sphere_b:
+        blockers.append((np.asarray(scene.center_b), scene.radius_b, code != 2))
+    masks, decided = [], []
+    for light in scene.lights:
+        w = np.asarray(light.position) - P
+        attached = np.einsum("hwc,hwc->hw", N, w)
+        ok, sure = attached > 0, np.abs(attached) > margin
+        if scene.floor:
+            ok &= ~((code != 3) & (light.position[2] * P[..., 2] < 0))
+        a = np.einsum("hwc,hwc->hw", w, w)
+        for center, radius, applies in blockers:
+            d = P - center
+            b, c = 2 * np.einsum("hwc,hwc->hw", d, w), np.einsum("hwc,hwc->hw", d, d) - radius**2
+            disc = b * b - 4 * a * c
+            root = np.sqrt(np.maximum(disc, 0.0))
+            s1, s2 = (-b - root) / (2 * a), (-b + root) / (2 * a)
+            cut = (disc >= 0) & (((s1 > 0) & (s1 < 1)) | ((s2 > 0) & (s2 < 1)))
+            ok &= ~(applies & cut)
+            near = (np.abs(disc) <= margin * b * b) | (np.minimum(np.abs(s1), np.abs(s2)) < margin) | \
+                (np.minimum(np.abs(s1 - 1), np.abs(s2 - 1)) < margin)
+            sure &= ~(applies & near & ok)
+        on = code != 0
+        masks.append(ok & on)
+        decided.append(sure | ~on)
+    return np.array(masks), np.array(decided)
+
+
+def reach_mismatches(size=128, reach=None):
+    """(differing, compared): pixels x lights where `renderer.pointwise.reach` (or ``reach``,
+    for wrong variants) and `predicate_masks` differ, over `REACH_SCENES`, decided pixels only."""
+    reach = reach or pointwise.reach
+    bad = total = 0
+    for scene in REACH_SCENES:
+        g = gbuffer(scene, size, size)
+        want, decided = predicate_masks(scene, g)
+        bad += int(np.count_nonzero((reach(scene, g) != want) & decided))
+        total += int(np.count_nonzero(decided))
+    return bad, total
+
+
+def _check(predicates, gate=False, reach=None):
     leaking = {name: sorted(str(sym) for sym in expr.free_symbols & BUMP_SYMBOLS)
                for name, expr in predicates.items()}
     leaking = {k: v for k, v in leaking.items() if v}
@@ -103,12 +158,18 @@ def _check(predicates, gate=False):
     if values or masks:
         return Verdict("refuted", f"over {frames} G-buffers, {values} geometry values and {masks} reach-mask "
                        "pixels differ from the beta = 0 frame")
+    differing, compared = reach_mismatches(reach=reach)
+    if differing:
+        return Verdict("refuted", f"kernel.reach differs from the shadow predicates at {differing} of {compared} "
+                       "(pixel, light) pairs")
     return Verdict("verified", f"free symbols of {len(predicates)} chamber and shadow predicates written here "
                    f"exclude beta, eps, k_u, k_v; the renderer's own: {frames} independent G-buffers (3 fields x "
                    f"eps 1e-1..1e-8 x 2 pipelines x beta {BETAS} (chart) or {SURFACE_BETAS} (surface), 64x64) "
                    "have the chamber, t, P "
-                   "and N of the beta = 0 frame bit for bit, and kernel.reach gives each light the same mask",
-                   residual=float(values + masks), points=frames)
+                   "and N of the beta = 0 frame bit for bit, and kernel.reach gives each light the same mask; "
+                   f"kernel.reach equals the predicates above, evaluated at the hit points, at all {compared} "
+                   f"decided (pixel, light) pairs of {len(REACH_SCENES)} scenes (128x128; a light inside sphere B, "
+                   "lights behind A and below the floor)", residual=float(values + masks + differing), points=frames)
 
 
 NO_BOUNDARY = Theorem(
@@ -127,7 +188,10 @@ NO_BOUNDARY = Theorem(
                     ("the seed's rule with the central-difference gradient",
                      lambda: _check({**PREDICATES, **_seed_attached_predicate("central")})),
                     ("the renderer's reach masks gated by the bumped normal (the seed's rule)",
-                     lambda: _check(PREDICATES, gate=True))),
+                     lambda: _check(PREDICATES, gate=True)),
+                    ("a reach predicate in which sphere B shadows nothing",
+                     lambda: _check(PREDICATES, reach=lambda scene, g: pointwise.reach(scene.replace(
+                         sphere_b=False), g)))),
     pages=("s1", "s3", "s4"),
     seed_says="§3: the chamber masks are functions of geometry alone; the seed's shading code "
               "nonetheless lets lights past the geometric terminator (errata E2).",
