@@ -126,7 +126,7 @@ def border_mismatches(samples=2000, seed=12, rule=_border_rule):
     return bad
 
 
-def _check_truncation(claimed, denominator=2, rule=_border_rule):
+def _check_truncation(claimed, denominator=2, rule=_border_rule, half=0.5):
     verdict = check_identities([_series_identity(claimed)] + _kernel_identities(denominator))
     if not verdict.holds:
         return verdict
@@ -137,10 +137,16 @@ def _check_truncation(claimed, denominator=2, rule=_border_rule):
     if border:
         return Verdict("refuted", f"at {border} of 2,000 points near the borders the stencil does not wrap u, "
                        "clamp v and divide by the clamped distance")
+    from .pixels import footprint_error
+    fp, pixels = footprint_error(half=half)
+    if fp > 1e-9:
+        return Verdict("refuted", f"the kernel's footprint steps differ from pbrt-v4's rule by {fp:.2g} (relative)")
     return Verdict(verdict.status, f"{verdict.evidence} (the series, and the 6 components of "
                    f"renderer.formulas.CENTRAL at interior points); the stencil takes its interior "
                    f"branch at 2,000 seeded interior points, and at 2,000 points near the borders wraps u, "
-                   f"clamps v and divides by the clamped distance", verdict.residual, verdict.digits, verdict.points)
+                   f"clamps v and divides by the clamped distance; the footprint steps (FOOTPRINT, compiled) "
+                   f"equal pbrt-v4's least-squares rule within {fp:.1e} (relative) at {pixels} sphere-A pixels",
+                   verdict.residual, verdict.digits, verdict.points)
 
 
 CENTRAL_DIFFERENCE_TRUNCATION = Theorem(
@@ -149,7 +155,8 @@ CENTRAL_DIFFERENCE_TRUNCATION = Theorem(
                r"\dfrac{\varepsilon^4}{120}h^{(5)} + O(\varepsilon^6)$. Away from the seam and the poles "
                r"this quotient is the renderer's stencil (`renderer.formulas.CENTRAL`), in $u$ and in $v$, "
                r"for every height field; at the borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient "
-               r"in $v$ then one-sided over the clamped distance."),
+               r"in $v$ then one-sided over the clamped distance.  The footprint steps are pbrt-v4's "
+               r"$\tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ (likewise $v$)."),
     steps=(("series", r"\frac{h(x+\varepsilon) - h(x-\varepsilon)}{2\varepsilon}", CLAIMED),
            ("stencil", r"\text{CENTRAL[sine]}_u", kernel_quotient("sine", 0).subs(F.eps_u, eps))),
     check=lambda: _check_truncation(CLAIMED),
@@ -160,6 +167,7 @@ CENTRAL_DIFFERENCE_TRUNCATION = Theorem(
                                                + eps**3 / 6 * sp.diff(f(x), x, 3))),
                     ("the stencil read as a quotient over eps, not 2 eps",
                      lambda: _check_truncation(CLAIMED, denominator=1)),
+                    ("the footprint without pbrt's factor 1/2", lambda: _check_truncation(CLAIMED, half=1.0)),
                     ("a v border divided by 2 eps",
                      lambda: _check_truncation(CLAIMED, rule=lambda u_, v_, e_: _border_rule(u_, v_, e_)[:4] + (2 * e_,)))),
     pages=("s3",),

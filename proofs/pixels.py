@@ -148,3 +148,46 @@ def normal_error(field, bump, corrupt=None):
     grad = px["grad"] if corrupt is None else corrupt(px["grad"])
     ref = _eval(list(normal), args, np.hstack([px["N"], grad, px["uv"]]))
     return float(np.max(np.abs(Ns - ref))), Ns.shape[0]
+
+
+def footprint_error(half=0.5, size=96):
+    """Worst relative difference between the kernel's footprint steps
+    (`formulas.FOOTPRINT` through `renderer.pointwise.footprint`) and pbrt-v4's
+    bump rule written here: the rays through the next column and row meet the
+    tangent plane at P (``ComputeDifferentials``), (du/dx, dv/dx) and (du/dy,
+    dv/dy) solve the 2x2 least squares against dP/du = 2 pi R sin(phi) e_theta,
+    dP/dv = pi R e_phi (the chart's rates, theorem `chart`), and du = ``half``
+    (|du/dx| + |du/dy|) (``BumpMap``), with the fallback and the cap of
+    `formulas.FOOTPRINT`; over the sphere-A pixels of the default frame (size²)
+    and of a pole zoom; and the count."""
+    from renderer import pointwise
+    scene = Scene()
+    e, R = scene.camera_z, scene.radius_a
+    fallback, cap, limit = (float(c) for c in (F.FOOTPRINT_FALLBACK, F.FOOTPRINT_MAX, F.FOOTPRINT_LIMIT))
+    worst, count = 0.0, 0
+    for zoom in (1.0, 300.0):
+        g = gbuffer(scene, size, size, zoom=zoom)
+        on_a = g.chamber == SPHERE_A
+        X, Y = np.meshgrid(g.x, g.y)
+        x, y, P, N = X[on_a], Y[on_a], g.P[on_a], g.N[on_a]
+        dx, dy = g.x[1] - g.x[0], g.y[0] - g.y[1]
+        sin_phi = np.hypot(N[:, 0], N[:, 1])
+        et, ep = (np.stack(t, axis=1) for t in pointwise.tangent_frame(N[:, 0], N[:, 1], N[:, 2], sin_phi))
+        dpdu, dpdv = (2 * np.pi * R * sin_phi)[:, None] * et, np.pi * R * ep
+        E = np.array([0.0, 0.0, e])
+        deriv = []
+        for sx, sy in ((dx, 0.0), (0.0, dy)):
+            d = np.stack([x + sx, y + sy, np.full(x.shape, -e)], axis=1)
+            t = np.einsum("ij,ij->i", N, P - E) / np.einsum("ij,ij->i", N, d)
+            dp = E + t[:, None] * d - P
+            A = np.stack([dpdu, dpdv], axis=2)                       # (k, 3, 2)
+            deriv.append(np.stack([np.linalg.lstsq(a, b, rcond=None)[0] for a, b in zip(A, dp)]))
+        steps = []
+        for k in range(2):
+            s = half * (np.abs(deriv[0][:, k]) + np.abs(deriv[1][:, k]))
+            steps.append(np.where((s > 0) & (s < limit), np.minimum(s, cap), fallback))
+        got = pointwise.footprint(x, y, dx, dy, e, P.T, N.T, et.T, ep.T, R, sin_phi)
+        for want, have in zip(steps, got):
+            worst = max(worst, float(np.max(np.abs(have - want) / want)))
+        count += int(x.size)
+    return worst, count
