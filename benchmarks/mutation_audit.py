@@ -18,14 +18,18 @@ cannot mutate the numba kernel (its trampolines are Python calls, which
 compiled code cannot make) nor formulas.py's module-level sympy, which is why
 the semantic mutants cover those.
 
-Results: benchmarks/results/mutation_audit.md.
+Results: benchmarks/results/mutation_audit.md (and .json).  With ``--only`` the
+named mutants are run again and their rows replace the earlier ones (from the
+.json, or else the .md table), so a fix can be re-audited without a full run.
 Usage: python benchmarks/mutation_audit.py [--only ID ...] [--mutmut] [--out FILE]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import re
 import platform
 import shutil
 import subprocess
@@ -185,6 +189,20 @@ def run_mutmut(work):
     return sum(s == "killed" for s in statuses), len(statuses)
 
 
+def _earlier(out):
+    """{mutant id: outcome} of the last run, from its .json or else its .md table."""
+    if out.with_suffix(".json").is_file():
+        return json.loads(out.with_suffix(".json").read_text(encoding="utf-8"))
+    rows = {}
+    if out.is_file():
+        for line in out.read_text(encoding="utf-8").splitlines():
+            m = re.match(r"^\| `([^`]+)` \(`[^`]+`\) \| .* \| (verify \(\d+ s\)|tests \(\d+ s\)|survived|"
+                         r"killed by the generator|timeout)", line)
+            if m:
+                rows[m.group(1)] = m.group(2)
+    return rows
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="*", help="mutant ids to run (default: all)")
@@ -203,6 +221,12 @@ def main(argv=None):
         mm = run_mutmut(work) if args.mutmut else None
     finally:
         shutil.rmtree(work, ignore_errors=True)
+    out = Path(args.out)
+    if args.only:                                   # merge into the earlier full run
+        earlier = _earlier(out)
+        fresh = {m[0]: o for m, o in rows}
+        rows = [(m, fresh.get(m[0], earlier.get(m[0]))) for m in MUTANTS if m[0] in fresh or m[0] in earlier]
+    out.with_suffix(".json").write_text(json.dumps({m[0]: o for m, o in rows}, indent=1) + "\n", encoding="utf-8")
     by_verify = sum(o.startswith(("verify", "killed by the generator")) for _, o in rows)
     by_any = sum(o != "survived" for _, o in rows)
     n = len(rows)
@@ -221,7 +245,7 @@ def main(argv=None):
     if args.mutmut:
         lines.append(f"mutmut over proofs/ with pytest verify: {mm[0]}/{mm[1]} killed." if mm else
                      "mutmut: not installed (pip install mutmut).")
-    Path(args.out).write_text("\n".join(lines) + "\n", encoding="utf-8")
+    out.write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("\n".join(lines[-2:]))
     return 0
 
