@@ -199,7 +199,9 @@ def reach(scene, gbuffer, *, gate=False):
     return out
 
 
-@njit(cache=True, error_model="numpy")
+# Not cached: numba's cache would key this on pointwise.py alone, and keep the
+# kernel's reach inlined as it was when first compiled after kernel.py changes.
+@njit(error_model="numpy")
 def _reach_rows(prm, lights, chamber, P, N, Ns, gate, out):
     s = kernel.unpack(prm)
     for j in range(chamber.shape[0]):
