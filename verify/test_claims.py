@@ -48,3 +48,17 @@ def test_every_claim_states_its_decision_rule():
 def test_register_records_false_claims_too():
     verdicts = [c.registered for c in CLAIMS]
     assert verdicts.count(FAILS) >= 5 and verdicts.count(HOLDS) >= 5
+
+
+def test_the_ledger_the_claims_read_sums_over_sphere_a_only():
+    """`renderer.compare` (the census, the crease ratio) against numpy over the pixels
+    both frames put on sphere A; a sum over every pixel would differ."""
+    import numpy as np
+
+    from renderer import Scene, compare, render
+    num, sym = render(Scene(), 96, 96, gradient="central"), render(Scene(), 96, 96)
+    led = compare(num, sym)
+    on_a = (num.chamber == 1) & (sym.chamber == 1)
+    d = np.abs(num.image - sym.image)
+    assert led.max_abs == d[on_a].max() and led.rms == pytest.approx(np.sqrt(np.mean(d[on_a] ** 2)), rel=1e-12)
+    assert led.rms != pytest.approx(np.sqrt(np.mean(d ** 2)), rel=1e-3)

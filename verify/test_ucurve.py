@@ -102,3 +102,10 @@ def test_the_fitted_optimum_does_not_jump_with_the_grid_where_the_argmin_does():
 def test_an_exact_quotient_has_no_fitted_optimum():
     flat = measure("rings", u=0.3, v=0.31)          # h_u = 0 for rings: every quotient is exact
     assert np.all(flat.error == 0) and np.isnan(flat.eps_opt_fitted)
+
+
+def test_unit_roundoff_is_half_the_machine_epsilon():
+    """u = eps_mach / 2 for float64 with round to nearest (Higham, Accuracy and
+    Stability of Numerical Algorithms, §2.1): the constant every model here uses."""
+    assert UNIT_ROUNDOFF == np.finfo(np.float64).eps / 2 == 2.0**-53
+    assert UNIT_ROUNDOFF != np.finfo(np.float64).eps          # the machine epsilon is twice it
