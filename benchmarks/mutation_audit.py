@@ -116,7 +116,6 @@ ACCEPTED = {
     "statement-drift": "the statement is prose beside the checked identities; printing it from the checked "
                        "sympy objects (open) would catch it",
     "pixels-tolerance": "only loosens a check: every renderer output still matches, so nothing can fail",
-    "claim-threshold": "the register's pass ranges are code, not data shown in the table (open)",
 }
 
 

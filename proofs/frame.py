@@ -81,12 +81,9 @@ def _check_frame(et, ep, corrupt=None):
     if not verdict.holds:
         return verdict
     # The renderer's shading normals, which the frame builds (proofs/pixels.py).
-    from .pixels import TOLERANCE, normal_error
-    worst, count = 0.0, 0
-    for field in ("sine", "ridges", "rings"):
-        for bump in ("chart", "surface"):
-            err, n = normal_error(field, bump, corrupt)
-            worst, count = max(worst, err), count + n
+    from .pixels import TOLERANCE, normal_error, worst_of
+    worst, count = worst_of(normal_error, [(f, b, corrupt) for f in ("sine", "ridges", "rings")
+                                           for b in ("chart", "surface")])
     if worst > TOLERANCE["normal"]:
         return Verdict("refuted", f"the renderer's N' differs from PERTURBED_NORMAL in this frame by {worst:.1e} "
                        f"at some of {count} sphere-A pixels")
@@ -200,11 +197,8 @@ def _check_chart(identities, corrupt=None):
     if not verdict.holds:
         return verdict
     # The renderer's own chart (GBuffer.uv) at its own N (proofs/pixels.py).
-    from .pixels import TOLERANCE, chart_error
-    worst, count = 0.0, 0
-    for field in ("sine", "ridges", "rings"):
-        err, n = chart_error(field, corrupt)
-        worst, count = max(worst, err), count + n
+    from .pixels import TOLERANCE, chart_error, worst_of
+    worst, count = worst_of(chart_error, [(f, corrupt) for f in ("sine", "ridges", "rings")])
     if worst > TOLERANCE["chart"]:
         return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
                        f"{count} sphere-A pixels")

@@ -28,7 +28,8 @@ from renderer import Scene, gbuffer
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
-__all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "TOLERANCE", "PER_FIELD"]
+__all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "footprint_error", "worst_of", "TOLERANCE",
+           "PER_FIELD"]
 
 #: Pixels drawn per field from each source (full frame, pole ring, crease neighbours): >= 200 in all.
 PER_FIELD = 240
@@ -72,6 +73,12 @@ def pixels(field, gradient="exact", bump="chart", seed=0):
             for name in picked:
                 picked[name].append(g[name].reshape(-1, g[name].shape[-1])[take])
     return scene, {name: np.concatenate(rows) for name, rows in picked.items()}
+
+
+def worst_of(check, cases):
+    """(largest error, pixels compared) of ``check(*case)`` -> (error, count) over ``cases``."""
+    results = [check(*case) for case in cases]
+    return max(err for err, _ in results), sum(n for _, n in results)
 
 
 @lru_cache(maxsize=None)

@@ -321,8 +321,8 @@ def render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_ki
 @njit(cache=True, error_model="numpy", parallel=True)
 def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
     """The exact frame (index 0) and one central frame per step (1, 2, ...).
-    Per pixel the geometry, the crease flag and the shadow rays are computed
-    once (they do not depend on the gradient); sphere A is re-shaded per step.
+    Per pixel the geometry and the shadow rays are computed once (they do not
+    depend on the gradient); sphere A is re-shaded per step, crease flag kept.
     images (S+1, H, W, 3), grads (S+1, H, W, 2); chamber, kink (H, W).
     The caller allocates the outputs with these shapes (nothing is checked here).
     """
