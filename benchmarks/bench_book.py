@@ -26,7 +26,15 @@ never touched.  Each build is the Makefile's ``book`` target
 (``make -o .venv/.installed BIN=<this venv>/bin book``: the venv is used as
 installed, not re-installed).  Results go to benchmarks/results/book_build.md.
 
+With ``--cold-vs REV`` the script instead times cold builds only, side by side
+in one run: REV, the copy with its pages executed one at a time
+(``SYMRENDER_BOOK_JOBS=1``), and the copy as configured, in rotation,
+``--repeats`` times each; before each build the copy's book/_build and numba's
+cache (renderer/__pycache__) are removed.  Results go to
+benchmarks/results/book_cold.md.
+
 Usage: python benchmarks/bench_book.py [--rev REV | --worktree] [--no-control] [--keep] [--out FILE]
+       python benchmarks/bench_book.py --cold-vs REV [--repeats N] [--worktree | --rev REV2]
 """
 
 from __future__ import annotations
@@ -37,6 +45,7 @@ import os
 import platform
 import re
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -87,13 +96,14 @@ class Book:
             return {}
         return {r.pk: Path(r.uri).stem for r in get_cache(str(path)).list_cache_records()}
 
-    def build(self):
-        """Run `make book`; return (seconds, pages executed, pages written)."""
+    def build(self, **env):
+        """Run `make book` (``env``: extra environment variables); return (seconds, pages executed,
+        pages written)."""
         before = self.cache_records()
         start_wall = time.time()
         t0 = time.perf_counter()
         result = subprocess.run(["make", "-s", "-o", ".venv/.installed", f"BIN={BIN}", "book"],
-                                cwd=self.repo, env=self.env, capture_output=True, text=True)
+                                cwd=self.repo, env={**self.env, **env}, capture_output=True, text=True)
         seconds = time.perf_counter() - t0
         if result.returncode:
             sys.stderr.write(result.stdout[-4000:] + result.stderr[-4000:])
@@ -103,6 +113,11 @@ class Book:
         written = sorted(p for p in self.pages
                          if (self.html / f"{p}.html").stat().st_mtime >= start_wall)
         return seconds, executed, written
+
+    def make_cold(self):
+        """Remove the build (with its jupyter-cache and store) and numba's cache of the kernel."""
+        shutil.rmtree(self.repo / "book" / "_build", ignore_errors=True)
+        shutil.rmtree(self.repo / "renderer" / "__pycache__", ignore_errors=True)
 
     def importers(self, relpath):
         """Pages whose code runs or reads ``relpath`` (nb_deps' finder on the copy)."""
@@ -171,8 +186,16 @@ def main(argv=None):
     parser.add_argument("--worktree", action="store_true", help="copy the working tree instead of a commit")
     parser.add_argument("--no-control", action="store_true", help="skip the build without nb_deps")
     parser.add_argument("--keep", action="store_true", help="keep the scratch copy")
-    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "book_build.md")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="results file (default results/book_build.md, or book_cold.md with --cold-vs)")
+    parser.add_argument("--cold-vs", metavar="REV", help="time cold builds only, against commit REV")
+    parser.add_argument("--repeats", type=int, default=3, help="cold builds of each kind with --cold-vs")
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be >= 1, got {args.repeats}")
+    if args.cold_vs:
+        return cold_side_by_side(args)
+    args.out = args.out or ROOT / "benchmarks" / "results" / "book_build.md"
 
     scratch = Path(tempfile.mkdtemp(prefix="bench_book_"))
     repo = scratch / "repo"
@@ -263,6 +286,49 @@ def main(argv=None):
     if failures:
         print("FAILED:\n  " + "\n  ".join(failures), file=sys.stderr)
         return 1
+    return 0
+
+
+def cold_side_by_side(args):
+    """Cold builds of REV and of the copy (pages one at a time, and as configured), in rotation."""
+    scratch = Path(tempfile.mkdtemp(prefix="bench_book_cold_"))
+    (scratch / "base").mkdir()
+    (scratch / "new").mkdir()
+    base_source = _scratch_copy(scratch / "base", False, args.cold_vs)
+    new_source = _scratch_copy(scratch / "new", args.worktree, args.rev)
+    base, new = Book(scratch / "base"), Book(scratch / "new")
+    base.check_imports()
+    new.check_imports()
+    kinds = [(f"{base_source} (baseline)", base, {}),
+             (f"{new_source}, pages one at a time (SYMRENDER_BOOK_JOBS=1)", new, {"SYMRENDER_BOOK_JOBS": "1"}),
+             (f"{new_source}, as configured ({os.cpu_count()} pages at a time)", new, {})]
+    times = {kind: [] for kind, _, _ in kinds}
+    for repeat in range(args.repeats):
+        for kind, book, env in kinds:
+            book.make_cold()
+            seconds, executed, _ = book.build(**env)
+            times[kind].append(seconds)
+            print(f"{repeat + 1}/{args.repeats}  {kind:<70} {seconds:6.1f} s  ({len(executed)} pages executed)",
+                  flush=True)
+    first = statistics.median(times[kinds[0][0]])
+    lines = ["# Book build: cold, side by side", "",
+             f"`python benchmarks/bench_book.py --cold-vs {args.cold_vs} --repeats {args.repeats}` on "
+             f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC, {os.cpu_count()} CPUs, "
+             f"Python {platform.python_version()}.",
+             "Each build is `make book` after removing book/_build (with its jupyter-cache and store of "
+             "measurements) and numba's cache in renderer/__pycache__; the three kinds run in rotation, "
+             "so that a change in the machine's speed reaches all three alike.", "",
+             "| build | median s | min–max s | builds | vs baseline |", "|---|---:|---:|---:|---:|"]
+    for kind, _, _ in kinds:
+        t = times[kind]
+        lines.append(f"| {kind} | {statistics.median(t):.1f} | {min(t):.1f}–{max(t):.1f} | {len(t)} | "
+                     f"{statistics.median(t) / first:.2f} |")
+    lines += ["", "Target: cold `make book` ≤ 45 s.", ""]
+    out = args.out or ROOT / "benchmarks" / "results" / "book_cold.md"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(lines), encoding="utf-8")
+    print("\n".join(lines) + f"\nwritten to {out}")
+    shutil.rmtree(scratch)
     return 0
 
 

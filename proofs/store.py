@@ -1,6 +1,6 @@
 """The build's measurements: each computed once, then read by every page that shows it.
 
-The book's pages run in separate kernels, one after another.  A quantity two
+The book's pages run in separate kernels, some at the same time.  A quantity two
 pages show (a theorem's verdict, say) is computed by the first page that asks
 for it and written to the store; later pages read the same value instead of
 computing their own, so the pages cannot disagree and the build pays once.
@@ -12,16 +12,20 @@ the process only.  Each measurement is one JSON file, ``<name>.json``, holding
 its parameters, its value and the digest of what it was computed from: every
 file of renderer/ and proofs/ and the versions of the numerical libraries.  A
 stored value whose parameters or digest differ is computed again, so an edit
-to the code never shows a stale number.
+to the code never shows a stale number.  While a measurement is computed its
+file is locked (``fcntl.flock`` on ``.<name>.json.lock``): a page that needs it
+meanwhile waits and reads the value instead of computing it a second time.
 """
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
 import re
 import tempfile
+from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
 
@@ -83,15 +87,32 @@ def measured(name, compute, **params):
         return _MEMORY[name, key]
     directory = os.environ.get(ENV)
     path = Path(directory, f"{name}.json") if directory else None
-    record = _read(path)
-    if record is not None and record.get("digest") == source_digest() and record.get("params") == json.loads(key):
-        value = record["value"]
-    else:
-        value = json.loads(json.dumps(compute(**params)))
-        if path is not None:
-            _write(path, {"name": name, "params": json.loads(key), "digest": source_digest(), "value": value})
+    with _locked(path):
+        record = _read(path)
+        if record is not None and record.get("digest") == source_digest() and record.get("params") == json.loads(key):
+            value = record["value"]
+        else:
+            value = json.loads(json.dumps(compute(**params)))
+            if path is not None:
+                _write(path, {"name": name, "params": json.loads(key), "digest": source_digest(), "value": value})
     _MEMORY[name, key] = value
     return value
+
+
+@contextmanager
+def _locked(path):
+    """Hold an exclusive lock on ``<path>.lock`` (no lock for the in-memory store): pages
+    executed at once that need the same measurement wait for the first to compute it."""
+    if path is None:
+        yield
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path.with_name(f".{path.name}.lock"), "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def _read(path):

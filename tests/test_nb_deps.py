@@ -253,7 +253,7 @@ def test_outdated_returns_unchanged_pages_whose_dependencies_changed(project, pa
     app = SimpleNamespace(env=env)
     for name in docs:                                    # the first build reads every page
         source = [docs[name]]
-        nb_deps._source_read(app, name, source)
+        nb_deps.rewrite(app, name, source)
         assert ("# nb-deps:" in source[0]) == (name != "prose")
     assert nb_deps._outdated(app, env, set(), set(), set()) == []
     (project / "plain/c.py").write_text("THING = 4\n")

@@ -110,4 +110,37 @@ def test_a_value_json_cannot_hold_writes_nothing(fresh):
         store.measured("bad", lambda: {1, 2})
     with pytest.raises(TypeError):
         store.measured("bad", lambda: 1, scene=object())
-    assert list(directory.iterdir()) == []
+    assert [p.name for p in directory.iterdir() if not p.name.endswith(".lock")] == []   # no record, no part file
+
+
+_RACER = """
+import sys, time
+from pathlib import Path
+from proofs import store
+if sys.argv[2] == "unlocked":                       # the wrong variant: no lock around the computation
+    import contextlib
+    store._locked = lambda path: contextlib.nullcontext()
+def compute():
+    with open(sys.argv[1], "a") as log:
+        log.write("computed\\n")
+    time.sleep(1.0)
+    return 42
+print(store.measured("shared", compute))
+"""
+
+
+@pytest.mark.parametrize("variant", ["locked", "unlocked"])
+def test_pages_running_at_once_compute_a_measurement_once(tmp_path, variant):
+    """Two processes started together ask for the same measurement: the second waits
+    for the first's value (the build runs pages side by side, book/_ext/parallel_execute.py)."""
+    import os
+    import subprocess
+    import sys
+    log = tmp_path / "log"
+    env = {**os.environ, store.ENV: str(tmp_path / "store")}
+    racers = [subprocess.Popen([sys.executable, "-c", _RACER, str(log), variant], env=env,
+                               stdout=subprocess.PIPE, text=True) for _ in range(2)]
+    outputs = [r.communicate(timeout=120)[0].strip() for r in racers]
+    assert outputs == ["42", "42"]
+    computed = log.read_text().count("computed")
+    assert computed == (1 if variant == "locked" else 2)

@@ -283,7 +283,10 @@ def _fingerprint(text, packages, path):
     return page_digest(text, packages, path=path), asset_digest(text, packages)
 
 
-def _source_read(app, docname, source):
+def rewrite(app, docname, source):
+    """The ``source-read`` handler: records the page's digests and, if it
+    imports project code, appends the digest cell to ``source[0]`` (a list of
+    one str, as Sphinx passes it)."""
     path = app.env.doc2path(docname)
     fingerprint = _fingerprint(source[0], project_packages(), path)
     app.env.nb_deps[docname] = fingerprint
@@ -320,7 +323,7 @@ def setup(app):
     app.connect("builder-inited", lambda app: _init_env(app, app.env, ()))
     app.connect("env-before-read-docs", _init_env)
     app.connect("env-get-outdated", _outdated)
-    app.connect("source-read", _source_read)
+    app.connect("source-read", rewrite)
     app.connect("env-purge-doc", _purge)
     app.connect("env-merge-info", _merge)
     return {"version": "1", "env_version": 1,
