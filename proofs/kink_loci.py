@@ -19,6 +19,7 @@ from renderer import Scene, gbuffer, render
 from renderer import formulas as F
 
 from .core import Identity, Theorem, Verdict, check_identities
+from .frame import ANGLE_NAMES, U_OF_THETA
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, e = sp.symbols("R e", positive=True)
@@ -29,12 +30,20 @@ y_img = P[1] * e / (e - P[2])
 RHO = e * R * sp.sin(phi) / (e - R * sp.cos(phi))
 DRHO = e * R * (e * sp.cos(phi) - R) / (e - R * sp.cos(phi)) ** 2
 DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 1.2), R: (0.5, 1.0), e: (2.0, 6.0)}
+#: The crease u = m / k_u solved for theta (the chart of theorem `chart`), which is alpha.
+m_sym = sp.Symbol("m", integer=True)
+ALPHA_M = sp.solve(sp.Eq(U_OF_THETA.subs(sp.Symbol("theta", real=True), theta), m_sym / F.k_u), theta)[0]
+_ALPHA_M = sp.lambdify((m_sym, F.k_u), ALPHA_M, modules="numpy")
+
+
+def _tex(expr):
+    return sp.latex(expr, order="rev-lex", symbol_names={**ANGLE_NAMES, phi: r"\varphi"})
 
 
 def ray_angles(k_u):
-    """Image-plane angles alpha_m of the rays u = m / k_u, m = 0 .. ceil(k_u) - 1."""
-    m = np.arange(int(np.ceil(k_u)))
-    return 2 * np.pi * m / k_u - np.pi
+    """Image-plane angles alpha_m (radians, float64 array) of the rays u = m / k_u,
+    m = 0 .. ceil(k_u) - 1 (`ALPHA_M`)."""
+    return np.asarray(_ALPHA_M(np.arange(int(np.ceil(k_u))), k_u), dtype=float)
 
 
 def circle_radii(radius_a, camera_z, k_v):
@@ -113,8 +122,9 @@ def _check(kind, rho=RHO, drho=DRHO, scene=None, shift=(0.0, 0.0)):
 KINK_LOCI_RAYS = Theorem(
     id="kink-loci-rays", title="The u-creases are rays",
     statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the "
-              r"$z$-axis, $\alpha = \theta$, so $u = (\alpha + \pi)/2\pi$ depends on the angle alone "
-              r"and the crease $u = m/k_u$ is the ray $\alpha_m = 2\pi m/k_u - \pi$.",
+              rf"$z$-axis, $\alpha = \theta$, so $u = {_tex(U_OF_THETA.subs(sp.Symbol('theta', real=True), sp.Symbol('alpha')))}$ "
+              r"depends on the angle alone and the crease $u = m/k_u$ is the ray "
+              rf"$\alpha_m = {_tex(ALPHA_M)}$.",
     steps=(("projection", r"(x, y)", sp.Matrix([x_img, y_img]).applyfunc(sp.simplify)),
            ("polar form", r"(x, y)", sp.Matrix([RHO * sp.cos(theta), RHO * sp.sin(theta)]))),
     check=lambda: _check("rays"),
@@ -128,9 +138,8 @@ KINK_LOCI_RAYS = Theorem(
 
 KINK_LOCI_CIRCLES = Theorem(
     id="kink-loci-circles", title="The v-creases are circles",
-    statement=r"$v = \varphi/\pi$ depends on the radius alone: $\rho(\varphi) = "
-              r"\dfrac{eR\sin\varphi}{e - R\cos\varphi}$ with $\rho'(\varphi) = "
-              r"\dfrac{eR(e\cos\varphi - R)}{(e - R\cos\varphi)^2} > 0$ on the visible cap "
+    statement=rf"$v = \varphi/\pi$ depends on the radius alone: $\rho(\varphi) = {_tex(RHO)}$ "
+              rf"with $\rho'(\varphi) = {_tex(DRHO)} > 0$ on the visible cap "
               r"$\cos\varphi > R/e$. The crease $v = m/k_v$ is the circle of radius "
               r"$\rho(\pi m/k_v)$, visible when $\cos(\pi m/k_v) > R/e$.",
     steps=(("radius", r"\rho(\varphi)", RHO), ("monotone", r"\rho'(\varphi)", DRHO)),

@@ -30,7 +30,19 @@ DOMAIN = {**{s: (-2.0, 2.0) for s in list(Nv) + list(et) + list(ep) + [F.h_u, F.
 M_SHOWN = M.subs({**dict(zip(et, sp.symbols(r"e_{\theta\,x} e_{\theta\,y} e_{\theta\,z}"))),
                   **dict(zip(ep, sp.symbols(r"e_{\varphi\,x} e_{\varphi\,y} e_{\varphi\,z}")))})
 
-CLOSED_FORM = (sp.eye(3) - N_PRIME * N_PRIME.T) * g / norm_M
+#: The claimed derivative as the statement prints it (matrix symbols N', g and the scalar
+#: ||M||), and, substituted into it, the explicit 3-vector the check compares with.
+N_S, G_S = sp.MatrixSymbol("N'", 3, 1), sp.MatrixSymbol("g", 3, 1)
+NORM_M_S = sp.Symbol(r"\lVert M\rVert", positive=True)
+CLAIMED_DERIVATIVE = (sp.Identity(3) - N_S * N_S.T) * G_S / NORM_M_S
+
+
+def explicit(shown):
+    """The 3-vector of a claim written in N', g and ||M|| (as `CLAIMED_DERIVATIVE`)."""
+    return sp.Matrix(shown.subs({N_S: N_PRIME, G_S: g, NORM_M_S: norm_M}).doit().as_explicit())
+
+
+CLOSED_FORM = explicit(CLAIMED_DERIVATIVE)
 
 
 def _identities(closed_form):
@@ -50,16 +62,15 @@ NORMAL_BETA_DERIVATIVE = Theorem(
     id="normal-beta-derivative", title="The beta-derivative of the perturbed normal",
     statement=r"The renderer's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`) is "
               r"$N' = M/\lVert M\rVert$ with $M = N + \beta g$, $g = h_u e_\theta + h_v e_\varphi$, and "
-              r"$\partial N'/\partial\beta = (I - N'N'^{\top})\,g/\lVert M\rVert$, for any $N$, frame and "
+              rf"$\partial N'/\partial\beta = {sp.latex(CLAIMED_DERIVATIVE)}$, for any $N$, frame and "
               r"gradient.",
     steps=((r"M", r"M", M_SHOWN), (r"N'", r"N'", r"M/\lVert M\rVert"),
-           (r"\partial N'/\partial\beta", r"\partial N'/\partial\beta",
-            r"(I - N'N'^{\top})\,g/\lVert M\rVert")),
+           (r"\partial N'/\partial\beta", r"\partial N'/\partial\beta", CLAIMED_DERIVATIVE)),
     check=lambda: _check_derivative(CLOSED_FORM),
     wrong_variants=(("sign of the projection flipped",
-                     lambda: _check_derivative((sp.eye(3) + N_PRIME * N_PRIME.T) * g / norm_M)),
+                     lambda: _check_derivative(explicit((sp.Identity(3) + N_S * N_S.T) * G_S / NORM_M_S))),
                     ("the 1/|M| factor dropped",
-                     lambda: _check_derivative((sp.eye(3) - N_PRIME * N_PRIME.T) * g))),
+                     lambda: _check_derivative(explicit((sp.Identity(3) - N_S * N_S.T) * G_S)))),
     pages=("s3", "s5"),
     seed_says="§3 and §6: 'verified to 1e-12' (Cell 5); Cell 5's Expect: '~1e-9 worst component'.",
 )
@@ -69,12 +80,26 @@ NORMAL_BETA_DERIVATIVE = Theorem(
 _FRAME_AT = {**frame.ON_SPHERE, **dict(zip(F.e_theta, frame.e_theta)), **dict(zip(F.e_phi, frame.e_phi))}
 ON_FRAME = {mode: sp.Matrix(n).subs(sp.Max(F.sin_phi, F.POLE_SIN_PHI), F.sin_phi).subs(_FRAME_AT)
             for mode, n in F.PERTURBED_NORMAL.items()}
-#: The first-order tilt dN'/dbeta at beta = 0, written by hand: the chart mode
-#: tilts by g = h_u e_theta + h_v e_phi (seed §3); the displaced sphere by the
+#: The frame's vectors as the statement prints them (non-commuting, so that they stay on the right).
+E_THETA, E_PHI = sp.symbols(r"e_\theta e_\varphi", commutative=False)
+#: The first-order tilt dN'/dbeta at beta = 0, written by hand in e_theta, e_phi: the chart
+#: mode tilts by g = h_u e_theta + h_v e_phi (seed §3); the displaced sphere by the
 #: gradient of beta h over the sphere's metric, |P_u| = 2 pi R sin phi, |P_v| = pi R.
-TILT = {"chart": F.h_u * frame.e_theta + F.h_v * frame.e_phi,
-        "surface": -(F.h_u / (2 * sp.pi * F.R * sp.sin(frame.phi))) * frame.e_theta
-                   - (F.h_v / (sp.pi * F.R)) * frame.e_phi}
+TILT_SHOWN = {"chart": F.h_u * E_THETA + F.h_v * E_PHI,
+              "surface": -(F.h_u / (2 * sp.pi * F.R * sp.sin(frame.phi))) * E_THETA
+                         - (F.h_v / (sp.pi * F.R)) * E_PHI}
+
+
+def tilt_vector(shown):
+    """The 3-vector of a tilt written in e_theta, e_phi (as `TILT_SHOWN`), in the frame at N(theta, phi)."""
+    return shown.coeff(E_THETA) * frame.e_theta + shown.coeff(E_PHI) * frame.e_phi
+
+
+def tilt_latex(shown):
+    return sp.latex(shown, symbol_names=frame.ANGLE_NAMES)
+
+
+TILT = {mode: tilt_vector(t) for mode, t in TILT_SHOWN.items()}
 SPHERE_DOMAIN = {frame.theta: (-3.1, 3.1), frame.phi: (0.05, 3.09), F.R: (0.5, 2.0), F.h: (-1.0, 1.0),
                  F.h_u: (-2.0, 2.0), F.h_v: (-2.0, 2.0)}
 #: The renders: beta -> 0 over these steps, on a 96x80 frame.
@@ -139,19 +164,19 @@ BETA_ZERO_REGRESSION = Theorem(
     id="beta-zero-regression", title="The beta -> 0 limit",
     statement=r"Both of the renderer's perturbed normals (`renderer.formulas.PERTURBED_NORMAL`, bump modes "
               r"chart and surface), on sphere A in the renderer's frame, satisfy $N'(0) = N$ and "
-              r"$N'(\beta) = N + \beta T + O(\beta^2)$ with $T_{\mathrm{chart}} = h_u e_\theta + h_v e_\varphi$ "
-              r"and $T_{\mathrm{surface}} = -\frac{h_u}{2\pi R\sin\varphi} e_\theta - \frac{h_v}{\pi R} e_\varphi$: "
+              rf"$N'(\beta) = N + \beta T + O(\beta^2)$ with $T_{{\mathrm{{chart}}}} = {tilt_latex(TILT_SHOWN['chart'])}$ "
+              rf"and $T_{{\mathrm{{surface}}}} = {tilt_latex(TILT_SHOWN['surface'])}$: "
               r"the regression is a limit of rate $\beta$.  The rendered images approach the $\beta = 0$ "
               r"image at that rate for both pipelines and every height field, and at $\beta = 0$ the height "
               r"field does not reach the image.",
-    steps=tuple((rf"\partial_\beta N'_{{\mathrm{{{mode}}}}}|_{{\beta=0}}", r"T_{\mathrm{" + mode + "}}", t)
-                for mode, t in TILT.items()),
+    steps=tuple((rf"\partial_\beta N'_{{\mathrm{{{mode}}}}}|_{{\beta=0}}", r"T_{\mathrm{" + mode + "}}",
+                 tilt_latex(t)) for mode, t in TILT_SHOWN.items()),
     check=_check_limit,
     wrong_variants=(("the chart tilt with h_u and h_v swapped",
-                     lambda: _check_limit({**TILT, "chart": F.h_v * frame.e_theta + F.h_u * frame.e_phi})),
+                     lambda: _check_limit({**TILT, "chart": tilt_vector(F.h_v * E_THETA + F.h_u * E_PHI)})),
                     ("the surface tilt without the metric factor 2 pi R sin phi",
-                     lambda: _check_limit({**TILT, "surface": -F.h_u * frame.e_theta - (F.h_v / (sp.pi * F.R))
-                                           * frame.e_phi})),
+                     lambda: _check_limit({**TILT, "surface": tilt_vector(-F.h_u * E_THETA
+                                                                           - F.h_v / (sp.pi * F.R) * E_PHI)})),
                     ("a quadratic rate claimed", lambda: _check_limit(order=2.0))),
     pages=("s3", "s5"),
     seed_says="Cell 6 expects beta = 0 agreement at ~1e-16.",

@@ -6,7 +6,7 @@ until the register (proofs/claims.py) is edited with it.
 
 import pytest
 
-from proofs.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Claim, ClaimChanged, checked, evaluate
+from proofs.claims import CLAIMS, CORRECTED, CRITERIA, FAILS, HOLDS, Bound, Claim, ClaimChanged, checked, evaluate, rule
 
 RESULTS = {c.id: (measured, verdict) for c, measured, verdict in evaluate()}
 
@@ -24,9 +24,34 @@ def test_computed_verdict_matches_register(claim):
 
 
 def test_register_mismatch_is_detected():
-    wrong = Claim("x", "§0", "q", "m", HOLDS, lambda: ("measured 2", FAILS))
+    wrong = Claim("x", "§0", "q", "m", HOLDS, lambda: ("measured 2", {"x": 2}), rule(HOLDS, Bound("x", hi=1)))
     _, verdict = wrong.measure()
     assert verdict != wrong.registered
+
+
+def test_criteria_decide_at_their_edges_as_written():
+    """A bound is inclusive unless strict; cases are tried in order; the table's text is the data's."""
+    r = rule(HOLDS, Bound("x", 1, 2), CORRECTED, (Bound("x", lo=0, strict=True), Bound("y", hi=0)))
+    assert [r.decide({"x": x, "y": 0}) for x in (1, 2, 0.5, 0, 3)] == [HOLDS, HOLDS, CORRECTED, FAILS, CORRECTED]
+    assert r.decide({"x": 0.5, "y": 1}) == FAILS
+    assert str(r) == "holds if 1 ≤ x ≤ 2; holds with a correction if x > 0 and y ≤ 0; otherwise does not hold"
+    assert not Bound("x", 1, 2, strict=True).holds({"x": 2}) and Bound("x", 1, 1).holds({"x": 1})
+    assert str(Bound("x", 1e-10, 1e-8, strict=True)) == "1e-10 < x < 1e-08"
+
+
+def _inside(bound):
+    if bound.lo is not None and bound.hi is not None:
+        return (bound.lo + bound.hi) / 2
+    return bound.lo + abs(bound.lo) + 1 if bound.lo is not None else bound.hi - abs(bound.hi) - 1
+
+
+@pytest.mark.parametrize("claim", CLAIMS, ids=[c.id for c in CLAIMS])
+def test_each_criterion_is_the_table_text_and_its_first_case_decides(claim):
+    """Numbers inside the first case's bounds get that case's verdict; the text the book's
+    table shows is the criterion's own."""
+    verdict, bounds = claim.criterion.cases[0]
+    assert claim.criterion.decide({b.quantity: _inside(b) for b in bounds}) == verdict
+    assert CRITERIA[claim.id] == str(claim.criterion)
 
 
 def test_the_books_table_refuses_a_flipped_verdict():
@@ -41,7 +66,6 @@ def test_the_books_table_refuses_a_flipped_verdict():
 
 
 def test_every_claim_states_its_decision_rule():
-    from proofs.claims import CRITERIA
     assert set(CRITERIA) == {c.id for c in CLAIMS} and all(CRITERIA.values())
 
 
