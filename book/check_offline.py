@@ -3,7 +3,8 @@
 Scans every HTML and CSS file under the build directory for resources that a
 browser would fetch from another host (script src, link href of stylesheets,
 preloads and icons, img/iframe/source src, CSS url() and @import), and checks
-that MathJax is served from the site itself.  Hyperlinks a reader may click
+that MathJax is served from the site itself.  An inline script that names a
+URL on another host (a CDN copy of a library it may load later) fails too.  Hyperlinks a reader may click
 (<a href>) are not fetched when the page loads and are allowed.
 
 Usage: python book/check_offline.py book/_build/html
@@ -17,6 +18,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 REMOTE = re.compile(r"^\s*(https?:)?//", re.IGNORECASE)
+INLINE_URL = re.compile(r"""(?<![\w.])(https?:)?//[\w.-]+\.[a-z]{2,}[^\s'"]*""", re.IGNORECASE)
 CSS_URL = re.compile(r"""(?:url\(\s*['"]?|@import\s+['"])([^'")\s]+)""", re.IGNORECASE)
 
 
@@ -55,6 +57,9 @@ def problems(root: Path) -> list[str]:
         parser.feed(text)
         for m in re.finditer(r"<style[^>]*>(.*?)</style>", text, re.S | re.I):
             parser.urls += [("style", u.group(1)) for u in CSS_URL.finditer(m.group(1))]
+        for m in re.finditer(r"<script[^>]*>(.*?)</script>", text, re.S | re.I):
+            for u in INLINE_URL.finditer(m.group(1)):     # a URL a script may load later (a CDN's, say)
+                out.append(f"{page.relative_to(root)}: inline script names {u.group(0)}")
         for kind, url in parser.urls:
             if REMOTE.match(url):
                 out.append(f"{page.relative_to(root)}: {kind} loads {url}")

@@ -11,6 +11,8 @@ per build: its entry is a measurement of `proofs.store`, which later pages
 
 from __future__ import annotations
 
+import re
+
 from . import store
 from .core import step_latex
 
@@ -23,10 +25,19 @@ class TheoremFailed(AssertionError):
     """A theorem the book relies on did not hold during the build."""
 
 
+def _proof_step(number, step):
+    """One step of a proof as a paragraph: "Step n." with the caption when it is words (not a
+    symbol or LaTeX), then the step's equation as a display."""
+    caption = step[0]
+    words = caption if re.fullmatch(r"[A-Za-z][A-Za-z0-9 ,;:'()\-=./]+", caption) and len(caption) > 2 else ""
+    lead = f"**Step {number}.** {words[0].upper()}{words[1:]}." if words else f"**Step {number}.**"
+    return f"{lead}\n\n$$\n{step_latex(step)}\n$$"
+
+
 def _entry(t):
     from .registry import pinned_failure
     v = t.check()
-    steps = "\n".join(f"- $\\displaystyle {step_latex(step)}$" for step in t.steps)
+    steps = "\n\n".join(_proof_step(i, step) for i, step in enumerate(t.steps, 1))
     evidence = v.evidence.replace("$", "")
     block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement}\n\n"
              f"**{BADGES[v.status]}** (`{t.id}`): {evidence}\n:::\n\n"

@@ -195,7 +195,10 @@ def identities_theorem(id, title, statement, identities, variants, *, steps=(), 
 def step_latex(step) -> str:
     """LaTeX of one (caption, lhs, rhs) step: ``lhs = rhs`` (or ``lhs``)."""
     _, lhs, rhs = step
-    tex = lambda e: e if isinstance(e, str) else sp.latex(e)  # noqa: E731 - str is LaTeX already
+    def tex(e):                       # a str is LaTeX already; the symbol phi prints as the book's \varphi
+        if isinstance(e, str):
+            return e
+        return sp.latex(e, symbol_names={s: r"\varphi" for s in getattr(e, "free_symbols", ()) if s.name == "phi"})
     if rhs is None:
         return tex(lhs)
     return f"{tex(lhs)} = {tex(rhs)}"

@@ -26,7 +26,6 @@ from `renderer.formulas.CHART` (theorem `chart`); and its rendered normals
 equal the displaced surface's, evaluated by mpmath.
 """
 
-
 import mpmath
 import numpy as np
 import sympy as sp

@@ -17,10 +17,7 @@ and passes it).  With CI=true a missing Chromium or Playwright fails the test.
 from __future__ import annotations
 
 import json
-import os
 import statistics
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -41,21 +38,6 @@ CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-
 CONTROLS = ["sim-height_field", "sim-k_u", "sim-k_v", "sim-beta", "sim-numeric", "sim-log_eps", "sim-model",
             "sim-resolution", "sim-view", "sim-zoom", "sim-sphere_b"]
 BUTTONS = ["sim-preset-try1", "sim-preset-try2", "sim-preset-try3", "sim-preset-try4", "sim-reset"]
-
-
-@pytest.fixture(scope="module")
-def book_html(tmp_path_factory):
-    given = os.environ.get("SYMRENDER_BOOK_HTML")
-    if given:
-        path = Path(given)
-        if not (path / "s4_simulator.html").is_file():
-            pytest.fail(f"SYMRENDER_BOOK_HTML={given} holds no s4_simulator.html")
-        return path
-    out = tmp_path_factory.mktemp("book")
-    jb = Path(sys.executable).with_name("jupyter-book")
-    subprocess.run([str(jb), "build", str(ROOT / "book"), "--path-output", str(out), "--warningiserror",
-                    "--keep-going", "--quiet"], check=True, timeout=1800)
-    return out / "_build" / "html"
 
 
 @pytest.fixture(scope="module")
