@@ -12,11 +12,14 @@ tests, or survived (listed with the reason it is acceptable, `ACCEPTED`, or
 flagged).  Not run in CI: it takes about a minute per mutant killed by
 verify and several per mutant that reaches the tests.
 
-``--mutmut`` also runs mutmut (``pip install mutmut``) over proofs/ with
-``pytest verify`` as its test command and reports its kill rate; mutmut
-cannot mutate the numba kernel (its trampolines are Python calls, which
-compiled code cannot make) nor formulas.py's module-level sympy, which is why
-the semantic mutants cover those.
+``--mutmut`` instead runs mutmut 3 (``pip install mutmut``) over each module
+of ``MUTMUT_SCOPES`` with the tests named beside it, and writes
+results/mutmut.md (kill rate, survivors).  mutmut runs the covering tests once
+per mutant, so a scope is a module whose tests take seconds; a module checked
+by the whole of ``pytest verify`` (minutes) would take days.  mutmut cannot
+mutate the numba kernel (its trampolines are Python calls, which compiled code
+cannot make) nor formulas.py's module-level sympy, which is why the semantic
+mutants cover those.
 
 Results: benchmarks/results/mutation_audit.md (and .json).  With ``--only`` the
 named mutants are run again and their rows replace the earlier ones (from the
@@ -175,17 +178,47 @@ def audit(mutant, work):
             _run([PYTHON, "-m", "renderer.codegen"], work)
 
 
+#: mutmut's scopes: a module and the tests that exercise it (fast enough to run per mutant).
+MUTMUT_SCOPES = (("proofs/store.py", "tests/test_store.py"),)
+
+
 def run_mutmut(work):
-    """mutmut over proofs/ with pytest verify; (killed, total) or None if mutmut is missing."""
-    if shutil.which("mutmut", path=str(Path(PYTHON).parent)) is None:
+    """mutmut 3 over each of `MUTMUT_SCOPES` in the scratch copy ``work``:
+    [(module, tests, killed, total, [surviving mutant names])], or None if mutmut is missing."""
+    mutmut = Path(PYTHON).parent / "mutmut"
+    if not mutmut.is_file():
         return None
-    (work / "setup.cfg").write_text("[mutmut]\npaths_to_mutate=proofs/\ntests_dir=verify/\n"
-                                    "pytest_add_cli_args_test_selection=verify\n", encoding="utf-8")
-    _run([str(Path(PYTHON).parent / "mutmut"), "run"], work)
-    out = subprocess.run([str(Path(PYTHON).parent / "mutmut"), "results", "--all", "true"], cwd=work,
-                         capture_output=True, text=True).stdout
-    statuses = [line.rsplit(":", 1)[-1].strip() for line in out.splitlines() if ":" in line]
-    return sum(s == "killed" for s in statuses), len(statuses)
+    found = []
+    for module, tests in MUTMUT_SCOPES:
+        shutil.rmtree(work / "mutants", ignore_errors=True)
+        (work / "setup.cfg").write_text(f"[mutmut]\nsource_paths={module}\n"
+                                        f"pytest_add_cli_args_test_selection={tests}\n"
+                                        "also_copy=renderer/\n    book/\n", encoding="utf-8")
+        subprocess.run([str(mutmut), "run"], cwd=work, capture_output=True, text=True)
+        out = subprocess.run([str(mutmut), "results", "--all", "true"], cwd=work,
+                             capture_output=True, text=True).stdout
+        statuses = dict(line.strip().rsplit(": ", 1) for line in out.splitlines() if ": " in line)
+        survivors = []
+        for name in sorted(k for k, v in statuses.items() if v == "survived"):
+            diff = subprocess.run([str(mutmut), "show", name], cwd=work, capture_output=True, text=True).stdout
+            change = [line[1:].strip() for line in diff.splitlines() if line.startswith(("-    ", "+    "))]
+            survivors.append((name, " → ".join(change)))
+        found.append((module, tests, sum(v == "killed" for v in statuses.values()), len(statuses), survivors))
+    return found
+
+
+def _write_mutmut(found, out, started):
+    lines = ["# mutmut", "",
+             f"`python benchmarks/mutation_audit.py --mutmut` on {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC, "
+             f"{time.time() - started:.0f} s: mutmut 3 over each module with the tests named, in a scratch copy.", "",
+             "| module | tests | killed | mutants | kill rate |", "|---|---|---:|---:|---:|"]
+    for module, tests, killed, total, _ in found:
+        lines.append(f"| `{module}` | `{tests}` | {killed} | {total} | {100 * killed / max(total, 1):.0f} % |")
+    for module, _, _, _, survivors in found:
+        lines += ["", f"Survivors in `{module}` (the line before → after):", ""]
+        lines += [f"- `{name}`: `{change}`" for name, change in survivors] or ["- none"]
+    out.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print("\n".join(lines))
 
 
 def _earlier(out):
@@ -205,9 +238,21 @@ def _earlier(out):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="*", help="mutant ids to run (default: all)")
-    parser.add_argument("--mutmut", action="store_true", help="also run mutmut over proofs/")
+    parser.add_argument("--mutmut", action="store_true",
+                        help="run mutmut over MUTMUT_SCOPES instead (results/mutmut.md)")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "mutation_audit.md"))
     args = parser.parse_args(argv)
+    if args.mutmut:
+        work, started = _scratch(), time.time()
+        try:
+            found = run_mutmut(work)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+        if found is None:
+            print("mutmut is not installed (pip install mutmut)", file=sys.stderr)
+            return 1
+        _write_mutmut(found, ROOT / "benchmarks" / "results" / "mutmut.md", started)
+        return 0
     check_mutants()
     chosen = [m for m in MUTANTS if not args.only or m[0] in args.only]
     work = _scratch()
@@ -217,7 +262,6 @@ def main(argv=None):
             outcome = audit(m, work)
             print(f"{m[0]:24s} {outcome}", flush=True)
             rows.append((m, outcome))
-        mm = run_mutmut(work) if args.mutmut else None
     finally:
         shutil.rmtree(work, ignore_errors=True)
     out = Path(args.out)
@@ -241,9 +285,6 @@ def main(argv=None):
         lines.append(f"| `{mid}` (`{path}`) | {what} | {outcome}{note} |")
     lines += ["", f"Kill rate: `pytest verify` alone {by_verify}/{n} ({100 * by_verify / max(n, 1):.0f} %); "
               f"verify + tests {by_any}/{n} ({100 * by_any / max(n, 1):.0f} %). Targets: 90 % and 98 %."]
-    if args.mutmut:
-        lines.append(f"mutmut over proofs/ with pytest verify: {mm[0]}/{mm[1]} killed." if mm else
-                     "mutmut: not installed (pip install mutmut).")
     out.write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("\n".join(lines[-2:]))
     return 0

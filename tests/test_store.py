@@ -64,7 +64,32 @@ def test_the_digest_follows_the_source_files(tmp_path, monkeypatch):
     before = store.source_digest()
     (tmp_path / "renderer" / "a.py").write_text("x = 2\n")
     monkeypatch.setattr(store, "_DIGEST", [])
-    assert store.source_digest() != before
+    changed = store.source_digest()
+    assert changed != before
+    # Bytecode and numba's cache (in __pycache__) and directories are not sources: the digest stays.
+    (tmp_path / "renderer" / "__pycache__").mkdir()
+    (tmp_path / "renderer" / "__pycache__" / "a.cpython-311.pyc").write_bytes(b"\0compiled")
+    (tmp_path / "proofs" / "sub").mkdir()
+    monkeypatch.setattr(store, "_DIGEST", [])
+    assert store.source_digest() == changed
+    # A file's name is part of what a measurement depends on: a renamed module changes the digest.
+    (tmp_path / "renderer" / "a.py").rename(tmp_path / "renderer" / "b.py")
+    monkeypatch.setattr(store, "_DIGEST", [])
+    assert store.source_digest() != changed
+
+
+def test_the_same_process_asks_twice_and_computes_once(fresh):
+    directory, calls, compute = fresh
+    first = store.measured("u-curve", compute, size=256)
+    assert store.measured("u-curve", compute, size=256) == first and len(calls) == 1
+
+
+def test_parameters_name_the_same_record_in_any_order(fresh, monkeypatch):
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256, field="sine")
+    _new_process(monkeypatch)
+    store.measured("u-curve", compute, field="sine", size=256)
+    assert len(calls) == 1
 
 
 def test_the_check_rejects_a_store_that_ignores_the_digest(fresh, monkeypatch):
