@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 
 from . import store
-from .core import step_latex
+from .core import step_parts
 
 __all__ = ["theorem_block", "ledger_table", "ledger", "TheoremFailed"]
 
@@ -26,12 +26,25 @@ class TheoremFailed(AssertionError):
 
 
 def _proof_step(number, step):
-    """One step of a proof as a paragraph: "Step n." with the caption when it is words (not a
-    symbol or LaTeX), then the step's equation as a display."""
+    """One step of a proof as a paragraph and a display.  A caption in words leads the
+    paragraph; a caption in LaTeX (the quantity, e.g. ``\\partial u/\\partial\\theta``) names it
+    in the display.  Where the computed side prints as the claimed one, the display is
+    ``caption = value`` (or the value alone) instead of the same expression twice."""
     caption = step[0]
-    words = caption if re.fullmatch(r"[A-Za-z][A-Za-z0-9 ,;:'()\-=./]+", caption) and len(caption) > 2 else ""
-    lead = f"**Step {number}.** {words[0].upper()}{words[1:]}." if words else f"**Step {number}.**"
-    return f"{lead}\n\n$$\n{step_latex(step)}\n$$"
+    lhs, rhs = step_parts(step)
+    words = bool(re.fullmatch(r"[A-Za-z][A-Za-z0-9 ,;:'()\-=./]+", caption)) and len(caption) > 2
+    lead = f"**Step {number}.** {caption[0].upper()}{caption[1:]}." if words else f"**Step {number}.**"
+    if rhs is None:
+        shown = lhs
+    elif lhs == rhs:
+        shown = rhs if words or caption == lhs else f"{caption} = {rhs}"
+    else:
+        shown = f"{lhs} = {rhs}" if words or caption == lhs else f"{caption}:\\quad {lhs} = {rhs}"
+    if lhs is not None and rhs is not None and lhs != rhs and len(lhs) + len(rhs) > 200:
+        # Long both sides: one line each, aligned on the equals sign, so the display is half as wide.
+        name = "" if words or caption == lhs else f"{caption}:\\quad "
+        shown = f"\\begin{{aligned}}{name}&{lhs}\\\\ &= {rhs}\\end{{aligned}}"
+    return f"{lead}\n\n$$\n{shown}\n$$"
 
 
 def _entry(t):

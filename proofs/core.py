@@ -192,13 +192,19 @@ def identities_theorem(id, title, statement, identities, variants, *, steps=(), 
     )
 
 
-def step_latex(step) -> str:
-    """LaTeX of one (caption, lhs, rhs) step: ``lhs = rhs`` (or ``lhs``)."""
+def step_parts(step):
+    """(lhs, rhs) of one (caption, lhs, rhs) step as LaTeX strings (rhs None if absent); sympy
+    objects are printed, with the symbol phi as the book's \\varphi."""
     _, lhs, rhs = step
-    def tex(e):                       # a str is LaTeX already; the symbol phi prints as the book's \varphi
-        if isinstance(e, str):
+
+    def tex(e):                       # a str is LaTeX already
+        if e is None or isinstance(e, str):
             return e
         return sp.latex(e, symbol_names={s: r"\varphi" for s in getattr(e, "free_symbols", ()) if s.name == "phi"})
-    if rhs is None:
-        return tex(lhs)
-    return f"{tex(lhs)} = {tex(rhs)}"
+    return tex(lhs), tex(rhs)
+
+
+def step_latex(step) -> str:
+    """LaTeX of one (caption, lhs, rhs) step: ``lhs = rhs`` (or ``lhs``)."""
+    lhs, rhs = step_parts(step)
+    return lhs if rhs is None else f"{lhs} = {rhs}"

@@ -276,3 +276,55 @@ def test_the_session_catches_network_use_and_errors(browser, tmp_path):
         assert any("boom" in e for e in s.errors) and any("undefinedFunction" in e for e in s.errors)
     finally:
         s.close()
+
+
+#: Everything on a page that has a width of its own; each must fit in the article's column.
+_OVERFLOW_JS = """(strip) => {
+  if (strip) {     // the wrong variant: the page without fit.css and fit.js's scaling
+    document.querySelectorAll('link[href*="fit.css"]').forEach(l => l.remove());
+    document.querySelectorAll('mjx-container').forEach(m => m.style.fontSize = '');
+  }
+  const main = document.querySelector('article.bd-article');
+  const right = main.getBoundingClientRect().right;
+  const els = [...main.querySelectorAll('mjx-container[display="true"], table, pre, img, canvas')];
+  const over = els.map(e => [e.tagName, Math.max(e.scrollWidth - e.clientWidth,
+                                                  e.getBoundingClientRect().right - right),
+                             (e.textContent || '').trim().slice(0, 60)]).filter(x => x[1] > 1);
+  return {checked: els.length, overflowing: over};
+}"""
+PAGES = ("index", "s1_what_changes", "s2_scene", "s3_math", "s4_simulator", "s5_lab", "s6_ledger",
+         "s7_pitfalls", "s8_history", "s9_roadmap")
+
+
+def _measure_overflow(browser, book_html, width, page, strip=False):
+    context = browser.new_context(viewport={"width": width, "height": 900})
+    context.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file://") else r.abort())
+    try:
+        p = context.new_page()
+        p.goto((book_html / f"{page}.html").as_uri())
+        p.wait_for_load_state("load")
+        p.wait_for_function("!window.MathJax || !MathJax.startup || MathJax.startup.promise", timeout=30_000)
+        p.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise : null")
+        p.wait_for_timeout(300)                      # fit.js runs after MathJax's promise
+        return p.evaluate(_OVERFLOW_JS, strip)
+    finally:
+        context.close()
+
+
+@pytest.mark.parametrize("width", [1280, 390])
+def test_no_display_table_or_code_block_is_wider_than_its_column(browser, book_html, width):
+    """Every display equation, table, code block, image and canvas of every page fits the
+    article's column at a desktop and a phone width (fit.css, fit.js); the report goes to
+    test-artifacts/overflow_<width>.json."""
+    report = {page: _measure_overflow(browser, book_html, width, page) for page in PAGES}
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    (ARTIFACTS / f"overflow_{width}.json").write_text(json.dumps(
+        {"checked": sum(r["checked"] for r in report.values()),
+         "overflowing": sum(len(r["overflowing"]) for r in report.values()), "pages": report}, indent=1))
+    assert sum(r["checked"] for r in report.values()) > 100
+    assert {p: r["overflowing"] for p, r in report.items() if r["overflowing"]} == {}
+
+
+def test_the_overflow_check_rejects_the_pages_without_their_fitting(browser, book_html):
+    stripped = _measure_overflow(browser, book_html, 390, "s3_math", strip=True)
+    assert len(stripped["overflowing"]) > 5
