@@ -16,7 +16,7 @@ import re
 from . import store
 from .core import step_parts
 
-__all__ = ["theorem_block", "ledger_table", "ledger", "TheoremFailed"]
+__all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed"]
 
 BADGES = {"proved": "PROVED", "verified": "VERIFIED numerically", "refuted": "REFUTED"}
 
@@ -117,3 +117,31 @@ def ledger_table():
                     f"{BADGES[e['status']]} | {e['evidence'].replace('|', '/')} | "
                     f"{e['seed_says'].replace('|', '/') or '—'} | {pages} |")
     return "\n".join(rows)
+
+
+def findings():
+    """What the build found, for the book's front page: a dict of counts.
+
+    ``theorems``: {status: count} over the theorem ledger; ``claims``: {verdict:
+    count} over the draft's claims register (`proofs.claims.checked`);
+    ``errata``: the number of defects of the draft's code the book records
+    (§6 re-measures each with `proofs.seed_errata.reproduced`, and its build
+    fails if one vanished).  Reads the build's measurements (`ledger`, the
+    register), computing what is missing.
+
+    Raises
+    ------
+    TheoremFailed, proofs.claims.ClaimChanged
+        As the pages that show the ledger and the register.
+    """
+    from .claims import checked
+    from .seed_errata import ERRATA
+    entries = ledger()
+    for theorem_id, entry in entries.items():
+        _refuse(theorem_id, entry)
+    theorems, claims = {}, {}
+    for entry in entries.values():
+        theorems[entry["status"]] = theorems.get(entry["status"], 0) + 1
+    for _, _, verdict in checked():
+        claims[verdict] = claims.get(verdict, 0) + 1
+    return {"theorems": theorems, "claims": claims, "errata": len(ERRATA)}

@@ -558,6 +558,10 @@ def evaluate():
     return [(c, *c.measure()) for c in CLAIMS]
 
 
+def _register():
+    return [[c.id, m, v] for c, m, v in evaluate()]
+
+
 class ClaimChanged(AssertionError):
     """A claim's computed verdict is not the one registered for it."""
 
@@ -565,14 +569,19 @@ class ClaimChanged(AssertionError):
 def checked(results=None):
     """`evaluate`'s results (or ``results``), after checking every computed
     verdict against the registered one: the book shows the register only
-    through this, so its build fails as `pytest verify` does.
+    through this, so its build fails as `pytest verify` does.  Without
+    ``results`` the evaluation is one measurement of the build
+    (`proofs.store`, "claims-register"), shared by the pages that show it.
 
     Raises
     ------
     ClaimChanged
         Naming every claim whose verdict changed, with its measurement.
     """
-    results = evaluate() if results is None else results
+    if results is None:
+        from .store import measured
+        by_id = {c.id: c for c in CLAIMS}
+        results = [(by_id[i], m, v) for i, m, v in measured("claims-register", _register)]
     changed = [f"{c.id}: registered {c.registered!r}, computed {v!r} ({m})"
                for c, m, v in results if v != c.registered]
     if changed:

@@ -293,7 +293,7 @@ _OVERFLOW_JS = """(strip) => {
   return {checked: els.length, overflowing: over};
 }"""
 PAGES = ("index", "s1_what_changes", "s2_scene", "s3_math", "s4_simulator", "s5_lab", "s6_ledger",
-         "s7_pitfalls", "s8_history", "s9_roadmap")
+         "s7_pitfalls", "s8_history", "s9_roadmap", "glossary")
 
 
 def _measure_overflow(browser, book_html, width, page, strip=False):
