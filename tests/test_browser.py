@@ -92,6 +92,22 @@ class Session:
         self.page.fill("#sim-log_eps", str(exponent))
         self.wait_update(before)
 
+    def select(self, name, value):
+        before = self.updates()
+        self.page.select_option(f"#sim-{name}", str(value))
+        self.wait_update(before)
+
+    def difference_levels(self):
+        """Grey levels (0-255) of the difference canvas at the pixels on sphere A in the symbolic frame."""
+        return self.page.evaluate("""() => {
+            const sim = document.querySelector('[data-symrender-sim]').symrender;
+            const c = document.getElementById('sim-canvas-difference');
+            const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+            const chamber = sim.frames.symbolic.chamber, out = [];
+            for (let k = 0; k < chamber.length; k++) if (chamber[k] === 1) out.push(d[4 * k]);
+            return out;
+        }""")
+
     def close(self):
         self.context.close()
 
@@ -328,3 +344,72 @@ def test_no_display_table_or_code_block_is_wider_than_its_column(browser, book_h
 def test_the_overflow_check_rejects_the_pages_without_their_fitting(browser, book_html):
     stripped = _measure_overflow(browser, book_html, 390, "s3_math", strip=True)
     assert len(stripped["overflowing"]) > 5
+
+
+LOG_EPS = (-1, -3, -6, -9, -12, -14)
+
+
+@pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
+def test_the_log_difference_view_shows_the_u_curve(browser, book_html, field):
+    """On the default log scale the difference canvas is visible on sphere A at every step from
+    1e-1 to 1e-14, and its mean level follows the U-curve: lower at the optimum than at
+    either end.  On the linear scale (the wrong variant for small steps) it is black."""
+    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    try:
+        s.select("height_field", field)
+        means = {}
+        for e in LOG_EPS:
+            s.set_eps(e)
+            levels = np.array(s.difference_levels())
+            assert np.count_nonzero(levels) > 0.5 * levels.size, (field, e)   # visible: not black
+            means[e] = float(levels.mean())
+            if field == "sine" and e in (-3, -6, -12):
+                ARTIFACTS.mkdir(parents=True, exist_ok=True)
+                s.page.locator("#sim").scroll_into_view_if_needed()
+                s.page.locator(".sim-canvases").screenshot(path=str(ARTIFACTS / f"s4_log_view_eps_1e{e}.png"))
+        assert min(means[-6], means[-9]) < min(means[-1], means[-14]), means
+        s.set_eps(-6)
+        s.select("scale", "linear")
+        assert np.count_nonzero(s.difference_levels()) == 0 or field == "ridges"   # creases stay visible
+        assert s.errors == []
+    finally:
+        s.close()
+
+
+def test_preset_three_shows_the_pinch_in_the_shaded_view(browser, book_html):
+    """Rings, pole magnified: the shaded canvas, which the preset shows, changes by more
+    across the pole than anywhere near it in the unmagnified frame."""
+    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    try:
+        before = s.updates()
+        s.page.click("#sim-preset-try3")
+        s.wait_update(before)
+        assert s.page.input_value("#sim-view") == "shaded" and s.page.input_value("#sim-zoom") == "8"
+        spread = s.page.evaluate("""() => {
+            const c = document.getElementById('sim-canvas-symbolic');
+            const n = c.width, d = c.getContext("2d").getImageData(n / 2 - 24, n / 2 - 24, 48, 48).data;
+            let lo = 255, hi = 0;
+            for (let k = 0; k < d.length; k += 4) { const y = d[k] + d[k + 1] + d[k + 2];
+                                                   lo = Math.min(lo, y / 3); hi = Math.max(hi, y / 3); }
+            return hi - lo;
+        }""")
+        assert spread > 60, spread          # a light and a dark side meet at the pole
+    finally:
+        s.close()
+
+
+@pytest.mark.parametrize("width", [1280, 390])
+def test_the_three_canvases_are_equal_and_side_by_side_at_every_width(browser, book_html, width):
+    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    try:
+        s.page.set_viewport_size({"width": width, "height": 1200})
+        s.page.wait_for_timeout(200)
+        boxes = [s.page.locator(f"#sim-canvas-{n}").bounding_box() for n in ("numeric", "symbolic", "difference")]
+        assert max(b["width"] for b in boxes) - min(b["width"] for b in boxes) < 1, boxes
+        assert max(b["y"] for b in boxes) - min(b["y"] for b in boxes) < 1, boxes          # one row
+        if width == 390:
+            ARTIFACTS.mkdir(parents=True, exist_ok=True)
+            s.page.locator(".sim-canvases").scroll_into_view_if_needed()
+            s.page.screenshot(path=str(ARTIFACTS / "s4_at_390px.png"), full_page=False)
+    finally:
+        s.close()

@@ -1,7 +1,7 @@
 // The §4 live simulator: controls, three canvases, the ledger and the hover
 // readout, wired to the renderer in render.js.  Only this module touches the
 // DOM; the renderer core runs the same under node (tests/test_js_parity.py).
-import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, SPHERE_A, CHAMBER_NAMES } from "./constants.js";
+import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES } from "./constants.js";
 import { render_pair, probe_pixel } from "./render.js";
 import { compare, to_srgb } from "./ledger.js";
 
@@ -22,9 +22,22 @@ const NUMERIC_CAPTION = {
 
 const DEFAULT_STATE = {
   numeric: "central", height_field: DEFAULT_SCENE.height_field, k_u: DEFAULT_SCENE.k_u, k_v: DEFAULT_SCENE.k_v,
-  beta: DEFAULT_SCENE.beta, log_eps: Math.log10(DEFAULT_SCENE.eps), model: DEFAULT_SCENE.model,
-  resolution: 256, view: "shaded", zoom: 1, sphere_b: DEFAULT_SCENE.sphere_b,
+  beta: DEFAULT_SCENE.beta, bump: DEFAULT_SCENE.bump, log_eps: Math.log10(DEFAULT_SCENE.eps),
+  model: DEFAULT_SCENE.model, resolution: 256, view: "shaded", scale: "log", zoom: 1,
+  sphere_b: DEFAULT_SCENE.sphere_b,
 };
+
+// The difference canvas on the log scale: log10 |difference| from LOG_FLOOR (black) to 0 (white),
+// so that differences from the rounding level of float64 up to a whole channel are all visible.
+export const LOG_FLOOR = -16;
+// The linear scale's gain.
+export const LINEAR_GAIN = 100;
+
+// Grey level in [0, 1] of a difference d >= 0 on the chosen scale.
+export function difference_level(d, scale) {
+  if (scale === "log") return d > 0 ? Math.min(1.0, Math.max(0.0, 1.0 - Math.log10(d) / LOG_FLOOR)) : 0.0;
+  return Math.min(1.0, LINEAR_GAIN * d);
+}
 
 // The controls, in tab order.  kind: select | range | checkbox.
 const CONTROLS = [
@@ -32,12 +45,15 @@ const CONTROLS = [
   { name: "k_u", label: "k_u", kind: "range", min: 1, max: 24, step: 1 },
   { name: "k_v", label: "k_v", kind: "range", min: 1, max: 24, step: 1 },
   { name: "beta", label: "β (bump amplitude)", kind: "range", min: 0, max: 2, step: 0.01 },
+  { name: "bump", label: "bump: the draft's chart formula or the displaced sphere's normal", kind: "select",
+    options: BUMPS },
   { name: "numeric", label: "numeric gradient", kind: "select", options: NUMERIC },
   { name: "log_eps", label: "ε (finite-difference step)", kind: "range", min: -14, max: -1, step: 0.1,
     show: (x) => eps_of(x).toExponential(1) },
   { name: "model", label: "shading model", kind: "select", options: MODELS },
   { name: "resolution", label: "resolution", kind: "select", options: [64, 128, 256, 512] },
   { name: "view", label: "view", kind: "select", options: ["shaded", "bump", "kink"] },
+  { name: "scale", label: "difference scale", kind: "select", options: ["log", "linear"] },
   { name: "zoom", label: "magnify the pole", kind: "select", options: [1, 2, 4, 8, 16, 32] },
   { name: "sphere_b", label: "sphere B", kind: "checkbox" },
 ];
@@ -46,19 +62,20 @@ const CONTROLS = [
 export const PRESETS = [
   { id: "try1", label: "1 · sine: sweep ε from 1e-1 down", set: { height_field: "sine", log_eps: -1 }, focus: "log_eps" },
   { id: "try2", label: "2 · ridges in the kink view", set: { height_field: "ridges", view: "kink" } },
-  { id: "try3", label: "3 · rings, magnify the pole", set: { height_field: "rings", zoom: 8, view: "bump" } },
+  { id: "try3", label: "3 · rings, magnify the pole", set: { height_field: "rings", zoom: 8, view: "shaded" } },
   { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta" },
 ];
 
 export function scene_of(state) {
   return { ...DEFAULT_SCENE, height_field: state.height_field, k_u: state.k_u, k_v: state.k_v,
-           beta: state.beta, eps: eps_of(state.log_eps), model: state.model, sphere_b: state.sphere_b };
+           beta: state.beta, bump: state.bump, eps: eps_of(state.log_eps), model: state.model,
+           sphere_b: state.sphere_b };
 }
 
 const STYLE = `
 .symrender-sim { font-size: 0.9rem; }
-.symrender-sim .sim-canvases { display: flex; gap: 0.6rem; flex-wrap: wrap; }
-.symrender-sim figure { margin: 0; flex: 1 1 0; min-width: 150px; }
+.symrender-sim .sim-canvases { display: grid; grid-template-columns: repeat(3, minmax(0, 1fr)); gap: 0.6rem; }
+.symrender-sim figure { margin: 0; min-width: 0; }
 .symrender-sim canvas { width: 100%; aspect-ratio: 1; image-rendering: pixelated; background: #000; display: block; }
 .symrender-sim canvas:focus { outline: 3px solid #4a90d9; }
 .symrender-sim figcaption { font-size: 0.8rem; line-height: 1.25; margin-top: 0.25rem; }
@@ -108,7 +125,7 @@ class Simulator {
     const figs = [
       ["numeric", NUMERIC_CAPTION.central],
       ["symbolic", "symbolic: the exact gradient"],
-      ["difference", "|difference| × 10²"],
+      ["difference", "log₁₀ |ΔI|"],
     ].map(([name, caption]) => {
       const canvas = el("canvas", { id: `sim-canvas-${name}`, tabindex: "0", role: "img",
                                     "aria-label": `${caption} (arrow keys move the probe)` });
@@ -158,7 +175,8 @@ class Simulator {
 
     const cell = (id) => el("td", { id });
     this.ledger = el("table", { class: "sim-ledger", "aria-live": "polite" }, [
-      el("thead", {}, [el("tr", {}, ["max |ΔI| on A", "RMS |ΔI| on A", "flips", "pixels on A", "update (both pipelines)"]
+      el("thead", {}, [el("tr", {}, ["max |ΔI| on A", "RMS |ΔI| on A", "flips (one shared geometry pass: 0 by construction)",
+                                      "pixels on A", "update (both pipelines)"]
         .map((h) => el("th", { text: h })))]),
       el("tbody", {}, [el("tr", {}, ["sim-max", "sim-rms", "sim-flips", "sim-pixels", "sim-time"].map(cell))]),
     ]);
@@ -227,7 +245,7 @@ class Simulator {
   }
 
   draw(numeric, symbolic) {
-    const view = this.state.view;
+    const view = this.state.view, scale = this.state.scale;
     const n = numeric.chamber.length;
     const w = numeric.width, h = numeric.height;
     let gmax = 0.0;
@@ -258,11 +276,16 @@ class Simulator {
           }
         } else if (view === "bump") {
           const both = numeric.chamber[k] === SPHERE_A && symbolic.chamber[k] === SPHERE_A;
-          r = g = b = both ? Math.min(1.0, 100 * Math.abs(gnorm(numeric, k) - gnorm(symbolic, k))) : 0.0;
+          r = g = b = both ? difference_level(Math.abs(gnorm(numeric, k) - gnorm(symbolic, k)), scale) : 0.0;
+        } else if (scale === "log") {     // one grey level: the largest channel difference
+          r = g = b = difference_level(Math.max(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]),
+                                                Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]),
+                                                Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2])), scale);
+          if (view === "kink" && symbolic.kink[k]) { r *= 0.6; g *= 0.6; b = Math.max(b, 0.35); }
         } else {
-          r = Math.min(1.0, 100 * Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]));
-          g = Math.min(1.0, 100 * Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]));
-          b = Math.min(1.0, 100 * Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2]));
+          r = difference_level(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]), scale);
+          g = difference_level(Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]), scale);
+          b = difference_level(Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2]), scale);
           if (view === "kink" && symbolic.kink[k]) b = Math.max(b, 0.35);
         }
         px[4 * k] = Math.round(255 * r); px[4 * k + 1] = Math.round(255 * g);
@@ -271,9 +294,10 @@ class Simulator {
       ctx.putImageData(img, 0, 0);
     }
     const pipe = this.state.numeric;
-    const cap = { shaded: [NUMERIC_CAPTION[pipe] ?? `numeric: ${pipe}`, "symbolic: the exact gradient", "|ΔI| × 10²"],
-                  bump: [`bump view: |∇h|, numeric (${pipe})`, "bump view: |∇h|, exact", "|Δ|∇h|| × 10² (relative to max)"],
-                  kink: [`kink view: crease band (white), numeric (${pipe})`, "kink view: crease band (white), exact", "|ΔI| × 10², band in blue"] }[view];
+    const diff = scale === "log" ? `log₁₀ |Δ| from ${LOG_FLOOR} (black) to 0 (white)` : `|Δ| × ${LINEAR_GAIN}`;
+    const cap = { shaded: [NUMERIC_CAPTION[pipe] ?? `numeric: ${pipe}`, "symbolic: the exact gradient", `|ΔI|: ${diff}`],
+                  bump: [`bump view: |∇h|, numeric (${pipe})`, "bump view: |∇h|, exact", `|Δ|∇h|| relative to its max: ${diff}`],
+                  kink: [`kink view: crease band (white), numeric (${pipe})`, "kink view: crease band (white), exact", `|ΔI|: ${diff}; band in blue`] }[view];
     ["numeric", "symbolic", "difference"].forEach((name, i) => {
       this.root.querySelector(`#sim-caption-${name}`).textContent = cap[i];
     });
