@@ -1,0 +1,188 @@
+"""The book's figure style and its explanatory diagrams, drawn when the book is built.
+
+`style` sets matplotlib for every figure of the book: PNG at twice the CSS
+size (for high-density screens), mathematical labels in mathtext, and no
+creation date in the file, so that a rebuild writes the same bytes.  The
+diagrams draw what the text asks the reader to picture, from the renderer's
+own functions (`renderer.pointwise`, generated from `renderer.formulas`):
+
+* `frame_diagram`: sphere A with its chart's meridians and parallels and the
+  tangent frame (e_theta, e_phi) and normal N at one point;
+* `normal_diagram`: the perturbed normal of both bump modes at one point of a
+  bumped meridian, beside the normal of the displaced curve itself;
+* `stencil_diagram`: the central-difference stencil straddling a crease of the
+  ridges field, its secant, and the two one-sided slopes;
+* `ucurve_anatomy` (in §7, on the measured curve): the regions of the U-curve.
+
+Each returns a matplotlib Figure (the caller glues and closes it).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from renderer import Scene, pointwise
+
+__all__ = ["style", "frame_diagram", "normal_diagram", "stencil_diagram", "ucurve_anatomy"]
+
+#: The book's colours: measured (dark red), exact (dark blue), third quantity (green), guides (grey).
+RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
+
+
+def style():
+    """Set matplotlib (and, inside IPython, the inline backend) for the book's figures."""
+    import matplotlib as mpl
+    mpl.rcParams.update({"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8,
+                         "savefig.bbox": "tight", "svg.hashsalt": "symrender", "image.interpolation": "nearest"})
+    try:
+        from matplotlib_inline.backend_inline import set_matplotlib_formats
+        set_matplotlib_formats("retina", metadata={"Software": None})
+    except (ImportError, AttributeError, NameError):
+        pass                                            # outside IPython: nothing to configure
+
+
+def _sphere_point(theta, phi):
+    return np.array([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)])
+
+
+def frame_diagram(theta=-0.35, phi=0.8):
+    """Sphere A (unit radius) seen obliquely: lines of constant u (meridians) and v (parallels)
+    of the renderer's chart, and at N(theta, phi) the normal and the tangent frame the
+    renderer computes there (`pointwise.tangent_frame`)."""
+    import matplotlib.pyplot as plt
+    toward = np.array([1.0, 0.35, 0.55]) / np.linalg.norm([1.0, 0.35, 0.55])   # towards the viewer
+    right = np.cross([0.0, 0.0, 1.0], toward)
+    right /= np.linalg.norm(right)
+    view = np.array([right, np.cross(toward, right)])                # an oblique orthographic view
+    depth = toward
+
+    def project(p):
+        return view @ p
+
+    fig, ax = plt.subplots(figsize=(4.6, 4.6))
+    t = np.linspace(0, 2 * np.pi, 400)
+    ax.plot(np.cos(t), np.sin(t), color=GREY, lw=1)
+    for k in range(12):                                               # meridians: u = k / 12
+        th = 2 * np.pi * k / 12 - np.pi
+        pts = np.array([_sphere_point(th, p) for p in np.linspace(0, np.pi, 60)])
+        front = pts @ depth > 0
+        xy = pts @ view.T
+        ax.plot(np.where(front, xy[:, 0], np.nan), np.where(front, xy[:, 1], np.nan), color=BLUE, lw=0.6, alpha=0.6)
+    for k in range(1, 6):                                             # parallels: v = k / 6
+        ph = np.pi * k / 6
+        pts = np.array([_sphere_point(th, ph) for th in np.linspace(-np.pi, np.pi, 120)])
+        front = pts @ depth > 0
+        xy = pts @ view.T
+        ax.plot(np.where(front, xy[:, 0], np.nan), np.where(front, xy[:, 1], np.nan), color=GREEN, lw=0.6, alpha=0.6)
+    N = _sphere_point(theta, phi)
+    sin_phi = np.hypot(N[0], N[1])
+    e_t, e_p = (np.array(v, float).ravel() for v in pointwise.tangent_frame(N[0], N[1], N[2], sin_phi))
+    base = project(N)
+    for vec, colour, label in ((N, RED, r"$N$"), (e_t, BLUE, r"$e_\theta$ (along $u$)"),
+                               (e_p, GREEN, r"$e_\varphi$ (along $v$)")):
+        tip = project(N + 0.45 * vec)
+        ax.annotate("", tip, base, arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.8))
+        ax.text(*(tip + 0.04 * (tip - base) / max(np.linalg.norm(tip - base), 1e-9)), label, color=colour)
+    ax.plot(*project(_sphere_point(0.0, 0.0)), "o", color="k", ms=3)
+    ax.text(*(project(_sphere_point(0.0, 0.0)) + [0.03, 0.03]), r"pole $\varphi = 0$")
+    ax.set_aspect("equal"); ax.axis("off")
+    ax.set_title(r"chart $u = (\theta + \pi)/2\pi$ (meridians), $v = \varphi/\pi$ (parallels)")
+    return fig
+
+
+def normal_diagram(field="rings", beta=0.35, theta=0.4, phi0=1.0, span=0.35):
+    """A meridian of sphere A (theta fixed) and of the displaced sphere (R + beta h) N, and at
+    its middle the shading normals the renderer computes in the two bump modes
+    (`formulas.PERTURBED_NORMAL`, via `renderer.gbuffer`-free `pointwise` evaluation), drawn
+    in the meridian's plane with the displaced curve's own normal."""
+    import matplotlib.pyplot as plt
+    import sympy as sp
+
+    from renderer import formulas as F
+    scene = Scene(height_field=field, beta=beta)
+    phis = np.linspace(phi0 - span, phi0 + span, 200)
+    u = np.full_like(phis, (theta + np.pi) / (2 * np.pi))
+    v = phis / np.pi
+    h = pointwise.height(field, u, v, scene.k_u, scene.k_v)
+    # The meridian's plane: x along (cos theta, sin theta, 0) (horizontal), z up.
+    r0 = scene.radius_a
+    base = np.stack([r0 * np.sin(phis), r0 * np.cos(phis)], axis=-1)
+    bumped = np.stack([(r0 + beta * h) * np.sin(phis), (r0 + beta * h) * np.cos(phis)], axis=-1)
+    fig, ax = plt.subplots(figsize=(6.4, 3.6))
+    ax.plot(*base.T, color=GREY, lw=1.2, label="sphere A (the geometry the bump keeps)")
+    ax.plot(*bumped.T, color=GREY, lw=1.2, ls="--", label=r"displaced sphere $(R + \beta h)N$")
+    k = len(phis) // 2
+    N3 = _sphere_point(theta, phis[k])
+    sin_phi = np.hypot(N3[0], N3[1])
+    e_t, e_p = (np.array(x, float).ravel() for x in pointwise.tangent_frame(N3[0], N3[1], N3[2], sin_phi))
+    hu, hv = (float(np.asarray(g).ravel()[0]) for g in pointwise.exact_gradient(field, u[k], v[k], scene.k_u, scene.k_v))
+    args = {F.N_x: N3[0], F.N_y: N3[1], F.N_z: N3[2], F.h_u: hu, F.h_v: hv, F.beta: beta, F.h: float(h[k]),
+            F.R: r0, F.sin_phi: sin_phi, **dict(zip(F.e_theta, e_t)), **dict(zip(F.e_phi, e_p))}
+    in_plane = np.array([[np.cos(theta), np.sin(theta), 0.0], [0.0, 0.0, 1.0]])
+    tangent = np.gradient(bumped, axis=0)[k]
+    displaced = np.array([tangent[1], -tangent[0]]) / np.hypot(*tangent)
+    displaced *= np.sign(displaced @ bumped[k])
+    at = bumped[k]
+    arrows = [(in_plane @ N3, GREY, r"$N$ (sphere A)"),
+              (in_plane @ np.array(sp.Matrix(F.PERTURBED_NORMAL["chart"]).subs(args), float).ravel(), RED,
+               r"$N'$ chart (the draft's)"),
+              (in_plane @ np.array(sp.Matrix(F.PERTURBED_NORMAL["surface"]).subs(args), float).ravel(), BLUE,
+               r"$N'$ surface"),
+              (displaced, GREEN, "normal of the displaced curve")]
+    for vec, colour, label in arrows:                  # the displaced curve's normal thin, on top of N' surface
+        tip = at + 0.35 * vec / np.linalg.norm(vec)
+        ax.plot(*np.array([at, tip]).T, alpha=0.0)      # the arrow inside the axes' limits
+        ax.annotate("", tip, at, annotation_clip=False,
+                    arrowprops=dict(arrowstyle="-|>", color=colour, lw=3.5 if colour == BLUE else 1.2))
+        ax.plot([], [], color=colour, lw=3.5 if colour == BLUE else 1.2, label=label)
+    ax.set_aspect("equal"); ax.axis("off")
+    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), frameon=False)
+    ax.set_title(rf"one meridian, {field} field, $\beta = {beta:g}$")
+    return fig
+
+
+def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
+    """h along u across the crease u = 1/k_u of the ridges field, the central stencil
+    u0 +- eps with u0 just beside the crease, its secant (the central difference), and the
+    exact one-sided slope at u0 (`pointwise.height`, `pointwise.exact_gradient`)."""
+    import matplotlib.pyplot as plt
+    crease = 1.0 / k_u
+    u = np.linspace(crease - 3 * eps, crease + 3 * eps, 400)
+    h = pointwise.height("ridges", u, np.full_like(u, v), k_u, k_v)
+    u0 = crease + offset
+    (h_m, h_0, h_p) = pointwise.height("ridges", np.array([u0 - eps, u0, u0 + eps]), np.full(3, v), k_u, k_v)
+    secant = (h_p - h_m) / (2 * eps)
+    exact = float(np.asarray(pointwise.exact_gradient("ridges", u0, v, k_u, k_v)[0]).ravel()[0])
+    fig, ax = plt.subplots(figsize=(5.6, 3.4))
+    ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
+    ax.axvline(crease, color=GREY, lw=0.8, ls=":")
+    ax.text(crease, h.max() * 1.02, r"crease $u = 1/k_u$", ha="center", va="bottom")
+    ax.plot([u0 - eps, u0 + eps], [h_m, h_p], "o-", color=RED, label=rf"central stencil: slope {secant:+.2f}")
+    du = np.array([-1.5 * eps, 1.5 * eps])
+    ax.plot(u0 + du, h_0 + exact * du, color=BLUE, lw=1.5, label=rf"exact slope at $u_0$: {exact:+.2f}")
+    ax.plot([u0], [h_0], "o", color=BLUE)
+    ax.set_xlabel(r"$u$"); ax.set_ylabel(r"$h$")
+    ax.legend(loc="lower right", frameon=False)
+    ax.set_title(r"the stencil $u_0 \pm \varepsilon$ straddles the crease")
+    return fig
+
+
+def ucurve_anatomy(curve):
+    """The measured U-curve of a `proofs.ucurve.UCurve` (error, truncation and roundoff parts,
+    fitted model) with its regions named: truncation falling as eps^2, rounding rising as
+    1/eps, the fitted optimum between them."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    ax.loglog(curve.eps, curve.error, lw=2, color=RED, label="|error| of the float64 quotient")
+    ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="|truncation| (exact arithmetic)")
+    ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="|roundoff| (the rest)")
+    ax.loglog(curve.eps, curve.model, color=GREY, lw=1, label=r"model $A\varepsilon^2 + B/\varepsilon$")
+    opt = curve.eps_opt_fitted
+    ax.axvline(opt, color=GREY, lw=0.8, ls="-.")
+    top = float(np.nanmax(curve.error))
+    ax.annotate(r"truncation falls as $\varepsilon^2$", (1e-2, top), (2e-2, top * 30), ha="center", fontsize=8)
+    ax.annotate(r"rounding rises as $1/\varepsilon$", (1e-11, top), (1e-11, top * 30), ha="center", fontsize=8)
+    ax.annotate(r"optimum $\varepsilon^\ast$", (opt, 1e-17), (opt * 3, 1e-17), fontsize=8)
+    ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $h_u$"); ax.set_ylim(1e-18, 1e3)
+    ax.legend(loc="lower left", frameon=False); ax.grid(alpha=0.3)
+    return fig
