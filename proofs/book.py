@@ -12,6 +12,7 @@ per build: its entry is a measurement of `proofs.store`, which later pages
 from __future__ import annotations
 
 import re
+from collections import Counter
 
 from . import store
 from .core import step_parts
@@ -139,9 +140,5 @@ def findings():
     entries = ledger()
     for theorem_id, entry in entries.items():
         _refuse(theorem_id, entry)
-    theorems, claims = {}, {}
-    for entry in entries.values():
-        theorems[entry["status"]] = theorems.get(entry["status"], 0) + 1
-    for _, _, verdict in checked():
-        claims[verdict] = claims.get(verdict, 0) + 1
-    return {"theorems": theorems, "claims": claims, "errata": len(ERRATA)}
+    return {"theorems": dict(Counter(e["status"] for e in entries.values())),
+            "claims": dict(Counter(verdict for _, _, verdict in checked())), "errata": len(ERRATA)}

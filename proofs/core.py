@@ -25,7 +25,7 @@ import mpmath
 import sympy as sp
 
 __all__ = ["Verdict", "Identity", "Theorem", "check_identities", "identities_theorem",
-           "step_latex", "DIGITS", "POINTS"]
+           "step_parts", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
 DIGITS = 30
@@ -204,7 +204,3 @@ def step_parts(step):
     return tex(lhs), tex(rhs)
 
 
-def step_latex(step) -> str:
-    """LaTeX of one (caption, lhs, rhs) step: ``lhs = rhs`` (or ``lhs``)."""
-    lhs, rhs = step_parts(step)
-    return lhs if rhs is None else f"{lhs} = {rhs}"

@@ -92,9 +92,10 @@ def frame_diagram(theta=-0.35, phi=0.8):
 
 def normal_diagram(field="rings", beta=0.35, theta=0.4, phi0=1.0, span=0.35):
     """A meridian of sphere A (theta fixed) and of the displaced sphere (R + beta h) N, and at
-    its middle the shading normals the renderer computes in the two bump modes
-    (`formulas.PERTURBED_NORMAL`, via `renderer.gbuffer`-free `pointwise` evaluation), drawn
-    in the meridian's plane with the displaced curve's own normal."""
+    its middle the shading normals of the two bump modes (the sympy objects
+    `formulas.PERTURBED_NORMAL`, fed the frame and gradient `pointwise` computes there), drawn
+    in the meridian's plane with the displaced curve's own normal.  With the rings field
+    (h_u = 0) every vector lies in that plane."""
     import matplotlib.pyplot as plt
     import sympy as sp
 

@@ -32,12 +32,12 @@ DRHO = e * R * (e * sp.cos(phi) - R) / (e - R * sp.cos(phi)) ** 2
 DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 1.2), R: (0.5, 1.0), e: (2.0, 6.0)}
 #: The crease u = m / k_u solved for theta (the chart of theorem `chart`), which is alpha.
 m_sym = sp.Symbol("m", integer=True)
-ALPHA_M = sp.solve(sp.Eq(U_OF_THETA.subs(sp.Symbol("theta", real=True), theta), m_sym / F.k_u), theta)[0]
+ALPHA_M = sp.solve(sp.Eq(U_OF_THETA, m_sym / F.k_u), theta)[0]      # frame's theta is this module's
 _ALPHA_M = sp.lambdify((m_sym, F.k_u), ALPHA_M, modules="numpy")
 
 
 def _tex(expr):
-    return sp.latex(expr, order="rev-lex", symbol_names={**ANGLE_NAMES, phi: r"\varphi"})
+    return sp.latex(expr, order="rev-lex", symbol_names=ANGLE_NAMES)
 
 
 def ray_angles(k_u):
@@ -122,7 +122,7 @@ def _check(kind, rho=RHO, drho=DRHO, scene=None, shift=(0.0, 0.0)):
 KINK_LOCI_RAYS = Theorem(
     id="kink-loci-rays", title="The u-creases are rays",
     statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the "
-              rf"$z$-axis, $\alpha = \theta$, so $u = {_tex(U_OF_THETA.subs(sp.Symbol('theta', real=True), sp.Symbol('alpha')))}$ "
+              rf"$z$-axis, $\alpha = \theta$, so $u = {_tex(U_OF_THETA.subs(theta, sp.Symbol('alpha')))}$ "
               r"depends on the angle alone and the crease $u = m/k_u$ is the ray "
               rf"$\alpha_m = {_tex(ALPHA_M)}$.",
     steps=(("projection", r"(x, y)", sp.Matrix([x_img, y_img]).applyfunc(sp.simplify)),

@@ -54,6 +54,12 @@ def formulas_js():
     return codegen.js_source()
 
 
+#: The simulator's difference canvas (§4): log10 |difference| is drawn from this floor (black)
+#: to 0 (white), about the rounding level of float64; the linear scale multiplies by the gain.
+DIFFERENCE_LOG_FLOOR = -16
+DIFFERENCE_LINEAR_GAIN = 100
+
+
 def constants_js():
     """Source of ``constants.js``: the default Scene and the renderer's constants."""
     consts = {
@@ -74,6 +80,8 @@ def constants_js():
         "FLOOR_LIGHT": kernel.FLOOR_LIGHT,
         "FLOOR_DARK": kernel.FLOOR_DARK,
         "TINY": kernel.TINY,
+        "LOG_FLOOR": DIFFERENCE_LOG_FLOOR,
+        "LINEAR_GAIN": DIFFERENCE_LINEAR_GAIN,
     }
     out = [_HEADER.format(src="renderer/scene.py, render.py and kernel.py")]
     for name, value in consts.items():

@@ -1,7 +1,8 @@
 // The §4 live simulator: controls, three canvases, the ledger and the hover
 // readout, wired to the renderer in render.js.  Only this module touches the
 // DOM; the renderer core runs the same under node (tests/test_js_parity.py).
-import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES } from "./constants.js";
+import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES,
+         LOG_FLOOR, LINEAR_GAIN } from "./constants.js";
 import { render_pair, probe_pixel } from "./render.js";
 import { compare, to_srgb } from "./ledger.js";
 
@@ -27,13 +28,9 @@ const DEFAULT_STATE = {
   sphere_b: DEFAULT_SCENE.sphere_b,
 };
 
-// The difference canvas on the log scale: log10 |difference| from LOG_FLOOR (black) to 0 (white),
-// so that differences from the rounding level of float64 up to a whole channel are all visible.
-export const LOG_FLOOR = -16;
-// The linear scale's gain.
-export const LINEAR_GAIN = 100;
-
-// Grey level in [0, 1] of a difference d >= 0 on the chosen scale.
+// Grey level in [0, 1] of a difference d >= 0 on the chosen scale: on the log scale log10 d from
+// LOG_FLOOR (black) to 0 (white), so that differences from the rounding level of float64 up to a
+// whole channel are all visible; on the linear scale d times LINEAR_GAIN (both from renderer/jsgen.py).
 export function difference_level(d, scale) {
   if (scale === "log") return d > 0 ? Math.min(1.0, Math.max(0.0, 1.0 - Math.log10(d) / LOG_FLOOR)) : 0.0;
   return Math.min(1.0, LINEAR_GAIN * d);
