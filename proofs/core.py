@@ -81,7 +81,7 @@ def _exactly_zero(expr) -> bool:
 
 
 def _numeric_residual(identity: Identity, seed: int, points: int, digits: int):
-    """Worst |lhs - rhs| over seeded random points, and the point where it occurs."""
+    """Worst |lhs - rhs| of a scalar identity over seeded random points, and the point where it occurs."""
     diff = sp.sympify(identity.lhs - identity.rhs)
     if identity.functions:
         diff = diff.subs(identity.functions).doit()
@@ -95,8 +95,7 @@ def _numeric_residual(identity: Identity, seed: int, points: int, digits: int):
     with mpmath.workdps(digits):
         for _ in range(points):
             point = {s: mpmath.mpf(rng.uniform(*identity.domain[s])) for s in free}
-            value = fn(*[point[s] for s in free])
-            r = abs(value) if not isinstance(value, sp.Matrix) else max(abs(v) for v in value)
+            r = abs(fn(*[point[s] for s in free]))
             if r > worst or where is None:
                 worst, where = r, point
     return float(worst), where

@@ -1,0 +1,81 @@
+"""The register's decision rules (proofs/claims.py: `Bound`, `Criterion`,
+`rule`, `Claim.measure`): how a measured number becomes a verdict, and how the
+rule is printed in the book's table.
+
+Fast on purpose: benchmarks/mutation_audit.py --mutmut runs this file once per
+mutant of proofs/claims.py (its measurements are checked by pytest verify).
+"""
+
+import pytest
+
+from proofs.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Bound, Claim, Criterion, rule
+
+
+@pytest.mark.parametrize("bound, x, inside", [
+    (Bound("q", 1, 2), 1, True), (Bound("q", 1, 2), 2, True), (Bound("q", 1, 2), 0.999, False),
+    (Bound("q", 1, 2), 2.001, False), (Bound("q", 1, 2, strict=True), 1, False),
+    (Bound("q", 1, 2, strict=True), 2, False), (Bound("q", 1, 2, strict=True), 1.5, True),
+    (Bound("q", lo=3), 1e300, True), (Bound("q", lo=3), 2.9, False), (Bound("q", hi=3), -1e300, True),
+    (Bound("q", hi=3), 3.1, False), (Bound("q", 0, 0), 0.0, True), (Bound("q", 0, 0), 1e-300, False),
+    (Bound("q"), float("nan"), True),
+])
+def test_a_bound_holds_inside_its_interval(bound, x, inside):
+    assert bound.holds({"q": x, "other": -7}) is inside
+
+
+def test_a_bound_reads_only_its_own_quantity_and_names_a_missing_one():
+    assert Bound("a", hi=1).holds({"a": 0, "b": 5})
+    with pytest.raises(KeyError, match="'a'"):
+        Bound("a", hi=1).holds({"b": 0})
+
+
+def test_nan_is_outside_every_closed_side():
+    assert not Bound("q", lo=0).holds({"q": float("nan")}) and not Bound("q", hi=0).holds({"q": float("nan")})
+
+
+@pytest.mark.parametrize("bound, text", [
+    (Bound("ratio", 1, 2), "1 ≤ ratio ≤ 2"), (Bound("ratio", 1, 2, strict=True), "1 < ratio < 2"),
+    (Bound("flips", 0, 0), "flips = 0"), (Bound("error", hi=1e-9), "error ≤ 1e-09"),
+    (Bound("error", hi=2.5e-7, strict=True), "error < 2.5e-07"), (Bound("count", lo=15875), "count ≥ 15,875"),
+    (Bound("count", lo=2e6), "count ≥ 2e+06"), (Bound("slope", lo=1.23456), "slope ≥ 1.23"),
+    (Bound("slope", lo=0.5, strict=True), "slope > 0.5"),
+])
+def test_a_bound_prints_as_the_book_shows_it(bound, text):
+    assert str(bound) == text
+
+
+def test_a_criterion_takes_the_first_case_whose_bounds_all_hold():
+    c = Criterion(((HOLDS, (Bound("a", hi=1), Bound("b", hi=1))), (CORRECTED, (Bound("a", hi=10),))))
+    assert c.decide({"a": 0.5, "b": 0.5}) == HOLDS
+    assert c.decide({"a": 0.5, "b": 2}) == CORRECTED      # one bound of the first case fails
+    assert c.decide({"a": 11, "b": 0}) == FAILS
+    assert Criterion(((HOLDS, (Bound("a", hi=1),)),), otherwise=CORRECTED).decide({"a": 2}) == CORRECTED
+    assert Criterion(((FAILS, (Bound("a", hi=1),)), (HOLDS, (Bound("a", hi=1),)))).decide({"a": 0}) == FAILS
+
+
+def test_a_criterion_prints_its_cases_in_order_and_its_default():
+    c = Criterion(((HOLDS, (Bound("a", hi=1), Bound("b", lo=2))), (CORRECTED, (Bound("a", hi=10),))))
+    assert str(c) == "holds if a ≤ 1 and b ≥ 2; holds with a correction if a ≤ 10; otherwise does not hold"
+
+
+def test_rule_pairs_verdicts_with_a_bound_or_a_tuple_of_them():
+    b1, b2, b3 = Bound("a", hi=1), Bound("b", hi=2), Bound("c", hi=3)
+    assert rule(HOLDS, b1, CORRECTED, (b2, b3)) == Criterion(((HOLDS, (b1,)), (CORRECTED, (b2, b3))), FAILS)
+    assert rule(FAILS, b1, otherwise=HOLDS) == Criterion(((FAILS, (b1,)),), HOLDS)
+
+
+def test_a_claim_is_decided_by_its_criterion_from_its_own_numbers():
+    calls = []
+
+    def quantify():
+        calls.append(1)
+        return "ratio 3.5", {"ratio": 3.5}
+    claim = Claim("c", "§1", "it is fast", "timed", HOLDS, quantify, rule(HOLDS, Bound("ratio", lo=3)))
+    assert claim.measure() == ("ratio 3.5", HOLDS) and calls == [1]
+    slow = Claim("c", "§1", "it is fast", "timed", HOLDS, quantify, rule(HOLDS, Bound("ratio", lo=4)))
+    assert slow.measure() == ("ratio 3.5", FAILS)
+
+
+def test_the_register_names_each_claim_once_with_a_known_verdict():
+    assert len(CLAIMS) == len({c.id for c in CLAIMS}) >= 30
+    assert all(c.registered in (HOLDS, FAILS, CORRECTED) for c in CLAIMS)
