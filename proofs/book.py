@@ -11,6 +11,7 @@ per build: its entry is a measurement of `proofs.store`, which later pages
 
 from __future__ import annotations
 
+import html
 import re
 from collections import Counter
 
@@ -102,22 +103,33 @@ def _refuse(theorem_id, entry):
         raise TheoremFailed(f"{entry['changed']} (proofs.registry.PINNED): {entry['evidence']}")
 
 
+def _folded(label, text):
+    """Raw HTML: ``label`` and ``text`` up to its first semicolon, the rest folded
+    into a <details> the reader opens."""
+    head, _, rest = (html.escape(t, quote=False) for t in text.partition("; "))
+    return f"<details><summary>{label}: {head}</summary>{rest}</details>" if rest else f"<p>{label}: {head}</p>"
+
+
 def ledger_table():
-    """Markdown table of every theorem: id, verdict, evidence, the pages using it.
+    """MyST markdown, one list item per theorem: its title (linked), id, verdict and
+    the pages using it; then its evidence, the first clause shown and the rest
+    folded, and what the draft says.  (A list, not a table: the evidence is a
+    paragraph, which a table column of a 700-pixel page squeezes to a word a line.)
 
     Raises
     ------
     TheoremFailed
         As `theorem_block`, for the first theorem whose verdict fails or changed.
     """
-    rows = ["| theorem | verdict | evidence | the draft says | used on |", "|---|---|---|---|---|"]
+    items = []
     for theorem_id, e in ledger().items():
         _refuse(theorem_id, e)
-        pages = ", ".join(f"{{ref}}`{p}`" for p in e["pages"])
-        rows.append(f"| {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`) | "
-                    f"{BADGES[e['status']]} | {e['evidence'].replace('|', '/')} | "
-                    f"{e['seed_says'].replace('|', '/') or '—'} | {pages} |")
-    return "\n".join(rows)
+        pages = ", ".join(f"{{ref}}`{p}`" for p in e["pages"]) or "no page"
+        draft = f"\n\n  {_folded('The draft says', e['seed_says'])}" if e["seed_says"] else ""
+        items.append(f"* {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
+                     f"**{BADGES[e['status']]}**; used on {pages}.\n\n"
+                     f"  {_folded('Evidence', e['evidence'])}{draft}")
+    return "\n".join(items)
 
 
 def findings():

@@ -737,8 +737,8 @@ def pareto_figure(measurement, *, error="max"):
     from matplotlib.figure import Figure
     from matplotlib.ticker import LogLocator, NullLocator
     names = list(dict.fromkeys(r.field for r in measurement.results))
-    fig = Figure(figsize=(3.4 * len(names), 3.7))
-    fig.subplots_adjust(left=0.07, right=0.99, top=0.92, bottom=0.24, wspace=0.06)
+    fig = Figure(figsize=(2.8 * len(names), 3.8))
+    fig.subplots_adjust(left=0.09, right=0.99, top=0.92, bottom=0.3, wspace=0.06)
     axes = fig.subplots(1, len(names), sharey=True, squeeze=False)[0]
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
     handles = {}
@@ -765,7 +765,7 @@ def pareto_figure(measurement, *, error="max"):
             if 1 < len(group) <= 6:
                 for r, ti, ei in zip(group, t, e):
                     ax.annotate(f"{r.eps:.0e}", (ti, ei), xytext=(-5, -2), textcoords="offset points",
-                                fontsize=6, color=color, ha="right")
+                                fontsize=7.5, color=color, ha="right")
         ax.set_xscale("log")
         ax.set_yscale("log")
         # Decades only: minor ticks on log axes cost most of the drawing time.
@@ -773,12 +773,12 @@ def pareto_figure(measurement, *, error="max"):
             axis.set_major_locator(LogLocator(base=10.0, numticks=9))
             axis.set_minor_locator(NullLocator())
         ax.set_xlim(t_lo, t_hi)
-        ax.set_title(name + ("" if ANALYTIC[name] else " (not analytic; off the crease band)"), fontsize=9)
-        ax.set_xlabel("time per frame, ms", fontsize=8)
-        ax.tick_params(labelsize=7)
+        ax.set_title(name + ("" if ANALYTIC[name] else " (off the crease band)"), fontsize=10)
+        ax.set_xlabel("time per frame, ms", fontsize=9.5)
+        ax.tick_params(labelsize=8.5)
         ax.grid(alpha=0.3, lw=0.3)
-    axes[0].set_ylabel(f"{error} |error| of (h_u, h_v)", fontsize=8)
-    fig.legend(list(handles.values()), list(handles), loc="lower center", ncols=4, fontsize=7,
+    axes[0].set_ylabel(f"{error} $|$error$|$ of $(h_u, h_v)$", fontsize=9.5)
+    fig.legend(list(handles.values()), list(handles), loc="lower center", ncols=4, fontsize=8,
                frameon=False)
     return fig
 

@@ -346,6 +346,49 @@ def test_the_overflow_check_rejects_the_pages_without_their_fitting(browser, boo
     assert len(stripped["overflowing"]) > 5
 
 
+#: Every image of the article: in a numbered, captioned figure, with alt text, at
+#: ``sharpness`` device pixels per CSS pixel or more.
+_FIGURES_JS = """(sharpness) => {
+  const main = document.querySelector('article.bd-article');
+  return [...main.querySelectorAll('img')].map(img => {
+    const fig = img.closest('figure');
+    const cap = fig && fig.querySelector('figcaption');
+    const number = cap && cap.querySelector('.caption-number');
+    return {src: img.getAttribute('src').slice(-24), alt: (img.getAttribute('alt') || '').length,
+            numbered: !!(number && /Fig\\. \\d+/.test(number.textContent)),
+            caption: cap ? cap.textContent.trim().length : 0,
+            ratio: img.naturalWidth / img.clientWidth, sharp: img.naturalWidth >= sharpness * img.clientWidth - 1};
+  });
+}"""
+
+
+def _figures(browser, book_html, page, sharpness):
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    context.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file://") else r.abort())
+    try:
+        p = context.new_page()
+        p.goto((book_html / f"{page}.html").as_uri())
+        p.wait_for_load_state("load")
+        return p.evaluate(_FIGURES_JS, sharpness)
+    finally:
+        context.close()
+
+
+def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_size(browser, book_html):
+    """No bare plot: each image of each page sits in a figure numbered "Fig. n" with a caption and
+    alt text, and has at least two device pixels per CSS pixel (for high-density screens)."""
+    found = {page: _figures(browser, book_html, page, 2) for page in PAGES}
+    images = [dict(i, page=page) for page, imgs in found.items() for i in imgs]
+    assert len(images) >= 15
+    bad = [i for i in images if not (i["numbered"] and i["caption"] > 40 and i["alt"] > 40 and i["sharp"])]
+    assert bad == []
+
+
+def test_the_figure_check_rejects_images_below_the_sharpness_asked(browser, book_html):
+    # The wrong variant: asking for four device pixels per CSS pixel, which no figure has.
+    assert not any(i["sharp"] for i in _figures(browser, book_html, "s5_lab", 4))
+
+
 LOG_EPS = (-1, -3, -6, -9, -12, -14)
 
 

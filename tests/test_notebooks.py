@@ -4,11 +4,14 @@ book/_ext/notebooks.py writes ``_notebooks/<page>.ipynb`` with jupytext and
 links it under the page's title.  Checked against the site `book_html` names:
 every page that is a notebook has one, linked from its page, with the page's
 code cells (as myst-nb reads them) in order; and one of them, copied to a
-directory outside the repository, runs top to bottom in a fresh kernel.
+directory outside the repository, runs top to bottom in a fresh kernel and
+draws its figures with the same bytes as the build did.
 """
 
 from __future__ import annotations
 
+import base64
+import hashlib
 import json
 import shutil
 import sys
@@ -52,3 +55,10 @@ def test_a_downloaded_notebook_runs_outside_the_repository(book_html, tmp_path):
     NotebookClient(notebook, timeout=600, resources={"metadata": {"path": str(tmp_path)}}).execute()
     assert any(o.get("output_type") in ("display_data", "execute_result")
                for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", []))
+    # Its figures, drawn again in another process, are byte for byte the site's images.
+    drawn = [base64.b64decode(v) for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", [])
+             for k, v in o.get("data", {}).items() if k.endswith("image/png")]
+    site = {hashlib.sha256(p.read_bytes()).hexdigest() for p in (book_html / "_images").glob("*.png")}
+    assert len(drawn) >= 2
+    assert [hashlib.sha256(b).hexdigest() in site for b in drawn] == [True] * len(drawn)
+    assert all(b"tIME" not in b[:4096] for b in drawn)      # no timestamp chunk
