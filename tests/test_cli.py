@@ -804,7 +804,7 @@ def copy_dir(src, dst):
 def test_figures_writes_pngs_and_manifest(s1_figures, tmp_path, capsys):
     a, stdout = s1_figures
     doc = json.loads((a / "manifest.json").read_text())
-    assert [f["id"] for f in doc["figures"]] == ["s1_what_changes-cell01-1"]
+    assert [f["id"] for f in doc["figures"]] == ["s1_what_changes-fig-s1-bump"]
     fig = doc["figures"][0]
     data = (a / fig["file"]).read_bytes()
     import hashlib
@@ -823,7 +823,7 @@ def test_figures_writes_pngs_and_manifest(s1_figures, tmp_path, capsys):
 def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
     a, _ = s1_figures
     rc, out, err = run(["figures", "--check", str(a)], capsys)
-    assert rc == 0 and "unchanged  s1_what_changes-cell01-1" in out and "no figure changed" in out
+    assert rc == 0 and "unchanged  s1_what_changes-fig-s1-bump" in out and "no figure changed" in out
     # Wrong variant: one pixel changed by 51/255 in the previous run's file.
     old = copy_dir(a, tmp_path / "old")
     doc = json.loads((old / "manifest.json").read_text())
@@ -834,14 +834,14 @@ def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
     doc["figures"][0]["sha256"] = sha256_of(f)
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
-    assert rc == 1 and "changed    s1_what_changes-cell01-1: max |dI| = 0.2000 (1 pixels differ)" in out
+    assert rc == 1 and "changed    s1_what_changes-fig-s1-bump: max |dI| = 0.2000 (1 pixels differ)" in out
     rc, out, _ = run(["figures", "--check", str(old), "--ignore", "s1_*"], capsys)
     assert rc == 0 and "(ignored)" in out
     # A figure the previous manifest does not have is reported as added.
     doc["figures"] = []
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
-    assert rc == 1 and "added      s1_what_changes-cell01-1" in out
+    assert rc == 1 and "added      s1_what_changes-fig-s1-bump" in out
 
 
 def fake_book(root, cell):
