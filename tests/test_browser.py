@@ -312,7 +312,8 @@ PAGES = ("index", "s1_what_changes", "s2_scene", "s3_math", "s4_simulator", "s5_
          "s7_pitfalls", "s8_history", "s9_roadmap", "glossary")
 
 
-def _measure_overflow(browser, book_html, width, page, strip=False):
+def _evaluate(browser, book_html, page, script, arg, width=1280):
+    """``script(arg)`` on a built page opened offline at ``width`` px, once MathJax and fit.js are done."""
     context = browser.new_context(viewport={"width": width, "height": 900})
     context.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file://") else r.abort())
     try:
@@ -322,9 +323,13 @@ def _measure_overflow(browser, book_html, width, page, strip=False):
         p.wait_for_function("!window.MathJax || !MathJax.startup || MathJax.startup.promise", timeout=30_000)
         p.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise : null")
         p.wait_for_timeout(300)                      # fit.js runs after MathJax's promise
-        return p.evaluate(_OVERFLOW_JS, strip)
+        return p.evaluate(script, arg)
     finally:
         context.close()
+
+
+def _measure_overflow(browser, book_html, width, page, strip=False):
+    return _evaluate(browser, book_html, page, _OVERFLOW_JS, strip, width)
 
 
 @pytest.mark.parametrize("width", [1280, 390])
@@ -363,15 +368,7 @@ _FIGURES_JS = """(sharpness) => {
 
 
 def _figures(browser, book_html, page, sharpness):
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    context.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file://") else r.abort())
-    try:
-        p = context.new_page()
-        p.goto((book_html / f"{page}.html").as_uri())
-        p.wait_for_load_state("load")
-        return p.evaluate(_FIGURES_JS, sharpness)
-    finally:
-        context.close()
+    return _evaluate(browser, book_html, page, _FIGURES_JS, sharpness)
 
 
 def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_size(browser, book_html):
