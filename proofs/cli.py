@@ -463,13 +463,18 @@ def atomic_write(path, write):
         stream = _stdout_bytes()
         buf = io.BytesIO()
         write(buf)
+        _stop_if_interrupted()
         sys.stdout.flush()
         stream.write(buf.getbuffer())
         stream.flush()
         return
     _check_output(path, "output")
+
+    def checked(f):
+        write(f)
+        _stop_if_interrupted()
     try:
-        files.atomic_write(path, write)
+        files.atomic_write(path, checked)
     except files.RefusedPath as exc:  # changed since checked
         raise UsageError(f"output {exc}") from None
 
@@ -624,6 +629,7 @@ def _cmd_sweep(args, out):
     _check_budget(width, height, len(steps) + 1, "sweep")
     scene = load_scene(args.scene, args.set)
     census = _run_sweep(scene, steps, width, height)
+    _stop_if_interrupted()
     rows = [dict(zip(_CENSUS_COLUMNS, (e, led.max_abs, led.rms, led.flips, led.pixels_a,
                                        led.mean_abs_kink, led.mean_abs_off_kink)))
             for e, led in zip(steps, census)]
@@ -717,6 +723,7 @@ def _cmd_ucurve(args, out):
             raise UsageError(f"--{name.replace('_', '-')} must be a finite number in "
                              f"(0, {MAX_FREQUENCY:g}], got {x!r}")
     uc = _measure_ucurve(args)
+    _stop_if_interrupted()
     print(f"U-curve: {uc.field}, h_{uc.component} at (u, v) = ({uc.u:g}, {uc.v:g}), "
           f"k = ({args.k_u:g}, {args.k_v:g}); reference mpmath 50 digits", file=out)
     if uc.reason is not None:
@@ -1038,6 +1045,7 @@ def _write_figures_staged(out_dir, pages):
         raise OSError(exc.errno, exc.strerror, str(out_dir)) from None
     try:
         manifest = _render_figures(staging, pages)
+        _stop_if_interrupted()
         try:
             os.chmod(staging, 0o777 & ~files.umask())
             if not out_dir.exists():
@@ -1444,11 +1452,41 @@ def _one_line(msg):
     return " ".join(str(msg).split())
 
 
+#: Whether `_interrupt_once` has run during this `main`.  Python code that C
+#: calls back (a ctypes callback: llvmlite's object cache while numba
+#: compiles the kernel) cannot pass an exception on: the KeyboardInterrupt
+#: raised there is dropped, and the command would go on to write its output.
+#: The flag keeps the Ctrl-C: `_stop_if_interrupted` raises it again before
+#: anything is written, and `_quiet_dropped_interrupt` keeps the dropped
+#: one's "Exception ignored" report off stderr.
+_sigint_seen = False
+
+
 def _interrupt_once(signum, frame):
     """`main`'s SIGINT handler: raise KeyboardInterrupt once, then ignore
     SIGINT, so that a second Ctrl-C cannot cut the clean-up short."""
+    global _sigint_seen
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _sigint_seen = True
     raise KeyboardInterrupt
+
+
+def _stop_if_interrupted():
+    """Raise KeyboardInterrupt if a Ctrl-C came during this `main`, even one
+    that a C callback dropped; called before every output is written."""
+    if _sigint_seen:
+        raise KeyboardInterrupt
+
+
+def _quiet_dropped_interrupt(previous):
+    """A `sys.unraisablehook` that drops the report of the KeyboardInterrupt
+    `_interrupt_once` raised inside a C callback (the flag has it) and passes
+    every other unraisable exception to ``previous``."""
+    def hook(unraisable):
+        if _sigint_seen and isinstance(unraisable.exc_value, KeyboardInterrupt):
+            return
+        previous(unraisable)
+    return hook
 
 
 def main(argv=None) -> int:
@@ -1480,7 +1518,12 @@ def main(argv=None) -> int:
     clean-up short: the partial output file or staging directory is
     removed, the notebook kernel of ``figures`` shut down (`_stop_kernel`).
     While ``verify``'s pytest runs, a SIGINT is noted and pytest, which got
-    the same Ctrl-C, is waited for (`_sigint_noted`).  Then one line
+    the same Ctrl-C, is waited for (`_sigint_noted`).  A KeyboardInterrupt
+    that a C callback drops (llvmlite's, while numba compiles) is not lost:
+    the handler notes it, the command is stopped before it writes anything
+    (`_stop_if_interrupted`), and the callback's "Exception ignored" report
+    is kept off stderr (`_quiet_dropped_interrupt`; the previous
+    `sys.unraisablehook` is restored like the SIGINT handler).  Then one line
     ``symrender: interrupted`` on stderr and 130.
 
     Called with an argument list (in-process use), `main` restores the
@@ -1505,7 +1548,11 @@ def main(argv=None) -> int:
             print("symrender: interrupted", file=sys.stderr)
         return 130
 
+    global _sigint_seen
     restore = None  # the SIGINT handler to put back, once main's is in place
+    _sigint_seen = False
+    previous_hook = sys.unraisablehook
+    sys.unraisablehook = _quiet_dropped_interrupt(previous_hook)
     try:
         try:
             try:
@@ -1536,8 +1583,10 @@ def main(argv=None) -> int:
                 os._exit(130)
         return code
     finally:
-        if restore is not None and not as_program:
-            signal.signal(signal.SIGINT, restore)
+        if not as_program:
+            sys.unraisablehook = previous_hook
+            if restore is not None:
+                signal.signal(signal.SIGINT, restore)
 
 
 def _run(argv, interrupted):
@@ -1548,7 +1597,9 @@ def _run(argv, interrupted):
             args = build_parser().parse_args(argv)
         except SystemExit as exc:  # --help (argparse prints, then exits 0)
             return exc.code if isinstance(exc.code, int) else 0
-        return _COMMANDS[args.command](args, out)
+        code = _COMMANDS[args.command](args, out)
+        _stop_if_interrupted()
+        return code
     except UsageError as exc:
         print(f"symrender: error: {_one_line(exc)}", file=sys.stderr)
         return 2

@@ -18,7 +18,9 @@ during ``render`` of a large frame and during ``sweep`` (once numba is
 loaded); during ``verify`` while its pytest child runs; during
 ``figures`` while the notebook kernel starts, and while it runs the page's
 cell, with one Ctrl-C and with two 50 ms apart.  In-process: `main` ignores a
-second Ctrl-C during the clean-up and restores the previous handler.
+second Ctrl-C during the clean-up and restores the previous handler; a Ctrl-C
+whose KeyboardInterrupt a C callback drops (as llvmlite's does while numba
+compiles) still stops the command before it writes.
 ``import proofs.cli`` (what the console script does before `main` runs)
 loads none of numpy, sympy, matplotlib or the renderer.  The
 checkers are shown to fail on a leaked process (in the session, and in a
@@ -352,3 +354,62 @@ def test_main_in_process_restores_the_handler_and_ignores_a_second_ctrl_c(capsys
     assert signal.getsignal(signal.SIGINT) is before
     capsys.readouterr()
 
+
+
+def _render_with_a_dropped_ctrl_c(monkeypatch):
+    """Make ``render``'s first frame take a Ctrl-C inside a C callback, as
+    llvmlite's object-cache callback does while numba compiles the kernel:
+    ctypes drops the KeyboardInterrupt (it only reports it) and the render
+    goes on."""
+    import ctypes
+    import importlib
+
+    module = importlib.import_module("renderer.render")   # the package's `render` is the function
+    real = module.render
+    calls = []
+
+    def body():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.05)                          # the KeyboardInterrupt is raised here, and dropped
+
+    callback = ctypes.CFUNCTYPE(None)(body)
+
+    def render(*args, **kwargs):
+        if not calls:
+            callback()
+        calls.append(True)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(module, "render", render)
+    return calls
+
+
+@pytest.mark.parametrize("variant", ["as built", "no check before writing", "no quiet hook"])
+def test_a_ctrl_c_that_a_c_callback_drops_still_stops_the_command(tmp_path, capsys, monkeypatch, variant):
+    """A Ctrl-C whose KeyboardInterrupt a C callback drops still ends the
+    command with 130 and the one line, and writes nothing.  Wrong variants:
+    without `_stop_if_interrupted` the command finishes, writes its PNG and
+    exits 0; without `_quiet_dropped_interrupt` ctypes' "Exception ignored"
+    report reaches stderr."""
+    import proofs.cli as cli
+
+    if variant == "no check before writing":
+        monkeypatch.setattr(cli, "_stop_if_interrupted", lambda: None)
+    elif variant == "no quiet hook":
+        monkeypatch.setattr(cli, "_quiet_dropped_interrupt", lambda previous: previous)
+    # Python's own hook, which prints the report (pytest's turns it into a warning).
+    monkeypatch.setattr(sys, "unraisablehook", sys.__unraisablehook__)
+    calls = _render_with_a_dropped_ctrl_c(monkeypatch)
+    out = tmp_path / "out.png"
+    before = sys.unraisablehook
+    code = cli.main(["render", "--size", "16x12", "-o", str(out)])
+    err = capsys.readouterr().err
+    assert calls, "the render did not run"
+    assert sys.unraisablehook is before
+    problems = interrupt_problems(code, err, [], listing(tmp_path), [])
+    if variant == "as built":
+        assert problems == []
+    elif variant == "no check before writing":
+        assert "exit code 0" in problems and "files left: ['out.png']" in problems
+    else:
+        assert code == 130 and "Exception ignored" in err and "traceback" in problems
