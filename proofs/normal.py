@@ -19,9 +19,16 @@ Nv = sp.Matrix([F.N_x, F.N_y, F.N_z])
 et, ep = sp.Matrix(F.e_theta), sp.Matrix(F.e_phi)
 #: The renderer's chart-mode normal, a function of N, the frame, (h_u, h_v) and beta.
 N_PRIME = sp.Matrix(F.PERTURBED_NORMAL["chart"])
-#: The seed's formula (§3), written here: the bump direction g and M = N + beta g.
-g = F.h_u * et + F.h_v * ep
-M = Nv + F.beta * g
+#: The seed's formula (§3), written here as the statement prints it (matrix
+#: symbols N, e_theta, e_phi, g): the bump direction g and M = N + beta g.  The
+#: check substitutes the renderer's symbols into these same objects, so the
+#: statement cannot say one thing while another is checked.
+N_S, G_S = sp.MatrixSymbol("N", 3, 1), sp.MatrixSymbol("g", 3, 1)
+E_THETA_S, E_PHI_S = sp.MatrixSymbol(r"e_\theta", 3, 1), sp.MatrixSymbol(r"e_\varphi", 3, 1)
+G_CLAIMED = F.h_u * E_THETA_S + F.h_v * E_PHI_S
+M_CLAIMED = sp.MatAdd(N_S, F.beta * G_S, evaluate=False)
+g = sp.Matrix(G_CLAIMED.subs({E_THETA_S: et, E_PHI_S: ep}).doit().as_explicit())
+M = sp.Matrix(M_CLAIMED.subs({N_S: Nv, G_S: g}).doit().as_explicit())
 norm_M = sp.sqrt(M.dot(M))
 DOMAIN = {**{s: (-2.0, 2.0) for s in list(Nv) + list(et) + list(ep) + [F.h_u, F.h_v]},
           F.beta: (0.01, 3.0)}
@@ -32,14 +39,14 @@ M_SHOWN = M.subs({**dict(zip(et, sp.symbols(r"e_{\theta\,x} e_{\theta\,y} e_{\th
 
 #: The claimed derivative as the statement prints it (matrix symbols N', g and the scalar
 #: ||M||), and, substituted into it, the explicit 3-vector the check compares with.
-N_S, G_S = sp.MatrixSymbol("N'", 3, 1), sp.MatrixSymbol("g", 3, 1)
+NP_S = sp.MatrixSymbol("N'", 3, 1)
 NORM_M_S = sp.Symbol(r"\lVert M\rVert", positive=True)
-CLAIMED_DERIVATIVE = (sp.Identity(3) - N_S * N_S.T) * G_S / NORM_M_S
+CLAIMED_DERIVATIVE = (sp.Identity(3) - NP_S * NP_S.T) * G_S / NORM_M_S
 
 
 def explicit(shown):
     """The 3-vector of a claim written in N', g and ||M|| (as `CLAIMED_DERIVATIVE`)."""
-    return sp.Matrix(shown.subs({N_S: N_PRIME, G_S: g, NORM_M_S: norm_M}).doit().as_explicit())
+    return sp.Matrix(shown.subs({NP_S: N_PRIME, G_S: g, NORM_M_S: norm_M}).doit().as_explicit())
 
 
 CLOSED_FORM = explicit(CLAIMED_DERIVATIVE)
@@ -61,16 +68,17 @@ def _check_derivative(closed_form):
 NORMAL_BETA_DERIVATIVE = Theorem(
     id="normal-beta-derivative", title="The beta-derivative of the perturbed normal",
     statement=r"The renderer's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`) is "
-              r"$N' = M/\lVert M\rVert$ with $M = N + \beta g$, $g = h_u e_\theta + h_v e_\varphi$, and "
+              rf"$N' = M/\lVert M\rVert$ with $M = {sp.latex(M_CLAIMED, order='none')}$, "
+              rf"$g = {sp.latex(G_CLAIMED)}$, and "
               rf"$\partial N'/\partial\beta = {sp.latex(CLAIMED_DERIVATIVE)}$, for any $N$, frame and "
               r"gradient.",
     steps=((r"M", r"M", M_SHOWN), (r"N'", r"N'", r"M/\lVert M\rVert"),
            (r"\partial N'/\partial\beta", r"\partial N'/\partial\beta", CLAIMED_DERIVATIVE)),
     check=lambda: _check_derivative(CLOSED_FORM),
     wrong_variants=(("sign of the projection flipped",
-                     lambda: _check_derivative(explicit((sp.Identity(3) + N_S * N_S.T) * G_S / NORM_M_S))),
+                     lambda: _check_derivative(explicit((sp.Identity(3) + NP_S * NP_S.T) * G_S / NORM_M_S))),
                     ("the 1/|M| factor dropped",
-                     lambda: _check_derivative(explicit((sp.Identity(3) - N_S * N_S.T) * G_S)))),
+                     lambda: _check_derivative(explicit((sp.Identity(3) - NP_S * NP_S.T) * G_S)))),
     pages=("s3", "s5"),
     seed_says="§3 and §6: 'verified to 1e-12' (Cell 5); Cell 5's Expect: '~1e-9 worst component'.",
 )
