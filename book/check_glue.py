@@ -20,14 +20,16 @@ MIME = "application/papermill.record/"
 
 
 def page_glue(notebook: dict) -> dict:
-    """{name: text/plain of the value} of every glue output of a notebook (a dict, nbformat 4)."""
+    """{name: shown value} of every glue output of a notebook (a dict, nbformat 4): its
+    text/markdown if it has one (`proofs.book.glue_math`), else its text/plain."""
     out = {}
     for cell in notebook.get("cells", []):
         for output in cell.get("outputs", []):
             scrap = output.get("metadata", {}).get("scrapbook")
             if scrap:
                 data = output.get("data", {})
-                out[scrap["name"]] = data.get(scrap.get("mime_prefix", MIME) + "text/plain")
+                prefix = scrap.get("mime_prefix", MIME)
+                out[scrap["name"]] = data.get(prefix + "text/markdown", data.get(prefix + "text/plain"))
     return out
 
 

@@ -18,9 +18,41 @@ from collections import Counter
 from . import store
 from .core import step_parts
 
-__all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed"]
+__all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math"]
 
 BADGES = {"proved": "PROVED", "verified": "VERIFIED numerically", "refuted": "REFUTED"}
+
+
+def tex_number(x) -> str:
+    """A number as the prose's LaTeX writes it: a power of ten as ``10^{-6}``,
+    another number below 0.01 as ``5\\cdot 10^{-4}`` (three significant
+    digits at most), the rest as ``%g`` (``0.47``, ``1.5``, ``256``).
+
+    Raises
+    ------
+    ValueError
+        If ``x`` is not a finite real number.
+    """
+    x = float(x)
+    if x != x or x in (float("inf"), float("-inf")):
+        raise ValueError(f"x must be a finite number, got {x!r}")
+    if x == 0 or abs(x) >= 0.01:
+        return f"{x:g}"
+    mantissa, exponent = f"{x:.2e}".split("e")
+    mantissa = mantissa.rstrip("0").rstrip(".")
+    power = f"10^{{{int(exponent)}}}"
+    if mantissa in ("1", "-1"):
+        return power if mantissa == "1" else f"-{power}"
+    return f"{mantissa}\\cdot {power}"
+
+
+def glue_math(name, x):
+    """Glue ``x`` under ``name`` as inline math (`tex_number`), for prose that
+    shows it with ``{glue:md}`name:myst```: ``$10^{-6}$`` where a plain glue
+    would print ``1e-06``."""
+    from IPython.display import Markdown
+    from myst_nb import glue
+    glue(name, Markdown(f"${tex_number(x)}$"), display=False)
 
 
 class TheoremFailed(AssertionError):

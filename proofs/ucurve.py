@@ -33,12 +33,16 @@ import sympy as sp
 from renderer import formulas as F
 from renderer import pointwise
 
-__all__ = ["UCurve", "measure", "fit_model", "default_optimum", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS"]
+__all__ = ["UCurve", "measure", "fit_model", "default_optimum", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS",
+           "SEED_POINT"]
 
 #: Unit roundoff of IEEE double precision (round to nearest).
 UNIT_ROUNDOFF = 2.0**-53
 #: mpmath working precision of the references, in decimal digits.
 DIGITS = 50
+#: The seed's chart point (u, v) of Cell 2's U-curve, on the sine field at the
+#: default scene's frequencies (k_u, k_v) = (8, 4).
+SEED_POINT = (0.31, 0.47)
 
 
 def non_differentiable(field, u, v, component, k_u, k_v):
@@ -223,14 +227,14 @@ def _stencil():
     return sp.lambdify(args, [points[p] for p in (F.u_p, F.u_m, F.v_p, F.v_m)] + dens, modules="math")
 
 
-def measure(field="sine", u=0.31, v=0.47, component="u", eps=None, k_u=8.0, k_v=4.0):
+def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=None, k_u=8.0, k_v=4.0):
     """Measure the central-difference U-curve at one chart point.
 
     Parameters
     ----------
     field : {"sine", "ridges", "rings"}
     u, v : float in [0, 1]
-        Chart point (the seed's default is (0.31, 0.47)).
+        Chart point (default `SEED_POINT`, the seed's).
     component : {"u", "v"}
         Which partial derivative.
     eps : array_like of float > 0, optional

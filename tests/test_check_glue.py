@@ -71,3 +71,43 @@ def test_no_cache_is_an_error(tmp_path):
     assert check_glue.main([str(tmp_path)]) == 2
     with pytest.raises(FileNotFoundError):
         check_glue.glued(tmp_path)
+
+
+def _math_page(**values):
+    """A page whose cell glues each value as `proofs.book.glue_math` does: a
+    Markdown object, whose text/plain is the same for every value."""
+    from proofs.book import tex_number
+    data = lambda v: {check_glue.MIME + "text/plain": "<IPython.core.display.Markdown object>",  # noqa: E731
+                      check_glue.MIME + "text/markdown": f"${tex_number(v)}$"}
+    outputs = [nbformat.v4.new_output("display_data", data=data(v),
+                                      metadata={"scrapbook": {"name": k, "mime_prefix": check_glue.MIME}})
+               for k, v in values.items()]
+    return nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(f"# {sorted(values.items())}", outputs=outputs)])
+
+
+def test_math_glue_is_compared_by_its_markdown(tmp_path, capsys):
+    """Two pages that glue 1e-4 and 3e-4 as math under one name conflict.
+    Wrong variant: comparing text/plain, as for a plain glue, sees two equal
+    reprs and lets the conflict through."""
+    cache = _cache(tmp_path, [("/b/s3_math.md", _math_page(pole_sin_phi=1e-4)),
+                              ("/b/s5_lab.md", _math_page(pole_sin_phi=3e-4))])
+    assert check_glue.main([str(cache)]) == 1
+    assert r"pole_sin_phi: s3_math = $10^{-4}$, s5_lab = $3\cdot 10^{-4}$" in capsys.readouterr().err
+    plain = lambda nb: {o["metadata"]["scrapbook"]["name"]: o["data"][check_glue.MIME + "text/plain"]  # noqa: E731
+                        for c in nb["cells"] for o in c["outputs"]}
+    assert plain(_math_page(x=1e-4)) == plain(_math_page(x=3e-4))
+
+
+@pytest.mark.parametrize("x, tex", [(1e-3, "10^{-3}"), (1e-16, "10^{-16}"), (5e-4, r"5\cdot 10^{-4}"),
+                                    (-1e-5, "-10^{-5}"), (2.5e-7, r"2.5\cdot 10^{-7}"), (0.47, "0.47"),
+                                    (1.5, "1.5"), (256, "256"), (0.0, "0")])
+def test_tex_number(x, tex):
+    from proofs.book import tex_number
+    assert tex_number(x) == tex
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
+def test_tex_number_refuses_a_non_finite_number(bad):
+    from proofs.book import tex_number
+    with pytest.raises(ValueError, match="x must be a finite number"):
+        tex_number(bad)
