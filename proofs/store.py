@@ -125,8 +125,8 @@ def _read(path):
 
 
 def _write(path, record):
-    """Write ``record`` to ``path`` atomically (a temporary file, then a rename)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
+    """Write ``record`` to ``path`` atomically (a temporary file, then a rename); the
+    directory exists (`_locked` made it)."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:

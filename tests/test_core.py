@@ -5,6 +5,8 @@ Fast on purpose (seconds): benchmarks/mutation_audit.py --mutmut runs this
 file once per mutant of proofs/core.py.
 """
 
+import re
+
 import pytest
 import sympy as sp
 
@@ -91,6 +93,9 @@ def test_several_symbols_are_sampled_each_from_its_own_interval():
     assert check_identities([ident]).status == "verified"
     r, at = core._numeric_residual(Identity("two", x * w, 0, {x: (3, 4), w: (-2, -1)}), 0, 5, 30)
     assert 3 <= at[x] <= 4 and -2 <= at[w] <= -1 and 3 <= r <= 8
+    # A counterexample in two symbols is named coordinate by coordinate, in the symbols' order.
+    v = check_identities([Identity("product", x * w, 0, {x: (3, 4), w: (-2, -1)})])
+    assert re.fullmatch(r"product: residual \S+ at w=-1\.\d+, x=3\.\d+", v.evidence), v.evidence
 
 
 def test_every_component_of_a_matrix_identity_is_checked_and_named():

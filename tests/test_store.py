@@ -144,7 +144,7 @@ from pathlib import Path
 from proofs import store
 if sys.argv[2] == "unlocked":                       # the wrong variant: no lock around the computation
     import contextlib
-    store._locked = lambda path: contextlib.nullcontext()
+    store._locked = lambda path: (path.parent.mkdir(parents=True, exist_ok=True), contextlib.nullcontext())[1]
 def compute():
     with open(sys.argv[1], "a") as log:
         log.write("computed\\n")
@@ -169,3 +169,32 @@ def test_pages_running_at_once_compute_a_measurement_once(tmp_path, variant):
     assert outputs == ["42", "42"]
     computed = log.read_text().count("computed")
     assert computed == (1 if variant == "locked" else 2)
+
+
+def test_without_a_store_parameters_in_any_order_are_one_measurement(monkeypatch):
+    """In-process only (no store directory), the key does not depend on the
+    order the parameters are given in.  Wrong variant: a key of the
+    parameters as given computes twice."""
+    monkeypatch.delenv(store.ENV, raising=False)
+    calls = []
+
+    def ask():
+        monkeypatch.setattr(store, "_MEMORY", {})
+        store.measured("count", lambda **p: calls.append(p) or len(calls), size=256, field="sine")
+        store.measured("count", lambda **p: calls.append(p) or len(calls), field="sine", size=256)
+        return len(calls)
+    assert ask() == 1
+    calls.clear()
+    real_dumps = store.json.dumps
+    monkeypatch.setattr(store.json, "dumps", lambda obj, **kw: real_dumps(obj))   # ignores sort_keys
+    assert ask() == 2
+
+
+def test_a_failed_write_leaves_no_temporary_file(fresh):
+    """The record cannot replace its path (a directory is in the way): the
+    error propagates and the temporary file is removed."""
+    directory, calls, compute = fresh
+    (directory / "u-curve.json").mkdir()
+    with pytest.raises(OSError):
+        store.measured("u-curve", compute)
+    assert sorted(p.name for p in directory.iterdir() if not p.name.endswith(".lock")) == ["u-curve.json"]
