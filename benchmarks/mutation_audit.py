@@ -190,6 +190,54 @@ MUTMUT_SCOPES = (("proofs/store.py", "tests/test_store.py"), ("proofs/core.py", 
                  ("proofs/claims.py", "tests/test_claim_rules.py"))
 
 
+#: Why a mutmut survivor is equivalent or acceptable: (module, pattern searched in "before → after", reason).
+#: A survivor no pattern explains is flagged in the report.
+MUTMUT_EXPLAINED = (
+    ("proofs/store.py", r'encoding=(None|"UTF-8")|"w", \)',
+     "equivalent: a record is ASCII JSON (json escapes the rest), the same bytes in any ASCII-compatible encoding"),
+    ("proofs/store.py", r"mkstemp\(",
+     "the temporary file's name is gone once it is renamed over the record; without dir= it would sit in "
+     "the system's temporary directory, which matters only when that is another file system"),
+    ("proofs/store.py", r"_locked\(None\)",
+     "the lock is for pages run in parallel processes: test_pages_running_at_once_compute_a_measurement_once "
+     "fails without it, but runs `measured` in subprocesses, where mutmut's per-test coverage does not see it"),
+    ("proofs/store.py", r'"XXnameXX"|"NAME"',
+     "the record's name field is for a reader of the file; the store finds a record by its file name"),
+    ("proofs/store.py", r'b"XX\\0XX"',
+     "another separator makes another, equally injective digest: only the digest's value changes"),
+    ("proofs/store.py", r"sort_keys",
+     "with a store directory a record's parameters are compared as dicts, in any order; in-process the "
+     "order is tested (test_without_a_store_parameters_in_any_order_are_one_measurement)"),
+    ("proofs/core.py", r"if expr == 1:",
+     "equivalent: the first simplifier (expand) maps 0 to 0; the line is a shortcut"),
+    ("proofs/core.py", r"continue → break",
+     "in the handler for sympy's own failures (TypeError, ValueError, NotImplementedError), which no "
+     "identity here provokes"),
+    ("proofs/core.py", r"lambda e: None",
+     "simplify after expand_trig is a fallback: every identity of the tests and the theorems is decided "
+     "by another simplifier or sampled"),
+    ("proofs/core.py", r"mpmath\.mpf\(1\)|r >= worst or where is None|if r > worst:",
+     "equivalent: the first point always sets the worst (where is None); ties only change which of two "
+     "equal residuals is reported"),
+    ("proofs/core.py", r"seed [-+] 100[01] [-+] i|seed - i|_numeric_residual\(comp, None|, 4, digits\)",
+     "another seed or a fourth probe point is an equally valid sample: no verdict changes"),
+    ("proofs/core.py", r"if r > tolerance:|if worst <= tolerance:",
+     "differs only at a residual exactly equal to the tolerance, 1e-20"),
+    ("proofs/core.py", r"and False else sp\.Matrix",
+     "equivalent: sp.Matrix of a column matrix is the same matrix"),
+    ("proofs/core.py", r'getattr\(e, "free_symbols", (None)?\)',
+     "equivalent: step_parts passes strings through before this line, and every sympy object has free_symbols"),
+    ("proofs/claims.py", r"abs\(x\) (<= 1e6|< 1000001\.0)",
+     "differs only for the integer 1,000,000 itself, which no claim shows"),
+)
+
+
+def explain(module, change):
+    """The reason `MUTMUT_EXPLAINED` gives for a survivor's change, or None."""
+    return next((why for mod, pattern, why in MUTMUT_EXPLAINED
+                 if mod == module and re.search(pattern, change)), None)
+
+
 def run_mutmut(work):
     """mutmut 3 over each of `MUTMUT_SCOPES` in the scratch copy ``work``:
     [(module, tests, {status: count}, [(surviving mutant, its change)])], or None if mutmut is missing.
@@ -232,8 +280,9 @@ def _write_mutmut(found, out, started):
         lines.append(f"| `{module}` | `{tests}` | {sum(n.values())} | {n['killed']} | {n['survived']} | "
                      f"{n['timeout']} | {n['no tests']} | {other} | {100 * n['killed'] / max(reached, 1):.0f} % |")
     for module, _, _, survivors in found:
-        lines += ["", f"Survivors in `{module}` (the line before → after):", ""]
-        lines += [f"- `{name}`: `{change}`" for name, change in survivors] or ["- none"]
+        lines += ["", f"Survivors in `{module}` (the line before → after; why it is equivalent or acceptable):", ""]
+        lines += [f"- `{name}`: `{change}`: " + (explain(module, change) or "**flagged**: not explained")
+                  for name, change in survivors] or ["- none"]
     out.write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("\n".join(lines))
 
