@@ -225,8 +225,6 @@ MUTMUT_EXPLAINED = (
      "differs only at a residual exactly equal to the tolerance, 1e-20"),
     ("proofs/core.py", r"and False else sp\.Matrix",
      "equivalent: sp.Matrix of a column matrix is the same matrix"),
-    ("proofs/core.py", r'getattr\(e, "free_symbols", (None)?\)',
-     "equivalent: step_parts passes strings through before this line, and every sympy object has free_symbols"),
     ("proofs/claims.py", r"abs\(x\) (<= 1e6|< 1000001\.0)",
      "differs only for the integer 1,000,000 itself, which no claim shows"),
 )

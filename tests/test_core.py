@@ -160,3 +160,5 @@ def test_step_parts_prints_sympy_and_passes_latex_through():
     assert step_parts(("c", sp.sin(phi), None)) == (r"\sin{\left(\varphi \right)}", None)
     assert step_parts(("c", r"\alpha", sp.Integer(2))) == (r"\alpha", "2")
     assert step_parts(("c", sp.Symbol("theta") + 1, "x")) == (r"\theta + 1", "x")
+    # A plain Python number (no free_symbols) is printed too.
+    assert step_parts(("c", 0, 0.5)) == ("0", "0.5")
