@@ -12,6 +12,7 @@ per build: its entry is a measurement of `proofs.store`, which later pages
 from __future__ import annotations
 
 import html
+import math
 import re
 from collections import Counter
 
@@ -34,7 +35,7 @@ def tex_number(x) -> str:
         If ``x`` is not a finite real number.
     """
     x = float(x)
-    if x != x or x in (float("inf"), float("-inf")):
+    if not math.isfinite(x):
         raise ValueError(f"x must be a finite number, got {x!r}")
     if x == 0 or abs(x) >= 0.01:
         return f"{x:g}"
@@ -49,7 +50,8 @@ def tex_number(x) -> str:
 def glue_math(name, x):
     """Glue ``x`` under ``name`` as inline math (`tex_number`), for prose that
     shows it with ``{glue:md}`name:myst```: ``$10^{-6}$`` where a plain glue
-    would print ``1e-06``."""
+    would print ``1e-06``.  Raises ValueError, as `tex_number`, for a
+    non-finite ``x``."""
     from IPython.display import Markdown
     from myst_nb import glue
     glue(name, Markdown(f"${tex_number(x)}$"), display=False)

@@ -456,7 +456,7 @@ CLAIMS = (
     Claim("h3-scale", "§3", "(π k_u)³ ≈ 2,000 at k_u = 8", "evaluate (π k_u)³", FAILS, _h3_scale,
           rule(HOLDS, Bound("(π k_u)³", 1000, 4000))),
     Claim("truncation-until-1e-6", "§3", "truncation dominates until ε ~ 10⁻⁶",
-          "U-curve at (0.31, 0.47), 50-digit reference (proofs/ucurve.py)", HOLDS, _truncation_until,
+          "U-curve at the seed's point against an mpmath reference (proofs/ucurve.py)", HOLDS, _truncation_until,
           rule(HOLDS, Bound("model optimum ε", 10 ** -6.5, 10 ** -5.5))),
     Claim("roundoff-drowns-1e-9", "§3", "roundoff drowns everything below ~10⁻⁹",
           "relative error of the float64 quotient at ε = 1e-9", FAILS, _drowns_below_1e9,

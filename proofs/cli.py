@@ -459,22 +459,19 @@ def atomic_write(path, write):
     OSError
         If the directory or the target cannot be written (naming ``path``).
     """
-    if path == STDOUT:
-        stream = _stdout_bytes()
-        buf = io.BytesIO()
-        write(buf)
-        _stop_if_interrupted()
+    stream = _stdout_bytes() if path == STDOUT else None
+    if stream is None:
+        _check_output(path, "output")
+    buf = io.BytesIO()
+    write(buf)
+    _stop_if_interrupted()                # a Ctrl-C a C callback dropped while the bytes were made
+    if stream is not None:
         sys.stdout.flush()
         stream.write(buf.getbuffer())
         stream.flush()
         return
-    _check_output(path, "output")
-
-    def checked(f):
-        write(f)
-        _stop_if_interrupted()
     try:
-        files.atomic_write(path, checked)
+        files.write_bytes(path, buf.getbuffer())
     except files.RefusedPath as exc:  # changed since checked
         raise UsageError(f"output {exc}") from None
 

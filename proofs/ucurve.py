@@ -34,15 +34,16 @@ from renderer import formulas as F
 from renderer import pointwise
 
 __all__ = ["UCurve", "measure", "fit_model", "default_optimum", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS",
-           "SEED_POINT"]
+           "SEED_POINT", "SEED_FREQUENCIES"]
 
 #: Unit roundoff of IEEE double precision (round to nearest).
 UNIT_ROUNDOFF = 2.0**-53
 #: mpmath working precision of the references, in decimal digits.
 DIGITS = 50
-#: The seed's chart point (u, v) of Cell 2's U-curve, on the sine field at the
-#: default scene's frequencies (k_u, k_v) = (8, 4).
+#: The seed's chart point (u, v) of Cell 2's U-curve (sine field), and its
+#: frequencies (k_u, k_v), the default scene's.
 SEED_POINT = (0.31, 0.47)
+SEED_FREQUENCIES = (8.0, 4.0)
 
 
 def non_differentiable(field, u, v, component, k_u, k_v):
@@ -192,7 +193,8 @@ def _default_optimum():
     return dict(eps=c.eps_opt_fitted, error=c.error_at_fitted_opt, band=[float(near.min()), float(near.max())],
                 A=c.truncation_coeff, B=c.roundoff_coeff, eps_predicted=c.eps_opt_predicted,
                 argmin=c.eps_opt_measured, min=c.error_at_measured_opt,
-                label=f"sine, (u, v) = ({c.u}, {c.v}), h_u, k_u = 8, k_v = 4, {c.eps.size} steps "
+                label=f"sine, (u, v) = ({c.u}, {c.v}), h_u, k_u = {SEED_FREQUENCIES[0]:g}, "
+                      f"k_v = {SEED_FREQUENCIES[1]:g}, {c.eps.size} steps "
                       f"from {c.eps.max():.0e} to {c.eps.min():.0e}")
 
 
@@ -227,7 +229,8 @@ def _stencil():
     return sp.lambdify(args, [points[p] for p in (F.u_p, F.u_m, F.v_p, F.v_m)] + dens, modules="math")
 
 
-def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=None, k_u=8.0, k_v=4.0):
+def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=None,
+            k_u=SEED_FREQUENCIES[0], k_v=SEED_FREQUENCIES[1]):
     """Measure the central-difference U-curve at one chart point.
 
     Parameters
