@@ -18,6 +18,8 @@ from renderer import Scene, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
+from .book import frame_label
+
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
            "image_beta_order", "DIGITS"]
 
@@ -132,7 +134,8 @@ def image_beta_order(size=64, beta=0.35, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e
 
     Returns
     -------
-    dict with "median_slope", "rms_slope", "median_errors", "rms_errors", "steps".
+    dict with "median_slope", "rms_slope", "median_errors", "rms_errors", "steps", and
+    "label", the scene and resolution (`proofs.book.frame_label`).
     """
     scene = Scene(height_field="sine", beta=beta)
 
@@ -149,4 +152,4 @@ def image_beta_order(size=64, beta=0.35, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e
     rms = np.array([np.sqrt(np.mean(d**2)) for d in diffs])
     fit = lambda e: float(np.polyfit(np.log(steps), np.log(e), 1)[0])  # noqa: E731
     return {"median_slope": fit(median), "rms_slope": fit(rms), "median_errors": median,
-            "rms_errors": rms, "steps": np.array(steps)}
+            "rms_errors": rms, "steps": np.array(steps), "label": frame_label(scene, size, size)}

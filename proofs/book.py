@@ -19,7 +19,8 @@ from collections import Counter
 from . import store
 from .core import step_parts
 
-__all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math"]
+__all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math",
+           "frame_label"]
 
 BADGES = {"proved": "PROVED", "verified": "VERIFIED numerically", "refuted": "REFUTED"}
 
@@ -45,6 +46,34 @@ def tex_number(x) -> str:
     if mantissa in ("1", "-1"):
         return power if mantissa == "1" else f"-{power}"
     return f"{mantissa}\\cdot {power}"
+
+
+def frame_label(scene, width, height) -> str:
+    """The label a number measured on a render carries: its scene and resolution.
+
+    ``"default scene, 256 × 256"``, or with the fields that differ from
+    `renderer.Scene`'s defaults: ``"default scene with height_field='sine',
+    64 × 64"``.  ``scene`` is a `renderer.Scene`; ``width``, ``height`` in pixels.
+
+    Raises
+    ------
+    TypeError
+        ``scene`` is not a `renderer.Scene`.
+    ValueError
+        ``width`` or ``height`` is not a positive integer.
+    """
+    from dataclasses import fields
+
+    from renderer import Scene
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
+    for name, n in (("width", width), ("height", height)):
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ValueError(f"{name} must be a positive integer number of pixels, got {n!r}")
+    default = Scene()
+    changed = [f"{f.name}={getattr(scene, f.name)!r}" for f in fields(Scene)
+               if getattr(scene, f.name) != getattr(default, f.name)]
+    return "default scene" + (" with " + ", ".join(changed) if changed else "") + f", {width} × {height}"
 
 
 def glue_math(name, x):

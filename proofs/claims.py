@@ -25,6 +25,8 @@ import numpy as np
 from renderer import Scene, compare, gbuffer, pointwise, render
 from renderer.render import SPHERE_A
 
+from .book import frame_label
+
 __all__ = ["Bound", "Criterion", "rule", "Claim", "CLAIMS", "CRITERIA", "HOLDS", "FAILS", "CORRECTED", "evaluate", "checked", "ClaimChanged",
            "crease_band_ratio"]
 
@@ -133,6 +135,11 @@ def _frames(field="ridges", beta=0.35, eps=1e-3, size=128):
     return render(scene, size, size, gradient="central"), render(scene, size, size)
 
 
+def _on(field="ridges", beta=0.35, size=128, **more):
+    """' (label)': the scene and resolution of `_frames` (or another frame) a measurement used."""
+    return f" ({frame_label(Scene(height_field=field, beta=beta, **more), size, size)})"
+
+
 def _err_at(eps):
     c = _ucurve()
     return float(c.error[np.argmin(np.abs(np.log10(c.eps) - np.log10(eps)))])
@@ -197,7 +204,7 @@ def _census_slope():
         off.append(led.mean_abs_off_kink)
     s_rms = np.polyfit(np.log(steps), np.log(rms), 1)[0]
     s_off = np.polyfit(np.log(steps), np.log(off), 1)[0]
-    return (f"fitted slope: RMS on A {s_rms:.2f}, off the crease band {s_off:.2f}",
+    return (f"fitted slope: RMS on A {s_rms:.2f}, off the crease band {s_off:.2f}" + _on(size=256),
             {"RMS slope": s_rms, "off-band slope": s_off})
 
 
@@ -212,14 +219,14 @@ def _cell3_runs():
     try:
         np.abs(num.image - sym.image)[same & on_a].max()
     except ValueError as error:
-        return (f"its sphere A covers {np.count_nonzero(on_a)} of {code.size} pixels, so the first row "
-                f"of the sweep stops with ValueError: {error}", {"rows computed": 0})
-    return "the sweep's first row is computed", {"rows computed": 1}
+        return (f"its sphere A covers {np.count_nonzero(on_a)} of {code.size} pixels{_on(size=256)}, so the "
+                f"first row of the sweep stops with ValueError: {error}", {"rows computed": 0})
+    return "the sweep's first row is computed" + _on(size=256), {"rows computed": 1}
 
 
 def _census_flips():
     flips = sum(compare(*_frames(eps=e)).flips for e in (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6))
-    return f"{flips} flips over 6 steps", {"flips": flips}
+    return f"{flips} flips over 6 steps" + _on(), {"flips": flips}
 
 
 def crease_band_ratio():
@@ -297,7 +304,7 @@ def _stacking():
     ratio = err[0.35] / err[0.0]
     return (f"the bump adds no integral (the pixel filter's integrand changes), but one sample per pixel "
             f"misses the filtered value by RMS {err[0.35]:.1e} on sphere A with the bump against "
-            f"{err[0.0]:.1e} without: {ratio:.0f}x, so the same filter needs more samples",
+            f"{err[0.0]:.1e} without: {ratio:.0f}x, so the same filter needs more samples{_on()}",
             {"one-sample error, with / without the bump": ratio})
 
 
@@ -344,8 +351,8 @@ def _timing():
     stage = t_central / t_exact
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
     return (f"sines and cosines per pixel: central {central.trig:g}, exact {exact.trig:g}; timed, the gradient "
-            f"stage central/exact = {stage:.1f}x and the whole 128^2 frame {f_central / f_exact:.2f}x (min of "
-            "repeated runs, not used for the verdict)", {"sin/cos calls, exact minus central": exact.trig - central.trig})
+            f"stage central/exact = {stage:.1f}x and the whole frame {f_central / f_exact:.2f}x (min of "
+            f"repeated runs, not used for the verdict){_on()}", {"sin/cos calls, exact minus central": exact.trig - central.trig})
 
 
 def _cell5_fd():
@@ -381,19 +388,20 @@ def _beta_order():
 def _beta0():
     a, b = _frames(beta=0.0)
     d = float(np.abs(a.image - b.image).max())
-    return f"max |dI| at beta = 0: {d:.1e}", {"max |ΔI|": d}
+    return f"max |dI| at beta = 0: {d:.1e}" + _on(beta=0.0), {"max |ΔI|": d}
 
 
 def _bump_nonzero():
     s = Scene(height_field="sine", beta=1.5)
     d = float(np.abs(render(s, 128, 128).image - render(s.replace(beta=0.0), 128, 128).image).mean())
-    return f"mean |dI| beta = 1.5 vs 0: {d:.3f}", {"mean |ΔI|": d}
+    return f"mean |dI| beta = 1.5 vs 0: {d:.3f}" + _on("sine", 1.5), {"mean |ΔI|": d}
 
 
 def _cell6_truncation():
     a = compare(*_frames("sine", 1.5, 1e-3)).max_abs
     b = compare(*_frames("sine", 1.5, 1e-4)).max_abs
-    return f"max |dI| at eps 1e-3 / 1e-4: {a:.1e} / {b:.1e} (ratio {a / b:.0f})", {"max |ΔI| ratio": a / b}
+    return (f"max |dI| at eps 1e-3 / 1e-4: {a:.1e} / {b:.1e} (ratio {a / b:.0f})" + _on("sine", 1.5),
+            {"max |ΔI| ratio": a / b})
 
 
 def _noise_below_1e11():
@@ -412,13 +420,13 @@ def _crease_values():
 def _pole_pixels():
     g = gbuffer(Scene(), 256, 256)
     n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= 1e-4)))
-    return f"pixels using the fallback at 256^2, from the geometry: {n}", {"fallback pixels": n}
+    return f"pixels using the fallback, from the geometry: {n}" + _on(size=256), {"fallback pixels": n}
 
 
 def _sweep_best():
     a = {eps: compare(*_frames("sine", 0.35, eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
     best = min(a, key=a.get)
-    return f"smallest RMS over the tried steps at eps = {best:.0e}", {"best ε": best}
+    return f"smallest RMS over the tried steps at eps = {best:.0e}" + _on("sine"), {"best ε": best}
 
 
 def _creases_part():
@@ -426,7 +434,7 @@ def _creases_part():
     diff = np.abs(num.image - sym.image).max(axis=-1)
     big = diff > 1e-3
     share = float(np.count_nonzero(big & sym.kink) / max(1, np.count_nonzero(big)))
-    return f"{share:.0%} of pixels with |dI| > 1e-3 lie in the crease band", {"share in the band": share}
+    return f"{share:.0%} of pixels with |dI| > 1e-3 lie in the crease band" + _on(), {"share in the band": share}
 
 
 def _rings_pinch():
@@ -449,7 +457,8 @@ def _beta_zero_slider():
     a = render(Scene(beta=0.0), 96, 96).image
     b = render(Scene(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
     n = int(np.count_nonzero(a != b))
-    return f"beta = 0 renders of two fields and pipelines differ in {n} values", {"values differing": n}
+    return (f"beta = 0 renders of two fields and pipelines differ in {n} values" + _on(beta=0.0, size=96),
+            {"values differing": n})
 
 
 CLAIMS = (

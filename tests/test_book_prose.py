@@ -12,6 +12,7 @@ added to a page is found.
 
 from __future__ import annotations
 
+import ast
 import re
 from collections import Counter
 from pathlib import Path
@@ -93,3 +94,153 @@ def test_a_typed_step_is_found():
     # Glued, the same values are not typed.
     assert typed_numbers(page + "\n\nAt {glue:md}`c1_eps_tex:myst`, {glue:text}`s4_size`.\n") == \
         Counter({"10^{-6}": 1})
+
+
+# ------------------------------------------------------------- scene and resolution labels
+ROOT = BOOK.parent
+#: A glue whose name ends so carries the scene or resolution of a render (e.g. "256 × 256",
+#: `proofs.book.frame_label`'s "default scene with height_field='sine', 64 × 64").
+#: A glue ``*_measured`` is a claim's measurement text, which ends with its frame (`proofs.claims`).
+LABEL = re.compile(r"(_size|_label|_measured)$")
+CELL = re.compile(r"```\{code-cell\}[^\n]*\n(.*?)\n```", re.S)
+GLUE_DEF = re.compile(r"\bglue(?:_math)?\(\s*(f?)[\"']([^\"']+)[\"']")
+GLUE_USE = re.compile(r"\{glue(?::\w+)?\}`([^`:]+)|```\{glue:figure\}\s*(\S+)")
+
+
+#: Functions of proofs/ that render but whose numbers on the pages are not measured on a
+#: frame of the scene, with why.
+NOT_A_FRAME = {
+    "theorem_block": "a theorem's verdict; its evidence names the pixels and renders it checked",
+    "ledger_table": "the theorems' verdicts, as theorem_block",
+    "findings": "counts of theorems and claims by verdict",
+    "checked": "the claims register's verdicts; each row's method names its frame",
+    "reproduced": "the errata's measurements, each reported with its own frame in its text",
+}
+
+
+def rendering_functions():
+    """Names that render, as a page cell calls them: `renderer.render`, `renderer.gbuffer`,
+    and every function of proofs/ whose body names one of them (calls it, or hands it to
+    `proofs.store.measured`), to a fixed point, less `NOT_A_FRAME`.  Matched by name, so a
+    homonym (ucurve.measure and gradient_methods.measure) asks for one label too many."""
+    names = {}
+    for path in sorted((ROOT / "proofs").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                names.setdefault(node.name, set()).update(
+                    n.id if isinstance(n, ast.Name) else n.attr
+                    for n in ast.walk(node) if isinstance(n, (ast.Name, ast.Attribute)))
+    found = {"render", "gbuffer"}
+    while True:
+        more = {f for f, used in names.items() if used & found} - found
+        if not more:
+            return found - set(NOT_A_FRAME)
+        found |= more
+
+
+def blocks(text):
+    """The page's prose in units that must carry a label: a glued figure with its caption, a
+    paragraph, a table row.  Yields (glue names used, glue names of the labels in force): its
+    own; for a table row, the paragraph before its table; and the section's, a label in the
+    first paragraph under a heading, which holds for the section ("Frames: ...")."""
+    text = CELL.sub("", text)
+    section, first = [], False
+    for chunk in re.split(r"(```\{glue:figure\}.*?\n```)", text, flags=re.S):
+        if chunk.startswith("```{glue:figure}"):
+            names = [a or b for a, b in GLUE_USE.findall(chunk)]
+            yield names, names + section
+            continue
+        before = []
+        for para in re.split(r"\n\s*\n", chunk):
+            if re.search(r"^#{1,6} ", para, re.M):
+                section, first = [], True
+                continue
+            rows = para.strip().splitlines()
+            if rows and all(r.lstrip().startswith("|") for r in rows):
+                for row in rows:
+                    names = [a or b for a, b in GLUE_USE.findall(row)]
+                    yield names, names + before + section
+                continue
+            before = [a or b for a, b in GLUE_USE.findall(para)]
+            if first and para.strip():
+                section, first = [n for n in before if LABEL.search(n)], False
+            yield before, before + section
+
+
+def _bound(target):
+    """The variable names an assignment target binds: ``a``, ``a, b``, and ``a`` for ``a[k]`` or ``a.x``."""
+    while isinstance(target, (ast.Subscript, ast.Attribute, ast.Starred)):
+        target = target.value
+    if isinstance(target, (ast.Tuple, ast.List)):
+        return [name for t in target.elts for name in _bound(t)]
+    return [target.id] if isinstance(target, ast.Name) else []
+
+
+def _loaded(tree):
+    """The variable names ``tree`` reads."""
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+
+
+def _assignments(tree):
+    """(value, bound names) of each assignment and for loop in ``tree``."""
+    for node in ast.walk(tree):
+        if isinstance(node, ast.For):
+            yield node.iter, _bound(node.target)
+        elif isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)) and node.value is not None:
+            yield node.value, [n for tg in getattr(node, "targets", [getattr(node, "target", None)])
+                               for n in _bound(tg)]
+
+
+def _rebound(tree, call, tainted):
+    """Names ``tree`` binds from values that owe nothing to a render (a loop variable reused)."""
+    return {n for value, names in _assignments(tree)
+            if not (call.search(ast.unparse(value)) or _loaded(value) & tainted) for n in names}
+
+
+def rendering_cells(text, renders):
+    """The code cells of a page whose values come from a render: a cell that calls one of
+    ``renders`` or names a variable holding a render's result, a variable assigned from
+    such a call or such a variable (in that cell or an earlier one)."""
+    call = re.compile(r"\b(" + "|".join(sorted(renders)) + r")\s*\(")
+    tainted, out = set(), []
+    for cell in CELL.findall(text):
+        cell = re.sub(r"\A(?:\s*:\w[\w-]*:.*\n)+", "", cell + "\n")      # the cell's options (:tags:)
+        tree = ast.parse(cell)
+        if not (call.search(cell) or (_loaded(tree) - _rebound(tree, call, tainted)) & tainted):
+            continue
+        out.append(cell)
+        for value, names in _assignments(tree):
+            if call.search(ast.unparse(value)) or _loaded(value) & tainted:
+                tainted |= set(names)
+    return out
+
+
+def unlabelled(text, renders):
+    """[glue names] of ``text``'s blocks that show a number glued by a cell of
+    `rendering_cells` without a scene/resolution label (a glue named ``*_size``, ``*_label``)."""
+    derived = [re.compile((re.sub(r"\\\{[^}]*\\\}", ".+", re.escape(n)) if f else re.escape(n)) + "$")
+               for cell in rendering_cells(text, renders) for f, n in GLUE_DEF.findall(cell)]
+    return [names for names, label in blocks(text)
+            if any(d.match(n) for n in names for d in derived if not LABEL.search(n))
+            and not any(LABEL.search(n) for n in label)]
+
+
+@pytest.mark.parametrize("page", sorted(p.name for p in BOOK.glob("*.md")))
+def test_every_rendered_number_names_its_resolution(page):
+    """A number measured on a render is shown beside its scene's resolution (or label)."""
+    assert unlabelled((BOOK / page).read_text(encoding="utf-8"), rendering_functions()) == []
+
+
+def test_an_unlabelled_rendered_number_is_found():
+    """Wrong variants: a label dropped from a caption, from a table's intro, and a new cell
+    that renders through a proofs/ function with a paragraph that does not say at what size."""
+    renders = rendering_functions()
+    assert {"render", "gbuffer", "image_beta_order", "crease_band_ratio", "gradient_accuracy"} <= renders
+    assert "tex_number" not in renders
+    s4 = (BOOK / "s4_simulator.md").read_text(encoding="utf-8")
+    assert unlabelled(s4.replace("The two pipelines at {glue:text}`s4_size`", "The two pipelines"), renders)
+    assert unlabelled(s4.replace("(default scene, {glue:text}`s4_size`):", ":"), renders)
+    cell = ("```{code-cell} ipython3\nfrom proofs.accuracy import image_beta_order\n"
+            "glue(\"x_slope\", image_beta_order()[\"median_slope\"])\n```\n\n")
+    assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f`.\n", renders) == [["x_slope"]]
+    assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f` ({glue:text}`x_label`).\n", renders) == []
