@@ -244,3 +244,16 @@ def test_an_unlabelled_rendered_number_is_found():
             "glue(\"x_slope\", image_beta_order()[\"median_slope\"])\n```\n\n")
     assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f`.\n", renders) == [["x_slope"]]
     assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f` ({glue:text}`x_label`).\n", renders) == []
+
+
+def test_frame_label_names_the_fields_that_differ_and_the_size():
+    from proofs.book import frame_label
+    from renderer import Scene
+    assert frame_label(Scene(), 256, 128) == "default scene, 256 × 128"
+    assert frame_label(Scene(height_field="sine", beta=1.5), 64, 64) == \
+        "default scene with height_field='sine', beta=1.5, 64 × 64"
+    with pytest.raises(TypeError, match="scene must be a renderer.Scene, got dict"):
+        frame_label({}, 64, 64)
+    for bad in (0, 2.0, True):
+        with pytest.raises(ValueError, match=f"width must be a positive integer number of pixels, got {bad!r}"):
+            frame_label(Scene(), bad, 64)
