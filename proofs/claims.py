@@ -135,9 +135,12 @@ def _frames(field="ridges", beta=0.35, eps=1e-3, size=128):
     return render(scene, size, size, gradient="central"), render(scene, size, size)
 
 
-def _on(field="ridges", beta=0.35, size=128, **more):
-    """' (label)': the scene and resolution of `_frames` (or another frame) a measurement used."""
-    return f" ({frame_label(Scene(height_field=field, beta=beta, **more), size, size)})"
+def _on(frame, scene=None):
+    """' (label)': the scene and size of the frame a measurement used (`proofs.book.frame_label`),
+    read from the frame itself.  ``frame``: a `renderer.Frame` or `renderer.GBuffer`; ``scene``:
+    the scene to name when the frame carries none (a GBuffer) or a sweep varies it."""
+    height, width = frame.chamber.shape
+    return f" ({frame_label(scene or frame.scene, width, height)})"
 
 
 def _err_at(eps):
@@ -204,7 +207,7 @@ def _census_slope():
         off.append(led.mean_abs_off_kink)
     s_rms = np.polyfit(np.log(steps), np.log(rms), 1)[0]
     s_off = np.polyfit(np.log(steps), np.log(off), 1)[0]
-    return (f"fitted slope: RMS on A {s_rms:.2f}, off the crease band {s_off:.2f}" + _on(size=256),
+    return (f"fitted slope: RMS on A {s_rms:.2f}, off the crease band {s_off:.2f}" + _on(sym),
             {"RMS slope": s_rms, "off-band slope": s_off})
 
 
@@ -219,14 +222,14 @@ def _cell3_runs():
     try:
         np.abs(num.image - sym.image)[same & on_a].max()
     except ValueError as error:
-        return (f"its sphere A covers {np.count_nonzero(on_a)} of {code.size} pixels{_on(size=256)}, so the "
+        return (f"its sphere A covers {np.count_nonzero(on_a)} of {code.size} pixels{_on(sym)}, so the "
                 f"first row of the sweep stops with ValueError: {error}", {"rows computed": 0})
-    return "the sweep's first row is computed" + _on(size=256), {"rows computed": 1}
+    return "the sweep's first row is computed" + _on(sym), {"rows computed": 1}
 
 
 def _census_flips():
     flips = sum(compare(*_frames(eps=e)).flips for e in (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6))
-    return f"{flips} flips over 6 steps" + _on(), {"flips": flips}
+    return f"{flips} flips over 6 steps" + _on(_frames()[1]), {"flips": flips}
 
 
 def crease_band_ratio():
@@ -304,7 +307,7 @@ def _stacking():
     ratio = err[0.35] / err[0.0]
     return (f"the bump adds no integral (the pixel filter's integrand changes), but one sample per pixel "
             f"misses the filtered value by RMS {err[0.35]:.1e} on sphere A with the bump against "
-            f"{err[0.0]:.1e} without: {ratio:.0f}x, so the same filter needs more samples{_on()}",
+            f"{err[0.0]:.1e} without: {ratio:.0f}x, so the same filter needs more samples{_on(one, Scene())}",
             {"one-sample error, with / without the bump": ratio})
 
 
@@ -352,7 +355,7 @@ def _timing():
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
     return (f"sines and cosines per pixel: central {central.trig:g}, exact {exact.trig:g}; timed, the gradient "
             f"stage central/exact = {stage:.1f}x and the whole frame {f_central / f_exact:.2f}x (min of "
-            f"repeated runs, not used for the verdict){_on()}", {"sin/cos calls, exact minus central": exact.trig - central.trig})
+            f"repeated runs, not used for the verdict){_on(g, Scene())}", {"sin/cos calls, exact minus central": exact.trig - central.trig})
 
 
 def _cell5_fd():
@@ -388,19 +391,20 @@ def _beta_order():
 def _beta0():
     a, b = _frames(beta=0.0)
     d = float(np.abs(a.image - b.image).max())
-    return f"max |dI| at beta = 0: {d:.1e}" + _on(beta=0.0), {"max |ΔI|": d}
+    return f"max |dI| at beta = 0: {d:.1e}" + _on(b), {"max |ΔI|": d}
 
 
 def _bump_nonzero():
     s = Scene(height_field="sine", beta=1.5)
-    d = float(np.abs(render(s, 128, 128).image - render(s.replace(beta=0.0), 128, 128).image).mean())
-    return f"mean |dI| beta = 1.5 vs 0: {d:.3f}" + _on("sine", 1.5), {"mean |ΔI|": d}
+    bumped = render(s, 128, 128)
+    d = float(np.abs(bumped.image - render(s.replace(beta=0.0), 128, 128).image).mean())
+    return f"mean |dI| beta = 1.5 vs 0: {d:.3f}" + _on(bumped), {"mean |ΔI|": d}
 
 
 def _cell6_truncation():
     a = compare(*_frames("sine", 1.5, 1e-3)).max_abs
     b = compare(*_frames("sine", 1.5, 1e-4)).max_abs
-    return (f"max |dI| at eps 1e-3 / 1e-4: {a:.1e} / {b:.1e} (ratio {a / b:.0f})" + _on("sine", 1.5),
+    return (f"max |dI| at eps 1e-3 / 1e-4: {a:.1e} / {b:.1e} (ratio {a / b:.0f})" + _on(_frames("sine", 1.5, 1e-3)[1]),
             {"max |ΔI| ratio": a / b})
 
 
@@ -420,13 +424,13 @@ def _crease_values():
 def _pole_pixels():
     g = gbuffer(Scene(), 256, 256)
     n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= 1e-4)))
-    return f"pixels using the fallback, from the geometry: {n}" + _on(size=256), {"fallback pixels": n}
+    return f"pixels using the fallback, from the geometry: {n}" + _on(g, Scene()), {"fallback pixels": n}
 
 
 def _sweep_best():
     a = {eps: compare(*_frames("sine", 0.35, eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
     best = min(a, key=a.get)
-    return f"smallest RMS over the tried steps at eps = {best:.0e}" + _on("sine"), {"best ε": best}
+    return f"smallest RMS over the tried steps at eps = {best:.0e}" + _on(_frames("sine")[1], Scene(height_field="sine")), {"best ε": best}
 
 
 def _creases_part():
@@ -434,7 +438,7 @@ def _creases_part():
     diff = np.abs(num.image - sym.image).max(axis=-1)
     big = diff > 1e-3
     share = float(np.count_nonzero(big & sym.kink) / max(1, np.count_nonzero(big)))
-    return f"{share:.0%} of pixels with |dI| > 1e-3 lie in the crease band" + _on(), {"share in the band": share}
+    return f"{share:.0%} of pixels with |dI| > 1e-3 lie in the crease band" + _on(sym), {"share in the band": share}
 
 
 def _rings_pinch():
@@ -454,10 +458,10 @@ def _rings_pinch():
 
 
 def _beta_zero_slider():
-    a = render(Scene(beta=0.0), 96, 96).image
+    flat = render(Scene(beta=0.0), 96, 96)
     b = render(Scene(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
-    n = int(np.count_nonzero(a != b))
-    return (f"beta = 0 renders of two fields and pipelines differ in {n} values" + _on(beta=0.0, size=96),
+    n = int(np.count_nonzero(flat.image != b))
+    return (f"beta = 0 renders of two fields and pipelines differ in {n} values" + _on(flat),
             {"values differing": n})
 
 

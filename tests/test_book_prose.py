@@ -13,6 +13,7 @@ added to a page is found.
 from __future__ import annotations
 
 import ast
+import importlib.util
 import re
 from collections import Counter
 from pathlib import Path
@@ -102,7 +103,10 @@ ROOT = BOOK.parent
 #: `proofs.book.frame_label`'s "default scene with height_field='sine', 64 × 64").
 #: A glue ``*_measured`` is a claim's measurement text, which ends with its frame (`proofs.claims`).
 LABEL = re.compile(r"(_size|_label|_measured)$")
-CELL = re.compile(r"```\{code-cell\}[^\n]*\n(.*?)\n```", re.S)
+CELL = re.compile(r"```\{code-cell\}[^\n]*\n(.*?)\n```", re.S)      # to drop cells from the prose
+_spec = importlib.util.spec_from_file_location("nb_deps", ROOT / "book" / "_ext" / "nb_deps.py")
+nb_deps = importlib.util.module_from_spec(_spec)       # the page reader the book's cache key uses
+_spec.loader.exec_module(nb_deps)
 GLUE_DEF = re.compile(r"\bglue(?:_math)?\(\s*(f?)[\"']([^\"']+)[\"']")
 GLUE_USE = re.compile(r"\{glue(?::\w+)?\}`([^`:]+)|```\{glue:figure\}\s*(\S+)")
 
@@ -203,9 +207,8 @@ def rendering_cells(text, renders):
     such a call or such a variable (in that cell or an earlier one)."""
     call = re.compile(r"\b(" + "|".join(sorted(renders)) + r")\s*\(")
     tainted, out = set(), []
-    for cell in CELL.findall(text):
-        cell = re.sub(r"\A(?:\s*:\w[\w-]*:.*\n)+", "", cell + "\n")      # the cell's options (:tags:)
-        tree = ast.parse(cell)
+    for cell in nb_deps.code_cells(text) or []:
+        tree = nb_deps._parse(cell)
         if not (call.search(cell) or (_loaded(tree) - _rebound(tree, call, tainted)) & tainted):
             continue
         out.append(cell)
@@ -240,10 +243,17 @@ def test_an_unlabelled_rendered_number_is_found():
     s4 = (BOOK / "s4_simulator.md").read_text(encoding="utf-8")
     assert unlabelled(s4.replace("The two pipelines at {glue:text}`s4_size`", "The two pipelines"), renders)
     assert unlabelled(s4.replace("(default scene, {glue:text}`s4_size`):", ":"), renders)
-    cell = ("```{code-cell} ipython3\nfrom proofs.accuracy import image_beta_order\n"
+    front = s4[:s4.index("---", 3) + 4]                  # a page's front matter: it is a notebook
+    cell = (front + "```{code-cell} ipython3\nfrom proofs.accuracy import image_beta_order\n"
             "glue(\"x_slope\", image_beta_order()[\"median_slope\"])\n```\n\n")
     assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f`.\n", renders) == [["x_slope"]]
     assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f` ({glue:text}`x_label`).\n", renders) == []
+    # A frame rendered in one cell, its number glued in a later one; a name the frame tainted,
+    # rebound by a loop over plain values, is not a frame's.
+    two = (front + "```{code-cell} ipython3\nfr = render(Scene(), 8, 8)\nk = fr.chamber.sum()\n```\n\n"
+           "```{code-cell} ipython3\nfor k in (1, 2):\n    glue(\"x_k\", k)\n```\n\n"
+           "```{code-cell} ipython3\nglue(\"x_n\", int(fr.chamber.sum()))\n```\n\n")
+    assert unlabelled(two + "It has {glue:text}`x_n`.\n\nAnd {glue:text}`x_k`.\n", renders) == [["x_n"]]
 
 
 def test_frame_label_names_the_fields_that_differ_and_the_size():
