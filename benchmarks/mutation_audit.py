@@ -30,7 +30,7 @@ statements), which is why the semantic mutants cover those.
 Results: benchmarks/results/mutation_audit.md (and .json).  With ``--only`` the
 named mutants are run again and their rows replace the earlier ones (from the
 .json, or else the .md table), so a fix can be re-audited without a full run.
-Usage: python benchmarks/mutation_audit.py [--only ID ...] [--mutmut [--work DIR] [--budget MIN]] [--out FILE]
+Usage: python benchmarks/mutation_audit.py [--only ID ...] [--mutmut [--work DIR] [--budget MIN] [--mutants GLOB ...]] [--out FILE]
 """
 
 from __future__ import annotations
@@ -251,17 +251,20 @@ for _m in THEOREM_MODULES:
     )
 
 
-def explain(module, change):
-    """The reason `MUTMUT_EXPLAINED` gives for a survivor's change, or None."""
+def explain(module, name, change):
+    """The reason `MUTMUT_EXPLAINED` gives for a survivor (its pattern searched in
+    "mutant name: before → after"), or None."""
     return next((why for mod, pattern, why in MUTMUT_EXPLAINED
-                 if mod == module and re.search(pattern, change)), None)
+                 if mod == module and re.search(pattern, f"{name}: {change}")), None)
 
 
-def run_mutmut(work, budget):
+def run_mutmut(work, budget, patterns=()):
     """mutmut 3 over each of `MUTMUT_SCOPES`, scope i in ``work``/scope-i (a scratch copy
     made if absent, else resumed): [(module, tests, {status: count}, [(surviving mutant, its
-    change)])], or None if mutmut is missing.  A budgeted scope runs for at most ``budget``
-    minutes (0: only collected).  mutmut's statuses: killed, survived, "no tests" (no named
+    change)])], or None if mutmut is missing.  ``work``'s copies are refreshed from the
+    working tree first.  A budgeted scope runs for at most ``budget``
+    minutes (0: only collected), over its mutants matching ``patterns`` (mutmut's globs, e.g.
+    "proofs.frame.*"; none: all).  mutmut's statuses: killed, survived, "no tests" (no named
     test calls the mutated function), timeout, "not checked" (budget spent), ..."""
     mutmut = Path(PYTHON).parent / "mutmut"
     if not mutmut.is_file():
@@ -269,8 +272,7 @@ def run_mutmut(work, budget):
     found = []
     for i, (modules, tests, isolation, budgeted) in enumerate(MUTMUT_SCOPES):
         d = work / f"scope-{i}"
-        if not d.is_dir():
-            _scratch(d)
+        _scratch(d)                   # new, or refreshed: mutmut reruns the functions whose code changed
         (d / "setup.cfg").write_text("[mutmut]\nsource_paths=" + "\n    ".join(modules) + "\n"
                                      f"pytest_add_cli_args_test_selection={tests}\n"
                                      "also_copy=renderer/\n    book/\n    verify/\n"
@@ -278,7 +280,8 @@ def run_mutmut(work, budget):
         env = dict(os.environ, NUMBA_CACHE_DIR=str(d / ".numba_cache"))
         env.pop("SYMRENDER_STORE", None)
         if not budgeted or budget > 0:
-            run = subprocess.Popen([str(mutmut), "run", "--max-children", str(os.cpu_count() or 2)], cwd=d,
+            chosen = list(patterns) if budgeted else []
+            run = subprocess.Popen([str(mutmut), "run", "--max-children", str(os.cpu_count() or 2), *chosen], cwd=d,
                                    env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             try:
                 run.wait(timeout=budget * 60 if budgeted else None)
@@ -326,9 +329,9 @@ def _write_mutmut(found, out, started):
                      f"{n['timeout']} | {n['no tests']} | {n['not checked']} | {other} | {rate} |")
     for module, _, _, survivors in found:
         lines += ["", f"Survivors in `{module}` (the line before → after; why it is equivalent or acceptable):", ""]
-        lines += [f"- `{name}`: `{change}`: " + (explain(module, change) or "**flagged**: not explained")
+        lines += [f"- `{name}`: `{change}`: " + (explain(module, name, change) or "**flagged**: not explained")
                   for name, change in survivors] or ["- none"]
-    flagged = sum(explain(m, c) is None for m, _, _, s in found for _, c in s)
+    flagged = sum(explain(m, n, c) is None for m, _, _, s in found for n, c in s)
     lines += ["", f"Survivors not explained (flagged): {flagged}."]
     out.write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("\n".join(lines))
@@ -356,13 +359,16 @@ def main(argv=None):
     parser.add_argument("--work", help="with --mutmut: keep the scratch copies here, and resume from them")
     parser.add_argument("--budget", type=float, default=60.0,
                         help="with --mutmut: minutes for the theorem modules' scope (0: only collect)")
+    parser.add_argument("--mutants", nargs="*", default=(),
+                        help="with --mutmut: run only the theorem modules' mutants matching these globs "
+                             "(e.g. 'proofs.kink_loci.*')")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "mutation_audit.md"))
     args = parser.parse_args(argv)
     if args.mutmut:
         work, started = Path(args.work or tempfile.mkdtemp(prefix="mutation-audit-")), time.time()
         work.mkdir(parents=True, exist_ok=True)
         try:
-            found = run_mutmut(work, args.budget)
+            found = run_mutmut(work, args.budget, args.mutants)
         finally:
             if not args.work:
                 shutil.rmtree(work, ignore_errors=True)

@@ -178,18 +178,21 @@ ERROR_MODEL = eps**2 * H3 / 6 + u_round * H / eps
 EPS_STAR = (3 * u_round * H / H3) ** sp.Rational(1, 3)
 
 
-def _optimum(claimed):
-    stationary = sp.solve(sp.Eq(sp.diff(ERROR_MODEL, eps), 0), eps)
-    curvature = sp.simplify(sp.diff(ERROR_MODEL, eps, 2).subs(eps, claimed))
-    ids = [Identity("stationary point", sp.diff(ERROR_MODEL, eps).subs(eps, claimed), sp.Integer(0),
-                    {H3: (1.0, 1e4), H: (0.1, 1.0), u_round: (1e-17, 1e-15)})]
-    verdict = check_identities(ids)
-    if not verdict.holds:
-        return verdict
-    if len(stationary) != 1 or not (curvature.is_positive):
-        return Verdict("refuted", f"stationary points {stationary}, curvature {curvature}")
-    return Verdict(verdict.status, f"the unique positive stationary point of the model; "
-                   f"second derivative {sp.latex(curvature)} > 0; {verdict.evidence}")
+def _optimum(claimed, model=ERROR_MODEL):
+    """Proved when sympy finds exactly one stationary point, decided positive, of ``model`` in eps,
+    equal to ``claimed``, with a positive second derivative there; else refuted."""
+    roots = sp.solve(sp.diff(model, eps), eps)
+    stationary = [r for r in roots if r.is_positive]
+    if len(stationary) != 1 or any(r.is_positive is None for r in roots):
+        return Verdict("refuted", f"{len(stationary)} stationary points sympy decides are positive, "
+                       f"among the roots {roots}")
+    if sp.simplify(stationary[0] - claimed) != 0:
+        return Verdict("refuted", f"the stationary point is {stationary[0]}, not the claimed {claimed}")
+    curvature = sp.simplify(sp.diff(model, eps, 2).subs(eps, claimed))
+    if not curvature.is_positive:
+        return Verdict("refuted", f"second derivative {curvature} at the stationary point: not a minimum")
+    return Verdict("proved", f"sympy solves E'(eps) = 0: one positive root, {sp.latex(stationary[0])}; "
+                   f"second derivative {sp.latex(curvature)} > 0 there")
 
 
 OPTIMAL_STEP = Theorem(
@@ -201,7 +204,11 @@ OPTIMAL_STEP = Theorem(
            (r"\varepsilon^\ast", r"\varepsilon^\ast", EPS_STAR)),
     check=lambda: _optimum(EPS_STAR),
     wrong_variants=(("exponent 1/2 instead of 1/3",
-                     lambda: _optimum((3 * u_round * H / H3) ** sp.Rational(1, 2))),),
+                     lambda: _optimum((3 * u_round * H / H3) ** sp.Rational(1, 2))),
+                    ("the roundoff term added with the wrong sign (no stationary point)",
+                     lambda: _optimum(EPS_STAR, eps**2 * H3 / 6 - u_round * H / eps)),
+                    ("both terms negated (the stationary point is a maximum)",
+                     lambda: _optimum(EPS_STAR, -ERROR_MODEL))),
     pages=("s3", "s5", "s7"),
     seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
 )

@@ -7,6 +7,8 @@ unit sphere in spherical coordinates, N(theta, phi), and its derivatives
 dN/dtheta and dN/dphi, written here.
 """
 
+import dataclasses
+
 import sympy as sp
 
 from renderer import formulas as F
@@ -128,37 +130,48 @@ def _orientation_value():
     return sp.simplify(e_theta.cross(e_phi).dot(N))
 
 
-def _fallback_orientation():
-    """(e_theta x e_phi) . N of the pole fallback at the north pole N = (0, 0, 1)."""
-    et, ep = sp.Matrix(F.FALLBACK_FRAME[:3]), sp.Matrix(F.FALLBACK_FRAME[3:])
-    return et.cross(ep).dot(sp.Matrix([0, 0, 1]))
+def _fallback_cross(fallback=F.FALLBACK_FRAME):
+    """e_theta x e_phi of the pole fallback (a constant frame)."""
+    return sp.Matrix(fallback[:3]).cross(sp.Matrix(fallback[3:]))
 
 
 #: What the theorem claims (e_theta x e_phi) . N is: the check compares the
 #: frame with this constant, not with its own simplification.
 CLAIMED_ORIENTATION = -1
+#: ... and what it claims the pole fallback's e_theta x e_phi is: +z, the outward
+#: normal at the north pole, so the fallback is right-handed there, unlike the regular frame.
+CLAIMED_FALLBACK_CROSS = sp.Matrix([0, 0, 1])
 
 
-def _check_orientation(claimed=CLAIMED_ORIENTATION) -> Verdict:
-    verdict = _orientation(e_theta, e_phi, claimed)
+def _check_orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME) -> Verdict:
+    verdict = check_identities([
+        Identity(r"(e_\theta\times e_\varphi)\cdot N", e_theta.cross(e_phi).dot(N), sp.Integer(claimed), DOMAIN),
+        Identity(r"\text{fallback } e_\theta\times e_\varphi", _fallback_cross(fallback), CLAIMED_FALLBACK_CROSS)])
     if not verdict.holds:
         return verdict
-    return Verdict(verdict.status, f"(e_theta x e_phi) . N = {claimed:+d}, the claimed value: the frame is "
-                   f"{'right' if claimed == 1 else 'left'}-handed about the outward normal (the pole "
-                   f"fallback's is {int(_fallback_orientation()):+d} at the north pole); "
-                   + verdict.evidence, verdict.residual, verdict.digits, verdict.points)
+    return dataclasses.replace(verdict, evidence=(
+        f"(e_theta x e_phi) . N = {claimed:+d} on the regular branch: the frame is "
+        f"{'right' if claimed == 1 else 'left'}-handed about the outward normal; the pole fallback's "
+        f"e_theta x e_phi = {list(CLAIMED_FALLBACK_CROSS)}, right-handed at the north pole; {verdict.evidence}"))
 
 
 FRAME_ORIENTATION = Theorem(
     id="frame-orientation", title="Orientation of the tangent frame",
     statement=rf"$(e_\theta \times e_\varphi)\cdot N = {CLAIMED_ORIENTATION}$: the pair $(e_\theta, e_\varphi)$ is "
-              r"left-handed about the outward normal, $e_\theta\times e_\varphi = -N$.",
+              r"left-handed about the outward normal, $e_\theta\times e_\varphi = -N$. The pole fallback "
+              rf"($\sin\varphi \le {sp.latex(sp.Float(F.POLE_SIN_PHI, 2))}$), "
+              rf"$e_\theta = {vector_latex(F.FALLBACK_FRAME[:3])}$, $e_\varphi = {vector_latex(F.FALLBACK_FRAME[3:])}$, "
+              rf"has $e_\theta\times e_\varphi = {sp.latex(CLAIMED_FALLBACK_CROSS.T)}$: right-handed at the "
+              r"north pole, where the outward normal is $+z$.",
     steps=((r"cross product", r"e_\theta\times e_\varphi", e_theta.cross(e_phi).applyfunc(sp.simplify)),
            (r"outward normal", "N", N),
-           (r"orientation", r"(e_\theta\times e_\varphi)\cdot N", _orientation_value())),
+           (r"orientation", r"(e_\theta\times e_\varphi)\cdot N", _orientation_value()),
+           (r"pole fallback", r"e_\theta\times e_\varphi", _fallback_cross())),
     check=_check_orientation,
     wrong_variants=(("the seed's reading: aligned with N (+1)", lambda: _check_orientation(1)),
-                    ("the frame with e_theta and e_phi swapped", lambda: _orientation(e_phi, e_theta, -1))),
+                    ("the frame with e_theta and e_phi swapped", lambda: _orientation(e_phi, e_theta, -1)),
+                    ("the pole fallback with e_theta and e_phi swapped",
+                     lambda: _check_orientation(fallback=F.FALLBACK_FRAME[3:] + F.FALLBACK_FRAME[:3]))),
     pages=("s3", "s5"),
     seed_says="Cell 2 prints (e_theta x e_phi) . N and labels the frame 'unit, aligned with N'.",
 )

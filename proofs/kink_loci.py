@@ -41,54 +41,72 @@ def _tex(expr):
 
 
 def ray_angles(k_u):
-    """Image-plane angles alpha_m (radians, float64 array) of the rays u = m / k_u,
-    m = 0 .. ceil(k_u) - 1 (`ALPHA_M`)."""
+    """Image-plane angles alpha_m (radians, float64 array of ceil(k_u)) of the rays
+    u = m / k_u, m = 0 .. ceil(k_u) - 1, from `ALPHA_M`."""
     return np.asarray(_ALPHA_M(np.arange(int(np.ceil(k_u))), k_u), dtype=float)
 
 
+def circle_angles(k_v):
+    """Polar angles phi_m = pi m / k_v (radians, float64 array) of the circles v = m / k_v,
+    m = 0 .. floor(k_v); m = 0 is the north pole, the circle of radius 0."""
+    return np.pi * np.arange(int(np.floor(k_v)) + 1) / k_v
+
+
+def rho_of_phi(phi_, radius_a, camera_z, rho=RHO, drho=DRHO):
+    """(rho, visible): the image radius of sphere A's circle of polar angle ``phi_``
+    (float64 arrays of phi_'s shape), from the expression `RHO` the theorem checks, and
+    whether it faces the camera: `DRHO` > 0, i.e. e cos(phi) > R.  ``rho``, ``drho``:
+    other expressions in (phi, R, e), for wrong variants."""
+    at = (np.asarray(phi_, dtype=float), radius_a, camera_z)
+    return (np.asarray(sp.lambdify((phi, R, e), rho, modules="numpy")(*at), dtype=float),
+            np.asarray(sp.lambdify((phi, R, e), drho, modules="numpy")(*at) > 0))
+
+
 def circle_radii(radius_a, camera_z, k_v):
-    """(phi_m, rho_m, visible) for the circles v = m / k_v with 0 < phi_m < pi."""
-    m = np.arange(1, int(np.ceil(k_v)))
-    phi_m = np.pi * m / k_v
-    rho = camera_z * radius_a * np.sin(phi_m) / (camera_z - radius_a * np.cos(phi_m))
-    return phi_m, rho, np.cos(phi_m) > radius_a / camera_z
+    """(phi_m, rho_m, visible), float64, float64 and bool arrays, of the circles
+    v = m / k_v (`circle_angles`, `rho_of_phi`)."""
+    phi_m = circle_angles(k_v)
+    return (phi_m, *rho_of_phi(phi_m, radius_a, camera_z))
 
 
-def phi_of_rho(rho, radius_a, camera_z):
-    """Invert rho(phi) on the visible cap: phi = asin(rho e / (R sqrt(e^2 + rho^2))) - atan2(rho, e)."""
-    s = np.clip(rho * camera_z / (radius_a * np.hypot(camera_z, rho)), -1.0, 1.0)
-    return np.arcsin(s) - np.arctan2(rho, camera_z)
+#: The crease band's half-width about a zero of sin(pi k t) (`formulas.RIDGE_FACTORS`):
+#: |sin(pi k (t - m/k))| < KINK_BAND_HALF_WIDTH, i.e. |t - m/k| < asin(w) / (pi k).
+def _half_width(k):
+    return float(np.arcsin(float(F.KINK_BAND_HALF_WIDTH)) / (np.pi * k))
 
 
-#: The crease flag's two parts (`formulas.KINK_BAND`: a factor of `RIDGE_FACTORS`
-#: below `KINK_BAND_HALF_WIDTH`), as functions of (u, k_u) and (v, k_v).
-_PART = [sp.lambdify((var, k), sp.Abs(f) < F.KINK_BAND_HALF_WIDTH, modules="numpy")
-         for var, k, f in ((F.u, F.k_u, F.RIDGE_FACTORS[0]), (F.v, F.k_v, F.RIDGE_FACTORS[1]))]
-
-
-def predicted_parts(scene, width, height, shift=(0.0, 0.0)):
-    """The two parts of the crease band predicted from the closed forms alone,
-    on sphere A's pixels: the rays (u from the image angle) and the circles (v
-    from the image radius); ``shift`` (in u, v) moves them, for wrong variants.
-    Returns (u part, v part, on A), (H, W) bool arrays."""
+def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO):
+    """The crease band about each locus, predicted from the loci alone: for the rays, the
+    pixels whose image angle is within 2 pi `_half_width`(k_u) of a ray's `ray_angles`
+    (u = (alpha + pi) / 2 pi); for the circles, those whose image radius lies between the
+    radii `rho_of_phi` gives at phi_m -+ pi `_half_width`(k_v) (v = phi / pi; to the limb
+    when the outer edge is hidden, nothing when the inner one is).  ``shift`` moves every
+    locus (radians of alpha or phi), for wrong variants.  Returns ((n, H, W) bool, one per
+    locus, sphere A's pixels only; (H, W) bool, sphere A's pixels)."""
     g = gbuffer(scene, width, height)
     X, Y = np.meshgrid(g.x, g.y)
-    u = (np.arctan2(Y, X) + np.pi) / (2 * np.pi) + shift[0]
-    v = phi_of_rho(np.hypot(X, Y), scene.radius_a, scene.camera_z) / np.pi + shift[1]
     on_a = g.chamber == 1
-    return _PART[0](u, scene.k_u) & on_a, _PART[1](v, scene.k_v) & on_a, on_a
+    if kind == "rays":
+        off = np.angle(np.exp(1j * (np.arctan2(Y, X)[None] - ray_angles(scene.k_u)[:, None, None] - shift)))
+        return (np.abs(off) < 2 * np.pi * _half_width(scene.k_u)) & on_a, on_a
+    r = np.hypot(X, Y)[None]
+    phi_m = circle_angles(scene.k_v)[:, None, None] + shift
+    (lo, lo_seen), (hi, hi_seen) = (rho_of_phi(phi_m + s * np.pi * _half_width(scene.k_v), scene.radius_a,
+                                               scene.camera_z, rho, drho) for s in (-1, 1))
+    return lo_seen & (r > lo) & (~hi_seen | (r < hi)) & on_a, on_a
 
 
-def part_mismatch(kind, scene=None, size=256, shift=(0.0, 0.0)):
-    """(mismatched, in the part, compared): where the other part's closed form is off, the
-    rendered kink flag against this part's closed form (rays: u; circles: v)."""
-    scene = scene or Scene()
-    u_part, v_part, on_a = predicted_parts(scene, size, size, shift)
-    mine, other = (u_part, v_part) if kind == "rays" else (v_part, u_part)
+def part_mismatch(kind, scene, size=256, shift=0.0, rho=RHO, drho=DRHO):
+    """(mismatched, pixels per locus, compared) at size x size: the rendered crease flag
+    against the union of ``kind``'s `locus_bands`, on the sphere-A pixels off the other
+    family's bands.  Pixels per locus: the rendered crease pixels in each locus's band
+    there (int array)."""
+    mine, on_a = locus_bands(kind, scene, size, size, shift, rho, drho)
+    other = locus_bands("circles" if kind == "rays" else "rays", scene, size, size)[0].any(axis=0)
     rendered = render(scene, size, size).kink
     where = on_a & ~other
-    return (int(np.count_nonzero((rendered != mine) & where)), int(np.count_nonzero(mine & where)),
-            int(np.count_nonzero(where)))
+    return (int(np.count_nonzero((rendered != mine.any(axis=0)) & where)),
+            np.count_nonzero(mine & (rendered & where)[None], axis=(1, 2)), int(np.count_nonzero(where)))
 
 
 def _projection_identities(rho, drho):
@@ -97,26 +115,39 @@ def _projection_identities(rho, drho):
             Identity(r"d\rho/d\varphi", sp.diff(RHO, phi), drho, DOMAIN)]
 
 
-def _check(kind, rho=RHO, drho=DRHO, scene=None, shift=(0.0, 0.0)):
+#: What the loci's check is handed in a wrong variant that skips the identities.
+PROVED = Verdict("proved", "(identities skipped)")
+
+
+def _check(kind, rho=RHO, drho=DRHO):
     symbolic = check_identities(_projection_identities(rho, drho))
-    if not symbolic.holds:
-        return symbolic
-    scene = scene or Scene()
-    mismatched, band, on_a = part_mismatch(kind, scene, shift=shift)
+    return _loci(kind, symbolic) if symbolic.holds else symbolic
+
+
+def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene()):
+    """The identities' verdict ``symbolic``, kept if the rendered crease flag is the bands
+    about ``kind``'s loci (`part_mismatch`) and every locus claimed visible has crease
+    pixels; else refuted."""
+    from .book import frame_label
+    mismatched, per_locus, compared = part_mismatch(kind, scene, shift=shift, rho=rho, drho=drho)
     if kind == "rays":
-        loci = ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
-        what = f"{len(ray_angles(scene.k_u))} rays at alpha = {loci} (all visible)"
+        seen = np.ones(len(per_locus), dtype=bool)             # every ray crosses the visible cap
+        what = f"{len(per_locus)} rays at alpha = " + ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
     else:
-        phis, rhos, vis = circle_radii(scene.radius_a, scene.camera_z, scene.k_v)
-        what = "; ".join(f"phi={p:.4f}: rho={r:.4f} ({'visible' if s else 'hidden'})"
-                         for p, r, s in zip(phis, rhos, vis))
-    part = "u-creases from the image angle" if kind == "rays" else "v-creases from the image radius"
+        phis, rhos, seen = circle_radii(scene.radius_a, scene.camera_z, scene.k_v)
+        what = "circles " + "; ".join(f"phi={p:.4f}: rho={r:.4f} ({'visible' if s else 'hidden'})"
+                                      for p, r, s in zip(phis, rhos, seen))
+    family = "u-creases (rays)" if kind == "rays" else "v-creases (circles)"
     if mismatched > 0:
-        return Verdict("refuted", f"{mismatched} of {on_a} sphere-A pixels: the rendered crease flag differs "
-                       f"from the {part}")
-    return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the {part} (closed form alone) equal the "
-                   f"rendered crease flag on all {on_a} sphere-A pixels off the other family ({band} on a "
-                   "crease) at 256x256")
+        return Verdict("refuted", f"{mismatched} of {compared} sphere-A pixels: the rendered crease flag differs "
+                       f"from the {family} predicted from the loci")
+    if not np.array_equal(per_locus > 0, seen):
+        return Verdict("refuted", f"rendered crease pixels per locus {per_locus.tolist()}, but the loci "
+                       f"claimed visible are {seen.tolist()}")
+    return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the bands about these loci (closed form "
+                   f"alone) equal the rendered crease flag on all {compared} sphere-A pixels off the other "
+                   f"family, and each visible locus has crease pixels ({', '.join(map(str, per_locus))}) "
+                   f"({frame_label(scene, 256, 256)})")
 
 
 KINK_LOCI_RAYS = Theorem(
@@ -130,8 +161,8 @@ KINK_LOCI_RAYS = Theorem(
     check=lambda: _check("rays"),
     wrong_variants=(("projection with a flipped sign: e + R cos(phi) in the denominator",
                      lambda: _check("rays", rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi)))),
-                    ("the rays turned by half a period (u + 1/2k_u)",
-                     lambda: _check("rays", shift=(0.5 / Scene().k_u, 0.0)))),
+                    ("the rays turned by half a period (alpha + pi/k_u)",
+                     lambda: _loci("rays", PROVED, shift=np.pi / Scene().k_u))),
     pages=("s3", "s4"),
     seed_says="§3: the zero lines u = m/k_u are rays 'by Chapter 5's longitude theorem'.",
 )
@@ -146,8 +177,10 @@ KINK_LOCI_CIRCLES = Theorem(
     check=lambda: _check("circles"),
     wrong_variants=(("derivative with the factor e cos(phi) - R replaced by e - R cos(phi)",
                      lambda: _check("circles", drho=e * R / (e - R * sp.cos(phi)))),
-                    ("the circles moved by half a period (v + 1/2k_v)",
-                     lambda: _check("circles", shift=(0.0, 0.5 / Scene().k_v)))),
+                    ("the circles moved by half a period (phi + pi/2k_v)",
+                     lambda: _loci("circles", PROVED, shift=np.pi / (2 * Scene().k_v))),
+                    ("the radii with e + R cos(phi) in the projection's denominator",
+                     lambda: _loci("circles", PROVED, rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi))))),
     pages=("s3", "s4"),
     seed_says="§3: the zero lines v = m/k_v are circles 'by its corollary'.",
 )

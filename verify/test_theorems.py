@@ -48,6 +48,7 @@ def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
 def test_wrong_variant_is_refuted(theorem_id, description, variant):
     verdict = variant()
     assert verdict.status == "refuted", f"{theorem_id}, {description}: {verdict.evidence}"
+    assert isinstance(verdict.evidence, str) and verdict.evidence, "a refutation says why"
 
 
 def test_every_theorem_has_a_variant_and_a_statement():
