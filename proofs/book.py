@@ -123,7 +123,7 @@ def _entry(t):
              f"(or, failing that, evaluated with mpmath), and a wrong variant "
              f"({t.wrong_variants[0][0]}) is refuted by the same check.\n:::\n")
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
-                pages=list(t.pages), block=block, changed=pinned_failure(t.id, v.status, v.residual))
+                pages=list(t.pages), block=block, changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
 
 
 def _ledger():
@@ -163,7 +163,7 @@ def _refuse(theorem_id, entry):
     if entry["status"] not in ("proved", "verified"):
         raise TheoremFailed(f"{theorem_id} is {entry['status']}: {entry['evidence']}")
     if entry["changed"]:
-        raise TheoremFailed(f"{entry['changed']} (proofs.registry.PINNED): {entry['evidence']}")
+        raise TheoremFailed(f"{entry['changed']} (proofs.registry.PINNED, RENDERED): {entry['evidence']}")
 
 
 def _folded(label, text):

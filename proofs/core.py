@@ -44,6 +44,7 @@ class Verdict:
     residual: float | None = None  # worst |lhs - rhs| found numerically (None if exact)
     digits: int | None = None
     points: int | None = None
+    rendered: int = 0              # renderer outputs (pixels, or frames) the check compared
 
     @property
     def holds(self) -> bool:

@@ -130,7 +130,8 @@ def _check(claim, kernel=KERNEL_COEFFS):
                    f"(the seed's bump is the normal of no displaced sphere for those); "
                    f"renderer's bump='surface' Ns within {worst:.1e} of the displaced normal (mpmath, "
                    f"{compared} seeded sphere-A pixels of the three fields, pole ring and crease neighbours "
-                   f"included; {left_out} inside the pole floor sin phi <= {float(F.POLE_SIN_PHI):g} left out)")
+                   f"included; {left_out} inside the pole floor sin phi <= {float(F.POLE_SIN_PHI):g} left out)",
+                   rendered=compared)
 
 
 BUMP_VS_DISPLACEMENT = Theorem(

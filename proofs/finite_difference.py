@@ -146,7 +146,7 @@ def _check_truncation(claimed, denominator=2, rule=_border_rule, half=0.5):
                    f"branch at 2,000 seeded interior points, and at 2,000 points near the borders wraps u, "
                    f"clamps v and divides by the clamped distance; the footprint steps (FOOTPRINT, compiled) "
                    f"equal pbrt-v4's least-squares rule within {fp:.1e} (relative) at {pixels} sphere-A pixels",
-                   verdict.residual, verdict.digits, verdict.points)
+                   verdict.residual, verdict.digits, verdict.points, pixels)
 
 
 CENTRAL_DIFFERENCE_TRUNCATION = Theorem(

@@ -92,7 +92,7 @@ def _check_frame(et, ep, corrupt=None):
     return Verdict(verdict.status, f"renderer.formulas.TANGENT_FRAME, regular branch at N(theta, phi): "
                    f"{verdict.evidence}; the renderer's N' (GBuffer.Ns, both bump modes, 3 fields) at {count} "
                    f"seeded sphere-A pixels (pole ring and fallback included) within {worst:.1e} of mpmath's "
-                   "PERTURBED_NORMAL in this frame", verdict.residual, verdict.digits, verdict.points)
+                   "PERTURBED_NORMAL in this frame", verdict.residual, verdict.digits, verdict.points, count)
 
 
 def vector_latex(components):
@@ -218,7 +218,7 @@ def _check_chart(identities, corrupt=None):
     return Verdict(verdict.status, f"renderer.formulas.CHART at N(theta, phi): {verdict.evidence}; the "
                    f"renderer's (u, v) (GBuffer.uv) at {count} seeded sphere-A pixels (pole ring and fallback "
                    f"included) within {worst:.1e} of mpmath's CHART at its N", verdict.residual, verdict.digits,
-                   verdict.points)
+                   verdict.points, count)
 
 
 _swapped = [Identity("v", sp.atan2(N[2], sp.sqrt(N[0]**2 + N[1]**2)) / sp.pi, V_OF_PHI, DOMAIN)]

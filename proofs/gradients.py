@@ -93,7 +93,7 @@ def _gradient_check(name, closed_form, corrupt=None):
                        f"footprint gradients (GBuffer.grad) at {rendered['exact'][1]} seeded sphere-A pixels within "
                        f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
                        "of their tolerances against GRADIENT, CENTRAL (stencil included) and CENTRAL with "
-                       "FOOTPRINT's steps at its (u, v)", worst, DIGITS, POINTS)
+                       "FOOTPRINT's steps at its (u, v)", worst, DIGITS, POINTS, rendered["exact"][1])
     return check
 
 

@@ -147,7 +147,7 @@ def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene()):
     return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the bands about these loci (closed form "
                    f"alone) equal the rendered crease flag on all {compared} sphere-A pixels off the other "
                    f"family, and each visible locus has crease pixels ({', '.join(map(str, per_locus))}) "
-                   f"({frame_label(scene, 256, 256)})")
+                   f"({frame_label(scene, 256, 256)})", rendered=compared)
 
 
 KINK_LOCI_RAYS = Theorem(

@@ -169,7 +169,8 @@ def _check(predicates, gate=False, reach=None):
                    "and N of the beta = 0 frame bit for bit, and kernel.reach gives each light the same mask; "
                    f"kernel.reach equals the predicates above, evaluated at the hit points, at all {compared} "
                    f"decided (pixel, light) pairs of {len(REACH_SCENES)} scenes (128x128; a light inside sphere B, "
-                   "lights behind A and below the floor)", residual=float(values + masks + differing), points=frames)
+                   "lights behind A and below the floor)", residual=float(values + masks + differing), points=frames,
+                   rendered=frames)
 
 
 NO_BOUNDARY = Theorem(

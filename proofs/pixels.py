@@ -31,8 +31,9 @@ from renderer.render import SPHERE_A
 __all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "footprint_error", "worst_of", "TOLERANCE",
            "PER_FIELD"]
 
-#: Pixels drawn per field from each source (full frame, pole ring, crease neighbours): >= 200 in all.
-PER_FIELD = 240
+#: Pixels drawn per field, a third from each source (full frame, pole ring at zoom 300 and 3e4; crease
+#: neighbours as well for ridges): >= 200 outside the pole floor, the 3e4 frame being inside it.
+PER_FIELD = 300
 DIGITS = 30
 UNIT = 2.0**-53
 #: Absolute tolerances of the outputs at their scale (chart units; gradient per k; unit normal).

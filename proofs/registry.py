@@ -22,8 +22,20 @@ PINNED = {
 }
 
 
-def pinned_failure(theorem_id, status, residual=None):
-    """Why the verdict (``status``, ``residual``) differs from `PINNED`, or None if it does not.
+#: Theorems whose check must evaluate the renderer's own outputs, and how many at least:
+#: sphere-A pixels (200 per field, per bump mode where both are compared), or whole
+#: G-buffers and renders.  A check that skips its renderer comparison reports fewer
+#: (`Verdict.rendered`), and `pinned_failure` names it.
+RENDERED = {
+    "chart": 3 * 200, "frame-orthonormal": 3 * 2 * 200, "gradient-sine": 200, "gradient-ridges": 200,
+    "gradient-rings": 200, "kink-loci-rays": 200, "kink-loci-circles": 200, "no-boundary": 100,
+    "beta-zero-regression": 12, "central-difference-truncation": 200, "bump-vs-displacement": 3 * 200,
+}
+
+
+def pinned_failure(theorem_id, status, residual=None, rendered=0):
+    """Why the verdict (``status``, ``residual``, ``rendered``) differs from `PINNED` and
+    `RENDERED`, or None if it does not.
 
     Raises
     ------
@@ -36,6 +48,8 @@ def pinned_failure(theorem_id, status, residual=None):
         return f"{theorem_id} is {status}, pinned {want}"
     if bound is not None and not (residual is not None and residual <= bound):
         return f"{theorem_id} is verified with residual {residual}, pinned at most {bound:g}"
+    if rendered < RENDERED.get(theorem_id, 0):
+        return f"{theorem_id} compared {rendered} renderer outputs, pinned at least {RENDERED[theorem_id]}"
     return None
 
 

@@ -10,7 +10,7 @@ import dataclasses
 
 import pytest
 
-from proofs.registry import PINNED, THEOREMS, get, pinned_failure
+from proofs.registry import PINNED, RENDERED, THEOREMS, get, pinned_failure
 from verify.conftest import LEDGER
 
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
@@ -21,7 +21,7 @@ def test_theorem_holds(theorem_id):
     verdict = THEOREMS[theorem_id].check()
     LEDGER[theorem_id] = verdict
     assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
-    assert pinned_failure(theorem_id, verdict.status, verdict.residual) is None
+    assert pinned_failure(theorem_id, verdict.status, verdict.residual, verdict.rendered) is None
     if verdict.status == "verified":      # mpmath at >= 30 digits, or >= 100 renders without a difference
         assert (verdict.digits is not None and verdict.digits >= 30 and verdict.points >= 20) or \
             (verdict.digits is None and verdict.points >= 100 and verdict.residual == 0.0)
@@ -29,6 +29,13 @@ def test_theorem_holds(theorem_id):
 
 def test_every_theorem_has_a_pinned_verdict():
     assert set(PINNED) == set(THEOREMS)
+    assert set(RENDERED) <= set(THEOREMS)
+
+
+def test_a_check_that_skips_the_renderer_is_named():
+    """A verdict reached without its renderer comparison (fewer outputs than pinned) is a change."""
+    assert "compared 599 renderer outputs, pinned at least 600" in pinned_failure("chart", "verified", 1e-30, 599)
+    assert pinned_failure("chart", "verified", 1e-30, 600) is None
 
 
 @pytest.mark.parametrize("pin, status, residual, why", [
@@ -40,7 +47,8 @@ def test_every_theorem_has_a_pinned_verdict():
 def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
     monkeypatch.setitem(PINNED, "chart", pin)
     assert why in pinned_failure("chart", status, residual)
-    assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30))) is None
+    assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30)),
+                          RENDERED["chart"]) is None
 
 
 @pytest.mark.parametrize("theorem_id, description, variant", VARIANTS,
@@ -106,3 +114,15 @@ def test_undecided_identity_is_verified_numerically(monkeypatch):
     assert verdict.points >= 20 and verdict.digits >= 30 and verdict.residual < 1e-25
     false = core.Identity("wrong angle", sp.sin(2 * x), sp.sin(x) * sp.cos(x), {x: (-3, 3)})
     assert core.check_identities([false]).status == "refuted"
+
+
+def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
+    """The chart's identities alone, its renderer comparison skipped: the build fails."""
+    from proofs import book, registry
+    from proofs.core import Verdict
+    skipped = dataclasses.replace(get("chart"), check=lambda: Verdict("verified", "identities only", 1e-31, 30, 24))
+    monkeypatch.setattr(registry, "THEOREMS", {"chart": skipped})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    with pytest.raises(book.TheoremFailed, match="chart compared 0 renderer outputs, pinned at least 600"):
+        book.theorem_block("chart")
