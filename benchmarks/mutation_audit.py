@@ -247,6 +247,49 @@ MUTMUT_EXPLAINED = (
      "builds a wrong variant, the seed's attached rule with the bumped N': any N' it is fed (either gradient, "
      "components in any order) contains beta, which is what refutes the variant"),
 )
+MUTMUT_EXPLAINED += (
+    ("proofs/frame.py", r"x__check_(frame|chart)__mutmut_\d+: .*(verdict\.residual, verdict\.digits, verdict\.points, "
+     r"count\)|PERTURBED_NORMAL in this frame)",
+     "the identities' residual, digits and points (None when sympy decided them all, as here) or the evidence "
+     "text; the status and the renderer count are unchanged"),
+    ("proofs/frame.py", r"if worst >= TOLERANCE\[",
+     "differs only when the worst error equals the tolerance (64 or 16 units of roundoff) exactly"),
+    ("proofs/frame.py", r"x__check_orientation__mutmut_\d+: if not verdict\.holds: → if verdict\.holds:",
+     "the verdict's evidence text: a verdict that holds keeps its status, without the handedness sentence"),
+    ("proofs/kink_loci.py", r"x__loci__mutmut_\d+: .*(what = |family = |frame_label\(|\.join\(|"
+     r"return Verdict\(symbolic\.status, f)",
+     "the verdict's evidence text, for a reader of the ledger; the status it carries is unchanged"),
+    ("proofs/kink_loci.py", r"x__tex__",
+     "the statement's typesetting (sp.latex of the checked expressions: term order, symbol names); the "
+     "checks compare the expressions, and no check reads the LaTeX back"),
+    ("proofs/kink_loci.py", r"if mismatched > 1:|per_locus > 1,",
+     "differs only with exactly one mismatched pixel, or a visible locus with exactly one crease pixel; "
+     "the wrong variants mismatch hundreds, and the fewest crease pixels of a visible locus is 4"),
+    ("proofs/kink_loci.py", r"np\.ones\(len\(per_locus\), (dtype=None|)\)|dtype=None|dtype=float\), \)|"
+     r"np\.asarray\(phi_, \)|modules=None|, \)\(\*at\)",
+     "equivalent: the values are float64 already (np.array_equal compares 1.0 with True by value), and "
+     "lambdify's default modules include numpy"),
+    ("proofs/kink_loci.py", r"\(\*at\) >= 0\)|\(r >= lo\)|\(r <= hi\)|np\.abs\(off\) <= ",
+     "differs only for a pixel exactly on a band's edge or a circle exactly on the horizon"),
+    ("proofs/kink_loci.py", r"arange\(int\(np\.floor\(k_v\)\) [-+] [12]\)",
+     "adds or drops only circles past the horizon (phi_m >= 3 pi/4 at k_v = 4): their bands are empty either "
+     "way, and only the evidence's list of circles changes"),
+    ("proofs/kink_loci.py", r"ray_angles\(scene\.k_u\)\[:, None, None\] \+ shift|\[None\] \+ ray_angles|"
+     r"\[:, None, None\] - shift$",
+     "equivalent: the rays' angles are symmetric under negation (k_u = 8), and a shift of half a period is "
+     "the same either way"),
+    ("proofs/kink_loci.py", r"rho, \)|drho, \)|drho=drho\) → .*rho=rho, \)",
+     "drho reaches the bands only in a wrong variant that its identity (d rho/d phi) refutes first"),
+    ("proofs/kink_loci.py", r"count_nonzero\(mine & \(rendered \| where\)",
+     "equivalent once no pixel mismatches (checked first): on the compared pixels the rendered flag is the "
+     "predicted band"),
+    ("proofs/kink_loci.py", r"x__check__mutmut_\d+: .*or True else symbolic",
+     "runs the render comparison for identities that failed as well; the verdict keeps their status"),
+    ("proofs/kink_loci.py", r"Identity\(\"y\", y_img, rho \* sp\.sin\(theta\), (None|)\)",
+     "the sampling domain, used only if sympy cannot decide the identity, which it does"),
+    ("proofs/finite_difference.py", r"sp\.latex\(None\)",
+     "the verdict's evidence text, for a reader of the ledger; the status it carries is unchanged"),
+)
 #: Explanations that hold in every theorem module.
 for _m in THEOREM_MODULES:
     MUTMUT_EXPLAINED += (
@@ -315,7 +358,8 @@ def run_mutmut(work, budget, patterns=()):
             for name in sorted(k for k, v in mine.items() if v == "survived"):
                 diff = subprocess.run([str(mutmut), "show", name], cwd=d, env=env, capture_output=True,
                                       text=True).stdout
-                change = [line[1:].strip() for line in diff.splitlines() if line.startswith(("-    ", "+    "))]
+                change = [line[1:].strip() for line in diff.splitlines()
+                          if line.startswith(("-", "+")) and not line.startswith(("---", "+++"))]
                 survivors.append((name, " → ".join(change)))
             found.append((module, tests, Counter(mine.values()), survivors))
     return found

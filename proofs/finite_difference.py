@@ -208,7 +208,9 @@ OPTIMAL_STEP = Theorem(
                     ("the roundoff term added with the wrong sign (no stationary point)",
                      lambda: _optimum(EPS_STAR, eps**2 * H3 / 6 - u_round * H / eps)),
                     ("both terms negated (the stationary point is a maximum)",
-                     lambda: _optimum(EPS_STAR, -ERROR_MODEL))),
+                     lambda: _optimum(EPS_STAR, -ERROR_MODEL)),
+                    ("a model with stationary points 1, 3/2 and 2: a minimum at 1, but not the only one",
+                     lambda: _optimum(sp.Integer(1), (eps - 1)**2 * (eps - 2)**2))),
     pages=("s3", "s5", "s7"),
     seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
 )

@@ -57,13 +57,13 @@ def _frame_identities(et, ep):
 SEED_POLE_SIN_PHI = 1e-4
 
 
-def _branch_structure():
-    """Refuted unless every component of TANGENT_FRAME is Piecewise((regular,
+def _branch_structure(frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
+    """Refuted unless every component of ``frame`` (TANGENT_FRAME) is Piecewise((regular,
     sin_phi > POLE_SIN_PHI), (fallback, True)) with FALLBACK_FRAME's values,
-    and POLE_SIN_PHI is the seed's cut-off."""
-    if F.POLE_SIN_PHI != SEED_POLE_SIN_PHI:
-        return Verdict("refuted", f"POLE_SIN_PHI is {F.POLE_SIN_PHI}, the seed's cut-off is {SEED_POLE_SIN_PHI}")
-    for k, (c, fallback) in enumerate(zip(F.TANGENT_FRAME, F.FALLBACK_FRAME)):
+    and ``pole`` (POLE_SIN_PHI) is the seed's cut-off."""
+    if pole != SEED_POLE_SIN_PHI:
+        return Verdict("refuted", f"POLE_SIN_PHI is {pole}, the seed's cut-off is {SEED_POLE_SIN_PHI}")
+    for k, (c, fallback) in enumerate(zip(frame, F.FALLBACK_FRAME)):
         if not isinstance(c, sp.Piecewise):
             ok = c.is_number and c - fallback == 0         # both branches equal: folded by sympy
         else:
@@ -75,8 +75,8 @@ def _branch_structure():
     return None
 
 
-def _check_frame(et, ep, corrupt=None):
-    bad = _branch_structure()
+def _check_frame(et, ep, corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
+    bad = _branch_structure(frame, pole)
     if bad is not None:
         return bad
     verdict = check_identities(_frame_identities(et, ep))
@@ -116,7 +116,12 @@ FRAME_ORTHONORMAL = Theorem(
                      lambda: check_identities([Identity(r"e_\theta", -e_theta, sp.diff(N, theta) / sp.sin(phi),
                                                         DOMAIN)])),
                     ("the kernel's N' built with h_u and h_v swapped",
-                     lambda: _check_frame(e_theta, e_phi, corrupt=lambda g: g[:, ::-1]))),
+                     lambda: _check_frame(e_theta, e_phi, corrupt=lambda g: g[:, ::-1])),
+                    ("the pole cut-off moved from 1e-4 to 3e-4", lambda: _check_frame(e_theta, e_phi, pole=3e-4)),
+                    ("the fallback's e_theta turned to (0, 1, 0)",
+                     lambda: _check_frame(e_theta, e_phi, frame=tuple(
+                         sp.Piecewise((c.args[0].expr, c.args[0].cond), (sp.Integer(k == 1), True))
+                         if k < 3 and isinstance(c, sp.Piecewise) else c for k, c in enumerate(F.TANGENT_FRAME))))),
     pages=("s3",),
 )
 

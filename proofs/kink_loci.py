@@ -75,6 +75,11 @@ def _half_width(k):
     return float(np.arcsin(float(F.KINK_BAND_HALF_WIDTH)) / (np.pi * k))
 
 
+#: The frame the loci are compared on (pixels per side).
+SIZE = 256
+KINDS = ("rays", "circles")
+
+
 def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO):
     """The crease band about each locus, predicted from the loci alone: for the rays, the
     pixels whose image angle is within 2 pi `_half_width`(k_u) of a ray's `ray_angles`
@@ -82,7 +87,15 @@ def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO):
     radii `rho_of_phi` gives at phi_m -+ pi `_half_width`(k_v) (v = phi / pi; to the limb
     when the outer edge is hidden, nothing when the inner one is).  ``shift`` moves every
     locus (radians of alpha or phi), for wrong variants.  Returns ((n, H, W) bool, one per
-    locus, sphere A's pixels only; (H, W) bool, sphere A's pixels)."""
+    locus, sphere A's pixels only; (H, W) bool, sphere A's pixels).
+
+    Raises
+    ------
+    ValueError
+        ``kind`` is not "rays" or "circles".
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     g = gbuffer(scene, width, height)
     X, Y = np.meshgrid(g.x, g.y)
     on_a = g.chamber == 1
@@ -96,7 +109,7 @@ def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO):
     return lo_seen & (r > lo) & (~hi_seen | (r < hi)) & on_a, on_a
 
 
-def part_mismatch(kind, scene, size=256, shift=0.0, rho=RHO, drho=DRHO):
+def part_mismatch(kind, scene, size, shift, rho, drho):
     """(mismatched, pixels per locus, compared) at size x size: the rendered crease flag
     against the union of ``kind``'s `locus_bands`, on the sphere-A pixels off the other
     family's bands.  Pixels per locus: the rendered crease pixels in each locus's band
@@ -124,17 +137,19 @@ def _check(kind, rho=RHO, drho=DRHO):
     return _loci(kind, symbolic) if symbolic.holds else symbolic
 
 
-def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene()):
+def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False):
     """The identities' verdict ``symbolic``, kept if the rendered crease flag is the bands
-    about ``kind``'s loci (`part_mismatch`) and every locus claimed visible has crease
-    pixels; else refuted."""
+    about ``kind``'s loci (`part_mismatch`) and exactly the loci claimed visible have
+    crease pixels; else refuted.  ``all_visible``: claim every circle visible (a wrong
+    variant)."""
     from .book import frame_label
-    mismatched, per_locus, compared = part_mismatch(kind, scene, shift=shift, rho=rho, drho=drho)
+    mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho)
     if kind == "rays":
         seen = np.ones(len(per_locus), dtype=bool)             # every ray crosses the visible cap
         what = f"{len(per_locus)} rays at alpha = " + ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
     else:
         phis, rhos, seen = circle_radii(scene.radius_a, scene.camera_z, scene.k_v)
+        seen = seen | all_visible
         what = "circles " + "; ".join(f"phi={p:.4f}: rho={r:.4f} ({'visible' if s else 'hidden'})"
                                       for p, r, s in zip(phis, rhos, seen))
     family = "u-creases (rays)" if kind == "rays" else "v-creases (circles)"
@@ -146,8 +161,8 @@ def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene()):
                        f"claimed visible are {seen.tolist()}")
     return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the bands about these loci (closed form "
                    f"alone) equal the rendered crease flag on all {compared} sphere-A pixels off the other "
-                   f"family, and each visible locus has crease pixels ({', '.join(map(str, per_locus))}) "
-                   f"({frame_label(scene, 256, 256)})", rendered=compared)
+                   f"family, and exactly the visible loci have crease pixels ({', '.join(map(str, per_locus))}) "
+                   f"({frame_label(scene, SIZE, SIZE)})", rendered=compared)
 
 
 KINK_LOCI_RAYS = Theorem(
@@ -179,6 +194,8 @@ KINK_LOCI_CIRCLES = Theorem(
                      lambda: _check("circles", drho=e * R / (e - R * sp.cos(phi)))),
                     ("the circles moved by half a period (phi + pi/2k_v)",
                      lambda: _loci("circles", PROVED, shift=np.pi / (2 * Scene().k_v))),
+                    ("every circle claimed visible (the visibility condition dropped)",
+                     lambda: _loci("circles", PROVED, all_visible=True)),
                     ("the radii with e + R cos(phi) in the projection's denominator",
                      lambda: _loci("circles", PROVED, rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi))))),
     pages=("s3", "s4"),

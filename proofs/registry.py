@@ -33,7 +33,7 @@ RENDERED = {
 }
 
 
-def pinned_failure(theorem_id, status, residual=None, rendered=0):
+def pinned_failure(theorem_id, status, residual, rendered):
     """Why the verdict (``status``, ``residual``, ``rendered``) differs from `PINNED` and
     `RENDERED`, or None if it does not.
 

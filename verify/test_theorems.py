@@ -21,6 +21,7 @@ def test_theorem_holds(theorem_id):
     verdict = THEOREMS[theorem_id].check()
     LEDGER[theorem_id] = verdict
     assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
+    assert isinstance(verdict.evidence, str) and verdict.evidence, "the ledger shows the evidence"
     assert pinned_failure(theorem_id, verdict.status, verdict.residual, verdict.rendered) is None
     if verdict.status == "verified":      # mpmath at >= 30 digits, or >= 100 renders without a difference
         assert (verdict.digits is not None and verdict.digits >= 30 and verdict.points >= 20) or \
@@ -46,7 +47,7 @@ def test_a_check_that_skips_the_renderer_is_named():
 ])
 def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
     monkeypatch.setitem(PINNED, "chart", pin)
-    assert why in pinned_failure("chart", status, residual)
+    assert why in pinned_failure("chart", status, residual, RENDERED["chart"])
     assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30)),
                           RENDERED["chart"]) is None
 
