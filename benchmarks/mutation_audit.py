@@ -269,6 +269,10 @@ MUTMUT_EXPLAINED += (
      r"np\.asarray\(phi_, \)|modules=None|, \)\(\*at\)",
      "equivalent: the values are float64 already (np.array_equal compares 1.0 with True by value), and "
      "lambdify's default modules include numpy"),
+    ("proofs/kink_loci.py", r"k_u\), \)$|\(\*at\), \),$",
+     "equivalent: the values are float64 already"),
+    ("proofs/frame.py", r"c \+ fallback == 0",
+     "equivalent: the only component sympy folds is e_theta's z, 0 in both branches, so c + 0 is c - 0"),
     ("proofs/kink_loci.py", r"\(\*at\) >= 0\)|\(r >= lo\)|\(r <= hi\)|np\.abs\(off\) <= ",
      "differs only for a pixel exactly on a band's edge or a circle exactly on the horizon"),
     ("proofs/kink_loci.py", r"arange\(int\(np\.floor\(k_v\)\) [-+] [12]\)",

@@ -118,6 +118,9 @@ FRAME_ORTHONORMAL = Theorem(
                     ("the kernel's N' built with h_u and h_v swapped",
                      lambda: _check_frame(e_theta, e_phi, corrupt=lambda g: g[:, ::-1])),
                     ("the pole cut-off moved from 1e-4 to 3e-4", lambda: _check_frame(e_theta, e_phi, pole=3e-4)),
+                    ("e_theta's z the constant 1 in both branches (the regular branch's 0 and the fallback's "
+                     "replaced)", lambda: _check_frame(e_theta, e_phi, frame=F.TANGENT_FRAME[:2] + (sp.Integer(1),)
+                                                        + F.TANGENT_FRAME[3:])),
                     ("the fallback's e_theta turned to (0, 1, 0)",
                      lambda: _check_frame(e_theta, e_phi, frame=tuple(
                          sp.Piecewise((c.args[0].expr, c.args[0].cond), (sp.Integer(k == 1), True))

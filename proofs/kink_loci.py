@@ -80,13 +80,13 @@ SIZE = 256
 KINDS = ("rays", "circles")
 
 
-def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO):
+def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO, band_scale=1.0):
     """The crease band about each locus, predicted from the loci alone: for the rays, the
     pixels whose image angle is within 2 pi `_half_width`(k_u) of a ray's `ray_angles`
     (u = (alpha + pi) / 2 pi); for the circles, those whose image radius lies between the
     radii `rho_of_phi` gives at phi_m -+ pi `_half_width`(k_v) (v = phi / pi; to the limb
     when the outer edge is hidden, nothing when the inner one is).  ``shift`` moves every
-    locus (radians of alpha or phi), for wrong variants.  Returns ((n, H, W) bool, one per
+    locus (radians of alpha or phi) and ``band_scale`` widens the bands, for wrong variants.  Returns ((n, H, W) bool, one per
     locus, sphere A's pixels only; (H, W) bool, sphere A's pixels).
 
     Raises
@@ -101,20 +101,21 @@ def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO):
     on_a = g.chamber == 1
     if kind == "rays":
         off = np.angle(np.exp(1j * (np.arctan2(Y, X)[None] - ray_angles(scene.k_u)[:, None, None] - shift)))
-        return (np.abs(off) < 2 * np.pi * _half_width(scene.k_u)) & on_a, on_a
+        return (np.abs(off) < 2 * np.pi * band_scale * _half_width(scene.k_u)) & on_a, on_a
     r = np.hypot(X, Y)[None]
     phi_m = circle_angles(scene.k_v)[:, None, None] + shift
-    (lo, lo_seen), (hi, hi_seen) = (rho_of_phi(phi_m + s * np.pi * _half_width(scene.k_v), scene.radius_a,
+    half = np.pi * band_scale * _half_width(scene.k_v)
+    (lo, lo_seen), (hi, hi_seen) = (rho_of_phi(phi_m + s * half, scene.radius_a,
                                                scene.camera_z, rho, drho) for s in (-1, 1))
     return lo_seen & (r > lo) & (~hi_seen | (r < hi)) & on_a, on_a
 
 
-def part_mismatch(kind, scene, size, shift, rho, drho):
+def part_mismatch(kind, scene, size, shift, rho, drho, band_scale=1.0):
     """(mismatched, pixels per locus, compared) at size x size: the rendered crease flag
     against the union of ``kind``'s `locus_bands`, on the sphere-A pixels off the other
     family's bands.  Pixels per locus: the rendered crease pixels in each locus's band
     there (int array)."""
-    mine, on_a = locus_bands(kind, scene, size, size, shift, rho, drho)
+    mine, on_a = locus_bands(kind, scene, size, size, shift, rho, drho, band_scale)
     other = locus_bands("circles" if kind == "rays" else "rays", scene, size, size)[0].any(axis=0)
     rendered = render(scene, size, size).kink
     where = on_a & ~other
@@ -137,13 +138,13 @@ def _check(kind, rho=RHO, drho=DRHO):
     return _loci(kind, symbolic) if symbolic.holds else symbolic
 
 
-def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False):
+def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False, band_scale=1.0):
     """The identities' verdict ``symbolic``, kept if the rendered crease flag is the bands
     about ``kind``'s loci (`part_mismatch`) and exactly the loci claimed visible have
-    crease pixels; else refuted.  ``all_visible``: claim every circle visible (a wrong
-    variant)."""
+    crease pixels; else refuted.  ``all_visible`` (claim every circle visible) and
+    ``band_scale`` (`locus_bands`): wrong variants."""
     from .book import frame_label
-    mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho)
+    mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho, band_scale)
     if kind == "rays":
         seen = np.ones(len(per_locus), dtype=bool)             # every ray crosses the visible cap
         what = f"{len(per_locus)} rays at alpha = " + ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
@@ -194,6 +195,8 @@ KINK_LOCI_CIRCLES = Theorem(
                      lambda: _check("circles", drho=e * R / (e - R * sp.cos(phi)))),
                     ("the circles moved by half a period (phi + pi/2k_v)",
                      lambda: _loci("circles", PROVED, shift=np.pi / (2 * Scene().k_v))),
+                    ("the circles' bands twice as wide as the renderer's (the loci right, their bands not)",
+                     lambda: _loci("circles", PROVED, band_scale=2.0)),
                     ("every circle claimed visible (the visibility condition dropped)",
                      lambda: _loci("circles", PROVED, all_visible=True)),
                     ("the radii with e + R cos(phi) in the projection's denominator",

@@ -127,3 +127,11 @@ def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
     monkeypatch.delenv(book.store.ENV, raising=False)
     with pytest.raises(book.TheoremFailed, match="chart compared 0 renderer outputs, pinned at least 600"):
         book.theorem_block("chart")
+
+
+def test_the_kink_loci_refuse_an_unknown_family():
+    from renderer import Scene
+
+    from proofs.kink_loci import locus_bands
+    with pytest.raises(ValueError, match=r"kind must be one of \('rays', 'circles'\), got 'lines'"):
+        locus_bands("lines", Scene(), 8, 8)
