@@ -271,6 +271,12 @@ MUTMUT_EXPLAINED += (
      "lambdify's default modules include numpy"),
     ("proofs/kink_loci.py", r"k_u\), \)$|\(\*at\), \),$",
      "equivalent: the values are float64 already"),
+    ("proofs/kink_loci.py", r"band_scale=2\.0\):$",
+     "the other family's bands, which only take pixels out of the comparison: twice as wide, they take "
+     "more (thousands are still compared)"),
+    ("proofs/kink_loci.py", r"np\.pi / band_scale \*",
+     "equivalent at band_scale 1; in the wrong variant (2) the bands come out half as wide instead of twice, "
+     "and are refuted either way"),
     ("proofs/frame.py", r"c \+ fallback == 0",
      "equivalent: the only component sympy folds is e_theta's z, 0 in both branches, so c + 0 is c - 0"),
     ("proofs/kink_loci.py", r"\(\*at\) >= 0\)|\(r >= lo\)|\(r <= hi\)|np\.abs\(off\) <= ",

@@ -110,7 +110,7 @@ def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO, band_
     return lo_seen & (r > lo) & (~hi_seen | (r < hi)) & on_a, on_a
 
 
-def part_mismatch(kind, scene, size, shift, rho, drho, band_scale=1.0):
+def part_mismatch(kind, scene, size, shift, rho, drho, band_scale):
     """(mismatched, pixels per locus, compared) at size x size: the rendered crease flag
     against the union of ``kind``'s `locus_bands`, on the sphere-A pixels off the other
     family's bands.  Pixels per locus: the rendered crease pixels in each locus's band
