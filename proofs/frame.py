@@ -129,11 +129,6 @@ FRAME_ORTHONORMAL = Theorem(
 )
 
 
-def _orientation(et, ep, claimed):
-    return check_identities([Identity(r"(e_\theta\times e_\varphi)\cdot N", et.cross(ep).dot(N),
-                                      sp.Integer(claimed), DOMAIN)])
-
-
 def _orientation_value():
     return sp.simplify(e_theta.cross(e_phi).dot(N))
 
@@ -151,9 +146,9 @@ CLAIMED_ORIENTATION = -1
 CLAIMED_FALLBACK_CROSS = sp.Matrix([0, 0, 1])
 
 
-def _check_orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME) -> Verdict:
+def _check_orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=e_theta, ep=e_phi) -> Verdict:
     verdict = check_identities([
-        Identity(r"(e_\theta\times e_\varphi)\cdot N", e_theta.cross(e_phi).dot(N), sp.Integer(claimed), DOMAIN),
+        Identity(r"(e_\theta\times e_\varphi)\cdot N", et.cross(ep).dot(N), sp.Integer(claimed), DOMAIN),
         Identity(r"\text{fallback } e_\theta\times e_\varphi", _fallback_cross(fallback), CLAIMED_FALLBACK_CROSS)])
     if not verdict.holds:
         return verdict
@@ -177,7 +172,7 @@ FRAME_ORIENTATION = Theorem(
            (r"pole fallback", r"e_\theta\times e_\varphi", _fallback_cross())),
     check=_check_orientation,
     wrong_variants=(("the seed's reading: aligned with N (+1)", lambda: _check_orientation(1)),
-                    ("the frame with e_theta and e_phi swapped", lambda: _orientation(e_phi, e_theta, -1)),
+                    ("the frame with e_theta and e_phi swapped", lambda: _check_orientation(et=e_phi, ep=e_theta)),
                     ("the pole fallback with e_theta and e_phi swapped",
                      lambda: _check_orientation(fallback=F.FALLBACK_FRAME[3:] + F.FALLBACK_FRAME[:3]))),
     pages=("s3", "s5"),

@@ -12,6 +12,8 @@ u = m / k_u is the ray alpha_m = 2 pi m / k_u - pi; the zero line v = m / k_v
 is the circle rho_m = rho(pi m / k_v), visible when cos(pi m / k_v) > R / e.
 """
 
+from functools import lru_cache
+
 import numpy as np
 import sympy as sp
 
@@ -52,14 +54,19 @@ def circle_angles(k_v):
     return np.pi * np.arange(int(np.floor(k_v)) + 1) / k_v
 
 
+@lru_cache(maxsize=None)
+def _numeric(expr):
+    """``expr`` in (phi, R, e) as a numpy function, made once per expression."""
+    return sp.lambdify((phi, R, e), expr, modules="numpy")
+
+
 def rho_of_phi(phi_, radius_a, camera_z, rho=RHO, drho=DRHO):
     """(rho, visible): the image radius of sphere A's circle of polar angle ``phi_``
     (float64 arrays of phi_'s shape), from the expression `RHO` the theorem checks, and
     whether it faces the camera: `DRHO` > 0, i.e. e cos(phi) > R.  ``rho``, ``drho``:
     other expressions in (phi, R, e), for wrong variants."""
     at = (np.asarray(phi_, dtype=float), radius_a, camera_z)
-    return (np.asarray(sp.lambdify((phi, R, e), rho, modules="numpy")(*at), dtype=float),
-            np.asarray(sp.lambdify((phi, R, e), drho, modules="numpy")(*at) > 0))
+    return np.asarray(_numeric(rho)(*at), dtype=float), np.asarray(_numeric(drho)(*at) > 0)
 
 
 def circle_radii(radius_a, camera_z, k_v):
@@ -69,9 +76,9 @@ def circle_radii(radius_a, camera_z, k_v):
     return (phi_m, *rho_of_phi(phi_m, radius_a, camera_z))
 
 
-#: The crease band's half-width about a zero of sin(pi k t) (`formulas.RIDGE_FACTORS`):
-#: |sin(pi k (t - m/k))| < KINK_BAND_HALF_WIDTH, i.e. |t - m/k| < asin(w) / (pi k).
 def _half_width(k):
+    """The crease band's half-width about a zero of sin(pi k t) (`formulas.RIDGE_FACTORS`):
+    |sin(pi k (t - m/k))| < KINK_BAND_HALF_WIDTH, i.e. |t - m/k| < asin(w) / (pi k)."""
     return float(np.arcsin(float(F.KINK_BAND_HALF_WIDTH)) / (np.pi * k))
 
 
@@ -86,8 +93,10 @@ def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO, band_
     (u = (alpha + pi) / 2 pi); for the circles, those whose image radius lies between the
     radii `rho_of_phi` gives at phi_m -+ pi `_half_width`(k_v) (v = phi / pi; to the limb
     when the outer edge is hidden, nothing when the inner one is).  ``shift`` moves every
-    locus (radians of alpha or phi) and ``band_scale`` widens the bands, for wrong variants.  Returns ((n, H, W) bool, one per
-    locus, sphere A's pixels only; (H, W) bool, sphere A's pixels).
+    locus (radians of alpha or phi) and ``band_scale`` widens the bands, for wrong variants.
+    Returns ((n, H, W) bool, one per locus, sphere A's pixels only; (H, W) bool, sphere A's
+    pixels).  Source: seed §3 (the zero lines are rays and circles); the projection in this
+    module's docstring.
 
     Raises
     ------
