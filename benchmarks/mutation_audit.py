@@ -25,12 +25,18 @@ fastest mutants first) and the report counts the rest as not checked.  With
 the first stopped; ``--budget 0`` only collects what DIR holds.  mutmut cannot
 mutate the numba kernel (its trampolines are Python calls, which compiled code
 cannot make) nor module-level code (formulas.py's sympy, the theorems'
-statements), which is why the semantic mutants cover those.
+statements), which is why the semantic mutants cover those.  A function that
+runs while the tests are imported does run under mutmut, but unmutated there
+(mutmut imports before it switches a mutant on): ``--fresh MIN`` runs such
+functions' survivors again, each in a new interpreter with the mutant on from
+the start.  With ``--mutants`` only the scopes the globs name run; the report
+keeps the earlier rows of the modules a run did not check.
 
 Results: benchmarks/results/mutation_audit.md (and .json).  With ``--only`` the
 named mutants are run again and their rows replace the earlier ones (from the
 .json, or else the .md table), so a fix can be re-audited without a full run.
-Usage: python benchmarks/mutation_audit.py [--only ID ...] [--mutmut [--work DIR] [--budget MIN] [--mutants GLOB ...]] [--out FILE]
+Usage: python benchmarks/mutation_audit.py [--only ID ...] [--mutmut [--work DIR] [--budget MIN] [--fresh MIN]
+       [--mutants GLOB ...]] [--out FILE]
 """
 
 from __future__ import annotations
@@ -317,14 +323,76 @@ def explain(module, name, change):
                  if mod == module and re.search(pattern, f"{name}: {change}")), None)
 
 
-def run_mutmut(work, budget, patterns=()):
+#: Lists the functions of the theorem modules that run while `verify/test_theorems.py` is
+#: imported: "module.function" per line (nested functions under their outer one).
+_IMPORT_TIME_PROBE = """
+import sys
+ran = set()
+def probe(frame, event, arg):
+    f = frame.f_code.co_filename.replace(chr(92), "/")
+    if event == "call" and "/proofs/" in f and frame.f_code.co_name != "<module>":
+        ran.add("proofs." + f.rsplit("/", 1)[1][:-3] + "." + frame.f_code.co_qualname.split(".")[0])
+sys.setprofile(probe)
+import verify.test_theorems
+sys.setprofile(None)
+print("\\n".join(sorted(ran)))
+"""
+
+
+def import_time_functions(d, env):
+    """{"proofs.module.function"} of the functions that run when the theorem tests are imported,
+    in scratch copy ``d`` (unmutated).  mutmut imports the modules before it switches a mutant
+    on, so these functions' import-time calls never run mutated under it."""
+    out = subprocess.run([PYTHON, "-c", _IMPORT_TIME_PROBE], cwd=d, env=dict(env, PYTHONPATH=str(d)),
+                         capture_output=True, text=True, check=True).stdout
+    return set(out.split())
+
+
+def _function_of(mutant):
+    """"proofs.frame.x_regular_branch__mutmut_3" -> "proofs.frame.regular_branch"."""
+    module, _, name = mutant.rpartition(".")
+    return module + "." + re.sub(r"^x_|__mutmut_\d+$", "", name)
+
+
+def fresh_process_recheck(d, env, survivors, deadline):
+    """Run each of ``survivors`` (mutant names) again in a new interpreter with the mutant
+    switched on before anything is imported, ``pytest -x verify/test_theorems.py`` in
+    ``d``/mutants: {name: "killed" | "survived"} (kept in ``d``/fresh.json, so that a resumed run
+    skips what it has), until ``deadline`` (time.time()); two at a time."""
+    done_file = d / "fresh.json"
+    done = json.loads(done_file.read_text(encoding="utf-8")) if done_file.is_file() else {}
+    todo = [n for n in survivors if n not in done]
+    running = {}
+    while (todo or running) and time.time() < deadline:
+        while todo and len(running) < (os.cpu_count() or 2):
+            name = todo.pop(0)
+            running[name] = subprocess.Popen(
+                [PYTHON, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "--rootdir=.",
+                 "verify/test_theorems.py"], cwd=d / "mutants",
+                env=dict(env, PYTHONPATH=str(d / "mutants"), MUTANT_UNDER_TEST=name),
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(1)
+        for name, proc in list(running.items()):
+            if proc.poll() is not None:
+                done[name] = "survived" if proc.returncode == 0 else "killed"
+                del running[name]
+                done_file.write_text(json.dumps(done, indent=1) + "\n", encoding="utf-8")
+    for proc in running.values():
+        proc.kill()
+    return {n: done[n] for n in survivors if n in done}
+
+
+def run_mutmut(work, budget, patterns=(), fresh_budget=0.0):
     """mutmut 3 over each of `MUTMUT_SCOPES`, scope i in ``work``/scope-i (a scratch copy
     made if absent, else resumed): [(module, tests, {status: count}, [(surviving mutant, its
     change)])], or None if mutmut is missing.  ``work``'s copies are refreshed from the
     working tree first.  A budgeted scope runs for at most ``budget``
     minutes (0: only collected), over its mutants matching ``patterns`` (mutmut's globs, e.g.
     "proofs.frame.*"; none: all).  mutmut's statuses: killed, survived, "no tests" (no named
-    test calls the mutated function), timeout, "not checked" (budget spent), ..."""
+    test calls the mutated function), timeout, "not checked" (budget spent), ...  Then, for
+    ``fresh_budget`` minutes, the budgeted scope's survivors in functions that run at import
+    time are run again in a fresh process (`fresh_process_recheck`); those it kills count as
+    killed ("fresh": how many)."""
     mutmut = Path(PYTHON).parent / "mutmut"
     if not mutmut.is_file():
         return None
@@ -344,8 +412,10 @@ def run_mutmut(work, budget, patterns=()):
                                      f"process_isolation={isolation}\n", encoding="utf-8")
         env = dict(os.environ, NUMBA_CACHE_DIR=str(d / ".numba_cache"))
         env.pop("SYMRENDER_STORE", None)
+        chosen = [p for p in patterns if any(p.startswith(m[:-3].replace("/", ".") + ".") for m in modules)]
+        if patterns and not chosen:
+            continue                                        # the globs name no mutant of this scope
         if not budgeted or budget > 0:
-            chosen = list(patterns) if budgeted else []
             run = subprocess.Popen([str(mutmut), "run", "--max-children", str(os.cpu_count() or 2), *chosen], cwd=d,
                                    env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             try:
@@ -361,6 +431,12 @@ def run_mutmut(work, budget, patterns=()):
         out = subprocess.run([str(mutmut), "results", "--all", "true"], cwd=d, env=env,
                              capture_output=True, text=True).stdout
         statuses = dict(line.strip().rsplit(": ", 1) for line in out.splitlines() if ": " in line)
+        fresh = {}
+        if budgeted:
+            at_import = import_time_functions(d, env)
+            suspects = [n for n, v in statuses.items() if v == "survived" and _function_of(n) in at_import]
+            fresh = fresh_process_recheck(d, env, suspects, time.time() + fresh_budget * 60)
+            statuses.update((n, "killed") for n, v in fresh.items() if v == "killed")
         for module in modules:
             prefix = module[:-3].replace("/", ".") + "."
             mine = {k: v for k, v in statuses.items() if k.startswith(prefix)}
@@ -371,33 +447,73 @@ def run_mutmut(work, budget, patterns=()):
                 change = [line[1:].strip() for line in diff.splitlines()
                           if line.startswith(("-", "+")) and not line.startswith(("---", "+++"))]
                 survivors.append((name, " → ".join(change)))
-            found.append((module, tests, Counter(mine.values()), survivors))
+            n = Counter(mine.values())
+            n["fresh"] = sum(fresh.get(k) == "killed" for k in mine)
+            found.append((module, tests, n, survivors))
+    return found
+
+
+def _earlier_mutmut(out):
+    """{module: (tests, Counter, [(mutant, change)], when)} of the last report: its .json, or
+    else its .md (table and survivor lists)."""
+    if out.with_suffix(".json").is_file():
+        return {m: (t, Counter(n), [tuple(x) for x in sv], w)
+                for m, (t, n, sv, w) in json.loads(out.with_suffix(".json").read_text(encoding="utf-8")).items()}
+    if not out.is_file():
+        return {}
+    text = out.read_text(encoding="utf-8")
+    when = re.search(r"on (\d{4}-\d\d-\d\d \d\d:\d\d) UTC", text).group(1)
+    found, module = {}, None
+    for line in text.splitlines():
+        row = re.match(r"^\| `([^`]+)` \| `([^`]+)` \|" + r" (\d+) \|" * 7, line)
+        if row:
+            counts = [int(x) for x in row.groups()[3:]]
+            found[row.group(1)] = (row.group(2), Counter(dict(zip(
+                ("killed", "survived", "timeout", "no tests", "not checked", "other"), counts))), [], when)
+        head = re.match(r"^Survivors in `([^`]+)`", line)
+        module = head.group(1) if head else module
+        item = re.match(r"^- `([^`]+)`: `(.*?)`: ", line)
+        if item and module in found:
+            found[module][2].append(item.groups())
     return found
 
 
 def _write_mutmut(found, out, started):
+    """Write results/mutmut.md (and .json): this run's rows, and the earlier report's for the
+    modules this run did not check (their "run" column says when they were)."""
+    now = f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M}"
+    merged = _earlier_mutmut(out)
+    for module, tests, n, survivors in found:
+        if n["killed"] + n["survived"] + n["timeout"] or module not in merged:
+            merged[module] = (tests, n, survivors, now)
+    out.with_suffix(".json").write_text(json.dumps(merged, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     lines = ["# mutmut", "",
-             f"`python benchmarks/mutation_audit.py --mutmut` on {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC, "
-             f"{time.time() - started:.0f} s: mutmut 3 over each module with the tests named, in a scratch copy "
-             "per scope; the theorem modules for a budget of minutes, fastest mutants first (\"not checked\": "
-             "the rest).", "",
+             f"`python benchmarks/mutation_audit.py --mutmut`, last on {now} UTC ({time.time() - started:.0f} s); "
+             "a module this run did not check keeps the row of the run named in its last column.  mutmut 3 "
+             "over each module with the tests named, in a scratch copy per scope; the theorem modules for a "
+             "budget of minutes, fastest mutants first (\"not checked\": the rest).  \"killed\" counts in "
+             "brackets those killed only in a fresh process: survivors in functions that run while the tests "
+             "are imported, which mutmut (it imports before it switches a mutant on) never ran mutated there, "
+             "run again with the mutant on from the start.", "",
              "Kill rate: killed / (killed + survived + timeout), the mutants the named tests reach.  "
              "\"not reached\": mutants in functions no named test calls (mutmut's \"no tests\"; the "
              "register's measurements, which `pytest verify` runs, take minutes per mutant).", "",
              "| module | tests | mutants | killed | survived | timeout | not reached | not checked | other | "
-             "kill rate |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    for module, tests, n, _ in found:
+             "kill rate | run (UTC) |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+    for module, (tests, n, _, when) in merged.items():
         reached = n["killed"] + n["survived"] + n["timeout"]
-        other = sum(n.values()) - reached - n["no tests"] - n["not checked"]
+        total = sum(v for k, v in n.items() if k != "fresh")
+        other = total - reached - n["no tests"] - n["not checked"]
         rate = f"{100 * n['killed'] / reached:.0f} %" if reached else "–"
-        lines.append(f"| `{module}` | `{tests}` | {sum(n.values())} | {n['killed']} | {n['survived']} | "
-                     f"{n['timeout']} | {n['no tests']} | {n['not checked']} | {other} | {rate} |")
-    for module, _, _, survivors in found:
+        killed = f"{n['killed']} ({n['fresh']})" if n["fresh"] else f"{n['killed']}"
+        lines.append(f"| `{module}` | `{tests}` | {total} | {killed} | {n['survived']} | "
+                     f"{n['timeout']} | {n['no tests']} | {n['not checked']} | {other} | {rate} | {when} |")
+    for module, (_, _, survivors, _) in merged.items():
         lines += ["", f"Survivors in `{module}` (the line before → after; why it is equivalent or acceptable):", ""]
         lines += [f"- `{name}`: `{change}`: " + (explain(module, name, change) or "**flagged**: not explained")
                   for name, change in survivors] or ["- none"]
-    flagged = sum(explain(m, n, c) is None for m, _, _, s in found for n, c in s)
+    flagged = sum(explain(m, n, c) is None for m, (_, _, s, _) in merged.items() for n, c in s)
     lines += ["", f"Survivors not explained (flagged): {flagged}."]
     out.write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("\n".join(lines))
@@ -425,16 +541,19 @@ def main(argv=None):
     parser.add_argument("--work", help="with --mutmut: keep the scratch copies here, and resume from them")
     parser.add_argument("--budget", type=float, default=60.0,
                         help="with --mutmut: minutes for the theorem modules' scope (0: only collect)")
+    parser.add_argument("--fresh", type=float, default=0.0,
+                        help="with --mutmut: minutes to run survivors of import-time functions again, each "
+                             "in a fresh process with the mutant on from the start")
     parser.add_argument("--mutants", nargs="*", default=(),
-                        help="with --mutmut: run only the theorem modules' mutants matching these globs "
-                             "(e.g. 'proofs.kink_loci.*')")
+                        help="with --mutmut: run only the mutants matching these globs, and only the "
+                             "scopes they name (e.g. 'proofs.kink_loci.*')")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "mutation_audit.md"))
     args = parser.parse_args(argv)
     if args.mutmut:
         work, started = Path(args.work or tempfile.mkdtemp(prefix="mutation-audit-")), time.time()
         work.mkdir(parents=True, exist_ok=True)
         try:
-            found = run_mutmut(work, args.budget, args.mutants)
+            found = run_mutmut(work, args.budget, args.mutants, args.fresh)
         finally:
             if not args.work:
                 shutil.rmtree(work, ignore_errors=True)

@@ -33,7 +33,7 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Identity, Theorem, Verdict, check_identities
-from .frame import CHART_RATES
+from .frame import CHART_RATES, U_OF_THETA, V_OF_PHI
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, beta = sp.symbols("R beta", positive=True)
@@ -57,7 +57,14 @@ CHART_COEFFS = tuple(c.subs({H_t: F.h_u * CHART_RATES[0], H_p: F.h_v * CHART_RAT
 #: The renderer's coefficients of bump="surface" (`renderer.formulas.BUMP`) away from
 #: the pole cut-off, where its floor max(sin phi, POLE_SIN_PHI) is sin phi.
 _FLOOR = sp.Max(F.sin_phi, F.POLE_SIN_PHI)
-KERNEL_COEFFS = tuple(b.subs(_FLOOR, F.sin_phi) for b in F.BUMP["surface"])
+
+
+def away_from_pole(bump):
+    """A bump's coefficients (b_u, b_v) with the pole floor max(sin_phi, POLE_SIN_PHI) read as sin_phi."""
+    return tuple(b.subs(_FLOOR, F.sin_phi) for b in bump)
+
+
+KERNEL_COEFFS = away_from_pole(F.BUMP["surface"])
 KERNEL_DOMAIN = {F.beta: (0.0, 2.0), F.R: (0.5, 2.0), F.h: (-1.0, 1.0), F.h_u: (-30.0, 30.0),
                  F.h_v: (-30.0, 30.0), F.sin_phi: (0.001, 1.0)}
 
@@ -72,62 +79,99 @@ DOMAIN = {theta: (-3.0, 3.0), phi: (0.1, 3.0), R: (0.5, 2.0), beta: (0.0, 0.3),
           a: (1.0, 4.0), b: (1.0, 4.0)}
 
 
+#: Which sphere P = (R + beta G) N has the seed's bump (`renderer.formulas.BUMP["chart"]`) as
+#: its normal to first order in beta?  Its gradient (G_theta, G_phi), solved from COEFFS's first
+#: order (H -> G) against the chart bump's coefficients in angular terms (h_u = H_theta / (du/dtheta),
+#: h_v = H_phi / (dv/dphi), the chart's rates of theorem `chart`).
+_G_t, _G_p = sp.symbols("G_theta G_phi")
+_SEED_ANGULAR = tuple(b.subs(F.beta, 1).subs({F.h_u: H_t / CHART_RATES[0], F.h_v: H_p / CHART_RATES[1]})
+                      for b in F.BUMP["chart"])
+SEED_DISPLACEMENT = tuple(sp.solve([sp.diff(c, beta).subs(beta, 0).subs({H_t: _G_t, H_p: _G_p}) - s_
+                                    for c, s_ in zip(COEFFS, _SEED_ANGULAR)], [_G_t, _G_p], dict=True)[0][g]
+                          for g in (_G_t, _G_p))
+#: G exists only where its gradient is curl-free: d/dphi G_theta - d/dtheta G_phi = 0.
+CURL = sp.diff(SEED_DISPLACEMENT[0], phi) - sp.diff(SEED_DISPLACEMENT[1], theta)
+#: The statement's obstruction, for a general H; CURL is -pi R times it (an identity of the check).
+OBSTRUCTION = 2 * sp.cos(phi) * H_t + (2 * sp.sin(phi) - 1) * sp.diff(H_t, phi)
+INTEGRABLE = ("rings",)
+
+
+def _angular(field):
+    """The field's height h(u, v) at the chart's (u, v) of (theta, phi), k_u and k_v symbolic."""
+    return F.HEIGHT[field].subs({F.u: U_OF_THETA, F.v: V_OF_PHI})
+
+
 def integrability_obstruction(field):
-    """2 cos(phi) h_theta + (2 sin(phi) - 1) h_theta_phi for a field, in (theta, phi)."""
-    h = F.HEIGHT[field].subs({F.u: (theta + sp.pi) / (2 * sp.pi), F.v: phi / sp.pi})
-    h_t = sp.diff(h, theta)
-    return sp.simplify(2 * sp.cos(phi) * h_t + (2 * sp.sin(phi) - 1) * sp.diff(h_t, phi))
+    """`OBSTRUCTION`, 2 cos(phi) h_theta + (2 sin(phi) - 1) h_theta_phi, for a field of
+    `renderer.formulas.HEIGHT` (sympy expression in theta, phi, k_u, k_v): zero exactly
+    when the seed's bump on that field is the first-order normal of a displaced sphere."""
+    return sp.simplify(OBSTRUCTION.subs(H, sp.Lambda((theta, phi), _angular(field))).doit())
 
 
-def surface_normal_residual(fields=("sine", "ridges", "rings")):
-    """(worst |N'_renderer - N'_exact|, pixels compared, pixels left out) for bump='surface'.
+#: The displaced sphere in the chart's coordinates: P(u, v) = (R + beta h(u, v)) N(theta(u), phi(v)),
+#: theta(u) and phi(v) solved from theorem `chart`'s u(theta), v(phi).
+_THETA_OF_U = sp.solve(sp.Eq(U_OF_THETA, F.u), theta)[0]
+_PHI_OF_V = sp.solve(sp.Eq(V_OF_PHI, F.v), phi)[0]
+
+
+def surface_normal_residual(fields=("sine", "ridges", "rings"), bump="surface"):
+    """(worst |N'_renderer - N'_exact|, pixels compared, pixels left out) for the renderer's
+    `bump` (default 'surface', the one claimed to be the displaced normal).
 
     The pixels are `proofs.pixels.pixels` (seeded: full frame, pole ring at zoom 300 and
-    3e4, crease neighbours) of each field.  N'_exact normalises P_phi x P_theta of
-    P = (R + beta h) N at the pixel's (theta, phi) = (2 pi u - pi, pi v), in mpmath at
-    `pixels.DIGITS` digits; N'_renderer is the G-buffer's Ns.  Pixels with
-    sin phi <= `formulas.POLE_SIN_PHI`, where the renderer floors sin phi by design,
-    are left out (and counted).
+    3e4, crease neighbours) of each field.  N'_exact normalises P_v x P_u of
+    P(u, v) = (R + beta h(u, v)) N(theta(u), phi(v)) at the pixel's (u, v), in mpmath at
+    `pixels.DIGITS` digits (P_v x P_u = (dtheta/du)(dphi/dv) P_phi x P_theta, an outward
+    normal); N'_renderer is the G-buffer's Ns.  Pixels with sin phi <= `formulas.POLE_SIN_PHI`,
+    where the renderer floors sin phi by design, are left out (and counted).
     """
     from .pixels import DIGITS, pixels
     worst, compared, left_out = 0.0, 0, 0
     for field in fields:
-        scene, px = pixels(field, "exact", "surface")
-        h_expr = F.HEIGHT[field].subs({F.k_u: scene.k_u, F.k_v: scene.k_v,
-                                       F.u: (theta + sp.pi) / (2 * sp.pi), F.v: phi / sp.pi})
-        P = (scene.radius_a + scene.beta * h_expr) * N
-        fn = sp.lambdify((theta, phi), list(sp.diff(P, phi).cross(sp.diff(P, theta))), modules="mpmath")
-        for (uu, vv), got in zip(px["uv"], px["Ns"]):
-            if np.sin(np.pi * vv) <= float(F.POLE_SIN_PHI):
-                left_out += 1
-                continue
+        scene, px = pixels(field, "exact", bump)
+        P = (scene.radius_a + scene.beta * F.HEIGHT[field].subs({F.k_u: scene.k_u, F.k_v: scene.k_v})) \
+            * N.subs({theta: _THETA_OF_U, phi: _PHI_OF_V}, simultaneous=True)
+        fn = sp.lambdify((F.u, F.v), list(sp.diff(P, F.v).cross(sp.diff(P, F.u))), modules="mpmath")
+        keep = np.sin(np.pi * px["uv"][:, 1]) > float(F.POLE_SIN_PHI)
+        compared, left_out = compared + int(np.count_nonzero(keep)), left_out + int(np.count_nonzero(~keep))
+        for (uu, vv), got in zip(px["uv"][keep], px["Ns"][keep]):
             with mpmath.workdps(DIGITS):
-                c = fn(2 * mpmath.pi * mpmath.mpf(float(uu)) - mpmath.pi, mpmath.pi * mpmath.mpf(float(vv)))
+                c = fn(mpmath.mpf(float(uu)), mpmath.mpf(float(vv)))
                 n = mpmath.sqrt(sum(x * x for x in c))
                 worst = max(worst, max(float(abs(mpmath.mpf(float(gk)) - ck / n)) for gk, ck in zip(got, c)))
-            compared += 1
     return worst, compared, left_out
 
 
-def _check(claim, kernel=KERNEL_COEFFS):
-    if any(b.has(_FLOOR) for b in kernel):
-        return Verdict("refuted", "the surface bump's pole floor max(sin_phi, POLE_SIN_PHI) was not "
-                       "found in renderer.formulas.BUMP['surface']")
-    symbolic = check_identities([Identity("P_phi x P_theta", CROSS, claim, DOMAIN, INSTANCE)]
-                                + _kernel_identities(kernel))
+def _check(claim, kernel=KERNEL_COEFFS, integrable=INTEGRABLE, bump="surface"):
+    """The theorem's check: the cross product `claim`, the renderer's surface-bump coefficients
+    `kernel` (pole floor read away), which fields' seed bump is a displacement's normal
+    (`integrable`), and the rendered normals of `bump` against the displaced surface's."""
+    if any(b.has(sp.Max) for b in kernel):
+        return Verdict("refuted", f"a floor other than max(sin_phi, POLE_SIN_PHI) in the surface bump: {kernel}")
+    rings = _angular("rings")
+    symbolic = check_identities(
+        [Identity("P_phi x P_theta", CROSS, claim, DOMAIN, INSTANCE)] + _kernel_identities(kernel)
+        + [Identity("curl of the seed's G", CURL, -sp.pi * R * OBSTRUCTION, DOMAIN, INSTANCE),
+           Identity("G_theta (rings)", SEED_DISPLACEMENT[0].subs(H, sp.Lambda((theta, phi), rings)).doit(),
+                    sp.diff(-sp.pi * R * rings, theta), DOMAIN),
+           Identity("G_phi (rings)", SEED_DISPLACEMENT[1].subs(H, sp.Lambda((theta, phi), rings)).doit(),
+                    sp.diff(-sp.pi * R * rings, phi), DOMAIN)])
     if not symbolic.holds:
         return symbolic
     obstruction = {f: integrability_obstruction(f) for f in ("sine", "ridges", "rings")}
-    if obstruction["rings"] != 0 or obstruction["sine"] == 0 or obstruction["ridges"] == 0:
-        return Verdict("refuted", f"integrability obstructions {obstruction}")
-    worst, compared, left_out = surface_normal_residual()
+    found = tuple(f for f, o in obstruction.items() if o == 0)
+    if set(found) != set(integrable):
+        return Verdict("refuted", f"the seed's bump is a displaced sphere's normal for {found or 'no field'}, "
+                       f"not {integrable}: integrability obstructions {obstruction}")
+    worst, compared, left_out = surface_normal_residual(bump=bump)
     if worst > 1e-12:
-        return Verdict("refuted", f"renderer's bump='surface' normal differs from the displaced "
-                       f"surface's by {worst:.2e}")
+        return Verdict("refuted", f"renderer's bump={bump!r} normal differs from the displaced "
+                       f"surface's by {worst:.2e}", worst, rendered=compared)
     return Verdict(symbolic.status,
-                   f"{symbolic.evidence} (the cross product, and renderer.formulas.BUMP['surface'] "
-                   f"against its chart form); obstruction is 0 for rings, nonzero for sine and ridges "
-                   f"(the seed's bump is the normal of no displaced sphere for those); "
+                   f"{symbolic.evidence} (the cross product, renderer.formulas.BUMP['surface'] "
+                   f"against its chart form, and the curl of the G whose sphere has the seed's bump as "
+                   f"normal, G = -pi R h for rings); obstruction is 0 for {', '.join(found)} only (the "
+                   f"seed's bump is the normal of no displaced sphere for the others); "
                    f"renderer's bump='surface' Ns within {worst:.1e} of the displaced normal (mpmath, "
                    f"{compared} seeded sphere-A pixels of the three fields, pole ring and crease neighbours "
                    f"included; {left_out} inside the pole floor sin phi <= {float(F.POLE_SIN_PHI):g} left out)",
@@ -155,6 +199,13 @@ BUMP_VS_DISPLACEMENT = Theorem(
     check=lambda: _check(CLAIM),
     wrong_variants=(("the renderer's chart bump (the seed's) as the displaced normal's coefficients",
                      lambda: _check(CLAIM, kernel=F.BUMP["chart"])),
+                    ("a surface bump floored at sin phi = 1e-3, not POLE_SIN_PHI",
+                     lambda: _check(CLAIM, kernel=away_from_pole(
+                         tuple(b.subs(F.POLE_SIN_PHI, sp.Float(1e-3)) for b in F.BUMP["surface"])))),
+                    ("the seed's bump the normal of a displaced sphere for every field",
+                     lambda: _check(CLAIM, integrable=("sine", "ridges", "rings"))),
+                    ("the renderer's bump='chart' normals as the displaced surface's",
+                     lambda: _check(CLAIM, bump="chart")),
                     ("the seed's reading: the bump is the displaced normal (+ sign, no metric)",
                      lambda: _check((R + beta * H(theta, phi)) ** 2 * sp.sin(phi)
                                     * (N + beta * (2 * sp.pi * H_t * e_theta + sp.pi * H_p * e_phi)))),),

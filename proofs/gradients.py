@@ -8,6 +8,7 @@ closed forms they are checked against are typed here from seed §3.
 """
 
 import random
+from functools import partial
 
 import mpmath
 import sympy as sp
@@ -71,30 +72,31 @@ GENERATED_TOLERANCE = 1e-13
 
 
 def _gradient_check(name, closed_form, corrupt=None):
-    def check():
-        identities = [Identity(f"h_u ({name})", F.GRADIENT[name][0], closed_form[0], DOMAIN),
-                      Identity(f"h_v ({name})", F.GRADIENT[name][1], closed_form[1], DOMAIN)]
-        symbolic = check_identities(identities)
-        if not symbolic.holds:
-            return symbolic
-        worst = generated_code_residual(name, closed_form)
-        if worst > GENERATED_TOLERANCE:
-            return Verdict("refuted", f"generated (compiled) gradient differs from the closed form by "
-                           f"{worst:.2e} (relative to pi max(k_u, 2 k_v))", worst, DIGITS, POINTS)
-        # The renderer's own gradients (GBuffer.grad) at its own (u, v) (proofs/pixels.py).
-        from .pixels import gradient_error
-        rendered = {method: gradient_error(name, method, corrupt) for method in ("exact", "central", "footprint")}
-        if max(r for r, _ in rendered.values()) > 1:
-            return Verdict("refuted", "the renderer's gradient leaves its tolerance by "
-                           + ", ".join(f"{m} {r:.2g}x" for m, (r, _) in rendered.items()))
-        return Verdict(symbolic.status, f"renderer.formulas.GRADIENT: {symbolic.evidence}; "
-                       f"the kernel's generated code within "
-                       f"{worst:.1e} of mpmath ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
-                       f"footprint gradients (GBuffer.grad) at {rendered['exact'][1]} seeded sphere-A pixels within "
-                       f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
-                       "of their tolerances against GRADIENT, CENTRAL (stencil included) and CENTRAL with "
-                       "FOOTPRINT's steps at its (u, v)", worst, DIGITS, POINTS, rendered["exact"][1])
-    return check
+    """The check of theorem gradient-<name> against `closed_form` (h_u, h_v); `corrupt` alters the
+    renderer's gradients first (a wrong variant).  Theorems bind it with functools.partial, so that it
+    runs when checked, not when the module is imported."""
+    identities = [Identity(f"h_u ({name})", F.GRADIENT[name][0], closed_form[0], DOMAIN),
+                  Identity(f"h_v ({name})", F.GRADIENT[name][1], closed_form[1], DOMAIN)]
+    symbolic = check_identities(identities)
+    if not symbolic.holds:
+        return symbolic
+    worst = generated_code_residual(name, closed_form)
+    if worst > GENERATED_TOLERANCE:
+        return Verdict("refuted", f"generated (compiled) gradient differs from the closed form by "
+                       f"{worst:.2e} (relative to pi max(k_u, 2 k_v))", worst, DIGITS, POINTS)
+    # The renderer's own gradients (GBuffer.grad) at its own (u, v) (proofs/pixels.py).
+    from .pixels import gradient_error
+    rendered = {method: gradient_error(name, method, corrupt) for method in ("exact", "central", "footprint")}
+    if max(r for r, _ in rendered.values()) > 1:
+        return Verdict("refuted", "the renderer's gradient leaves its tolerance by "
+                       + ", ".join(f"{m} {r:.2g}x" for m, (r, _) in rendered.items()))
+    return Verdict(symbolic.status, f"renderer.formulas.GRADIENT: {symbolic.evidence}; "
+                   f"the kernel's generated code within "
+                   f"{worst:.1e} of mpmath ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
+                   f"footprint gradients (GBuffer.grad) at {rendered['exact'][1]} seeded sphere-A pixels within "
+                   f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
+                   "of their tolerances against GRADIENT, CENTRAL (stencil included) and CENTRAL with "
+                   "FOOTPRINT's steps at its (u, v)", worst, DIGITS, POINTS, rendered["exact"][1])
 
 
 def _theorem(name):
@@ -107,10 +109,10 @@ def _theorem(name):
                    r"generated code evaluates them to float64 accuracy."),
         steps=((r"h_u", sp.Derivative(F.HEIGHT[name], u), F.GRADIENT[name][0]),
                (r"h_v", sp.Derivative(F.HEIGHT[name], v), F.GRADIENT[name][1])),
-        check=_gradient_check(name, PRINTED[name]),
-        wrong_variants=((description, _gradient_check(name, wrong)),
+        check=partial(_gradient_check, name, PRINTED[name]),
+        wrong_variants=((description, partial(_gradient_check, name, wrong)),
                         ("the kernel's h_u and h_v swapped",
-                         _gradient_check(name, PRINTED[name], corrupt=lambda g: g[:, ::-1]))),
+                         partial(_gradient_check, name, PRINTED[name], corrupt=lambda g: g[:, ::-1]))),
         pages=("s3", "s5"),
     )
 

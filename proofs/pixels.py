@@ -158,7 +158,7 @@ def normal_error(field, bump, corrupt=None):
     return float(np.max(np.abs(Ns - ref))), Ns.shape[0]
 
 
-def footprint_error(half=0.5, size=96):
+def footprint_error(half, size=96):
     """Worst relative difference between the kernel's footprint steps
     (`formulas.FOOTPRINT` through `renderer.pointwise.footprint`) and pbrt-v4's
     bump rule written here: the rays through the next column and row meet the
@@ -167,9 +167,10 @@ def footprint_error(half=0.5, size=96):
     dP/dv = pi R e_phi (the chart's rates, theorem `chart`), and du = ``half``
     (|du/dx| + |du/dy|) (``BumpMap``), with the fallback and the cap of
     `formulas.FOOTPRINT`; over the sphere-A pixels of the default frame (size²)
-    and of a pole zoom; and the count."""
+    and of a pole zoom, with sphere A's radius 0.8 (not 1, so that a lost factor R
+    shows); and the count."""
     from renderer import pointwise
-    scene = Scene()
+    scene = Scene(radius_a=0.8)
     e, R = scene.camera_z, scene.radius_a
     fallback, cap, limit = (float(c) for c in (F.FOOTPRINT_FALLBACK, F.FOOTPRINT_MAX, F.FOOTPRINT_LIMIT))
     worst, count = 0.0, 0
