@@ -97,8 +97,10 @@ def _numeric_residual(identity: Identity, seed: int, points: int, digits: int):
         for _ in range(points):
             point = {s: mpmath.mpf(rng.uniform(*identity.domain[s])) for s in free}
             r = abs(fn(*[point[s] for s in free]))
-            if r > worst or where is None:
+            if not r <= worst or where is None:     # NaN is the worst residual
                 worst, where = r, point
+                if mpmath.isnan(r):
+                    break
     return float(worst), where
 
 
@@ -129,7 +131,7 @@ def check_identities(identities, *, seed=0, points=POINTS, digits=DIGITS) -> Ver
     undecided = []
     for i, comp in enumerate(components):
         r, at = _numeric_residual(comp, seed + 1000 + i, 3, digits)
-        if r >= tolerance:
+        if not r < tolerance:                       # a NaN residual refutes as well
             return refuted(r, comp.label, at)
         if not _exactly_zero(comp.lhs - comp.rhs):
             undecided.append(comp)
@@ -138,7 +140,7 @@ def check_identities(identities, *, seed=0, points=POINTS, digits=DIGITS) -> Ver
     worst, worst_label, worst_at = 0.0, None, None
     for i, comp in enumerate(undecided):
         r, at = _numeric_residual(comp, seed + i, points, digits)
-        if r >= worst:
+        if not r < worst:                           # NaN included: it is kept, and refutes
             worst, worst_label, worst_at = r, comp.label, at
     if worst < tolerance:
         return Verdict("verified",

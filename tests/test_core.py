@@ -130,6 +130,13 @@ def test_an_undefined_function_is_sampled_through_its_instances():
     assert check_identities([wrong]).status == "refuted"
 
 
+def test_a_residual_that_is_not_a_number_refutes():
+    # Sides that evaluate to NaN (0/0 in a broken formula) must not pass as a residual of 0.
+    nan = Identity("nan", h(x), 0, {x: (0.5, 2)}, {h: sp.Lambda(x, sp.nan)})
+    assert check_identities([nan]).status == "refuted"
+    assert check_identities([Identity("true", sp.sin(x) ** 2 + sp.cos(x) ** 2, 1, {x: (0, 1)}), nan]).status == "refuted"
+
+
 def test_the_numbers_are_seeded():
     ident = Identity("arctangents", sp.atan(x) + sp.atan(1 / x), sp.pi / 2 + sp.Float(1e-3) * x, {x: (0.1, 10)})
     a, b = core._numeric_residual(ident, 7, 5, 30), core._numeric_residual(ident, 7, 5, 30)
