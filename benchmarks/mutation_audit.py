@@ -306,6 +306,271 @@ MUTMUT_EXPLAINED += (
     ("proofs/finite_difference.py", r"sp\.latex\(None\)",
      "the verdict's evidence text, for a reader of the ledger; the status it carries is unchanged"),
 )
+MUTMUT_EXPLAINED += (
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: def footprint_error\(half=0\.5, size=96\): → .*half=1\.5",
+     "fixed since this run: footprint_error's half has no default any more (its only caller passes it)"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: .*(size=97\)|zoom in \((2\.0|1\.0), (300|301)\.0\)|"
+     r"gbuffer\(scene, size, size, \))",
+     "another frame or zoom: an equally valid sample of sphere-A pixels (the kernel and the rule agree on every "
+     "pixel of each)"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: .*\"IJ,IJ->I\"",
+     "equivalent: einsum's subscripts are letters of either case"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: .*lstsq\(a, b, \)",
+     "equivalent: the 3x2 systems have full rank, and rcond only drops singular values below its cutoff"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: .*np\.where\(\((s >= 0|s > 0)\) [&|] \((s <= limit|s < limit)\)"
+     r", np\.minimum\(s, cap\), (fallback|None)\)\)$",
+     "differs only for a footprint step exactly 0 or at least FOOTPRINT_LIMIT (1e8), which no sphere-A pixel "
+     "of these frames has"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: .*np\.abs\(have - want\) \* want",
+     "scales the difference by the step (at most 0.25) instead of dividing by it: a kernel off by 1e-9 relative "
+     "on any step above the fallback (5e-4) still fails"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: (count \+= int\(x\.size\) → count = |worst, count = 0\.0, 0 → )",
+     "the evidence's pixel count: still above its pinned least count (registry.RENDERED); the comparison is "
+     "unchanged"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: dx, dy = g\.x\[1\] - g\.x\[0\], g\.y\[0\] - g\.y\[1\] → ",
+     "the pixel spacing is an input to both the kernel and the rule, which agree for any spacing; the spacing "
+     "the renderer passes is checked through its footprint gradients (theorems gradient-*)"),
+    ("proofs/pixels.py", r"x_footprint_error__mutmut_\d+: dpdu, dpdv = .* → .*(np\.pi / R \* sin_phi|np\.pi / R \* ep)",
+     "fixed since this run: footprint_error runs at R = 0.8, where a lost factor R gives a relative error of 0.56"),
+    ("proofs/frame.py", r"x_vector_latex__", "the statement's typesetting (sp.latex of the checked vectors); the "
+     "checks compare the expressions, and no check reads the LaTeX back"),
+    ("proofs/blinn.py", r"x__tex__|x__slopes_tex__", "the statement's typesetting (sp.latex of the checked slopes); "
+     "the checks compare the expressions, and no check reads the LaTeX back"),
+    ("proofs/normal.py", r"x_tilt_latex__", "the statement's typesetting (sp.latex of the checked tilt); the "
+     "checks compare the expressions, and no check reads the LaTeX back"),
+    ("proofs/frame.py", r"x__chart_identities__mutmut_\d+: .*RATES_CLAIMED\[[01]\], (None|)\),$",
+     "the sampling domain, used only if sympy cannot decide the identity, which it does"),
+)
+MUTMUT_EXPLAINED += (
+    ("proofs/gradients.py", r"x_generated_code_residual__mutmut_\d+: (.*seed=1, points|.*Random\(None\)|taken = 0 → "
+     r"taken = 1|taken \+= 1 → taken \+= 2|while taken < points: → while taken <= points:|.*rng\.uniform\((0\.5|1\.5), (12|13)\.0\), "
+     r"rng\.uniform\((0\.5|1\.5), (12|13)\.0\)$)",
+     "another seed, another number of points, or k drawn from a slightly other range: an equally valid sample"),
+    ("proofs/gradients.py", r"x_generated_code_residual__mutmut_\d+: (if name == \"ridges\" and .* → if name (!= \"ridges\""
+     r"|== \"XXridgesXX\"|== \"RIDGES\")|.*mpmath\.pi (\*|/) k[uv] (\*|/) [uv]{2}\)+ <?=? ?(< )?1e-9:?|.* < 1e-9: → .* <= 1e-9:)",
+     "which points near a ridges crease are skipped (or also skipped for the smooth fields): another valid sample, "
+     "where the float64 sign factor is decided"),
+    ("proofs/gradients.py", r"x_generated_code_residual__mutmut_\d+: .* → .*mpmath\.pi (\*|/) ku (\*|/) uu\)\),$",
+     "which points near a ridges crease are skipped: another valid sample, where the float64 sign factor is "
+     "decided"),
+    ("proofs/gradients.py", r"x_generated_code_residual__mutmut_\d+: continue → break",
+     "stops the sample at the first point near a ridges crease: fewer points, each within the tolerance "
+     "(the renderer's own gradients are compared at hundreds of pixels after this)"),
+    ("proofs/gradients.py", r"x_generated_code_residual__mutmut_\d+: scale = mpmath\.pi \* max\(ku, 2 \* kv\) → ",
+     "another normalising scale for the error (within a factor 48 of this one): float64 errors of a few "
+     "units of roundoff stay far inside the 1e-13 tolerance, and a wrong formula far outside"),
+    ("proofs/displacement.py", r"x__check__mutmut_\d+: .*Identity\(\"G_theta \(rings\)\".*|.*sp\.diff\((-sp\.pi \* R / rings|"
+     r"-sp\.pi / R \* rings|\+sp\.pi \* R \* rings), theta\)",
+     "equivalent: the rings field does not depend on theta, so any multiple of it has theta-derivative 0"),
+    ("proofs/displacement.py", r"x__check__mutmut_\d+: .*sp\.diff\(-sp\.pi \* R \* rings, (theta|phi)\), (None|)\)",
+     "the sampling domain, used only if sympy cannot decide the identity, which it does"),
+    ("proofs/displacement.py", r"x__check__mutmut_\d+: .*\{found (or|and) '(no field|XXno fieldXX|NO FIELD)'\}|"
+     r"'XX, XX'\.join\(found\)",
+     "the verdict's evidence text, for a reader of the ledger; the status it carries is unchanged"),
+    ("proofs/displacement.py", r"x__check__mutmut_\d+: .*by \{worst:\.2e\}\", (worst|None), (rendered=(compared|None)|)\)$",
+     "a refutation's residual and renderer count, which nothing reads: a refuted theorem fails the build "
+     "whatever they are"),
+    ("proofs/displacement.py", r"x__kernel_identities__mutmut_\d+: .*CHART_COEFFS\[1\], (None|)\)\]$",
+     "the sampling domain of b_v's identity, used only if sympy cannot decide it, which it does"),
+    ("proofs/displacement.py", r"x_surface_normal_residual__mutmut_\d+: def .* → .*bump=\"(XXsurfaceXX|SURFACE)\"\):$",
+     "fixed since this run: surface_normal_residual's bump and gradient have no defaults (its only caller "
+     "passes them)"),
+    ("proofs/displacement.py", r"x__check__mutmut_\d+: if worst > 1e-12: → if worst > 1\.000000000001:",
+     "fixed since this run: a new wrong variant, the central-difference pipeline's surface normals, differs "
+     "by 0.41 and is refuted only with the 1e-12 threshold"),
+    ("proofs/displacement.py", r"x__check__mutmut_\d+: .*by \{worst:\.2e\}\", worst, rendered=compared\) → "
+     r".*by \{worst:\.2e\}\", rendered=compared\)$",
+     "a refutation's residual, which nothing reads: a refuted theorem fails the build whatever it is"),
+    ("proofs/displacement.py", r"x__check__mutmut_\d+: if worst > 1e-12: → if worst >= 1e-12:",
+     "differs only when the worst difference is exactly 1e-12"),
+    ("proofs/displacement.py", r"x_surface_normal_residual__mutmut_\d+: .*simultaneous=(None|False)\)$|"
+     r"_PHI_OF_V\}, \)$",
+     "equivalent: theta(u) and phi(v) contain neither theta nor phi, so one substitution after the other "
+     "is the simultaneous one"),
+    ("proofs/displacement.py", r"x_surface_normal_residual__mutmut_\d+: .*> float\(F\.POLE_SIN_PHI\) → .*>= float",
+     "differs only for a pixel with sin phi exactly POLE_SIN_PHI"),
+    ("proofs/displacement.py", r"x_surface_normal_residual__mutmut_\d+: (.*left_out [-+] int\(np\.count_nonzero\((None|keep)\)\)"
+     r"|.*left_out - int|worst, compared, left_out = 0\.0, [01], [01] → )",
+     "the counts in the evidence (pixels left out inside the pole floor; compared, still above the pinned "
+     "least count, registry.RENDERED); the comparison is unchanged"),
+)
+MUTMUT_EXPLAINED += (
+    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .* → (rf\"\$h_u = \{sp\.latex\((None|hu)\)\}\$ and \$h_v = \{sp\.latex\((None|hv)"
+     r"\)\}\$|\s*r\"(XXgenerated code evaluates them to float64 accuracy\.XX|GENERATED CODE EVALUATES THEM TO FLOAT64 "
+     r"ACCURACY\.)\"\),|statement=\(rf\"For \$h = \{sp\.latex\(None\)\}\$: \")",
+     "the statement's typesetting (sp.latex of the checked expressions); the checks compare the expressions, and "
+     "no check reads the LaTeX back"),
+    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .* → .*\(r\"(H_U|XXh_uXX|H_V|XXh_vXX)\", sp\.Derivative",
+     "a step's caption in the book; the step's two sides are checked (test_a_step_the_book_shows_holds)"),
+    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .* → \s*\(\"(THE KERNEL'S H_U AND H_V SWAPPED|XXthe kernel's h_u and "
+     r"h_v swappedXX)\",",
+     "a wrong variant's description, the test's name; the variant itself is unchanged"),
+    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .* → \s*pages=\(\"(S3|XXs3XX|s3)\", \"(s5|S5|XXs5XX)\"\),$",
+     "the page names in the theorem's ledger record; the pages place their theorems by id"),
+)
+MUTMUT_EXPLAINED += (
+    ("proofs/finite_difference.py",
+     r"x__border_rule__mutmut_\d+: (u_p = .* → u_p = u \+ eps - 1 if u \+ eps > 1 else u \+ eps|"
+     r"u_m = .* → u_m = u - eps \+ 1 if u - eps <= 0 else u - eps|"
+     r"return .* → .*\((v \+ eps >= 1 or v - eps < 0|v \+ eps > 1 or v - eps <= 0)\) else 2 \* eps)$",
+     "differs only where u + eps, u - eps, v + eps or v - eps is exactly 1 or 0 in float64, which none of the "
+     "2,000 seeded border points is (and for v both branches then give the same distance, 2 eps)"),
+    ("proofs/finite_difference.py",
+     r"x__border_rule__mutmut_\d+: return .* → .*\((v \+ eps > 1 or v - eps < 0\) or True|"
+     r"v \+ eps > 1 or v - eps < 1\)) else 2 \* eps$",
+     "the rule then divides by v_p - v_m everywhere (v - eps < 1 holds for every v in [0, 1]), which away from "
+     "the v borders is 2 eps up to rounding, about 1e-10 relative at the smallest step (1e-6), inside the "
+     "quotient's 1e-9 tolerance"),
+    ("proofs/finite_difference.py",
+     r'x__check_truncation__mutmut_\d+: "clamp v and divide by the clamped distance"\) → '
+     r'"(XXclamp v and divide by the clamped distanceXX|CLAMP V AND DIVIDE BY THE CLAMPED DISTANCE)"\)$',
+     "the border refutation's evidence text, for a reader of the ledger; the status it carries is unchanged"),
+    ("proofs/finite_difference.py",
+     r"x__check_truncation__mutmut_\d+: if fp > 1e-9: → if fp >= 1e-9:$",
+     "differs only for a footprint error of exactly 1e-9; the kernel's is about 1e-13 and the wrong variant's 0.5"),
+    ("proofs/finite_difference.py",
+     r"x__check_truncation__mutmut_\d+: verdict\.residual, verdict\.digits, verdict\.points, pixels\) → "
+     r"(None, verdict\.digits, verdict\.points|verdict\.residual, None, verdict\.points|"
+     r"verdict\.residual, verdict\.digits, None), pixels\)$",
+     "the identities are proved (the pinned verdict), so their residual, digits and points are None already; "
+     "the status and the pixel count are unchanged"),
+    ("proofs/finite_difference.py",
+     r'x__kernel_identities__mutmut_\d+: return \[Identity\(rf"\\text\{\{CENTRAL\[\{name\}\]\}\}_\{var\}", '
+     r"(.*) → return \[Identity\(None, \1$",
+     "an identity's label: it names the component in a refutation's evidence; the check compares lhs and rhs only"),
+    ("proofs/finite_difference.py",
+     r"(x__kernel_identities__mutmut_\d+: def _kernel_identities\(denominator=2\): → "
+     r"def _kernel_identities\(denominator=3\):|x_quotient__mutmut_\d+: def quotient\(h, var, denominator=2\): → "
+     r"def quotient\(h, var, denominator=3\):)$",
+     "fixed since this run: the default was never used (every call passes the denominator) and is gone"),
+    ("proofs/finite_difference.py",
+     r"x_central_series__mutmut_\d+: return sp\.series\(q, eps, 0, order\)\.removeO\(\)\.doit\(\) → "
+     r"return sp\.series\(q, eps, (None, order|0, )\)\.removeO\(\)\.doit\(\)$",
+     "equivalent: sympy's Expr.series expands about 0 when x0 is falsy (None), and its default order n is 6, "
+     "which is ORDER"),
+    ("proofs/finite_difference.py",
+     r"x_interior__mutmut_\d+: .*lambda e: e\.args\[-1\]\.expr\) → .*lambda e: e\.args\[\+1\]\.expr\)$",
+     "equivalent: every Piecewise of the kernel's stencil points and v-denominator has two branches, so args[1] "
+     "is args[-1]"),
+    ("proofs/finite_difference.py",
+     r"x_border_mismatches__mutmut_\d+: (def border_mismatches\(samples=2000, seed=12, rule=_border_rule\): → "
+     r"def border_mismatches\((samples=2001, seed=12|samples=2000, seed=13), rule=_border_rule\):|"
+     r"rng = random\.Random\(seed\) → rng = random\.Random\(None\))$",
+     "one more point, or another seed or none: an equally valid sample of border points, at each of which the "
+     "kernel matches the rule, and where every border variant is still refuted"),
+    ("proofs/finite_difference.py",
+     r"x_interior_branch_mismatches__mutmut_\d+: (def interior_branch_mismatches\(samples=2000, seed=11\): → "
+     r"def interior_branch_mismatches\((samples=2001, seed=11|samples=2000, seed=12)\):|"
+     r"rng = random\.Random\(seed\) → rng = random\.Random\(None\))$",
+     "one more point, or another seed or none: an equally valid sample of interior points, every one of which "
+     "is compared and takes the interior branch"),
+    ("proofs/finite_difference.py",
+     r'x_(border|interior_branch)_mismatches__mutmut_\d+: .*modules="math"\) → (.*modules=None\)|.*, \)|\))$',
+     "lambdify's default modules (numpy) give the same float64 values for the stencil's sums, min and max, and "
+     "sines within a few ulps of math's, far inside the quotient's 1e-9 tolerance"),
+    ("proofs/finite_difference.py",
+     r"x_border_mismatches__mutmut_\d+: step = 10\.0 \*\* rng\.uniform\(-6, -1\) → step = "
+     r"(11\.0 \*\* rng\.uniform\(-6, -1\)|10\.0 \*\* rng\.uniform\((\+6, -1|-7, -1|-6, \+1|-6, -2)\))$",
+     "another range of steps (base 11, 1e-7 to 0.1, 1e-6 to 0.01, 1e-6 to 10 or 0.1 to 1e6): the kernel and the "
+     "rule do the same float64 operations at any step, and every wrap and clamp is still taken, so each border "
+     "variant is still refuted"),
+    ("proofs/finite_difference.py",
+     r"x_interior_branch_mismatches__mutmut_\d+: step = 10\.0 \*\* rng\.uniform\(-9, -1\) → step = "
+     r"(11\.0 \*\* rng\.uniform\(-9, -1\)|10\.0 \*\* rng\.uniform\((-10, -1|-9, -2)\))$",
+     "another range of small steps (4e-10 to 0.09, 1e-10 to 0.1, or 1e-9 to 0.01): an equally valid sample, "
+     "all 2,000 points still interior, compared, and on the interior branch"),
+    ("proofs/finite_difference.py",
+     r"x_border_mismatches__mutmut_\d+: ([uv])_ = rng\.choice\(.* → \1_ = rng\.choice\(\(rng\.uniform\((0\.0|1\.0), "
+     r"step\), rng\.uniform\((1\.0|2\.0) [-+] step, (1\.0|2\.0)( [-+] (1e-12|1\.000000000001))?\), "
+     r"rng\.uniform\((0, 1|1, 1|0, 2)\)\)\)$",
+     "one of the three intervals u or v is drawn from moved: every wrap and clamp is still reached (within a step "
+     "of 0 or 1 also through uniform(0, 1), steps up to 0.1; beyond 1 on the same branch as just below), the "
+     "kernel matches the rule at any point, and each border variant is still refuted"),
+    ("proofs/finite_difference.py",
+     r"x_border_mismatches__mutmut_\d+: bad \+= list\(got\) .* → bad -= list\(got\) |"
+     r"x_interior_branch_mismatches__mutmut_\d+: bad \+= full\(.* → bad -= full\(",
+     "the count comes out negative, which is as truthy as a positive one: the check refutes at the same points, "
+     "and only the evidence's count changes sign"),
+    ("proofs/finite_difference.py",
+     r"x_border_mismatches__mutmut_\d+: .* → .*abs\(central_v\(u_, v_, None, step\) - quotient\)",
+     "equivalent: the v-quotient's stencil points and denominator use eps_v only, so the value passed for eps_u "
+     "is never read"),
+    ("proofs/finite_difference.py",
+     r"x_border_mismatches__mutmut_\d+: .* → .*- quotient\) >= 1e-9 \* \(1 \+ abs\(quotient\)\)$",
+     "differs only when the kernel's quotient is off by exactly the tolerance"),
+    ("proofs/finite_difference.py",
+     r"x_border_mismatches__mutmut_\d+: .* → .*- quotient\) > 1e-9 (/ \(1|\* \(2) \+ abs\(quotient\)\)$",
+     "a tolerance at most (1 + 2 pi)^2 times tighter (|h_v| <= 2 pi for the sampled sine field) or under twice "
+     "as loose: the kernel evaluates the same quotient up to rounding, and the border variant misses by up to "
+     "50 percent"),
+    ("proofs/finite_difference.py",
+     r"x_interior_branch_mismatches__mutmut_\d+: if u_ \+ step < 1\.0 and u_ - step >= 0\.0 and v_ \+ step <= 1\.0 "
+     r"and v_ - step >= 0\.0: → if (u_ \+ step < 1\.0 and u_ - step >= 0\.0 and v_ \+ step <= 1\.0 or |"
+     r"u_ \+ step < 1\.0 and u_ - step >= 0\.0 or |u_ \+ step < 1\.0 or |u_ - step < 1\.0 |u_ \+ step <= 1\.0 |"
+     r"u_ \+ step < 2\.0 |u_ \+ step < 1\.0 and u_ \+ step >= 0\.0 |.* and v_ - step <= 1\.0 and |"
+     r".* and v_ \+ step <= 2\.0 and |.* and v_ \+ step >= 0\.0:$)",
+     "the seeded u_ and v_ lie in [step, 1 - step], where every clause of this guard holds (all 2,000 points "
+     "pass), so a weakened clause admits the same points"),
+    ("proofs/finite_difference.py",
+     r"x_interior_branch_mismatches__mutmut_\d+: if u_ \+ step < 1\.0 and u_ - step >= 0\.0 and v_ \+ step <= 1\.0 "
+     r"and v_ - step >= 0\.0: → if .*(u_ - step > 0\.0 and v_ \+ step <= 1\.0|v_ \+ step < 1\.0 and|"
+     r"v_ - step > 0\.0:$)",
+     "differs only where u_ - step, v_ + step or v_ - step is exactly 0 or 1, which none of the 2,000 seeded "
+     "points is (all pass the strict test too)"),
+)
+MUTMUT_EXPLAINED += (
+    ("proofs/kinks.py", r"x__identities__mutmut_\d+: (?P<p>.*)sp\.diff\(sp\.Abs\(x\), x\)(?P<r>.*) → "
+     r"(?P=p)sp\.diff\(sp\.Abs\(x\), \)(?P=r)$",
+     "equivalent: without a variable sp.diff differentiates in the expression's only free symbol, x"),
+    ("proofs/kinks.py", r"x__identities__mutmut_\d+: \{x: \(-3\.0, 3\.0\)\}\), → "
+     r"(None\)|\)|\{x: \((\+3\.0, 3\.0|-4\.0, 3\.0|-3\.0, 4\.0)\)\}\)),$",
+     "the sampling domain of d|x|/dx = sign(x), never read: for x real and nonzero sympy builds diff(Abs(x), x) "
+     "as sign(x) itself, so lhs - rhs is 0 with no symbol left to sample"),
+    ("proofs/kinks.py", r"x__identities__mutmut_\d+: (?P<k>.*(sp\.Integer\([01]\)|sp\.Integer\(flag\)|"
+     r"sp\.Abs\(FACTORS\[0\] \* FACTORS\[1\]\))), DOMAIN\)(?P<t>\]?,?) → (?P=k), (None|)\)(?P=t)$",
+     "the sampling domain, never read: lhs - rhs is 0 as sympy builds it (h is Abs(s1 s2) itself, sin(pi m) is 0 "
+     "for the integer m, the flag's Piecewise evaluates to 0 or 1), so no symbol is sampled, and a wrong lhs "
+     "would still fail the test, sampling raising without a domain"),
+    ("proofs/kinks.py", r'x__identities__mutmut_\d+: (?P<p>.*)Identity\((?:rf"[^"]*"|None),(?P<r>.*) → '
+     r'(?P=p)Identity\((?:rf"[^"]*"|None),(?P=r)$',
+     "an identity's label (an f-string here): the name a refutation's evidence shows; the check compares lhs "
+     "and rhs only"),
+    ("proofs/kinks.py", r'x_one_sided__mutmut_\d+: (right|left) = sp\.limit\((.*), delta, 0, "\+"\) → '
+     r"\1 = sp\.limit\(\2, delta, 0, \)$",
+     "equivalent: \"+\" is sp.limit's default direction"),
+    ("proofs/kinks.py", r'x_one_sided__mutmut_\d+: (right = sp\.limit\(\(expr\.subs\(var, at \+ delta\) - base\) / delta, '
+     r'delta, 0, "\+"\) → right = sp\.limit\(\(expr\.subs\(var, at (\+ delta\) \+|- delta\) -) base\) / delta, delta, 0, '
+     r'"\+"\)|left = sp\.limit\(\(base - expr\.subs\(var, at - delta\)\) / delta, delta, 0, "\+"\) → left = sp\.limit\('
+     r'\(base - expr\.subs\(var, at \+ delta\)\) / delta, delta, 0, "\+"\))$',
+     "equivalent for the only expression one_sided is given, h with the other factor c at a zero line: there h "
+     "is 0 (base) and even in the distance to the line (|sin| is symmetric about its zeros), so adding base, or "
+     "taking the point on the other side, gives the same limits, and an h other than |s1 s2| is refuted by that "
+     "identity first"),
+    ("proofs/kinks.py", r"x__check__mutmut_\d+: return Verdict\(\"refuted\", f\"KINK_BAND_HALF_WIDTH is ",
+     "fixed since this run: the comparison of the constant KINK_BAND_HALF_WIDTH is gone; the check now evaluates "
+     "the renderer's band (KINK_BAND) just inside and just outside the seed's half-width, and the wrong variants "
+     "with a band ten times wider and half as wide reach it"),
+)
+MUTMUT_EXPLAINED += (
+    ("proofs/finite_difference.py", r"x__check_truncation__mutmut_(9|1[0-5]): (bad = interior_branch_mismatches\(\)|"
+     r"return Verdict\(\"refuted\", f\"at \{bad\} interior points)",
+     "fixed since this run: a new wrong variant (v_p clamped to 1/2 in the kernel and the border rule alike) is "
+     "refuted only by the interior-branch check, which no variant reached before"),
+    ("proofs/finite_difference.py", r"x_interior_branch_mismatches__mutmut_\d+: (step = 10\.0 \*\* rng\.uniform\(-9, -1\)|"
+     r"u_, v_ = rng\.uniform\(step, 1\.0 - step\)|if u_ \+ step < 1\.0 and u_ - step >= 0\.0|bad \+= full\()",
+     "fixed since this run: the check now counts the interior points it compares and refutes with fewer than "
+     "2,000, and the v_p variant reaches the mismatch count"),
+    ("proofs/finite_difference.py", r"x_interior__mutmut_\d+: ",
+     "fixed since this run: the interior branches are worked out inside the check (interior_points), no longer "
+     "only at import, where mutmut could not switch these mutants on"),
+    ("proofs/finite_difference.py", r"x_border_mismatches__mutmut_\d+: bad \+= list\(got\) .* → bad = list\(got\)",
+     "fixed since this run: the new variant with u_m's interior branch everywhere mismatches at points before "
+     "the last, so a count that keeps only the last point is refuted"),
+    ("proofs/kinks.py", r"x__flag__mutmut_\d+: return sp\.Piecewise\(\(sp\.Integer\(1\), condition\), \(sp\.Integer\(0\), "
+     r"True\)\) → ",
+     "fixed since this run: the check evaluates the renderer's band just outside the seed's half-width, where "
+     "the flag's otherwise-branch must give 0"),
+)
 #: Explanations that hold in every theorem module.
 for _m in THEOREM_MODULES:
     MUTMUT_EXPLAINED += (
@@ -316,11 +581,13 @@ for _m in THEOREM_MODULES:
     )
 
 
-def explain(module, name, change):
+def explain(module, name, change, current=False):
     """The reason `MUTMUT_EXPLAINED` gives for a survivor (its pattern searched in
-    "mutant name: before → after"), or None."""
+    "mutant name: before → after"), or None.  A reason "fixed since this run: ..." speaks of
+    an earlier run's survivor; for a ``current`` run's it does not count."""
     return next((why for mod, pattern, why in MUTMUT_EXPLAINED
-                 if mod == module and re.search(pattern, f"{name}: {change}")), None)
+                 if mod == module and re.search(pattern, f"{name}: {change}")
+                 and not (current and why.startswith("fixed since this run"))), None)
 
 
 #: Lists the functions of the theorem modules that run while `verify/test_theorems.py` is
@@ -382,21 +649,22 @@ def fresh_process_recheck(d, env, survivors, deadline):
     return {n: done[n] for n in survivors if n in done}
 
 
-def run_mutmut(work, budget, patterns=(), fresh_budget=0.0):
+def run_mutmut(work, budget, patterns=(), fresh_budget=0.0, earlier=None):
     """mutmut 3 over each of `MUTMUT_SCOPES`, scope i in ``work``/scope-i (a scratch copy
-    made if absent, else resumed): [(module, tests, {status: count}, [(surviving mutant, its
-    change)])], or None if mutmut is missing.  ``work``'s copies are refreshed from the
+    made if absent, else resumed): ([(module, tests, {status: count}, [(surviving mutant, its
+    change)])], {mutant: fresh-process outcome}), or None if mutmut is missing.  ``work``'s copies are refreshed from the
     working tree first.  A budgeted scope runs for at most ``budget``
     minutes (0: only collected), over its mutants matching ``patterns`` (mutmut's globs, e.g.
     "proofs.frame.*"; none: all).  mutmut's statuses: killed, survived, "no tests" (no named
     test calls the mutated function), timeout, "not checked" (budget spent), ...  Then, for
     ``fresh_budget`` minutes, the budgeted scope's survivors in functions that run at import
     time are run again in a fresh process (`fresh_process_recheck`); those it kills count as
-    killed ("fresh": how many)."""
+    killed ("fresh": how many).  So are ``earlier``'s ({module: [(mutant, change)]}, the last
+    report's survivors) where the mutant is still the same change."""
     mutmut = Path(PYTHON).parent / "mutmut"
     if not mutmut.is_file():
         return None
-    found = []
+    found, fresh = [], {}
     for i, (modules, tests, isolation, budgeted) in enumerate(MUTMUT_SCOPES):
         d = work / f"scope-{i}"
         changed = _scratch(d)[1]
@@ -431,26 +699,28 @@ def run_mutmut(work, budget, patterns=(), fresh_budget=0.0):
         out = subprocess.run([str(mutmut), "results", "--all", "true"], cwd=d, env=env,
                              capture_output=True, text=True).stdout
         statuses = dict(line.strip().rsplit(": ", 1) for line in out.splitlines() if ": " in line)
-        fresh = {}
-        if budgeted:
+        show = lambda name: " → ".join(  # noqa: E731
+            line[1:].strip() for line in subprocess.run([str(mutmut), "show", name], cwd=d, env=env,
+                                                        capture_output=True, text=True).stdout.splitlines()
+            if line.startswith(("-", "+")) and not line.startswith(("---", "+++")))
+        if budgeted and fresh_budget > 0:
             at_import = import_time_functions(d, env)
-            suspects = [n for n, v in statuses.items() if v == "survived" and _function_of(n) in at_import]
-            fresh = fresh_process_recheck(d, env, suspects, time.time() + fresh_budget * 60)
-            statuses.update((n, "killed") for n, v in fresh.items() if v == "killed")
+            suspects = {n: show(n) for n, v in statuses.items() if v == "survived" and _function_of(n) in at_import}
+            # The earlier report's survivors of import-time functions, where the mutant is still the same.
+            suspects.update((n, c) for m, sv in (earlier or {}).items() for n, c in sv
+                            if _function_of(n) in at_import and n in statuses and show(n) == c)
+            fresh.update(fresh_process_recheck(d, env, [n for n, c in suspects.items() if explain(
+                n.rsplit(".", 1)[0].replace(".", "/") + ".py", n, c, current=True) is None],
+                time.time() + fresh_budget * 60))
         for module in modules:
             prefix = module[:-3].replace("/", ".") + "."
             mine = {k: v for k, v in statuses.items() if k.startswith(prefix)}
-            survivors = []
-            for name in sorted(k for k, v in mine.items() if v == "survived"):
-                diff = subprocess.run([str(mutmut), "show", name], cwd=d, env=env, capture_output=True,
-                                      text=True).stdout
-                change = [line[1:].strip() for line in diff.splitlines()
-                          if line.startswith(("-", "+")) and not line.startswith(("---", "+++"))]
-                survivors.append((name, " → ".join(change)))
+            mine.update((k, "killed") for k in mine if fresh.get(k) == "killed")
+            survivors = [(name, show(name)) for name in sorted(k for k, v in mine.items() if v == "survived")]
             n = Counter(mine.values())
             n["fresh"] = sum(fresh.get(k) == "killed" for k in mine)
             found.append((module, tests, n, survivors))
-    return found
+    return found, fresh
 
 
 def _earlier_mutmut(out):
@@ -478,7 +748,7 @@ def _earlier_mutmut(out):
     return found
 
 
-def _write_mutmut(found, out, started):
+def _write_mutmut(found, fresh, out, started):
     """Write results/mutmut.md (and .json): this run's rows, and the earlier report's for the
     modules this run did not check (their "run" column says when they were)."""
     now = f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M}"
@@ -486,6 +756,14 @@ def _write_mutmut(found, out, started):
     for module, tests, n, survivors in found:
         if n["killed"] + n["survived"] + n["timeout"] or module not in merged:
             merged[module] = (tests, n, survivors, now)
+        else:                                   # an earlier row: its survivors this run killed afresh
+            tests, n, survivors, when = merged[module]
+            gone = [s for s in survivors if fresh.get(s[0]) == "killed"]
+            if gone:
+                n = n + Counter(killed=len(gone), fresh=len(gone))
+                n["survived"] -= len(gone)
+                merged[module] = (tests, n, [s for s in survivors if s not in gone],
+                                  f"{when}; {len(gone)} rerun {now}")
     out.with_suffix(".json").write_text(json.dumps(merged, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     lines = ["# mutmut", "",
              f"`python benchmarks/mutation_audit.py --mutmut`, last on {now} UTC ({time.time() - started:.0f} s); "
@@ -509,11 +787,12 @@ def _write_mutmut(found, out, started):
         killed = f"{n['killed']} ({n['fresh']})" if n["fresh"] else f"{n['killed']}"
         lines.append(f"| `{module}` | `{tests}` | {total} | {killed} | {n['survived']} | "
                      f"{n['timeout']} | {n['no tests']} | {n['not checked']} | {other} | {rate} | {when} |")
+    why = {(m, n): explain(m, n, c, current=w == now) for m, (_, _, s, w) in merged.items() for n, c in s}
     for module, (_, _, survivors, _) in merged.items():
         lines += ["", f"Survivors in `{module}` (the line before → after; why it is equivalent or acceptable):", ""]
-        lines += [f"- `{name}`: `{change}`: " + (explain(module, name, change) or "**flagged**: not explained")
+        lines += [f"- `{name}`: `{change}`: " + (why[module, name] or "**flagged**: not explained")
                   for name, change in survivors] or ["- none"]
-    flagged = sum(explain(m, n, c) is None for m, (_, _, s, _) in merged.items() for n, c in s)
+    flagged = sum(w is None for w in why.values())
     lines += ["", f"Survivors not explained (flagged): {flagged}."]
     out.write_text("\n".join(lines) + "\n", encoding="utf-8")
     print("\n".join(lines))
@@ -553,14 +832,16 @@ def main(argv=None):
         work, started = Path(args.work or tempfile.mkdtemp(prefix="mutation-audit-")), time.time()
         work.mkdir(parents=True, exist_ok=True)
         try:
-            found = run_mutmut(work, args.budget, args.mutants, args.fresh)
+            out = ROOT / "benchmarks" / "results" / "mutmut.md"
+            found = run_mutmut(work, args.budget, args.mutants, args.fresh,
+                               {m: sv for m, (_, _, sv, _) in _earlier_mutmut(out).items()})
         finally:
             if not args.work:
                 shutil.rmtree(work, ignore_errors=True)
         if found is None:
             print("mutmut is not installed (pip install mutmut)", file=sys.stderr)
             return 1
-        _write_mutmut(found, ROOT / "benchmarks" / "results" / "mutmut.md", started)
+        _write_mutmut(*found, out, started)
         return 0
     check_mutants()
     chosen = [m for m in MUTANTS if not args.only or m[0] in args.only]
