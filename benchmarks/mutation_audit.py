@@ -571,6 +571,101 @@ MUTMUT_EXPLAINED += (
      "fixed since this run: the check evaluates the renderer's band just outside the seed's half-width, where "
      "the flag's otherwise-branch must give 0"),
 )
+MUTMUT_EXPLAINED += (
+    ("proofs/no_boundary.py",
+     r'x__check__mutmut_\d+: .* → .*"XX(predicates depend on bump parameters: |; |pixels differ from the beta = 0 frame|'
+     r'\(pixel, light\) pairs|have the chamber, t, P |and N of the beta = 0 frame|lights behind A|inside sphere B, lights)',
+     "the verdict's evidence text, for a reader of the ledger; the status it carries is unchanged"),
+    ("proofs/no_boundary.py",
+     r'x__check__mutmut_\d+: .* → .*"(PREDICATES DEPEND ON BUMP|PIXELS DIFFER FROM|\(PIXEL, LIGHT\) PAIRS|HAVE THE CHAMBER, T, P|'
+     r'have the chamber, t, p |AND N OF THE BETA|and n of the beta|LIGHTS BEHIND A|lights behind a and|INSIDE SPHERE B|'
+     r'inside sphere b, )',
+     "the verdict's evidence text, for a reader of the ledger; the status it carries is unchanged"),
+    ("proofs/no_boundary.py",
+     r"x__check__mutmut_\d+: leaking = \{name: sorted\(str\(sym\) .* → leaking = \{name: sorted\(str\(None\) for sym in "
+     r"expr\.free_symbols & BUMP_SYMBOLS\)",
+     "the refutation's evidence text: each leaking predicate lists 'None' once per leaking symbol instead of its name, "
+     "so the list is non-empty exactly when before and the status is unchanged"),
+    ("proofs/no_boundary.py",
+     r"x__check__mutmut_\d+: .* → .*residual=float\(values (- masks \+|\+ masks -) differing\)",
+     "equivalent: the verified verdict is returned only when values, masks and differing are all 0, so any signed sum "
+     "of them is 0 too, and a refutation carries no residual"),
+    ("proofs/no_boundary.py",
+     r"x__check__mutmut_\d+: .* → .*if differing or compared <= pairs \* 0\.99:$",
+     "equivalent: compared is an integer and pairs x 0.99 (131072 x 0.99 = 129761.28) is not, so they are never equal"),
+    ("proofs/no_boundary.py",
+     r"x_(render_flips|reach_mismatches|root_mismatches)__mutmut_\d+: def \w+\((root, )?size=(64|128)(, \w+=\w+)*\): → "
+     r"def \w+\((root, )?size=(65|129)(, \w+=\w+)*\):$",
+     "another frame size (65 or 129 pixels a side instead of 64 or 128): an equally valid sample of the same "
+     "scenes, where the renderer and the predicates agree as well; only the size the evidence states is off"),
+    ("proofs/no_boundary.py",
+     r"x_render_flips__mutmut_\d+: def render_flips\(size=64, gate=False(, shading=None)?\): → "
+     r"def render_flips\(size=64, gate=True(, shading=None)?\):$",
+     "the theorem's check and its variants always pass gate (False, or True in the gated variant); the default serves "
+     "only claims.py's flips-zero claim, outside verify"),
+    ("proofs/no_boundary.py",
+     r'x_render_flips__mutmut_\d+: (base, base_masks|base) = geometry\(Scene\(height_field="sine", beta=0\.0\)\)(\[1\])? → '
+     r'(base, base_masks|base) = geometry\(Scene\((beta=0\.0|height_field="sine", |height_field="sine", beta=1\.0)\)\)(\[1\])?$',
+     "another reference frame (the default ridges field, the default beta 0.35, or beta 1.0): the beta = 0 sine frame is "
+     "among the G-buffers compared with it, so every frame equals the reference only if every frame equals the beta = 0 "
+     "one, and a reference that differed would itself be a moved boundary"),
+    ("proofs/no_boundary.py",
+     r'x_predicate_masks__mutmut_\d+: .* → .*np\.einsum\("HWC,HWC->HW"',
+     "equivalent: einsum's subscripts are letters of either case"),
+    ("proofs/no_boundary.py",
+     r"x_predicate_masks__mutmut_\d+: ok, sure = attached > 0, np\.abs\(attached\) > margin → "
+     r"ok, sure = attached (>= 0, np\.abs\(attached\) > margin|> 0, np\.abs\(attached\) >= margin)$",
+     "differs only where N . (L - P) is exactly 0 or exactly the margin 1e-9, and a pair at 0 is left undecided either "
+     "way"),
+    ("proofs/no_boundary.py",
+     r"x_predicate_masks__mutmut_\d+: cut = .* → cut = \(disc >=? 0\) & \(\(\(s1 >=? 0\) & \(s1 <=? 1\)\) \| "
+     r"\(\(s2 >=? 0\) & \(s2 <=? 1\)\)\)$",
+     "differs only for a discriminant exactly 0 or a root exactly 0 or 1 (the hit point or the light on a blocker's "
+     "surface), which no (pixel, light) pair of these scenes has: the masks are identical"),
+    ("proofs/no_boundary.py",
+     r"x_predicate_masks__mutmut_\d+: (s1, s2 = \(-b - root\) / \(2 \* a\), \(-b \+ root\) / \(2 \* a\) → s1, s2 = "
+     r"\(-b - root\) / \(2 \* a\), \(-b - root\) / \(2 \* a\)$|cut = .* → cut = .*\(\(s2 > 1\) & \(s2 < 1\)\)\)$)",
+     "equivalent: the far root s2 alone decides a cut only when s1 <= 0 < s2, a hit point inside a blocker sphere, "
+     "and no visible point is (the camera is outside every sphere, so an eye ray enters a sphere before any point inside it)"),
+    ("proofs/no_boundary.py",
+     r"x_predicate_masks__mutmut_\d+: (near = \(np\.abs\(disc\) <= margin \* b \* b\)|\(np\.minimum\(np\.abs\(s1 - 1\), "
+     r"np\.abs\(s2 - 1\)\) < margin\) →|sure &= ~\(applies & near & ok\) →|decided\.append\(sure \| ~on\) →)",
+     "these lines decide only which pairs within the margin 1e-9 of a threshold are compared, never a mask: comparing "
+     "more pairs could only add a mismatch, comparing fewer is caught by the 99% floor, and here every one of the "
+     "131072 pairs stays decided"),
+    ("proofs/no_boundary.py",
+     r"x_predicate_masks__mutmut_\d+: ok &= ~\(\(code != 3\) .* → ok &= ~\(\(code != 4\) & \(light\.position\[2\] \* "
+     r"P\[\.\.\., 2\] < 0\)\)$",
+     "equivalent: a floor pixel's P_z is exactly 0 (the eye ray meets z = 0 at t = 1), so L_z P_z < 0 is false for it "
+     "whether or not the floor chamber (3) is excluded, and there is no chamber 4"),
+    ("proofs/no_boundary.py",
+     r"x_predicate_masks__mutmut_\d+: ok &= ~\(\(code != 3\) .* → ok &= ~\(\(code != 3\) & \(light\.position\[2\] / "
+     r"P\[\.\.\., 2\] < 0\)\)$",
+     "equivalent: L_z / P_z has the sign of L_z P_z wherever P_z is not 0, and P_z is 0 only on floor pixels, which "
+     "code != 3 excludes"),
+    ("proofs/no_boundary.py",
+     r"x_predicate_masks__mutmut_\d+: ok &= ~\(\(code != 3\) .* → ok &= ~\(\(code != 3\) & \(light\.position\[2\] \* "
+     r"P\[\.\.\., 2\] <= 0\)\)$",
+     "differs only where L_z P_z is exactly 0 off the floor: no light of these scenes lies in the floor plane, and "
+     "visible sphere points have z >= 0.26"),
+    ("proofs/no_boundary.py",
+     r"x_root_mismatches__mutmut_\d+: .* → .*~\(np\.abs\(want - g\.t\) < 1e-9\)\)",
+     "differs only for a root exactly 1e-9 from the renderer's t; they agree to 6e-16"),
+)
+MUTMUT_EXPLAINED += (
+    ("proofs/no_boundary.py", r"x__sphere_roots__mutmut_\d+: ",
+     "fixed since this run: the check evaluates _sphere_roots' near root against the renderer's t at every "
+     "sphere pixel (within 1e-9; 6e-16 today), and a variant taking the far root is refuted"),
+    ("proofs/no_boundary.py", r"x_predicate_masks__mutmut_(40|92|93|96|97|107|112): ",
+     "fixed since this run: a reach scene with sphere B off and two lights just above the floor beside A "
+     "reaches the roots beyond the light and the lights below a surface point's height"),
+    ("proofs/no_boundary.py", r"x_predicate_masks__mutmut_1: |x_reach_mismatches__mutmut_(18|19|28|29|31): ",
+     "fixed since this run: reach_mismatches sums per-scene counts, and at least 99 % of (pixel, light) pairs "
+     "must be decided"),
+    ("proofs/no_boundary.py", r"x_render_flips__mutmut_(13|51|54|55|64|69|70|71|72|73|74|77|83|84|90): ",
+     "fixed since this run: the check requires as many distinct bumped normals as its betas, steps, fields "
+     "and bump modes make (136), and counts the five arrays in one list per frame"),
+)
 #: Explanations that hold in every theorem module.
 for _m in THEOREM_MODULES:
     MUTMUT_EXPLAINED += (

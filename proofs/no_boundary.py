@@ -9,7 +9,8 @@ hand-written numba), so the verdict is "verified", earned on the renderer's own
 outputs: independent G-buffers across height fields, beta, eps, both bump
 modes and both pipelines have the same chamber, t, P and N bit for bit, and the
 kernel's own reach predicate (`renderer.pointwise.reach`) gives every light the
-same mask.
+same mask.  The sphere roots written here are the renderer's t, and its reach
+masks are these predicates, evaluated at its hit points.
 """
 
 import itertools
@@ -70,32 +71,56 @@ SURFACE_BETAS = (0.0, 0.35, 0.9)
 EPSILONS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 
 
-def render_flips(size=64, gate=False):
+def render_flips(size=64, gate=False, shading=None):
     """(G-buffers, differing values, differing reach-mask pixels): each G-buffer
     independent (3 fields x `EPSILONS` x 2 pipelines x `BETAS` for the chart
     bump and `SURFACE_BETAS` for the surface bump),
     its chamber, t, P, N and per-light reach masks (`renderer.pointwise.reach`,
     with ``gate`` the kernel's Ns . w > 0 gate as well) compared with those of a
-    beta = 0 sine G-buffer."""
+    beta = 0 sine G-buffer.  ``shading``, a set if given, collects each G-buffer's
+    shading normals Ns (as bytes): `SHADINGS` distinct ones if every parameter reached it."""
     def geometry(scene, gradient="exact"):
         g = gbuffer(scene, size, size, gradient=gradient)
-        return (g.chamber, g.t, g.P, g.N), pointwise.reach(scene, g, gate=gate)
+        return g.Ns, (g.chamber, g.t, g.P, g.N, pointwise.reach(scene, g, gate=gate))
 
-    base, base_masks = geometry(Scene(height_field="sine", beta=0.0))
-    values = masks = frames = 0
+    base = geometry(Scene(height_field="sine", beta=0.0))[1]
+    counts = []
     for field, eps_, bump in itertools.product(("sine", "ridges", "rings"), EPSILONS, ("chart", "surface")):
         for b, gradient in itertools.product(BETAS if bump == "chart" else SURFACE_BETAS, ("exact", "central")):
-            arrays, reach = geometry(Scene(height_field=field, beta=b, eps=eps_, bump=bump), gradient)
-            values += sum(int(np.count_nonzero(a != a0)) for a, a0 in zip(arrays, base))
-            masks += int(np.count_nonzero(reach != base_masks))
-            frames += 1
-    return frames, values, masks
+            Ns, arrays = geometry(Scene(height_field=field, beta=b, eps=eps_, bump=bump), gradient)
+            counts.append([np.count_nonzero(a != a0) for a, a0 in zip(arrays, base)])
+            if shading is not None:
+                shading.add(Ns.tobytes())
+    *values, masks = (int(sum(n)) for n in zip(*counts))
+    return len(counts), sum(values), masks
+
+
+#: Distinct shading normals Ns over `render_flips`' G-buffers: one for all beta = 0 frames, one per
+#: field, bump and beta > 0 in the exact pipeline, and per eps as well in the central-difference one.
+SHADINGS = 1 + 3 * (len(BETAS) + len(SURFACE_BETAS) - 2) * (1 + len(EPSILONS))
+
+
+def root_mismatches(root, size=64):
+    """(differing, compared): pixels of the default scene on sphere A or B where root ``root``
+    of `_sphere_roots` (0, the near one; 1 for a wrong variant), solved at check time and
+    evaluated in float64, differs from the renderer's ray parameter t by more than 1e-9."""
+    scene = Scene()
+    g = gbuffer(scene, size, size)
+    at = (*np.meshgrid(g.x, g.y), scene.camera_z, scene.radius_a, scene.radius_b, *scene.center_b)
+    with np.errstate(invalid="ignore"):                 # sqrt of a negative off the sphere
+        near = [sp.lambdify((x, y, e, R, r_b, *Cb), _sphere_roots(C, r)[root])(*at)
+                for C, r in ((sp.zeros(3, 1), R), (Cb, r_b))]
+    on = (g.chamber == 1) | (g.chamber == 2)
+    want = np.where(g.chamber == 1, *near)
+    return int(np.count_nonzero(on & ~(np.abs(want - g.t) <= 1e-9))), int(np.count_nonzero(on))
 
 
 #: Scenes for comparing the renderer's reach masks with the predicates: the default, lights
-#: behind sphere A and below the floor, and a light inside sphere B.
+#: behind sphere A and below the floor, a light inside sphere B, and (sphere B off) lights just
+#: above the floor beside A, which lies beyond them from nearby floor pixels (roots s > 1).
 REACH_SCENES = (Scene(), Scene(lights=(PointLight((0.5, -1.0, -6.0)), PointLight((3.0, -2.0, -4.0)))),
-                Scene(lights=(PointLight((0.5, 0.5, 1.3)), PointLight((5.0, 5.0, 10.0)))))
+                Scene(lights=(PointLight((0.5, 0.5, 1.3)), PointLight((5.0, 5.0, 10.0)))),
+                Scene(sphere_b=False, lights=(PointLight((0.0, -1.02, 0.1)), PointLight((1.0, -0.4, 0.15)))))
 
 
 def predicate_masks(scene, g, margin=1e-9):
@@ -135,42 +160,50 @@ def predicate_masks(scene, g, margin=1e-9):
 
 
 def reach_mismatches(size=128, reach=None):
-    """(differing, compared): pixels x lights where `renderer.pointwise.reach` (or ``reach``,
-    for wrong variants) and `predicate_masks` differ, over `REACH_SCENES`, decided pixels only."""
+    """(differing, decided, all): (pixel, light) pairs over `REACH_SCENES` where
+    `renderer.pointwise.reach` (or ``reach``, for wrong variants) and `predicate_masks` differ
+    (decided pairs only), the decided pairs, and all pairs."""
     reach = reach or pointwise.reach
-    bad = total = 0
+    counts = []
     for scene in REACH_SCENES:
         g = gbuffer(scene, size, size)
         want, decided = predicate_masks(scene, g)
-        bad += int(np.count_nonzero((reach(scene, g) != want) & decided))
-        total += int(np.count_nonzero(decided))
-    return bad, total
+        counts.append((np.count_nonzero((reach(scene, g) != want) & decided), np.count_nonzero(decided),
+                       decided.size))
+    return tuple(int(sum(n)) for n in zip(*counts))
 
 
-def _check(predicates, gate=False, reach=None):
+def _check(predicates, gate=False, reach=None, root=0):
     leaking = {name: sorted(str(sym) for sym in expr.free_symbols & BUMP_SYMBOLS)
                for name, expr in predicates.items()}
     leaking = {k: v for k, v in leaking.items() if v}
     if leaking:
         return Verdict("refuted", "predicates depend on bump parameters: "
                        + "; ".join(f"{k}: {v}" for k, v in leaking.items()))
-    frames, values, masks = render_flips(gate=gate)
-    if values or masks:
+    roots, on_spheres = root_mismatches(root)
+    if roots:
+        return Verdict("refuted", f"the roots t_A, t_B written here miss the renderer's t at {roots} of "
+                       f"{on_spheres} sphere pixels")
+    shading = set()
+    frames, values, masks = render_flips(gate=gate, shading=shading)
+    if values or masks or len(shading) != SHADINGS:
         return Verdict("refuted", f"over {frames} G-buffers, {values} geometry values and {masks} reach-mask "
-                       "pixels differ from the beta = 0 frame")
-    differing, compared = reach_mismatches(reach=reach)
-    if differing:
+                       f"pixels differ from the beta = 0 frame ({len(shading)} distinct Ns, want {SHADINGS})")
+    differing, compared, pairs = reach_mismatches(reach=reach)
+    if differing or compared < pairs * 0.99:
         return Verdict("refuted", f"kernel.reach differs from the shadow predicates at {differing} of {compared} "
-                       "(pixel, light) pairs")
+                       f"decided (pixel, light) pairs (of {pairs}; 99% must be decided)")
     return Verdict("verified", f"free symbols of {len(predicates)} chamber and shadow predicates written here "
-                   f"exclude beta, eps, k_u, k_v; the renderer's own: {frames} independent G-buffers (3 fields x "
+                   f"exclude beta, eps, k_u, k_v, and their near roots t_A, t_B are the renderer's t (to 1e-9) at "
+                   f"its {on_spheres} sphere pixels; the renderer's own: {frames} independent G-buffers (3 fields x "
                    f"eps 1e-1..1e-8 x 2 pipelines x beta {BETAS} (chart) or {SURFACE_BETAS} (surface), 64x64) "
                    "have the chamber, t, P "
-                   "and N of the beta = 0 frame bit for bit, and kernel.reach gives each light the same mask; "
+                   "and N of the beta = 0 frame bit for bit, and kernel.reach gives each light the same mask "
+                   f"({len(shading)} distinct shading normals Ns: every parameter reaches them); "
                    f"kernel.reach equals the predicates above, evaluated at the hit points, at all {compared} "
-                   f"decided (pixel, light) pairs of {len(REACH_SCENES)} scenes (128x128; a light inside sphere B, "
-                   "lights behind A and below the floor)", residual=float(values + masks + differing), points=frames,
-                   rendered=frames)
+                   f"decided (pixel, light) pairs (of {pairs}) of {len(REACH_SCENES)} scenes (128x128; a light "
+                   "inside sphere B, lights behind A, below the floor, and beside A just above it)",
+                   residual=float(values + masks + differing), points=frames, rendered=frames)
 
 
 NO_BOUNDARY = Theorem(
@@ -190,6 +223,8 @@ NO_BOUNDARY = Theorem(
                      lambda: _check({**PREDICATES, **_seed_attached_predicate("central")})),
                     ("the renderer's reach masks gated by the bumped normal (the seed's rule)",
                      lambda: _check(PREDICATES, gate=True)),
+                    ("the far root of each sphere's quadratic for the hit (t_A, t_B)",
+                     lambda: _check(PREDICATES, root=1)),
                     ("a reach predicate in which sphere B shadows nothing",
                      lambda: _check(PREDICATES, reach=lambda scene, g: pointwise.reach(scene.replace(
                          sphere_b=False), g)))),
