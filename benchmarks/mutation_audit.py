@@ -798,7 +798,7 @@ def run_mutmut(work, budget, patterns=(), fresh_budget=0.0, earlier=None):
             line[1:].strip() for line in subprocess.run([str(mutmut), "show", name], cwd=d, env=env,
                                                         capture_output=True, text=True).stdout.splitlines()
             if line.startswith(("-", "+")) and not line.startswith(("---", "+++")))
-        if budgeted and fresh_budget > 0:
+        if budgeted:                            # with fresh_budget 0: what fresh.json holds
             at_import = import_time_functions(d, env)
             suspects = {n: show(n) for n, v in statuses.items() if v == "survived" and _function_of(n) in at_import}
             # The earlier report's survivors of import-time functions, where the mutant is still the same.
