@@ -34,12 +34,10 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Identity, Theorem, Verdict, check_identities
-from .frame import ANGLE_NAMES, CHART_RATES, N, ON_SPHERE, U_OF_THETA, V_OF_PHI, e_phi, e_theta, phi, theta
+from .frame import (ANGLE_NAMES, CHART_RATES, N, ON_SPHERE, PHI_OF_V, THETA_OF_U, U_OF_THETA, V_OF_PHI, e_phi,
+                    e_theta, phi, theta)
 
 # ----------------------------------------------------------- Blinn's surface, his notation
-#: The chart's inverse, solved from theorem `chart`'s u(theta) and v(phi).
-THETA_OF_U = sp.solve(sp.Eq(U_OF_THETA, F.u), theta)[0]
-PHI_OF_V = sp.solve(sp.Eq(V_OF_PHI, F.v), phi)[0]
 _TO_ANGLES = {F.u: U_OF_THETA, F.v: V_OF_PHI}
 #: Sphere A as a parametric surface P(u, v) of the renderer's chart.
 P_UV = F.R * N.subs({theta: THETA_OF_U, phi: PHI_OF_V}, simultaneous=True)

@@ -33,7 +33,7 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Identity, Theorem, Verdict, check_identities
-from .frame import CHART_RATES, U_OF_THETA, V_OF_PHI
+from .frame import CHART_RATES, PHI_OF_V, THETA_OF_U, U_OF_THETA, V_OF_PHI
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, beta = sp.symbols("R beta", positive=True)
@@ -108,10 +108,6 @@ def integrability_obstruction(field):
     return sp.simplify(OBSTRUCTION.subs(H, sp.Lambda((theta, phi), _angular(field))).doit())
 
 
-#: The displaced sphere in the chart's coordinates: P(u, v) = (R + beta h(u, v)) N(theta(u), phi(v)),
-#: theta(u) and phi(v) solved from theorem `chart`'s u(theta), v(phi).
-_THETA_OF_U = sp.solve(sp.Eq(U_OF_THETA, F.u), theta)[0]
-_PHI_OF_V = sp.solve(sp.Eq(V_OF_PHI, F.v), phi)[0]
 
 
 def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
@@ -131,7 +127,7 @@ def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
     for field in fields:
         scene, px = pixels(field, gradient, bump)
         P = (scene.radius_a + scene.beta * F.HEIGHT[field].subs({F.k_u: scene.k_u, F.k_v: scene.k_v})) \
-            * N.subs({theta: _THETA_OF_U, phi: _PHI_OF_V}, simultaneous=True)
+            * N.subs({theta: THETA_OF_U, phi: PHI_OF_V}, simultaneous=True)
         fn = sp.lambdify((F.u, F.v), list(sp.diff(P, F.v).cross(sp.diff(P, F.u))), modules="mpmath")
         keep = np.sin(np.pi * px["uv"][:, 1]) > float(F.POLE_SIN_PHI)
         compared, left_out = compared + int(np.count_nonzero(keep)), left_out + int(np.count_nonzero(~keep))

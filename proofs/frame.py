@@ -205,6 +205,9 @@ def _chart_identities(u_claim, v_claim):
 
 
 U_OF_THETA, V_OF_PHI = (theta + sp.pi) / (2 * sp.pi), phi / sp.pi
+#: The chart's inverse, theta(u) and phi(v), solved from u(theta) and v(phi).
+THETA_OF_U = sp.solve(sp.Eq(U_OF_THETA, F.u), theta)[0]
+PHI_OF_V = sp.solve(sp.Eq(V_OF_PHI, F.v), phi)[0]
 ANGLE_NAMES = {phi: r"\varphi"}
 
 
