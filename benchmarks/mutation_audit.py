@@ -405,8 +405,13 @@ MUTMUT_EXPLAINED += (
     ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .* → \s*\(\"(THE KERNEL'S H_U AND H_V SWAPPED|XXthe kernel's h_u and "
      r"h_v swappedXX)\",",
      "a wrong variant's description, the test's name; the variant itself is unchanged"),
-    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .* → \s*pages=\(\"(S3|XXs3XX|s3)\", \"(s5|S5|XXs5XX)\"\),$",
-     "the page names in the theorem's ledger record; the pages place their theorems by id"),
+    ("proofs/gradients.py", r"x__gradient_check__mutmut_\d+: .*Identity\(f\"h_[uv] \(\{name\}\)\", .* → "
+     r".*Identity\(None, F\.GRADIENT",
+     "an identity's label: it names the component in a refutation's evidence; the check compares lhs and rhs only"),
+    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .*corrupt=lambda g: g\[:, ::-1\]\)\), → .*corrupt=lambda g: "
+     r"g\[:, ::-2\]\)\),$",
+     "the swapped-gradient variant then keeps h_v alone (a one-column array), another wrong gradient, which the "
+     "check refutes as well"),
 )
 MUTMUT_EXPLAINED += (
     ("proofs/finite_difference.py",

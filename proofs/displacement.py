@@ -60,7 +60,23 @@ _FLOOR = sp.Max(F.sin_phi, F.POLE_SIN_PHI)
 
 
 def away_from_pole(bump):
-    """A bump's coefficients (b_u, b_v) with the pole floor max(sin_phi, POLE_SIN_PHI) read as sin_phi."""
+    """A bump's coefficients away from the pole cut-off.
+
+    Parameters
+    ----------
+    bump : sequence of two sympy expressions
+        (b_u, b_v), the coefficients of dpdu and dpdv in N' for one bump mode
+        (`renderer.formulas.BUMP`), in the symbols of `renderer.formulas`.
+
+    Returns
+    -------
+    tuple of two sympy expressions
+        The same with the kernel's floor max(sin_phi, POLE_SIN_PHI) replaced by
+        sin_phi: equal to the input wherever sin_phi > POLE_SIN_PHI (1e-4), the
+        only region the symbolic identities below compare.  An expression
+        without the floor comes back unchanged.  Source: the renderer's pole
+        guard (seed §3, the 1/sin phi of the chart's v-derivative).
+    """
     return tuple(b.subs(_FLOOR, F.sin_phi) for b in bump)
 
 

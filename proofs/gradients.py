@@ -11,6 +11,7 @@ import random
 from functools import partial
 
 import mpmath
+import numpy as np
 import sympy as sp
 
 from renderer import formulas as F
@@ -39,13 +40,14 @@ WRONG = {
 }
 
 
-def generated_code_residual(name, closed_form, *, seed=0, points=POINTS):
+def generated_code_residual(name, closed_form, *, seed=0, points=POINTS, compiled=None):
     """Worst relative error of the renderer's float64 gradient against mpmath.
 
     The closed form is evaluated at ``DIGITS`` digits at seeded random points
     (float64-representable, so both sides see the same input).  Points within
     1e-9 of a crease of the ridges field are skipped: there the sign factor
-    depends on the last bit of the float64 sine.
+    depends on the last bit of the float64 sine.  ``compiled`` alters the
+    kernel's (h_u, h_v) first (a wrong variant).
     """
     rng = random.Random(seed)
     fn = sp.lambdify((u, v, k_u, k_v), list(closed_form), modules="mpmath")
@@ -59,6 +61,7 @@ def generated_code_residual(name, closed_form, *, seed=0, points=POINTS):
                                         abs(mpmath.sin(mpmath.pi * kv * vv))) < 1e-9:
                 continue
             got = pointwise.exact_gradient(name, uu, vv, ku, kv)        # 0-d arrays
+            got = compiled(got) if compiled else got
             ref = fn(mpmath.mpf(uu), mpmath.mpf(vv), mpmath.mpf(ku), mpmath.mpf(kv))
             scale = mpmath.pi * max(ku, 2 * kv)
             for g, r in zip(got, ref):
@@ -71,16 +74,16 @@ def generated_code_residual(name, closed_form, *, seed=0, points=POINTS):
 GENERATED_TOLERANCE = 1e-13
 
 
-def _gradient_check(name, closed_form, corrupt=None):
+def _gradient_check(name, closed_form, corrupt=None, compiled=None):
     """The check of theorem gradient-<name> against `closed_form` (h_u, h_v); `corrupt` alters the
-    renderer's gradients first (a wrong variant).  Theorems bind it with functools.partial, so that it
+    renderer's gradients, `compiled` the kernel's pointwise ones, first (wrong variants).  Theorems bind it with functools.partial, so that it
     runs when checked, not when the module is imported."""
     identities = [Identity(f"h_u ({name})", F.GRADIENT[name][0], closed_form[0], DOMAIN),
                   Identity(f"h_v ({name})", F.GRADIENT[name][1], closed_form[1], DOMAIN)]
     symbolic = check_identities(identities)
     if not symbolic.holds:
         return symbolic
-    worst = generated_code_residual(name, closed_form)
+    worst = generated_code_residual(name, closed_form, compiled=compiled)
     if worst > GENERATED_TOLERANCE:
         return Verdict("refuted", f"generated (compiled) gradient differs from the closed form by "
                        f"{worst:.2e} (relative to pi max(k_u, 2 k_v))", worst, DIGITS, POINTS)
@@ -112,7 +115,10 @@ def _theorem(name):
         check=partial(_gradient_check, name, PRINTED[name]),
         wrong_variants=((description, partial(_gradient_check, name, wrong)),
                         ("the kernel's h_u and h_v swapped",
-                         partial(_gradient_check, name, PRINTED[name], corrupt=lambda g: g[:, ::-1]))),
+                         partial(_gradient_check, name, PRINTED[name], corrupt=lambda g: g[:, ::-1])),
+                        ("the kernel's gradient evaluated in float32",
+                         partial(_gradient_check, name, PRINTED[name],
+                                 compiled=lambda g: [np.float32(x) for x in g]))),
         pages=("s3", "s5"),
     )
 

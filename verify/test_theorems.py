@@ -7,12 +7,15 @@ the checker has teeth.
 """
 
 import dataclasses
+import re
+from pathlib import Path
 
 import pytest
 
 from proofs.registry import PINNED, RENDERED, THEOREMS, get, pinned_failure
 from verify.conftest import LEDGER
 
+BOOK = Path(__file__).resolve().parents[1] / "book"
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
 
 
@@ -64,6 +67,18 @@ def test_every_theorem_has_a_variant_and_a_statement():
     for t in THEOREMS.values():
         assert t.wrong_variants, t.id
         assert t.statement and t.steps, t.id
+
+
+def test_every_theorem_is_titled_and_used_on_pages_that_place_it():
+    """The ledger's "used on" list names book pages, among them the page whose theorem block shows
+    the theorem; the title is the block's heading."""
+    pages = {p.name.split("_")[0]: p.read_text(encoding="utf-8") for p in BOOK.glob("s[0-9]_*.md")}
+    for t in THEOREMS.values():
+        assert isinstance(t.title, str) and t.title.strip() == t.title and len(t.title) > 3, t.id
+        assert isinstance(t.pages, tuple) and set(t.pages) <= set(pages), (t.id, t.pages)
+        placed = {name for name, text in pages.items() for line in text.splitlines()
+                  if "theorem_block(" in line and re.search(rf"[\"']{re.escape(t.id)}[\"']", line)}
+        assert placed and placed <= set(t.pages), (t.id, placed, t.pages)
 
 
 def _step_residual(lhs, rhs, seed=0):
