@@ -409,7 +409,7 @@ MUTMUT_EXPLAINED += (
      r".*Identity\(None, F\.GRADIENT",
      "an identity's label: it names the component in a refutation's evidence; the check compares lhs and rhs only"),
     ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .*corrupt=lambda g: g\[:, ::-1\]\)\), → .*corrupt=lambda g: "
-     r"g\[:, ::-2\]\)\),$",
+     r"g\[:, ::-2\]\)+,$",
      "the swapped-gradient variant then keeps h_v alone (a one-column array), another wrong gradient, which the "
      "check refutes as well"),
 )
@@ -854,7 +854,9 @@ def _write_mutmut(found, fresh, out, started):
     now = f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M}"
     merged = _earlier_mutmut(out)
     for module, tests, n, survivors in found:
-        if n["killed"] + n["survived"] + n["timeout"] or module not in merged:
+        # A row this run checked replaces the earlier one; kills made only by rerunning the earlier
+        # report's survivors in a fresh process (n["fresh"]) amend it.
+        if n["killed"] - n["fresh"] + n["survived"] + n["timeout"] or module not in merged:
             merged[module] = (tests, n, survivors, now)
         else:                                   # an earlier row: its survivors this run killed afresh
             tests, n, survivors, when = merged[module]
