@@ -408,10 +408,22 @@ MUTMUT_EXPLAINED += (
     ("proofs/gradients.py", r"x__gradient_check__mutmut_\d+: .*Identity\(f\"h_[uv] \(\{name\}\)\", .* → "
      r".*Identity\(None, F\.GRADIENT",
      "an identity's label: it names the component in a refutation's evidence; the check compares lhs and rhs only"),
-    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .*corrupt=lambda g: g\[:, ::-1\]\)\), → .*corrupt=lambda g: "
+    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: .*corrupt=lambda g: g\[:, ::-1\]\)+, → .*corrupt=lambda g: "
      r"g\[:, ::-2\]\)+,$",
      "the swapped-gradient variant then keeps h_v alone (a one-column array), another wrong gradient, which the "
      "check refutes as well"),
+    ("proofs/gradients.py", r"x__theorem__mutmut_\d+: (.* → .*(title=None|pages=(None|\(\"(S3|XXs3XX)\", \"s5\"\)|"
+     r"\(\"s3\", \"(S5|XXs5XX)\"\))),|pages=\(\"s3\", \"s5\"\), → \) → \))$",
+     "fixed since this run: test_every_theorem_is_titled_and_used_on_pages_that_place_it checks each theorem's "
+     "title and that its pages exist and include the page whose theorem block shows it"),
+    ("proofs/gradients.py", r"x__gradient_check__mutmut_\d+: return Verdict\(\"refuted\", f\"generated \(compiled\) .* → "
+     r"return Verdict\(None, ",
+     "fixed since this run: a wrong variant (the kernel's gradient in float32) now reaches the compiled-code "
+     "refutation, and test_wrong_variant_is_refuted asks for its status"),
+    ("proofs/blinn.py", r"x__at_angles__mutmut_\d+: .* → return expr\.subs\(_TO_ANGLES, (simultaneous=(None|False)|)\)"
+     r"\.applyfunc\(sp\.simplify\)$",
+     "equivalent: u(theta) and v(phi) contain neither u nor v, so one substitution after the other is the "
+     "simultaneous one"),
 )
 MUTMUT_EXPLAINED += (
     ("proofs/finite_difference.py",
