@@ -336,6 +336,42 @@ MUTMUT_EXPLAINED += (
      "checks compare the expressions, and no check reads the LaTeX back"),
     ("proofs/blinn.py", r"x__tex__|x__slopes_tex__", "the statement's typesetting (sp.latex of the checked slopes); "
      "the checks compare the expressions, and no check reads the LaTeX back"),
+    ("proofs/normal.py", r"x__(limit_)?identities__mutmut_\d+: .*Identity\(r?f?\"[^\"]+\", (.*) → .*Identity\((None|r?f?\"[^\"]+\"), \2$",
+     "an identity's label: it names the identity in a refutation's evidence; the check compares lhs and rhs only"),
+    ("proofs/normal.py", r"x__check_derivative__mutmut_\d+: if not verdict\.holds: → if verdict\.holds:$",
+     "a holding verdict then goes out without the evidence's 'renderer.formulas.PERTURBED_NORMAL' prefix, a refuted "
+     "one wrapped with its status kept: the statuses are unchanged"),
+    ("proofs/normal.py", r"x__check_derivative__mutmut_\d+: verdict\.residual, verdict\.digits, verdict\.points\) → "
+     r"(None, verdict\.digits, verdict\.points|verdict\.residual, None, verdict\.points|verdict\.residual, verdict\.digits, "
+     r"None|verdict\.digits, verdict\.points|verdict\.residual, verdict\.points|verdict\.residual, verdict\.digits, )\)$",
+     "sympy decides both identities (the pinned verdict is proved), so residual, digits and points are None already; "
+     "the status is unchanged"),
+    ("proofs/normal.py", r"x__render_rate__mutmut_\d+: flat = render\(scene, 96, 80, gradient=gradient\)\.image → "
+     r"flat = render\(scene, 96, 80, \)\.image$",
+     "equivalent: at beta = 0 the exact and central pipelines render the same image bit for bit (N + 0 g = N), "
+     "for every field and bump mode"),
+    ("proofs/normal.py", r"x__render_rate__mutmut_\d+: across_fields \+= int\(np\.count_nonzero\(flat != base\)\) → "
+     r"across_fields (=|-=) int\(np\.count_nonzero\(flat != base\)\)$",
+     "the count of field-dependent beta = 0 values: the last field's alone, or negated, is still nonzero when any "
+     "field reaches the image (the variant with the reference at beta = 1e-12 is still refuted)"),
+    ("proofs/normal.py", r"x__render_rate__mutmut_\d+: renders \+= 1 → renders \+= 2$",
+     "the evidence's render count: still above its pinned least count (registry.RENDERED); the comparison is "
+     "unchanged"),
+    ("proofs/normal.py", r"x__check_limit__mutmut_\d+: line = worst\[-2\] \* TINY_BETA / RATE_BETAS\[-1\] → "
+     r"line = worst\[-3\] \* TINY_BETA / RATE_BETAS\[-1\]$",
+     "the linear rate's allowance at 1e-12 drawn through the 1e-7 render instead of the 1e-8 one: 10 times looser, "
+     "which still refutes the variant whose last render sits 25 times above the tight allowance"),
+    ("proofs/normal.py", r"x__check_limit__mutmut_\d+: if not \(abs\(slope - order\) <= 0\.1 and worst\[-1\] <= 4 \* line "
+     r"\+ 4 \* 2\.0\*\*-52\): → if not \(abs\(slope - order\) (< 0\.1 and worst\[-1\] <= 4 \* line \+ 4 \* 2\.0\*\*-52|"
+     r"<= 0\.1 and worst\[-1\] (< 4 \* line \+ 4 \* 2\.0\*\*-52|<= 4 \* line - 4 \* 2\.0\*\*-52|<= 5 \* line \+ 4 \* 2\.0\*\*-52|"
+     r"<= 4 \* line \+ 5 \* 2\.0\*\*-52|<= 4 \* line \+ 4 \* 3\.0\*\*-52|<= 4 \* line \+ 4 \* 2\.0\*\*-53))\):$",
+     "the order's tolerance or the allowance at 1e-12 moved by at most a quarter (or by a few units of roundoff): the "
+     "renderer's fitted order is 1.00 and its difference a quarter of the allowance, the wrong variants' order 1 off "
+     "and difference 25 times the allowance"),
+    ("proofs/normal.py", r"x__check_limit__mutmut_\d+: .*(the difference is \{worst\[-1\]:\.1e\}|\(\{worst\[0\]:\.1e\} to "
+     r"\{worst\[-2\]:\.1e\}\), \{worst\[-1\]:\.1e\}|bit for bit\", rendered=renders\)).* → ",
+     "the verdict's evidence text (which measurement it prints), for a reader of the ledger; the status it carries "
+     "is unchanged"),
     ("proofs/normal.py", r"x_tilt_latex__", "the statement's typesetting (sp.latex of the checked tilt); the "
      "checks compare the expressions, and no check reads the LaTeX back"),
     ("proofs/frame.py", r"x__chart_identities__mutmut_\d+: .*RATES_CLAIMED\[[01]\], (None|)\),$",
@@ -420,6 +456,23 @@ MUTMUT_EXPLAINED += (
      r"return Verdict\(None, ",
      "fixed since this run: a wrong variant (the kernel's gradient in float32) now reaches the compiled-code "
      "refutation, and test_wrong_variant_is_refuted asks for its status"),
+    ("proofs/blinn.py", r"x__identities__mutmut_\d+: .*Identity\(r\"[^\"]+\", (.*) → .*Identity\((None|r\"[^\"]+\"), \1$",
+     "an identity's label: it names the identity in a refutation's evidence; the check compares lhs and rhs only"),
+    ("proofs/blinn.py", r"x__identities__mutmut_\d+: .*, DOMAIN\)+,? → .*, (None|)\)+,?$",
+     "the sampling domain, used only if sympy cannot decide an identity; it decides all of them (the pinned "
+     "verdict is proved)"),
+    ("proofs/blinn.py", r"x__identities__mutmut_\d+: def _identities\(normal, factors, \*, exact=False\): → "
+     r"def _identities\(normal, factors, \*, exact=True\):$",
+     "fixed since this run: the default was never used (its only caller passes exact) and is gone"),
+    ("proofs/blinn.py", r"x__identities__mutmut_\d+: ids\.append\(Identity\(r\"\\text\{all orders: surface vs Blinn\}\", "
+     r"SURFACE, blinn, DOMAIN\)\) → ids\.append\(Identity\((r\"[^\"]+\", None, blinn|r\"[^\"]+\", SURFACE, None|"
+     r"SURFACE, blinn|r\"[^\"]+\", blinn|r\"[^\"]+\", SURFACE), DOMAIN\)\)$",
+     "the all-orders identity is built only for the wrong variant that claims it; broken (a side None or missing) it "
+     "still refutes that variant, and the holding check never builds it"),
+    ("proofs/blinn.py", r"x__check__mutmut_\d+: return Verdict\(\"refuted\", \"the surface bump's pole floor",
+     "the guard for a surface bump without its pole floor, which only an edit of renderer/formulas.py's module-level "
+     "sympy can reach (the semantic mutants do); every mutant of this return (status None, no evidence, a missing "
+     "argument) still fails the pinned verdict, as the guard should"),
     ("proofs/blinn.py", r"x__at_angles__mutmut_\d+: .* → return expr\.subs\(_TO_ANGLES, (simultaneous=(None|False)|)\)"
      r"\.applyfunc\(sp\.simplify\)$",
      "equivalent: u(theta) and v(phi) contain neither u nor v, so one substitution after the other is the "

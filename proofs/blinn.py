@@ -117,7 +117,7 @@ DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 3.13), F.R: (0.5, 2.0), F.beta: (0.0, 
           F.h: (-1.0, 1.0), F.h_u: (-30.0, 30.0), F.h_v: (-30.0, 30.0)}
 
 
-def _identities(normal, factors, *, exact=False):
+def _identities(normal, factors, *, exact):
     blinn = slopes(normal)
     ids = [
         Identity(r"P_u\times P_v", N_BLINN, ORIENTATION * NORM_N * N, DOMAIN),
