@@ -458,6 +458,14 @@ MUTMUT_EXPLAINED += (
      "refutation, and test_wrong_variant_is_refuted asks for its status"),
     ("proofs/blinn.py", r"x__identities__mutmut_\d+: .*Identity\(r\"[^\"]+\", (.*) → .*Identity\((None|r\"[^\"]+\"), \1$",
      "an identity's label: it names the identity in a refutation's evidence; the check compares lhs and rhs only"),
+    ("proofs/blinn.py", r"x__check__mutmut_\d+: if not verdict\.holds: → if verdict\.holds:$",
+     "a holding verdict then goes out without the evidence's explanation, a refuted one wrapped with its status "
+     "kept: the statuses are unchanged"),
+    ("proofs/blinn.py", r"x__check__mutmut_\d+: verdict\.residual, verdict\.digits, verdict\.points\) → "
+     r"(None, verdict\.digits, verdict\.points|verdict\.residual, None, verdict\.points|verdict\.residual, verdict\.digits, "
+     r"None|verdict\.digits, verdict\.points|verdict\.residual, verdict\.points|verdict\.residual, verdict\.digits, )\)$",
+     "sympy decides every identity (the pinned verdict is proved), so residual, digits and points are None already; "
+     "the status is unchanged"),
     ("proofs/blinn.py", r"x__identities__mutmut_\d+: .*, DOMAIN\)+,? → .*, (None|)\)+,?$",
      "the sampling domain, used only if sympy cannot decide an identity; it decides all of them (the pinned "
      "verdict is proved)"),
@@ -469,7 +477,8 @@ MUTMUT_EXPLAINED += (
      r"SURFACE, blinn|r\"[^\"]+\", blinn|r\"[^\"]+\", SURFACE), DOMAIN\)\)$",
      "the all-orders identity is built only for the wrong variant that claims it; broken (a side None or missing) it "
      "still refutes that variant, and the holding check never builds it"),
-    ("proofs/blinn.py", r"x__check__mutmut_\d+: return Verdict\(\"refuted\", \"the surface bump's pole floor",
+    ("proofs/blinn.py", r"x__check__mutmut_\d+: (return Verdict\(\"refuted\", \"the surface bump's pole floor|"
+     r"\"found in renderer\.formulas\.PERTURBED_NORMAL\['surface'\]\"\) → )",
      "the guard for a surface bump without its pole floor, which only an edit of renderer/formulas.py's module-level "
      "sympy can reach (the semantic mutants do); every mutant of this return (status None, no evidence, a missing "
      "argument) still fails the pinned verdict, as the guard should"),
