@@ -354,6 +354,9 @@ MUTMUT_EXPLAINED += (
      r"across_fields (=|-=) int\(np\.count_nonzero\(flat != base\)\)$",
      "the count of field-dependent beta = 0 values: the last field's alone, or negated, is still nonzero when any "
      "field reaches the image (the variant with the reference at beta = 1e-12 is still refuted)"),
+    ("proofs/normal.py", r"x__render_rate__mutmut_\d+: if k == 0: → if k == 1:$",
+     "the configurations' distinct images counted at beta = 1e-3 instead of 1e-2: another beta > 0, where each of "
+     "the 12 reaches the image as well (and the one-field variant gives 4 of 12 alike)"),
     ("proofs/normal.py", r"x__render_rate__mutmut_\d+: renders \+= 1 → renders \+= 2$",
      "the evidence's render count: still above its pinned least count (registry.RENDERED); the comparison is "
      "unchanged"),
@@ -368,7 +371,9 @@ MUTMUT_EXPLAINED += (
      "the order's tolerance or the allowance at 1e-12 moved by at most a quarter (or by a few units of roundoff): the "
      "renderer's fitted order is 1.00 and its difference a quarter of the allowance, the wrong variants' order 1 off "
      "and difference 25 times the allowance"),
-    ("proofs/normal.py", r"x__check_limit__mutmut_\d+: .*(the difference is \{worst\[-1\]:\.1e\}|\(\{worst\[0\]:\.1e\} to "
+    ("proofs/normal.py", r"x__check_limit__mutmut_\d+: .*(the difference is \{worst\[-1\]:\.1e\}|the linear rate allows \{4 \* "
+     r"line:\.1e\}|at beta = \{RATE_BETAS\[0\]:g\} only \{distinct\} of the|\"renders \(fields x bump modes x pipelines\) "
+     r"differ|\(\{worst\[0\]:\.1e\} to "
      r"\{worst\[-2\]:\.1e\}\), \{worst\[-1\]:\.1e\}|bit for bit\", rendered=renders\)).* → ",
      "the verdict's evidence text (which measurement it prints), for a reader of the ledger; the status it carries "
      "is unchanged"),
