@@ -128,7 +128,7 @@ FIELDS = ("sine", "ridges", "rings")
 
 
 def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=FIELDS):
-    """Renders of 3 fields x 2 bump modes x 2 pipelines (96x80): max |I(beta) - I(0)| over
+    """Renders of ``fields`` x 2 bump modes x 2 pipelines (96x80): max |I(beta) - I(0)| over
     them per beta in RATE_BETAS and at ``tiny_beta`` (float64 array, length 8); the channel
     values of the beta = 0 renders (at ``reference_beta``, 0 but in a wrong variant) that differ
     between fields (the height field must not reach the shading at beta = 0); how many renders
@@ -155,18 +155,19 @@ def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=FIELDS):
     return worst, across_fields, renders, len(bumped)
 
 
-def _check_limit(tilt=None, order=1.0, **renders):
+def _check_limit(tilt=None, order=1.0, **sampling):
     """The limit beta -> 0: symbolic (N'(0) = N and dN'/dbeta at 0 = ``tilt``, both
     modes) and rendered (the images approach the beta = 0 image at rate beta^``order``;
-    ``renders`` go to `_render_rate`, for the wrong variants)."""
+    ``sampling`` goes to `_render_rate`, for the wrong variants)."""
     symbolic = check_identities(_limit_identities(TILT if tilt is None else tilt))
     if not symbolic.holds:
         return symbolic
-    worst, across_fields, renders, distinct = _render_rate(**renders)
+    worst, across_fields, renders, distinct = _render_rate(**sampling)
+    configurations = 2 * 2 * len(FIELDS)
     if across_fields:
         return Verdict("refuted", f"at beta = 0, {across_fields} channel values depend on the height field")
-    if distinct < 2 * 2 * len(FIELDS):
-        return Verdict("refuted", f"at beta = {RATE_BETAS[0]:g} only {distinct} of the {2 * 2 * len(FIELDS)} "
+    if distinct < configurations:
+        return Verdict("refuted", f"at beta = {RATE_BETAS[0]:g} only {distinct} of the {configurations} "
                        "renders (fields x bump modes x pipelines) differ: not every configuration was rendered")
     slope = float(np.polyfit(np.log(RATE_BETAS), np.log(worst[:-1]), 1)[0])
     # Linear rate: the tiny step's difference is at most the fitted line's value there (and
@@ -177,8 +178,8 @@ def _check_limit(tilt=None, order=1.0, **renders):
                        f"(claimed {order:g}); at beta = {TINY_BETA:g} the difference is {worst[-1]:.1e}, "
                        f"the linear rate allows {4 * line:.1e}")
     return Verdict(symbolic.status, f"renderer.formulas.PERTURBED_NORMAL (both modes) at N(theta, phi) in the "
-                   f"renderer's frame: {symbolic.evidence}; {distinct} distinct renders per beta (3 fields x 2 modes "
-                   f"x 2 pipelines, 96x80): max |I(beta) - I(0)| falls with fitted order {slope:.2f} over beta = "
+                   f"renderer's frame: {symbolic.evidence}; {configurations} renders per beta (3 fields x 2 modes "
+                   f"x 2 pipelines, 96x80), {distinct} distinct at beta = {RATE_BETAS[0]:g}: max |I(beta) - I(0)| falls with fitted order {slope:.2f} over beta = "
                    f"1e-2 ... 1e-8 ({worst[0]:.1e} to {worst[-2]:.1e}), {worst[-1]:.1e} at beta = {TINY_BETA:g} "
                    f"(the linear rate allows {4 * line:.1e}); the beta = 0 renders of the three fields are equal "
                    "bit for bit", rendered=renders)
