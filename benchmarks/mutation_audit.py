@@ -336,16 +336,9 @@ MUTMUT_EXPLAINED += (
      "checks compare the expressions, and no check reads the LaTeX back"),
     ("proofs/blinn.py", r"x__tex__|x__slopes_tex__", "the statement's typesetting (sp.latex of the checked slopes); "
      "the checks compare the expressions, and no check reads the LaTeX back"),
-    ("proofs/normal.py", r"x__(limit_)?identities__mutmut_\d+: .*Identity\(r?f?\"[^\"]+\", (.*) → .*Identity\((None|r?f?\"[^\"]+\"), \2$",
-     "an identity's label: it names the identity in a refutation's evidence; the check compares lhs and rhs only"),
     ("proofs/normal.py", r"x__check_derivative__mutmut_\d+: if not verdict\.holds: → if verdict\.holds:$",
      "a holding verdict then goes out without the evidence's 'renderer.formulas.PERTURBED_NORMAL' prefix, a refuted "
      "one wrapped with its status kept: the statuses are unchanged"),
-    ("proofs/normal.py", r"x__check_derivative__mutmut_\d+: verdict\.residual, verdict\.digits, verdict\.points\) → "
-     r"(None, verdict\.digits, verdict\.points|verdict\.residual, None, verdict\.points|verdict\.residual, verdict\.digits, "
-     r"None|verdict\.digits, verdict\.points|verdict\.residual, verdict\.points|verdict\.residual, verdict\.digits, )\)$",
-     "sympy decides both identities (the pinned verdict is proved), so residual, digits and points are None already; "
-     "the status is unchanged"),
     ("proofs/normal.py", r"x__render_rate__mutmut_\d+: flat = render\(scene, 96, 80, gradient=gradient\)\.image → "
      r"flat = render\(scene, 96, 80, \)\.image$",
      "equivalent: at beta = 0 the exact and central pipelines render the same image bit for bit (N + 0 g = N), "
@@ -461,16 +454,9 @@ MUTMUT_EXPLAINED += (
      r"return Verdict\(None, ",
      "fixed since this run: a wrong variant (the kernel's gradient in float32) now reaches the compiled-code "
      "refutation, and test_wrong_variant_is_refuted asks for its status"),
-    ("proofs/blinn.py", r"x__identities__mutmut_\d+: .*Identity\(r\"[^\"]+\", (.*) → .*Identity\((None|r\"[^\"]+\"), \1$",
-     "an identity's label: it names the identity in a refutation's evidence; the check compares lhs and rhs only"),
     ("proofs/blinn.py", r"x__check__mutmut_\d+: if not verdict\.holds: → if verdict\.holds:$",
      "a holding verdict then goes out without the evidence's explanation, a refuted one wrapped with its status "
      "kept: the statuses are unchanged"),
-    ("proofs/blinn.py", r"x__check__mutmut_\d+: verdict\.residual, verdict\.digits, verdict\.points\) → "
-     r"(None, verdict\.digits, verdict\.points|verdict\.residual, None, verdict\.points|verdict\.residual, verdict\.digits, "
-     r"None|verdict\.digits, verdict\.points|verdict\.residual, verdict\.points|verdict\.residual, verdict\.digits, )\)$",
-     "sympy decides every identity (the pinned verdict is proved), so residual, digits and points are None already; "
-     "the status is unchanged"),
     ("proofs/blinn.py", r"x__identities__mutmut_\d+: .*, DOMAIN\)+,? → .*, (None|)\)+,?$",
      "the sampling domain, used only if sympy cannot decide an identity; it decides all of them (the pinned "
      "verdict is proved)"),
@@ -753,8 +739,13 @@ MUTMUT_EXPLAINED += (
 #: Explanations that hold in every theorem module.
 for _m in THEOREM_MODULES:
     MUTMUT_EXPLAINED += (
-        (_m, r'Identity\((?:r?"[^"]*"|None), (.*) → .*Identity\((?:r?"[^"]*"|None), \1',
+        (_m, r'Identity\((?:r?f?"[^"]*"|None), (.*) → .*Identity\((?:r?f?"[^"]*"|None), \1',
          "an identity's label: the name its step shows in the book; the check compares lhs and rhs only"),
+        (_m, r"verdict\.residual, verdict\.digits, verdict\.points\) → (None, verdict\.digits, verdict\.points|"
+         r"verdict\.residual, None, verdict\.points|verdict\.residual, verdict\.digits, None|verdict\.digits, "
+         r"verdict\.points|verdict\.residual, verdict\.points|verdict\.residual, verdict\.digits, )\)$",
+         "sympy decides every identity (the pinned verdict is proved), so residual, digits and points are None "
+         "already; the status is unchanged"),
         (_m, r"-handed about the outward normal|Verdict\(verdict\.status, None",
          "the verdict's evidence text, for a reader of the ledger; the status it carries is unchanged"),
     )
