@@ -10,6 +10,7 @@ here.
 import numpy as np
 import sympy as sp
 
+from renderer import BUMPS, HEIGHT_FIELDS
 from renderer import formulas as F
 
 from . import frame
@@ -113,6 +114,8 @@ SPHERE_DOMAIN = {frame.theta: (-3.1, 3.1), frame.phi: (0.05, 3.09), F.R: (0.5, 2
 #: The renders: beta -> 0 over these steps, on a 96x80 frame.
 RATE_BETAS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 TINY_BETA = 1e-12
+#: The seed's two pipelines: the exact gradient and central differences.
+PIPELINES = ("exact", "central")
 
 
 def _limit_identities(tilt):
@@ -124,10 +127,7 @@ def _limit_identities(tilt):
     return ids
 
 
-FIELDS = ("sine", "ridges", "rings")
-
-
-def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=FIELDS):
+def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=HEIGHT_FIELDS):
     """Renders of ``fields`` x 2 bump modes x 2 pipelines (96x80): max |I(beta) - I(0)| over
     them per beta in RATE_BETAS and at ``tiny_beta`` (float64 array, length 8); the channel
     values of the beta = 0 renders (at ``reference_beta``, 0 but in a wrong variant) that differ
@@ -138,8 +138,8 @@ def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=FIELDS):
     worst = np.zeros(len(RATE_BETAS) + 1)
     across_fields = renders = 0
     bumped = set()
-    for mode in ("chart", "surface"):
-        for gradient in ("exact", "central"):
+    for mode in BUMPS:
+        for gradient in PIPELINES:
             base = None
             for field in fields:
                 scene = Scene(height_field=field, bump=mode, beta=reference_beta)
@@ -163,7 +163,7 @@ def _check_limit(tilt=None, order=1.0, **sampling):
     if not symbolic.holds:
         return symbolic
     worst, across_fields, renders, distinct = _render_rate(**sampling)
-    configurations = 2 * 2 * len(FIELDS)
+    configurations = len(BUMPS) * len(PIPELINES) * len(HEIGHT_FIELDS)
     if across_fields:
         return Verdict("refuted", f"at beta = 0, {across_fields} channel values depend on the height field")
     if distinct < configurations:
