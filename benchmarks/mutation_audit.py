@@ -365,7 +365,7 @@ MUTMUT_EXPLAINED += (
      "renderer's fitted order is 1.00 and its difference a quarter of the allowance, the wrong variants' order 1 off "
      "and difference 25 times the allowance"),
     ("proofs/normal.py", r"x__check_limit__mutmut_\d+: .*(the difference is \{worst\[-1\]:\.1e\}|the linear rate allows \{4 \* "
-     r"line:\.1e\}|at beta = \{RATE_BETAS\[0\]:g\} only \{distinct\} of the|\"renders \(fields x bump modes x pipelines\) "
+     r"line:\.1e\}|at beta = \{RATE_BETAS\[0\]:g\} only \{distinct\} of the|\{distinct\} distinct at beta = |\"renders \(fields x bump modes x pipelines\) "
      r"differ|\(\{worst\[0\]:\.1e\} to "
      r"\{worst\[-2\]:\.1e\}\), \{worst\[-1\]:\.1e\}|bit for bit\", rendered=renders\)).* → ",
      "the verdict's evidence text (which measurement it prints), for a reader of the ledger; the status it carries "
