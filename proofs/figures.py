@@ -23,7 +23,7 @@ import numpy as np
 
 from renderer import Scene, pointwise
 
-__all__ = ["style", "frame_diagram", "normal_diagram", "stencil_diagram", "ucurve_anatomy"]
+__all__ = ["style", "frame_diagram", "normal_diagram", "stencil_diagram", "ucurve_anatomy", "text_overlaps"]
 
 #: The book's colours: measured (dark red), exact (dark blue), third quantity (green), guides (grey).
 RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
@@ -187,3 +187,24 @@ def ucurve_anatomy(curve):
     ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $h_u$"); ax.set_ylim(1e-18, 1e3)
     ax.legend(loc="lower left", frameon=False); ax.grid(alpha=0.3)
     return fig
+
+
+def text_overlaps(fig):
+    """Pairs of the figure's visible text artists (titles, labels, tick labels, legend
+    and annotation text) whose drawn extents overlap, as strings ``"'a' / 'b'"``;
+    an empty list when none do.  Draws the figure once (matplotlib reports the
+    extents of drawn text only).
+
+    First version: a full check (tick labels across axes, legends) to follow.
+    """
+    from matplotlib.text import Text
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    texts = [t for t in fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
+    boxes = [(t, t.get_window_extent(renderer)) for t in texts]
+    out = []
+    for i, (a, ba) in enumerate(boxes):
+        for b, bb in boxes[i + 1:]:
+            if ba.overlaps(bb):
+                out.append(f"{a.get_text()!r} / {b.get_text()!r}")
+    return out

@@ -12,11 +12,13 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from proofs.page import BUILD_ENV
 from proofs.store import ENV
 
 
 def _set_store(app, config):
     os.environ.setdefault(ENV, str(Path(app.outdir).parent / ".measurements"))
+    os.environ[BUILD_ENV] = "1"        # proofs.page: glue for the prose instead of displaying
 
 
 def setup(app):
