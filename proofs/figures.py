@@ -198,6 +198,9 @@ def text_overlaps(fig):
     First version: a full check (tick labels across axes, legends) to follow.
     """
     from matplotlib.text import Text
+    if not hasattr(fig.canvas, "get_renderer"):      # a closed pyplot figure keeps a bare canvas
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        FigureCanvasAgg(fig)
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     # Tick labels of ticks outside the view are not drawn but keep a stale extent: leave them out.
