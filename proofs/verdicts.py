@@ -1,0 +1,100 @@
+"""The draft's claims on the book's pages: a verdict where the reader meets each claim,
+and the register of §6 that collects them.
+
+Every claim of `proofs.claims.CLAIMS` is *placed* on exactly one page section
+(`PLACES`): there `verdicts(place)` shows it in one sentence (the draft's words,
+the verdict, the measurement) linked to its row of the register, and the
+register row links back.  Both read the same evaluation of the register
+(`proofs.claims.checked`), so a verdict cannot read one way in §5 and another
+in §6, and the build fails, as `pytest verify` does, when a computed verdict
+is not the registered one.
+"""
+
+from __future__ import annotations
+
+from .claims import CLAIMS, CORRECTED, CRITERIA, FAILS, HOLDS, checked
+
+__all__ = ["PLACES", "verdicts", "register", "place_of"]
+
+#: Book section label -> the claims shown there, in the order the section meets them.
+PLACES = {
+    "s1": ("flips-zero", "shadow-curves-unchanged"),
+    "s3-ucurve": ("h3-scale", "truncation-until-1e-6", "roundoff-drowns-1e-9"),
+    "sim": ("try-sweep", "try-creases", "try-pinch", "try-beta0"),
+    "cell1": ("cell1-ripples",),
+    "cell2": ("frame-aligned", "cell2-minimum"),
+    "cell3": ("cell3-runs", "census-flips", "census-slope", "kink-order-of-magnitude"),
+    "cell4": ("cell4-counter", "four-evals-vs-one", "symbolic-not-slower"),
+    "cell5": ("cell5-fd-1e-9", "dn-verified-1e-12", "beta-quadratic"),
+    "cell6": ("beta0-1e-16", "bump-nonzero", "cell6-truncation"),
+    "cell7": ("noise-below-1e-11", "crease-fd-zero", "pole-pixels"),
+    "s6": ("stacking",),
+    "s8": ("blinn-exact",),
+}
+
+#: How a verdict reads in a sentence.
+WORDS = {HOLDS: "Holds", CORRECTED: "Holds with a correction", FAILS: "Does not hold"}
+
+
+def place_of(claim_id):
+    """The section label where ``claim_id`` is shown.
+
+    Raises
+    ------
+    KeyError
+        If the claim is placed nowhere (or is not a claim).
+    """
+    for place, ids in PLACES.items():
+        if claim_id in ids:
+            return place
+    raise KeyError(f"claim {claim_id!r} is placed in no section of PLACES")
+
+
+def _results():
+    return {c.id: (c, m, v) for c, m, v in checked()}
+
+
+def _sentence(claim, measured, verdict):
+    return (f"**{claim.where}:** “{claim.quote}”. **{WORDS[verdict]}:** {measured}. "
+            f"{{ref}}`Register <claim-{claim.id}>`.")
+
+
+def verdicts(place):
+    """MyST markdown for the section labelled ``place``: one paragraph per claim placed
+    there (`PLACES`), in a container of class ``verdicts``.
+
+    Raises
+    ------
+    KeyError
+        If ``place`` is not a key of `PLACES`.
+    proofs.claims.ClaimChanged
+        If a computed verdict is not the registered one.
+    """
+    if place not in PLACES:
+        raise KeyError(f"place must be one of {sorted(PLACES)}, got {place!r}")
+    results = _results()
+    body = "\n\n".join(_sentence(*results[i]) for i in PLACES[place])
+    return f":::{{container}} verdicts\n{body}\n:::\n"
+
+
+def register():
+    """MyST markdown: the register of §6, one entry per claim in `proofs.claims.CLAIMS`
+    order, each with the target ``claim-<id>``, its verdict and measurement, a link
+    to the section that discusses it, and (folded) how it is measured and decided.
+
+    Raises
+    ------
+    proofs.claims.ClaimChanged
+        If a computed verdict is not the registered one.
+    """
+    results = _results()
+    entries = []
+    for n, c in enumerate(CLAIMS, start=1):
+        claim, measured, verdict = results[c.id]
+        entries.append(
+            f"(claim-{c.id})=\n"
+            f"**{n}. {claim.where}:** “{claim.quote}”. **{WORDS[verdict]}:** {measured}. "
+            f"Discussed in {{ref}}`{place_of(c.id)}`.\n\n"
+            f"<details><summary>How it is decided</summary><p>Measured: {claim.measurement}. "
+            f"Rule: {CRITERIA[c.id]}.</p></details>\n")
+    return "\n".join(entries)
