@@ -92,11 +92,17 @@ def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=8
 
 
 def normal_beta_derivative_residual(trials=2000, seed=5):
-    """Worst |float64 (I - N'N'^T) g / |M| - dN'/dbeta| over random (N, g, beta).
+    """Worst |float64 (I - N'N'^T) g / |M| - dN'/dbeta| over random (N, g, beta), a float.
 
     The reference is mpmath's numerical derivative of N'(beta) = M / |M| at 50
-    digits (mpmath.diff), independent of the closed form.
+    digits (mpmath.diff), independent of the closed form.  One measurement of
+    the build (`proofs.store`): §5, §6 and the claims register show the same value.
     """
+    from .store import measured
+    return measured("normal-beta-derivative-residual", _normal_beta_derivative_residual, trials=trials, seed=seed)
+
+
+def _normal_beta_derivative_residual(trials, seed):
     rng = np.random.default_rng(seed)
     worst = 0.0
     with mpmath.workdps(DIGITS):
@@ -122,6 +128,12 @@ def normal_beta_derivative_residual(trials=2000, seed=5):
 
 
 def image_beta_order(size=64, beta=0.35, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e-3)):
+    """`_image_beta_order`, one measurement of the build (`proofs.store`; arrays come back as lists)."""
+    from .store import measured
+    return measured("image-beta-order", _image_beta_order, size=size, beta=beta, steps=list(steps))
+
+
+def _image_beta_order(size, beta, steps):
     """Convergence order of the image's central beta-derivative, fitted from renders.
 
     For each step db, D(db) = (I(beta + db) - I(beta - db)) / (2 db) on the
@@ -151,5 +163,5 @@ def image_beta_order(size=64, beta=0.35, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e
     median = np.array([np.median(d) for d in diffs])
     rms = np.array([np.sqrt(np.mean(d**2)) for d in diffs])
     fit = lambda e: float(np.polyfit(np.log(steps), np.log(e), 1)[0])  # noqa: E731
-    return {"median_slope": fit(median), "rms_slope": fit(rms), "median_errors": median,
-            "rms_errors": rms, "steps": np.array(steps), "label": frame_label(scene, size, size)}
+    return {"median_slope": fit(median), "rms_slope": fit(rms), "median_errors": median.tolist(),
+            "rms_errors": rms.tolist(), "steps": list(steps), "label": frame_label(scene, size, size)}

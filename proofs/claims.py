@@ -150,65 +150,107 @@ def _err_at(eps):
 
 def _h3_scale():
     value = (np.pi * 8.0) ** 3
-    return f"(pi k_u)^3 = {value:,.0f}", {"(π k_u)³": value}
+    return f"$(\\pi k_u)^3 =$ {value:,.0f} at $k_u = 8$", {"(π kᵤ)³": value}
 
 
 def _truncation_until():
     c = _ucurve()
-    return (f"model optimum {c.eps_opt_predicted:.1e} (measured minimum {c.eps_opt_measured:.1e})",
-            {"model optimum ε": c.eps_opt_predicted})
+    return (f"the two-term model's optimal step is {c.eps_opt_predicted:.1e} (the measured curve's lowest "
+            f"point: {c.eps_opt_measured:.1e})", {"model optimum ε": c.eps_opt_predicted})
 
 
 def _drowns_below_1e9():
     c = _ucurve()
     rel = _err_at(1e-9) / abs(c.derivative)
-    return f"relative error of h_u at eps = 1e-9: {rel:.1e}", {"relative error at ε = 1e-9": rel}
+    return (f"the quotient's relative error at a step of 1e-9 is {rel:.1e}: nine digits still right",
+            {"relative error at ε = 1e-9": rel})
 
 
 def _cell2_minimum():
     from .ucurve import default_optimum
     opt = default_optimum()
-    return (f"fitted optimum at eps = {opt['eps']:.1e} (model error {opt['error']:.1e}; the curve's lowest "
-            f"point {opt['argmin']:.1e})", {"fitted optimum ε": opt["eps"]})
+    return (f"the fitted optimal step is {opt['eps']:.1e}, where the model's error is {opt['error']:.1e}",
+            {"fitted optimum ε": opt["eps"]})
 
 
 def _orientation():
     from .frame import _orientation_value
     value = int(_orientation_value())
-    return f"(e_theta x e_phi) . N = {value}", {"(e_θ × e_φ)·N": value}
+    return (f"$(e_\\theta \\times e_\\varphi)\\cdot N = {value}$: the frame is left-handed about the outward normal",
+            {"(eθ × eφ)·N": value})
 
 
 def _flips_zero():
     from .no_boundary import render_flips
     frames, values, masks = render_flips()
-    return (f"{values} geometry values (chamber, t, P, N) and {masks} reach-mask pixels differ over {frames} "
-            "independent G-buffers", {"geometry values differing": values, "reach-mask pixels differing": masks})
+    return (f"over {frames} independent G-buffers, {values} geometry values (chamber, $t$, $P$, $N$) and {masks} "
+            "reach-mask pixels differ", {"geometry values differing": values, "reach-mask pixels differing": masks})
 
 
 def _shadow_curves_unchanged():
     leak = _errata()["terminator-leak"]["leak_pixels_default"]
-    return (f"renderer: geometric predicates (0 flips); seed's code: {leak} (pixel, light) pairs lit "
+    return (f"true of the renderer, not of the draft's code: its shading lights {leak:,} (pixel, light) pairs "
             "past the terminator", {"pairs lit past the terminator": leak})
 
 
 def _cell1_ripples():
     m = _errata()["sphere-b-quadratic"]
-    return (f"seed's code: sphere B covers {m['seed_pixels_b']} of {m['pixels']} pixels, sphere A "
+    return (f"the draft's sphere B covers {m['seed_pixels_b']:,} of the {m['pixels']:,} pixels, so sphere A "
             "never appears", {"share of the frame on the draft's sphere B": m["seed_pixels_b"] / m["pixels"]})
 
 
+#: The draft's Cell 3 sweep of steps, and the frame it renders.
+CENSUS_STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
+CENSUS_SIZE = 256
+
+
+def census():
+    """The draft's Cell 3 census, one measurement of the build (`proofs.store`): the
+    default scene (ridges) at 256 x 256, the exact frame against the central frame at
+    each step of `CENSUS_STEPS`.
+
+    Returns a dict: ``steps``; per step (lists in step order) ``max``, ``rms``,
+    ``on_band`` and ``off_band`` (mean |ΔI| on and off the crease band), ``flips``
+    and ``straddling`` (sphere-A pixels within the step of a ridge zero line, whose
+    stencil straddles a crease); the fitted exponents p of RMS ~ eps^p and of the
+    off-band mean ~ eps^p over all the steps (``rms_slope``, ``off_slope``); the
+    crease ratio at the default step (``ratio``, on-band over off-band mean); and
+    the frame's ``label``.
+    """
+    from .store import measured
+    return measured("census", _census, size=CENSUS_SIZE)
+
+
+def _census(size):
+    scene = Scene()
+    symbolic = render(scene, size, size)
+    on_a = symbolic.chamber == SPHERE_A
+    uv = gbuffer(scene, size, size).uv[on_a]
+    # Chart distance of each sphere-A pixel to the nearest ridge zero line, in u or in v.
+    dist = np.minimum(np.abs(uv[:, 0] * scene.k_u - np.rint(uv[:, 0] * scene.k_u)) / scene.k_u,
+                      np.abs(uv[:, 1] * scene.k_v - np.rint(uv[:, 1] * scene.k_v)) / scene.k_v)
+    out = {k: [] for k in ("max", "rms", "on_band", "off_band", "flips", "straddling")}
+    for eps in CENSUS_STEPS:
+        led = compare(render(scene.replace(eps=eps), size, size, gradient="central"), symbolic)
+        for key, value in (("max", led.max_abs), ("rms", led.rms), ("on_band", led.mean_abs_kink),
+                           ("off_band", led.mean_abs_off_kink), ("flips", led.flips),
+                           ("straddling", int(np.count_nonzero(dist < eps)))):
+            out[key].append(value)
+    logs = np.log(CENSUS_STEPS)
+    default = CENSUS_STEPS.index(scene.eps)
+    return dict(out, steps=list(CENSUS_STEPS),
+                rms_slope=float(np.polyfit(logs, np.log(out["rms"]), 1)[0]),
+                off_slope=float(np.polyfit(logs, np.log(out["off_band"]), 1)[0]),
+                ratio=out["on_band"][default] / out["off_band"][default],
+                label=frame_label(scene, size, size))
+
+
 def _census_slope():
-    steps = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)          # the seed's Cell 3 sweep, 256^2
-    sym = render(Scene(), 256, 256)
-    rms, off = [], []
-    for eps in steps:
-        led = compare(render(Scene(eps=eps), 256, 256, gradient="central"), sym)
-        rms.append(led.rms)
-        off.append(led.mean_abs_off_kink)
-    s_rms = np.polyfit(np.log(steps), np.log(rms), 1)[0]
-    s_off = np.polyfit(np.log(steps), np.log(off), 1)[0]
-    return (f"fitted slope: RMS on A {s_rms:.2f}, off the crease band {s_off:.2f}" + _on(sym),
-            {"RMS slope": s_rms, "off-band slope": s_off})
+    c = census()
+    return (f"the RMS slope of the census is {c['rms_slope']:.2f} and its off-band slope "
+            f"{c['off_slope']:.2f} (fitted exponents over steps from 1e-1 to 1e-6, {c['label']}): only "
+            "the pixels off the crease band descend at second order",
+            {"RMS slope": c["rms_slope"], "off-band slope": c["off_slope"]})
 
 
 def _cell3_runs():
@@ -222,34 +264,30 @@ def _cell3_runs():
     try:
         np.abs(num.image - sym.image)[same & on_a].max()
     except ValueError as error:
-        return (f"its sphere A covers {np.count_nonzero(on_a)} of {code.size} pixels{_on(sym)}, so the "
-                f"first row of the sweep stops with ValueError: {error}", {"rows computed": 0})
+        return (f"the cell crashes before printing a row: its sphere A covers {np.count_nonzero(on_a)} of "
+                f"{code.size:,} pixels{_on(sym)}, and the maximum over no pixels raises ValueError "
+                f"(“{error}”)", {"rows computed": 0})
     return "the sweep's first row is computed" + _on(sym), {"rows computed": 1}
 
 
 def _census_flips():
-    flips = sum(compare(*_frames(eps=e)).flips for e in (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6))
-    return f"{flips} flips over 6 steps" + _on(_frames()[1]), {"flips": flips}
+    c = census()
+    return (f"{sum(c['flips'])} flips over the six steps ({c['label']})", {"flips": sum(c["flips"])})
 
 
 def crease_band_ratio():
-    """Mean |ΔI| on and off the crease band between the numeric (central,
-    eps = 1e-3) and the symbolic frame of the default scene (ridges) at 256²,
-    and their ratio: a dict with ``on``, ``off``, ``ratio`` and a ``label``;
-    one measurement of the build (`proofs.store`), shown in §5 and the register."""
-    from .store import measured
-    return measured("crease-band-ratio", _crease_band_ratio, size=256)
-
-
-def _crease_band_ratio(size):
-    led = compare(*_frames(size=size))
-    return dict(on=led.mean_abs_kink, off=led.mean_abs_off_kink, ratio=led.mean_abs_kink / led.mean_abs_off_kink,
-                label=f"default scene (ridges, beta = 0.35), eps = 1e-3, {size}x{size}")
+    """The crease ratio of the census at the default step (`census`): mean |ΔI| on the
+    crease band over the mean off it, with the two means (``on``, ``off``) and the label."""
+    c = census()
+    default = c["steps"].index(Scene().eps)
+    return dict(on=c["on_band"][default], off=c["off_band"][default], ratio=c["ratio"], label=c["label"])
 
 
 def _kink_order_of_magnitude():
-    ratio = crease_band_ratio()["ratio"]
-    return f"mean |dI| on / off the band = {ratio:,.0f}", {"on/off ratio": ratio}
+    band = crease_band_ratio()
+    return (f"the crease ratio is {band['ratio']:,.0f}: mean $\\lvert\\Delta I\\rvert$ {band['on']:.1e} on "
+            f"the band against {band['off']:.1e} off it at the default step ({band['label']})",
+            {"on/off ratio": band["ratio"]})
 
 
 def _evals():
@@ -258,9 +296,9 @@ def _evals():
     from the sympy objects the kernel is generated from, `gradient_methods.evaluations`)."""
     from .gradient_methods import evaluations
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
-    return (f"values of h per pixel in the kernel's formulas: central {central.h:g} "
-            f"({central.trig:g} sines after sharing), exact {exact.h:g} (one evaluation of the "
-            f"generated gradient: {exact.trig:g} sines and cosines)",
+    return (f"the central stencil evaluates $h$ {central.h:g} times per pixel ({central.trig:g} sines once "
+            f"common factors are shared); the exact gradient evaluates $h$ {exact.h:g} times, and its "
+            f"generated code calls {exact.trig:g} sines and cosines",
             {"values of h, central": central.h, "values of h, exact": exact.h})
 
 
@@ -288,8 +326,9 @@ def _cell4_counter():
         gradient()
         counts.append(Counter.n)
     numeric, exact, wired = counts
-    return (f"the counter prints {numeric} and {exact}: the wrapper is never called; wired into the "
-            f"central gradient it counts {wired}", {"count printed, numeric": numeric, "count printed, exact": exact})
+    return (f"the counter prints {numeric} and {exact}: the gradients call the unwrapped $h$, so the wrapper "
+            f"never runs (wired into the central gradient it counts {wired})",
+            {"count printed, numeric": numeric, "count printed, exact": exact})
 
 
 def _stacking():
@@ -305,9 +344,9 @@ def _stacking():
         d = (box - one.image)[all_a & (one.chamber == SPHERE_A)]
         err[beta] = float(np.sqrt(np.mean(d ** 2)))
     ratio = err[0.35] / err[0.0]
-    return (f"the bump adds no integral (the pixel filter's integrand changes), but one sample per pixel "
-            f"misses the filtered value by RMS {err[0.35]:.1e} on sphere A with the bump against "
-            f"{err[0.0]:.1e} without: {ratio:.0f}x, so the same filter needs more samples{_on(one, Scene())}",
+    return (f"no new integral, but the filter's integrand gets harder: one sample per pixel misses the "
+            f"4 × 4 box-filtered value by RMS {err[0.35]:.1e} on sphere A with the bump and {err[0.0]:.1e} "
+            f"without, {ratio:.0f} times as far{_on(one, Scene())}",
             {"one-sample error, with / without the bump": ratio})
 
 
@@ -322,9 +361,10 @@ def _blinn_exact():
     at = {F.R: 1.0, F.beta: 0.35, F.h: 0.5, F.h_u: 3.0, F.h_v: -2.0, phi: 1.1, theta: 0.4}
     gap = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE))
     first = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE).diff(F.beta).subs(F.beta, 0))
-    return (f"derived from the surface, but only to first order in beta: at beta = 0.35 (h = 0.5, "
-            f"h_u = 3, h_v = -2, phi = 1.1) his slopes differ from the displaced sphere's by {gap:.2e} "
-            f"(first-order terms: {first:.0e})", {"slope gap": gap, "first-order gap": first})
+    return (f"derived from the surface, but exact only to first order in $\\beta$: at $\\beta = 0.35$ "
+            f"($h = 0.5$, $h_u = 3$, $h_v = -2$, $\\varphi = 1.1$) his slopes differ from the displaced "
+            f"sphere's by {gap:.2e}, while their first-order terms agree exactly",
+            {"slope gap": gap, "first-order gap": first})
 
 
 def _timing():
@@ -353,9 +393,11 @@ def _timing():
     f_central = best(lambda: render(Scene(), 128, 128, gradient="central"), 7)
     stage = t_central / t_exact
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
-    return (f"sines and cosines per pixel: central {central.trig:g}, exact {exact.trig:g}; timed, the gradient "
-            f"stage central/exact = {stage:.1f}x and the whole frame {f_central / f_exact:.2f}x (min of "
-            f"repeated runs, not used for the verdict){_on(g, Scene())}", {"sin/cos calls, exact minus central": exact.trig - central.trig})
+    return (f"decided by a count, not a clock: the exact gradient calls {exact.trig:g} sines and cosines per "
+            f"pixel, the central stencil {central.trig:g}; timed (fastest of repeated runs, deciding nothing), "
+            f"the central gradient stage takes {stage:.1f} times as long and the whole central frame "
+            f"{f_central / f_exact:.2f} times{_on(g, Scene())}",
+            {"sin/cos calls, exact minus central": exact.trig - central.trig})
 
 
 def _cell5_fd():
@@ -370,67 +412,77 @@ def _cell5_fd():
         exact = (g - Np * (Np @ g)) / np.linalg.norm(M)
         M2 = N + (0.35 + 1e-7) * g
         worst = max(worst, float(np.abs(exact - (M2 / np.linalg.norm(M2) - Np) / 1e-7).max()))
-    return (f"the seed's forward difference (dbeta = 1e-7), 2,000 trials: worst {worst:.1e}",
+    return (f"the draft's own check, a forward difference with step 1e-7 over 2,000 random cases, has a "
+            f"worst component error of {worst:.1e}, a hundred times its expectation",
             {"worst component": worst})
 
 
 def _dn_1e12():
     from .accuracy import normal_beta_derivative_residual
-    r = normal_beta_derivative_residual(trials=500)
-    return (f"closed form against 50-digit mpmath: {r:.1e} (not shown by the seed's own check, claim cell5-fd-1e-9)",
-            {"closed form's residual": r})
+    r = normal_beta_derivative_residual()
+    return (f"the closed form's worst error is {r:.1e} against a 50-digit mpmath derivative over 2,000 random "
+            "cases; the draft's own forward-difference check cannot show it", {"closed form's residual": r})
 
 
 def _beta_order():
     from .accuracy import image_beta_order
     o = image_beta_order()
-    return (f"fitted order: median {o['median_slope']:.2f}, RMS {o['rms_slope']:.2f}",
-            {"median order": o["median_slope"], "RMS order": o["rms_slope"]})
+    return (f"the median order of the image's β-derivative is {o['median_slope']:.2f}, but its RMS order "
+            f"{o['rms_slope']:.2f}: second order at most pixels, not where a clip or a max(0, ·) switches "
+            f"({o['label']})", {"median order": o["median_slope"], "RMS order": o["rms_slope"]})
 
 
 def _beta0():
     a, b = _frames(beta=0.0)
     d = float(np.abs(a.image - b.image).max())
-    return f"max |dI| at beta = 0: {d:.1e}" + _on(b), {"max |ΔI|": d}
+    return (f"the two pipelines differ by at most {d:g} at $\\beta = 0$: exactly zero, since the gradient is "
+            f"never used there{_on(b)}", {"max |ΔI|": d})
 
 
 def _bump_nonzero():
     s = Scene(height_field="sine", beta=1.5)
     bumped = render(s, 128, 128)
     d = float(np.abs(bumped.image - render(s.replace(beta=0.0), 128, 128).image).mean())
-    return f"mean |dI| beta = 1.5 vs 0: {d:.3f}" + _on(bumped), {"mean |ΔI|": d}
+    return (f"the sine bump at $\\beta = 1.5$ moves the frame by a mean $\\lvert\\Delta I\\rvert$ of {d:.3f}"
+            + _on(bumped), {"mean |ΔI|": d})
 
 
 def _cell6_truncation():
     a = compare(*_frames("sine", 1.5, 1e-3)).max_abs
     b = compare(*_frames("sine", 1.5, 1e-4)).max_abs
-    return (f"max |dI| at eps 1e-3 / 1e-4: {a:.1e} / {b:.1e} (ratio {a / b:.0f})" + _on(_frames("sine", 1.5, 1e-3)[1]),
+    return (f"the largest $\\lvert\\Delta I\\rvert$ falls from {a:.1e} at a step of 1e-3 to {b:.1e} at 1e-4, "
+            f"{a / b:.0f} times, as a second-order error should" + _on(_frames("sine", 1.5, 1e-3)[1]),
             {"max |ΔI| ratio": a / b})
 
 
 def _noise_below_1e11():
     c = _ucurve()
     rel = _err_at(1e-11) / abs(c.derivative)
-    return f"relative error at eps = 1e-11: {rel:.1e}", {"relative error at ε = 1e-11": rel}
+    return (f"the quotient's relative error at a step of 1e-11 is {rel:.1e}: digits lost, not noise",
+            {"relative error at ε = 1e-11": rel})
 
 
 def _crease_values():
     fd = float(pointwise.central_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0, 1e-4)[0])
     ex = float(pointwise.exact_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0)[0])
-    return (f"FD {fd:+.1e}; exact {ex:+.3f} (sin(pi) rounds to 1.2e-16, so the sign picks a side)",
-            {"|FD h_u|": abs(fd), "|exact h_u|": abs(ex)})
+    return (f"the central difference gives {fd:+.1e} on the crease, as expected, but the exact gradient gives "
+            f"{ex:+.3f}, not zero: $\\sin(\\pi k_u u)$ at the float nearest $1/k_u$ is not zero, so the sign "
+            "factor picks a side",
+            {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex)})
 
 
 def _pole_pixels():
     g = gbuffer(Scene(), 256, 256)
     n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= 1e-4)))
-    return f"pixels using the fallback, from the geometry: {n}" + _on(g, Scene()), {"fallback pixels": n}
+    return (f"{n} pixels use the fallback{_on(g, Scene())}; the draft counts points of a grid of "
+            "$N_z$ values unrelated to the image", {"fallback pixels": n})
 
 
 def _sweep_best():
     a = {eps: compare(*_frames("sine", 0.35, eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
     best = min(a, key=a.get)
-    return f"smallest RMS over the tried steps at eps = {best:.0e}" + _on(_frames("sine")[1], Scene(height_field="sine")), {"best ε": best}
+    return (f"of the steps tried, {best:.0e} gives the smallest RMS difference"
+            + _on(_frames("sine")[1], Scene(height_field="sine")), {"best ε": best})
 
 
 def _creases_part():
@@ -438,7 +490,8 @@ def _creases_part():
     diff = np.abs(num.image - sym.image).max(axis=-1)
     big = diff > 1e-3
     share = float(np.count_nonzero(big & sym.kink) / max(1, np.count_nonzero(big)))
-    return f"{share:.0%} of pixels with |dI| > 1e-3 lie in the crease band" + _on(sym), {"share in the band": share}
+    return (f"{share:.0%} of the pixels whose $\\lvert\\Delta I\\rvert$ exceeds 1e-3 lie in the crease band"
+            + _on(sym), {"share in the band": share})
 
 
 def _rings_pinch():
@@ -453,21 +506,21 @@ def _rings_pinch():
         M = N + 0.35 * float(hv) * np.array([float(c) for c in e_phi])
         out.append(M / np.linalg.norm(M))
     angle = float(np.degrees(np.arccos(np.clip(out[0] @ out[1], -1, 1))))
-    return (f"N' on opposite sides of the pole (sin phi = 1e-3, rings, beta = 0.35) differ by "
-            f"{angle:.0f} degrees", {"angle (degrees)": angle})
+    return (f"with the draft's formula, $N'$ on opposite sides of the pole ($\\sin\\varphi = 10^{{-3}}$, "
+            f"rings, $\\beta = 0.35$) differ by {angle:.0f}°", {"angle (degrees)": angle})
 
 
 def _beta_zero_slider():
     flat = render(Scene(beta=0.0), 96, 96)
     b = render(Scene(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
     n = int(np.count_nonzero(flat.image != b))
-    return (f"beta = 0 renders of two fields and pipelines differ in {n} values" + _on(flat),
+    return (f"at $\\beta = 0$, renders of two fields by the two pipelines differ in {n} values" + _on(flat),
             {"values differing": n})
 
 
 CLAIMS = (
-    Claim("h3-scale", "§3", "(π k_u)³ ≈ 2,000 at k_u = 8", "evaluate (π k_u)³", FAILS, _h3_scale,
-          rule(HOLDS, Bound("(π k_u)³", 1000, 4000))),
+    Claim("h3-scale", "§3", "(π kᵤ)³ ≈ 2,000 at kᵤ = 8", "evaluate (π kᵤ)³", FAILS, _h3_scale,
+          rule(HOLDS, Bound("(π kᵤ)³", 1000, 4000))),
     Claim("truncation-until-1e-6", "§3", "truncation dominates until ε ~ 10⁻⁶",
           "U-curve at the seed's point against an mpmath reference (proofs/ucurve.py)", HOLDS, _truncation_until,
           rule(HOLDS, Bound("model optimum ε", 10 ** -6.5, 10 ** -5.5))),
@@ -478,11 +531,11 @@ CLAIMS = (
           "optimum of the two-term model fitted to the measured U-curve (proofs/ucurve.py)", HOLDS,
           _cell2_minimum,
           rule(HOLDS, Bound("fitted optimum ε", 10 ** -6.5, 10 ** -5.5), CORRECTED, Bound("fitted optimum ε", 1e-8, 1e-5))),
-    Claim("frame-aligned", "Cell 2", "e_th × e_ph … (unit, aligned with N)",
-          "sympy: (e_θ × e_φ)·N", FAILS, _orientation,
-          rule(HOLDS, Bound("(e_θ × e_φ)·N", 1, 1))),
+    Claim("frame-aligned", "Cell 2", "`e_th × e_ph` … (unit, aligned with N)",
+          "sympy: (eθ × eφ)·N", FAILS, _orientation,
+          rule(HOLDS, Bound("(eθ × eφ)·N", 1, 1))),
     Claim("flips-zero", "§1, §3", "Chamber flips are zero by construction",
-          "336 independent G-buffers across fields, β, ε, bump modes, pipelines (proofs/no_boundary.py)",
+          "independent G-buffers across fields, β, ε, bump modes and pipelines (proofs/no_boundary.py)",
           HOLDS, _flips_zero,
           rule(HOLDS, (Bound("geometry values differing", 0, 0), Bound("reach-mask pixels differing", 0, 0)))),
     Claim("shadow-curves-unchanged", "§1", "Silhouettes, seams, shadow curves: unchanged",
@@ -494,7 +547,7 @@ CLAIMS = (
     Claim("census-slope", "Cell 3, Expect", "the ε-sweep table descending the truncation slope",
           "fitted slope of the census over ε = 1e-1 … 1e-6 (ridges, 256²)", CORRECTED, _census_slope,
           rule(HOLDS, Bound("RMS slope", lo=1.8, strict=True), CORRECTED, Bound("off-band slope", lo=1.8, strict=True))),
-    Claim("census-flips", "Cell 3, Expect", "flips = 0 everywhere", "census over six steps", HOLDS,
+    Claim("census-flips", "Cell 3, Expect", "flips = 0 everywhere", "the census of Cell 3 (ridges, 256²)", HOLDS,
           _census_flips,
           rule(HOLDS, Bound("flips", 0, 0))),
     Claim("cell3-runs", "Cell 3", "the census as an epsilon sweep … print the table",
@@ -511,11 +564,11 @@ CLAIMS = (
           "the draft's counting scheme, run: a counter around h, gradients calling h", FAILS, _cell4_counter,
           rule(HOLDS, (Bound("count printed, numeric", 4, 4), Bound("count printed, exact", 1, 1)))),
     Claim("stacking", "§6, Stacking", "bump composes under Ch. 6's filter … no new integral, ever",
-          "4 x 4 box filter against one sample per pixel, with and without the bump (128²)", CORRECTED,
+          "4 × 4 box filter against one sample per pixel, with and without the bump (128²)", CORRECTED,
           _stacking,
           rule(CORRECTED, Bound("one-sample error, with / without the bump", lo=2, strict=True), otherwise=HOLDS)),
     Claim("blinn-exact", "§8", "Blinn computed his perturbation exactly",
-          "Blinn's slopes against the displaced sphere's, exact at beta = 0.35", CORRECTED, _blinn_exact,
+          "Blinn's slopes against the displaced sphere's, exact at β = 0.35", CORRECTED, _blinn_exact,
           rule(CORRECTED, (Bound("slope gap", lo=1e-6, strict=True), Bound("first-order gap", hi=1e-12, strict=True)), HOLDS, Bound("slope gap", hi=1e-12))),
     Claim("symbolic-not-slower", "Cell 4, Expect", "the symbolic column at or under the numeric",
           "transcendental calls in the generated gradients; timings beside", HOLDS, _timing,
@@ -542,9 +595,9 @@ CLAIMS = (
           "relative error at ε = 1e-11", FAILS, _noise_below_1e11,
           rule(HOLDS, Bound("relative error at ε = 1e-11", lo=0.1, strict=True))),
     Claim("crease-fd-zero", "Cell 7b, Expect", "the crease showing FD≈0 vs exact sign-ambiguity",
-          "FD and exact h_u at u = 1/k_u as float64 represents it", CORRECTED, _crease_values,
-          rule(CORRECTED, (Bound("|FD h_u|", hi=1e-6, strict=True), Bound("|exact h_u|", lo=0, strict=True)), HOLDS, Bound("|FD h_u|", hi=1e-6, strict=True))),
-    Claim("pole-pixels", "Cell 7c", "fallback engages below 1e-4. Pixels affected at 256^2: …",
+          "the central and exact hᵤ at u = 1/kᵤ as float64 represents it", CORRECTED, _crease_values,
+          rule(CORRECTED, (Bound("|central hᵤ|", hi=1e-6, strict=True), Bound("|exact hᵤ|", lo=0, strict=True)), HOLDS, Bound("|central hᵤ|", hi=1e-6, strict=True))),
+    Claim("pole-pixels", "Cell 7c", "fallback engages below 1e-4. Pixels affected at 256²: …",
           "count from the rendered geometry", FAILS, _pole_pixels,
           rule(HOLDS, Bound("fallback pixels", lo=1))),
     Claim("try-sweep", "§4 Try this (1)", "bottoms out near 1e-6, and brightens again past 1e-8",

@@ -243,12 +243,11 @@ ERRATA = (
         criterion="the draft's hit points lie over one radius off sphere B, which covers over 5 times the true pixels",
         present=lambda m: m["off_surface_relative"] > 1.0 and m["seed_pixels_b"] > 5 * m["true_pixels_b"],
         finding=(
-            "In the default {pixels}-pixel frame the draft's sphere B is hit by every ray: "
-                "it covers {seed_pixels_b} pixels where the true sphere covers {true_pixels_b}, "
-                "so {chamber_flips} pixels change chamber and sphere A is not visible at all. "
-                "The draft's 'hit points' lie up to {off_surface_max:.3f} scene units "
-                "({off_surface_relative:.1f} radii) off the sphere. With the correction every "
-                "hit point is on its surface to 1e-12 relative."
+            "In the default frame of {pixels:,} pixels every ray hits the draft's sphere B: it "
+                "covers {seed_pixels_b:,} pixels where the true sphere covers {true_pixels_b:,}, so "
+                "{chamber_flips:,} pixels change chamber and sphere A is not visible at all. Its "
+                "'hit points' lie up to {off_surface_max:.3f} scene units ({off_surface_relative:.1f} "
+                "radii) off the sphere."
         ),
     ),
     Erratum(
@@ -262,12 +261,11 @@ ERRATA = (
         criterion="the draft's rule lights a pair beyond the terminator at the default beta, by more than one 8-bit level",
         present=lambda m: m["leak_pixels_default"] > 0 and m["leak_diffuse_max_default"] > 1 / 255,
         finding=(
-            "At the default beta the draft's rule lights {leak_pixels_default} (pixel, light) pairs "
-                "on sphere A whose geometric normal faces away from the light (Lambert term up to "
-                "{leak_diffuse_max_default:.2f}); at beta = 1.5, {leak_pixels_beta_1_5}; "
-                "at beta = 0, none. The boundary of the lit region therefore moves with "
-                "beta, against the draft's own theorem. Under the geometric rule no pixel "
-                "beyond the terminator receives light, at any beta."
+            "At the default $\\beta$ the draft's rule lights {leak_pixels_default:,} (pixel, light) "
+                "pairs on sphere A whose geometric normal faces away from the light (Lambert term up "
+                "to {leak_diffuse_max_default:.2f}); at $\\beta = 1.5$, {leak_pixels_beta_1_5:,}; at "
+                "$\\beta = 0$, none. The lit region's boundary moves with $\\beta$, against the "
+                "draft's own theorem."
         ),
     ),
     Erratum(
@@ -281,10 +279,9 @@ ERRATA = (
         criterion="some pair facing away from its light receives a nonzero lobe",
         present=lambda m: m["pixels"] > 0 and m["max_specular_added"] > 0,
         finding=(
-            "In the default frame {pixels} (pixel, light) pairs on the spheres face away "
-                "from the light yet receive a lobe; the largest such contribution is "
-                "{max_specular_added:.1e}, far below one 8-bit level, so the defect is "
-                "invisible here but wrong in principle (it grows as the shininess falls)."
+            "In the default frame {pixels:,} (pixel, light) pairs face away from the light yet "
+                "receive a lobe; the largest is {max_specular_added:.1e}, far below one 8-bit level: "
+                "invisible here, wrong in principle."
         ),
     ),
     Erratum(
@@ -298,12 +295,10 @@ ERRATA = (
         criterion="the branch fires at some interior pixels at eps = 1e-3, and at more at 1e-9",
         present=lambda m: 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"],
         finding=(
-            "At eps = 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
-                "sphere-A pixels, changing the quotient by at most {rel_change_1e-3:.1e} "
-                "(relative); at eps = 1e-6, {fraction_interior_1e-6:.0%} of pixels "
-                "({rel_change_1e-6:.1e}); at eps = 1e-9, {fraction_interior_1e-9:.0%} "
-                "({rel_change_1e-9:.1e}). Small, but it makes the numeric pipeline's "
-                "denominator depend on rounding."
+            "At a step of 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
+                "sphere-A pixels (relative change of the quotient up to {rel_change_1e-3:.1e}); at "
+                "1e-6 at {fraction_interior_1e-6:.0%} ({rel_change_1e-6:.1e}); at 1e-9 at "
+                "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e})."
         ),
     ),
     Erratum(
@@ -317,9 +312,9 @@ ERRATA = (
         criterion="acos loses more than 1e-3 (relative) while atan2 stays within 1e-14",
         present=lambda m: m["max_rel_error_acos"] > 1e-3 and m["max_rel_error_atan2"] < 1e-14,
         finding=(
-            "For float64 unit normals with sin(phi) between 1e-8 and 1e-2, the relative "
-                "error of acos(N_z) reaches {max_rel_error_acos:.1e} (against mpmath at 40 "
-                "digits); atan2 stays within {max_rel_error_atan2:.1e}."
+            "For unit normals with $10^{{-8}} < \\sin\\varphi < 10^{{-2}}$ the relative error of "
+                "$\\arccos N_z$ reaches {max_rel_error_acos:.1e} against mpmath; atan2 stays within "
+                "{max_rel_error_atan2:.1e}."
         ),
     ),
     Erratum(
@@ -334,10 +329,9 @@ ERRATA = (
         present=lambda m: (m["orientation_fallback"] == 1.0
                          and max(abs(m["orientation_regular_min"] + 1), abs(m["orientation_regular_max"] + 1)) <= 1e-12),
         finding=(
-            "(e_theta x e_phi) . N lies in [{orientation_regular_min:.16f}, "
-                "{orientation_regular_max:.16f}] on the regular frame and is "
-                "{orientation_fallback:+.0f} on the fallback: the fallback pair is a "
-                "reflection of the frame it replaces, not a rotation."
+            "$(e_\\theta \\times e_\\varphi)\\cdot N$ is {orientation_regular_min:.0f} on the "
+                "regular frame (to rounding) and {orientation_fallback:+.0f} on the fallback: the "
+                "fallback pair is a reflection of the frame it replaces, not a rotation."
         ),
     ),
 )
