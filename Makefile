@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml constraints.txt
 book: $(STAMP)
 	$(BIN)/jupyter-book build book --warningiserror --keep-going --quiet
 	$(BIN)/python book/check_offline.py book/_build/html
-	$(BIN)/python book/check_glue.py book/_build/.jupyter_cache
+	$(BIN)/python book/check_glue.py book/_build/.jupyter_cache book/_build/html
 	@echo "$(CURDIR)/book/_build/html/index.html"
 
 test: $(STAMP)

@@ -28,7 +28,14 @@ def _page(page="", **values):
     return nbformat.v4.new_notebook(cells=[cell])
 
 
+@pytest.fixture(autouse=True)
+def _no_named(monkeypatch):
+    """The tests of names glue no named quantities (the words' tests set their own)."""
+    monkeypatch.setattr(check_glue, "NAMED", {})
+
+
 def _cache(tmp_path, pages):
+    (tmp_path / "html").mkdir(exist_ok=True)
     cache = get_cache(str(tmp_path / "cache"))
     for uri, nb in pages:
         cache.cache_notebook_bundle(CacheBundleIn(nb, uri), check_validity=False)
@@ -111,3 +118,66 @@ def test_tex_number_refuses_a_non_finite_number(bad):
     from proofs.book import tex_number
     with pytest.raises(ValueError, match="x must be a finite number"):
         tex_number(bad)
+
+
+def _site(tmp_path, **pages):
+    """A built site: one HTML page per keyword, its body the given HTML."""
+    site = tmp_path / "html"
+    site.mkdir(exist_ok=True)
+    for name, body in pages.items():
+        (site / f"{name}.html").write_text(f"<html><body><article>{body}</article></body></html>", encoding="utf-8")
+    return site
+
+
+NAMED = {"census_rms_slope": "rms slope", "census_off_slope": "off-band slope"}
+VALUES = {"census_rms_slope": {"s5_lab": "0.5412"}, "census_off_slope": {"s5_lab": "2.19"}}
+
+
+def test_words_carrying_their_value_pass(tmp_path):
+    site = _site(tmp_path, s5_lab="<p>The RMS slope is <span class='pasted-text'>0.54</span> and the off-band "
+                                  "slope 2.19.</p>", s6_ledger="<p>Its off-band slope, <b>2.2</b>, is second order.</p>")
+    assert check_glue.words_conflicts(site, VALUES, NAMED) == []
+
+
+def test_the_same_words_with_another_number_fail_wherever_the_number_comes_from(tmp_path):
+    """The register's text (not a glued span) says 1.65 under the words that carry 0.54 in §5."""
+    site = _site(tmp_path, s5_lab="<p>The RMS slope is 0.54; the off-band slope is 2.19.</p>",
+                 s6_ledger="<li>fitted exponent: the RMS slope 1.65 over 1e-3 to 1e-5.</li>")
+    bad = check_glue.words_conflicts(site, VALUES, NAMED)
+    assert len(bad) == 1 and "s6_ledger: 'rms slope' is followed by 1.65" in bad[0]
+
+
+def test_a_rule_threshold_after_the_words_is_not_a_value(tmp_path):
+    site = _site(tmp_path, s6_ledger="<p>Holds if RMS slope &gt; 1.8. The RMS slope is 0.54, the off-band slope 2.19.</p>")
+    assert check_glue.words_conflicts(site, VALUES, NAMED) == []
+
+
+def test_words_inside_maths_or_code_are_not_prose(tmp_path):
+    site = _site(tmp_path, s5_lab="<p>RMS slope 0.54, off-band slope 2.19. <code>rms slope 9.9</code> "
+                                  "<span class='math'>rms slope 7</span></p>")
+    assert check_glue.words_conflicts(site, VALUES, NAMED) == []
+
+
+def test_words_never_met_or_a_name_never_glued_or_words_inside_words_fail(tmp_path):
+    site = _site(tmp_path, s5_lab="<p>The RMS slope is 0.54.</p>")
+    bad = check_glue.words_conflicts(site, VALUES, {**NAMED, "extra": "slope"})
+    assert any("prose never calls it 'off-band slope'" in b for b in bad)
+    assert any("extra: glued nowhere" in b for b in bad)
+    assert any("contain 'slope'" in b for b in bad)
+
+
+def test_main_fails_on_words_with_two_values(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(check_glue, "NAMED", {"c3_rms_slope": "rms slope"})
+    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(c3_rms_slope=0.5412))])
+    _site(tmp_path, s5_lab="<p>The RMS slope is 0.54.</p>", s6_ledger="<p>The RMS slope is 1.65.</p>")
+    assert check_glue.main([str(cache)]) == 1
+    assert "the same words carry different numbers" in capsys.readouterr().err
+    _site(tmp_path, s6_ledger="<p>The RMS slope is 0.541.</p>")
+    assert check_glue.main([str(cache)]) == 0
+
+
+@pytest.mark.parametrize("shown, value, ok", [("0.54", 0.5412, True), ("0.54", 0.546, False), ("2.0e-15", 2.04e-15, True),
+                                              ("2.0e-15", 2.7e-15, False), ("29,919", 29919, True), ("−0.3", -0.3, True),
+                                              ("1e-9", 1.4e-9, True), ("1.4e-9", 1.9e-8, False)])
+def test_a_number_matches_its_value_to_the_digits_shown(shown, value, ok):
+    assert check_glue._matches(shown, value) is ok
