@@ -721,7 +721,7 @@ def pareto_figure(measurement, *, error="max"):
 
     Each point is a method at its median time, with a horizontal bar from the
     fastest to the slowest run; difference sweeps are joined in order of eps
-    (steps labelled when a sweep has at most six); the Pareto front is the
+    (unlabelled: neighbouring steps' labels would collide); the Pareto front is the
     grey staircase.  Methods whose premise fails on a field are drawn hollow.
     An error of exactly 0 would be drawn at 1e-18.
 
@@ -762,10 +762,6 @@ def pareto_figure(measurement, *, error="max"):
                             marker=marker, ms=ms, markevery=list(np.flatnonzero(ok)))
             ax.plot(t[~ok], e[~ok], ls="none", marker=marker, ms=ms, color=color, mfc="white")
             handles.setdefault(method, line)
-            if 1 < len(group) <= 6:
-                for r, ti, ei in zip(group, t, e):
-                    ax.annotate(f"{r.eps:.0e}", (ti, ei), xytext=(-5, -2), textcoords="offset points",
-                                fontsize=7.5, color=color, ha="right")
         ax.set_xscale("log")
         ax.set_yscale("log")
         # Decades only: minor ticks on log axes cost most of the drawing time.
