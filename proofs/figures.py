@@ -157,7 +157,8 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     fig, ax = plt.subplots(figsize=(5.6, 3.4))
     ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
     ax.axvline(crease, color=GREY, lw=0.8, ls=":")
-    ax.text(crease, h.max() * 1.02, r"crease $u = 1/k_u$", ha="center", va="bottom")
+    ax.annotate(r"crease $u = 1/k_u$", (crease, 1), xycoords=("data", "axes fraction"), xytext=(-4, -4),
+                textcoords="offset points", ha="right", va="top")      # inside the axes, clear of the title
     ax.plot([u0 - eps, u0 + eps], [h_m, h_p], "o-", color=RED, label=rf"central stencil: slope {secant:+.2f}")
     du = np.array([-1.5 * eps, 1.5 * eps])
     ax.plot(u0 + du, h_0 + exact * du, color=BLUE, lw=1.5, label=rf"exact slope at $u_0$: {exact:+.2f}")
@@ -181,7 +182,7 @@ def ucurve_anatomy(curve):
     opt = curve.eps_opt_fitted
     ax.axvline(opt, color=GREY, lw=0.8, ls="-.")
     top = float(np.nanmax(curve.error))
-    ax.annotate(r"truncation falls as $\varepsilon^2$", (1e-2, top), (2e-2, top * 30), ha="center", fontsize=8)
+    ax.annotate(r"truncation falls as $\varepsilon^2$", (3e-3, top), (3e-3, top * 30), ha="center", fontsize=8)
     ax.annotate(r"rounding rises as $1/\varepsilon$", (1e-11, top), (1e-11, top * 30), ha="center", fontsize=8)
     ax.annotate(r"optimum $\varepsilon^\ast$", (opt, 1e-17), (opt * 3, 1e-17), fontsize=8)
     ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $h_u$"); ax.set_ylim(1e-18, 1e3)
@@ -189,32 +190,100 @@ def ucurve_anatomy(curve):
     return fig
 
 
-def text_overlaps(fig):
-    """Pairs of the figure's visible text artists (titles, labels, tick labels, legend
-    and annotation text) whose drawn extents overlap, as strings ``"'a' / 'b'"``;
-    an empty list when none do.  Draws the figure once (matplotlib reports the
-    extents of drawn text only).
+def text_overlaps(fig, gap=0.5):
+    """What of ``fig``'s text collides when it is drawn, as strings (an empty list when nothing does).
 
-    First version: a full check (tick labels across axes, legends) to follow.
+    Every text artist matplotlib draws is a candidate: titles, suptitles, axis
+    labels, tick labels (of the ticks in view only), offset texts, legend entries
+    and titles, annotations and free text, in every axes of the figure.  It
+    reports
+
+    * two texts whose boxes overlap, or two texts of different axes side by side
+      on one line with less than ``gap`` times the smaller font size between
+      them (tick labels of neighbouring axes that read as one number):
+      ``'a' / 'b'``;
+    * a text overlapping a framed legend it is not part of (a legend's own
+      entries sit inside its box by design, but two of them may not overlap):
+      ``'a' / legend``;
+    * a text drawn into the plotting area of another axes than its own (a
+      y label on the neighbouring image): ``'a' / axes 'title'``.  Axes whose
+      boxes overlap (twins, insets) are not each other's "other" axes;
+    * a text or annotation placed in an axes with a frame that straddles the
+      frame: ``'a' / the frame of its axes``.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        Drawn once here (at ``fig.dpi``), with an Agg canvas if it has none
+        (a closed pyplot figure).
+    gap : float >= 0
+        Least clear space between two texts of different axes on one line, in
+        units of the smaller one's font size.
+
+    Raises
+    ------
+    TypeError
+        ``fig`` is not a Figure.
+    ValueError
+        ``gap`` is negative or not finite.
     """
+    import math
+
+    from matplotlib.figure import Figure
+    from matplotlib.legend import Legend
     from matplotlib.text import Text
+    if not isinstance(fig, Figure):
+        raise TypeError(f"fig must be a matplotlib.figure.Figure, got {type(fig).__name__}")
+    if not (isinstance(gap, (int, float)) and math.isfinite(gap) and gap >= 0):
+        raise ValueError(f"gap must be a finite number >= 0 (font sizes), got {gap!r}")
     if not hasattr(fig.canvas, "get_renderer"):      # a closed pyplot figure keeps a bare canvas
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         FigureCanvasAgg(fig)
-    fig.canvas.draw()
+    # Record the texts as they are drawn: only then is it known which are (ticks out of
+    # view keep labels that are not drawn) and where (layout engines move them).
+    drawn, draw = [], Text.draw
+
+    def recording(text, renderer):
+        draw(text, renderer)
+        if text.get_visible() and text.get_text().strip() and (text.get_alpha() is None or text.get_alpha() > 0):
+            drawn.append(text)
+    Text.draw = recording
+    try:
+        fig.canvas.draw()
+    finally:
+        Text.draw = draw
     renderer = fig.canvas.get_renderer()
-    # Tick labels of ticks outside the view are not drawn but keep a stale extent: leave them out.
-    drawn = {id(label) for ax in fig.axes for axis in (ax.xaxis, ax.yaxis)
-             for tick in axis.get_major_ticks() + axis.get_minor_ticks() for label in (tick.label1, tick.label2)}
-    shown = {id(label) for ax in fig.axes for axis in (ax.xaxis, ax.yaxis)
-             for tick in axis._update_ticks() for label in (tick.label1, tick.label2)
-             if label.get_visible()}
-    texts = [t for t in fig.findobj(Text) if t.get_visible() and t.get_text().strip()
-             and (id(t) not in drawn or id(t) in shown)]
-    boxes = [(t, t.get_window_extent(renderer)) for t in texts]
+    px = fig.dpi / 72                                       # pixels per point
+    boxes = [t.get_window_extent(renderer) for t in drawn]
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    owner = {id(t): ax for ax in axes for t in ax.findobj(Text)}
+    name = lambda t: repr(t.get_text())                      # noqa: E731
     out = []
-    for i, (a, ba) in enumerate(boxes):
-        for b, bb in boxes[i + 1:]:
-            if ba.overlaps(bb):
-                out.append(f"{a.get_text()!r} / {b.get_text()!r}")
+    for i, (a, ba) in enumerate(zip(drawn, boxes)):
+        for b, bb in zip(drawn[i + 1:], boxes[i + 1:]):
+            across = min(ba.x1, bb.x1) - max(ba.x0, bb.x0)      # > 0: the boxes share columns
+            down = min(ba.y1, bb.y1) - max(ba.y0, bb.y0)        # > 0: the boxes share rows
+            room = gap * min(a.get_fontsize(), b.get_fontsize()) * px
+            if (across > 0 and down > 0) or (owner.get(id(a)) is not owner.get(id(b))
+                                                 and down > 0.5 * min(ba.height, bb.height) and across > -room):
+                out.append(f"{name(a)} / {name(b)}")
+    legends = [lg for lg in fig.findobj(Legend) if lg.get_visible() and lg.get_frame_on()]
+    for lg in legends:
+        own = {id(t) for t in lg.findobj(Text)}
+        frame = lg.get_window_extent(renderer)
+        out += [f"{name(t)} / legend" for t, bt in zip(drawn, boxes) if id(t) not in own and frame.overlaps(bt)]
+    for t, bt in zip(drawn, boxes):
+        home = owner.get(id(t))
+        if home is not None and home.axison and t in home.texts:
+            frame = home.get_window_extent(renderer)
+            inside = frame.padded(1)
+            if bt.padded(-1).overlaps(frame) and not (inside.contains(bt.x0, bt.y0) and inside.contains(bt.x1, bt.y1)):
+                out.append(f"{name(t)} / the frame of its axes")
+        for ax in axes:
+            area = ax.get_window_extent(renderer)
+            if ax is home or (home is not None and home.get_window_extent(renderer).overlaps(area)):
+                continue
+            if bt.padded(-1).overlaps(area):
+                label = ax.get_title() or f"{fig.axes.index(ax) + 1} of {len(fig.axes)}"
+                out.append(f"{name(t)} / axes {label!r}")
     return out
