@@ -8,8 +8,9 @@ hand:
   and central gradients, crease band, chart, tangent frame, perturbed normals,
   pixel footprint), printed by `renderer.codegen.js_source` from the same
   sympy objects that renderer/generated.py is printed from for the kernel;
-* ``constants.js``: the default `Scene` and the renderer's constants, read
-  from their homes (`renderer.scene`, `renderer.render`, `renderer.kernel`).
+* ``constants.js``: the default `Scene`, the simulator's (`SIMULATOR_SCENE`) and
+  the renderer's constants, read from their homes (`renderer.scene`,
+  `renderer.render`, `renderer.kernel`).
 
 `write_modules` writes the ES modules to a directory (node runs them in the
 parity tests).  `write_bundle` joins them into one classic script for the
@@ -33,7 +34,7 @@ from . import codegen, kernel, scene
 from .files import atomic_write
 from .render import CHAMBER_NAMES, GRADIENTS, MAX_SIDE, MAX_ZOOM, WINDOW_MARGIN, WINDOW_OFFSET
 
-__all__ = ["JS_DIR", "MODULE_ORDER", "GENERATED", "formulas_js", "constants_js", "sources",
+__all__ = ["JS_DIR", "MODULE_ORDER", "GENERATED", "SIMULATOR_SCENE", "formulas_js", "constants_js", "sources",
            "write_modules", "bundle_source", "write_bundle", "BundleError"]
 
 #: Hand-written modules live here.
@@ -54,6 +55,11 @@ def formulas_js():
     return codegen.js_source()
 
 
+#: The scene the simulator opens on: the draft's (`Scene()`), shaded with the
+#: displaced sphere's normal (``formulas.PERTURBED_NORMAL["surface"]``), the bump a
+#: reader expects; the draft's chart formula is one control away.
+SIMULATOR_SCENE = scene.Scene(bump="surface")
+
 #: The simulator's difference canvas (§4): log10 |difference| is drawn from this floor (black)
 #: to 0 (white), about the rounding level of float64; the linear scale multiplies by the gain.
 DIFFERENCE_LOG_FLOOR = -16
@@ -64,6 +70,7 @@ def constants_js():
     """Source of ``constants.js``: the default Scene and the renderer's constants."""
     consts = {
         "DEFAULT_SCENE": dataclasses.asdict(scene.Scene()),
+        "SIMULATOR_SCENE": dataclasses.asdict(SIMULATOR_SCENE),
         "HEIGHT_FIELDS": list(scene.HEIGHT_FIELDS),
         "MODELS": list(scene.MODELS),
         "BUMPS": list(scene.BUMPS),

@@ -489,8 +489,8 @@ WRONG_VARIANTS = {
                             [("tie", Scene(center_b=(0.0, 0.0, 0.0), radius_b=1.0), 33, 33, "exact", 1.0)]),
     "shadow ray ignores the floor plane": ("render", "if (s.floor && code !== FLOOR && (", "if (false && (",
                                            "image", ["sine-eps1e-2-lights"]),
-    "shading with the geometric normal": ("render", "light_term(s, s.lights[k].color, px.w, px.axis, wv, px.Ns,",
-                                          "light_term(s, s.lights[k].color, px.w, px.axis, wv, px.N,", "image",
+    "shading with the geometric normal": ("render", "light_term(s, s.lights[k].color, px.w, px.axis, 0, wv, px.Ns,",
+                                          "light_term(s, s.lights[k].color, px.w, px.axis, 0, wv, px.N,", "image",
                                           ["default-exact"]),
     "footprint with the column spacing for rows": (
         "render", "const dy = height > 1 ? y[0] - y[1] : window;",

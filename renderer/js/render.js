@@ -114,18 +114,19 @@ function surface(s, x, y, checker, px) {
 }
 
 // Does light L reach P?  The geometric normal faces it (attached shadow), the
-// floor plane does not separate them (floor on, P off the floor), Ns . w > 0
-// (else the light adds nothing and no shadow ray is traced), and no blocker
-// sphere (B for A, A for B, both for the floor) cuts the segment (cast
-// shadow).  Writes the unit vector w from P to L into `w` once it is known.
-function reach(s, L, P, N, code, Ns, w) {
+// floor plane does not separate them (floor on, P off the floor), and no
+// blocker sphere (B for A, A for B, both for the floor) cuts the segment (cast
+// shadow): geometry only.  With `gate`, Ns . w > 0 is asked first (else the
+// light adds nothing, no shadow ray is traced and false is returned).  Writes
+// the unit vector w from P to L into `w` once it is known.
+function reach(s, L, P, N, code, Ns, w, gate = true) {
   const wx = L[0] - P[0], wy = L[1] - P[1], wz = L[2] - P[2];
   if (!(N[0] * wx + N[1] * wy + N[2] * wz > 0.0)) return false;
   if (s.floor && code !== FLOOR && ((L[2] < 0.0 && P[2] > 0.0) || (L[2] > 0.0 && P[2] < 0.0))) return false;
   const w2 = wx * wx + wy * wy + wz * wz;
   const inv = 1.0 / Math.sqrt(w2);
   w[0] = wx * inv; w[1] = wy * inv; w[2] = wz * inv;
-  if (!(Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0)) return false;
+  if (gate && !(Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0)) return false;
   if (code !== SPHERE_A && segment_blocked(wx, wy, wz, w2, L, 0.0, 0.0, 0.0, s.radius_a)) return false;
   if (code !== SPHERE_B && s.sphere_b) {
     const c = s.center_b;
@@ -160,19 +161,20 @@ function specular_axis(s, w, view, axis) {
 // are the kernel's.
 function int_power(base, n) {
   let r = 1.0, a = base;
-  for (let e = n; e !== 0; e = Math.floor(e / 2)) {
-    if (e % 2 === 1) r *= a;
+  for (let e = n; e !== 0; e >>= 1) {      // n < 2^31 (Scene: shininess <= 1e4)
+    if (e & 1) r *= a;
     a *= a;
   }
   return r;
 }
 
 // Add a light's Lambert and Blinn/Phong terms at a point it reaches to rgb:
-// `w` the unit vector to the light, (`axis`, `wv`) its `specular_axis`.
-function light_term(s, color, w, axis, wv, Ns, albedo, rgb) {
-  const mu = Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2];
+// the unit vector w to the light and its `specular_axis` (axis, wv), the
+// vectors at offset `o` of `w` and `axis`.
+function light_term(s, color, w, axis, o, wv, Ns, albedo, rgb) {
+  const mu = Ns[0] * w[o] + Ns[1] * w[o + 1] + Ns[2] * w[o + 2];
   if (!(mu > 0.0)) return;
-  let spec_cos = Ns[0] * axis[0] + Ns[1] * axis[1] + Ns[2] * axis[2];
+  let spec_cos = Ns[0] * axis[o] + Ns[1] * axis[o + 1] + Ns[2] * axis[o + 2];
   if (s.phong) spec_cos = 2.0 * mu * spec_cos - wv;
   // Clamped before the power: rounding can put the cosine an ulp above 1.
   const base = Math.min(Math.max(spec_cos, 0.0), 1.0);
@@ -194,7 +196,7 @@ function shade(s, px) {
     if (reach(s, L, P, px.N, px.code, px.Ns, px.w)) {
       if (view[2] === 0.0) view_vector(s, P, view);      // > 0 once computed: P is below the eye
       const wv = specular_axis(s, px.w, view, px.axis);
-      light_term(s, s.lights[k].color, px.w, px.axis, wv, px.Ns, px.albedo, rgb);
+      light_term(s, s.lights[k].color, px.w, px.axis, 0, wv, px.Ns, px.albedo, rgb);
     }
   }
   for (let c = 0; c < 3; c++) rgb[c] = Math.min(Math.max(rgb[c], 0.0), 1.0);
@@ -220,17 +222,17 @@ function gradient(s, method, eps, x, y, dx, dy, px) {
   central_gradient(s.field, u, v, s.k_u, s.k_v, px.steps[0], px.steps[1], px.grad);
 }
 
-// N' of sphere A into px.Ns (formulas.py `PERTURBED_NORMAL`).
-function shading_normal(s, px) {
-  const N = px.N, f = px.frame, hu = px.grad[0], hv = px.grad[1];
+// N' of sphere A into Ns (formulas.py `PERTURBED_NORMAL`) from the normal at
+// offset n of N, the tangent frame at offset f of F, the gradient (hu, hv),
+// and the height h and sin(phi) (read by the surface bump only).
+function shading_normal(s, N, n, F, f, hu, hv, h, sin_phi, Ns) {
   if (s.surface) {
-    const u = px.uvs[0], v = px.uvs[1], sin_phi = px.uvs[2];
-    const h = height(s.field, u, v, s.k_u, s.k_v);
-    perturbed_normal_surface(N[0], N[1], N[2], f[0], f[1], f[2], f[3], f[4], f[5], hu, hv, s.beta,
-                             h, s.radius_a, sin_phi, px.Ns);
+    perturbed_normal_surface(N[n], N[n + 1], N[n + 2], F[f], F[f + 1], F[f + 2], F[f + 3], F[f + 4], F[f + 5],
+                             hu, hv, s.beta, h, s.radius_a, sin_phi, Ns);
     return;
   }
-  perturbed_normal_chart(N[0], N[1], N[2], f[0], f[1], f[2], f[3], f[4], f[5], hu, hv, s.beta, px.Ns);
+  perturbed_normal_chart(N[n], N[n + 1], N[n + 2], F[f], F[f + 1], F[f + 2], F[f + 3], F[f + 4], F[f + 5],
+                         hu, hv, s.beta, Ns);
 }
 
 // ---- one pixel, one frame ------------------------------------------------------------
@@ -255,6 +257,9 @@ class Pixel {
 function params(scene) {
   if (!(scene.height_field in FIELD_CODES)) {
     throw new RangeError(`height_field must be one of ${Object.keys(FIELD_CODES).join(", ")}, got ${scene.height_field}`);
+  }
+  if (scene.bump === "surface" && !(scene.beta < scene.radius_a)) {     // scene.py: R + beta h > 0
+    throw new RangeError(`beta must be < radius_a = ${scene.radius_a} when bump is "surface", got ${scene.beta}`);
   }
   const f64 = (a) => Float64Array.from(a);
   return {
@@ -289,7 +294,8 @@ function shade_pixel(s, method, eps, x, y, dx, dy, px) {
   if (px.code === BACKGROUND) { px.rgb.fill(0.0); return; }
   if (px.code === SPHERE_A) {
     gradient(s, method, eps, x, y, dx, dy, px);
-    shading_normal(s, px);
+    const h = s.surface ? height(s.field, px.uvs[0], px.uvs[1], s.k_u, s.k_v) : 0.0;
+    shading_normal(s, px.N, 0, px.frame, 0, px.grad[0], px.grad[1], h, px.uvs[2], px.Ns);
   }
   shade(s, px);
 }
@@ -358,30 +364,254 @@ export function render(scene, width, height, gradient = "exact", zoom = 1.0) {
   return frame;
 }
 
-// A numeric pipeline ("central" or "footprint") and the symbolic one ("exact")
-// in one pass: { numeric, symbolic }, each equal to `render`'s frame bit for
-// bit (tests/test_js_parity.py).  The geometry is computed once per pixel and
-// pixels off sphere A are shaded once: they do not depend on the gradient
-// (theorem "bump moves no boundary").
-export function render_pair(scene, width, height, zoom = 1.0, numeric = "central") {
-  check_args(width, height, numeric, zoom);
-  if (numeric === "exact") throw new RangeError("numeric must be a numeric gradient (central or footprint), got exact");
+// ---- geometry kept between frames: re-shading sphere A -----------------------------
+//
+// Theorem "bump moves no boundary": what a pixel sees, its hit point, normal,
+// chart and tangent frame, and which lights reach it on geometry alone do not
+// depend on the bump.  A G-buffer keeps them for a frame; `shade_a` shades
+// sphere A on it for any values of the bump's fields (kernel.py `sweep_row`
+// does the same for an eps sweep), bit for bit what `render` gives
+// (tests/test_js_reshade.py).
+
+// The Scene fields a G-buffer does not depend on.
+export const BUMP_FIELDS = ["height_field", "k_u", "k_v", "beta", "eps", "bump"];
+
+// The geometry of a width x height frame of `scene`: `chamber` (H*W), `image`
+// (H*W*3: the final colour of every pixel off sphere A, 0 on it), `uv` (H*W*2,
+// sphere A's chart), and per pixel a of sphere A (row-major; `pixels[a]` its
+// index in the frame): N (3), uvs (3: u, v, sin phi), frame (6: e_theta,
+// e_phi), steps (2: the footprint's), and per light l (index q = a * lights + l)
+// lit[q] (it reaches the point on geometry alone: `reach` ungated), w (3, the
+// unit vector to it), axis (3) and wv (its `specular_axis`).  Throws RangeError
+// as `render` does.
+export function gbuffer(scene, width, height, zoom = 1.0) {
+  check_args(width, height, "exact", zoom);
   const s = params(scene);
   const { x, y, dx, dy, sin_x, sin_y } = camera(scene, width, height, zoom);
-  const method = GRADIENTS.indexOf(numeric);
-  const frames = { numeric: new_frame(width, height, numeric), symbolic: new_frame(width, height, "exact") };
+  const n = width * height, nl = s.lights.length;
+  const chamber = new Uint8Array(n), t = new Float64Array(n);
   const px = new Pixel();
+  let m = 0;
+  for (let j = 0; j < height; j++) {
+    for (let i = 0; i < width; i++) {
+      nearest_hit(s, x[i], y[j], px);
+      chamber[j * width + i] = px.code; t[j * width + i] = px.t;
+      if (px.code === SPHERE_A) m++;
+    }
+  }
+  const gb = { scene: { ...scene }, s, width, height, zoom, lights: nl, chamber,
+               image: new Float64Array(3 * n), uv: new Float64Array(2 * n), pixels: new Int32Array(m),
+               N: new Float64Array(3 * m), uvs: new Float64Array(3 * m), frame: new Float64Array(6 * m),
+               steps: new Float64Array(2 * m), lit: new Uint8Array(m * nl), w: new Float64Array(3 * m * nl),
+               axis: new Float64Array(3 * m * nl), wv: new Float64Array(m * nl), terms: null };
+  let a = 0;
   for (let j = 0; j < height; j++) {
     for (let i = 0; i < width; i++) {
       const k = j * width + i;
-      geometry(s, x[i], y[j], sin_x[i] * sin_y[j], px);
-      shade_pixel(s, method, scene.eps, x[i], y[j], dx, dy, px);
-      store(frames.numeric, k, px);
-      if (px.code === SPHERE_A) shade_pixel(s, EXACT, scene.eps, x[i], y[j], dx, dy, px);
-      store(frames.symbolic, k, px);
+      px.code = chamber[k]; px.t = t[k];
+      if (px.code === BACKGROUND) continue;                 // black
+      surface(s, x[i], y[j], sin_x[i] * sin_y[j], px);
+      if (px.code !== SPHERE_A) {
+        px.Ns.set(px.N);
+        shade(s, px);
+        gb.image.set(px.rgb, 3 * k);
+        continue;
+      }
+      const N = px.N, f = px.frame;
+      chart(N[0], N[1], N[2], px.uvs);
+      tangent_frame(N[0], N[1], N[2], px.uvs[2], f);
+      footprint(x[i], y[j], dx, dy, s.camera_z, px.P[0], px.P[1], px.P[2], N[0], N[1], N[2],
+                f[0], f[1], f[2], f[3], f[4], f[5], s.radius_a, px.uvs[2], px.steps);
+      view_vector(s, px.P, px.view);
+      for (let l = 0; l < nl; l++) {
+        const q = a * nl + l;
+        gb.lit[q] = reach(s, s.lights[l].position, px.P, N, SPHERE_A, null, px.w, false) ? 1 : 0;
+        if (!gb.lit[q]) continue;
+        gb.wv[q] = specular_axis(s, px.w, px.view, px.axis);
+        gb.w.set(px.w, 3 * q); gb.axis.set(px.axis, 3 * q);
+      }
+      gb.pixels[a] = k;
+      gb.N.set(N, 3 * a); gb.uvs.set(px.uvs, 3 * a); gb.frame.set(f, 6 * a); gb.steps.set(px.steps, 2 * a);
+      gb.uv[2 * k] = px.uvs[0]; gb.uv[2 * k + 1] = px.uvs[1];
+      a++;
     }
   }
-  return frames;
+  return gb;
+}
+
+// `scene`'s kernel parameters, after checking that it has the G-buffer's geometry:
+// RangeError naming the first field (outside BUMP_FIELDS) that differs.
+function bump_params(gb, scene) {
+  for (const name of Object.keys(gb.scene)) {
+    if (!BUMP_FIELDS.includes(name) && JSON.stringify(scene[name]) !== JSON.stringify(gb.scene[name])) {
+      throw new RangeError(`scene.${name} is ${JSON.stringify(scene[name])}, but the G-buffer was made with ` +
+                           `${JSON.stringify(gb.scene[name])}: only ${BUMP_FIELDS.join(", ")} may change`);
+    }
+  }
+  return params(scene);
+}
+
+// The height field's terms on sphere A, kept in the G-buffer while the field
+// and its frequencies stay: the crease flag (H*W), and per pixel of A the
+// height h and the exact gradient (2).
+function field_terms(gb, s) {
+  const key = `${s.field} ${s.k_u} ${s.k_v}`;
+  if (gb.terms !== null && gb.terms.key === key) return gb.terms;
+  const m = gb.pixels.length, uvs = gb.uvs, out = new Float64Array(2);
+  const terms = { key, kink: new Uint8Array(gb.chamber.length), h: new Float64Array(m), grad: new Float64Array(2 * m) };
+  for (let a = 0; a < m; a++) {
+    const u = uvs[3 * a], v = uvs[3 * a + 1];
+    terms.kink[gb.pixels[a]] = kink_band(s.field, u, v, s.k_u, s.k_v) ? 1 : 0;
+    terms.h[a] = height(s.field, u, v, s.k_u, s.k_v);
+    exact_gradient(s.field, u, v, s.k_u, s.k_v, out);
+    terms.grad[2 * a] = out[0]; terms.grad[2 * a + 1] = out[1];
+  }
+  gb.terms = terms;
+  return terms;
+}
+
+// (h_u, h_v) of pixel a of sphere A by gradient `method` into out (`gradient`
+// on the kept geometry).
+function gradient_a(gb, s, terms, a, method, eps, out) {
+  if (method === EXACT) {
+    out[0] = terms.grad[2 * a]; out[1] = terms.grad[2 * a + 1];
+    return;
+  }
+  const u = gb.uvs[3 * a], v = gb.uvs[3 * a + 1];
+  if (method === CENTRAL) central_gradient(s.field, u, v, s.k_u, s.k_v, eps, eps, out);
+  else central_gradient(s.field, u, v, s.k_u, s.k_v, gb.steps[2 * a], gb.steps[2 * a + 1], out);
+}
+
+// Pixel a of sphere A with the gradient (hu, hv): the shading normal into
+// px.Ns and the colour into px.rgb (`shading_normal` and `shade` on the kept
+// geometry: `light_term` for every light that reaches the point on geometry
+// alone, which adds nothing where Ns . w <= 0).
+function shade_a_pixel(gb, s, terms, a, hu, hv, px) {
+  shading_normal(s, gb.N, 3 * a, gb.frame, 6 * a, hu, hv, terms.h[a], gb.uvs[3 * a + 2], px.Ns);
+  const rgb = px.rgb, nl = gb.lights;
+  for (let c = 0; c < 3; c++) rgb[c] = s.ka * s.ambient[c];
+  for (let l = 0; l < nl; l++) {
+    const q = a * nl + l;
+    if (gb.lit[q]) light_term(s, s.lights[l].color, gb.w, gb.axis, 3 * q, gb.wv[q], px.Ns, s.albedo_a, rgb);
+  }
+  for (let c = 0; c < 3; c++) rgb[c] = Math.min(Math.max(rgb[c], 0.0), 1.0);
+}
+
+// The frame of `scene` by `gradient` on the G-buffer `gb` (see `new_frame`):
+// only sphere A is shaded; `scene` may differ from gb's in BUMP_FIELDS only
+// (else RangeError).  `grad`, if given, is the gradient to shade with (H*W*2,
+// a frame's `grad`): the caller vouches that it is this scene's by `gradient`
+// (`PairRenderer` passes it when only beta or bump changed).  The frame shares
+// gb's chamber and uv arrays.
+export function shade_a(gb, scene, gradient, grad = null) {
+  check_args(gb.width, gb.height, gradient, gb.zoom);
+  const s = bump_params(gb, scene), terms = field_terms(gb, s), method = GRADIENTS.indexOf(gradient);
+  const frame = { image: gb.image.slice(), chamber: gb.chamber, kink: terms.kink,
+                  grad: grad === null ? new Float64Array(2 * gb.chamber.length) : grad, uv: gb.uv,
+                  width: gb.width, height: gb.height, gradient };
+  const px = new Pixel(), g = px.grad;
+  for (let a = 0; a < gb.pixels.length; a++) {
+    const k = gb.pixels[a];
+    if (grad === null) {
+      gradient_a(gb, s, terms, a, method, scene.eps, g);
+      frame.grad[2 * k] = g[0]; frame.grad[2 * k + 1] = g[1];
+    }
+    shade_a_pixel(gb, s, terms, a, frame.grad[2 * k], frame.grad[2 * k + 1], px);
+    frame.image[3 * k] = px.rgb[0]; frame.image[3 * k + 1] = px.rgb[1]; frame.image[3 * k + 2] = px.rgb[2];
+  }
+  return frame;
+}
+
+// The ledger (ledger.js `compare`: max and RMS of |I_numeric - I_symbolic| on
+// sphere A) of the central pipeline at each step of `eps_list` against the
+// frame `symbolic`, over the pixels of sphere A whose column and row are
+// multiples of `stride`: [{ eps, max_abs, rms, pixels_a }].  With stride 1 it is
+// `compare` of the full frames, bit for bit.  The gradients at these pixels
+// and steps are kept in gb while the height field, k_u, k_v, the steps and the
+// stride stay (a change of beta or bump re-shades with them).
+export function ledger_along_eps(gb, scene, symbolic, eps_list, stride = 1) {
+  if (!(Number.isInteger(stride) && stride >= 1)) throw new RangeError(`stride must be an integer >= 1, got ${stride}`);
+  const s = bump_params(gb, scene), terms = field_terms(gb, s), px = new Pixel();
+  const key = JSON.stringify([terms.key, eps_list, stride]);
+  if (gb.along?.key !== key) {
+    const sample = [];
+    gb.pixels.forEach((k, a) => {
+      if ((k % gb.width) % stride === 0 && Math.floor(k / gb.width) % stride === 0) sample.push(a);
+    });
+    const grads = new Float64Array(2 * sample.length * eps_list.length);
+    eps_list.forEach((eps, e) => sample.forEach((a, i) => {
+      gradient_a(gb, s, terms, a, CENTRAL, eps, px.grad);
+      grads.set(px.grad, 2 * (e * sample.length + i));
+    }));
+    gb.along = { key, sample, grads };
+  }
+  const { sample, grads } = gb.along;
+  return eps_list.map((eps, e) => {
+    let max_abs = 0.0, sum2 = 0.0;
+    sample.forEach((a, i) => {
+      const o = 2 * (e * sample.length + i), k = gb.pixels[a];
+      shade_a_pixel(gb, s, terms, a, grads[o], grads[o + 1], px);
+      for (let c = 0; c < 3; c++) {
+        const d = Math.abs(px.rgb[c] - symbolic.image[3 * k + c]);
+        if (d > max_abs) max_abs = d;
+        sum2 += d * d;
+      }
+    });
+    return { eps, max_abs, rms: sample.length ? Math.sqrt(sum2 / (3 * sample.length)) : 0.0, pixels_a: sample.length };
+  });
+}
+
+// The simulator's two frames, a numeric pipeline ("central" or "footprint")
+// and the symbolic one ("exact"), with memory: `update` makes a new G-buffer
+// only when the geometry changes (size, zoom, or a Scene field outside
+// BUMP_FIELDS), and re-shades a pipeline only when its inputs change (the
+// symbolic one: the height field, k_u, k_v, beta, bump; the numeric one also
+// its gradient and, for "central", eps).  Each frame equals `render`'s bit for
+// bit (tests/test_js_reshade.py).
+export class PairRenderer {
+  constructor() { this.gb = null; this.keys = {}; this.frames = { numeric: null, symbolic: null }; }
+
+  // { numeric, symbolic, full: whether the geometry was computed afresh,
+  //   shaded: the pipelines shaded by this call }.
+  update(scene, width, height, zoom = 1.0, numeric = "central") {
+    check_args(width, height, numeric, zoom);
+    if (numeric === "exact") throw new RangeError("numeric must be a numeric gradient (central or footprint), got exact");
+    const geometry = JSON.stringify([width, height, zoom,
+                                     Object.entries(scene).filter(([name]) => !BUMP_FIELDS.includes(name))]);
+    const full = geometry !== this.keys.geometry;
+    if (full) {
+      this.gb = gbuffer(scene, width, height, zoom);
+      this.keys = { geometry };
+    }
+    // What each pipeline's gradient depends on, and what its colours depend on.
+    const grads = { symbolic: [scene.height_field, scene.k_u, scene.k_v],
+                    numeric: [scene.height_field, scene.k_u, scene.k_v, numeric, numeric === "central" ? scene.eps : null] };
+    const shaded = [];
+    for (const [name, gradient] of [["symbolic", "exact"], ["numeric", numeric]]) {
+      const grad = JSON.stringify(grads[name]), key = JSON.stringify([grad, scene.beta, scene.bump]);
+      if (key === this.keys[name]) continue;
+      const same = this.frames[name] !== null && grad === this.keys[name + "_grad"];
+      this.frames[name] = shade_a(this.gb, scene, gradient, same ? this.frames[name].grad : null);
+      this.keys[name] = key;
+      this.keys[name + "_grad"] = grad;
+      shaded.push(name);
+    }
+    this.scene = { ...scene };
+    return { ...this.frames, full, shaded };
+  }
+
+  // `ledger_along_eps` of the central pipeline on the current G-buffer and symbolic frame.
+  ledger_along_eps(eps_list, stride = 1) {
+    return ledger_along_eps(this.gb, this.scene, this.frames.symbolic, eps_list, stride);
+  }
+}
+
+// A numeric pipeline ("central" or "footprint") and the symbolic one ("exact")
+// from one G-buffer: { numeric, symbolic }, each equal to `render`'s frame bit
+// for bit (tests/test_js_parity.py).
+export function render_pair(scene, width, height, zoom = 1.0, numeric = "central") {
+  const { numeric: n, symbolic } = new PairRenderer().update(scene, width, height, zoom, numeric);
+  return { numeric: n, symbolic };
 }
 
 // Everything both pipelines compute for pixel (column i, row j) of a
