@@ -2,12 +2,19 @@
 
 The built page is loaded from disk (file://), as a reader without a network
 opens it, and every request that is not for a local file is blocked and
-recorded.  The test checks: no console errors, MathJax typeset from the site,
-canvases that are not blank, the ledger's RMS and max at eps = 1e-3 and 1e-6
-within the bounds that the JavaScript-vs-Python error model
-(tests/test_js_parity.py) puts around the Python renderer's, the hover
-readout's (u, v) within the model's chart bound of Python's for a given
-pixel, and every control reachable and movable from the keyboard.  It saves a screenshot and the timings to test-artifacts/.
+recorded.  The tests check: no console errors, MathJax typeset from the site,
+canvases that are not blank; the opening scene (the draft's, shaded with the
+displaced sphere's normal); the ledger's RMS and max at eps = 1e-3 and 1e-6,
+and the U-curve's points, within the bounds that the JavaScript-vs-Python
+error model (tests/test_js_parity.py) puts around the Python renderer's; an
+eps or beta move re-shading sphere A on kept geometry (the update times go to
+test-artifacts/, never asserted); each "Try this" preset's end state (its
+view, its scale, and what its canvases show); the hover readout's (u, v)
+within the model's chart bound of Python's; every control reachable and
+movable from the keyboard; the layout at 1280 x 900 (canvases, U-curve and
+readout in view together) and at 390 px (canvases stacked, at least 300 px
+wide, and a tap on a phone reading out the pixel tapped).  Screenshots go to
+test-artifacts/.  Each check is shown rejecting a wrong variant.
 
 The book is built into a temporary directory for the test unless
 SYMRENDER_BOOK_HTML names a freshly built site (.ci/run builds the book first
@@ -16,7 +23,10 @@ and passes it).  With CI=true a missing Chromium or Playwright fails the test.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import json
+import os
 import statistics
 from pathlib import Path
 
@@ -24,6 +34,7 @@ import numpy as np
 import pytest
 
 from renderer import Scene, compare, gbuffer, render
+from renderer.jsgen import SIMULATOR_SCENE
 
 from .jsnode import ARTIFACTS, in_ci, require_tool
 from .test_js_parity import CHART_TOL, image_bound
@@ -35,9 +46,10 @@ SIZE = 256
 # background-networking ones Chromium keeps trying to reach Google's hosts.
 CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
-CONTROLS = ["sim-height_field", "sim-k_u", "sim-k_v", "sim-beta", "sim-numeric", "sim-log_eps", "sim-model",
-            "sim-resolution", "sim-view", "sim-zoom", "sim-sphere_b"]
+CONTROLS = ["sim-height_field", "sim-log_eps", "sim-beta", "sim-bump", "sim-view", "sim-scale", "sim-numeric",
+            "sim-k_u", "sim-k_v", "sim-model", "sim-resolution", "sim-zoom", "sim-sphere_b"]
 BUTTONS = ["sim-preset-try1", "sim-preset-try2", "sim-preset-try3", "sim-preset-try4", "sim-reset"]
+SIM = "document.querySelector('[data-symrender-sim]').symrender"
 
 
 @pytest.fixture(scope="module")
@@ -56,10 +68,12 @@ def browser():
 
 
 class Session:
-    """One page of the built book, with the network blocked and errors recorded."""
+    """One page of the built book, with the network blocked and errors recorded.
+    ``options`` go to the browser context (viewport, has_touch, is_mobile)."""
 
-    def __init__(self, browser, url):
-        self.context = browser.new_context(viewport={"width": 1200, "height": 1400})
+    def __init__(self, browser, url, **options):
+        options.setdefault("viewport", {"width": 1200, "height": 1400})
+        self.context = browser.new_context(**options)
         self.blocked, self.errors = [], []
 
         def route(r):
@@ -87,34 +101,56 @@ class Session:
     def ledger(self, name):
         return float(self.page.get_attribute(f"#sim-{name}", "data-value"))
 
-    def set_eps(self, exponent):
+    def fill(self, name, value):
         before = self.updates()
-        self.page.fill("#sim-log_eps", str(exponent))
+        self.page.fill(f"#sim-{name}", str(value))
         self.wait_update(before)
+
+    def set_eps(self, exponent):
+        self.fill("log_eps", exponent)
 
     def select(self, name, value):
         before = self.updates()
         self.page.select_option(f"#sim-{name}", str(value))
         self.wait_update(before)
 
+    def click(self, button):
+        before = self.updates()
+        self.page.click(f"#{button}")
+        self.wait_update(before)
+
+    def sim(self, expression):
+        """``expression`` evaluated on the page's simulator object (``sim``)."""
+        return self.page.evaluate(f"(sim => {expression})({SIM})")
+
+    def canvas(self, name):
+        """The canvas's RGBA bytes as an (H, W, 4) uint8 array."""
+        data = self.page.evaluate(f"""() => {{
+            const c = document.getElementById('sim-canvas-{name}');
+            return [c.width, c.height, Array.from(c.getContext('2d').getImageData(0, 0, c.width, c.height).data)];
+        }}""")
+        return np.array(data[2], np.uint8).reshape(data[1], data[0], 4)
+
+    def frame(self, key):
+        """An array of the symbolic frame the canvases show: chamber, kink or uv, as (H, W[, 2])."""
+        n = self.sim("sim.frames.symbolic.width")
+        return np.array(self.sim(f"Array.from(sim.frames.symbolic.{key})")).reshape(n, n, -1).squeeze()
+
     def difference_levels(self):
         """Grey levels (0-255) of the difference canvas at the pixels on sphere A in the symbolic frame."""
-        return self.page.evaluate("""() => {
-            const sim = document.querySelector('[data-symrender-sim]').symrender;
-            const c = document.getElementById('sim-canvas-difference');
-            const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
-            const chamber = sim.frames.symbolic.chamber, out = [];
-            for (let k = 0; k < chamber.length; k++) if (chamber[k] === 1) out.push(d[4 * k]);
-            return out;
-        }""")
+        return self.canvas("difference")[..., 0][self.frame("chamber") == 1]
 
     def close(self):
         self.context.close()
 
 
+def _url(book_html):
+    return (book_html / "s4_simulator.html").as_uri()
+
+
 @pytest.fixture(scope="module")
 def session(browser, book_html):
-    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    s = Session(browser, _url(book_html))
     yield s
     s.close()
 
@@ -132,35 +168,59 @@ def test_page_loads_offline_without_errors(session):
 
 
 def test_canvases_are_not_blank(session):
-    stats = session.page.evaluate("""() => ['numeric', 'symbolic', 'difference'].map(name => {
-        const c = document.getElementById('sim-canvas-' + name);
-        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
-        let lit = 0; const colours = new Set();
-        for (let k = 0; k < d.length; k += 4) {
-            if (d[k] || d[k + 1] || d[k + 2]) lit++;
-            colours.add((d[k] << 16) | (d[k + 1] << 8) | d[k + 2]);
-        }
-        return {name, width: c.width, lit, colours: colours.size};
-    })""")
-    by = {s["name"]: s for s in stats}
     for name in ("numeric", "symbolic"):
-        assert by[name]["width"] == SIZE
-        assert by[name]["lit"] > 0.5 * SIZE * SIZE and by[name]["colours"] > 1000, by[name]
-    assert by["difference"]["lit"] > 100, by["difference"]   # ridges at eps = 1e-3 differ visibly
+        rgb = session.canvas(name)[..., :3]
+        assert rgb.shape[:2] == (SIZE, SIZE)
+        assert np.count_nonzero(rgb.any(axis=-1)) > 0.5 * SIZE * SIZE, name
+        assert len(np.unique(rgb.reshape(-1, 3), axis=0)) > 1000, name
+    assert np.count_nonzero(session.canvas("difference")[..., :3].any(axis=-1)) > 100   # sphere A differs visibly
 
 
-def _python_ledger(eps):
-    """Python's ledger at eps, and bounds of how far the simulator's RMS and max may lie from it.
+@functools.lru_cache(maxsize=None)
+def _python_frames(scene):
+    """Python's central and exact frames of ``scene`` at SIZE x SIZE, and the error model's bound
+    b = b_central + b_exact of |dI| between the simulator's difference and Python's (H, W, 3)."""
+    return (render(scene, SIZE, SIZE, gradient="central"), render(scene, SIZE, SIZE),
+            image_bound(scene, SIZE, SIZE, "central") + image_bound(scene, SIZE, SIZE, "exact"))
+
+
+def _python_ledger(scene, eps, stride=1):
+    """Python's ledger at eps (over the pixels of sphere A whose column and row are multiples of
+    ``stride``), and bounds of how far the simulator's RMS and max may lie from it.
 
     Per pixel and channel the two |I_numeric - I_symbolic| differ by at most
     b = b_central + b_exact (`image_bound` of each pipeline), so the maxima
     differ by at most max b and, the RMS being a norm, the RMS by at most the
     RMS of b over the same pixels (sphere A in both frames)."""
-    scene = Scene(eps=eps)
-    led = compare(render(scene, SIZE, SIZE, gradient="central"), render(scene, SIZE, SIZE))
-    b = image_bound(scene, SIZE, SIZE, "central") + image_bound(scene, SIZE, SIZE, "exact")
-    on_a = render(scene, SIZE, SIZE, kink=False, grad=False).chamber == 1
-    return led, float(np.sqrt(np.mean(b[on_a] ** 2))), float(b[on_a].max())
+    numeric, symbolic, b = _python_frames(scene.replace(eps=eps))
+    grid = np.zeros((SIZE, SIZE), bool)
+    grid[::stride, ::stride] = True
+    on = grid & (numeric.chamber == 1) & (symbolic.chamber == 1)
+    d = np.abs(numeric.image - symbolic.image)[on]
+    led = compare(numeric, symbolic)
+    return (led if stride == 1 else None, float(np.sqrt(np.mean(d**2))), float(d.max()),
+            float(np.sqrt(np.mean(b[on] ** 2))), float(b[on].max()))
+
+
+def _within(got, python):
+    """Whether the simulator's (rms, max) lie within the error model's bounds of Python's."""
+    _, rms, top, rms_bound, max_bound = python
+    return abs(got[0] - rms) <= rms_bound and abs(got[1] - top) <= max_bound
+
+
+def test_the_simulator_opens_on_the_displaced_sphere_normal(session):
+    """The opening scene is the draft's with bump="surface" (renderer.jsgen.SIMULATOR_SCENE), and
+    its ledger is Python's for that scene; Python's ledger of the draft's chart formula (the wrong
+    variant: a simulator that ignored the bump control) lies outside the bounds."""
+    session.set_eps(-3)
+    assert session.page.input_value("#sim-bump") == "surface"
+    opened = session.sim("sim.frames.scene")
+    want = json.loads(json.dumps(dataclasses.asdict(SIMULATOR_SCENE)))
+    assert opened == want
+    assert dataclasses.replace(SIMULATOR_SCENE, bump="chart") == Scene()        # the rest is the draft's
+    got = (session.ledger("rms"), session.ledger("max"))
+    assert _within(got, _python_ledger(SIMULATOR_SCENE, 1e-3))
+    assert not _within(got, _python_ledger(Scene(), 1e-3))
 
 
 def test_eps_slider_moves_the_ledger_as_python_predicts(session):
@@ -171,18 +231,84 @@ def test_eps_slider_moves_the_ledger_as_python_predicts(session):
         got[exponent] = (session.ledger("rms"), session.ledger("max"), session.ledger("flips"))
     report = {}
     for e, eps in ((-3, 1e-3), (-6, 1e-6)):
-        led, rms_bound, max_bound = _python_ledger(eps)
+        python = _python_ledger(SIMULATOR_SCENE, eps)
+        led, _, _, rms_bound, max_bound = python
         rms, top, flips = got[e]
-        assert abs(rms - led.rms) <= rms_bound, (e, rms, led.rms, rms_bound)
-        assert abs(top - led.max_abs) <= max_bound, (e, top, led.max_abs, max_bound)
+        assert _within((rms, top), python), (e, rms, led.rms, rms_bound, top, led.max_abs, max_bound)
         assert flips == led.flips == 0
         report[f"eps={eps:g}"] = {"rms": rms, "max": top, "python_rms": led.rms, "python_max": led.max_abs,
                                   "rms_bound": rms_bound, "max_bound": max_bound}
     # The slider moves the ledger down the truncation slope: by three orders
     # of magnitude or more from 1e-3 to 1e-6.
     assert got[-6][0] < 1e-3 * got[-3][0]
+    assert not _within(got[-6][:2], _python_ledger(SIMULATOR_SCENE, 1e-3))   # the check tells the steps apart
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     (ARTIFACTS / "browser_ledger.json").write_text(json.dumps(report, indent=1))
+
+
+def test_the_u_curve_is_the_ledger_of_its_sample_and_follows_the_controls(session):
+    """The plot's points are the ledger (RMS, max |dI| on sphere A) at each step of the slider's
+    range in half decades, over the pixels of the frame's sample grid, within the error model of
+    Python's ledger over the same pixels; a sample one pixel coarser (the wrong variant) is not.
+    An eps move moves the marker only; a beta move recomputes the curve."""
+    session.select("height_field", "ridges")
+    session.fill("beta", SIMULATOR_SCENE.beta)
+    session.set_eps(-3)
+    curve = session.sim("sim.curve")
+    stride = curve["stride"]
+    assert stride == session.sim(f"Math.max(1, Math.ceil({SIZE} / 48))") and stride > 1
+    steps = [p["eps"] for p in curve["points"]]
+    assert len(steps) == 27 and steps[0] == 1e-14 and steps[-1] == 0.1
+    assert curve["here"]["eps"] == 1e-3
+    for eps in (1e-3, 3.2e-3):                    # where the model's bound is far below the differences
+        point = next(p for p in curve["points"] if p["eps"] == eps)
+        got = (point["rms"], point["max_abs"])
+        assert _within(got, _python_ledger(SIMULATOR_SCENE, eps, stride)), eps
+        assert not _within(got, _python_ledger(SIMULATOR_SCENE, eps, stride + 1)), eps
+    plot = session.page.locator("#sim-curve")
+    rms_line = plot.locator("#sim-curve-rms").get_attribute("points")
+    assert len(rms_line.split()) == 27
+    marker = plot.locator("#sim-curve-marker").get_attribute("x1")
+    session.set_eps(-6)
+    assert plot.locator("#sim-curve-rms").get_attribute("points") == rms_line          # the curve stays
+    assert plot.locator("#sim-curve-marker").get_attribute("x1") != marker            # the marker moves
+    session.fill("beta", 0.6)
+    assert plot.locator("#sim-curve-rms").get_attribute("points") != rms_line          # recomputed
+    session.fill("beta", SIMULATOR_SCENE.beta)
+    assert plot.locator("#sim-curve-rms").get_attribute("points") == rms_line
+    assert session.errors == []
+
+
+def test_an_eps_or_beta_move_reshades_sphere_a_only_and_is_timed(browser, book_html):
+    """Slider moves of eps re-shade the numeric pipeline only, of beta both, on the kept
+    geometry; a resolution change (the wrong variant for "kept") makes new geometry.  The
+    update times (median of the moves, at 256 x 256) go to test-artifacts/browser_timing.json,
+    with the machine's load: they are reported, not asserted."""
+    s = Session(browser, _url(book_html))
+    try:
+        moves = {"eps": ("log_eps", [-3.1, -3]), "beta": ("beta", [0.3, 0.4])}
+        report = {"size": SIZE, "load_average_1min": os.getloadavg()[0]}
+        for kind, (control, values) in moves.items():
+            start = len(s.sim("sim.timings"))
+            for k in range(16):
+                s.fill(control, values[k % 2])
+            timings = s.sim("sim.timings")[start:]
+            assert len(timings) == 16 and not any(t["full"] for t in timings), kind
+            want = ["numeric"] if kind == "eps" else ["symbolic", "numeric"]
+            assert all(t["shaded"] == want for t in timings), kind
+            assert all(t["resolution"] == SIZE for t in timings)
+            ms = [t["ms"] for t in timings[1:]]          # the first move warms the JIT up
+            report[kind] = {"updates": len(ms), "median_ms": statistics.median(ms), "min_ms": min(ms),
+                            "max_ms": max(ms), **{f"median_{p}": statistics.median(t[p] for t in timings[1:])
+                                                  for p in ("shade_ms", "draw_ms", "curve_ms")}}
+        s.select("resolution", 128)
+        assert s.sim("sim.timings.at(-1).full") is True
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        (ARTIFACTS / "browser_timing.json").write_text(json.dumps(report, indent=1))
+        print("simulator update at 256^2:", json.dumps(report))
+        assert s.errors == [] and s.blocked == []
+    finally:
+        s.close()
 
 
 def test_hover_readout_gives_pythons_chart(session):
@@ -190,7 +316,8 @@ def test_hover_readout_gives_pythons_chart(session):
     which pixel the readout reports (within one of the aim), and compares that
     pixel's (u, v) with Python's, within the error model's chart bound (the
     browser's atan2 may round the last bit differently)."""
-    session.set_eps(-3)
+    session.select("resolution", SIZE)
+    session.select("zoom", 1)
     gb = gbuffer(Scene(), SIZE, SIZE)
     rows, cols = np.nonzero(gb.chamber == 1)
     pick = [(int(cols[k]), int(rows[k])) for k in (len(rows) // 5, len(rows) // 3, len(rows) // 2,
@@ -203,11 +330,7 @@ def test_hover_readout_gives_pythons_chart(session):
     for i, j in pick:
         session.page.mouse.move(box["x"] + (i + 0.5) * box["width"] / SIZE,
                                 box["y"] + (j + 0.5) * box["height"] / SIZE)
-        session.page.wait_for_function(
-            f"Math.abs(Number(document.getElementById('sim-readout').dataset.i) - {i}) <= 1 && "
-            f"Math.abs(Number(document.getElementById('sim-readout').dataset.j) - {j}) <= 1", timeout=10_000)
-        ri = int(session.page.get_attribute("#sim-readout", "data-i"))
-        rj = int(session.page.get_attribute("#sim-readout", "data-j"))
+        ri, rj = _readout_pixel(session, i, j)
         assert gb.chamber[rj, ri] == int(session.page.get_attribute("#sim-readout", "data-chamber")) == 1
         u = float(session.page.get_attribute("#sim-readout", "data-u"))
         v = float(session.page.get_attribute("#sim-readout", "data-v"))
@@ -217,16 +340,25 @@ def test_hover_readout_gives_pythons_chart(session):
     assert "(u, v)" in session.page.text_content("#sim-readout")
 
 
+def _readout_pixel(session, i, j):
+    """Wait until the readout shows a pixel within one of (i, j); return the pixel it shows."""
+    session.page.wait_for_function(
+        f"Math.abs(Number(document.getElementById('sim-readout').dataset.i) - {i}) <= 1 && "
+        f"Math.abs(Number(document.getElementById('sim-readout').dataset.j) - {j}) <= 1", timeout=10_000)
+    return (int(session.page.get_attribute("#sim-readout", "data-i")),
+            int(session.page.get_attribute("#sim-readout", "data-j")))
+
+
 def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_html):
-    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    s = Session(browser, _url(book_html))
     try:
         page = s.page
-        page.focus("#sim-canvas-numeric")
-        seen = []
+        page.focus("#sim-preset-try1")
+        seen = ["sim-preset-try1"]
         for _ in range(40):
             page.keyboard.press("Tab")
             seen.append(page.evaluate("document.activeElement.id"))
-        missing = [c for c in CONTROLS + BUTTONS if c not in seen]
+        missing = [c for c in CONTROLS + BUTTONS + ["sim-canvas-numeric"] if c not in seen]
         assert not missing, f"not reachable with Tab: {missing}"
         # Move each control with the keys a keyboard user has.
         for cid in CONTROLS:
@@ -237,8 +369,8 @@ def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_
             before, n = value(), s.updates()
             key = {"range": "ArrowLeft" if cid == "sim-log_eps" else "ArrowRight",
                    "checkbox": "Space"}.get(kind, "ArrowDown")
-            if cid == "sim-resolution":
-                key = "ArrowUp"          # 256 -> 128: keeps the test quick
+            if cid in ("sim-resolution", "sim-bump"):
+                key = "ArrowUp"          # 256 -> 128 keeps the test quick; the displaced sphere is last
             page.keyboard.press(key)
             s.wait_update(n)
             assert value() != before, (cid, kind, key)
@@ -252,28 +384,6 @@ def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_
         page.focus("#sim-canvas-symbolic")
         page.keyboard.press("ArrowRight")
         assert page.get_attribute("#sim-readout", "data-i") is not None
-        assert s.errors == [] and s.blocked == []
-    finally:
-        s.close()
-
-
-def test_update_time_is_measured_and_a_screenshot_saved(browser, book_html):
-    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
-    try:
-        for k in range(16):
-            s.set_eps(-3 if k % 2 else -3.1)
-        timings = s.page.evaluate(
-            "document.querySelector('[data-symrender-sim]').symrender.timings")
-        ms = [t["ms"] for t in timings if t["resolution"] == SIZE][1:]     # drop the first (JIT warm-up)
-        assert len(ms) >= 15 and all(np.isfinite(ms))
-        ARTIFACTS.mkdir(parents=True, exist_ok=True)
-        s.page.set_viewport_size({"width": 1200, "height": 1600})
-        s.page.locator("#sim").scroll_into_view_if_needed()
-        s.page.screenshot(path=str(ARTIFACTS / "s4_simulator.png"), full_page=False)
-        report = {"updates": len(ms), "median_ms": statistics.median(ms), "min_ms": min(ms),
-                  "max_ms": max(ms), "size": SIZE}
-        (ARTIFACTS / "browser_timing.json").write_text(json.dumps(report, indent=1))
-        print("simulator update at 256^2 (both pipelines + difference):", report)
         assert s.errors == [] and s.blocked == []
     finally:
         s.close()
@@ -386,6 +496,8 @@ def test_the_figure_check_rejects_images_below_the_sharpness_asked(browser, book
     assert not any(i["sharp"] for i in _figures(browser, book_html, "s5_lab", 4))
 
 
+
+
 LOG_EPS = (-1, -3, -6, -9, -12, -14)
 
 
@@ -394,19 +506,19 @@ def test_the_log_difference_view_shows_the_u_curve(browser, book_html, field):
     """On the default log scale the difference canvas is visible on sphere A at every step from
     1e-1 to 1e-14, and its mean level follows the U-curve: lower at the optimum than at
     either end.  On the linear scale (the wrong variant for small steps) it is black."""
-    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+    s = Session(browser, _url(book_html))
     try:
         s.select("height_field", field)
         means = {}
         for e in LOG_EPS:
             s.set_eps(e)
-            levels = np.array(s.difference_levels())
+            levels = s.difference_levels()
             assert np.count_nonzero(levels) > 0.5 * levels.size, (field, e)   # visible: not black
             means[e] = float(levels.mean())
             if field == "sine" and e in (-3, -6, -12):
                 ARTIFACTS.mkdir(parents=True, exist_ok=True)
                 s.page.locator("#sim").scroll_into_view_if_needed()
-                s.page.locator(".sim-canvases").screenshot(path=str(ARTIFACTS / f"s4_log_view_eps_1e{e}.png"))
+                s.page.locator(".sim-stage").screenshot(path=str(ARTIFACTS / f"s4_log_view_eps_1e{e}.png"))
         assert min(means[-6], means[-9]) < min(means[-1], means[-14]), means
         s.set_eps(-6)
         s.select("scale", "linear")
@@ -416,40 +528,220 @@ def test_the_log_difference_view_shows_the_u_curve(browser, book_html, field):
         s.close()
 
 
-def test_preset_three_shows_the_pinch_in_the_shaded_view(browser, book_html):
-    """Rings, pole magnified: the shaded canvas, which the preset shows, changes by more
-    across the pole than anywhere near it in the unmagnified frame."""
-    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+# ---- the "Try this" presets: each opens on the view that makes its point ------------------
+
+def _preset(s, preset):
+    """Click a preset; the controls' values afterwards."""
+    s.click(f"sim-preset-{preset}")
+    return {c: s.page.input_value(f"#sim-{c}")
+            for c in ("height_field", "view", "scale", "zoom", "bump", "log_eps", "beta", "numeric")}
+
+
+def _rgb(canvas):
+    return canvas[..., :3]
+
+
+def test_preset_one_sweeps_eps_down_and_the_symbolic_canvas_stays(browser, book_html):
+    """Sine at the slider's largest step, shaded, log scale, the eps slider focused: the arrow
+    keys sweep eps down, the RMS falls along the truncation slope, and the symbolic canvas keeps
+    every byte (a beta move, the wrong variant, changes it)."""
+    s = Session(browser, _url(book_html))
     try:
-        before = s.updates()
-        s.page.click("#sim-preset-try3")
-        s.wait_update(before)
-        assert s.page.input_value("#sim-view") == "shaded" and s.page.input_value("#sim-zoom") == "8"
-        spread = s.page.evaluate("""() => {
-            const c = document.getElementById('sim-canvas-symbolic');
-            const n = c.width, d = c.getContext("2d").getImageData(n / 2 - 24, n / 2 - 24, 48, 48).data;
-            let lo = 255, hi = 0;
-            for (let k = 0; k < d.length; k += 4) { const y = d[k] + d[k + 1] + d[k + 2];
-                                                   lo = Math.min(lo, y / 3); hi = Math.max(hi, y / 3); }
-            return hi - lo;
-        }""")
-        assert spread > 60, spread          # a light and a dark side meet at the pole
+        state = _preset(s, "try1")
+        assert state == dict(height_field="sine", view="shaded", scale="log", zoom="1", bump="surface",
+                             log_eps="-1", beta=str(SIMULATOR_SCENE.beta), numeric="central")
+        assert s.page.evaluate("document.activeElement.id") == "sim-log_eps"
+        assert s.sim("sim.curve.here.eps") == 0.1
+        assert "Move ε down" in s.page.text_content("#sim-hint")
+        symbolic, rms = _rgb(s.canvas("symbolic")), [s.ledger("rms")]
+        for _ in range(20):                       # 0.1 decade a key: down to 1e-3
+            n = s.updates()
+            s.page.keyboard.press("ArrowLeft")
+            s.wait_update(n)
+            rms.append(s.ledger("rms"))
+        assert s.page.text_content("#sim-log_eps-value") == "1.0e-3"
+        assert np.array_equal(_rgb(s.canvas("symbolic")), symbolic)
+        assert rms[-1] < 1e-3 * rms[0] and sorted(rms, reverse=True) == rms
+        s.fill("beta", 0.3)
+        assert not np.array_equal(_rgb(s.canvas("symbolic")), symbolic)
     finally:
         s.close()
 
 
-@pytest.mark.parametrize("width", [1280, 390])
-def test_the_three_canvases_are_equal_and_side_by_side_at_every_width(browser, book_html, width):
-    s = Session(browser, (book_html / "s4_simulator.html").as_uri())
+#: A difference this large is "where the pipelines part" (the register's claim try-creases).
+BIG = 1e-3
+
+
+def _share_in_band(s):
+    """(pixels of sphere A whose difference canvas is brighter than BIG on the linear scale, the
+    share of them in the crease band); the band's blue tint is not counted (red channel only)."""
+    from renderer.jsgen import DIFFERENCE_LINEAR_GAIN
+    bright = (s.canvas("difference")[..., 0] >= round(255 * min(1.0, DIFFERENCE_LINEAR_GAIN * BIG))) \
+        & (s.frame("chamber") == 1)
+    return int(bright.sum()), float((bright & (s.frame("kink") == 1)).sum() / max(1, bright.sum()))
+
+
+def test_preset_two_shows_the_pipelines_parting_on_the_crease_band(browser, book_html):
+    """Ridges, kink view, linear difference scale: the crease band white on both renders, and
+    the bright pixels of the difference canvas in the band.  On the log scale (the view the
+    preset does not open on: the wrong variant) nearly all of sphere A is bright."""
+    s = Session(browser, _url(book_html))
     try:
-        s.page.set_viewport_size({"width": width, "height": 1200})
-        s.page.wait_for_timeout(200)
-        boxes = [s.page.locator(f"#sim-canvas-{n}").bounding_box() for n in ("numeric", "symbolic", "difference")]
-        assert max(b["width"] for b in boxes) - min(b["width"] for b in boxes) < 1, boxes
-        assert max(b["y"] for b in boxes) - min(b["y"] for b in boxes) < 1, boxes          # one row
-        if width == 390:
-            ARTIFACTS.mkdir(parents=True, exist_ok=True)
-            s.page.locator(".sim-canvases").scroll_into_view_if_needed()
-            s.page.screenshot(path=str(ARTIFACTS / "s4_at_390px.png"), full_page=False)
+        state = _preset(s, "try2")
+        assert (state["height_field"], state["view"], state["scale"]) == ("ridges", "kink", "linear")
+        kink = s.frame("kink") == 1
+        assert kink.sum() > 500
+        for name in ("numeric", "symbolic"):
+            assert (_rgb(s.canvas(name))[kink] == 255).all(), name
+        bright, share = _share_in_band(s)
+        assert bright > 100 and share > 0.9, (bright, share)
+        s.select("scale", "log")
+        bright_log, share_log = _share_in_band(s)
+        assert bright_log > 10 * bright and share_log < 0.5, (bright_log, share_log)
+    finally:
+        s.close()
+
+
+def _pole_ring_spread(s, radius=8, angles=32):
+    """Spread (max - min, grey levels) of the symbolic canvas around the pole: on a circle of
+    ``radius`` pixels about the pixel of sphere A nearest the pole (smallest v)."""
+    uv, chamber = s.frame("uv"), s.frame("chamber")
+    v = np.where(chamber == 1, uv[..., 1], np.inf)
+    j0, i0 = np.unravel_index(np.argmin(v), v.shape)
+    grey = _rgb(s.canvas("symbolic")).mean(axis=-1)
+    t = 2 * np.pi * np.arange(angles) / angles
+    ring = grey[np.round(j0 + radius * np.sin(t)).astype(int), np.round(i0 + radius * np.cos(t)).astype(int)]
+    return float(ring.max() - ring.min())
+
+
+def test_preset_three_magnifies_the_pole_where_the_shading_flips(browser, book_html):
+    """Rings, the pole magnified, shaded: around the pole the shading turns over, from dark
+    to light, on a small circle; with beta = 0 (the wrong variant) the same circle is even."""
+    s = Session(browser, _url(book_html))
+    try:
+        state = _preset(s, "try3")
+        assert (state["height_field"], state["view"], state["zoom"], state["bump"]) == \
+            ("rings", "shaded", "4", "surface")
+        spread = _pole_ring_spread(s)
+        assert spread > 60, spread
+        s.fill("beta", 0)
+        flat = _pole_ring_spread(s)
+        assert flat < 10, flat
+    finally:
+        s.close()
+
+
+def test_preset_four_returns_the_smooth_sphere(browser, book_html):
+    """beta = 0, its slider focused: the ledger reads exactly zero, the two renders are the
+    same bytes, the difference is black and the U-curve lies on its floor; at beta = 0.01
+    (the wrong variant) none of that holds."""
+    s = Session(browser, _url(book_html))
+    try:
+        state = _preset(s, "try4")
+        assert state["beta"] == "0" and s.page.evaluate("document.activeElement.id") == "sim-beta"
+        assert s.ledger("max") == 0.0 and s.ledger("rms") == 0.0
+        assert np.array_equal(_rgb(s.canvas("numeric")), _rgb(s.canvas("symbolic")))
+        assert not _rgb(s.canvas("difference")).any()
+        assert all(p["rms"] == 0 == p["max_abs"] for p in s.sim("sim.curve.points"))
+        s.fill("beta", 0.01)
+        assert s.ledger("max") > 0.0 and _rgb(s.canvas("difference")).any()
+        assert not np.array_equal(_rgb(s.canvas("numeric")), _rgb(s.canvas("symbolic")))
+    finally:
+        s.close()
+
+
+# ---- layout: 1280 x 900 and a phone --------------------------------------------------------
+
+def _box(s, selector):
+    return s.page.locator(selector).bounding_box()
+
+
+def _inside(box, width, height, top=0.0):
+    return box["x"] >= 0 and box["x"] + box["width"] <= width + 0.5 and box["y"] >= top - 0.5 \
+        and box["y"] + box["height"] <= height + 0.5
+
+
+def _scroll_to_canvases(s):
+    """Scroll the canvases to just below the theme's sticky header; return the header's bottom."""
+    header = s.page.evaluate("Math.max(0, ...[...document.querySelectorAll('header')]"
+                             ".map(h => h.getBoundingClientRect().bottom))")
+    s.page.locator("#sim-canvas-numeric").evaluate("c => c.scrollIntoView({block: 'start'})")
+    s.page.evaluate(f"window.scrollBy(0, -{header + 8})")
+    s.page.wait_for_timeout(100)
+    return header
+
+
+def _canvases_and_readout_in_view(s, width, height, header):
+    """Whether the three canvases, the U-curve and the readout are all within the viewport
+    below the header, and the readout beside the plot; and their boxes."""
+    boxes = {sel: _box(s, sel) for sel in ("#sim-canvas-numeric", "#sim-canvas-symbolic", "#sim-canvas-difference",
+                                            "#sim-curve", "#sim-readout")}
+    beside = boxes["#sim-readout"]["x"] >= boxes["#sim-curve"]["x"] + boxes["#sim-curve"]["width"] - 1
+    return all(_inside(b, width, height, header) for b in boxes.values()) and beside, boxes
+
+
+def test_at_1280_the_readout_and_the_u_curve_sit_beside_the_canvases(browser, book_html):
+    """At 1280 x 900, with the canvases in view, the U-curve and the readout (filled in by hovering
+    over a pixel of sphere A) are in view too, the readout beside the plot; the readout moved
+    under the controls (the wrong variant) is not in view."""
+    s = Session(browser, _url(book_html), viewport={"width": 1280, "height": 900})
+    try:
+        header = _scroll_to_canvases(s)
+        canvas = _box(s, "#sim-canvas-symbolic")
+        i, j = SIZE // 2, SIZE // 3
+        s.page.mouse.move(canvas["x"] + (i + 0.5) * canvas["width"] / SIZE,
+                          canvas["y"] + (j + 0.5) * canvas["height"] / SIZE)
+        _readout_pixel(s, i, j)
+        assert "(u, v)" in s.page.text_content("#sim-readout")          # a pixel of sphere A: every row
+        in_view, boxes = _canvases_and_readout_in_view(s, 1280, 900, header)
+        assert in_view, boxes
+        row = [boxes[f"#sim-canvas-{n}"] for n in ("numeric", "symbolic", "difference")]
+        assert max(b["y"] for b in row) - min(b["y"] for b in row) < 1                   # one row
+        assert max(b["width"] for b in row) - min(b["width"] for b in row) < 1           # equal
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        s.page.screenshot(path=str(ARTIFACTS / "s4_simulator.png"))
+        s.page.evaluate("document.querySelector('[data-symrender-sim]').append(document.getElementById('sim-readout'))")
+        assert not _canvases_and_readout_in_view(s, 1280, 900, header)[0]
+        assert s.errors == []
+    finally:
+        s.close()
+
+
+def _canvases_stacked(s):
+    """(whether the three canvases are stacked one above the other, each at least 300 px wide; boxes)."""
+    boxes = [_box(s, f"#sim-canvas-{n}") for n in ("numeric", "symbolic", "difference")]
+    stacked = all(b["y"] >= a["y"] + a["height"] for a, b in zip(boxes, boxes[1:]))
+    return stacked and min(b["width"] for b in boxes) >= 300, boxes
+
+
+def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_html):
+    """At 390 px, with touch: the canvases stacked, each at least 300 px wide; a tap on a canvas
+    shows the pixel tapped in the readout, which stays in view (it sticks to the bottom of the
+    screen while the canvases scroll by).  Without the narrow-screen rule (the wrong variant)
+    the canvases sit side by side, too small."""
+    s = Session(browser, _url(book_html), viewport={"width": 390, "height": 844}, has_touch=True,
+                is_mobile=True, device_scale_factor=2)
+    try:
+        stacked, boxes = _canvases_stacked(s)
+        assert stacked, boxes
+        gb = gbuffer(Scene(), SIZE, SIZE)
+        rows, cols = np.nonzero(gb.chamber == 1)
+        canvas = s.page.locator("#sim-canvas-symbolic")
+        canvas.evaluate("c => c.scrollIntoView({block: 'center'})")
+        box = canvas.bounding_box()
+        for k in (len(rows) // 3, 2 * len(rows) // 3):
+            i, j = int(cols[k]), int(rows[k])
+            s.page.tap("#sim-canvas-symbolic", position={"x": (i + 0.5) * box["width"] / SIZE,
+                                                         "y": (j + 0.5) * box["height"] / SIZE})
+            ri, rj = _readout_pixel(s, i, j)
+            assert s.page.get_attribute("#sim-readout", "data-chamber") == str(gb.chamber[rj, ri]) == "1"
+            assert _inside(_box(s, "#sim-readout"), 390, 844), _box(s, "#sim-readout")
+        assert "(u, v)" in s.page.text_content("#sim-readout")
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        s.page.screenshot(path=str(ARTIFACTS / "s4_at_390px.png"))
+        s.page.evaluate("(st => st.textContent = st.textContent.replace(/@media[^]*$/, ''))"
+                        "(document.getElementById('symrender-sim-style'))")
+        assert not _canvases_stacked(s)[0]
+        assert s.errors == []
     finally:
         s.close()

@@ -1,9 +1,10 @@
-// The §4 live simulator: controls, three canvases, the ledger and the hover
-// readout, wired to the renderer in render.js.  Only this module touches the
-// DOM; the renderer core runs the same under node (tests/test_js_parity.py).
-import { DEFAULT_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES,
+// The §4 live simulator: presets, three canvases, the U-curve plot, the pixel
+// readout, the controls and the ledger, wired to the renderer in render.js.
+// Only this module touches the DOM; the renderer core runs the same under node
+// (tests/test_js_parity.py, tests/test_js_reshade.py).
+import { SIMULATOR_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES,
          LOG_FLOOR, LINEAR_GAIN } from "./constants.js";
-import { render_pair, probe_pixel } from "./render.js";
+import { PairRenderer, probe_pixel } from "./render.js";
 import { compare, to_srgb } from "./ledger.js";
 
 // The step of the numeric pipeline as shown on the slider: 10^x rounded to two
@@ -15,17 +16,31 @@ export function eps_of(log_eps) {
 // The numeric pipelines the left canvas can show: every gradient method but the exact one.
 const NUMERIC = GRADIENTS.filter((g) => g !== "exact");
 
-// What the left canvas shows, per numeric pipeline.
-const NUMERIC_CAPTION = {
-  central: "numeric: central differences, step ε",
-  footprint: "numeric: central differences, step = the pixel's footprint",
-};
+// The slider of log10 eps, and the steps of the U-curve: the slider's range in
+// half decades (27 steps), fine enough to show the bottom of the U and its two
+// slopes, coarse enough to stay cheap (see CURVE_SAMPLE).
+const LOG_EPS = { min: -14, max: -1, step: 0.1 };
+export const CURVE_LOG_EPS = Array.from({ length: 2 * (LOG_EPS.max - LOG_EPS.min) + 1 }, (_, i) => LOG_EPS.min + i / 2);
+// The U-curve is the ledger over a grid of at most CURVE_SAMPLE x CURVE_SAMPLE
+// of the frame's pixels (every 6th column and row at 256 x 256: a 36th of
+// sphere A's pixels): its 27 steps then cost less than re-shading sphere A once
+// for the whole frame, so a change of beta, bump or field, which recomputes the
+// curve, stays within one update.
+export const CURVE_SAMPLE = 48;
+export function curve_stride(resolution) {
+  return Math.max(1, Math.ceil(resolution / CURVE_SAMPLE));
+}
+
+// The β slider: up to 2 for the chart formula; below R for the displaced sphere
+// (scene.py: R + β h must stay positive), on the slider's grid of 0.01.
+const BETA = { min: 0, max: 2, step: 0.01 };
+const beta_max = (bump) => bump === "surface" ? Math.round(100 * (SIMULATOR_SCENE.radius_a - BETA.step)) / 100 : BETA.max;
 
 const DEFAULT_STATE = {
-  numeric: "central", height_field: DEFAULT_SCENE.height_field, k_u: DEFAULT_SCENE.k_u, k_v: DEFAULT_SCENE.k_v,
-  beta: DEFAULT_SCENE.beta, bump: DEFAULT_SCENE.bump, log_eps: Math.log10(DEFAULT_SCENE.eps),
-  model: DEFAULT_SCENE.model, resolution: 256, view: "shaded", scale: "log", zoom: 1,
-  sphere_b: DEFAULT_SCENE.sphere_b,
+  numeric: "central", height_field: SIMULATOR_SCENE.height_field, k_u: SIMULATOR_SCENE.k_u,
+  k_v: SIMULATOR_SCENE.k_v, beta: SIMULATOR_SCENE.beta, bump: SIMULATOR_SCENE.bump,
+  log_eps: Math.log10(SIMULATOR_SCENE.eps), model: SIMULATOR_SCENE.model, resolution: 256, view: "shaded",
+  scale: "log", zoom: 1, sphere_b: SIMULATOR_SCENE.sphere_b,
 };
 
 // Grey level in [0, 1] of a difference d >= 0 on the chosen scale: on the log scale log10 d from
@@ -36,55 +51,96 @@ export function difference_level(d, scale) {
   return Math.min(1.0, LINEAR_GAIN * d);
 }
 
-// The controls, in tab order.  kind: select | range | checkbox.
+// The 8-bit sRGB value of a linear channel.
+const srgb_byte = (x) => Math.round(255 * to_srgb(x));
+
+const SUP = { "-": "⁻", 0: "⁰", 1: "¹", 2: "²", 3: "³", 4: "⁴", 5: "⁵", 6: "⁶", 7: "⁷", 8: "⁸", 9: "⁹" };
+const power_of_ten = (e) => "10" + String(e).split("").map((c) => SUP[c]).join("");
+const LOG_SCALE = `log: ${power_of_ten(LOG_FLOOR)} black, 1 white`;
+const LINEAR_SCALE = `linear: |ΔI| × ${LINEAR_GAIN}`;
+
+// The controls, in tab order.  kind: select | range | checkbox; `labels` names a select's options.
 const CONTROLS = [
   { name: "height_field", label: "height field", kind: "select", options: HEIGHT_FIELDS },
-  { name: "k_u", label: "k_u", kind: "range", min: 1, max: 24, step: 1 },
-  { name: "k_v", label: "k_v", kind: "range", min: 1, max: 24, step: 1 },
-  { name: "beta", label: "β (bump amplitude)", kind: "range", min: 0, max: 2, step: 0.01 },
-  { name: "bump", label: "bump: the draft's chart formula or the displaced sphere's normal", kind: "select",
-    options: BUMPS },
-  { name: "numeric", label: "numeric gradient", kind: "select", options: NUMERIC },
-  { name: "log_eps", label: "ε (finite-difference step)", kind: "range", min: -14, max: -1, step: 0.1,
+  { name: "log_eps", label: "ε, the finite-difference step", kind: "range", ...LOG_EPS,
     show: (x) => eps_of(x).toExponential(1) },
+  { name: "beta", label: "β, the bump's amplitude", kind: "range", ...BETA, show: (x) => x.toFixed(2) },
+  { name: "bump", label: "shading normal", kind: "select", options: BUMPS,
+    labels: { surface: "the displaced sphere's", chart: "the draft's chart formula" } },
+  { name: "view", label: "view", kind: "select", options: ["shaded", "bump", "kink"],
+    labels: { shaded: "shaded", bump: "bump: size of ∇h", kink: "kink: the crease band" } },
+  { name: "scale", label: "difference scale", kind: "select", options: ["log", "linear"],
+    labels: { log: LOG_SCALE, linear: LINEAR_SCALE } },
+  { name: "numeric", label: "numeric gradient", kind: "select", options: NUMERIC,
+    labels: { central: "central differences, step ε", footprint: "central, step = pixel footprint" } },
+  { name: "k_u", label: "kᵤ, periods in u", kind: "range", min: 1, max: 24, step: 1 },
+  { name: "k_v", label: "kᵥ, periods in v", kind: "range", min: 1, max: 24, step: 1 },
   { name: "model", label: "shading model", kind: "select", options: MODELS },
-  { name: "resolution", label: "resolution", kind: "select", options: [64, 128, 256, 512] },
-  { name: "view", label: "view", kind: "select", options: ["shaded", "bump", "kink"] },
-  { name: "scale", label: "difference scale", kind: "select", options: ["log", "linear"] },
-  { name: "zoom", label: "magnify the pole", kind: "select", options: [1, 2, 4, 8, 16, 32] },
+  { name: "resolution", label: "resolution", kind: "select", options: [64, 128, 256, 512],
+    labels: { 64: "64 × 64", 128: "128 × 128", 256: "256 × 256", 512: "512 × 512" } },
+  { name: "zoom", label: "magnify the pole", kind: "select", options: [1, 2, 4, 8, 16, 32],
+    labels: { 1: "×1", 2: "×2", 4: "×4", 8: "×8", 16: "×16", 32: "×32" } },
   { name: "sphere_b", label: "sphere B", kind: "checkbox" },
 ];
 
-// The seed's four "Try this" experiments (§4), applied on top of the defaults.
+// The draft's four "Try this" experiments (§4), applied on top of the defaults,
+// each opening on the view and scale that show its point; `hint` says what to look at.
 export const PRESETS = [
-  { id: "try1", label: "1 · sine: sweep ε from 1e-1 down", set: { height_field: "sine", log_eps: -1 }, focus: "log_eps" },
-  { id: "try2", label: "2 · ridges in the kink view", set: { height_field: "ridges", view: "kink" } },
-  { id: "try3", label: "3 · rings, magnify the pole", set: { height_field: "rings", zoom: 8, view: "shaded" } },
-  { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta" },
+  { id: "try1", label: "1 · sine: sweep ε down", set: { height_field: "sine", log_eps: LOG_EPS.max },
+    focus: "log_eps",
+    hint: "Move ε down with the slider (or the arrow keys): the difference darkens along the truncation " +
+          "slope, bottoms out, then brightens as rounding takes over. The dot rides the U-curve; " +
+          "the symbolic canvas never changes." },
+  { id: "try2", label: "2 · ridges: where the pipelines part", set: { height_field: "ridges", view: "kink", scale: "linear" },
+    hint: "Kink view, linear difference scale: the crease band is white on the renders and blue on the " +
+          "difference, where the large differences sit: central differences straddle the crease." },
+  { id: "try3", label: "3 · rings: magnify the pole", set: { height_field: "rings", zoom: 4, view: "shaded" },
+    hint: "The pole, magnified: the rings converge on it, and the shading flips from one side of the " +
+          "pole to the other, where the perturbed normal turns over." },
+  { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta",
+    hint: "With β = 0 both renders are the un-bumped sphere: the difference is black, the ledger reads " +
+          "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
 ];
 
+const HINT = "Hover over a canvas, or tap it, to read that pixel in the readout beside the U-curve.";
+
 export function scene_of(state) {
-  return { ...DEFAULT_SCENE, height_field: state.height_field, k_u: state.k_u, k_v: state.k_v,
+  return { ...SIMULATOR_SCENE, height_field: state.height_field, k_u: state.k_u, k_v: state.k_v,
            beta: state.beta, bump: state.bump, eps: eps_of(state.log_eps), model: state.model,
            sphere_b: state.sphere_b };
 }
 
 const STYLE = `
 .symrender-sim { font-size: 0.9rem; }
-.symrender-sim .sim-canvases { display: grid; grid-template-columns: repeat(3, minmax(0, 1fr)); gap: 0.6rem; }
+.symrender-sim .sim-stage { display: grid; grid-template-columns: repeat(3, minmax(0, 1fr)); gap: 0.6rem; }
 .symrender-sim figure { margin: 0; min-width: 0; }
-.symrender-sim canvas { width: 100%; aspect-ratio: 1; image-rendering: pixelated; background: #000; display: block; }
+.symrender-sim canvas { width: 100%; aspect-ratio: 1; image-rendering: pixelated; background: #000; display: block;
+  touch-action: manipulation; }
 .symrender-sim canvas:focus { outline: 3px solid #4a90d9; }
 .symrender-sim figcaption { font-size: 0.8rem; line-height: 1.25; margin-top: 0.25rem; }
+.symrender-sim .sim-curve { grid-column: 1 / span 2; }
+.symrender-sim .sim-curve svg { width: 100%; height: 13rem; display: block; overflow: visible; }
+.symrender-sim .sim-curve text { fill: currentColor; font-size: 11px; }
+.symrender-sim .sim-readout { grid-column: 3; font-size: 0.75rem; line-height: 1.3; margin: 0;
+  display: grid; grid-template-columns: max-content minmax(0, 1fr); gap: 0.1rem 0.5rem; align-content: start;
+  font-variant-numeric: tabular-nums; background: var(--pst-color-background, #fff); }
+.symrender-sim .sim-readout dt { font-weight: 600; }
+.symrender-sim .sim-readout dd { margin: 0; overflow-wrap: break-word; min-width: 0; }
 .symrender-sim .sim-controls { display: grid; grid-template-columns: repeat(auto-fill, minmax(13rem, 1fr)); gap: 0.4rem 1rem; margin: 0.8rem 0; }
 .symrender-sim .sim-controls label { display: flex; flex-direction: column; }
 .symrender-sim .sim-controls label.sim-check { flex-direction: row; align-items: center; gap: 0.4rem; }
 .symrender-sim output { font-variant-numeric: tabular-nums; }
-.symrender-sim .sim-presets { display: flex; flex-wrap: wrap; gap: 0.4rem; margin: 0.4rem 0; }
+.symrender-sim .sim-presets { display: flex; flex-wrap: wrap; gap: 0.4rem; margin: 0.4rem 0; align-items: center; }
 .symrender-sim .sim-presets button, .symrender-sim .sim-reset { padding: 0.2rem 0.6rem; }
+.symrender-sim .sim-hint { min-height: 2.6em; margin: 0 0 0.4rem; font-style: italic; }
 .symrender-sim table { font-variant-numeric: tabular-nums; margin: 0.4rem 0; }
 .symrender-sim td, .symrender-sim th { padding: 0.1rem 0.7rem; }
-.symrender-sim .sim-readout { font-family: monospace; font-size: 0.8rem; white-space: pre; overflow-x: auto; min-height: 9em; }
+@media (max-width: 720px) {
+  .symrender-sim .sim-stage { grid-template-columns: minmax(0, 1fr); }
+  .symrender-sim .sim-curve, .symrender-sim .sim-readout { grid-column: 1; }
+  .symrender-sim .sim-readout { position: sticky; bottom: 0; z-index: 2; padding: 0.3rem 0.4rem;
+    border-top: 1px solid currentColor; max-height: 40vh; overflow-y: auto; }
+}
 `;
 
 function el(tag, attrs = {}, children = []) {
@@ -96,18 +152,34 @@ function el(tag, attrs = {}, children = []) {
   return node;
 }
 
+// SVG markup of one element (the plot's text is ours: nothing to escape but <, &).
+function svg(tag, attrs = {}, text = null) {
+  const a = Object.entries(attrs).map(([k, v]) => ` ${k}="${v}"`).join("");
+  return text === null ? `<${tag}${a}/>` : `<${tag}${a}>${String(text).replace(/&/g, "&amp;").replace(/</g, "&lt;")}</${tag}>`;
+}
+
 function fmt(x, digits = 3) {
   return Number.isFinite(x) ? x.toExponential(digits) : String(x);
 }
+
+// The U-curve plot's axes: log10 eps over the slider's range, log10 |ΔI| from
+// CURVE_FLOOR (where an exact zero is drawn) to 0.
+const CURVE_FLOOR = LOG_FLOOR - 1;
+// The crease band on the difference canvas of the kink view: at least this much blue.
+const BAND_BLUE = 90;
+const CURVE_COLOURS = { rms: "#2f7ed8", max: "#e8590c" };
 
 class Simulator {
   constructor(root) {
     this.root = root;
     this.state = { ...DEFAULT_STATE };
+    this.renderer = new PairRenderer();
     this.timings = [];
     this.frames = null;
+    this.curve = null;
     this.probe = null;
     this.pending = false;
+    this.drawn = null;
     this.build();
     this.update();
   }
@@ -115,24 +187,10 @@ class Simulator {
   build() {
     const root = this.root;
     root.replaceChildren();
+    root.classList.add("symrender-sim");
     if (!document.getElementById("symrender-sim-style")) {
       document.head.append(el("style", { id: "symrender-sim-style", text: STYLE }));
     }
-    this.canvases = {};
-    const figs = [
-      ["numeric", NUMERIC_CAPTION.central],
-      ["symbolic", "symbolic: the exact gradient"],
-      ["difference", "log₁₀ |ΔI|"],
-    ].map(([name, caption]) => {
-      const canvas = el("canvas", { id: `sim-canvas-${name}`, tabindex: "0", role: "img",
-                                    "aria-label": `${caption} (arrow keys move the probe)` });
-      canvas.addEventListener("mousemove", (ev) => this.hover(canvas, ev));
-      canvas.addEventListener("keydown", (ev) => this.probe_key(ev));
-      this.canvases[name] = canvas;
-      return el("figure", {}, [canvas, el("figcaption", { id: `sim-caption-${name}`, text: caption })]);
-    });
-    root.append(el("div", { class: "sim-canvases" }, figs));
-
     const presets = PRESETS.map((p) => {
       const b = el("button", { type: "button", id: `sim-preset-${p.id}`, text: p.label });
       b.addEventListener("click", () => this.apply_preset(p));
@@ -142,6 +200,38 @@ class Simulator {
     reset.addEventListener("click", () => this.apply_preset({ set: {} }));
     root.append(el("div", { class: "sim-presets", role: "group", "aria-label": "Try this" },
                    [el("span", { text: "Try this:" }), ...presets, reset]));
+    this.hint = el("p", { id: "sim-hint", class: "sim-hint", "aria-live": "polite", text: HINT });
+    root.append(this.hint);
+
+    this.canvases = {};
+    const figs = ["numeric", "symbolic", "difference"].map((name) => {
+      const canvas = el("canvas", { id: `sim-canvas-${name}`, tabindex: "0", role: "img",
+                                    "aria-label": `${name} canvas (arrow keys move the probe)` });
+      canvas.addEventListener("pointermove", (ev) => { if (ev.pointerType === "mouse") this.pointer(canvas, ev); });
+      canvas.addEventListener("pointerdown", (ev) => this.pointer(canvas, ev));
+      canvas.addEventListener("keydown", (ev) => this.probe_key(ev));
+      this.canvases[name] = canvas;
+      return el("figure", {}, [canvas, el("figcaption", { id: `sim-caption-${name}` })]);
+    });
+    // An inline <svg>, parsed from markup (no namespace address in the script).
+    const holder = el("div");
+    holder.innerHTML = svg("svg", { id: "sim-curve", role: "img" });
+    this.plot = holder.firstChild;
+    const curve = el("figure", { class: "sim-curve" },
+                     [this.plot, el("figcaption", { id: "sim-curve-caption" })]);
+    this.readout = el("dl", { id: "sim-readout", class: "sim-readout", "aria-live": "polite" });
+    root.append(el("div", { class: "sim-stage" }, [...figs, curve, this.readout]));
+    this.show_readout([["pixel", "hover over a canvas, tap it, or focus it and use the arrow keys"]]);
+    this.readout.setAttribute("aria-label", "the pixel readout");
+    if (typeof ResizeObserver !== "undefined") new ResizeObserver(() => this.draw_curve()).observe(this.plot);
+
+    const cell = (id) => el("td", { id });
+    this.ledger = el("table", { class: "sim-ledger", "aria-live": "polite" }, [
+      el("thead", {}, [el("tr", {}, ["max |ΔI| on A", "RMS |ΔI| on A", "flips", "pixels on A", "last update"]
+        .map((h) => el("th", { text: h })))]),
+      el("tbody", {}, [el("tr", {}, ["sim-max", "sim-rms", "sim-flips", "sim-pixels", "sim-time"].map(cell))]),
+    ]);
+    root.append(this.ledger);
 
     this.inputs = {};
     this.outputs = {};
@@ -149,7 +239,7 @@ class Simulator {
       let input;
       if (c.kind === "select") {
         input = el("select", { id: `sim-${c.name}` },
-                   c.options.map((o) => el("option", { value: String(o), text: String(o) })));
+                   c.options.map((o) => el("option", { value: String(o), text: c.labels?.[o] ?? String(o) })));
         input.addEventListener("change", () => this.set_from_input(c, input));
         input.addEventListener("input", () => this.set_from_input(c, input));
       } else if (c.kind === "range") {
@@ -169,22 +259,18 @@ class Simulator {
       return el("label", {}, [el("span", {}, [c.label + " ", out]), input]);
     });
     root.append(el("div", { class: "sim-controls" }, controls));
-
-    const cell = (id) => el("td", { id });
-    this.ledger = el("table", { class: "sim-ledger", "aria-live": "polite" }, [
-      el("thead", {}, [el("tr", {}, ["max |ΔI| on A", "RMS |ΔI| on A", "flips (one shared geometry pass: 0 by construction)",
-                                      "pixels on A", "update (both pipelines)"]
-        .map((h) => el("th", { text: h })))]),
-      el("tbody", {}, [el("tr", {}, ["sim-max", "sim-rms", "sim-flips", "sim-pixels", "sim-time"].map(cell))]),
-    ]);
-    root.append(this.ledger);
-    this.readout = el("div", { id: "sim-readout", class: "sim-readout", "aria-live": "polite",
-                               text: "hover over a canvas (or focus one and use the arrow keys) to probe a pixel" });
-    root.append(this.readout);
     this.sync_inputs();
   }
 
+  // The β slider's range follows the shading normal; β is clamped into it.
+  clamp_beta() {
+    const top = beta_max(this.state.bump);
+    this.inputs.beta.max = String(top);
+    this.state.beta = Math.min(this.state.beta, top);
+  }
+
   sync_inputs() {
+    this.clamp_beta();
     for (const c of CONTROLS) {
       const input = this.inputs[c.name];
       const value = this.state[c.name];
@@ -199,6 +285,7 @@ class Simulator {
     else if (c.kind === "range" || typeof c.options[0] === "number") value = Number(input.value);
     else value = input.value;
     this.state[c.name] = value;
+    if (c.name === "bump") this.sync_inputs();
     if (this.outputs[c.name]) this.outputs[c.name].textContent = c.show ? c.show(value) : String(value);
     this.schedule();
   }
@@ -206,6 +293,8 @@ class Simulator {
   apply_preset(p) {
     this.state = { ...DEFAULT_STATE, ...p.set };
     this.sync_inputs();
+    this.hint.textContent = p.hint ?? HINT;
+    this.root.dataset.preset = p.id ?? "";
     this.update();
     if (p.focus) this.inputs[p.focus].focus();
   }
@@ -216,17 +305,26 @@ class Simulator {
     requestAnimationFrame(() => { this.pending = false; this.update(); });
   }
 
+  // Re-shade what changed (render.js `PairRenderer`), the ledger, the canvases, the U-curve.
   update() {
     const s = this.state;
     const scene = scene_of(s);
     const t0 = performance.now();
-    // One pass for both pipelines: the geometry is shared (bump moves no boundary).
-    const { numeric, symbolic } = render_pair(scene, s.resolution, s.resolution, s.zoom, s.numeric);
-    const ledger = compare(numeric, symbolic);
-    this.draw(numeric, symbolic);
+    const res = this.renderer.update(scene, s.resolution, s.resolution, s.zoom, s.numeric);
+    const ledger = compare(res.numeric, res.symbolic);
+    const t_shade = performance.now();
+    this.draw(res);
+    const t1 = performance.now();
+    const stride = curve_stride(s.resolution);
+    if (res.full || res.shaded.includes("symbolic") || this.curve === null || this.curve.stride !== stride) {
+      this.curve = { stride, points: this.renderer.ledger_along_eps(CURVE_LOG_EPS.map(eps_of), stride) };
+    }
+    this.curve.here = this.renderer.ledger_along_eps([scene.eps], stride)[0];
+    this.draw_curve();
     const ms = performance.now() - t0;
-    this.timings.push({ resolution: s.resolution, ms });
-    this.frames = { scene, numeric, symbolic, ledger, ms };
+    this.timings.push({ resolution: s.resolution, ms, shade_ms: t_shade - t0, draw_ms: t1 - t_shade,
+                        curve_ms: performance.now() - t1, full: res.full, shaded: res.shaded });
+    this.frames = { scene, numeric: res.numeric, symbolic: res.symbolic, ledger, ms };
     const put = (id, text, value) => {
       const td = this.root.querySelector(`#${id}`);
       td.textContent = text;
@@ -236,15 +334,21 @@ class Simulator {
     put("sim-rms", fmt(ledger.rms), ledger.rms);
     put("sim-flips", String(ledger.flips), ledger.flips);
     put("sim-pixels", String(ledger.pixels_a), ledger.pixels_a);
-    put("sim-time", `${ms.toFixed(1)} ms`, ms);
+    put("sim-time", `${ms.toFixed(0)} ms (${res.full ? "new geometry" : "sphere A re-shaded"})`, ms);
     this.root.dataset.updates = String(this.timings.length);
     if (this.probe) this.show_probe(this.probe.i, this.probe.j);
   }
 
-  draw(numeric, symbolic) {
-    const view = this.state.view, scale = this.state.scale;
+  // The three canvases.  Off sphere A nothing changes while the geometry, the
+  // view and the scale stay, so only A's pixels are redrawn then, and only on
+  // the canvases whose frame was re-shaded.
+  draw(res) {
+    const { numeric, symbolic } = res;
+    const view = this.state.view, scale = this.state.scale, w = numeric.width, h = numeric.height;
+    const look = `${view} ${scale} ${w}`;
+    const all = res.full || this.drawn !== look;
+    this.drawn = look;
     const n = numeric.chamber.length;
-    const w = numeric.width, h = numeric.height;
     let gmax = 0.0;
     if (view === "bump") {
       for (let k = 0; k < n; k++) {
@@ -252,55 +356,124 @@ class Simulator {
       }
     }
     const gnorm = (f, k) => Math.hypot(f.grad[2 * k], f.grad[2 * k + 1]) / (gmax || 1.0);
+    const pixels = all ? null : this.renderer.gb.pixels;
+    const redraw = { numeric: all || res.shaded.includes("numeric"), symbolic: all || res.shaded.includes("symbolic") };
+    redraw.difference = redraw.numeric || redraw.symbolic;
     for (const name of ["numeric", "symbolic", "difference"]) {
+      if (!redraw[name]) continue;
       const canvas = this.canvases[name];
-      canvas.width = w; canvas.height = h;
+      if (all) { canvas.width = w; canvas.height = h; }
       const ctx = canvas.getContext("2d");
-      const img = ctx.createImageData(w, h);
+      const img = all ? ctx.createImageData(w, h) : this.images[name];
       const px = img.data;
       const frame = name === "numeric" ? numeric : symbolic;
-      for (let k = 0; k < n; k++) {
-        let r, g, b;
+      const count = pixels ? pixels.length : n;
+      for (let a = 0; a < count; a++) {
+        const k = pixels ? pixels[a] : a;
+        let r, g, b;                      // bytes
         if (name !== "difference") {
           if (view === "bump") {
-            const on_a = frame.chamber[k] === SPHERE_A;
-            r = g = b = on_a ? to_srgb(gnorm(frame, k)) : 0.0;
+            r = g = b = frame.chamber[k] === SPHERE_A ? srgb_byte(gnorm(frame, k)) : 0;
           } else {
-            r = to_srgb(frame.image[3 * k]); g = to_srgb(frame.image[3 * k + 1]); b = to_srgb(frame.image[3 * k + 2]);
+            r = srgb_byte(frame.image[3 * k]); g = srgb_byte(frame.image[3 * k + 1]); b = srgb_byte(frame.image[3 * k + 2]);
             if (view === "kink") {
-              if (symbolic.kink[k]) { r = g = b = 1.0; } else { r *= 0.4; g *= 0.4; b *= 0.4; }
+              if (symbolic.kink[k]) { r = g = b = 255; } else { r = Math.round(0.4 * r); g = Math.round(0.4 * g); b = Math.round(0.4 * b); }
             }
           }
-        } else if (view === "bump") {
-          const both = numeric.chamber[k] === SPHERE_A && symbolic.chamber[k] === SPHERE_A;
-          r = g = b = both ? difference_level(Math.abs(gnorm(numeric, k) - gnorm(symbolic, k)), scale) : 0.0;
-        } else if (scale === "log") {     // one grey level: the largest channel difference
-          r = g = b = difference_level(Math.max(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]),
-                                                Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]),
-                                                Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2])), scale);
-          if (view === "kink" && symbolic.kink[k]) { r *= 0.6; g *= 0.6; b = Math.max(b, 0.35); }
         } else {
-          r = difference_level(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]), scale);
-          g = difference_level(Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]), scale);
-          b = difference_level(Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2]), scale);
-          if (view === "kink" && symbolic.kink[k]) b = Math.max(b, 0.35);
+          const level = (d) => Math.round(255 * difference_level(d, scale));
+          if (view === "bump") {
+            const both = numeric.chamber[k] === SPHERE_A && symbolic.chamber[k] === SPHERE_A;
+            r = g = b = both ? level(Math.abs(gnorm(numeric, k) - gnorm(symbolic, k))) : 0;
+          } else if (scale === "log") {     // one grey level: the largest channel difference
+            r = g = b = level(Math.max(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]),
+                                       Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]),
+                                       Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2])));
+            if (view === "kink" && symbolic.kink[k]) { r = Math.round(0.6 * r); g = r; b = Math.max(b, BAND_BLUE); }
+          } else {
+            r = level(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]));
+            g = level(Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]));
+            b = level(Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2]));
+            if (view === "kink" && symbolic.kink[k]) b = Math.max(b, BAND_BLUE);
+          }
         }
-        px[4 * k] = Math.round(255 * r); px[4 * k + 1] = Math.round(255 * g);
-        px[4 * k + 2] = Math.round(255 * b); px[4 * k + 3] = 255;
+        px[4 * k] = r; px[4 * k + 1] = g; px[4 * k + 2] = b; px[4 * k + 3] = 255;
       }
       ctx.putImageData(img, 0, 0);
+      (this.images ??= {})[name] = img;
     }
-    const pipe = this.state.numeric;
-    const diff = scale === "log" ? `log₁₀ |Δ| from ${LOG_FLOOR} (black) to 0 (white)` : `|Δ| × ${LINEAR_GAIN}`;
-    const cap = { shaded: [NUMERIC_CAPTION[pipe] ?? `numeric: ${pipe}`, "symbolic: the exact gradient", `|ΔI|: ${diff}`],
-                  bump: [`bump view: |∇h|, numeric (${pipe})`, "bump view: |∇h|, exact", `|Δ|∇h|| relative to its max: ${diff}`],
-                  kink: [`kink view: crease band (white), numeric (${pipe})`, "kink view: crease band (white), exact", `|ΔI|: ${diff}; band in blue`] }[view];
+    const pipe = this.state.numeric === "central" ? `central differences, ε = ${eps_of(this.state.log_eps).toExponential(1)}`
+      : "central differences, step = the pixel's footprint";
+    const diff = scale === "log" ? `log scale, ${power_of_ten(LOG_FLOOR)} black to 1 white` : `linear scale, × ${LINEAR_GAIN}`;
+    const cap = { shaded: [`numeric: ${pipe}`, "symbolic: the exact gradient", `difference |ΔI|, ${diff}`],
+                  bump: [`size of ∇h, numeric (${pipe})`, "size of ∇h, exact", `difference of the sizes, ${diff}`],
+                  kink: [`crease band in white, numeric (${pipe})`, "crease band in white, exact",
+                         `difference |ΔI|, ${diff}; the band in blue`] }[view];
     ["numeric", "symbolic", "difference"].forEach((name, i) => {
       this.root.querySelector(`#sim-caption-${name}`).textContent = cap[i];
+      this.canvases[name].setAttribute("aria-label", `${cap[i]} (arrow keys move the probe)`);
     });
   }
 
-  hover(canvas, ev) {
+  // The U-curve: RMS and max |ΔI| on sphere A against ε, log-log, the current ε marked.
+  draw_curve() {
+    if (this.curve === null) return;
+    const plot = this.plot, box = plot.getBoundingClientRect();
+    const W = Math.max(box.width, 240), H = Math.max(box.height, 160);
+    const m = { left: 44, right: 10, top: 24, bottom: 36 };
+    const X = (le) => m.left + (le - LOG_EPS.min) / (LOG_EPS.max - LOG_EPS.min) * (W - m.left - m.right);
+    const Y = (d) => {
+      const ld = d > 0 ? Math.max(CURVE_FLOOR, Math.log10(d)) : CURVE_FLOOR;
+      return m.top + (0 - ld) / (0 - CURVE_FLOOR) * (H - m.top - m.bottom);
+    };
+    plot.setAttribute("viewBox", `0 0 ${W} ${H}`);
+    const nodes = [];
+    for (let e = LOG_EPS.min; e <= LOG_EPS.max; e++) {
+      nodes.push(svg("line", { x1: X(e), x2: X(e), y1: m.top, y2: H - m.bottom, stroke: "currentColor", "stroke-opacity": 0.12 }));
+      if ((e - LOG_EPS.min) % 3 === 0) nodes.push(svg("text", { x: X(e), y: H - m.bottom + 14, "text-anchor": "middle" }, power_of_ten(e)));
+    }
+    for (let d = CURVE_FLOOR + 1; d <= 0; d++) {
+      nodes.push(svg("line", { x1: m.left, x2: W - m.right, y1: Y(10 ** d), y2: Y(10 ** d), stroke: "currentColor", "stroke-opacity": 0.12 }));
+      if (d % 4 === 0 && d > CURVE_FLOOR + 1) {
+        nodes.push(svg("text", { x: m.left - 4, y: Y(10 ** d) + 4, "text-anchor": "end" }, power_of_ten(d)));
+      }
+    }
+    nodes.push(svg("text", { x: m.left - 4, y: H - m.bottom + 4, "text-anchor": "end" }, "0"));
+    nodes.push(svg("text", { x: (m.left + W - m.right) / 2, y: H - 4, "text-anchor": "middle" }, "ε, the finite-difference step"));
+    nodes.push(svg("rect", { x: m.left, y: m.top, width: W - m.left - m.right, height: H - m.top - m.bottom,
+                             fill: "none", stroke: "currentColor", "stroke-opacity": 0.5 }));
+    const points = this.curve.points;
+    for (const key of ["rms", "max"]) {
+      const value = (p) => key === "rms" ? p.rms : p.max_abs;
+      nodes.push(svg("polyline", { id: `sim-curve-${key}`, fill: "none", stroke: CURVE_COLOURS[key], "stroke-width": 2,
+                                   "stroke-dasharray": key === "max" ? "6 3" : "none",
+                                   points: points.map((p, i) => `${X(CURVE_LOG_EPS[i]).toFixed(1)},${Y(value(p)).toFixed(1)}`).join(" ") }));
+    }
+    const here = this.curve.here, x = X(Math.log10(here.eps));
+    nodes.push(svg("line", { id: "sim-curve-marker", x1: x, x2: x, y1: m.top, y2: H - m.bottom, stroke: "currentColor",
+                             "stroke-dasharray": "2 2" }));
+    for (const key of ["rms", "max"]) {
+      nodes.push(svg("circle", { cx: x, cy: Y(key === "rms" ? here.rms : here.max_abs), r: 4.5, fill: CURVE_COLOURS[key],
+                                 stroke: "currentColor" }));
+    }
+    [["rms", "RMS |ΔI| on sphere A"], ["max", "max |ΔI| on sphere A"]].forEach(([key, label], i) => {
+      const y = m.top - 8, x0 = m.left + i * 160;
+      nodes.push(svg("line", { x1: x0, x2: x0 + 22, y1: y - 4, y2: y - 4, stroke: CURVE_COLOURS[key], "stroke-width": 2,
+                               "stroke-dasharray": key === "max" ? "6 3" : "none" }));
+      nodes.push(svg("text", { x: x0 + 27, y }, label));
+    });
+    plot.innerHTML = nodes.join("");
+    const stride = this.curve.stride, s = this.state.resolution;
+    const sample = stride === 1 ? `all ${s} × ${s} pixels` : `every ${stride}th pixel of the ${s} × ${s} frame in each direction`;
+    plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; at ε = ` +
+                      `${here.eps.toExponential(1)} RMS ${fmt(here.rms, 1)}, max ${fmt(here.max_abs, 1)}`);
+    plot.dataset.eps = String(here.eps);
+    this.root.querySelector("#sim-curve-caption").textContent =
+      `The U-curve of central differences, on ${sample}, at half-decade steps of ε; the dashed line and ` +
+      `the dots: the current ε. An exact zero lies on the bottom axis.`;
+  }
+
+  pointer(canvas, ev) {
     const rect = canvas.getBoundingClientRect();
     const res = this.state.resolution;
     const i = Math.min(res - 1, Math.max(0, Math.floor((ev.clientX - rect.left) * res / rect.width)));
@@ -318,6 +491,10 @@ class Simulator {
     this.show_probe(Math.min(res - 1, Math.max(0, p.i + di)), Math.min(res - 1, Math.max(0, p.j + dj)));
   }
 
+  show_readout(rows) {
+    this.readout.replaceChildren(...rows.flatMap(([k, v]) => [el("dt", { text: k }), el("dd", { text: v })]));
+  }
+
   show_probe(i, j) {
     const s = this.state;
     const res = s.resolution;
@@ -325,23 +502,20 @@ class Simulator {
     this.probe = { i, j };
     const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom, s.numeric);
     const a = pr.symbolic, b = pr.numeric;
-    const vec = (v) => v ? "(" + v.map((x) => x.toPrecision(10)).join(", ") + ")" : "—";
-    const lines = [
-      `pixel (column ${i}, row ${j})  ray through (${pr.X.toPrecision(8)}, ${pr.Y.toPrecision(8)}, 0)`,
-      `object        ${CHAMBER_NAMES[a.chamber]}`,
-      `world point   ${vec(a.P)}`,
-    ];
+    const vec = (v, digits = 10) => v ? "(" + v.map((x) => x.toPrecision(digits)).join(", ") + ")" : "—";
+    const rows = [["pixel", `(${i}, ${j}): ${CHAMBER_NAMES[a.chamber]}`], ["sees", vec(a.P, 6)]];
     if (a.chamber === SPHERE_A) {
-      lines.push(`(u, v)        ${vec(a.uv)}`);
-      lines.push(`∇h exact      ${vec(a.grad)}`);
-      const steps = b.steps[0] === b.steps[1] ? `ε = ${b.steps[0].toExponential(1)}`
-        : `ε_u = ${b.steps[0].toExponential(2)}, ε_v = ${b.steps[1].toExponential(2)}`;
-      lines.push(`${("∇h " + b.gradient).padEnd(14)}${vec(b.grad)}   (${steps})`);
-      lines.push(`kink band     ${a.kink ? "yes: the gradient is undefined on the crease" : "no"}`);
+      rows.push(["(u, v)", vec(a.uv, 8)]);
+      rows.push(["∇h exact", vec(a.grad)]);
+      rows.push([`∇h ${b.gradient}`, vec(b.grad)]);
+      rows.push(["step", b.steps[0] === b.steps[1] ? `ε = ${b.steps[0].toExponential(1)}`
+        : `εᵤ = ${b.steps[0].toExponential(2)}, εᵥ = ${b.steps[1].toExponential(2)}`]);
+      rows.push(["crease", a.kink ? "in the band: the gradient is undefined on the crease" : "not in the band"]);
     }
-    lines.push(`RGB symbolic  ${vec(a.rgb)}`);
-    lines.push(`RGB numeric   ${vec(b.rgb)}`);
-    this.readout.textContent = lines.join("\n");
+    rows.push(["RGB exact", vec(a.rgb, 6)]);
+    rows.push([`RGB ${b.gradient}`, vec(b.rgb, 6)]);
+    rows.push(["|ΔI|", `${fmt(Math.max(...a.rgb.map((x, c) => Math.abs(x - b.rgb[c]))), 2)}, the largest channel`]);
+    this.show_readout(rows);
     const d = this.readout.dataset;
     d.i = String(i); d.j = String(j); d.chamber = String(a.chamber);
     d.u = a.uv ? String(a.uv[0]) : ""; d.v = a.uv ? String(a.uv[1]) : "";
