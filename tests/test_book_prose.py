@@ -229,8 +229,8 @@ def test_an_unlabelled_rendered_number_is_found():
     assert {"render", "gbuffer", "image_beta_order", "crease_band_ratio", "gradient_accuracy"} <= renders
     assert "tex_number" not in renders
     s4 = (BOOK / "s4_simulator.md").read_text(encoding="utf-8")
-    assert unlabelled(s4.replace("The two pipelines at {glue:text}`s4_size`", "The two pipelines"), renders)
-    assert unlabelled(s4.replace("(default scene, {glue:text}`s4_size`):", ":"), renders)
+    assert unlabelled(s4.replace("The opening frame ({glue:text}`s4_label`):", "The opening frame:"), renders)
+    assert unlabelled(s4.replace("({glue:text}`s4_label`):", "({glue:text}`s4_max`):"), renders)
     front = s4[:s4.index("---", 3) + 4]                  # a page's front matter: it is a notebook
     cell = (front + "```{code-cell} ipython3\nfrom proofs.accuracy import image_beta_order\n"
             "glue(\"x_slope\", image_beta_order()[\"median_slope\"])\n```\n\n")
