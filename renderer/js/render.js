@@ -403,7 +403,7 @@ export function gbuffer(scene, width, height, zoom = 1.0) {
                image: new Float64Array(3 * n), uv: new Float64Array(2 * n), pixels: new Int32Array(m),
                N: new Float64Array(3 * m), uvs: new Float64Array(3 * m), frame: new Float64Array(6 * m),
                steps: new Float64Array(2 * m), lit: new Uint8Array(m * nl), w: new Float64Array(3 * m * nl),
-               axis: new Float64Array(3 * m * nl), wv: new Float64Array(m * nl), terms: null };
+               axis: new Float64Array(3 * m * nl), wv: new Float64Array(m * nl), terms: null, along: new Map() };
   let a = 0;
   for (let j = 0; j < height; j++) {
     for (let i = 0; i < width; i++) {
@@ -526,14 +526,14 @@ export function shade_a(gb, scene, gradient, grad = null) {
 // sphere A) of the central pipeline at each step of `eps_list` against the
 // frame `symbolic`, over the pixels of sphere A whose column and row are
 // multiples of `stride`: [{ eps, max_abs, rms, pixels_a }].  With stride 1 it is
-// `compare` of the full frames, bit for bit.  The gradients at these pixels
-// and steps are kept in gb while the height field, k_u, k_v, the steps and the
-// stride stay (a change of beta or bump re-shades with them).
-export function ledger_along_eps(gb, scene, symbolic, eps_list, stride = 1) {
+// `compare` of the full frames, bit for bit.  With `keep`, the gradients at
+// these pixels and steps are kept in gb, per height field, k_u, k_v, list of
+// steps and stride: a change of beta or bump re-shades with them.
+export function ledger_along_eps(gb, scene, symbolic, eps_list, stride = 1, keep = true) {
   if (!(Number.isInteger(stride) && stride >= 1)) throw new RangeError(`stride must be an integer >= 1, got ${stride}`);
   const s = bump_params(gb, scene), terms = field_terms(gb, s), px = new Pixel();
   const key = JSON.stringify([terms.key, eps_list, stride]);
-  if (gb.along?.key !== key) {
+  if (!keep || !gb.along.has(key)) {
     const sample = [];
     gb.pixels.forEach((k, a) => {
       if ((k % gb.width) % stride === 0 && Math.floor(k / gb.width) % stride === 0) sample.push(a);
@@ -543,9 +543,16 @@ export function ledger_along_eps(gb, scene, symbolic, eps_list, stride = 1) {
       gradient_a(gb, s, terms, a, CENTRAL, eps, px.grad);
       grads.set(px.grad, 2 * (e * sample.length + i));
     }));
-    gb.along = { key, sample, grads };
+    if (!keep) return along(gb, s, terms, symbolic, eps_list, sample, grads, px);
+    if (gb.along.size >= 4) gb.along.clear();             // fields or strides have changed: start afresh
+    gb.along.set(key, { sample, grads });
   }
-  const { sample, grads } = gb.along;
+  const { sample, grads } = gb.along.get(key);
+  return along(gb, s, terms, symbolic, eps_list, sample, grads, px);
+}
+
+// `ledger_along_eps` on the gradients `grads` at the pixels `sample` of sphere A.
+function along(gb, s, terms, symbolic, eps_list, sample, grads, px) {
   return eps_list.map((eps, e) => {
     let max_abs = 0.0, sum2 = 0.0;
     sample.forEach((a, i) => {
@@ -601,8 +608,8 @@ export class PairRenderer {
   }
 
   // `ledger_along_eps` of the central pipeline on the current G-buffer and symbolic frame.
-  ledger_along_eps(eps_list, stride = 1) {
-    return ledger_along_eps(this.gb, this.scene, this.frames.symbolic, eps_list, stride);
+  ledger_along_eps(eps_list, stride = 1, keep = true) {
+    return ledger_along_eps(this.gb, this.scene, this.frames.symbolic, eps_list, stride, keep);
   }
 }
 
