@@ -1,21 +1,77 @@
-// Scale each display equation that is wider than its column down to fit it (MathJax 3 has no
-// automatic line breaking); undone and redone when the window is resized.  See fit.css.
+// Keeps every page within its column without breaking a word or a number (see fit.css):
+// - each table cell carries its column's header as data-label (fit.css shows it in a narrow window);
+// - a number with a hyphen in it (1e-16, 2-3) is kept on one line: Chromium breaks after that hyphen;
+// - a long identifier or code line gets <wbr> break points between its parts (after . _ / ( [ , = and
+//   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word;
+// - typeset maths (MathJax 3 has no automatic line breaking) and tables wider than their column are
+//   scaled down to fit, tables to no less than MIN_TABLE; a wider table scrolls inside its box.
+// Scaling is redone when the window is resized or a <details> opens.
 (function () {
-  function fit() {
-    document.querySelectorAll('article.bd-article mjx-container[display="true"]').forEach(function (m) {
-      m.style.fontSize = "";
-      var room = m.parentElement.clientWidth, need = m.scrollWidth;
-      if (need > room && room > 0) m.style.fontSize = Math.floor(1000 * room / need) / 10 + "%";
+  var MIN_TABLE = 0.75, LONG = 16;
+  // Not inside maths (MathJax reads its source from these nodes), a piece already kept whole, or the
+  // §4 simulator (its script rewrites its own text as it runs).
+  var SKIP = "script, style, textarea, .math, mjx-container, .fit-whole, [data-symrender-sim]";
+
+  function article() { return document.querySelector("article.bd-article"); }
+
+  function textNodes(root, skip) {
+    var out = [], walker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+    for (var n = walker.nextNode(); n; n = walker.nextNode())
+      if (!n.parentElement.closest(skip)) out.push(n);
+    return out;
+  }
+
+  // Replace text node n by its pieces: strings, and [string] for a piece kept whole, with <wbr> where
+  // a piece is null.
+  function splice(n, pieces) {
+    var frag = document.createDocumentFragment();
+    pieces.forEach(function (p) {
+      if (p === null) frag.appendChild(document.createElement("wbr"));
+      else if (typeof p === "string") { if (p) frag.appendChild(document.createTextNode(p)); }
+      else { var s = document.createElement("span"); s.className = "fit-whole"; s.textContent = p[0];
+             frag.appendChild(s); }
+    });
+    n.parentNode.replaceChild(frag, n);
+  }
+
+  var NUMBER = /\d[\d.,]*(?:[eE][-+]?\d+)?(?:-\d[\d.,]*(?:[eE][-+]?\d+)?)*/g;
+  function keepNumbersWhole(root) {
+    textNodes(root, SKIP).forEach(function (n) {
+      var pieces = [], last = 0, m;
+      NUMBER.lastIndex = 0;
+      while ((m = NUMBER.exec(n.data))) {
+        if (m[0].indexOf("-") < 0) continue;
+        pieces.push(n.data.slice(last, m.index), [m[0]]);
+        last = m.index + m[0].length;
+      }
+      if (pieces.length) { pieces.push(n.data.slice(last)); splice(n, pieces); }
     });
   }
-  function whenTypeset() {
-    var mj = window.MathJax;
-    if (mj && mj.startup && mj.startup.promise) mj.startup.promise.then(fit);
-    else fit();
+
+  // After . _ / = , ( [ between a letter (or closing bracket) and a letter: "renderer.<wbr>formulas".
+  var JOINT = /([\p{L}\p{N}\])'"])([._\/=,(\[])(?=[\p{L}'"(\[])/gu;
+  function breakLongWords(root) {
+    textNodes(root, SKIP + ", pre").forEach(function (n) {
+      var words = n.data.split(/(\s+)/), changed = false;
+      var pieces = [];
+      words.forEach(function (w) {
+        if (w.length < LONG || /^\s/.test(w)) { pieces.push(w); return; }
+        var parts = w.replace(JOINT, "$1$2\u0000").split("\u0000");
+        if (parts.length > 1) changed = true;
+        parts.forEach(function (p, i) { if (i) pieces.push(null); pieces.push(p); });
+      });
+      if (changed) splice(n, pieces);
+    });
+    // Highlighted code: a break point between two tokens with no blank between them ("np.|array(|x").
+    root.querySelectorAll(".highlight pre > span").forEach(function (s) {
+      var next = s.nextSibling;
+      if (next && next.nodeType === 1 && next.tagName === "SPAN" && /\S$/.test(s.textContent) && /^\S/.test(next.textContent))
+        s.parentNode.insertBefore(document.createElement("wbr"), next);
+    });
   }
-  // Each table cell carries its column's header as data-label (shown by fit.css in a narrow window).
-  function label() {
-    document.querySelectorAll("article.bd-article table").forEach(function (t) {
+
+  function label(root) {
+    root.querySelectorAll("table").forEach(function (t) {
       var heads = Array.prototype.map.call(t.querySelectorAll("thead th"), function (th) {
         return th.textContent.trim();
       });
@@ -26,7 +82,51 @@
       });
     });
   }
-  window.addEventListener("DOMContentLoaded", label);
+
+  // The width the content of block-level element el may take.
+  function room(el) {
+    while (el && /^(inline|contents)/.test(getComputedStyle(el).display)) el = el.parentElement;
+    if (!el) return 0;
+    var cs = getComputedStyle(el);
+    return el.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight);
+  }
+
+  function fit() {
+    var root = article();
+    if (!root) return;
+    root.querySelectorAll("mjx-container").forEach(function (m) {
+      m.style.fontSize = "";
+      var display = m.getAttribute("display") === "true";
+      var space = display ? m.parentElement.clientWidth : room(m.parentElement);
+      var math = m.querySelector("mjx-math"), need = display ? m.scrollWidth : (math ? math.getBoundingClientRect().width : 0);
+      if (need > space && space > 0) m.style.fontSize = Math.floor(1000 * space / need) / 10 + "%";
+    });
+    root.querySelectorAll("table").forEach(function (t) {
+      t.style.fontSize = "";
+      var space = t.parentElement.clientWidth, need = t.getBoundingClientRect().width, scale = 1;
+      // The cells' padding does not scale with the font: a few steps, each by the remaining excess.
+      for (var k = 0; k < 8 && space > 0 && need > space + 0.5 && scale > MIN_TABLE; k++) {
+        scale = Math.max(MIN_TABLE, scale * space / need);
+        t.style.fontSize = 100 * scale + "%";
+        need = t.getBoundingClientRect().width;
+      }
+    });
+  }
+
+  // Once MathJax has typeset the page (its source text is then out of the way): break points, then scaling.
+  function whenTypeset() {
+    var mj = window.MathJax, root = article();
+    function done() {
+      if (root) { keepNumbersWhole(root); breakLongWords(root); }
+      fit();
+      document.documentElement.setAttribute("data-fit", "done");     // for the browser tests
+    }
+    if (mj && mj.startup && mj.startup.promise) mj.startup.promise.then(done);
+    else done();
+  }
+
+  window.addEventListener("DOMContentLoaded", function () { if (article()) label(article()); });
   window.addEventListener("load", whenTypeset);
   window.addEventListener("resize", fit);
+  document.addEventListener("toggle", fit, true);     // a <details> opened: its maths and tables are laid out now
 })();

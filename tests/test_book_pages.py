@@ -1,0 +1,625 @@
+"""Every page of the built book as a reader sees it: Chromium at 1280 and 390 px wide.
+
+Each page (index, §1-§9, glossary) is opened offline from the built site, its folded material
+(<details>, the hidden code cells' toggles) opened, and one script (AUDIT, below) measures:
+
+(a) images: every image (and canvas) shown at its natural aspect ratio, within 1 %;
+(b) source shown as text: no TeX command (``\frac``), ``$``, ``_`` name (``sin_φ``), slashes used as
+    bars (``/dI/``), TeX name without its backslash (``sinvarphi``) or two numbers with only a blank
+    between them (``256 × 256 29846``) in the text outside typeset maths, code and pre; no prose set
+    as maths (eight or more single italic letters in a row) and no TeX name spelled out in maths;
+(c) breaks: no word or number broken across two lines (each word's first and last characters'
+    client rects, then the character where the line changes);
+(d) width: nothing wider than the article's column, nothing cut off by a box that hides its
+    overflow (a box that scrolls may hold wider content), the page no wider than the window.
+
+Every check is shown catching a planted defect (the ``test_the_*_check_*`` tests), and
+`proofs.figures.text_overlaps`, which `proofs.page.show` runs on every figure a page publishes, is
+tested on planted overlaps and on the book's diagrams.  Screenshots of every page at both widths go
+to test-artifacts/pages/, the measurements to test-artifacts/book_pages.json.
+
+A finding in a page's text (class b, or a break or overflow caused by what the text says) is the
+page author's or the theorem printer's to fix: these tests fail on it and name page, class and text.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+
+import pytest
+
+from .jsnode import ARTIFACTS, in_ci, require_tool
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+PAGES = ("index", "s1_what_changes", "s2_scene", "s3_math", "s4_simulator", "s5_lab", "s6_ledger",
+         "s7_pitfalls", "s8_history", "s9_roadmap", "glossary")
+WIDTHS = (1280, 390)
+#: Largest relative error of a shown image's aspect ratio against its natural one.
+RATIO_TOL = 0.01
+
+#: Run in a page (playwright's evaluate): the measurements of classes (a)-(d), as a dict.
+AUDIT = r"""async () => {
+  const root = document.querySelector('article.bd-article');
+  // Folded material is opened first: what a reader can unfold is checked too.
+  root.querySelectorAll('details').forEach(d => { d.open = true; });
+  await new Promise(r => setTimeout(r, 100));            // fit.js re-fits on each <details> toggle
+  const where = el => { const s = el.closest('section[id]'); return s ? '#' + s.id : ''; };
+  const short = s => s.replace(/\s+/g, ' ').trim().slice(0, 90);
+  const styles = new Map();
+  const style = el => { let s = styles.get(el); if (!s) { s = getComputedStyle(el); styles.set(el, s); } return s; };
+
+  // (a) every image and canvas shown at its natural aspect ratio
+  const imgs = [...root.querySelectorAll('img')];
+  await Promise.all(imgs.map(i => i.complete ? null : new Promise(r => { i.onload = i.onerror = r; })));
+  const images = [...imgs, ...root.querySelectorAll('canvas')].map(e => {
+    const r = e.getBoundingClientRect(), img = e.tagName === 'IMG';
+    const nw = img ? e.naturalWidth : e.width, nh = img ? e.naturalHeight : e.height;
+    return {tag: e.tagName.toLowerCase(), src: (e.getAttribute('src') || '#' + e.id).slice(-40), natural: [nw, nh],
+            shown: [+r.width.toFixed(1), +r.height.toFixed(1)],
+            ratio: nw && nh && r.width && r.height ? +((r.width / r.height) / (nw / nh)).toFixed(4) : null,
+            where: where(e)};
+  }).filter(i => i.tag === 'img' || i.shown[0] > 0);
+
+  // The article's text in reading order, one entry per character: {n: text node, i: offset}, SEP
+  // where no word can continue (a block's edge, typeset maths, an image) and WBR at a <wbr>.
+  const SEP = null, WBR = {};
+  const SKIP = 'script, style, template, select, textarea, mjx-assistive-mml';
+  const ATOMS = ['MJX-CONTAINER', 'BR', 'IMG', 'CANVAS', 'SVG', 'INPUT', 'BUTTON', 'VIDEO', 'IFRAME'];
+  const chars = [], texts = [];
+  (function visit(el) {
+    for (const c of el.childNodes) {
+      if (c.nodeType === Node.TEXT_NODE) {
+        texts.push(c);
+        for (let i = 0; i < c.data.length; i++) chars.push({n: c, i});
+      } else if (c.nodeType === Node.ELEMENT_NODE && !c.matches(SKIP)) {
+        const d = style(c).display;
+        if (d === 'none') continue;
+        if (c.tagName === 'WBR') { chars.push(WBR); continue; }
+        if (ATOMS.includes(c.tagName.toUpperCase())) { chars.push(SEP); continue; }
+        const inline = d === 'inline' || d === 'contents';
+        if (!inline) chars.push(SEP);
+        visit(c);
+        if (!inline) chars.push(SEP);
+      }
+    }
+  })(root);
+  const CODE = 'pre, code, kbd, samp';
+  const code = new Map();
+  const isCode = n => { if (!code.has(n)) code.set(n, !!n.parentElement.closest(CODE)); return code.get(n); };
+  const ch = c => c.n.data[c.i];
+
+  // (b) source markup shown as text, outside typeset maths, code and pre.  Each run of text between
+  // two separators is one string (a <wbr> does not split it; code is masked out).
+  const source = [];
+  const runs = [];                          // [string, chars of it]
+  for (let k = 0; k < chars.length;) {
+    if (chars[k] === SEP) { k++; continue; }
+    let s = '', at = [];
+    for (; k < chars.length && chars[k] !== SEP; k++) {
+      if (chars[k] === WBR) continue;
+      const c = chars[k];
+      s += isCode(c.n) || c.n.parentElement.closest('.headerlink') ? '\u0000' : ch(c); at.push(c);
+    }
+    if (s.replace(/\u0000/g, '').trim()) runs.push([s, at]);
+  }
+  const TEX_WORDS = ['sin', 'cos', 'tan', 'exp', 'log', 'ln', 'sqrt', 'frac', 'dfrac', 'tfrac', 'partial', 'nabla',
+    'cdot', 'times', 'pi', 'theta', 'vartheta', 'phi', 'varphi', 'epsilon', 'varepsilon', 'alpha', 'beta', 'gamma',
+    'delta', 'lambda', 'mu', 'sigma', 'rho', 'omega', 'operatorname', 'mathrm', 'mathbf', 'mathcal', 'text', 'left',
+    'right', 'hat', 'tilde', 'vec', 'infty', 'approx', 'leq', 'geq', 'neq', 'sum', 'int', 'max', 'min', 'quad'];
+  // TeX's names that are no English word: alone, or any run of TeX names glued together ("sinvarphi").
+  const NOT_ENGLISH = ['sqrt', 'frac', 'dfrac', 'tfrac', 'nabla', 'cdot', 'vartheta', 'varphi', 'varepsilon',
+    'operatorname', 'mathrm', 'mathbf', 'mathcal', 'infty', 'leq', 'geq', 'neq'];
+  const glued = new RegExp('^(?:' + TEX_WORDS.join('|') + '){2,}$');
+  const texName = w => NOT_ENGLISH.includes(w) || glued.test(w);
+  const PATTERNS = [
+    ['TeX command', /\\[A-Za-z]+|\\[{}(),;!|\[\]]/g],
+    ['dollar sign', /\$/g],
+    ['underscore name', /[\p{L}\p{N})}\]]_+[\p{L}\p{N}{(\\]/gu],
+    ['slashes for bars', /(?<![\p{L}\p{N}\/<])\/(?=[^\s\/])[^\/\n\u0000]{1,40}(?<=[^\s\/])\/(?![\p{L}\p{N}\/>])/gu],
+    ['TeX name without its backslash', /(?<![\\\p{L}])\p{L}+/gu],
+  ];
+  const FILE = /^[\w.\/-]+\.(ipynb|py|md|html|json|toml|csv|png|js|css|txt)[,.;:)]*$/;
+  for (const [s, at] of runs) {
+    for (const [kind, re] of PATTERNS)
+      for (const m of s.matchAll(re)) {
+        if (kind === 'TeX name without its backslash' && !texName(m[0])) continue;
+        const word = s.slice(0, m.index).match(/\S*$/)[0] + s.slice(m.index).match(/^\S*/)[0];
+        if (kind === 'underscore name' && FILE.test(word)) continue;
+        const context = s.slice(Math.max(0, m.index - 40), m.index + m[0].length + 40).replace(/\u0000+/g, '…');
+        source.push({kind, text: m[0], context: short(context),
+                     where: where(at[m.index].n.parentElement)});
+      }
+  }
+  // Words: runs of characters between blanks, separators and <wbr>.
+  const words = [];
+  for (let k = 0; k < chars.length;) {
+    const blank = c => c === SEP || c === WBR || /\s/.test(ch(c));
+    if (blank(chars[k])) { k++; continue; }
+    let e = k; while (e < chars.length && !blank(chars[e])) e++;
+    words.push([k, e]); k = e;
+  }
+  const wordText = ([a, b]) => chars.slice(a, b).map(ch).join('');
+  // Two numbers with only a blank between them read as one ("256 × 256 29846").
+  const FIRST = /^[+\-−]?\d(?:[\d,.]*\d)?(?:e[+\-−]?\d+)?$/;
+  const SECOND = /^[+\-−]?\d[\d,.]*(?:e[+\-−]?\d+)?[,.;:)]*$/;
+  for (let t = 1; t < words.length; t++) {
+    const [a0, b0] = words[t - 1], [a1] = words[t];
+    if (chars.slice(b0, a1).some(c => c === SEP || c === WBR) || isCode(chars[a0].n) || isCode(chars[a1].n)) continue;
+    const x = wordText(words[t - 1]), y = wordText(words[t]);
+    if (FIRST.test(x) && SECOND.test(y))
+      source.push({kind: 'numbers run together', text: x + ' ' + y, context: x + ' ' + y,
+                   where: where(chars[a1].n.parentElement)});
+  }
+  // Typeset maths holding prose (eight or more single italic letters in a row) or a TeX name spelled out.
+  for (const m of root.querySelectorAll('mjx-container')) {
+    const mml = m.querySelector('mjx-assistive-mml math');
+    if (!mml) continue;
+    const letters = [];
+    let run = '';
+    for (const k of mml.querySelectorAll('*')) {
+      if (k.children.length) continue;
+      if (k.tagName.toLowerCase() === 'mi' && /^\p{L}$/u.test(k.textContent)) run += k.textContent;
+      else { if (run) letters.push(run); run = ''; }
+    }
+    if (run) letters.push(run);
+    for (const r of letters) {
+      const name = NOT_ENGLISH.find(w => r.includes(w));
+      if (r.length >= 8 || name)
+        source.push({kind: name ? 'TeX name set as maths' : 'prose set as maths', text: r,
+                     context: short(mml.textContent), where: where(m)});
+    }
+  }
+
+  // (c) a word or number broken across two lines: a line break between two letters or digits (or at
+  // an apostrophe, point or comma between them: "draft’s", "29,846"), or anywhere inside a number
+  // ("9.001e-11").  Breaking after a hyphen, a dash, a bracket or a quote breaks no word.
+  const range = document.createRange();
+  const rectOf = c => {
+    range.setStart(c.n, c.i); range.setEnd(c.n, c.i + 1);
+    for (const r of range.getClientRects()) if (r.width > 0 && r.height > 0) return r;
+    return null;
+  };
+  const broken = [];
+  for (const w of words) {
+    const [a, b] = w;
+    if (b - a < 2) continue;
+    const first = rectOf(chars[a]), last = rectOf(chars[b - 1]);
+    if (!first || !last || last.top < first.bottom - 0.5 * first.height) continue;       // on one line
+    let k = a + 1;
+    for (; k < b; k++) { const r = rectOf(chars[k]); if (r && r.top >= first.bottom - 0.5 * first.height) break; }
+    const s = wordText(w), at = k - a, W = x => /[\p{L}\p{N}]/u.test(x || ''), J = x => /['’.,]/.test(x || '');
+    const inWord = (W(s[at - 1]) && W(s[at])) || (J(s[at - 1]) && W(s[at - 2]) && W(s[at]))
+                   || (J(s[at]) && W(s[at - 1]) && W(s[at + 1]));
+    const inNumber = [...s.matchAll(/\d[\d.,]*(?:[eE][-+−]?\d+)?/g)]
+      .some(m => m.index < at && at < m.index + m[0].length);
+    if (inWord || inNumber)
+      broken.push({text: s.slice(0, 60), at: s.slice(Math.max(0, at - 24), at) + '|' + s.slice(at, at + 24),
+                   code: isCode(chars[a].n), where: where(chars[a].n.parentElement)});
+  }
+
+  // (d) nothing wider than the column, nothing cut off by a box that hides its overflow.  A box that
+  // scrolls (overflow auto or scroll) may hold wider content; it must fit itself.
+  const cs = style(root), box = root.getBoundingClientRect();
+  const col = {left: box.left + parseFloat(cs.paddingLeft), right: box.right - parseFloat(cs.paddingRight)};
+  const clips = new Map();                 // element -> its nearest ancestor below root that clips or scrolls
+  const clipper = el => {
+    if (!clips.has(el)) {
+      let found = null;
+      for (let p = el.parentElement; p && p !== root; p = p.parentElement)
+        if (style(p).overflowX !== 'visible') { found = p; break; }
+      clips.set(el, found);
+    }
+    return clips.get(el);
+  };
+  const scrolls = el => ['auto', 'scroll'].includes(style(el).overflowX);
+  const found = [];
+  const check = (owner, r, text) => {
+    if (r.width === 0 && r.height === 0) return;
+    const c = clipper(owner);
+    if (c && scrolls(c)) return;
+    const edge = c ? c.getBoundingClientRect() : col;
+    const by = Math.max(r.right - edge.right, edge.left - r.left);
+    if (by > 1) found.push({kind: c ? 'cut off' : 'wider than the column', by: Math.round(by), owner, text});
+  };
+  for (const el of root.querySelectorAll('*')) {
+    if (el.closest(SKIP) || style(el).display === 'none' || style(el).visibility === 'hidden') continue;
+    if (el.tagName !== 'MJX-CONTAINER' && el.closest('mjx-container')) continue;    // maths: its box only
+    check(el, el.getBoundingClientRect(), short(el.textContent || el.tagName));
+  }
+  for (const n of texts) {
+    if (n.parentElement.closest('mjx-container') || !n.data.trim()) continue;
+    range.selectNodeContents(n);
+    for (const r of range.getClientRects()) check(n.parentElement, r, short(n.data));
+  }
+  const owners = new Set(found.map(f => f.owner)), reported = new Set();
+  const overflow = found.filter(f => {
+    for (let p = f.owner.parentElement; p && p !== root; p = p.parentElement) if (owners.has(p)) return false;
+    if (reported.has(f.owner)) return false;
+    reported.add(f.owner); return true;
+  }).map(f => ({kind: f.kind, by: f.by, tag: f.owner.tagName.toLowerCase(), text: f.text, where: where(f.owner)}));
+  const wide = document.documentElement.scrollWidth - window.innerWidth;
+  if (wide > 1) overflow.push({kind: 'page wider than the window', by: wide, tag: 'html', text: '', where: ''});
+  const scrollers = [...new Set([...clips.values()])].filter(c => c && scrolls(c) && c.scrollWidth > c.clientWidth + 1)
+    .map(c => ({tag: c.tagName.toLowerCase(), scrolls_by: c.scrollWidth - c.clientWidth, text: short(c.textContent),
+                where: where(c)}));
+  return {images, text_nodes: texts.length, words: words.length, source, broken, overflow, scrollers,
+          column: [Math.round(col.left), Math.round(col.right)]};
+}"""
+
+
+@pytest.fixture(scope="module")
+def browser():
+    require_tool(CHROMIUM, "the page tests drive Debian's Chromium (apt-get install chromium)")
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        if in_ci():
+            pytest.fail("playwright is not installed (CI=true: this test may not skip)")
+        pytest.skip("playwright is not installed")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+class Page:
+    """A page opened offline at ``width`` px (only file: and data: addresses load), once MathJax has
+    typeset it and fit.js (if the page has it) is done."""
+
+    def __init__(self, browser, url, width, height=900):
+        self.context = browser.new_context(viewport={"width": width, "height": height})
+        self.context.route("**/*", lambda r: r.continue_() if r.request.url.startswith(("file:", "data:"))
+                           else r.abort())
+        self.page = self.context.new_page()
+        self.page.goto(url)
+        self.page.wait_for_load_state("load")
+        self.page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise : null")
+        self.page.wait_for_function("!document.querySelector('script[src*=\"fit.js\"]')"
+                                    " || document.documentElement.dataset.fit === 'done'", timeout=30_000)
+
+    def audit(self):
+        return self.page.evaluate(AUDIT)
+
+    def screenshot(self, path):
+        """The whole page, taken at its full height (a full-page capture would resize the window
+        under fit.js's feet)."""
+        width = self.page.viewport_size["width"]
+        self.page.set_viewport_size({"width": width, "height": self.page.evaluate(
+            "document.documentElement.scrollHeight")})
+        self.page.screenshot(path=str(path))
+
+    def close(self):
+        self.context.close()
+
+
+@pytest.fixture(scope="module")
+def site(browser, book_html):
+    """{(page, width): audit} for every page of the built site at both widths; saves the report and
+    a screenshot of each."""
+    shots = ARTIFACTS / "pages"
+    shots.mkdir(parents=True, exist_ok=True)
+    found = {}
+    for width in WIDTHS:
+        for name in PAGES:
+            p = Page(browser, (book_html / f"{name}.html").as_uri(), width)
+            try:
+                found[name, width] = p.audit()
+                p.screenshot(shots / f"{name}_{width}.png")
+            finally:
+                p.close()
+    summary = {f"{w}px": {"images": sum(len(found[n, w]["images"]) for n in PAGES),
+                          "images_off_ratio": sum(len(_stretched(found[n, w])) for n in PAGES),
+                          "text_nodes": sum(found[n, w]["text_nodes"] for n in PAGES),
+                          "words": sum(found[n, w]["words"] for n in PAGES),
+                          "source_in_text": sum(len(found[n, w]["source"]) for n in PAGES),
+                          "broken_words": sum(len(found[n, w]["broken"]) for n in PAGES),
+                          "overflowing": sum(len(found[n, w]["overflow"]) for n in PAGES),
+                          "scrolling_boxes": sum(len(found[n, w]["scrollers"]) for n in PAGES)}
+               for w in WIDTHS}
+    report = {"site": str(book_html), "ratio_tolerance": RATIO_TOL, "summary": summary,
+              "pages": {n: {f"{w}px": found[n, w] for w in WIDTHS} for n in PAGES}}
+    (ARTIFACTS / "book_pages.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
+    return found
+
+
+def _stretched(audit):
+    return [i for i in audit["images"] if i["ratio"] is None or abs(i["ratio"] - 1) > RATIO_TOL]
+
+
+def _listing(findings):
+    return "\n".join("  " + json.dumps(f, ensure_ascii=False) for f in findings)
+
+
+cases = pytest.mark.parametrize("name, width", [(n, w) for w in WIDTHS for n in PAGES])
+
+
+@cases
+def test_every_image_keeps_its_aspect_ratio(site, name, width):
+    bad = _stretched(site[name, width])
+    assert not bad, f"{name} at {width} px: images shown off their natural aspect ratio:\n{_listing(bad)}"
+
+
+@cases
+def test_no_source_markup_in_the_text(site, name, width):
+    bad = site[name, width]["source"]
+    assert not bad, f"{name} at {width} px: source shown as text (the page's or a printed string's):\n{_listing(bad)}"
+
+
+@cases
+def test_no_word_or_number_broken_across_lines(site, name, width):
+    bad = site[name, width]["broken"]
+    assert not bad, f"{name} at {width} px: words or numbers broken across lines:\n{_listing(bad)}"
+
+
+@cases
+def test_nothing_wider_than_its_column(site, name, width):
+    bad = site[name, width]["overflow"]
+    assert not bad, f"{name} at {width} px: wider than the column or cut off:\n{_listing(bad)}"
+
+
+def test_every_page_was_measured(site, book_html):
+    """The audit saw each page's content, not an empty shell: every image of its article (as many as
+    the HTML file holds) and its text."""
+    import re
+    for name in PAGES:
+        html = (book_html / f"{name}.html").read_text(encoding="utf-8")
+        article = html[html.index("<article"):html.index("</article>")]
+        for width in WIDTHS:
+            audit = site[name, width]
+            assert len([i for i in audit["images"] if i["tag"] == "img"]) == len(re.findall(r"<img\b", article))
+            assert audit["words"] > 100 and audit["text_nodes"] > 10, (name, width)
+
+
+# --- each check catches a planted defect ---------------------------------------------------------
+
+def _png(width, height):
+    """A width x height PNG, as a data: address."""
+    import base64
+
+    import matplotlib.pyplot as plt
+    import numpy as np
+    buf = io.BytesIO()
+    plt.imsave(buf, np.linspace(0, 1, width * height).reshape(height, width), format="png")
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode()
+
+
+def _synthetic(tmp_path, body, book_html=None, css=""):
+    """A page with an article like the book's; with ``book_html``, the site's fit.css and fit.js."""
+    links = ""
+    if book_html is not None:
+        links = (f'<link rel="stylesheet" href="{(book_html / "_static" / "fit.css").as_uri()}">'
+                 f'<script src="{(book_html / "_static" / "fit.js").as_uri()}"></script>')
+    path = tmp_path / f"page{len(list(tmp_path.iterdir()))}.html"
+    path.write_text(f'<!DOCTYPE html><html><head><meta charset="utf-8">{links}<style>{css}</style></head>'
+                    f'<body style="margin:0"><article class="bd-article" style="width:300px;padding:0 10px">'
+                    f'<section id="planted">{body}</section></article></body></html>', encoding="utf-8")
+    return path.as_uri()
+
+
+def _audit(browser, url, width=390):
+    p = Page(browser, url, width)
+    try:
+        return p.audit()
+    finally:
+        p.close()
+
+
+def test_the_ratio_check_catches_a_stretched_image(browser, book_html, tmp_path):
+    """The reviewer's case: myst-nb's inline width and height, a column narrower than the width, and
+    a stylesheet whose ``height: auto`` cannot outrank the inline height (the old fit.css).  With the
+    site's fit.css the same image keeps its shape."""
+    img = f'<img src="{_png(400, 200)}" style="width: 400px; height: 200px;">'
+    old = _audit(browser, _synthetic(tmp_path, img, css="article img { max-width: 100%; height: auto; }"))
+    assert [i["ratio"] for i in _stretched(old)] == [0.75]           # 300 x 200 px for a 2:1 image
+    new = _audit(browser, _synthetic(tmp_path, img, book_html))
+    assert _stretched(new) == [] and new["images"][0]["shown"] == [300, 150]
+    # Injected into a built page: the first figure of §5 squeezed to half its height.
+    p = Page(browser, (book_html / "s5_lab.html").as_uri(), 1280)
+    try:
+        p.page.evaluate("() => { const i = document.querySelector('article.bd-article img');"
+                        " i.style.setProperty('height', (i.getBoundingClientRect().height / 2) + 'px', 'important'); }")
+        assert len(_stretched(p.audit())) == 1
+    finally:
+        p.close()
+
+
+PLANTED_PROSE = ("Planted: the root \\frac{a}{b}, a $ sign, the name sin_φ, mean /dI/ on the band, "
+                 "at 256 × 256 29846 pixels, and Listing 1's sinvarphi.")
+
+
+def test_the_source_check_catches_markup_in_prose(browser, book_html):
+    p = Page(browser, (book_html / "glossary.html").as_uri(), 1280)
+    try:
+        before = len(p.audit()["source"])
+        # The same text in code, in pre and as typeset maths is no finding ...
+        p.page.evaluate("""(t) => {
+            const a = document.querySelector('article.bd-article section');
+            const pre = document.createElement('pre'); pre.textContent = t; a.append(pre);
+            const code = document.createElement('code'); code.textContent = t; a.append(code);
+            const m = document.createElement('p');
+            m.innerHTML = '<span class="math">\\\\(\\\\frac{a}{b} + x_y\\\\)</span>';
+            a.append(m); return MathJax.typesetPromise([m]);
+        }""", PLANTED_PROSE)
+        assert len(p.audit()["source"]) == before
+        # ... in a paragraph each is one.
+        p.page.evaluate("""(t) => { const q = document.createElement('p'); q.textContent = t;
+            document.querySelector('article.bd-article section').append(q); }""", PLANTED_PROSE)
+        found = p.audit()["source"][before:]
+        assert sorted(f["kind"] for f in found) == sorted([
+            "TeX command", "dollar sign", "underscore name", "slashes for bars", "numbers run together",
+            "TeX name without its backslash"]), found
+        assert {f["text"] for f in found} == {"\\frac", "$", "n_φ", "/dI/", "256 29846", "sinvarphi"}
+        # Prose typeset as maths (a source line that broke a $...$ pair) and a TeX name spelled out.
+        p.page.evaluate("""() => { const q = document.createElement('p');
+            q.innerHTML = '<span class="math">\\\\(That these are the angles\\\\)</span> and '
+                + '<span class="math">\\\\(sinvarphi\\\\)</span>';
+            document.querySelector('article.bd-article section').append(q); return MathJax.typesetPromise([q]); }""")
+        kinds = [f["kind"] for f in p.audit()["source"][before + len(found):]]
+        assert sorted(kinds) == ["TeX name set as maths", "prose set as maths"], kinds
+    finally:
+        p.close()
+
+
+def test_the_break_check_catches_a_broken_number(browser, book_html, tmp_path):
+    """A ledger number in a narrow table cell: broken by the old ``overflow-wrap: anywhere`` (and
+    by Chromium after its hyphen), whole with the site's fit.css and fit.js."""
+    cell = ('<table><tr><td>9.001e-11</td>' + '<td>RMS |ΔI| on sphere A at the default step</td>' * 4
+            + '</tr></table><p style="width:5.5em">step 9.001e-11 here</p>')
+    old = _audit(browser, _synthetic(tmp_path, cell, css="td { overflow-wrap: anywhere; }"))
+    assert {b["at"].replace("|", "") for b in old["broken"]} == {"9.001e-11"}, old["broken"]
+    assert len(old["broken"]) == 2                        # in the cell and in the paragraph
+    new = _audit(browser, _synthetic(tmp_path, cell, book_html))
+    assert new["broken"] == []
+    # A word broken between two letters is caught; a break after a compound's hyphen is none.
+    words = ('<p style="width:2.5em; overflow-wrap:anywhere">verdict</p>'
+             '<p style="width:5em">central-difference</p>')
+    found = _audit(browser, _synthetic(tmp_path, words))["broken"]
+    assert [b["text"] for b in found] == ["verdict"], found
+
+
+def test_the_width_check_catches_an_overwide_block_in_details(browser, book_html):
+    p = Page(browser, (book_html / "s9_roadmap.html").as_uri(), 390)
+    try:
+        assert p.audit()["overflow"] == []
+        p.page.evaluate("""() => { const d = document.createElement('details');
+            d.innerHTML = '<summary>folded</summary><div style="width:700px">a wide table</div>';
+            document.querySelector('article.bd-article section').append(d); }""")
+        found = p.audit()["overflow"]
+        assert [(f["kind"], f["tag"]) for f in found] == [("wider than the column", "div"),
+                                                         ("page wider than the window", "html")], found
+        p.page.evaluate("""() => { document.querySelector('article.bd-article details').remove();
+            const c = document.createElement('div'); c.style.overflow = 'hidden';
+            c.innerHTML = '<p style="white-space:nowrap">Theorem 11: a statement longer than the phone is wide</p>';
+            document.querySelector('article.bd-article section').append(c); }""")
+        assert [(f["kind"], f["tag"]) for f in p.audit()["overflow"]] == [("cut off", "p")]
+    finally:
+        p.close()
+
+
+# --- figures: proofs.figures.text_overlaps, which proofs.page.show runs before publishing ---------
+
+@pytest.fixture
+def figure():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    made = []
+
+    def make(*args, **kwargs):
+        fig, ax = plt.subplots(*args, **kwargs)
+        made.append(fig)
+        return fig, ax
+    yield make
+    for fig in made:
+        plt.close(fig)
+
+
+def _clean(ax):
+    import numpy as np
+    x = np.linspace(0, 1, 50)
+    ax.plot(x, x ** 2, label="a curve")
+    ax.plot(x, x, label="a line")
+    ax.set_title("a title"); ax.set_xlabel("$u$"); ax.set_ylabel("$h$")
+    ax.annotate("a note", (0.2, 0.6))
+    ax.legend(loc="lower right")
+
+
+def test_text_overlaps_passes_a_clean_figure_and_catches_two_labels_on_top_of_each_other(figure):
+    from proofs.figures import text_overlaps
+    fig, ax = figure(figsize=(5, 3.5))
+    _clean(ax)
+    assert text_overlaps(fig) == []
+    ax.text(0.2, 0.6, "a second note")                       # right on top of the first
+    assert text_overlaps(fig) == ["'a note' / 'a second note'"]
+
+
+def test_text_overlaps_catches_a_title_on_a_label(figure):
+    """The diagram of the central stencil as it was: the crease's label just above the axes, under the title."""
+    import matplotlib.pyplot as plt
+    from proofs.figures import stencil_diagram, style, text_overlaps
+    style()
+    fig = stencil_diagram()
+    try:
+        assert text_overlaps(fig) == []
+        ax = fig.axes[0]
+        label = next(t for t in ax.texts if "crease" in t.get_text())
+        label.remove()
+        ax.text(0.125, ax.get_ylim()[1] * 0.985, label.get_text(), ha="center", va="bottom")
+        assert any("crease" in c and "straddles" in c for c in text_overlaps(fig)), text_overlaps(fig)
+    finally:
+        plt.close(fig)
+
+
+def test_text_overlaps_catches_neighbouring_axes_running_together(figure):
+    """§2's three fields in a row, as first drawn: the last tick label of one image and the first of
+    the next read as one number, and a y label sits on the neighbouring image."""
+    import numpy as np
+    from proofs.figures import style, text_overlaps
+    style()
+    def fields(**layout):
+        fig, axes = figure(1, 3, figsize=(10, 2.8), **layout)
+        for a in axes:
+            im = a.imshow(np.zeros((20, 40)), extent=(0, 1, 0, 1), aspect=0.5)
+            a.set_title("a field"); a.set_xlabel("$u$"); a.set_ylabel("$v$")
+        fig.colorbar(im, ax=axes, shrink=0.8)
+        return text_overlaps(fig)
+    found = fields()
+    assert "'1.00' / '0.00'" in found and "'$v$' / axes 'a field'" in found, found
+    assert fields(layout="constrained") == []                 # laid out with room between them
+
+
+def test_text_overlaps_catches_legend_entries_on_each_other_not_inside_their_box(figure):
+    from proofs.figures import text_overlaps
+    fig, ax = figure(figsize=(5, 3.5))
+    _clean(ax)
+    ax.get_legend().remove()
+    ax.legend(loc="lower right", frameon=True)                # entries inside their frame: fine
+    assert text_overlaps(fig) == []
+    ax.legend(loc="lower right", frameon=True, labelspacing=-1.2)
+    assert text_overlaps(fig) == ["'a curve' / 'a line'"]
+    ax.legend(loc="center")                                  # a framed legend over the note
+    ax.texts[0].set_position((0.45, 0.5))
+    assert "'a note' / legend" in text_overlaps(fig)
+
+
+def test_text_overlaps_catches_an_annotation_across_the_frame_and_ignores_ticks_out_of_view(figure):
+    from proofs.figures import text_overlaps
+    fig, ax = figure(figsize=(5, 3.5))
+    _clean(ax)
+    ax.set_xticks([0, 0.5, 1, 1.02])                          # a tick out of view: not drawn, not counted
+    ax.set_xlim(0, 1)
+    assert text_overlaps(fig) == []
+    ax.annotate("half in, half out", (0.95, 0.5))
+    assert text_overlaps(fig) == ["'half in, half out' / the frame of its axes"]
+
+
+def test_text_overlaps_works_on_a_closed_figure_and_rejects_bad_arguments(figure):
+    import matplotlib.pyplot as plt
+    from proofs.figures import text_overlaps
+    fig, ax = figure()
+    ax.text(0.5, 0.5, "x"); ax.text(0.5, 0.5, "y")
+    plt.close(fig)
+    assert text_overlaps(fig) == ["'x' / 'y'"]
+    with pytest.raises(TypeError, match="fig must be a matplotlib.figure.Figure"):
+        text_overlaps(ax)
+    with pytest.raises(ValueError, match="gap must be"):
+        text_overlaps(fig, gap=-1)
+
+
+def test_the_books_diagrams_have_no_colliding_text():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from proofs import figures
+    from proofs.ucurve import measure
+    figures.style()
+    for make in (figures.frame_diagram, figures.normal_diagram, figures.stencil_diagram,
+                 lambda: figures.ucurve_anatomy(measure("sine"))):
+        fig = make()
+        try:
+            assert figures.text_overlaps(fig) == [], make
+        finally:
+            plt.close(fig)
