@@ -15,6 +15,10 @@ own functions (`renderer.pointwise`, generated from `renderer.formulas`):
 * `ucurve_anatomy` (in §7, on the measured curve): the regions of the U-curve.
 
 Each returns a matplotlib Figure (the caller glues and closes it).
+
+`text_overlaps` lists what of a figure's text collides when it is drawn (two
+texts, a text and a legend, a text and another axes' plotting area, an
+annotation and its axes' frame); `proofs.page.show` refuses a figure with any.
 """
 
 from __future__ import annotations
