@@ -121,7 +121,7 @@ AUDIT = r"""async () => {
     ['slashes for bars', /(?<![\p{L}\p{N}\/<])\/(?=[^\s\/])[^\/\n\u0000]{1,40}(?<=[^\s\/])\/(?![\p{L}\p{N}\/>])/gu],
     ['TeX name without its backslash', /(?<![\\\p{L}])\p{L}+/gu],
   ];
-  const FILE = /^[\w.\/-]+\.(ipynb|py|md|html|json|toml|csv|png|js|css|txt)[,.;:)]*$/;
+  const FILE = /^[(\["'“‘]*[\w.\/-]+\.(ipynb|py|md|html|json|toml|csv|png|js|css|txt)[,.;:)\]"'”’]*$/;   // a file name
   for (const [s, at] of runs) {
     for (const [kind, re] of PATTERNS)
       for (const m of s.matchAll(re)) {
@@ -427,7 +427,8 @@ def test_the_ratio_check_catches_a_stretched_image(browser, book_html, tmp_path)
 
 
 PLANTED_PROSE = ("Planted: the root \\frac{a}{b}, a $ sign, the name sin_φ, mean /dI/ on the band, "
-                 "at 256 × 256 29846 pixels, and Listing 1's sinvarphi.")
+                 "at 256 × 256 29846 pixels, and Listing 1's sinvarphi (a file name, proofs/no_boundary.py, "
+                 "is none).")
 
 
 def test_the_source_check_catches_markup_in_prose(browser, book_html):
