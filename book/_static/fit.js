@@ -5,7 +5,7 @@
 //   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word;
 // - typeset maths (MathJax 3 has no automatic line breaking) and tables wider than their column are
 //   scaled down to fit, tables to no less than MIN_TABLE; a wider table scrolls inside its box.
-// Scaling is redone when the window is resized or a <details> opens.
+// Scaling is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
   // Not inside maths (MathJax reads its source from these nodes), a piece already kept whole, or the
@@ -94,13 +94,16 @@
   function fit() {
     var root = article();
     if (!root) return;
-    root.querySelectorAll("mjx-container").forEach(function (m) {
-      m.style.fontSize = "";
-      var display = m.getAttribute("display") === "true";
+    // MathJax's output scales with its font size, so a formula's full width is its width over its
+    // scale: all measured first, then only the changed sizes set (one layout, not one per formula).
+    Array.prototype.map.call(root.querySelectorAll("mjx-container"), function (m) {
+      var display = m.getAttribute("display") === "true", math = m.querySelector("mjx-math");
+      var scale = parseFloat(m.style.fontSize) / 100 || 1, width = math ? math.getBoundingClientRect().width : 0;
+      if (display && m.scrollWidth > m.clientWidth) width = Math.max(width, m.scrollWidth);
+      var need = width / scale;
       var space = display ? m.parentElement.clientWidth : room(m.parentElement);
-      var math = m.querySelector("mjx-math"), need = display ? m.scrollWidth : (math ? math.getBoundingClientRect().width : 0);
-      if (need > space && space > 0) m.style.fontSize = Math.floor(1000 * space / need) / 10 + "%";
-    });
+      return [m, need > space && space > 0 ? Math.floor(1000 * space / need) / 10 + "%" : ""];
+    }).forEach(function (f) { if (f[0].style.fontSize !== f[1]) f[0].style.fontSize = f[1]; });
     root.querySelectorAll("table").forEach(function (t) {
       t.style.fontSize = "";
       var space = t.parentElement.clientWidth, need = t.getBoundingClientRect().width, scale = 1;
@@ -127,6 +130,11 @@
 
   window.addEventListener("DOMContentLoaded", function () { if (article()) label(article()); });
   window.addEventListener("load", whenTypeset);
-  window.addEventListener("resize", fit);
-  document.addEventListener("toggle", fit, true);     // a <details> opened: its maths and tables are laid out now
+  // Whenever the article changes size: the window resized, a sidebar slid in or out (the column
+  // settles after the resize event), a <details> opened (its maths and tables have a width only now).
+  window.addEventListener("load", function () {
+    var root = article();
+    if (root && window.ResizeObserver) new ResizeObserver(function () { fit(); }).observe(root);
+  });
+  document.addEventListener("toggle", fit, true);
 })();
