@@ -132,9 +132,15 @@
   window.addEventListener("load", whenTypeset);
   // Whenever the article changes size: the window resized, a sidebar slid in or out (the column
   // settles after the resize event), a <details> opened (its maths and tables have a width only now).
+  // Refitted in the next frame, not in the observer's callback: a change of size there would be a
+  // "ResizeObserver loop" error.
+  var pending = 0;
   window.addEventListener("load", function () {
     var root = article();
-    if (root && window.ResizeObserver) new ResizeObserver(function () { fit(); }).observe(root);
+    if (root && window.ResizeObserver) new ResizeObserver(function () {
+      cancelAnimationFrame(pending);
+      pending = requestAnimationFrame(fit);
+    }).observe(root);
   });
   document.addEventListener("toggle", fit, true);
 })();
