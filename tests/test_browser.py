@@ -452,7 +452,7 @@ def test_no_display_table_or_code_block_is_wider_than_its_column(browser, book_h
     (ARTIFACTS / f"overflow_{width}.json").write_text(json.dumps(
         {"checked": sum(r["checked"] for r in report.values()),
          "overflowing": sum(len(r["overflowing"]) for r in report.values()), "pages": report}, indent=1))
-    assert sum(r["checked"] for r in report.values()) > 100
+    assert sum(r["checked"] for r in report.values()) > 80        # not vacuous: most pages have several
     assert {p: r["overflowing"] for p, r in report.items() if r["overflowing"]} == {}
 
 
@@ -486,7 +486,7 @@ def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_s
     alt text, and has at least two device pixels per CSS pixel (for high-density screens)."""
     found = {page: _figures(browser, book_html, page, 2) for page in PAGES}
     images = [dict(i, page=page) for page, imgs in found.items() for i in imgs]
-    assert len(images) >= 15
+    assert len(images) >= 12
     bad = [i for i in images if not (i["numbered"] and i["caption"] > 40 and i["alt"] > 40 and i["sharp"])]
     assert bad == []
 
@@ -646,6 +646,56 @@ def test_preset_four_returns_the_smooth_sphere(browser, book_html):
         s.fill("beta", 0.01)
         assert s.ledger("max") > 0.0 and _rgb(s.canvas("difference")).any()
         assert not np.array_equal(_rgb(s.canvas("numeric")), _rgb(s.canvas("symbolic")))
+    finally:
+        s.close()
+
+
+# ---- the page around the simulator -------------------------------------------------------
+
+#: What the reader must not meet in the page's text (outside code, maths and file names):
+#: raw TeX, dollar signs, Python names with underscores, slashes standing between quantities.
+RAW = {"TeX command": r"\\[A-Za-z]+", "dollar": r"\$", "underscore name": r"\b[A-Za-z]+_[A-Za-z_]+\b",
+       "slash between words": r"\w \/ \w"}
+_TEXT_JS = """() => {
+  document.querySelectorAll('details').forEach(d => d.open = true);
+  const main = document.querySelector('article.bd-article').cloneNode(true);
+  main.querySelectorAll('pre, code, mjx-container, .cell_input, script, style, a[href$=".ipynb"]')
+      .forEach(e => e.remove());
+  document.body.append(main);
+  const text = main.innerText;
+  main.remove();
+  return text;
+}"""
+
+
+def _raw(text):
+    import re
+    return {kind: re.findall(pattern, text) for kind, pattern in RAW.items() if re.search(pattern, text)}
+
+
+def test_the_page_is_short_and_reads_without_code_names_or_raw_tex(browser, book_html):
+    """At 1280 px with its dropdowns closed the page is at most 12,000 px tall, and its text
+    (every dropdown open, the simulator's labels, captions and readout included; code, maths and
+    file names left out) holds no raw TeX, dollar sign, underscore name or slash between
+    quantities.  Wrong variants: the page's text with a Python name and raw TeX added, and the
+    page repeated five times, are caught."""
+    s = Session(browser, _url(book_html), viewport={"width": 1280, "height": 900})
+    try:
+        s.page.wait_for_function("document.querySelectorAll('mjx-container').length > 0", timeout=30_000)
+        _scroll_to_canvases(s)
+        canvas = _box(s, "#sim-canvas-symbolic")
+        s.page.mouse.move(canvas["x"] + canvas["width"] / 2, canvas["y"] + canvas["height"] / 3)
+        _readout_pixel(s, SIZE // 2, SIZE // 3)
+        height = s.page.evaluate("document.documentElement.scrollHeight")
+        assert height <= 12_000, height
+        text = s.page.evaluate(_TEXT_JS)
+        assert "RGB exact" in text and "Try this" in text                     # the readout and the prose
+        assert _raw(text) == {}
+        assert set(_raw(text + " the field height_field and \\varepsilon cost $5")) == \
+            {"underscore name", "TeX command", "dollar"}
+        assert _raw(text + " max / RMS") == {"slash between words": ["x / R"]}
+        s.page.evaluate("(a => a.innerHTML = a.innerHTML.repeat(5))(document.querySelector('article.bd-article'))")
+        assert s.page.evaluate("document.documentElement.scrollHeight") > 12_000
     finally:
         s.close()
 

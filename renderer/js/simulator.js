@@ -105,7 +105,7 @@ export const PRESETS = [
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
 ];
 
-const HINT = "Hover over a canvas, or tap it, to read that pixel in the readout beside the U-curve.";
+const HINT = "Hover over a canvas, or tap it, to read that pixel in the readout.";
 
 export function scene_of(state) {
   return { ...SIMULATOR_SCENE, height_field: state.height_field, k_u: state.k_u, k_v: state.k_v,
@@ -467,7 +467,7 @@ class Simulator {
     });
     plot.innerHTML = nodes.join("");
     const stride = this.curve.stride, s = this.state.resolution;
-    const sample = stride === 1 ? `all ${s} × ${s} pixels` : `every ${stride}th pixel of the ${s} × ${s} frame in each direction`;
+    const sample = stride === 1 ? `all ${s} × ${s} pixels` : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame`;
     plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; at ε = ` +
                       `${here.eps.toExponential(1)} RMS ${fmt(here.rms, 1)}, max ${fmt(here.max_abs, 1)}`);
     plot.dataset.eps = String(here.eps);
