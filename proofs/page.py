@@ -241,7 +241,8 @@ def plain_directive(name, argument, options, body, convert=None):
     """A directive as plain Markdown, or None for one this knows no form for: code
     (``code-block``, ``code``) as a fence, ``math`` as a display, ``prf:proof`` as
     *Proof.*, another ``prf:`` kind as **Kind (argument).**, an admonition as a
-    quotation and a ``container`` or ``div`` as its body.  ``convert`` turns the
+    quotation, a ``dropdown`` as its title in bold and its body, and a
+    ``container`` or ``div`` as its body.  ``convert`` turns the
     body's MyST into Markdown (default `plain_markdown`)."""
     convert = convert or plain_markdown
     if name in ("code-block", "code", "sourcecode"):
@@ -255,6 +256,8 @@ def plain_directive(name, argument, options, body, convert=None):
     if name in _ADMONITIONS:
         head = convert(argument) if name == "admonition" else name.title()
         return "\n".join(f"> {line}".rstrip() for line in f"**{head}.** {convert(body)}".split("\n"))
+    if name in ("dropdown", "toggle"):                    # folded on the page, open in a notebook
+        return f"**{convert(argument)}**\n\n{convert(body)}" if argument else convert(body)
     if name in ("container", "div"):
         return convert(body)
     return None

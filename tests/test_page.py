@@ -118,11 +118,12 @@ MYST_OUTPUT = (":::{container} verdicts\n**§1:** “No pixel changes chamber”
                ":::{prf:theorem} The bump moves no boundary\n:label: thm-no-boundary\n\n"
                "For every pixel, $c(\\beta) = c(0)$.\n\n**PROVED** · evidence: {ref}`§6 <ledger-no-boundary>`\n:::\n\n"
                ":::{prf:proof}\n**Step 1.** The chamber is computed first.\n:::\n\n"
-               "* (ledger-no-boundary)=\n  {prf:ref}`The bump moves no boundary <thm-no-boundary>`: used on {ref}`s3`.\n")
+               "* (ledger-no-boundary)=\n  {prf:ref}`The bump moves no boundary <thm-no-boundary>`: used on {ref}`s3`.\n\n"
+               "::::{dropdown} Why\nBecause:\n\n```{math}\nc = c_0\n```\n::::\n")
 
 
 def test_markdown_is_myst_in_a_build_and_plain_markdown_elsewhere(monkeypatch):
-    assert len(MYST.findall(MYST_OUTPUT)) == 8              # the scan sees every piece of MyST in it
+    assert len(MYST.findall(MYST_OUTPUT)) == 10             # the scan sees every piece of MyST in it
     monkeypatch.setenv(page.BUILD_ENV, "1")
     assert page.markdown(MYST_OUTPUT).data == MYST_OUTPUT
     monkeypatch.delenv(page.BUILD_ENV)
@@ -131,7 +132,7 @@ def test_markdown_is_myst_in_a_build_and_plain_markdown_elsewhere(monkeypatch):
     assert shown == ("**§1:** “No pixel changes chamber”. **Holds:** 0 pixels. Register.\n\n"
                      "**Theorem (The bump moves no boundary).** For every pixel, $c(\\beta) = c(0)$.\n\n"
                      "**PROVED** · evidence: §6\n\n*Proof.* **Step 1.** The chamber is computed first.\n\n"
-                     "*\n  The bump moves no boundary: used on s3.")
+                     "*\n  The bump moves no boundary: used on s3.\n\n**Why**\n\nBecause:\n\n$$\nc = c_0\n$$")
     with pytest.raises(TypeError, match="text must be a str of MyST markdown, got int"):
         page.markdown(3)
 
