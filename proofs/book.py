@@ -17,7 +17,6 @@ import re
 from collections import Counter
 
 from . import store
-from .core import step_parts
 
 __all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math",
            "frame_label"]
@@ -49,11 +48,12 @@ def tex_number(x) -> str:
 
 
 def frame_label(scene, width, height) -> str:
-    """The label a number measured on a render carries: its scene and resolution.
+    """The label a number measured on a render carries: its scene and resolution, in words.
 
-    ``"default scene, 256 × 256"``, or with the fields that differ from
-    `renderer.Scene`'s defaults: ``"default scene with height_field='sine',
-    64 × 64"``.  ``scene`` is a `renderer.Scene`; ``width``, ``height`` in pixels.
+    ``"the draft's scene, 256 × 256"``, or with the fields that differ from
+    `renderer.Scene`'s defaults (the draft's scene): ``"the draft's scene with the
+    sine field, β = 1.5, 64 × 64"``.  ``scene`` is a `renderer.Scene`; ``width``,
+    ``height`` in pixels.
 
     Raises
     ------
@@ -71,9 +71,22 @@ def frame_label(scene, width, height) -> str:
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise ValueError(f"{name} must be a positive integer number of pixels, got {n!r}")
     default = Scene()
-    changed = [f"{f.name}={getattr(scene, f.name)!r}" for f in fields(Scene)
+    changed = [_field_words(f.name, getattr(scene, f.name)) for f in fields(Scene)
                if getattr(scene, f.name) != getattr(default, f.name)]
-    return "default scene" + (" with " + ", ".join(changed) if changed else "") + f", {width} × {height}"
+    return "the draft's scene" + (" with " + ", ".join(changed) if changed else "") + f", {width} × {height}"
+
+
+#: How `frame_label` words a field of `renderer.Scene` that differs from the draft's.
+_WORDS = {"height_field": "the {} field", "beta": "β = {:g}", "eps": "ε = {:g}", "k_u": "kᵤ = {:g}",
+          "k_v": "kᵥ = {:g}", "radius_a": "R = {:g}", "model": "{} shading", "shininess": "shininess {:g}"}
+
+
+def _field_words(name, value):
+    if name == "bump":
+        return {"surface": "the displaced sphere's normal", "chart": "the draft's normal"}[value]
+    if name in ("sphere_b", "floor") and isinstance(value, bool):
+        return f"{'with' if value else 'no'} {'sphere B' if name == 'sphere_b' else name}"
+    return _WORDS.get(name, name.replace("_", " ") + " {}").format(value)
 
 
 def glue_math(name, x):
@@ -90,38 +103,32 @@ class TheoremFailed(AssertionError):
     """A theorem the book relies on did not hold during the build."""
 
 
-def _proof_step(number, step):
-    """One step of a proof as a paragraph and a display.  A caption in words leads the
-    paragraph; a caption in LaTeX (the quantity, e.g. ``\\partial u/\\partial\\theta``) names it
-    in the display.  Where the computed side prints as the claimed one, the display is
-    ``caption = value`` (or the value alone) instead of the same expression twice."""
-    caption = step[0]
-    lhs, rhs = step_parts(step)
-    words = bool(re.fullmatch(r"[A-Za-z][A-Za-z0-9 ,;:'()\-=./]+", caption)) and len(caption) > 2
-    lead = f"**Step {number}.** {caption[0].upper()}{caption[1:]}." if words else f"**Step {number}.**"
-    if rhs is None:
-        shown = lhs
-    elif lhs == rhs:
-        shown = rhs if words or caption == lhs else f"{caption} = {rhs}"
-    else:
-        shown = f"{lhs} = {rhs}" if words or caption == lhs else f"{caption}:\\quad {lhs} = {rhs}"
-    if lhs is not None and rhs is not None and lhs != rhs and len(lhs) + len(rhs) > 200:
-        # Long both sides: one line each, aligned on the equals sign, so the display is half as wide.
-        name = "" if words or caption == lhs else f"{caption}:\\quad "
-        shown = f"\\begin{{aligned}}{name}&{lhs}\\\\ &= {rhs}\\end{{aligned}}"
-    return f"{lead}\n\n$$\n{shown}\n$$"
+def _prose(text):
+    """A step's sentence as MyST: ``*`` and ``_`` escaped outside code spans (``ε*`` is not emphasis)."""
+    parts = re.split(r"(`[^`]*`)", text)
+    return "".join(p if p.startswith("`") else re.sub(r"([*_])", r"\\\1", p) for p in parts)
+
+
+def _proof_step(t, number, step):
+    """One step of ``t``'s proof as MyST: "**Step k.** Sentence:" and the display ``lhs = rhs``
+    (``= rhs`` where the step continues a calc chain), two aligned lines where both sides
+    are long, then the definitions the step introduces (``where ...``)."""
+    lhs, rhs = t.tex(step.lhs), t.tex(step.rhs)
+    shown = f"= {rhs}" if step.link and step.lhs == t.steps[number - 2].rhs else f"{lhs} = {rhs}"
+    if not shown.startswith("=") and len(lhs) + len(rhs) > 200:
+        shown = f"\\begin{{aligned}}&{lhs}\\\\ &= {rhs}\\end{{aligned}}"
+    why = _prose(step.why.rstrip(".:"))
+    where = ", ".join(f"${t.definition_tex(s)}$" for s in step.defines)
+    return f"**Step {number}.** {why}:\n\n$$\n{shown}\n$$" + (f"\n\nwhere {where}." if where else "")
 
 
 def _entry(t):
     from .registry import pinned_failure
     v = t.check()
-    steps = "\n\n".join(_proof_step(i, step) for i, step in enumerate(t.steps, 1))
-    evidence = v.evidence.replace("$", "")
-    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement}\n\n"
-             f"**{BADGES[v.status]}** (`{t.id}`): {evidence}\n:::\n\n"
-             f":::{{prf:proof}}\n{steps}\n\nThe check: every identity above is decided by sympy "
-             f"(or, failing that, evaluated with mpmath), and a wrong variant "
-             f"({t.wrong_variants[0][0]}) is refuted by the same check.\n:::\n")
+    steps = "\n\n".join(_proof_step(t, i, step) for i, step in enumerate(t.steps, 1))
+    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement_tex()}\n\n"
+             f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`\n:::\n\n"
+             f":::{{prf:proof}}\n{steps}\n:::\n")
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
                 pages=list(t.pages), block=block, changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
 
@@ -141,8 +148,9 @@ def ledger():
 
 
 def theorem_block(theorem_id):
-    """MyST markdown: a prf:theorem (label ``thm-<id>``) with statement and
-    badge, and a prf:proof with the steps.
+    """MyST markdown: a prf:theorem (label ``thm-<id>``) with the statement and the
+    badge, which links to the theorem's ledger row (``ledger-<id>``, `ledger_table`),
+    and a prf:proof with the steps, each a sentence and an equation.
 
     Raises
     ------
@@ -174,9 +182,11 @@ def _folded(label, text):
 
 
 def ledger_table():
-    """MyST markdown, one list item per theorem: its title (linked), id, verdict and
-    the pages using it; then its evidence, the first clause shown and the rest
-    folded, and what the draft says.  (A list, not a table: the evidence is a
+    """MyST markdown, one list item per theorem, labelled ``ledger-<id>`` (the theorem's box
+    links here with ``{ref}`§6 <ledger-<id>>```): its title (linked to the box), id,
+    verdict and the pages using it; then its evidence (what its steps took, and the
+    renderer's outputs compared), the first clause shown and the rest folded, and what
+    the draft says.  (A list, not a table: the evidence is a
     paragraph, which a table column of a 700-pixel page squeezes to a word a line.)
 
     Raises
@@ -189,7 +199,7 @@ def ledger_table():
         _refuse(theorem_id, e)
         pages = ", ".join(f"{{ref}}`{p}`" for p in e["pages"]) or "no page"
         draft = f"\n\n  {_folded('The draft says', e['seed_says'])}" if e["seed_says"] else ""
-        items.append(f"* {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
+        items.append(f"* (ledger-{theorem_id})=\n  {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
                      f"**{BADGES[e['status']]}**; used on {pages}.\n\n"
                      f"  {_folded('Evidence', e['evidence'])}{draft}")
     return "\n".join(items)

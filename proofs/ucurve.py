@@ -193,8 +193,8 @@ def _default_optimum():
     return dict(eps=c.eps_opt_fitted, error=c.error_at_fitted_opt, band=[float(near.min()), float(near.max())],
                 A=c.truncation_coeff, B=c.roundoff_coeff, eps_predicted=c.eps_opt_predicted,
                 argmin=c.eps_opt_measured, min=c.error_at_measured_opt,
-                label=f"sine, (u, v) = ({c.u}, {c.v}), h_u, k_u = {SEED_FREQUENCIES[0]:g}, "
-                      f"k_v = {SEED_FREQUENCIES[1]:g}, {c.eps.size} steps "
+                label=f"sine field, hᵤ at (u, v) = ({c.u}, {c.v}), kᵤ = {SEED_FREQUENCIES[0]:g}, "
+                      f"kᵥ = {SEED_FREQUENCIES[1]:g}, {c.eps.size} steps "
                       f"from {c.eps.max():.0e} to {c.eps.min():.0e}")
 
 

@@ -88,7 +88,7 @@ def test_a_typed_step_is_found():
 # ------------------------------------------------------------- scene and resolution labels
 ROOT = BOOK.parent
 #: A glue whose name ends so carries the scene or resolution of a render (e.g. "256 × 256",
-#: `proofs.book.frame_label`'s "default scene with height_field='sine', 64 × 64").
+#: `proofs.book.frame_label`'s "the draft's scene with the sine field, 64 × 64").
 #: A glue ``*_measured`` is a claim's measurement text, which ends with its frame (`proofs.claims`).
 LABEL = re.compile(r"(_size|_label|_measured)$")
 CELL = re.compile(r"```\{code-cell\}[^\n]*\n(.*?)\n```", re.S)      # to drop cells from the prose
@@ -247,9 +247,11 @@ def test_an_unlabelled_rendered_number_is_found():
 def test_frame_label_names_the_fields_that_differ_and_the_size():
     from proofs.book import frame_label
     from renderer import Scene
-    assert frame_label(Scene(), 256, 128) == "default scene, 256 × 128"
+    assert frame_label(Scene(), 256, 128) == "the draft's scene, 256 × 128"
     assert frame_label(Scene(height_field="sine", beta=1.5), 64, 64) == \
-        "default scene with height_field='sine', beta=1.5, 64 × 64"
+        "the draft's scene with the sine field, β = 1.5, 64 × 64"
+    assert frame_label(Scene(bump="surface", sphere_b=False, k_v=2.0), 8, 8) == \
+        "the draft's scene with no sphere B, kᵥ = 2, the displaced sphere's normal, 8 × 8"
     with pytest.raises(TypeError, match="scene must be a renderer.Scene, got dict"):
         frame_label({}, 64, 64)
     for bad in (0, 2.0, True):
