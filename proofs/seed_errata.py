@@ -252,13 +252,13 @@ ERRATA = (
     ),
     Erratum(
         id="terminator-leak",
-        where="Cell 1, shade1 (used by Cells 1, 3, 5, 6)",
+        where="Cell 1, `shade1`, used by Cells 1, 3, 5 and 6",
         title="Lights leak past the terminator of the bumped sphere",
         seed=r"a light counts wherever $N'\cdot\hat w > 0$; the geometric normal is never asked",
         correction=r"a light reaches $P$ only if $N\cdot w > 0$ (geometric) and no blocker cuts the segment; $N'$ then only weights Lambert and the lobe",
         exposed_by="tests/test_parity.py (scalar reference with geometric shadow predicate)",
         measure=_terminator_leak,
-        criterion="the draft's rule lights a pair beyond the terminator at the default beta, by more than one 8-bit level",
+        criterion="the draft's rule lights a pair beyond the terminator at the default β, by more than one 8-bit level",
         present=lambda m: m["leak_pixels_default"] > 0 and m["leak_diffuse_max_default"] > 1 / 255,
         finding=(
             "At the default $\\beta$ the draft's rule lights {leak_pixels_default:,} (pixel, light) "
@@ -270,7 +270,7 @@ ERRATA = (
     ),
     Erratum(
         id="specular-ungated",
-        where="Cell 1, shade1",
+        where="Cell 1, `shade1`",
         title="The specular lobe is added where the surface faces away from the light",
         seed=r"$k_s \max(0, N'\cdot h)^{n}$ added for every unshadowed light",
         correction=r"the lobe is zero where $N'\cdot\hat w \le 0$",
@@ -286,13 +286,13 @@ ERRATA = (
     ),
     Erratum(
         id="v-border-branch",
-        where="Cell 1, grad_numeric",
+        where="Cell 1, `grad_numeric`",
         title="The one-sided v-difference fires in the interior",
         seed=r"one-sided quotient whenever $\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border",
         correction=r"one-sided only where $v \pm \varepsilon$ leaves $[0, 1]$; elsewhere divide by $2\varepsilon$",
         exposed_by="verify/test_theorems.py (central-difference-truncation: interior points take the 2 eps branch)",
         measure=_v_border_branch,
-        criterion="the branch fires at some interior pixels at eps = 1e-3, and at more at 1e-9",
+        criterion="the branch fires at some interior pixels at a step of 1e-3, and at more at 1e-9",
         present=lambda m: 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"],
         finding=(
             "At a step of 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
@@ -303,13 +303,13 @@ ERRATA = (
     ),
     Erratum(
         id="acos-pole",
-        where="Cell 1, chartA1",
+        where="Cell 1, `chartA1`",
         title="The polar angle loses digits near the pole",
         seed=r"$\varphi = \arccos N_z$ and $\sin\varphi = \sqrt{1 - N_z^2}$",
         correction=r"$\varphi = \operatorname{atan2}(\operatorname{hypot}(N_x, N_y), N_z)$ and $\sin\varphi = \operatorname{hypot}(N_x, N_y)$",
         exposed_by="verify/test_errata.py (mpmath reference)",
         measure=_acos_pole,
-        criterion="acos loses more than 1e-3 (relative) while atan2 stays within 1e-14",
+        criterion="arccos loses more than 1e-3 (relative) while atan2 stays within 1e-14",
         present=lambda m: m["max_rel_error_acos"] > 1e-3 and m["max_rel_error_atan2"] < 1e-14,
         finding=(
             "For unit normals with $10^{{-8}} < \\sin\\varphi < 10^{{-2}}$ the relative error of "
@@ -319,7 +319,7 @@ ERRATA = (
     ),
     Erratum(
         id="fallback-orientation",
-        where="Cell 1, tangent_frame; §7 item 4",
+        where="Cell 1, `tangent_frame`, and §7 item 4",
         title="The pole fallback frame has the opposite orientation",
         seed=r"fallback $e_\theta = (1,0,0)$, $e_\varphi = (0,1,0)$",
         correction="kept as the seed has it (the convention is the seed's); measured and disclosed",
