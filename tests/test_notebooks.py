@@ -1,11 +1,21 @@
-"""Each notebook page of the built site can be downloaded as a notebook, and that notebook runs.
+"""Each notebook page of the built site can be downloaded as a notebook that stands alone.
 
-book/_ext/notebooks.py writes ``_notebooks/<page>.ipynb`` with jupytext and
-links it under the page's title.  Checked against the site `book_html` names:
-every page that is a notebook has one, linked from its page, with the page's
-code cells (as myst-nb reads them) in order; and one of them, copied to a
-directory outside the repository, runs top to bottom in a fresh kernel and
-draws its figures with the same bytes as the build did.
+book/_ext/notebooks.py writes ``_notebooks/<page>.ipynb`` (jupytext), links it under
+the page's title, and serves the project's wheel and README beside the pages.
+Checked against the site `book_html` names:
+
+* every page that is a notebook has one, linked from its page with the wheel and
+  the README, with the page's code cells (as myst-nb reads them) in order and a
+  first cell that says how to install the wheel the site serves;
+* no notebook carries MyST markup a plain Jupyter shows raw (a role, a fenced
+  directive, a target), and every value the page pastes from glue is in its text
+  (the scan is shown catching planted markup);
+* the wheel holds the project's packages and declares the ``notebook`` extra;
+* what a reader does: a new virtual environment in a temporary directory, the
+  site's wheel installed there with its ``notebook`` extra (versions pinned by
+  constraints.txt), and §1's notebook, copied outside the repository, run top to
+  bottom by that environment's ``jupyter-execute``; its figures must be the
+  page's, by name and byte for byte, and what it shows as Markdown plain Markdown.
 """
 
 from __future__ import annotations
@@ -13,20 +23,48 @@ from __future__ import annotations
 import base64
 import hashlib
 import json
+import os
+import re
 import shutil
+import subprocess
 import sys
+import time
+import zipfile
+from collections import Counter
+from html import unescape
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
 ROOT = Path(__file__).parents[1]
 sys.path.insert(0, str(ROOT / "book" / "_ext"))
 import nb_deps  # noqa: E402  (book/_ext is not a package)
+import notebooks  # noqa: E402
 
 sys.path.remove(str(ROOT / "book" / "_ext"))
 
 PAGES = sorted(p for p in (ROOT / "book").glob("*.md")
                if nb_deps.code_cells(p.read_text(encoding="utf-8"), path=p) is not None)
+
+#: MyST markup a plain Jupyter would show as it is: a role, a fenced directive, a target line.
+LEFTOVER = re.compile(r"\{[A-Za-z][\w:.+-]*\}`|`{3,}\s*\{|:{3,}\s*\{|^\s*\([^()\s]+\)=\s*$", re.M)
+
+
+def leftovers(notebook):
+    """[(cell index, markup)] of every MyST role or directive left in a notebook's Markdown cells."""
+    return [(i, m.group()) for i, cell in enumerate(notebook["cells"]) if cell["cell_type"] == "markdown"
+            for m in LEFTOVER.finditer("".join(cell["source"]))]
+
+
+def _notebook(book_html, stem):
+    return json.loads((book_html / "_notebooks" / f"{stem}.ipynb").read_text(encoding="utf-8"))
+
+
+def _wheel(book_html):
+    wheels = sorted((book_html / notebooks.DOWNLOADS).glob("*.whl"))
+    assert len(wheels) == 1, f"{book_html / notebooks.DOWNLOADS} holds {len(wheels)} wheels"
+    return wheels[0]
 
 
 def test_the_book_has_notebook_pages():
@@ -42,23 +80,151 @@ def test_each_notebook_page_links_its_notebook_with_its_code_cells(book_html, pa
     assert code == nb_deps.code_cells(page.read_text(encoding="utf-8"), path=page)
     assert notebook["metadata"]["kernelspec"]["name"] == "python3"
     assert all(not c.get("outputs") for c in notebook["cells"] if c["cell_type"] == "code")
+    # The first cell: how to install the wheel the site serves, linked from where the notebook lies.
+    wheel = _wheel(book_html).name
+    first = notebook["cells"][0]
+    assert first["cell_type"] == "markdown"
+    text = "".join(first["source"])
+    assert f'pip install "{wheel}[notebook]"' in text
+    for link in re.findall(r"\]\(([^)]+)\)", text):
+        assert (nb_file.parent / link).resolve().is_file(), f"{page.stem}: the first cell's link {link} is broken"
+    assert f"../{notebooks.DOWNLOADS}/{wheel}" in text and f"../{notebooks.README}" in text
+    # The page links its notebook, the wheel and the README under its title.
     html = (book_html / f"{page.stem}.html").read_text(encoding="utf-8")
-    assert f'href="_notebooks/{page.stem}.ipynb"' in html
+    for href in (f"_notebooks/{page.stem}.ipynb", f"{notebooks.DOWNLOADS}/{wheel}", notebooks.README):
+        assert f'href="{href}"' in html, f"{page.stem}.html does not link {href}"
 
 
-def test_a_downloaded_notebook_runs_outside_the_repository(book_html, tmp_path):
-    from nbclient import NotebookClient
-    import nbformat
-    copy = tmp_path / "s2_scene.ipynb"
-    shutil.copy(book_html / "_notebooks" / "s2_scene.ipynb", copy)
-    notebook = nbformat.read(copy, as_version=4)
-    NotebookClient(notebook, timeout=600, resources={"metadata": {"path": str(tmp_path)}}).execute()
-    assert any(o.get("output_type") in ("display_data", "execute_result")
-               for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", []))
-    # Its figures, drawn again in another process, are byte for byte the site's images.
-    drawn = [base64.b64decode(v) for c in notebook.cells if c.cell_type == "code" for o in c.get("outputs", [])
-             for k, v in o.get("data", {}).items() if k.endswith("image/png")]
-    site = {hashlib.sha256(p.read_bytes()).hexdigest() for p in (book_html / "_images").glob("*.png")}
-    assert len(drawn) >= 2
-    assert [hashlib.sha256(b).hexdigest() in site for b in drawn] == [True] * len(drawn)
-    assert all(b"tIME" not in b[:4096] for b in drawn)      # no timestamp chunk
+@pytest.mark.parametrize("page", PAGES, ids=[p.stem for p in PAGES])
+def test_no_notebook_carries_myst_markup_and_each_shows_the_values_its_page_pasted(book_html, page):
+    notebook = _notebook(book_html, page.stem)
+    assert leftovers(notebook) == []
+    # Every value the page shows from glue (myst-nb's pasted text) is in the notebook's text.
+    html = (book_html / f"{page.stem}.html").read_text(encoding="utf-8")
+    pasted = [_plain(unescape(v)) for v in re.findall(r'<span class="pasted-text">([^<]*)</span>', html)]
+    prose = re.sub(r"\\(.)", r"\1", "".join("".join(c["source"]) for c in notebook["cells"]
+                                            if c["cell_type"] == "markdown"))
+    assert [v for v in pasted if v not in prose] == []
+
+
+def _plain(text):
+    """Text with Sphinx's smart quotes turned back into plain ones."""
+    return text.translate(str.maketrans("‘’“”", "''\"\""))
+
+
+def test_the_markup_scan_finds_planted_roles_and_directives(book_html):
+    clean = _notebook(book_html, "s1_what_changes")
+    assert leftovers(clean) == []
+    at = next(i for i, c in enumerate(clean["cells"]) if c["cell_type"] == "markdown" and i > 0)
+    for planted in ("see {numref}`fig-s1-bump`", "{glue:text}`s1_size`", "```{glue:figure} fig-s1-bump",
+                    ":::{prf:theorem} A title", "(s1)="):
+        notebook = json.loads(json.dumps(clean))
+        notebook["cells"][at]["source"] = "".join(notebook["cells"][at]["source"]) + "\n\n" + planted + "\n"
+        assert [i for i, _ in leftovers(notebook)] == [at], planted
+
+
+def test_the_writer_refuses_a_role_or_directive_it_cannot_write_naming_the_page():
+    # (proofs.page.plain_markdown, the converter, is tested in tests/test_page.py.)
+    app = SimpleNamespace(env=SimpleNamespace(doc2path=lambda d: f"book/{d}.md"))
+    page = notebooks.PageMarkdown(app, "s9_x")
+    with pytest.raises(notebooks.NotebookError, match=r"book/s9_x.md: \{kbd\}`C-c`: this role has no"):
+        page("Press {kbd}`C-c`.")
+    with pytest.raises(notebooks.NotebookError, match=r"book/s9_x.md: \{figure\} a.png: this directive has no"):
+        page("```{figure} a.png\n```")
+
+
+def test_the_site_serves_a_wheel_of_the_project_and_the_readme(book_html):
+    with zipfile.ZipFile(_wheel(book_html)) as wheel:
+        names = set(wheel.namelist())
+        metadata = wheel.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
+    packaged = {n for n in names if ".dist-info/" not in n}
+    on_disk = {p.relative_to(ROOT).as_posix() for package in ("renderer", "proofs")
+               for p in (ROOT / package).rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+    assert packaged == on_disk
+    assert {"renderer/generated.py", "renderer/js/render.js", "proofs/page.py"} <= packaged
+    assert "Provides-Extra: notebook" in metadata
+    assert re.search(r'^Requires-Dist: ipykernel\S* ?;\s*extra == "notebook"', metadata, re.M)
+    readme = (book_html / notebooks.README).read_text(encoding="utf-8")
+    headings = re.findall(r"^#+ (.+)$", (ROOT / "README.md").read_text(encoding="utf-8"), re.M)
+    shown = [unescape(re.sub(r"<[^>]+>", "", h)) for h in re.findall(r"<h\d>(.*?)</h\d>", readme)]
+    assert shown == [h.replace("`", "") for h in headings]
+    assert (book_html / notebooks.DOWNLOADS / "constraints.txt").read_bytes() == (ROOT / "constraints.txt").read_bytes()
+
+
+def test_a_failed_wheel_build_names_what_failed(tmp_path):
+    # The project as it is, but with a version no packaging tool accepts.
+    root = tmp_path / "project"
+    root.mkdir()
+    (root / "pyproject.toml").write_text((ROOT / "pyproject.toml").read_text(encoding="utf-8").replace(
+        'version = "', 'version = "not a version ', 1), encoding="utf-8")
+    shutil.copy(ROOT / "README.md", root)
+    for package in ("renderer", "proofs"):
+        (root / package).mkdir()
+        (root / package / "__init__.py").write_text("")
+    with pytest.raises(notebooks.NotebookError, match=r"(?s)building the project's wheel with pip failed.*version"):
+        notebooks.build_wheel(root, tmp_path / "site")
+    assert not list((tmp_path / "site").glob("*"))
+
+
+def _clean_env(tmp, venv):
+    """The environment of a reader's shell: the new venv first on PATH, nothing pointing into
+    the repository, and Jupyter's and IPython's settings in temporary directories."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYTHONPATH", "VIRTUAL_ENV", "PYTHONHOME", "MPLBACKEND") and not k.startswith("SYMRENDER_")}
+    path = [p for p in env.get("PATH", "").split(os.pathsep) if p and not Path(p).resolve().is_relative_to(ROOT)]
+    env.update(PATH=os.pathsep.join([str(venv / "bin"), *path]), JUPYTER_DATA_DIR=str(tmp / "jupyter-data"),
+               JUPYTER_CONFIG_DIR=str(tmp / "jupyter-config"), IPYTHONDIR=str(tmp / "ipython"))
+    return env
+
+
+RUN = ["s1_what_changes"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stem", RUN)
+def test_a_downloaded_notebook_runs_in_a_new_environment_with_the_wheel(book_html, tmp_path, stem):
+    assert not tmp_path.resolve().is_relative_to(ROOT)
+    venv, work = tmp_path / "venv", tmp_path / "reader"
+    work.mkdir()
+    env = _clean_env(tmp_path, venv)
+    seconds = {}
+
+    def run(step, *command, timeout):
+        t0 = time.perf_counter()
+        done = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True, timeout=timeout)
+        seconds[step] = round(time.perf_counter() - t0, 1)
+        assert done.returncode == 0, f"{step} failed:\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}"
+        return done.stdout
+
+    wheel = Path(shutil.copy(_wheel(book_html), work)).name
+    run("venv", sys.executable, "-m", "venv", str(venv), timeout=300)
+    # The first cell's command, pinned; --no-compile halves the install (the kernel compiles what it imports).
+    run("install", str(venv / "bin" / "python"), "-m", "pip", "install", "--quiet", "--no-compile",
+        "-c", str(ROOT / "constraints.txt"), f"{wheel}[notebook]", timeout=1800)
+    python = str(venv / "bin" / "python")
+    where = run("import", python, "-c", "import proofs, renderer; print(proofs.__file__, renderer.__file__)", timeout=300)
+    assert all(Path(p).is_relative_to(venv) for p in where.split()), where
+    copy = Path(shutil.copy(book_html / "_notebooks" / f"{stem}.ipynb", work))
+    run("run", str(venv / "bin" / "jupyter-execute"), "--inplace", "--timeout=900", copy.name, timeout=1800)
+    print(f"\n{stem}: seconds {seconds}")
+
+    notebook = json.loads(copy.read_text(encoding="utf-8"))
+    code = [c for c in notebook["cells"] if c["cell_type"] == "code"]
+    assert all(c["execution_count"] for c in code), "a code cell did not run"
+    assert not [o for c in code for o in c["outputs"] if o["output_type"] == "error"]
+    # What it shows as Markdown (proofs.page.markdown) is plain Markdown too.
+    shown_md = ["".join(o["data"]["text/markdown"]) for c in code for o in c["outputs"]
+                if "text/markdown" in o.get("data", {})]
+    assert shown_md and [m for text in shown_md for m in LEFTOVER.findall(text)] == []
+    # The kernel ran the installed renderer: numba cached its compiled functions beside it.
+    assert list((Path(where.split()[1]).parent / "__pycache__").glob("*.nbi"))
+    # Its figures are the page's: the names its glue:figure directives show, in order, and the same PNGs.
+    shown = [(o["metadata"].get("symrender", {}).get("figure"), o["data"]["image/png"]) for c in code
+             for o in c["outputs"] if "image/png" in o.get("data", {})]
+    page = (ROOT / "book" / f"{stem}.md").read_text(encoding="utf-8")
+    assert [name for name, _ in shown] == re.findall(r"^`{3,}\{glue:figure\}\s*(\S+)", page, re.M)
+    html = (book_html / f"{stem}.html").read_text(encoding="utf-8")
+    site = Counter(hashlib.sha256((book_html / src).read_bytes()).hexdigest()
+                   for src in re.findall(r'<img[^>]* src="(_images/[^"]+\.png)"', html))
+    drawn = Counter(hashlib.sha256(base64.b64decode(png)).hexdigest() for _, png in shown)
+    assert drawn == site

@@ -1,38 +1,334 @@
-"""Sphinx extension: each notebook page of the book can be downloaded as a Jupyter notebook.
+"""Sphinx extension: each notebook page of the book can be downloaded as a notebook that stands alone.
 
-The pages are MyST markdown notebooks.  At the end of an HTML build, jupytext
-(the well-kept converter between the two formats) turns each page's source into
-``_notebooks/<page>.ipynb`` in the site: its code cells with their tags, its
-markdown, its kernelspec, no outputs.  Each such page gets a line under its
-title linking to the file.  The notebooks import the project's packages
-(``renderer``, ``proofs``) and myst-nb's ``glue``, so they run wherever the
-project is installed with its book extra (``pip install -e '.[book]'``, as
-``make book`` does), from any directory.
+An HTML build puts into the site, beside the pages:
 
-A file is written to a temporary name and renamed into place, so the site
-never holds a half-written notebook.
+* ``_downloads/<wheel>``: the project's wheel, built when the build starts with
+  ``pip wheel`` and the setuptools of the build's own environment (offline,
+  no build isolation), from a copy of the files it packages (so nothing is
+  written into the source tree); and ``_downloads/constraints.txt``, the
+  versions the book was built with;
+* ``README.html``: the README, rendered with markdown-it (the parser the book
+  itself uses; the README has no relative links to break);
+* ``_notebooks/<page>.ipynb`` for each page that is a MyST notebook, written by
+  jupytext when the build finishes: the page's code cells as they are, with
+  their tags and no outputs, and its prose as plain Markdown any Jupyter
+  renders (`proofs.page.plain_markdown`, which `proofs.page.markdown` also
+  applies to what a page shows when it runs outside the book, with
+  `PageMarkdown` resolving against this build): each glue role becomes the value this build
+  computed (myst-nb's glue data of the page), each cross-reference its text
+  ("§3 · The mathematics", "Fig. 2"), a ``glue:figure`` its numbered caption
+  (the figure is drawn by the code cell that calls `proofs.page.show`), a
+  ``literalinclude`` the code it includes (Sphinx's own reader), and so on.
+  A first cell says how to install the project to run the notebook.
+
+Each notebook page gets a line under its title linking its notebook, the wheel
+and the README.  Every file is written to a temporary name and renamed into
+place, so the site never holds a half-written one.  A role or directive with no
+plain-Markdown form, a glued name without a value or a failed wheel build fails
+the build, and the message names the page and the markup, or pip's output; a
+page that failed to execute gets no notebook (a warning says so).
 """
 
 from __future__ import annotations
 
+import json
 import os
+import shutil
+import subprocess
+import sys
 import tempfile
+import tomllib
 from pathlib import Path
 
 from docutils import nodes
 
-#: The site folder that holds the notebooks.
-FOLDER = "_notebooks"
+from proofs.page import TITLED, escape, fenced, plain_directive, plain_markdown
 
+#: The site folder that holds the notebooks, and the one that holds the wheel and constraints.txt.
+FOLDER, DOWNLOADS = "_notebooks", "_downloads"
+#: The README, rendered into the site.
+README = "README.html"
+#: The project's root (pyproject.toml, README.md, constraints.txt).
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class NotebookError(Exception):
+    """Something the site's notebooks or the files beside them need could not be made."""
+
+
+# --- files of the site -------------------------------------------------------------------------
+
+def write_atomic(target, data: bytes):
+    """Write ``data`` to ``target`` through a temporary file beside it and a rename."""
+    target = Path(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".part")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.chmod(tmp, 0o644)                          # mkstemp's 0600 would hide it from a web server
+        os.replace(tmp, target)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+def build_wheel(root, folder) -> Path:
+    """Build the project at ``root`` into a wheel in ``folder`` (replacing older wheels of
+    the project there) and return its path.
+
+    The files the wheel packages (pyproject.toml, the README, the packages named
+    by ``[tool.setuptools] packages``, without ``__pycache__``) are copied to a
+    temporary directory, and ``python -m pip wheel --no-deps --no-build-isolation
+    --no-index --check-build-dependencies`` builds there with this environment's
+    setuptools: no network, nothing written into ``root``.  ``SOURCE_DATE_EPOCH``
+    (1980-01-01) gives the zip entries fixed times, so the same sources give the
+    same bytes.
+
+    Raises
+    ------
+    NotebookError
+        If pip fails (the message holds the end of its output).
+    """
+    root, folder = Path(root), Path(folder)
+    pyproject = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))
+    with tempfile.TemporaryDirectory(prefix="symrender-wheel-") as tmp:
+        src, out = Path(tmp, "src"), Path(tmp, "out")
+        src.mkdir()
+        for name in ("pyproject.toml", pyproject["project"]["readme"]):
+            shutil.copy2(root / name, src / name)
+        for package in pyproject["tool"]["setuptools"]["packages"]:
+            shutil.copytree(root / package, src / package, ignore=shutil.ignore_patterns("__pycache__"))
+        run = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation",
+                              "--no-index", "--check-build-dependencies", "--quiet", "-w", str(out), str(src)],
+                             capture_output=True, text=True, cwd=tmp,
+                             env={**os.environ, "SOURCE_DATE_EPOCH": "315532800"})
+        wheels = sorted(out.glob("*.whl"))
+        if run.returncode != 0 or len(wheels) != 1:
+            raise NotebookError(f"building the project's wheel with pip failed (exit {run.returncode}):\n"
+                                + (run.stdout + run.stderr)[-3000:])
+        target = folder / wheels[0].name
+        write_atomic(target, wheels[0].read_bytes())
+    for old in folder.glob(f"{target.name.split('-')[0]}-*.whl"):
+        if old != target:
+            old.unlink()
+    return target
+
+
+def write_readme(root, target):
+    """Render ``root``/README.md (CommonMark and tables) as a standalone HTML page at ``target``."""
+    from html import escape as html_escape
+
+    from markdown_it import MarkdownIt
+    text = Path(root, "README.md").read_text(encoding="utf-8")
+    title = text.lstrip("# ").partition("\n")[0]
+    body = MarkdownIt("commonmark", {"html": False}).enable("table").render(text)
+    style = ("body{max-width:46rem;margin:2rem auto;padding:0 1rem;font:16px/1.55 system-ui,sans-serif}"
+             "pre{overflow-x:auto;background:#f5f5f5;padding:.6rem}code{font-size:.9em}"
+             "table{border-collapse:collapse;display:block;overflow-x:auto}"
+             "td,th{border:1px solid #ccc;padding:.3rem;vertical-align:top}")
+    page = (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>README · {html_escape(title)}</title><style>{style}</style></head>\n<body>\n"
+            f'<p><a href="index.html">The book</a></p>\n{body}</body></html>\n')
+    write_atomic(target, page.encode("utf-8"))
+
+
+# --- MyST -> plain Markdown, with the build's values ----------------------------------------
+
+class PageMarkdown:
+    """The role and directive callbacks of `plain_markdown` for one page of a built book:
+    glue values from myst-nb's glue data, reference texts from the Sphinx environment."""
+
+    def __init__(self, app, docname):
+        self.app, self.env, self.docname = app, app.env, docname
+        self._glue = {}
+
+    def __call__(self, text):
+        return plain_markdown(text, self.role, self.directive)
+
+    def fail(self, what, why):
+        raise NotebookError(f"{self.env.doc2path(self.docname)}: {what}: {why}")
+
+    # glue ---------------------------------------------------------------------------------------
+    def glued(self, key, what):
+        """The mime bundle glued under ``key`` (``name`` or ``page::name``)."""
+        doc, _, name = key.rpartition("::")
+        docname = self.env.path2doc(self.env.relfn2path(doc, self.docname)[1]) if doc else self.docname
+        if docname not in self._glue:
+            path = Path(self.env.mystnb_config.output_folder, *f"{docname}.glue.json".split("/"))
+            self._glue[docname] = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+        if name not in self._glue[docname]:
+            self.fail(what, f"no value is glued under {name!r} on page {docname}")
+        return self._glue[docname][name]["data"]
+
+    def glue_markdown(self, key, what):
+        data = self.glued(key, what)
+        if "text/markdown" in data:
+            return self(data["text/markdown"])
+        if "text/plain" in data:
+            from myst_nb.core.variables import format_plain_text
+            return escape(format_plain_text(data["text/plain"], ""))
+        self.fail(what, f"the value glued under {key!r} is not text ({', '.join(data)})")
+
+    # references ---------------------------------------------------------------------------------
+    def label(self, target, what):
+        """(docname, id, title) of a label of the std domain."""
+        std = self.env.get_domain("std")
+        if target in std.labels:
+            return std.labels[target]
+        if target in std.anonlabels:
+            return (*std.anonlabels[target], "")
+        self.fail(what, f"no label {target!r}")
+
+    def number(self, docname, node_id):
+        """(figtype, "1.2") of a numbered node, or None."""
+        for figtype, numbers in self.env.toc_fignumbers.get(docname, {}).items():
+            if node_id in numbers:
+                return figtype, ".".join(map(str, numbers[node_id]))
+        return None
+
+    def role(self, name, content):
+        what = f"{{{name}}}`{content}`"
+        titled = TITLED.match(content)
+        title, target = (titled["title"], titled["target"]) if titled else (None, content)
+        if name == "glue:text":                      # name:format, split as myst-nb splits it
+            key, fmt = content.rsplit(":", 1) if ":" in content else (content, "s")
+            from myst_nb.core.variables import format_plain_text
+            data = self.glued(key, what)
+            if "text/plain" not in data:
+                self.fail(what, "the value has no text/plain")
+            return escape(format_plain_text(data["text/plain"], fmt))
+        if name == "glue:md":                        # name:myst or name:commonmark
+            return self.glue_markdown(content.rsplit(":", 1)[0] if ":" in content else content, what)
+        if name in ("glue", "glue:any"):
+            return self.glue_markdown(content, what)
+        if name == "ref":
+            title = title or self.label(target, what)[2]
+            return escape(title) if title else self.fail(what, "the label has no title")
+        if name == "numref":
+            docname, node_id, caption = self.label(target, what)
+            numbered = self.number(docname, node_id) or self.fail(what, "the target is not numbered")
+            figtype, number = numbered
+            text = title or self.app.config.numfig_format[figtype]
+            return escape(text.replace("%s", number).replace("{number}", number).replace("{name}", caption))
+        if name == "prf:ref":
+            return escape(title or self.proof_title(target, what))
+        if name == "doc":
+            if title:
+                return escape(title)
+            from sphinx.util import docname_join
+            docname = docname_join(self.docname, target)
+            if docname not in self.env.titles:
+                self.fail(what, "no such page")
+            return escape(self.env.titles[docname].astext())
+        if name == "term":
+            return escape(title or target)
+        if name == "math":
+            return f"${content}$"
+        self.fail(what, "this role has no plain-Markdown form in the notebook")
+
+    def proof_title(self, label, what):
+        """'Theorem 3' for a sphinx-proof label, as sphinx-proof's own references write it."""
+        entry = getattr(self.env, "proof_list", {}).get(label) or self.fail(what, f"no proof label {label!r}")
+        number = "" if entry.get("nonumber") else ".".join(
+            map(str, self.env.toc_fignumbers.get(entry["docname"], {}).get(entry["countertype"], {}).get(label, ())))
+        return f"{entry['realtype'].title()} {number}".strip()
+
+    # directives ---------------------------------------------------------------------------------
+    def directive(self, name, arg, options, body):
+        what = f"{{{name}}} {arg}".strip()
+        if name == "glue:figure":
+            caption = self(body)
+            node = self.number(*self.label(options["name"], what)[:2]) if "name" in options else None
+            lead = f"**{self.app.config.numfig_format[node[0]] % node[1]}.** " if node else ""
+            return f"{lead}{caption}" if caption else lead.strip()
+        if name in ("glue", "glue:any", "glue:md"):
+            return self.glue_markdown(arg, what)
+        if name == "literalinclude":
+            from sphinx.directives.code import LiteralIncludeReader
+            path = self.env.relfn2path(arg, self.docname)[1]
+            try:
+                code, _ = LiteralIncludeReader(path, options, self.app.config).read(location=(self.docname, None))
+            except Exception as error:          # the reader's own errors (a missing file or pyobject)
+                self.fail(what, str(error))
+            caption = f"*{self(options['caption'])}*\n\n" if options.get("caption") else ""
+            return caption + fenced(code, options.get("language", ""))
+        if name.startswith("prf:") and options.get("label") in getattr(self.env, "proof_list", {}):
+            kind = self.proof_title(options["label"], what)           # numbered, as the page numbers it
+            return f"**{kind}{f' ({self(arg)})' if arg else ''}.** {self(body)}"
+        if name == "raw":
+            return "*(Here the page on the site shows interactive content that a notebook cannot.)*"
+        if name == "tableofcontents":
+            docs = self.env.toctree_includes.get(self.docname, [])
+            return "\n".join(f"- {escape(self.env.titles[d].astext())}" for d in docs if d in self.env.titles)
+        return plain_directive(name, arg, options, body, self) or self.fail(
+            what, "this directive has no plain-Markdown form in the notebook")
+
+
+# --- the notebook ------------------------------------------------------------------------------
+
+def _prefix(docname):
+    """The path from a page's HTML file, or from its notebook, up to the site's root."""
+    return "../" * docname.count("/")
+
+
+def notebook_uri(docname):
+    """The notebook's address relative to the page's HTML file."""
+    return _prefix(docname) + f"{FOLDER}/{docname}.ipynb"
+
+
+def install_cell(title, book, docname, wheel):
+    """The notebook's first cell (Markdown): what it is and how to install the project to run it."""
+    up = "../" + _prefix(docname)                 # from _notebooks/<docname>.ipynb to the site's root
+    return (f"*{escape(title)}*, a page of *{escape(book)}*, as a notebook: its text holds the values "
+            f"the book's build computed; its code computes them again and draws the figures.\n\n"
+            f"**To run it**, install the project into the Python (3.11 or newer) of your Jupyter kernel, "
+            f"from the wheel served with the book, [{wheel}]({up}{DOWNLOADS}/{wheel}):\n\n"
+            f'```sh\npip install "{wheel}[notebook]"\n```\n\n'
+            f"Then the notebook runs top to bottom in any Jupyter, from any directory, or headless: "
+            f"`jupyter-execute {Path(docname).name}.ipynb`. The `notebook` extra adds a kernel and "
+            f"`jupyter-execute`; adding `-c constraints.txt` ([constraints.txt]({up}{DOWNLOADS}/constraints.txt)) "
+            f"installs the exact versions the book was built with. More in the project's [README]({up}{README}).")
+
+
+def write_notebook(source, target, *, markdown=lambda text: text, first_cell=None):
+    """Convert the MyST notebook ``source`` to ``target`` (.ipynb) with jupytext, atomically.
+
+    ``markdown`` turns each Markdown cell's MyST into what the notebook shows
+    (cells it leaves empty are dropped); ``first_cell``, if given, is a
+    Markdown cell put before all others.
+    """
+    import jupytext
+    from nbformat.v4 import new_markdown_cell
+    notebook = jupytext.read(source, fmt="md:myst")
+    notebook.metadata.pop("jupytext", None)          # the pairing describes the source, not this file
+    cells = [new_markdown_cell(first_cell)] if first_cell else []
+    for cell in notebook.cells:
+        if cell.cell_type == "markdown":
+            cell.source = markdown(cell.source)
+            if not cell.source.strip():
+                continue
+        cells.append(cell)
+    notebook.cells = cells
+    write_atomic(target, jupytext.writes(notebook, fmt="ipynb").encode("utf-8"))
+
+
+# --- Sphinx ------------------------------------------------------------------------------------
 
 def is_notebook(app, docname):
     """Whether the page is a MyST notebook (its front matter names a kernelspec)."""
     return bool(app.env.metadata.get(docname, {}).get("kernelspec"))
 
 
-def notebook_uri(docname):
-    """The notebook's address relative to the page's HTML file."""
-    return "../" * docname.count("/") + f"{FOLDER}/{docname}.ipynb"
+def _project_files(app):
+    """The wheel (its name kept for the links), constraints.txt and the README, into the site."""
+    if app.builder.format != "html":
+        return
+    site = Path(app.outdir)
+    app.notebook_wheel = build_wheel(ROOT, site / DOWNLOADS).name
+    write_atomic(site / DOWNLOADS / "constraints.txt", (ROOT / "constraints.txt").read_bytes())
+    write_readme(ROOT, site / README)
 
 
 def _link(app, doctree, docname):
@@ -41,42 +337,39 @@ def _link(app, doctree, docname):
     sections = list(doctree.findall(nodes.section))
     if not sections:
         return
-    name = f"{Path(docname).name}.ipynb"
+    up = _prefix(docname)
     para = nodes.paragraph("", "", nodes.Text("This page as a Jupyter notebook: "),
-                           nodes.reference("", name, refuri=notebook_uri(docname)),
-                           nodes.Text(" (runs wherever the project is installed; see the README)."),
+                           nodes.reference("", f"{Path(docname).name}.ipynb", refuri=notebook_uri(docname)),
+                           nodes.Text("; it runs in any Jupyter where "),
+                           nodes.reference("", "the project's wheel",
+                                           refuri=f"{up}{DOWNLOADS}/{app.notebook_wheel}"),
+                           nodes.Text(" is installed (see the "),
+                           nodes.reference("", "README", refuri=up + README), nodes.Text(")."),
                            classes=["notebook-download"])
     title = sections[0].next_node(nodes.title)
     sections[0].insert(sections[0].index(title) + 1 if title is not None else 0, para)
 
 
-def write_notebook(source, target):
-    """Convert the MyST notebook ``source`` to ``target`` (.ipynb) with jupytext, atomically."""
-    import jupytext
-    notebook = jupytext.read(source, fmt="md:myst")
-    notebook.metadata.pop("jupytext", None)          # the pairing describes the source, not this file
-    target.parent.mkdir(parents=True, exist_ok=True)
-    text = jupytext.writes(notebook, fmt="ipynb")
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)                          # mkstemp's 0600 would hide it from a web server
-        os.replace(tmp, target)
-    except BaseException:
-        os.unlink(tmp)
-        raise
-
-
 def _write_all(app, exception):
     if exception is not None or app.builder.format != "html":
         return
+    from myst_nb.sphinx_ import NbMetadataCollector
+    from sphinx.util import logging
     for docname in sorted(app.env.found_docs):
         if is_notebook(app, docname):
-            write_notebook(app.env.doc2path(docname), Path(app.outdir, FOLDER, f"{docname}.ipynb"))
+            target = Path(app.outdir, FOLDER, f"{docname}.ipynb")
+            if (NbMetadataCollector.get_exec_data(app.env, docname) or {}).get("succeeded") is False:
+                # Its glue is incomplete; myst-nb has reported the cell that failed.
+                logging.getLogger(__name__).warning(f"{docname}: no notebook written: the page failed to execute")
+                target.unlink(missing_ok=True)           # nor an earlier build's left in its place
+                continue
+            first = install_cell(app.env.titles[docname].astext(), app.env.titles[app.config.root_doc].astext(),
+                                 docname, app.notebook_wheel)
+            write_notebook(app.env.doc2path(docname), target, markdown=PageMarkdown(app, docname), first_cell=first)
 
 
 def setup(app):
+    app.connect("builder-inited", _project_files)
     app.connect("doctree-resolved", _link)
     app.connect("build-finished", _write_all)
-    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
+    return {"version": "2", "parallel_read_safe": True, "parallel_write_safe": True}
