@@ -1,31 +1,53 @@
-"""Theorems as objects: a statement, the sympy steps of the argument, a check.
+"""Theorems as derivations: a statement, a chain of steps a person reads, each step checked.
 
-A check returns a `Verdict`:
+A proof is a sequence of `Step`s.  Each step is one sentence (why it holds) and one
+equation ``lhs = rhs`` between sympy objects, and each is decided on its own by
+`check_identities`:
 
-* ``proved``: sympy decided every identity exactly (lhs - rhs reduces to 0 under
-  ``expand``, ``simplify`` or ``trigsimp``);
-* ``verified``: sympy could not decide, and every identity holds at >= 20
-  seeded random points evaluated with mpmath at 30 significant digits, with
-  the worst residual stated;
-* ``refuted``: some identity fails, with the residual or counterexample.
+* ``proved``: sympy reduces lhs - rhs to 0 (``expand``, ``simplify`` or ``trigsimp``);
+* ``verified``: sympy could not decide, and lhs - rhs vanishes at `POINTS` seeded
+  random points evaluated with mpmath at `DIGITS` significant digits (worst residual
+  stated);
+* ``refuted``: a residual, or a counterexample, naming the theorem, the step's number
+  and its sentence.
 
-Each theorem also carries *wrong variants* (a flipped sign, a dropped factor,
-a wrong exponent) that the same checker must refute: the checker has teeth.
-(SymPy's ``sympy/vector`` tests and mpmath's precision discipline are the
-models.)
+Steps form calc chains, as in Lean's ``calc``: a step with ``link=True`` continues
+the one before it, its lhs being that step's rhs (`calc` builds such chains; a link
+whose lhs is not the previous rhs must be decided equal to it, or the proof is
+refuted).  A theorem's ``claims`` are the equations its statement makes, printed into
+the statement from these same objects; each must be the two ends of a run of one
+chain, so the steps are checked to reach the statement, not trusted to.
+
+A step may name a quantity by a symbol (``E``, ``N``, ``\\varepsilon^\\ast``) that the
+theorem's ``where`` defines: the step prints the name, and is checked with the
+definition substituted.  `Dot`, `Cross` and `Jacobian` print as a person writes them
+and evaluate when checked; unevaluated sympy forms (``Derivative``, ``Limit``,
+``Subs``, ``UnevaluatedExpr``) likewise, so that a theorem module builds its steps
+cheaply and the check does the work.
+
+After the steps, a theorem's ``evidence`` (the renderer's outputs compared with the
+statement) must hold too.  Each theorem carries *wrong variants* that the same check
+must refute: the checker has teeth.  (SymPy's ``sympy/vector`` tests and mpmath's
+precision discipline are the models.)
 """
 
 from __future__ import annotations
 
+import dataclasses
 import random
+import re
 from dataclasses import dataclass, field
 from typing import Callable
 
 import mpmath
 import sympy as sp
+from sympy.core.function import AppliedUndef
+from sympy.printing.conventions import requires_partial
+from sympy.printing.latex import LatexPrinter
+from sympy.printing.precedence import PRECEDENCE
 
-__all__ = ["Verdict", "Identity", "Theorem", "check_identities", "identities_theorem",
-           "step_parts", "DIGITS", "POINTS"]
+__all__ = ["Verdict", "Identity", "Step", "calc", "Theorem", "variant", "check_identities", "tex", "written", "Dot",
+           "Cross", "Jacobian", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
 DIGITS = 30
@@ -37,7 +59,7 @@ TOLERANCE_DIGITS = 20
 
 @dataclass(frozen=True)
 class Verdict:
-    """Outcome of a theorem's check."""
+    """Outcome of a check."""
 
     status: str                   # "proved" | "verified" | "refuted"
     evidence: str                 # one line a reader can check
@@ -68,9 +90,30 @@ class Identity:
     functions: dict = field(default_factory=dict)
 
 
+def _radicals_reduced(expr):
+    """``expr`` with each square root sqrt(S) (and S^(k/2)) written as a new positive symbol r
+    (r^k), r^k then reduced to r^(k mod 2) S^(k div 2), expanded: 0 (a sufficient test) when the
+    terms cancel with the roots kept whole, as in a normalised vector's derivative, where it takes
+    a fraction of a second and ``expand`` seconds."""
+    halves = [p for p in expr.atoms(sp.Pow) if p.exp.is_Rational and p.exp.q == 2]
+    roots = {sp.expand(p.base): sp.Dummy("r", positive=True) for p in halves}
+    if not roots:
+        return sp.expand(expr)
+
+    def of_root(p):                       # S^(k/2) and S^k of a root's S, however S is written
+        return p.is_Pow and p.exp.is_Rational and p.exp.q <= 2 and not p.base.is_Atom and sp.expand(p.base) in roots
+    e = sp.expand(expr.replace(of_root, lambda p: roots[sp.expand(p.base)] ** (2 * p.exp)))
+    for base, r in roots.items():
+        e = e.replace(lambda x: x.is_Pow and x.base == r and x.exp.is_Integer and x.exp != 1,
+                      lambda x: r ** (x.exp % 2) * base ** (x.exp // 2))
+    return sp.expand(e)
+
+
 def _exactly_zero(expr) -> bool:
     expr = sp.sympify(expr)
     if expr == 0:
+        return True
+    if _radicals_reduced(expr) == 0:
         return True
     for simplifier in (sp.expand, sp.simplify, lambda e: sp.simplify(sp.expand_trig(e)), sp.trigsimp):
         try:
@@ -150,6 +193,268 @@ def check_identities(identities, *, seed=0, points=POINTS, digits=DIGITS) -> Ver
     return refuted(worst, worst_label, worst_at)
 
 
+# ------------------------------------------------------------------- notation that evaluates
+def _explicit(x):
+    """``x`` evaluated: written forms unwrapped, ``doit`` (derivatives, limits, `Dot`, ...), matrices explicit."""
+    x = x.replace(lambda e: isinstance(e, sp.UnevaluatedExpr), lambda e: e.args[0]).doit()
+    return x.as_explicit() if isinstance(x, sp.MatrixExpr) else x
+
+
+def _concrete(x, **hints):
+    """``x.doit()``, and an explicit matrix where it is a matrix expression of explicit matrices
+    (sympy leaves 2 * Matrix(...) a MatMul); a named vector stays a name."""
+    x = x.doit(**hints)
+    if isinstance(x, sp.MatrixExpr) and not x.atoms(sp.MatrixSymbol) and not x.has(Cross, Jacobian):
+        return x.as_explicit()
+    return x
+
+
+class Dot(sp.Expr):
+    """a . b of two 3-vectors: prints ``a \\cdot b``; ``doit`` gives the scalar once both are explicit."""
+
+    is_commutative = True
+
+    def __new__(cls, a, b):
+        return sp.Expr.__new__(cls, sp.sympify(a), sp.sympify(b))
+
+    def doit(self, **hints):
+        a, b = (_concrete(x, **hints) for x in self.args)
+        if isinstance(a, sp.MatrixBase) and isinstance(b, sp.MatrixBase):
+            return sp.Matrix(a).dot(sp.Matrix(b))
+        return Dot(a, b)
+
+    def _latex(self, printer):
+        return r" \cdot ".join(rf"\left({printer._print(x)}\right)" if isinstance(x, (Cross, sp.MatAdd, sp.Add))
+                               else printer._print(x) for x in self.args)
+
+
+class Cross(sp.MatrixExpr):
+    """a x b of two 3-vectors: prints ``a \\times b``; ``doit`` gives the 3-vector once both are explicit."""
+
+    def __new__(cls, a, b):
+        return sp.Basic.__new__(cls, sp.sympify(a), sp.sympify(b))
+
+    @property
+    def shape(self):
+        return (3, 1)
+
+    def doit(self, **hints):
+        a, b = (_concrete(x, **hints) for x in self.args)
+        if isinstance(a, sp.MatrixBase) and isinstance(b, sp.MatrixBase):
+            return sp.ImmutableMatrix(sp.Matrix(a).cross(sp.Matrix(b)))
+        return Cross(a, b)
+
+    def _latex(self, printer):
+        return r" \times ".join(rf"\left({printer._print(x)}\right)" if isinstance(x, sp.MatAdd) else printer._print(x)
+                                 for x in self.args)
+
+
+class Jacobian(sp.MatrixExpr):
+    """The Jacobian d(f_1..f_m)/d(x_1..x_n) (an m x n matrix): prints
+    ``\\partial(f_1, ..)/\\partial(x_1, ..)``; ``doit`` differentiates."""
+
+    def __new__(cls, fs, xs):
+        return sp.Basic.__new__(cls, sp.Tuple(*fs), sp.Tuple(*xs))
+
+    @property
+    def shape(self):
+        return (len(self.args[0]), len(self.args[1]))
+
+    def doit(self, **hints):
+        fs, xs = self.args
+        return sp.ImmutableMatrix(sp.Matrix([f.doit(**hints) for f in fs]).jacobian(list(xs)))
+
+    def _latex(self, printer):
+        fs, xs = (", ".join(printer._print(a) for a in t) for t in self.args)
+        return rf"\frac{{\partial({fs})}}{{\partial({xs})}}"
+
+
+# ------------------------------------------------------------------------------- printing
+#: LaTeX of symbols by name, wherever they appear: the book writes the colatitude varphi.
+NAMES_BY_NAME = {"phi": r"\varphi", "sin_phi": r"\sin\varphi", "varepsilon": r"\varepsilon",
+                 "eps_u": r"\varepsilon_u", "eps_v": r"\varepsilon_v"}
+
+
+class _Printer(LatexPrinter):
+    """sympy's LaTeX as a person writes it: ``\\sin\\varphi`` (no brackets around a plain
+    argument), round parentheses around vectors, 0 for a float zero, a `written` form
+    in the order it was written, ``a \\cdot b`` for a
+    dot product, ``(a)^{1/3}`` for a cube root, ``h'''(x)`` and ``H_\\theta`` for
+    derivatives of a function, ``\\frac{dE}{d\\varepsilon}`` for the derivative of a name."""
+
+    def __init__(self, names):
+        super().__init__({"fold_func_brackets": True, "mat_delim": "(", "fold_frac_powers": True})
+        self.names = names
+
+    def _print_Symbol(self, expr, style="plain"):
+        if expr in self.names:
+            return self.names[expr]
+        return NAMES_BY_NAME.get(expr.name) or super()._print_Symbol(expr, style)
+
+    def _needs_function_brackets(self, expr):
+        """Only a plain argument goes without brackets: sin φ, but sin(πk_u u)."""
+        return not expr.is_Symbol
+
+    def _print_MatrixSymbol(self, expr):
+        return self.names.get(expr) or super()._print_MatrixSymbol(expr)
+
+    def _print_Float(self, expr):
+        return self._print(sp.Integer(int(expr))) if float(expr).is_integer() else super()._print_Float(expr)
+
+    def _print_Pow(self, expr):
+        if expr.exp.is_Rational and expr.exp.q > 2 and expr.exp.p == 1:
+            return rf"{self.parenthesize(expr.base, PRECEDENCE['Pow'], strict=True)}^{{1/{expr.exp.q}}}"
+        return super()._print_Pow(expr)
+
+    def _print_atan2(self, expr):
+        return rf"\operatorname{{atan2}}\left({self._print(expr.args[0])}, {self._print(expr.args[1])}\right)"
+
+    def _print_ZeroMatrix(self, expr):
+        return "0"
+
+    def _print_UnevaluatedExpr(self, expr):
+        """A written form (`written`): its sums and products in the order written."""
+        order, self._settings["order"] = self._settings["order"], "none"
+        try:
+            return self._print(expr.args[0])
+        finally:
+            self._settings["order"] = order
+
+    def _print_Mul(self, expr):
+        """A coefficient times the derivative of a name: ``\\frac{1}{\\sin\\varphi} \\frac{\\partial N}{\\partial\\theta}``."""
+        named = [a for a in expr.args if isinstance(a, sp.Derivative) and isinstance(a.expr, (sp.Symbol, sp.MatrixSymbol))]
+        if len(named) == 1 and len(expr.args) > 1:
+            rest = sp.Mul(*[a for a in expr.args if a is not named[0]])
+            coefficient = "-" if rest == -1 else self.parenthesize(rest, PRECEDENCE["Mul"])
+            return f"{coefficient} {self._print(named[0])}"
+        return super()._print_Mul(expr)
+
+    def _print_MatAdd(self, expr):
+        """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), then by their vectors' names."""
+        def negative(t):
+            return isinstance(t, sp.MatMul) and t.as_coeff_matrices()[0].could_extract_minus_sign()
+        out = ""
+        for i, t in enumerate(sorted(expr.args, key=lambda t: (negative(t), self._print(sp.MatMul(
+                *t.as_coeff_matrices()[1])) if isinstance(t, sp.MatMul) else self._print(t)))):
+            shown = self.parenthesize(-t if negative(t) else t, PRECEDENCE["Add"])
+            out += (" - " if negative(t) else " + " if i else "") + shown
+        return out.lstrip()
+
+    def _print_Identity(self, expr):
+        return "I"
+
+    def _print_MatMul(self, expr):
+        """A scalar coefficient, then the matrices; a vector over a scalar as a fraction:
+        ``\\frac{M}{\\lVert M\\rVert}``, ``\\frac{(I - N'N'^T) g}{\\lVert M\\rVert}``."""
+        coeff, matrices = expr.as_coeff_matrices()
+        coeff = sp.Mul(*coeff) if isinstance(coeff, (list, tuple)) else coeff
+        numer, denom = sp.fraction(coeff)
+        mats = " ".join(self.parenthesize(m, PRECEDENCE["Mul"], strict=False) if not isinstance(m, sp.MatAdd)
+                        else rf"\left({self._print(m)}\right)" for m in matrices)
+        if numer == -1:
+            top = f"- {mats}"
+        elif numer == 1:
+            top = mats
+        else:
+            shown = self._print(numer)
+            top = (rf"\left({shown}\right)" if numer.is_Add or isinstance(numer, Dot) else shown) + f" {mats}"
+        return top if denom == 1 else (rf"- \frac{{{top[2:]}}}{{{self._print(denom)}}}" if top.startswith("- ")
+                                       else rf"\frac{{{top}}}{{{self._print(denom)}}}")
+
+    def _print_Function(self, expr, exp=None):
+        if expr in self.names:                                     # H(theta, phi) written H
+            return self.names[expr] + (f"^{{{exp}}}" if exp else "")
+        if expr.func in self.names or isinstance(expr, AppliedUndef):     # h(x), always with its brackets
+            name = self.names.get(expr.func) or self._print(sp.Symbol(expr.func.__name__))
+            args = ", ".join(self._print(a) for a in expr.args)
+            return rf"{name}\left({args}\right)" + (f"^{{{exp}}}" if exp else "")
+        return super()._print_Function(expr, exp)
+
+    def _print_Subs(self, expr):
+        """E'(x) at x = a as E'(a)."""
+        f, (var,), (point,) = expr.args
+        if isinstance(f, sp.Derivative) and isinstance(f.expr, AppliedUndef) and f.expr.args == (var,):
+            return self._print(f).replace(rf"\left({self._print(var)}\right)", rf"\left({self._print(point)}\right)")
+        return super()._print_Subs(expr)
+
+    def _print_Derivative(self, expr):
+        f, counts = expr.expr, expr.variable_count
+        n = sum(c for _, c in counts)
+        if isinstance(f, AppliedUndef) and all(isinstance(a, sp.Symbol) for a in f.args):
+            name = self.names.get(f.func) or self._print(sp.Symbol(f.func.__name__))
+            if len(f.args) == 1:                              # h'(x), h'''(x), h^{(5)}(x)
+                return name + ("'" * n if n <= 3 else f"^{{({n})}}") + rf"\left({self._print(f.args[0])}\right)"
+            if all(c == 1 for _, c in counts):               # H_\theta, H_{\theta\varphi}
+                return f"{name}_{{{' '.join(self._print(v) for v, _ in counts)}}}"
+        named = isinstance(f, (sp.Symbol, sp.MatrixSymbol))       # dE/d(eps), dN/d(theta): a named quantity
+        d = r"\partial" if named or requires_partial(f) else "d"
+        below = " ".join(f"{d} {self._print(v)}" + (f"^{{{c}}}" if c > 1 else "") for v, c in counts)
+        top = d + ("" if n == 1 else f"^{{{n}}}")
+        if named:
+            return rf"\frac{{{top} {self._print(f)}}}{{{below}}}"
+        return rf"\frac{{{top}}}{{{below}}} \left({self._print(f)}\right)"         # d/du (expression)
+
+
+def written(expr):
+    """``expr`` (built with ``evaluate=False``) kept as written: printed in the order written
+    (``3 u |h|``, not sympy's ``3 |h| u``), evaluated when checked."""
+    return sp.UnevaluatedExpr(expr)
+
+
+def tex(expr, names=None) -> str:
+    """LaTeX of a sympy object as the book prints it (see `_Printer`); a str is LaTeX already.
+
+    ``names``: {symbol or MatrixSymbol: LaTeX}, for the symbols whose name is not
+    their notation (``H_3`` printed ``\\lvert h'''\\rvert``).
+    """
+    if isinstance(expr, str):
+        return expr
+    return _Printer(names or {}).doprint(sp.sympify(expr))
+
+
+# ----------------------------------------------------------------------------- the proofs
+@dataclass(frozen=True)
+class Step:
+    """One step of a proof: ``why`` (one sentence) and the equation ``lhs = rhs``.
+
+    ``link``: the step continues the previous one (a calc chain): its ``lhs`` must be
+    the previous step's ``rhs``, and the book shows ``= rhs``.  ``defines``: named
+    symbols (keys of the theorem's ``where``) whose definitions the book prints with
+    the step.  ``using``: numbers of earlier steps whose left side is a name (or a tuple
+    of names): the step is checked with each name replaced by what that step proved it
+    equal to, as Lean's ``rw`` (a quantity sympy would otherwise recompute from scratch).
+    ``cases``: (label, substitutions) pairs; the step must hold under each
+    (a statement about every height field, say), with undefined functions replaced by
+    Lambdas and symbols by expressions.  ``domain``, ``functions``: sampling intervals
+    and instances of undefined functions for the numerical fallback (`Identity`),
+    where they differ from the theorem's.
+
+    A side may end in ``+ O(x**n)``: the step then holds when the series of lhs - rhs
+    about the Order's point vanishes below that order.
+    """
+
+    why: str
+    lhs: object
+    rhs: object
+    link: bool = False
+    defines: tuple = ()
+    using: tuple = ()
+    cases: tuple = ()
+    domain: dict | None = None
+    functions: dict | None = None
+
+
+def calc(lhs, *links, **options):
+    """A calc chain ``lhs = r_1 = r_2 = ...``: ``links`` are (why, r_k) pairs, or (why, r_k,
+    {Step options}) triples; each step after the first continues the one before
+    (`Step.link`).  ``options`` (`Step` fields) apply to every step.  Returns a tuple of `Step`."""
+    steps = []
+    for why, rhs, *own in links:
+        steps.append(Step(why, lhs, rhs, link=bool(steps), **{**options, **(own[0] if own else {})}))
+        lhs = rhs
+    return tuple(steps)
+
+
 @dataclass(frozen=True)
 class Theorem:
     """A theorem of the chapter.
@@ -158,12 +463,20 @@ class Theorem:
     ----------
     id : str            stable identifier (cited by the book and verify/)
     title : str
-    statement : str     LaTeX
-    steps : tuple       (caption, lhs, rhs) triples of sympy objects or LaTeX strings
-                        (rhs may be None):
-                        the argument a reader sees, rendered as lhs = rhs
-    check : callable    () -> Verdict
+    statement : str     MyST with LaTeX; ``⟦key⟧`` prints ``claims[key]`` as lhs = rhs, or the
+                        named symbol whose name is ``key`` as name = definition (``where``)
+    steps : tuple       the proof, `Step` objects in order
+    claims : dict       key -> (lhs, rhs): the equations the statement makes; each must be the
+                        two ends of a run of one calc chain of ``steps``
     wrong_variants : tuple of (description, callable () -> Verdict); each must be refuted
+    where : dict        named symbol (Symbol, MatrixSymbol or undefined function) -> its
+                        definition, substituted before a step is checked
+    names : dict        symbol -> LaTeX, for symbols whose name is not their notation
+    domain : dict       symbol -> (lo, hi): sampling intervals for the steps
+    functions : dict    undefined function -> Lambda, substituted only for sampling
+    evidence : callable () -> Verdict, or None: the renderer's outputs (or code) against the
+                        statement; its status is "verified" where the theorem rests on it,
+                        "proved" where it is a gate that passed
     pages : tuple       book pages that use the theorem
     seed_says : str     what the seed claims, where it makes a claim about this
     """
@@ -172,37 +485,209 @@ class Theorem:
     title: str
     statement: str
     steps: tuple
-    check: Callable[[], Verdict]
-    wrong_variants: tuple
+    claims: dict
+    wrong_variants: tuple = ()
+    where: dict = field(default_factory=dict)
+    names: dict = field(default_factory=dict)
+    domain: dict = field(default_factory=dict)
+    functions: dict = field(default_factory=dict)
+    evidence: Callable[[], Verdict] | None = None
     pages: tuple = ()
     seed_says: str = ""
 
+    def check(self) -> Verdict:
+        """Every link, every step on its own, every claim reached, then the evidence: the
+        first failure refutes, naming the theorem and the step (number and sentence) or claim."""
+        return _prove(self)
 
-def identities_theorem(id, title, statement, identities, variants, *, steps=(), pages=(),
-                       seed_says=""):
-    """A `Theorem` whose check is `check_identities` on ``identities``.
+    def tex(self, expr) -> str:
+        """LaTeX of ``expr`` with this theorem's ``names`` (`tex`)."""
+        return tex(expr, self.names)
 
-    ``variants`` is a sequence of (description, list of Identity) that must be refuted.
-    """
-    identities = tuple(identities)
-    steps = tuple(steps) or tuple((i.label, i.lhs, i.rhs) for i in identities)
-    return Theorem(
-        id=id, title=title, statement=statement, steps=steps,
-        check=lambda: check_identities(identities),
-        wrong_variants=tuple((d, (lambda ids=tuple(v): check_identities(ids))) for d, v in variants),
-        pages=tuple(pages), seed_says=seed_says,
-    )
+    def definition_tex(self, symbol) -> str:
+        """``name = definition`` of a named symbol of ``where`` (``E(x) = ...`` for a function), in LaTeX."""
+        d = self.where[symbol]
+        if isinstance(d, sp.Lambda):
+            return f"{self.tex(symbol(*d.variables))} = {self.tex(d.expr)}"
+        return f"{self.tex(symbol)} = {self.tex(d)}"
+
+    def statement_tex(self) -> str:
+        """The statement with each ``⟦key⟧`` printed from its claim or named symbol.
+
+        Raises
+        ------
+        KeyError
+            A ``⟦key⟧`` that is neither a claim nor the name of a ``where`` symbol.
+        """
+        named = {_name(s): s for s in self.where}
+
+        def fill(m):
+            key = m.group(1)
+            if key in self.claims:
+                return " = ".join(self.tex(x) for x in self.claims[key])
+            if key in named:
+                return self.definition_tex(named[key])
+            raise KeyError(f"theorem {self.id!r}: the statement names ⟦{key}⟧, neither a claim "
+                           f"{sorted(self.claims)} nor a named symbol {sorted(named)}")
+        return re.sub(r"⟦([^⟧]+)⟧", fill, self.statement)
 
 
-def step_parts(step):
-    """(lhs, rhs) of one (caption, lhs, rhs) step as LaTeX strings (rhs None if absent); sympy
-    objects are printed, with the symbol phi as the book's \\varphi."""
-    _, lhs, rhs = step
-
-    def tex(e):                       # a str is LaTeX already
-        if e is None or isinstance(e, str):
-            return e
-        return sp.latex(e, symbol_names={s: r"\varphi" for s in getattr(e, "free_symbols", ()) if s.name == "phi"})
-    return tex(lhs), tex(rhs)
+def _name(s):
+    """The key ``⟦key⟧`` names a named symbol by: its name, or its function's (E for E(x))."""
+    return s.func.__name__ if isinstance(s, AppliedUndef) else getattr(s, "__name__", None) or str(s)
 
 
+def variant(theorem, **changes):
+    """A wrong variant's check: ``theorem`` with ``changes`` (fields of `Theorem`), checked when called."""
+    from dataclasses import replace
+    return lambda: replace(theorem, **changes).check()
+
+
+def _basic(x):
+    x = sp.sympify(x)
+    return sp.ImmutableMatrix(x) if isinstance(x, sp.MatrixBase) else x
+
+
+def _substitute(x, where):
+    """``x`` with named symbols (xreplace) and undefined functions (subs) replaced, to a fixed point."""
+    symbols = {k: _basic(v) for k, v in where.items() if not isinstance(k, sp.FunctionClass)}
+    functions = {k: v for k, v in where.items() if isinstance(k, sp.FunctionClass)}
+    x = _basic(x)
+    for _ in range(8):
+        y = x.xreplace(symbols)
+        if functions:
+            y = y.subs(functions)
+        if y == x:
+            return x
+        x = y
+    return x
+
+
+def _value(x):
+    """``x`` (named symbols already substituted) evaluated (``doit``), as the checker compares
+    it: a column Matrix for a vector or a tuple of them, a scalar for a 1 x 1."""
+    x = _explicit(x)
+    if isinstance(x, sp.Tuple):
+        parts = [_explicit(e) for e in x]
+        x = sp.Matrix.vstack(*[sp.Matrix(e) if isinstance(e, sp.MatrixBase) else sp.Matrix([e]) for e in parts])
+    if isinstance(x, sp.MatrixBase):
+        x = sp.Matrix(x)
+        return x[0] if x.shape == (1, 1) else x
+    return x
+
+
+def _below_order(lhs, rhs):
+    """For ``rhs`` ending in ``+ O(x**n)`` (x -> x0): the series of lhs - (rhs without its O) about x0,
+    to order n (an expression that must vanish); else None."""
+    orders = list(rhs.atoms(sp.Order)) if isinstance(rhs, sp.Expr) else []
+    if not orders:
+        return None
+    (order,) = orders
+    var, point = order.variables[0], order.point[0]
+    return sp.series(lhs - rhs.removeO(), var, point, sp.degree(order.expr, var)).removeO()
+
+
+#: Verdicts of the equations already decided in this process: a theorem, its wrong variants
+#: and the tests that plant a wrong step share most of their steps.
+_DECIDED = {}
+
+
+def _decide(theorem, step, lhs, rhs, rewrites=None):
+    """`check_identities` on lhs = rhs, with ``rewrites`` (name -> what an earlier step proved) and the
+    theorem's named symbols substituted, in every case of ``step.cases`` (or once).  The verdict's
+    evidence names the case that fails."""
+    domain = theorem.domain if step.domain is None else step.domain
+    functions = theorem.functions if step.functions is None else step.functions
+    verdicts = []
+    for label, case in step.cases or (("", {}),):
+        where = {**theorem.where, **(rewrites or {}), **case}
+        a, b = _substitute(lhs, where), _substitute(rhs, where)
+        key = (a, b, frozenset(domain.items()), frozenset(functions.items()))
+        if key not in _DECIDED:
+            a, b = _value(a), _value(b)
+            series = _below_order(a, b)
+            if series is not None:
+                a, b = series, sp.Integer(0)
+            _DECIDED[key] = check_identities([Identity("", a, b, domain, functions)])
+        v = _DECIDED[key]
+        if not v.holds:      # "[k]: residual ..." of a vector's component k, ": residual ..." of a scalar
+            where_ = re.sub(r"^\[(\d+)\]: ", r"component \1: ", v.evidence).removeprefix(": ")
+            return dataclasses.replace(v, evidence=(f"in case {label}, " if label else "") + where_)
+        verdicts.append(v)
+    return max(verdicts, key=lambda v: (v.status == "verified", v.residual or 0.0))
+
+
+def _chains(steps):
+    """[first, last] step indices of each maximal calc chain."""
+    runs = []
+    for k, s in enumerate(steps):
+        if s.link and runs:
+            runs[-1][1] = k
+        else:
+            runs.append([k, k])
+    return runs
+
+
+def _reaches(steps, lhs, rhs):
+    """Whether a run a..b of one chain goes from ``lhs`` (step a's left side) to ``rhs`` (step b's right)."""
+    return any(steps[a].lhs == lhs and steps[b].rhs == rhs
+               for first, last in _chains(steps) for a in range(first, last + 1) for b in range(a, last + 1))
+
+
+def _rewrites(t, k, step):
+    """{name: proved value} of the earlier steps ``step.using`` names, or a str saying why not."""
+    out = {}
+    for j in step.using:
+        if not 1 <= j < k:
+            return f"uses step {j}, which does not come before it"
+        lhs, rhs = t.steps[j - 1].lhs, t.steps[j - 1].rhs
+        pairs = zip(lhs, rhs) if isinstance(lhs, sp.Tuple) and isinstance(rhs, sp.Tuple) and len(lhs) == len(rhs) \
+            else [(lhs, rhs)]
+        for name, value in pairs:
+            if not isinstance(name, (sp.Symbol, sp.MatrixSymbol, AppliedUndef)):
+                return f"uses step {j}, whose left side is not a name"
+            out[name] = value
+    return out
+
+
+def _prove(t: Theorem) -> Verdict:
+    decided = []                   # (step number, verdict) of every step and link
+    for k, step in enumerate(t.steps, 1):
+        name = f"{t.id}, step {k} ({step.why.rstrip('.:')})"
+        rewrites = _rewrites(t, k, step)
+        if isinstance(rewrites, str):
+            return Verdict("refuted", f"{name} {rewrites}")
+        if step.link:
+            if k == 1:
+                return Verdict("refuted", f"{name}: continues a step that does not exist")
+            before = t.steps[k - 2].rhs
+            if step.lhs != before:
+                v = _decide(t, step, before, step.lhs, rewrites)
+                if not v.holds:
+                    return Verdict("refuted", f"{name} does not continue step {k - 1}: its left side differs "
+                                   f"from step {k - 1}'s right side, {v.evidence}", v.residual, v.digits, v.points)
+                decided.append((k, v))
+        v = _decide(t, step, step.lhs, step.rhs, rewrites)
+        if not v.holds:
+            return Verdict("refuted", f"{name}: {v.evidence}", v.residual, v.digits, v.points)
+        decided.append((k, v))
+    for key, (lhs, rhs) in t.claims.items():
+        if not _reaches(t.steps, lhs, rhs):
+            return Verdict("refuted", f"{t.id}: no chain of steps runs from the left side of the claim {key!r} "
+                           "to its right side: the proof does not reach the statement")
+    numeric = sorted({k for k, v in decided if v.status == "verified"})
+    worst = max((v.residual for _, v in decided if v.status == "verified"), default=None)
+    summary = (f"{len(t.steps)} steps, each reduced to 0 by sympy" if not numeric else
+               f"{len(t.steps)} steps; sympy reduced all but step{'s' if len(numeric) > 1 else ''} "
+               f"{', '.join(map(str, numeric))}, verified numerically: worst residual {worst:.1e} at "
+               f"{POINTS} seeded points, {DIGITS} digits")
+    residual, digits, points = (worst, DIGITS, POINTS) if numeric else (None, None, None)
+    if t.evidence is None:
+        return Verdict("verified" if numeric else "proved", summary, residual, digits, points)
+    e = t.evidence()
+    if not e.holds:
+        return e
+    if e.status == "verified" and not numeric:
+        residual, digits, points = e.residual, e.digits, e.points
+    status = "verified" if numeric or e.status == "verified" else "proved"
+    return Verdict(status, f"{summary}; {e.evidence}", residual, digits, points, e.rendered)

@@ -1,17 +1,19 @@
 """The proof checker's engine (proofs/core.py): what it calls proved, verified
-and refuted, on identities whose truth is known without it.
+and refuted, on identities and small proofs whose truth is known without it; and
+how it prints them.
 
 Fast on purpose (seconds): benchmarks/mutation_audit.py --mutmut runs this
 file once per mutant of proofs/core.py.
 """
 
+import dataclasses
 import re
 
 import pytest
 import sympy as sp
 
 from proofs import core
-from proofs.core import Identity, Verdict, check_identities, identities_theorem, step_parts
+from proofs.core import Cross, Dot, Identity, Jacobian, Step, Theorem, Verdict, calc, check_identities, tex, written
 
 x = sp.Symbol("x", positive=True)
 y = sp.Symbol("y")
@@ -150,22 +152,154 @@ def test_a_verdict_holds_only_when_proved_or_verified():
     assert [Verdict(s, "").holds for s in ("proved", "verified", "refuted", "")] == [True, True, False, False]
 
 
-def test_identities_theorem_checks_its_identities_and_refutes_its_variants():
-    ids = [Identity("double angle", sp.sin(2 * y), 2 * sp.sin(y) * sp.cos(y), {y: (-1, 1)})]
-    t = identities_theorem("t", "Title", "statement", ids, [("factor dropped", [
-        Identity("double angle", sp.sin(2 * y), sp.sin(y) * sp.cos(y), {y: (-1, 1)})])], pages=["s3"],
-        seed_says="so")
-    assert (t.id, t.title, t.statement, t.seed_says) == ("t", "Title", "statement", "so")
-    assert identities_theorem("t", "Title", "statement", ids, []).seed_says == ""
-    assert t.check().status == "proved"
-    assert [(d, f().status) for d, f in t.wrong_variants] == [("factor dropped", "refuted")]
-    assert t.steps == (("double angle", sp.sin(2 * y), 2 * sp.sin(y) * sp.cos(y)),) and t.pages == ("s3",)
+# ------------------------------------------------------------------------------------ proofs
+a_, b_ = sp.symbols("a b", positive=True)
+SQUARE = (a_ + b_) ** 2
 
 
-def test_step_parts_prints_sympy_and_passes_latex_through():
+def square_theorem(*steps, claims=None, **fields):
+    """(a + b)^2 = a^2 + 2ab + b^2, by the steps given."""
+    return Theorem("square", "A square", "$⟦square⟧$", steps,
+                   {"square": (SQUARE, a_**2 + 2 * a_ * b_ + b_**2)} if claims is None else claims,
+                   domain={a_: (0.5, 2.0), b_: (0.5, 2.0)}, **fields)
+
+
+CHAIN = calc(SQUARE, ("multiply out", (a_ + b_) * a_ + (a_ + b_) * b_),
+             ("and again", a_**2 + 2 * a_ * b_ + b_**2))
+
+
+def test_a_correct_chain_is_proved_step_by_step():
+    t = square_theorem(*CHAIN)
+    assert [s.link for s in t.steps] == [False, True] and t.steps[1].lhs is t.steps[0].rhs
+    v = t.check()
+    assert (v.status, v.evidence, v.rendered) == ("proved", "2 steps, each reduced to 0 by sympy", 0)
+
+
+def test_a_wrong_step_is_refuted_and_named_by_number_and_sentence():
+    wrong = (CHAIN[0], Step("and again", CHAIN[1].lhs, a_**2 + a_ * b_ + b_**2, link=True))
+    v = square_theorem(*wrong).check()
+    assert v.status == "refuted"
+    assert re.fullmatch(r"square, step 2 \(and again\): residual \S+ at a=\S+, b=\S+", v.evidence), v.evidence
+
+
+def test_a_chain_whose_links_do_not_connect_is_refuted_at_the_link():
+    # Step 2 claims to continue step 1 but starts from another expression (each step true on its own).
+    broken = (CHAIN[0], Step("and again", (a_ + b_) * a_ + b_**2 + a_ * b_ + 1, a_**2 + 2 * a_ * b_ + b_**2 + 1,
+                             link=True))
+    v = square_theorem(*broken, claims={}).check()
+    assert v.status == "refuted" and v.evidence.startswith(
+        "square, step 2 (and again) does not continue step 1: its left side differs from step 1's right side")
+    # The same left side written differently is a link: it is decided equal to step 1's right side.
+    rewritten = (CHAIN[0], Step("and again", a_ * (a_ + b_) + b_ * (a_ + b_), a_**2 + 2 * a_ * b_ + b_**2, link=True))
+    assert square_theorem(*rewritten).check().status == "proved"
+    assert square_theorem(Step("first", SQUARE, SQUARE, link=True), claims={}).check().evidence == \
+        "square, step 1 (first): continues a step that does not exist"
+
+
+def test_steps_that_hold_but_do_not_reach_the_statement_are_refuted():
+    # Every step true, but no chain runs from the claim's left side to its right side.
+    v = square_theorem(CHAIN[0], Step("and again", a_**2, a_ * a_)).check()
+    assert v.status == "refuted" and v.evidence == (
+        "square: no chain of steps runs from the left side of the claim 'square' to its right side: the proof "
+        "does not reach the statement")
+    # A claim may be any run of one chain: the first step alone reaches (a + b)^2 = (a + b) a + (a + b) b.
+    assert square_theorem(*CHAIN, claims={"first": (SQUARE, CHAIN[0].rhs)}).check().status == "proved"
+
+
+def test_a_step_undecided_by_sympy_makes_the_theorem_verified_with_its_residual():
+    x_ = sp.Symbol("x", positive=True)
+    t = Theorem("arc", "Arctangents", "$⟦arc⟧$",
+                (Step("complementary angles", sp.atan(x_) + sp.atan(1 / x_), sp.pi / 2),),
+                {"arc": (sp.atan(x_) + sp.atan(1 / x_), sp.pi / 2)}, domain={x_: (0.1, 10)})
+    v = t.check()
+    assert v.status == "verified" and v.residual < 1e-25 and (v.digits, v.points) == (core.DIGITS, core.POINTS)
+    assert v.evidence.startswith("1 steps; sympy reduced all but step 1, verified numerically: worst residual")
+
+
+def test_named_symbols_are_printed_and_substituted_when_checked():
+    e = sp.Symbol("e")
+    t = square_theorem(Step("by definition", e, a_**2 + 2 * a_ * b_ + b_**2),
+                       claims={"square": (e, a_**2 + 2 * a_ * b_ + b_**2)}, where={e: SQUARE})
+    assert t.check().status == "proved" and t.statement_tex() == "$e = a^{2} + 2 a b + b^{2}$"
+    wrong = square_theorem(Step("by definition", e, a_**2 + b_**2), claims={}, where={e: SQUARE})
+    assert wrong.check().evidence.startswith("square, step 1 (by definition): residual")
+    with pytest.raises(KeyError, match=r"⟦cube⟧, neither a claim \['square'\] nor a named symbol"):
+        dataclasses.replace(square_theorem(*CHAIN), statement="⟦cube⟧").statement_tex()
+
+
+def test_using_rewrites_with_an_earlier_step_and_only_an_earlier_named_one():
+    e, f = sp.symbols("e f")
+    lemma = Step("name the square", e, a_**2 + 2 * a_ * b_ + b_**2)
+    # f is defined as e + 1; with step 1 it is the expansion plus 1 (where maps e back to the square too).
+    ok = square_theorem(lemma, Step("add one", f, a_**2 + 2 * a_ * b_ + b_**2 + 1, using=(1,)), claims={},
+                        where={e: SQUARE, f: e + 1})
+    assert ok.check().status == "proved"
+    later = square_theorem(Step("use a later step", f, e + 1, using=(2,)), lemma, claims={}, where={e: SQUARE, f: e + 1})
+    assert later.check().evidence == "square, step 1 (use a later step) uses step 2, which does not come before it"
+    unnamed = square_theorem(*CHAIN, Step("use an unnamed side", a_, a_, using=(1,)), claims={})
+    assert unnamed.check().evidence == "square, step 3 (use an unnamed side) uses step 1, whose left side is not a name"
+
+
+def test_cases_must_each_hold_and_the_failing_one_is_named():
+    h = sp.Function("h")
+    step = Step("double it", 2 * h(a_), h(a_) + h(a_), cases=(("square", {h: sp.Lambda(a_, a_**2)}),
+                                                             ("cube", {h: sp.Lambda(a_, a_**3)})))
+    assert square_theorem(step, claims={}).check().status == "proved"
+    wrong = Step("double it", 2 * h(a_), h(a_) + a_**2, cases=step.cases)
+    assert square_theorem(wrong, claims={}).check().evidence.startswith(
+        "square, step 1 (double it): in case cube, residual")
+
+
+def test_a_side_up_to_an_order_term_is_compared_by_its_series():
+    x_ = sp.Symbol("x")
+    good = Step("Taylor", sp.exp(x_), 1 + x_ + x_**2 / 2 + sp.O(x_**3))
+    bad = Step("Taylor", sp.exp(x_), 1 + x_ + x_**2 / 3 + sp.O(x_**3))
+    t = lambda s: Theorem("exp", "exp", "", (s,), {}, domain={x_: (-1, 1)})  # noqa: E731
+    assert t(good).check().status == "proved"
+    assert t(bad).check().evidence.startswith("exp, step 1 (Taylor): residual")
+
+
+def test_the_evidence_decides_last_and_sets_the_rendered_count():
+    holds = square_theorem(*CHAIN, evidence=lambda: Verdict("proved", "12 renders agree", rendered=12))
+    v = holds.check()
+    assert (v.status, v.evidence, v.rendered) == ("proved", "2 steps, each reduced to 0 by sympy; 12 renders agree", 12)
+    rests = square_theorem(*CHAIN, evidence=lambda: Verdict("verified", "no pixel differs", 0.0, None, 100, 100))
+    assert (rests.check().status, rests.check().residual, rests.check().points) == ("verified", 0.0, 100)
+    fails = square_theorem(*CHAIN, evidence=lambda: Verdict("refuted", "3 pixels differ"))
+    assert fails.check() == Verdict("refuted", "3 pixels differ")
+    called = []
+    first = square_theorem(Step("wrong", SQUARE, a_**2), claims={}, evidence=lambda: called.append(1))
+    assert first.check().status == "refuted" and not called          # a refuted step stops before the renders
+
+
+def test_vectors_dot_cross_and_jacobians_evaluate_when_checked():
+    u_, v_ = sp.MatrixSymbol("u", 3, 1), sp.MatrixSymbol("v", 3, 1)
+    where = {u_: sp.ImmutableMatrix([1, a_, 0]), v_: sp.ImmutableMatrix([0, 1, b_])}
+    steps = (Step("dot", Dot(u_, v_), a_), Step("cross", Cross(u_, v_), sp.Matrix([a_ * b_, -b_, 1])),
+             Step("jacobian", Jacobian((a_ * b_, a_), (a_, b_)), sp.Matrix([[b_, a_], [1, 0]])))
+    assert square_theorem(*steps, claims={}, where=where).check().status == "proved"
+    assert tex(Dot(Cross(u_, v_), u_)) == r"\left(u \times v\right) \cdot u"
+    assert tex(Jacobian((a_, b_), (a_,))) == r"\frac{\partial(a, b)}{\partial(a)}"
+
+
+def test_printing_as_a_person_writes():
     phi = sp.Symbol("phi")
-    assert step_parts(("c", sp.sin(phi), None)) == (r"\sin{\left(\varphi \right)}", None)
-    assert step_parts(("c", r"\alpha", sp.Integer(2))) == (r"\alpha", "2")
-    assert step_parts(("c", sp.Symbol("theta") + 1, "x")) == (r"\theta + 1", "x")
-    # A plain Python number (no free_symbols) is printed too.
-    assert step_parts(("c", 0, 0.5)) == ("0", "0.5")
+    H3, H, u_round = sp.symbols("H_3 H u", positive=True)
+    names = {H: r"\lvert h\rvert", H3: r"\lvert h'''\rvert", u_round: r"\mathrm{u}"}
+    star = written(sp.Pow(sp.Mul(3, u_round, H, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
+    assert tex(star, names) == r"\left(\frac{3 \mathrm{u} \lvert h\rvert}{\lvert h'''\rvert}\right)^{1/3}"
+    assert tex(sp.Symbol("sin_phi", nonnegative=True)) == r"\sin\varphi"
+    assert tex(sp.sin(phi) * sp.cos(sp.pi * phi)) == r"\sin {\varphi} \cos{\left(\pi \varphi \right)}"
+    assert tex(sp.Matrix([sp.Float(0.0), 1])) == r"\left(\begin{matrix}0\\1\end{matrix}\right)"
+    x_, h = sp.Symbol("x"), sp.Function("h")
+    assert tex(sp.Derivative(h(x_), (x_, 3))) == r"h'''\left(x\right)"
+    assert tex(sp.Derivative(h(x_), (x_, 5))) == r"h^{(5)}\left(x\right)"
+    assert tex("\\alpha") == "\\alpha"
+
+
+def test_square_roots_are_reduced_whatever_way_their_radicand_is_written():
+    # sqrt(S)^3 = S sqrt(S) with S written two ways: zero without simplify; a different radicand is not.
+    S, T = (x + 1) ** 2 - 2 * x, x**2 + 1
+    assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T)) == 0
+    assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T + 1)) != 0
+    assert core._radicals_reduced((x + 1) ** 2 - x**2 - 2 * x - 1) == 0          # no root: plain expansion
