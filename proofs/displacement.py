@@ -26,14 +26,16 @@ from `renderer.formulas.CHART` (theorem `chart`); and its rendered normals
 equal the displaced surface's, evaluated by mpmath.
 """
 
+from functools import partial
+
 import mpmath
 import numpy as np
 import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Identity, Theorem, Verdict, check_identities
-from .frame import CHART_RATES, PHI_OF_V, THETA_OF_U, U_OF_THETA, V_OF_PHI
+from .core import Cross, Step, Theorem, Verdict, calc, written
+from .frame import PHI_OF_V, THETA_OF_U, U_OF_THETA, V_OF_PHI
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, beta = sp.symbols("R beta", positive=True)
@@ -41,19 +43,22 @@ H = sp.Function("H")
 N = sp.Matrix([sp.sin(phi) * sp.cos(theta), sp.sin(phi) * sp.sin(theta), sp.cos(phi)])
 e_theta = sp.diff(N, theta) / sp.sin(phi)
 e_phi = sp.diff(N, phi)
-P = (R + beta * H(theta, phi)) * N
-CROSS = sp.diff(P, phi).cross(sp.diff(P, theta))
-H_t, H_p = sp.diff(H(theta, phi), theta), sp.diff(H(theta, phi), phi)
-#: The tangential coefficients of the displaced normal: BRACKET = N + c_theta e_theta + c_phi e_phi.
-COEFFS = (-beta / (R + beta * H(theta, phi)) * H_t / sp.sin(phi), -beta / (R + beta * H(theta, phi)) * H_p)
-BRACKET = N + COEFFS[0] * e_theta + COEFFS[1] * e_phi
-CLAIM = (R + beta * H(theta, phi)) ** 2 * sp.sin(phi) * BRACKET
+H_at = H(theta, phi)
+H_t, H_p = sp.Derivative(H_at, theta), sp.Derivative(H_at, phi)
 
-#: The same coefficients in chart terms: H(theta, phi) = h(u, v) with the chart's rates
-#: (theorem `chart`), H_theta = h_u du/dtheta and H_phi = h_v dv/dphi; in the renderer's symbols.
-CHART_COEFFS = tuple(c.subs({H_t: F.h_u * CHART_RATES[0], H_p: F.h_v * CHART_RATES[1]})
-                     .subs({H(theta, phi): F.h, sp.sin(phi): F.sin_phi, beta: F.beta, R: F.R})
-                     for c in COEFFS)
+#: The vectors the proof names: N, e_theta, e_phi (at N(theta, phi)) and the displaced point P.
+N_S, P_S = sp.MatrixSymbol("N", 3, 1), sp.MatrixSymbol("P", 3, 1)
+ET_S, EP_S = sp.MatrixSymbol("e_theta", 3, 1), sp.MatrixSymbol("e_phi", 3, 1)
+#: The displaced normal, as the statement writes it: (R + beta H)^2 sin(phi) [N - beta/(R + beta H) (...)].
+TANGENTIAL = sp.MatAdd(H_t / sp.sin(phi) * ET_S, H_p * EP_S, evaluate=False)
+CLAIM = sp.MatMul((R + beta * H_at) ** 2 * sp.sin(phi),
+                  sp.MatAdd(N_S, sp.MatMul(-beta / (R + beta * H_at), TANGENTIAL, evaluate=False), evaluate=False),
+                  evaluate=False)
+#: The seed's reading (a wrong variant): the bump is the displaced normal, + sign and no metric.
+SEED_READING = sp.MatMul((R + beta * H_at) ** 2 * sp.sin(phi),
+                         sp.MatAdd(N_S, beta * (2 * sp.pi * H_t * ET_S + sp.pi * H_p * EP_S), evaluate=False),
+                         evaluate=False)
+
 #: The renderer's coefficients of bump="surface" (`renderer.formulas.BUMP`) away from
 #: the pole cut-off, where its floor max(sin phi, POLE_SIN_PHI) is sin phi.
 _FLOOR = sp.Max(F.sin_phi, F.POLE_SIN_PHI)
@@ -81,34 +86,28 @@ def away_from_pole(bump):
 
 
 KERNEL_COEFFS = away_from_pole(F.BUMP["surface"])
+#: ... and as the statement writes them: the displaced normal's tangential coefficients in chart terms.
+_w = -F.beta / (F.R + F.beta * F.h)
+CHART_COEFFS = sp.Tuple(_w * F.h_u / (2 * sp.pi * F.sin_phi), _w * F.h_v / sp.pi)
+B_U, B_V = sp.symbols("b_u b_v")
 KERNEL_DOMAIN = {F.beta: (0.0, 2.0), F.R: (0.5, 2.0), F.h: (-1.0, 1.0), F.h_u: (-30.0, 30.0),
                  F.h_v: (-30.0, 30.0), F.sin_phi: (0.001, 1.0)}
 
-
-def _kernel_identities(coeffs):
-    return [Identity(r"b_u\ (\text{surface})", coeffs[0], CHART_COEFFS[0], KERNEL_DOMAIN),
-            Identity(r"b_v\ (\text{surface})", coeffs[1], CHART_COEFFS[1], KERNEL_DOMAIN)]
-
 a, b = sp.symbols("a b", real=True)
 INSTANCE = {H: sp.Lambda((theta, phi), sp.sin(a * theta) * sp.cos(b * phi) + sp.sin(phi))}
-DOMAIN = {theta: (-3.0, 3.0), phi: (0.1, 3.0), R: (0.5, 2.0), beta: (0.0, 0.3),
-          a: (1.0, 4.0), b: (1.0, 4.0)}
+DOMAIN = {theta: (-3.0, 3.0), phi: (0.1, 3.0), R: (0.5, 2.0), beta: (0.0, 0.3), a: (1.0, 4.0), b: (1.0, 4.0),
+          **KERNEL_DOMAIN}
 
-
-#: Which sphere P = (R + beta G) N has the seed's bump (`renderer.formulas.BUMP["chart"]`) as
-#: its normal to first order in beta?  Its gradient (G_theta, G_phi), solved from COEFFS's first
-#: order (H -> G) against the chart bump's coefficients in angular terms (h_u = H_theta / (du/dtheta),
-#: h_v = H_phi / (dv/dphi), the chart's rates of theorem `chart`).
-_G_t, _G_p = sp.symbols("G_theta G_phi")
-_SEED_ANGULAR = tuple(b.subs(F.beta, 1).subs({F.h_u: H_t / CHART_RATES[0], F.h_v: H_p / CHART_RATES[1]})
-                      for b in F.BUMP["chart"])
-SEED_DISPLACEMENT = tuple(sp.solve([sp.diff(c, beta).subs(beta, 0).subs({H_t: _G_t, H_p: _G_p}) - s_
-                                    for c, s_ in zip(COEFFS, _SEED_ANGULAR)], [_G_t, _G_p], dict=True)[0][g]
-                          for g in (_G_t, _G_p))
-#: G exists only where its gradient is curl-free: d/dphi G_theta - d/dtheta G_phi = 0.
-CURL = sp.diff(SEED_DISPLACEMENT[0], phi) - sp.diff(SEED_DISPLACEMENT[1], theta)
-#: The statement's obstruction, for a general H; CURL is -pi R times it (an identity of the check).
-OBSTRUCTION = 2 * sp.cos(phi) * H_t + (2 * sp.sin(phi) - 1) * sp.diff(H_t, phi)
+#: Which sphere P = (R + beta G) N has the seed's bump as its normal to first order in beta?  The
+#: gradient (G_theta, G_phi) that matches the displaced normal's first-order tangential part,
+#: -beta (G_theta / (R sin phi) e_theta + G_phi / R e_phi), with the seed's beta (h_u e_theta + h_v e_phi)
+#: = beta (2 pi H_theta e_theta + pi H_phi e_phi) (h_u = H_theta / (du/dtheta), theorem `chart`).
+G_T, G_P = sp.symbols("G_theta G_phi")
+SEED_DISPLACEMENT = (-2 * sp.pi * R * sp.sin(phi) * H_t, -sp.pi * R * H_p)
+#: The obstruction: G exists only where d/dphi G_theta - d/dtheta G_phi = -pi R OBSTRUCTION vanishes.
+OBSTRUCTION = written(sp.Add(2 * sp.cos(phi) * H_t, sp.Mul(sp.Add(2 * sp.sin(phi), -1, evaluate=False),
+                                                          sp.Derivative(H_at, theta, phi), evaluate=False),
+                             evaluate=False))
 INTEGRABLE = ("rings",)
 
 
@@ -122,8 +121,6 @@ def integrability_obstruction(field):
     `renderer.formulas.HEIGHT` (sympy expression in theta, phi, k_u, k_v): zero exactly
     when the seed's bump on that field is the first-order normal of a displaced sphere."""
     return sp.simplify(OBSTRUCTION.subs(H, sp.Lambda((theta, phi), _angular(field))).doit())
-
-
 
 
 def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
@@ -155,23 +152,12 @@ def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
     return worst, compared, left_out
 
 
-def _check(claim, kernel=KERNEL_COEFFS, integrable=INTEGRABLE, bump="surface", gradient="exact"):
-    """The theorem's check: the cross product `claim`, the renderer's surface-bump coefficients
-    `kernel` (pole floor read away), which fields' seed bump is a displacement's normal
-    (`integrable`), and the rendered normals of `bump` and `gradient` against the displaced
-    surface's."""
-    if any(b.has(sp.Max) for b in kernel):
+def _evidence(kernel=KERNEL_COEFFS, integrable=INTEGRABLE, bump="surface", gradient="exact"):
+    """The renderer: its surface-bump coefficients ``kernel`` carry no floor but the pole's; the seed's
+    bump is a displacement's normal for the fields ``integrable`` (the obstruction of each of the
+    renderer's fields); the rendered normals of ``bump`` and ``gradient`` are the displaced surface's."""
+    if any(c.has(sp.Max) for c in kernel):
         return Verdict("refuted", f"a floor other than max(sin_phi, POLE_SIN_PHI) in the surface bump: {kernel}")
-    rings = _angular("rings")
-    symbolic = check_identities(
-        [Identity("P_phi x P_theta", CROSS, claim, DOMAIN, INSTANCE)] + _kernel_identities(kernel)
-        + [Identity("curl of the seed's G", CURL, -sp.pi * R * OBSTRUCTION, DOMAIN, INSTANCE),
-           Identity("G_theta (rings)", SEED_DISPLACEMENT[0].subs(H, sp.Lambda((theta, phi), rings)).doit(),
-                    sp.diff(-sp.pi * R * rings, theta), DOMAIN),
-           Identity("G_phi (rings)", SEED_DISPLACEMENT[1].subs(H, sp.Lambda((theta, phi), rings)).doit(),
-                    sp.diff(-sp.pi * R * rings, phi), DOMAIN)])
-    if not symbolic.holds:
-        return symbolic
     obstruction = {f: integrability_obstruction(f) for f in ("sine", "ridges", "rings")}
     found = tuple(f for f, o in obstruction.items() if o == 0)
     if set(found) != set(integrable):
@@ -181,52 +167,75 @@ def _check(claim, kernel=KERNEL_COEFFS, integrable=INTEGRABLE, bump="surface", g
     if worst > 1e-12:
         return Verdict("refuted", f"renderer's bump={bump!r}, gradient={gradient!r} normal differs from the displaced "
                        f"surface's by {worst:.2e}", worst, rendered=compared)
-    return Verdict(symbolic.status,
-                   f"{symbolic.evidence} (the cross product, renderer.formulas.BUMP['surface'] "
-                   f"against its chart form, and the curl of the G whose sphere has the seed's bump as "
-                   f"normal, G = -pi R h for rings); obstruction is 0 for {', '.join(found)} only (the "
-                   f"seed's bump is the normal of no displaced sphere for the others); "
-                   f"renderer's bump='surface' Ns within {worst:.1e} of the displaced normal (mpmath, "
-                   f"{compared} seeded sphere-A pixels of the three fields, pole ring and crease neighbours "
-                   f"included; {left_out} inside the pole floor sin phi <= {float(F.POLE_SIN_PHI):g} left out)",
-                   rendered=compared)
+    return Verdict("proved", f"the obstruction is 0 for {', '.join(found)} only (the seed's bump is the normal of no "
+                   f"displaced sphere for the others); the renderer's bump='surface' Ns within {worst:.1e} of the "
+                   f"displaced normal (mpmath, {compared} seeded sphere-A pixels of the three fields, pole ring and "
+                   f"crease neighbours included; {left_out} inside the pole floor sin phi <= "
+                   f"{float(F.POLE_SIN_PHI):g} left out)", rendered=compared)
 
 
-BUMP_VS_DISPLACEMENT = Theorem(
-    id="bump-vs-displacement", title="Bump versus displacement",
-    statement=r"For $P = (R + \beta H)N$: $P_\varphi \times P_\theta = (R+\beta H)^2\sin\varphi\,"
-              r"\bigl[N - \tfrac{\beta}{R + \beta H}\bigl(\tfrac{H_\theta}{\sin\varphi}e_\theta + "
-              r"H_\varphi e_\varphi\bigr)\bigr]$. In chart terms the displaced normal's tangential "
-              r"part is $-\tfrac{\beta}{R+\beta h}\bigl(\tfrac{h_u}{2\pi\sin\varphi}e_\theta + "
-              r"\tfrac{h_v}{\pi}e_\varphi\bigr)$, against the seed's $+\beta(h_u e_\theta + h_v e_\varphi)$: "
-              r"opposite sign, and the chart's metric factors missing; the renderer's "
-              r"`bump='surface'` (`renderer.formulas.BUMP['surface']`) is the displaced normal's. "
-              r"The seed's bump is, to first "
-              r"order, the normal of the sphere displaced by $G = -\pi R h$ for the rings field, and "
-              r"of no displaced sphere for the sine and ridges fields.",
-    steps=(("cross product", r"P_\varphi \times P_\theta", CLAIM),
-           ("obstruction (sine)", r"2\cos\varphi\,h_\theta + (2\sin\varphi - 1)h_{\theta\varphi}",
-            integrability_obstruction("sine")),
-           ("obstruction (rings)", r"2\cos\varphi\,h_\theta + (2\sin\varphi - 1)h_{\theta\varphi}",
-            integrability_obstruction("rings")),
-           ("the renderer's surface bump", r"(b_u, b_v)", sp.Tuple(*KERNEL_COEFFS))),
-    check=lambda: _check(CLAIM),
-    wrong_variants=(("the renderer's chart bump (the seed's) as the displaced normal's coefficients",
-                     lambda: _check(CLAIM, kernel=F.BUMP["chart"])),
-                    ("a surface bump floored at sin phi = 1e-3, not POLE_SIN_PHI",
-                     lambda: _check(CLAIM, kernel=away_from_pole(
-                         tuple(b.subs(F.POLE_SIN_PHI, sp.Float(1e-3)) for b in F.BUMP["surface"])))),
-                    ("the seed's bump the normal of a displaced sphere for every field",
-                     lambda: _check(CLAIM, integrable=("sine", "ridges", "rings"))),
-                    ("the renderer's bump='chart' normals as the displaced surface's",
-                     lambda: _check(CLAIM, bump="chart")),
-                    ("the numeric pipeline's bump='surface' normals (central differences) as exactly the "
-                     "displaced surface's", lambda: _check(CLAIM, gradient="central")),
-                    ("the seed's reading: the bump is the displaced normal (+ sign, no metric)",
-                     lambda: _check((R + beta * H(theta, phi)) ** 2 * sp.sin(phi)
-                                    * (N + beta * (2 * sp.pi * H_t * e_theta + sp.pi * H_p * e_phi)))),),
-    pages=("s3", "s7"),
-    seed_says="§3 and Cell 8 present the bump as the shading-side stand-in for displacement.",
-)
+def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, **evidence):
+    """Theorem bump-vs-displacement claiming the cross product ``claim``, for the renderer's surface-bump
+    coefficients ``kernel``, with the evidence's options (wrong variants)."""
+    cross = Cross(sp.Derivative(P_S, phi), sp.Derivative(P_S, theta))
+    coeffs = sp.Tuple(B_U, B_V)
+    curl = written(sp.Add(sp.Derivative(G_T, phi), -sp.Derivative(G_P, theta), evaluate=False))
+    rings = _angular("rings")
+    potential = sp.Tuple(sp.Derivative(-sp.pi * R * H_at, theta), sp.Derivative(-sp.pi * R * H_at, phi))
+    return Theorem(
+        id="bump-vs-displacement", title="Bump versus displacement",
+        statement=r"For $⟦P⟧$: $⟦cross⟧$. In chart terms ($H_\theta = h_u/2\pi$, $H_\varphi = h_v/\pi$) the "
+                  r"displaced normal's tangential coefficients are the renderer's `bump='surface'` "
+                  r"(`renderer.formulas.BUMP['surface']`): $⟦kernel⟧$, against the seed's $\beta(h_u, h_v)$: opposite "
+                  r"sign, and the chart's metric factors missing. The seed's bump is, to first order, the normal of a "
+                  r"displaced sphere $(R + \beta G)N$ only if $⟦curl⟧$ vanishes identically: it does for the rings "
+                  r"field, with $G = -\pi R h$, and not for the sine and ridges fields.",
+        steps=(
+            *calc(cross,
+                  (r"Differentiate $P = (R + \beta H)N$, with $\partial N/\partial\theta = \sin\varphi\, e_\theta$ and "
+                   r"$\partial N/\partial\varphi = e_\varphi$ (theorem frame-orthonormal)",
+                   Cross(beta * H_p * N_S + (R + beta * H_at) * EP_S,
+                         beta * H_t * N_S + (R + beta * H_at) * sp.sin(phi) * ET_S)),
+                  (r"Expand: $N \times N = 0$, and the frame is left-handed (theorem frame-orientation), so "
+                   r"$e_\varphi \times e_\theta = N$, $N \times e_\theta = -e_\varphi$ and $e_\varphi \times N = "
+                   r"-e_\theta$", claim)),
+            Step(r"In chart terms $H_\theta = h_u/2\pi$ and $H_\varphi = h_v/\pi$ (theorem chart); the renderer's "
+                 r"`bump='surface'` coefficients of $e_\theta$ and $e_\varphi$, off its pole floor, are the bracket's",
+                 coeffs, CHART_COEFFS),
+            Step(r"To first order in $\beta$ the normal of $P = (R + \beta G)N$ tilts by $-\beta\,(G_\theta/(R\sin"
+                 r"\varphi), G_\varphi/R)$; it is the seed's $\beta(h_u, h_v) = \beta(2\pi H_\theta, \pi H_\varphi)$ "
+                 r"for", sp.Tuple(-G_T / (R * sp.sin(phi)), -G_P / R), sp.Tuple(2 * sp.pi * H_t, sp.pi * H_p),
+                 defines=(G_T, G_P)),
+            Step("Such a $G$ exists only where this gradient is curl-free", curl, -sp.pi * R * OBSTRUCTION),
+            Step(r"For the rings field $h$ depends on $\varphi$ alone, $H_\theta = 0$ and the curl vanishes: "
+                 r"$G = -\pi R h$", sp.Tuple(G_T, G_P), potential,
+                 cases=(("rings", {H: sp.Lambda((theta, phi), rings)}),)),
+        ),
+        claims={"cross": (cross, claim), "kernel": (coeffs, CHART_COEFFS), "curl": (curl, -sp.pi * R * OBSTRUCTION)},
+        where={N_S: sp.ImmutableMatrix(N), ET_S: sp.ImmutableMatrix(e_theta), EP_S: sp.ImmutableMatrix(e_phi),
+               P_S: sp.MatMul(R + beta * H_at, N_S), B_U: kernel[0], B_V: kernel[1],
+               G_T: SEED_DISPLACEMENT[0], G_P: SEED_DISPLACEMENT[1]},
+        names={ET_S: r"e_\theta", EP_S: r"e_\varphi", H_at: "H", G_T: r"G_\theta", G_P: r"G_\varphi"},
+        domain={**DOMAIN, sp.Symbol("k_v", real=True): (0.5, 12.0)}, functions=INSTANCE,
+        evidence=partial(_evidence, kernel, **evidence),
+        wrong_variants=(("the renderer's chart bump (the seed's) as the displaced normal's coefficients",
+                         lambda: _theorem(kernel=F.BUMP["chart"]).check()),
+                        ("a surface bump floored at sin phi = 1e-3, not POLE_SIN_PHI",
+                         lambda: _theorem(kernel=away_from_pole(
+                             tuple(c.subs(F.POLE_SIN_PHI, sp.Float(1e-3)) for c in F.BUMP["surface"]))).check()),
+                        ("the seed's bump the normal of a displaced sphere for every field",
+                         lambda: _theorem(integrable=("sine", "ridges", "rings")).check()),
+                        ("the renderer's bump='chart' normals as the displaced surface's",
+                         lambda: _theorem(bump="chart").check()),
+                        ("the numeric pipeline's bump='surface' normals (central differences) as exactly the "
+                         "displaced surface's", lambda: _theorem(gradient="central").check()),
+                        ("the seed's reading: the bump is the displaced normal (+ sign, no metric)",
+                         lambda: _theorem(SEED_READING).check())),
+        pages=("s3", "s7"),
+        seed_says="§3 and Cell 8 present the bump as the shading-side stand-in for displacement.",
+    )
+
+
+BUMP_VS_DISPLACEMENT = _theorem()
 
 THEOREMS = (BUMP_VS_DISPLACEMENT,)

@@ -1,21 +1,23 @@
 """Central differences: the truncation series and the optimal step (seed §3).
 
-The series is proved for any h.  That it is the renderer's quotient is part
-of the theorem: away from the chart's seam and poles, each component of
-`renderer.formulas.CENTRAL` (the kernel's stencil, with the interior branch
-of `renderer.formulas.STENCIL_POINTS` and of its denominator) equals the
-quotient (h(x + eps) - h(x - eps)) / (2 eps) written here, for every field;
-and the branches the kernel's formulas take at seeded interior points are
-checked to be those interior branches.
+The series is proved for any h, by Taylor's theorem.  That it is the renderer's
+quotient is part of the theorem: away from the chart's seam and poles, each
+component of `renderer.formulas.CENTRAL` (the kernel's stencil, with the interior
+branch of `renderer.formulas.STENCIL_POINTS` and of its denominator) equals the
+quotient (h(x + eps) - h(x - eps)) / (2 eps) written here, for every field (a step
+of the proof); the evidence checks that the kernel's formulas take those interior
+branches at seeded interior points, wrap and clamp at the borders, and take
+pbrt-v4's footprint steps.
 """
 
 import random
+from functools import partial
 
 import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Identity, Theorem, Verdict, check_identities
+from .core import Step, Theorem, Verdict, calc, written
 
 x = sp.Symbol("x", real=True)
 eps = sp.Symbol("varepsilon", positive=True)
@@ -23,12 +25,16 @@ f = sp.Function("h")
 ORDER = 6
 
 
-def central_series(order=ORDER):
-    """Series of (h(x + eps) - h(x - eps)) / (2 eps) in eps, up to O(eps**order)."""
-    q = (f(x + eps) - f(x - eps)) / (2 * eps)
-    return sp.series(q, eps, 0, order).removeO().doit()
+def _d(n):
+    """h^(n)(x)."""
+    return sp.Derivative(f(x), (x, n)) if n else f(x)
 
 
+#: Taylor's theorem for h(x + eps), written out to fifth order.
+TAYLOR = written(sp.Add(*[eps**n / sp.factorial(n) * _d(n) for n in range(ORDER)], sp.O(eps**ORDER), evaluate=False))
+#: The central quotient, as written.
+QUOTIENT = written(sp.Add(f(sp.Add(x, eps, evaluate=False)), -f(sp.Add(x, -eps, evaluate=False)), evaluate=False)
+                   / (2 * eps))
 CLAIMED = (sp.diff(f(x), x) + eps**2 / 6 * sp.diff(f(x), x, 3)
            + eps**4 / 120 * sp.diff(f(x), x, 5))
 
@@ -36,10 +42,6 @@ a, b = sp.symbols("a b", real=True)
 #: A concrete analytic h for numerical sampling only (the proof is for any h).
 INSTANCE = {f: sp.Lambda(x, sp.sin(a * x) + sp.exp(b * x))}
 SERIES_DOMAIN = {x: (-1.0, 1.0), eps: (0.01, 0.3), a: (0.5, 3.0), b: (-1.0, 1.0)}
-
-
-def _series_identity(rhs):
-    return Identity("series", central_series(), rhs, SERIES_DOMAIN, INSTANCE)
 
 
 def interior(expr):
@@ -54,7 +56,7 @@ def interior(expr):
 
 def interior_points(stencil=F.STENCIL_POINTS):
     """{point symbol: its interior branch} of ``stencil``'s (symbol, expression) pairs: the kernel's
-    stencil points at an interior point (computed in the check, so that `interior` runs there)."""
+    stencil points at an interior point."""
     return {p: interior(e) for p, e in stencil}
 
 
@@ -64,20 +66,16 @@ KERNEL_DOMAIN = {F.u: (0.0, 1.0), F.v: (0.0, 1.0), F.k_u: (0.5, 12.0), F.k_v: (0
 
 
 def quotient(h, var, denominator):
-    """(h(var + eps) - h(var - eps)) / (denominator eps) of the expression ``h``, eps the step of ``var``."""
+    """(h(var + eps) - h(var - eps)) / (denominator eps) of the expression ``h``, eps the step of ``var``,
+    as written (unevaluated: var + eps, not eps + var)."""
     e = STEP[var]
-    return (h.subs(var, var + e) - h.subs(var, var - e)) / (denominator * e)
+    at = (lambda sign: h.subs(var, sp.Add(var, sign * e, evaluate=False)))
+    return written(sp.Add(at(1), -at(-1), evaluate=False) / (denominator * e))
 
 
 def kernel_quotient(name, k):
     """Component ``k`` (0: h_u, 1: h_v) of `formulas.CENTRAL` for field ``name`` at an interior point."""
     return interior(F.CENTRAL[name][k]).subs(interior_points())
-
-
-def _kernel_identities(denominator):
-    return [Identity(rf"\text{{CENTRAL[{name}]}}_{var}", kernel_quotient(name, k), quotient(h, var, denominator),
-                     KERNEL_DOMAIN)
-            for name, h in F.HEIGHT.items() for k, var in enumerate((F.u, F.v))]
 
 
 def interior_branch_mismatches(stencil=F.STENCIL_POINTS, samples=2000, seed=11):
@@ -139,10 +137,9 @@ def _stencil_with(point, change):
     return tuple((p, change(e) if p == point else e) for p, e in F.STENCIL_POINTS)
 
 
-def _check_truncation(claimed, denominator=2, rule=_border_rule, half=0.5, stencil=F.STENCIL_POINTS):
-    verdict = check_identities([_series_identity(claimed)] + _kernel_identities(denominator))
-    if not verdict.holds:
-        return verdict
+def _stencil_evidence(rule=_border_rule, half=0.5, stencil=F.STENCIL_POINTS):
+    """The kernel's stencil (`stencil`) takes its interior branch inside the chart and wraps u, clamps v
+    at the borders as `rule` says; its footprint steps are pbrt-v4's with the factor ``half``."""
     bad, compared = interior_branch_mismatches(stencil)
     if bad or compared < 2000:
         return Verdict("refuted", f"the kernel's stencil is not its interior branch at {bad} of the {compared:,} "
@@ -155,84 +152,126 @@ def _check_truncation(claimed, denominator=2, rule=_border_rule, half=0.5, stenc
     fp, pixels = footprint_error(half=half)
     if fp > 1e-9:
         return Verdict("refuted", f"the kernel's footprint steps differ from pbrt-v4's rule by {fp:.2g} (relative)")
-    return Verdict(verdict.status, f"{verdict.evidence} (the series, and the 6 components of "
-                   f"renderer.formulas.CENTRAL at interior points); the stencil takes its interior "
-                   f"branch at 2,000 seeded interior points, and at 2,000 points near the borders wraps u, "
-                   f"clamps v and divides by the clamped distance; the footprint steps (FOOTPRINT, compiled) "
-                   f"equal pbrt-v4's least-squares rule within {fp:.1e} (relative) at {pixels} sphere-A pixels",
-                   verdict.residual, verdict.digits, verdict.points, pixels)
+    return Verdict("proved", "the stencil takes its interior branch at 2,000 seeded interior points, and at "
+                   "2,000 points near the borders wraps u, clamps v and divides by the clamped distance; the "
+                   f"footprint steps (FOOTPRINT, compiled) equal pbrt-v4's least-squares rule within {fp:.1e} "
+                   f"(relative) at {pixels} sphere-A pixels", rendered=pixels)
 
 
-CENTRAL_DIFFERENCE_TRUNCATION = Theorem(
-    id="central-difference-truncation", title="Truncation error of the central difference",
-    statement=(r"$\dfrac{h(x+\varepsilon) - h(x-\varepsilon)}{2\varepsilon} = h' + \dfrac{\varepsilon^2}{6}h''' + "
-               r"\dfrac{\varepsilon^4}{120}h^{(5)} + O(\varepsilon^6)$. Away from the seam and the poles "
-               r"this quotient is the renderer's stencil (`renderer.formulas.CENTRAL`), in $u$ and in $v$, "
-               r"for every height field; at the borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient "
-               r"in $v$ then one-sided over the clamped distance.  The footprint steps are pbrt-v4's "
-               r"$\tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ (likewise $v$)."),
-    steps=(("series", r"\frac{h(x+\varepsilon) - h(x-\varepsilon)}{2\varepsilon}", CLAIMED),
-           ("stencil", r"\text{CENTRAL[sine]}_u", kernel_quotient("sine", 0).subs(F.eps_u, eps))),
-    check=lambda: _check_truncation(CLAIMED),
-    wrong_variants=(("coefficient 1/3 instead of 1/6",
-                     lambda: _check_truncation(CLAIMED + eps**2 / 6 * sp.diff(f(x), x, 3))),
-                    ("eps^3 instead of eps^2",
-                     lambda: _check_truncation(CLAIMED - eps**2 / 6 * sp.diff(f(x), x, 3)
-                                               + eps**3 / 6 * sp.diff(f(x), x, 3))),
-                    ("the stencil read as a quotient over eps, not 2 eps",
-                     lambda: _check_truncation(CLAIMED, denominator=1)),
-                    ("the footprint without pbrt's factor 1/2", lambda: _check_truncation(CLAIMED, half=1.0)),
-                    ("a v border divided by 2 eps",
-                     lambda: _check_truncation(CLAIMED, rule=lambda u_, v_, e_: _border_rule(u_, v_, e_)[:4] + (2 * e_,))),
-                    ("v_p clamped to 1/2, in the kernel and the border rule alike: a clamp inside the chart",
-                     lambda: _check_truncation(CLAIMED, rule=lambda u_, v_, e_: _border_rule(u_, v_, e_, top=0.5),
-                                               stencil=_stencil_with(F.v_p, lambda e: e.xreplace({1: sp.S.Half})))),
-                    *((f"{p} without its {'wrap' if p.name[0] == 'u' else 'clamp'} (its interior branch everywhere)",
-                       lambda p=p: _check_truncation(CLAIMED, stencil=_stencil_with(p, interior)))
-                      for p in (F.u_p, F.u_m, F.v_p, F.v_m))),
-    pages=("s3",),
-)
+#: The renderer's stencil as functions of (u, v), one pair per height field (the steps' cases).
+CENTRAL_U, CENTRAL_V = sp.Function("CENTRAL_u"), sp.Function("CENTRAL_v")
+h_uv = sp.Function("h")
 
+
+def _kernel_cases():
+    return tuple((name, {h_uv: sp.Lambda((F.u, F.v), height),
+                         CENTRAL_U: sp.Lambda((F.u, F.v), kernel_quotient(name, 0)),
+                         CENTRAL_V: sp.Lambda((F.u, F.v), kernel_quotient(name, 1))})
+                 for name, height in F.HEIGHT.items())
+
+
+def _truncation(claimed=CLAIMED, denominator=2, **stencil):
+    """Theorem central-difference-truncation with the series ``claimed``, the stencil's quotients over
+    ``denominator`` eps, and the evidence's ``stencil`` options (`_stencil_evidence`): wrong variants."""
+    kernel = sp.Tuple(CENTRAL_U(F.u, F.v), CENTRAL_V(F.u, F.v))
+    quotients = sp.Tuple(*(quotient(h_uv(F.u, F.v), var, denominator) for var in (F.u, F.v)))
+    series = claimed + sp.O(eps**ORDER)
+    return Theorem(
+        id="central-difference-truncation", title="Truncation error of the central difference",
+        statement=(r"$⟦series⟧$. Away from the seam and the poles this quotient is the renderer's stencil "
+                   r"(`renderer.formulas.CENTRAL`), in $u$ and in $v$, for every height field: $⟦stencil⟧$; at the "
+                   r"borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
+                   r"clamped distance.  The footprint steps are pbrt-v4's "
+                   r"$\tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ (likewise $v$)."),
+        steps=(
+            Step(r"Taylor's theorem: $h$ is smooth, so $h(x + \varepsilon)$ is its Taylor polynomial of degree 5 "
+                 r"about $x$, up to a remainder of order $\varepsilon^6$", written(f(sp.Add(x, eps, evaluate=False))),
+                 TAYLOR),
+            Step(r"Write the same series for $h(x - \varepsilon)$: in the difference the even powers of "
+                 r"$\varepsilon$ cancel and the odd ones double; divide by $2\varepsilon$", QUOTIENT, series),
+            Step(r"Away from the seam and the poles the kernel's stencil points are $u \pm \varepsilon_u$ and "
+                 r"$v \pm \varepsilon_v$ (the interior branches of `STENCIL_POINTS`) and its $v$-denominator is "
+                 r"$2\varepsilon_v$, so for each height field $h$ the stencil is the central quotient", kernel,
+                 quotients, cases=_kernel_cases()),
+        ),
+        claims={"series": (QUOTIENT, series), "stencil": (kernel, quotients)},
+        names={CENTRAL_U: r"\mathrm{CENTRAL}_u", CENTRAL_V: r"\mathrm{CENTRAL}_v"},
+        domain={**SERIES_DOMAIN, **KERNEL_DOMAIN}, functions=INSTANCE,
+        evidence=partial(_stencil_evidence, **stencil),
+        wrong_variants=(("coefficient 1/3 instead of 1/6",
+                         lambda: _truncation(CLAIMED + eps**2 / 6 * sp.diff(f(x), x, 3)).check()),
+                        ("eps^3 instead of eps^2",
+                         lambda: _truncation(CLAIMED - eps**2 / 6 * sp.diff(f(x), x, 3)
+                                             + eps**3 / 6 * sp.diff(f(x), x, 3)).check()),
+                        ("the stencil read as a quotient over eps, not 2 eps",
+                         lambda: _truncation(denominator=1).check()),
+                        ("the footprint without pbrt's factor 1/2", lambda: _truncation(half=1.0).check()),
+                        ("a v border divided by 2 eps",
+                         lambda: _truncation(rule=lambda u_, v_, e_: _border_rule(u_, v_, e_)[:4] + (2 * e_,)).check()),
+                        ("v_p clamped to 1/2, in the kernel and the border rule alike: a clamp inside the chart",
+                         lambda: _truncation(rule=lambda u_, v_, e_: _border_rule(u_, v_, e_, top=0.5),
+                                             stencil=_stencil_with(F.v_p, lambda e: e.xreplace({1: sp.S.Half}))
+                                             ).check()),
+                        *((f"{p} without its {'wrap' if p.name[0] == 'u' else 'clamp'} (its interior branch "
+                           "everywhere)", lambda p=p: _truncation(stencil=_stencil_with(p, interior)).check())
+                          for p in (F.u_p, F.u_m, F.v_p, F.v_m))),
+        pages=("s3",),
+    )
+
+
+CENTRAL_DIFFERENCE_TRUNCATION = _truncation()
+
+# ----------------------------------------------------------------------------- the optimal step
 H3, H, u_round = sp.symbols("H_3 H u", positive=True)
-ERROR_MODEL = eps**2 * H3 / 6 + u_round * H / eps
-EPS_STAR = (3 * u_round * H / H3) ** sp.Rational(1, 3)
+E = sp.Function("E")
+eps_star = sp.Symbol("eps_star", positive=True)
+#: The error model, truncation plus roundoff, as written: eps^2 |h'''| / 6 + u |h| / eps.
+ERROR_MODEL = written(sp.Add(sp.Mul(sp.Rational(1, 6), eps**2, H3, evaluate=False),
+                             sp.Mul(u_round, H, 1 / eps, evaluate=False), evaluate=False))
+#: The optimal step, as written: (3 u |h| / |h'''|)^(1/3).
+EPS_STAR = written(sp.Pow(sp.Mul(3, u_round, H, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
+NAMES = {H: r"\lvert h\rvert", H3: r"\lvert h'''\rvert", u_round: r"\mathrm{u}", eps_star: r"\varepsilon^\ast"}
+STEP_DOMAIN = {eps: (0.05, 2.0), H: (0.1, 10.0), H3: (0.1, 10.0), u_round: (1e-3, 0.1)}
 
 
-def _optimum(claimed, model=ERROR_MODEL):
-    """Proved when sympy finds exactly one stationary point, decided positive, of ``model`` in eps,
-    equal to ``claimed``, with a positive second derivative there; else refuted."""
-    roots = sp.solve(sp.diff(model, eps), eps)
-    stationary = [r for r in roots if r.is_positive]
-    if len(stationary) != 1 or any(r.is_positive is None for r in roots):
-        return Verdict("refuted", f"{len(stationary)} stationary points sympy decides are positive, "
-                       f"among the roots {roots}")
-    if sp.simplify(stationary[0] - claimed) != 0:
-        return Verdict("refuted", f"the stationary point is {stationary[0]}, not the claimed {claimed}")
-    curvature = sp.simplify(sp.diff(model, eps, 2).subs(eps, claimed))
-    if not curvature.is_positive:
-        return Verdict("refuted", f"second derivative {curvature} at the stationary point: not a minimum")
-    return Verdict("proved", f"sympy solves E'(eps) = 0: one positive root, {sp.latex(stationary[0])}; "
-                   f"second derivative {sp.latex(curvature)} > 0 there")
+def _optimal(model=ERROR_MODEL, star=EPS_STAR):
+    """Theorem optimal-step for the error model ``model`` and the claimed optimum ``star`` (wrong variants)."""
+    slope, curvature = sp.Derivative(E(eps), eps), sp.Derivative(E(eps), (eps, 2))
+    stationary, minimum = sp.Subs(slope, eps, eps_star), sp.Subs(curvature, eps, eps_star)
+    return Theorem(
+        id="optimal-step", title="The optimal central-difference step",
+        statement=r"The error model $⟦E⟧$ ($\mathrm{u}$ the unit roundoff) has one stationary point on "
+                  r"$\varepsilon > 0$, $⟦eps_star⟧$, and it is the minimum: $⟦stationary⟧$, $⟦minimum⟧ > 0$.",
+        steps=(
+            *calc(slope,
+                  ("Differentiate the model term by term",
+                   written(sp.Add(sp.Mul(sp.Rational(1, 3), eps, H3, evaluate=False),
+                                  sp.Mul(-1, u_round, H, eps**-2, evaluate=False), evaluate=False))),
+                  (r"Put it over the common denominator $3\varepsilon^2$ and write $3\mathrm{u}\lvert h\rvert/"
+                   r"\lvert h'''\rvert$ as $\varepsilon^{\ast 3}$",
+                   written(sp.Mul(sp.Rational(1, 3), H3, sp.Add(eps**3, -eps_star**3, evaluate=False), eps**-2,
+                                  evaluate=False)))),
+            Step(r"For $\varepsilon > 0$ the factor $\varepsilon^3 - \varepsilon^{\ast 3}$ vanishes only at "
+                 r"$\varepsilon = \varepsilon^\ast$, negative below it and positive above", stationary, sp.Integer(0)),
+            Step(r"Differentiate again: $E'' = \lvert h'''\rvert/3 + 2\mathrm{u}\lvert h\rvert/\varepsilon^3$, which at "
+                 r"$\varepsilon^\ast$ is $\lvert h'''\rvert/3 + 2\lvert h'''\rvert/3 > 0$: $\varepsilon^\ast$ is the "
+                 r"minimum", minimum, H3),
+        ),
+        claims={"stationary": (stationary, sp.Integer(0)), "minimum": (minimum, H3)},
+        where={E(eps): model, eps_star: star}, names=NAMES, domain=STEP_DOMAIN,
+        wrong_variants=(("exponent 1/2 instead of 1/3",
+                         lambda: _optimal(star=(3 * u_round * H / H3) ** sp.Rational(1, 2)).check()),
+                        ("the roundoff term added with the wrong sign (no stationary point)",
+                         lambda: _optimal(eps**2 * H3 / 6 - u_round * H / eps).check()),
+                        ("both terms negated (the stationary point is a maximum)",
+                         lambda: _optimal(-ERROR_MODEL).check()),
+                        ("a model with stationary points 1, 3/2 and 2: a minimum at 1, but not the only one",
+                         lambda: _optimal((eps - 1)**2 * (eps - 2)**2, sp.Integer(1)).check())),
+        pages=("s3", "s5", "s7"),
+        seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
+    )
 
 
-OPTIMAL_STEP = Theorem(
-    id="optimal-step", title="The optimal central-difference step",
-    statement=r"The error model $E(\varepsilon) = \varepsilon^2\lvert h'''\rvert/6 + "
-              r"\mathrm{u}\lvert h\rvert/\varepsilon$ ($\mathrm{u}$ the unit roundoff) has its "
-              r"minimum at $\varepsilon^\ast = (3\mathrm{u}\lvert h\rvert/\lvert h'''\rvert)^{1/3}$.",
-    steps=((r"derivative", r"E'(\varepsilon)", sp.diff(ERROR_MODEL, eps)),
-           (r"\varepsilon^\ast", r"\varepsilon^\ast", EPS_STAR)),
-    check=lambda: _optimum(EPS_STAR),
-    wrong_variants=(("exponent 1/2 instead of 1/3",
-                     lambda: _optimum((3 * u_round * H / H3) ** sp.Rational(1, 2))),
-                    ("the roundoff term added with the wrong sign (no stationary point)",
-                     lambda: _optimum(EPS_STAR, eps**2 * H3 / 6 - u_round * H / eps)),
-                    ("both terms negated (the stationary point is a maximum)",
-                     lambda: _optimum(EPS_STAR, -ERROR_MODEL)),
-                    ("a model with stationary points 1, 3/2 and 2: a minimum at 1, but not the only one",
-                     lambda: _optimum(sp.Integer(1), (eps - 1)**2 * (eps - 2)**2))),
-    pages=("s3", "s5", "s7"),
-    seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
-)
+OPTIMAL_STEP = _optimal()
 
 THEOREMS = (CENTRAL_DIFFERENCE_TRUNCATION, OPTIMAL_STEP)

@@ -4,16 +4,17 @@ The theorems are about `renderer.formulas`: its chart ``CHART`` (u, v, sin phi
 of a unit normal) and the regular branch of its ``TANGENT_FRAME`` (the
 branch taken where sin phi > ``POLE_SIN_PHI``).  The independent side is the
 unit sphere in spherical coordinates, N(theta, phi), and its derivatives
-dN/dtheta and dN/dphi, written here.
+dN/dtheta and dN/dphi.  The proofs write the renderer's formulas in its own
+symbols (N_x, N_y, N_z, sin_phi) and check each step at N(theta, phi).
 """
 
-import dataclasses
+from functools import partial
 
 import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Identity, Theorem, Verdict, check_identities
+from .core import Cross, Dot, Step, Theorem, Verdict, calc, tex
 
 theta, phi = sp.symbols("theta phi", real=True)
 #: The unit normal in spherical coordinates (the independent side).
@@ -23,8 +24,20 @@ N = sp.Matrix([sp.sin(phi) * sp.cos(theta), sp.sin(phi) * sp.sin(theta), sp.cos(
 ON_SPHERE = {F.N_x: N[0], F.N_y: N[1], F.N_z: N[2], F.sin_phi: sp.sin(phi)}
 #: Sampling domain: away from the poles, where sin(phi) > 0, and off the seam theta = +-pi.
 DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 3.13)}
-#: LaTeX names of the renderer's symbols.
-NAMES = {F.sin_phi: r"\sin\varphi"}
+
+#: The vectors the proofs name: N, e_theta and e_phi, defined (``where``) as the renderer's.
+N_S = sp.MatrixSymbol("N", 3, 1)
+ET_S, EP_S = sp.MatrixSymbol("e_theta", 3, 1), sp.MatrixSymbol("e_phi", 3, 1)
+VECTOR_NAMES = {ET_S: r"e_\theta", EP_S: r"e_\varphi"}
+
+
+#: A left-handed orthonormal basis, as the renderer's frame is (theorems frame-orthonormal, frame-orientation):
+#: e_theta = x, e_phi = y, N = -z, for the named vectors and the renderer's symbols alike.  A quantity built from
+#: the frame by dot and cross products (a normal's slopes, its coefficients in the frame) takes the same value
+#: in every orthonormal frame of that handedness, so a step about one may be checked in this one.
+STANDARD_FRAME = {N_S: sp.ImmutableMatrix([0, 0, -1]), ET_S: sp.ImmutableMatrix([1, 0, 0]),
+                  EP_S: sp.ImmutableMatrix([0, 1, 0]), F.N_x: 0, F.N_y: 0, F.N_z: -1,
+                  **dict(zip(F.e_theta, (1, 0, 0))), **dict(zip(F.e_phi, (0, 1, 0)))}
 
 
 def regular_branch(component):
@@ -41,18 +54,75 @@ e_theta = sp.Matrix(REGULAR[:3]).subs(ON_SPHERE)
 e_phi = sp.Matrix(REGULAR[3:]).subs(ON_SPHERE)
 
 
-def _frame_identities(et, ep):
-    return [
-        Identity(r"e_\theta\cdot e_\theta", et.dot(et), sp.Integer(1), DOMAIN),
-        Identity(r"e_\varphi\cdot e_\varphi", ep.dot(ep), sp.Integer(1), DOMAIN),
-        Identity(r"e_\theta\cdot e_\varphi", et.dot(ep), sp.Integer(0), DOMAIN),
-        Identity(r"e_\theta\cdot N", et.dot(N), sp.Integer(0), DOMAIN),
-        Identity(r"e_\varphi\cdot N", ep.dot(N), sp.Integer(0), DOMAIN),
-        Identity(r"e_\theta", et, sp.diff(N, theta) / sp.sin(phi), DOMAIN),
-        Identity(r"e_\varphi", ep, sp.diff(N, phi), DOMAIN),
-    ]
+def vector_latex(components):
+    """LaTeX of a row vector of the renderer's expressions (sin_phi as sin(varphi), a float 0 as 0)."""
+    return tex(sp.Matrix(components).T)
 
 
+def _where(et=REGULAR[:3], ep=REGULAR[3:]):
+    """The named vectors as the renderer's, and its symbols at N(theta, phi)."""
+    return {N_S: sp.ImmutableMatrix([F.N_x, F.N_y, F.N_z]), ET_S: sp.ImmutableMatrix(et),
+            EP_S: sp.ImmutableMatrix(ep), **ON_SPHERE}
+
+
+# ------------------------------------------------------------------------------- the chart
+U_OF_THETA, V_OF_PHI = (theta + sp.pi) / (2 * sp.pi), phi / sp.pi
+#: The chart's inverse, theta(u) and phi(v), solved from u(theta) and v(phi).
+THETA_OF_U = sp.solve(sp.Eq(U_OF_THETA, F.u), theta)[0]
+PHI_OF_V = sp.solve(sp.Eq(V_OF_PHI, F.v), phi)[0]
+#: The rates du/dtheta and dv/dphi the theorem proves: the factors that turn chart
+#: derivatives h_u, h_v into angular ones.
+RATES_CLAIMED = (1 / (2 * sp.pi), 1 / sp.pi)
+CHART_RATES = RATES_CLAIMED
+
+
+def _chart_evidence(corrupt=None):
+    """The renderer's own chart (GBuffer.uv) at its own N against CHART (proofs/pixels.py); ``corrupt``
+    alters the renderer's (u, v) first (a wrong variant)."""
+    from .pixels import TOLERANCE, chart_error, worst_of
+    worst, count = worst_of(chart_error, [(f, corrupt) for f in ("sine", "ridges", "rings")])
+    if worst > TOLERANCE["chart"]:
+        return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
+                       f"{count} sphere-A pixels")
+    return Verdict("proved", f"the renderer's (u, v) (GBuffer.uv) at {count} seeded sphere-A pixels (pole ring and "
+                   f"fallback included) within {worst:.1e} of mpmath's CHART at its N", rendered=count)
+
+
+def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
+    """Theorem chart, claiming u = ``u_claim`` for the kernel's v = ``v_kernel`` (wrong variants)."""
+    u_kernel, sin_kernel = F.CHART[0], F.CHART[2]
+    rates = sp.Tuple(sp.Derivative(U_OF_THETA, theta), sp.Derivative(V_OF_PHI, phi))
+    return Theorem(
+        id="chart", title="The chart is the spherical angles",
+        statement=(r"For $-\pi < \theta < \pi$ and $0 < \varphi < \pi$ the renderer's chart "
+                   r"(`renderer.formulas.CHART`) at $N = (N_x, N_y, N_z) = N(\theta, \varphi)$ is "
+                   r"$u$: $⟦u⟧$, $v$: $⟦v⟧$ and $⟦sin⟧$; so $⟦rates⟧$, the factors between chart and angular "
+                   r"derivatives of $h$."),
+        steps=(
+            Step(r"At $N(\theta, \varphi)$ the radicand is $\sin^2\varphi\,(\cos^2\theta + \sin^2\theta) = "
+                 r"\sin^2\varphi$, and $\sin\varphi > 0$ for $0 < \varphi < \pi$", sin_kernel, sp.sin(phi)),
+            Step(r"Both arguments of atan2 carry the factor $\sin\varphi > 0$, which leaves the angle unchanged, and "
+                 r"$\operatorname{atan2}(\sin\theta, \cos\theta) = \theta$ for $-\pi < \theta < \pi$", u_kernel, u_claim),
+            Step(r"By step 1 the first argument is $\sin\varphi$, and $\operatorname{atan2}(\sin\varphi, \cos\varphi) "
+                 r"= \varphi$ for $0 < \varphi < \pi$", v_kernel, V_OF_PHI),
+            Step("Differentiate $u$ and $v$", rates, sp.Tuple(*RATES_CLAIMED)),
+        ),
+        claims={"u": (u_kernel, u_claim), "v": (v_kernel, V_OF_PHI), "sin": (sin_kernel, sp.sin(phi)),
+                "rates": (rates, sp.Tuple(*RATES_CLAIMED))},
+        where={F.N_x: N[0], F.N_y: N[1], F.N_z: N[2]}, domain=DOMAIN,
+        evidence=partial(_chart_evidence, corrupt),
+        wrong_variants=(("u without the offset pi: theta / 2 pi", lambda: _chart(u_claim=theta / (2 * sp.pi)).check()),
+                        ("v with the arguments of atan2 swapped",
+                         lambda: _chart(v_kernel=sp.atan2(F.N_z, sp.sqrt(F.N_x**2 + F.N_y**2)) / sp.pi).check()),
+                        ("the kernel's u and v swapped", lambda: _chart(corrupt=lambda a: a[:, ::-1]).check())),
+        pages=("s3",),
+        seed_says="Cell 1 (chartA1): u = (theta + pi) / 2 pi, v = acos(N_z) / pi.",
+    )
+
+
+CHART_INVERSE = _chart()
+
+# ------------------------------------------------------------------------------- the frame
 #: The cut-off below which the frame is the fallback (seed Cell 1, ``tangent_frame``: sin phi > 1e-4).
 SEED_POLE_SIN_PHI = 1e-4
 
@@ -75,178 +145,112 @@ def _branch_structure(frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
     return None
 
 
-def _check_frame(et, ep, corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
+def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
+    """The frame's branches and pole cut-off, and the renderer's shading normals, which the frame
+    builds (proofs/pixels.py); ``corrupt`` alters the gradient the kernel is compared with."""
     bad = _branch_structure(frame, pole)
     if bad is not None:
         return bad
-    verdict = check_identities(_frame_identities(et, ep))
-    if not verdict.holds:
-        return verdict
-    # The renderer's shading normals, which the frame builds (proofs/pixels.py).
     from .pixels import TOLERANCE, normal_error, worst_of
     worst, count = worst_of(normal_error, [(f, b, corrupt) for f in ("sine", "ridges", "rings")
                                            for b in ("chart", "surface")])
     if worst > TOLERANCE["normal"]:
         return Verdict("refuted", f"the renderer's N' differs from PERTURBED_NORMAL in this frame by {worst:.1e} "
                        f"at some of {count} sphere-A pixels")
-    return Verdict(verdict.status, f"renderer.formulas.TANGENT_FRAME, regular branch at N(theta, phi): "
-                   f"{verdict.evidence}; the renderer's N' (GBuffer.Ns, both bump modes, 3 fields) at {count} "
-                   f"seeded sphere-A pixels (pole ring and fallback included) within {worst:.1e} of mpmath's "
-                   "PERTURBED_NORMAL in this frame", verdict.residual, verdict.digits, verdict.points, count)
+    return Verdict("proved", f"TANGENT_FRAME is (regular, sin phi > {float(F.POLE_SIN_PHI):g}), (fallback) in each "
+                   f"component; the renderer's N' (GBuffer.Ns, both bump modes, 3 fields) at {count} seeded sphere-A "
+                   f"pixels (pole ring and fallback included) within {worst:.1e} of mpmath's PERTURBED_NORMAL in "
+                   "this frame", rendered=count)
 
 
-def vector_latex(components):
-    """LaTeX of a row vector of the renderer's expressions (sin_phi as sin(varphi)).
-    The z-component 0 of e_theta is a sympy Float; shown as 0."""
-    return sp.latex(sp.Matrix(components).T.applyfunc(lambda c: sp.Integer(0) if c.is_zero else c),
-                    symbol_names=NAMES)
+def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
+    """Theorem frame-orthonormal for the frame (``et``, ``ep``) and the evidence's options (wrong variants)."""
+    d_theta, d_phi = sp.Mul(1 / sp.sin(phi), sp.Derivative(N_S, theta)), sp.Derivative(N_S, phi)
+    tangent, unit = sp.Tuple(Dot(ET_S, N_S), Dot(EP_S, N_S)), sp.Tuple(Dot(ET_S, ET_S), Dot(EP_S, EP_S), Dot(ET_S, EP_S))
+    return Theorem(
+        id="frame-orthonormal", title="The tangent frame is orthonormal and tangent",
+        statement=(r"For $0 < \varphi < \pi$ the renderer's frame (`renderer.formulas.TANGENT_FRAME`, "
+                   rf"regular branch) $e_\theta = {vector_latex(REGULAR[:3])}$ and "
+                   rf"$e_\varphi = {vector_latex(REGULAR[3:])}$, at $N(\theta, \varphi)$, satisfies "
+                   r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
+        steps=(
+            *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ (theorem chart), "
+                         r"$e_\theta = (-N_y, N_x, 0)/\sin\varphi$ is", sp.Matrix([-sp.sin(theta), sp.cos(theta), 0])),
+                  (r"This is $\partial N/\partial\theta = \sin\varphi\,(-\sin\theta, \cos\theta, 0)$ divided by "
+                   r"$\sin\varphi$", d_theta)),
+            *calc(EP_S, (r"Likewise $e_\varphi = (N_z N_x, N_z N_y, -\sin^2\varphi)/\sin\varphi$ is",
+                         sp.Matrix([sp.cos(phi) * sp.cos(theta), sp.cos(phi) * sp.sin(theta), -sp.sin(phi)])),
+                  (r"This is the $\varphi$-derivative of $N$", d_phi)),
+            Step(r"Differentiating $N \cdot N = 1$ gives $N \cdot \partial N/\partial\theta = N \cdot \partial N/"
+                 r"\partial\varphi = 0$, so by steps 2 and 4 both vectors are tangent", tangent, sp.Tuple(0, 0)),
+            Step(r"From steps 1 and 3: $\sin^2\theta + \cos^2\theta = 1$, $\cos^2\varphi + \sin^2\varphi = 1$, and the "
+                 r"mixed products cancel", unit, sp.Tuple(1, 1, 0)),
+        ),
+        claims={"e_theta": (ET_S, d_theta), "e_phi": (EP_S, d_phi), "tangent": (tangent, sp.Tuple(0, 0)),
+                "unit": (unit, sp.Tuple(1, 1, 0))},
+        where=_where(et, ep), names=VECTOR_NAMES, domain=DOMAIN, evidence=partial(_frame_evidence, **evidence),
+        wrong_variants=(("e_phi multiplied by sin(phi)", lambda: _orthonormal(ep=[c * F.sin_phi for c in REGULAR[3:]]).check()),
+                        ("e_theta with a flipped sign", lambda: _orthonormal(et=[-c for c in REGULAR[:3]]).check()),
+                        ("the kernel's N' built with h_u and h_v swapped",
+                         lambda: _orthonormal(corrupt=lambda g: g[:, ::-1]).check()),
+                        ("the pole cut-off moved from 1e-4 to 3e-4", lambda: _orthonormal(pole=3e-4).check()),
+                        ("e_theta's z the constant 1 in both branches (the regular branch's 0 and the fallback's "
+                         "replaced)", lambda: _orthonormal(frame=F.TANGENT_FRAME[:2] + (sp.Integer(1),)
+                                                           + F.TANGENT_FRAME[3:]).check()),
+                        ("the fallback's e_theta turned to (0, 1, 0)",
+                         lambda: _orthonormal(frame=tuple(
+                             sp.Piecewise((c.args[0].expr, c.args[0].cond), (sp.Integer(k == 1), True))
+                             if k < 3 and isinstance(c, sp.Piecewise) else c
+                             for k, c in enumerate(F.TANGENT_FRAME))).check())),
+        pages=("s3",),
+    )
 
 
-FRAME_ORTHONORMAL = Theorem(
-    id="frame-orthonormal", title="The tangent frame is orthonormal and tangent",
-    statement=(r"For $0 < \varphi < \pi$ the renderer's frame (`renderer.formulas.TANGENT_FRAME`, "
-               rf"regular branch) $e_\theta = {vector_latex(REGULAR[:3])}$ and "
-               rf"$e_\varphi = {vector_latex(REGULAR[3:])}$ "
-               r"are unit vectors, orthogonal to each other and to $N$, and equal "
-               r"$\frac{1}{\sin\varphi}\partial N/\partial\theta$ and $\partial N/\partial\varphi$."),
-    steps=tuple((i.label, i.lhs, i.rhs) for i in _frame_identities(e_theta, e_phi)),
-    check=lambda: _check_frame(e_theta, e_phi),
-    wrong_variants=(("e_phi multiplied by sin(phi)", lambda: _check_frame(e_theta, e_phi * sp.sin(phi))),
-                    ("e_theta with a flipped sign",
-                     lambda: check_identities([Identity(r"e_\theta", -e_theta, sp.diff(N, theta) / sp.sin(phi),
-                                                        DOMAIN)])),
-                    ("the kernel's N' built with h_u and h_v swapped",
-                     lambda: _check_frame(e_theta, e_phi, corrupt=lambda g: g[:, ::-1])),
-                    ("the pole cut-off moved from 1e-4 to 3e-4", lambda: _check_frame(e_theta, e_phi, pole=3e-4)),
-                    ("e_theta's z the constant 1 in both branches (the regular branch's 0 and the fallback's "
-                     "replaced)", lambda: _check_frame(e_theta, e_phi, frame=F.TANGENT_FRAME[:2] + (sp.Integer(1),)
-                                                        + F.TANGENT_FRAME[3:])),
-                    ("the fallback's e_theta turned to (0, 1, 0)",
-                     lambda: _check_frame(e_theta, e_phi, frame=tuple(
-                         sp.Piecewise((c.args[0].expr, c.args[0].cond), (sp.Integer(k == 1), True))
-                         if k < 3 and isinstance(c, sp.Piecewise) else c for k, c in enumerate(F.TANGENT_FRAME))))),
-    pages=("s3",),
-)
+FRAME_ORTHONORMAL = _orthonormal()
 
 
 def _orientation_value():
     return sp.simplify(e_theta.cross(e_phi).dot(N))
 
 
-def _fallback_cross(fallback=F.FALLBACK_FRAME):
-    """e_theta x e_phi of the pole fallback (a constant frame)."""
-    return sp.Matrix(fallback[:3]).cross(sp.Matrix(fallback[3:]))
-
-
-#: What the theorem claims (e_theta x e_phi) . N is: the check compares the
-#: frame with this constant, not with its own simplification.
+#: What the theorem claims (e_theta x e_phi) . N is.
 CLAIMED_ORIENTATION = -1
-#: ... and what it claims the pole fallback's e_theta x e_phi is: +z, the outward
-#: normal at the north pole, so the fallback is right-handed there, unlike the regular frame.
+#: ... and what it claims the pole fallback's e_theta x e_phi is: +z, the outward normal at the
+#: north pole, so the fallback is right-handed there, unlike the regular frame.
 CLAIMED_FALLBACK_CROSS = sp.Matrix([0, 0, 1])
 
 
-def _check_orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=e_theta, ep=e_phi) -> Verdict:
-    verdict = check_identities([
-        Identity(r"(e_\theta\times e_\varphi)\cdot N", et.cross(ep).dot(N), sp.Integer(claimed), DOMAIN),
-        Identity(r"\text{fallback } e_\theta\times e_\varphi", _fallback_cross(fallback), CLAIMED_FALLBACK_CROSS)])
-    if not verdict.holds:
-        return verdict
-    return dataclasses.replace(verdict, evidence=(
-        f"(e_theta x e_phi) . N = {claimed:+d} on the regular branch: the frame is "
-        f"{'right' if claimed == 1 else 'left'}-handed about the outward normal; the pole fallback's "
-        f"e_theta x e_phi = {list(CLAIMED_FALLBACK_CROSS)}, right-handed at the north pole; {verdict.evidence}"))
+def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGULAR[:3], ep=REGULAR[3:]):
+    """Theorem frame-orientation claiming ``claimed``, for the frame (``et``, ``ep``) and pole ``fallback``."""
+    triple = Dot(Cross(ET_S, EP_S), N_S)
+    poles = Cross(sp.Matrix(fallback[:3]), sp.Matrix(fallback[3:]))
+    return Theorem(
+        id="frame-orientation", title="Orientation of the tangent frame",
+        statement=r"$⟦orientation⟧$: the pair $(e_\theta, e_\varphi)$ is left-handed about the outward normal, "
+                  r"$e_\theta\times e_\varphi = -N$. The pole fallback "
+                  rf"($\sin\varphi \le {tex(sp.Float(F.POLE_SIN_PHI, 2))}$) has $⟦fallback⟧$: right-handed at the "
+                  r"north pole, where the outward normal is $+z$.",
+        steps=(
+            Step(r"Cross the frame of theorem frame-orthonormal: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
+                 r"\cos\theta, \cos\varphi\sin\theta, -\sin\varphi) = (-\sin\varphi\cos\theta, -\sin\varphi\sin\theta, "
+                 r"-\cos\varphi)$", Cross(ET_S, EP_S), -N_S),
+            *calc(triple, ("Dot both sides of step 1 with $N$", -Dot(N_S, N_S)),
+                  ("$N$ is a unit vector", sp.Integer(claimed))),
+            Step(r"At the poles the kernel takes the fixed pair $e_\theta = (1, 0, 0)$, $e_\varphi = (0, 1, 0)$, "
+                 r"whose cross product is $+z$, the outward normal at the north pole", poles, CLAIMED_FALLBACK_CROSS),
+        ),
+        claims={"orientation": (triple, sp.Integer(claimed)), "fallback": (poles, CLAIMED_FALLBACK_CROSS)},
+        where=_where(et, ep), names=VECTOR_NAMES, domain=DOMAIN,
+        wrong_variants=(("the seed's reading: aligned with N (+1)", lambda: _orientation(1).check()),
+                        ("the frame with e_theta and e_phi swapped",
+                         lambda: _orientation(et=REGULAR[3:], ep=REGULAR[:3]).check()),
+                        ("the pole fallback with e_theta and e_phi swapped",
+                         lambda: _orientation(fallback=F.FALLBACK_FRAME[3:] + F.FALLBACK_FRAME[:3]).check())),
+        pages=("s3", "s5"),
+        seed_says="Cell 2 prints (e_theta x e_phi) . N and labels the frame 'unit, aligned with N'.",
+    )
 
 
-FRAME_ORIENTATION = Theorem(
-    id="frame-orientation", title="Orientation of the tangent frame",
-    statement=rf"$(e_\theta \times e_\varphi)\cdot N = {CLAIMED_ORIENTATION}$: the pair $(e_\theta, e_\varphi)$ is "
-              r"left-handed about the outward normal, $e_\theta\times e_\varphi = -N$. The pole fallback "
-              rf"($\sin\varphi \le {sp.latex(sp.Float(F.POLE_SIN_PHI, 2))}$), "
-              rf"$e_\theta = {vector_latex(F.FALLBACK_FRAME[:3])}$, $e_\varphi = {vector_latex(F.FALLBACK_FRAME[3:])}$, "
-              rf"has $e_\theta\times e_\varphi = {sp.latex(CLAIMED_FALLBACK_CROSS.T)}$: right-handed at the "
-              r"north pole, where the outward normal is $+z$.",
-    steps=((r"cross product", r"e_\theta\times e_\varphi", e_theta.cross(e_phi).applyfunc(sp.simplify)),
-           (r"outward normal", "N", N),
-           (r"orientation", r"(e_\theta\times e_\varphi)\cdot N", _orientation_value()),
-           (r"pole fallback", r"e_\theta\times e_\varphi", _fallback_cross())),
-    check=_check_orientation,
-    wrong_variants=(("the seed's reading: aligned with N (+1)", lambda: _check_orientation(1)),
-                    ("the frame with e_theta and e_phi swapped", lambda: _check_orientation(et=e_phi, ep=e_theta)),
-                    ("the pole fallback with e_theta and e_phi swapped",
-                     lambda: _check_orientation(fallback=F.FALLBACK_FRAME[3:] + F.FALLBACK_FRAME[:3]))),
-    pages=("s3", "s5"),
-    seed_says="Cell 2 prints (e_theta x e_phi) . N and labels the frame 'unit, aligned with N'.",
-)
-
-
-# ------------------------------------------------------------------------------- the chart
-#: The renderer's chart (u, v, sin phi) at N(theta, phi).
-CHART_AT = tuple(c.subs({F.N_x: N[0], F.N_y: N[1], F.N_z: N[2]}) for c in F.CHART)
-#: The chart's rates du/dtheta and dv/dphi, from `formulas.CHART` with its own sin phi
-#: (CHART[2]) written as the symbol sin_phi and then as sin(phi): the factors that turn
-#: chart derivatives h_u, h_v into angular ones.
-CHART_RATES = (sp.simplify(sp.diff(CHART_AT[0], theta)),
-               sp.simplify(sp.diff(F.CHART[1].subs(F.CHART[2], F.sin_phi).subs(ON_SPHERE), phi)))
-
-
-#: The rates the statement claims (printed from these objects).
-RATES_CLAIMED = (1 / (2 * sp.pi), 1 / sp.pi)
-
-
-def _chart_identities(u_claim, v_claim):
-    return [
-        Identity("u", CHART_AT[0], u_claim, DOMAIN),
-        Identity("v", CHART_AT[1], v_claim, DOMAIN),
-        Identity(r"\sin\varphi", CHART_AT[2], sp.sin(phi), DOMAIN),
-        Identity(r"\partial u/\partial\theta", CHART_RATES[0], RATES_CLAIMED[0], DOMAIN),
-        Identity(r"\partial v/\partial\varphi", CHART_RATES[1], RATES_CLAIMED[1], DOMAIN),
-    ]
-
-
-U_OF_THETA, V_OF_PHI = (theta + sp.pi) / (2 * sp.pi), phi / sp.pi
-#: The chart's inverse, theta(u) and phi(v), solved from u(theta) and v(phi).
-THETA_OF_U = sp.solve(sp.Eq(U_OF_THETA, F.u), theta)[0]
-PHI_OF_V = sp.solve(sp.Eq(V_OF_PHI, F.v), phi)[0]
-ANGLE_NAMES = {phi: r"\varphi"}
-
-
-def _check_chart(identities, corrupt=None):
-    verdict = check_identities(identities)
-    if not verdict.holds:
-        return verdict
-    # The renderer's own chart (GBuffer.uv) at its own N (proofs/pixels.py).
-    from .pixels import TOLERANCE, chart_error, worst_of
-    worst, count = worst_of(chart_error, [(f, corrupt) for f in ("sine", "ridges", "rings")])
-    if worst > TOLERANCE["chart"]:
-        return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
-                       f"{count} sphere-A pixels")
-    return Verdict(verdict.status, f"renderer.formulas.CHART at N(theta, phi): {verdict.evidence}; the "
-                   f"renderer's (u, v) (GBuffer.uv) at {count} seeded sphere-A pixels (pole ring and fallback "
-                   f"included) within {worst:.1e} of mpmath's CHART at its N", verdict.residual, verdict.digits,
-                   verdict.points, count)
-
-
-_swapped = [Identity("v", sp.atan2(N[2], sp.sqrt(N[0]**2 + N[1]**2)) / sp.pi, V_OF_PHI, DOMAIN)]
-
-CHART_INVERSE = Theorem(
-    id="chart", title="The chart is the spherical angles",
-    statement=(r"For $-\pi < \theta < \pi$ and $0 < \varphi < \pi$ the renderer's chart "
-               r"(`renderer.formulas.CHART`) of $N(\theta, \varphi)$ is "
-               rf"$u = {sp.latex(F.CHART[0])} = {sp.latex(U_OF_THETA)}$, "
-               rf"$v = {sp.latex(F.CHART[1])} = {sp.latex(V_OF_PHI, symbol_names=ANGLE_NAMES)}$ and "
-               rf"${sp.latex(F.CHART[2])} = \sin\varphi$; so $\partial u/\partial\theta = {sp.latex(RATES_CLAIMED[0])}$ "
-               rf"and $\partial v/\partial\varphi = {sp.latex(RATES_CLAIMED[1])}$, the factors between chart and angular "
-               r"derivatives of $h$."),
-    steps=tuple((i.label, i.lhs, i.rhs) for i in _chart_identities(U_OF_THETA, V_OF_PHI)),
-    check=lambda: _check_chart(_chart_identities(U_OF_THETA, V_OF_PHI)),
-    wrong_variants=(("u without the offset pi: theta / 2 pi",
-                     lambda: _check_chart(_chart_identities(theta / (2 * sp.pi), V_OF_PHI))),
-                    ("v with the arguments of atan2 swapped", lambda: _check_chart(_swapped)),
-                    ("the kernel's u and v swapped",
-                     lambda: _check_chart(_chart_identities(U_OF_THETA, V_OF_PHI), corrupt=lambda a: a[:, ::-1]))),
-    pages=("s3",),
-    seed_says="Cell 1 (chartA1): u = (theta + pi) / 2 pi, v = acos(N_z) / pi.",
-)
+FRAME_ORIENTATION = _orientation()
 
 THEOREMS = (CHART_INVERSE, FRAME_ORTHONORMAL, FRAME_ORIENTATION)

@@ -12,7 +12,7 @@ u = m / k_u is the ray alpha_m = 2 pi m / k_u - pi; the zero line v = m / k_v
 is the circle rho_m = rho(pi m / k_v), visible when cos(pi m / k_v) > R / e.
 """
 
-from functools import lru_cache
+from functools import lru_cache, partial
 
 import numpy as np
 import sympy as sp
@@ -20,8 +20,8 @@ import sympy as sp
 from renderer import Scene, gbuffer, render
 from renderer import formulas as F
 
-from .core import Identity, Theorem, Verdict, check_identities
-from .frame import ANGLE_NAMES, U_OF_THETA
+from .core import Dot, Step, Theorem, Verdict, written
+from .frame import U_OF_THETA
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, e = sp.symbols("R e", positive=True)
@@ -36,10 +36,6 @@ DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 1.2), R: (0.5, 1.0), e: (2.0, 6.0)}
 m_sym = sp.Symbol("m", integer=True)
 ALPHA_M = sp.solve(sp.Eq(U_OF_THETA, m_sym / F.k_u), theta)[0]      # frame's theta is this module's
 _ALPHA_M = sp.lambdify((m_sym, F.k_u), ALPHA_M, modules="numpy")
-
-
-def _tex(expr):
-    return sp.latex(expr, order="rev-lex", symbol_names=ANGLE_NAMES)
 
 
 def ray_angles(k_u):
@@ -132,26 +128,11 @@ def part_mismatch(kind, scene, size, shift, rho, drho, band_scale):
             np.count_nonzero(mine & (rendered & where)[None], axis=(1, 2)), int(np.count_nonzero(where)))
 
 
-def _projection_identities(rho, drho):
-    return [Identity("x", x_img, rho * sp.cos(theta), DOMAIN),
-            Identity("y", y_img, rho * sp.sin(theta), DOMAIN),
-            Identity(r"d\rho/d\varphi", sp.diff(RHO, phi), drho, DOMAIN)]
-
-
-#: What the loci's check is handed in a wrong variant that skips the identities.
-PROVED = Verdict("proved", "(identities skipped)")
-
-
-def _check(kind, rho=RHO, drho=DRHO):
-    symbolic = check_identities(_projection_identities(rho, drho))
-    return _loci(kind, symbolic) if symbolic.holds else symbolic
-
-
-def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False, band_scale=1.0):
-    """The identities' verdict ``symbolic``, kept if the rendered crease flag is the bands
-    about ``kind``'s loci (`part_mismatch`) and exactly the loci claimed visible have
-    crease pixels; else refuted.  ``all_visible`` (claim every circle visible) and
-    ``band_scale`` (`locus_bands`): wrong variants."""
+def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False, band_scale=1.0):
+    """Proved if the rendered crease flag is the bands about ``kind``'s loci (`part_mismatch`) and
+    exactly the loci claimed visible have crease pixels; else refuted.  ``shift``, ``rho``,
+    ``drho``, ``band_scale`` (`locus_bands`) and ``all_visible`` (claim every circle visible):
+    wrong variants."""
     from .book import frame_label
     mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho, band_scale)
     if kind == "rays":
@@ -169,49 +150,97 @@ def _loci(kind, symbolic, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visi
     if not np.array_equal(per_locus > 0, seen):
         return Verdict("refuted", f"rendered crease pixels per locus {per_locus.tolist()}, but the loci "
                        f"claimed visible are {seen.tolist()}")
-    return Verdict(symbolic.status, f"{symbolic.evidence}; {what}; the bands about these loci (closed form "
-                   f"alone) equal the rendered crease flag on all {compared} sphere-A pixels off the other "
-                   f"family, and exactly the visible loci have crease pixels ({', '.join(map(str, per_locus))}) "
-                   f"({frame_label(scene, SIZE, SIZE)})", rendered=compared)
+    return Verdict("proved", f"{what}; the bands about these loci (closed form alone) equal the rendered crease "
+                   f"flag on all {compared} sphere-A pixels off the other family, and exactly the visible loci have "
+                   f"crease pixels ({', '.join(map(str, per_locus))}) ({frame_label(scene, SIZE, SIZE)})",
+                   rendered=compared)
 
 
-KINK_LOCI_RAYS = Theorem(
-    id="kink-loci-rays", title="The u-creases are rays",
-    statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the "
-              rf"$z$-axis, $\alpha = \theta$, so $u = {_tex(U_OF_THETA.subs(theta, sp.Symbol('alpha')))}$ "
-              r"depends on the angle alone and the crease $u = m/k_u$ is the ray "
-              rf"$\alpha_m = {_tex(ALPHA_M)}$.",
-    steps=(("projection", r"(x, y)", sp.Matrix([x_img, y_img]).applyfunc(sp.simplify)),
-           ("polar form", r"(x, y)", sp.Matrix([RHO * sp.cos(theta), RHO * sp.sin(theta)]))),
-    check=lambda: _check("rays"),
-    wrong_variants=(("projection with a flipped sign: e + R cos(phi) in the denominator",
-                     lambda: _check("rays", rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi)))),
-                    ("the rays turned by half a period (alpha + pi/k_u)",
-                     lambda: _loci("rays", PROVED, shift=np.pi / Scene().k_u))),
-    pages=("s3", "s4"),
-    seed_says="§3: the zero lines u = m/k_u are rays 'by Chapter 5's longitude theorem'.",
-)
+#: The quantities the proofs name: the image point (x, y), its radius rho(phi), the ray's angle alpha_m,
+#: the eye E and the normal N.
+X, Y = sp.symbols("x y", real=True)
+rho = sp.Function("rho")
+alpha_m = sp.Symbol("alpha_m")
+E_S, N_S, P_S = (sp.MatrixSymbol(name, 3, 1) for name in "ENP")
+NAMES = {alpha_m: r"\alpha_m"}
+#: rho(phi) and the ray's angle as written: e R sin(phi) / (e - R cos(phi)), 2 pi m / k_u - pi.
+RHO_SHOWN = written(sp.Mul(e, R, sp.sin(phi), sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -1), evaluate=False))
+ALPHA_SHOWN = written(sp.Add(2 * sp.pi * m_sym / F.k_u, -sp.pi, evaluate=False))
+#: rho'(phi) as written: e R (e cos phi - R) / (e - R cos phi)^2.
+DRHO_SHOWN = written(sp.Mul(e, R, sp.Add(e * sp.cos(phi), -R, evaluate=False),
+                            sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -2), evaluate=False))
 
-KINK_LOCI_CIRCLES = Theorem(
-    id="kink-loci-circles", title="The v-creases are circles",
-    statement=rf"$v = \varphi/\pi$ depends on the radius alone: $\rho(\varphi) = {_tex(RHO)}$ "
-              rf"with $\rho'(\varphi) = {_tex(DRHO)} > 0$ on the visible cap "
-              r"$\cos\varphi > R/e$. The crease $v = m/k_v$ is the circle of radius "
-              r"$\rho(\pi m/k_v)$, visible when $\cos(\pi m/k_v) > R/e$.",
-    steps=(("radius", r"\rho(\varphi)", RHO), ("monotone", r"\rho'(\varphi)", DRHO)),
-    check=lambda: _check("circles"),
-    wrong_variants=(("derivative with the factor e cos(phi) - R replaced by e - R cos(phi)",
-                     lambda: _check("circles", drho=e * R / (e - R * sp.cos(phi)))),
-                    ("the circles moved by half a period (phi + pi/2k_v)",
-                     lambda: _loci("circles", PROVED, shift=np.pi / (2 * Scene().k_v))),
-                    ("the circles' bands twice as wide as the renderer's (the loci right, their bands not)",
-                     lambda: _loci("circles", PROVED, band_scale=2.0)),
-                    ("every circle claimed visible (the visibility condition dropped)",
-                     lambda: _loci("circles", PROVED, all_visible=True)),
-                    ("the radii with e + R cos(phi) in the projection's denominator",
-                     lambda: _loci("circles", PROVED, rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi))))),
-    pages=("s3", "s4"),
-    seed_says="§3: the zero lines v = m/k_v are circles 'by its corollary'.",
-)
+
+def _where(rho_):
+    return {X: x_img, Y: y_img, rho(phi): rho_, alpha_m: ALPHA_SHOWN, E_S: sp.ImmutableMatrix([0, 0, e]),
+            N_S: P / R, P_S: P}
+
+
+def _rays(rho_=RHO_SHOWN, **evidence):
+    """Theorem kink-loci-rays for the radius ``rho_`` and the evidence's options (wrong variants)."""
+    polar = sp.Tuple(rho(phi) * sp.cos(theta), rho(phi) * sp.sin(theta))
+    ray = U_OF_THETA.subs(theta, alpha_m)
+    return Theorem(
+        id="kink-loci-rays", title="The u-creases are rays",
+        statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the $z$-axis, "
+                  r"$⟦polar⟧$ with $⟦rho⟧$: $\alpha = \theta$, so $u = (\alpha + \pi)/2\pi$ depends on the angle "
+                  r"alone, and the crease $u = m/k_u$ is the ray $⟦alpha_m⟧$: $⟦ray⟧$.",
+        steps=(
+            Step(r"Project $P = R\,N(\theta, \varphi)$ from the eye $(0, 0, e)$ onto the image plane $z = 0$: its "
+                 r"$x$ and $y$ scale by $e/(e - P_z)$, and $P_z = R\cos\varphi$", sp.Tuple(X, Y), polar,
+                 defines=(rho(phi),)),
+            Step(r"So the image point's polar angle $\alpha$ is $\theta$, and $u = (\theta + \pi)/2\pi$ (theorem "
+                 r"chart) is a function of $\alpha$ alone; $u = m/k_u$ on the ray", ray, m_sym / F.k_u,
+                 defines=(alpha_m,)),
+        ),
+        claims={"polar": (sp.Tuple(X, Y), polar), "ray": (ray, m_sym / F.k_u)},
+        where=_where(rho_), names=NAMES, domain={**DOMAIN, m_sym: (0.0, 8.0), F.k_u: (0.5, 12.0)},
+        evidence=partial(_loci, "rays", **evidence),
+        wrong_variants=(("projection with a flipped sign: e + R cos(phi) in the denominator",
+                         lambda: _rays(e * R * sp.sin(phi) / (e + R * sp.cos(phi))).check()),
+                        ("the rays turned by half a period (alpha + pi/k_u)",
+                         lambda: _rays(shift=np.pi / Scene().k_u).check())),
+        pages=("s3", "s4"),
+        seed_says="§3: the zero lines u = m/k_u are rays 'by Chapter 5's longitude theorem'.",
+    )
+
+
+def _circles(drho=DRHO_SHOWN, **evidence):
+    """Theorem kink-loci-circles claiming rho' = ``drho``, with the evidence's options (wrong variants)."""
+    radius, slope, facing = X**2 + Y**2, sp.Derivative(rho(phi), phi), Dot(N_S, E_S - P_S)
+    cap = written(sp.Add(e * sp.cos(phi), -R, evaluate=False))
+    return Theorem(
+        id="kink-loci-circles", title="The v-creases are circles",
+        statement=r"$v = \varphi/\pi$ depends on the image radius alone: $⟦radius⟧$, and "
+                  r"$⟦slope⟧ > 0$ on the visible cap, where $⟦facing⟧ > 0$. The crease $v = m/k_v$ is the circle of "
+                  r"radius $\rho(\pi m/k_v)$, visible when $\cos(\pi m/k_v) > R/e$.",
+        steps=(
+            Step(r"By theorem kink-loci-rays, $x^2 + y^2 = \rho(\varphi)^2 (\cos^2\theta + \sin^2\theta)$", radius,
+                 rho(phi)**2),
+            Step(r"Differentiate $\rho(\varphi) = eR\sin\varphi/(e - R\cos\varphi)$ with the quotient rule", slope,
+                 drho),
+            Step(r"The point $P = R N$ faces the eye $E = (0, 0, e)$ where $N \cdot (E - P) > 0$, that is "
+                 r"$e\cos\varphi > R$: there $\rho' > 0$, so $\rho$ increases with $\varphi$ and each circle "
+                 r"$\varphi = \pi m/k_v$ has one radius", facing, cap),
+        ),
+        claims={"radius": (radius, rho(phi)**2), "slope": (slope, drho), "facing": (facing, cap)},
+        where=_where(RHO_SHOWN), names=NAMES, domain=DOMAIN, evidence=partial(_loci, "circles", **evidence),
+        wrong_variants=(("derivative with the factor e cos(phi) - R replaced by e - R cos(phi)",
+                         lambda: _circles(e * R / (e - R * sp.cos(phi))).check()),
+                        ("the circles moved by half a period (phi + pi/2k_v)",
+                         lambda: _circles(shift=np.pi / (2 * Scene().k_v)).check()),
+                        ("the circles' bands twice as wide as the renderer's (the loci right, their bands not)",
+                         lambda: _circles(band_scale=2.0).check()),
+                        ("every circle claimed visible (the visibility condition dropped)",
+                         lambda: _circles(all_visible=True).check()),
+                        ("the radii with e + R cos(phi) in the projection's denominator",
+                         lambda: _circles(rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi))).check())),
+        pages=("s3", "s4"),
+        seed_says="§3: the zero lines v = m/k_v are circles 'by its corollary'.",
+    )
+
+
+KINK_LOCI_RAYS = _rays()
+KINK_LOCI_CIRCLES = _circles()
 
 THEOREMS = (KINK_LOCI_RAYS, KINK_LOCI_CIRCLES)

@@ -9,7 +9,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Identity, Theorem, check_identities
+from .core import Step, Theorem, calc
 
 u, v = F.u, F.v
 #: The frequencies are positive in the scene (Scene validates k_u, k_v > 0): the
@@ -17,7 +17,6 @@ u, v = F.u, F.v
 k_u, k_v = sp.symbols("k_u k_v", positive=True)
 POSITIVE = {F.k_u: k_u, F.k_v: k_v}
 delta = sp.Symbol("delta", positive=True)
-x = sp.Symbol("x", real=True, nonzero=True)
 #: The renderer's ridges field and its two factors.
 h = F.HEIGHT["ridges"].subs(POSITIVE)
 FACTORS = tuple(s.subs(POSITIVE) for s in F.RIDGE_FACTORS)
@@ -31,78 +30,75 @@ DOMAIN = {u: (0.0, 1.0), v: (0.0, 1.0), k_u: (0.5, 12.0), k_v: (0.5, 12.0), c: (
 #: The crease flag's half-width (seed Cell 1, ``height1``: |s1| < 0.03 or |s2| < 0.03).
 SEED_HALF_WIDTH = sp.Rational(3, 100)
 
+#: The one-sided derivatives the proof names: h_u^+, h_u^- on u = m/k_u, h_v^+, h_v^- on v = m/k_v.
+HU_P, HU_M, HV_P, HV_M = sp.symbols("h_u^+ h_u^- h_v^+ h_v^-")
+#: The renderer's crease flag as a function of (u, v): 1 where KINK_BAND holds, else 0.
+crease = sp.Function("crease")
+
 
 def one_sided(expr, var, at):
-    """(right, left) derivatives of ``expr`` in ``var`` at ``var = at``."""
+    """(right, left) derivatives of ``expr`` in ``var`` at ``var = at``, as unevaluated limits."""
     base = expr.subs(var, at)
-    right = sp.limit((expr.subs(var, at + delta) - base) / delta, delta, 0, "+")
-    left = sp.limit((base - expr.subs(var, at - delta)) / delta, delta, 0, "+")
-    return sp.simplify(right), sp.simplify(left)
+    return (sp.Limit((expr.subs(var, at + delta) - base) / delta, delta, 0, "+"),
+            sp.Limit((base - expr.subs(var, at - delta)) / delta, delta, 0, "+"))
 
 
-def _flag(condition):
-    """1 where the crease flag's condition holds, 0 where it does not."""
-    return sp.Piecewise((sp.Integer(1), condition), (sp.Integer(0), True))
+def _ridges(jump_u, jump_v, band=BAND):
+    """Theorem ridges-kinks claiming the jumps ``jump_u``, ``jump_v`` (in c), for the crease band ``band``."""
+    on_u = one_sided(h.subs(FACTORS[1], c), u, m / k_u)
+    on_v = one_sided(h.subs(FACTORS[0], c), v, m / k_v)
+    jumps, values = sp.Tuple(HU_P - HU_M, HV_P - HV_M), sp.Tuple(jump_u, jump_v)
+    on_lines = sp.Tuple(crease(m / k_u, v), crease(u, m / k_v))
+    # Just inside and just outside the seed's half-width: |s| = 0.03 (1 -+ 1e-6), where the other factor is 1.
+    w_in, w_out = (sp.asin(sp.Float(SEED_HALF_WIDTH * (1 + s * sp.Rational(1, 10**6)), 8), evaluate=False)
+                   for s in (-1, 1))
+    edges = sp.Tuple(*(crease(w / (sp.pi * k_u), 1 / (2 * k_v)) for w in (w_in, w_out)),
+                     *(crease(1 / (2 * k_u), w / (sp.pi * k_v)) for w in (w_in, w_out)))
+    return Theorem(
+        id="ridges-kinks", title="The creases of the ridges field",
+        statement=r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
+                  r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
+                  r"(`RIDGE_FACTORS`) is differentiable wherever $s_1 s_2 \ne 0$ (theorem gradient-ridges). "
+                  r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, the "
+                  r"one-sided derivatives $h_u^\pm$ differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$, a crease. "
+                  r"The renderer's crease flag (`KINK_BAND`) is set on every zero line, $⟦lines⟧$, and where "
+                  rf"$\lvert s_1\rvert < {float(SEED_HALF_WIDTH):g}$ or $\lvert s_2\rvert < {float(SEED_HALF_WIDTH):g}$ "
+                  r"(the seed's half-width) only.",
+        steps=(
+            *calc(sp.Tuple(HU_P, HU_M),
+                  (r"On the line $u = m/k_u$ the factor $s_1 = \sin\pi k_u u$ vanishes; with $c \ne 0$ the value of "
+                   r"$s_2$ there, the one-sided derivatives of $h = \lvert s_1 c\rvert$ in $u$ are the limits",
+                   sp.Tuple(*on_u)),
+                  (r"$\lvert\sin\pi k_u u\rvert$ is a V about its zero, of slopes $\pm\pi k_u$",
+                   sp.Tuple(k_u * sp.pi * sp.Abs(c), -k_u * sp.pi * sp.Abs(c)))),
+            Step(r"So they differ by $2\pi k_u\lvert c\rvert$; the same limits with $u$ and $v$ exchanged give "
+                 r"$h_v^\pm$ on $v = m/k_v$", jumps, values),
+            Step("The crease flag is set on both lines, where one factor is 0", on_lines, sp.Tuple(1, 1)),
+            Step(r"Where the other factor is 1, it is set at $\lvert s\rvert = 0.03\,(1 - 10^{-6})$, just inside "
+                 r"the seed's half-width, and not at $0.03\,(1 + 10^{-6})$, just outside", edges, sp.Tuple(1, 0, 1, 0)),
+        ),
+        claims={"jumps": (jumps, values), "lines": (on_lines, sp.Tuple(1, 1))},
+        where={HU_P: on_u[0], HU_M: on_u[1], HV_P: on_v[0], HV_M: on_v[1],
+               crease: sp.Lambda((u, v), sp.Piecewise((1, band), (0, True)))},
+        names={HU_P: r"h_u^+", HU_M: r"h_u^-", HV_P: r"h_v^+", HV_M: r"h_v^-", crease: r"\mathrm{crease}"},
+        domain=DOMAIN,
+        wrong_variants=(
+            ("jump without the factor 2", lambda: _ridges(sp.pi * k_u * sp.Abs(c), JUMP_V).check()),
+            ("jump with the roles of k_u and k_v swapped", lambda: _ridges(2 * sp.pi * k_v * sp.Abs(c), JUMP_V).check()),
+            ("the crease band ten times wider",
+             lambda: _ridges(JUMP_U, JUMP_V, BAND.xreplace({F.KINK_BAND_HALF_WIDTH: 10 * F.KINK_BAND_HALF_WIDTH})
+                             ).check()),
+            ("the crease band half as wide",
+             lambda: _ridges(JUMP_U, JUMP_V, BAND.xreplace({F.KINK_BAND_HALF_WIDTH: F.KINK_BAND_HALF_WIDTH / 2})
+                             ).check())),
+        pages=("s3", "s7"),
+    )
 
 
-def _identities(jump_u, jump_v, band):
-    ids = [Identity(r"\frac{d}{dx}\lvert x\rvert,\ x \ne 0", sp.diff(sp.Abs(x), x), sp.sign(x),
-                    {x: (-3.0, 3.0)}),
-           Identity(r"h = \lvert s_1 s_2\rvert", h, sp.Abs(FACTORS[0] * FACTORS[1]), DOMAIN)]
-    for var, k, peak, factor, other, hand, jump in (
-            (u, k_u, {v: 1 / (2 * k_v)}, FACTORS[0], FACTORS[1], s2_hand, jump_u),
-            (v, k_v, {u: 1 / (2 * k_u)}, FACTORS[1], FACTORS[0], s1_hand, jump_v)):
-        line = m / k
-        r, l = one_sided(h.subs(other, c), var, line)
-        ids += [Identity(rf"h_{var}^+ - h_{var}^-\ \text{{at}}\ {var} = m/k_{var}", r - l, jump.subs(hand, c), DOMAIN),
-                Identity(rf"s\ \text{{at}}\ {var} = m/k_{var}", factor.subs(var, line), sp.Integer(0), DOMAIN),
-                Identity(rf"\text{{crease flag at}}\ {var} = m/k_{var}", _flag(band.subs(var, line)),
-                         sp.Integer(1), DOMAIN)]
-        # The band's edge: where the other factor is 1 (``peak``) and this one is just inside or
-        # just outside the seed's half-width, the flag is set and not set.
-        ids += [Identity(rf"\text{{crease flag at}}\ \lvert s\rvert = {float(w):.8g},\ {var}",
-                         _flag(band.subs(peak).subs(var, sp.asin(w) / (sp.pi * k))), sp.Integer(flag), DOMAIN)
-                for w, flag in ((SEED_HALF_WIDTH * (1 - sp.Rational(1, 10**6)), 1),
-                                (SEED_HALF_WIDTH * (1 + sp.Rational(1, 10**6)), 0))]
-    return ids
+#: The jumps, written by hand (seed §3), with c the other factor's value on the line.
+JUMP_U = 2 * sp.pi * k_u * sp.Abs(c)
+JUMP_V = 2 * sp.pi * k_v * sp.Abs(c)
 
-
-def _check(jump_u, jump_v, band=BAND):
-    return check_identities(_identities(jump_u, jump_v, band))
-
-
-#: The jumps, written by hand (seed §3): independent of the renderer's expressions.
-s1_hand, s2_hand = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
-JUMP_U = 2 * sp.pi * k_u * sp.Abs(s2_hand)
-JUMP_V = 2 * sp.pi * k_v * sp.Abs(s1_hand)
-
-RIDGES_KINKS = Theorem(
-    id="ridges-kinks", title="The creases of the ridges field",
-    statement=r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
-              r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
-              r"(`RIDGE_FACTORS`) is "
-              r"differentiable wherever $s_1 s_2 \ne 0$, with gradient $\operatorname{sign}(s_1 s_2)\,\nabla(s_1 s_2)$. "
-              r"On every zero line $u = m/k_u$ ($m$ any integer) the one-sided derivatives in $u$ differ by "
-              r"$2\pi k_u \lvert\sin\pi k_v v\rvert$, and on $v = m/k_v$ those in $v$ by "
-              r"$2\pi k_v \lvert\sin\pi k_u u\rvert$: a crease wherever the other factor is nonzero. "
-              r"The renderer's crease flag (`KINK_BAND`) is set on every zero line, and where "
-              rf"$\lvert s_1\rvert < {float(SEED_HALF_WIDTH):g}$ or $\lvert s_2\rvert < {float(SEED_HALF_WIDTH):g}$ "
-              r"(the seed's half-width) only.",
-    # The identities take one-sided limits: built when checked, not on import.
-    check=lambda: _check(JUMP_U, JUMP_V),
-    wrong_variants=(
-        ("jump without the factor 2", lambda: _check(sp.pi * k_u * sp.Abs(s2_hand), JUMP_V)),
-        ("jump with the roles of k_u and k_v swapped", lambda: _check(2 * sp.pi * k_v * sp.Abs(s2_hand), JUMP_V)),
-        ("the crease band ten times wider",
-         lambda: _check(JUMP_U, JUMP_V, BAND.xreplace({F.KINK_BAND_HALF_WIDTH: 10 * F.KINK_BAND_HALF_WIDTH}))),
-        ("the crease band half as wide",
-         lambda: _check(JUMP_U, JUMP_V, BAND.xreplace({F.KINK_BAND_HALF_WIDTH: F.KINK_BAND_HALF_WIDTH / 2})))),
-    steps=((r"one-sided", r"(h_u^+, h_u^-)\big|_{u = m/k_u,\ \sin\pi k_v v = c \ne 0}",
-            sp.Tuple(*one_sided(h.subs(FACTORS[1], c), u, m / k_u))),
-           (r"h_u^+ - h_u^-", r"h_u^+ - h_u^-", JUMP_U),
-           (r"h_v^+ - h_v^-", r"h_v^+ - h_v^-", JUMP_V),
-           (r"crease flag", r"\text{KINK\_BAND}", BAND)),
-    pages=("s3", "s7"),
-)
+RIDGES_KINKS = _ridges(JUMP_U, JUMP_V)
 
 THEOREMS = (RIDGES_KINKS,)

@@ -7,6 +7,8 @@ formula N' = M / |M| with M = N + beta g, g = h_u e_theta + h_v e_phi, written
 here.
 """
 
+from functools import partial
+
 import numpy as np
 import sympy as sp
 
@@ -14,7 +16,7 @@ from renderer import BUMPS, HEIGHT_FIELDS
 from renderer import formulas as F
 
 from . import frame
-from .core import Identity, Theorem, Verdict, check_identities
+from .core import Dot, Step, Theorem, Verdict, calc
 
 Nv = sp.Matrix([F.N_x, F.N_y, F.N_z])
 et, ep = sp.Matrix(F.e_theta), sp.Matrix(F.e_phi)
@@ -25,106 +27,68 @@ N_PRIME = sp.Matrix(F.PERTURBED_NORMAL["chart"])
 #: check substitutes the renderer's symbols into these same objects, so the
 #: statement cannot say one thing while another is checked.
 N_S, G_S = sp.MatrixSymbol("N", 3, 1), sp.MatrixSymbol("g", 3, 1)
-E_THETA_S, E_PHI_S = sp.MatrixSymbol(r"e_\theta", 3, 1), sp.MatrixSymbol(r"e_\varphi", 3, 1)
+E_THETA_S, E_PHI_S = frame.ET_S, frame.EP_S
 G_CLAIMED = F.h_u * E_THETA_S + F.h_v * E_PHI_S
 M_CLAIMED = sp.MatAdd(N_S, F.beta * G_S, evaluate=False)
-g = sp.Matrix(G_CLAIMED.subs({E_THETA_S: et, E_PHI_S: ep}).doit().as_explicit())
-M = sp.Matrix(M_CLAIMED.subs({N_S: Nv, G_S: g}).doit().as_explicit())
-norm_M = sp.sqrt(M.dot(M))
 DOMAIN = {**{s: (-2.0, 2.0) for s in list(Nv) + list(et) + list(ep) + [F.h_u, F.h_v]},
           F.beta: (0.01, 3.0)}
 
-#: M as the book shows it: the frame's components named as in §3.
-M_SHOWN = M.subs({**dict(zip(et, sp.symbols(r"e_{\theta\,x} e_{\theta\,y} e_{\theta\,z}"))),
-                  **dict(zip(ep, sp.symbols(r"e_{\varphi\,x} e_{\varphi\,y} e_{\varphi\,z}")))})
-
-#: The claimed derivative as the statement prints it (matrix symbols N', g and the scalar
-#: ||M||), and, substituted into it, the explicit 3-vector the check compares with.
-NP_S = sp.MatrixSymbol("N'", 3, 1)
+#: The names the proof uses: N', M and ||M||, and the claimed derivative as the statement prints it.
+NP_S, M_S = sp.MatrixSymbol("N'", 3, 1), sp.MatrixSymbol("M", 3, 1)
 NORM_M_S = sp.Symbol(r"\lVert M\rVert", positive=True)
 CLAIMED_DERIVATIVE = (sp.Identity(3) - NP_S * NP_S.T) * G_S / NORM_M_S
 
 
-def explicit(shown):
-    """The 3-vector of a claim written in N', g and ||M|| (as `CLAIMED_DERIVATIVE`)."""
-    return sp.Matrix(shown.subs({NP_S: N_PRIME, G_S: g, NORM_M_S: norm_M}).doit().as_explicit())
+def _derivative(claimed=CLAIMED_DERIVATIVE, m=M_CLAIMED):
+    """Theorem normal-beta-derivative claiming ``claimed`` for M = ``m`` (wrong variants)."""
+    slope = sp.Derivative(NP_S, F.beta)
+    return Theorem(
+        id="normal-beta-derivative", title="The beta-derivative of the perturbed normal",
+        statement=r"The renderer's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`) is "
+                  r"$⟦normal⟧$ with $⟦M⟧$, $⟦g⟧$, and $⟦derivative⟧$, for any $N$, frame and gradient.",
+        steps=(
+            Step("The renderer's $N'$ is $M$ normalised", NP_S, M_S / NORM_M_S),
+            Step(r"$M$ is linear in $\beta$, and $N$, the frame, $h_u$ and $h_v$ do not depend on $\beta$",
+                 sp.Derivative(M_S, F.beta), G_S),
+            Step(r"So $\lVert M\rVert = \sqrt{M \cdot M}$ has the derivative", sp.Derivative(NORM_M_S, F.beta),
+                 Dot(M_S, G_S) / NORM_M_S),
+            *calc(slope, (r"The quotient rule on $M/\lVert M\rVert$, with steps 2 and 3",
+                          G_S / NORM_M_S - M_S * Dot(M_S, G_S) / NORM_M_S**3),
+                  (r"$M/\lVert M\rVert = N'$ (step 1), so $M (M \cdot g)/\lVert M\rVert^3 = N' N'^{T} g/\lVert M\rVert$",
+                   claimed)),
+        ),
+        claims={"normal": (NP_S, M_S / NORM_M_S), "derivative": (slope, claimed)},
+        where={NP_S: N_PRIME, M_S: m, G_S: G_CLAIMED, N_S: Nv, E_THETA_S: et, E_PHI_S: ep,
+               NORM_M_S: sp.sqrt(Dot(M_S, M_S))},
+        names=frame.VECTOR_NAMES, domain=DOMAIN,
+        wrong_variants=(("sign of the projection flipped",
+                         lambda: _derivative((sp.Identity(3) + NP_S * NP_S.T) * G_S / NORM_M_S).check()),
+                        ("the 1/|M| factor dropped", lambda: _derivative((sp.Identity(3) - NP_S * NP_S.T) * G_S).check())),
+        pages=("s3", "s5"),
+        seed_says="§3 and §6: 'verified to 1e-12' (Cell 5); Cell 5's Expect: '~1e-9 worst component'.",
+    )
 
 
-CLOSED_FORM = explicit(CLAIMED_DERIVATIVE)
+NORMAL_BETA_DERIVATIVE = _derivative()
 
-
-def _identities(closed_form):
-    return [Identity(r"N' = M/\lVert M\rVert", N_PRIME, M / norm_M, DOMAIN),
-            Identity(r"\partial N'/\partial\beta", sp.diff(N_PRIME, F.beta), closed_form, DOMAIN)]
-
-
-def _check_derivative(closed_form):
-    verdict = check_identities(_identities(closed_form))
-    if not verdict.holds:
-        return verdict
-    return Verdict(verdict.status, f"renderer.formulas.PERTURBED_NORMAL['chart']: {verdict.evidence}",
-                   verdict.residual, verdict.digits, verdict.points)
-
-
-NORMAL_BETA_DERIVATIVE = Theorem(
-    id="normal-beta-derivative", title="The beta-derivative of the perturbed normal",
-    statement=r"The renderer's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`) is "
-              rf"$N' = M/\lVert M\rVert$ with $M = {sp.latex(M_CLAIMED, order='none')}$, "
-              rf"$g = {sp.latex(G_CLAIMED)}$, and "
-              rf"$\partial N'/\partial\beta = {sp.latex(CLAIMED_DERIVATIVE)}$, for any $N$, frame and "
-              r"gradient.",
-    steps=((r"M", r"M", M_SHOWN), (r"N'", r"N'", r"M/\lVert M\rVert"),
-           (r"\partial N'/\partial\beta", r"\partial N'/\partial\beta", CLAIMED_DERIVATIVE)),
-    check=lambda: _check_derivative(CLOSED_FORM),
-    wrong_variants=(("sign of the projection flipped",
-                     lambda: _check_derivative(explicit((sp.Identity(3) + NP_S * NP_S.T) * G_S / NORM_M_S))),
-                    ("the 1/|M| factor dropped",
-                     lambda: _check_derivative(explicit((sp.Identity(3) - NP_S * NP_S.T) * G_S)))),
-    pages=("s3", "s5"),
-    seed_says="§3 and §6: 'verified to 1e-12' (Cell 5); Cell 5's Expect: '~1e-9 worst component'.",
-)
-
-#: The renderer's normals on the sphere, in the frame it uses there (regular
-#: branch; for "surface", sin phi above the pole cut-off).
-_FRAME_AT = {**frame.ON_SPHERE, **dict(zip(F.e_theta, frame.e_theta)), **dict(zip(F.e_phi, frame.e_phi))}
-ON_FRAME = {mode: sp.Matrix(n).subs(sp.Max(F.sin_phi, F.POLE_SIN_PHI), F.sin_phi).subs(_FRAME_AT)
+#: The renderer's normals, for "surface" with sin phi above the pole cut-off (its floor
+#: max(sin phi, POLE_SIN_PHI) read as sin phi).
+NP_MODE = {mode: sp.MatrixSymbol(f"N'_{mode}", 3, 1) for mode in F.PERTURBED_NORMAL}
+ON_FRAME = {NP_MODE[mode]: sp.ImmutableMatrix(n).xreplace({sp.Max(F.sin_phi, F.POLE_SIN_PHI): F.sin_phi})
             for mode, n in F.PERTURBED_NORMAL.items()}
-#: The frame's vectors as the statement prints them (non-commuting, so that they stay on the right).
-E_THETA, E_PHI = sp.symbols(r"e_\theta e_\varphi", commutative=False)
+#: The frame's vectors and the normal as the statement prints them.
+ET_S, EP_S, N_SPHERE = frame.ET_S, frame.EP_S, frame.N_S
 #: The first-order tilt dN'/dbeta at beta = 0, written by hand in e_theta, e_phi: the chart
 #: mode tilts by g = h_u e_theta + h_v e_phi (seed §3); the displaced sphere by the
 #: gradient of beta h over the sphere's metric, |P_u| = 2 pi R sin phi, |P_v| = pi R.
-TILT_SHOWN = {"chart": F.h_u * E_THETA + F.h_v * E_PHI,
-              "surface": -(F.h_u / (2 * sp.pi * F.R * sp.sin(frame.phi))) * E_THETA
-                         - (F.h_v / (sp.pi * F.R)) * E_PHI}
-
-
-def tilt_vector(shown):
-    """The 3-vector of a tilt written in e_theta, e_phi (as `TILT_SHOWN`), in the frame at N(theta, phi)."""
-    return shown.coeff(E_THETA) * frame.e_theta + shown.coeff(E_PHI) * frame.e_phi
-
-
-def tilt_latex(shown):
-    return sp.latex(shown, symbol_names=frame.ANGLE_NAMES)
-
-
-TILT = {mode: tilt_vector(t) for mode, t in TILT_SHOWN.items()}
-SPHERE_DOMAIN = {frame.theta: (-3.1, 3.1), frame.phi: (0.05, 3.09), F.R: (0.5, 2.0), F.h: (-1.0, 1.0),
-                 F.h_u: (-2.0, 2.0), F.h_v: (-2.0, 2.0)}
+TILT_SHOWN = {"chart": F.h_u * ET_S + F.h_v * EP_S,
+              "surface": -(F.h_u / (2 * sp.pi * F.R * sp.sin(frame.phi))) * ET_S - (F.h_v / (sp.pi * F.R)) * EP_S}
+SPHERE_DOMAIN = {frame.phi: (0.05, 3.09), F.R: (0.5, 2.0), F.h: (-1.0, 1.0), F.h_u: (-2.0, 2.0), F.h_v: (-2.0, 2.0)}
 #: The renders: beta -> 0 over these steps, on a 96x80 frame.
 RATE_BETAS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 TINY_BETA = 1e-12
 #: The seed's two pipelines: the exact gradient and central differences.
 PIPELINES = ("exact", "central")
-
-
-def _limit_identities(tilt):
-    ids = []
-    for mode, n in ON_FRAME.items():
-        ids += [Identity(rf"N'_{{\mathrm{{{mode}}}}}|_{{\beta=0}}", n.subs(F.beta, 0), frame.N, SPHERE_DOMAIN),
-                Identity(rf"\partial_\beta N'_{{\mathrm{{{mode}}}}}|_{{\beta=0}}", n.diff(F.beta).subs(F.beta, 0),
-                         tilt[mode], SPHERE_DOMAIN)]
-    return ids
 
 
 def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=HEIGHT_FIELDS):
@@ -155,13 +119,10 @@ def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=HEIGHT_FIELDS):
     return worst, across_fields, renders, len(bumped)
 
 
-def _check_limit(tilt=None, order=1.0, **sampling):
-    """The limit beta -> 0: symbolic (N'(0) = N and dN'/dbeta at 0 = ``tilt``, both
-    modes) and rendered (the images approach the beta = 0 image at rate beta^``order``;
-    ``sampling`` goes to `_render_rate`, for the wrong variants)."""
-    symbolic = check_identities(_limit_identities(TILT if tilt is None else tilt))
-    if not symbolic.holds:
-        return symbolic
+def _rate_evidence(order=1.0, **sampling):
+    """The rendered limit: the images approach the beta = 0 image at rate beta^``order``, every
+    configuration reaches the image, and at beta = 0 the field does not (``sampling`` goes to
+    `_render_rate`, for the wrong variants)."""
     worst, across_fields, renders, distinct = _render_rate(**sampling)
     configurations = len(BUMPS) * len(PIPELINES) * len(HEIGHT_FIELDS)
     if across_fields:
@@ -177,39 +138,61 @@ def _check_limit(tilt=None, order=1.0, **sampling):
         return Verdict("refuted", f"renders approach the beta = 0 render with fitted order {slope:.2f} "
                        f"(claimed {order:g}); at beta = {TINY_BETA:g} the difference is {worst[-1]:.1e}, "
                        f"the linear rate allows {4 * line:.1e}")
-    return Verdict(symbolic.status, f"renderer.formulas.PERTURBED_NORMAL (both modes) at N(theta, phi) in the "
-                   f"renderer's frame: {symbolic.evidence}; {configurations} renders per beta (3 fields x 2 modes "
-                   f"x 2 pipelines, 96x80), {distinct} distinct at beta = {RATE_BETAS[0]:g}: max |I(beta) - I(0)| falls with fitted order {slope:.2f} over beta = "
-                   f"1e-2 ... 1e-8 ({worst[0]:.1e} to {worst[-2]:.1e}), {worst[-1]:.1e} at beta = {TINY_BETA:g} "
-                   f"(the linear rate allows {4 * line:.1e}); the beta = 0 renders of the three fields are equal "
-                   "bit for bit", rendered=renders)
+    return Verdict("proved", f"{configurations} renders per beta (3 fields x 2 modes x 2 pipelines, 96x80), "
+                   f"{distinct} distinct at beta = {RATE_BETAS[0]:g}: max |I(beta) - I(0)| falls with fitted order "
+                   f"{slope:.2f} over beta = 1e-2 ... 1e-8 ({worst[0]:.1e} to {worst[-2]:.1e}), {worst[-1]:.1e} at "
+                   f"beta = {TINY_BETA:g} (the linear rate allows {4 * line:.1e}); the beta = 0 renders of the three "
+                   "fields are equal bit for bit", rendered=renders)
 
 
-BETA_ZERO_REGRESSION = Theorem(
-    id="beta-zero-regression", title="The beta -> 0 limit",
-    statement=r"Both of the renderer's perturbed normals (`renderer.formulas.PERTURBED_NORMAL`, bump modes "
-              r"chart and surface), on sphere A in the renderer's frame, satisfy $N'(0) = N$ and "
-              rf"$N'(\beta) = N + \beta T + O(\beta^2)$ with $T_{{\mathrm{{chart}}}} = {tilt_latex(TILT_SHOWN['chart'])}$ "
-              rf"and $T_{{\mathrm{{surface}}}} = {tilt_latex(TILT_SHOWN['surface'])}$: "
-              r"the regression is a limit of rate $\beta$.  The rendered images approach the $\beta = 0$ "
-              r"image at that rate for both pipelines and every height field, and at $\beta = 0$ the height "
-              r"field does not reach the image.",
-    steps=tuple((rf"\partial_\beta N'_{{\mathrm{{{mode}}}}}|_{{\beta=0}}", r"T_{\mathrm{" + mode + "}}",
-                 tilt_latex(t)) for mode, t in TILT_SHOWN.items()),
-    check=_check_limit,
-    wrong_variants=(("the chart tilt with h_u and h_v swapped",
-                     lambda: _check_limit({**TILT, "chart": tilt_vector(F.h_v * E_THETA + F.h_u * E_PHI)})),
-                    ("the surface tilt without the metric factor 2 pi R sin phi",
-                     lambda: _check_limit({**TILT, "surface": tilt_vector(-F.h_u * E_THETA
-                                                                           - F.h_v / (sp.pi * F.R) * E_PHI)})),
-                    ("a quadratic rate claimed", lambda: _check_limit(order=2.0)),
-                    ("the beta = 0 reference rendered at beta = 1e-12, where the field reaches it",
-                     lambda: _check_limit(reference_beta=TINY_BETA)),
-                    ("the last render at beta = 1e-10 taken for 1e-12 (a floor above the linear rate)",
-                     lambda: _check_limit(tiny_beta=1e-10)),
-                    ("one height field rendered three times", lambda: _check_limit(fields=("sine",) * 3))),
-    pages=("s3", "s5"),
-    seed_says="Cell 6 expects beta = 0 agreement at ~1e-16.",
-)
+def _limit(tilt=None, **evidence):
+    """Theorem beta-zero-regression claiming the tilts ``tilt`` ({mode: T}, default `TILT_SHOWN`), with the
+    evidence's options (wrong variants)."""
+    tilt = {**TILT_SHOWN, **(tilt or {})}
+    at_zero = sp.Tuple(*(sp.Subs(NP_MODE[mode], F.beta, 0) for mode in NP_MODE))
+    slope = {mode: sp.Subs(sp.Derivative(NP_MODE[mode], F.beta), F.beta, 0) for mode in NP_MODE}
+    return Theorem(
+        id="beta-zero-regression", title="The beta -> 0 limit",
+        statement=r"Both of the renderer's perturbed normals (`renderer.formulas.PERTURBED_NORMAL`, bump modes "
+                  r"chart and surface), on sphere A in the renderer's frame (orthonormal and left-handed: theorems "
+                  r"frame-orthonormal, frame-orientation), satisfy $⟦limit⟧$ and "
+                  r"$N'(\beta) = N + \beta\,\partial N'/\partial\beta|_{\beta=0} + O(\beta^2)$ with $⟦chart⟧$ and "
+                  r"$⟦surface⟧$: the regression is a limit of rate $\beta$.  The rendered images approach the "
+                  r"$\beta = 0$ image at that rate for both pipelines and every height field, and at $\beta = 0$ the "
+                  r"height field does not reach the image.",
+        steps=(
+            Step(r"Both normals are built from $N$, $e_\theta$, $e_\varphi$ by dot products, the same in every "
+                 r"orthonormal frame, so take $e_\theta = x$, $e_\varphi = y$, $N = -z$; at $\beta = 0$ both bump "
+                 r"modes leave $M = N$, a unit vector", at_zero, sp.Tuple(N_SPHERE, N_SPHERE)),
+            Step(r"By theorem normal-beta-derivative at $\beta = 0$, where $N' = N$ and $\lVert M\rVert = 1$, the "
+                 r"chart mode tilts by the part of $g$ orthogonal to $N$, which is $g$ itself", slope["chart"],
+                 tilt["chart"]),
+            Step(r"The displaced sphere's $M = N - \frac{\beta}{R + \beta h}\bigl(\frac{h_u}{2\pi\sin\varphi} "
+                 r"e_\theta + \frac{h_v}{\pi} e_\varphi\bigr)$ tilts, likewise, by its tangential part's "
+                 r"$\beta$-derivative at 0: the gradient over the arc lengths $2\pi R\sin\varphi$ and $\pi R$",
+                 slope["surface"], tilt["surface"]),
+        ),
+        claims={"limit": (at_zero, sp.Tuple(N_SPHERE, N_SPHERE)), "chart": (slope["chart"], tilt["chart"]),
+                "surface": (slope["surface"], tilt["surface"])},
+        where={**ON_FRAME, **frame.STANDARD_FRAME, F.sin_phi: sp.sin(frame.phi)},
+        names={**frame.VECTOR_NAMES, NP_MODE["chart"]: r"N'_{\mathrm{chart}}",
+               NP_MODE["surface"]: r"N'_{\mathrm{surface}}"},
+        domain=SPHERE_DOMAIN, evidence=partial(_rate_evidence, **evidence),
+        wrong_variants=(("the chart tilt with h_u and h_v swapped",
+                         lambda: _limit({"chart": F.h_v * ET_S + F.h_u * EP_S}).check()),
+                        ("the surface tilt without the metric factor 2 pi R sin phi",
+                         lambda: _limit({"surface": -F.h_u * ET_S - F.h_v / (sp.pi * F.R) * EP_S}).check()),
+                        ("a quadratic rate claimed", lambda: _limit(order=2.0).check()),
+                        ("the beta = 0 reference rendered at beta = 1e-12, where the field reaches it",
+                         lambda: _limit(reference_beta=TINY_BETA).check()),
+                        ("the last render at beta = 1e-10 taken for 1e-12 (a floor above the linear rate)",
+                         lambda: _limit(tiny_beta=1e-10).check()),
+                        ("one height field rendered three times", lambda: _limit(fields=("sine",) * 3).check())),
+        pages=("s3", "s5"),
+        seed_says="Cell 6 expects beta = 0 agreement at ~1e-16.",
+    )
+
+
+BETA_ZERO_REGRESSION = _limit()
 
 THEOREMS = (NORMAL_BETA_DERIVATIVE, BETA_ZERO_REGRESSION)

@@ -7,9 +7,11 @@ THEOREMS = {t.id: t for mod in (frame, gradients, kinks, kink_loci, no_boundary,
                                         finite_difference, displacement, blinn)
             for t in mod.THEOREMS}
 
-#: The verdict each theorem must reach: "proved" (sympy decided every
-#: identity) or ("verified", bound): sympy left some undecided and mpmath
-#: found no residual above ``bound`` at the check's seeded points and digits.
+#: The verdict each theorem must reach: "proved" (sympy decided every step
+#: of its proof, and its evidence holds) or ("verified", bound): sympy left a
+#: step undecided and mpmath found no residual above ``bound`` at the check's
+#: seeded points and digits, or the theorem rests on its renderer evidence
+#: (no-boundary: ``bound`` is then the number of differing outputs).
 #: `pinned_failure` compares a verdict with it; `pytest verify` and the book
 #: build fail on any difference, so a verdict cannot change unnoticed.
 PINNED = {

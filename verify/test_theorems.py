@@ -1,8 +1,9 @@
-"""`pytest verify`: one test per theorem, and one per wrong variant.
+"""`pytest verify`: one test per theorem, one per wrong variant, one per step.
 
 A theorem passes when its check returns proved or verified; the ledger of
 verdicts is printed at the end of the run (see conftest.py).  Each wrong
-variant (a flipped sign, a dropped factor, a wrong exponent) must be refuted:
+variant (a flipped sign, a dropped factor, a wrong exponent) must be refuted,
+and so must each theorem with a wrong step planted in its proof, at that step:
 the checker has teeth.
 """
 
@@ -11,6 +12,7 @@ import re
 from pathlib import Path
 
 import pytest
+import sympy as sp
 
 from proofs.registry import PINNED, RENDERED, THEOREMS, get, pinned_failure
 from verify.conftest import LEDGER
@@ -67,50 +69,83 @@ def test_every_theorem_has_a_variant_and_a_statement():
     for t in THEOREMS.values():
         assert t.wrong_variants, t.id
         assert t.statement and t.steps, t.id
+        assert 1 <= len(t.steps) <= 6, (t.id, len(t.steps))
+
+
+def _placed(text):
+    """The theorem ids a page shows: string constants in the statements of its code cells that call
+    theorem_block, or a function of the page that calls it (as s3's ``theorems(*ids)``)."""
+    import ast
+    cells = [ast.parse(re.sub(r"\A(:\w+:[^\n]*\n)+", "", code))           # less the cell's :tags: lines
+             for code in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)\n```", text, re.S) if "theorem_block" in text]
+    calls = lambda node, names: any(isinstance(n, ast.Call) and isinstance(n.func, ast.Name) and n.func.id in names  # noqa: E731
+                                    for n in ast.walk(node))
+    helpers = {"theorem_block"} | {n.name for tree in cells for n in tree.body
+                                   if isinstance(n, ast.FunctionDef) and calls(n, {"theorem_block"})}
+    return {c.value for tree in cells for stmt in tree.body if not isinstance(stmt, ast.FunctionDef)
+            and calls(stmt, helpers) for c in ast.walk(stmt) if isinstance(c, ast.Constant) and isinstance(c.value, str)}
+
+
+def test_placed_finds_the_ids_a_page_shows_and_no_other_string():
+    page = ('```{code-cell} ipython3\n:tags: [remove-cell]\nfrom proofs.book import theorem_block\n'
+            'def theorems(*ids):\n    return "".join(theorem_block(t) for t in ids)\n```\n\ntext\n\n'
+            '```{code-cell} ipython3\ntheorems("chart", "frame-orientation")\n```\n\n'
+            '```{code-cell} ipython3\nx = render(Scene(bump="chart"))\ntheorem_block("optimal-step")\n```\n')
+    assert _placed(page) == {"chart", "frame-orientation", "optimal-step"}
+    assert _placed(page.replace('theorems("chart", "frame-orientation")', 'print("chart")')) == {"optimal-step"}
 
 
 def test_every_theorem_is_titled_and_used_on_pages_that_place_it():
     """The ledger's "used on" list names book pages, among them the page whose theorem block shows
-    the theorem; the title is the block's heading."""
+    the theorem (`_placed`); the title is the block's heading."""
     pages = {p.name.split("_")[0]: p.read_text(encoding="utf-8") for p in BOOK.glob("s[0-9]_*.md")}
     for t in THEOREMS.values():
         assert isinstance(t.title, str) and t.title.strip() == t.title and len(t.title) > 3, t.id
         assert isinstance(t.pages, tuple) and set(t.pages) <= set(pages), (t.id, t.pages)
-        placed = {name for name, text in pages.items() for line in text.splitlines()
-                  if "theorem_block(" in line and re.search(rf"[\"']{re.escape(t.id)}[\"']", line)}
+        placed = {name for name, text in pages.items() if t.id in _placed(text)}
         assert placed and placed <= set(t.pages), (t.id, placed, t.pages)
 
 
-def _step_residual(lhs, rhs, seed=0):
-    """Worst |lhs - rhs| (derivatives evaluated) at 20 seeded points, every free symbol in
-    (0.2, 2.5): inside the chart's range (theta in (-pi, pi), phi in (0, pi)) and the fields'."""
-    import random
-
-    import sympy as sp
-    diff = sp.Matrix(lhs).doit() - sp.Matrix(rhs) if isinstance(lhs, sp.MatrixBase) else lhs.doit() - rhs
-    free = sorted(diff.free_symbols, key=str)
-    fn = sp.lambdify(free, diff, modules="mpmath")
-    rng = random.Random(seed)
-    return max(float(abs(sp.Matrix(fn(*at)).norm()) if isinstance(diff, sp.MatrixBase) else abs(fn(*at)))
-               for at in ([rng.uniform(0.2, 2.5) for _ in free] for _ in range(20)))
+def _wrong(rhs):
+    """``rhs`` made wrong: 1 added to a scalar, to every entry of a matrix, to the first entry of a tuple."""
+    if isinstance(rhs, sp.Tuple):
+        return sp.Tuple(_wrong(rhs[0]), *rhs[1:])
+    if isinstance(rhs, (sp.MatrixBase, sp.MatrixExpr)):
+        return rhs + sp.ImmutableMatrix(sp.ones(*rhs.shape))
+    return rhs + 1
 
 
-#: Steps the book shows as "lhs = rhs" between two sympy objects (the rest pair LaTeX with one).
-SYMPY_STEPS = [(t.id, caption, lhs, rhs) for t in THEOREMS.values() for caption, lhs, rhs in t.steps
-               if all(hasattr(x, "free_symbols") for x in (lhs, rhs))]
+STEPS = [(t.id, k) for t in THEOREMS.values() for k in range(1, len(t.steps) + 1)]
 
 
-@pytest.mark.parametrize("theorem_id, caption, lhs, rhs", SYMPY_STEPS,
-                         ids=[f"{s[0]}:{s[1]}" for s in SYMPY_STEPS])
-def test_a_step_the_book_shows_holds(theorem_id, caption, lhs, rhs):
-    assert _step_residual(lhs, rhs) < 1e-12, f"{theorem_id}, step {caption}: the two sides differ"
+@pytest.mark.parametrize("theorem_id, k", STEPS, ids=[f"{i}: step {k}" for i, k in STEPS])
+def test_a_wrong_step_is_refuted_and_named(theorem_id, k):
+    """Every step is checked on its own: plant a wrong right side in step k of any theorem, and the
+    check refutes the theorem at step k, naming it (the steps before it still hold)."""
+    t = THEOREMS[theorem_id]
+    steps = list(t.steps)
+    steps[k - 1] = dataclasses.replace(steps[k - 1], rhs=_wrong(steps[k - 1].rhs))
+    verdict = dataclasses.replace(t, steps=tuple(steps)).check()
+    assert verdict.status == "refuted", verdict.evidence
+    assert verdict.evidence.startswith(f"{theorem_id}, step {k} ({t.steps[k - 1].why.rstrip('.:')})"), verdict.evidence
 
 
-def test_a_step_check_refutes_a_wrong_step():
-    import sympy as sp
-    from renderer import formulas as F
-    assert _step_residual(sp.Derivative(F.HEIGHT["sine"], F.u), F.GRADIENT["sine"][0]) < 1e-12
-    assert _step_residual(sp.Derivative(F.HEIGHT["sine"], F.u), F.GRADIENT["sine"][1]) > 1e-3
+def test_every_claim_is_stated_and_every_statement_prints():
+    """The statement prints each claim (``⟦key⟧``) from the objects the steps reach; nothing else is named."""
+    for t in THEOREMS.values():
+        assert t.claims, t.id
+        for key in t.claims:
+            assert f"⟦{key}⟧" in t.statement, (t.id, key)
+        assert "⟦" not in t.statement_tex(), t.id
+
+
+def test_no_sentence_is_shared_between_theorems():
+    """Each step says why it holds in its own words: no boilerplate repeated across theorems."""
+    seen = {}
+    for t in THEOREMS.values():
+        for step in t.steps:
+            assert seen.setdefault(step.why, t.id) == t.id, (step.why, seen[step.why], t.id)
+            assert step.why and len(step.why.split(". ")) <= 2, (t.id, step.why)
 
 
 def test_registry_names_unknown_ids():
@@ -122,14 +157,14 @@ def test_book_block_refuses_a_failing_theorem(monkeypatch):
     """A theorem that does not hold fails the build (the cell raises)."""
     from proofs import book, registry
     from proofs.core import Verdict
-    refuted = dataclasses.replace(get("optimal-step"), check=lambda: Verdict("refuted", "forced for the test"))
+    refuted = dataclasses.replace(get("optimal-step"), evidence=lambda: Verdict("refuted", "forced for the test"))
     monkeypatch.setattr(registry, "THEOREMS", {"optimal-step": refuted,
-                                               "frame-orthonormal": get("frame-orthonormal")})
+                                               "frame-orientation": get("frame-orientation")})
     monkeypatch.setattr(book.store, "_MEMORY", {})
     monkeypatch.delenv(book.store.ENV, raising=False)
     with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
         book.theorem_block("optimal-step")
-    assert "PROVED" in book.theorem_block("frame-orthonormal")
+    assert "PROVED" in book.theorem_block("frame-orientation")
     with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
         book.ledger_table()
     with pytest.raises(KeyError, match="no theorem 'no-such'"):
@@ -139,13 +174,30 @@ def test_book_block_refuses_a_failing_theorem(monkeypatch):
 def test_book_block_refuses_a_changed_verdict(monkeypatch):
     """A theorem that holds but not with its pinned verdict also fails the build."""
     from proofs import book, registry
-    monkeypatch.setattr(registry, "THEOREMS", {"frame-orthonormal": get("frame-orthonormal")})
-    monkeypatch.setitem(registry.PINNED, "frame-orthonormal", ("verified", 1e-25))
+    monkeypatch.setattr(registry, "THEOREMS", {"frame-orientation": get("frame-orientation")})
+    monkeypatch.setitem(registry.PINNED, "frame-orientation", ("verified", 1e-25))
     monkeypatch.setattr(book.store, "_MEMORY", {})
     monkeypatch.delenv(book.store.ENV, raising=False)
-    for show in (lambda: book.theorem_block("frame-orthonormal"), book.ledger_table):
-        with pytest.raises(book.TheoremFailed, match="frame-orthonormal is proved, pinned verified"):
+    for show in (lambda: book.theorem_block("frame-orientation"), book.ledger_table):
+        with pytest.raises(book.TheoremFailed, match="frame-orientation is proved, pinned verified"):
             show()
+
+def test_the_box_shows_statement_badge_and_steps_and_links_its_ledger_row(monkeypatch):
+    """The theorem's box: the statement, the badge with a link to the ledger row (``ledger-<id>``), then the
+    proof, one "Step k." per step with its equation; the evidence (what the check compared) is in the
+    ledger row, which links back to the box."""
+    from proofs import book, registry
+    t = get("optimal-step")
+    monkeypatch.setattr(registry, "THEOREMS", {t.id: t})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    block, row = book.theorem_block(t.id), book.ledger_table()
+    places = [block.index(t.statement_tex()), block.index("**PROVED** · evidence: {ref}`§6 <ledger-optimal-step>`"),
+              block.index(":::{prf:proof}")] + [block.index(f"**Step {k}.** ") for k in range(1, len(t.steps) + 1)]
+    assert places == sorted(places)
+    assert r"\varepsilon^\ast = \left(\frac{3 \mathrm{u} \lvert h\rvert}{\lvert h'''\rvert}\right)^{1/3}" in block
+    assert "reduced to 0" not in block and "reduced to 0 by sympy" in row
+    assert row.startswith("* (ledger-optimal-step)=\n  {prf:ref}`The optimal central-difference step <thm-optimal-step>`")
 
 
 def test_undecided_identity_is_verified_numerically(monkeypatch):
@@ -168,7 +220,7 @@ def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
     """The chart's identities alone, its renderer comparison skipped: the build fails."""
     from proofs import book, registry
     from proofs.core import Verdict
-    skipped = dataclasses.replace(get("chart"), check=lambda: Verdict("verified", "identities only", 1e-31, 30, 24))
+    skipped = dataclasses.replace(get("chart"), evidence=lambda: Verdict("proved", "renders skipped"))
     monkeypatch.setattr(registry, "THEOREMS", {"chart": skipped})
     monkeypatch.setattr(book.store, "_MEMORY", {})
     monkeypatch.delenv(book.store.ENV, raising=False)
