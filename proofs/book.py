@@ -104,9 +104,9 @@ class TheoremFailed(AssertionError):
 
 
 def _prose(text):
-    """A step's sentence as MyST: ``*`` and ``_`` escaped outside code spans (``ε*`` is not emphasis)."""
-    parts = re.split(r"(`[^`]*`)", text)
-    return "".join(p if p.startswith("`") else re.sub(r"([*_])", r"\\\1", p) for p in parts)
+    """A step's sentence as MyST: ``*`` and ``_`` escaped outside code and math spans (not emphasis)."""
+    parts = re.split(r"(`[^`]*`|\$[^$]*\$)", text)
+    return "".join(p if p[:1] in "`$" and p else re.sub(r"([*_])", r"\\\1", p) for p in parts)
 
 
 def _proof_step(t, number, step):
