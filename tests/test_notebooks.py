@@ -151,6 +151,17 @@ def test_the_site_serves_a_wheel_of_the_project_and_the_readme(book_html):
     assert (book_html / notebooks.DOWNLOADS / "constraints.txt").read_bytes() == (ROOT / "constraints.txt").read_bytes()
 
 
+def test_a_new_wheel_name_makes_every_notebook_page_written_again():
+    # The line under each title links the wheel by name; a new version must not leave it dangling.
+    env = SimpleNamespace(found_docs={"s1", "s9", "new"}, notebook_wheel="p-0.1.0-py3-none-any.whl",
+                          metadata={"s1": {"kernelspec": {"name": "python3"}}, "s9": {}, "new": {"kernelspec": {}}})
+    app = SimpleNamespace(env=env, notebook_wheel="p-0.1.0-py3-none-any.whl")
+    assert notebooks._outdated(app, env, set(), set(), set()) == []
+    app.notebook_wheel = "p-0.2.0-py3-none-any.whl"
+    assert notebooks._outdated(app, env, {"new"}, set(), set()) == ["s1"]
+    assert env.notebook_wheel == app.notebook_wheel and notebooks._outdated(app, env, set(), set(), set()) == []
+
+
 def test_a_failed_wheel_build_names_what_failed(tmp_path):
     # The project as it is, but with a version no packaging tool accepts.
     root = tmp_path / "project"

@@ -5,10 +5,11 @@ An HTML build puts into the site, beside the pages:
 * ``_downloads/<wheel>``: the project's wheel, built when the build starts with
   ``pip wheel`` and the setuptools of the build's own environment (offline,
   no build isolation), from a copy of the files it packages (so nothing is
-  written into the source tree); and ``_downloads/constraints.txt``, the
-  versions the book was built with;
-* ``README.html``: the README, rendered with markdown-it (the parser the book
-  itself uses; the README has no relative links to break);
+  written into the source tree); ``_downloads/constraints.txt``, the
+  versions the book was built with; and ``_downloads/README.html``, the README
+  rendered with markdown-it (the parser the book itself uses; the README has no
+  relative links to break), beside the files it describes and not among the
+  pages that the build's checks read;
 * ``_notebooks/<page>.ipynb`` for each page that is a MyST notebook, written by
   jupytext when the build finishes: the page's code cells as they are, with
   their tags and no outputs, and its prose as plain Markdown any Jupyter
@@ -47,7 +48,7 @@ from proofs.page import TITLED, escape, fenced, plain_directive, plain_markdown
 #: The site folder that holds the notebooks, and the one that holds the wheel and constraints.txt.
 FOLDER, DOWNLOADS = "_notebooks", "_downloads"
 #: The README, rendered into the site.
-README = "README.html"
+README = f"{DOWNLOADS}/README.html"
 #: The project's root (pyproject.toml, README.md, constraints.txt).
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -130,7 +131,7 @@ def write_readme(root, target):
     page = (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
             f'<meta name="viewport" content="width=device-width, initial-scale=1">'
             f"<title>README · {html_escape(title)}</title><style>{style}</style></head>\n<body>\n"
-            f'<p><a href="index.html">The book</a></p>\n{body}</body></html>\n')
+            f'<p><a href="../index.html">The book</a></p>\n{body}</body></html>\n')
     write_atomic(target, page.encode("utf-8"))
 
 
@@ -331,6 +332,15 @@ def _project_files(app):
     write_readme(ROOT, site / README)
 
 
+def _outdated(app, env, added, changed, removed):
+    """The notebook pages to write again because the wheel they link has a new name."""
+    wheel = getattr(app, "notebook_wheel", None)
+    if getattr(env, "notebook_wheel", None) == wheel:
+        return []
+    env.notebook_wheel = wheel
+    return sorted(d for d in env.found_docs - added - changed - removed if is_notebook(app, d))
+
+
 def _link(app, doctree, docname):
     if app.builder.format != "html" or not is_notebook(app, docname):
         return
@@ -370,6 +380,8 @@ def _write_all(app, exception):
 
 def setup(app):
     app.connect("builder-inited", _project_files)
+    app.connect("env-get-outdated", _outdated)
     app.connect("doctree-resolved", _link)
     app.connect("build-finished", _write_all)
-    return {"version": "2", "parallel_read_safe": True, "parallel_write_safe": True}
+    # env_version: a new version makes Sphinx read every page again (the line under each title changed).
+    return {"version": "2", "env_version": 2, "parallel_read_safe": True, "parallel_write_safe": True}
