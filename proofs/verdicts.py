@@ -50,8 +50,14 @@ def place_of(claim_id):
     raise KeyError(f"claim {claim_id!r} is placed in no section of PLACES")
 
 
-def _results():
-    return {c.id: (c, m, v) for c, m, v in checked()}
+def _results(ids=None):
+    """{claim id: (claim, measured, verdict)}, checked against the register.  Inside a book
+    build the whole register is one measurement shared by every page (`proofs.claims.checked`);
+    elsewhere (a downloaded notebook) only the claims ``ids`` are measured."""
+    from .page import in_book_build
+    if ids is None or in_book_build():
+        return {c.id: (c, m, v) for c, m, v in checked()}
+    return {c.id: (c, m, v) for c, m, v in checked([(c, *c.measure()) for c in CLAIMS if c.id in ids])}
 
 
 def _sentence(claim, measured, verdict):
@@ -72,7 +78,7 @@ def verdicts(place):
     """
     if place not in PLACES:
         raise KeyError(f"place must be one of {sorted(PLACES)}, got {place!r}")
-    results = _results()
+    results = _results(PLACES[place])
     body = "\n\n".join(_sentence(*results[i]) for i in PLACES[place])
     return f":::{{container}} verdicts\n{body}\n:::\n"
 

@@ -44,17 +44,17 @@ def test_every_place_is_a_label_of_a_page_that_shows_its_verdicts():
 
 def test_a_verdict_sentence_names_the_claim_the_verdict_and_links_its_register_row(monkeypatch):
     claim = next(c for c in CLAIMS if c.id == "h3-scale")
-    monkeypatch.setattr(verdicts, "_results", lambda: {"h3-scale": (claim, "measured text", FAILS)})
+    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {"h3-scale": (claim, "measured text", FAILS)})
     monkeypatch.setitem(verdicts.PLACES, "s3-ucurve", ("h3-scale",))
     md = verdicts.verdicts("s3-ucurve")
     assert md.startswith(":::{container} verdicts") and f"“{claim.quote}”" in md
     assert "**Does not hold:** measured text." in md and "{ref}`Register <claim-h3-scale>`" in md
-    monkeypatch.setattr(verdicts, "_results", lambda: {"h3-scale": (claim, "measured text", HOLDS)})
+    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {"h3-scale": (claim, "measured text", HOLDS)})
     assert "**Holds:**" in verdicts.verdicts("s3-ucurve")
 
 
 def test_the_register_gives_each_claim_a_target_and_a_link_back(monkeypatch):
-    monkeypatch.setattr(verdicts, "_results", lambda: {c.id: (c, f"m-{c.id}", c.registered) for c in CLAIMS})
+    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {c.id: (c, f"m-{c.id}", c.registered) for c in CLAIMS})
     md = verdicts.register()
     for c in CLAIMS:
         assert f"(claim-{c.id})=\n" in md
@@ -64,3 +64,12 @@ def test_the_register_gives_each_claim_a_target_and_a_link_back(monkeypatch):
 def test_an_unknown_place_is_refused():
     with pytest.raises(KeyError, match="place must be one of"):
         verdicts.verdicts("cell9")
+
+
+def test_outside_a_book_build_only_the_places_claims_are_measured(monkeypatch):
+    """A downloaded notebook measures the two claims of §1, not the register (wrong variant: all)."""
+    measured = []
+    monkeypatch.setattr("proofs.claims.Claim.measure", lambda self: measured.append(self.id) or ("m", self.registered))
+    monkeypatch.delenv("SYMRENDER_BOOK_BUILD", raising=False)
+    assert "**Holds" in verdicts.verdicts("s1")
+    assert sorted(measured) == sorted(verdicts.PLACES["s1"])
