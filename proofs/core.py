@@ -307,7 +307,7 @@ class _Printer(LatexPrinter):
         return super()._print_Pow(expr)
 
     def _print_atan2(self, expr):
-        return rf"\operatorname{{atan2}}\left({self._print(expr.args[0])}, {self._print(expr.args[1])}\right)"
+        return rf"\mathrm{{atan2}}\left({self._print(expr.args[0])}, {self._print(expr.args[1])}\right)"
 
     def _print_ZeroMatrix(self, expr):
         return "0"

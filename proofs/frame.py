@@ -102,8 +102,8 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
             Step(r"At $N(\theta, \varphi)$ the radicand is $\sin^2\varphi\,(\cos^2\theta + \sin^2\theta) = "
                  r"\sin^2\varphi$, and $\sin\varphi > 0$ for $0 < \varphi < \pi$", sin_kernel, sp.sin(phi)),
             Step(r"Both arguments of atan2 carry the factor $\sin\varphi > 0$, which leaves the angle unchanged, and "
-                 r"$\operatorname{atan2}(\sin\theta, \cos\theta) = \theta$ for $-\pi < \theta < \pi$", u_kernel, u_claim),
-            Step(r"By step 1 the first argument is $\sin\varphi$, and $\operatorname{atan2}(\sin\varphi, \cos\varphi) "
+                 r"$\mathrm{atan2}(\sin\theta, \cos\theta) = \theta$ for $-\pi < \theta < \pi$", u_kernel, u_claim),
+            Step(r"By step 1 the first argument is $\sin\varphi$, and $\mathrm{atan2}(\sin\varphi, \cos\varphi) "
                  r"= \varphi$ for $0 < \varphi < \pi$", v_kernel, V_OF_PHI),
             Step("Differentiate $u$ and $v$", rates, sp.Tuple(*RATES_CLAIMED)),
         ),

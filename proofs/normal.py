@@ -43,7 +43,7 @@ def _derivative(claimed=CLAIMED_DERIVATIVE, m=M_CLAIMED):
     """Theorem normal-beta-derivative claiming ``claimed`` for M = ``m`` (wrong variants)."""
     slope = sp.Derivative(NP_S, F.beta)
     return Theorem(
-        id="normal-beta-derivative", title="The beta-derivative of the perturbed normal",
+        id="normal-beta-derivative", title="The β-derivative of the perturbed normal",
         statement=r"The renderer's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`) is "
                   r"$⟦normal⟧$ with $⟦M⟧$, $⟦g⟧$, and $⟦derivative⟧$, for any $N$, frame and gradient.",
         steps=(
@@ -152,7 +152,7 @@ def _limit(tilt=None, **evidence):
     at_zero = sp.Tuple(*(sp.Subs(NP_MODE[mode], F.beta, 0) for mode in NP_MODE))
     slope = {mode: sp.Subs(sp.Derivative(NP_MODE[mode], F.beta), F.beta, 0) for mode in NP_MODE}
     return Theorem(
-        id="beta-zero-regression", title="The beta -> 0 limit",
+        id="beta-zero-regression", title="The β → 0 limit",
         statement=r"Both of the renderer's perturbed normals (`renderer.formulas.PERTURBED_NORMAL`, bump modes "
                   r"chart and surface), on sphere A in the renderer's frame (orthonormal and left-handed: theorems "
                   r"frame-orthonormal, frame-orientation), satisfy $⟦limit⟧$ and "
