@@ -134,7 +134,7 @@ def prose_sentences(html: str) -> list:
     parser = _Prose()
     parser.feed(html)
     parser._flush()
-    return [s for block in parser.blocks for s in re.split(r"(?<=[.;!?])\s+(?=[A-Z(“])", block)]
+    return [s.replace("’", "'") for block in parser.blocks for s in re.split(r"(?<=[.;!?])\s+(?=[A-Z(“])", block)]
 
 
 def _value(text):

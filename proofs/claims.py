@@ -148,6 +148,12 @@ def _err_at(eps):
     return float(c.error[np.argmin(np.abs(np.log10(c.eps) - np.log10(eps)))])
 
 
+def relative_error_at(eps):
+    """The central difference's relative error in hᵤ on the U-curve of Cell 2 (`proofs.ucurve.measure`'s
+    default curve) at its step nearest ``eps``: what the register's claims about 1e-9 and 1e-11 decide on."""
+    return _err_at(eps) / abs(_ucurve().derivative)
+
+
 def _h3_scale():
     value = (np.pi * 8.0) ** 3
     return f"$(\\pi k_u)^3 =$ {value:,.0f} at $k_u = 8$", {"(π kᵤ)³": value}
@@ -160,9 +166,8 @@ def _truncation_until():
 
 
 def _drowns_below_1e9():
-    c = _ucurve()
-    rel = _err_at(1e-9) / abs(c.derivative)
-    return (f"the quotient's relative error at a step of 1e-9 is {rel:.1e}: nine digits still right",
+    rel = relative_error_at(1e-9)
+    return (f"the quotient's relative error at a step of 1e-9 is {rel:.1e}: {int(-np.log10(rel))} digits still right",
             {"relative error at ε = 1e-9": rel})
 
 
@@ -456,8 +461,7 @@ def _cell6_truncation():
 
 
 def _noise_below_1e11():
-    c = _ucurve()
-    rel = _err_at(1e-11) / abs(c.derivative)
+    rel = relative_error_at(1e-11)
     return (f"the quotient's relative error at a step of 1e-11 is {rel:.1e}: digits lost, not noise",
             {"relative error at ε = 1e-11": rel})
 

@@ -85,8 +85,8 @@ def verdicts(place):
 
 def register():
     """MyST markdown: the register of §6, one entry per claim in `proofs.claims.CLAIMS`
-    order, each with the target ``claim-<id>``, its verdict and measurement, a link
-    to the section that discusses it, and (folded) how it is measured and decided.
+    order, each with the target ``claim-<id>``, its verdict, the rule that decided it, and
+    a link to the section that shows the measurement (`verdicts`).
 
     Raises
     ------
@@ -99,8 +99,6 @@ def register():
         claim, measured, verdict = results[c.id]
         entries.append(
             f"(claim-{c.id})=\n"
-            f"**{n}. {claim.where}:** “{claim.quote}”. **{WORDS[verdict]}:** {measured}. "
-            f"Discussed in {{ref}}`{place_of(c.id)}`.\n\n"
-            f"<details><summary>How it is decided</summary><p>Measured: {claim.measurement}. "
-            f"Rule: {CRITERIA[c.id]}.</p></details>\n")
+            f"**{n}. {claim.where}:** “{claim.quote}”. **{WORDS[verdict]}**, by the rule: {CRITERIA[c.id]}. "
+            f"Measured in {{ref}}`{place_of(c.id)}`.\n")
     return "\n".join(entries)

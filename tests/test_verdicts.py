@@ -58,7 +58,7 @@ def test_the_register_gives_each_claim_a_target_and_a_link_back(monkeypatch):
     md = verdicts.register()
     for c in CLAIMS:
         assert f"(claim-{c.id})=\n" in md
-    assert md.count("Discussed in {ref}`cell3`") == len(verdicts.PLACES["cell3"])
+    assert md.count("Measured in {ref}`cell3`") == len(verdicts.PLACES["cell3"])
 
 
 def test_an_unknown_place_is_refused():
