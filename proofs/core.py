@@ -679,9 +679,9 @@ def _prove(t: Theorem) -> Verdict:
     numeric = sorted({k for k, v in decided if v.status == "verified"})
     worst = max((v.residual for _, v in decided if v.status == "verified"), default=None)
     summary = (f"{len(t.steps)} steps, each reduced to 0 by sympy" if not numeric else
-               f"{len(t.steps)} steps; sympy reduced all but step{'s' if len(numeric) > 1 else ''} "
-               f"{', '.join(map(str, numeric))}, verified numerically: worst residual {worst:.1e} at "
-               f"{POINTS} seeded points, {DIGITS} digits")
+               f"{len(t.steps)} steps, reduced to 0 by sympy but for step{'s' if len(numeric) > 1 else ''} "
+               f"{', '.join(map(str, numeric))}, which hold{'' if len(numeric) > 1 else 's'} numerically (worst "
+               f"residual {worst:.1e} at {POINTS} seeded points, {DIGITS} digits)")
     residual, digits, points = (worst, DIGITS, POINTS) if numeric else (None, None, None)
     if t.evidence is None:
         return Verdict("verified" if numeric else "proved", summary, residual, digits, points)

@@ -34,6 +34,8 @@ SEED_HALF_WIDTH = sp.Rational(3, 100)
 HU_P, HU_M, HV_P, HV_M = sp.symbols("h_u^+ h_u^- h_v^+ h_v^-")
 #: The renderer's crease flag as a function of (u, v): 1 where KINK_BAND holds, else 0.
 crease = sp.Function("crease")
+#: Points just inside and just outside the crease band about u = 0 and v = 0.
+U_IN, U_OUT, V_IN, V_OUT = sp.symbols("u_in u_out v_in v_out")
 
 
 def one_sided(expr, var, at):
@@ -52,8 +54,8 @@ def _ridges(jump_u, jump_v, band=BAND):
     # Just inside and just outside the seed's half-width: |s| = 0.03 (1 -+ 1e-6), where the other factor is 1.
     w_in, w_out = (sp.asin(sp.Float(SEED_HALF_WIDTH * (1 + s * sp.Rational(1, 10**6)), 8), evaluate=False)
                    for s in (-1, 1))
-    edges = sp.Tuple(*(crease(w / (sp.pi * k_u), 1 / (2 * k_v)) for w in (w_in, w_out)),
-                     *(crease(1 / (2 * k_u), w / (sp.pi * k_v)) for w in (w_in, w_out)))
+    edges = {"u": sp.Tuple(crease(U_IN, 1 / (2 * k_v)), crease(U_OUT, 1 / (2 * k_v))),
+             "v": sp.Tuple(crease(1 / (2 * k_u), V_IN), crease(1 / (2 * k_u), V_OUT))}
     return Theorem(
         id="ridges-kinks", title="The creases of the ridges field",
         statement=r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
@@ -74,13 +76,18 @@ def _ridges(jump_u, jump_v, band=BAND):
             Step(r"So they differ by $2\pi k_u\lvert c\rvert$; the same limits with $u$ and $v$ exchanged give "
                  r"$h_v^\pm$ on $v = m/k_v$", jumps, values),
             Step("The crease flag is set on both lines, where one factor is 0", on_lines, sp.Tuple(1, 1)),
-            Step(r"Where the other factor is 1, it is set at $\lvert s\rvert = 0.03\,(1 - 10^{-6})$, just inside "
-                 r"the seed's half-width, and not at $0.03\,(1 + 10^{-6})$, just outside", edges, sp.Tuple(1, 0, 1, 0)),
+            Step(r"Where $s_2 = 1$ it is set at $u_-$, where $\lvert s_1\rvert = 0.03\,(1 - 10^{-6})$ is just inside "
+                 r"the seed's half-width, and not at $u_+$, just outside", edges["u"], sp.Tuple(1, 0),
+                 defines=(U_IN, U_OUT)),
+            Step(r"Likewise across $v$, where $s_1 = 1$", edges["v"], sp.Tuple(1, 0), defines=(V_IN, V_OUT)),
         ),
         claims={"jumps": (jumps, values), "lines": (on_lines, sp.Tuple(1, 1))},
         where={HU_P: on_u[0], HU_M: on_u[1], HV_P: on_v[0], HV_M: on_v[1],
-               crease: sp.Lambda((u, v), sp.Piecewise((1, band), (0, True)))},
-        names={HU_P: r"h_u^+", HU_M: r"h_u^-", HV_P: r"h_v^+", HV_M: r"h_v^-", crease: r"\mathrm{crease}"},
+               crease: sp.Lambda((u, v), sp.Piecewise((1, band), (0, True))),
+               U_IN: w_in / (sp.pi * k_u), U_OUT: w_out / (sp.pi * k_u), V_IN: w_in / (sp.pi * k_v),
+               V_OUT: w_out / (sp.pi * k_v)},
+        names={HU_P: r"h_u^+", HU_M: r"h_u^-", HV_P: r"h_v^+", HV_M: r"h_v^-", crease: r"\mathrm{crease}",
+               U_IN: "u_-", U_OUT: "u_+", V_IN: "v_-", V_OUT: "v_+"},
         domain=DOMAIN,
         wrong_variants=(
             ("jump without the factor 2", lambda: _ridges(sp.pi * k_u * sp.Abs(c), JUMP_V).check()),
