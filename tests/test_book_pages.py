@@ -250,6 +250,27 @@ AUDIT = r"""async () => {
 }"""
 
 
+#: The book's length limits: words of prose in the whole book, and each page's height at 1280 px
+#: with folded material closed.
+MAX_WORDS, MAX_HEIGHT = 11_000, 12_000
+LENGTH = r"""() => {
+  const art = document.querySelector('article.bd-article') || document.body;
+  const prose = art.cloneNode(true);
+  prose.querySelectorAll('pre, .highlight, mjx-container, .math, script, style, .cell_input').forEach(e => e.remove());
+  const words = (prose.textContent || '').split(/\s+/).filter(w => /\w/.test(w)).length;
+  return {height: document.documentElement.scrollHeight, words};
+}"""
+
+
+def too_long(lengths):
+    """The length limits a site breaks: pages taller than `MAX_HEIGHT` at 1280 px, and the book's
+    words beyond `MAX_WORDS`.  ``lengths``: {page: Page.length() at 1280 px}."""
+    bad = [f"{n}: {v['height']} px tall at 1280 px (at most {MAX_HEIGHT})" for n, v in lengths.items()
+           if v["height"] > MAX_HEIGHT]
+    words = sum(v["words"] for v in lengths.values())
+    return bad + ([f"{words} words of prose in the book (at most {MAX_WORDS})"] if words > MAX_WORDS else [])
+
+
 @pytest.fixture(scope="module")
 def browser():
     require_tool(CHROMIUM, "the page tests drive Debian's Chromium (apt-get install chromium)")
@@ -283,6 +304,11 @@ class Page:
     def audit(self):
         return self.page.evaluate(AUDIT)
 
+    def length(self):
+        """{"height": px, "words": n} of the page as it opens (folded material closed): the page's
+        height, and the words of its prose (the article without code, maths and scripts)."""
+        return self.page.evaluate(LENGTH)
+
     def screenshot(self, path):
         """The whole page, taken at its full height (a full-page capture would resize the window
         under fit.js's feet)."""
@@ -306,7 +332,9 @@ def site(browser, book_html):
         for name in PAGES:
             p = Page(browser, (book_html / f"{name}.html").as_uri(), width)
             try:
+                lengths = p.length()
                 found[name, width] = p.audit()
+                found[name, width]["length"] = lengths
                 p.screenshot(shots / f"{name}_{width}.png")
             finally:
                 p.close()
@@ -317,7 +345,9 @@ def site(browser, book_html):
                           "source_in_text": sum(len(found[n, w]["source"]) for n in PAGES),
                           "broken_words": sum(len(found[n, w]["broken"]) for n in PAGES),
                           "overflowing": sum(len(found[n, w]["overflow"]) for n in PAGES),
-                          "scrolling_boxes": sum(len(found[n, w]["scrollers"]) for n in PAGES)}
+                          "scrolling_boxes": sum(len(found[n, w]["scrollers"]) for n in PAGES),
+                          "prose_words": sum(found[n, w]["length"]["words"] for n in PAGES),
+                          "heights_closed": {n: found[n, w]["length"]["height"] for n in PAGES}}
                for w in WIDTHS}
     report = {"site": str(book_html), "ratio_tolerance": RATIO_TOL, "summary": summary,
               "pages": {n: {f"{w}px": found[n, w] for w in WIDTHS} for n in PAGES}}
@@ -358,6 +388,13 @@ def test_no_word_or_number_broken_across_lines(site, name, width):
 def test_nothing_wider_than_its_column(site, name, width):
     bad = site[name, width]["overflow"]
     assert not bad, f"{name} at {width} px: wider than the column or cut off:\n{_listing(bad)}"
+
+
+def test_the_book_is_short_enough(site):
+    """At most `MAX_WORDS` words of prose in the whole book and no page over `MAX_HEIGHT` px at 1280 px,
+    folded material closed."""
+    bad = too_long({n: site[n, 1280]["length"] for n in PAGES})
+    assert not bad, "\n".join(bad)
 
 
 def test_every_page_was_measured(site, book_html):
@@ -629,3 +666,24 @@ def test_the_books_diagrams_have_no_colliding_text():
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     (ARTIFACTS / "figure_overlaps.json").write_text(json.dumps(found, indent=1))
     assert found == dict.fromkeys(found, [])
+
+
+def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_html, tmp_path):
+    """Wrong variants: a page 13,000 px tall, and a page of 11,001 words; folded words count, a
+    folded block's height does not, and code does not count as prose."""
+    tall = _synthetic(tmp_path, '<div style="height: 13000px"></div><details><summary>s</summary>'
+                      '<div style="height: 20000px"></div></details>')
+    wordy = _synthetic(tmp_path, "<p>" + "word " * 10_000 + "</p><details><summary>fold </summary><p>"
+                       + "word " * 1000 + "</p></details><pre>" + "code " * 5000 + "</pre>")
+    lengths = {}
+    for name, url in (("tall", tall), ("wordy", wordy)):
+        p = Page(browser, url, 1280)
+        try:
+            lengths[name] = p.length()
+        finally:
+            p.close()
+    assert 13_000 <= lengths["tall"]["height"] < 20_000
+    assert lengths["wordy"]["words"] == 11_001
+    bad = too_long(lengths)
+    assert len(bad) == 2 and bad[0].startswith("tall:") and "11" in bad[1]
+    assert too_long({"wordy": {"height": 100, "words": 10_999}}) == []
