@@ -682,8 +682,8 @@ def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_htm
             lengths[name] = p.length()
         finally:
             p.close()
-    assert 13_000 <= lengths["tall"]["height"] < 20_000
-    assert lengths["wordy"]["words"] == 11_001
+    assert 13_000 <= lengths["tall"]["height"] < 20_000          # the folded 20,000 px do not count
+    assert 11_001 <= lengths["wordy"]["words"] < 12_000          # the folded words count, the code does not
     bad = too_long(lengths)
-    assert len(bad) == 2 and bad[0].startswith("tall:") and "11" in bad[1]
+    assert any(b.startswith("tall:") for b in bad) and any("words of prose in the book" in b for b in bad)
     assert too_long({"wordy": {"height": 100, "words": 10_999}}) == []
