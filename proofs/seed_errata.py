@@ -312,7 +312,7 @@ ERRATA = (
         criterion="arccos loses more than 1e-3 (relative) while atan2 stays within 1e-14",
         present=lambda m: m["max_rel_error_acos"] > 1e-3 and m["max_rel_error_atan2"] < 1e-14,
         finding=(
-            "For unit normals with $10^{{-8}} < \\sin\\varphi < 10^{{-2}}$ the relative error of "
+            "For unit normals with $\\sin\\varphi$ between 1e-8 and 1e-2 the relative error of "
                 "$\\arccos N_z$ reaches {max_rel_error_acos:.1e} against mpmath; atan2 stays within "
                 "{max_rel_error_atan2:.1e}."
         ),
