@@ -128,7 +128,7 @@ def _entry(t):
     steps = "\n\n".join(_proof_step(t, i, step) for i, step in enumerate(t.steps, 1))
     block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement_tex()}\n\n"
              f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`\n:::\n\n"
-             f":::{{prf:proof}}\n{steps}\n:::\n")
+             f":::{{prf:proof}}\n:class: dropdown\n\n{steps}\n:::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
                 pages=list(t.pages), block=block, changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
 
