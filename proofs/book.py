@@ -128,7 +128,7 @@ def _entry(t):
     steps = "\n\n".join(_proof_step(t, i, step) for i, step in enumerate(t.steps, 1))
     block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement_tex()}\n\n"
              f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`\n:::\n\n"
-             f":::{{prf:proof}}\n:class: dropdown\n\n{steps}\n:::\n")   # folded: the statement reads first
+             f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
                 pages=list(t.pages), block=block, changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
 
@@ -174,10 +174,14 @@ def _refuse(theorem_id, entry):
         raise TheoremFailed(f"{entry['changed']} (proofs.registry.PINNED, RENDERED): {entry['evidence']}")
 
 
+#: A name from the code in a checker's text (``TANGENT_FRAME``, ``t_A``, ``PERTURBED_NORMAL['surface']``).
+_CODE_NAME = re.compile(r"(?<![\w>])([A-Za-z][\w.]*_[\w.]*(?:\['\w+'\])?)")
+
+
 def _folded(label, text):
     """Raw HTML: ``label`` and ``text`` up to its first semicolon, the rest folded
-    into a <details> the reader opens."""
-    head, _, rest = (html.escape(t, quote=False) for t in text.partition("; "))
+    into a <details> the reader opens; the code's names in it set as code."""
+    head, _, rest = (_CODE_NAME.sub(r"<code>\1</code>", html.escape(t, quote=False)) for t in text.partition("; "))
     return f"<details><summary>{label}: {head}</summary>{rest}</details>" if rest else f"<p>{label}: {head}</p>"
 
 
