@@ -188,7 +188,7 @@ def _folded(label, text):
 def ledger_table():
     """MyST markdown, one list item per theorem, labelled ``ledger-<id>`` (the theorem's box
     links here with ``{ref}`§6 <ledger-<id>>```): its title (linked to the box), id,
-    verdict and the pages using it; then its evidence (what its steps took, and the
+    verdict; then its evidence (what its steps took, and the
     renderer's outputs compared), the first clause shown and the rest folded, and what
     the draft says.  (A list, not a table: the evidence is a
     paragraph, which a table column of a 700-pixel page squeezes to a word a line.)
@@ -201,10 +201,9 @@ def ledger_table():
     items = []
     for theorem_id, e in ledger().items():
         _refuse(theorem_id, e)
-        pages = ", ".join(f"{{ref}}`{p}`" for p in e["pages"]) or "no page"
         draft = f"\n\n  {_folded('The draft says', e['seed_says'])}" if e["seed_says"] else ""
         items.append(f"* (ledger-{theorem_id})=\n  {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
-                     f"**{BADGES[e['status']]}**; used on {pages}.\n\n"
+                     f"**{BADGES[e['status']]}**.\n\n"
                      f"  {_folded('Evidence', e['evidence'])}{draft}")
     return "\n".join(items)
 

@@ -252,9 +252,8 @@ def _census(size):
 
 def _census_slope():
     c = census()
-    return (f"the RMS slope of the census is {c['rms_slope']:.2f} and its off-band slope "
-            f"{c['off_slope']:.2f} (fitted exponents over steps from 1e-1 to 1e-6, {c['label']}): only "
-            "the pixels off the crease band descend at second order",
+    return (f"the RMS slope is {c['rms_slope']:.2f}, the off-band slope {c['off_slope']:.2f} (fitted over "
+            f"the six steps, {c['label']}): only the pixels off the crease band descend at second order",
             {"RMS slope": c["rms_slope"], "off-band slope": c["off_slope"]})
 
 
@@ -269,9 +268,9 @@ def _cell3_runs():
     try:
         np.abs(num.image - sym.image)[same & on_a].max()
     except ValueError as error:
-        return (f"the cell crashes before printing a row: its sphere A covers {np.count_nonzero(on_a)} of "
-                f"{code.size:,} pixels{_on(sym)}, and the maximum over no pixels raises ValueError "
-                f"(“{error}”)", {"rows computed": 0})
+        return (f"the cell crashes before its first row: its sphere A covers {np.count_nonzero(on_a)} of "
+                f"{code.size:,} pixels{_on(sym)}, and a maximum over no pixels raises ValueError",
+                {"rows computed": 0})
     return "the sweep's first row is computed" + _on(sym), {"rows computed": 1}
 
 
@@ -349,9 +348,8 @@ def _stacking():
         d = (box - one.image)[all_a & (one.chamber == SPHERE_A)]
         err[beta] = float(np.sqrt(np.mean(d ** 2)))
     ratio = err[0.35] / err[0.0]
-    return (f"no new integral, but the filter's integrand gets harder: one sample per pixel misses the "
-            f"4 × 4 box-filtered value by RMS {err[0.35]:.1e} on sphere A with the bump and {err[0.0]:.1e} "
-            f"without, {ratio:.0f} times as far{_on(one, Scene())}",
+    return (f"no new integral, but a harder integrand: one sample per pixel misses the 4 × 4 box filter "
+            f"by RMS {err[0.35]:.1e} with the bump, {err[0.0]:.1e} without{_on(one, Scene())}",
             {"one-sample error, with / without the bump": ratio})
 
 
@@ -398,10 +396,9 @@ def _timing():
     f_central = best(lambda: render(Scene(), 128, 128, gradient="central"), 7)
     stage = t_central / t_exact
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
-    return (f"decided by a count, not a clock: the exact gradient calls {exact.trig:g} sines and cosines per "
-            f"pixel, the central stencil {central.trig:g}; timed (fastest of repeated runs, deciding nothing), "
-            f"the central gradient stage takes {stage:.1f} times as long and the whole central frame "
-            f"{f_central / f_exact:.2f} times{_on(g, Scene())}",
+    return (f"by count: the exact gradient calls {exact.trig:g} sines and cosines per pixel, the central "
+            f"stencil {central.trig:g}; timed, deciding nothing, the central stage takes {stage:.1f} times as "
+            f"long, the whole frame {f_central / f_exact:.2f} times{_on(g, Scene())}",
             {"sin/cos calls, exact minus central": exact.trig - central.trig})
 
 
@@ -425,8 +422,8 @@ def _cell5_fd():
 def _dn_1e12():
     from .accuracy import normal_beta_derivative_residual
     r = normal_beta_derivative_residual()
-    return (f"the closed form's worst error is {r:.1e} against a 50-digit mpmath derivative over 2,000 random "
-            "cases; the draft's own forward-difference check cannot show it", {"closed form's residual": r})
+    return (f"the closed form's worst error is {r:.1e} against a 50-digit mpmath derivative, which the "
+            "draft's forward difference cannot show", {"closed form's residual": r})
 
 
 def _beta_order():
@@ -469,9 +466,8 @@ def _noise_below_1e11():
 def _crease_values():
     fd = float(pointwise.central_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0, 1e-4)[0])
     ex = float(pointwise.exact_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0)[0])
-    return (f"the central difference gives {fd:+.1e} on the crease, as expected, but the exact gradient gives "
-            f"{ex:+.3f}, not zero: $\\sin(\\pi k_u u)$ at the float nearest $1/k_u$ is not zero, so the sign "
-            "factor picks a side",
+    return (f"the central difference gives {fd:+.1e} on the crease, but the exact gradient {ex:+.3f}: "
+            f"$\\sin(\\pi k_u u)$ at the float nearest $1/k_u$ is not zero, so the sign picks a side",
             {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex)})
 
 
