@@ -981,7 +981,8 @@ def _page_figures(book, page):
             key = next((k for k in data if k == "image/png" or k.endswith("record/image/png")), None)
             if key is None:
                 continue
-            glue = (o.get("metadata", {}).get("scrapbook", {}) or {}).get("name")
+            meta = o.get("metadata", {})       # proofs.page.show names its figure outside a book build
+            glue = ((meta.get("scrapbook") or {}).get("name") or (meta.get("symrender") or {}).get("figure"))
             j += 1
             fid = f"{page}-{glue}" if glue else f"{page}-cell{ordinal:02d}-{j}"
             tags = tuple(cell.get("metadata", {}).get("tags", ()))
