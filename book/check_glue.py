@@ -37,6 +37,7 @@ NAMED = {
     "census_ratio": "crease ratio",
     "dn_residual": "closed form's worst error",
     "ucurve_eps_opt": "fitted optimal step",
+    "ucurve_eps_pred": "predicted optimal step",
     "ucurve_rel_1e9": "relative error at a step of 1e-9",
     "ucurve_rel_1e11": "relative error at a step of 1e-11",
     "beta_median_order": "median order",

@@ -94,54 +94,66 @@ def frame_diagram(theta=-0.35, phi=0.8):
     return fig
 
 
-def normal_diagram(field="rings", beta=0.35, theta=0.4, phi0=1.0, span=0.35):
-    """A meridian of sphere A (theta fixed) and of the displaced sphere (R + beta h) N, and at
-    its middle the shading normals of the two bump modes (the sympy objects
-    `formulas.PERTURBED_NORMAL`, fed the frame and gradient `pointwise` computes there), drawn
-    in the meridian's plane with the displaced curve's own normal.  With the rings field
-    (h_u = 0) every vector lies in that plane."""
+def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span=0.4, count=9):
+    """What a bump does, in one meridian of sphere A (theta fixed): the sphere (solid) keeps its
+    shape, while the shading normals drawn on it follow the sphere displaced to (R + beta h) N
+    (dashed).  At ``count`` points of the sphere, the displaced sphere's normal (the sympy object
+    `formulas.PERTURBED_NORMAL["surface"]`, fed the frame and gradient `pointwise` computes
+    there); at the middle point also the unbumped N and the draft's normal (``["chart"]``), and,
+    at the displaced point above it, the displaced curve's own normal.  With the rings field
+    (h_u = 0) every vector lies in the meridian's plane."""
     import matplotlib.pyplot as plt
     import sympy as sp
 
     from renderer import formulas as F
     scene = Scene(height_field=field, beta=beta)
-    phis = np.linspace(phi0 - span, phi0 + span, 200)
-    u = np.full_like(phis, (theta + np.pi) / (2 * np.pi))
-    v = phis / np.pi
-    h = pointwise.height(field, u, v, scene.k_u, scene.k_v)
-    # The meridian's plane: x along (cos theta, sin theta, 0) (horizontal), z up.
     r0 = scene.radius_a
-    base = np.stack([r0 * np.sin(phis), r0 * np.cos(phis)], axis=-1)
+    phis = np.linspace(phi0 - span, phi0 + span, 400)
+    u = (theta + np.pi) / (2 * np.pi)
+    h = pointwise.height(field, np.full_like(phis, u), phis / np.pi, scene.k_u, scene.k_v)
+    base = np.stack([r0 * np.sin(phis), r0 * np.cos(phis)], axis=-1)       # x along the meridian's plane, z up
     bumped = np.stack([(r0 + beta * h) * np.sin(phis), (r0 + beta * h) * np.cos(phis)], axis=-1)
-    fig, ax = plt.subplots(figsize=(6.4, 3.6))
-    ax.plot(*base.T, color=GREY, lw=1.2, label="sphere A (the geometry the bump keeps)")
-    ax.plot(*bumped.T, color=GREY, lw=1.2, ls="--", label=r"displaced sphere $(R + \beta h)N$")
-    k = len(phis) // 2
-    N3 = _sphere_point(theta, phis[k])
-    sin_phi = np.hypot(N3[0], N3[1])
-    e_t, e_p = (np.array(x, float).ravel() for x in pointwise.tangent_frame(N3[0], N3[1], N3[2], sin_phi))
-    hu, hv = (float(np.asarray(g).ravel()[0]) for g in pointwise.exact_gradient(field, u[k], v[k], scene.k_u, scene.k_v))
-    args = {F.N_x: N3[0], F.N_y: N3[1], F.N_z: N3[2], F.h_u: hu, F.h_v: hv, F.beta: beta, F.h: float(h[k]),
-            F.R: r0, F.sin_phi: sin_phi, **dict(zip(F.e_theta, e_t)), **dict(zip(F.e_phi, e_p))}
     in_plane = np.array([[np.cos(theta), np.sin(theta), 0.0], [0.0, 0.0, 1.0]])
-    tangent = np.gradient(bumped, axis=0)[k]
-    displaced = np.array([tangent[1], -tangent[0]]) / np.hypot(*tangent)
-    displaced *= np.sign(displaced @ bumped[k])
-    at = bumped[k]
-    arrows = [(in_plane @ N3, GREY, r"$N$ (sphere A)"),
-              (in_plane @ np.array(sp.Matrix(F.PERTURBED_NORMAL["chart"]).subs(args), float).ravel(), RED,
-               r"$N'$ chart (the draft's)"),
-              (in_plane @ np.array(sp.Matrix(F.PERTURBED_NORMAL["surface"]).subs(args), float).ravel(), BLUE,
-               r"$N'$ surface"),
-              (displaced, GREEN, "normal of the displaced curve")]
-    for vec, colour, label in arrows:                  # the displaced curve's normal thin, on top of N' surface
-        tip = at + 0.35 * vec / np.linalg.norm(vec)
-        ax.plot(*np.array([at, tip]).T, alpha=0.0)      # the arrow inside the axes' limits
-        ax.annotate("", tip, at, annotation_clip=False,
-                    arrowprops=dict(arrowstyle="-|>", color=colour, lw=3.5 if colour == BLUE else 1.2))
-        ax.plot([], [], color=colour, lw=3.5 if colour == BLUE else 1.2, label=label)
+    normal = {mode: sp.lambdify([F.N_x, F.N_y, F.N_z, *F.e_theta, *F.e_phi, F.h_u, F.h_v, F.beta, F.h, F.R,
+                                 F.sin_phi], sp.Matrix(F.PERTURBED_NORMAL[mode]), "numpy")
+              for mode in ("chart", "surface")}
+
+    def shading(mode, phi):
+        N3 = _sphere_point(theta, phi)
+        sin_phi = np.hypot(N3[0], N3[1])
+        e_t, e_p = (np.array(x, float).ravel() for x in pointwise.tangent_frame(N3[0], N3[1], N3[2], sin_phi))
+        hu, hv = (float(np.asarray(g).ravel()[0]) for g in
+                  pointwise.exact_gradient(field, u, phi / np.pi, scene.k_u, scene.k_v))
+        hh = float(pointwise.height(field, u, phi / np.pi, scene.k_u, scene.k_v))
+        return in_plane @ np.array(normal[mode](*N3, *e_t, *e_p, hu, hv, beta, hh, r0, sin_phi), float).ravel()
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.plot(*base.T, color=GREY, lw=1.5)
+    ax.plot(*bumped.T, color=GREY, lw=1.0, ls="--")
+    length = 0.22
+
+    def arrow(at, vec, colour, lw=1.4):
+        tip = at + length * vec / np.linalg.norm(vec)
+        ax.plot(*np.array([at, tip]).T, alpha=0.0)          # keeps the arrow inside the axes' limits
+        ax.annotate("", tip, at, arrowprops=dict(arrowstyle="-|>", color=colour, lw=lw))
+
+    for phi in np.linspace(phi0 - 0.85 * span, phi0 + 0.85 * span, count):
+        arrow(r0 * np.array([np.sin(phi), np.cos(phi)]), shading("surface", phi), BLUE)
+    mid = len(phis) // 2
+    arrow(base[mid], shading("surface", phis[mid]), BLUE, lw=3.5)     # wide, under the displaced curve's normal
+    at = base[mid]
+    arrow(at, in_plane @ _sphere_point(theta, phis[mid]), GREY)
+    arrow(at, shading("chart", phis[mid]), RED)
+    tangent = np.gradient(bumped, axis=0)[mid]
+    own = np.array([tangent[1], -tangent[0]]) * np.sign(np.array([tangent[1], -tangent[0]]) @ bumped[mid])
+    arrow(bumped[mid], own, GREEN, lw=1.0)
+    handles = [plt.Line2D([], [], color=c, lw=lw, ls=ls) for c, lw, ls in
+               ((GREY, 1.5, "-"), (GREY, 1.0, "--"), (BLUE, 1.4, "-"), (GREEN, 1.0, "-"), (RED, 1.4, "-"), (GREY, 1.4, "-"))]
+    ax.legend(handles, ["sphere A: the geometry, unchanged", r"the sphere displaced by $\beta h$",
+                        "shading normal: the displaced sphere's", "the displaced curve's own normal",
+                        "the draft's formula", r"$N$, no bump"],
+              loc="upper center", bbox_to_anchor=(0.5, -0.02), ncols=2, frameon=False, fontsize=8.5)
     ax.set_aspect("equal"); ax.axis("off")
-    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), frameon=False)
     ax.set_title(rf"one meridian, {field} field, $\beta = {beta:g}$")
     return fig
 
@@ -180,8 +192,8 @@ def ucurve_anatomy(curve):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
     ax.loglog(curve.eps, curve.error, lw=2, color=RED, label="|error| of the float64 quotient")
-    ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="|truncation| (exact arithmetic)")
-    ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="|roundoff| (the rest)")
+    ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="exact arithmetic at the rounded $u \\pm \\varepsilon$")
+    ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="rounding of the float64 evaluation")
     ax.loglog(curve.eps, curve.model, color=GREY, lw=1, label=r"model $A\varepsilon^2 + B/\varepsilon$")
     opt = curve.eps_opt_fitted
     ax.axvline(opt, color=GREY, lw=0.8, ls="-.")

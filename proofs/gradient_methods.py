@@ -774,7 +774,8 @@ def pareto_figure(measurement, *, error="max"):
         ax.tick_params(labelsize=8.5)
         ax.grid(alpha=0.3, lw=0.3)
     axes[0].set_ylabel(f"{error} $|$error$|$ of $(h_u, h_v)$", fontsize=9.5)
-    fig.legend(list(handles.values()), list(handles), loc="lower center", ncols=4, fontsize=8,
+    fig.legend(list(handles.values()), [{"richardson": "SciPy (Richardson)"}.get(m, m) for m in handles],
+               loc="lower center", ncols=4, fontsize=8,
                frameon=False)
     return fig
 

@@ -44,6 +44,8 @@ DIGITS = 50
 #: frequencies (k_u, k_v), the default scene's.
 SEED_POINT = (0.31, 0.47)
 SEED_FREQUENCIES = (8.0, 4.0)
+#: The default steps: 14 per decade from 1e-1 to 1e-15, so that every power of ten is one of them.
+DEFAULT_STEPS = np.logspace(-1, -15, 14 * 14 + 1)
 
 
 def non_differentiable(field, u, v, component, k_u, k_v):
@@ -178,7 +180,7 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
 def default_optimum():
     """The U-curve optimum the book shows, one measurement of the build
     (`proofs.store`): `measure`'s default curve (sine, (u, v) = (0.31, 0.47),
-    h_u, k_u = 8, k_v = 4, 200 steps from 1e-1 to 1e-15), as a dict: the
+    h_u, k_u = 8, k_v = 4, `DEFAULT_STEPS`), as a dict: the
     fitted optimum ``eps`` and the model's ``error`` there, the measured
     errors ``band`` (min, max) within a factor 2 of it, the coefficients
     ``A`` and ``B``, the model's prediction ``eps_predicted`` and, for
@@ -241,7 +243,7 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     component : {"u", "v"}
         Which partial derivative.
     eps : array_like of float > 0, optional
-        Steps; default 200 log-spaced from 1e-1 to 1e-15.
+        Steps; default `DEFAULT_STEPS`.
     k_u, k_v : float > 0
 
     Returns
@@ -272,7 +274,7 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     for name, value in (("k_u", k_u), ("k_v", k_v)):
         if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
             raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    steps = np.logspace(-1, -15, 200) if eps is None else np.asarray(eps, dtype=np.float64).ravel()
+    steps = DEFAULT_STEPS if eps is None else np.asarray(eps, dtype=np.float64).ravel()
     if steps.size == 0 or not np.all(np.isfinite(steps)) or np.any(steps <= 0):
         raise ValueError("eps must be a non-empty array of finite steps > 0")
 

@@ -18,7 +18,7 @@ __all__ = ["PLACES", "verdicts", "register", "place_of"]
 
 #: Book section label -> the claims shown there, in the order the section meets them.
 PLACES = {
-    "s1": ("flips-zero", "shadow-curves-unchanged"),
+    "s3-boundary": ("flips-zero", "shadow-curves-unchanged"),
     "s3-ucurve": ("h3-scale", "truncation-until-1e-6", "roundoff-drowns-1e-9"),
     "sim": ("try-sweep", "try-creases", "try-pinch", "try-beta0"),
     "cell1": ("cell1-ripples",),

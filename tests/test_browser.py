@@ -214,6 +214,7 @@ def test_the_simulator_opens_on_the_displaced_sphere_normal(session):
     variant: a simulator that ignored the bump control) lies outside the bounds."""
     session.set_eps(-3)
     assert session.page.input_value("#sim-bump") == "surface"
+    assert session.page.input_value("#sim-scale") == "linear"        # as the book's figures show it
     opened = session.sim("sim.frames.scene")
     want = json.loads(json.dumps(dataclasses.asdict(SIMULATOR_SCENE)))
     assert opened == want
@@ -503,12 +504,13 @@ LOG_EPS = (-1, -3, -6, -9, -12, -14)
 
 @pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
 def test_the_log_difference_view_shows_the_u_curve(browser, book_html, field):
-    """On the default log scale the difference canvas is visible on sphere A at every step from
+    """On the log scale the difference canvas is visible on sphere A at every step from
     1e-1 to 1e-14, and its mean level follows the U-curve: lower at the optimum than at
     either end.  On the linear scale (the wrong variant for small steps) it is black."""
     s = Session(browser, _url(book_html))
     try:
         s.select("height_field", field)
+        s.select("scale", "log")
         means = {}
         for e in LOG_EPS:
             s.set_eps(e)
@@ -621,7 +623,7 @@ def test_preset_three_magnifies_the_pole_where_the_shading_flips(browser, book_h
     try:
         state = _preset(s, "try3")
         assert (state["height_field"], state["view"], state["zoom"], state["bump"]) == \
-            ("rings", "shaded", "4", "surface")
+            ("rings", "shaded", "4", "chart")
         spread = _pole_ring_spread(s)
         assert spread > 60, spread
         s.fill("beta", 0)

@@ -67,9 +67,9 @@ def test_an_unknown_place_is_refused():
 
 
 def test_outside_a_book_build_only_the_places_claims_are_measured(monkeypatch):
-    """A downloaded notebook measures the two claims of §1, not the register (wrong variant: all)."""
+    """A downloaded notebook measures the two claims of its section, not the register (wrong variant: all)."""
     measured = []
     monkeypatch.setattr("proofs.claims.Claim.measure", lambda self: measured.append(self.id) or ("m", self.registered))
     monkeypatch.delenv("SYMRENDER_BOOK_BUILD", raising=False)
-    assert "**Holds" in verdicts.verdicts("s1")
-    assert sorted(measured) == sorted(verdicts.PLACES["s1"])
+    assert "**Holds" in verdicts.verdicts("s3-boundary")
+    assert sorted(measured) == sorted(verdicts.PLACES["s3-boundary"])

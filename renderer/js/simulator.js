@@ -40,7 +40,7 @@ const DEFAULT_STATE = {
   numeric: "central", height_field: SIMULATOR_SCENE.height_field, k_u: SIMULATOR_SCENE.k_u,
   k_v: SIMULATOR_SCENE.k_v, beta: SIMULATOR_SCENE.beta, bump: SIMULATOR_SCENE.bump,
   log_eps: Math.log10(SIMULATOR_SCENE.eps), model: SIMULATOR_SCENE.model, resolution: 256, view: "shaded",
-  scale: "log", zoom: 1, sphere_b: SIMULATOR_SCENE.sphere_b,
+  scale: "linear", zoom: 1, sphere_b: SIMULATOR_SCENE.sphere_b,
 };
 
 // Grey level in [0, 1] of a difference d >= 0 on the chosen scale: on the log scale log10 d from
@@ -89,23 +89,25 @@ const CONTROLS = [
 // The draft's four "Try this" experiments (§4), applied on top of the defaults,
 // each opening on the view and scale that show its point; `hint` says what to look at.
 export const PRESETS = [
-  { id: "try1", label: "1 · sine: sweep ε down", set: { height_field: "sine", log_eps: LOG_EPS.max },
+  { id: "try1", label: "1 · sine: sweep ε down", set: { height_field: "sine", log_eps: LOG_EPS.max, scale: "log" },
     focus: "log_eps",
-    hint: "Move ε down with the slider (or the arrow keys): the difference darkens along the truncation " +
+    hint: "On the log scale, move ε down with the slider (or the arrow keys): the difference darkens along the truncation " +
           "slope, bottoms out, then brightens as rounding takes over. The dot rides the U-curve; " +
           "the symbolic canvas never changes." },
   { id: "try2", label: "2 · ridges: where the pipelines part", set: { height_field: "ridges", view: "kink", scale: "linear" },
     hint: "Kink view, linear difference scale: the crease band is white on the renders and blue on the " +
           "difference, where the large differences sit: central differences straddle the crease." },
-  { id: "try3", label: "3 · rings: magnify the pole", set: { height_field: "rings", zoom: 4, view: "shaded" },
-    hint: "The pole, magnified: the rings converge on it, and the shading flips from one side of the " +
-          "pole to the other, where the perturbed normal turns over." },
+  { id: "try3", label: "3 · rings: magnify the pole", set: { height_field: "rings", zoom: 4, view: "shaded", bump: "chart" },
+    hint: "The draft's formula at the pole, magnified: the rings converge on it, and the shading flips from " +
+          "one side of the pole to the other, where the draft's normal turns over." },
   { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta",
     hint: "With β = 0 both renders are the un-bumped sphere: the difference is black, the ledger reads " +
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
 ];
 
 const HINT = "Hover over a canvas, or tap it, to read that pixel in the readout.";
+// The controls shown above the canvases.
+const MAIN = ["height_field", "log_eps", "beta"];
 
 export function scene_of(state) {
   return { ...SIMULATOR_SCENE, height_field: state.height_field, k_u: state.k_u, k_v: state.k_v,
@@ -138,7 +140,10 @@ const STYLE = `
 .symrender-sim .sim-hint { min-height: 2.6em; margin: 0 0 0.4rem; font-style: italic; }
 .symrender-sim table { font-variant-numeric: tabular-nums; margin: 0.4rem 0; }
 .symrender-sim td, .symrender-sim th { padding: 0.1rem 0.7rem; }
+.symrender-sim .sim-main { grid-template-columns: repeat(3, minmax(0, 1fr)); margin: 0.4rem 0; }
 @media (max-width: 720px) {
+  .symrender-sim .sim-main { grid-template-columns: minmax(0, 1fr); position: sticky; top: 0; z-index: 2;
+    background: var(--pst-color-background, #fff); padding: 0.3rem 0; }
   .symrender-sim .sim-stage { grid-template-columns: minmax(0, 1fr); }
   .symrender-sim .sim-curve, .symrender-sim .sim-readout { grid-column: 1; }
   .symrender-sim .sim-readout { position: sticky; bottom: 0; z-index: 2; padding: 0.3rem 0.4rem;
@@ -205,6 +210,10 @@ class Simulator {
                    [el("span", { text: "Try this:" }), ...presets, reset]));
     this.hint = el("p", { id: "sim-hint", class: "sim-hint", "aria-live": "polite", text: HINT });
     root.append(this.hint);
+    // The step, the amplitude and the field sit just above the canvases (sticky on a phone), so the
+    // reader sees the images move while dragging them; the other controls follow the ledger.
+    this.main_controls = el("div", { class: "sim-controls sim-main" });
+    root.append(this.main_controls);
 
     this.canvases = {};
     const figs = ["numeric", "symbolic", "difference"].map((name) => {
@@ -261,7 +270,9 @@ class Simulator {
       this.outputs[c.name] = out;
       return el("label", {}, [el("span", {}, [c.label + " ", out]), input]);
     });
-    root.append(el("div", { class: "sim-controls" }, controls));
+    const main = CONTROLS.map((c, i) => MAIN.includes(c.name) ? controls[i] : null).filter(Boolean);
+    this.main_controls.append(...main);
+    root.append(el("div", { class: "sim-controls" }, controls.filter((c) => !main.includes(c))));
     this.sync_inputs();
   }
 
