@@ -189,8 +189,8 @@ def ledger_table():
     """MyST markdown, one list item per theorem, labelled ``ledger-<id>`` (the theorem's box
     links here with ``{ref}`§6 <ledger-<id>>```): its title (linked to the box), id,
     verdict; then its evidence (what its steps took, and the
-    renderer's outputs compared), the first clause shown and the rest folded, and what
-    the draft says.  (A list, not a table: the evidence is a
+    renderer's outputs compared), the first clause shown and the rest folded.  (What the
+    draft says about a theorem is in the claims register, `proofs.verdicts.register`.)  (A list, not a table: the evidence is a
     paragraph, which a table column of a 700-pixel page squeezes to a word a line.)
 
     Raises
@@ -201,10 +201,9 @@ def ledger_table():
     items = []
     for theorem_id, e in ledger().items():
         _refuse(theorem_id, e)
-        draft = f"\n\n  {_folded('The draft says', e['seed_says'])}" if e["seed_says"] else ""
         items.append(f"* (ledger-{theorem_id})=\n  {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
                      f"**{BADGES[e['status']]}**.\n\n"
-                     f"  {_folded('Evidence', e['evidence'])}{draft}")
+                     f"  {_folded('Evidence', e['evidence'])}")
     return "\n".join(items)
 
 

@@ -370,8 +370,8 @@ def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_
             before, n = value(), s.updates()
             key = {"range": "ArrowLeft" if cid == "sim-log_eps" else "ArrowRight",
                    "checkbox": "Space"}.get(kind, "ArrowDown")
-            if cid in ("sim-resolution", "sim-bump"):
-                key = "ArrowUp"          # 256 -> 128 keeps the test quick; the displaced sphere is last
+            if cid in ("sim-resolution", "sim-bump", "sim-scale"):
+                key = "ArrowUp"          # 256 -> 128 keeps the test quick; the displaced sphere, linear are last
             page.keyboard.press(key)
             s.wait_update(n)
             assert value() != before, (cid, kind, key)
@@ -554,7 +554,7 @@ def test_preset_one_sweeps_eps_down_and_the_symbolic_canvas_stays(browser, book_
                              log_eps="-1", beta=str(SIMULATOR_SCENE.beta), numeric="central")
         assert s.page.evaluate("document.activeElement.id") == "sim-log_eps"
         assert s.sim("sim.curve.here.eps") == 0.1
-        assert "Move ε down" in s.page.text_content("#sim-hint")
+        assert "move ε down" in s.page.text_content("#sim-hint")
         symbolic, rms = _rgb(s.canvas("symbolic")), [s.ledger("rms")]
         for _ in range(20):                       # 0.1 decade a key: down to 1e-3
             n = s.updates()
