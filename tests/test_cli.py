@@ -804,14 +804,14 @@ def copy_dir(src, dst):
 def test_figures_writes_pngs_and_manifest(s1_figures, tmp_path, capsys):
     a, stdout = s1_figures
     doc = json.loads((a / "manifest.json").read_text())
-    assert [f["id"] for f in doc["figures"]] == ["s1_what_changes-fig-s1-bump"]
+    assert [f["id"] for f in doc["figures"]] == ["s1_what_changes-fig-normals", "s1_what_changes-fig-s1-bump"]
     fig = doc["figures"][0]
     data = (a / fig["file"]).read_bytes()
     import hashlib
     assert hashlib.sha256(data).hexdigest() == fig["sha256"] and varying_chunks(data) == []
     assert read_png(a / fig["file"]).shape == (fig["height"], fig["width"], 3)
     assert len(doc["code_version"]["source_sha256"]) == 64 and "timestamp" not in json.dumps(doc)
-    assert "wrote 1 figures" in stdout
+    assert "wrote 2 figures" in stdout
     # A second run gives byte-identical files, the manifest included.
     rc, _, _ = run(["figures", "--out", str(tmp_path / "b"), "--pages", "s1_what_changes"], capsys)
     assert rc == 0
@@ -824,6 +824,7 @@ def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
     a, _ = s1_figures
     rc, out, err = run(["figures", "--check", str(a)], capsys)
     assert rc == 0 and "unchanged  s1_what_changes-fig-s1-bump" in out and "no figure changed" in out
+    assert "unchanged  s1_what_changes-fig-normals" in out
     # Wrong variant: one pixel changed by 51/255 in the previous run's file.
     old = copy_dir(a, tmp_path / "old")
     doc = json.loads((old / "manifest.json").read_text())
@@ -834,11 +835,11 @@ def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
     doc["figures"][0]["sha256"] = sha256_of(f)
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
-    assert rc == 1 and "changed    s1_what_changes-fig-s1-bump: max |dI| = 0.2000 (1 pixels differ)" in out
+    assert rc == 1 and "changed    s1_what_changes-fig-normals: max |dI| = 0.2000 (1 pixels differ)" in out
     rc, out, _ = run(["figures", "--check", str(old), "--ignore", "s1_*"], capsys)
     assert rc == 0 and "(ignored)" in out
     # A figure the previous manifest does not have is reported as added.
-    doc["figures"] = []
+    doc["figures"] = doc["figures"][:1]
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
     assert rc == 1 and "added      s1_what_changes-fig-s1-bump" in out

@@ -226,7 +226,8 @@ def test_a_downloaded_notebook_runs_in_a_new_environment_with_the_wheel(book_htm
     # What it shows as Markdown (proofs.page.markdown) is plain Markdown too.
     shown_md = ["".join(o["data"]["text/markdown"]) for c in code for o in c["outputs"]
                 if "text/markdown" in o.get("data", {})]
-    assert shown_md and [m for text in shown_md for m in LEFTOVER.findall(text)] == []
+    assert [m for text in shown_md for m in LEFTOVER.findall(text)] == []
+    assert bool(shown_md) == ("markdown(" in (ROOT / "book" / f"{stem}.md").read_text(encoding="utf-8"))
     # The kernel ran the installed renderer: numba cached its compiled functions beside it.
     assert list((Path(where.split()[1]).parent / "__pycache__").glob("*.nbi"))
     # Its figures are the page's: the names its glue:figure directives show, in order, and the same PNGs.
