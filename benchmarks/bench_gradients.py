@@ -1,6 +1,6 @@
 """Run time against error of the gradient methods, release configuration.
 
-Runs `proofs.gradient_methods.measure` with the FULL configuration (all sphere-A
+Runs `lab.gradient_methods.measure` with the FULL configuration (all sphere-A
 pixels of a 256^2 frame in the mpmath reference, twelve steps per difference
 sweep, fifteen interleaved repeats), prints the Pareto front of each height
 field, the best step of every method and the full table (medians with the
@@ -21,7 +21,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from proofs import gradient_methods as gm  # noqa: E402
+from lab import gradient_methods as gm  # noqa: E402
 
 
 def main(argv=None):

@@ -1,7 +1,7 @@
 """Check a built book: one value per quantity, under its name and under its words.
 
 A quantity shown on several pages is glued under one name (``ucurve_eps_opt``,
-say) and computed once per build (`proofs.store`).  This reads, for each page,
+say) and computed once per build (`lab.store`).  This reads, for each page,
 the notebook jupyter-cache holds for the page's current execution (the record
 of that page accessed last: the build touches the record it uses) and fails,
 naming the pages and values, if two pages glue different values under one name.
@@ -49,7 +49,7 @@ NAMED = {
 
 def page_glue(notebook: dict) -> dict:
     """{name: shown value} of every glue output of a notebook (a dict, nbformat 4): its
-    text/markdown if it has one (`proofs.book.glue_math`), else its text/plain."""
+    text/markdown if it has one (`chapter.theorems.glue_math`), else its text/plain."""
     out = {}
     for cell in notebook.get("cells", []):
         for output in cell.get("outputs", []):

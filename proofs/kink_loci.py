@@ -133,7 +133,7 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False,
     exactly the loci claimed visible have crease pixels; else refuted.  ``shift``, ``rho``,
     ``drho``, ``band_scale`` (`locus_bands`) and ``all_visible`` (claim every circle visible):
     wrong variants."""
-    from .book import frame_label
+    from renderer import frame_label
     mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho, band_scale)
     if kind == "rays":
         seen = np.ones(len(per_locus), dtype=bool)             # every ray crosses the visible cap

@@ -116,23 +116,23 @@ def gradient_error(field, gradient, corrupt=None):
     grad = px["grad"] if corrupt is None else corrupt(px["grad"])
     consts = {F.k_u: scene.k_u, F.k_v: scene.k_v}
     if gradient == "exact":
-        exprs = [e.subs(consts) for e in F.GRADIENT[field]]
+        exprs = [e.xreplace(consts) for e in F.GRADIENT[field]]
         ref = _eval(exprs, (F.u, F.v), px["uv"])
         bound = TOLERANCE["gradient"] * np.pi * max(scene.k_u, 2 * scene.k_v)
     elif gradient == "footprint":
         # The steps from formulas.FOOTPRINT at the pixel (its frame from TANGENT_FRAME), then CENTRAL.
         sin_phi = F.CHART[2]
-        frame = dict(zip(F.e_theta + F.e_phi, [c.subs(F.sin_phi, sin_phi) for c in F.TANGENT_FRAME]))
-        steps = _eval([e.subs(frame).subs({F.sin_phi: sin_phi, F.R: scene.radius_a, F.camera_z: scene.camera_z})
+        frame = dict(zip(F.e_theta + F.e_phi, [c.xreplace({F.sin_phi: sin_phi}) for c in F.TANGENT_FRAME]))
+        steps = _eval([e.xreplace(frame).xreplace({F.sin_phi: sin_phi, F.R: scene.radius_a, F.camera_z: scene.camera_z})
                        for e in F.FOOTPRINT], (F.N_x, F.N_y, F.N_z) + tuple(F.P) + (F.x, F.y, F.dx, F.dy),
                       np.hstack([px["N"], px["P"], px["xy"]]))
-        exprs = [e.subs(dict(F.STENCIL_POINTS)).subs(consts) for e in F.CENTRAL[field]]
+        exprs = [e.xreplace(dict(F.STENCIL_POINTS)).xreplace(consts) for e in F.CENTRAL[field]]
         ref = _eval(exprs, (F.u, F.v, F.eps_u, F.eps_v), np.hstack([px["uv"], steps]))
         scale = np.pi * max(scene.k_u, 2 * scene.k_v)
         bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / float(steps.min())
     else:
         stencil = dict(F.STENCIL_POINTS)
-        exprs = [e.subs(stencil).subs({F.eps_u: scene.eps, F.eps_v: scene.eps, **consts})
+        exprs = [e.xreplace(stencil).xreplace({F.eps_u: scene.eps, F.eps_v: scene.eps, **consts})
                  for e in F.CENTRAL[field]]
         ref = _eval(exprs, (F.u, F.v), px["uv"])
         scale = np.pi * max(scene.k_u, 2 * scene.k_v)
@@ -148,10 +148,10 @@ def normal_error(field, bump, corrupt=None):
     scene, px = pixels(field, "exact", bump)
     Ns = px["Ns"]
     sin_phi = F.CHART[2]
-    frame = [c.subs(F.sin_phi, sin_phi) for c in F.TANGENT_FRAME]
-    normal = sp.Matrix(F.PERTURBED_NORMAL[bump]).subs(
+    frame = [c.xreplace({F.sin_phi: sin_phi}) for c in F.TANGENT_FRAME]
+    normal = sp.Matrix(F.PERTURBED_NORMAL[bump]).xreplace(
         {**dict(zip(F.e_theta + F.e_phi, frame)), F.sin_phi: sin_phi, F.R: scene.radius_a, F.beta: scene.beta,
-         F.h: F.HEIGHT[field].subs({F.k_u: scene.k_u, F.k_v: scene.k_v})}, simultaneous=True)
+         F.h: F.HEIGHT[field].xreplace({F.k_u: scene.k_u, F.k_v: scene.k_v})})
     args = (F.N_x, F.N_y, F.N_z, F.h_u, F.h_v, F.u, F.v)
     grad = px["grad"] if corrupt is None else corrupt(px["grad"])
     ref = _eval(list(normal), args, np.hstack([px["N"], grad, px["uv"]]))

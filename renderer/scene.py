@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
+__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS", "frame_label"]
 
 #: Largest accepted magnitude of a length or coordinate (scene units): squares of
 #: lengths are formed everywhere, and 1e6 keeps them far from overflow.
@@ -280,3 +280,42 @@ class Scene:
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         values.update(changes)
         return Scene(**values)
+
+
+def frame_label(scene, width, height) -> str:
+    """The label a number measured on a render carries: its scene and resolution, in words.
+
+    ``"the draft's scene, 256 × 256"``, or with the fields that differ from
+    `renderer.Scene`'s defaults (the draft's scene): ``"the draft's scene with the
+    sine field, β = 1.5, 64 × 64"``.  ``scene`` is a `renderer.Scene`; ``width``,
+    ``height`` in pixels.
+
+    Raises
+    ------
+    TypeError
+        ``scene`` is not a `renderer.Scene`.
+    ValueError
+        ``width`` or ``height`` is not a positive integer.
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
+    for name, n in (("width", width), ("height", height)):
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ValueError(f"{name} must be a positive integer number of pixels, got {n!r}")
+    default = Scene()
+    changed = [_field_words(f.name, getattr(scene, f.name)) for f in fields(Scene)
+               if getattr(scene, f.name) != getattr(default, f.name)]
+    return "the draft's scene" + (" with " + ", ".join(changed) if changed else "") + f", {width} × {height}"
+
+
+#: How `frame_label` words a field of `renderer.Scene` that differs from the draft's.
+_WORDS = {"height_field": "the {} field", "beta": "β = {:g}", "eps": "ε = {:g}", "k_u": "kᵤ = {:g}",
+          "k_v": "kᵥ = {:g}", "radius_a": "R = {:g}", "model": "{} shading", "shininess": "shininess {:g}"}
+
+
+def _field_words(name, value):
+    if name == "bump":
+        return {"surface": "the displaced sphere's normal", "chart": "the draft's normal"}[value]
+    if name in ("sphere_b", "floor") and isinstance(value, bool):
+        return f"{'with' if value else 'no'} {'sphere B' if name == 'sphere_b' else name}"
+    return _WORDS.get(name, name.replace("_", " ") + " {}").format(value)

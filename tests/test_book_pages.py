@@ -14,7 +14,7 @@ Each page (index, §1-§9, glossary) is opened offline from the built site, its 
     overflow (a box that scrolls may hold wider content), the page no wider than the window.
 
 Every check is shown catching a planted defect (the ``test_the_*_check_*`` tests), and
-`proofs.figures.text_overlaps`, which `proofs.page.show` runs on every figure a page publishes, is
+`chapter.figures.text_overlaps`, which `chapter.page.show` runs on every figure a page publishes, is
 tested on planted overlaps and on the book's diagrams.  Screenshots of every page at both widths go
 to test-artifacts/pages/, the measurements to test-artifacts/book_pages.json.
 
@@ -537,7 +537,7 @@ def test_the_width_check_catches_an_overwide_block_in_details(browser, book_html
         p.close()
 
 
-# --- figures: proofs.figures.text_overlaps, which proofs.page.show runs before publishing ---------
+# --- figures: chapter.figures.text_overlaps, which chapter.page.show runs before publishing ---------
 
 @pytest.fixture
 def figure():
@@ -566,7 +566,7 @@ def _clean(ax):
 
 
 def test_text_overlaps_passes_a_clean_figure_and_catches_two_labels_on_top_of_each_other(figure):
-    from proofs.figures import text_overlaps
+    from chapter.figures import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
     _clean(ax)
     assert text_overlaps(fig) == []
@@ -577,7 +577,7 @@ def test_text_overlaps_passes_a_clean_figure_and_catches_two_labels_on_top_of_ea
 def test_text_overlaps_catches_a_title_on_a_label(figure):
     """The diagram of the central stencil as it was: the crease's label just above the axes, under the title."""
     import matplotlib.pyplot as plt
-    from proofs.figures import stencil_diagram, style, text_overlaps
+    from chapter.figures import stencil_diagram, style, text_overlaps
     style()
     fig = stencil_diagram()
     try:
@@ -595,7 +595,7 @@ def test_text_overlaps_catches_neighbouring_axes_running_together(figure):
     """§2's three fields in a row, as first drawn: the last tick label of one image and the first of
     the next read as one number, and a y label sits on the neighbouring image."""
     import numpy as np
-    from proofs.figures import style, text_overlaps
+    from chapter.figures import style, text_overlaps
     style()
     def fields(**layout):
         fig, axes = figure(1, 3, figsize=(10, 2.8), **layout)
@@ -610,7 +610,7 @@ def test_text_overlaps_catches_neighbouring_axes_running_together(figure):
 
 
 def test_text_overlaps_catches_legend_entries_on_each_other_not_inside_their_box(figure):
-    from proofs.figures import text_overlaps
+    from chapter.figures import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
     _clean(ax)
     ax.get_legend().remove()
@@ -624,7 +624,7 @@ def test_text_overlaps_catches_legend_entries_on_each_other_not_inside_their_box
 
 
 def test_text_overlaps_catches_an_annotation_across_the_frame_and_ignores_ticks_out_of_view(figure):
-    from proofs.figures import text_overlaps
+    from chapter.figures import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
     _clean(ax)
     ax.set_xticks([0, 0.5, 1, 1.02])                          # a tick out of view: not drawn, not counted
@@ -636,7 +636,7 @@ def test_text_overlaps_catches_an_annotation_across_the_frame_and_ignores_ticks_
 
 def test_text_overlaps_works_on_a_closed_figure_and_rejects_bad_arguments(figure):
     import matplotlib.pyplot as plt
-    from proofs.figures import text_overlaps
+    from chapter.figures import text_overlaps
     fig, ax = figure()
     ax.text(0.5, 0.5, "x"); ax.text(0.5, 0.5, "y")
     plt.close(fig)
@@ -651,8 +651,8 @@ def test_the_books_diagrams_have_no_colliding_text():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from proofs import figures
-    from proofs.ucurve import measure
+    from chapter import figures
+    from renderer.ucurve import measure
     figures.style()
     found = {}
     for name, make in (("frame_diagram", figures.frame_diagram), ("normal_diagram", figures.normal_diagram),

@@ -1,6 +1,6 @@
 """The book's prose types no number: every value it shows is glued from the
 code that computes or uses it (``{glue:text}``, ``{glue:md}`` with
-`proofs.book.glue_math`).
+`chapter.theorems.glue_math`).
 
 The scan reads each page's Markdown outside code cells, drops glue roles,
 inline code, cross-references and link targets, and looks for numeric
@@ -25,7 +25,7 @@ BOOK = Path(__file__).resolve().parents[1] / "book"
 NUMBER = re.compile(r"10\^\{-?\d+\}|\d+(?:\.\d+)?e-?\d+|\d+\.\d+|\d{1,3}(?:,\d{3})+|\d{1,3}(?:\{,\}\d{3})+|\d{3,}")
 
 #: Literals that stay typed, per page, with how often they occur and why.  (The draft's
-#: claims are quoted from the register, `proofs.claims`, not typed into the pages.)
+#: claims are quoted from the register, `lab.claims`, not typed into the pages.)
 QUOTED = {
     "s8_history.md": {"1978": (1, "Blinn's paper's year")},
 }
@@ -87,8 +87,8 @@ def test_a_typed_step_is_found():
 # ------------------------------------------------------------- scene and resolution labels
 ROOT = BOOK.parent
 #: A glue whose name ends so carries the scene or resolution of a render (e.g. "256 × 256",
-#: `proofs.book.frame_label`'s "the draft's scene with the sine field, 64 × 64").
-#: A glue ``*_measured`` is a claim's measurement text, which ends with its frame (`proofs.claims`).
+#: `chapter.theorems.frame_label`'s "the draft's scene with the sine field, 64 × 64").
+#: A glue ``*_measured`` is a claim's measurement text, which ends with its frame (`lab.claims`).
 LABEL = re.compile(r"(_size|_label|_measured)$")
 CELL = re.compile(r"```\{code-cell\}[^\n]*\n(.*?)\n```", re.S)      # to drop cells from the prose
 _spec = importlib.util.spec_from_file_location("nb_deps", ROOT / "book" / "_ext" / "nb_deps.py")
@@ -112,7 +112,7 @@ NOT_A_FRAME = {
 def rendering_functions():
     """Names that render, as a page cell calls them: `renderer.render`, `renderer.gbuffer`,
     and every function of proofs/ whose body names one of them (calls it, or hands it to
-    `proofs.store.measured`), to a fixed point, less `NOT_A_FRAME`.  Matched by name, so a
+    `lab.store.measured`), to a fixed point, less `NOT_A_FRAME`.  Matched by name, so a
     homonym (ucurve.measure and gradient_methods.measure) asks for one label too many."""
     names = {}
     for path in sorted((ROOT / "proofs").glob("*.py")):
@@ -231,7 +231,7 @@ def test_an_unlabelled_rendered_number_is_found():
     assert unlabelled(s4.replace("The opening frame ({glue:text}`s4_label`):", "The opening frame:"), renders)
     assert unlabelled(s4.replace("({glue:text}`s4_label`):", "({glue:text}`s4_max`):"), renders)
     front = s4[:s4.index("---", 3) + 4]                  # a page's front matter: it is a notebook
-    cell = (front + "```{code-cell} ipython3\nfrom proofs.accuracy import image_beta_order\n"
+    cell = (front + "```{code-cell} ipython3\nfrom lab.accuracy import image_beta_order\n"
             "glue(\"x_slope\", image_beta_order()[\"median_slope\"])\n```\n\n")
     assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f`.\n", renders) == [["x_slope"]]
     assert unlabelled(cell + "The slope is {glue:text}`x_slope:.2f` ({glue:text}`x_label`).\n", renders) == []
@@ -244,7 +244,7 @@ def test_an_unlabelled_rendered_number_is_found():
 
 
 def test_frame_label_names_the_fields_that_differ_and_the_size():
-    from proofs.book import frame_label
+    from chapter.theorems import frame_label
     from renderer import Scene
     assert frame_label(Scene(), 256, 128) == "the draft's scene, 256 × 128"
     assert frame_label(Scene(height_field="sine", beta=1.5), 64, 64) == \

@@ -81,9 +81,9 @@ def test_no_cache_is_an_error(tmp_path):
 
 
 def _math_page(**values):
-    """A page whose cell glues each value as `proofs.book.glue_math` does: a
+    """A page whose cell glues each value as `chapter.theorems.glue_math` does: a
     Markdown object, whose text/plain is the same for every value."""
-    from proofs.book import tex_number
+    from chapter.theorems import tex_number
     data = lambda v: {check_glue.MIME + "text/plain": "<IPython.core.display.Markdown object>",  # noqa: E731
                       check_glue.MIME + "text/markdown": f"${tex_number(v)}$"}
     outputs = [nbformat.v4.new_output("display_data", data=data(v),
@@ -109,13 +109,13 @@ def test_math_glue_is_compared_by_its_markdown(tmp_path, capsys):
                                     (-1e-5, "-10^{-5}"), (2.5e-7, r"2.5\cdot 10^{-7}"), (0.47, "0.47"),
                                     (1.5, "1.5"), (256, "256"), (0.0, "0")])
 def test_tex_number(x, tex):
-    from proofs.book import tex_number
+    from chapter.theorems import tex_number
     assert tex_number(x) == tex
 
 
 @pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
 def test_tex_number_refuses_a_non_finite_number(bad):
-    from proofs.book import tex_number
+    from chapter.theorems import tex_number
     with pytest.raises(ValueError, match="x must be a finite number"):
         tex_number(bad)
 

@@ -1,14 +1,14 @@
-"""The register's decision rules (proofs/claims.py: `Bound`, `Criterion`,
+"""The register's decision rules (lab/claims.py: `Bound`, `Criterion`,
 `rule`, `Claim.measure`): how a measured number becomes a verdict, and how the
 rule is printed in the book's table.
 
 Fast on purpose: benchmarks/mutation_audit.py --mutmut runs this file once per
-mutant of proofs/claims.py (its measurements are checked by pytest verify).
+mutant of lab/claims.py (its measurements are checked by pytest verify).
 """
 
 import pytest
 
-from proofs.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Bound, Claim, Criterion, rule
+from lab.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Bound, Claim, ClaimChanged, Criterion, checked, rule
 
 
 @pytest.mark.parametrize("bound, x, inside", [
@@ -79,3 +79,26 @@ def test_a_claim_is_decided_by_its_criterion_from_its_own_numbers():
 def test_the_register_names_each_claim_once_with_a_known_verdict():
     assert len(CLAIMS) == len({c.id for c in CLAIMS}) >= 30
     assert all(c.registered in (HOLDS, FAILS, CORRECTED) for c in CLAIMS)
+
+
+def _inside(bound):
+    if bound.lo is not None and bound.hi is not None:
+        return (bound.lo + bound.hi) / 2
+    return bound.lo + abs(bound.lo) + 1 if bound.lo is not None else bound.hi - abs(bound.hi) - 1
+
+
+@pytest.mark.parametrize("claim", CLAIMS, ids=[c.id for c in CLAIMS])
+def test_each_claims_first_case_is_reachable(claim):
+    """Numbers inside the first case's bounds get that case's verdict: no claim's first case is dead."""
+    verdict, bounds = claim.criterion.cases[0]
+    assert claim.criterion.decide({b.quantity: _inside(b) for b in bounds}) == verdict
+
+
+def test_the_books_table_refuses_a_flipped_verdict():
+    """The book's register goes through `checked`: one flipped verdict fails the build, naming the claim."""
+    results = [(c, {}, c.registered) for c in CLAIMS]
+    assert checked(results) == results
+    c = CLAIMS[3]
+    flipped = results[:3] + [(c, {}, HOLDS if c.registered != HOLDS else FAILS)] + results[4:]
+    with pytest.raises(ClaimChanged, match=f"{c.id}: registered"):
+        checked(flipped)

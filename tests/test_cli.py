@@ -1,7 +1,7 @@
-"""Tests of the ``symrender`` command line (proofs/cli.py).
+"""Tests of the ``symrender`` command line (renderer/cli.py).
 
 Every subcommand runs on real input through ``main([...])``; the installed
-console script and ``python -m proofs`` run once each.  Outputs are checked
+console script and ``python -m renderer.cli`` run once each.  Outputs are checked
 against an independent route (the library called directly), PNGs are checked
 byte for byte and chunk by chunk, the atomic write is interrupted on purpose,
 and bad inputs (hand-picked and hypothesis-generated) must each give exit
@@ -29,8 +29,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import proofs.cli as cli
-from proofs.cli import main
+import renderer.cli as cli
+from renderer.cli import main
 from renderer import PointLight, Scene, compare, render, sweep, to_srgb
 
 SMALL = "48x40"
@@ -68,15 +68,15 @@ def expected_pixels(rgb):
     return np.round(np.clip(rgb, 0, 1) * 255).astype(np.uint8)
 
 
-def failure_problems(rc, err, before, after):
+def failure_problems(rc, err, before, after, prog="symrender"):
     """What is wrong with a failed run: a zero or unexpected exit code, a
-    stderr that is not one ``symrender: error:`` line, a traceback, or a
+    stderr that is not one ``<prog>: error:`` line, a traceback, or a
     file left behind."""
     problems = []
     if rc != 2:
         problems.append(f"exit code {rc}")
     lines = err.strip().splitlines()
-    if len(lines) != 1 or not lines[0].startswith("symrender: error: "):
+    if len(lines) != 1 or not lines[0].startswith(f"{prog}: error: "):
         problems.append(f"stderr is not one error line: {err!r}")
     if "Traceback" in err:
         problems.append("traceback")
@@ -451,7 +451,7 @@ def test_dash_on_a_terminal_is_refused(capsys, monkeypatch, argv):
 def test_stdout_and_dev_stdout_in_a_real_process(tmp_path):
     """Through a real pipe: ``-o -`` gives the PNG alone on stdout; ``-o
     /dev/stdout`` (a link) writes through it; a pseudo-terminal is refused."""
-    cmd = [sys.executable, "-m", "proofs", "render", "--size", "8x8", "-o"]
+    cmd = [sys.executable, "-m", "renderer.cli", "render", "--size", "8x8", "-o"]
     ref = tmp_path / "ref.png"
     assert main(["render", "--size", "8x8", "-o", str(ref)]) == 0
     dash = subprocess.run([*cmd, "-"], capture_output=True)
@@ -589,7 +589,7 @@ def test_sweep_formats_match_renderer_sweep(capsys):
 
 
 def test_ucurve_table_matches_measure(tmp_path, capsys):
-    from proofs.ucurve import measure
+    from renderer.ucurve import measure
     plot = tmp_path / "u.png"
     rc, out, err = run(["ucurve", "--field", "sine", "--u", "0.31", "--v", "0.47", "--component", "u",
                         "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
@@ -634,11 +634,6 @@ def test_ucurve_in_chunks_for_progress_equals_one_measure(capsys, monkeypatch):
 # ------------------------------------------------------------------ verify, help, entry points
 
 
-def test_verify_runs_the_proof_checker(capsys):
-    rc, out, _ = run(["verify", "-k", "test_theorem_holds and frame"], capsys)
-    assert rc == 0 and "theorem ledger" in out and "frame-orthonormal" in out and "proved" in out
-    # pytest's "no tests collected" (5) comes through.
-    assert run(["verify", "-k", "no_such_test_anywhere"], capsys)[0] == 5
 
 
 class ClosedPipe(io.StringIO):
@@ -656,12 +651,9 @@ def test_broken_pipe_is_quiet(capsys, monkeypatch):
     assert rc == 2 and capsys.readouterr().err == "symrender: error: I/O error\n"
 
 
-def test_verify_passes_the_exit_code_through(capsys, monkeypatch):
-    monkeypatch.setattr(cli.subprocess, "run", lambda cmd, **k: subprocess.CompletedProcess(cmd, 3, "x\n"))
-    assert run(["verify"], capsys)[0] == 3
 
 
-@pytest.mark.parametrize("command", ["render", "sweep", "ucurve", "verify", "figures"])
+@pytest.mark.parametrize("command", ["render", "sweep", "ucurve"])
 def test_help_on_each_subcommand(capsys, command):
     rc, out, err = run([command, "--help"], capsys)
     assert rc == 0 and out.startswith(f"usage: symrender {command}") and err == ""
@@ -678,7 +670,7 @@ def test_console_script_and_module(tmp_path):
     proc = subprocess.run([str(exe), "render", "--size", "16x12", "-o", str(out)],
                           capture_output=True, text=True)
     assert proc.returncode == 0 and "ledger" in proc.stdout and out.exists()
-    proc = subprocess.run([sys.executable, "-m", "proofs", "render", "--size", "0x0", "-o", str(out)],
+    proc = subprocess.run([sys.executable, "-m", "renderer.cli", "render", "--size", "0x0", "-o", str(out)],
                           capture_output=True, text=True)
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
 
@@ -777,384 +769,3 @@ def test_fuzz_reached_both_outcomes():
 
 
 # ------------------------------------------------------------------ figures
-
-
-@pytest.fixture(scope="module")
-def s1_figures(tmp_path_factory):
-    """`symrender figures --out` of the real §1 page (one figure), run once."""
-    d = tmp_path_factory.mktemp("figs")
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        rc = main(["figures", "--out", str(d / "a"), "--pages", "s1"])
-    assert rc == 0, err.getvalue()
-    return d / "a", out.getvalue()
-
-
-def sha256_of(path):
-    import hashlib
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
-def copy_dir(src, dst):
-    import shutil
-    shutil.copytree(src, dst)
-    return dst
-
-
-def test_figures_writes_pngs_and_manifest(s1_figures, tmp_path, capsys):
-    a, stdout = s1_figures
-    doc = json.loads((a / "manifest.json").read_text())
-    assert [f["id"] for f in doc["figures"]] == ["s1_what_changes-fig-normals", "s1_what_changes-fig-s1-bump"]
-    fig = doc["figures"][0]
-    data = (a / fig["file"]).read_bytes()
-    import hashlib
-    assert hashlib.sha256(data).hexdigest() == fig["sha256"] and varying_chunks(data) == []
-    assert read_png(a / fig["file"]).shape == (fig["height"], fig["width"], 3)
-    assert len(doc["code_version"]["source_sha256"]) == 64 and "timestamp" not in json.dumps(doc)
-    assert "wrote 2 figures" in stdout
-    # A second run gives byte-identical files, the manifest included.
-    rc, _, _ = run(["figures", "--out", str(tmp_path / "b"), "--pages", "s1_what_changes"], capsys)
-    assert rc == 0
-    assert sorted(p.name for p in a.iterdir()) == sorted(p.name for p in (tmp_path / "b").iterdir())
-    for p in a.iterdir():
-        assert p.read_bytes() == (tmp_path / "b" / p.name).read_bytes(), p.name
-
-
-def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
-    a, _ = s1_figures
-    rc, out, err = run(["figures", "--check", str(a)], capsys)
-    assert rc == 0 and "unchanged  s1_what_changes-fig-s1-bump" in out and "no figure changed" in out
-    assert "unchanged  s1_what_changes-fig-normals" in out
-    # Wrong variant: one pixel changed by 51/255 in the previous run's file.
-    old = copy_dir(a, tmp_path / "old")
-    doc = json.loads((old / "manifest.json").read_text())
-    f = old / doc["figures"][0]["file"]
-    px = read_png(f)
-    px[10, 10] = np.where(px[10, 10] >= 128, px[10, 10].astype(int) - 51, px[10, 10].astype(int) + 51)
-    cli.write_png(f, px / 255.0)
-    doc["figures"][0]["sha256"] = sha256_of(f)
-    (old / "manifest.json").write_text(json.dumps(doc))
-    rc, out, _ = run(["figures", "--check", str(old)], capsys)
-    assert rc == 1 and "changed    s1_what_changes-fig-normals: max |dI| = 0.2000 (1 pixels differ)" in out
-    rc, out, _ = run(["figures", "--check", str(old), "--ignore", "s1_*"], capsys)
-    assert rc == 0 and "(ignored)" in out
-    # A figure the previous manifest does not have is reported as added.
-    doc["figures"] = doc["figures"][:1]
-    (old / "manifest.json").write_text(json.dumps(doc))
-    rc, out, _ = run(["figures", "--check", str(old)], capsys)
-    assert rc == 1 and "added      s1_what_changes-fig-s1-bump" in out
-
-
-def fake_book(root, cell):
-    (root / "book").mkdir(parents=True)
-    (root / "book" / "_toc.yml").write_text("format: jb-book\nroot: index\nchapters:\n  - file: s1_bad\n")
-    head = "---\nkernelspec:\n  display_name: Python 3\n  language: python\n  name: python3\n---\n\n# T\n\n"
-    (root / "book" / "index.md").write_text(head)
-    (root / "book" / "s1_bad.md").write_text(head + "```{code-cell} ipython3\n" + cell + "\n```\n")
-
-
-def test_figures_failing_page_is_one_line(tmp_path, capsys, monkeypatch):
-    fake_book(tmp_path / "repo", "x = 1 / 0")
-    monkeypatch.setattr(cli, "_repo_root", lambda: tmp_path / "repo")
-    out_dir = tmp_path / "out"
-    rc, stdout, err = run(["figures", "--out", str(out_dir)], capsys)
-    assert failure_problems(rc, err, [], []) == []
-    assert "page s1_bad failed: ZeroDivisionError" in err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["repo"]  # no out dir, no staging dir
-
-
-@pytest.mark.parametrize("argv, word", [
-    (["figures"], "--out"),
-    (["figures", "--out", "DIR/a", "--check", "DIR/a"], "--check"),
-    (["figures", "--check", "DIR/none"], "--check"),
-    (["figures", "--check", "DIR"], "--check"),
-    (["figures", "--out", "DIR/a", "--pages", "s99"], "--pages"),
-    (["figures", "--out", "DIR/no/such"], "--out"),
-    (["figures", "--out", "DIR/file.txt"], "--out"),
-    (["figures", "--out", ""], "--out"),
-    (["figures", "--out", "-"], "--out"),
-    (["figures", "--check", ""], "--check"),
-    (["figures", "--out", "DIR/a", "--pages", ""], "--pages"),
-    (["figures", "--out", "DIR/a", "--pages", ","], "--pages"),
-])
-def test_figures_bad_input(tmp_path, capsys, argv, word):
-    (tmp_path / "file.txt").write_text("x")
-    (tmp_path / "manifest.json").write_text("{not json")
-    argv = [a.replace("DIR", str(tmp_path)) for a in argv]
-    before = sorted(p.name for p in tmp_path.iterdir())
-    rc, stdout, err = run(argv, capsys)
-    assert failure_problems(rc, err, before, sorted(p.name for p in tmp_path.iterdir())) == []
-    assert word in err
-
-
-def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_figures, tmp_path,
-                                                                               capsys, monkeypatch):
-    a, _ = s1_figures
-    old = copy_dir(a, tmp_path / "old")
-    doc = json.loads((old / "manifest.json").read_text())
-    f = old / doc["figures"][0]["file"]
-    px = read_png(f)
-    px[5, 5] = 255 - px[5, 5]
-    cli.write_png(f, px / 255.0)
-    doc["figures"][0]["sha256"] = sha256_of(f)
-    doc["figures"][0]["varies"] = "measured timing"
-    (old / "manifest.json").write_text(json.dumps(doc))
-    rc, out, _ = run(["figures", "--check", str(old)], capsys)
-    assert rc == 0 and "measured timing: varies by run" in out and "no figure changed" in out
-    # Without the mark the same difference fails the check (the mark is what lets it pass).
-    del doc["figures"][0]["varies"]
-    (old / "manifest.json").write_text(json.dumps(doc))
-    rc, out, _ = run(["figures", "--check", str(old)], capsys)
-    assert rc == 1
-    # A cell tagged measured-timing is marked in the manifest; an untagged one is not.
-    png = (a / json.loads((a / "manifest.json").read_text())["figures"][0]["file"]).read_bytes()
-    monkeypatch.setattr(cli, "_page_figures", lambda book, page: iter([
-        ("p-cell01-1", 1, "plot()", png, (cli.VARIES_TAG,)), ("p-cell02-1", 2, "plot()", png, ())]))
-    manifest = cli._render_figures(tmp_path / "new", ["p"]) if (tmp_path / "new").mkdir() is None else None
-    marks = {f["id"]: f.get("varies") for f in manifest["figures"]}
-    assert marks == {"p-cell01-1": "measured timing", "p-cell02-1": None}
-
-
-# ------------------------------------------------------------------ --check: manifest validation
-
-
-def figure_pixels(h=40, w=50):
-    """A deterministic RGB test image with no flat regions."""
-    y, x = np.mgrid[0:h, 0:w]
-    return np.stack([(7 * x + 3 * y) % 256, (5 * x * y) % 256, (x ^ y) * 4 % 256], axis=2).astype(np.uint8)
-
-
-def write_check_dir(d, px=None, **entry):
-    """A previous ``--out`` directory with one synthetic figure; returns the manifest."""
-    import hashlib
-    d.mkdir(exist_ok=True)
-    data = cli._png_bytes(figure_pixels() if px is None else px)
-    (d / "fig.png").write_bytes(data)
-    h, w = (px if px is not None else figure_pixels()).shape[:2]
-    page = cli._known_pages()[1]
-    doc = {"code_version": {"git_commit": None, "git_dirty": None, "source_sha256": "0" * 64},
-           "pages": [page],
-           "figures": [{"id": f"{page}-cell01-1", "page": page, "code_cell": 1, "file": "fig.png",
-                        "sha256": hashlib.sha256(data).hexdigest(), "width": w, "height": h, **entry}]}
-    (d / "manifest.json").write_text(json.dumps(doc))
-    return doc
-
-
-def fake_run(monkeypatch, new_pngs):
-    """Replace page execution by writing ``new_pngs`` (id -> PNG bytes) as the fresh run."""
-    def render_figures(out_dir, pages):
-        import hashlib
-        figs = []
-        for fid, data in new_pngs.items():
-            (out_dir / f"{fid}.png").write_bytes(data)
-            figs.append({"id": fid, "file": f"{fid}.png", "sha256": hashlib.sha256(data).hexdigest()})
-        return {"code_version": {"git_commit": None, "git_dirty": False, "source_sha256": "1" * 64},
-                "pages": pages, "figures": figs}
-    monkeypatch.setattr(cli, "_render_figures", render_figures)
-
-
-def no_run(out_dir, pages):
-    raise AssertionError("pages were executed")
-
-
-#: Tamperings that name a figure file outside the directory or not a plain name.
-BAD_FILE_NAMES = {"dev-zero": "/dev/zero", "dotdot": "../../x", "dotdot-png": "../x.png",
-                  "subdir": "sub/fig.png", "nul": "fig\0.png", "double-dot-name": "..png"}
-
-
-def tamper(name):
-    """Mutations of a valid check directory ``d`` with manifest ``doc``."""
-    def apply(d, doc):
-        f = doc["figures"][0]
-        if name in BAD_FILE_NAMES:
-            f["file"] = BAD_FILE_NAMES[name]
-        elif name == "bad-json":
-            return "{not json"
-        elif name == "deep-json":
-            return "[" * 100_000 + "]" * 100_000
-        elif name == "not-utf8":
-            return b'{"pages": ["\xff"]}'
-        elif name == "list":
-            return "[]"
-        elif name == "no-pages":
-            del doc["pages"]
-        elif name == "empty-pages":
-            doc["pages"] = []
-        elif name == "unknown-page":
-            doc["pages"] = ["s99_nope"]
-        elif name == "page-int":
-            doc["pages"] = [1]
-        elif name == "figures-dict":
-            doc["figures"] = {"a": f}
-        elif name == "figure-str":
-            doc["figures"] = ["fig.png"]
-        elif name == "id-int":
-            f["id"] = 3
-        elif name == "no-file":
-            del f["file"]
-        elif name == "sha-short":
-            f["sha256"] = f["sha256"][:63]
-        elif name == "sha-upper":
-            f["sha256"] = f["sha256"].upper()
-        elif name == "width-str":
-            f["width"] = str(f["width"])
-        elif name == "width-bool":
-            f["width"] = True
-        elif name == "width-zero":
-            f["width"] = 0
-        elif name == "height-huge":
-            f["height"] = 8193
-        elif name == "height-float":
-            f["height"] = float(f["height"])
-        elif name == "varies-int":
-            f["varies"] = 1
-        elif name == "code-version-list":
-            doc["code_version"] = []
-        elif name == "duplicate-id":
-            doc["figures"].append(dict(f, file="fig2.png"))
-        elif name == "duplicate-file":
-            doc["figures"].append(dict(f, id="other"))
-        elif name == "sha-mismatch":
-            f["sha256"] = "0" * 64
-        elif name == "file-changed":
-            (d / "fig.png").write_bytes(cli._png_bytes(255 - figure_pixels()))
-        elif name == "missing-file":
-            (d / "fig.png").unlink()
-        elif name == "link-to-dev-zero":
-            (d / "fig.png").unlink()
-            (d / "fig.png").symlink_to("/dev/zero")
-        elif name == "fifo-figure":
-            (d / "fig.png").unlink()
-            os.mkfifo(d / "fig.png")
-        elif name in ("corrupt-png", "bomb-header"):
-            import hashlib
-            data = bytearray((d / "fig.png").read_bytes())
-            if name == "corrupt-png":
-                data[41:-12] = bytes(len(data) - 53)  # IDAT contents zeroed, header kept
-            else:
-                data[16:24] = struct.pack(">II", 100_000, 100_000)
-            (d / "fig.png").write_bytes(bytes(data))
-            f["sha256"] = hashlib.sha256(bytes(data)).hexdigest()
-        elif name == "manifest-link":
-            (d / "manifest.json").unlink()
-            (d / "manifest.json").symlink_to("/dev/zero")
-            return None
-        elif name == "manifest-sparse":
-            with open(d / "manifest.json", "wb") as fh:
-                fh.truncate(2 << 30)
-            return None
-        elif name == "manifest-fifo":
-            (d / "manifest.json").unlink()
-            os.mkfifo(d / "manifest.json")
-            return None
-        elif name == "manifest-dir":
-            (d / "manifest.json").unlink()
-            (d / "manifest.json").mkdir()
-            return None
-        else:
-            raise KeyError(name)
-        return json.dumps(doc)
-    return apply
-
-
-TAMPERED = ["dev-zero", "dotdot", "dotdot-png", "subdir", "nul", "double-dot-name", "bad-json", "deep-json",
-            "not-utf8", "list", "no-pages", "empty-pages", "unknown-page", "page-int", "figures-dict",
-            "figure-str", "id-int", "no-file", "sha-short", "sha-upper", "width-str", "width-bool",
-            "width-zero", "height-huge", "height-float", "varies-int", "code-version-list", "duplicate-id",
-            "duplicate-file", "sha-mismatch", "file-changed", "missing-file", "link-to-dev-zero",
-            "fifo-figure", "corrupt-png", "bomb-header", "manifest-link", "manifest-sparse",
-            "manifest-fifo", "manifest-dir"]
-
-
-def test_check_accepts_the_untampered_directory(tmp_path, capsys, monkeypatch):
-    """The control for the refusals below: the same directory, untouched, is
-    validated and compared (so each refusal is the tampering's doing)."""
-    d = tmp_path / "old"
-    doc = write_check_dir(d)
-    fake_run(monkeypatch, {doc["figures"][0]["id"]: (d / "fig.png").read_bytes()})
-    rc, out, err = run(["figures", "--check", str(d)], capsys)
-    assert rc == 0 and err == "" and f"unchanged  {doc['figures'][0]['id']}" in out
-
-
-@pytest.mark.parametrize("name", TAMPERED)
-def test_check_refuses_a_tampered_directory_before_running_pages(tmp_path, capsys, monkeypatch, name):
-    d = tmp_path / "old"
-    doc = write_check_dir(d)
-    text = tamper(name)(d, doc)
-    if text is not None:
-        (d / "manifest.json").write_bytes(text if isinstance(text, bytes) else text.encode())
-    monkeypatch.setattr(cli, "_render_figures", no_run)
-    decoded = []
-    if name == "bomb-header":  # refused on the header, before any decoding
-        monkeypatch.setattr(cli, "_png_pixels", lambda data: decoded.append(1) or no_run(None, None))
-    reads = []
-    if name == "manifest-sparse":
-        real_read = os.read
-        monkeypatch.setattr(cli.files.os, "read", lambda fd, n: reads.append(n) or real_read(fd, n))
-    rc, out, err = run(["figures", "--check", str(d)], capsys)
-    assert failure_problems(rc, err, [], []) == [], err
-    assert err.startswith("symrender: error: --check") and out == ""
-    assert decoded == [] and reads == []             # no page ran (no_run), nothing decoded or read
-
-
-def test_check_names_what_is_wrong(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(cli, "_render_figures", no_run)
-    expect = {"dev-zero": "plain file name", "dotdot": "plain file name", "duplicate-id": "appears twice",
-              "sha-mismatch": "does not match its sha256", "link-to-dev-zero": "symbolic link",
-              "corrupt-png": "not a readable PNG", "bomb-header": "is not a 50x40 PNG",
-              "manifest-sparse": "larger than 1,048,576 bytes", "manifest-link": "symbolic link",
-              "manifest-fifo": "FIFO", "bad-json": "not JSON", "width-bool": "width must be an integer"}
-    for i, (name, words) in enumerate(expect.items()):
-        d = tmp_path / f"old{i}"
-        text = tamper(name)(d, write_check_dir(d))
-        if text is not None:
-            (d / "manifest.json").write_text(text)
-        rc, _, err = run(["figures", "--check", str(d)], capsys)
-        assert rc == 2 and words in err, (name, err)
-
-
-# ------------------------------------------------------------------ --check: tolerance
-
-
-def test_compare_figure_tolerance_on_synthetic_pngs():
-    base = figure_pixels()
-    n = base.shape[0] * base.shape[1]
-    allowed = int(cli.CHECK_TOLERANCE_FRACTION * n)
-    levels = cli.CHECK_TOLERANCE_LEVELS
-    assert allowed >= 1
-    png = cli._png_bytes(base)
-
-    def changed(count, by):
-        px = base.astype(int)
-        flat = px.reshape(-1, 3)
-        idx = np.arange(count) * (n // max(count, 1))
-        flat[idx, 1] = np.where(flat[idx, 1] >= 128, flat[idx, 1] - by, flat[idx, 1] + by)
-        return cli._png_bytes(px.astype(np.uint8))
-
-    assert cli.compare_figure(png, png) == ("unchanged", "")
-    verdict, how = cli.compare_figure(png, changed(allowed, levels))
-    assert verdict == "within tolerance" and f"({allowed:,} pixels differ)" in how
-    assert cli.compare_figure(png, changed(1, 1))[0] == "within tolerance"
-    # Wrong variants: one level more, one pixel more, another size.
-    verdict, how = cli.compare_figure(png, changed(1, levels + 1))
-    assert verdict == "changed" and how == f"max |dI| = {(levels + 1) / 255:.4f} (1 pixels differ)"
-    assert cli.compare_figure(png, changed(allowed + 1, 1))[0] == "changed"
-    assert cli.compare_figure(png, cli._png_bytes(base[:-1]))[0] == "changed"
-    assert cli.compare_figure(png, changed(1, 127))[0] == "changed"
-
-
-def test_check_passes_within_tolerance_and_fails_beyond(tmp_path, capsys, monkeypatch):
-    d = tmp_path / "old"
-    doc = write_check_dir(d)
-    fid = doc["figures"][0]["id"]
-    px = figure_pixels().astype(int)
-    near, far = px.copy(), px.copy()
-    near[3, 4] += np.where(near[3, 4] < 255, 1, -1)
-    far[3, 4] += np.where(far[3, 4] < 128, cli.CHECK_TOLERANCE_LEVELS + 1, -cli.CHECK_TOLERANCE_LEVELS - 1)
-    fake_run(monkeypatch, {fid: cli._png_bytes(near.astype(np.uint8))})
-    rc, out, _ = run(["figures", "--check", str(d)], capsys)
-    assert rc == 0 and f"within tolerance {fid}: max |dI| = 0.0039 (1 pixels differ)" in out
-    assert "no figure changed" in out
-    fake_run(monkeypatch, {fid: cli._png_bytes(far.astype(np.uint8))})
-    rc, out, _ = run(["figures", "--check", str(d)], capsys)
-    assert rc == 1 and f"changed    {fid}: max |dI|" in out and "1 figure(s) changed" in out

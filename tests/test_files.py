@@ -18,7 +18,7 @@ import threading
 
 import pytest
 
-from proofs.cli import main
+from renderer.cli import main
 from renderer import files
 
 from .test_cli import returns_without_blocking

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from proofs import gradient_methods as gm
+from lab import gradient_methods as gm
 from renderer import formulas as F
 from renderer import generated as G
 from renderer import pointwise

@@ -124,7 +124,7 @@ def test_the_markup_scan_finds_planted_roles_and_directives(book_html):
 
 
 def test_the_writer_refuses_a_role_or_directive_it_cannot_write_naming_the_page():
-    # (proofs.page.plain_markdown, the converter, is tested in tests/test_page.py.)
+    # (chapter.page.plain_markdown, the converter, is tested in tests/test_page.py.)
     app = SimpleNamespace(env=SimpleNamespace(doc2path=lambda d: f"book/{d}.md"))
     page = notebooks.PageMarkdown(app, "s9_x")
     with pytest.raises(notebooks.NotebookError, match=r"book/s9_x.md: \{kbd\}`C-c`: this role has no"):
@@ -169,8 +169,8 @@ def test_a_failed_wheel_build_names_what_failed(tmp_path):
     (root / "pyproject.toml").write_text((ROOT / "pyproject.toml").read_text(encoding="utf-8").replace(
         'version = "', 'version = "not a version ', 1), encoding="utf-8")
     shutil.copy(ROOT / "README.md", root)
-    for package in ("renderer", "proofs"):
-        (root / package).mkdir()
+    for package in ("renderer", "proofs", "lab", "book/chapter"):
+        (root / package).mkdir(parents=True)
         (root / package / "__init__.py").write_text("")
     with pytest.raises(notebooks.NotebookError, match=r"(?s)building the project's wheel with pip failed.*version"):
         notebooks.build_wheel(root, tmp_path / "site")
@@ -223,7 +223,7 @@ def test_a_downloaded_notebook_runs_in_a_new_environment_with_the_wheel(book_htm
     code = [c for c in notebook["cells"] if c["cell_type"] == "code"]
     assert all(c["execution_count"] for c in code), "a code cell did not run"
     assert not [o for c in code for o in c["outputs"] if o["output_type"] == "error"]
-    # What it shows as Markdown (proofs.page.markdown) is plain Markdown too.
+    # What it shows as Markdown (chapter.page.markdown) is plain Markdown too.
     shown_md = ["".join(o["data"]["text/markdown"]) for c in code for o in c["outputs"]
                 if "text/markdown" in o.get("data", {})]
     assert [m for text in shown_md for m in LEFTOVER.findall(text)] == []

@@ -1,4 +1,4 @@
-"""proofs.page: inside a book build `glue` and `show` glue for the prose and `markdown`
+"""chapter.page: inside a book build `glue` and `show` glue for the prose and `markdown`
 hands on MyST; anywhere else `show` displays the figure, `glue` does nothing (without
 needing myst-nb) and `markdown` shows plain Markdown (`plain_markdown`).
 
@@ -19,7 +19,7 @@ import pytest
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from proofs import page  # noqa: E402
+from chapter import page  # noqa: E402
 
 
 @pytest.fixture

@@ -1,4 +1,4 @@
-"""`proofs.store`: a measurement is computed once per build and read back by later pages.
+"""`lab.store`: a measurement is computed once per build and read back by later pages.
 
 The pages of the book run in separate processes; here a second process is
 played by clearing the store's in-process memory (`_MEMORY`).  Each check is
@@ -11,7 +11,7 @@ import json
 
 import pytest
 
-from proofs import store
+from lab import store
 
 
 @pytest.fixture
@@ -55,11 +55,11 @@ def test_other_parameters_or_another_digest_compute_again(fresh, monkeypatch):
 
 
 def test_the_digest_follows_the_source_files(tmp_path, monkeypatch):
-    """A changed byte in any file of renderer/ or proofs/ changes the digest."""
+    """A changed byte in any file of the project's packages changes the digest."""
     for package in store.PACKAGES:
         (tmp_path / package).mkdir()
         (tmp_path / package / "a.py").write_text("x = 1\n")
-    monkeypatch.setattr(store, "__file__", str(tmp_path / "proofs" / "store.py"))
+    monkeypatch.setattr(store, "_roots", lambda: {p: tmp_path / p for p in store.PACKAGES})
     monkeypatch.setattr(store, "_DIGEST", [])
     before = store.source_digest()
     (tmp_path / "renderer" / "a.py").write_text("x = 2\n")
@@ -141,7 +141,7 @@ def test_a_value_json_cannot_hold_writes_nothing(fresh):
 _RACER = """
 import sys, time
 from pathlib import Path
-from proofs import store
+from lab import store
 if sys.argv[2] == "unlocked":                       # the wrong variant: no lock around the computation
     import contextlib
     store._locked = lambda path: (path.parent.mkdir(parents=True, exist_ok=True), contextlib.nullcontext())[1]
@@ -192,9 +192,10 @@ def test_without_a_store_parameters_in_any_order_are_one_measurement(monkeypatch
 
 def test_a_failed_write_leaves_no_temporary_file(fresh):
     """The record cannot replace its path (a directory is in the way): the
-    error propagates and the temporary file is removed."""
+    error (renderer.files refuses a directory) propagates and no temporary file is left."""
+    from renderer.files import RefusedPath
     directory, calls, compute = fresh
     (directory / "u-curve.json").mkdir()
-    with pytest.raises(OSError):
+    with pytest.raises(RefusedPath, match="directory"):
         store.measured("u-curve", compute)
     assert sorted(p.name for p in directory.iterdir() if not p.name.endswith(".lock")) == ["u-curve.json"]

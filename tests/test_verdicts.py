@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from proofs import verdicts
-from proofs.claims import CLAIMS, FAILS, HOLDS
+from chapter import verdicts
+from lab.claims import CLAIMS, FAILS, HOLDS
 
 BOOK = Path(__file__).parents[1] / "book"
 
@@ -69,7 +69,7 @@ def test_an_unknown_place_is_refused():
 def test_outside_a_book_build_only_the_places_claims_are_measured(monkeypatch):
     """A downloaded notebook measures the two claims of its section, not the register (wrong variant: all)."""
     measured = []
-    monkeypatch.setattr("proofs.claims.Claim.measure", lambda self: measured.append(self.id) or ("m", self.registered))
+    monkeypatch.setattr("lab.claims.Claim.measure", lambda self: measured.append(self.id) or ("m", self.registered))
     monkeypatch.delenv("SYMRENDER_BOOK_BUILD", raising=False)
     assert "**Holds" in verdicts.verdicts("s3-boundary")
     assert sorted(measured) == sorted(verdicts.PLACES["s3-boundary"])

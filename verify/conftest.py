@@ -1,6 +1,30 @@
-"""Collects each theorem's verdict and prints the ledger after `pytest verify`."""
+"""Shared measurements of `pytest verify`, each computed once per session (and only
+when a test asks for it), and the theorem ledger printed at the end of the run."""
+
+import pytest
 
 LEDGER = {}
+
+
+@pytest.fixture(scope="session")
+def claim_results():
+    """{claim id: (measured, verdict)} of the whole register (`lab.claims.evaluate`)."""
+    from lab.claims import evaluate
+    return {c.id: (measured, verdict) for c, measured, verdict in evaluate()}
+
+
+@pytest.fixture(scope="session")
+def errata():
+    """{erratum id: measurement} of the draft's errata (`lab.seed_errata.measure_all`)."""
+    from lab.seed_errata import measure_all
+    return measure_all()
+
+
+@pytest.fixture(scope="session")
+def curve():
+    """The default U-curve (`renderer.ucurve.measure`: sine, (0.31, 0.47), h_u, k = (8, 4))."""
+    from renderer.ucurve import measure
+    return measure()
 
 
 def pytest_terminal_summary(terminalreporter):

@@ -5,21 +5,18 @@ defect, the book's errata section would be false: this fails first."""
 import numpy as np
 import pytest
 
-from proofs.seed_errata import ERRATA, ErratumVanished, measure_all, reproduced
+from lab.seed_errata import ERRATA, ErratumVanished, reproduced
 from renderer import Scene, gbuffer
 
-MEASURED = measure_all()
-
-
-def test_every_erratum_is_measured_and_reported():
-    assert [e.id for e in ERRATA] == list(MEASURED)
+def test_every_erratum_is_measured_and_reported(errata):
+    assert [e.id for e in ERRATA] == list(errata)
     for e in ERRATA:
-        text = e.report(MEASURED[e.id])
+        text = e.report(errata[e.id])
         assert text and "{" not in text
 
 
-def test_sphere_b_seed_variant_is_off_the_surface():
-    m = MEASURED["sphere-b-quadratic"]
+def test_sphere_b_seed_variant_is_off_the_surface(errata):
+    m = errata["sphere-b-quadratic"]
     assert m["off_surface_relative"] > 1.0            # seed: points far off sphere B
     assert m["seed_pixels_b"] > 5 * m["true_pixels_b"]
     # The renderer's own sphere-B hit points are on the surface.
@@ -30,8 +27,8 @@ def test_sphere_b_seed_variant_is_off_the_surface():
     assert np.max(np.abs(dist - scene.radius_b)) <= 1e-12 * scene.radius_b
 
 
-def test_terminator_leak_exists_in_seed_rule_only():
-    m = MEASURED["terminator-leak"]
+def test_terminator_leak_exists_in_seed_rule_only(errata):
+    m = errata["terminator-leak"]
     assert m["leak_pixels_default"] > 0 and m["leak_diffuse_max_default"] > 1 / 255
     # The renderer: with one light and no ambient, every sphere-A pixel whose
     # geometric normal faces away from the light is exactly black.
@@ -47,26 +44,26 @@ def test_terminator_leak_exists_in_seed_rule_only():
     assert np.all(image[away] == 0.0)
 
 
-def test_acos_pole_loses_digits_atan2_does_not():
-    m = MEASURED["acos-pole"]
+def test_acos_pole_loses_digits_atan2_does_not(errata):
+    m = errata["acos-pole"]
     assert m["max_rel_error_acos"] > 1e-3
     assert m["max_rel_error_atan2"] < 1e-14
 
 
-def test_fallback_orientation_is_reflected():
-    m = MEASURED["fallback-orientation"]
+def test_fallback_orientation_is_reflected(errata):
+    m = errata["fallback-orientation"]
     assert m["orientation_fallback"] == 1.0
     assert m["orientation_regular_max"] == pytest.approx(-1.0, abs=1e-12)
 
 
-def test_v_border_branch_fires_in_interior():
-    m = MEASURED["v-border-branch"]
+def test_v_border_branch_fires_in_interior(errata):
+    m = errata["v-border-branch"]
     assert 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"]
 
 
-def test_every_erratum_is_present_by_its_criterion():
-    assert reproduced(MEASURED) is MEASURED
-    assert all(e.criterion and e.present(MEASURED[e.id]) for e in ERRATA)
+def test_every_erratum_is_present_by_its_criterion(errata):
+    assert reproduced(errata) is errata
+    assert all(e.criterion and e.present(errata[e.id]) for e in ERRATA)
 
 
 @pytest.mark.parametrize("erratum_id, key, fixed", [
@@ -77,9 +74,9 @@ def test_every_erratum_is_present_by_its_criterion():
     ("acos-pole", "max_rel_error_acos", 1e-16),
     ("fallback-orientation", "orientation_fallback", -1.0),
 ])
-def test_a_vanished_erratum_fails_the_book(erratum_id, key, fixed):
+def test_a_vanished_erratum_fails_the_book(erratum_id, key, fixed, errata):
     """The measurement of a corrected draft (its defect gone) is refused by name."""
-    gone = {**MEASURED, erratum_id: {**MEASURED[erratum_id], key: fixed}}
+    gone = {**errata, erratum_id: {**errata[erratum_id], key: fixed}}
     with pytest.raises(ErratumVanished, match=erratum_id):
         reproduced(gone)
 

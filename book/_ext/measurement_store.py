@@ -1,9 +1,9 @@
 """Sphinx extension: the pages of one build share one store of measurements.
 
-Sets ``SYMRENDER_STORE`` (`proofs.store.ENV`) to ``<build dir>/.measurements``
+Sets ``SYMRENDER_STORE`` (`lab.store.ENV`) to ``<build dir>/.measurements``
 unless it is set already; the kernels myst-nb starts for the pages inherit it,
 so a quantity shown on several pages (a theorem's verdict) is computed by the
-first page that needs it and read by the others (`proofs.store.measured`).
+first page that needs it and read by the others (`lab.store.measured`).
 ``make clean`` removes it with the rest of the build.
 """
 
@@ -12,13 +12,13 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from proofs.page import BUILD_ENV
-from proofs.store import ENV
+from chapter.page import BUILD_ENV
+from lab.store import ENV
 
 
 def _set_store(app, config):
     os.environ.setdefault(ENV, str(Path(app.outdir).parent / ".measurements"))
-    os.environ[BUILD_ENV] = "1"        # proofs.page: glue for the prose instead of displaying
+    os.environ[BUILD_ENV] = "1"        # chapter.page: glue for the prose instead of displaying
 
 
 def setup(app):

@@ -13,12 +13,12 @@ An HTML build puts into the site, beside the pages:
 * ``_notebooks/<page>.ipynb`` for each page that is a MyST notebook, written by
   jupytext when the build finishes: the page's code cells as they are, with
   their tags and no outputs, and its prose as plain Markdown any Jupyter
-  renders (`proofs.page.plain_markdown`, which `proofs.page.markdown` also
+  renders (`chapter.page.plain_markdown`, which `chapter.page.markdown` also
   applies to what a page shows when it runs outside the book, with
   `PageMarkdown` resolving against this build): each glue role becomes the value this build
   computed (myst-nb's glue data of the page), each cross-reference its text
   ("§3 · The mathematics", "Fig. 2"), a ``glue:figure`` its numbered caption
-  (the figure is drawn by the code cell that calls `proofs.page.show`), a
+  (the figure is drawn by the code cell that calls `chapter.page.show`), a
   ``literalinclude`` the code it includes (Sphinx's own reader), and so on.
   A first cell says how to install the project to run the notebook.
 
@@ -43,7 +43,8 @@ from pathlib import Path
 
 from docutils import nodes
 
-from proofs.page import TITLED, escape, fenced, plain_directive, plain_markdown
+from renderer import files
+from chapter.page import TITLED, escape, fenced, plain_directive, plain_markdown
 
 #: The site folder that holds the notebooks, and the one that holds the wheel and constraints.txt.
 FOLDER, DOWNLOADS = "_notebooks", "_downloads"
@@ -60,18 +61,9 @@ class NotebookError(Exception):
 # --- files of the site -------------------------------------------------------------------------
 
 def write_atomic(target, data: bytes):
-    """Write ``data`` to ``target`` through a temporary file beside it and a rename."""
-    target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.chmod(tmp, 0o644)                          # mkstemp's 0600 would hide it from a web server
-        os.replace(tmp, target)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    """Write ``data`` to ``target`` (its directory made first) atomically, by `renderer.files.write_bytes`."""
+    Path(target).parent.mkdir(parents=True, exist_ok=True)
+    files.write_bytes(target, data)
 
 
 def build_wheel(root, folder) -> Path:
@@ -98,8 +90,10 @@ def build_wheel(root, folder) -> Path:
         src.mkdir()
         for name in ("pyproject.toml", pyproject["project"]["readme"]):
             shutil.copy2(root / name, src / name)
+        where = pyproject["tool"].get("setuptools", {}).get("package-dir", {})
         for package in pyproject["tool"]["setuptools"]["packages"]:
-            shutil.copytree(root / package, src / package, ignore=shutil.ignore_patterns("__pycache__"))
+            path = where.get(package, package)
+            shutil.copytree(root / path, src / path, ignore=shutil.ignore_patterns("__pycache__"))
         run = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation",
                               "--no-index", "--check-build-dependencies", "--quiet", "-w", str(out), str(src)],
                              capture_output=True, text=True, cwd=tmp,

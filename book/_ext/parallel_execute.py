@@ -21,7 +21,7 @@ does the executing first and leaves the reading to myst-nb:
    cached: myst-nb executes it again when it reads it, and reports the error
    as it always does.
 
-Pages share measurements through `proofs.store`, which locks each one while
+Pages share measurements through `lab.store`, which locks each one while
 it is computed, so two pages running at once that need the same measurement
 compute it once.
 """

@@ -13,7 +13,7 @@ renders (`plain_markdown`: a cross-reference becomes its title, a directive
 its body).  book/_ext/notebooks.py writes the downloaded notebooks' prose with
 the same `plain_markdown`.
 
-`show` refuses a figure whose text overlaps (`proofs.figures.text_overlaps`),
+`show` refuses a figure whose text overlaps (`chapter.figures.text_overlaps`),
 so the build fails on one instead of publishing it.
 """
 
@@ -87,7 +87,7 @@ def show(name, fig):
     Inside a book build it is glued under ``name`` (for the page's
     ``{glue:figure}`` directive, which numbers and captions it); anywhere else
     it is displayed here, as the cell's output (``IPython.display.display``:
-    a PNG in Jupyter, with the settings `proofs.figures.style` made), its
+    a PNG in Jupyter, with the settings `chapter.figures.style` made), its
     output metadata ``{"symrender": {"figure": name}}`` naming it.  Either
     way the figure is closed, so Jupyter's inline backend does not draw it a
     second time.  Returns None.
@@ -122,7 +122,7 @@ def show(name, fig):
             try:
                 from IPython.display import display
             except ImportError as error:
-                raise ImportError("proofs.page.show displays a figure with IPython outside a book build; "
+                raise ImportError("chapter.page.show displays a figure with IPython outside a book build; "
                                   "install it (the project's notebook extra: ipykernel)") from error
             display(fig, metadata={"symrender": {"figure": name}})
     finally:

@@ -1,18 +1,18 @@
 """The draft's claims on the book's pages: a verdict where the reader meets each claim,
 and the register of §6 that collects them.
 
-Every claim of `proofs.claims.CLAIMS` is *placed* on exactly one page section
+Every claim of `lab.claims.CLAIMS` is *placed* on exactly one page section
 (`PLACES`): there `verdicts(place)` shows it in one sentence (the draft's words,
 the verdict, the measurement) linked to its row of the register, and the
 register row links back.  Both read the same evaluation of the register
-(`proofs.claims.checked`), so a verdict cannot read one way in §5 and another
+(`lab.claims.checked`), so a verdict cannot read one way in §5 and another
 in §6, and the build fails, as `pytest verify` does, when a computed verdict
 is not the registered one.
 """
 
 from __future__ import annotations
 
-from .claims import CLAIMS, CORRECTED, CRITERIA, FAILS, HOLDS, checked
+from lab.claims import CLAIMS, CORRECTED, CRITERIA, FAILS, HOLDS, checked
 
 __all__ = ["PLACES", "verdicts", "register", "place_of"]
 
@@ -52,7 +52,7 @@ def place_of(claim_id):
 
 def _results(ids=None):
     """{claim id: (claim, measured, verdict)}, checked against the register.  Inside a book
-    build the whole register is one measurement shared by every page (`proofs.claims.checked`);
+    build the whole register is one measurement shared by every page (`lab.claims.checked`);
     elsewhere (a downloaded notebook) only the claims ``ids`` are measured."""
     from .page import in_book_build
     if ids is None or in_book_build():
@@ -73,7 +73,7 @@ def verdicts(place):
     ------
     KeyError
         If ``place`` is not a key of `PLACES`.
-    proofs.claims.ClaimChanged
+    lab.claims.ClaimChanged
         If a computed verdict is not the registered one.
     """
     if place not in PLACES:
@@ -84,13 +84,13 @@ def verdicts(place):
 
 
 def register():
-    """MyST markdown: the register of §6, one entry per claim in `proofs.claims.CLAIMS`
+    """MyST markdown: the register of §6, one entry per claim in `lab.claims.CLAIMS`
     order, each with the target ``claim-<id>``, its verdict, the rule that decided it, and
     a link to the section that shows the measurement (`verdicts`).
 
     Raises
     ------
-    proofs.claims.ClaimChanged
+    lab.claims.ClaimChanged
         If a computed verdict is not the registered one.
     """
     results = _results()

@@ -18,7 +18,7 @@ Each returns a matplotlib Figure (the caller glues and closes it).
 
 `text_overlaps` lists what of a figure's text collides when it is drawn (two
 texts, a text and a legend, a text and another axes' plotting area, an
-annotation and its axes' frame); `proofs.page.show` refuses a figure with any.
+annotation and its axes' frame); `chapter.page.show` refuses a figure with any.
 """
 
 from __future__ import annotations
@@ -186,7 +186,7 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
 
 
 def ucurve_anatomy(curve):
-    """The measured U-curve of a `proofs.ucurve.UCurve` (error, truncation and roundoff parts,
+    """The measured U-curve of a `renderer.ucurve.UCurve` (error, truncation and roundoff parts,
     fitted model) with its regions named: truncation falling as eps^2, rounding rising as
     1/eps, the fitted optimum between them."""
     import matplotlib.pyplot as plt

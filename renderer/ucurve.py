@@ -33,7 +33,7 @@ import sympy as sp
 from renderer import formulas as F
 from renderer import pointwise
 
-__all__ = ["UCurve", "measure", "fit_model", "default_optimum", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS",
+__all__ = ["UCurve", "measure", "fit_model", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS",
            "SEED_POINT", "SEED_FREQUENCIES"]
 
 #: Unit roundoff of IEEE double precision (round to nearest).
@@ -177,30 +177,6 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
                      "convergence in 100 Gauss-Newton steps)")
 
 
-def default_optimum():
-    """The U-curve optimum the book shows, one measurement of the build
-    (`proofs.store`): `measure`'s default curve (sine, (u, v) = (0.31, 0.47),
-    h_u, k_u = 8, k_v = 4, `DEFAULT_STEPS`), as a dict: the
-    fitted optimum ``eps`` and the model's ``error`` there, the measured
-    errors ``band`` (min, max) within a factor 2 of it, the coefficients
-    ``A`` and ``B``, the model's prediction ``eps_predicted`` and, for
-    comparison, the curve's ``argmin`` and ``min``, and a ``label``."""
-    from .store import measured
-    return measured("ucurve.default-optimum", _default_optimum)
-
-
-def _default_optimum():
-    c = measure()
-    near = c.error[(c.eps >= c.eps_opt_fitted / 2) & (c.eps <= 2 * c.eps_opt_fitted)]
-    return dict(eps=c.eps_opt_fitted, error=c.error_at_fitted_opt, band=[float(near.min()), float(near.max())],
-                A=c.truncation_coeff, B=c.roundoff_coeff, eps_predicted=c.eps_opt_predicted,
-                argmin=c.eps_opt_measured, min=c.error_at_measured_opt,
-                label=f"sine field, hᵤ at (u, v) = ({c.u}, {c.v}), kᵤ = {SEED_FREQUENCIES[0]:g}, "
-                      f"kᵥ = {SEED_FREQUENCIES[1]:g}, {c.eps.size} steps "
-                      f"from {c.eps.max():.0e} to {c.eps.min():.0e}")
-
-
-@lru_cache(maxsize=None)
 def _mp_functions(field, component, ku, kv):
     var = F.u if component == "u" else F.v
     # Exact rational frequencies so that mpmath does not inherit float64 rounding.

@@ -5,7 +5,7 @@ parses the output as MyST (``nb_render_markdown_format: myst``), so the
 statement and the argument shown are the proof object's, and the badge is the
 verdict its check returned during this build.  A theorem that does not hold
 raises, and the cell error fails the build.  Each theorem's check runs once
-per build: its entry is a measurement of `proofs.store`, which later pages
+per build: its entry is a measurement of `lab.store`, which later pages
 (§6's ledger) read.
 """
 
@@ -16,7 +16,7 @@ import math
 import re
 from collections import Counter
 
-from . import store
+from lab import store
 
 __all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math",
            "frame_label"]
@@ -45,48 +45,6 @@ def tex_number(x) -> str:
     if mantissa in ("1", "-1"):
         return power if mantissa == "1" else f"-{power}"
     return f"{mantissa}\\cdot {power}"
-
-
-def frame_label(scene, width, height) -> str:
-    """The label a number measured on a render carries: its scene and resolution, in words.
-
-    ``"the draft's scene, 256 × 256"``, or with the fields that differ from
-    `renderer.Scene`'s defaults (the draft's scene): ``"the draft's scene with the
-    sine field, β = 1.5, 64 × 64"``.  ``scene`` is a `renderer.Scene`; ``width``,
-    ``height`` in pixels.
-
-    Raises
-    ------
-    TypeError
-        ``scene`` is not a `renderer.Scene`.
-    ValueError
-        ``width`` or ``height`` is not a positive integer.
-    """
-    from dataclasses import fields
-
-    from renderer import Scene
-    if not isinstance(scene, Scene):
-        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
-    for name, n in (("width", width), ("height", height)):
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-            raise ValueError(f"{name} must be a positive integer number of pixels, got {n!r}")
-    default = Scene()
-    changed = [_field_words(f.name, getattr(scene, f.name)) for f in fields(Scene)
-               if getattr(scene, f.name) != getattr(default, f.name)]
-    return "the draft's scene" + (" with " + ", ".join(changed) if changed else "") + f", {width} × {height}"
-
-
-#: How `frame_label` words a field of `renderer.Scene` that differs from the draft's.
-_WORDS = {"height_field": "the {} field", "beta": "β = {:g}", "eps": "ε = {:g}", "k_u": "kᵤ = {:g}",
-          "k_v": "kᵥ = {:g}", "radius_a": "R = {:g}", "model": "{} shading", "shininess": "shininess {:g}"}
-
-
-def _field_words(name, value):
-    if name == "bump":
-        return {"surface": "the displaced sphere's normal", "chart": "the draft's normal"}[value]
-    if name in ("sphere_b", "floor") and isinstance(value, bool):
-        return f"{'with' if value else 'no'} {'sphere B' if name == 'sphere_b' else name}"
-    return _WORDS.get(name, name.replace("_", " ") + " {}").format(value)
 
 
 def glue_math(name, x):
@@ -123,7 +81,7 @@ def _proof_step(t, number, step):
 
 
 def _entry(t):
-    from .registry import pinned_failure
+    from proofs.registry import pinned_failure
     v = t.check()
     steps = "\n\n".join(_proof_step(t, i, step) for i, step in enumerate(t.steps, 1))
     block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement_tex()}\n\n"
@@ -134,7 +92,7 @@ def _entry(t):
 
 
 def _ledger():
-    from .registry import THEOREMS
+    from proofs.registry import THEOREMS
     return {theorem_id: _entry(t) for theorem_id, t in THEOREMS.items()}
 
 
@@ -142,7 +100,7 @@ def ledger():
     """{theorem id: entry} for every theorem, in the registry's order; an entry
     holds the title, the verdict (``status``, ``evidence``), what the draft
     says, the pages and the MyST ``block``.  One measurement of the build
-    (`proofs.store`): every check runs once, in the first page that needs
+    (`lab.store`): every check runs once, in the first page that needs
     any, and the later pages read the verdicts it reached."""
     return store.measured("theorem-ledger", _ledger)
 
@@ -190,7 +148,7 @@ def ledger_table():
     links here with ``{ref}`§6 <ledger-<id>>```): its title (linked to the box), id,
     verdict; then its evidence (what its steps took, and the
     renderer's outputs compared), the first clause shown and the rest folded.  (What the
-    draft says about a theorem is in the claims register, `proofs.verdicts.register`.)  (A list, not a table: the evidence is a
+    draft says about a theorem is in the claims register, `chapter.verdicts.register`.)  (A list, not a table: the evidence is a
     paragraph, which a table column of a 700-pixel page squeezes to a word a line.)
 
     Raises
@@ -211,19 +169,19 @@ def findings():
     """What the build found, for the book's front page: a dict of counts.
 
     ``theorems``: {status: count} over the theorem ledger; ``claims``: {verdict:
-    count} over the draft's claims register (`proofs.claims.checked`);
+    count} over the draft's claims register (`lab.claims.checked`);
     ``errata``: the number of defects of the draft's code the book records
-    (§6 re-measures each with `proofs.seed_errata.reproduced`, and its build
+    (§6 re-measures each with `lab.seed_errata.reproduced`, and its build
     fails if one vanished).  Reads the build's measurements (`ledger`, the
     register), computing what is missing.
 
     Raises
     ------
-    TheoremFailed, proofs.claims.ClaimChanged
+    TheoremFailed, lab.claims.ClaimChanged
         As the pages that show the ledger and the register.
     """
-    from .claims import checked
-    from .seed_errata import ERRATA
+    from lab.claims import checked
+    from lab.seed_errata import ERRATA
     entries = ledger()
     for theorem_id, entry in entries.items():
         _refuse(theorem_id, entry)

@@ -18,10 +18,10 @@ from renderer import Scene, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
-from .book import frame_label
+from renderer import frame_label
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
-           "image_beta_order", "DIGITS"]
+           "image_beta_order", "default_optimum", "DIGITS"]
 
 DIGITS = 50
 STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
@@ -96,7 +96,7 @@ def normal_beta_derivative_residual(trials=2000, seed=5):
 
     The reference is mpmath's numerical derivative of N'(beta) = M / |M| at 50
     digits (mpmath.diff), independent of the closed form.  One measurement of
-    the build (`proofs.store`): §5, §6 and the claims register show the same value.
+    the build (`lab.store`): §5, §6 and the claims register show the same value.
     """
     from .store import measured
     return measured("normal-beta-derivative-residual", _normal_beta_derivative_residual, trials=trials, seed=seed)
@@ -128,7 +128,7 @@ def _normal_beta_derivative_residual(trials, seed):
 
 
 def image_beta_order(size=64, beta=0.35, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e-3)):
-    """`_image_beta_order`, one measurement of the build (`proofs.store`; arrays come back as lists)."""
+    """`_image_beta_order`, one measurement of the build (`lab.store`; arrays come back as lists)."""
     from .store import measured
     return measured("image-beta-order", _image_beta_order, size=size, beta=beta, steps=list(steps))
 
@@ -147,7 +147,7 @@ def _image_beta_order(size, beta, steps):
     Returns
     -------
     dict with "median_slope", "rms_slope", "median_errors", "rms_errors", "steps", and
-    "label", the scene and resolution (`proofs.book.frame_label`).
+    "label", the scene and resolution (`chapter.theorems.frame_label`).
     """
     scene = Scene(height_field="sine", beta=beta)
 
@@ -165,3 +165,27 @@ def _image_beta_order(size, beta, steps):
     fit = lambda e: float(np.polyfit(np.log(steps), np.log(e), 1)[0])  # noqa: E731
     return {"median_slope": fit(median), "rms_slope": fit(rms), "median_errors": median.tolist(),
             "rms_errors": rms.tolist(), "steps": list(steps), "label": frame_label(scene, size, size)}
+
+
+def default_optimum():
+    """The U-curve optimum the book shows, one measurement of the build
+    (`lab.store`): `renderer.ucurve.measure`'s default curve (sine, (u, v) = (0.31, 0.47),
+    h_u, k_u = 8, k_v = 4, `DEFAULT_STEPS`), as a dict: the
+    fitted optimum ``eps`` and the model's ``error`` there, the measured
+    errors ``band`` (min, max) within a factor 2 of it, the coefficients
+    ``A`` and ``B``, the model's prediction ``eps_predicted`` and, for
+    comparison, the curve's ``argmin`` and ``min``, and a ``label``."""
+    from .store import measured
+    return measured("ucurve.default-optimum", _default_optimum)
+
+
+def _default_optimum():
+    from renderer.ucurve import SEED_FREQUENCIES, measure
+    c = measure()
+    near = c.error[(c.eps >= c.eps_opt_fitted / 2) & (c.eps <= 2 * c.eps_opt_fitted)]
+    return dict(eps=c.eps_opt_fitted, error=c.error_at_fitted_opt, band=[float(near.min()), float(near.max())],
+                A=c.truncation_coeff, B=c.roundoff_coeff, eps_predicted=c.eps_opt_predicted,
+                argmin=c.eps_opt_measured, min=c.error_at_measured_opt,
+                label=f"sine field, hᵤ at (u, v) = ({c.u}, {c.v}), kᵤ = {SEED_FREQUENCIES[0]:g}, "
+                      f"kᵥ = {SEED_FREQUENCIES[1]:g}, {c.eps.size} steps "
+                      f"from {c.eps.max():.0e} to {c.eps.min():.0e}")

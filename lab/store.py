@@ -29,29 +29,38 @@ from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
 
+from renderer import files
+
 __all__ = ["ENV", "measured", "source_digest"]
 
 #: Environment variable naming the store's directory.
 ENV = "SYMRENDER_STORE"
 #: The packages whose files a measurement may depend on, and the libraries whose versions it may.
-PACKAGES = ("renderer", "proofs")
+PACKAGES = ("renderer", "proofs", "lab", "chapter")
 LIBRARIES = ("numpy", "sympy", "mpmath", "numba", "llvmlite")
 _NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,99}")
 _MEMORY = {}
 _DIGEST = []
 
 
+def _roots():
+    """{package: its directory} of `PACKAGES`, where Python imports them from."""
+    from importlib.util import find_spec
+    return {package: Path(find_spec(package).origin).parent for package in PACKAGES}
+
+
 def source_digest():
-    """SHA-256 (hex str) of every file of renderer/ and proofs/ (their paths and
-    bytes, __pycache__ left out) and the versions of `LIBRARIES`; computed
-    once per process."""
+    """SHA-256 (hex str) of every file of the project's packages (`PACKAGES`, found where
+    Python imports them from: a checkout or an installed wheel; paths and bytes,
+    __pycache__ left out) and the versions of `LIBRARIES`; computed once per process.
+    The project's one source digest: the store, the book's page cache and the figure
+    manifests all use it."""
     if not _DIGEST:
         h = hashlib.sha256()
-        root = Path(__file__).resolve().parents[1]
-        for package in PACKAGES:
-            for path in sorted((root / package).rglob("*")):
+        for package, root in _roots().items():
+            for path in sorted(root.rglob("*")):
                 if path.is_file() and "__pycache__" not in path.parts:
-                    h.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes() + b"\0")
+                    h.update(f"{package}/{path.relative_to(root)}".encode() + b"\0" + path.read_bytes() + b"\0")
         for name in LIBRARIES:
             h.update(f"{name}=={metadata.version(name)}\0".encode())
         _DIGEST.append(h.hexdigest())
@@ -125,13 +134,6 @@ def _read(path):
 
 
 def _write(path, record):
-    """Write ``record`` to ``path`` atomically (a temporary file, then a rename); the
+    """Write ``record`` to ``path`` atomically (`renderer.files.write_bytes`); the
     directory exists (`_locked` made it)."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(record, f)             # key order kept: a dict reads back as written
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    files.write_bytes(path, json.dumps(record).encode("utf-8"))   # key order kept: reads back as written

@@ -25,7 +25,7 @@ import numpy as np
 from renderer import Scene, compare, gbuffer, pointwise, render
 from renderer.render import SPHERE_A
 
-from .book import frame_label
+from renderer import frame_label
 
 __all__ = ["Bound", "Criterion", "rule", "Claim", "CLAIMS", "CRITERIA", "HOLDS", "FAILS", "CORRECTED", "evaluate", "checked", "ClaimChanged",
            "crease_band_ratio"]
@@ -119,7 +119,7 @@ class Claim:
 
 @lru_cache(maxsize=None)
 def _ucurve():
-    from .ucurve import measure
+    from renderer.ucurve import measure
     return measure()
 
 
@@ -136,7 +136,7 @@ def _frames(field="ridges", beta=0.35, eps=1e-3, size=128):
 
 
 def _on(frame, scene=None):
-    """' (label)': the scene and size of the frame a measurement used (`proofs.book.frame_label`),
+    """' (label)': the scene and size of the frame a measurement used (`chapter.theorems.frame_label`),
     read from the frame itself.  ``frame``: a `renderer.Frame` or `renderer.GBuffer`; ``scene``:
     the scene to name when the frame carries none (a GBuffer) or a sweep varies it."""
     height, width = frame.chamber.shape
@@ -149,7 +149,7 @@ def _err_at(eps):
 
 
 def relative_error_at(eps):
-    """The central difference's relative error in hᵤ on the U-curve of Cell 2 (`proofs.ucurve.measure`'s
+    """The central difference's relative error in hᵤ on the U-curve of Cell 2 (`renderer.ucurve.measure`'s
     default curve) at its step nearest ``eps``: what the register's claims about 1e-9 and 1e-11 decide on."""
     return _err_at(eps) / abs(_ucurve().derivative)
 
@@ -173,21 +173,21 @@ def _drowns_below_1e9():
 
 
 def _cell2_minimum():
-    from .ucurve import default_optimum
+    from .accuracy import default_optimum
     opt = default_optimum()
     return (f"the fitted optimal step is {opt['eps']:.1e}, where the model's error is {opt['error']:.1e}",
             {"fitted optimum ε": opt["eps"]})
 
 
 def _orientation():
-    from .frame import _orientation_value
+    from proofs.frame import _orientation_value
     value = int(_orientation_value())
     return (f"$(e_\\theta \\times e_\\varphi)\\cdot N = {value}$: the frame is left-handed about the outward normal",
             {"(eθ × eφ)·N": value})
 
 
 def _flips_zero():
-    from .no_boundary import render_flips
+    from proofs.no_boundary import render_flips
     frames, values, masks = render_flips()
     return (f"over {frames} independent G-buffers, {values} geometry values (chamber, $t$, $P$, $N$) and {masks} "
             "reach-mask pixels differ", {"geometry values differing": values, "reach-mask pixels differing": masks})
@@ -211,7 +211,7 @@ CENSUS_SIZE = 256
 
 
 def census():
-    """The draft's Cell 3 census, one measurement of the build (`proofs.store`): the
+    """The draft's Cell 3 census, one measurement of the build (`lab.store`): the
     default scene (ridges) at 256 x 256, the exact frame against the central frame at
     each step of `CENSUS_STEPS`.
 
@@ -362,7 +362,7 @@ def _blinn_exact():
 
     from renderer import formulas as F
 
-    from .blinn import BLINN, SURFACE, phi, theta
+    from proofs.blinn import BLINN, SURFACE, phi, theta
     at = {F.R: 1.0, F.beta: 0.35, F.h: 0.5, F.h_u: 3.0, F.h_v: -2.0, phi: 1.1, theta: 0.4}
     gap = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE))
     first = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE).diff(F.beta).subs(F.beta, 0))
@@ -639,7 +639,7 @@ def checked(results=None):
     verdict against the registered one: the book shows the register only
     through this, so its build fails as `pytest verify` does.  Without
     ``results`` the evaluation is one measurement of the build
-    (`proofs.store`, "claims-register"), shared by the pages that show it.
+    (`lab.store`, "claims-register"), shared by the pages that show it.
 
     Raises
     ------

@@ -1,0 +1,881 @@
+"""``symrender``: the renderer's command line.
+
+Subcommands (``symrender <command> --help`` for each)::
+
+    symrender render  [--scene FILE.toml] [--set key=value ...] --size WxH
+                      --gradient exact|central|footprint --view shaded|difference|bump|kink -o out.png
+    symrender sweep   --eps 1e-1:1e-8:8 [--scene ...] [--set ...] [--size WxH] [--format text|csv|json]
+    symrender ucurve  --field sine --u 0.31 --v 0.47 --component u [--eps ...] [--plot out.png]
+
+Errors.  Every input error (a bad argument, a malformed or unknown scene key, a
+value `Scene` refuses, a size over the limits, an output path that cannot be
+written) prints ONE line ``symrender: error: ...`` naming the argument, writes
+nothing and returns 2.  Anything else is a bug: one line ``symrender: internal
+error: ...`` and 1; a traceback is never printed.
+
+Ctrl-C prints ``symrender: interrupted`` and returns 130, and leaves no file:
+outputs are written atomically (`renderer.files.write_bytes`) after the work,
+and an interrupt that numba's compiler swallowed is caught before writing.
+
+Reproducibility.  PNG files carry no varying metadata: two runs give the same
+bytes.  ``-o -`` (``--plot -``) writes to standard output, the report to
+standard error, and is refused on a terminal.
+
+Limits (refused before anything is allocated): each side of ``--size`` in
+[1, 8192]; ``render`` holds two frames, at most ``MAX_PIXELS`` = 4096^2
+pixels; ``sweep`` holds one frame per step plus one, (steps + 1) * W * H <=
+``FRAME_PIXEL_BUDGET`` = 2 * 4096^2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import csv
+import io
+import json
+import math
+import os
+import re
+import signal
+import sys
+import tomllib
+from pathlib import Path
+
+from . import files
+
+__all__ = ["main", "load_scene", "parse_size", "parse_eps", "write_png", "atomic_write",
+           "MAX_PIXELS", "FRAME_PIXEL_BUDGET", "MAX_UCURVE_STEPS"]
+
+#: Most pixels `render` accepts (W * H): the two frames of the ledger then take
+#: about 2 * 57 bytes * 4096^2 = 1.9 GB.
+MAX_PIXELS = 4096 * 4096
+#: Most frame-pixels a command holds at once: render holds 2 frames, a sweep of
+#: n steps holds n + 1.
+FRAME_PIXEL_BUDGET = 2 * MAX_PIXELS
+#: Most steps of one U-curve (each step is a 50-digit mpmath evaluation).
+MAX_UCURVE_STEPS = 10_000
+
+VIEWS = ("shaded", "difference", "bump", "kink")
+FORMATS = ("text", "csv", "json")
+_BARE_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*\Z")
+
+
+def _field_names():
+    """(`Scene` field names, `PointLight` field names), in declaration order."""
+    from dataclasses import fields as dataclass_fields
+
+    from renderer.scene import PointLight, Scene
+    return (tuple(f.name for f in dataclass_fields(Scene)),
+            tuple(f.name for f in dataclass_fields(PointLight)))
+
+
+class UsageError(Exception):
+    """A bad argument or input: printed as one line, exit code 2."""
+
+
+_NEGATIVE_VALUE = re.compile(r"-[0-9.]")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises `UsageError` instead of printing usage and exiting,
+    and that takes a value starting with ``-`` and a digit or ``.`` as the
+    value of the option before it (``--size -5x5``, ``--eps -1e-3``), so that
+    such values reach the command's own checks and messages."""
+
+    def error(self, message):
+        raise UsageError(message)
+
+    def parse_known_args(self, args=None, namespace=None):
+        if args is not None:
+            takes_value = {o for a in self._actions if a.nargs is None for o in a.option_strings}
+            args, joined = list(args), []
+            while args:
+                token = args.pop(0)
+                if token == "--":
+                    joined += [token, *args]
+                    break
+                if token in takes_value and args and _NEGATIVE_VALUE.match(args[0]):
+                    token = f"{token}={args.pop(0)}"
+                joined.append(token)
+            args = joined
+        return super().parse_known_args(args, namespace)
+
+
+def _version():
+    """The installed version of the project, or a note when it is not installed."""
+    from importlib import metadata
+    try:
+        return metadata.version("symbolic-rendering-ch9")
+    except metadata.PackageNotFoundError:
+        return "unknown (not installed)"
+
+
+# ---------------------------------------------------------------- parsing helpers
+
+
+def parse_size(text):
+    """Parse ``"WxH"`` into ``(width, height)`` ints, each in [1, 8192].
+
+    Raises
+    ------
+    UsageError
+        Naming ``--size`` and the text: not of the form WxH with integer
+        sides, or a side outside [1, 8192] (negative, zero or huge sides are
+        reported with the range).  The pixel limits of a command are checked
+        separately, still before any allocation.
+    """
+    from renderer.render import MAX_SIDE
+    m = re.fullmatch(r"\s*([-+]?\d+)\s*[xX]\s*([-+]?\d+)\s*", str(text))
+    if not m:
+        raise UsageError(f"--size must be WxH with integer sides in [1, {MAX_SIDE}] (e.g. 256x256), "
+                         f"got {text!r}")
+    for name, digits in (("width", m.group(1)), ("height", m.group(2))):
+        # Decided on the digits, so a huge side is never converted to an int.
+        if not (len(digits.lstrip("+").lstrip("0")) <= 6 and 1 <= int(digits) <= MAX_SIDE):
+            raise UsageError(f"--size {name} must be between 1 and {MAX_SIDE} pixels, got {text!r}")
+    return int(m.group(1)), int(m.group(2))
+
+
+def _check_budget(width, height, frames, what):
+    """Refuse a size whose ``frames`` frames exceed the pixel budget (no allocation)."""
+    if width * height > MAX_PIXELS:
+        raise UsageError(f"--size {width}x{height} is {width * height:,} pixels; {what} accepts at "
+                         f"most {MAX_PIXELS:,} (4096x4096)")
+    if frames * width * height > FRAME_PIXEL_BUDGET:
+        raise UsageError(
+            f"--size {width}x{height} with {frames} frames is {frames * width * height:,} frame-pixels; "
+            f"{what} accepts at most {FRAME_PIXEL_BUDGET:,} (use a smaller size or fewer steps)")
+
+
+def _positive_float(text, name, bounds=None):
+    try:
+        x = float(text)
+    except ValueError:
+        raise UsageError(f"{name}: {text!r} is not a number") from None
+    if bounds is not None and not (math.isfinite(x) and bounds[0] <= x <= bounds[1]):
+        raise UsageError(f"{name}: each step must be in [{bounds[0]:g}, {bounds[1]:g}] "
+                         f"(chart units), got {text.strip()!r}")
+    if not (math.isfinite(x) and x > 0):
+        raise UsageError(f"{name}: each step must be a finite number > 0, got {text!r}")
+    return x
+
+
+def parse_eps(text, *, name="--eps", max_steps=None, bounds=None):
+    """Parse steps: ``"a:b:n"`` (n log-spaced from a to b) or ``"e1,e2,..."``.
+
+    Parameters
+    ----------
+    text : str
+    name : str
+        The option named in errors.
+    max_steps : int or None
+        Most steps accepted; None means `renderer.sweep.MAX_STEPS`.
+    bounds : (float, float) or None
+        If given, the closed range every step must lie in (chart units), as
+        ``(renderer.scene.MIN_EPS, renderer.scene.MAX_EPS)`` for a sweep.
+
+    Returns
+    -------
+    tuple of float, each finite and > 0 (and within ``bounds``), chart units;
+    1 to ``max_steps`` of them.
+
+    Raises
+    ------
+    UsageError
+        Naming ``name``, for a malformed text, a step that is not a finite
+        positive number or lies outside ``bounds`` (the range is named), or a
+        count outside [1, max_steps].
+    """
+    import numpy as np
+    if max_steps is None:
+        from renderer.sweep import MAX_STEPS as max_steps
+    text = str(text).strip()
+    if ":" in text:
+        parts = text.split(":")
+        if len(parts) != 3:
+            raise UsageError(f"{name} must be a:b:n (n log-spaced steps from a to b) or a comma "
+                             f"list, got {text!r}")
+        a, b = (_positive_float(p, name, bounds) for p in parts[:2])
+        count = parts[2].strip()
+        if not re.fullmatch(r"[-+]?\d+", count):
+            raise UsageError(f"{name}: the count n in a:b:n must be an integer in [1, {max_steps}], "
+                             f"got {parts[2]!r}")
+        if not (len(count.lstrip("+")) <= 6 and 1 <= int(count) <= max_steps):
+            raise UsageError(f"{name}: the count n must be between 1 and {max_steps}, got {count}")
+        # Rounded to 15 significant digits so that decades print as 1e-05, not
+        # 9.999999999999999e-06 (a relative change below 1e-15).
+        steps = tuple(float(f"{e:.15g}") for e in np.logspace(math.log10(a), math.log10(b), int(count)))
+        if bounds is not None:  # rounding could step just outside the range
+            steps = tuple(min(max(e, bounds[0]), bounds[1]) for e in steps)
+    else:
+        items = [p for p in text.split(",")]
+        if not 1 <= len(items) <= max_steps:
+            raise UsageError(f"{name} must hold 1 to {max_steps} steps, got {len(items)}")
+        steps = tuple(_positive_float(p, name, bounds) for p in items)
+    return steps
+
+
+#: Largest scene file `load_scene` reads (bytes); a scene is a few hundred.
+MAX_SCENE_BYTES = 1 << 20
+#: Deepest nesting of arrays and tables accepted in a scene value (a light's
+#: position inside its table inside the lights array is 3 levels).
+MAX_NESTING = 8
+
+
+def _toml_value(key, text):
+    """The value of ``--set key=text``: TOML, or a bare word taken as a string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except RecursionError:
+        raise UsageError(f"--set {key}: the value is nested too deeply (at most {MAX_NESTING} "
+                         "levels of arrays and tables)") from None
+    except ValueError:  # TOMLDecodeError, or an integer of over 4300 digits
+        if _BARE_WORD.match(text):
+            return text
+        raise UsageError(f"--set {key}: cannot parse {text!r} as a TOML value "
+                         f"(quote a string: {key}=\"...\")") from None
+
+
+def _check_ints(source, name, value):
+    """Refuse, naming the key path, a TOML integer too large for a float or a
+    value nested deeper than `MAX_NESTING` levels.
+
+    TOML integers are unbounded in tomllib; one beyond about 1.8e308 is
+    refused here, with the file (or --set) and the key path, before `Scene`
+    sees it.  The walk is iterative and stops at the nesting limit.
+    """
+    stack = [(name, value, 0)]
+    while stack:
+        where, item, depth = stack.pop()
+        if isinstance(item, (list, dict)):
+            if depth >= MAX_NESTING:
+                raise UsageError(f"{source}: {where} is nested too deeply (at most {MAX_NESTING} "
+                                 "levels of arrays and tables)")
+            pairs = item.items() if isinstance(item, dict) else enumerate(item)
+            stack.extend((f"{where}.{k}" if isinstance(item, dict) else f"{where}[{k}]", v, depth + 1)
+                         for k, v in reversed(list(pairs)))
+        elif isinstance(item, int) and not isinstance(item, bool):
+            try:
+                float(item)
+            except OverflowError:
+                raise UsageError(f"{source}: {where} = {str(item)[:20]}... is too large for a number "
+                                 f"(more than {len(str(item))} digits)") from None
+
+
+def _scene_mapping(data, source):
+    """Turn a TOML mapping into `Scene` keyword arguments, refusing unknown keys."""
+    from renderer.scene import PointLight
+    scene_fields, light_fields = _field_names()
+    out = {}
+    for key, value in data.items():
+        if key not in scene_fields:
+            raise UsageError(f"{source}: unknown scene field {key!r}; fields are {', '.join(scene_fields)}")
+        _check_ints(source, key, value)
+        if key == "lights":
+            if not isinstance(value, list):
+                raise UsageError(f"{source}: lights must be an array of tables with position and "
+                                 f"color, got {value!r}")
+            lights = []
+            for i, table in enumerate(value):
+                if not isinstance(table, dict):
+                    raise UsageError(f"{source}: lights[{i}] must be a table with position and "
+                                     f"color, got {table!r}")
+                unknown = sorted(set(table) - set(light_fields))
+                if unknown:
+                    raise UsageError(f"{source}: unknown light field {unknown[0]!r} in lights[{i}]; "
+                                     f"fields are {', '.join(light_fields)}")
+                missing = [k for k in light_fields if k not in table]
+                if missing:
+                    raise UsageError(f"{source}: lights[{i}] has no {missing[0]!r}; each light needs "
+                                     f"{' and '.join(light_fields)}")
+                try:
+                    lights.append(PointLight(**table))
+                except (TypeError, ValueError) as exc:  # the message names the field and the value
+                    raise UsageError(f"{source}: lights[{i}]: {exc}") from None
+            value = tuple(lights)
+        out[key] = value
+    return out
+
+
+def _read_scene_text(path):
+    """The text of a scene file: a regular file of at most `MAX_SCENE_BYTES`,
+    UTF-8 with an optional byte-order mark."""
+    if not str(path):
+        raise UsageError("--scene: the path is empty (give a TOML file)")
+    try:
+        raw = files.read_regular(path, MAX_SCENE_BYTES)
+    except files.RefusedPath as exc:
+        raise UsageError(f"--scene {exc}") from None
+    except OSError as exc:
+        raise UsageError(f"--scene: cannot read {str(path)!r}: {exc.strerror or exc}") from None
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise UsageError(f"--scene {path}: not UTF-8 text") from None
+
+
+def load_scene(path=None, sets=()):
+    """Build a `Scene` from a TOML file and ``key=value`` overrides.
+
+    Parameters
+    ----------
+    path : str or None
+        A TOML file whose top-level keys are `Scene` field names; ``lights``
+        is an array of tables ``[[lights]]``, each with ``position`` and
+        ``color``.  Missing fields keep the Scene's defaults (the seed's,
+        Cell 1).  It must be a regular file (a symbolic link to one is
+        followed) of at most `MAX_SCENE_BYTES` = 1 MiB, UTF-8 (a leading
+        byte-order mark is accepted).
+    sets : sequence of str
+        ``key=value`` overrides applied after the file; ``value`` is parsed
+        as TOML (``beta=0.5``, ``floor=false``, ``center_b=[0.5, 0.5, 1.3]``),
+        and a bare word that is not TOML is taken as a string (``height_field=sine``).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    UsageError
+        An empty path; a file that is missing, unreadable, not a regular
+        file (a directory, FIFO or device) or over 1 MiB; malformed TOML; a
+        value nested more than `MAX_NESTING` levels; an unknown key (named);
+        a light without ``position`` or ``color`` (named as ``lights[i]``);
+        or a malformed ``--set``.
+        Also what `Scene` and `PointLight` refuse (their message names the field).
+    """
+    from renderer.scene import Scene
+    scene_fields = _field_names()[0]
+    data = {}
+    if path is not None:
+        text = _read_scene_text(path)
+        try:
+            data = tomllib.loads(text)
+        except RecursionError:
+            raise UsageError(f"--scene {path}: nested too deeply (at most {MAX_NESTING} levels of "
+                             "arrays and tables)") from None
+        except ValueError as exc:  # TOMLDecodeError, or an integer of over 4300 digits
+            raise UsageError(f"--scene {path}: malformed TOML: {exc}") from None
+        data = _scene_mapping(data, f"--scene {path}")
+    for item in sets:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise UsageError(f"--set must be key=value, got {item!r}")
+        if key not in scene_fields:
+            raise UsageError(f"--set: unknown scene field {key!r}; fields are {', '.join(scene_fields)}")
+        data.update(_scene_mapping({key: _toml_value(key, text.strip())}, "--set"))
+    try:
+        return Scene(**data)
+    except (TypeError, ValueError) as exc:  # Scene's validation names the field, the value, what is accepted
+        raise UsageError(str(exc)) from None
+
+
+# ---------------------------------------------------------------- output helpers
+
+
+#: The output path that means standard output (``-o -``, ``--plot -``).
+STDOUT = "-"
+
+
+def _stdout_bytes():
+    """The binary stream under ``sys.stdout``, refused when it is a terminal."""
+    stream = sys.stdout
+    if stream.isatty():
+        raise UsageError("output '-' is standard output, which is a terminal; redirect it to a "
+                         "file or a pipe, or give a file name")
+    if getattr(stream, "buffer", None) is None:
+        raise UsageError("output '-': standard output does not take bytes here; give a file name")
+    return stream.buffer
+
+
+def atomic_write(path, write):
+    """Write an output file from ``write(fileobj)`` (a callable given a binary
+    file object), after checking the path as a command-line argument.
+
+    The bytes are prepared in memory first (an exception in ``write`` writes
+    nothing), then written by `renderer.files.write_bytes`: a path that is
+    absent or a regular file is replaced atomically (a temporary file in its
+    directory, then `os.replace`; on any exception, KeyboardInterrupt
+    included, ``path`` is untouched and no temporary file is left), and so
+    is the final target of a symbolic link to a regular file; a character
+    device or FIFO (``/dev/null``), or a link to one (``/dev/stdout`` on a
+    pipe), is written through and stays what it was.  ``path`` ``-`` writes the bytes to standard output.
+    New files get 0666 & ~umask permissions.
+
+    Raises
+    ------
+    UsageError
+        If ``path`` is empty, ends in ``/``, is a directory, a block device, a
+        socket or a dangling symbolic link, or its directory does not exist; or if it
+        is ``-`` and standard output is a terminal.
+    OSError
+        If the directory or the target cannot be written (naming ``path``).
+    """
+    stream = _stdout_bytes() if path == STDOUT else None
+    if stream is None:
+        _check_output(path, "output")
+    buf = io.BytesIO()
+    write(buf)
+    _stop_if_interrupted()                # a Ctrl-C a C callback dropped while the bytes were made
+    if stream is not None:
+        sys.stdout.flush()
+        stream.write(buf.getbuffer())
+        stream.flush()
+        return
+    try:
+        files.write_bytes(path, buf.getbuffer())
+    except files.RefusedPath as exc:  # changed since checked
+        raise UsageError(f"output {exc}") from None
+
+
+def _png_bytes_writer(rgb8):
+    def write(f):
+        import matplotlib.image
+        # No tEXt chunks at all ("Software" is matplotlib's only default key),
+        # so the bytes depend on the pixels alone.
+        matplotlib.image.imsave(f, rgb8, format="png", metadata={"Software": None})
+    return write
+
+
+def write_png(path, rgb):
+    """Write an (H, W, 3) float image with values in [0, 1] (already display-
+    encoded) as an 8-bit PNG without varying metadata, by `atomic_write`
+    (``-`` is standard output).
+
+    Raises
+    ------
+    UsageError, OSError
+        As `atomic_write`.
+    """
+    import numpy as np
+    rgb8 = np.round(np.clip(np.asarray(rgb, dtype=np.float64), 0.0, 1.0) * 255.0).astype(np.uint8)
+    atomic_write(path, _png_bytes_writer(rgb8))
+
+
+def _check_output(path, flag):
+    """Fail fast, before any work, on an output path that cannot be written:
+    ``-`` on a terminal; an empty path, a trailing ``/``, a directory, a
+    block device, a socket or a dangling link; a new or regular file (or
+    the regular file a link leads to) whose directory is missing or not
+    writable; a device or FIFO that is not writable (its directory need not
+    be writable)."""
+    if path == STDOUT:
+        try:
+            _stdout_bytes()
+        except UsageError as exc:
+            raise UsageError(f"{flag} {str(exc).removeprefix('output ')}") from None
+        return
+    try:
+        route = files.output_route(path)
+    except files.RefusedPath as exc:
+        raise UsageError(f"{flag} {exc}") from None
+    except NotADirectoryError:
+        route = "replace"  # a parent that is not a directory: named below
+    if route == "through":
+        if not os.access(path, os.W_OK):
+            raise UsageError(f"{flag} {str(path)!r} is not writable")
+        return
+    parent = Path(os.path.realpath(path) if route == "link" else path).parent
+    if not parent.is_dir():
+        what = "is not a directory" if parent.exists() else "does not exist"
+        raise UsageError(f"{flag} {str(path)!r}: {str(parent)!r} {what}")
+    if not os.access(parent, os.W_OK):
+        raise UsageError(f"{flag} {str(path)!r}: directory {str(parent)!r} is not writable")
+
+
+def _progress(iterable=None, **kwargs):
+    """A tqdm bar on stderr, shown only when stderr is a terminal and the work
+    takes more than a second."""
+    from tqdm import tqdm
+    return tqdm(iterable, file=sys.stderr, disable=not sys.stderr.isatty(), delay=1.0,
+                leave=False, **kwargs)
+
+
+def _show_progress():
+    return sys.stderr.isatty()
+
+
+def _fmt(x):
+    return "nan" if isinstance(x, float) and math.isnan(x) else f"{x:.3e}"
+
+
+def _ledger_lines(led):
+    return [
+        "ledger (central vs exact, sphere A)",
+        f"  max |dI|            {_fmt(led.max_abs)}",
+        f"  RMS |dI|            {_fmt(led.rms)}",
+        f"  flips               {led.flips}",
+        f"  pixels on A         {led.pixels_a}",
+        f"  mean |dI| on band   {_fmt(led.mean_abs_kink)}",
+        f"  mean |dI| off band  {_fmt(led.mean_abs_off_kink)}",
+    ]
+
+
+# ---------------------------------------------------------------- subcommands
+
+
+def view_image(view, selected, numeric, symbolic):
+    """The display image (H, W, 3) float64 in [0, 1] of a view (as the §4 simulator).
+
+    shaded: ``to_srgb(selected.image)``.  difference: ``clip(100 |I_central -
+    I_exact|, 0, 1)`` per channel (not sRGB-encoded, as book/s4_simulator.md).
+    bump: ``to_srgb(|grad h| / max over A of the exact |grad h|)`` on sphere A,
+    black elsewhere.  kink: the selected image sRGB-encoded and dimmed to 40 %,
+    the exact frame's crease band painted white.
+    """
+    import numpy as np
+    from renderer.ledger import to_srgb
+    from renderer.render import SPHERE_A
+    if view == "shaded":
+        return to_srgb(selected.image)
+    if view == "difference":
+        return np.clip(100.0 * np.abs(numeric.image - symbolic.image), 0.0, 1.0)
+    if view == "bump":
+        on_a_exact = symbolic.chamber == SPHERE_A
+        gmax = float(np.hypot(symbolic.grad[..., 0], symbolic.grad[..., 1])[on_a_exact].max(initial=0.0))
+        g = np.hypot(selected.grad[..., 0], selected.grad[..., 1]) / (gmax or 1.0)
+        g = np.where(selected.chamber == SPHERE_A, to_srgb(np.minimum(g, 1.0)), 0.0)
+        return np.repeat(g[..., None], 3, axis=2)
+    if view == "kink":
+        out = 0.4 * to_srgb(selected.image)
+        out[symbolic.kink] = 1.0
+        return out
+    raise UsageError(f"--view must be one of {VIEWS}, got {view!r}")
+
+
+def _cmd_render(args, out):
+    from renderer.ledger import compare
+    from renderer.render import render
+    width, height = args.size
+    _check_budget(width, height, 2, "render")
+    _check_output(args.output, "-o")
+    if args.output == STDOUT:  # the PNG takes stdout; the report goes to stderr
+        out = sys.stderr
+    scene = load_scene(args.scene, args.set)
+    frames = {}
+    wanted = ("central", "exact") + (() if args.gradient in ("central", "exact") else (args.gradient,))
+    for g in _progress(wanted, desc="render", unit="frame"):
+        frames[g] = render(scene, width, height, gradient=g)
+    numeric, symbolic = frames["central"], frames["exact"]
+    selected = frames[args.gradient]
+    write_png(args.output, view_image(args.view, selected, numeric, symbolic))
+    where = "standard output" if args.output == STDOUT else args.output
+    print(f"wrote {where} ({width}x{height}, view {args.view}, gradient {args.gradient})", file=out)
+    print("\n".join(_ledger_lines(compare(numeric, symbolic))), file=out)
+    return 0
+
+
+_CENSUS_COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink", "mean_abs_off_kink")
+
+
+def _run_sweep(scene, steps, width, height):
+    """The census of `renderer.sweep` over ``steps``."""
+    from renderer.sweep import sweep
+    return list(sweep(scene, steps, width, height).census)
+
+
+def _cmd_sweep(args, out):
+    steps = args.eps
+    width, height = args.size
+    _check_budget(width, height, len(steps) + 1, "sweep")
+    scene = load_scene(args.scene, args.set)
+    census = _run_sweep(scene, steps, width, height)
+    _stop_if_interrupted()
+    rows = [dict(zip(_CENSUS_COLUMNS, (e, led.max_abs, led.rms, led.flips, led.pixels_a,
+                                       led.mean_abs_kink, led.mean_abs_off_kink)))
+            for e, led in zip(steps, census)]
+    if args.format == "json":
+        clean = lambda x: None if isinstance(x, float) and math.isnan(x) else x  # noqa: E731
+        doc = {"size": [width, height], "height_field": scene.height_field,
+               "rows": [{k: clean(v) for k, v in r.items()} for r in rows]}
+        print(json.dumps(doc, indent=1, allow_nan=False), file=out)
+    elif args.format == "csv":
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(_CENSUS_COLUMNS)
+        for r in rows:
+            w.writerow([repr(r[k]) if isinstance(r[k], float) else r[k] for k in _CENSUS_COLUMNS])
+        out.write(buf.getvalue())
+    else:
+        print(f"census: {scene.height_field}, beta {scene.beta:g}, {width}x{height}, central vs exact on sphere A",
+              file=out)
+        print(f"{'eps':>9}  {'max |dI|':>9}  {'RMS |dI|':>9}  {'flips':>5}  {'on band':>9}  {'off band':>9}",
+              file=out)
+        for r in rows:
+            print(f"{r['eps']:9.2e}  {_fmt(r['max_abs']):>9}  {_fmt(r['rms']):>9}  {r['flips']:5d}  "
+                  f"{_fmt(r['mean_abs_kink']):>9}  {_fmt(r['mean_abs_off_kink']):>9}", file=out)
+    return 0
+
+
+def _measure_ucurve(args):
+    import numpy as np
+    from renderer.ucurve import UNIT_ROUNDOFF, UCurve, fit_model, measure
+    steps = np.asarray(args.eps, dtype=np.float64)
+    kw = dict(field=args.field, u=args.u, v=args.v, component=args.component, k_u=args.k_u, k_v=args.k_v)
+    if not _show_progress() or steps.size < 50:
+        return measure(eps=steps, **kw)
+    parts = []
+    with _progress(total=steps.size, desc="ucurve", unit="step") as bar:
+        for chunk in np.array_split(steps, math.ceil(steps.size / 25)):
+            parts.append(measure(eps=chunk, **kw))
+            bar.update(chunk.size)
+    cat = lambda name: np.concatenate([getattr(p, name) for p in parts])  # noqa: E731
+    error = cat("error")
+    best = int(np.argmin(error))
+    p0 = parts[0]
+    reason = getattr(p0, "reason", None)
+    opt = (float("nan"),) * 2 if reason is not None else (float(steps[best]), float(error[best]))
+    fit = (float("nan"),) * 4
+    if reason is None:
+        with contextlib.suppress(ValueError):
+            A, B = fit_model(steps, error, start=(max(abs(p0.third_derivative), 1e-300) / 6, UNIT_ROUNDOFF))
+            e_fit = (B / (2 * A)) ** (1 / 3)
+            fit = (A, B, e_fit, A * e_fit**2 + B / e_fit)
+    return UCurve(p0.field, p0.u, p0.v, p0.component, steps, error, cat("truncation"), cat("roundoff"),
+                  cat("model"), p0.derivative, p0.third_derivative, p0.eps_opt_predicted, *opt, reason, *fit)
+
+
+def _ucurve_plot_writer(uc):
+    def write(f):
+        import numpy as np
+        import matplotlib
+        from matplotlib.figure import Figure
+        with matplotlib.rc_context({"svg.hashsalt": "symrender", "path.simplify": False}):
+            fig = Figure(figsize=(6.0, 4.0), dpi=100)
+            ax = fig.subplots()
+            floor = np.finfo(float).tiny
+            ax.loglog(uc.eps, np.maximum(uc.error, floor), "k.-", label="measured |error|")
+            ax.loglog(uc.eps, np.maximum(np.abs(uc.truncation), floor), "C0--", label="|truncation|")
+            ax.loglog(uc.eps, np.maximum(np.abs(uc.roundoff), floor), "C3--", label="|roundoff|")
+            ax.loglog(uc.eps, uc.model, "C2:", label="model eps^2|h'''|/6 + u|h|/eps")
+            if math.isfinite(uc.eps_opt_predicted):
+                ax.axvline(uc.eps_opt_predicted, color="0.6", lw=0.8, label="predicted eps*")
+            ax.set_xlabel("eps (chart units)")
+            ax.set_ylabel(f"|error| of h_{uc.component}")
+            ax.set_title(f"U-curve: {uc.field} at (u, v) = ({uc.u:g}, {uc.v:g})"
+                         + (" (not differentiable there)" if uc.reason else ""))
+            ax.legend(fontsize=7)
+            fig.tight_layout()
+            fig.savefig(f, format="png", metadata={"Software": None})
+    return write
+
+
+def _cmd_ucurve(args, out):
+    if args.plot is not None:
+        _check_output(args.plot, "--plot")
+        if args.plot == STDOUT:  # the plot takes stdout; the table goes to stderr
+            out = sys.stderr
+    for name in ("u", "v"):
+        x = getattr(args, name)
+        if not (math.isfinite(x) and 0.0 <= x <= 1.0):
+            raise UsageError(f"--{name} must be a number in [0, 1], got {x!r}")
+    from renderer.scene import MAX_FREQUENCY
+    for name in ("k_u", "k_v"):
+        x = getattr(args, name)
+        if not (math.isfinite(x) and 0.0 < x <= MAX_FREQUENCY):
+            raise UsageError(f"--{name.replace('_', '-')} must be a finite number in "
+                             f"(0, {MAX_FREQUENCY:g}], got {x!r}")
+    uc = _measure_ucurve(args)
+    _stop_if_interrupted()
+    print(f"U-curve: {uc.field}, h_{uc.component} at (u, v) = ({uc.u:g}, {uc.v:g}), "
+          f"k = ({args.k_u:g}, {args.k_v:g}); reference mpmath 50 digits", file=out)
+    if uc.reason is not None:
+        # No derivative: no "true derivative", no model and no optimal step to print.
+        print(f"not differentiable: {uc.reason}", file=out)
+        print("error, truncation: against the one-sided derivative from the side of larger "
+              f"{uc.component} (smaller at 1); no true derivative and no optimal step exist here", file=out)
+        print(f"{'eps':>9}  {'truncation':>11}  {'roundoff':>11}  {'|error|':>10}", file=out)
+        for i in range(uc.eps.size):
+            print(f"{uc.eps[i]:9.2e}  {uc.truncation[i]:11.3e}  {uc.roundoff[i]:11.3e}  "
+                  f"{uc.error[i]:10.3e}", file=out)
+    else:
+        print(f"true derivative {uc.derivative:.17g}; |h'''| = {abs(uc.third_derivative):.6g}", file=out)
+        print(f"{'eps':>9}  {'truncation':>11}  {'roundoff':>11}  {'|error|':>10}  {'model':>10}", file=out)
+        for i in range(uc.eps.size):
+            print(f"{uc.eps[i]:9.2e}  {uc.truncation[i]:11.3e}  {uc.roundoff[i]:11.3e}  "
+                  f"{uc.error[i]:10.3e}  {uc.model[i]:10.3e}", file=out)
+        print(f"eps* predicted {uc.eps_opt_predicted:.3e}; measured minimum {uc.error_at_measured_opt:.3e} "
+              f"at eps {uc.eps_opt_measured:.3e}", file=out)
+    if args.plot is not None:
+        atomic_write(args.plot, _ucurve_plot_writer(uc))
+        print(f"wrote {'standard output' if args.plot == STDOUT else args.plot}", file=out)
+    return 0
+
+
+# ---------------------------------------------------------------- argument parser
+
+
+def _size_arg(text):
+    try:
+        return parse_size(text)
+    except UsageError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--size ")) from None
+
+
+def _eps_arg(max_steps, bounds=None):
+    def parse(text):
+        try:
+            return parse_eps(text, name="", max_steps=max_steps, bounds=bounds)
+        except UsageError as exc:
+            raise argparse.ArgumentTypeError(str(exc).lstrip(": ")) from None
+    return parse
+
+
+def _float_arg(text):
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+
+
+def build_parser():
+    """The argparse parser of ``symrender`` (one subparser per command)."""
+    from renderer.render import MAX_SIDE
+    from renderer.scene import HEIGHT_FIELDS
+    from renderer.sweep import MAX_STEPS
+    limits = (f"Limits: each side 1..{MAX_SIDE}; render at most {MAX_PIXELS:,} pixels (4096^2); "
+              f"sweep at most (steps + 1) * W * H <= {FRAME_PIXEL_BUDGET:,}; refused before allocating.")
+    p = _Parser(prog="symrender", description="Render, sweep and measure the Chapter-9 scene.",
+                epilog=limits)
+    p.add_argument("--version", action="version", version=f"symrender {_version()}")
+    sub = p.add_subparsers(dest="command", metavar="command", required=True, parser_class=_Parser)
+
+    def scene_opts(sp):
+        sp.add_argument("--scene", metavar="FILE.toml",
+                        help="TOML file with Scene field names ([[lights]] tables with position, color); "
+                             "unknown keys are errors")
+        sp.add_argument("--set", action="append", default=[], metavar="key=value",
+                        help="override a Scene field; value is TOML (a bare word is a string); repeatable")
+
+    r = sub.add_parser("render", help="render a PNG and print the frame's ledger",
+                       description="Render the scene (both pipelines), write an sRGB PNG of one view, "
+                                   "print the ledger (central vs exact on sphere A).", epilog=limits)
+    scene_opts(r)
+    r.add_argument("--size", type=_size_arg, default=(256, 256), metavar="WxH",
+                   help=f"image size, each side 1..{MAX_SIDE}, W*H <= {MAX_PIXELS:,} (default 256x256)")
+    r.add_argument("--gradient", choices=("exact", "central", "footprint"), default="exact",
+                   help="pipeline shown by the shaded, bump and kink views (default exact)")
+    r.add_argument("--view", choices=VIEWS, default="shaded",
+                   help="shaded image; difference clip(100|dI|); bump |grad h|; kink band over dimmed image")
+    r.add_argument("-o", "--output", required=True, metavar="out.png", help="PNG to write (atomically)")
+
+    s = sub.add_parser("sweep", help="eps sweep: census table of central vs exact",
+                       description="Render the exact frame and one central frame per step; print the census: "
+                                   "eps, max and RMS |dI| on A, flips, mean |dI| on and off the kink band.",
+                       epilog=limits)
+    scene_opts(s)
+    from renderer.scene import MAX_EPS, MIN_EPS
+    s.add_argument("--eps", type=_eps_arg(MAX_STEPS, (MIN_EPS, MAX_EPS)), default=parse_eps("1e-1:1e-8:8"),
+                   metavar="a:b:n|e1,e2,..",
+                   help=f"n log-spaced steps from a to b, or a comma list; 1..{MAX_STEPS} steps, each in "
+                        f"[{MIN_EPS:g}, {MAX_EPS:g}] (default 1e-1:1e-8:8)")
+    s.add_argument("--size", type=_size_arg, default=(256, 256), metavar="WxH",
+                   help="image size (default 256x256); (steps + 1) * W * H <= "
+                        f"{FRAME_PIXEL_BUDGET:,}")
+    s.add_argument("--format", choices=FORMATS, default="text", help="output format (default text)")
+
+    u = sub.add_parser("ucurve", help="the measured finite-difference U-curve at one chart point",
+                       description="Central-difference error against a 50-digit mpmath reference, split "
+                                   "into truncation and roundoff, per step (proofs/ucurve.py).")
+    u.add_argument("--field", choices=HEIGHT_FIELDS, default="sine")
+    u.add_argument("--u", type=_float_arg, default=0.31, help="chart u in [0, 1] (default 0.31)")
+    u.add_argument("--v", type=_float_arg, default=0.47, help="chart v in [0, 1] (default 0.47)")
+    u.add_argument("--component", choices=("u", "v"), default="u", help="h_u or h_v (default u)")
+    u.add_argument("--k-u", dest="k_u", type=_float_arg, default=8.0, help="frequency k_u (default 8)")
+    u.add_argument("--k-v", dest="k_v", type=_float_arg, default=4.0, help="frequency k_v (default 4)")
+    u.add_argument("--eps", type=_eps_arg(MAX_UCURVE_STEPS), default=parse_eps("1e-1:1e-15:15"),
+                   metavar="a:b:n|e1,e2,..",
+                   help=f"steps, as for sweep; 1..{MAX_UCURVE_STEPS} (default 1e-1:1e-15:15)")
+    u.add_argument("--plot", metavar="out.png", help="also save a log-log plot (PNG, atomically)")
+
+    return p
+
+
+_COMMANDS = {"render": _cmd_render, "sweep": _cmd_sweep, "ucurve": _cmd_ucurve}
+
+
+def _one_line(msg):
+    return " ".join(str(msg).split())
+
+
+#: A Ctrl-C seen during `main`: numba's compiler runs Python callbacks from C, which drop
+#: the KeyboardInterrupt raised in them; the flag keeps it (`_stop_if_interrupted`).
+_sigint_seen = False
+
+
+def _interrupt(signum, frame):
+    global _sigint_seen
+    _sigint_seen = True
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # a second Ctrl-C does not cut the clean-up short
+    raise KeyboardInterrupt
+
+
+def _stop_if_interrupted():
+    """Raise KeyboardInterrupt if a Ctrl-C came during `main`, even one a C callback dropped;
+    called before any output is written."""
+    if _sigint_seen:
+        raise KeyboardInterrupt
+
+
+def main(argv=None) -> int:
+    """Run ``symrender`` with ``argv`` (default ``sys.argv[1:]``); return the exit code:
+    0 on success, 2 on an input error, 1 on a bug or a broken pipe, 130 on Ctrl-C.
+    Never raises; ``--help`` prints to stdout and returns 0."""
+    global _sigint_seen
+    _sigint_seen = False
+    previous_hook, previous = sys.unraisablehook, None
+    # The report of an interrupt swallowed in a C callback stays off stderr: the flag has it.
+    sys.unraisablehook = lambda u: None if isinstance(u.exc_value, KeyboardInterrupt) else previous_hook(u)
+    try:
+        previous = signal.signal(signal.SIGINT, _interrupt)
+    except ValueError:                      # not the main thread: signals are left alone
+        pass
+    try:
+        return _run(sys.argv[1:] if argv is None else list(argv))
+    except KeyboardInterrupt:
+        print("symrender: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        sys.unraisablehook = previous_hook
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+
+
+def _run(argv):
+    """`main` without its signal handling."""
+    out = sys.stdout
+    try:
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit as exc:           # --help (argparse prints, then exits 0)
+            return exc.code if isinstance(exc.code, int) else 0
+        code = _COMMANDS[args.command](args, out)
+        _stop_if_interrupted()
+        return code
+    except UsageError as exc:
+        print(f"symrender: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:                 # stdout closed early (| head): stop quietly, as cat does
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return 1
+    except OSError as exc:
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        print(f"symrender: error: {where}{_one_line(exc.strerror or exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("symrender: error: out of memory (use a smaller --size)", file=sys.stderr)
+        return 2
+    except Exception as exc:                # a bug: still one line, no traceback
+        print(f"symrender: internal error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
+        return 1
+
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

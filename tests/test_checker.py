@@ -1,0 +1,188 @@
+"""The proof checker has teeth: every wrong variant of every theorem is refuted, and so is
+every theorem with a wrong step planted in its proof, at that step; a changed or skipped
+verdict is named; the book's theorem blocks refuse a theorem that fails.  These are tests of
+the checker (proofs/core.py, proofs/registry.py, chapter.theorems), run by ``make test``;
+``pytest verify`` checks the theorems themselves.
+"""
+
+import dataclasses
+
+import pytest
+import sympy as sp
+
+from proofs.registry import PINNED, RENDERED, THEOREMS, get, pinned_failure
+from verify.test_theorems import _placed
+
+VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
+
+def test_a_check_that_skips_the_renderer_is_named():
+    """A verdict reached without its renderer comparison (fewer outputs than pinned) is a change."""
+    assert "compared 599 renderer outputs, pinned at least 600" in pinned_failure("chart", "verified", 1e-30, 599)
+    assert pinned_failure("chart", "verified", 1e-30, 600) is None
+
+
+@pytest.mark.parametrize("pin, status, residual, why", [
+    ("proved", "verified", 1e-30, "is verified, pinned proved"),
+    (("verified", 1e-25), "proved", None, "is proved, pinned verified"),
+    (("verified", 1e-25), "verified", 1e-20, "residual 1e-20, pinned at most 1e-25"),
+    (("verified", 1e-25), "verified", None, "residual None"),
+])
+
+
+def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
+    monkeypatch.setitem(PINNED, "chart", pin)
+    assert why in pinned_failure("chart", status, residual, RENDERED["chart"])
+    assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30)),
+                          RENDERED["chart"]) is None
+
+
+@pytest.mark.parametrize("theorem_id, description, variant", VARIANTS,
+                         ids=[f"{i}: {d}" for i, d, _ in VARIANTS])
+
+
+def test_wrong_variant_is_refuted(theorem_id, description, variant):
+    verdict = variant()
+    assert verdict.status == "refuted", f"{theorem_id}, {description}: {verdict.evidence}"
+    assert isinstance(verdict.evidence, str) and verdict.evidence, "a refutation says why"
+
+
+def test_every_theorem_has_a_variant_and_a_statement():
+    for t in THEOREMS.values():
+        assert t.wrong_variants, t.id
+        assert t.statement and t.steps, t.id
+        assert 1 <= len(t.steps) <= 6, (t.id, len(t.steps))
+
+
+def test_placed_finds_the_ids_a_page_shows_and_no_other_string():
+    page = ('```{code-cell} ipython3\n:tags: [remove-cell]\nfrom chapter.theorems import theorem_block\n'
+            'def theorems(*ids):\n    return "".join(theorem_block(t) for t in ids)\n```\n\ntext\n\n'
+            '```{code-cell} ipython3\ntheorems("chart", "frame-orientation")\n```\n\n'
+            '```{code-cell} ipython3\nx = render(Scene(bump="chart"))\ntheorem_block("optimal-step")\n```\n')
+    assert _placed(page) == {"chart", "frame-orientation", "optimal-step"}
+    assert _placed(page.replace('theorems("chart", "frame-orientation")', 'print("chart")')) == {"optimal-step"}
+
+
+def _wrong(rhs):
+    """``rhs`` made wrong: 1 added to a scalar, to every entry of a matrix, to the first entry of a tuple."""
+    if isinstance(rhs, sp.Tuple):
+        return sp.Tuple(_wrong(rhs[0]), *rhs[1:])
+    if isinstance(rhs, (sp.MatrixBase, sp.MatrixExpr)):
+        return rhs + sp.ImmutableMatrix(sp.ones(*rhs.shape))
+    return rhs + 1
+
+
+STEPS = [(t.id, k) for t in THEOREMS.values() for k in range(1, len(t.steps) + 1)]
+
+
+@pytest.mark.parametrize("theorem_id, k", STEPS, ids=[f"{i}: step {k}" for i, k in STEPS])
+def test_a_wrong_step_is_refuted_and_named(theorem_id, k):
+    """Every step is checked on its own: plant a wrong right side in step k of any theorem, and the
+    check refutes the theorem at step k, naming it (the steps before it still hold)."""
+    t = THEOREMS[theorem_id]
+    steps = list(t.steps)
+    steps[k - 1] = dataclasses.replace(steps[k - 1], rhs=_wrong(steps[k - 1].rhs))
+    verdict = dataclasses.replace(t, steps=tuple(steps)).check()
+    assert verdict.status == "refuted", verdict.evidence
+    assert verdict.evidence.startswith(f"{theorem_id}, step {k} ({t.steps[k - 1].why.rstrip('.:')})"), verdict.evidence
+
+
+def test_no_sentence_is_shared_between_theorems():
+    """Each step says why it holds in its own words: no boilerplate repeated across theorems."""
+    seen = {}
+    for t in THEOREMS.values():
+        for step in t.steps:
+            assert seen.setdefault(step.why, t.id) == t.id, (step.why, seen[step.why], t.id)
+            assert step.why and len(step.why.split(". ")) <= 2, (t.id, step.why)
+
+
+def test_registry_names_unknown_ids():
+    with pytest.raises(KeyError, match="no theorem 'no-such'"):
+        get("no-such")
+
+
+def test_book_block_refuses_a_failing_theorem(monkeypatch):
+    """A theorem that does not hold fails the build (the cell raises)."""
+    from chapter import theorems as book
+    from proofs import registry
+    from proofs.core import Verdict
+    refuted = dataclasses.replace(get("optimal-step"), evidence=lambda: Verdict("refuted", "forced for the test"))
+    monkeypatch.setattr(registry, "THEOREMS", {"optimal-step": refuted,
+                                               "frame-orientation": get("frame-orientation")})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
+        book.theorem_block("optimal-step")
+    assert "PROVED" in book.theorem_block("frame-orientation")
+    with pytest.raises(book.TheoremFailed, match="optimal-step is refuted"):
+        book.ledger_table()
+    with pytest.raises(KeyError, match="no theorem 'no-such'"):
+        book.theorem_block("no-such")
+
+
+def test_book_block_refuses_a_changed_verdict(monkeypatch):
+    """A theorem that holds but not with its pinned verdict also fails the build."""
+    from chapter import theorems as book
+    from proofs import registry
+    monkeypatch.setattr(registry, "THEOREMS", {"frame-orientation": get("frame-orientation")})
+    monkeypatch.setitem(registry.PINNED, "frame-orientation", ("verified", 1e-25))
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    for show in (lambda: book.theorem_block("frame-orientation"), book.ledger_table):
+        with pytest.raises(book.TheoremFailed, match="frame-orientation is proved, pinned verified"):
+            show()
+
+
+def test_the_box_shows_statement_badge_and_steps_and_links_its_ledger_row(monkeypatch):
+    """The theorem's box: the statement, the badge with a link to the ledger row (``ledger-<id>``), then the
+    proof, one "Step k." per step with its equation; the evidence (what the check compared) is in the
+    ledger row, which links back to the box."""
+    from chapter import theorems as book
+    from proofs import registry
+    t = get("optimal-step")
+    monkeypatch.setattr(registry, "THEOREMS", {t.id: t})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    block, row = book.theorem_block(t.id), book.ledger_table()
+    places = [block.index(t.statement_tex()), block.index("**PROVED** · evidence: {ref}`§6 <ledger-optimal-step>`"),
+              block.index(":::{prf:proof}")] + [block.index(f"**Step {k}.** ") for k in range(1, len(t.steps) + 1)]
+    assert places == sorted(places)
+    assert r"\varepsilon^\ast = \left(\frac{3 \mathrm{u} \lvert h\rvert}{\lvert h'''\rvert}\right)^{1/3}" in block
+    assert "reduced to 0" not in block and "reduced to 0 by sympy" in row
+    assert row.startswith("* (ledger-optimal-step)=\n  {prf:ref}`The optimal central-difference step <thm-optimal-step>`")
+
+
+def test_undecided_identity_is_verified_numerically(monkeypatch):
+    """When sympy cannot decide, a true identity is 'verified' at >= 20 points and
+    >= 30 digits with its worst residual stated, and a false one is still refuted."""
+    import sympy as sp
+
+    from proofs import core
+    monkeypatch.setattr(core, "_exactly_zero", lambda expr: False)   # sympy "cannot decide"
+    x = sp.Symbol("x", real=True)
+    true = core.Identity("double angle", sp.sin(2 * x), 2 * sp.sin(x) * sp.cos(x), {x: (-3, 3)})
+    verdict = core.check_identities([true])
+    assert verdict.status == "verified"
+    assert verdict.points >= 20 and verdict.digits >= 30 and verdict.residual < 1e-25
+    false = core.Identity("wrong angle", sp.sin(2 * x), sp.sin(x) * sp.cos(x), {x: (-3, 3)})
+    assert core.check_identities([false]).status == "refuted"
+
+
+def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
+    """The chart's identities alone, its renderer comparison skipped: the build fails."""
+    from chapter import theorems as book
+    from proofs import registry
+    from proofs.core import Verdict
+    skipped = dataclasses.replace(get("chart"), evidence=lambda: Verdict("proved", "renders skipped"))
+    monkeypatch.setattr(registry, "THEOREMS", {"chart": skipped})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    with pytest.raises(book.TheoremFailed, match="chart compared 0 renderer outputs, pinned at least 600"):
+        book.theorem_block("chart")
+
+
+def test_the_kink_loci_refuse_an_unknown_family():
+    from renderer import Scene
+
+    from proofs.kink_loci import locus_bands
+    with pytest.raises(ValueError, match=r"kind must be one of \('rays', 'circles'\), got 'lines'"):
+        locus_bands("lines", Scene(), 8, 8)
