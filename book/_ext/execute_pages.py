@@ -1,0 +1,74 @@
+"""Sphinx extension: the pages' notebooks are executed by jupyter-cache, side by side, and
+re-executed when the project's code changes.
+
+myst-nb (``execute_notebooks: cache``) keys a page's cached outputs on its code cells
+alone, and executes the pages it has to one after another.  Before Sphinx reads:
+
+1. The project's one source digest (`lab.store.source_digest`: every file of the
+   packages, and the numerical libraries' versions) is compared with the one the cache
+   was filled under; when they differ the cache is emptied and every notebook page is
+   read again, so an edit to any module re-executes every page.
+2. The pages about to be read are added to the cache's project (jupyter-cache's
+   ``jupytext`` reader gives the same notebook, and so the same key, as myst-nb's) and
+   the ones the cache does not hold run in jupyter-cache's ``local-parallel`` executor,
+   one process per CPU: first the pages of ``execute_pages_first``, last those of
+   ``execute_pages_last``, the others between them.
+   myst-nb then finds each page in the cache; a page that failed is not cached, and
+   myst-nb executes it again and reports its error as usual.
+
+Pages share measurements through `lab.store` (a lock per measurement), so the
+pages that wait for the theorem ledger go last.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from sphinx.util import logging
+
+from lab.store import source_digest
+
+DIGEST_FILE = "source-digest"
+
+
+def _cache_dir(app):
+    return Path(app.env.mystnb_config.execution_cache_path or Path(app.outdir).parent / ".jupyter_cache")
+
+
+def _outdated(app, env, added, changed, removed):
+    """Every notebook page, when the source digest is not the one the cache holds."""
+    path = _cache_dir(app) / DIGEST_FILE
+    if path.is_file() and path.read_text(encoding="utf-8") == source_digest():
+        return []
+    shutil.rmtree(_cache_dir(app), ignore_errors=True)
+    _cache_dir(app).mkdir(parents=True)
+    path.write_text(source_digest(), encoding="utf-8")
+    return sorted(d for d in env.found_docs - added - changed - removed if env.doc2path(d).endswith(".md"))
+
+
+def _execute(app, env, docnames):
+    if env.mystnb_config.execution_mode != "cache" or not docnames:
+        return
+    from jupyter_cache import get_cache
+    from jupyter_cache.executors import load_executor
+    first, last = app.config.execute_pages_first, app.config.execute_pages_last
+    order = sorted(docnames, key=lambda d: (d in last) - (d in first))
+    cache = get_cache(str(_cache_dir(app)))
+    pks = [cache.add_nb_to_project(env.doc2path(d), read_data={"name": "jupytext", "type": "plugin"}).pk
+           for d in order if env.doc2path(d).endswith(".md")]
+    todo = [pk for pk in pks if cache.get_cached_project_nb(pk) is None]
+    if not todo:
+        return
+    result = load_executor("local-parallel", cache=cache).run_and_cache(
+        filter_pks=todo, timeout=env.mystnb_config.execution_timeout, allow_errors=False)
+    for uri in result.errored + result.excepted:
+        logging.getLogger(__name__).info(f"{uri}: failed; myst-nb executes it again and reports the error")
+
+
+def setup(app):
+    app.add_config_value("execute_pages_first", [], "env", types=[list])
+    app.add_config_value("execute_pages_last", [], "env", types=[list])
+    app.connect("env-get-outdated", _outdated)
+    app.connect("env-before-read-docs", _execute, priority=900)
+    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
