@@ -13,12 +13,13 @@ added to a page is found.
 from __future__ import annotations
 
 import ast
-import importlib.util
 import re
 from collections import Counter
 from pathlib import Path
 
 import pytest
+
+from .pages import code_cells, parse_cell
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 
@@ -91,9 +92,6 @@ ROOT = BOOK.parent
 #: A glue ``*_measured`` is a claim's measurement text, which ends with its frame (`lab.claims`).
 LABEL = re.compile(r"(_size|_label|_measured)$")
 CELL = re.compile(r"```\{code-cell\}[^\n]*\n(.*?)\n```", re.S)      # to drop cells from the prose
-_spec = importlib.util.spec_from_file_location("nb_deps", ROOT / "book" / "_ext" / "nb_deps.py")
-nb_deps = importlib.util.module_from_spec(_spec)       # the page reader the book's cache key uses
-_spec.loader.exec_module(nb_deps)
 GLUE_DEF = re.compile(r"\bglue(?:_math)?\(\s*(f?)[\"']([^\"']+)[\"']")
 GLUE_USE = re.compile(r"\{glue(?::\w+)?\}`([^`:]+)|```\{glue:figure\}\s*(\S+)")
 
@@ -111,11 +109,11 @@ NOT_A_FRAME = {
 
 def rendering_functions():
     """Names that render, as a page cell calls them: `renderer.render`, `renderer.gbuffer`,
-    and every function of proofs/ whose body names one of them (calls it, or hands it to
+    and every function of proofs/ and lab/ whose body names one of them (calls it, or hands it to
     `lab.store.measured`), to a fixed point, less `NOT_A_FRAME`.  Matched by name, so a
     homonym (ucurve.measure and gradient_methods.measure) asks for one label too many."""
     names = {}
-    for path in sorted((ROOT / "proofs").glob("*.py")):
+    for path in sorted([*(ROOT / "proofs").glob("*.py"), *(ROOT / "lab").glob("*.py")]):
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 names.setdefault(node.name, set()).update(
@@ -194,8 +192,8 @@ def rendering_cells(text, renders):
     such a call or such a variable (in that cell or an earlier one)."""
     call = re.compile(r"\b(" + "|".join(sorted(renders)) + r")\s*\(")
     tainted, out = set(), []
-    for cell in nb_deps.code_cells(text) or []:
-        tree = nb_deps._parse(cell)
+    for cell in code_cells(text) or []:
+        tree = parse_cell(cell)
         if not (call.search(cell) or (_loaded(tree) - _rebound(tree, call, tainted)) & tainted):
             continue
         out.append(cell)
@@ -244,7 +242,7 @@ def test_an_unlabelled_rendered_number_is_found():
 
 
 def test_frame_label_names_the_fields_that_differ_and_the_size():
-    from chapter.theorems import frame_label
+    from renderer import frame_label
     from renderer import Scene
     assert frame_label(Scene(), 256, 128) == "the draft's scene, 256 × 128"
     assert frame_label(Scene(height_field="sine", beta=1.5), 64, 64) == \

@@ -37,15 +37,16 @@ from types import SimpleNamespace
 
 import pytest
 
+from .pages import code_cells
+
 ROOT = Path(__file__).parents[1]
 sys.path.insert(0, str(ROOT / "book" / "_ext"))
-import nb_deps  # noqa: E402  (book/_ext is not a package)
 import notebooks  # noqa: E402
 
 sys.path.remove(str(ROOT / "book" / "_ext"))
 
 PAGES = sorted(p for p in (ROOT / "book").glob("*.md")
-               if nb_deps.code_cells(p.read_text(encoding="utf-8"), path=p) is not None)
+               if code_cells(p.read_text(encoding="utf-8")) is not None)
 
 #: MyST markup a plain Jupyter would show as it is: a role, a fenced directive, a target line.
 LEFTOVER = re.compile(r"\{[A-Za-z][\w:.+-]*\}`|`{3,}\s*\{|:{3,}\s*\{|^\s*\([^()\s]+\)=\s*$", re.M)
@@ -77,7 +78,7 @@ def test_each_notebook_page_links_its_notebook_with_its_code_cells(book_html, pa
     assert nb_file.is_file(), f"{nb_file} is missing"
     notebook = json.loads(nb_file.read_text(encoding="utf-8"))
     code = ["".join(c["source"]) for c in notebook["cells"] if c["cell_type"] == "code"]
-    assert code == nb_deps.code_cells(page.read_text(encoding="utf-8"), path=page)
+    assert code == code_cells(page.read_text(encoding="utf-8"))
     assert notebook["metadata"]["kernelspec"]["name"] == "python3"
     assert all(not c.get("outputs") for c in notebook["cells"] if c["cell_type"] == "code")
     # The first cell: how to install the wheel the site serves, linked from where the notebook lies.
@@ -138,10 +139,12 @@ def test_the_site_serves_a_wheel_of_the_project_and_the_readme(book_html):
         names = set(wheel.namelist())
         metadata = wheel.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
     packaged = {n for n in names if ".dist-info/" not in n}
-    on_disk = {p.relative_to(ROOT).as_posix() for package in ("renderer", "proofs")
-               for p in (ROOT / package).rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+    where = {"renderer": ROOT / "renderer", "proofs": ROOT / "proofs", "lab": ROOT / "lab",
+             "chapter": ROOT / "book" / "chapter"}
+    on_disk = {f"{package}/{p.relative_to(root).as_posix()}" for package, root in where.items()
+               for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
     assert packaged == on_disk
-    assert {"renderer/generated.py", "renderer/js/render.js", "proofs/page.py"} <= packaged
+    assert {"renderer/generated.py", "renderer/js/render.js", "chapter/page.py"} <= packaged
     assert "Provides-Extra: notebook" in metadata
     assert re.search(r'^Requires-Dist: ipykernel\S* ?;\s*extra == "notebook"', metadata, re.M)
     readme = (book_html / notebooks.README).read_text(encoding="utf-8")
