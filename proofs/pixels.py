@@ -83,18 +83,19 @@ def worst_of(check, cases):
 
 
 @lru_cache(maxsize=None)
-def _mp(expr, args):
-    return sp.lambdify(args, expr, modules="mpmath")
+def _mp(exprs, args):
+    """One mpmath function of ``args`` returning every expression of ``exprs``, their common
+    subexpressions computed once (``cse``)."""
+    return sp.lambdify(args, list(exprs), modules="mpmath", cse=True)
 
 
 def _eval(exprs, args, rows):
     """Each expression of ``exprs`` at each row of float64 ``rows`` (columns = ``args``), in mpmath."""
-    fns = [_mp(e, tuple(args)) for e in exprs]
+    fn = _mp(tuple(exprs), tuple(args))
     out = np.empty((rows.shape[0], len(exprs)))
     with mpmath.workdps(DIGITS):
         for i, row in enumerate(rows):
-            point = [mpmath.mpf(float(x)) for x in row]
-            out[i] = [float(f(*point)) for f in fns]
+            out[i] = [float(x) for x in fn(*[mpmath.mpf(float(x)) for x in row])]
     return out
 
 
@@ -121,11 +122,13 @@ def gradient_error(field, gradient, corrupt=None):
         bound = TOLERANCE["gradient"] * np.pi * max(scene.k_u, 2 * scene.k_v)
     elif gradient == "footprint":
         # The steps from formulas.FOOTPRINT at the pixel (its frame from TANGENT_FRAME), then CENTRAL.
-        sin_phi = F.CHART[2]
-        frame = dict(zip(F.e_theta + F.e_phi, [c.xreplace({F.sin_phi: sin_phi}) for c in F.TANGENT_FRAME]))
-        steps = _eval([e.xreplace(frame).xreplace({F.sin_phi: sin_phi, F.R: scene.radius_a, F.camera_z: scene.camera_z})
-                       for e in F.FOOTPRINT], (F.N_x, F.N_y, F.N_z) + tuple(F.P) + (F.x, F.y, F.dx, F.dy),
-                      np.hstack([px["N"], px["P"], px["xy"]]))
+        # sin(phi) and the frame enter as arguments, evaluated from CHART and TANGENT_FRAME first:
+        # substituted into FOOTPRINT, they would make sympy re-decide each Max it meets (seconds).
+        n_sin = np.hstack([px["N"], _eval([F.CHART[2]], (F.N_x, F.N_y, F.N_z), px["N"])])
+        n_sin_frame = np.hstack([n_sin, _eval(F.TANGENT_FRAME, (F.N_x, F.N_y, F.N_z, F.sin_phi), n_sin)])
+        footprint = [e.xreplace({F.R: scene.radius_a, F.camera_z: scene.camera_z}) for e in F.FOOTPRINT]
+        steps = _eval(footprint, (F.N_x, F.N_y, F.N_z, F.sin_phi) + F.e_theta + F.e_phi + tuple(F.P)
+                      + (F.x, F.y, F.dx, F.dy), np.hstack([n_sin_frame, px["P"], px["xy"]]))
         exprs = [e.xreplace(dict(F.STENCIL_POINTS)).xreplace(consts) for e in F.CENTRAL[field]]
         ref = _eval(exprs, (F.u, F.v, F.eps_u, F.eps_v), np.hstack([px["uv"], steps]))
         scale = np.pi * max(scene.k_u, 2 * scene.k_v)
