@@ -18,8 +18,9 @@ book: $(STAMP)
 	$(BIN)/python book/check_glue.py book/_build/.jupyter_cache book/_build/html
 	@echo "$(CURDIR)/book/_build/html/index.html"
 
-test: $(STAMP)
-	$(BIN)/python -m pytest verify tests
+# The book first (the browser tests read it), then the checker and the tests on every CPU.
+test: book
+	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto verify tests
 
 # The numerics-heavy tests again with numpy's optional SIMD features (those
 # found on this CPU beyond its baseline) disabled, and the kernel compiled by
@@ -33,10 +34,10 @@ test-baseline-simd: $(STAMP)
 	echo "NPY_DISABLE_CPU_FEATURES=\"$$features\""; \
 	cache="$$(mktemp -d)"; trap 'rm -rf "$$cache"' EXIT; \
 	NPY_DISABLE_CPU_FEATURES="$$features" NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR="$$cache" \
-	  $(BIN)/python -m pytest $(NUMERIC_TESTS) -p no:cacheprovider
+	  $(BIN)/python -m pytest -n auto $(NUMERIC_TESTS) -p no:cacheprovider
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_render.py
 
 clean:
-	rm -rf book/_build .pytest_cache .benchmarks
+	rm -rf book/_build book/.build.lock .pytest_cache .benchmarks
