@@ -524,13 +524,13 @@ CLAIMS = (
     Claim("h3-scale", "§3", "(π kᵤ)³ ≈ 2,000 at kᵤ = 8", "evaluate (π kᵤ)³", FAILS, _h3_scale,
           rule(HOLDS, Bound("(π kᵤ)³", 1000, 4000))),
     Claim("truncation-until-1e-6", "§3", "truncation dominates until ε ~ 10⁻⁶",
-          "U-curve at the seed's point against an mpmath reference (proofs/ucurve.py)", HOLDS, _truncation_until,
+          "U-curve at the seed's point against an mpmath reference (renderer/ucurve.py)", HOLDS, _truncation_until,
           rule(HOLDS, Bound("model optimum ε", 10 ** -6.5, 10 ** -5.5))),
     Claim("roundoff-drowns-1e-9", "§3", "roundoff drowns everything below ~10⁻⁹",
           "relative error of the float64 quotient at ε = 1e-9", FAILS, _drowns_below_1e9,
           rule(HOLDS, Bound("relative error at ε = 1e-9", lo=1e-2, strict=True))),
     Claim("cell2-minimum", "Cell 2, Expect", "minimum near ε ≈ 1e-6, cliff beyond 1e-8",
-          "optimum of the two-term model fitted to the measured U-curve (proofs/ucurve.py)", HOLDS,
+          "optimum of the two-term model fitted to the measured U-curve (renderer/ucurve.py)", HOLDS,
           _cell2_minimum,
           rule(HOLDS, Bound("fitted optimum ε", 10 ** -6.5, 10 ** -5.5), CORRECTED, Bound("fitted optimum ε", 1e-8, 1e-5))),
     Claim("frame-aligned", "Cell 2", "`e_th × e_ph` … (unit, aligned with N)",
@@ -582,7 +582,7 @@ CLAIMS = (
           "float64 closed form against mpmath at 50 digits", CORRECTED, _dn_1e12,
           rule(CORRECTED, Bound("closed form's residual", hi=1e-12, strict=True))),
     Claim("beta-quadratic", "Cell 5, Expect", "clean quadratic convergence — 100× per decade",
-          "fitted order of the image's central β-derivative (proofs/accuracy.py)", CORRECTED, _beta_order,
+          "fitted order of the image's central β-derivative (lab/accuracy.py)", CORRECTED, _beta_order,
           rule(HOLDS, (Bound("median order", 1.8, 2.3, strict=True), Bound("RMS order", lo=1.8, strict=True)), CORRECTED, Bound("median order", 1.8, 2.3, strict=True))),
     Claim("beta0-1e-16", "Cell 6, Expect", "β=0 agreement at ~1e-16",
           "numeric vs symbolic at β = 0", HOLDS, _beta0,
@@ -653,5 +653,5 @@ def checked(results=None):
     changed = [f"{c.id}: registered {c.registered!r}, computed {v!r} ({m})"
                for c, m, v in results if v != c.registered]
     if changed:
-        raise ClaimChanged("; ".join(changed) + " (edit the register in proofs/claims.py with the change)")
+        raise ClaimChanged("; ".join(changed) + " (edit the register in lab/claims.py with the change)")
     return results

@@ -779,7 +779,7 @@ def build_parser():
 
     u = sub.add_parser("ucurve", help="the measured finite-difference U-curve at one chart point",
                        description="Central-difference error against a 50-digit mpmath reference, split "
-                                   "into truncation and roundoff, per step (proofs/ucurve.py).")
+                                   "into truncation and roundoff, per step (renderer/ucurve.py).")
     u.add_argument("--field", choices=HEIGHT_FIELDS, default="sine")
     u.add_argument("--u", type=_float_arg, default=0.31, help="chart u in [0, 1] (default 0.31)")
     u.add_argument("--v", type=_float_arg, default=0.47, help="chart v in [0, 1] (default 0.47)")

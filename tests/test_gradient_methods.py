@@ -1,4 +1,4 @@
-"""The gradient methods of proofs/gradient_methods.py: their orders against
+"""The gradient methods of lab/gradient_methods.py: their orders against
 sympy's derivative evaluated by mpmath, the complex step's analyticity
 premise, the work per pixel counted from the formulas, and the Pareto front.
 Each check is shown to reject a wrong variant.
@@ -20,7 +20,7 @@ from renderer import generated as G
 from renderer import pointwise
 
 KU, KV = 8.0, 4.0
-#: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as proofs/accuracy.py).
+#: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as lab/accuracy.py).
 SPACING = float(np.spacing(np.pi * max(KU, 2 * KV)))
 #: Over many pixels a float64 evaluation of the gradient is off by up to ~40 spacings: the
 #: phase pi k u (up to 8 pi) is rounded, and the rounding is multiplied by the slope, up to

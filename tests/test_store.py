@@ -157,7 +157,7 @@ print(store.measured("shared", compute))
 @pytest.mark.parametrize("variant", ["locked", "unlocked"])
 def test_pages_running_at_once_compute_a_measurement_once(tmp_path, variant):
     """Two processes started together ask for the same measurement: the second waits
-    for the first's value (the build runs pages side by side, book/_ext/parallel_execute.py)."""
+    for the first's value (the build runs pages side by side, book/_ext/execute_pages.py)."""
     import os
     import subprocess
     import sys

@@ -1,4 +1,4 @@
-"""proofs/verdicts.py: every claim of the draft is shown once, where the book discusses it,
+"""book/chapter/verdicts.py: every claim of the draft is shown once, where the book discusses it,
 and the register's row and the place link to each other."""
 
 from __future__ import annotations

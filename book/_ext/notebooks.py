@@ -32,6 +32,7 @@ page that failed to execute gets no notebook (a warning says so).
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
@@ -43,6 +44,7 @@ from pathlib import Path
 
 from docutils import nodes
 
+from lab.store import source_digest
 from renderer import files
 from chapter.page import TITLED, escape, fenced, plain_directive, plain_markdown
 
@@ -321,7 +323,15 @@ def _project_files(app):
     if app.builder.format != "html":
         return
     site = Path(app.outdir)
-    app.notebook_wheel = build_wheel(ROOT, site / DOWNLOADS).name
+    # The wheel is built again only when what it packages changed (pip takes about 2 s).
+    key = source_digest() + hashlib.sha256((ROOT / "pyproject.toml").read_bytes()
+                                           + (ROOT / "README.md").read_bytes()).hexdigest()
+    stamp, wheels = site.parent / ".wheel-source", sorted((site / DOWNLOADS).glob("*.whl"))
+    if len(wheels) == 1 and stamp.is_file() and stamp.read_text(encoding="utf-8") == key:
+        app.notebook_wheel = wheels[0].name
+    else:
+        app.notebook_wheel = build_wheel(ROOT, site / DOWNLOADS).name
+        stamp.write_text(key, encoding="utf-8")
     write_atomic(site / DOWNLOADS / "constraints.txt", (ROOT / "constraints.txt").read_bytes())
     write_readme(ROOT, site / README)
 
