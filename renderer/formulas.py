@@ -1,6 +1,9 @@
-"""Every formula the render kernel evaluates, written once as sympy objects.
+"""Every bump-mapping formula the render kernel evaluates, written once as sympy objects.
 
-This module is the single source of the renderer's mathematics.  Nothing
+This module is the single source of sphere A's mathematics (height fields,
+gradients, stencil, crease band, chart, frame, perturbed normals, footprint);
+the ray-sphere hit, the shadow test and the shading are written by hand in
+renderer/kernel.py and renderer/js/render.js, held together by tests.  Nothing
 imports it at render time: `renderer.codegen` prints each entry of
 `FUNCTIONS` as a scalar Python function that numba compiles
 (renderer/generated.py, which the kernel calls) and as a JavaScript function

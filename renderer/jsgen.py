@@ -32,6 +32,7 @@ from pathlib import Path
 
 from . import codegen, kernel, scene
 from .files import atomic_write
+from .ledger import DIFFERENCE_LINEAR_GAIN, DIFFERENCE_LOG_FLOOR, SIMULATOR_SCENE
 from .render import CHAMBER_NAMES, GRADIENTS, MAX_SIDE, MAX_ZOOM, WINDOW_MARGIN, WINDOW_OFFSET
 
 __all__ = ["JS_DIR", "MODULE_ORDER", "GENERATED", "SIMULATOR_SCENE", "formulas_js", "constants_js", "sources",
@@ -55,15 +56,6 @@ def formulas_js():
     return codegen.js_source()
 
 
-#: The scene the simulator opens on: the draft's (`Scene()`), shaded with the
-#: displaced sphere's normal (``formulas.PERTURBED_NORMAL["surface"]``), the bump a
-#: reader expects; the draft's chart formula is one control away.
-SIMULATOR_SCENE = scene.Scene(bump="surface")
-
-#: The simulator's difference canvas (§4): log10 |difference| is drawn from this floor (black)
-#: to 0 (white), about the rounding level of float64; the linear scale multiplies by the gain.
-DIFFERENCE_LOG_FLOOR = -16
-DIFFERENCE_LINEAR_GAIN = 100
 
 
 def constants_js():

@@ -22,6 +22,7 @@ pages that wait for the theorem ledger go last.
 
 from __future__ import annotations
 
+import logging as std_logging
 import shutil
 from pathlib import Path
 
@@ -60,7 +61,9 @@ def _execute(app, env, docnames):
     todo = [pk for pk in pks if cache.get_cached_project_nb(pk) is None]
     if not todo:
         return
-    result = load_executor("local-parallel", cache=cache).run_and_cache(
+    quiet = std_logging.getLogger("execute_pages")          # multiprocessing's INFO lines stay off the console
+    quiet.setLevel(std_logging.WARNING)
+    result = load_executor("local-parallel", cache=cache, logger=quiet).run_and_cache(
         filter_pks=todo, timeout=env.mystnb_config.execution_timeout, allow_errors=False)
     for uri in result.errored + result.excepted:
         logging.getLogger(__name__).info(f"{uri}: failed; myst-nb executes it again and reports the error")
