@@ -20,7 +20,7 @@ book: $(STAMP)
 
 # The book first (the browser tests read it), then the checker and the tests on every CPU.
 test: book
-	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto verify tests
+	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadscope verify tests
 
 # The numerics-heavy tests again with numpy's optional SIMD features (those
 # found on this CPU beyond its baseline) disabled, and the kernel compiled by
@@ -34,7 +34,7 @@ test-baseline-simd: $(STAMP)
 	echo "NPY_DISABLE_CPU_FEATURES=\"$$features\""; \
 	cache="$$(mktemp -d)"; trap 'rm -rf "$$cache"' EXIT; \
 	NPY_DISABLE_CPU_FEATURES="$$features" NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR="$$cache" \
-	  $(BIN)/python -m pytest -n auto $(NUMERIC_TESTS) -p no:cacheprovider
+	  $(BIN)/python -m pytest -n auto --dist loadscope $(NUMERIC_TESTS) -p no:cacheprovider
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_render.py

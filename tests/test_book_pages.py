@@ -15,8 +15,11 @@ Each page (index, §1-§9, glossary) is opened offline from the built site, its 
 
 Every check is shown catching a planted defect (the ``test_the_*_check_*`` tests), and
 `chapter.figures.text_overlaps`, which `chapter.page.show` runs on every figure a page publishes, is
-tested on planted overlaps and on the book's diagrams.  Screenshots of every page at both widths go
-to test-artifacts/pages/, the measurements to test-artifacts/book_pages.json.
+tested on planted overlaps and on the book's diagrams.  The measurements go to
+test-artifacts/book_pages.json; with ``SYMRENDER_SHOTS=1`` a screenshot of every page at both widths
+goes to test-artifacts/pages/ (full-page captures take about a second each).  Each page is opened
+once, at 1280 px, and then resized to 390 px (fit.js refits on the article's resize; a fresh load at
+390 px measures the same on every page).
 
 A finding in a page's text (class b, or a break or overflow caused by what the text says) is the
 page author's or the theorem printer's to fix: these tests fail on it and name page, class and text.
@@ -26,6 +29,7 @@ from __future__ import annotations
 
 import io
 import json
+import os
 
 import pytest
 
@@ -300,9 +304,21 @@ class Page:
         self.page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise : null")
         self.page.wait_for_function("!document.querySelector('script[src*=\"fit.js\"]')"
                                     " || document.documentElement.dataset.fit === 'done'", timeout=30_000)
+        self.page.evaluate("() => document.querySelectorAll('article.bd-article details[open]')"
+                           ".forEach(d => d.setAttribute('data-open-at-load', ''))")
 
     def audit(self):
         return self.page.evaluate(AUDIT)
+
+    def resize(self, width, height=900):
+        """The same page at another width, as a reader who turns a phone would see it: the folds
+        the audit opened closed again, the viewport resized, and fit.js's refit (on the
+        article's resize) done.  Saves a second load and MathJax typesetting."""
+        self.page.evaluate("() => document.querySelectorAll('article.bd-article details')"
+                           ".forEach(d => { d.open = d.hasAttribute('data-open-at-load'); })")
+        self.page.set_viewport_size({"width": width, "height": height})
+        self.page.evaluate("() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => "
+                           "setTimeout(r, 100))))")
 
     def length(self):
         """{"height": px, "words": n} of the page as it opens (folded material closed): the page's
@@ -321,6 +337,27 @@ class Page:
         self.context.close()
 
 
+#: Every image of the article: in a numbered, captioned figure, with alt text, at
+#: ``sharpness`` device pixels per CSS pixel or more.
+FIGURES = """(sharpness) => {
+  const main = document.querySelector('article.bd-article');
+  return [...main.querySelectorAll('img')].map(img => {
+    const fig = img.closest('figure');
+    const cap = fig && fig.querySelector('figcaption');
+    const number = cap && cap.querySelector('.caption-number');
+    return {src: img.getAttribute('src').slice(-24), alt: (img.getAttribute('alt') || '').length,
+            numbered: !!(number && /Fig\\. \\d+/.test(number.textContent)),
+            caption: cap ? cap.textContent.trim().length : 0,
+            sharp: img.naturalWidth >= sharpness * img.clientWidth - 1};
+  });
+}"""
+
+
+def bare_figures(figures):
+    """The images that are not a numbered, captioned figure with alt text at two device pixels per CSS pixel."""
+    return [i for i in figures if not (i["numbered"] and i["caption"] > 40 and i["alt"] > 40 and i["sharp"])]
+
+
 @pytest.fixture(scope="module")
 def site(browser, book_html):
     """{(page, width): audit} for every page of the built site at both widths; saves the report and
@@ -328,16 +365,20 @@ def site(browser, book_html):
     shots = ARTIFACTS / "pages"
     shots.mkdir(parents=True, exist_ok=True)
     found = {}
-    for width in WIDTHS:
-        for name in PAGES:
-            p = Page(browser, (book_html / f"{name}.html").as_uri(), width)
-            try:
+    for name in PAGES:
+        p = Page(browser, (book_html / f"{name}.html").as_uri(), WIDTHS[0])
+        try:
+            for width in WIDTHS:
+                if width != WIDTHS[0]:
+                    p.resize(width)
                 lengths = p.length()
                 found[name, width] = p.audit()
                 found[name, width]["length"] = lengths
-                p.screenshot(shots / f"{name}_{width}.png")
-            finally:
-                p.close()
+                found[name, width]["figures"] = p.page.evaluate(FIGURES, 2)
+                if os.environ.get("SYMRENDER_SHOTS") == "1":
+                    p.screenshot(shots / f"{name}_{width}.png")
+        finally:
+            p.close()
     summary = {f"{w}px": {"images": sum(len(found[n, w]["images"]) for n in PAGES),
                           "images_off_ratio": sum(len(_stretched(found[n, w])) for n in PAGES),
                           "text_nodes": sum(found[n, w]["text_nodes"] for n in PAGES),
@@ -388,6 +429,30 @@ def test_no_word_or_number_broken_across_lines(site, name, width):
 def test_nothing_wider_than_its_column(site, name, width):
     bad = site[name, width]["overflow"]
     assert not bad, f"{name} at {width} px: wider than the column or cut off:\n{_listing(bad)}"
+
+
+def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_size(site):
+    """No bare plot: each image of each page sits in a figure numbered "Fig. n" with a caption and
+    alt text, and has at least two device pixels per CSS pixel (for high-density screens)."""
+    images = [dict(i, page=name) for (name, width), a in site.items() if width == 1280 for i in a["figures"]]
+    assert len(images) >= 12
+    assert bare_figures(images) == []
+
+
+def test_the_figure_check_catches_a_bare_image_and_a_blurred_one(browser, book_html, tmp_path):
+    """A plot without figure, caption or alt text is caught; so is a figure drawn at one device pixel per
+    CSS pixel (a 300 px image in a 300 px column)."""
+    p = Page(browser, _synthetic(tmp_path, f'<img src="{_png(300, 150)}">'), 390)
+    try:
+        assert len(bare_figures(p.page.evaluate(FIGURES, 2))) == 1
+    finally:
+        p.close()
+    p = Page(browser, (book_html / "s5_lab.html").as_uri(), 1280)
+    try:
+        assert bare_figures(p.page.evaluate(FIGURES, 2)) == []
+        assert len(bare_figures(p.page.evaluate(FIGURES, 8))) >= 1       # asked for 8x: blurred
+    finally:
+        p.close()
 
 
 def test_the_book_is_short_enough(site):
