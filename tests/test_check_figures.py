@@ -26,6 +26,10 @@ cli = importlib.util.module_from_spec(_SPEC)
 _SPEC.loader.exec_module(cli)
 
 
+#: The tool's own page runner (some tests replace it on the module).
+RENDER_FIGURES = cli._render_figures
+
+
 def failure_problems(rc, err, before, after):
     return _failure_problems(rc, err, before, after, prog="check_figures")
 
@@ -81,11 +85,25 @@ def test_figures_writes_pngs_and_manifest(s1_figures, tmp_path, capsys):
         assert p.read_bytes() == (tmp_path / "b" / p.name).read_bytes(), p.name
 
 
-def test_figures_check_reports_changes(s1_figures, tmp_path, capsys):
+def replay(monkeypatch, fresh):
+    """Replace page execution by the real run in ``fresh`` (a previous ``--out`` directory):
+    the figures a rerun of its pages gives, without running them again."""
+    import shutil
+    manifest = json.loads((fresh / "manifest.json").read_text())
+
+    def render_figures(out_dir, pages):
+        for f in manifest["figures"]:
+            shutil.copy(fresh / f["file"], out_dir / f["file"])
+        return manifest
+    monkeypatch.setattr(cli, "_render_figures", render_figures)
+
+
+def test_figures_check_reports_changes(s1_figures, tmp_path, capsys, monkeypatch):
     a, _ = s1_figures
-    rc, out, err = run(["figures", "--check", str(a)], capsys)
+    rc, out, err = run(["figures", "--check", str(a)], capsys)          # the page runs again, for real
     assert rc == 0 and "unchanged  s1_what_changes-fig-s1-bump" in out and "no figure changed" in out
     assert "unchanged  s1_what_changes-fig-normals" in out
+    replay(monkeypatch, a)                                               # the wrong variants: replayed
     # Wrong variant: one pixel changed by 51/255 in the previous run's file.
     old = copy_dir(a, tmp_path / "old")
     doc = json.loads((old / "manifest.json").read_text())
@@ -151,6 +169,7 @@ def test_figures_bad_input(tmp_path, capsys, argv, word):
 def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_figures, tmp_path,
                                                                                capsys, monkeypatch):
     a, _ = s1_figures
+    replay(monkeypatch, a)
     old = copy_dir(a, tmp_path / "old")
     doc = json.loads((old / "manifest.json").read_text())
     f = old / doc["figures"][0]["file"]
@@ -171,7 +190,8 @@ def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_
     png = (a / json.loads((a / "manifest.json").read_text())["figures"][0]["file"]).read_bytes()
     monkeypatch.setattr(cli, "_page_figures", lambda book, page: iter([
         ("p-cell01-1", 1, "plot()", png, (cli.VARIES_TAG,)), ("p-cell02-1", 2, "plot()", png, ())]))
-    manifest = cli._render_figures(tmp_path / "new", ["p"]) if (tmp_path / "new").mkdir() is None else None
+    (tmp_path / "new").mkdir()
+    manifest = RENDER_FIGURES(tmp_path / "new", ["p"])
     marks = {f["id"]: f.get("varies") for f in manifest["figures"]}
     assert marks == {"p-cell01-1": "measured timing", "p-cell02-1": None}
 
