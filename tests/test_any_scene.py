@@ -85,7 +85,7 @@ def check_frame(render_fn, scene, width, height, gradient, zoom):
     return frame
 
 
-@settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow,
                                                                     HealthCheck.filter_too_much])
 @given(scene=accepted_scenes(), size=st.tuples(st.integers(1, 12), st.integers(1, 12)),
        gradient=st.sampled_from(GRADIENTS),
