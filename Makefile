@@ -23,10 +23,9 @@ test: book
 	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadscope verify tests
 
 # The checks whose numbers could depend on the CPU's code paths (the theorems' comparisons of
-# the renderer's outputs with mpmath, parity with the scalar reference, the generated formulas)
-# again, with numpy's optional SIMD features (those found on this CPU beyond its baseline)
+# the renderer's outputs with mpmath, parity with the scalar reference) again, with numpy's optional SIMD features (those found on this CPU beyond its baseline)
 # disabled and the kernel compiled by numba for a generic x86-64 CPU (into a cache of its own).
-NUMERIC_TESTS := verify tests/test_parity.py tests/test_codegen.py
+NUMERIC_TESTS := verify/test_theorems.py tests/test_parity.py
 test-baseline-simd: $(STAMP)
 	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')" \
 	  || { echo "test-baseline-simd: cannot list numpy's CPU features" >&2; exit 1; }; \
