@@ -7,11 +7,9 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: book test test-baseline-simd bench clean
 
-# --no-compile: Python writes the bytecode of what it imports when it first imports it, instead
-# of pip compiling every module of every package at install.
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --no-compile -c constraints.txt -e '.[book,test]'
+	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[book,test]'
 	touch $(STAMP)
 
 book: $(STAMP)
