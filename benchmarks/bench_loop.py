@@ -27,6 +27,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from mutation_audit import scratch_copy      # benchmarks/: this working tree, copied
+
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 
@@ -83,12 +85,8 @@ def main(argv=None):
         subprocess.run(["git", "worktree", "add", "--detach", str(base), args.base], cwd=ROOT, check=True,
                        capture_output=True)
         try:
-            names = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=ROOT, check=True,
-                                   capture_output=True).stdout.decode().split("\0")
-            for name in filter(None, names):
-                if (ROOT / name).is_file():
-                    (head / name).parent.mkdir(parents=True, exist_ok=True)
-                    shutil.copy2(ROOT / name, head / name)
+            head.mkdir()
+            scratch_copy(head)
             for tree in (base, head):
                 where = subprocess.run([str(BIN / "python"), "-c", "import renderer; print(renderer.__file__)"],
                                        cwd=tree, env=env_for(tree), capture_output=True, text=True).stdout

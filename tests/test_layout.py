@@ -111,3 +111,22 @@ def test_a_cycle_is_caught(tmp_path):
     (layers["lab"] / "a.py").write_text("from . import b\n")
     (layers["lab"] / "b.py").write_text("def f():\n    from lab.a import x\n")
     assert cycle(graph(layers)) == ["lab.a", "lab.b", "lab.a"]
+
+
+_SHADOW = ("import sys, types\n"
+           "{undo}"
+           "import renderer.render, renderer.sweep\n"
+           "from renderer import render, sweep\n"
+           "print(type(render).__name__, type(sweep).__name__)\n")
+
+
+def test_the_package_keeps_its_functions_when_their_submodules_load_first():
+    """``renderer.render`` and ``renderer.sweep`` are submodules and functions of the same names;
+    with the submodules imported first, ``from renderer import render, sweep`` still gives the
+    functions.  Wrong variant: a plain module (the package's class undone) gives the modules."""
+    import subprocess
+    import sys
+    run = lambda undo: subprocess.run([sys.executable, "-c", _SHADOW.format(undo=undo)], capture_output=True,  # noqa: E731
+                                      text=True, check=True, cwd=ROOT).stdout.split()
+    assert run("") == ["function", "function"]
+    assert run("import renderer; sys.modules['renderer'].__class__ = types.ModuleType\n") == ["module", "module"]
