@@ -16,6 +16,7 @@ applied by `Claim.measure` and shown in the book's table as written
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable
@@ -27,10 +28,17 @@ from renderer.render import SPHERE_A
 
 from renderer import frame_label
 
-__all__ = ["Bound", "Criterion", "rule", "Claim", "CLAIMS", "CRITERIA", "HOLDS", "FAILS", "CORRECTED", "evaluate", "checked", "ClaimChanged",
-           "crease_band_ratio"]
+__all__ = ["Bound", "Criterion", "rule", "Claim", "CLAIMS", "CRITERIA", "HOLDS", "FAILS", "CORRECTED",
+           "UNMEASURED", "Unmeasured", "evaluate", "checked", "ClaimChanged", "crease_band_ratio"]
 
 HOLDS, FAILS, CORRECTED = "holds", "does not hold", "holds with a correction"
+#: The verdict of a claim whose measurement raised or gave no finite number for a quantity its
+#: criterion reads: registered for no claim, so `checked` and `pytest verify` refuse it.
+UNMEASURED = "not measured"
+
+
+class Unmeasured(ValueError):
+    """A quantity a criterion reads is missing or not a finite number."""
 
 
 def _number(x):
@@ -75,7 +83,22 @@ class Criterion:
     otherwise: str = FAILS
 
     def decide(self, values):
-        """The verdict for the measured ``values`` (a dict: quantity name -> number)."""
+        """The verdict for the measured ``values`` (a dict: quantity name -> number).
+
+        Raises
+        ------
+        Unmeasured
+            If a quantity any case reads is missing or not a finite real number: a
+            NaN fails every bound, and would otherwise fall through to ``otherwise``.
+        """
+        for quantity in dict.fromkeys(b.quantity for _, bounds in self.cases for b in bounds):
+            x = values.get(quantity)
+            try:
+                finite = math.isfinite(x) and not isinstance(x, complex)
+            except TypeError:
+                finite = False
+            if not finite:
+                raise Unmeasured(f"{quantity} measured {x!r:.80}: a verdict needs a finite number")
         for verdict, bounds in self.cases:
             if all(b.holds(values) for b in bounds):
                 return verdict
@@ -112,9 +135,14 @@ class Claim:
     criterion: Criterion
 
     def measure(self):
-        """(measured text, computed verdict): the measurement, decided by the criterion."""
-        text, values = self.quantify()
-        return text, self.criterion.decide(values)
+        """(measured text, computed verdict): the measurement, decided by the criterion; or
+        ("not measured: <the error>", `UNMEASURED`) when measuring or deciding raised, so
+        that one broken claim neither passes nor hides the verdicts of the others."""
+        try:
+            text, values = self.quantify()
+            return text, self.criterion.decide(values)
+        except Exception as e:          # noqa: BLE001 - reported as the claim's verdict, never passed
+            return f"not measured: {type(e).__name__}: {e}"[:300], UNMEASURED
 
 
 @lru_cache(maxsize=None)

@@ -124,6 +124,14 @@ def _exactly_zero(expr) -> bool:
     return False
 
 
+class Unevaluable(Exception):
+    """An identity's difference raised at a sampled point: the checker cannot decide it there."""
+
+    def __init__(self, label, point, error):
+        where = ", ".join(f"{k}={float(v):.6g}" for k, v in point.items())
+        super().__init__(f"{label}: cannot be evaluated at {where} ({type(error).__name__}: {error})")
+
+
 def _numeric_residual(identity: Identity, seed: int, points: int, digits: int):
     """Worst |lhs - rhs| of a scalar identity over seeded random points, and the point where it occurs."""
     diff = sp.sympify(identity.lhs - identity.rhs)
@@ -139,7 +147,10 @@ def _numeric_residual(identity: Identity, seed: int, points: int, digits: int):
     with mpmath.workdps(digits):
         for _ in range(points):
             point = {s: mpmath.mpf(rng.uniform(*identity.domain[s])) for s in free}
-            r = abs(fn(*[point[s] for s in free]))
+            try:
+                r = abs(fn(*[point[s] for s in free]))
+            except (ArithmeticError, ValueError, TypeError) as e:   # 1/0, log(-1) as a real, ...
+                raise Unevaluable(identity.label, point, e) from None
             if not r <= worst or where is None:     # NaN is the worst residual
                 worst, where = r, point
                 if mpmath.isnan(r):
@@ -153,7 +164,10 @@ def check_identities(identities, *, seed=0, points=POINTS, digits=DIGITS) -> Ver
     Per component: a quick numerical probe (3 points) looks for a
     counterexample first, which refutes at once; otherwise sympy tries to
     prove the identity exactly; what sympy cannot decide is verified at
-    ``points`` seeded points with ``digits`` digits, or refuted.
+    ``points`` seeded points with ``digits`` digits, or refuted.  A component
+    that cannot be evaluated at a sampled point (its difference raises there,
+    as ``1/floor(x)`` on (0.1, 0.9)) is refuted, the evidence naming it, the
+    point and the error: what the checker cannot evaluate it does not pass.
     """
     components = []
     for ident in identities:
@@ -164,6 +178,13 @@ def check_identities(identities, *, seed=0, points=POINTS, digits=DIGITS) -> Ver
         for k, (a, b) in enumerate(zip(lhs, rhs)):
             label = ident.label if lhs.shape == (1, 1) else f"{ident.label}[{k}]"
             components.append(Identity(label, a, b, ident.domain, ident.functions))
+    try:
+        return _decide_components(components, seed, points, digits)
+    except Unevaluable as e:
+        return Verdict("refuted", str(e), digits=digits, points=points)
+
+
+def _decide_components(components, seed, points, digits) -> Verdict:
     tolerance = 10.0 ** (-TOLERANCE_DIGITS)
 
     def refuted(r, label, at):

@@ -6,6 +6,7 @@ the checker (proofs/core.py, proofs/registry.py, chapter.theorems), run by ``mak
 """
 
 import dataclasses
+import re
 
 import pytest
 import sympy as sp
@@ -186,3 +187,25 @@ def test_the_kink_loci_refuse_an_unknown_family():
     from proofs.kink_loci import locus_bands
     with pytest.raises(ValueError, match=r"kind must be one of \('rays', 'circles'\), got 'lines'"):
         locus_bands("lines", Scene(), 8, 8)
+
+
+@pytest.mark.parametrize("rhs, low", [(0, 0.1), (1, 0.5)], ids=["everywhere", "where-it-holds-elsewhere"])
+def test_an_identity_that_cannot_be_evaluated_is_refuted_naming_the_point(rhs, low):
+    """A sampled point where lhs - rhs raises must not be skipped (worst residual 0, 'verified'),
+    even where the identity holds at the other points (1/floor(x) = 1 on [1, 1.5)): the verdict
+    is refuted and says where and why."""
+    from proofs.core import Identity, check_identities
+    x = sp.Symbol("x")
+    v = check_identities([Identity("inverse floor", 1 / sp.floor(x), sp.Integer(rhs), {x: (low, low + 1)})])
+    assert v.status == "refuted", v
+    assert re.fullmatch(r"inverse floor: cannot be evaluated at x=0\.\d+ \(\w+Error: .*\)", v.evidence), v.evidence
+
+
+def test_a_theorem_step_that_cannot_be_evaluated_refutes_the_theorem():
+    from proofs.core import Step, Theorem
+    t = get("optimal-step")
+    x = sp.Symbol("x")
+    step = Step("A step whose sides raise at every sampled point", 1 / sp.floor(x), sp.Integer(0),
+                domain={x: (0.1, 0.9)})
+    v = dataclasses.replace(t, steps=(*t.steps, step), claims={}).check()
+    assert v.status == "refuted" and "cannot be evaluated at x=" in v.evidence, v

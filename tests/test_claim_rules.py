@@ -8,7 +8,8 @@ mutant of lab/claims.py (its measurements are checked by pytest verify).
 
 import pytest
 
-from lab.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Bound, Claim, ClaimChanged, Criterion, checked, rule
+from lab.claims import (CLAIMS, CORRECTED, FAILS, HOLDS, UNMEASURED, Bound, Claim, ClaimChanged, Criterion,
+                        Unmeasured, checked, rule)
 
 
 @pytest.mark.parametrize("bound, x, inside", [
@@ -91,7 +92,8 @@ def _inside(bound):
 def test_each_claims_first_case_is_reachable(claim):
     """Numbers inside the first case's bounds get that case's verdict: no claim's first case is dead."""
     verdict, bounds = claim.criterion.cases[0]
-    assert claim.criterion.decide({b.quantity: _inside(b) for b in bounds}) == verdict
+    others = {b.quantity: _inside(b) for _, bs in claim.criterion.cases[1:] for b in bs}
+    assert claim.criterion.decide({**others, **{b.quantity: _inside(b) for b in bounds}}) == verdict
 
 
 def test_the_books_table_refuses_a_flipped_verdict():
@@ -102,3 +104,29 @@ def test_the_books_table_refuses_a_flipped_verdict():
     flipped = results[:3] + [(c, {}, HOLDS if c.registered != HOLDS else FAILS)] + results[4:]
     with pytest.raises(ClaimChanged, match=f"{c.id}: registered"):
         checked(flipped)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), None, "3", 1j],
+                         ids=["nan", "inf", "none", "text", "complex"])
+def test_a_verdict_needs_a_finite_measurement_even_does_not_hold(value):
+    """NaN fails every bound, so a criterion would fall to 'otherwise': for a claim registered
+    as failing, any broken measurement would match.  It is refused instead, naming the quantity."""
+    c = rule(HOLDS, Bound("on/off ratio", lo=10))          # otherwise FAILS
+    with pytest.raises(Unmeasured, match=r"^on/off ratio measured .*: a verdict needs a finite number$"):
+        c.decide({"on/off ratio": value})
+    with pytest.raises(Unmeasured, match="^other measured None"):
+        rule(HOLDS, Bound("a", lo=10), CORRECTED, Bound("other", lo=1)).decide({"a": 1.0})
+
+
+def test_a_claim_that_cannot_be_measured_is_refused_and_hides_no_other():
+    broken = Claim("broken", "§3", "a crease band", "ratio", FAILS,
+                   lambda: ("ratio nan", {"ratio": float("nan")}), rule(HOLDS, Bound("ratio", lo=10)))
+    crashing = Claim("crashing", "§3", "an integer", "int()", HOLDS,
+                     lambda: ("", {"n": int(__import__("sympy").Symbol("x"))}), rule(HOLDS, Bound("n", lo=0)))
+    fine = Claim("fine", "§3", "ok", "ratio", HOLDS, lambda: ("ratio 20", {"ratio": 20}), rule(HOLDS, Bound("ratio", lo=10)))
+    results = [(c, *c.measure()) for c in (broken, crashing, fine)]
+    assert [v for _, _, v in results] == [UNMEASURED, UNMEASURED, HOLDS]
+    assert results[1][1].startswith("not measured: TypeError: ")
+    with pytest.raises(ClaimChanged, match=r"^broken: registered 'does not hold', computed 'not measured' "
+                                           r"\(not measured: Unmeasured: ratio measured nan.*; crashing: "):
+        checked(results)
