@@ -433,3 +433,16 @@ def test_reach_gate_adds_the_shading_normal_and_bad_arguments_are_named():
         pointwise.reach(scene, render(scene, 8, 8))
     with pytest.raises(TypeError, match="gate"):
         pointwise.reach(scene, g, gate=1)
+
+
+@pytest.mark.parametrize("width, height", [(64, 64), (96, 48), (40, 120)])
+def test_sphere_a_fills_the_seeds_window_where_cell_1_puts_it(width, height):
+    """Seed Cell 1's window: sphere A's silhouette (radius r = eR / sqrt(e^2 - R^2) on z = 0) is
+    0.8 of the half-width (half = 1.25 r), centred across, and the window is shifted down by
+    0.15 half, so the disk spans the pixel centres 0.1..0.9 across and 0.025..0.825 down.  A
+    wrong vertical offset, sign or scale moves those rows, whatever the pixel count does."""
+    scene = Scene(sphere_b=False, floor=False)
+    rows, cols = np.nonzero(gbuffer(scene, width, height).chamber == 1)
+    inside = lambda n, lo, hi: np.flatnonzero((lo * n < np.arange(n) + 0.5) & (np.arange(n) + 0.5 < hi * n))  # noqa: E731
+    assert np.array_equal(np.unique(rows), inside(height, 0.025, 0.825))
+    assert np.array_equal(np.unique(cols), inside(width, 0.1, 0.9))

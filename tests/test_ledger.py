@@ -95,3 +95,27 @@ def test_sweep_census_is_the_ledger_of_its_frames():
 def test_frames_of_different_sizes_are_refused():
     with pytest.raises(ValueError, match="same shape"):
         compare(render(Scene(), 8, 8), render(Scene(), 9, 8))
+
+
+#: Linear value -> encoded value of the sRGB curve, IEC 61966-2-1 (six decimals).  A gamma-2.2
+#: curve (0.5 -> 0.729740), or the breakpoint taken on the encoded side (0.01 -> 0.1292), fails.
+SRGB = {0.0: 0.0, 0.001: 0.01292, 0.0031308: 0.040450, 0.01: 0.099853, 0.18: 0.461356,
+        0.5: 0.735357, 0.8: 0.906332, 1.0: 1.0, -0.25: 0.0}
+
+
+def test_to_srgb_is_the_iec_curve():
+    from renderer import to_srgb
+    np.testing.assert_allclose(to_srgb(np.array(list(SRGB))), list(SRGB.values()), rtol=0, atol=1e-6)
+
+
+def test_the_simulators_to_srgb_is_the_iec_curve(tmp_path):
+    import json
+    import subprocess
+
+    from tests.jsnode import require_tool, write_modules
+    node = require_tool("node", "the simulator's sRGB curve runs under node")
+    modules = write_modules(tmp_path)
+    script = (f"import('{(modules / 'ledger.js').as_uri()}').then(m => "
+              f"console.log(JSON.stringify({json.dumps(list(SRGB))}.map(m.to_srgb))))")
+    out = subprocess.run([node, "--input-type=module", "-e", script], capture_output=True, text=True, check=True)
+    np.testing.assert_allclose(json.loads(out.stdout), list(SRGB.values()), rtol=0, atol=1e-6)

@@ -20,6 +20,16 @@ def test_truncation_follows_eps_squared_h3_over_6_at_large_steps(curve):
     assert not np.allclose(curve.truncation[big], 2 * predicted, rtol=2e-2)
 
 
+def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the_predicted_step(curve):
+    """`UCurve.model` (the curve the book plots): its truncation part is the measured truncation at
+    large steps (a wrong 1/6 fails), and its minimum lies at the predicted optimum (a wrong roundoff
+    coefficient moves it by the cube root of the error)."""
+    big = (curve.eps > 1e-4) & (curve.eps < 1e-2)
+    assert np.allclose(curve.model[big], np.abs(curve.truncation[big]), rtol=2e-2)
+    around = measure(eps=curve.eps_opt_predicted * np.array([0.75, 0.9, 1.0, 1.1, 1.3]))
+    assert np.argmin(around.model) == 2, around.model
+
+
 def test_roundoff_is_bounded_by_a_few_ulps_over_eps(curve):
     # |roundoff| <= c u |h'| ... bounded by (2 ulp(h) + ulp of the quotient) / (2 eps).
     bound = 4 * UNIT_ROUNDOFF * (1 + abs(curve.derivative)) / curve.eps
