@@ -130,3 +130,15 @@ def test_a_claim_that_cannot_be_measured_is_refused_and_hides_no_other():
     with pytest.raises(ClaimChanged, match=r"^broken: registered 'does not hold', computed 'not measured' "
                                            r"\(not measured: Unmeasured: ratio measured nan.*; crashing: "):
         checked(results)
+
+
+def test_a_claim_whose_sympy_value_does_not_reduce_to_an_integer_is_not_measured(monkeypatch):
+    """The frame's orientation claim takes int() of a sympy value: one that does not reduce
+    (a symbol left in it) makes that claim 'not measured', not an error of the whole register."""
+    import sympy as sp
+
+    import proofs.frame
+    claim = next(c for c in CLAIMS if c.quantify.__name__ == "_orientation")
+    monkeypatch.setattr(proofs.frame, "_orientation_value", lambda: sp.Symbol("s") - 1)
+    measured, verdict = claim.measure()
+    assert verdict == UNMEASURED and measured.startswith("not measured: TypeError"), measured

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import logging as std_logging
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -72,8 +73,22 @@ def _execute(app, env, docnames):
     quiet.setLevel(std_logging.WARNING)
     result = load_executor("local-parallel", cache=cache, logger=quiet).run_and_cache(
         filter_pks=todo, timeout=env.mystnb_config.execution_timeout, allow_errors=False)
-    for uri in result.errored + result.excepted:
-        logging.getLogger(__name__).info(f"{uri}: failed; myst-nb executes it again and reports the error")
+    for uri in result.errored + result.excepted:       # the console names the cause, not only the log file
+        record = cache.get_project_record(uri)
+        logging.getLogger(__name__).warning(f"{Path(uri).stem} failed to execute: {cause(record.traceback)}")
+
+
+#: A terminal colour code, and an exception line as a traceback ends with it ("ClaimChanged: ...").
+_ANSI, _RAISED = re.compile(r"\x1b\[[0-9;]*m"), re.compile(r"^[A-Za-z_][\w.]*(Error|Exception|Changed|Failed|Interrupt|Exit)\b.*")
+
+
+def cause(traceback) -> str:
+    """The exception line of a page's execution ``traceback`` (jupyter-cache's record of it),
+    e.g. ``ClaimChanged: h3-scale: registered 'holds', computed 'does not hold' (...)``, at
+    most 1,000 characters; the traceback's last line when no line names an exception."""
+    lines = [line.strip() for line in _ANSI.sub("", traceback or "").splitlines() if line.strip()]
+    raised = [line for line in lines if _RAISED.match(line)]
+    return ((raised or lines or ["no traceback recorded"])[-1])[:1000]
 
 
 def setup(app):

@@ -1,0 +1,58 @@
+"""book/_ext/execute_pages.py: a page that fails to execute is named on the console with the
+exception that stopped it (a changed verdict's claim and both verdicts), not only in a log file."""
+
+from __future__ import annotations
+
+import importlib.util
+import logging
+from pathlib import Path
+from types import SimpleNamespace
+
+ROOT = Path(__file__).resolve().parents[1]
+_spec = importlib.util.spec_from_file_location("execute_pages", ROOT / "book" / "_ext" / "execute_pages.py")
+execute_pages = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(execute_pages)
+
+PAGE = """---
+jupytext:
+  text_representation:
+    extension: .md
+    format_name: myst
+kernelspec:
+  display_name: Python 3
+  language: python
+  name: python3
+---
+
+# A page
+
+```{code-cell}
+class ClaimChanged(AssertionError):
+    pass
+raise ClaimChanged("h3-scale: registered 'holds', computed 'does not hold' (ratio 2.1)")
+```
+"""
+
+
+def test_a_page_that_fails_is_named_with_its_exception_on_the_console(tmp_path, caplog):
+    (tmp_path / "page.md").write_text(PAGE, encoding="utf-8")
+    (tmp_path / "plain.md").write_text("# No code\n", encoding="utf-8")
+    env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60,
+                                                        execution_cache_path=str(tmp_path / "cache")),
+                          doc2path=lambda d: str(tmp_path / f"{d}.md"))
+    app = SimpleNamespace(env=env, outdir=str(tmp_path / "html"),
+                          config=SimpleNamespace(execute_pages_first=[], execute_pages_last=[]))
+    with caplog.at_level(logging.WARNING):
+        execute_pages._execute(app, env, ["page", "plain"])
+    assert [r.getMessage() for r in caplog.records if "failed to execute" in r.getMessage()] == [
+        "page failed to execute: ClaimChanged: h3-scale: registered 'holds', computed 'does not hold' (ratio 2.1)"]
+
+
+def test_the_cause_is_the_exception_line_without_colours():
+    tb = ("An error occurred while executing the following cell:\n------------------\nx = 1\n"
+          "\x1b[0;31mKeyError\x1b[0m: 'inner'\n\nDuring handling...\n"
+          "\x1b[0;31mTheoremFailed\x1b[0m: no-boundary: refuted, residual 3e-2\n")
+    assert execute_pages.cause(tb) == "TheoremFailed: no-boundary: refuted, residual 3e-2"
+    assert execute_pages.cause("") == "no traceback recorded"
+    assert execute_pages.cause("just text\nlast line") == "last line"
+    assert len(execute_pages.cause("ValueError: " + "9" * 900_000)) == 1000
