@@ -11,8 +11,11 @@ Public API::
 """
 
 import importlib
+import os
 import sys
+import tempfile
 import types
+from pathlib import Path
 
 #: Each public name and the submodule that defines it, loaded on first use (PEP 562):
 #: ``import renderer`` alone loads neither numpy nor the compiled kernel, so the command
@@ -54,3 +57,36 @@ class _Package(types.ModuleType):
 
 
 sys.modules[__name__].__class__ = _Package
+
+
+def _writable(path):
+    try:
+        os.makedirs(path, exist_ok=True)
+        tempfile.TemporaryFile(dir=path).close()
+        return True
+    except OSError:
+        return False
+
+
+def _numba_cache():
+    """Where numba can cache the compiled kernel.  numba caches beside the package
+    (``renderer/__pycache__``) or in the user's cache directory, and refuses to compile
+    at all ("no locator available") where it can write neither: a read-only or
+    system-wide install run by a user without a writable home.  There the cache goes
+    to ``symrender-numba-<uid>`` in the temporary directory, and one line on stderr
+    says so.  ``NUMBA_CACHE_DIR``, when set, is left to numba."""
+    if os.environ.get("NUMBA_CACHE_DIR") or _writable(Path(__file__).with_name("__pycache__")):
+        return
+    from numba.misc.appdirs import AppDirs
+    user = AppDirs(appname="numba", appauthor=False).user_cache_dir
+    if _writable(user):
+        return
+    fallback = os.path.join(tempfile.gettempdir(), f"symrender-numba-{os.getuid()}")
+    os.environ["NUMBA_CACHE_DIR"] = fallback
+    import numba
+    numba.config.CACHE_DIR = fallback
+    print(f"symrender: numba cannot cache beside the package nor in {user}: "
+          f"compiled functions are cached in {fallback}", file=sys.stderr)
+
+
+_numba_cache()

@@ -12,6 +12,7 @@ device (``os.mknod``) case runs there; it skips only without root.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import stat
 import tempfile
 import threading
@@ -276,3 +277,32 @@ def test_read_regular_refuses_a_large_file_without_reading_it(tmp_path, monkeypa
     assert files.read_regular(small, 100) == b"x" * 100 and max(reads) <= 101
     with pytest.raises(files.RefusedPath):
         files.read_regular(small, 99)
+
+
+def test_a_read_only_install_without_a_writable_home_renders(tmp_path):
+    """numba refuses to compile where it can cache neither beside the package nor in the user's
+    cache ("no locator available").  Files in place of both directories stand for a read-only
+    install and a missing home (for root too, whom permissions do not stop): the kernel loads,
+    with one line of notice, and the cache lands in the temporary directory."""
+    import shutil
+    import subprocess
+    import sys
+    copy = tmp_path / "install"
+    shutil.copytree(Path(__file__).parents[1] / "renderer", copy / "renderer",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    (copy / "renderer" / "__pycache__").write_text("not a directory")
+    home = tmp_path / "home"
+    home.mkdir()
+    (home / ".cache").write_text("not a directory")
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("NUMBA_", "XDG_"))}
+    env.update(PYTHONPATH=str(copy), HOME=str(home), TMPDIR=str(scratch))
+    # Importing the kernel decorates every compiled function (where numba refused); one small
+    # function is then compiled and cached (the whole frame's kernel would take 15 s more).
+    done = subprocess.run([sys.executable, "-c", "import renderer.kernel; from renderer import pointwise; "
+                           "import numpy as np; print('ok' if np.isfinite(pointwise.height('sine', 0.3, 0.4, 8, 4)).all() else 'bad')"],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0 and done.stdout == "ok\n", done.stderr[-2000:]
+    assert done.stderr.count("\n") == 1 and "compiled functions are cached in" in done.stderr, done.stderr
+    assert list((scratch / f"symrender-numba-{os.getuid()}").rglob("*.nbi"))
