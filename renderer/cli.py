@@ -847,7 +847,12 @@ def main(argv=None) -> int:
 def _run(argv):
     """`main` without its signal handling."""
     out = sys.stdout
+    for stream in (sys.stdout, sys.stderr):     # a name the terminal cannot encode prints escaped
+        if hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     try:
+        if out is None:                     # started with it closed (>&-): no report could be read
+            raise UsageError("standard output is closed: symrender reports there (and -o - writes there)")
         try:
             args = build_parser().parse_args(argv)
         except SystemExit as exc:           # --help (argparse prints, then exits 0)

@@ -769,3 +769,28 @@ def test_fuzz_reached_both_outcomes():
 
 
 # ------------------------------------------------------------------ figures
+
+
+@pytest.mark.parametrize("command", [["render", "--size", "8x8", "-o"], ["ucurve", "--eps", "1e-3", "--plot"]],
+                         ids=["render", "ucurve"])
+def test_a_file_name_stdout_cannot_encode_is_written_and_reported(tmp_path, command):
+    """With a strict UTF-8 stdout, a name from undecodable bytes used to be written, then its
+    report raised UnicodeEncodeError and the command exited 2: it now succeeds, the name escaped."""
+    name = os.fsdecode(b"\xff.png")
+    env = {**os.environ, "PYTHONIOENCODING": "utf-8:strict"}
+    done = subprocess.run([sys.executable, "-m", "renderer.cli", *command, name], cwd=tmp_path, env=env,
+                          capture_output=True, timeout=600)
+    assert done.returncode == 0 and done.stderr == b"", done.stderr
+    assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert b"wrote \\udcff.png" in done.stdout
+
+
+@pytest.mark.parametrize("command", [["render", "--size", "8x8", "-o", "-"], ["sweep", "--size", "8x8"],
+                                     ["render", "--size", "8x8", "-o", "x.png"]])
+def test_a_closed_stdout_is_an_error_before_any_work(tmp_path, command):
+    """`>&-`: the report (and `-o -`'s image) would be lost; an AttributeError or exit 0 before."""
+    done = subprocess.run([sys.executable, "-m", "renderer.cli", *command], cwd=tmp_path, capture_output=False,
+                          stderr=subprocess.PIPE, preexec_fn=lambda: os.close(1), timeout=600)
+    assert done.returncode == 2 and done.stderr == b"symrender: error: standard output is closed: symrender " \
+                                                   b"reports there (and -o - writes there)\n", done.stderr
+    assert not list(tmp_path.iterdir())
