@@ -83,6 +83,9 @@ class _Parser(argparse.ArgumentParser):
     value of the option before it (``--size -5x5``, ``--eps -1e-3``), so that
     such values reach the command's own checks and messages."""
 
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, allow_abbrev=False, **kwargs)   # --v is not --version
+
     def error(self, message):
         raise UsageError(message)
 
@@ -126,7 +129,7 @@ def parse_size(text):
         separately, still before any allocation.
     """
     from renderer.render import MAX_SIDE
-    m = re.fullmatch(r"\s*([-+]?\d+)\s*[xX]\s*([-+]?\d+)\s*", str(text))
+    m = re.fullmatch(r"\s*([-+]?[0-9]+)\s*[xX]\s*([-+]?[0-9]+)\s*", str(text))    # ASCII digits only
     if not m:
         raise UsageError(f"--size must be WxH with integer sides in [1, {MAX_SIDE}] (e.g. 256x256), "
                          f"got {text!r}")
@@ -148,9 +151,22 @@ def _check_budget(width, height, frames, what):
             f"{what} accepts at most {FRAME_PIXEL_BUDGET:,} (use a smaller size or fewer steps)")
 
 
+#: A number as the options take it: ASCII digits, no ``_`` separators (``float`` also takes
+#: ``1_0e-3`` and other scripts' digits), or inf/nan for the range checks to name.
+_NUMBER = re.compile(r"\s*[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?\s*|\s*[-+]?(inf|infinity|nan)\s*",
+                     re.IGNORECASE)
+
+
+def _number(text):
+    """``text`` as a float if it is a plain decimal number (`_NUMBER`); else ValueError."""
+    if not _NUMBER.fullmatch(str(text)):
+        raise ValueError(text)
+    return float(text)
+
+
 def _positive_float(text, name, bounds=None):
     try:
-        x = float(text)
+        x = _number(text)
     except ValueError:
         raise UsageError(f"{name}: {text!r} is not a number") from None
     if bounds is not None and not (math.isfinite(x) and bounds[0] <= x <= bounds[1]):
@@ -198,7 +214,7 @@ def parse_eps(text, *, name="--eps", max_steps=None, bounds=None):
                              f"list, got {text!r}")
         a, b = (_positive_float(p, name, bounds) for p in parts[:2])
         count = parts[2].strip()
-        if not re.fullmatch(r"[-+]?\d+", count):
+        if not re.fullmatch(r"[-+]?[0-9]+", count):
             raise UsageError(f"{name}: the count n in a:b:n must be an integer in [1, {max_steps}], "
                              f"got {parts[2]!r}")
         if not (len(count.lstrip("+")) <= 6 and 1 <= int(count) <= max_steps):
@@ -726,7 +742,7 @@ def _eps_arg(max_steps, bounds=None):
 
 def _float_arg(text):
     try:
-        return float(text)
+        return _number(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
 
@@ -797,8 +813,10 @@ def build_parser():
 _COMMANDS = {"render": _cmd_render, "sweep": _cmd_sweep, "ucurve": _cmd_ucurve}
 
 
-def _one_line(msg):
-    return " ".join(str(msg).split())
+def _one_line(msg, limit=500):
+    """``msg`` on one line, cut to ``limit`` characters (a bad value can be megabytes long)."""
+    text = " ".join(str(msg).split())
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text):,} characters)"
 
 
 #: A Ctrl-C seen during `main`: numba's compiler runs Python callbacks from C, which drop

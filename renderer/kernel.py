@@ -238,7 +238,8 @@ def shade(s, lights, P, N, Ns, albedo, code, skip):
             axis, wv = specular_axis(s, w, view)
             dr, dg, db = light_term(s, color, w, axis, wv, Ns, albedo)
             r, g, b = r + dr, g + dg, b + db
-    return min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0), min(max(b, 0.0), 1.0)
+    # + 0.0: a -0.0 (a -0.0 albedo times a light) leaves as 0.0, not as a negative zero pixel.
+    return min(max(r, 0.0), 1.0) + 0.0, min(max(g, 0.0), 1.0) + 0.0, min(max(b, 0.0), 1.0) + 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -372,8 +373,8 @@ def sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads
                     dr, dg, db = light_term(s, color, (geo[k, 0], geo[k, 1], geo[k, 2]),
                                             (geo[k, 3], geo[k, 4], geo[k, 5]), geo[k, 6], Ns, albedo)
                     r, g, b = r + dr, g + dg, b + db
-            images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0)
-            images[f, j, i, 2] = min(max(b, 0.0), 1.0)
+            images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0) + 0.0, min(max(g, 0.0), 1.0) + 0.0
+            images[f, j, i, 2] = min(max(b, 0.0), 1.0) + 0.0
             grads[f, j, i, 0], grads[f, j, i, 1] = hu, hv
 
 

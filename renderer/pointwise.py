@@ -59,6 +59,8 @@ def _real(name, value, low=None, high=None, high_open=False):
     [low, high)); TypeError or ValueError naming ``name``, the first bad
     value and its flat index."""
     try:
+        if np.iscomplexobj(value):          # asarray would drop the imaginary part with a warning
+            raise TypeError
         a = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be real numbers (a scalar or an array), got "
@@ -188,11 +190,22 @@ def reach(scene, gbuffer, *, gate=False):
     ------
     TypeError
         ``scene`` not a Scene, ``gbuffer`` not a GBuffer, ``gate`` not a bool.
+    ValueError
+        If ``gbuffer``'s chamber is not an (H, W) array or its P, N, Ns are not
+        (H, W, 3) arrays of the same frame (the loop would read past them).
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
     if not isinstance(gbuffer, GBuffer):
         raise TypeError(f"gbuffer must be a renderer.GBuffer, got {type(gbuffer).__name__}")
+    chamber = np.asarray(gbuffer.chamber)
+    if chamber.ndim != 2:
+        raise ValueError(f"gbuffer.chamber must be an (H, W) array, got shape {chamber.shape}")
+    for name in ("P", "N", "Ns"):
+        shape = np.shape(getattr(gbuffer, name))
+        if shape != chamber.shape + (3,):
+            raise ValueError(f"gbuffer.{name} has shape {shape}, gbuffer.chamber {chamber.shape}: "
+                             f"the arrays must be one frame's, {chamber.shape + (3,)}")
     prm, lights = kernel.params(scene, skip=False)
     out = np.zeros((lights.shape[0],) + gbuffer.chamber.shape, dtype=bool)
     _reach_rows(prm, lights, gbuffer.chamber, gbuffer.P, gbuffer.N, gbuffer.Ns, check_flag("gate", gate), out)

@@ -794,3 +794,23 @@ def test_a_closed_stdout_is_an_error_before_any_work(tmp_path, command):
     assert done.returncode == 2 and done.stderr == b"symrender: error: standard output is closed: symrender " \
                                                    b"reports there (and -o - writes there)\n", done.stderr
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["--v"], "required: command"),                                   # was taken as --version
+    (["render", "-o", "x.png", "--siz", "8x8"], "unrecognized arguments: --siz 8x8"),
+    (["render", "--size", "٥x٥"], "--size"),                           # Arabic-Indic digits
+    (["render", "--size", "8x８"], "--size"),                           # a full-width digit
+    (["sweep", "--eps", "1_0e-3"], "is not a number"),                 # float() takes underscores
+    (["ucurve", "--u", "0_3"], "is not a number"),
+    (["ucurve", "--eps", "1e-3,٣e-4"], "is not a number"),
+])
+def test_options_take_neither_abbreviations_nor_other_digits(argv, fragment, capsys):
+    rc, out, err = run(argv, capsys)
+    assert rc == 2 and out == "" and fragment in err and err.count("\n") == 1, err
+
+
+def test_an_error_line_does_not_repeat_a_huge_value(capsys):
+    rc, out, err = run(["render", "--size", "9" * 900_000], capsys)
+    assert rc == 2 and err.startswith("symrender: error: ") and err.count("\n") == 1
+    assert len(err) < 700 and err.rstrip().endswith("characters)"), err[-200:]

@@ -446,3 +446,36 @@ def test_sphere_a_fills_the_seeds_window_where_cell_1_puts_it(width, height):
     inside = lambda n, lo, hi: np.flatnonzero((lo * n < np.arange(n) + 0.5) & (np.arange(n) + 0.5 < hi * n))  # noqa: E731
     assert np.array_equal(np.unique(rows), inside(height, 0.025, 0.825))
     assert np.array_equal(np.unique(cols), inside(width, 0.1, 0.9))
+
+
+@pytest.mark.parametrize("field", ["P", "N", "Ns", "chamber"])
+def test_reach_refuses_a_gbuffer_whose_arrays_are_of_another_frame(field):
+    """The compiled loop indexes P, N, Ns by chamber's shape: arrays of another size were read
+    past their end, and the masks came back wrong without a word."""
+    import dataclasses
+    scene = Scene()
+    small, big = gbuffer(scene, 8, 8), gbuffer(scene, 16, 12)
+    mixed = dataclasses.replace(big, **{field: getattr(small, field)})
+    with pytest.raises(ValueError, match=r"^gbuffer\.\w+ has shape \(8, 8, 3\), gbuffer\.chamber \(12, 16\)"
+                                         if field != "chamber" else r"^gbuffer\.P has shape \(12, 16, 3\), "
+                                                                     r"gbuffer\.chamber \(8, 8\)"):
+        pointwise.reach(scene, mixed)
+    with pytest.raises(ValueError, match=r"^gbuffer\.chamber must be an \(H, W\) array, got shape \(12, 16, 3\)"):
+        pointwise.reach(scene, dataclasses.replace(big, chamber=big.P))
+
+
+def test_no_pixel_is_a_negative_zero():
+    """A -0.0 albedo or ambient term (accepted: it is zero) gave -0.0 pixels, which print as -0."""
+    from renderer import sweep
+    scene = Scene(albedo_a=(-0.0, 0.5, 0.5), ambient=(-0.0, 0.1, 0.1), albedo_b=(-0.0, 0.2, 0.2))
+    s = sweep(scene, (1e-3,), 16, 16)
+    for image in (render(scene, 32, 32).image, render(scene, 32, 32, gradient="central").image,
+                  s.numeric[0].image, s.symbolic.image):
+        assert not np.signbit(image).any()
+
+
+@pytest.mark.parametrize("value", [0.3 + 0j, np.array([0.3, 0.4 + 1e-3j]), [0.3, 1j]])
+def test_pointwise_refuses_complex_numbers_naming_the_argument(value):
+    """numpy would drop the imaginary part with a ComplexWarning and compute on the rest."""
+    with pytest.raises(TypeError, match=r"^u must be real numbers"):
+        pointwise.height("sine", value, 0.4, 8, 4)
