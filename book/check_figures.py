@@ -16,11 +16,13 @@ through a staging directory, so a failed or interrupted run leaves it as it was.
 from __future__ import annotations
 
 import argparse
+import asyncio
 import hashlib
 import io
 import json
 import os
 import re
+import signal
 import subprocess
 import sys
 import tempfile
@@ -122,10 +124,17 @@ def _page_figures(book, page):
     nb = read_myst_markdown_notebook(path.read_text(encoding="utf-8"), path=path)
     client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
                                      resources={"metadata": {"path": str(book)}})
+    # nbclient takes SIGINT and SIGTERM while it runs (it shuts the kernel down, and the run ends
+    # in a CancelledError) and leaves them at their defaults: the tool's handlers are put back.
+    handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         client.execute()            # nbclient shuts its kernel down on the way out, Ctrl-C included
     except nbclient.exceptions.CellExecutionError as exc:
         raise UsageError(f"page {page} failed: {exc.ename}: {exc.evalue}") from None
+    finally:
+        for sig, handler in handlers.items():
+            if handler is not None:
+                signal.signal(sig, handler)
     ordinal = 0
     for cell in nb.cells:
         if cell.cell_type != "code":
@@ -313,6 +322,8 @@ def _validate_manifest(doc, path, known_pages):
             raise bad(f"figures[{i}].sha256 must be 64 lowercase hex digits")
         if not isinstance(f.get("varies", ""), str):
             raise bad(f"figures[{i}].varies must be a string")
+        if f.get("page") not in pages:
+            raise bad(f"figures[{i}].page must be one of the manifest's pages, got {f.get('page')!r:.80}")
         if f["id"] in figures:
             raise bad(f"figure id {f['id'][:80]!r} appears twice")
         if name in names:
@@ -450,6 +461,7 @@ def run(args, out):
         return 0
     old_doc, old, old_pages = _load_manifest(args.check, _known_pages())
     pages = _resolve_pages(old_pages if pages is None else pages)
+    old = {fid: f for fid, f in old.items() if f["page"] in pages}    # the pages not run are not compared
     with tempfile.TemporaryDirectory(prefix="symrender-figures-") as tmp:
         tmp = Path(tmp)
         new_doc = _render_figures(tmp, pages)
@@ -489,8 +501,22 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+#: Set by SIGTERM: the KeyboardInterrupt `_terminate` raises unwinds like a Ctrl-C (removing the
+#: temporary and staging directories).  While a page runs, nbclient takes the signal itself:
+#: it shuts the kernel down and the run ends in a CancelledError, reported as an interrupt.
+_terminated = False
+
+
+def _terminate(signum, frame):
+    global _terminated
+    _terminated = True
+    raise KeyboardInterrupt
+
+
 def main(argv=None) -> int:
-    """Run the tool; return 0, 1 (a figure changed) or 2 (a usage error)."""
+    """Run the tool; return 0, 1 (a figure changed), 2 (a usage error), 130 (Ctrl-C, or either
+    signal while a page runs) or 143 (SIGTERM); either signal removes the temporary and staging
+    directories first."""
     p = _Parser(prog="check_figures.py", description=__doc__.split("\n\n")[1])
     what = p.add_mutually_exclusive_group(required=True)
     what.add_argument("--out", metavar="DIR", help="directory to write the figures and manifest.json into")
@@ -499,16 +525,25 @@ def main(argv=None) -> int:
     p.add_argument("--ignore", action="append", default=[], metavar="ID-PATTERN",
                    help="with --check: report but do not fail on figures matching this pattern; repeatable")
     try:
+        previous = signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:                       # not the main thread: signals are left alone
+        previous = None
+    global _terminated
+    _terminated = False
+    try:
         return run(p.parse_args(argv), sys.stdout)
+    except (KeyboardInterrupt, asyncio.CancelledError):
+        print(f"check_figures: {'terminated' if _terminated else 'interrupted'}", file=sys.stderr)
+        return 143 if _terminated else 130
     except UsageError as exc:
         print(f"check_figures: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except OSError as exc:
         print(f"check_figures: error: {exc.filename or ''}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("check_figures: interrupted", file=sys.stderr)
-        return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

@@ -439,3 +439,66 @@ def test_check_passes_within_tolerance_and_fails_beyond(tmp_path, capsys, monkey
     fake_run(monkeypatch, {fid: cli._png_bytes(far.astype(np.uint8))})
     rc, out, _ = run(["figures", "--check", str(d)], capsys)
     assert rc == 1 and f"changed    {fid}: max |dI|" in out and "1 figure(s) changed" in out
+
+
+def test_check_of_some_pages_compares_only_their_figures(s1_figures, tmp_path, capsys, monkeypatch):
+    """``--check DIR --pages s1`` used to report every figure of the other pages "removed"."""
+    import shutil
+    a, _ = s1_figures
+    old = copy_dir(a, tmp_path / "old")
+    doc = json.loads((old / "manifest.json").read_text())
+    shutil.copy(old / doc["figures"][0]["file"], old / "s2_scene-fig-x.png")
+    doc["pages"].append("s2_scene")
+    doc["figures"].append({**doc["figures"][0], "id": "s2_scene-fig-x", "page": "s2_scene",
+                           "file": "s2_scene-fig-x.png"})
+    (old / "manifest.json").write_text(json.dumps(doc))
+    replay(monkeypatch, a)                                     # a rerun of s1 alone gives a's figures
+    rc, out, err = run(["figures", "--check", str(old), "--pages", "s1"], capsys)
+    assert rc == 0 and "removed" not in out and "no figure changed" in out, out + err
+    monkeypatch.setattr(cli, "_resolve_pages", lambda pages: list(pages))   # all of the manifest's pages
+    rc, out, _ = run(["figures", "--check", str(old)], capsys)
+    assert rc == 1 and "removed    s2_scene-fig-x" in out              # a page that lost its figure still fails
+    doc["figures"][-1]["page"] = "s9_roadmap"                               # not a page of the manifest
+    (old / "manifest.json").write_text(json.dumps(doc))
+    rc, _, err = run(["figures", "--check", str(old), "--pages", "s1"], capsys)
+    assert rc == 2 and "figures[2].page must be one of the manifest's pages" in err
+
+
+def test_sigterm_during_check_leaves_no_temporary_directory(s1_figures, tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+    a, _ = s1_figures
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    proc = subprocess.Popen([sys.executable, str(Path(__file__).parents[1] / "book" / "check_figures.py"),
+                             "--check", str(a)], env={**os.environ, "TMPDIR": str(scratch)},
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while not list(scratch.glob("symrender-figures-*")) and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    assert list(scratch.glob("symrender-figures-*")), "the check never made its temporary directory"
+    time.sleep(0.5)                                             # inside the page run
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    # nbclient takes the signal while the page runs (its kernel shut down): reported as an interrupt.
+    last = err.decode().splitlines()[-1:]
+    assert (proc.returncode, last) in [(130, ["check_figures: interrupted"]),
+                                       (143, ["check_figures: terminated"])], err.decode()[-2000:]
+    assert not list(scratch.glob("symrender-figures-*"))
+
+
+def test_the_tools_signal_handlers_are_back_after_a_page(tmp_path, monkeypatch):
+    """nbclient leaves SIGTERM at its default after a page: a SIGTERM between pages (or while the
+    figures are compared) killed the tool with its temporary directory left behind."""
+    import signal
+    fake_book(tmp_path, "print('one cell')")
+    monkeypatch.setattr(cli, "_repo_root", lambda: tmp_path)
+    mine = lambda signum, frame: None  # noqa: E731
+    previous = signal.signal(signal.SIGTERM, mine)
+    try:
+        list(cli._page_figures(tmp_path / "book", "s1_bad"))
+        assert signal.getsignal(signal.SIGTERM) is mine
+    finally:
+        signal.signal(signal.SIGTERM, previous)
