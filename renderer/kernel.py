@@ -268,16 +268,16 @@ def shading_normal(s, N, frame, hu, hv, u, v, sin_phi):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def render_rows(prm, lights, xs, ys, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
+def render_rows(prm, lights, xs, ys, first, last, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
                 image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out):
-    """Render every pixel (rows in parallel) into the preallocated outputs:
-    xs (W,), ys (H,): pixel centres on the image plane; image (H, W, 3),
+    """Render the pixels of rows ``first`` to ``last - 1`` (in parallel) into the preallocated
+    outputs: xs (W,), ys (H,): pixel centres on the image plane; image (H, W, 3),
     chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2) when wanted;
     t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) when ``want_geo`` (the GBuffer);
     the caller allocates them with these shapes (nothing is checked here).
     """
     sin_x = np.sin(np.pi * xs)
-    for j in prange(ys.shape[0]):
+    for j in prange(first, last):
         render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
                    image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out)
 
@@ -320,15 +320,16 @@ def render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_ki
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def sweep_rows(prm, lights, xs, ys, steps, images, chamber, kink, grads):
-    """The exact frame (index 0) and one central frame per step (1, 2, ...).
+def sweep_rows(prm, lights, xs, ys, first, last, steps, images, chamber, kink, grads):
+    """Rows ``first`` to ``last - 1`` of the exact frame (index 0) and of one central frame per
+    step (1, 2, ...).
     Per pixel the geometry and the shadow rays are computed once (they do not
     depend on the gradient); sphere A is re-shaded per step, crease flag kept.
     images (S+1, H, W, 3), grads (S+1, H, W, 2); chamber, kink (H, W).
     The caller allocates the outputs with these shapes (nothing is checked here).
     """
     sin_x = np.sin(np.pi * xs)
-    for j in prange(ys.shape[0]):
+    for j in prange(first, last):
         sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads)
 
 

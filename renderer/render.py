@@ -155,6 +155,17 @@ def check_workers(workers):
     return workers
 
 
+#: Pixels per call of the compiled kernel: a frame is rendered in bands of rows, so that a Ctrl-C
+#: (a KeyboardInterrupt, raised between two calls) stops a large render within one band.
+BAND_PIXELS = 1 << 16
+
+
+def bands(height, width):
+    """(first, last) row ranges of about `BAND_PIXELS` pixels each (at least one row), in order."""
+    rows = max(1, BAND_PIXELS // width)
+    return [(j, min(j + rows, height)) for j in range(0, height, rows)]
+
+
 @contextmanager
 def threads(workers):
     """Run the kernel inside the block, alone (`_KERNEL_LOCK`), its rows on
@@ -182,9 +193,11 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     window = window_width(scene.radius_a, scene.camera_z, zoom)
     dx = float(x[1] - x[0]) if width > 1 else window
     dy = float(y[0] - y[1]) if height > 1 else window
+    prm, lights = kernel.params(scene, skip)
     with threads(workers):
-        kernel.render_rows(*kernel.params(scene, skip), x, y, dx, dy, GRADIENTS.index(gradient),
-                           float(scene.eps), skip, want_kink, want_grad, want_geo, *out.values(), *geo.values())
+        for first, last in bands(height, width):
+            kernel.render_rows(prm, lights, x, y, first, last, dx, dy, GRADIENTS.index(gradient),
+                               float(scene.eps), skip, want_kink, want_grad, want_geo, *out.values(), *geo.values())
     return x, y, out, geo
 
 

@@ -37,6 +37,8 @@ MIN_EPS, MAX_EPS = 1e-16, 0.25
 #: Largest accepted light colour or ambient component (linear RGB): 1000
 #: times the default white light already saturates every lit pixel.
 MAX_INTENSITY = 1e3
+#: Most lights a scene may hold (the draft's has two; each is a shadow ray per pixel).
+MAX_LIGHTS = 16
 #: Accepted Blinn/Phong exponents: n >= 1 keeps the lobe inside the cosine
 #: lobe (n < 1 widens it towards a step at the horizon); at 1e4 the Blinn
 #: highlight's half-width, acos(2^(-1/n)) between N and the half vector, is
@@ -240,7 +242,9 @@ class Scene:
         if isinstance(lights, PointLight):
             raise TypeError("Scene.lights must be a sequence of PointLight, got a single PointLight")
         if not isinstance(lights, (tuple, list)):
-            raise TypeError(f"Scene.lights must be a tuple of PointLight, got {lights!r}")
+            raise TypeError(f"Scene.lights must be a tuple of PointLight, got {lights!r:.80}")
+        if len(lights) > MAX_LIGHTS:     # each light costs a shadow ray per pixel
+            raise ValueError(f"Scene.lights holds at most {MAX_LIGHTS} lights, got {len(lights):,}")
         for i, light in enumerate(lights):
             if not isinstance(light, PointLight):
                 raise TypeError(f"Scene.lights[{i}] must be a PointLight, got {light!r}")

@@ -22,7 +22,7 @@ import numpy as np
 
 from . import kernel
 from .ledger import compare
-from .render import Frame, check_args, check_workers, image_plane, threads
+from .render import Frame, bands, check_args, check_workers, image_plane, threads
 from .scene import MAX_EPS, MIN_EPS
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS", "MAX_SWEEP_PIXELS"]
@@ -124,8 +124,10 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
     images, grads = np.zeros((n, height, width, 3)), np.zeros((n, height, width, 2))
     chamber, kink = np.zeros((height, width), np.uint8), np.zeros((height, width), bool)
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
+    prm, lights = kernel.params(scene)
     with threads(workers):
-        kernel.sweep_rows(*kernel.params(scene), x, y, np.array(steps), images, chamber, kink, grads)
+        for first, last in bands(height, width):       # a Ctrl-C stops the sweep between two bands
+            kernel.sweep_rows(prm, lights, x, y, first, last, np.array(steps), images, chamber, kink, grads)
     frames = [Frame(images[f], chamber.copy(), kink.copy(), grads[f], scene.replace(eps=e) if f else scene,
                     "central" if f else "exact") for f, e in enumerate((scene.eps,) + steps)]
     census = tuple(compare(frame, frames[0]) for frame in frames[1:])

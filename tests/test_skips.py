@@ -335,3 +335,47 @@ def test_a_refused_thread_count_leaves_numbas_count_alone():
     with pytest.raises(ValueError):
         render(Scene(), 8, 8, workers=0)
     assert numba.get_num_threads() == before
+
+
+@pytest.mark.parametrize("call", ["render", "sweep"])
+def test_a_ctrl_c_stops_a_large_frame_within_one_band(monkeypatch, call):
+    """The compiled kernel cannot be interrupted: a frame is rendered in bands of rows, and a
+    Ctrl-C raised during one band stops the render before the next (17k lights at 512^2 ran
+    for minutes before; the lights are capped too)."""
+    import signal
+
+    from renderer.render import bands
+    name = "render_rows" if call == "render" else "sweep_rows"
+    real, calls = getattr(kernel, name), []
+
+    def band(*args):
+        calls.append(args[4:6])
+        real(*args)
+        if len(calls) == 2:
+            os.kill(os.getpid(), signal.SIGINT)
+    monkeypatch.setattr(kernel, name, band)
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGINT, interrupt)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            render(Scene(), 512, 512) if call == "render" else sweep(Scene(), (1e-3,), 512, 512)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert calls == [(0, 128), (128, 256)] and bands(512, 512)[2:] == [(256, 384), (384, 512)]
+
+
+def test_bands_cover_every_row_once():
+    from renderer.render import BAND_PIXELS, bands
+    for height, width in [(1, 1), (7, 8192), (8192, 7), (300, 256), (4096, 4096)]:
+        b = bands(height, width)
+        assert [r for first, last in b for r in range(first, last)] == list(range(height))
+        assert all(last - first == max(1, BAND_PIXELS // width) for first, last in b[:-1])
+
+
+def test_a_scene_holds_at_most_sixteen_lights():
+    light = PointLight(position=(1.0, 2.0, 3.0))
+    assert len(Scene(lights=(light,) * 16).lights) == 16
+    with pytest.raises(ValueError, match=r"^Scene.lights holds at most 16 lights, got 17,000$"):
+        Scene(lights=[light] * 17_000)
