@@ -47,8 +47,10 @@ from . import files
 __all__ = ["main", "load_scene", "parse_size", "parse_eps", "write_png", "atomic_write",
            "MAX_PIXELS", "FRAME_PIXEL_BUDGET", "MAX_UCURVE_STEPS"]
 
-#: Most pixels `render` accepts (W * H): the two frames of the ledger then take
-#: about 2 * 57 bytes * 4096^2 = 1.9 GB.
+#: Most pixels `render` accepts (W * H): the library's `renderer.render.MAX_PIXELS` (not imported:
+#: the command line starts without numpy; a test holds them equal).  The peak of ``render`` is the
+#: two frames of the ledger (26 bytes a pixel each; the bump view adds 16 for each gradient it
+#: reads) and the display image's float64 temporaries (about 100 bytes a pixel).
 MAX_PIXELS = 4096 * 4096
 #: Most frame-pixels a command holds at once: render holds 2 frames, a sweep of
 #: n steps holds n + 1.
@@ -574,7 +576,9 @@ def _cmd_render(args, out):
     frames = {}
     wanted = ("central", "exact") + (() if args.gradient in ("central", "exact") else (args.gradient,))
     for g in _progress(wanted, desc="render", unit="frame"):
-        frames[g] = render(scene, width, height, gradient=g)
+        # The gradients only for the bump view (exact: its scale; selected: its pixels): 16 bytes a pixel.
+        frames[g] = render(scene, width, height, gradient=g,
+                           grad=args.view == "bump" and g in ("exact", args.gradient))
     numeric, symbolic = frames["central"], frames["exact"]
     selected = frames[args.gradient]
     write_png(args.output, view_image(args.view, selected, numeric, symbolic))

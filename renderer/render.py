@@ -23,7 +23,7 @@ from .kernel import BACKGROUND, FLOOR, SPHERE_A, SPHERE_B
 from .scene import Scene
 
 __all__ = [
-    "Frame", "render", "GBuffer", "gbuffer", "image_plane", "window_width", "GRADIENTS", "MAX_SIDE", "MAX_ZOOM",
+    "Frame", "render", "GBuffer", "gbuffer", "image_plane", "window_width", "GRADIENTS", "MAX_SIDE", "MAX_PIXELS", "MAX_ZOOM",
     "CHAMBER_NAMES", "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR", "WINDOW_MARGIN", "WINDOW_OFFSET",
 ]
 
@@ -31,6 +31,9 @@ __all__ = [
 GRADIENTS = ("exact", "central", "footprint")
 #: Largest accepted image side, in pixels.
 MAX_SIDE = 8192
+#: Most pixels (W * H) of one frame: a frame with kink and grad holds 42 bytes a pixel (0.7 GB at
+#: the most), a G-buffer 138.
+MAX_PIXELS = 4096 * 4096
 #: Largest accepted magnification of the image window (`render`'s ``zoom``).
 MAX_ZOOM = 1e6
 #: Chamber codes of `Frame.chamber`.
@@ -130,6 +133,9 @@ def check_args(scene, width, height, gradient, zoom):
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
     width, height = _check_size("width", width), _check_size("height", height)
+    if width * height > MAX_PIXELS:
+        raise ValueError(f"width * height must be at most {MAX_PIXELS:,} pixels (4096 x 4096), "
+                         f"got {width} x {height} = {width * height:,}")
     if not isinstance(gradient, str):
         raise TypeError(f"gradient must be a string, one of {GRADIENTS}, got {type(gradient).__name__} {gradient!r}")
     if gradient not in GRADIENTS:

@@ -453,3 +453,18 @@ def test_compare_without_a_crease_band_says_what_to_pass():
     assert compare(numeric, render(Scene(), 8, 8)).pixels_a > 0
     with pytest.raises(TypeError, match="numeric must be a renderer Frame"):
         compare(numeric.image, symbolic)
+
+
+@pytest.mark.parametrize("call", ["render", "gbuffer", "sweep"])
+def test_the_library_refuses_a_frame_over_its_pixel_cap_before_allocating(call):
+    """Sides up to 8192 are accepted, but not 8192 x 8192 (67 M pixels, 2.7 GB for one frame)."""
+    from renderer import cli, gbuffer, sweep
+    from renderer.render import MAX_PIXELS
+    assert cli.MAX_PIXELS == MAX_PIXELS
+    run = {"render": lambda w, h: render(Scene(), w, h), "gbuffer": lambda w, h: gbuffer(Scene(), w, h),
+           "sweep": lambda w, h: sweep(Scene(), (1e-3,), w, h)}[call]
+    with pytest.raises(ValueError, match=r"^width \* height must be at most 16,777,216 pixels \(4096 x 4096\), "
+                                         r"got 8192 x 8192 = 67,108,864$"):
+        run(8192, 8192)
+    with pytest.raises(ValueError, match="got 4097 x 4096"):
+        run(4097, 4096)
