@@ -805,7 +805,8 @@ def test_a_closed_stdout_is_an_error_before_any_work(tmp_path, command):
     (["ucurve", "--u", "0_3"], "is not a number"),
     (["ucurve", "--eps", "1e-3,٣e-4"], "is not a number"),
 ])
-def test_options_take_neither_abbreviations_nor_other_digits(argv, fragment, capsys):
+def test_options_take_neither_abbreviations_nor_other_digits(argv, fragment, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)                 # a wrong variant that accepts --siz writes x.png here
     rc, out, err = run(argv, capsys)
     assert rc == 2 and out == "" and fragment in err and err.count("\n") == 1, err
 
