@@ -37,6 +37,14 @@ def test_roundoff_is_bounded_by_a_few_ulps_over_eps(curve):
     assert np.any(np.abs(curve.roundoff) > 1e-3 * bound)   # and it is not identically tiny
 
 
+def test_at_the_v_border_the_split_divides_by_the_kernels_own_denominator():
+    """Near v = 1 the stencil clamps and the kernel divides by v_p - v_m, not 2 eps: the exact
+    quotient must use that denominator, or its error is counted as roundoff (half of h_v here)."""
+    c = measure(v=0.9995, component="v")
+    assert c.reason is None and np.count_nonzero(c.eps > 5e-4) > 10    # steps that clamp
+    assert np.all(np.abs(c.roundoff) <= 4 * UNIT_ROUNDOFF * (1 + abs(c.derivative)) / c.eps)
+
+
 def test_measured_optimum_near_predicted(curve):
     ratio = curve.eps_opt_measured / curve.eps_opt_predicted
     assert 0.05 < ratio < 20
