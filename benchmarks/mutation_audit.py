@@ -58,7 +58,7 @@ MUTANTS = [
     ("ledger-rms-per-pixel", "renderer/ledger.py", "rms=math.sqrt(sq / entries) if entries else 0.0,",
      "rms=math.sqrt(sq / pixels) if entries else 0.0,", "the RMS over pixels, not channel values"),
     ("ledger-squares", "renderer/ledger.py", "top, sq = max(top, d), sq + d * d", "top, sq = max(top, d), sq + d",
-     "the ledger sums |dI|, not its square"),
+     "the ledger sums abs(dI), not its square"),
     ("js-srgb-gamma", "renderer/js/ledger.js", "1.055 * Math.pow(c, 1.0 / 2.4) - 0.055",
      "Math.pow(c, 1.0 / 2.2)", "the simulator encodes with gamma 2.2"),
     ("js-floor-tint", "renderer/js/render.js", "const rg = base * (1.0 - s.floor_tint);",
