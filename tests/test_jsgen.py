@@ -44,7 +44,6 @@ def test_the_book_uses_the_regenerated_bundle(tmp_path):
     app = SimpleNamespace(outdir=str(tmp_path / "_build" / "html"))
     config = SimpleNamespace(html_static_path=["_static"])
     assets._generate(app, config)
-    assets._join(app, None)
     static = Path(config.html_static_path[-1])
     assert (static / "sim" / "simulator.js").read_text(encoding="utf-8") == jsgen.bundle_source()
 

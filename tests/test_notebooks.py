@@ -165,13 +165,6 @@ def test_a_new_wheel_name_makes_every_notebook_page_written_again():
     assert env.notebook_wheel == app.notebook_wheel and notebooks._outdated(app, env, set(), set(), set()) == []
 
 
-def test_the_wheel_name_the_pages_link_is_the_one_pip_built(book_html, tmp_path):
-    """The pages link `wheel_name` before pip has finished; the build checks it, and so does this."""
-    assert notebooks.wheel_name(ROOT) == _wheel(book_html).name
-    (tmp_path / "pyproject.toml").write_text('[project]\nname = "Symbolic.Rendering--CH9"\nversion = "2.0"\n')
-    assert notebooks.wheel_name(tmp_path) == "symbolic_rendering_ch9-2.0-py3-none-any.whl"
-
-
 def test_a_failed_wheel_build_names_what_failed(tmp_path):
     # The project as it is, but with a version no packaging tool accepts.
     root = tmp_path / "project"

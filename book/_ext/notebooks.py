@@ -2,8 +2,7 @@
 
 An HTML build puts into the site, beside the pages:
 
-* ``_downloads/<wheel>``: the project's wheel, built while the pages execute (a
-  thread started when the build starts, joined before pages are written) with
+* ``_downloads/<wheel>``: the project's wheel, built when the build starts with
   ``pip wheel`` and the setuptools of the build's own environment (offline,
   no build isolation), from a copy of the files it packages (so nothing is
   written into the source tree); ``_downloads/constraints.txt``, the
@@ -41,7 +40,6 @@ import subprocess
 import sys
 import tempfile
 import tomllib
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from docutils import nodes
@@ -112,14 +110,6 @@ def build_wheel(root, folder) -> Path:
         if old != target:
             old.unlink()
     return target
-
-
-def wheel_name(root) -> str:
-    """The file name ``pip wheel`` gives the pure-Python project at ``root`` (its distribution
-    name normalized as the wheel format asks, its version, ``py3-none-any``)."""
-    project = tomllib.loads(Path(root, "pyproject.toml").read_text(encoding="utf-8"))["project"]
-    name = "_".join(filter(None, project["name"].replace("-", "_").replace(".", "_").lower().split("_")))
-    return f"{name}-{project['version']}-py3-none-any.whl"
 
 
 def write_readme(root, target):
@@ -339,25 +329,11 @@ def _project_files(app):
     stamp, wheels = site.parent / ".wheel-source", sorted((site / DOWNLOADS).glob("*.whl"))
     if len(wheels) == 1 and stamp.is_file() and stamp.read_text(encoding="utf-8") == key:
         app.notebook_wheel = wheels[0].name
-    else:                     # pip runs (about 3 s) while the pages execute; `_wheel_built` joins it
-        stamp.unlink(missing_ok=True)
-        app.notebook_wheel = wheel_name(ROOT)
-        app.notebook_wheel_build = (ThreadPoolExecutor(1).submit(build_wheel, ROOT, site / DOWNLOADS), stamp, key)
+    else:
+        app.notebook_wheel = build_wheel(ROOT, site / DOWNLOADS).name
+        stamp.write_text(key, encoding="utf-8")
     write_atomic(site / DOWNLOADS / "constraints.txt", (ROOT / "constraints.txt").read_bytes())
     write_readme(ROOT, site / README)
-
-
-def _wheel_built(app, env):
-    """Wait for the wheel `_project_files` started; NotebookError if it failed or has another name."""
-    build = getattr(app, "notebook_wheel_build", None)
-    if build is None:
-        return
-    app.notebook_wheel_build = None
-    future, stamp, key = build
-    built = future.result().name
-    if built != app.notebook_wheel:
-        raise NotebookError(f"pip built {built}, but the pages link {app.notebook_wheel} (`wheel_name`)")
-    stamp.write_text(key, encoding="utf-8")
 
 
 def _outdated(app, env, added, changed, removed):
@@ -409,7 +385,6 @@ def _write_all(app, exception):
 def setup(app):
     app.connect("builder-inited", _project_files)
     app.connect("env-get-outdated", _outdated)
-    app.connect("env-updated", _wheel_built)
     app.connect("doctree-resolved", _link)
     app.connect("build-finished", _write_all)
     # env_version: a new version makes Sphinx read every page again (the line under each title changed).

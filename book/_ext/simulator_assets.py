@@ -4,45 +4,28 @@ On ``config-inited`` it writes ``sim/simulator.js`` (renderer.jsgen's bundle of
 renderer/js/*.js with the formulas that renderer.codegen prints from
 renderer/formulas.py) into a build-side directory and adds that directory to
 ``html_static_path``, so the site serves ``_static/sim/simulator.js``.
-Nothing generated is written into book/.  The bundle is made in a thread while the
-pages execute, and joined on ``env-updated`` (before any page is written); it is
-made again only when the project's source digest (`lab.store.source_digest`, which covers renderer/js and
+Nothing generated is written into book/.  The bundle is made again only when the
+project's source digest (`lab.store.source_digest`, which covers renderer/js and
 renderer/formulas.py) differs from the one it was made from.
 """
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from lab.store import source_digest
 
 
-def _write(bundle, stamp):
-    from renderer import jsgen           # sympy's printers: about 3 s with the imports
-    jsgen.write_bundle(bundle)
-    stamp.write_text(source_digest(), encoding="utf-8")
-
-
 def _generate(app, config):
     static = Path(app.outdir).parent / "sim_static"
     bundle, stamp = static / "sim" / "simulator.js", static / "sim" / ".source-digest"
-    app.simulator_bundle = None
     if not (bundle.is_file() and stamp.is_file() and stamp.read_text(encoding="utf-8") == source_digest()):
-        stamp.unlink(missing_ok=True)
-        bundle.parent.mkdir(parents=True, exist_ok=True)    # Sphinx checks html_static_path now
-        app.simulator_bundle = ThreadPoolExecutor(1).submit(_write, bundle, stamp)
+        from renderer import jsgen           # sympy's printers: about 1.5 s
+        jsgen.write_bundle(bundle)
+        stamp.write_text(source_digest(), encoding="utf-8")
     config.html_static_path = list(config.html_static_path) + [str(static)]
-
-
-def _join(app, env):
-    """The bundle made (or its error raised) before the pages are written."""
-    if app.simulator_bundle is not None:
-        app.simulator_bundle, future = None, app.simulator_bundle
-        future.result()
 
 
 def setup(app):
     app.connect("config-inited", _generate)
-    app.connect("env-updated", _join)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
