@@ -24,9 +24,10 @@ book: $(STAMP)
 test: book
 	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadscope verify tests
 
-# The checks whose numbers could depend on the CPU's code paths (the theorems' comparisons of
-# the renderer's outputs with mpmath, parity with the scalar reference) again, with numpy's optional SIMD features (those found on this CPU beyond its baseline)
-# disabled and the kernel compiled by numba for a generic x86-64 CPU (into a cache of its own).
+# The checks whose numbers could depend on the CPU's code paths (marked cpu_dependent: the theorems
+# whose checks compare the renderer's outputs with mpmath, and parity with the scalar reference)
+# again, with numpy's optional SIMD features (those found on this CPU beyond its baseline) disabled
+# and the kernel compiled by numba for a generic x86-64 CPU (into a cache of its own).
 NUMERIC_TESTS := verify/test_theorems.py tests/test_parity.py
 test-baseline-simd: $(STAMP)
 	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')" \
@@ -34,7 +35,7 @@ test-baseline-simd: $(STAMP)
 	echo "NPY_DISABLE_CPU_FEATURES=\"$$features\""; \
 	cache="$$(mktemp -d)"; trap 'rm -rf "$$cache"' EXIT; \
 	NPY_DISABLE_CPU_FEATURES="$$features" NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR="$$cache" \
-	  $(BIN)/python -m pytest -n auto --dist loadscope $(NUMERIC_TESTS) -p no:cacheprovider
+	  $(BIN)/python -m pytest -n auto --dist loadscope -m cpu_dependent $(NUMERIC_TESTS) -p no:cacheprovider
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_render.py

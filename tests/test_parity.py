@@ -33,6 +33,8 @@ import pytest
 from renderer import PointLight, Scene, render
 from tests import scalar_reference as ref
 
+pytestmark = pytest.mark.cpu_dependent     # make test-baseline-simd runs the file again
+
 SIZES = ((24, 20), (17, 13), (17, 20))
 IMAGE_TOL = 1e-12          # per channel, required by the issue
 FIELDS = ("sine", "ridges", "rings")
