@@ -10,7 +10,7 @@ median in seconds and the ratio base / head.
 * ``book cold``: ``make book`` with no book/_build;
 * ``book no change``: ``make book`` again;
 * ``book ledger.py edited``: a comment appended to renderer/ledger.py, ``make book``;
-* ``test``: ``make test`` (``--test``: slow, the base's takes minutes).
+* ``test``: ``make test`` after ``make book`` (``--test``: slow, the base's takes minutes).
 
 Usage: python benchmarks/bench_loop.py --base REV [--repeats N] [--test]
 """
@@ -69,6 +69,7 @@ def rounds(tree: Path, with_test: bool) -> dict[str, float]:
     finally:
         ledger.write_text(text, encoding="utf-8")
     if with_test:     # a base whose tests need what this checkout no longer installs may fail some
+        timed(tree, make("book"))           # the edit reverted: make test then finds the book current
         out["test"] = timed(tree, make("test"), must_pass=False)
     print(f"{tree.name}: " + ", ".join(f"{k} {v:.1f} s" for k, v in out.items()), file=sys.stderr, flush=True)
     return out
