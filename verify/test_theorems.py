@@ -14,7 +14,7 @@ from verify.conftest import LEDGER
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 
-@pytest.mark.parametrize("theorem_id", [pytest.param(t, marks=[pytest.mark.cpu_dependent] * (t in RENDERED))
+@pytest.mark.parametrize("theorem_id", [pytest.param(t, marks=pytest.mark.cpu_dependent if t in RENDERED else ())
                                         for t in THEOREMS])
 def test_theorem_holds(theorem_id):
     verdict = THEOREMS[theorem_id].check()
