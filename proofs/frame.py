@@ -67,9 +67,10 @@ def _where(et=REGULAR[:3], ep=REGULAR[3:]):
 
 # ------------------------------------------------------------------------------- the chart
 U_OF_THETA, V_OF_PHI = (theta + sp.pi) / (2 * sp.pi), phi / sp.pi
-#: The chart's inverse, theta(u) and phi(v), solved from u(theta) and v(phi).
-THETA_OF_U = sp.solve(sp.Eq(U_OF_THETA, F.u), theta)[0]
-PHI_OF_V = sp.solve(sp.Eq(V_OF_PHI, F.v), phi)[0]
+#: The chart's inverse, theta(u) and phi(v), solved from u(theta) and v(phi) (linear: without
+#: solve's simplification, 0.3 s at every import, then factored).
+THETA_OF_U, PHI_OF_V = (sp.factor(sp.solve(sp.Eq(c, F.u if a == theta else F.v), a, simplify=False)[0])
+                        for c, a in ((U_OF_THETA, theta), (V_OF_PHI, phi)))
 #: The rates du/dtheta and dv/dphi the theorem proves: the factors that turn chart
 #: derivatives h_u, h_v into angular ones.
 RATES_CLAIMED = (1 / (2 * sp.pi), 1 / sp.pi)

@@ -158,8 +158,10 @@ def _footprint():
         d = [sum(a * c for a, c in zip(axis, _ray_differential(*s))) / scale
              for s in ((dx, 0), (0, dy))]
         half = (sp.Abs(d[0]) + sp.Abs(d[1])) / 2
-        steps.append(sp.Piecewise((sp.Min(half, FOOTPRINT_MAX), sp.And(half > 0, half < FOOTPRINT_LIMIT)),
-                                  (FOOTPRINT_FALLBACK, True)))
+        # Min left unevaluated: sympy would try to order its arguments (0.2 s at every import), and
+        # the printed code is the same.
+        steps.append(sp.Piecewise((sp.Min(half, FOOTPRINT_MAX, evaluate=False),
+                                   sp.And(half > 0, half < FOOTPRINT_LIMIT)), (FOOTPRINT_FALLBACK, True)))
     return tuple(steps)
 
 
