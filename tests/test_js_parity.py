@@ -259,6 +259,11 @@ def image_tolerance(scene, on_a, P, Ns, d_ns):
 
 # ---- margins: where the model allows a discrete difference ---------------------------------
 
+#: How close to a multiple of pi or to the band's edge an argument's float64 margin must be for
+#: `crease_margins` to compute it again in mpmath: a million times the float's error.
+NEAR = 1e-6
+
+
 def ridge_arguments(scene, uv):
     """The float arguments a_u = (pi k_u) u, a_v = (pi k_v) v of the ridges' two
     sines (`formulas.RIDGE_FACTORS`), rounded as formulas.js and generated.py
@@ -267,16 +272,20 @@ def ridge_arguments(scene, uv):
 
 
 def crease_margins(args):
-    """(distance of a to the nearest multiple of pi, | |sin a| - 0.03 |) per
-    argument, exactly enough: with 40 digits both are known to ~1e-36
-    absolute for |a| <= pi k <= 3.2e3, far below the thresholds (~1e-14)."""
-    to_pi, to_edge = np.empty(args.shape), np.empty(args.shape)
+    """(distance of a to the nearest multiple of pi, | |sin a| - 0.03 |) per argument, exactly
+    enough where it decides anything.  In float64 first: for |a| <= pi k <= 3.2e3 both are
+    within 1e-12 of the truth (pi's rounding times k, and sin's), so a margin above `NEAR` is
+    far above the thresholds (~1e-14 to 1e-11) and its float suffices; the arguments within
+    `NEAR` of either edge get mpmath at 40 digits (known to ~1e-36 absolute)."""
+    a = np.asarray(args, float)
+    to_pi = np.abs(a - np.pi * np.rint(a / np.pi))
+    to_edge = np.abs(np.abs(np.sin(a)) - KINK_BAND_HALF_WIDTH)
     with mp.workdps(40):
         edge = mpf(KINK_BAND_HALF_WIDTH)          # the float 0.03 the code compares with, exactly
-        for k, a in enumerate(args):
-            a = mpf(float(a))
-            to_pi[k] = float(abs(a - mp.pi * mp.nint(a / mp.pi)))
-            to_edge[k] = float(abs(abs(mp.sin(a)) - edge))
+        for k in np.flatnonzero((to_pi < NEAR) | (to_edge < NEAR)):
+            x = mpf(float(a[k]))
+            to_pi[k] = float(abs(x - mp.pi * mp.nint(x / mp.pi)))
+            to_edge[k] = float(abs(abs(mp.sin(x)) - edge))
     return to_pi, to_edge
 
 
