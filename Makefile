@@ -27,7 +27,8 @@ test: book
 # The checks whose numbers could depend on the CPU's code paths (marked cpu_dependent: the theorems
 # whose checks compare the renderer's outputs with mpmath, and parity with the scalar reference)
 # again, with numpy's optional SIMD features (those found on this CPU beyond its baseline) disabled
-# and the kernel compiled by numba for a generic x86-64 CPU (into a cache of its own).
+# and the kernel compiled by numba for a generic x86-64 CPU (into a cache of its own).  The tests
+# are dealt out one by one (--dist load): by module, parity's 378 went to one worker.
 NUMERIC_TESTS := verify/test_theorems.py tests/test_parity.py
 test-baseline-simd: $(STAMP)
 	@features="$$($(BIN)/python -c 'from numpy._core._multiarray_umath import __cpu_dispatch__ as d, __cpu_features__ as f; print(" ".join(x for x in d if f[x]))')" \
@@ -35,7 +36,7 @@ test-baseline-simd: $(STAMP)
 	echo "NPY_DISABLE_CPU_FEATURES=\"$$features\""; \
 	cache="$$(mktemp -d)"; trap 'rm -rf "$$cache"' EXIT; \
 	NPY_DISABLE_CPU_FEATURES="$$features" NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR="$$cache" \
-	  $(BIN)/python -m pytest -n auto --dist loadscope -m cpu_dependent $(NUMERIC_TESTS) -p no:cacheprovider
+	  $(BIN)/python -m pytest -n auto --dist load -m cpu_dependent $(NUMERIC_TESTS) -p no:cacheprovider
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_render.py
