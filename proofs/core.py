@@ -34,6 +34,8 @@ precision discipline are the models.)
 from __future__ import annotations
 
 import dataclasses
+import functools
+import operator
 import random
 import re
 from dataclasses import dataclass, field
@@ -218,6 +220,15 @@ def _decide_components(components, seed, points, digits) -> Verdict:
 def _explicit(x):
     """``x`` evaluated: written forms unwrapped, ``doit`` (derivatives, limits, `Dot`, ...), matrices explicit."""
     x = x.replace(lambda e: isinstance(e, sp.UnevaluatedExpr), lambda e: e.args[0]).doit()
+    return _dense(x)
+
+
+def _dense(x):
+    """A matrix expression as an explicit matrix, its sums and products formed from explicit
+    factors (``as_explicit`` of a product writes each entry as a ``Sum`` over an index and hands
+    it to sympy's summation, which is many times slower); scalars and explicit matrices pass through."""
+    if isinstance(x, (sp.MatMul, sp.MatAdd)):
+        return functools.reduce(operator.mul if isinstance(x, sp.MatMul) else operator.add, map(_dense, x.args))
     return x.as_explicit() if isinstance(x, sp.MatrixExpr) else x
 
 
@@ -226,7 +237,7 @@ def _concrete(x, **hints):
     (sympy leaves 2 * Matrix(...) a MatMul); a named vector stays a name."""
     x = x.doit(**hints)
     if isinstance(x, sp.MatrixExpr) and not x.atoms(sp.MatrixSymbol) and not x.has(Cross, Jacobian):
-        return x.as_explicit()
+        return _dense(x)
     return x
 
 

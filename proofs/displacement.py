@@ -149,7 +149,7 @@ def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
         scene, px = pixels(field, gradient, bump)
         P = (scene.radius_a + scene.beta * F.HEIGHT[field].subs({F.k_u: scene.k_u, F.k_v: scene.k_v})) \
             * N.subs({theta: THETA_OF_U, phi: PHI_OF_V}, simultaneous=True)
-        fn = sp.lambdify((F.u, F.v), list(sp.diff(P, F.v).cross(sp.diff(P, F.u))), modules="mpmath")
+        fn = sp.lambdify((F.u, F.v), list(sp.diff(P, F.v).cross(sp.diff(P, F.u))), modules="mpmath", cse=True)
         keep = np.sin(np.pi * px["uv"][:, 1]) > float(F.POLE_SIN_PHI)
         compared, left_out = compared + int(np.count_nonzero(keep)), left_out + int(np.count_nonzero(~keep))
         for (uu, vv), got in zip(px["uv"][keep], px["Ns"][keep]):

@@ -193,7 +193,7 @@ def footprint_error(half, size=96):
             t = np.einsum("ij,ij->i", N, P - E) / np.einsum("ij,ij->i", N, d)
             dp = E + t[:, None] * d - P
             A = np.stack([dpdu, dpdv], axis=2)                       # (k, 3, 2)
-            deriv.append(np.stack([np.linalg.lstsq(a, b, rcond=None)[0] for a, b in zip(A, dp)]))
+            deriv.append((np.linalg.pinv(A) @ dp[:, :, None])[:, :, 0])       # least squares, per pixel
         steps = []
         for k in range(2):
             s = half * (np.abs(deriv[0][:, k]) + np.abs(deriv[1][:, k]))
