@@ -216,7 +216,7 @@ def _orientation():
 
 def _flips_zero():
     from proofs.no_boundary import render_flips
-    frames, values, masks = render_flips()
+    frames, values, masks, _ = render_flips()
     return (f"over {frames} independent G-buffers, {values} geometry values (chamber, $t$, $P$, $N$) and {masks} "
             "reach-mask pixels differ", {"geometry values differing": values, "reach-mask pixels differing": masks})
 

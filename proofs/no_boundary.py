@@ -14,7 +14,7 @@ masks are these predicates, evaluated at its hit points.
 """
 
 import itertools
-from functools import partial
+from functools import lru_cache, partial
 
 import numpy as np
 import sympy as sp
@@ -74,28 +74,33 @@ SURFACE_BETAS = (0.0, 0.35, 0.9)
 EPSILONS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 
 
-def render_flips(size=64, gate=False, shading=None):
-    """(G-buffers, differing values, differing reach-mask pixels): each G-buffer
-    independent (3 fields x `EPSILONS` x 2 pipelines x `BETAS` for the chart
-    bump and `SURFACE_BETAS` for the surface bump),
-    its chamber, t, P, N and per-light reach masks (`renderer.pointwise.reach`,
-    with ``gate`` the kernel's Ns . w > 0 gate as well) compared with those of a
-    beta = 0 sine G-buffer.  ``shading``, a set if given, collects each G-buffer's
-    shading normals Ns (as bytes): `SHADINGS` distinct ones if every parameter reached it."""
+def render_flips(size=64, gate=False):
+    """(G-buffers, differing values, differing reach-mask pixels, distinct shading normals):
+    each G-buffer independent (3 fields x `EPSILONS` x 2 pipelines x `BETAS` for the chart
+    bump and `SURFACE_BETAS` for the surface bump), its chamber, t, P, N and per-light
+    reach masks (`renderer.pointwise.reach`, with ``gate`` the kernel's Ns . w > 0 gate as
+    well) compared with those of a beta = 0 sine G-buffer; the last count is of the
+    G-buffers' distinct Ns arrays, `SHADINGS` if every parameter reached the shading.
+    Computed once per process and arguments: theorem no-boundary and claim flips-zero
+    ask for the same renders."""
+    return _render_flips(int(size), bool(gate))
+
+
+@lru_cache(maxsize=None)
+def _render_flips(size, gate):
     def geometry(scene, gradient="exact"):
         g = gbuffer(scene, size, size, gradient=gradient)
         return g.Ns, (g.chamber, g.t, g.P, g.N, pointwise.reach(scene, g, gate=gate))
 
     base = geometry(Scene(height_field="sine", beta=0.0))[1]
-    counts = []
+    counts, shading = [], set()
     for field, eps_, bump in itertools.product(("sine", "ridges", "rings"), EPSILONS, ("chart", "surface")):
         for b, gradient in itertools.product(BETAS if bump == "chart" else SURFACE_BETAS, ("exact", "central")):
             Ns, arrays = geometry(Scene(height_field=field, beta=b, eps=eps_, bump=bump), gradient)
             counts.append([np.count_nonzero(a != a0) for a, a0 in zip(arrays, base)])
-            if shading is not None:
-                shading.add(Ns.tobytes())
+            shading.add(Ns.tobytes())
     *values, masks = (int(sum(n)) for n in zip(*counts))
-    return len(counts), sum(values), masks
+    return len(counts), sum(values), masks, len(shading)
 
 
 #: Distinct shading normals Ns over `render_flips`' G-buffers: one for all beta = 0 frames, one per
@@ -185,11 +190,10 @@ def _evidence(gate=False, reach=None, root=0):
     if roots:
         return Verdict("refuted", f"the roots t_A, t_B written here miss the renderer's t at {roots} of "
                        f"{on_spheres} sphere pixels")
-    shading = set()
-    frames, values, masks = render_flips(gate=gate, shading=shading)
-    if values or masks or len(shading) != SHADINGS:
+    frames, values, masks, shadings = render_flips(gate=gate)
+    if values or masks or shadings != SHADINGS:
         return Verdict("refuted", f"over {frames} G-buffers, {values} geometry values and {masks} reach-mask "
-                       f"pixels differ from the beta = 0 frame ({len(shading)} distinct Ns, want {SHADINGS})")
+                       f"pixels differ from the beta = 0 frame ({shadings} distinct Ns, want {SHADINGS})")
     differing, compared, pairs = reach_mismatches(reach=reach)
     if differing or compared < pairs * 0.99:
         return Verdict("refuted", f"kernel.reach differs from the shadow predicates at {differing} of {compared} "
@@ -198,7 +202,7 @@ def _evidence(gate=False, reach=None, root=0):
                    f"pixels; {frames} independent G-buffers (3 fields x eps 1e-1..1e-8 x 2 pipelines x beta {BETAS} "
                    f"(chart) or {SURFACE_BETAS} (surface), 64x64) have the chamber, t, P and N of the beta = 0 frame "
                    "bit for bit, and kernel.reach gives each light the same mask "
-                   f"({len(shading)} distinct shading normals Ns: every parameter reaches them); kernel.reach equals "
+                   f"({shadings} distinct shading normals Ns: every parameter reaches them); kernel.reach equals "
                    f"the predicates, evaluated at the hit points, at all {compared} decided (pixel, light) pairs (of "
                    f"{pairs}) of {len(REACH_SCENES)} scenes (128x128; a light inside sphere B, lights behind A, below "
                    "the floor, and beside A just above it)",
