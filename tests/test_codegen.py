@@ -87,7 +87,17 @@ def evaluate(expr, env):
     bound and one rounding (two for the libm functions, which are within an
     ulp); pi and decimal constants one rounding.  A branch (Piecewise, sign,
     a comparison) decided within its bound raises `Ambiguous`.
+
+    Each subexpression's result is kept in ``env`` and found there again: a tree
+    evaluates its shared subtrees once (the generated code too: it is printed after
+    common-subexpression elimination).
     """
+    if expr not in env:
+        env[expr] = _evaluate(expr, env)
+    return env[expr]
+
+
+def _evaluate(expr, env):
     if expr.is_Symbol:
         return env[expr]
     if expr is sp.pi:
