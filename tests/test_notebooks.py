@@ -175,7 +175,8 @@ def test_a_failed_wheel_build_names_what_failed(tmp_path):
     for package in ("renderer", "proofs", "lab", "book/chapter"):
         (root / package).mkdir(parents=True)
         (root / package / "__init__.py").write_text("")
-    with pytest.raises(notebooks.NotebookError, match=r"(?s)building the project's wheel with setuptools.build_meta failed.*version"):
+    with pytest.raises(notebooks.NotebookError,
+                       match=r"(?s)building the project's wheel with setuptools\.build_meta failed.*version"):
         notebooks.build_wheel(root, tmp_path / "site")
     assert not list((tmp_path / "site").glob("*"))
 

@@ -78,7 +78,7 @@ def build_wheel(root, folder) -> Path:
     (``[build-system] build-backend``, setuptools) builds there through its PEP 517
     hook ``build_wheel``, in a child process with this environment's setuptools:
     no network, nothing written into ``root``.  (``pip wheel --no-build-isolation``
-    gives the same files, in about three times as long: pip's own start-up.)  ``SOURCE_DATE_EPOCH``
+    gives the same files, after pip's own start-up.)  ``SOURCE_DATE_EPOCH``
     (1980-01-01) gives the zip entries fixed times, so the same sources give the
     same bytes.
 
@@ -98,14 +98,13 @@ def build_wheel(root, folder) -> Path:
         for package in pyproject["tool"]["setuptools"]["packages"]:
             path = where.get(package, package)
             shutil.copytree(root / path, src / path, ignore=shutil.ignore_patterns("__pycache__"))
-        hook = f"import importlib, sys; importlib.import_module({pyproject['build-system']['build-backend']!r})" \
-               ".build_wheel(sys.argv[1])"
+        backend = pyproject["build-system"]["build-backend"]
+        hook = f"import importlib, sys; importlib.import_module({backend!r}).build_wheel(sys.argv[1])"
         run = subprocess.run([sys.executable, "-c", hook, str(out)], capture_output=True, text=True, cwd=src,
                              env={**os.environ, "SOURCE_DATE_EPOCH": "315532800"})
         wheels = sorted(out.glob("*.whl"))
         if run.returncode != 0 or len(wheels) != 1:
-            raise NotebookError(f"building the project's wheel with {pyproject['build-system']['build-backend']} "
-                                f"failed (exit {run.returncode}):\n"
+            raise NotebookError(f"building the project's wheel with {backend} failed (exit {run.returncode}):\n"
                                 + (run.stdout + run.stderr)[-3000:])
         target = folder / wheels[0].name
         write_atomic(target, wheels[0].read_bytes())
