@@ -12,6 +12,7 @@ Public API::
 
 import importlib
 import os
+import stat
 import sys
 import tempfile
 import types
@@ -68,13 +69,46 @@ def _writable(path):
         return False
 
 
+def _private_cache(path):
+    """``path`` if it is a directory this user may trust with numba's cache, else why not.
+
+    numba unpickles its index files, so whoever can write the cache directory runs code as
+    the user who renders.  A directory in the shared temporary directory is trusted only
+    when it is no symbolic link, is owned by this user and has mode 0700 (no one else can
+    have put or replaced a file in it); it is created so when absent.  Returns None when
+    trusted, else a phrase saying what is wrong with it."""
+    try:
+        os.mkdir(path, 0o700)
+    except FileExistsError:
+        pass
+    except OSError as exc:
+        return f"cannot be created ({exc.strerror})"
+    try:
+        st = os.lstat(path)
+    except OSError as exc:
+        return f"cannot be examined ({exc.strerror})"
+    if stat.S_ISLNK(st.st_mode):
+        return "is a symbolic link"
+    if not stat.S_ISDIR(st.st_mode):
+        return "is not a directory"
+    if st.st_uid != os.getuid():
+        return f"is owned by uid {st.st_uid}, not by this user (uid {os.getuid()})"
+    if stat.S_IMODE(st.st_mode) != 0o700:
+        return f"has mode {stat.S_IMODE(st.st_mode):04o}, not 0700"
+    return None
+
+
 def _numba_cache():
     """Where numba can cache the compiled kernel.  numba caches beside the package
     (``renderer/__pycache__``) or in the user's cache directory, and refuses to compile
     at all ("no locator available") where it can write neither: a read-only or
     system-wide install run by a user without a writable home.  There the cache goes
-    to ``symrender-numba-<uid>`` in the temporary directory, and one line on stderr
-    says so.  ``NUMBA_CACHE_DIR``, when set, is left to numba."""
+    to ``symrender-numba-<uid>`` in the temporary directory, created private to the user
+    (mode 0700), and one line on stderr says so.  When that name exists and is not
+    private to the user (`_private_cache`: another user could have planted index files,
+    which numba unpickles), it is refused, with one line naming it, and this process
+    caches in a new private directory (``mkdtemp``) removed at exit.  ``NUMBA_CACHE_DIR``,
+    when set, is left to numba."""
     if os.environ.get("NUMBA_CACHE_DIR") or _writable(Path(__file__).with_name("__pycache__")):
         return
     from numba.misc.appdirs import AppDirs
@@ -82,11 +116,21 @@ def _numba_cache():
     if _writable(user):
         return
     fallback = os.path.join(tempfile.gettempdir(), f"symrender-numba-{os.getuid()}")
+    refused = _private_cache(fallback)
+    if refused is None:
+        note = f"compiled functions are cached in {fallback}"
+    else:
+        import atexit
+        import shutil
+        refused_path, fallback = fallback, tempfile.mkdtemp(prefix="symrender-numba-")
+        atexit.register(shutil.rmtree, fallback, ignore_errors=True)
+        note = (f"refusing the cache directory {refused_path}, which {refused}; compiled functions "
+                f"are cached in {fallback} for this run only")
     os.environ["NUMBA_CACHE_DIR"] = fallback
     import numba
     numba.config.CACHE_DIR = fallback
-    print(f"symrender: numba cannot cache beside the package nor in {user}: "
-          f"compiled functions are cached in {fallback}", file=sys.stderr)
+    if sys.stderr is not None:           # started with stderr closed: the note is lost, not sent elsewhere
+        print(f"symrender: numba cannot cache beside the package nor in {user}: {note}", file=sys.stderr)
 
 
 _numba_cache()
