@@ -15,6 +15,12 @@ stored value whose parameters or digest differ is computed again, so an edit
 to the code never shows a stale number.  While a measurement is computed its
 file is locked (``fcntl.flock`` on ``.<name>.json.lock``): a page that needs it
 meanwhile waits and reads the value instead of computing it a second time.
+
+A record is served only when it is well formed (`_served`): a JSON object of exactly
+the fields written, each of its type, whose ``sha256`` is the checksum of the others
+(`_checksum`).  Anything else (not JSON, another shape, a value edited by hand
+while the digest still matches, a record larger than `MAX_RECORD_BYTES`, not a
+regular file) is computed again and replaced, never served and never a traceback.
 """
 
 from __future__ import annotations
@@ -39,6 +45,10 @@ ENV = "SYMRENDER_STORE"
 PACKAGES = ("renderer", "proofs", "lab", "chapter")
 LIBRARIES = ("numpy", "sympy", "mpmath", "numba", "llvmlite")
 _NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,99}")
+#: Largest record read (bytes); the largest the book writes (the theorem ledger) is some tens of KiB.
+MAX_RECORD_BYTES = 16 << 20
+#: The fields of a record and the type of each.
+FIELDS = {"name": str, "params": dict, "digest": str, "value": object, "sha256": str}
 _MEMORY = {}
 _DIGEST = []
 
@@ -97,13 +107,14 @@ def measured(name, compute, **params):
     directory = os.environ.get(ENV)
     path = Path(directory, f"{name}.json") if directory else None
     with _locked(path):
-        record = _read(path)
-        if record is not None and record.get("digest") == source_digest() and record.get("params") == json.loads(key):
+        record = _served(_read(path), name, json.loads(key))
+        if record is not None:
             value = record["value"]
         else:
             value = json.loads(json.dumps(compute(**params)))
             if path is not None:
-                _write(path, {"name": name, "params": json.loads(key), "digest": source_digest(), "value": value})
+                record = {"name": name, "params": json.loads(key), "digest": source_digest(), "value": value}
+                _write(path, {**record, "sha256": _checksum(record)})
     _MEMORY[name, key] = value
     return value
 
@@ -124,16 +135,46 @@ def _locked(path):
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
+def _checksum(record):
+    """SHA-256 (hex) of a record's fields other than ``sha256``, in one canonical JSON form."""
+    fields = {k: v for k, v in record.items() if k != "sha256"}
+    return hashlib.sha256(json.dumps(fields, sort_keys=True, separators=(",", ":")).encode("utf-8")).hexdigest()
+
+
+def _served(record, name, params):
+    """``record`` if it may be served for ``name`` and ``params`` under today's source digest: of
+    the shape `FIELDS` says, its checksum matching; else None (it is computed again)."""
+    if not (isinstance(record, dict) and record.keys() == FIELDS.keys()
+            and all(isinstance(record[k], t) for k, t in FIELDS.items())):
+        return None
+    if record["sha256"] != _checksum(record):
+        return None
+    if (record["name"], record["params"], record["digest"]) != (name, params, source_digest()):
+        return None
+    return record
+
+
 def _read(path):
-    if path is None or not path.is_file():
+    """The parsed JSON of ``path``, or None when there is none or it cannot be read or parsed."""
+    if path is None:
         return None
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None                      # unreadable: computed again and replaced
+        return json.loads(files.read_regular(path, MAX_RECORD_BYTES, follow=False).decode("utf-8"))
+    except (OSError, ValueError, RecursionError):      # absent, not a regular file, too big, not JSON
+        return None
 
 
 def _write(path, record):
     """Write ``record`` to ``path`` atomically (`renderer.files.write_bytes`); the
-    directory exists (`_locked` made it)."""
+    directory exists (`_locked` made it).
+
+    Raises
+    ------
+    renderer.files.RefusedPath
+        ``path`` exists and is not a regular file (a symbolic link, a FIFO, a device, a
+        directory): a record replaces only a record, and is never written through to
+        something else."""
+    if files.output_route(path) != "replace":
+        raise files.RefusedPath(f"{str(path)!r} is not a regular file (accepted: a record the store "
+                                "wrote, or no file)")
     files.write_bytes(path, json.dumps(record).encode("utf-8"))   # key order kept: reads back as written

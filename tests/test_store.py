@@ -100,9 +100,89 @@ def test_the_check_rejects_a_store_that_ignores_the_digest(fresh, monkeypatch):
     store.measured("u-curve", compute, size=256)
     _new_process(monkeypatch)
     monkeypatch.setattr(store, "_DIGEST", ["edited"])
-    monkeypatch.setattr(store, "_read", lambda path: {**json.loads(path.read_text()), "digest": "edited"})
+    monkeypatch.setattr(store, "_read", lambda path: _sealed({**json.loads(path.read_text()), "digest": "edited"}))
     store.measured("u-curve", compute, size=256)
     assert len(calls) == 1
+
+
+def _sealed(record):
+    """``record`` with a checksum matching its (edited) fields, as the store writes one."""
+    return {**record, "sha256": store._checksum(record)}
+
+
+def _stored(directory, name="u-curve"):
+    return json.loads((directory / f"{name}.json").read_text())
+
+
+_GOOD = object()        # stands for the record as written, in the table below
+
+
+@pytest.mark.parametrize("edit", [
+    lambda r: [r],                                       # JSON of another shape: a list, a string, a number
+    lambda r: "record",
+    lambda r: 3.0,
+    lambda r: {k: v for k, v in r.items() if k != "value"},          # a field missing
+    lambda r: {k: v for k, v in r.items() if k != "sha256"},
+    lambda r: {**r, "extra": 1},                                     # a field too many
+    lambda r: {**r, "params": [["size", 256]]},                      # a field of the wrong type
+    lambda r: {**r, "digest": None},
+    lambda r: {**r, "sha256": 7},
+    lambda r: {**r, "value": {"value": 0.4, "params": {"size": 256}}},   # the value edited, digest intact
+    lambda r: {**r, "sha256": "0" * 64},                             # the checksum edited
+    lambda r: _sealed({**r, "name": "other"}),                       # another measurement's record, sealed
+    lambda r: _sealed({**r, "params": {"size": 128}}),
+], ids=["list", "str", "number", "no-value", "no-sha256", "extra-field", "params-list", "digest-null",
+        "sha256-int", "value-edited", "sha256-edited", "other-name", "other-params"])
+def test_a_record_of_the_wrong_shape_or_an_edited_one_is_computed_again(fresh, monkeypatch, edit):
+    """The record on disk is replaced by a malformed or tampered one: the next process computes the
+    value again and rewrites the record (never a traceback, never the stored value)."""
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    (directory / "u-curve.json").write_text(json.dumps(edit(_stored(directory))))
+    _new_process(monkeypatch)
+    assert store.measured("u-curve", compute, size=256) == {"value": 0.1 + 0.2, "params": {"size": 256}}
+    assert len(calls) == 2
+    assert _stored(directory)["sha256"] == store._checksum(_stored(directory))
+
+
+def test_the_checksum_rejects_an_edited_value_that_the_digest_alone_would_serve(fresh, monkeypatch):
+    """Wrong variant: a store that checks the digest and parameters but not the checksum serves
+    a value edited by hand (the test above would see one computation, not two)."""
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    (directory / "u-curve.json").write_text(json.dumps({**_stored(directory), "value": "edited"}))
+    _new_process(monkeypatch)
+    monkeypatch.setattr(store, "_checksum", lambda record: record.get("sha256"))
+    assert store.measured("u-curve", compute, size=256) == "edited" and len(calls) == 1
+
+
+@pytest.mark.parametrize("kind", ["link", "fifo", "too-big"])
+def test_a_record_that_is_not_a_small_regular_file_is_never_served(fresh, monkeypatch, kind):
+    """A symbolic link (to a valid record, even), a FIFO (which would block a plain read) or a
+    file over `MAX_RECORD_BYTES` is not read: the value is computed again.  A record that is
+    too big is then replaced; a link or a FIFO is refused, naming it (the store writes neither
+    through a link nor into a FIFO, where a write would block)."""
+    import os
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    path = directory / "u-curve.json"
+    if kind == "link":
+        path.rename(directory / "elsewhere.json")
+        path.symlink_to(directory / "elsewhere.json")
+    elif kind == "fifo":
+        path.unlink()
+        os.mkfifo(path)
+    else:
+        monkeypatch.setattr(store, "MAX_RECORD_BYTES", path.stat().st_size - 1)
+    _new_process(monkeypatch)
+    if kind == "too-big":
+        store.measured("u-curve", compute, size=256)
+        assert _stored(directory)["sha256"] == store._checksum(_stored(directory))
+    else:
+        from renderer.files import RefusedPath
+        with pytest.raises(RefusedPath, match="u-curve.json' is not a regular file"):
+            store.measured("u-curve", compute, size=256)
+    assert len(calls) == 2
 
 
 def test_an_unreadable_record_is_computed_again(fresh, monkeypatch):
