@@ -37,11 +37,11 @@ raise ClaimChanged("h3-scale: registered 'holds', computed 'does not hold' (rati
 def test_a_page_that_fails_is_named_with_its_exception_on_the_console(tmp_path, caplog):
     (tmp_path / "page.md").write_text(PAGE, encoding="utf-8")
     (tmp_path / "plain.md").write_text("# No code\n", encoding="utf-8")
-    env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60,
-                                                        execution_cache_path=str(tmp_path / "cache")),
+    env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60),
                           doc2path=lambda d: str(tmp_path / f"{d}.md"))
     app = SimpleNamespace(env=env, outdir=str(tmp_path / "html"),
-                          config=SimpleNamespace(execute_pages_first=[], execute_pages_last=[]))
+                          config=SimpleNamespace(execute_pages_first=[], execute_pages_last=[],
+                                                 nb_execution_cache_path=str(tmp_path / "cache")))
     with caplog.at_level(logging.WARNING):
         execute_pages._execute(app, env, ["page", "plain"])
     assert [r.getMessage() for r in caplog.records if "failed to execute" in r.getMessage()] == [
