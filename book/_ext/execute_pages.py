@@ -18,9 +18,11 @@ alone, and executes the pages it has to one after another.  This extension:
    again (its outputs from the cache where the cache holds the page).  So an edit to any
    module re-executes every page, and a build killed at any moment (the cache half filled,
    the environment saved but the pages not all written, a page's HTML half written) is
-   redone by the next one, which executes again only the pages the cache lacks.  After a
-   build that did not finish, a cached notebook whose file does not read as a notebook
-   (jupyter-cache records a notebook, then writes its file) is dropped from the cache.
+   redone by the next one, which executes again only the pages the cache lacks; a build
+   that failed is not trusted either (the next reads every page again, and a page that
+   failed fails again).  After a build that did not finish, a cached notebook whose file
+   does not read as a notebook (jupyter-cache records a notebook, then writes its file) is
+   dropped from the cache.
 3. Executes the pages before Sphinx reads them.  The pages about to be read are added to
    the cache's project (jupyter-cache's ``jupytext`` reader gives the same notebook, and
    so the same key, as myst-nb's) and the ones the cache does not hold run in a pool of
@@ -32,7 +34,8 @@ alone, and executes the pages it has to one after another.  This extension:
 4. Stops on SIGINT (Ctrl-C) or SIGTERM.  The build's process freezes every process it
    started (the pool's, their kernels, a kernel myst-nb runs), so that none starts another,
    kills them, removes their kernels' connection files, prints one line and exits with
-   128 + the signal's number; the pool's processes leave the signal to it.  It leaves what
+   128 + the signal's number; the pool's processes leave the signal to it, and one the pool
+   forks meanwhile (to replace one it lost) ends at once.  It leaves what
    a killed build leaves, which 2. does not trust.  ``make book`` runs this file
    (jupyter-book's command line) so that this holds from the first instant of the build,
    not only once Sphinx has loaded its extensions.  A signal the build was started with
