@@ -14,10 +14,16 @@ $(STAMP): pyproject.toml constraints.txt
 	$(BIN)/uv pip install --quiet --python $(BIN)/python --compile-bytecode -c constraints.txt -e '.[book,test]'
 	touch $(STAMP)
 
+# book/_ext/execute_pages.py runs jupyter-book's command line (`jupyter-book build`) with the
+# build's own handling of Ctrl-C and SIGTERM from its first instant: one line, exit 130 or 143,
+# no process of the build left.  The build takes book/.build.lock: a second one in the tree waits.
+# The checks after it only read, and each prints a line naming itself; they run with SIGINT
+# ignored, so that a Ctrl-C meanwhile stops make when the check ends, without a traceback.
+UNINTERRUPTED := $(BIN)/python -c 'import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_IGN); os.execv(sys.executable, [sys.executable, *sys.argv[1:]])'
 book: $(STAMP)
-	$(BIN)/jupyter-book build book --warningiserror --keep-going --quiet
-	$(BIN)/python book/check_offline.py book/_build/html
-	$(BIN)/python book/check_glue.py book/_build/.jupyter_cache book/_build/html
+	$(BIN)/python book/_ext/execute_pages.py build book --warningiserror --keep-going --quiet
+	@$(UNINTERRUPTED) book/check_offline.py book/_build/html
+	@$(UNINTERRUPTED) book/check_glue.py book/_build/.jupyter_cache book/_build/html
 	@echo "$(CURDIR)/book/_build/html/index.html"
 
 # The book first (the browser tests read it), then the checker and the tests on every CPU.
@@ -42,4 +48,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_render.py
 
 clean:
-	rm -rf book/_build book/.build.lock .pytest_cache .benchmarks
+	rm -rf book/_build .pytest_cache .benchmarks

@@ -37,11 +37,11 @@ raise ClaimChanged("h3-scale: registered 'holds', computed 'does not hold' (rati
 def test_a_page_that_fails_is_named_with_its_exception_on_the_console(tmp_path, caplog):
     (tmp_path / "page.md").write_text(PAGE, encoding="utf-8")
     (tmp_path / "plain.md").write_text("# No code\n", encoding="utf-8")
-    env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60,
-                                                        execution_cache_path=str(tmp_path / "cache")),
+    env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60),
                           doc2path=lambda d: str(tmp_path / f"{d}.md"))
     app = SimpleNamespace(env=env, outdir=str(tmp_path / "html"),
-                          config=SimpleNamespace(execute_pages_first=[], execute_pages_last=[]))
+                          config=SimpleNamespace(execute_pages_first=[], execute_pages_last=[],
+                                                 nb_execution_cache_path=str(tmp_path / "cache")))
     with caplog.at_level(logging.WARNING):
         execute_pages._execute(app, env, ["page", "plain"])
     assert [r.getMessage() for r in caplog.records if "failed to execute" in r.getMessage()] == [
@@ -56,3 +56,45 @@ def test_the_cause_is_the_exception_line_without_colours():
     assert execute_pages.cause("") == "no traceback recorded"
     assert execute_pages.cause("just text\nlast line") == "last line"
     assert len(execute_pages.cause("ValueError: " + "9" * 900_000)) == 1000
+
+
+# A process forked from the build's (multiprocessing's "fork", as the page pool's are), after
+# the build installed its signal handling; prints what became of it.
+FORKED = """
+import importlib.util, multiprocessing, os, signal, sys
+spec = importlib.util.spec_from_file_location("execute_pages", sys.argv[1])
+execute_pages = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(execute_pages)
+execute_pages._handle_signals()
+def signalled(queue):
+    os.kill(os.getpid(), signal.SIGINT)
+    os.kill(os.getpid(), signal.SIGTERM)
+    queue.put("carried on")
+fork = multiprocessing.get_context("fork")
+queue = fork.Queue()
+execute_pages._build["stopping"] = sys.argv[2] == "stopping"
+child = fork.Process(target=signalled, args=(queue,))
+child.start()
+child.join(20)
+print(queue.get(timeout=1) if not queue.empty() else "nothing", child.exitcode)
+"""
+
+
+def _forked(state):
+    import subprocess
+    import sys
+    run = subprocess.run([sys.executable, "-c", FORKED, str(ROOT / "book" / "_ext" / "execute_pages.py"), state],
+                         capture_output=True, text=True, timeout=60)
+    return run.stdout, run.stderr
+
+
+def test_a_pool_process_leaves_the_signal_to_the_build():
+    """A process forked from the build's inherits its handler, which does nothing there: a page
+    worker neither prints nor exits on SIGINT or SIGTERM; the build's process ends it."""
+    assert _forked("running") == ("carried on 0\n", "")
+
+
+def test_a_process_forked_once_the_build_stops_ends_at_once():
+    """Once the build's process is stopping, a process forked from it (the pool replacing a
+    worker it lost) ends before it runs anything, with status 128 + SIGKILL."""
+    assert _forked("stopping") == ("nothing 137\n", "")

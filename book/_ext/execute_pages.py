@@ -1,20 +1,45 @@
 """Sphinx extension: the pages' notebooks are executed by jupyter-cache, side by side, and
-re-executed when the project's code changes.
+re-executed when the project's code changes; a build stopped or killed at any moment is
+finished by the next one, and two builds in one tree take turns.
 
 myst-nb (``execute_notebooks: cache``) keys a page's cached outputs on its code cells
-alone, and executes the pages it has to one after another.  Before Sphinx reads:
+alone, and executes the pages it has to one after another.  This extension:
 
-1. The project's one source digest (`lab.store.source_digest`: every file of the
-   packages, and the numerical libraries' versions) is compared with the one the cache
-   was filled under; when they differ the cache is emptied and every notebook page is
-   read again, so an edit to any module re-executes every page.
-2. The pages about to be read are added to the cache's project (jupyter-cache's
-   ``jupytext`` reader gives the same notebook, and so the same key, as myst-nb's) and
-   the ones the cache does not hold run in jupyter-cache's ``local-parallel`` executor,
-   one process per CPU: first the pages of ``execute_pages_first``, last those of
-   ``execute_pages_last``, the others between them.
-   myst-nb then finds each page in the cache; a page that failed is not cached, and
-   myst-nb executes it again and reports its error as usual.
+1. Takes turns.  When the configuration is read, the build takes an exclusive lock on
+   ``.build.lock`` in the book's directory (``fcntl.flock``, held until the build's
+   process ends); a second build in the same tree says in one line that it waits, and waits.
+2. Trusts only what a finished build left.  A build that finishes without an error or a
+   warning writes the project's one source digest (`lab.store.source_digest`: every file
+   of the packages, and the numerical libraries' versions) to ``build-complete`` in the
+   doctree directory, and every build deletes that file first.  The cache directory's
+   ``source-digest`` is the digest its notebooks were executed under; when it is not the
+   current one, the cache is emptied, then given the current one.  Unless both hold the
+   current digest, Sphinx's saved environment is deleted, so every page is read and written
+   again (its outputs from the cache where the cache holds the page).  So an edit to any
+   module re-executes every page, and a build killed at any moment (the cache half filled,
+   the environment saved but the pages not all written, a page's HTML half written) is
+   redone by the next one, which executes again only the pages the cache lacks; a build
+   that failed is not trusted either (the next reads every page again, and a page that
+   failed fails again).  After a build that did not finish, a cached notebook whose file
+   does not read as a notebook (jupyter-cache records a notebook, then writes its file) is
+   dropped from the cache.
+3. Executes the pages before Sphinx reads them.  The pages about to be read are added to
+   the cache's project (jupyter-cache's ``jupytext`` reader gives the same notebook, and
+   so the same key, as myst-nb's) and the ones the cache does not hold run in a pool of
+   processes forked from the build's, one per CPU, each with jupyter-cache's
+   ``local-parallel`` worker: first the pages of ``execute_pages_first``, last those of
+   ``execute_pages_last``, the others between them.  myst-nb then finds each page in the
+   cache; a page that failed is not cached, and myst-nb executes it again and reports its
+   error as usual.
+4. Stops on SIGINT (Ctrl-C) or SIGTERM.  The build's process freezes every process it
+   started (the pool's, their kernels, a kernel myst-nb runs), so that none starts another,
+   kills them, removes their kernels' connection files, prints one line and exits with
+   128 + the signal's number; the pool's processes leave the signal to it, and one the pool
+   forks meanwhile (to replace one it lost) ends at once.  It leaves what
+   a killed build leaves, which 2. does not trust.  ``make book`` runs this file
+   (jupyter-book's command line) so that this holds from the first instant of the build,
+   not only once Sphinx has loaded its extensions.  A signal the build was started with
+   ignored stays ignored.
 
 Pages share measurements through `lab.store` (a lock per measurement), so the
 pages that wait for the theorem ledger go last.  Each page's kernel renders on one
@@ -25,40 +50,100 @@ numba's threads on top of them oversubscribe the cores (a cold build on 2 cores 
 
 from __future__ import annotations
 
-import logging as std_logging
+import fcntl
+import multiprocessing
 import os
 import re
 import shutil
+import signal
+import sys
+from contextlib import suppress
 from pathlib import Path
 
-from sphinx.util import logging
-
-from lab.store import source_digest
-
+#: In the cache directory: the source digest its notebooks were executed under.
 DIGEST_FILE = "source-digest"
+#: In the doctree directory: the source digest of the last build that finished clean.
+COMPLETE_FILE = "build-complete"
+#: In the book's directory: the lock a build holds while it runs.
+LOCK_FILE = ".build.lock"
+#: The build's process ("pid") and its lock ("lock", an open file held until the process ends).
+_build = {}
 
 
 def _cache_dir(app):
-    return Path(app.env.mystnb_config.execution_cache_path or Path(app.outdir).parent / ".jupyter_cache")
+    return Path(app.config.nb_execution_cache_path or Path(app.outdir).parent / ".jupyter_cache")
 
 
-def _outdated(app, env, added, changed, removed):
-    """Every notebook page, when the source digest is not the one the cache holds."""
-    path = _cache_dir(app) / DIGEST_FILE
-    if path.is_file() and path.read_text(encoding="utf-8") == source_digest():
-        return []
-    shutil.rmtree(_cache_dir(app), ignore_errors=True)
-    _cache_dir(app).mkdir(parents=True)
-    path.write_text(source_digest(), encoding="utf-8")
-    return sorted(d for d in env.found_docs - added - changed - removed if env.doc2path(d).endswith(".md"))
+def _read(path):
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return None
+
+
+def _lock(path):
+    """``path`` opened and locked (``LOCK_EX``); if another build holds it, after one line on stderr."""
+    lock = open(path, "a")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        print(f"waiting for the build running in {path.parent} to finish (it holds {path.name})",
+              file=sys.stderr, flush=True)
+        fcntl.flock(lock, fcntl.LOCK_EX)
+    return lock
+
+
+def _begin(app, config):
+    """Take the build's lock, then set aside what of the last build's output is not to be trusted (2.)."""
+    from lab.store import source_digest
+    from renderer import files
+    from sphinx.application import ENV_PICKLE_FILENAME
+    _build["lock"] = _lock(Path(app.srcdir) / LOCK_FILE)
+    digest, doctrees, cache = source_digest(), Path(app.doctreedir), _cache_dir(app)
+    complete = _read(doctrees / COMPLETE_FILE) == digest
+    (doctrees / COMPLETE_FILE).unlink(missing_ok=True)        # first: this build may be killed
+    cached = _read(cache / DIGEST_FILE) == digest
+    if not cached:
+        if cache.exists():
+            shutil.rmtree(cache)
+        cache.mkdir(parents=True)
+        files.write_bytes(cache / DIGEST_FILE, digest.encode())
+    elif not complete:
+        _drop_unreadable(cache)
+    if not (complete and cached):
+        (doctrees / ENV_PICKLE_FILENAME).unlink(missing_ok=True)
+
+
+def _drop_unreadable(cache_dir):
+    """Remove from the jupyter-cache in ``cache_dir`` every executed notebook whose file is
+    missing or does not read as a notebook, leaving the records of the others untouched."""
+    import nbformat
+    from jupyter_cache import get_cache
+    from jupyter_cache.cache.db import NbCacheRecord
+    cache = get_cache(str(cache_dir))
+    for record in cache.list_cache_records():
+        path = Path(cache_dir, "executed", record.hashkey, "base.ipynb")
+        try:
+            nbformat.reads(path.read_text(encoding="utf-8"), nbformat.NO_CONVERT)
+        except (OSError, ValueError):
+            shutil.rmtree(path.parent, ignore_errors=True)
+            NbCacheRecord.remove_records([record.pk], cache.db)
+
+
+def _finish(app, exception):
+    """A build that finished without an error or a warning: the next one may trust what it wrote."""
+    if exception is None and not app._warncount:
+        from lab.store import source_digest
+        from renderer import files
+        files.write_bytes(Path(app.doctreedir) / COMPLETE_FILE, source_digest().encode())
 
 
 def _execute(app, env, docnames):
     if env.mystnb_config.execution_mode != "cache" or not docnames:
         return
     from jupyter_cache import get_cache
-    from jupyter_cache.executors import load_executor
     from myst_nb.core.read import is_myst_markdown_notebook
+    from sphinx.util import logging
     first, last = app.config.execute_pages_first, app.config.execute_pages_last
     order = sorted(docnames, key=lambda d: (d in last) - (d in first))
     paths = [env.doc2path(d) for d in order if env.doc2path(d).endswith(".md")]
@@ -69,13 +154,71 @@ def _execute(app, env, docnames):
     if not todo:
         return
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")          # the kernels inherit it
-    quiet = std_logging.getLogger("execute_pages")          # multiprocessing's INFO lines stay off the console
-    quiet.setLevel(std_logging.WARNING)
-    result = load_executor("local-parallel", cache=cache, logger=quiet).run_and_cache(
-        filter_pks=todo, timeout=env.mystnb_config.execution_timeout, allow_errors=False)
-    for uri in result.errored + result.excepted:       # the console names the cause, not only the log file
-        record = cache.get_project_record(uri)
-        logging.getLogger(__name__).warning(f"{Path(uri).stem} failed to execute: {cause(record.traceback)}")
+    for status, uri in _run(cache, todo, env.mystnb_config.execution_timeout):
+        if status:                                      # the console names the cause, not only the log file
+            record = cache.get_project_record(uri)
+            logging.getLogger(__name__).warning(f"{Path(uri).stem} failed to execute: {cause(record.traceback)}")
+
+
+def _run(cache, pks, timeout):
+    """Execute the project notebooks ``pks`` of ``cache`` in this order, in a pool of processes
+    forked from this one (so `_stop` is theirs too), one per CPU, caching each that succeeds.
+    Returns [(status, uri)] in the same order: status 0 if it succeeded, 1 if a cell raised,
+    2 if it could not be executed or cached."""
+    from jupyter_cache.cache.db import NbProjectRecord
+    from jupyter_cache.executors.basic import ExecutionWorkerLocalMProc, ProcessData
+    NbProjectRecord.remove_tracebacks(pks, cache.db)
+    jobs = [ProcessData(pk, cache.get_project_record(pk).uri, cache, timeout, False) for pk in pks]
+    with multiprocessing.get_context("fork").Pool() as pool:
+        return pool.map(ExecutionWorkerLocalMProc(), jobs)
+
+
+def _stop(signum, frame):
+    """SIGINT or SIGTERM in the build's process: freeze, kill and wait for every process it
+    started, remove their kernels' connection files (``ipykernel_launcher -f <file>``), say so
+    on stderr in one line and exit with 128 + ``signum``.  In the pool's processes: nothing."""
+    if os.getpid() != _build.get("pid"):
+        return
+    for other in (signal.SIGINT, signal.SIGTERM):     # a second Ctrl-C changes nothing
+        signal.signal(other, signal.SIG_IGN)
+    import psutil
+    _build["stopping"] = True                 # a process forked from now on (the pool replacing
+    me, frozen = psutil.Process(), {}         # one it lost) ends at once: `_stillborn`
+    while new := [p for p in me.children(recursive=True) if p.pid not in frozen]:
+        for p in new:
+            frozen[p.pid] = p
+            with suppress(psutil.Error):
+                p.suspend()
+    leftovers = []
+    for p in frozen.values():
+        with suppress(psutil.Error):
+            command = p.cmdline()
+            if "ipykernel_launcher" in command and "-f" in command[:-1]:
+                leftovers.append(command[command.index("-f") + 1])
+        with suppress(psutil.Error):
+            p.kill()
+    psutil.wait_procs(list(frozen.values()), timeout=5)
+    for path in leftovers:
+        with suppress(OSError):
+            os.unlink(path)
+    os.write(2, f"book build stopped by {signal.Signals(signum).name}; the next build redoes "
+                f"what it left unfinished\n".encode())
+    os._exit(128 + signum)
+
+
+def _stillborn():
+    if _build.get("stopping"):
+        os._exit(128 + signal.SIGKILL)
+
+
+def _handle_signals():
+    """`_stop` on SIGINT and SIGTERM in this process, the build's (a signal it ignores stays ignored)."""
+    if "pid" not in _build:
+        os.register_at_fork(after_in_child=_stillborn)
+    _build["pid"] = os.getpid()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(signum) is not signal.SIG_IGN:
+            signal.signal(signum, _stop)
 
 
 #: A terminal colour code, and an exception line as a traceback ends with it ("ClaimChanged: ...").
@@ -92,8 +235,18 @@ def cause(traceback) -> str:
 
 
 def setup(app):
+    _handle_signals()
     app.add_config_value("execute_pages_first", [], "env", types=[list])
     app.add_config_value("execute_pages_last", [], "env", types=[list])
-    app.connect("env-get-outdated", _outdated)
+    app.connect("config-inited", _begin, priority=100)          # before the extensions that write
     app.connect("env-before-read-docs", _execute, priority=900)
+    app.connect("build-finished", _finish, priority=900)        # after the extensions that write
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
+
+
+if __name__ == "__main__":
+    # make book runs this file: jupyter-book's command line, stopped as `_stop` says from the
+    # start, not only once Sphinx has imported and loaded this extension.
+    _handle_signals()
+    from jupyter_book.cli.main import main
+    main()
