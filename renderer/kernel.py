@@ -136,18 +136,50 @@ def nearest_hit(s, x, y, skip):
 
 
 @njit(cache=True, error_model="numpy")
+def sphere_a_point(x, y, e, r):
+    """Hit point P of the ray E + t (x, y, -e) on sphere A (centre 0, radius r);
+    the ray must hit it (`sphere_hit` finite).
+
+    Not (t x, t y, e (1 - t)) from `sphere_hit`'s t: where the sphere is small
+    against its distance t is near 1, and e (1 - t) cancels to an error of u e
+    (u the unit roundoff), u e / r in N = P / r, and an accepted scene has e / r
+    up to MAX_LENGTH / MIN_RADIUS.  With the centre on the axis t and 1 - t
+    both have forms free of cancellation.  With rho^2 = x^2 + y^2, a = rho^2 +
+    e^2, disc = b^2 - a c = a r^2 - e^2 rho^2 (the e^4 terms cancelled by hand)
+    and q = e^2 + sqrt(disc): t = c / q (pbrt-v4's stable root) with c =
+    (e - r)(e + r) (e - r exact for e <= 2 r), and 1 - t = (q - c) / q =
+    (r^2 + sqrt(disc)) / q.  Each is a quotient of sums of non-negative terms,
+    so each component of P is within a few u of the exact hit's, but for the
+    rounding of disc itself (the ill-condition of a grazing ray, `sphere_hit`'s
+    too): that moves P along the ray and leaves |P|^2 = r^2 (1 + O(u)), so
+    N = P / r is unit to a few u at every accepted e and r.
+    """
+    rho2 = x * x + y * y
+    root = math.sqrt(max((rho2 + e * e) * r * r - e * e * rho2, 0.0))
+    q = e * e + root
+    t = (e - r) * (e + r) / q
+    return t * x, t * y, e * ((r * r + root) / q)
+
+
+@njit(cache=True, error_model="numpy")
 def surface(s, x, y, t, code, checker):
-    """Hit point P, geometric normal N and albedo of a hit (geometry only).
+    """Hit point P, geometric normal N (unit) and albedo of a hit (geometry only).
 
     ``checker`` = sin(pi x) sin(pi y): a floor hit is the pixel centre (x, y, 0)
     itself (t = 1), so the caller takes the sines once per column and row."""
-    P = (t * x, t * y, s.camera_z * (1.0 - t))
     if code == SPHERE_A:
         r = s.radius_a
+        P = sphere_a_point(x, y, s.camera_z, r)
         return P, (P[0] / r, P[1] / r, P[2] / r), s.albedo_a
+    P = (t * x, t * y, s.camera_z * (1.0 - t))
     if code == SPHERE_B:
-        c, r = s.center_b, s.radius_b
-        return P, ((P[0] - c[0]) / r, (P[1] - c[1]) / r, (P[2] - c[2]) / r), s.albedo_b
+        # P - C carries the rounding of E - C, u |E - C|, against a radius
+        # that may be far smaller: N is P - C over its own length (pbrt-v4
+        # reprojects its sphere hits onto the surface by the same ratio).
+        c = s.center_b
+        nx, ny, nz = P[0] - c[0], P[1] - c[1], P[2] - c[2]
+        inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+        return P, (nx * inv, ny * inv, nz * inv), s.albedo_b
     # Checker: light squares where sin(pi x) sin(pi y) >= 0 (seed Cell 1).
     base = FLOOR_LIGHT if checker >= 0.0 else FLOOR_DARK
     rg = base * (1.0 - s.floor_tint)
