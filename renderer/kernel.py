@@ -49,6 +49,8 @@ EXACT, CENTRAL, FOOTPRINT = 0, 1, 2
 FLOOR_LIGHT, FLOOR_DARK = 0.85, 0.15
 #: Floor under |h| in Blinn's half-vector quotient (|h| = 0 only where w = -v).
 TINY = 1e-300
+#: The smallest positive float64 (a subnormal) and the smallest normal one.
+SUBNORMAL_MIN, NORMAL_MIN = 2.0**-1074, 2.0**-1022
 
 #: The scene as the pixel code reads it: floats, bools, triples, int codes
 #: (the lights are a separate array, see `params`).
@@ -187,6 +189,35 @@ def surface(s, x, y, t, code, checker):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def unit_vector(wx, wy, wz, w2):
+    """(wx, wy, wz) / |w| for w != 0, given w2 = |w|^2 as computed.  Below the
+    smallest normal float64 (a light within its square root of the point it
+    lights) w2 has lost its digits or underflowed to 0 (1 / 0: inf, then NaN
+    in the shading, compiled; ZeroDivisionError, interpreted), so w is first
+    divided by its largest component."""
+    if w2 < NORMAL_MIN:
+        m = max(abs(wx), abs(wy), abs(wz))
+        wx, wy, wz = wx / m, wy / m, wz / m
+        w2 = wx * wx + wy * wy + wz * wz
+    inv = 1.0 / math.sqrt(w2)
+    return wx * inv, wy * inv, wz * inv
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def chart_of(N):
+    """`chart` of sphere A's normal N: (u, v, sin phi), sin phi at least the
+    smallest positive float64.  At the pole itself (N_x = N_y = 0, a pixel
+    centre on the optical axis) sin phi is 0, and `tangent_frame` and
+    `footprint` divide by it in the branch they then discard (the pole
+    fallbacks).  Compiled, 1 / 0 is inf and so is 1 / SUBNORMAL_MIN (it
+    overflows), so the outputs are the same bits; interpreted
+    (NUMBA_DISABLE_JIT=1), Python's float division by 0 raises
+    ZeroDivisionError."""
+    u, v, sin_phi = chart(N[0], N[1], N[2])
+    return u, v, max(sin_phi, SUBNORMAL_MIN)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def reach(s, L, P, N, code, skip, gate, Ns):
     """Unit vector w from P to the light L and whether the light reaches P:
     the geometric normal faces it (attached shadow), the floor plane does not
@@ -201,8 +232,7 @@ def reach(s, L, P, N, code, skip, gate, Ns):
     if s.floor and code != FLOOR and ((L[2] < 0.0 and P[2] > 0.0) or (L[2] > 0.0 and P[2] < 0.0)):
         return (0.0, 0.0, 0.0), False
     w2 = wx * wx + wy * wy + wz * wz
-    inv = 1.0 / math.sqrt(w2)
-    w = (wx * inv, wy * inv, wz * inv)
+    w = unit_vector(wx, wy, wz, w2)
     if gate and not Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0:
         return w, False
     if code != SPHERE_A and segment_blocked(wx, wy, wz, w2, L, 0.0, 0.0, 0.0, s.radius_a):
@@ -235,6 +265,21 @@ def specular_axis(s, w, view):
     return (hx * inv, hy * inv, hz * inv), 0.0
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def int_power(base, n):
+    """base ** n for an integer n >= 0 by repeated squaring: numba's own
+    float ** int, the same multiplications in the same order, written out so
+    that the kernel run interpreted (NUMBA_DISABLE_JIT=1, where Python's **
+    calls libm's pow) gives the compiled bits, as renderer/js/render.js does."""
+    r = 1.0
+    while n != 0:
+        if n & 1:
+            r *= base
+        n >>= 1
+        base *= base
+    return r
+
+
 @njit(cache=True, error_model="numpy")
 def light_term(s, color, w, axis, wv, Ns, albedo):
     """A light's Lambert and Blinn/Phong terms (r, g, b) at a point it reaches:
@@ -247,10 +292,9 @@ def light_term(s, color, w, axis, wv, Ns, albedo):
         spec_cos = 2.0 * mu * spec_cos - wv
     # Clamped before the power: rounding can put the cosine an ulp above 1.
     base = min(max(spec_cos, 0.0), 1.0)
-    # An integral exponent (the seed's 32) by repeated squaring (numba's
-    # float ** int), faster than libm's pow.
+    # An integral exponent (the seed's 32) by repeated squaring, faster than libm's pow.
     n = int(s.shininess)
-    spec = (base ** n if n == s.shininess else base ** s.shininess) * s.ks
+    spec = (int_power(base, n) if n == s.shininess else base ** s.shininess) * s.ks
     diffuse = mu * s.kd
     return (color[0] * (diffuse * albedo[0] + spec), color[1] * (diffuse * albedo[1] + spec),
             color[2] * (diffuse * albedo[2] + spec))
@@ -332,7 +376,7 @@ def render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_ki
         P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
         Ns = N
         if code == SPHERE_A:
-            u, v, sin_phi = chart(N[0], N[1], N[2])
+            u, v, sin_phi = chart_of(N)
             frame = tangent_frame(N[0], N[1], N[2], sin_phi)
             hu, hv, flag = 0.0, 0.0, False
             if want_grad or want_geo or s.beta != 0.0 or not skip:
@@ -384,7 +428,7 @@ def sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads
             for f in range(images.shape[0]):
                 images[f, j, i, 0], images[f, j, i, 1], images[f, j, i, 2] = rgb
             continue
-        u, v, sin_phi = chart(N[0], N[1], N[2])
+        u, v, sin_phi = chart_of(N)
         frame = tangent_frame(N[0], N[1], N[2], sin_phi)
         view = view_vector(s, P)
         for k in range(n):
