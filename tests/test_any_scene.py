@@ -135,7 +135,7 @@ def unit_errors(g):
                                                                     HealthCheck.filter_too_much])
 @given(scene=accepted_scenes(), gradient=st.sampled_from(GRADIENTS),
        zoom=st.one_of(st.just(1.0), st.floats(1.0, MAX_ZOOM)))
-# The tester's scene: N was off unit length by 1e-4 there.
+# The tester's scene (N was not unit there while P_z = e (1 - t) cancelled).
 @example(scene=Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH), gradient="exact", zoom=1.0)
 @example(scene=Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH, beta=S.MIN_RADIUS / 2, bump="surface"),
          gradient="central", zoom=1.0)

@@ -325,8 +325,8 @@ def exact_hit_errors(scene, g, pixels):
 @pytest.mark.parametrize("zoom", [1.0, 1e3])
 @pytest.mark.parametrize("name", sorted(EXTREME_SCENES))
 def test_hit_points_and_normals_are_exact_at_the_accepted_extremes(name, zoom):
-    """The tester's case first: at R = 1e-6, e = 1e6, N = P / R was off unit length by
-    1e-4 (e (1 - t) cancelled to u e against R)."""
+    """The tester's case first: at R = 1e-6, e = 1e6, N = P / R was not unit while
+    P_z = e (1 - t) cancelled to an error of u e against R."""
     scene = EXTREME_SCENES[name]
     g = gbuffer(scene, 24, 24, zoom=zoom)
     pixels = np.argwhere(g.chamber > 0)

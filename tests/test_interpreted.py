@@ -3,11 +3,13 @@
 numba compiles the kernel with ``error_model="numpy"``: a float division by
 zero is inf there, and the kernel may discard it (the tangent frame and the
 footprint divide by sin(phi) in the branch their pole fallback replaces).
-Interpreted, Python's float division by zero raises ZeroDivisionError.  Every
-other operation of the kernel is an IEEE operation or a call of the same libm
-function in both modes, and the integral power is numba's own repeated
-squaring written out (`renderer.kernel.int_power`; Python's ``**`` calls
-libm's pow), so the outputs must be equal, not close.
+Interpreted, Python's float division by zero raises ZeroDivisionError.  The
+kernel divides by no zero now (`renderer.kernel.chart_of`, and
+`renderer.kernel.unit_vector` for a light so close to a point that |w|^2
+underflows); every other operation is an IEEE operation or a call of the
+same libm function in both modes, and the integral power is numba's own
+repeated squaring written out (`renderer.kernel.int_power`; Python's ``**``
+calls libm's pow), so the outputs must be equal, not close.
 
 A grid of scenes at the accepted extremes (renderer/scene.py's limits) runs
 in a child process with NUMBA_DISABLE_JIT=1, at 8 x 8, and at 9 x 20 the
