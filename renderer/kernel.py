@@ -49,6 +49,8 @@ EXACT, CENTRAL, FOOTPRINT = 0, 1, 2
 FLOOR_LIGHT, FLOOR_DARK = 0.85, 0.15
 #: Floor under |h| in Blinn's half-vector quotient (|h| = 0 only where w = -v).
 TINY = 1e-300
+#: The smallest positive float64 (a subnormal) and the smallest normal one.
+SUBNORMAL_MIN, NORMAL_MIN = 2.0**-1074, 2.0**-1022
 
 #: The scene as the pixel code reads it: floats, bools, triples, int codes
 #: (the lights are a separate array, see `params`).
@@ -136,22 +138,83 @@ def nearest_hit(s, x, y, skip):
 
 
 @njit(cache=True, error_model="numpy")
+def sphere_a_point(x, y, e, r):
+    """Hit point P of the ray E + t (x, y, -e) on sphere A (centre 0, radius r);
+    the ray must hit it (`sphere_hit` finite).
+
+    Not (t x, t y, e (1 - t)) from `sphere_hit`'s t: where the sphere is small
+    against its distance t is near 1, and e (1 - t) cancels to an error of u e
+    (u the unit roundoff), u e / r in N = P / r, and an accepted scene has e / r
+    up to MAX_LENGTH / MIN_RADIUS.  With the centre on the axis t and 1 - t
+    both have forms free of cancellation.  With rho^2 = x^2 + y^2, a = rho^2 +
+    e^2, disc = b^2 - a c = a r^2 - e^2 rho^2 (the e^4 terms cancelled by hand)
+    and q = e^2 + sqrt(disc): t = c / q (pbrt-v4's stable root) with c =
+    (e - r)(e + r) (e - r exact for e <= 2 r), and 1 - t = (q - c) / q =
+    (r^2 + sqrt(disc)) / q.  Each is a quotient of sums of non-negative terms,
+    so each component of P is within a few u of the exact hit's, but for the
+    rounding of disc itself (the ill-condition of a grazing ray, `sphere_hit`'s
+    too): that moves P along the ray and leaves |P|^2 = r^2 (1 + O(u)), so
+    N = P / r is unit to a few u at every accepted e and r.
+    """
+    rho2 = x * x + y * y
+    root = math.sqrt(max((rho2 + e * e) * r * r - e * e * rho2, 0.0))
+    q = e * e + root
+    t = (e - r) * (e + r) / q
+    return t * x, t * y, e * ((r * r + root) / q)
+
+
+@njit(cache=True, error_model="numpy")
 def surface(s, x, y, t, code, checker):
-    """Hit point P, geometric normal N and albedo of a hit (geometry only).
+    """Hit point P, geometric normal N (unit) and albedo of a hit (geometry only).
 
     ``checker`` = sin(pi x) sin(pi y): a floor hit is the pixel centre (x, y, 0)
     itself (t = 1), so the caller takes the sines once per column and row."""
-    P = (t * x, t * y, s.camera_z * (1.0 - t))
     if code == SPHERE_A:
         r = s.radius_a
+        P = sphere_a_point(x, y, s.camera_z, r)
         return P, (P[0] / r, P[1] / r, P[2] / r), s.albedo_a
+    P = (t * x, t * y, s.camera_z * (1.0 - t))
     if code == SPHERE_B:
-        c, r = s.center_b, s.radius_b
-        return P, ((P[0] - c[0]) / r, (P[1] - c[1]) / r, (P[2] - c[2]) / r), s.albedo_b
+        # P - C carries the rounding of E - C, u |E - C|, against a radius
+        # that may be far smaller: N is P - C over its own length (pbrt-v4
+        # reprojects its sphere hits onto the surface by the same ratio).
+        c = s.center_b
+        nx, ny, nz = P[0] - c[0], P[1] - c[1], P[2] - c[2]
+        inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+        return P, (nx * inv, ny * inv, nz * inv), s.albedo_b
     # Checker: light squares where sin(pi x) sin(pi y) >= 0 (seed Cell 1).
     base = FLOOR_LIGHT if checker >= 0.0 else FLOOR_DARK
     rg = base * (1.0 - s.floor_tint)
     return P, (0.0, 0.0, 1.0), (rg, rg, base)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def unit_vector(wx, wy, wz, w2):
+    """(wx, wy, wz) / |w| for w != 0, given w2 = |w|^2 as computed.  Below the
+    smallest normal float64 (a light within its square root of the point it
+    lights) w2 has lost its digits or underflowed to 0 (1 / 0: inf, then NaN
+    in the shading, compiled; ZeroDivisionError, interpreted), so w is first
+    divided by its largest component."""
+    if w2 < NORMAL_MIN:
+        m = max(abs(wx), abs(wy), abs(wz))
+        wx, wy, wz = wx / m, wy / m, wz / m
+        w2 = wx * wx + wy * wy + wz * wz
+    inv = 1.0 / math.sqrt(w2)
+    return wx * inv, wy * inv, wz * inv
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def chart_of(N):
+    """`chart` of sphere A's normal N: (u, v, sin phi), sin phi at least the
+    smallest positive float64.  At the pole itself (N_x = N_y = 0, a pixel
+    centre on the optical axis) sin phi is 0, and `tangent_frame` and
+    `footprint` divide by it in the branch they then discard (the pole
+    fallbacks).  Compiled, 1 / 0 is inf and so is 1 / SUBNORMAL_MIN (it
+    overflows), so the outputs are the same bits; interpreted
+    (NUMBA_DISABLE_JIT=1), Python's float division by 0 raises
+    ZeroDivisionError."""
+    u, v, sin_phi = chart(N[0], N[1], N[2])
+    return u, v, max(sin_phi, SUBNORMAL_MIN)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -169,8 +232,7 @@ def reach(s, L, P, N, code, skip, gate, Ns):
     if s.floor and code != FLOOR and ((L[2] < 0.0 and P[2] > 0.0) or (L[2] > 0.0 and P[2] < 0.0)):
         return (0.0, 0.0, 0.0), False
     w2 = wx * wx + wy * wy + wz * wz
-    inv = 1.0 / math.sqrt(w2)
-    w = (wx * inv, wy * inv, wz * inv)
+    w = unit_vector(wx, wy, wz, w2)
     if gate and not Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0:
         return w, False
     if code != SPHERE_A and segment_blocked(wx, wy, wz, w2, L, 0.0, 0.0, 0.0, s.radius_a):
@@ -203,6 +265,21 @@ def specular_axis(s, w, view):
     return (hx * inv, hy * inv, hz * inv), 0.0
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def int_power(base, n):
+    """base ** n for an integer n >= 0 by repeated squaring: numba's own
+    float ** int, the same multiplications in the same order, written out so
+    that the kernel run interpreted (NUMBA_DISABLE_JIT=1, where Python's **
+    calls libm's pow) gives the compiled bits, as renderer/js/render.js does."""
+    r = 1.0
+    while n != 0:
+        if n & 1:
+            r *= base
+        n >>= 1
+        base *= base
+    return r
+
+
 @njit(cache=True, error_model="numpy")
 def light_term(s, color, w, axis, wv, Ns, albedo):
     """A light's Lambert and Blinn/Phong terms (r, g, b) at a point it reaches:
@@ -215,10 +292,9 @@ def light_term(s, color, w, axis, wv, Ns, albedo):
         spec_cos = 2.0 * mu * spec_cos - wv
     # Clamped before the power: rounding can put the cosine an ulp above 1.
     base = min(max(spec_cos, 0.0), 1.0)
-    # An integral exponent (the seed's 32) by repeated squaring (numba's
-    # float ** int), faster than libm's pow.
+    # An integral exponent (the seed's 32) by repeated squaring, faster than libm's pow.
     n = int(s.shininess)
-    spec = (base ** n if n == s.shininess else base ** s.shininess) * s.ks
+    spec = (int_power(base, n) if n == s.shininess else base ** s.shininess) * s.ks
     diffuse = mu * s.kd
     return (color[0] * (diffuse * albedo[0] + spec), color[1] * (diffuse * albedo[1] + spec),
             color[2] * (diffuse * albedo[2] + spec))
@@ -300,7 +376,7 @@ def render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_ki
         P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
         Ns = N
         if code == SPHERE_A:
-            u, v, sin_phi = chart(N[0], N[1], N[2])
+            u, v, sin_phi = chart_of(N)
             frame = tangent_frame(N[0], N[1], N[2], sin_phi)
             hu, hv, flag = 0.0, 0.0, False
             if want_grad or want_geo or s.beta != 0.0 or not skip:
@@ -352,7 +428,7 @@ def sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads
             for f in range(images.shape[0]):
                 images[f, j, i, 0], images[f, j, i, 1], images[f, j, i, 2] = rgb
             continue
-        u, v, sin_phi = chart(N[0], N[1], N[2])
+        u, v, sin_phi = chart_of(N)
         frame = tangent_frame(N[0], N[1], N[2], sin_phi)
         view = view_vector(s, P)
         for k in range(n):

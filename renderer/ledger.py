@@ -33,13 +33,21 @@ class Ledger:
     ----------
     max_abs, rms : float
         Max and root-mean-square of |I_numeric - I_symbolic| over the colour
-        channels of the pixels that are sphere A in both frames.
+        channels of the pixels that are sphere A in both frames (0.0 when
+        there are none).
     flips : int
         Pixels whose chamber code differs between the frames.
     pixels_a : int
         Number of pixels on sphere A in both frames.
     mean_abs_kink, mean_abs_off_kink : float
-        Mean |dI| on and off the crease band (nan where a set is empty).
+        Mean |dI| over the channels of those pixels on and off the symbolic
+        frame's crease band.  A mean over no pixel is ``nan`` (numpy's mean
+        of an empty array, and a float like the others, so that a census is
+        an array of floats): mean_abs_kink is nan where the band holds no
+        pixel of sphere A, always for "sine" and "rings", which have no
+        creases; mean_abs_off_kink where the band holds every one; both
+        where pixels_a is 0.  Otherwise they are finite (the images are), so
+        ``math.isnan`` tells exactly whether the set was empty.
     """
 
     max_abs: float
@@ -54,7 +62,8 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
     """Ledger of two frames of the same size.
 
     The crease band is read from ``symbolic.kink``, so ``symbolic`` must be
-    rendered with ``kink=True`` (the default).
+    rendered with ``kink=True`` (the default).  A mean over an empty set of
+    pixels is nan (see `Ledger`).
 
     Raises
     ------

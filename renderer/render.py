@@ -96,9 +96,12 @@ class GBuffer:
     """Per-pixel geometry of a frame, for checks and figures.
 
     chamber (H, W) uint8; t (H, W) float64, the ray parameter of the nearest
-    hit (inf: none); P, N, Ns (H, W, 3) float64: hit point, geometric and
-    shading normal (0 where chamber is 0); uv, grad (H, W, 2) float64: sphere
-    A's chart and gradient (0 elsewhere); x (W,), y (H,): pixel centres.
+    hit (inf: none), which decides the chamber; P, N, Ns (H, W, 3) float64:
+    hit point, geometric and shading normal, unit (0 where chamber is 0); on
+    sphere A, P is computed apart from t, within a few ulps of the radius of
+    the exact hit (`renderer.kernel.sphere_a_point`); uv, grad (H, W, 2)
+    float64: sphere A's chart and gradient (0 elsewhere); x (W,), y (H,):
+    pixel centres.
     """
 
     chamber: np.ndarray

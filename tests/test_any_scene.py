@@ -12,18 +12,25 @@ around the kernel (the window, the parameters, a sweep's ledger) runs under
 ``np.errstate(all="raise")`` with warnings turned into errors, so an
 overflow there is an error.  The checker is shown to reject a frame with a
 NaN, an out-of-range chamber and a stray crease flag.
+
+Every normal the documentation calls unit is unit to 1e-12 at every accepted
+scene: the G-buffer's N and N' (either bump mode, as the scene draws it) and
+sphere A's tangent frame, which the kernel computes from N with
+`renderer.generated.tangent_frame` (`renderer.pointwise.tangent_frame` is the
+same compiled function).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
-from renderer import BUMPS, GRADIENTS, HEIGHT_FIELDS, MODELS, PointLight, Scene, gbuffer, render, sweep
+from renderer import BUMPS, GRADIENTS, HEIGHT_FIELDS, MODELS, PointLight, Scene, gbuffer, pointwise, render, sweep
 from renderer import scene as S
 from renderer.render import MAX_ZOOM
 
@@ -108,6 +115,50 @@ def test_every_accepted_scene_sweeps_and_buffers_finite(scene, steps):
     for g in buffers:
         hit = g.chamber > 0
         assert np.all(np.isfinite(g.Ns[hit])) and np.all(np.isfinite(g.P[hit])) and np.all(np.isfinite(g.uv))
+
+
+UNIT_TOL = 1e-12
+
+
+def unit_errors(g):
+    """| |V| - 1 | at worst, per kind of unit vector of a G-buffer: N and N' on
+    every hit, and sphere A's e_theta and e_phi (the kernel's frame of N)."""
+    hit, on_a = g.chamber > 0, g.chamber == 1
+    N = g.N[on_a]
+    with np.errstate(divide="ignore", invalid="ignore"):     # 1 / sin(phi) at the pole, discarded
+        e_theta, e_phi = (np.stack(e, -1) for e in pointwise.tangent_frame(*N.T, pointwise.chart(*N.T)[2]))
+    vectors = dict(N=g.N[hit], Ns=g.Ns[hit], e_theta=e_theta, e_phi=e_phi)
+    return {name: float(np.abs(np.linalg.norm(v, axis=-1) - 1.0).max(initial=0.0)) for name, v in vectors.items()}
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                    HealthCheck.filter_too_much])
+@given(scene=accepted_scenes(), gradient=st.sampled_from(GRADIENTS),
+       zoom=st.one_of(st.just(1.0), st.floats(1.0, MAX_ZOOM)))
+# The tester's scene (N was not unit there while P_z = e (1 - t) cancelled).
+@example(scene=Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH), gradient="exact", zoom=1.0)
+@example(scene=Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH, beta=S.MIN_RADIUS / 2, bump="surface"),
+         gradient="central", zoom=1.0)
+@example(scene=Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH, center_b=(0.0, 0.0, 1e5),
+                     radius_b=S.MIN_RADIUS), gradient="footprint", zoom=1.0)        # sphere B as small, far
+@example(scene=Scene(radius_a=1.0, camera_z=1.0 + 2.0**-52), gradient="exact", zoom=S.MAX_LENGTH)
+def test_every_accepted_scene_has_unit_normals(scene, gradient, zoom):
+    errors = unit_errors(gbuffer(scene, 9, 7, gradient=gradient, zoom=zoom))
+    assert max(errors.values()) <= UNIT_TOL, errors
+
+
+def test_the_unit_check_rejects_a_normal_off_by_1e_11():
+    g = gbuffer(Scene(), 9, 7)
+    assert max(unit_errors(g).values()) <= UNIT_TOL
+    j, i = np.argwhere(g.chamber == 1)[0]
+    for name, change, caught in (("N", 1.0 + 1e-11, ("N", "e_phi")), ("Ns", 1.0 - 1e-11, ("Ns",))):
+        wrong = getattr(g, name).copy()
+        wrong[j, i] *= change
+        errors = unit_errors(dataclasses.replace(g, **{name: wrong}))
+        assert all(errors[k] > UNIT_TOL for k in caught), errors
+    # A frame not divided by sin(phi): e_theta = (-N_y, N_x, 0).
+    N = g.N[g.chamber == 1]
+    assert np.abs(np.linalg.norm(np.stack([-N[:, 1], N[:, 0]], -1), axis=-1) - 1.0).max() > UNIT_TOL
 
 
 def _corrupting(name, index, value):

@@ -8,10 +8,17 @@ Then: every hit point lies on its surface, floor points have z == 0, normals
 are unit vectors, the chamber is the nearest positive hit, nothing is NaN,
 and the image lies in [0, 1].  The seed's sphere-B quadratic (constant term
 |C_B|^2 - R_2^2, seed Cell 1) is shown to fail the on-surface invariant.
+
+The G-buffer's own hit points on sphere A (`renderer.kernel.sphere_a_point`,
+not E + t d) and its normals are checked against the exact hits (mpmath), at
+these scenes and at the accepted extremes of the geometry (a sphere of the
+least radius seen from the farthest camera, a camera one ulp outside the
+sphere, the largest sphere, a sphere B as small and far).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import mpmath
@@ -19,6 +26,7 @@ import numpy as np
 import pytest
 
 from renderer import GRADIENTS, PointLight, Scene, gbuffer, kernel, pointwise, render
+from renderer import scene as S
 from renderer.render import image_plane
 
 from . import scalar_reference as ref
@@ -180,7 +188,10 @@ def test_grid_and_hit_points_agree_with_gbuffer(case):
     assert np.array_equal(x, X[0]) and np.array_equal(y, Y[:, 0])
     hit = g.chamber > 0
     assert np.array_equal(g.t[hit], t[hit])
-    assert np.abs(g.P[hit] - P[hit]).max() <= 1e-15 * (1 + np.abs(P[hit]).max())
+    # Off sphere A the G-buffer's P is E + t d, the same bits; on A it is
+    # computed afresh (`test_sphere_a_hit_points_are_the_exact_hits`).
+    off_a = hit & (g.chamber != 1)
+    assert np.array_equal(g.P[off_a], P[off_a])
 
 
 def test_sphere_a_hits_are_on_sphere_a(case):
@@ -210,12 +221,18 @@ def test_normals_are_unit(case):
     hit = g.chamber > 0
     assert off_unit(g.N[hit]) <= UNIT_TOL
     assert off_unit(g.Ns[hit]) <= UNIT_TOL
-    # The geometric normal is the independent one: (P - C) / r, or +z on the floor.
+    # The geometric normal is that of the G-buffer's hit point: (P - C) / r, or +z on the floor.
     for code, C, r in ((1, (0, 0, 0), scene.radius_a), (2, scene.center_b, scene.radius_b)):
         m = g.chamber == code
         if m.any():
-            assert np.abs(g.N[m] - (P[m] - np.asarray(C)) / r).max() <= 1e-15 / r * 4
+            assert np.abs(g.N[m] - (g.P[m] - np.asarray(C)) / r).max() <= 1e-15 / r * 4
     assert np.all(g.N[g.chamber == 3] == (0.0, 0.0, 1.0))
+
+
+def test_sphere_a_hit_points_are_the_exact_hits(case):
+    scene, g, X, Y, t, P = case
+    pixels = sample_pixels(g.chamber, np.random.default_rng(20261121))
+    assert exact_hit_errors(scene, g, pixels)[1] <= HIT_TOL
 
 
 def test_chamber_is_the_nearest_positive_hit(case):
@@ -234,6 +251,104 @@ def test_no_nan_and_image_in_unit_interval(case, gradient):
     assert in_unit_interval(frame.image)
     assert np.array_equal(frame.chamber, g.chamber)
     assert np.all(frame.image[frame.chamber == 0] == 0.0)
+
+
+# --- the G-buffer's hit points and normals against the exact hits, to the accepted extremes ----
+
+#: Allowed error of a hit point on sphere A, in units of u R (1 + R / h), and of
+#: a normal of sphere B, in units of u (1 + (|E - C| + |P| + |C|) / r) (1 + r / h),
+#: u = 2^-53 and h the ray's half chord, sqrt(D / a) for a t^2 + 2 b t + c = 0:
+#: a rounding of the discriminant D moves the hit along the ray by about
+#: u R^2 / h (R / h is the grazing ray's ill-condition), and sphere B's N carries
+#: the rounding of E - C, P and C against its radius (`kernel.surface`).  4: the
+#: few roundings of either route.
+HIT_TOL = 4.0
+U = 2.0**-53
+
+#: Scenes at the limits of renderer/scene.py (R, e up to MAX_LENGTH, radii down to MIN_RADIUS).
+EXTREME_SCENES = {
+    "least sphere from the farthest camera": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH),
+    "unit sphere from the farthest camera": Scene(radius_a=1.0, camera_z=S.MAX_LENGTH),
+    "camera one ulp outside sphere A": Scene(radius_a=0.3, camera_z=math.nextafter(0.3, 1.0),
+                                             center_b=(0.5, 0.5, 5.0)),
+    "largest sphere A": Scene(radius_a=math.nextafter(S.MAX_LENGTH, 0.0), camera_z=S.MAX_LENGTH,
+                              center_b=(0.0, 0.0, -S.MAX_LENGTH), radius_b=1.0),
+    "least sphere B, far from all": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH,
+                                          center_b=(0.0, 0.0, 1e5), radius_b=S.MIN_RADIUS),
+}
+
+
+def mp_sphere_hit(x, y, e, C, r, dps=80):
+    """(P, N, h) of the nearest hit of the ray through (x, y) on the sphere (C, r),
+    exactly (mpmath at ``dps`` digits, rounded to float64 at the end); None for a
+    miss or a tangent ray.  80 digits: at e = 1e6, R = 1e-6 the discriminant
+    cancels 24 of them, and a float64 answer needs 17 more."""
+    with mpmath.workdps(dps):
+        x, y, e, r = (mpmath.mpf(v) for v in (x, y, e, r))
+        C = [mpmath.mpf(c) for c in C]
+        d, oc = (x, y, -e), (-C[0], -C[1], e - C[2])
+        a = sum(v * v for v in d)
+        b = sum(p * q for p, q in zip(d, oc))
+        D = b * b - a * (sum(v * v for v in oc) - r * r)
+        if D <= 0:
+            return None
+        t = (-b - mpmath.sqrt(D)) / a
+        rel = [oc[k] + t * d[k] for k in range(3)]               # P - C
+        return (np.array([float(rel[k] + C[k]) for k in range(3)]), np.array([float(v / r) for v in rel]),
+                float(mpmath.sqrt(D / a)))
+
+
+def exact_hit_errors(scene, g, pixels):
+    """Worst error, in units of `HIT_TOL`'s, of the G-buffer's hit points on sphere A
+    and normals on sphere B over ``pixels`` (rows of (j, i)), and each normal's
+    |  |N| - 1 |: (worst on A, worst on B, worst | |N| - 1 |)."""
+    e, worst = scene.camera_z, {1: 0.0, 2: 0.0}
+    for j, i in pixels:
+        code = int(g.chamber[j, i])
+        if code not in worst:
+            continue
+        C, r = ((0.0, 0.0, 0.0), scene.radius_a) if code == 1 else (scene.center_b, scene.radius_b)
+        exact = mp_sphere_hit(g.x[i], g.y[j], e, C, r)
+        if exact is None:
+            continue
+        P, N, h = exact
+        if code == 1:
+            error = np.abs(g.P[j, i] - P).max() / (U * r * (1 + r / h))
+        else:
+            size = math.dist((0.0, 0.0, e), C) + np.abs(P).max() + np.abs(C).max()
+            error = np.abs(g.N[j, i] - N).max() / (U * (1 + size / r) * (1 + r / h))
+        worst[code] = max(worst[code], float(error))
+    hit = g.chamber[tuple(np.transpose(pixels))] > 0
+    return worst[1], worst[2], off_unit(g.N[tuple(np.transpose(pixels))][hit])
+
+
+@pytest.mark.parametrize("zoom", [1.0, 1e3])
+@pytest.mark.parametrize("name", sorted(EXTREME_SCENES))
+def test_hit_points_and_normals_are_exact_at_the_accepted_extremes(name, zoom):
+    """The tester's case first: at R = 1e-6, e = 1e6, N = P / R was not unit while
+    P_z = e (1 - t) cancelled to an error of u e against R."""
+    scene = EXTREME_SCENES[name]
+    g = gbuffer(scene, 24, 24, zoom=zoom)
+    pixels = np.argwhere(g.chamber > 0)
+    error_a, error_b, unit = exact_hit_errors(scene, g, pixels)
+    assert error_a <= HIT_TOL and error_b <= HIT_TOL and unit <= UNIT_TOL, (error_a, error_b, unit)
+    assert np.count_nonzero(np.isin(g.chamber, (1, 2))) > 250         # half the frame or more
+
+
+def test_the_exact_hit_check_rejects_the_hit_point_from_t():
+    """Teeth: P = (t x, t y, e (1 - t)) from `kernel.sphere_hit` and N = P / R (the
+    kernel before), and the same with N renormalised (unit, but the point is still
+    off by u e): both are rejected at the tester's scene; the kernel's passes."""
+    scene = EXTREME_SCENES["least sphere from the farthest camera"]
+    g = gbuffer(scene, 24, 24)
+    X, Y = pixel_grid(scene, 24, 24)
+    t, P = hit_points(scene, X, Y, g.chamber)
+    pixels = np.argwhere(g.chamber == 1)
+    for N in (P / scene.radius_a, P / np.linalg.norm(P, axis=-1, keepdims=True)):
+        wrong = dataclasses.replace(g, P=P, N=N)
+        assert exact_hit_errors(scene, wrong, pixels)[0] > 1e6 * HIT_TOL
+    assert off_unit((P / scene.radius_a)[g.chamber == 1]) > 1e6 * UNIT_TOL
+    assert exact_hit_errors(scene, g, pixels)[0] <= HIT_TOL
 
 
 # --- the seed's sphere-B quadratic, and teeth for each check -----------------------------
@@ -452,7 +567,6 @@ def test_sphere_a_fills_the_seeds_window_where_cell_1_puts_it(width, height):
 def test_reach_refuses_a_gbuffer_whose_arrays_are_of_another_frame(field):
     """The compiled loop indexes P, N, Ns by chamber's shape: arrays of another size were read
     past their end, and the masks came back wrong without a word."""
-    import dataclasses
     scene = Scene()
     small, big = gbuffer(scene, 8, 8), gbuffer(scene, 16, 12)
     mixed = dataclasses.replace(big, **{field: getattr(small, field)})

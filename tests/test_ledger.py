@@ -92,6 +92,43 @@ def test_sweep_census_is_the_ledger_of_its_frames():
         assert ledger_differences(led, whole_image_ledger(frame, sw.symbolic)) == []
 
 
+# --- empty sets: a mean over no pixel is nan, and only then ---------------------------------------
+
+#: name: (scene, render keywords, which means are over an empty set).  "sine" has no
+#: crease; at zoom 1e3 the frame is sphere A's pole, inside the band of the factor
+#: sin(pi k_v v); sphere B centred at (0, 0, 2) with radius 1.9 hides sphere A.
+EMPTY_SETS = {
+    "no crease band": (Scene(height_field="sine", eps=1e-1), {}, {"mean_abs_kink"}),
+    "all in the band": (Scene(eps=1e-1), dict(zoom=1e3), {"mean_abs_off_kink"}),
+    "no sphere A": (Scene(center_b=(0.0, 0.0, 2.0), radius_b=1.9), {}, {"mean_abs_kink", "mean_abs_off_kink"}),
+}
+
+
+@pytest.mark.parametrize("name", sorted(EMPTY_SETS))
+def test_a_mean_over_no_pixel_is_nan_and_the_rest_is_the_whole_image_computation(name):
+    scene, kw, empty = EMPTY_SETS[name]
+    numeric, symbolic = render(scene, 31, 23, gradient="central", **kw), render(scene, 31, 23, **kw)
+    on_a = (numeric.chamber == SPHERE_A) & (symbolic.chamber == SPHERE_A)
+    sets = {"mean_abs_kink": symbolic.kink & on_a, "mean_abs_off_kink": ~symbolic.kink & on_a}
+    assert {k for k, m in sets.items() if not m.any()} == empty      # the scene has the empty sets named
+    led = compare(numeric, symbolic)
+    assert {k for k in sets if math.isnan(getattr(led, k))} == empty
+    assert ledger_differences(led, whole_image_ledger(numeric, symbolic)) == []
+    if len(empty) == 2:
+        assert (led.pixels_a, led.max_abs, led.rms) == (0, 0.0, 0.0)
+    else:
+        assert led.pixels_a > 100 and led.max_abs > 0.0
+
+
+def test_the_empty_set_check_rejects_zero_for_nan_and_nan_for_a_mean():
+    scene, kw, _ = EMPTY_SETS["no crease band"]
+    numeric, symbolic = render(scene, 31, 23, gradient="central"), render(scene, 31, 23)
+    led, want = compare(numeric, symbolic), whole_image_ledger(numeric, symbolic)
+    for wrong in (dataclasses.replace(led, mean_abs_kink=0.0),
+                  dataclasses.replace(led, mean_abs_off_kink=math.nan)):
+        assert ledger_differences(wrong, want) != []
+
+
 def test_frames_of_different_sizes_are_refused():
     with pytest.raises(ValueError, match="same shape"):
         compare(render(Scene(), 8, 8), render(Scene(), 9, 8))

@@ -206,7 +206,10 @@ def footprint_allowances(scene, width, height, chamber, grad_ref):
 
     The image allowance is how far the reference's own shading of the pixel
     moves when its gradient moves by the gradient tolerance (the largest
-    change over the four corners of the tolerance box, first order).
+    change over the four corners of the tolerance box, first order).  Where
+    delta > WIDE_DELTA the step may be anything the cap and the fallback
+    allow, and first order bounds nothing: the image is not compared there
+    (no more than MAX_GRAZING such pixels, `parity_failures`).
     """
     steps, delta = np.ones(grad_ref.shape), np.zeros(grad_ref.shape)
     extra = np.zeros(chamber.shape)
@@ -215,7 +218,7 @@ def footprint_allowances(scene, width, height, chamber, grad_ref):
         steps[j, i], delta[j, i] = footprint_bound(scene, i, j, width, height)
     tol = grad_tolerance(scene, "footprint", grad_ref, steps, delta)
     for j, i in on_a:
-        if not np.all(np.isfinite(tol[j, i])):
+        if not np.all(np.isfinite(tol[j, i])) or np.any(delta[j, i] > WIDE_DELTA):
             extra[j, i] = math.inf
             continue
         x, y = ref.pixel_point(scene, i, j, width, height)

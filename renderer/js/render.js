@@ -90,19 +90,36 @@ function nearest_hit(s, x, y, px) {
   px.t = t; px.code = code;
 }
 
-// Hit point P, geometric normal N and albedo of a hit (geometry only).
+// Hit point of the ray through (x, y) on sphere A (centre 0, radius r) into P
+// (kernel.py `sphere_a_point`): t = c / q and 1 - t = (r^2 + sqrt(disc)) / q,
+// free of the cancellation of e (1 - t) where t is near 1.
+function sphere_a_point(x, y, e, r, P) {
+  const rho2 = x * x + y * y;
+  const root = Math.sqrt(Math.max((rho2 + e * e) * r * r - e * e * rho2, 0.0));
+  const q = e * e + root;
+  const t = (e - r) * (e + r) / q;
+  P[0] = t * x; P[1] = t * y; P[2] = e * ((r * r + root) / q);
+}
+
+// Hit point P, geometric normal N (unit) and albedo of a hit (geometry only).
 // `checker` = sin(pi x) sin(pi y): a floor hit is the pixel centre (x, y, 0)
 // itself (t = 1), so the caller takes the sines once per column and row.
 function surface(s, x, y, checker, px) {
   const t = px.t, P = px.P, N = px.N, albedo = px.albedo;
-  P[0] = t * x; P[1] = t * y; P[2] = s.camera_z * (1.0 - t);
   if (px.code === SPHERE_A) {
     const r = s.radius_a;
+    sphere_a_point(x, y, s.camera_z, r, P);
     N[0] = P[0] / r; N[1] = P[1] / r; N[2] = P[2] / r;
     albedo.set(s.albedo_a);
-  } else if (px.code === SPHERE_B) {
-    const c = s.center_b, r = s.radius_b;
-    N[0] = (P[0] - c[0]) / r; N[1] = (P[1] - c[1]) / r; N[2] = (P[2] - c[2]) / r;
+    return;
+  }
+  P[0] = t * x; P[1] = t * y; P[2] = s.camera_z * (1.0 - t);
+  if (px.code === SPHERE_B) {
+    // P - C over its own length: it carries the rounding of E - C (kernel.py `surface`).
+    const c = s.center_b;
+    const nx = P[0] - c[0], ny = P[1] - c[1], nz = P[2] - c[2];
+    const inv = 1.0 / Math.sqrt(nx * nx + ny * ny + nz * nz);
+    N[0] = nx * inv; N[1] = ny * inv; N[2] = nz * inv;
     albedo.set(s.albedo_b);
   } else {
     // Checker: light squares where sin(pi x) sin(pi y) >= 0 (seed Cell 1).
