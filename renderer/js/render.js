@@ -130,6 +130,20 @@ function surface(s, x, y, checker, px) {
   }
 }
 
+// (wx, wy, wz) / |w| into `w`, given w2 = |w|^2 as computed (kernel.py
+// `unit_vector`): below the smallest normal double (a light within its square
+// root of the point it lights) w is first divided by its largest component.
+const NORMAL_MIN = 2 ** -1022;
+function unit_vector(wx, wy, wz, w2, w) {
+  if (w2 < NORMAL_MIN) {
+    const m = Math.max(Math.abs(wx), Math.abs(wy), Math.abs(wz));
+    wx /= m; wy /= m; wz /= m;
+    w2 = wx * wx + wy * wy + wz * wz;
+  }
+  const inv = 1.0 / Math.sqrt(w2);
+  w[0] = wx * inv; w[1] = wy * inv; w[2] = wz * inv;
+}
+
 // Does light L reach P?  The geometric normal faces it (attached shadow), the
 // floor plane does not separate them (floor on, P off the floor), and no
 // blocker sphere (B for A, A for B, both for the floor) cuts the segment (cast
@@ -141,8 +155,7 @@ function reach(s, L, P, N, code, Ns, w, gate = true) {
   if (!(N[0] * wx + N[1] * wy + N[2] * wz > 0.0)) return false;
   if (s.floor && code !== FLOOR && ((L[2] < 0.0 && P[2] > 0.0) || (L[2] > 0.0 && P[2] < 0.0))) return false;
   const w2 = wx * wx + wy * wy + wz * wz;
-  const inv = 1.0 / Math.sqrt(w2);
-  w[0] = wx * inv; w[1] = wy * inv; w[2] = wz * inv;
+  unit_vector(wx, wy, wz, w2, w);
   if (gate && !(Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0)) return false;
   if (code !== SPHERE_A && segment_blocked(wx, wy, wz, w2, L, 0.0, 0.0, 0.0, s.radius_a)) return false;
   if (code !== SPHERE_B && s.sphere_b) {
