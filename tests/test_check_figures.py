@@ -18,6 +18,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from renderer.cmdline import png_bytes
+
 from .test_cli import failure_problems as _failure_problems
 from .test_cli import read_png, varying_chunks
 
@@ -106,7 +108,7 @@ def test_figures_check_reports_changes(s1_figures, tmp_path, capsys, monkeypatch
     f = old / doc["figures"][0]["file"]
     px = read_png(f)
     px[10, 10] = np.where(px[10, 10] >= 128, px[10, 10].astype(int) - 51, px[10, 10].astype(int) + 51)
-    f.write_bytes(cli._png_bytes(px.astype(np.uint8)))
+    f.write_bytes(png_bytes(px.astype(np.uint8)))
     doc["figures"][0]["sha256"] = sha256_of(f)
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
@@ -171,7 +173,7 @@ def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_
     f = old / doc["figures"][0]["file"]
     px = read_png(f)
     px[5, 5] = 255 - px[5, 5]
-    f.write_bytes(cli._png_bytes(px.astype(np.uint8)))
+    f.write_bytes(png_bytes(px.astype(np.uint8)))
     doc["figures"][0]["sha256"] = sha256_of(f)
     doc["figures"][0]["varies"] = "measured timing"
     (old / "manifest.json").write_text(json.dumps(doc))
@@ -205,7 +207,7 @@ def write_check_dir(d, px=None, **entry):
     """A previous ``--out`` directory with one synthetic figure; returns the manifest."""
     import hashlib
     d.mkdir(exist_ok=True)
-    data = cli._png_bytes(figure_pixels() if px is None else px)
+    data = png_bytes(figure_pixels() if px is None else px)
     (d / "fig.png").write_bytes(data)
     h, w = (px if px is not None else figure_pixels()).shape[:2]
     page = cli._known_pages()[1]
@@ -294,7 +296,7 @@ def tamper(name):
         elif name == "sha-mismatch":
             f["sha256"] = "0" * 64
         elif name == "file-changed":
-            (d / "fig.png").write_bytes(cli._png_bytes(255 - figure_pixels()))
+            (d / "fig.png").write_bytes(png_bytes(255 - figure_pixels()))
         elif name == "missing-file":
             (d / "fig.png").unlink()
         elif name == "link-to-dev-zero":
@@ -399,14 +401,14 @@ def test_compare_figure_tolerance_on_synthetic_pngs():
     allowed = int(cli.CHECK_TOLERANCE_FRACTION * n)
     levels = cli.CHECK_TOLERANCE_LEVELS
     assert allowed >= 1
-    png = cli._png_bytes(base)
+    png = png_bytes(base)
 
     def changed(count, by):
         px = base.astype(int)
         flat = px.reshape(-1, 3)
         idx = np.arange(count) * (n // max(count, 1))
         flat[idx, 1] = np.where(flat[idx, 1] >= 128, flat[idx, 1] - by, flat[idx, 1] + by)
-        return cli._png_bytes(px.astype(np.uint8))
+        return png_bytes(px.astype(np.uint8))
 
     assert cli.compare_figure(png, png) == ("unchanged", "")
     verdict, how = cli.compare_figure(png, changed(allowed, levels))
@@ -416,7 +418,7 @@ def test_compare_figure_tolerance_on_synthetic_pngs():
     verdict, how = cli.compare_figure(png, changed(1, levels + 1))
     assert verdict == "changed" and how == f"max |dI| = {(levels + 1) / 255:.4f} (1 pixels differ)"
     assert cli.compare_figure(png, changed(allowed + 1, 1))[0] == "changed"
-    assert cli.compare_figure(png, cli._png_bytes(base[:-1]))[0] == "changed"
+    assert cli.compare_figure(png, png_bytes(base[:-1]))[0] == "changed"
     assert cli.compare_figure(png, changed(1, 127))[0] == "changed"
 
 
@@ -428,11 +430,11 @@ def test_check_passes_within_tolerance_and_fails_beyond(tmp_path, capsys, monkey
     near, far = px.copy(), px.copy()
     near[3, 4] += np.where(near[3, 4] < 255, 1, -1)
     far[3, 4] += np.where(far[3, 4] < 128, cli.CHECK_TOLERANCE_LEVELS + 1, -cli.CHECK_TOLERANCE_LEVELS - 1)
-    fake_run(monkeypatch, {fid: cli._png_bytes(near.astype(np.uint8))})
+    fake_run(monkeypatch, {fid: png_bytes(near.astype(np.uint8))})
     rc, out, _ = run(["figures", "--check", str(d)], capsys)
     assert rc == 0 and f"within tolerance {fid}: max |dI| = 0.0039 (1 pixels differ)" in out
     assert "no figure changed" in out
-    fake_run(monkeypatch, {fid: cli._png_bytes(far.astype(np.uint8))})
+    fake_run(monkeypatch, {fid: png_bytes(far.astype(np.uint8))})
     rc, out, _ = run(["figures", "--check", str(d)], capsys)
     assert rc == 1 and f"changed    {fid}: max |dI|" in out and "1 figure(s) changed" in out
 

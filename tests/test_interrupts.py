@@ -352,11 +352,12 @@ def test_a_ctrl_c_that_a_c_callback_drops_still_stops_the_command(tmp_path, caps
     """A Ctrl-C whose KeyboardInterrupt a C callback drops still ends the
     command with 130 and the one line, and writes nothing.  Wrong variants:
     without `_stop_if_interrupted` the command finishes, writes its PNG and
-    exits 0."""
+    exits 0 (`renderer.cmdline.check_signal`)."""
     import renderer.cli as cli
+    from renderer import cmdline
 
     if variant == "no check before writing":
-        monkeypatch.setattr(cli, "_stop_if_interrupted", lambda: None)
+        monkeypatch.setattr(cmdline, "check_signal", lambda: None)
     # Python's own hook, which prints the report (pytest's turns it into a warning).
     monkeypatch.setattr(sys, "unraisablehook", sys.__unraisablehook__)
     calls = _render_with_a_dropped_ctrl_c(monkeypatch)
