@@ -16,7 +16,9 @@ import contextlib
 import csv
 import io
 import json
+import math
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -101,6 +103,54 @@ def test_failure_checker_rejects_wrong_variants():
     assert failure_problems(2, "symrender: error: x\n", [], ["out.png"])
 
 
+# ------------------------------------------------------------------ reading the reports back
+
+
+#: Each labelled line of the render ledger and the `Ledger` field it reports.
+LEDGER_LABELS = {"max |dI|": "max_abs", "RMS |dI|": "rms", "flips": "flips", "pixels on A": "pixels_a",
+                 "mean |dI| on band": "mean_abs_kink", "mean |dI| off band": "mean_abs_off_kink"}
+#: Each column of the sweep's text census and the `Ledger` field it reports.
+CENSUS_LABELS = {"max |dI|": "max_abs", "RMS |dI|": "rms", "flips": "flips", "on band": "mean_abs_kink",
+                 "off band": "mean_abs_off_kink"}
+#: Each column of the U-curve table and the `UCurve` field it reports.
+UCURVE_LABELS = {"eps": "eps", "truncation": "truncation", "roundoff": "roundoff", "|error|": "error", "model": "model"}
+
+
+def value_of(text):
+    """A reported number: an int, a float, or None for "none" (no pixel in that set)."""
+    if text.startswith("none"):
+        return None
+    return int(text) if re.fullmatch(r"-?[0-9]+", text) else float(text)
+
+
+def agrees(got, want, rel=1e-3):
+    """A printed value (4 significant digits) against the library's; None stands for NaN."""
+    if got is None or (isinstance(want, float) and math.isnan(want)):
+        return got is None and math.isnan(want)
+    return got == want if isinstance(want, int) else math.isclose(got, want, rel_tol=rel, abs_tol=1e-300)
+
+
+def ledger_lines(report):
+    """{Ledger field: value} read from a render report's labelled lines (by their labels)."""
+    found = (re.fullmatch(r"  (.+?)\s{2,}(\S.*)", line) for line in report.splitlines())
+    return {LEDGER_LABELS[m[1]]: value_of(m[2]) for m in found if m}
+
+
+def table(report, labels):
+    """A report's table read by its header: one {field: value} per row."""
+    lines = report.splitlines()
+    head = next(i for i, line in enumerate(lines) if line.split()[:1] == ["eps"])
+    columns = [labels.get(c, c) for c in re.split(r"\s{2,}", lines[head].strip())]
+    rows = [line.split() for line in lines[head + 1:]]
+    return [dict(zip(columns, map(value_of, row))) for row in rows if len(row) == len(columns)]
+
+
+def ledger_problems(report, led):
+    """The fields of `Ledger` ``led`` that the report's ledger lines do not show."""
+    got = ledger_lines(report)
+    return [f for f in LEDGER_LABELS.values() if f not in got or not agrees(got[f], getattr(led, f))]
+
+
 # ------------------------------------------------------------------ render
 
 
@@ -130,11 +180,32 @@ def test_render_views_match_the_library(tmp_path, capsys, view, gradient):
     got = read_png(out)
     assert got.shape == (40, 48, 3)
     np.testing.assert_array_equal(got, expected_pixels(want))
-    # The ledger printed is compare(central, exact).
-    led = compare(numeric, symbolic)
-    assert f"max |dI|            {led.max_abs:.3e}" in stdout
-    assert f"flips               {led.flips}" in stdout
-    assert f"pixels on A         {led.pixels_a}" in stdout
+    # The ledger printed is compare(central, exact), each value under its own label.
+    assert ledger_problems(stdout, compare(numeric, symbolic)) == []
+
+
+def test_a_frame_with_no_band_pixel_says_so(tmp_path, capsys):
+    """4x4 of the draft's scene has no pixel in the crease band: its mean is none, not nan."""
+    rc, out, _ = run(["render", "--size", "4x4", "-o", str(tmp_path / "o.png")], capsys)
+    led = compare(render(Scene(), 4, 4, gradient="central"), render(Scene(), 4, 4))
+    assert rc == 0 and math.isnan(led.mean_abs_kink) and led.pixels_a > 0
+    assert "  mean |dI| on band   none (no pixel in the band)\n" in out and "nan" not in out
+    assert ledger_problems(out, led) == []
+
+
+def test_the_report_checkers_see_swapped_labels():
+    """A ledger whose two band means are printed under each other's labels, and a census
+    whose RMS and max columns are swapped, are caught."""
+    led = compare(render(Scene(), 24, 20, gradient="central"), render(Scene(), 24, 20))
+    lines = cli._ledger_lines(led)
+    assert ledger_problems("\n".join(lines), led) == []
+    swapped = [*lines[:5], lines[6].replace("off band", "on band "), lines[5].replace("on band ", "off band")]
+    assert ledger_problems("\n".join(swapped), led) == ["mean_abs_kink", "mean_abs_off_kink"]
+    header = "      eps   max |dI|   RMS |dI|  flips    on band   off band"
+    row = (f" 1.00e-03  {led.rms:.3e}  {led.max_abs:.3e}  {led.flips:5d}  {led.mean_abs_kink:.3e}  "
+           f"{led.mean_abs_off_kink:.3e}")
+    (got,) = table(f"{header}\n{row}", CENSUS_LABELS)
+    assert [f for f in CENSUS_LABELS.values() if not agrees(got[f], getattr(led, f))] == ["max_abs", "rms"]
 
 
 def test_views_differ_so_the_pixel_check_can_fail(tmp_path, capsys):
@@ -565,7 +636,23 @@ def test_sweep_formats_match_renderer_sweep(capsys):
     rc, out, _ = run(["sweep", "--eps", "1e-1:1e-6:6", "--size", "40x32"], capsys)
     lines = out.strip().splitlines()
     assert rc == 0 and len(lines) == 2 + 6 and lines[2].split()[0] == "1.00e-01"
-    assert f"{ref[0].max_abs:.3e}" in lines[2]
+    rows = table(out, CENSUS_LABELS)
+    assert len(rows) == 6
+    for row, e, led in zip(rows, steps, ref):     # each column under its own label
+        assert agrees(row["eps"], e, rel=1e-2) and all(agrees(row[f], getattr(led, f)) for f in CENSUS_LABELS.values())
+
+
+def test_sweep_of_a_field_without_a_crease_band_says_none(capsys):
+    """The sine field has no crease band: the on-band mean is a missing value in every format."""
+    argv = ["sweep", "--eps", "1e-2,1e-5", "--size", "24x20", "--set", "height_field=sine"]
+    ref = sweep(Scene(height_field="sine"), (1e-2, 1e-5), 24, 20).census
+    assert all(math.isnan(led.mean_abs_kink) for led in ref)
+    rc, out, _ = run(argv, capsys)
+    rows = table(out, CENSUS_LABELS)
+    assert rc == 0 and "nan" not in out and [r["mean_abs_kink"] for r in rows] == [None, None]
+    assert all(agrees(r[f], getattr(led, f)) for r, led in zip(rows, ref) for f in CENSUS_LABELS.values())
+    rc, out, _ = run([*argv, "--format", "csv"], capsys)
+    assert rc == 0 and [r["mean_abs_kink"] for r in csv.DictReader(io.StringIO(out))] == ["", ""]
 
 
 # ------------------------------------------------------------------ ucurve
@@ -578,10 +665,16 @@ def test_ucurve_table_matches_measure(tmp_path, capsys):
                         "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
     assert rc == 0 and err == ""
     uc = measure("sine", 0.31, 0.47, "u", eps=cli.parse_eps("1e-1:1e-12:12", max_steps=100))
-    rows = [line.split() for line in out.splitlines() if line.split()[0][:1].isdigit()]
+    rows = table(out, UCURVE_LABELS)
     assert len(rows) == 12
-    for r, e, t, ro, er in zip(rows, uc.eps, uc.truncation, uc.roundoff, uc.error):
-        assert r[:4] == [f"{e:.2e}", f"{t:.3e}", f"{ro:.3e}", f"{er:.3e}"]
+    for i, row in enumerate(rows):                # each column under its own label
+        assert agrees(row["eps"], uc.eps[i], rel=1e-2)
+        assert all(agrees(row[f], float(getattr(uc, f)[i])) for f in ("truncation", "roundoff", "error", "model"))
+    m = re.search(r"^true derivative (\S+); \|h'''\| = (\S+)$", out, re.M)
+    assert float(m[1]) == uc.derivative and agrees(float(m[2]), abs(uc.third_derivative))
+    m = re.search(r"^eps\* predicted (\S+); measured minimum (\S+) at eps (\S+)$", out, re.M)
+    assert all(agrees(float(m[i]), getattr(uc, f)) for i, f in enumerate(
+        ("eps_opt_predicted", "error_at_measured_opt", "eps_opt_measured"), 1))
     first = plot.read_bytes()
     assert varying_chunks(first) == []
     rc, _, _ = run(["ucurve", "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
