@@ -306,26 +306,29 @@ def check_signal():
 
 
 def import_matplotlib():
-    """matplotlib, imported with its configuration and cache directories resolved
-    quietly: where $HOME (or XDG_CONFIG_HOME, XDG_CACHE_HOME) is not writable,
-    matplotlib falls back to a temporary directory of its own, removed at exit, and
-    logs two warnings saying so; a command's standard error gets nothing from that."""
-    log = logging.getLogger("matplotlib")
+    """matplotlib (with ``matplotlib.image``), imported with what it logs meanwhile dropped.
+
+    Where $HOME (or XDG_CONFIG_HOME, XDG_CACHE_HOME) is not writable, matplotlib
+    falls back to a temporary directory of its own, removed at exit, logs two
+    warnings saying so, and builds its font cache there (a third warning if that
+    takes over 5 s): a command's standard error gets none of that."""
+    loggers = [logging.getLogger(name) for name in ("matplotlib", "matplotlib.font_manager")]
     drop = lambda record: False  # noqa: E731
-    log.addFilter(drop)
+    for log in loggers:
+        log.addFilter(drop)
     try:
         import matplotlib
-        matplotlib.get_cachedir()            # resolved once here (and cached by matplotlib)
+        import matplotlib.image              # the font manager is loaded (or its cache built) here
     finally:
-        log.removeFilter(drop)
+        for log in loggers:
+            log.removeFilter(drop)
     return matplotlib
 
 
 def png_bytes(pixels):
     """PNG bytes of an (H, W, 3 or 4) uint8 image without metadata: no tEXt chunk
     ("Software" is matplotlib's only default key), so two runs give the same bytes."""
-    import_matplotlib()
-    import matplotlib.image
+    matplotlib = import_matplotlib()
     buf = io.BytesIO()
     matplotlib.image.imsave(buf, pixels, format="png", metadata={"Software": None})
     return buf.getvalue()

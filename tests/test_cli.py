@@ -891,3 +891,230 @@ def test_an_error_line_does_not_repeat_a_huge_value(capsys):
     rc, out, err = run(["render", "--size", "9" * 900_000], capsys)
     assert rc == 2 and err.startswith("symrender: error: ") and err.count("\n") == 1
     assert len(err) < 700 and err.rstrip().endswith("characters)"), err[-200:]
+
+
+# ------------------------------------------------------------------ render's frames
+
+
+@pytest.mark.parametrize("view", cli.VIEWS)
+@pytest.mark.parametrize("gradient", ["exact", "central", "footprint"])
+def test_render_holds_at_most_two_frames(tmp_path, capsys, monkeypatch, gradient, view):
+    """The pixel budget counts two frames: when another frame is rendered, at most one
+    earlier frame is still held (the footprint frame replaces the central one; the
+    difference view does not render it at all)."""
+    import importlib
+    import weakref
+    module = importlib.import_module("renderer.render")
+    real, made, held = module.render, [], []
+
+    def counting(*args, **kwargs):
+        held.append(sum(ref() is not None for ref in made))
+        frame = real(*args, **kwargs)
+        made.append(weakref.ref(frame.image))
+        return frame
+
+    monkeypatch.setattr(module, "render", counting)
+    out = tmp_path / "o.png"
+    assert run(["render", "--size", "16x12", "--gradient", gradient, "--view", view, "-o", str(out)], capsys)[0] == 0
+    shown = gradient == "footprint" and view != "difference"
+    assert len(held) == 2 + shown and max(held) <= 1, held
+
+
+@pytest.mark.parametrize("view", cli.VIEWS)
+def test_footprint_views_match_the_library(tmp_path, capsys, view):
+    out = tmp_path / "o.png"
+    rc, stdout, _ = run(["render", "--size", SMALL, "--gradient", "footprint", "--view", view, "-o", str(out)], capsys)
+    numeric, symbolic = render(Scene(), 48, 40, gradient="central"), render(Scene(), 48, 40)
+    selected = render(Scene(), 48, 40, gradient="footprint")
+    want = cli.view_image(view, selected, numeric, symbolic)
+    assert rc == 0 and ledger_problems(stdout, compare(numeric, symbolic)) == []
+    np.testing.assert_array_equal(read_png(out), expected_pixels(want))
+    if view != "difference":                  # the view shows the footprint frame, not the central one
+        assert not np.array_equal(want, cli.view_image(view, numeric, numeric, symbolic))
+
+
+# ------------------------------------------------------------------ every limit at the limit and one past
+
+
+class Reached(Exception):
+    """Raised by a stand-in for the work: the arguments passed every check."""
+
+
+def _past(x, direction):
+    return repr(float(np.nextafter(x, direction)))
+
+
+LIMIT_CASES = [
+    # (argv, the word of the refusal or None: accepted)
+    (["render", "--size", "8192x1"], None), (["render", "--size", "8193x1"], "between 1 and 8192"),
+    (["render", "--size", "1x1"], None), (["render", "--size", "1x0"], "between 1 and 8192"),
+    (["render", "--size", "4096x4096"], None), (["render", "--size", "4097x4096"], "at most 16,777,216"),
+    (["sweep", "--eps", "1e-3", "--size", "4096x4096"], None),
+    (["sweep", "--eps", "1e-3", "--size", "4097x4096"], "at most 16,777,216"),
+    (["sweep", "--eps", "1e-1:1e-7:7", "--size", "2048x2048"], None),
+    (["sweep", "--eps", "1e-1:1e-8:8", "--size", "2048x2048"], "at most 33,554,432"),
+    (["sweep", "--eps", "1e-1:1e-8:64", "--size", "8x8"], None),
+    (["sweep", "--eps", "1e-1:1e-8:65", "--size", "8x8"], "between 1 and 64"),
+    (["sweep", "--eps", ",".join(["1e-3"] * 65), "--size", "8x8"], "1 to 64 steps"),
+    (["sweep", "--eps", "1e-16,0.25", "--size", "8x8"], None),
+    (["sweep", "--eps", _past(0.25, 1), "--size", "8x8"], f"--eps must be in [1e-16, 0.25], got {_past(0.25, 1)}"),
+    (["sweep", "--eps", _past(1e-16, 0), "--size", "8x8"], "--eps must be in [1e-16, 0.25]"),
+    (["ucurve", "--u", "0", "--v", "1"], None), (["ucurve", "--u", "1"], None),
+    (["ucurve", "--u", _past(1.0, 2)], f"--u must be in [0, 1], got {_past(1.0, 2)}"),
+    (["ucurve", "--v", "-5e-324"], "--v must be in [0, 1], got -5e-324"),
+    (["ucurve", "--k-u", "1000", "--k-v", "5e-324"], None),
+    (["ucurve", "--k-u", _past(1e3, 2e3)], f"--k-u must be in (0, 1000], got {_past(1e3, 2e3)}"),
+    (["ucurve", "--k-v", "0"], "--k-v must be in (0, 1000], got 0.0"),
+    (["ucurve", "--eps", f"1e-300,{_past(1.0, 0)}"], None),
+    (["ucurve", "--eps", "1"], "--eps must be in [1e-300, 1), got 1.0 at flat index 0"),
+    (["ucurve", "--eps", f"1e-3,{_past(1e-300, 0)}"], "--eps must be in [1e-300, 1)"),
+    (["ucurve", "--eps", "1e-1:1e-15:10000"], None), (["ucurve", "--eps", "1e-1:1e-15:10001"], "between 1 and 10000"),
+    (["render", "--set", "center_b=" + "[" * 8 + "]" * 8], "Scene.center_b"),
+    (["render", "--set", "center_b=" + "[" * 9 + "]" * 9], "nested too deeply (at most 8 levels"),
+]
+
+
+@pytest.mark.parametrize("argv, word", LIMIT_CASES, ids=[" ".join(a)[:50] for a, _ in LIMIT_CASES])
+def test_command_line_limits_at_the_limit_and_one_past(tmp_path, capsys, monkeypatch, argv, word):
+    """Accepted: the command reaches its work (a stand-in raises `Reached`, reported as a bug);
+    refused: exit 2 with the limit named, before any work."""
+    import importlib
+
+    def reach(*args, **kwargs):
+        raise Reached
+    for module, name in (("renderer.render", "render"), ("renderer.sweep", "sweep"), ("renderer.ucurve", "measure")):
+        monkeypatch.setattr(importlib.import_module(module), name, reach)
+    if argv[0] == "render":
+        argv = [*argv, "-o", str(tmp_path / "o.png")]
+    rc, out, err = run(argv, capsys)
+    if word is None:
+        assert (rc, err) == (1, "symrender: internal error: Reached: \n"), err
+    else:
+        assert rc == 2 and err.startswith("symrender: error: ") and word in err, err
+    assert out == "" and list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ input errors and bugs
+
+
+def test_an_input_error_the_library_finds_is_exit_2_and_a_bug_is_exit_1(tmp_path, capsys, monkeypatch):
+    """``ucurve --eps 2`` passed the command line's checks and `measure` refused it:
+    "internal error", exit 1.  A ValueError that is not the library's validation stays a bug."""
+    rc, _, err = run(["ucurve", "--eps", "2"], capsys)
+    assert (rc, err) == (2, "symrender: error: --eps must be in [1e-300, 1), got 2.0 at flat index 0\n")
+    rc, _, err = run(["render", "--size", "8x8", "--set", "bump=surface", "--set", "beta=1",
+                      "-o", str(tmp_path / "o.png")], capsys)
+    assert rc == 2 and err.startswith("symrender: error: Scene.beta must be < radius_a")
+    import importlib
+
+    def broken(*args, **kwargs):
+        raise ValueError("a bug")
+    monkeypatch.setattr(importlib.import_module("renderer.render"), "render", broken)
+    rc, _, err = run(["render", "--size", "8x8", "-o", str(tmp_path / "o.png")], capsys)
+    assert (rc, err) == (1, "symrender: internal error: ValueError: a bug\n") and list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ full and closed standard streams
+
+
+def symrender(argv, cwd, code=None, **kwargs):
+    """Run ``python -m renderer.cli`` (or ``code``, a harness) with ``argv``; the CompletedProcess."""
+    head = [sys.executable, "-c", code] if code else [sys.executable, "-m", "renderer.cli"]
+    return subprocess.run([*head, *argv], cwd=cwd, timeout=600, **kwargs)
+
+
+@pytest.fixture(scope="module")
+def reference_png(tmp_path_factory):
+    """The bytes of ``render --size 8x8`` (the PNG every stream test expects, or none)."""
+    d = tmp_path_factory.mktemp("ref")
+    assert main(["render", "--size", "8x8", "-o", str(d / "ref.png")]) == 0
+    return (d / "ref.png").read_bytes()
+
+
+@pytest.mark.parametrize("argv", [["render", "--size", "8x8", "-o", "y.png"],
+                                  ["ucurve", "--eps", "1e-3", "--plot", "y.png"]], ids=["render", "ucurve"])
+def test_a_full_stdout_leaves_no_output_file(tmp_path, argv):
+    """``>/dev/full``: the report cannot be written, so the output is not put in place (it was
+    written, and the command exited 2)."""
+    with open("/dev/full", "w") as full:
+        done = symrender(argv, tmp_path, stdout=full, stderr=subprocess.PIPE)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == b"symrender: error: standard output: No space left on device\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_full_stderr_changes_nothing_written(tmp_path, reference_png):
+    """``2>/dev/full``: nothing needs stderr for ``-o y.png``: the PNG and the report as ever."""
+    with open("/dev/full", "w") as full:
+        done = symrender(["render", "--size", "8x8", "-o", "y.png"], tmp_path, stdout=subprocess.PIPE, stderr=full)
+    assert done.returncode == 0 and b"ledger" in done.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["y.png"] and (tmp_path / "y.png").read_bytes() == reference_png
+
+
+def test_output_on_stdout_with_a_full_stderr_writes_no_png(tmp_path):
+    """``-o - 2>/dev/full``: the report (on stderr) cannot be written: exit 2 and no PNG on stdout."""
+    with open("/dev/full", "w") as full:
+        done = symrender(["render", "--size", "8x8", "-o", "-"], tmp_path, stdout=subprocess.PIPE, stderr=full)
+    assert done.returncode == 2 and done.stdout == b"" and list(tmp_path.iterdir()) == []
+
+
+#: A harness: symrender, with a message written to descriptor 2 while the output file is
+#: open (as a C library's warning would be), then the PNG completed.
+NOISY = ("import os, sys, renderer.files as files\n"
+         "real = files.os.fsync\n"
+         "def fsync(fd):\n"
+         "    try:\n"
+         "        os.write(2, b'a message for standard error\\n')\n"
+         "    except OSError:\n"
+         "        pass\n"
+         "    real(fd)\n"
+         "files.os.fsync = fsync\n"
+         "from renderer.cli import main\n"
+         "sys.exit(main())\n")
+
+
+@pytest.mark.parametrize("code", [None, NOISY], ids=["plain", "a message to descriptor 2"])
+def test_a_closed_stderr_loses_messages_and_changes_nothing_written(tmp_path, reference_png, code):
+    """``2>&-``: the run used to end in an AttributeError printed on stdout (``-o -``: into the
+    PNG stream).  Now the PNG and the report are as ever; with descriptor 2 closed, the output
+    file would take its number, and a message to it would land in the PNG."""
+    done = symrender(["render", "--size", "8x8", "-o", "x.png"], tmp_path, code, stdout=subprocess.PIPE,
+                     preexec_fn=lambda: os.close(2))
+    assert done.returncode == 0 and done.stdout.startswith(b"wrote x.png")
+    assert [p.name for p in tmp_path.iterdir()] == ["x.png"] and (tmp_path / "x.png").read_bytes() == reference_png
+    done = symrender(["render", "--size", "8x8", "-o", "-"], tmp_path, code, stdout=subprocess.PIPE,
+                     preexec_fn=lambda: os.close(2))
+    assert done.returncode == 0 and done.stdout == reference_png
+
+
+# ------------------------------------------------------------------ the environment
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "abc", "", "2.5", "1e3"])
+def test_numba_num_threads_that_is_not_a_positive_integer_is_one_line(tmp_path, value):
+    """numba printed a 9-line warning with a traceback for "abc" and failed as a bug for "0"."""
+    done = symrender(["render", "--size", "4x4", "-o", "z.png"], tmp_path, capture_output=True, text=True,
+                     env={**os.environ, "NUMBA_NUM_THREADS": value})
+    assert (done.returncode, done.stderr) == (2, "symrender: error: the environment variable NUMBA_NUM_THREADS must "
+                                                 f"be a positive integer (numba's thread count), got {value!r}\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_numba_num_threads_at_its_limit_renders(tmp_path):
+    done = symrender(["render", "--size", "4x4", "-o", "z.png"], tmp_path, capture_output=True, text=True,
+                     env={**os.environ, "NUMBA_NUM_THREADS": "1"})
+    assert done.returncode == 0 and done.stderr == "" and (tmp_path / "z.png").exists()
+
+
+def test_an_unwritable_home_adds_nothing_to_stderr(tmp_path):
+    """matplotlib logged two warnings (its config and cache directories fell back to a
+    temporary one) where $HOME cannot be written: here HOME is a file (root writes anywhere
+    else), with the XDG directories unset, then set beneath it."""
+    home = tmp_path / "home"
+    home.write_text("not a directory")
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("XDG_", "MPLCONFIGDIR"))}
+    for xdg in ({}, {"XDG_CONFIG_HOME": str(home / "config"), "XDG_CACHE_HOME": str(home / "cache")}):
+        done = symrender(["ucurve", "--eps", "1e-3", "--plot", "p.png"], tmp_path, capture_output=True,
+                         env={**env, "HOME": str(home), **xdg})
+        assert done.returncode == 0 and done.stderr == b"", done.stderr
+        assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
