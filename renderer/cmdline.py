@@ -30,11 +30,12 @@ descriptor number (and a library's message to it cannot land in an output); its
 messages are lost, never sent to another stream.  A closed standard output is an
 input error before any work: the report could not be read.
 
-Signals.  SIGINT and SIGTERM raise `KeyboardInterrupt` and `Terminated` (one of
-them) in the main thread, so that every clean-up runs; a second signal during the
-clean-up is ignored, and the previous handlers are back when `main` returns.  A
-signal whose exception a C callback dropped (llvmlite's, while numba compiles) is
-remembered and raised by `check_signal` before anything is written.
+Signals.  SIGINT and SIGTERM raise `KeyboardInterrupt` in the main thread, so that
+every clean-up runs; the signal is recorded, and decides the message and the exit
+code.  A second signal during the clean-up is ignored, and the previous handlers
+are back when `main` returns.  A signal whose exception a C callback dropped
+(llvmlite's, while numba compiles) is remembered and raised again by
+`check_signal` before anything is written.
 
 This module imports neither numpy nor matplotlib: ``symrender`` starts at once.
 """
@@ -51,7 +52,7 @@ import sys
 
 from . import files
 
-__all__ = ["main", "Parser", "UsageError", "Terminated", "Outputs", "check_signal", "record_signal",
+__all__ = ["main", "Parser", "UsageError", "Outputs", "check_signal", "record_signal",
            "one_line", "progress", "show_progress", "import_matplotlib", "png_bytes", "binary_stdout", "is_stdout",
            "STDOUT"]
 
@@ -61,10 +62,6 @@ STDOUT = "-"
 
 class UsageError(Exception):
     """A bad argument or input: printed as one line, exit code 2."""
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM: unwinds like a Ctrl-C (every clean-up runs), reported as terminated."""
 
 
 _NEGATIVE_VALUE = re.compile(r"-[0-9.]")
@@ -274,10 +271,6 @@ _SIGNALS = (signal.SIGINT, signal.SIGTERM)
 _seen = None
 
 
-def _exception(signum):
-    return Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
-
-
 def record_signal(signum):
     """Note that ``signum`` arrived (for a handler other than `main`'s, as a page
     runner's); return whether it is the first signal of the run."""
@@ -292,14 +285,14 @@ def _on_signal(signum, frame):
     if record_signal(signum):
         for sig in _SIGNALS:                 # a second signal does not cut the clean-up short
             signal.signal(sig, signal.SIG_IGN)
-        raise _exception(signum)
+        raise KeyboardInterrupt
 
 
 def check_signal():
-    """Raise `KeyboardInterrupt` or `Terminated` if a signal came during `main`, even
-    one whose exception a C callback dropped."""
+    """Raise `KeyboardInterrupt` if a signal came during `main`, even one whose
+    exception a C callback dropped."""
     if _seen is not None:
-        raise _exception(_seen)
+        raise KeyboardInterrupt
 
 
 # ---------------------------------------------------------------- libraries
@@ -409,8 +402,8 @@ def _run(prog, command, argv):
                 _say(f"{prog}: error: {err.filename}: {one_line(err.strerror)}")
                 return 2
         return exc.code if isinstance(exc.code, int) else 0
-    except KeyboardInterrupt as exc:
-        signum = _seen or (signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT)
+    except KeyboardInterrupt:
+        signum = _seen or signal.SIGINT        # raised without our handler: Python's Ctrl-C
         _say(f"{prog}: {'terminated' if signum == signal.SIGTERM else 'interrupted'}")
         return 128 + signum
     except UsageError as exc:
