@@ -127,6 +127,11 @@ def _page_figures(book, page):
     ------
     UsageError
         If a cell fails (the page's exception, in one line).
+    RuntimeError
+        If the kernel dies (with the last line it wrote to its standard error,
+        which is kept off the tool's: its warnings are not the tool's messages).
+    KeyboardInterrupt
+        If a signal stopped the page (whatever nbclient raised on its way out).
     """
     import base64
 
@@ -139,17 +144,24 @@ def _page_figures(book, page):
     # nbclient takes SIGINT and SIGTERM while it runs and leaves them at their defaults after:
     # the tool's handlers are put back.
     handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        client.execute()            # nbclient shuts its kernel down on the way out, a signal included
-    except nbclient.exceptions.CellExecutionError as exc:
-        raise UsageError(f"page {page} failed: {exc.ename}: {exc.evalue}") from None
-    except asyncio.CancelledError:
-        cmdline.check_signal()      # the signal that cancelled the page
-        raise KeyboardInterrupt from None      # a cancel without one (nbclient's own handler)
-    finally:
-        for sig, handler in handlers.items():
-            if handler is not None:
-                signal.signal(sig, handler)
+    with tempfile.TemporaryFile() as kernel_stderr:
+        try:
+            client.execute(stderr=kernel_stderr)    # the kernel is shut down on the way out, a signal included
+        except BaseException as exc:
+            cmdline.check_signal()                  # a signal stopped the page
+            if isinstance(exc, nbclient.exceptions.CellExecutionError):
+                raise UsageError(f"page {page} failed: {exc.ename}: {exc.evalue}") from None
+            if isinstance(exc, nbclient.exceptions.DeadKernelError):
+                kernel_stderr.seek(0)
+                last = [line for line in kernel_stderr.read().decode(errors="replace").splitlines() if line.strip()]
+                raise RuntimeError(f"page {page}: the kernel died ({(last or ['no message'])[-1]})") from None
+            if isinstance(exc, asyncio.CancelledError):     # nbclient's own handler, before the tool's
+                raise KeyboardInterrupt from None
+            raise
+        finally:
+            for sig, handler in handlers.items():
+                if handler is not None:
+                    signal.signal(sig, handler)
     ordinal = 0
     for cell in nb.cells:
         if cell.cell_type != "code":

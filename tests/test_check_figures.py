@@ -12,7 +12,9 @@ import importlib.util
 import io
 import json
 import os
+import signal
 import struct
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -462,29 +464,74 @@ def test_check_of_some_pages_compares_only_their_figures(s1_figures, tmp_path, c
     assert rc == 2 and "figures[2].page must be one of the manifest's pages" in err
 
 
-def test_sigterm_during_check_leaves_no_temporary_directory(s1_figures, tmp_path):
-    import signal
-    import subprocess
-    import sys
-    import time
-    a, _ = s1_figures
-    scratch = tmp_path / "tmp"
+#: A page that announces that it runs (the harness's READY file), then runs on.
+RUNNING_PAGE = "import os, time\nopen(os.environ['READY'], 'w').close()\ntime.sleep(120)"
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("what, moment", [("--out", "page"), ("--check", "page"), ("--out", "commit")])
+def test_a_signal_at_any_moment_leaves_nothing_behind(tmp_path, what, moment, signum):
+    """SIGTERM while a page ran was reported as an interrupt (nbclient's handler took it); now
+    each signal gives its own line and code, while a page runs (its kernel shut down) and
+    when the figures are about to be moved into place.  No DIR, no staging or temporary
+    directory, no process (the kernel included) is left."""
+    from .test_interrupts import Run, check
+    fake_book(tmp_path / "repo", RUNNING_PAGE if moment == "page" else "print('no figure')")
+    scratch, work = tmp_path / "tmp", tmp_path / "work"
     scratch.mkdir()
-    proc = subprocess.Popen([sys.executable, str(Path(__file__).parents[1] / "book" / "check_figures.py"),
-                             "--check", str(a)], env={**os.environ, "TMPDIR": str(scratch)},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    deadline = time.monotonic() + 120
-    while not list(scratch.glob("symrender-figures-*")) and time.monotonic() < deadline and proc.poll() is None:
-        time.sleep(0.05)
-    assert list(scratch.glob("symrender-figures-*")), "the check never made its temporary directory"
-    time.sleep(0.5)                                             # inside the page run
-    proc.send_signal(signal.SIGTERM)
-    _, err = proc.communicate(timeout=120)
-    # nbclient takes the signal while the page runs (its kernel shut down): reported as an interrupt.
-    last = err.decode().splitlines()[-1:]
-    assert (proc.returncode, last) in [(130, ["check_figures: interrupted"]),
-                                       (143, ["check_figures: terminated"])], err.decode()[-2000:]
-    assert not list(scratch.glob("symrender-figures-*"))
+    work.mkdir()
+    if what == "--check":
+        write_check_dir(work / "old")
+        doc = json.loads((work / "old" / "manifest.json").read_text())
+        doc["pages"], doc["figures"][0]["page"] = ["s1_bad"], "s1_bad"
+        (work / "old" / "manifest.json").write_text(json.dumps(doc))
+    before = sorted(p.name for p in work.iterdir())
+    run = Run("--tool", "check_figures", what, work / ("old" if what == "--check" else "figs"), "--pages", "s1",
+              cwd=work, moment=moment, env={"BOOK_ROOT": str(tmp_path / "repo"), "TMPDIR": str(scratch)})
+    run.at_the_moment()
+    run.send(signum)
+    check(run, work, before, grace=30, signum=signum, prog="check_figures")
+    assert list(scratch.iterdir()) == []
+
+
+def test_abbreviations_are_not_options(tmp_path, capsys, monkeypatch):
+    """``--chec DIR`` ran the check, ``--pag`` took pages: the tool had a parser of its own."""
+    monkeypatch.setattr(cli, "_render_figures", no_run)
+    for argv, words in ((["--chec", str(tmp_path)], "one of the arguments --out --check is required"),
+                        (["--out", str(tmp_path / "a"), "--pag", "s1"], "unrecognized arguments: --pag s1"),
+                        (["--o", str(tmp_path / "a")], "one of the arguments --out --check is required")):
+        rc, out, err = run(argv, capsys)
+        assert failure_problems(rc, err, [], []) == [] and words in err and out == "", err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_report_that_cannot_be_written_leaves_no_directory(tmp_path, capsys, monkeypatch):
+    """The figures are moved into DIR after the report is out: with standard output full,
+    exit 2 and DIR as it was (absent), no staging directory."""
+    class Full(io.StringIO):
+        def write(self, text):
+            raise OSError(28, "No space left on device")
+
+    def render_figures(out_dir, pages):
+        (out_dir / "manifest.json").write_text("{}")
+        return {"figures": [], "code_version": {"git_commit": None, "git_dirty": None, "source_sha256": "0" * 64}}
+
+    monkeypatch.setattr(cli, "_render_figures", render_figures)
+    monkeypatch.setattr(sys, "stdout", Full())
+    rc = main(["--out", str(tmp_path / "figs"), "--pages", "s1"])
+    err = capsys.readouterr().err
+    assert (rc, err) == (2, "check_figures: error: standard output: No space left on device\n")
+    assert list(tmp_path.iterdir()) == []
+    monkeypatch.setattr(sys, "stdout", io.StringIO())          # the control: the same run, reported
+    assert main(["--out", str(tmp_path / "figs"), "--pages", "s1"]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == ["figs"] and "wrote 0 figures" in sys.stdout.getvalue()
+
+
+def test_a_bad_environment_is_an_error_before_any_page(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(cli, "_render_figures", no_run)
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "0")
+    rc, _, err = run(["--out", str(tmp_path / "figs")], capsys)
+    assert rc == 2 and err.startswith("check_figures: error: the environment variable NUMBA_NUM_THREADS must be")
 
 
 def test_the_tools_signal_handlers_are_back_after_a_page(tmp_path, monkeypatch):

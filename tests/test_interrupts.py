@@ -54,7 +54,8 @@ OUTCOME = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminate
 #: and keeps the child there until the signal's exception arrives (or exits 99 after 120 s).
 #: band: the compiled band of the render or sweep, repeated (the exception comes between two
 #: calls, as in a real render); write: the output's temporary file is written (before its
-#: sync); commit: the report is out, the output not yet renamed into place.
+#: sync); commit: the report is out, the output not yet renamed into place; any other
+#: moment: nothing is held by the harness (a book page announces it, check_figures).
 HARNESS = """
 import os, sys, time
 import renderer.kernel as kernel
@@ -77,7 +78,7 @@ if moment == "band":
             while True:
                 real(*args)
         setattr(kernel, name, band)
-else:
+elif moment in ("write", "commit"):
     call = {"write": "fsync", "commit": "replace"}[moment]
     real = getattr(os, call)
     # fsync: of the output's temporary file; replace: of a staged output (a .part name).
