@@ -360,12 +360,14 @@ def test_a_signal_inside_the_band_loop(tmp_path, args, signum):
     check(run, tmp_path, [], signum=signum)
 
 
-@pytest.mark.parametrize("signum", SIGNALS, ids=["SIGINT", "SIGTERM"])
-@pytest.mark.parametrize("moment", ["write", "commit"])
-@pytest.mark.parametrize("args", [
-    ("render", "--size", "8x8", "-o", "out.png"),
-    ("ucurve", "--eps", "1e-3", "--plot", "out.png"),
-], ids=["render", "ucurve"])
+RENDER_8 = ("render", "--size", "8x8", "-o", "out.png")
+
+
+@pytest.mark.parametrize("args, moment, signum", [
+    *[(RENDER_8, moment, signum) for moment in ("write", "commit") for signum in SIGNALS],
+    (("ucurve", "--eps", "1e-3", "--plot", "out.png"), "commit", signal.SIGTERM),
+], ids=["render-write-SIGINT", "render-write-SIGTERM", "render-commit-SIGINT", "render-commit-SIGTERM",
+        "ucurve-commit-SIGTERM"])
 def test_a_signal_while_the_output_is_written_leaves_nothing(tmp_path, args, moment, signum):
     """SIGTERM while the output's temporary file was written exited 143 silently and left
     ``.out.png.XXXX.part`` behind; SIGINT was clean.  Both now: one line, nothing left, at
