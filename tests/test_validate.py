@@ -18,7 +18,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from renderer import PointLight, Scene, frame_label, pointwise
+from renderer import PointLight, Scene, pointwise
 from renderer.scene import COORDINATE, MAX_LENGTH, MIN_RADIUS
 from renderer.ucurve import measure
 from renderer.validate import (InputError, InvalidType, InvalidValue, choice, flag, positive_int, real,
@@ -139,14 +139,6 @@ def test_every_place_refuses_bools_strings_and_complex_numbers_by_name(site, val
 def test_every_place_refuses_an_integer_too_large_for_a_float_as_a_value_error(site):
     with pytest.raises(ValueError, match=rf"^{site.replace('[', '.').replace(']', '.')} must be .*, got an integer"):
         {**SCALAR_SITES, **ARRAY_SITES}[site](10**400)
-
-
-def test_frame_label_takes_sizes_as_a_positive_integer():
-    assert frame_label(Scene(), np.int64(64), 32) == "the draft's scene, 64 × 32"
-    with pytest.raises(TypeError, match=r"^width must be a positive integer, got bool True$"):
-        frame_label(Scene(), True, 32)
-    with pytest.raises(ValueError, match=r"^height must be a positive integer, got 0$"):
-        frame_label(Scene(), 32, 0)
 
 
 # ------------------------------------------------------------------ pointwise: every range at its limit and one past
