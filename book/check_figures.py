@@ -9,19 +9,26 @@ give the same bytes) into DIR, with manifest.json (figure id, page, code cell,
 content hash, the code version).  ``--check`` refuses a malformed or tampered DIR
 before any page runs, then reports each figure that changed and by how much
 (max |dI|), and exits 1 on a change beyond `CHECK_TOLERANCE_LEVELS` /
-`CHECK_TOLERANCE_FRACTION`.  Errors print one line and exit 2; DIR is written
-through a staging directory, so a failed or interrupted run leaves it as it was.
+`CHECK_TOLERANCE_FRACTION`.
+
+Exit paths are `renderer.cmdline`'s, as ``symrender``'s: an error prints one
+line and exits 2, a bug one line and 1, SIGINT 130 and SIGTERM 143 (at any
+moment, a page's run included).  DIR is written through a staging directory,
+moved into place only after the report is written: a failed, interrupted or
+terminated run, or one whose report cannot be written, leaves DIR as it was
+and no staging or temporary directory.
 """
 
 from __future__ import annotations
 
-import argparse
 import asyncio
+import contextlib
 import hashlib
 import io
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -30,33 +37,14 @@ from pathlib import Path
 
 import numpy as np
 
-from renderer import files
+from renderer import cmdline, files
+from renderer.cmdline import UsageError, one_line
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-class UsageError(Exception):
-    """A bad argument or input: one line, exit code 2."""
-
-
-def _one_line(msg):
-    return " ".join(str(msg).split())
-
-
 def _repo_root():
     return ROOT
-
-
-def _png_bytes_writer(rgb8):
-    def write(f):
-        import matplotlib.image
-        matplotlib.image.imsave(f, rgb8, format="png", metadata={"Software": None})   # no varying chunks
-    return write
-
-
-def _progress(iterable, **kwargs):
-    from tqdm import tqdm
-    return tqdm(iterable, file=sys.stderr, disable=not sys.stderr.isatty(), delay=1.0, leave=False, **kwargs)
 
 
 def _book_pages(book):
@@ -89,6 +77,7 @@ def _code_version(root):
 
 def _png_pixels(data):
     """Decode PNG bytes to an (H, W, 4) uint8 RGBA array."""
+    cmdline.import_matplotlib()
     import matplotlib.image
     rgba = matplotlib.image.imread(io.BytesIO(data), format="png")
     if rgba.dtype != np.uint8:
@@ -105,6 +94,30 @@ def _png_pixels(data):
 VARIES_TAG = "measured-timing"
 
 
+def _page_client():
+    """nbclient's NotebookClient, answering SIGINT and SIGTERM while a page runs as the
+    tool does: the signal is recorded (`renderer.cmdline.record_signal`) and the page's
+    task cancelled, once; nbclient shuts its kernel down on the way out.  (nbclient's
+    own handlers, which these replace once the kernel is up, do the same without
+    telling which signal came.)"""
+    import nbclient
+
+    class PageClient(nbclient.NotebookClient):
+        @contextlib.asynccontextmanager
+        async def async_setup_kernel(self, **kwargs):
+            async with super().async_setup_kernel(**kwargs):
+                loop, task = asyncio.get_running_loop(), asyncio.current_task()
+
+                def stop(signum):
+                    if cmdline.record_signal(signum):
+                        task.cancel()
+                for sig in (signal.SIGINT, signal.SIGTERM):
+                    with contextlib.suppress(RuntimeError):      # not the main thread
+                        loop.add_signal_handler(sig, stop, sig)
+                yield
+    return PageClient
+
+
 def _page_figures(book, page):
     """Execute one book page (a MyST notebook) in a fresh kernel; yield
     (figure id, code-cell ordinal, cell source, PNG bytes, cell tags) for every
@@ -114,6 +127,11 @@ def _page_figures(book, page):
     ------
     UsageError
         If a cell fails (the page's exception, in one line).
+    RuntimeError
+        If the kernel dies (with the last line it wrote to its standard error,
+        which is kept off the tool's: its warnings are not the tool's messages).
+    KeyboardInterrupt
+        If a signal stopped the page (whatever nbclient raised on its way out).
     """
     import base64
 
@@ -122,19 +140,28 @@ def _page_figures(book, page):
 
     path = book / f"{page}.md"
     nb = read_myst_markdown_notebook(path.read_text(encoding="utf-8"), path=path)
-    client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
-                                     resources={"metadata": {"path": str(book)}})
-    # nbclient takes SIGINT and SIGTERM while it runs (it shuts the kernel down, and the run ends
-    # in a CancelledError) and leaves them at their defaults: the tool's handlers are put back.
+    client = _page_client()(nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(book)}})
+    # nbclient takes SIGINT and SIGTERM while it runs and leaves them at their defaults after:
+    # the tool's handlers are put back.
     handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        client.execute()            # nbclient shuts its kernel down on the way out, Ctrl-C included
-    except nbclient.exceptions.CellExecutionError as exc:
-        raise UsageError(f"page {page} failed: {exc.ename}: {exc.evalue}") from None
-    finally:
-        for sig, handler in handlers.items():
-            if handler is not None:
-                signal.signal(sig, handler)
+    with tempfile.TemporaryFile() as kernel_stderr:
+        try:
+            client.execute(stderr=kernel_stderr)    # the kernel is shut down on the way out, a signal included
+        except BaseException as exc:
+            cmdline.check_signal()                  # a signal stopped the page
+            if isinstance(exc, nbclient.exceptions.CellExecutionError):
+                raise UsageError(f"page {page} failed: {exc.ename}: {exc.evalue}") from None
+            if isinstance(exc, nbclient.exceptions.DeadKernelError):
+                kernel_stderr.seek(0)
+                last = [line for line in kernel_stderr.read().decode(errors="replace").splitlines() if line.strip()]
+                raise RuntimeError(f"page {page}: the kernel died ({(last or ['no message'])[-1]})") from None
+            if isinstance(exc, asyncio.CancelledError):     # nbclient's own handler, before the tool's
+                raise KeyboardInterrupt from None
+            raise
+        finally:
+            for sig, handler in handlers.items():
+                if handler is not None:
+                    signal.signal(sig, handler)
     ordinal = 0
     for cell in nb.cells:
         if cell.cell_type != "code":
@@ -176,11 +203,11 @@ def _render_figures(out_dir, pages):
     root = _repo_root()
     book = root / "book"
     figures = []
-    for page in _progress(pages, desc="figures", unit="page"):
+    for page in cmdline.progress(pages, desc="figures", unit="page"):
         for fid, ordinal, source, png, tags in _page_figures(book, page):
             rgba = _png_pixels(png)
             name = _figure_file_name(fid, {f["file"] for f in figures})
-            data = _png_bytes(rgba)
+            data = cmdline.png_bytes(rgba)
             files.write_bytes(out_dir / name, data)
             entry = {"id": fid, "page": page, "code_cell": ordinal, "file": name,
                      "width": int(rgba.shape[1]), "height": int(rgba.shape[0]),
@@ -196,31 +223,35 @@ def _render_figures(out_dir, pages):
     return manifest
 
 
-def _write_figures_staged(out_dir, pages):
-    """Run `_render_figures` into a staging directory beside ``out_dir``, then
-    move the result in (the whole directory if ``out_dir`` is new, else file by
-    file with manifest.json last).  A failed or interrupted run removes the
-    staging directory and leaves ``out_dir`` as it was."""
-    import shutil
-    try:
-        staging = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name[:64]}.", suffix=".part"))
-    except OSError as exc:
-        raise OSError(exc.errno, exc.strerror, str(out_dir)) from None
-    try:
-        manifest = _render_figures(staging, pages)
+class _StagedDir:
+    """A staging directory beside ``out_dir`` (``.<name>.XXXX.part``) for `_render_figures`;
+    `commit` moves the result in (the whole directory if ``out_dir`` is new, else file by
+    file with manifest.json last), `discard` removes it: ``out_dir`` is left as it was
+    until the commit (a `renderer.cmdline.Outputs` staged output)."""
+
+    def __init__(self, out_dir):
+        self.out_dir = out_dir
         try:
-            os.chmod(staging, 0o777 & ~files.umask())
-            if not out_dir.exists():
-                os.replace(staging, out_dir)
-            else:
-                names = sorted(p.name for p in staging.iterdir() if p.name != "manifest.json")
-                for name in [*names, "manifest.json"]:
-                    os.replace(staging / name, out_dir / name)
+            self.path = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name[:64]}.", suffix=".part"))
         except OSError as exc:
             raise OSError(exc.errno, exc.strerror, str(out_dir)) from None
-        return manifest
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+
+    def commit(self):
+        try:
+            os.chmod(self.path, 0o777 & ~files.umask())
+            if not self.out_dir.exists():
+                os.replace(self.path, self.out_dir)
+            else:
+                names = sorted(p.name for p in self.path.iterdir() if p.name != "manifest.json")
+                for name in [*names, "manifest.json"]:
+                    os.replace(self.path / name, self.out_dir / name)
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, str(self.out_dir)) from None
+        finally:
+            self.discard()
+
+    def discard(self):
+        shutil.rmtree(self.path, ignore_errors=True)
 
 
 #: Largest manifest.json that ``figures --check`` reads (bytes); the whole
@@ -265,13 +296,6 @@ def _figure_file_name(fid, taken):
         k += 1
         name = f"{base}-{k}.png"
     return name
-
-
-def _png_bytes(rgb8):
-    """PNG bytes of an (H, W, 3 or 4) uint8 image, without metadata."""
-    buf = io.BytesIO()
-    _png_bytes_writer(rgb8)(buf)
-    return buf.getvalue()
 
 
 def _known_pages():
@@ -395,7 +419,7 @@ def _load_manifest(old_dir, known_pages):
     try:
         doc = json.loads(raw.decode("utf-8"))
     except (ValueError, RecursionError) as exc:  # bad UTF-8, bad JSON, nesting too deep
-        raise _manifest_error(path, f"not JSON ({_one_line(exc)[:120]})") from None
+        raise _manifest_error(path, f"not JSON ({one_line(exc)[:120]})") from None
     figures, pages = _validate_manifest(doc, path, known_pages)
     for entry in figures.values():
         _read_figure(old_dir, entry)
@@ -436,6 +460,8 @@ def compare_figure(old_png, new_png):
 
 
 def run(args, out):
+    """Do what ``args`` asks, the report into ``out`` (a `renderer.cmdline.Outputs`); return
+    0, or 1 when ``--check`` finds a changed figure."""
     import fnmatch
     pages = None
     if args.pages is not None:
@@ -451,7 +477,8 @@ def run(args, out):
         if not out_dir.parent.is_dir():
             raise UsageError(f"--out {args.out!r}: directory {str(out_dir.parent)!r} does not exist")
         pages = _resolve_pages(pages)
-        manifest = _write_figures_staged(out_dir, pages)
+        staged = out.stage(_StagedDir(out_dir))
+        manifest = _render_figures(staged.path, pages)
         for f in manifest["figures"]:
             print(f"{f['id']:40s} {f['width']:4d}x{f['height']:<4d} {f['sha256'][:16]}", file=out)
         v = manifest["code_version"]
@@ -496,54 +523,21 @@ def run(args, out):
     return 1 if changed else 0
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):                # one line, as every other error of the tool
-        raise UsageError(message)
-
-
-#: Set by SIGTERM: the KeyboardInterrupt `_terminate` raises unwinds like a Ctrl-C (removing the
-#: temporary and staging directories).  While a page runs, nbclient takes the signal itself:
-#: it shuts the kernel down and the run ends in a CancelledError, reported as an interrupt.
-_terminated = False
-
-
-def _terminate(signum, frame):
-    global _terminated
-    _terminated = True
-    raise KeyboardInterrupt
-
-
-def main(argv=None) -> int:
-    """Run the tool; return 0, 1 (a figure changed), 2 (a usage error), 130 (Ctrl-C, or either
-    signal while a page runs) or 143 (SIGTERM); either signal removes the temporary and staging
-    directories first."""
-    p = _Parser(prog="check_figures.py", description=__doc__.split("\n\n")[1])
+def _command(argv, outputs):
+    p = cmdline.Parser(prog="check_figures.py", description=__doc__.split("\n\n")[1])
     what = p.add_mutually_exclusive_group(required=True)
     what.add_argument("--out", metavar="DIR", help="directory to write the figures and manifest.json into")
     what.add_argument("--check", metavar="DIR", help="a previous --out directory to compare a fresh run with")
     p.add_argument("--pages", metavar="s1,s4,...", help="only these pages (default: all; --check: the manifest's)")
     p.add_argument("--ignore", action="append", default=[], metavar="ID-PATTERN",
                    help="with --check: report but do not fail on figures matching this pattern; repeatable")
-    try:
-        previous = signal.signal(signal.SIGTERM, _terminate)
-    except ValueError:                       # not the main thread: signals are left alone
-        previous = None
-    global _terminated
-    _terminated = False
-    try:
-        return run(p.parse_args(argv), sys.stdout)
-    except (KeyboardInterrupt, asyncio.CancelledError):
-        print(f"check_figures: {'terminated' if _terminated else 'interrupted'}", file=sys.stderr)
-        return 143 if _terminated else 130
-    except UsageError as exc:
-        print(f"check_figures: error: {_one_line(exc)}", file=sys.stderr)
-        return 2
-    except OSError as exc:
-        print(f"check_figures: error: {exc.filename or ''}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
-        return 2
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+    return run(p.parse_args(argv), outputs)
+
+
+def main(argv=None) -> int:
+    """Run the tool; return 0, 1 (a figure changed), 2 (an error), 130 (SIGINT) or 143
+    (SIGTERM), as `renderer.cmdline.main`."""
+    return cmdline.main("check_figures", _command, sys.argv[1:] if argv is None else list(argv))
 
 
 if __name__ == "__main__":

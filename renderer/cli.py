@@ -7,50 +7,52 @@ Subcommands (``symrender <command> --help`` for each)::
     symrender sweep   --eps 1e-1:1e-8:8 [--scene ...] [--set ...] [--size WxH] [--format text|csv|json]
     symrender ucurve  --field sine --u 0.31 --v 0.47 --component u [--eps ...] [--plot out.png]
 
-Errors.  Every input error (a bad argument, a malformed or unknown scene key, a
-value `Scene` refuses, a size over the limits, an output path that cannot be
-written) prints ONE line ``symrender: error: ...`` naming the argument, writes
-nothing and returns 2.  Anything else is a bug: one line ``symrender: internal
-error: ...`` and 1; a traceback is never printed.
+Errors and exit codes are `renderer.cmdline`'s: an input error (a bad argument,
+a malformed or unknown scene key, a value the library's validation refuses,
+named by its option, a size over the limits, an output path that cannot be
+written) prints ONE line ``symrender: error: ...`` and returns 2; anything else
+is a bug: one line ``symrender: internal error: ...`` and 1; a traceback is
+never printed.  Ctrl-C prints ``symrender: interrupted`` and returns 130,
+SIGTERM ``symrender: terminated`` and 143.
 
-Ctrl-C prints ``symrender: interrupted`` and returns 130, and leaves no file:
-outputs are written atomically (`renderer.files.write_bytes`) after the work,
-and an interrupt that numba's compiler swallowed is caught before writing.
-
-Reproducibility.  PNG files carry no varying metadata: two runs give the same
-bytes.  ``-o -`` (``--plot -``) writes to standard output, the report to
-standard error, and is refused on a terminal.
+Outputs.  The report (the ledger, the census, the U-curve table) is written and
+flushed before the output file is put in place, atomically
+(`renderer.files.Staged`): a failure or a signal at any moment, or a report
+that cannot be written (a full standard output), leaves no output file and no
+temporary file.  PNG files carry no varying metadata: two runs give the same
+bytes.  ``-o -`` (``--plot -``) writes to standard output, and is refused on a
+terminal; the report then goes to standard error (as with ``-o /dev/stdout``).
 
 Limits (refused before anything is allocated): each side of ``--size`` in
-[1, 8192]; ``render`` holds two frames, at most ``MAX_PIXELS`` = 4096^2
-pixels; ``sweep`` holds one frame per step plus one, (steps + 1) * W * H <=
-``FRAME_PIXEL_BUDGET`` = 2 * 4096^2.
+[1, 8192]; ``render`` holds two frames at a time (central and exact for the
+ledger; the footprint frame, when shown, replaces the central one), at most
+``MAX_PIXELS`` = 4096^2 pixels each; ``sweep`` holds one frame per step plus
+one, (steps + 1) * W * H <= ``FRAME_PIXEL_BUDGET`` = 2 * 4096^2.
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import csv
 import io
 import json
 import math
 import os
 import re
-import signal
 import sys
 import tomllib
 from pathlib import Path
 
-from . import files
+from . import cmdline, files
+from .cmdline import STDOUT, UsageError
 
-__all__ = ["main", "load_scene", "parse_size", "parse_eps", "write_png", "atomic_write",
-           "MAX_PIXELS", "FRAME_PIXEL_BUDGET", "MAX_UCURVE_STEPS"]
+__all__ = ["main", "load_scene", "parse_size", "parse_eps", "view_image", "MAX_PIXELS", "FRAME_PIXEL_BUDGET",
+           "MAX_UCURVE_STEPS"]
 
 #: Most pixels `render` accepts (W * H): the library's `renderer.render.MAX_PIXELS` (not imported:
-#: the command line starts without numpy; a test holds them equal).  The peak of ``render`` is the
-#: two frames of the ledger (26 bytes a pixel each; the bump view adds 16 for each gradient it
-#: reads) and the display image's float64 temporaries (about 100 bytes a pixel).
+#: the command line starts without numpy; a test holds them equal).  The peak of ``render`` is two
+#: frames (26 bytes a pixel each; the bump view adds 16 for each gradient it reads) and the
+#: display image's float64 temporaries (about 100 bytes a pixel).
 MAX_PIXELS = 4096 * 4096
 #: Most frame-pixels a command holds at once: render holds 2 frames, a sweep of
 #: n steps holds n + 1.
@@ -70,41 +72,6 @@ def _field_names():
     from renderer.scene import PointLight, Scene
     return (tuple(f.name for f in dataclass_fields(Scene)),
             tuple(f.name for f in dataclass_fields(PointLight)))
-
-
-class UsageError(Exception):
-    """A bad argument or input: printed as one line, exit code 2."""
-
-
-_NEGATIVE_VALUE = re.compile(r"-[0-9.]")
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse that raises `UsageError` instead of printing usage and exiting,
-    and that takes a value starting with ``-`` and a digit or ``.`` as the
-    value of the option before it (``--size -5x5``, ``--eps -1e-3``), so that
-    such values reach the command's own checks and messages."""
-
-    def __init__(self, *args, **kwargs):
-        super().__init__(*args, allow_abbrev=False, **kwargs)   # --v is not --version
-
-    def error(self, message):
-        raise UsageError(message)
-
-    def parse_known_args(self, args=None, namespace=None):
-        if args is not None:
-            takes_value = {o for a in self._actions if a.nargs is None for o in a.option_strings}
-            args, joined = list(args), []
-            while args:
-                token = args.pop(0)
-                if token == "--":
-                    joined += [token, *args]
-                    break
-                if token in takes_value and args and _NEGATIVE_VALUE.match(args[0]):
-                    token = f"{token}={args.pop(0)}"
-                joined.append(token)
-            args = joined
-        return super().parse_known_args(args, namespace)
 
 
 def _version():
@@ -166,21 +133,12 @@ def _number(text):
     return float(text)
 
 
-def _positive_float(text, name, bounds=None):
-    try:
-        x = _number(text)
-    except ValueError:
-        raise UsageError(f"{name}: {text!r} is not a number") from None
-    if bounds is not None and not (math.isfinite(x) and bounds[0] <= x <= bounds[1]):
-        raise UsageError(f"{name}: each step must be in [{bounds[0]:g}, {bounds[1]:g}] "
-                         f"(chart units), got {text.strip()!r}")
-    if not (math.isfinite(x) and x > 0):
-        raise UsageError(f"{name}: each step must be a finite number > 0, got {text!r}")
-    return x
+def parse_eps(text, *, name="--eps", max_steps=None):
+    """Parse steps: ``"a:b:n"`` (n log-spaced from a to b, both ends exact) or ``"e1,e2,..."``.
 
-
-def parse_eps(text, *, name="--eps", max_steps=None, bounds=None):
-    """Parse steps: ``"a:b:n"`` (n log-spaced from a to b) or ``"e1,e2,..."``.
+    The text only: the range of the steps is the command's (``sweep``: the
+    Scene's, ``ucurve``: `renderer.ucurve.measure`'s), checked by
+    `renderer.validate.steps`.
 
     Parameters
     ----------
@@ -189,49 +147,53 @@ def parse_eps(text, *, name="--eps", max_steps=None, bounds=None):
         The option named in errors.
     max_steps : int or None
         Most steps accepted; None means `renderer.sweep.MAX_STEPS`.
-    bounds : (float, float) or None
-        If given, the closed range every step must lie in (chart units), as
-        ``(renderer.scene.MIN_EPS, renderer.scene.MAX_EPS)`` for a sweep.
 
     Returns
     -------
-    tuple of float, each finite and > 0 (and within ``bounds``), chart units;
-    1 to ``max_steps`` of them.
+    tuple of float (chart units), 1 to ``max_steps`` of them.
 
     Raises
     ------
     UsageError
-        Naming ``name``, for a malformed text, a step that is not a finite
-        positive number or lies outside ``bounds`` (the range is named), or a
-        count outside [1, max_steps].
+        Naming ``name``, for a malformed text, a step that is not a number,
+        an end of a:b:n that is not a finite number > 0 (they are log-spaced),
+        or a count outside [1, max_steps].
     """
-    import numpy as np
     if max_steps is None:
         from renderer.sweep import MAX_STEPS as max_steps
+
+    def number(part):
+        try:
+            return _number(part)
+        except ValueError:
+            raise UsageError(f"{name}: {part!r} is not a number") from None
+
     text = str(text).strip()
-    if ":" in text:
-        parts = text.split(":")
-        if len(parts) != 3:
-            raise UsageError(f"{name} must be a:b:n (n log-spaced steps from a to b) or a comma "
-                             f"list, got {text!r}")
-        a, b = (_positive_float(p, name, bounds) for p in parts[:2])
-        count = parts[2].strip()
-        if not re.fullmatch(r"[-+]?[0-9]+", count):
-            raise UsageError(f"{name}: the count n in a:b:n must be an integer in [1, {max_steps}], "
-                             f"got {parts[2]!r}")
-        if not (len(count.lstrip("+")) <= 6 and 1 <= int(count) <= max_steps):
-            raise UsageError(f"{name}: the count n must be between 1 and {max_steps}, got {count}")
-        # Rounded to 15 significant digits so that decades print as 1e-05, not
-        # 9.999999999999999e-06 (a relative change below 1e-15).
-        steps = tuple(float(f"{e:.15g}") for e in np.logspace(math.log10(a), math.log10(b), int(count)))
-        if bounds is not None:  # rounding could step just outside the range
-            steps = tuple(min(max(e, bounds[0]), bounds[1]) for e in steps)
-    else:
-        items = [p for p in text.split(",")]
+    if ":" not in text:
+        items = text.split(",")
         if not 1 <= len(items) <= max_steps:
             raise UsageError(f"{name} must hold 1 to {max_steps} steps, got {len(items)}")
-        steps = tuple(_positive_float(p, name, bounds) for p in items)
-    return steps
+        return tuple(number(p) for p in items)
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise UsageError(f"{name} must be a:b:n (n log-spaced steps from a to b) or a comma "
+                         f"list, got {text!r}")
+    a, b = (number(p) for p in parts[:2])
+    if not all(math.isfinite(x) and x > 0 for x in (a, b)):
+        raise UsageError(f"{name}: the ends a, b of a:b:n must be finite numbers > 0 (the steps are "
+                         f"log-spaced), got {text!r}")
+    count = parts[2].strip()
+    if not re.fullmatch(r"[-+]?[0-9]+", count):
+        raise UsageError(f"{name}: the count n in a:b:n must be an integer in [1, {max_steps}], "
+                         f"got {parts[2]!r}")
+    if not (len(count.lstrip("+")) <= 6 and 1 <= int(count) <= max_steps):
+        raise UsageError(f"{name}: the count n must be between 1 and {max_steps}, got {count}")
+    import numpy as np
+    # Rounded to 15 significant digits so that decades print as 1e-05, not
+    # 9.999999999999999e-06 (a relative change below 1e-15); the ends are the given ones.
+    steps = [float(f"{e:.15g}") for e in np.logspace(math.log10(a), math.log10(b), int(count))]
+    steps[0], steps[-1] = a, b if len(steps) > 1 else a
+    return tuple(steps)
 
 
 #: Largest scene file `load_scene` reads (bytes); a scene is a few hundred.
@@ -284,6 +246,7 @@ def _check_ints(source, name, value):
 def _scene_mapping(data, source):
     """Turn a TOML mapping into `Scene` keyword arguments, refusing unknown keys."""
     from renderer.scene import PointLight
+    from renderer.validate import InputError
     scene_fields, light_fields = _field_names()
     out = {}
     for key, value in data.items():
@@ -309,7 +272,7 @@ def _scene_mapping(data, source):
                                      f"{' and '.join(light_fields)}")
                 try:
                     lights.append(PointLight(**table))
-                except (TypeError, ValueError) as exc:  # the message names the field and the value
+                except InputError as exc:  # the message names the field and the value
                     raise UsageError(f"{source}: lights[{i}]: {exc}") from None
             value = tuple(lights)
         out[key] = value
@@ -362,7 +325,8 @@ def load_scene(path=None, sets=()):
         value nested more than `MAX_NESTING` levels; an unknown key (named);
         a light without ``position`` or ``color`` (named as ``lights[i]``);
         or a malformed ``--set``.
-        Also what `Scene` and `PointLight` refuse (their message names the field).
+    renderer.validate.InputError
+        What `Scene` and `PointLight` refuse (the message names the field).
     """
     from renderer.scene import Scene
     scene_fields = _field_names()[0]
@@ -385,92 +349,18 @@ def load_scene(path=None, sets=()):
         if key not in scene_fields:
             raise UsageError(f"--set: unknown scene field {key!r}; fields are {', '.join(scene_fields)}")
         data.update(_scene_mapping({key: _toml_value(key, text.strip())}, "--set"))
-    try:
-        return Scene(**data)
-    except (TypeError, ValueError) as exc:  # Scene's validation names the field, the value, what is accepted
-        raise UsageError(str(exc)) from None
+    return Scene(**data)
 
 
-# ---------------------------------------------------------------- output helpers
+# ---------------------------------------------------------------- outputs
 
 
-#: The output path that means standard output (``-o -``, ``--plot -``).
-STDOUT = "-"
-
-
-def _stdout_bytes():
-    """The binary stream under ``sys.stdout``, refused when it is a terminal."""
-    stream = sys.stdout
-    if stream.isatty():
-        raise UsageError("output '-' is standard output, which is a terminal; redirect it to a "
-                         "file or a pipe, or give a file name")
-    if getattr(stream, "buffer", None) is None:
-        raise UsageError("output '-': standard output does not take bytes here; give a file name")
-    return stream.buffer
-
-
-def atomic_write(path, write):
-    """Write an output file from ``write(fileobj)`` (a callable given a binary
-    file object), after checking the path as a command-line argument.
-
-    The bytes are prepared in memory first (an exception in ``write`` writes
-    nothing), then written by `renderer.files.write_bytes`: a path that is
-    absent or a regular file is replaced atomically (a temporary file in its
-    directory, then `os.replace`; on any exception, KeyboardInterrupt
-    included, ``path`` is untouched and no temporary file is left), and so
-    is the final target of a symbolic link to a regular file; a character
-    device or FIFO (``/dev/null``), or a link to one (``/dev/stdout`` on a
-    pipe), is written through and stays what it was.  ``path`` ``-`` writes the bytes to standard output.
-    New files get 0666 & ~umask permissions.
-
-    Raises
-    ------
-    UsageError
-        If ``path`` is empty, ends in ``/``, is a directory, a block device, a
-        socket or a dangling symbolic link, or its directory does not exist; or if it
-        is ``-`` and standard output is a terminal.
-    OSError
-        If the directory or the target cannot be written (naming ``path``).
-    """
-    stream = _stdout_bytes() if path == STDOUT else None
-    if stream is None:
-        _check_output(path, "output")
-    buf = io.BytesIO()
-    write(buf)
-    _stop_if_interrupted()                # a Ctrl-C a C callback dropped while the bytes were made
-    if stream is not None:
-        sys.stdout.flush()
-        stream.write(buf.getbuffer())
-        stream.flush()
-        return
-    try:
-        files.write_bytes(path, buf.getbuffer())
-    except files.RefusedPath as exc:  # changed since checked
-        raise UsageError(f"output {exc}") from None
-
-
-def _png_bytes_writer(rgb8):
-    def write(f):
-        import matplotlib.image
-        # No tEXt chunks at all ("Software" is matplotlib's only default key),
-        # so the bytes depend on the pixels alone.
-        matplotlib.image.imsave(f, rgb8, format="png", metadata={"Software": None})
-    return write
-
-
-def write_png(path, rgb):
-    """Write an (H, W, 3) float image with values in [0, 1] (already display-
-    encoded) as an 8-bit PNG without varying metadata, by `atomic_write`
-    (``-`` is standard output).
-
-    Raises
-    ------
-    UsageError, OSError
-        As `atomic_write`.
-    """
+def _stage_png(outputs, path, rgb, flag):
+    """Stage an (H, W, 3) float image with values in [0, 1] (already display-encoded)
+    as an 8-bit PNG without varying metadata (``-``: standard output)."""
     import numpy as np
     rgb8 = np.round(np.clip(np.asarray(rgb, dtype=np.float64), 0.0, 1.0) * 255.0).astype(np.uint8)
-    atomic_write(path, _png_bytes_writer(rgb8))
+    outputs.stage_bytes(path, cmdline.png_bytes(rgb8), flag)
 
 
 def _check_output(path, flag):
@@ -481,10 +371,7 @@ def _check_output(path, flag):
     writable; a device or FIFO that is not writable (its directory need not
     be writable)."""
     if path == STDOUT:
-        try:
-            _stdout_bytes()
-        except UsageError as exc:
-            raise UsageError(f"{flag} {str(exc).removeprefix('output ')}") from None
+        cmdline.binary_stdout(flag)
         return
     try:
         route = files.output_route(path)
@@ -504,20 +391,13 @@ def _check_output(path, flag):
         raise UsageError(f"{flag} {str(path)!r}: directory {str(parent)!r} is not writable")
 
 
-def _progress(iterable=None, **kwargs):
-    """A tqdm bar on stderr, shown only when stderr is a terminal and the work
-    takes more than a second."""
-    from tqdm import tqdm
-    return tqdm(iterable, file=sys.stderr, disable=not sys.stderr.isatty(), delay=1.0,
-                leave=False, **kwargs)
-
-
-def _show_progress():
-    return sys.stderr.isatty()
-
-
 def _fmt(x):
-    return "nan" if isinstance(x, float) and math.isnan(x) else f"{x:.3e}"
+    return f"{x:.3e}"
+
+
+def _mean(x, where):
+    """A band mean for the report: the Ledger's NaN (no pixel in the set) in words."""
+    return f"none (no pixel {where})" if math.isnan(x) else _fmt(x)
 
 
 def _ledger_lines(led):
@@ -527,8 +407,8 @@ def _ledger_lines(led):
         f"  RMS |dI|            {_fmt(led.rms)}",
         f"  flips               {led.flips}",
         f"  pixels on A         {led.pixels_a}",
-        f"  mean |dI| on band   {_fmt(led.mean_abs_kink)}",
-        f"  mean |dI| off band  {_fmt(led.mean_abs_off_kink)}",
+        f"  mean |dI| on band   {_mean(led.mean_abs_kink, 'in the band')}",
+        f"  mean |dI| off band  {_mean(led.mean_abs_off_kink, 'off the band')}",
     ]
 
 
@@ -542,7 +422,9 @@ def view_image(view, selected, numeric, symbolic):
     I_exact|, 0, 1)`` per channel (not sRGB-encoded, as book/s4_simulator.md).
     bump: ``to_srgb(|grad h| / max over A of the exact |grad h|)`` on sphere A,
     black elsewhere.  kink: the selected image sRGB-encoded and dimmed to 40 %,
-    the exact frame's crease band painted white.
+    the exact frame's crease band painted white.  The difference view reads
+    ``numeric`` and ``symbolic`` only, the others ``selected`` and ``symbolic``
+    (``numeric`` may then be None).
     """
     import numpy as np
     from renderer.ledger import to_srgb
@@ -564,81 +446,82 @@ def view_image(view, selected, numeric, symbolic):
     raise UsageError(f"--view must be one of {VIEWS}, got {view!r}")
 
 
-def _cmd_render(args, out):
+def _cmd_render(args, outputs):
     from renderer.ledger import compare
     from renderer.render import render
     width, height = args.size
     _check_budget(width, height, 2, "render")
     _check_output(args.output, "-o")
-    if args.output == STDOUT:  # the PNG takes stdout; the report goes to stderr
-        out = sys.stderr
+    outputs.to_stderr = cmdline.is_stdout(args.output)    # the PNG takes stdout: the report goes to stderr
     scene = load_scene(args.scene, args.set)
-    frames = {}
-    wanted = ("central", "exact") + (() if args.gradient in ("central", "exact") else (args.gradient,))
-    for g in _progress(wanted, desc="render", unit="frame"):
-        # The gradients only for the bump view (exact: its scale; selected: its pixels): 16 bytes a pixel.
-        frames[g] = render(scene, width, height, gradient=g,
-                           grad=args.view == "bump" and g in ("exact", args.gradient))
-    numeric, symbolic = frames["central"], frames["exact"]
-    selected = frames[args.gradient]
-    write_png(args.output, view_image(args.view, selected, numeric, symbolic))
+    bump = args.view == "bump"     # the gradients only for the bump view: 16 bytes a pixel each
+    footprint = args.gradient == "footprint" and args.view != "difference"
+    with cmdline.progress(total=2 + footprint, desc="render", unit="frame") as bar:
+        numeric = render(scene, width, height, gradient="central", kink=False,
+                         grad=bump and args.gradient == "central")
+        bar.update()
+        symbolic = render(scene, width, height, gradient="exact", grad=bump)   # its kink: the ledger's band
+        bar.update()
+        ledger = compare(numeric, symbolic)
+        selected = symbolic if args.gradient == "exact" else numeric
+        if footprint:
+            # The footprint frame takes the central frame's place: two frames at a time.
+            numeric = selected = None
+            selected = render(scene, width, height, gradient="footprint", kink=False, grad=bump)
+            bar.update()
+    _stage_png(outputs, args.output, view_image(args.view, selected, numeric, symbolic), "-o")
     where = "standard output" if args.output == STDOUT else args.output
-    print(f"wrote {where} ({width}x{height}, view {args.view}, gradient {args.gradient})", file=out)
-    print("\n".join(_ledger_lines(compare(numeric, symbolic))), file=out)
+    print(f"wrote {where} ({width}x{height}, view {args.view}, gradient {args.gradient})", file=outputs)
+    print("\n".join(_ledger_lines(ledger)), file=outputs)
     return 0
 
 
 _CENSUS_COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink", "mean_abs_off_kink")
 
 
-def _run_sweep(scene, steps, width, height):
-    """The census of `renderer.sweep` over ``steps``."""
+def _cmd_sweep(args, outputs):
+    from renderer.scene import MAX_EPS, MIN_EPS
     from renderer.sweep import sweep
-    return list(sweep(scene, steps, width, height).census)
-
-
-def _cmd_sweep(args, out):
-    steps = args.eps
+    from renderer.validate import steps as valid_steps
+    steps = tuple(float(e) for e in valid_steps("--eps", args.eps, low=MIN_EPS, high=MAX_EPS))
     width, height = args.size
     _check_budget(width, height, len(steps) + 1, "sweep")
     scene = load_scene(args.scene, args.set)
-    census = _run_sweep(scene, steps, width, height)
-    _stop_if_interrupted()
+    census = sweep(scene, steps, width, height).census
     rows = [dict(zip(_CENSUS_COLUMNS, (e, led.max_abs, led.rms, led.flips, led.pixels_a,
                                        led.mean_abs_kink, led.mean_abs_off_kink)))
             for e, led in zip(steps, census)]
+    missing = lambda x: isinstance(x, float) and math.isnan(x)  # noqa: E731  (no pixel in the set)
     if args.format == "json":
-        clean = lambda x: None if isinstance(x, float) and math.isnan(x) else x  # noqa: E731
         doc = {"size": [width, height], "height_field": scene.height_field,
-               "rows": [{k: clean(v) for k, v in r.items()} for r in rows]}
-        print(json.dumps(doc, indent=1, allow_nan=False), file=out)
+               "rows": [{k: None if missing(v) else v for k, v in r.items()} for r in rows]}
+        print(json.dumps(doc, indent=1, allow_nan=False), file=outputs)
     elif args.format == "csv":
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
+        w = csv.writer(outputs, lineterminator="\n")
         w.writerow(_CENSUS_COLUMNS)
         for r in rows:
-            w.writerow([repr(r[k]) if isinstance(r[k], float) else r[k] for k in _CENSUS_COLUMNS])
-        out.write(buf.getvalue())
+            w.writerow(["" if missing(r[k]) else repr(r[k]) if isinstance(r[k], float) else r[k]
+                        for k in _CENSUS_COLUMNS])
     else:
         print(f"census: {scene.height_field}, beta {scene.beta:g}, {width}x{height}, central vs exact on sphere A",
-              file=out)
+              file=outputs)
         print(f"{'eps':>9}  {'max |dI|':>9}  {'RMS |dI|':>9}  {'flips':>5}  {'on band':>9}  {'off band':>9}",
-              file=out)
+              file=outputs)
+        cell = lambda x: "none" if missing(x) else _fmt(x)  # noqa: E731
         for r in rows:
             print(f"{r['eps']:9.2e}  {_fmt(r['max_abs']):>9}  {_fmt(r['rms']):>9}  {r['flips']:5d}  "
-                  f"{_fmt(r['mean_abs_kink']):>9}  {_fmt(r['mean_abs_off_kink']):>9}", file=out)
+                  f"{cell(r['mean_abs_kink']):>9}  {cell(r['mean_abs_off_kink']):>9}", file=outputs)
     return 0
 
 
-def _measure_ucurve(args):
+def _measure_ucurve(args, steps):
     import numpy as np
     from renderer.ucurve import UNIT_ROUNDOFF, UCurve, fit_model, measure
-    steps = np.asarray(args.eps, dtype=np.float64)
     kw = dict(field=args.field, u=args.u, v=args.v, component=args.component, k_u=args.k_u, k_v=args.k_v)
-    if not _show_progress() or steps.size < 50:
+    if not cmdline.show_progress() or steps.size < 50:
         return measure(eps=steps, **kw)
     parts = []
-    with _progress(total=steps.size, desc="ucurve", unit="step") as bar:
+    with cmdline.progress(total=steps.size, desc="ucurve", unit="step") as bar:
         for chunk in np.array_split(steps, math.ceil(steps.size / 25)):
             parts.append(measure(eps=chunk, **kw))
             bar.update(chunk.size)
@@ -650,56 +533,54 @@ def _measure_ucurve(args):
     opt = (float("nan"),) * 2 if reason is not None else (float(steps[best]), float(error[best]))
     fit = (float("nan"),) * 4
     if reason is None:
-        with contextlib.suppress(ValueError):
+        try:
             A, B = fit_model(steps, error, start=(max(abs(p0.third_derivative), 1e-300) / 6, UNIT_ROUNDOFF))
+        except ValueError:
+            pass
+        else:
             e_fit = (B / (2 * A)) ** (1 / 3)
             fit = (A, B, e_fit, A * e_fit**2 + B / e_fit)
     return UCurve(p0.field, p0.u, p0.v, p0.component, steps, error, cat("truncation"), cat("roundoff"),
                   cat("model"), p0.derivative, p0.third_derivative, p0.eps_opt_predicted, *opt, reason, *fit)
 
 
-def _ucurve_plot_writer(uc):
-    def write(f):
-        import numpy as np
-        import matplotlib
-        from matplotlib.figure import Figure
-        with matplotlib.rc_context({"svg.hashsalt": "symrender", "path.simplify": False}):
-            fig = Figure(figsize=(6.0, 4.0), dpi=100)
-            ax = fig.subplots()
-            floor = np.finfo(float).tiny
-            ax.loglog(uc.eps, np.maximum(uc.error, floor), "k.-", label="measured |error|")
-            ax.loglog(uc.eps, np.maximum(np.abs(uc.truncation), floor), "C0--", label="|truncation|")
-            ax.loglog(uc.eps, np.maximum(np.abs(uc.roundoff), floor), "C3--", label="|roundoff|")
-            ax.loglog(uc.eps, uc.model, "C2:", label="model eps^2|h'''|/6 + u|h|/eps")
-            if math.isfinite(uc.eps_opt_predicted):
-                ax.axvline(uc.eps_opt_predicted, color="0.6", lw=0.8, label="predicted eps*")
-            ax.set_xlabel("eps (chart units)")
-            ax.set_ylabel(f"|error| of h_{uc.component}")
-            ax.set_title(f"U-curve: {uc.field} at (u, v) = ({uc.u:g}, {uc.v:g})"
-                         + (" (not differentiable there)" if uc.reason else ""))
-            ax.legend(fontsize=7)
-            fig.tight_layout()
-            fig.savefig(f, format="png", metadata={"Software": None})
-    return write
+def _ucurve_png(uc):
+    """The U-curve's log-log plot as PNG bytes without varying metadata."""
+    import numpy as np
+    matplotlib = cmdline.import_matplotlib()
+    from matplotlib.figure import Figure
+    with matplotlib.rc_context({"svg.hashsalt": "symrender", "path.simplify": False}):
+        fig = Figure(figsize=(6.0, 4.0), dpi=100)
+        ax = fig.subplots()
+        floor = np.finfo(float).tiny
+        ax.loglog(uc.eps, np.maximum(uc.error, floor), "k.-", label="measured |error|")
+        ax.loglog(uc.eps, np.maximum(np.abs(uc.truncation), floor), "C0--", label="|truncation|")
+        ax.loglog(uc.eps, np.maximum(np.abs(uc.roundoff), floor), "C3--", label="|roundoff|")
+        ax.loglog(uc.eps, uc.model, "C2:", label="model eps^2|h'''|/6 + u|h|/eps")
+        if math.isfinite(uc.eps_opt_predicted):
+            ax.axvline(uc.eps_opt_predicted, color="0.6", lw=0.8, label="predicted eps*")
+        ax.set_xlabel("eps (chart units)")
+        ax.set_ylabel(f"|error| of h_{uc.component}")
+        ax.set_title(f"U-curve: {uc.field} at (u, v) = ({uc.u:g}, {uc.v:g})"
+                     + (" (not differentiable there)" if uc.reason else ""))
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", metadata={"Software": None})
+    return buf.getvalue()
 
 
-def _cmd_ucurve(args, out):
+def _cmd_ucurve(args, outputs):
+    from renderer import pointwise, validate
     if args.plot is not None:
         _check_output(args.plot, "--plot")
-        if args.plot == STDOUT:  # the plot takes stdout; the table goes to stderr
-            out = sys.stderr
-    for name in ("u", "v"):
-        x = getattr(args, name)
-        if not (math.isfinite(x) and 0.0 <= x <= 1.0):
-            raise UsageError(f"--{name} must be a number in [0, 1], got {x!r}")
-    from renderer.scene import MAX_FREQUENCY
-    for name in ("k_u", "k_v"):
-        x = getattr(args, name)
-        if not (math.isfinite(x) and 0.0 < x <= MAX_FREQUENCY):
-            raise UsageError(f"--{name.replace('_', '-')} must be a finite number in "
-                             f"(0, {MAX_FREQUENCY:g}], got {x!r}")
-    uc = _measure_ucurve(args)
-    _stop_if_interrupted()
+        outputs.to_stderr = cmdline.is_stdout(args.plot)   # the plot takes stdout: the table goes to stderr
+    # `measure`'s own checks (its ranges are `pointwise.central_gradient`'s), named by the
+    # options, before the slow import of the U-curve's sympy formulas.
+    for name in ("u", "v", "k_u", "k_v"):
+        validate.real(f"--{name.replace('_', '-')}", getattr(args, name), **pointwise.RANGES_CENTRAL[name])
+    uc = _measure_ucurve(args, validate.steps("--eps", args.eps, **pointwise.RANGES_CENTRAL["eps"]))
+    out = outputs
     print(f"U-curve: {uc.field}, h_{uc.component} at (u, v) = ({uc.u:g}, {uc.v:g}), "
           f"k = ({args.k_u:g}, {args.k_v:g}); reference mpmath 50 digits", file=out)
     if uc.reason is not None:
@@ -720,7 +601,7 @@ def _cmd_ucurve(args, out):
         print(f"eps* predicted {uc.eps_opt_predicted:.3e}; measured minimum {uc.error_at_measured_opt:.3e} "
               f"at eps {uc.eps_opt_measured:.3e}", file=out)
     if args.plot is not None:
-        atomic_write(args.plot, _ucurve_plot_writer(uc))
+        outputs.stage_bytes(args.plot, _ucurve_png(uc), "--plot")
         print(f"wrote {'standard output' if args.plot == STDOUT else args.plot}", file=out)
     return 0
 
@@ -735,12 +616,12 @@ def _size_arg(text):
         raise argparse.ArgumentTypeError(str(exc).removeprefix("--size ")) from None
 
 
-def _eps_arg(max_steps, bounds=None):
+def _eps_arg(max_steps):
     def parse(text):
         try:
-            return parse_eps(text, name="", max_steps=max_steps, bounds=bounds)
+            return parse_eps(text, name="steps", max_steps=max_steps)
         except UsageError as exc:
-            raise argparse.ArgumentTypeError(str(exc).lstrip(": ")) from None
+            raise argparse.ArgumentTypeError(str(exc)) from None
     return parse
 
 
@@ -753,15 +634,16 @@ def _float_arg(text):
 
 def build_parser():
     """The argparse parser of ``symrender`` (one subparser per command)."""
+    from renderer.pointwise import MIN_STEP
     from renderer.render import MAX_SIDE
-    from renderer.scene import HEIGHT_FIELDS
+    from renderer.scene import HEIGHT_FIELDS, MAX_EPS, MAX_FREQUENCY, MIN_EPS
     from renderer.sweep import MAX_STEPS
     limits = (f"Limits: each side 1..{MAX_SIDE}; render at most {MAX_PIXELS:,} pixels (4096^2); "
               f"sweep at most (steps + 1) * W * H <= {FRAME_PIXEL_BUDGET:,}; refused before allocating.")
-    p = _Parser(prog="symrender", description="Render, sweep and measure the Chapter-9 scene.",
-                epilog=limits)
+    p = cmdline.Parser(prog="symrender", description="Render, sweep and measure the Chapter-9 scene.",
+                       epilog=limits)
     p.add_argument("--version", action="version", version=f"symrender {_version()}")
-    sub = p.add_subparsers(dest="command", metavar="command", required=True, parser_class=_Parser)
+    sub = p.add_subparsers(dest="command", metavar="command", required=True, parser_class=cmdline.Parser)
 
     def scene_opts(sp):
         sp.add_argument("--scene", metavar="FILE.toml",
@@ -784,11 +666,11 @@ def build_parser():
 
     s = sub.add_parser("sweep", help="eps sweep: census table of central vs exact",
                        description="Render the exact frame and one central frame per step; print the census: "
-                                   "eps, max and RMS |dI| on A, flips, mean |dI| on and off the kink band.",
+                                   "eps, max and RMS |dI| on A, flips, mean |dI| on and off the kink band "
+                                   "(none: no pixel of A there).",
                        epilog=limits)
     scene_opts(s)
-    from renderer.scene import MAX_EPS, MIN_EPS
-    s.add_argument("--eps", type=_eps_arg(MAX_STEPS, (MIN_EPS, MAX_EPS)), default=parse_eps("1e-1:1e-8:8"),
+    s.add_argument("--eps", type=_eps_arg(MAX_STEPS), default=parse_eps("1e-1:1e-8:8"),
                    metavar="a:b:n|e1,e2,..",
                    help=f"n log-spaced steps from a to b, or a comma list; 1..{MAX_STEPS} steps, each in "
                         f"[{MIN_EPS:g}, {MAX_EPS:g}] (default 1e-1:1e-8:8)")
@@ -804,11 +686,14 @@ def build_parser():
     u.add_argument("--u", type=_float_arg, default=0.31, help="chart u in [0, 1] (default 0.31)")
     u.add_argument("--v", type=_float_arg, default=0.47, help="chart v in [0, 1] (default 0.47)")
     u.add_argument("--component", choices=("u", "v"), default="u", help="h_u or h_v (default u)")
-    u.add_argument("--k-u", dest="k_u", type=_float_arg, default=8.0, help="frequency k_u (default 8)")
-    u.add_argument("--k-v", dest="k_v", type=_float_arg, default=4.0, help="frequency k_v (default 4)")
+    u.add_argument("--k-u", dest="k_u", type=_float_arg, default=8.0,
+                   help=f"frequency k_u in (0, {MAX_FREQUENCY:g}] (default 8)")
+    u.add_argument("--k-v", dest="k_v", type=_float_arg, default=4.0,
+                   help=f"frequency k_v in (0, {MAX_FREQUENCY:g}] (default 4)")
     u.add_argument("--eps", type=_eps_arg(MAX_UCURVE_STEPS), default=parse_eps("1e-1:1e-15:15"),
                    metavar="a:b:n|e1,e2,..",
-                   help=f"steps, as for sweep; 1..{MAX_UCURVE_STEPS} (default 1e-1:1e-15:15)")
+                   help=f"steps, as for sweep; 1..{MAX_UCURVE_STEPS} steps, each in [{MIN_STEP:g}, 1) "
+                        "(default 1e-1:1e-15:15)")
     u.add_argument("--plot", metavar="out.png", help="also save a log-log plot (PNG, atomically)")
 
     return p
@@ -817,91 +702,19 @@ def build_parser():
 _COMMANDS = {"render": _cmd_render, "sweep": _cmd_sweep, "ucurve": _cmd_ucurve}
 
 
-def _one_line(msg, limit=500):
-    """``msg`` on one line, cut to ``limit`` characters (a bad value can be megabytes long)."""
-    text = " ".join(str(msg).split())
-    return text if len(text) <= limit else f"{text[:limit]}... ({len(text):,} characters)"
-
-
-#: A Ctrl-C seen during `main`: numba's compiler runs Python callbacks from C, which drop
-#: the KeyboardInterrupt raised in them; the flag keeps it (`_stop_if_interrupted`).
-_sigint_seen = False
-
-
-def _interrupt(signum, frame):
-    global _sigint_seen
-    _sigint_seen = True
-    signal.signal(signal.SIGINT, signal.SIG_IGN)   # a second Ctrl-C does not cut the clean-up short
-    raise KeyboardInterrupt
-
-
-def _stop_if_interrupted():
-    """Raise KeyboardInterrupt if a Ctrl-C came during `main`, even one a C callback dropped;
-    called before any output is written."""
-    if _sigint_seen:
-        raise KeyboardInterrupt
+def _command(argv, outputs):
+    args = build_parser().parse_args(argv)
+    try:
+        return _COMMANDS[args.command](args, outputs)
+    except MemoryError:
+        raise UsageError("out of memory (use a smaller --size)") from None
 
 
 def main(argv=None) -> int:
-    """Run ``symrender`` with ``argv`` (default ``sys.argv[1:]``); return the exit code:
-    0 on success, 2 on an input error, 1 on a bug or a broken pipe, 130 on Ctrl-C.
-    Never raises; ``--help`` prints to stdout and returns 0."""
-    global _sigint_seen
-    _sigint_seen = False
-    previous_hook, previous = sys.unraisablehook, None
-    # The report of an interrupt swallowed in a C callback stays off stderr: the flag has it.
-    sys.unraisablehook = lambda u: None if isinstance(u.exc_value, KeyboardInterrupt) else previous_hook(u)
-    try:
-        previous = signal.signal(signal.SIGINT, _interrupt)
-    except ValueError:                      # not the main thread: signals are left alone
-        pass
-    try:
-        return _run(sys.argv[1:] if argv is None else list(argv))
-    except KeyboardInterrupt:
-        print("symrender: interrupted", file=sys.stderr)
-        return 130
-    finally:
-        sys.unraisablehook = previous_hook
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
-
-
-def _run(argv):
-    """`main` without its signal handling."""
-    out = sys.stdout
-    for stream in (sys.stdout, sys.stderr):     # a name the terminal cannot encode prints escaped
-        if hasattr(stream, "reconfigure"):
-            stream.reconfigure(errors="backslashreplace")
-    try:
-        if out is None:                     # started with it closed (>&-): no report could be read
-            raise UsageError("standard output is closed: symrender reports there (and -o - writes there)")
-        try:
-            args = build_parser().parse_args(argv)
-        except SystemExit as exc:           # --help (argparse prints, then exits 0)
-            return exc.code if isinstance(exc.code, int) else 0
-        code = _COMMANDS[args.command](args, out)
-        _stop_if_interrupted()
-        return code
-    except UsageError as exc:
-        print(f"symrender: error: {_one_line(exc)}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:                 # stdout closed early (| head): stop quietly, as cat does
-        try:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except (OSError, ValueError, AttributeError):
-            pass
-        return 1
-    except OSError as exc:
-        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
-        print(f"symrender: error: {where}{_one_line(exc.strerror or exc)}", file=sys.stderr)
-        return 2
-    except MemoryError:
-        print("symrender: error: out of memory (use a smaller --size)", file=sys.stderr)
-        return 2
-    except Exception as exc:                # a bug: still one line, no traceback
-        print(f"symrender: internal error: {type(exc).__name__}: {_one_line(exc)}", file=sys.stderr)
-        return 1
-
+    """Run ``symrender`` with ``argv`` (default ``sys.argv[1:]``); return the exit code
+    (`renderer.cmdline.main`: 0; 1 a bug or a broken pipe; 2 an input error; 130
+    SIGINT; 143 SIGTERM).  Never raises; ``--help`` prints to stdout and returns 0."""
+    return cmdline.main("symrender", _command, sys.argv[1:] if argv is None else list(argv))
 
 
 if __name__ == "__main__":  # pragma: no cover

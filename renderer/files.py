@@ -19,12 +19,12 @@ import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write", "write_bytes", "output_route", "read_regular", "RefusedPath", "umask"]
+__all__ = ["atomic_write", "write_bytes", "Staged", "output_route", "read_regular", "RefusedPath", "umask"]
 
 
 class RefusedPath(ValueError):
     """A path this module will not write to or read from; the message names it
-    and says what is accepted."""
+    and says what is accepted (a ValueError, as an argument refused)."""
 
 
 def umask():
@@ -106,8 +106,88 @@ def _write_all(fd, data):
         view = view[os.write(fd, view):]
 
 
+class Staged:
+    """An output prepared but not yet in place: `write_bytes` in two steps, so that a
+    caller can do something between them (a command reports, then commits).
+
+    On creation the route is chosen (`output_route`) and, for a replaced file, the
+    whole content is written and synced into a temporary file beside the target
+    (``.<name>.XXXX.part``); `commit` renames it onto the target, `discard` removes
+    it.  A device or FIFO is written through at `commit` (nothing is staged on disk).
+    Until `commit` returns, ``path`` is untouched; on any exception in either step
+    (KeyboardInterrupt included) the temporary file is removed.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    data : bytes-like
+        The whole content.
+
+    Raises
+    ------
+    RefusedPath
+        As `output_route`.
+    OSError
+        If the directory or the target cannot be written; the error names
+        ``path``, never the temporary file.
+    """
+
+    def __init__(self, path, data):
+        self.path, self._data, self._tmp = path, None, None
+        route = output_route(path)
+        if route == "through":
+            self._data = data
+            return
+        target = Path(os.path.realpath(path)) if route == "link" else Path(path)
+        self._target = target
+        try:
+            fd, self._tmp = tempfile.mkstemp(dir=target.parent if str(target.parent) else Path("."),
+                                             prefix=f".{target.name[:64]}.", suffix=".part")
+        except OSError as exc:
+            raise _named(exc, path) from None
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+            os.chmod(self._tmp, 0o666 & ~umask())
+        except BaseException as exc:
+            self.discard()
+            if isinstance(exc, OSError):
+                raise _named(exc, path) from None
+            raise
+
+    def commit(self):
+        """Put the content in place: rename the temporary file onto the target, or write
+        a device or FIFO through.  Raises OSError naming ``path``."""
+        try:
+            if self._tmp is None:
+                fd = os.open(self.path, os.O_WRONLY | os.O_CLOEXEC | getattr(os, "O_NOCTTY", 0))
+                try:
+                    _write_all(fd, self._data)
+                finally:
+                    os.close(fd)
+            else:
+                os.replace(self._tmp, self._target)
+                self._tmp = None
+        except BaseException as exc:
+            self.discard()
+            if isinstance(exc, OSError):
+                raise _named(exc, self.path) from None
+            raise
+
+    def discard(self):
+        """Remove the temporary file, if any (the target is left as it was)."""
+        tmp, self._tmp = self._tmp, None
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except FileNotFoundError:
+                pass
+
+
 def write_bytes(path, data):
-    """Write ``data`` to ``path`` by the route of `output_route`.
+    """Write ``data`` to ``path`` by the route of `output_route`: `Staged`, then its commit.
 
     Parameters
     ----------
@@ -130,40 +210,7 @@ def write_bytes(path, data):
         If the directory or the target cannot be written; the error names
         ``path``, never the temporary file.
     """
-    target = Path(path)
-    route = output_route(path)
-    if route == "through":
-        try:
-            fd = os.open(path, os.O_WRONLY | os.O_CLOEXEC | getattr(os, "O_NOCTTY", 0))
-            try:
-                _write_all(fd, data)
-            finally:
-                os.close(fd)
-        except OSError as exc:
-            raise _named(exc, path) from None
-        return
-    if route == "link":
-        target = Path(os.path.realpath(path))
-    parent = target.parent if str(target.parent) else Path(".")
-    try:
-        fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{target.name[:64]}.", suffix=".part")
-    except OSError as exc:
-        raise _named(exc, path) from None
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o666 & ~umask())
-        os.replace(tmp, target)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        if isinstance(exc, OSError):
-            raise _named(exc, path) from None
-        raise
+    Staged(path, data).commit()
 
 
 def atomic_write(path, write):

@@ -6,12 +6,16 @@ the same machine code as a render, so a value here is the bits the renderer
 uses at the same point (tests/test_codegen.py checks it against `render`).
 
 Fields are named as in `renderer.Scene.height_field`: "sine", "ridges",
-"rings".  Arguments are scalars or float64 arrays that broadcast together
-(chart coordinates u, v in chart units, positions in scene units); results
-are float64 arrays of the broadcast shape.  Every function raises ValueError
-for an unknown field, TypeError for an argument that is not real numbers,
-and ValueError for a value that is not finite or arguments that do not
-broadcast, naming the argument (and the first bad value's flat index).
+"rings".  Arguments are real scalars or arrays that broadcast together (as
+`renderer.validate.real_array` accepts them: integer or floating, not bool);
+results are float64 arrays of the broadcast shape.
+
+Each argument has an accepted range (`RANGES`), chosen so that every output is
+finite; a value outside it, a non-finite one or an integer too large for a
+float raises ValueError naming the argument, the range and the first bad
+value's flat index; an argument that is not real numbers raises TypeError; an
+unknown field or arguments that do not broadcast raise ValueError (all are
+`renderer.validate.InputError`).
 Source: the formulas of seed §2-§3 as corrected in `renderer.formulas`.
 """
 
@@ -22,57 +26,52 @@ from numba import njit
 
 from . import generated as G
 from . import kernel
-from .render import GBuffer, check_flag
-from .scene import Scene
+from .render import GBuffer
+from .scene import COORDINATE, FREQUENCY, RADIUS, UNIT, Scene
+from .validate import InvalidType, InvalidValue, choice, flag, real_array
 
 __all__ = ["height", "exact_gradient", "central_gradient", "kink_band", "chart", "tangent_frame",
-           "footprint", "reach"]
+           "footprint", "reach", "RANGES", "RANGES_CENTRAL", "MIN_STEP"]
+
+#: Smallest step `central_gradient` accepts: the generated quotient multiplies
+#: by 1 / (2 eps), which overflows for eps below about 2.8e-309.
+MIN_STEP = 1e-300
+
+#: The range each argument accepts (keyword arguments of `renderer.validate.real_array`).
+#: Chart coordinates u, v: [-1, 2], the chart [0, 1] and one chart width beyond each edge,
+#: where a difference stencil or a derivative routine around a chart point samples h
+#: (`central_gradient`: [0, 1], where its stencil wraps u and clamps v).  Frequencies and
+#: radii: `renderer.Scene`'s.  Steps: [`MIN_STEP`, 1) (below 1 the stencil wraps u once).
+#: Everything else (positions, normals and tangents, sin phi, pixel coordinates and
+#: spacing, camera_z): `Scene`'s coordinates, [-1e6, 1e6], whose squares and quotients
+#: by the tangent frame's smallest sin phi (1e-4) stay far from overflow.
+RANGES = {"u": dict(low=-1.0, high=2.0), "v": dict(low=-1.0, high=2.0), "k_u": FREQUENCY, "k_v": FREQUENCY,
+          "eps": dict(low=MIN_STEP, high=1.0, high_open=True), "radius": RADIUS}
+#: `central_gradient`'s ranges: its chart coordinates in [0, 1].
+RANGES_CENTRAL = {**RANGES, "u": UNIT, "v": UNIT, "eps_v": RANGES["eps"]}
 
 
 def _field(name):
-    if name not in G.FIELD_CODES:
-        raise ValueError(f"height_field must be one of {tuple(G.FIELD_CODES)}, got {name!r}")
-    return G.FIELD_CODES[name]
+    return G.FIELD_CODES[choice("height_field", name, tuple(G.FIELD_CODES))]
 
 
-def _evaluate(loop, k, lead, names, args):
+def _evaluate(loop, k, lead, names, args, ranges=RANGES):
     """``loop`` over the broadcast ``args``: k arrays of the broadcast shape.
 
-    Each argument must hold finite real numbers; TypeError or ValueError
-    names the argument (``names``), the first bad value and its index."""
-    arrays = [_real(name, a) for name, a in zip(names, args)]
+    Each argument is validated (`renderer.validate.real_array`) in its range,
+    ``ranges[name]`` or else `COORDINATE`'s."""
+    arrays = [real_array(name, a, **ranges.get(name, COORDINATE)) for name, a in zip(names, args)]
     try:
         arrays = np.broadcast_arrays(*arrays)
     except ValueError:
         shapes = ", ".join(f"{n} {a.shape}" for n, a in zip(names, arrays))
-        raise ValueError(f"the arguments must broadcast to one shape, got {shapes}") from None
+        raise InvalidValue(f"the arguments must broadcast to one shape, got {shapes}", names[0]) from None
     shape = arrays[0].shape
     # Copies: numba warns on the read-only views broadcast_arrays returns.
     flat = [np.array(a, dtype=np.float64).reshape(-1) for a in arrays]
     out = np.empty((k, flat[0].size))
     loop(*lead, *flat, out)
     return [row.reshape(shape) for row in out]
-
-
-def _real(name, value, low=None, high=None, high_open=False):
-    """``value`` as a float64 array of finite numbers (in [low, high] or
-    [low, high)); TypeError or ValueError naming ``name``, the first bad
-    value and its flat index."""
-    try:
-        if np.iscomplexobj(value):          # asarray would drop the imaginary part with a warning
-            raise TypeError
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be real numbers (a scalar or an array), got "
-                        f"{type(value).__name__} {value!r:.60}") from None
-    ok = np.isfinite(a)
-    if low is not None:
-        ok &= (a >= low) & ((a < high) if high_open else (a <= high))
-    bad = np.flatnonzero(~ok)
-    if bad.size:
-        accepted = "finite" if low is None else f"in [{low:g}, {high:g}{')' if high_open else ']'}"
-        raise ValueError(f"{name} must be {accepted}, got {float(a.reshape(-1)[bad[0]])!r} at flat index {bad[0]}")
-    return a
 
 
 def _triple(name, value):
@@ -82,7 +81,7 @@ def _triple(name, value):
     except TypeError:
         parts = ()
     if len(parts) != 3:
-        raise ValueError(f"{name} must have three components (x, y, z), got {value!r:.60}")
+        raise InvalidValue(f"{name} must have three components (x, y, z), got {value!r:.60}", name)
     return parts
 
 
@@ -92,59 +91,86 @@ _UV = ("u", "v", "k_u", "k_v")
 def height(name, u, v, k_u, k_v):
     """h(u, v) of field ``name`` (`renderer.formulas.HEIGHT`).
 
-    Parameters: ``u``, ``v`` float64 arrays (chart units, broadcastable), ``k_u``,
-    ``k_v`` frequencies.  Returns a float64 array of the broadcast shape.
-    Raises ValueError for an unknown ``name``.
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    u, v : array_like of float in [-1, 2]
+        Chart coordinates (chart units), broadcast together with ``k_u``, ``k_v``.
+    k_u, k_v : array_like of float in (0, 1e3]
+        Frequencies (periods over the chart).
+
+    Returns
+    -------
+    ndarray of float64, the broadcast shape, in [-1, 1].
+
+    Raises
+    ------
+    TypeError, ValueError
+        As the module says (`RANGES`).
     """
     return _evaluate(G.height_array, 1, (_field(name),), _UV, (u, v, k_u, k_v))[0]
 
 
 def exact_gradient(name, u, v, k_u, k_v):
-    """(h_u, h_v), sympy's derivative (`renderer.formulas.GRADIENT`); for ridges
-    sign(f) f' (one of the one-sided derivatives on a crease, 0 where the
-    float64 factor is exactly 0).  Two float64 arrays of the broadcast shape."""
+    """(h_u, h_v), sympy's derivative (`renderer.formulas.GRADIENT`).
+
+    For ridges sign(f) f' (one of the one-sided derivatives on a crease, 0
+    where the float64 factor is exactly 0).  Arguments as `height`; returns
+    two float64 arrays of the broadcast shape (per chart unit); raises as `height`.
+    """
     return tuple(_evaluate(G.exact_gradient_array, 2, (_field(name),), _UV, (u, v, k_u, k_v)))
-
-
-#: Smallest step `central_gradient` accepts: the generated quotient multiplies
-#: by 1 / (2 eps), which overflows for eps below about 2.8e-309.
-MIN_STEP = 1e-300
 
 
 def central_gradient(name, u, v, k_u, k_v, eps, eps_v=None):
     """Central differences (h_u, h_v) with step ``eps`` (and ``eps_v`` in v, default eps).
 
     u wraps modulo 1, v clamps to [0, 1] with a one-sided quotient where it
-    clamps (`renderer.formulas.CENTRAL`, seed Cell 1 ``grad_numeric``).  ``u``,
-    ``v`` in [0, 1]; steps in [`MIN_STEP`, 1), scalars or arrays (broadcast).
+    clamps (`renderer.formulas.CENTRAL`, seed Cell 1 ``grad_numeric``).
+
+    Parameters
+    ----------
+    name, k_u, k_v
+        As `height`.
+    u, v : array_like of float in [0, 1]
+        Chart coordinates (the stencil wraps u and clamps v on [0, 1]).
+    eps, eps_v : array_like of float in [`MIN_STEP`, 1)
+        Steps (chart units), broadcast with the rest.
+
+    Returns
+    -------
+    (h_u, h_v) : two float64 arrays of the broadcast shape.
 
     Raises
     ------
     TypeError, ValueError
-        As every function here; also a u or v outside [0, 1], a step outside
-        [`MIN_STEP`, 1).
+        As the module says (`RANGES`; u, v in [0, 1] here).
     """
     eps_v = eps if eps_v is None else eps_v
-    # The stencil wraps u and clamps v on [0, 1], for steps below 1.
-    u, v = _real("u", u, 0.0, 1.0), _real("v", v, 0.0, 1.0)
-    eps, eps_v = _real("eps", eps, MIN_STEP, 1.0, True), _real("eps_v", eps_v, MIN_STEP, 1.0, True)
     return tuple(_evaluate(G.central_gradient_array, 2, (_field(name),), _UV + ("eps", "eps_v"),
-                           (u, v, k_u, k_v, eps, eps_v)))
+                           (u, v, k_u, k_v, eps, eps_v), RANGES_CENTRAL))
 
 
 def kink_band(name, u, v, k_u, k_v):
-    """The seed's crease flag (`renderer.formulas.KINK_BAND`): bool array of the broadcast shape."""
+    """The seed's crease flag (`renderer.formulas.KINK_BAND`): a bool array of the
+    broadcast shape; arguments and errors as `height`."""
     return _evaluate(G.kink_band_array, 1, (_field(name),), _UV, (u, v, k_u, k_v))[0] != 0.0
 
 
 def chart(N_x, N_y, N_z):
-    """(u, v, sin phi) of unit normals of sphere A (`renderer.formulas.CHART`)."""
+    """(u, v, sin phi) of unit normals of sphere A (`renderer.formulas.CHART`).
+
+    ``N_x``, ``N_y``, ``N_z``: array_like in [-1e6, 1e6] (broadcast).  Returns three
+    float64 arrays; raises as the module says.
+    """
     return tuple(_evaluate(G.chart_array, 3, (), ("N_x", "N_y", "N_z"), (N_x, N_y, N_z)))
 
 
 def tangent_frame(N_x, N_y, N_z, sin_phi):
-    """(e_theta, e_phi), each a triple of arrays, with the pole fallback
-    (`renderer.formulas.TANGENT_FRAME`)."""
+    """(e_theta, e_phi), each a triple of float64 arrays, with the pole fallback
+    (`renderer.formulas.TANGENT_FRAME`).
+
+    All arguments array_like in [-1e6, 1e6] (broadcast); raises as the module says.
+    """
     c = _evaluate(G.tangent_frame_array, 6, (), ("N_x", "N_y", "N_z", "sin_phi"), (N_x, N_y, N_z, sin_phi))
     return tuple(c[:3]), tuple(c[3:])
 
@@ -152,8 +178,30 @@ def tangent_frame(N_x, N_y, N_z, sin_phi):
 def footprint(x, y, dx, dy, camera_z, P, N, e_theta, e_phi, radius, sin_phi):
     """(eps_u, eps_v), the pixel footprint in the chart (`renderer.formulas.FOOTPRINT`).
 
-    ``x``, ``y``: pixel centres on the image plane; ``dx``, ``dy``: the pixel
-    spacing; ``P``, ``N``, ``e_theta``, ``e_phi``: triples of arrays.
+    Parameters
+    ----------
+    x, y : array_like
+        Pixel centres on the image plane (scene units).
+    dx, dy : array_like
+        The pixel spacing (scene units).
+    camera_z : array_like
+    P, N, e_theta, e_phi : triples (x, y, z) of array_like
+        Hit points, unit normals and the tangent frame.
+    radius : array_like in [1e-6, 1e6]
+        Sphere A's radius.
+    sin_phi : array_like
+
+    All but ``radius`` in [-1e6, 1e6]; everything broadcasts together.
+
+    Returns
+    -------
+    (eps_u, eps_v) : two float64 arrays of the broadcast shape, chart units.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As the module says; ValueError also for a P, N, e_theta or e_phi that
+        is not three components.
     """
     P, N, e_theta, e_phi = (_triple(n, t) for n, t in (("P", P), ("N", N), ("e_theta", e_theta),
                                                         ("e_phi", e_phi)))
@@ -161,7 +209,6 @@ def footprint(x, y, dx, dy, camera_z, P, N, e_theta, e_phi, radius, sin_phi):
              "ep_x", "ep_y", "ep_z", "radius", "sin_phi")
     return tuple(_evaluate(G.footprint_array, 2, (), names, (x, y, dx, dy, camera_z, *P, *N, *e_theta, *e_phi,
                                                              radius, sin_phi)))
-
 
 
 def reach(scene, gbuffer, *, gate=False):
@@ -195,20 +242,20 @@ def reach(scene, gbuffer, *, gate=False):
         (H, W, 3) arrays of the same frame (the loop would read past them).
     """
     if not isinstance(scene, Scene):
-        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
+        raise InvalidType(f"scene must be a renderer.Scene, got {type(scene).__name__}", "scene")
     if not isinstance(gbuffer, GBuffer):
-        raise TypeError(f"gbuffer must be a renderer.GBuffer, got {type(gbuffer).__name__}")
+        raise InvalidType(f"gbuffer must be a renderer.GBuffer, got {type(gbuffer).__name__}", "gbuffer")
     chamber = np.asarray(gbuffer.chamber)
     if chamber.ndim != 2:
-        raise ValueError(f"gbuffer.chamber must be an (H, W) array, got shape {chamber.shape}")
+        raise InvalidValue(f"gbuffer.chamber must be an (H, W) array, got shape {chamber.shape}", "gbuffer")
     for name in ("P", "N", "Ns"):
         shape = np.shape(getattr(gbuffer, name))
         if shape != chamber.shape + (3,):
-            raise ValueError(f"gbuffer.{name} has shape {shape}, gbuffer.chamber {chamber.shape}: "
-                             f"the arrays must be one frame's, {chamber.shape + (3,)}")
+            raise InvalidValue(f"gbuffer.{name} has shape {shape}, gbuffer.chamber {chamber.shape}: "
+                               f"the arrays must be one frame's, {chamber.shape + (3,)}", "gbuffer")
     prm, lights = kernel.params(scene, skip=False)
     out = np.zeros((lights.shape[0],) + gbuffer.chamber.shape, dtype=bool)
-    _reach_rows(prm, lights, gbuffer.chamber, gbuffer.P, gbuffer.N, gbuffer.Ns, check_flag("gate", gate), out)
+    _reach_rows(prm, lights, gbuffer.chamber, gbuffer.P, gbuffer.N, gbuffer.Ns, flag("gate", gate), out)
     return out
 
 

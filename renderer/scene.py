@@ -7,11 +7,9 @@ downstream can then trust its inputs.  Seed names are given in brackets in the
 
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import dataclass, field, fields
 
-import numpy as np
+from .validate import InvalidType, InvalidValue, choice, flag, real, vector3
 
 __all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS", "frame_label"]
 
@@ -54,59 +52,14 @@ MODELS = ("blinn", "phong")
 BUMPS = ("chart", "surface")
 
 
-def _real(owner: str, name: str, value, *, low=None, low_open=False, high=None):
-    """Return ``value`` as a finite float, or raise naming ``owner.name``."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(
-            f"{owner}.{name} must be a real number, got {type(value).__name__} {value!r}"
-        )
-    try:
-        x = float(value)
-    except OverflowError:                      # an integer beyond float64's range
-        raise ValueError(f"{owner}.{name} must be finite, got an integer of "
-                         f"{len(str(abs(int(value))))} digits") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{owner}.{name} must be finite, got {value!r}")
-    below = low is not None and (x <= low if low_open else x < low)
-    if below or (high is not None and x > high):
-        if low is not None and high is not None:
-            accepted = f"in {'(' if low_open else '['}{low:g}, {high:g}]"
-        elif low is not None:
-            accepted = f"{'>' if low_open else '>='} {low:g}"
-        else:
-            accepted = f"<= {high:g}"
-        raise ValueError(f"{owner}.{name} must be {accepted}, got {value!r}")
-    return x
-
-
-def _vec3(owner: str, name: str, value, *, nonneg=False, high=None, low=None):
-    """Return ``value`` as a tuple of three finite floats, or raise."""
-    if not isinstance(value, (tuple, list, np.ndarray)):
-        raise TypeError(
-            f"{owner}.{name} must be a sequence of 3 real numbers, got {value!r}"
-        )
-    if len(value) != 3:
-        raise ValueError(
-            f"{owner}.{name} must have exactly 3 components, got {len(value)}: {value!r}"
-        )
-    low = 0.0 if nonneg else low
-    return tuple(
-        _real(owner, f"{name}[{i}]", c, low=low, high=high) for i, c in enumerate(value)
-    )
-
-
-def _flag(owner: str, name: str, value):
-    if not isinstance(value, bool):
-        raise TypeError(f"{owner}.{name} must be True or False, got {value!r}")
-    return value
-
-
-def _choice(owner: str, name: str, value, accepted):
-    if not isinstance(value, str):
-        raise TypeError(f"{owner}.{name} must be a string, one of {accepted}, got {value!r}")
-    if value not in accepted:
-        raise ValueError(f"{owner}.{name} must be one of {accepted}, got {value!r}")
-    return value
+#: The accepted ranges, as keyword arguments of `renderer.validate.real` (and of
+#: `real_array`, `vector3`): one range per kind of quantity, shared by `Scene`,
+#: `renderer.pointwise` and `renderer.ucurve`, so that they accept the same values.
+COORDINATE = dict(low=-MAX_LENGTH, high=MAX_LENGTH)          # scene units
+RADIUS = dict(low=MIN_RADIUS, high=MAX_LENGTH)               # scene units
+FREQUENCY = dict(low=0.0, low_open=True, high=MAX_FREQUENCY)  # periods over the chart
+UNIT = dict(low=0.0, high=1.0)                               # weights, albedos, chart coordinates
+INTENSITY = dict(low=0.0, high=MAX_INTENSITY)                # linear RGB
 
 
 @dataclass(frozen=True)
@@ -132,10 +85,8 @@ class PointLight:
     color: tuple = (1.0, 1.0, 1.0)
 
     def __post_init__(self):
-        object.__setattr__(self, "position", _vec3("PointLight", "position", self.position,
-                                                   low=-MAX_LENGTH, high=MAX_LENGTH))
-        object.__setattr__(self, "color", _vec3("PointLight", "color", self.color, nonneg=True,
-                                                high=MAX_INTENSITY))
+        object.__setattr__(self, "position", vector3("PointLight.position", self.position, **COORDINATE))
+        object.__setattr__(self, "color", vector3("PointLight.color", self.color, **INTENSITY))
 
 
 _DEFAULT_LIGHTS = (
@@ -175,7 +126,10 @@ class Scene:
     Raises
     ------
     TypeError
-        A field has the wrong type (a string for a number, a number for a flag).
+        A field has the wrong type (a string or a bool for a number, a number
+        for a flag).  Numbers are accepted as `renderer.validate` says: Python
+        or numpy scalars (``np.float32(0.5)``, ``np.int64(3)``) or 0-d arrays;
+        vectors as tuples, lists or 1-D arrays of three.
     ValueError
         A field is out of its range, each chosen to mean something (see the
         module constants for why): every number finite; radii in [1e-6, 1e6]
@@ -186,7 +140,7 @@ class Scene:
         [0, 100] (and < ``radius_a`` for ``bump="surface"``); ``eps`` in
         [1e-16, 0.25] chart units; ``model``, ``height_field`` and ``bump``
         one of their names.  The message names the field, the value and what
-        is accepted.
+        is accepted.  Both are `renderer.validate.InputError`.
 
     Examples
     --------
@@ -219,55 +173,50 @@ class Scene:
 
     def __post_init__(self):
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
-        S = "Scene"
-        set_("radius_a", _real(S, "radius_a", self.radius_a, low=MIN_RADIUS, high=MAX_LENGTH))
-        set_("camera_z", _real(S, "camera_z", self.camera_z, high=MAX_LENGTH))
+        set_("radius_a", real("Scene.radius_a", self.radius_a, **RADIUS))
+        set_("camera_z", real("Scene.camera_z", self.camera_z, high=MAX_LENGTH))
         if not self.camera_z > self.radius_a:
-            raise ValueError(
-                f"Scene.camera_z must be > radius_a = {self.radius_a} (camera outside "
-                f"sphere A), got {self.camera_z!r}"
-            )
-        set_("center_b", _vec3(S, "center_b", self.center_b, low=-MAX_LENGTH, high=MAX_LENGTH))
-        set_("radius_b", _real(S, "radius_b", self.radius_b, low=MIN_RADIUS, high=MAX_LENGTH))
+            raise InvalidValue(f"Scene.camera_z must be > radius_a = {self.radius_a} (camera outside "
+                               f"sphere A), got {self.camera_z!r}", "Scene.camera_z")
+        set_("center_b", vector3("Scene.center_b", self.center_b, **COORDINATE))
+        set_("radius_b", real("Scene.radius_b", self.radius_b, **RADIUS))
         # Camera outside sphere B: the nearest hit is then always a front face.
         d2 = self.center_b[0] ** 2 + self.center_b[1] ** 2 + (self.camera_z - self.center_b[2]) ** 2
         if not d2 > self.radius_b**2:
-            raise ValueError(
-                f"Scene.radius_b = {self.radius_b!r} puts the camera (0, 0, {self.camera_z}) "
-                f"inside or on sphere B centred at {self.center_b}; the camera must be outside"
-            )
-        set_("sphere_b", _flag(S, "sphere_b", self.sphere_b))
-        set_("floor", _flag(S, "floor", self.floor))
+            raise InvalidValue(f"Scene.radius_b = {self.radius_b!r} puts the camera (0, 0, {self.camera_z}) "
+                               f"inside or on sphere B centred at {self.center_b}; the camera must be outside",
+                               "Scene.radius_b")
+        set_("sphere_b", flag("Scene.sphere_b", self.sphere_b))
+        set_("floor", flag("Scene.floor", self.floor))
         lights = self.lights
         if isinstance(lights, PointLight):
-            raise TypeError("Scene.lights must be a sequence of PointLight, got a single PointLight")
+            raise InvalidType("Scene.lights must be a sequence of PointLight, got a single PointLight",
+                              "Scene.lights")
         if not isinstance(lights, (tuple, list)):
-            raise TypeError(f"Scene.lights must be a tuple of PointLight, got {lights!r:.80}")
+            raise InvalidType(f"Scene.lights must be a tuple of PointLight, got {lights!r:.80}", "Scene.lights")
         if len(lights) > MAX_LIGHTS:     # each light costs a shadow ray per pixel
-            raise ValueError(f"Scene.lights holds at most {MAX_LIGHTS} lights, got {len(lights):,}")
+            raise InvalidValue(f"Scene.lights holds at most {MAX_LIGHTS} lights, got {len(lights):,}",
+                               "Scene.lights")
         for i, light in enumerate(lights):
             if not isinstance(light, PointLight):
-                raise TypeError(f"Scene.lights[{i}] must be a PointLight, got {light!r}")
+                raise InvalidType(f"Scene.lights[{i}] must be a PointLight, got {light!r:.80}", "Scene.lights")
         set_("lights", tuple(lights))
-        set_("ambient", _vec3(S, "ambient", self.ambient, nonneg=True, high=MAX_INTENSITY))
-        set_("albedo_a", _vec3(S, "albedo_a", self.albedo_a, nonneg=True, high=1.0))
-        set_("albedo_b", _vec3(S, "albedo_b", self.albedo_b, nonneg=True, high=1.0))
-        for name in ("ka", "kd", "ks"):
-            set_(name, _real(S, name, getattr(self, name), low=0.0, high=1.0))
-        set_("shininess", _real(S, "shininess", self.shininess, low=MIN_SHININESS, high=MAX_SHININESS))
-        set_("model", _choice(S, "model", self.model, MODELS))
-        set_("floor_tint", _real(S, "floor_tint", self.floor_tint, low=0.0, high=1.0))
-        set_("height_field", _choice(S, "height_field", self.height_field, HEIGHT_FIELDS))
-        set_("k_u", _real(S, "k_u", self.k_u, low=0.0, low_open=True, high=MAX_FREQUENCY))
-        set_("k_v", _real(S, "k_v", self.k_v, low=0.0, low_open=True, high=MAX_FREQUENCY))
-        set_("beta", _real(S, "beta", self.beta, low=0.0, high=MAX_BETA))
-        set_("eps", _real(S, "eps", self.eps, low=MIN_EPS, high=MAX_EPS))
-        set_("bump", _choice(S, "bump", self.bump, BUMPS))
+        set_("ambient", vector3("Scene.ambient", self.ambient, **INTENSITY))
+        set_("albedo_a", vector3("Scene.albedo_a", self.albedo_a, **UNIT))
+        set_("albedo_b", vector3("Scene.albedo_b", self.albedo_b, **UNIT))
+        for name in ("ka", "kd", "ks", "floor_tint"):
+            set_(name, real(f"Scene.{name}", getattr(self, name), **UNIT))
+        set_("shininess", real("Scene.shininess", self.shininess, low=MIN_SHININESS, high=MAX_SHININESS))
+        set_("model", choice("Scene.model", self.model, MODELS))
+        set_("height_field", choice("Scene.height_field", self.height_field, HEIGHT_FIELDS))
+        set_("k_u", real("Scene.k_u", self.k_u, **FREQUENCY))
+        set_("k_v", real("Scene.k_v", self.k_v, **FREQUENCY))
+        set_("beta", real("Scene.beta", self.beta, low=0.0, high=MAX_BETA))
+        set_("eps", real("Scene.eps", self.eps, low=MIN_EPS, high=MAX_EPS))
+        set_("bump", choice("Scene.bump", self.bump, BUMPS))
         if self.bump == "surface" and not self.beta < self.radius_a:
-            raise ValueError(
-                f"Scene.beta must be < radius_a = {self.radius_a} when bump='surface' (the "
-                f"displaced radius R + beta h must stay positive), got {self.beta!r}"
-            )
+            raise InvalidValue(f"Scene.beta must be < radius_a = {self.radius_a} when bump='surface' (the "
+                               f"displaced radius R + beta h must stay positive), got {self.beta!r}", "Scene.beta")
 
     def replace(self, **changes) -> "Scene":
         """Return a copy with ``changes`` applied (and validated).
@@ -280,7 +229,7 @@ class Scene:
         names = {f.name for f in fields(self)}
         unknown = sorted(set(changes) - names)
         if unknown:
-            raise TypeError(f"Scene has no field(s) {unknown}; fields are {sorted(names)}")
+            raise InvalidType(f"Scene has no field(s) {unknown}; fields are {sorted(names)}", "Scene")
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         values.update(changes)
         return Scene(**values)

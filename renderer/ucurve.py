@@ -31,7 +31,7 @@ import numpy as np
 import sympy as sp
 
 from renderer import formulas as F
-from renderer import pointwise
+from renderer import pointwise, validate
 
 __all__ = ["UCurve", "measure", "fit_model", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS",
            "SEED_POINT", "SEED_FREQUENCIES"]
@@ -218,9 +218,13 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
         Chart point (default `SEED_POINT`, the seed's).
     component : {"u", "v"}
         Which partial derivative.
-    eps : array_like of float > 0, optional
-        Steps; default `DEFAULT_STEPS`.
-    k_u, k_v : float > 0
+    eps : array_like of float in [`renderer.pointwise.MIN_STEP`, 1), optional
+        Steps (chart units; any shape, taken flat); default `DEFAULT_STEPS`.
+    k_u, k_v : float in (0, 1e3]
+        Frequencies, as `renderer.Scene` accepts them.
+
+    Scalars are accepted as `renderer.validate.real` says (Python or numpy
+    numbers, 0-d arrays; not bools).
 
     Returns
     -------
@@ -230,7 +234,11 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     ------
     ValueError
         Naming the argument, for an unknown field or component, a chart
-        point outside [0, 1], or a non-positive or non-finite step.
+        point outside [0, 1], a frequency outside (0, 1e3], no steps or a
+        step outside [`renderer.pointwise.MIN_STEP`, 1).
+    TypeError
+        Naming the argument, for one of the wrong type (a bool, a string
+        for a number).  Both are `renderer.validate.InputError`.
 
     Notes
     -----
@@ -240,21 +248,13 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     1), ``truncation`` does not vanish as eps -> 0, and the derivative and
     the optimal step are NaN.
     """
-    if field not in F.HEIGHT:
-        raise ValueError(f"field must be one of {tuple(F.HEIGHT)}, got {field!r}")
-    if component not in ("u", "v"):
-        raise ValueError(f"component must be 'u' or 'v', got {component!r}")
-    for name, value in (("u", u), ("v", v)):
-        if not (isinstance(value, (int, float)) and 0.0 <= value <= 1.0):
-            raise ValueError(f"{name} must be a number in [0, 1], got {value!r}")
-    for name, value in (("k_u", k_u), ("k_v", k_v)):
-        if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    steps = DEFAULT_STEPS if eps is None else np.asarray(eps, dtype=np.float64).ravel()
-    if steps.size == 0 or not np.all(np.isfinite(steps)) or np.any(steps <= 0):
-        raise ValueError("eps must be a non-empty array of finite steps > 0")
+    field = validate.choice("field", field, tuple(F.HEIGHT))
+    component = validate.choice("component", component, ("u", "v"))
+    # The ranges of `pointwise.central_gradient`, which the measurement calls.
+    u, v, k_u, k_v = (validate.real(name, x, **pointwise.RANGES_CENTRAL[name])
+                      for name, x in (("u", u), ("v", v), ("k_u", k_u), ("k_v", k_v)))
+    steps = DEFAULT_STEPS if eps is None else validate.steps("eps", eps, **pointwise.RANGES["eps"])
 
-    u, v, k_u, k_v = float(u), float(v), float(k_u), float(k_v)
     reason = non_differentiable(field, u, v, component, k_u, k_v)
     h_mp, dh_mp, d3h_mp = _mp_functions(field, component, k_u, k_v)
     stencil = _stencil()

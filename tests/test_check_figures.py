@@ -12,11 +12,15 @@ import importlib.util
 import io
 import json
 import os
+import signal
 import struct
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from renderer.cmdline import png_bytes
 
 from .test_cli import failure_problems as _failure_problems
 from .test_cli import read_png, varying_chunks
@@ -106,7 +110,7 @@ def test_figures_check_reports_changes(s1_figures, tmp_path, capsys, monkeypatch
     f = old / doc["figures"][0]["file"]
     px = read_png(f)
     px[10, 10] = np.where(px[10, 10] >= 128, px[10, 10].astype(int) - 51, px[10, 10].astype(int) + 51)
-    f.write_bytes(cli._png_bytes(px.astype(np.uint8)))
+    f.write_bytes(png_bytes(px.astype(np.uint8)))
     doc["figures"][0]["sha256"] = sha256_of(f)
     (old / "manifest.json").write_text(json.dumps(doc))
     rc, out, _ = run(["figures", "--check", str(old)], capsys)
@@ -171,7 +175,7 @@ def test_figures_marks_measured_timing_plots_and_check_does_not_fail_on_them(s1_
     f = old / doc["figures"][0]["file"]
     px = read_png(f)
     px[5, 5] = 255 - px[5, 5]
-    f.write_bytes(cli._png_bytes(px.astype(np.uint8)))
+    f.write_bytes(png_bytes(px.astype(np.uint8)))
     doc["figures"][0]["sha256"] = sha256_of(f)
     doc["figures"][0]["varies"] = "measured timing"
     (old / "manifest.json").write_text(json.dumps(doc))
@@ -205,7 +209,7 @@ def write_check_dir(d, px=None, **entry):
     """A previous ``--out`` directory with one synthetic figure; returns the manifest."""
     import hashlib
     d.mkdir(exist_ok=True)
-    data = cli._png_bytes(figure_pixels() if px is None else px)
+    data = png_bytes(figure_pixels() if px is None else px)
     (d / "fig.png").write_bytes(data)
     h, w = (px if px is not None else figure_pixels()).shape[:2]
     page = cli._known_pages()[1]
@@ -294,7 +298,7 @@ def tamper(name):
         elif name == "sha-mismatch":
             f["sha256"] = "0" * 64
         elif name == "file-changed":
-            (d / "fig.png").write_bytes(cli._png_bytes(255 - figure_pixels()))
+            (d / "fig.png").write_bytes(png_bytes(255 - figure_pixels()))
         elif name == "missing-file":
             (d / "fig.png").unlink()
         elif name == "link-to-dev-zero":
@@ -399,14 +403,14 @@ def test_compare_figure_tolerance_on_synthetic_pngs():
     allowed = int(cli.CHECK_TOLERANCE_FRACTION * n)
     levels = cli.CHECK_TOLERANCE_LEVELS
     assert allowed >= 1
-    png = cli._png_bytes(base)
+    png = png_bytes(base)
 
     def changed(count, by):
         px = base.astype(int)
         flat = px.reshape(-1, 3)
         idx = np.arange(count) * (n // max(count, 1))
         flat[idx, 1] = np.where(flat[idx, 1] >= 128, flat[idx, 1] - by, flat[idx, 1] + by)
-        return cli._png_bytes(px.astype(np.uint8))
+        return png_bytes(px.astype(np.uint8))
 
     assert cli.compare_figure(png, png) == ("unchanged", "")
     verdict, how = cli.compare_figure(png, changed(allowed, levels))
@@ -416,7 +420,7 @@ def test_compare_figure_tolerance_on_synthetic_pngs():
     verdict, how = cli.compare_figure(png, changed(1, levels + 1))
     assert verdict == "changed" and how == f"max |dI| = {(levels + 1) / 255:.4f} (1 pixels differ)"
     assert cli.compare_figure(png, changed(allowed + 1, 1))[0] == "changed"
-    assert cli.compare_figure(png, cli._png_bytes(base[:-1]))[0] == "changed"
+    assert cli.compare_figure(png, png_bytes(base[:-1]))[0] == "changed"
     assert cli.compare_figure(png, changed(1, 127))[0] == "changed"
 
 
@@ -428,11 +432,11 @@ def test_check_passes_within_tolerance_and_fails_beyond(tmp_path, capsys, monkey
     near, far = px.copy(), px.copy()
     near[3, 4] += np.where(near[3, 4] < 255, 1, -1)
     far[3, 4] += np.where(far[3, 4] < 128, cli.CHECK_TOLERANCE_LEVELS + 1, -cli.CHECK_TOLERANCE_LEVELS - 1)
-    fake_run(monkeypatch, {fid: cli._png_bytes(near.astype(np.uint8))})
+    fake_run(monkeypatch, {fid: png_bytes(near.astype(np.uint8))})
     rc, out, _ = run(["figures", "--check", str(d)], capsys)
     assert rc == 0 and f"within tolerance {fid}: max |dI| = 0.0039 (1 pixels differ)" in out
     assert "no figure changed" in out
-    fake_run(monkeypatch, {fid: cli._png_bytes(far.astype(np.uint8))})
+    fake_run(monkeypatch, {fid: png_bytes(far.astype(np.uint8))})
     rc, out, _ = run(["figures", "--check", str(d)], capsys)
     assert rc == 1 and f"changed    {fid}: max |dI|" in out and "1 figure(s) changed" in out
 
@@ -460,29 +464,74 @@ def test_check_of_some_pages_compares_only_their_figures(s1_figures, tmp_path, c
     assert rc == 2 and "figures[2].page must be one of the manifest's pages" in err
 
 
-def test_sigterm_during_check_leaves_no_temporary_directory(s1_figures, tmp_path):
-    import signal
-    import subprocess
-    import sys
-    import time
-    a, _ = s1_figures
-    scratch = tmp_path / "tmp"
+#: A page that announces that it runs (the harness's READY file), then runs on.
+RUNNING_PAGE = "import os, time\nopen(os.environ['READY'], 'w').close()\ntime.sleep(120)"
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("what, moment", [("--out", "page"), ("--check", "page"), ("--out", "commit")])
+def test_a_signal_at_any_moment_leaves_nothing_behind(tmp_path, what, moment, signum):
+    """SIGTERM while a page ran was reported as an interrupt (nbclient's handler took it); now
+    each signal gives its own line and code, while a page runs (its kernel shut down) and
+    when the figures are about to be moved into place.  No DIR, no staging or temporary
+    directory, no process (the kernel included) is left."""
+    from .test_interrupts import Run, check
+    fake_book(tmp_path / "repo", RUNNING_PAGE if moment == "page" else "print('no figure')")
+    scratch, work = tmp_path / "tmp", tmp_path / "work"
     scratch.mkdir()
-    proc = subprocess.Popen([sys.executable, str(Path(__file__).parents[1] / "book" / "check_figures.py"),
-                             "--check", str(a)], env={**os.environ, "TMPDIR": str(scratch)},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    deadline = time.monotonic() + 120
-    while not list(scratch.glob("symrender-figures-*")) and time.monotonic() < deadline and proc.poll() is None:
-        time.sleep(0.05)
-    assert list(scratch.glob("symrender-figures-*")), "the check never made its temporary directory"
-    time.sleep(0.5)                                             # inside the page run
-    proc.send_signal(signal.SIGTERM)
-    _, err = proc.communicate(timeout=120)
-    # nbclient takes the signal while the page runs (its kernel shut down): reported as an interrupt.
-    last = err.decode().splitlines()[-1:]
-    assert (proc.returncode, last) in [(130, ["check_figures: interrupted"]),
-                                       (143, ["check_figures: terminated"])], err.decode()[-2000:]
-    assert not list(scratch.glob("symrender-figures-*"))
+    work.mkdir()
+    if what == "--check":
+        write_check_dir(work / "old")
+        doc = json.loads((work / "old" / "manifest.json").read_text())
+        doc["pages"], doc["figures"][0]["page"] = ["s1_bad"], "s1_bad"
+        (work / "old" / "manifest.json").write_text(json.dumps(doc))
+    before = sorted(p.name for p in work.iterdir())
+    run = Run("--tool", "check_figures", what, work / ("old" if what == "--check" else "figs"), "--pages", "s1",
+              cwd=work, moment=moment, env={"BOOK_ROOT": str(tmp_path / "repo"), "TMPDIR": str(scratch)})
+    run.at_the_moment()
+    run.send(signum)
+    check(run, work, before, grace=30, signum=signum, prog="check_figures")
+    assert list(scratch.iterdir()) == []
+
+
+def test_abbreviations_are_not_options(tmp_path, capsys, monkeypatch):
+    """``--chec DIR`` ran the check, ``--pag`` took pages: the tool had a parser of its own."""
+    monkeypatch.setattr(cli, "_render_figures", no_run)
+    for argv, words in ((["--chec", str(tmp_path)], "one of the arguments --out --check is required"),
+                        (["--out", str(tmp_path / "a"), "--pag", "s1"], "unrecognized arguments: --pag s1"),
+                        (["--o", str(tmp_path / "a")], "one of the arguments --out --check is required")):
+        rc, out, err = run(argv, capsys)
+        assert failure_problems(rc, err, [], []) == [] and words in err and out == "", err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_report_that_cannot_be_written_leaves_no_directory(tmp_path, capsys, monkeypatch):
+    """The figures are moved into DIR after the report is out: with standard output full,
+    exit 2 and DIR as it was (absent), no staging directory."""
+    class Full(io.StringIO):
+        def write(self, text):
+            raise OSError(28, "No space left on device")
+
+    def render_figures(out_dir, pages):
+        (out_dir / "manifest.json").write_text("{}")
+        return {"figures": [], "code_version": {"git_commit": None, "git_dirty": None, "source_sha256": "0" * 64}}
+
+    monkeypatch.setattr(cli, "_render_figures", render_figures)
+    monkeypatch.setattr(sys, "stdout", Full())
+    rc = main(["--out", str(tmp_path / "figs"), "--pages", "s1"])
+    err = capsys.readouterr().err
+    assert (rc, err) == (2, "check_figures: error: standard output: No space left on device\n")
+    assert list(tmp_path.iterdir()) == []
+    monkeypatch.setattr(sys, "stdout", io.StringIO())          # the control: the same run, reported
+    assert main(["--out", str(tmp_path / "figs"), "--pages", "s1"]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == ["figs"] and "wrote 0 figures" in sys.stdout.getvalue()
+
+
+def test_a_bad_environment_is_an_error_before_any_page(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(cli, "_render_figures", no_run)
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "0")
+    rc, _, err = run(["--out", str(tmp_path / "figs")], capsys)
+    assert rc == 2 and err.startswith("check_figures: error: the environment variable NUMBA_NUM_THREADS must be")
 
 
 def test_the_tools_signal_handlers_are_back_after_a_page(tmp_path, monkeypatch):

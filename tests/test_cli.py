@@ -16,7 +16,9 @@ import contextlib
 import csv
 import io
 import json
+import math
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -30,6 +32,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import renderer.cli as cli
+from renderer import cmdline
 from renderer.cli import main
 from renderer import PointLight, Scene, compare, render, sweep, to_srgb
 
@@ -100,6 +103,54 @@ def test_failure_checker_rejects_wrong_variants():
     assert failure_problems(2, "symrender: error: x\n", [], ["out.png"])
 
 
+# ------------------------------------------------------------------ reading the reports back
+
+
+#: Each labelled line of the render ledger and the `Ledger` field it reports.
+LEDGER_LABELS = {"max |dI|": "max_abs", "RMS |dI|": "rms", "flips": "flips", "pixels on A": "pixels_a",
+                 "mean |dI| on band": "mean_abs_kink", "mean |dI| off band": "mean_abs_off_kink"}
+#: Each column of the sweep's text census and the `Ledger` field it reports.
+CENSUS_LABELS = {"max |dI|": "max_abs", "RMS |dI|": "rms", "flips": "flips", "on band": "mean_abs_kink",
+                 "off band": "mean_abs_off_kink"}
+#: Each column of the U-curve table and the `UCurve` field it reports.
+UCURVE_LABELS = {"eps": "eps", "truncation": "truncation", "roundoff": "roundoff", "|error|": "error", "model": "model"}
+
+
+def value_of(text):
+    """A reported number: an int, a float, or None for "none" (no pixel in that set)."""
+    if text.startswith("none"):
+        return None
+    return int(text) if re.fullmatch(r"-?[0-9]+", text) else float(text)
+
+
+def agrees(got, want, rel=1e-3):
+    """A printed value (4 significant digits) against the library's; None stands for NaN."""
+    if got is None or (isinstance(want, float) and math.isnan(want)):
+        return got is None and math.isnan(want)
+    return got == want if isinstance(want, int) else math.isclose(got, want, rel_tol=rel, abs_tol=1e-300)
+
+
+def ledger_lines(report):
+    """{Ledger field: value} read from a render report's labelled lines (by their labels)."""
+    found = (re.fullmatch(r"  (.+?)\s{2,}(\S.*)", line) for line in report.splitlines())
+    return {LEDGER_LABELS[m[1]]: value_of(m[2]) for m in found if m}
+
+
+def table(report, labels):
+    """A report's table read by its header: one {field: value} per row."""
+    lines = report.splitlines()
+    head = next(i for i, line in enumerate(lines) if line.split()[:1] == ["eps"])
+    columns = [labels.get(c, c) for c in re.split(r"\s{2,}", lines[head].strip())]
+    rows = [line.split() for line in lines[head + 1:]]
+    return [dict(zip(columns, map(value_of, row))) for row in rows if len(row) == len(columns)]
+
+
+def ledger_problems(report, led):
+    """The fields of `Ledger` ``led`` that the report's ledger lines do not show."""
+    got = ledger_lines(report)
+    return [f for f in LEDGER_LABELS.values() if f not in got or not agrees(got[f], getattr(led, f))]
+
+
 # ------------------------------------------------------------------ render
 
 
@@ -129,11 +180,32 @@ def test_render_views_match_the_library(tmp_path, capsys, view, gradient):
     got = read_png(out)
     assert got.shape == (40, 48, 3)
     np.testing.assert_array_equal(got, expected_pixels(want))
-    # The ledger printed is compare(central, exact).
-    led = compare(numeric, symbolic)
-    assert f"max |dI|            {led.max_abs:.3e}" in stdout
-    assert f"flips               {led.flips}" in stdout
-    assert f"pixels on A         {led.pixels_a}" in stdout
+    # The ledger printed is compare(central, exact), each value under its own label.
+    assert ledger_problems(stdout, compare(numeric, symbolic)) == []
+
+
+def test_a_frame_with_no_band_pixel_says_so(tmp_path, capsys):
+    """4x4 of the draft's scene has no pixel in the crease band: its mean is none, not nan."""
+    rc, out, _ = run(["render", "--size", "4x4", "-o", str(tmp_path / "o.png")], capsys)
+    led = compare(render(Scene(), 4, 4, gradient="central"), render(Scene(), 4, 4))
+    assert rc == 0 and math.isnan(led.mean_abs_kink) and led.pixels_a > 0
+    assert "  mean |dI| on band   none (no pixel in the band)\n" in out and "nan" not in out
+    assert ledger_problems(out, led) == []
+
+
+def test_the_report_checkers_see_swapped_labels():
+    """A ledger whose two band means are printed under each other's labels, and a census
+    whose RMS and max columns are swapped, are caught."""
+    led = compare(render(Scene(), 24, 20, gradient="central"), render(Scene(), 24, 20))
+    lines = cli._ledger_lines(led)
+    assert ledger_problems("\n".join(lines), led) == []
+    swapped = [*lines[:5], lines[6].replace("off band", "on band "), lines[5].replace("on band ", "off band")]
+    assert ledger_problems("\n".join(swapped), led) == ["mean_abs_kink", "mean_abs_off_kink"]
+    header = "      eps   max |dI|   RMS |dI|  flips    on band   off band"
+    row = (f" 1.00e-03  {led.rms:.3e}  {led.max_abs:.3e}  {led.flips:5d}  {led.mean_abs_kink:.3e}  "
+           f"{led.mean_abs_off_kink:.3e}")
+    (got,) = table(f"{header}\n{row}", CENSUS_LABELS)
+    assert [f for f in CENSUS_LABELS.values() if not agrees(got[f], getattr(led, f))] == ["max_abs", "rms"]
 
 
 def test_views_differ_so_the_pixel_check_can_fail(tmp_path, capsys):
@@ -205,25 +277,6 @@ def test_failure_mid_write_leaves_no_file(tmp_path, capsys, monkeypatch):
     rc, stdout, err = run(["render", "--size", "8x8", "-o", str(out)], capsys)
     assert failure_problems(rc, err, [], list(tmp_path.iterdir())) == []
     assert "No space left on device" in err
-
-
-def test_interrupt_mid_write_keeps_the_old_file(tmp_path):
-    out = tmp_path / "o.png"
-    out.write_bytes(b"old")
-
-    def interrupted(f):
-        f.write(b"new, half")
-        raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
-        cli.atomic_write(out, interrupted)
-    assert out.read_bytes() == b"old"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["o.png"]
-    # Wrong variant: a plain open-and-write leaves the half-written file.
-    with pytest.raises(KeyboardInterrupt):
-        with open(out, "wb") as f:
-            interrupted(f)
-    assert out.read_bytes() == b"new, half"
 
 
 # ------------------------------------------------------------------ bad inputs
@@ -356,10 +409,10 @@ def test_huge_size_refused_before_allocating(tmp_path, capsys, monkeypatch):
 
 @pytest.mark.parametrize("argv, word", [
     (["render", "--size", "-5x5", "-o", "OUT"], "--size: width must be between 1 and 8192"),
-    (["ucurve", "--u", "-0.5"], "--u must be a number in [0, 1]"),
-    (["ucurve", "--k-u", "-3"], "--k-u must be a finite number in (0, 1000]"),
-    (["sweep", "--eps", "-1e-3"], "each step must be in [1e-16, 0.25]"),
-    (["sweep", "--eps", "-.5"], "each step must be in [1e-16, 0.25]"),
+    (["ucurve", "--u", "-0.5"], "--u must be in [0, 1], got -0.5"),
+    (["ucurve", "--k-u", "-3"], "--k-u must be in (0, 1000], got -3.0"),
+    (["sweep", "--eps", "-1e-3"], "--eps must be in [1e-16, 0.25], got -0.001 at flat index 0"),
+    (["sweep", "--eps", "-.5"], "--eps must be in [1e-16, 0.25], got -0.5 at flat index 0"),
 ])
 def test_negative_values_reach_our_checks(tmp_path, capsys, argv, word):
     argv = [a.replace("OUT", str(tmp_path / "o.png")) for a in argv]
@@ -373,7 +426,7 @@ def test_negative_values_reach_our_checks(tmp_path, capsys, argv, word):
 
 
 def test_a_value_after_double_dash_is_left_alone():
-    p = cli._Parser(prog="t")
+    p = cmdline.Parser(prog="t")
     p.add_argument("--u")
     p.add_argument("rest", nargs="*")
     assert p.parse_args(["--u", "-1", "--", "--u", "-2"]) == argparse.Namespace(u="-1", rest=["--u", "-2"])
@@ -449,15 +502,16 @@ def test_dash_on_a_terminal_is_refused(capsys, monkeypatch, argv):
 
 
 def test_stdout_and_dev_stdout_in_a_real_process(tmp_path):
-    """Through a real pipe: ``-o -`` gives the PNG alone on stdout; ``-o
-    /dev/stdout`` (a link) writes through it; a pseudo-terminal is refused."""
+    """Through a real pipe: ``-o -`` gives the PNG alone on stdout; so does ``-o
+    /dev/stdout`` (a link written through), the report going to stderr (it went
+    into the PNG stream); a pseudo-terminal is refused."""
     cmd = [sys.executable, "-m", "renderer.cli", "render", "--size", "8x8", "-o"]
     ref = tmp_path / "ref.png"
     assert main(["render", "--size", "8x8", "-o", str(ref)]) == 0
     dash = subprocess.run([*cmd, "-"], capture_output=True)
     assert dash.returncode == 0 and dash.stdout == ref.read_bytes() and b"ledger" in dash.stderr
     dev = subprocess.run([*cmd, "/dev/stdout"], capture_output=True)
-    assert dev.returncode == 0 and dev.stdout.startswith(ref.read_bytes()) and dev.stderr == b""
+    assert dev.returncode == 0 and dev.stdout == ref.read_bytes() and b"ledger" in dev.stderr
     primary, secondary = os.openpty()
     try:
         tty = subprocess.run([*cmd, "-"], stdout=secondary, stderr=subprocess.PIPE)
@@ -582,7 +636,23 @@ def test_sweep_formats_match_renderer_sweep(capsys):
     rc, out, _ = run(["sweep", "--eps", "1e-1:1e-6:6", "--size", "40x32"], capsys)
     lines = out.strip().splitlines()
     assert rc == 0 and len(lines) == 2 + 6 and lines[2].split()[0] == "1.00e-01"
-    assert f"{ref[0].max_abs:.3e}" in lines[2]
+    rows = table(out, CENSUS_LABELS)
+    assert len(rows) == 6
+    for row, e, led in zip(rows, steps, ref):     # each column under its own label
+        assert agrees(row["eps"], e, rel=1e-2) and all(agrees(row[f], getattr(led, f)) for f in CENSUS_LABELS.values())
+
+
+def test_sweep_of_a_field_without_a_crease_band_says_none(capsys):
+    """The sine field has no crease band: the on-band mean is a missing value in every format."""
+    argv = ["sweep", "--eps", "1e-2,1e-5", "--size", "24x20", "--set", "height_field=sine"]
+    ref = sweep(Scene(height_field="sine"), (1e-2, 1e-5), 24, 20).census
+    assert all(math.isnan(led.mean_abs_kink) for led in ref)
+    rc, out, _ = run(argv, capsys)
+    rows = table(out, CENSUS_LABELS)
+    assert rc == 0 and "nan" not in out and [r["mean_abs_kink"] for r in rows] == [None, None]
+    assert all(agrees(r[f], getattr(led, f)) for r, led in zip(rows, ref) for f in CENSUS_LABELS.values())
+    rc, out, _ = run([*argv, "--format", "csv"], capsys)
+    assert rc == 0 and [r["mean_abs_kink"] for r in csv.DictReader(io.StringIO(out))] == ["", ""]
 
 
 # ------------------------------------------------------------------ ucurve
@@ -595,10 +665,16 @@ def test_ucurve_table_matches_measure(tmp_path, capsys):
                         "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
     assert rc == 0 and err == ""
     uc = measure("sine", 0.31, 0.47, "u", eps=cli.parse_eps("1e-1:1e-12:12", max_steps=100))
-    rows = [line.split() for line in out.splitlines() if line.split()[0][:1].isdigit()]
+    rows = table(out, UCURVE_LABELS)
     assert len(rows) == 12
-    for r, e, t, ro, er in zip(rows, uc.eps, uc.truncation, uc.roundoff, uc.error):
-        assert r[:4] == [f"{e:.2e}", f"{t:.3e}", f"{ro:.3e}", f"{er:.3e}"]
+    for i, row in enumerate(rows):                # each column under its own label
+        assert agrees(row["eps"], uc.eps[i], rel=1e-2)
+        assert all(agrees(row[f], float(getattr(uc, f)[i])) for f in ("truncation", "roundoff", "error", "model"))
+    m = re.search(r"^true derivative (\S+); \|h'''\| = (\S+)$", out, re.M)
+    assert float(m[1]) == uc.derivative and agrees(float(m[2]), abs(uc.third_derivative))
+    m = re.search(r"^eps\* predicted (\S+); measured minimum (\S+) at eps (\S+)$", out, re.M)
+    assert all(agrees(float(m[i]), getattr(uc, f)) for i, f in enumerate(
+        ("eps_opt_predicted", "error_at_measured_opt", "eps_opt_measured"), 1))
     first = plot.read_bytes()
     assert varying_chunks(first) == []
     rc, _, _ = run(["ucurve", "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
@@ -626,7 +702,7 @@ def test_ucurve_says_where_the_field_is_not_differentiable(argv, where, tmp_path
 def test_ucurve_in_chunks_for_progress_equals_one_measure(capsys, monkeypatch):
     argv = ["ucurve", "--field", "ridges", "--component", "v", "--eps", "1e-1:1e-14:120"]
     rc, plain, _ = run(argv, capsys)
-    monkeypatch.setattr(cli, "_show_progress", lambda: True)
+    monkeypatch.setattr(cmdline, "show_progress", lambda: True)
     rc2, chunked, _ = run(argv, capsys)
     assert rc == rc2 == 0 and plain == chunked and len(plain.splitlines()) == 3 + 120 + 1
 
@@ -648,7 +724,7 @@ def test_broken_pipe_is_quiet(capsys, monkeypatch):
     # Wrong variant: any other OSError on output is still reported.
     monkeypatch.setattr(ClosedPipe, "write", lambda self, t: (_ for _ in ()).throw(OSError(5, "I/O error")))
     rc = main(["sweep", "--size", "8x8", "--eps", "1e-2"])
-    assert rc == 2 and capsys.readouterr().err == "symrender: error: I/O error\n"
+    assert rc == 2 and capsys.readouterr().err == "symrender: error: standard output: I/O error\n"
 
 
 
@@ -791,8 +867,8 @@ def test_a_closed_stdout_is_an_error_before_any_work(tmp_path, command):
     """`>&-`: the report (and `-o -`'s image) would be lost; an AttributeError or exit 0 before."""
     done = subprocess.run([sys.executable, "-m", "renderer.cli", *command], cwd=tmp_path, capture_output=False,
                           stderr=subprocess.PIPE, preexec_fn=lambda: os.close(1), timeout=600)
-    assert done.returncode == 2 and done.stderr == b"symrender: error: standard output is closed: symrender " \
-                                                   b"reports there (and -o - writes there)\n", done.stderr
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == b"symrender: error: standard output is closed: symrender reports there\n", done.stderr
     assert not list(tmp_path.iterdir())
 
 
@@ -815,3 +891,229 @@ def test_an_error_line_does_not_repeat_a_huge_value(capsys):
     rc, out, err = run(["render", "--size", "9" * 900_000], capsys)
     assert rc == 2 and err.startswith("symrender: error: ") and err.count("\n") == 1
     assert len(err) < 700 and err.rstrip().endswith("characters)"), err[-200:]
+
+
+# ------------------------------------------------------------------ render's frames
+
+
+@pytest.mark.parametrize("view", cli.VIEWS)
+@pytest.mark.parametrize("gradient", ["exact", "central", "footprint"])
+def test_render_holds_at_most_two_frames(tmp_path, capsys, monkeypatch, gradient, view):
+    """The pixel budget counts two frames: when another frame is rendered, at most one
+    earlier frame is still held (the footprint frame replaces the central one; the
+    difference view does not render it at all)."""
+    import importlib
+    import weakref
+    module = importlib.import_module("renderer.render")
+    real, made, held = module.render, [], []
+
+    def counting(*args, **kwargs):
+        held.append(sum(ref() is not None for ref in made))
+        frame = real(*args, **kwargs)
+        made.append(weakref.ref(frame.image))
+        return frame
+
+    monkeypatch.setattr(module, "render", counting)
+    out = tmp_path / "o.png"
+    assert run(["render", "--size", "16x12", "--gradient", gradient, "--view", view, "-o", str(out)], capsys)[0] == 0
+    shown = gradient == "footprint" and view != "difference"
+    assert len(held) == 2 + shown and max(held) <= 1, held
+
+
+@pytest.mark.parametrize("view", cli.VIEWS)
+def test_footprint_views_match_the_library(tmp_path, capsys, view):
+    out = tmp_path / "o.png"
+    rc, stdout, _ = run(["render", "--size", SMALL, "--gradient", "footprint", "--view", view, "-o", str(out)], capsys)
+    numeric, symbolic = render(Scene(), 48, 40, gradient="central"), render(Scene(), 48, 40)
+    selected = render(Scene(), 48, 40, gradient="footprint")
+    want = cli.view_image(view, selected, numeric, symbolic)
+    assert rc == 0 and ledger_problems(stdout, compare(numeric, symbolic)) == []
+    np.testing.assert_array_equal(read_png(out), expected_pixels(want))
+    if view != "difference":                  # the view shows the footprint frame, not the central one
+        assert not np.array_equal(want, cli.view_image(view, numeric, numeric, symbolic))
+
+
+# ------------------------------------------------------------------ every limit at the limit and one past
+
+
+class Reached(Exception):
+    """Raised by a stand-in for the work: the arguments passed every check."""
+
+
+def _past(x, direction):
+    return repr(float(np.nextafter(x, direction)))
+
+
+LIMIT_CASES = [
+    # (argv, the word of the refusal or None: accepted)
+    (["render", "--size", "8192x1"], None), (["render", "--size", "8193x1"], "between 1 and 8192"),
+    (["render", "--size", "1x1"], None), (["render", "--size", "1x0"], "between 1 and 8192"),
+    (["render", "--size", "4096x4096"], None), (["render", "--size", "4097x4096"], "at most 16,777,216"),
+    (["sweep", "--eps", "1e-3", "--size", "4096x4096"], None),
+    (["sweep", "--eps", "1e-3", "--size", "4097x4096"], "at most 16,777,216"),
+    (["sweep", "--eps", "1e-1:1e-7:7", "--size", "2048x2048"], None),
+    (["sweep", "--eps", "1e-1:1e-8:8", "--size", "2048x2048"], "at most 33,554,432"),
+    (["sweep", "--eps", "1e-1:1e-8:64", "--size", "8x8"], None),
+    (["sweep", "--eps", "1e-1:1e-8:65", "--size", "8x8"], "between 1 and 64"),
+    (["sweep", "--eps", ",".join(["1e-3"] * 65), "--size", "8x8"], "1 to 64 steps"),
+    (["sweep", "--eps", "1e-16,0.25", "--size", "8x8"], None),
+    (["sweep", "--eps", _past(0.25, 1), "--size", "8x8"], f"--eps must be in [1e-16, 0.25], got {_past(0.25, 1)}"),
+    (["sweep", "--eps", _past(1e-16, 0), "--size", "8x8"], "--eps must be in [1e-16, 0.25]"),
+    (["ucurve", "--u", "0", "--v", "1"], None), (["ucurve", "--u", "1"], None),
+    (["ucurve", "--u", _past(1.0, 2)], f"--u must be in [0, 1], got {_past(1.0, 2)}"),
+    (["ucurve", "--v", "-5e-324"], "--v must be in [0, 1], got -5e-324"),
+    (["ucurve", "--k-u", "1000", "--k-v", "5e-324"], None),
+    (["ucurve", "--k-u", _past(1e3, 2e3)], f"--k-u must be in (0, 1000], got {_past(1e3, 2e3)}"),
+    (["ucurve", "--k-v", "0"], "--k-v must be in (0, 1000], got 0.0"),
+    (["ucurve", "--eps", f"1e-300,{_past(1.0, 0)}"], None),
+    (["ucurve", "--eps", "1"], "--eps must be in [1e-300, 1), got 1.0 at flat index 0"),
+    (["ucurve", "--eps", f"1e-3,{_past(1e-300, 0)}"], "--eps must be in [1e-300, 1)"),
+    (["ucurve", "--eps", "1e-1:1e-15:10000"], None), (["ucurve", "--eps", "1e-1:1e-15:10001"], "between 1 and 10000"),
+    (["render", "--set", "center_b=" + "[" * 8 + "]" * 8], "Scene.center_b"),
+    (["render", "--set", "center_b=" + "[" * 9 + "]" * 9], "nested too deeply (at most 8 levels"),
+]
+
+
+@pytest.mark.parametrize("argv, word", LIMIT_CASES, ids=[" ".join(a)[:50] for a, _ in LIMIT_CASES])
+def test_command_line_limits_at_the_limit_and_one_past(tmp_path, capsys, monkeypatch, argv, word):
+    """Accepted: the command reaches its work (a stand-in raises `Reached`, reported as a bug);
+    refused: exit 2 with the limit named, before any work."""
+    import importlib
+
+    def reach(*args, **kwargs):
+        raise Reached
+    for module, name in (("renderer.render", "render"), ("renderer.sweep", "sweep"), ("renderer.ucurve", "measure")):
+        monkeypatch.setattr(importlib.import_module(module), name, reach)
+    if argv[0] == "render":
+        argv = [*argv, "-o", str(tmp_path / "o.png")]
+    rc, out, err = run(argv, capsys)
+    if word is None:
+        assert (rc, err) == (1, "symrender: internal error: Reached: \n"), err
+    else:
+        assert rc == 2 and err.startswith("symrender: error: ") and word in err, err
+    assert out == "" and list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ input errors and bugs
+
+
+def test_an_input_error_the_library_finds_is_exit_2_and_a_bug_is_exit_1(tmp_path, capsys, monkeypatch):
+    """``ucurve --eps 2`` passed the command line's checks and `measure` refused it:
+    "internal error", exit 1.  A ValueError that is not the library's validation stays a bug."""
+    rc, _, err = run(["ucurve", "--eps", "2"], capsys)
+    assert (rc, err) == (2, "symrender: error: --eps must be in [1e-300, 1), got 2.0 at flat index 0\n")
+    rc, _, err = run(["render", "--size", "8x8", "--set", "bump=surface", "--set", "beta=1",
+                      "-o", str(tmp_path / "o.png")], capsys)
+    assert rc == 2 and err.startswith("symrender: error: Scene.beta must be < radius_a")
+    import importlib
+
+    def broken(*args, **kwargs):
+        raise ValueError("a bug")
+    monkeypatch.setattr(importlib.import_module("renderer.render"), "render", broken)
+    rc, _, err = run(["render", "--size", "8x8", "-o", str(tmp_path / "o.png")], capsys)
+    assert (rc, err) == (1, "symrender: internal error: ValueError: a bug\n") and list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------ full and closed standard streams
+
+
+def symrender(argv, cwd, code=None, **kwargs):
+    """Run ``python -m renderer.cli`` (or ``code``, a harness) with ``argv``; the CompletedProcess."""
+    head = [sys.executable, "-c", code] if code else [sys.executable, "-m", "renderer.cli"]
+    return subprocess.run([*head, *argv], cwd=cwd, timeout=600, **kwargs)
+
+
+@pytest.fixture(scope="module")
+def reference_png(tmp_path_factory):
+    """The bytes of ``render --size 8x8`` (the PNG every stream test expects, or none)."""
+    d = tmp_path_factory.mktemp("ref")
+    assert main(["render", "--size", "8x8", "-o", str(d / "ref.png")]) == 0
+    return (d / "ref.png").read_bytes()
+
+
+@pytest.mark.parametrize("argv", [["render", "--size", "8x8", "-o", "y.png"],
+                                  ["ucurve", "--eps", "1e-3", "--plot", "y.png"]], ids=["render", "ucurve"])
+def test_a_full_stdout_leaves_no_output_file(tmp_path, argv):
+    """``>/dev/full``: the report cannot be written, so the output is not put in place (it was
+    written, and the command exited 2)."""
+    with open("/dev/full", "w") as full:
+        done = symrender(argv, tmp_path, stdout=full, stderr=subprocess.PIPE)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == b"symrender: error: standard output: No space left on device\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_full_stderr_changes_nothing_written(tmp_path, reference_png):
+    """``2>/dev/full``: nothing needs stderr for ``-o y.png``: the PNG and the report as ever."""
+    with open("/dev/full", "w") as full:
+        done = symrender(["render", "--size", "8x8", "-o", "y.png"], tmp_path, stdout=subprocess.PIPE, stderr=full)
+    assert done.returncode == 0 and b"ledger" in done.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["y.png"] and (tmp_path / "y.png").read_bytes() == reference_png
+
+
+def test_output_on_stdout_with_a_full_stderr_writes_no_png(tmp_path):
+    """``-o - 2>/dev/full``: the report (on stderr) cannot be written: exit 2 and no PNG on stdout."""
+    with open("/dev/full", "w") as full:
+        done = symrender(["render", "--size", "8x8", "-o", "-"], tmp_path, stdout=subprocess.PIPE, stderr=full)
+    assert done.returncode == 2 and done.stdout == b"" and list(tmp_path.iterdir()) == []
+
+
+#: A harness: symrender, with a message written to descriptor 2 while the output file is
+#: open (as a C library's warning would be), then the PNG completed.
+NOISY = ("import os, sys, renderer.files as files\n"
+         "real = files.os.fsync\n"
+         "def fsync(fd):\n"
+         "    try:\n"
+         "        os.write(2, b'a message for standard error\\n')\n"
+         "    except OSError:\n"
+         "        pass\n"
+         "    real(fd)\n"
+         "files.os.fsync = fsync\n"
+         "from renderer.cli import main\n"
+         "sys.exit(main())\n")
+
+
+def test_a_closed_stderr_loses_messages_and_changes_nothing_written(tmp_path, reference_png):
+    """``2>&-``: the run used to end in an AttributeError printed on stdout (``-o -``: into the
+    PNG stream).  Now the PNG and the report are as ever, though a message goes to descriptor
+    2 while the output is open (`NOISY`): with the descriptor left closed, the output file
+    would take its number, and the message would land in the PNG."""
+    done = symrender(["render", "--size", "8x8", "-o", "x.png"], tmp_path, NOISY, stdout=subprocess.PIPE,
+                     preexec_fn=lambda: os.close(2))
+    assert done.returncode == 0 and done.stdout.startswith(b"wrote x.png")
+    assert [p.name for p in tmp_path.iterdir()] == ["x.png"] and (tmp_path / "x.png").read_bytes() == reference_png
+    done = symrender(["render", "--size", "8x8", "-o", "-"], tmp_path, NOISY, stdout=subprocess.PIPE,
+                     preexec_fn=lambda: os.close(2))
+    assert done.returncode == 0 and done.stdout == reference_png
+
+
+# ------------------------------------------------------------------ the environment
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "abc", "", "2.5", "1e3"])
+def test_numba_num_threads_that_is_not_a_positive_integer_is_one_line(tmp_path, value):
+    """numba printed a 9-line warning with a traceback for "abc" and failed as a bug for "0"."""
+    done = symrender(["render", "--size", "4x4", "-o", "z.png"], tmp_path, capture_output=True, text=True,
+                     env={**os.environ, "NUMBA_NUM_THREADS": value})
+    assert (done.returncode, done.stderr) == (2, "symrender: error: the environment variable NUMBA_NUM_THREADS must "
+                                                 f"be a positive integer (numba's thread count), got {value!r}\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_numba_num_threads_at_its_limit_renders(tmp_path):
+    done = symrender(["render", "--size", "4x4", "-o", "z.png"], tmp_path, capture_output=True, text=True,
+                     env={**os.environ, "NUMBA_NUM_THREADS": "1"})
+    assert done.returncode == 0 and done.stderr == "" and (tmp_path / "z.png").exists()
+
+
+def test_an_unwritable_home_adds_nothing_to_stderr(tmp_path):
+    """matplotlib logged two warnings (its config and cache directories fell back to a
+    temporary one) where $HOME cannot be written: here HOME is a file (root writes anywhere
+    else), with the XDG directories unset (matplotlib would use them first)."""
+    home = tmp_path / "home"
+    home.write_text("not a directory")
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("XDG_", "MPLCONFIGDIR"))}
+    done = symrender(["ucurve", "--eps", "1e-3", "--plot", "p.png"], tmp_path, capture_output=True,
+                     env={**env, "HOME": str(home)})
+    assert done.returncode == 0 and done.stderr == b"", done.stderr
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -232,6 +232,50 @@ def test_an_error_while_encoding_writes_nothing(tmp_path):
     assert target.read_bytes() == b"half"
 
 
+# ------------------------------------------------------------------ staged writes
+
+
+def test_a_staged_file_is_in_place_only_once_committed(tmp_path):
+    """`files.Staged`: the content waits in a temporary file beside the target; the target
+    is untouched until `commit`; `discard` (any number of times) leaves it as it was."""
+    target = tmp_path / "o.png"
+    target.write_bytes(b"old")
+    staged = files.Staged(target, b"new")
+    (part,) = [p for p in tmp_path.iterdir() if p.name != "o.png"]
+    assert part.name.startswith(".o.png.") and part.name.endswith(".part") and part.read_bytes() == b"new"
+    assert target.read_bytes() == b"old"
+    staged.commit()
+    assert target.read_bytes() == b"new" and sorted(p.name for p in tmp_path.iterdir()) == ["o.png"]
+    staged = files.Staged(target, b"newer")
+    staged.discard()
+    staged.discard()
+    assert target.read_bytes() == b"new" and sorted(p.name for p in tmp_path.iterdir()) == ["o.png"]
+
+
+def test_a_staged_fifo_is_written_at_commit_only(tmp_path):
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    staged = files.Staged(fifo, b"through")          # opening the FIFO now would block: no reader yet
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe"]
+    t, got = read_fifo_in_thread(fifo)
+    staged.commit()
+    t.join(10)
+    assert got == [b"through"] and kind(fifo) == "FIFO"
+
+
+def test_an_interrupt_at_the_commit_keeps_the_old_file(tmp_path, monkeypatch):
+    target = tmp_path / "o.png"
+    target.write_bytes(b"old")
+    staged = files.Staged(target, b"new")
+
+    def interrupted(*args):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(files.os, "replace", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        staged.commit()
+    assert target.read_bytes() == b"old" and sorted(p.name for p in tmp_path.iterdir()) == ["o.png"]
+
+
 # ------------------------------------------------------------------ bounded reads
 
 

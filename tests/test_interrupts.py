@@ -1,25 +1,29 @@
-"""Ctrl-C at any moment of a ``symrender`` command (renderer/cli.py, `main`).
+"""Ctrl-C and SIGTERM at any moment of a ``symrender`` command (renderer/cli.py and
+`renderer.cmdline.main`).
 
-Each test starts the installed console script in a session of its own (as a
-shell starts a foreground job), waits for a chosen moment, and sends SIGINT
-to the child's whole process group, as a terminal's Ctrl-C does.  Then it
-asks for: exit code 130; stderr exactly one line ``symrender: interrupted``
-(no traceback); the output directory as it was (no output file, no ``.part``
-staging directory, no temporary file); and no process left behind, neither in
-the child's session nor anywhere else.  The notebook kernel (jupyter_client)
-starts a session of its own, so
-a session check alone would miss them: every run carries a marker in its
-environment, which all its descendants inherit, and any live process with
-that marker after the run is a leftover.
+Each test starts the command in a session of its own (as a shell starts a
+foreground job), waits for a chosen moment, and sends SIGINT to the child's
+whole process group, as a terminal's Ctrl-C does, or SIGTERM to the child, as
+``timeout``, CI and service managers do.  Then it asks for: exit code 130 (143);
+stderr exactly one line ``symrender: interrupted`` (``terminated``), no
+traceback; the output directory as it was (no output file, no ``.part``
+file, no temporary file); and no process left behind, neither in the child's
+session nor anywhere else: every run carries a marker in its environment,
+which all its descendants inherit, and any live process with that marker
+after the run is a leftover (a notebook kernel starts a session of its own).
 
 The moments: during the start-up imports (numpy, the renderer, then
-matplotlib), and during ``render`` of a large frame and ``sweep`` once numba
-is loaded.  In-process: `main` ignores a second Ctrl-C during the clean-up
-and restores the previous handler; a Ctrl-C whose KeyboardInterrupt a C
-callback drops (as llvmlite's does while numba compiles) still stops the
-command before it writes.  ``import renderer.cli`` (what the console script
-does before `main` runs) loads neither numpy nor the kernel.  The checkers
-are shown to fail on a leaked process and on a traceback.
+matplotlib), found by watching the child's memory maps; and moments a harness
+in the child announces by writing a file (`HARNESS`): inside the render's or
+the sweep's band loop (compiled bands run again and again until the signal
+comes), while the output's temporary file is being written, and after the
+report is out but before the output is renamed into place.  In-process:
+`main` ignores a second signal during the clean-up and restores the previous
+handlers; a Ctrl-C whose KeyboardInterrupt a C callback drops (as llvmlite's
+does while numba compiles) still stops the command before it writes.
+``import renderer.cli`` (what the console script does before `main` runs)
+loads neither numpy nor the kernel.  The checkers are shown to fail on a
+leaked process and on a traceback.
 
 Linux only (/proc).
 """
@@ -42,6 +46,53 @@ ROOT = Path(__file__).resolve().parent.parent
 SYMRENDER = Path(sys.executable).with_name("symrender")
 MARKER = "SYMRENDER_INTERRUPT_TEST"
 INTERRUPTED = "symrender: interrupted\n"
+#: What each signal must end in: the exit code and stderr's one line (after ``<prog>: ``).
+OUTCOME = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminated")}
+
+#: Runs ``renderer.cli.main`` (or with ``--tool check_figures``, book/check_figures.py's) with
+#: the moment MOMENT held open: the harness writes the file READY when the moment has come,
+#: and keeps the child there until the signal's exception arrives (or exits 99 after 120 s).
+#: band: the compiled band of the render or sweep, repeated (the exception comes between two
+#: calls, as in a real render); write: the output's temporary file is written (before its
+#: sync); commit: the report is out, the output not yet renamed into place; any other
+#: moment: nothing is held by the harness (a book page announces it, check_figures).
+HARNESS = """
+import os, sys, time
+import renderer.kernel as kernel
+ready, moment = os.environ["READY"], os.environ["MOMENT"]
+
+def arrive():
+    if not os.path.exists(ready):
+        open(ready, "w").close()
+
+def hold():
+    arrive()
+    for _ in range(12000):
+        time.sleep(0.01)
+    os._exit(99)
+
+if moment == "band":
+    for name in ("render_rows", "sweep_rows"):
+        def band(*args, real=getattr(kernel, name)):
+            arrive()
+            while True:
+                real(*args)
+        setattr(kernel, name, band)
+elif moment in ("write", "commit"):
+    call = {"write": "fsync", "commit": "replace"}[moment]
+    real = getattr(os, call)
+    # fsync: of the output's temporary file; replace: of a staged output (a .part name).
+    setattr(os, call, lambda *args: (call == "fsync" or ".part" in str(args[0])) and hold() or real(*args))
+if sys.argv[1] == "--tool":
+    sys.path.insert(0, os.path.join(os.environ["REPO"], "book"))
+    import check_figures
+    from pathlib import Path
+    if os.environ.get("BOOK_ROOT"):
+        check_figures.ROOT = Path(os.environ["BOOK_ROOT"])
+    sys.exit(check_figures.main(sys.argv[3:]))
+from renderer.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
 
 
 # ------------------------------------------------------------------ processes
@@ -92,14 +143,17 @@ def live_processes(session, token):
 
 class Run:
     """``symrender *args`` in a new session with piped output, marked in its
-    environment so that every descendant can be found."""
+    environment so that every descendant can be found.  With ``moment``, the
+    `HARNESS` runs the command and holds that moment open; `ready` is its file."""
 
-    def __init__(self, *args, cwd, env=None):
+    def __init__(self, *args, cwd, env=None, moment=None):
         self.token = uuid.uuid4().hex
+        self.ready = Path(cwd) / f".ready-{self.token}"
         environ = dict(os.environ, **(env or {}))
-        environ[MARKER] = self.token
+        environ.update({MARKER: self.token, "READY": str(self.ready), "MOMENT": moment or "", "REPO": str(ROOT)})
+        command = [sys.executable, "-c", HARNESS] if moment else [str(SYMRENDER)]
         self.started = time.monotonic()
-        self.proc = subprocess.Popen([str(SYMRENDER), *map(str, args)], cwd=cwd, env=environ,
+        self.proc = subprocess.Popen([*command, *map(str, args)], cwd=cwd, env=environ,
                                      stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                      stderr=subprocess.PIPE, start_new_session=True)
 
@@ -136,6 +190,19 @@ class Run:
         """Ctrl-C at a terminal: SIGINT to the whole foreground process group."""
         os.killpg(self.proc.pid, signal.SIGINT)
 
+    def send(self, signum):
+        """SIGINT as a terminal sends it (`interrupt`), SIGTERM as ``timeout`` does: to the child."""
+        if signum == signal.SIGINT:
+            self.interrupt()
+        else:
+            self.proc.send_signal(signum)
+
+    def at_the_moment(self, timeout=120):
+        """Wait until the harness has announced its moment (its READY file), then remove
+        the file (it is not the command's output)."""
+        self.wait_until(self.ready.exists, timeout, "the harness's moment")
+        self.ready.unlink()
+
     def finish(self, timeout=60):
         """Wait for the command; return (exit code, stdout, stderr, seconds
         from start)."""
@@ -163,14 +230,15 @@ def leftovers(session, token, grace):
         time.sleep(0.05)
 
 
-def interrupt_problems(rc, err, before, after, left):
-    """What is wrong with an interrupted run: an exit code other than 130,
-    stderr other than the one line, a traceback, a file added to the output
-    directory, a process left behind."""
+def interrupt_problems(rc, err, before, after, left, signum=signal.SIGINT, prog="symrender"):
+    """What is wrong with a run stopped by ``signum``: an exit code other than 130
+    (SIGINT) or 143 (SIGTERM), stderr other than the one line, a traceback, a file
+    added to the output directory, a process left behind."""
     problems = []
-    if rc != 130:
+    code, word = OUTCOME[signum]
+    if rc != code:
         problems.append(f"exit code {rc}")
-    if err != INTERRUPTED:
+    if err != f"{prog}: {word}\n":
         problems.append(f"stderr is not the one line: {err[-3000:]!r}")
     if "Traceback" in err:
         problems.append("traceback")
@@ -185,9 +253,9 @@ def listing(directory):
     return sorted(p.name for p in Path(directory).iterdir())
 
 
-def check(run, directory, before, grace=5.0):
+def check(run, directory, before, grace=5.0, signum=signal.SIGINT, prog="symrender"):
     rc, out, err, seconds = run.finish()
-    problems = interrupt_problems(rc, err, before, listing(directory), run.leftovers(grace))
+    problems = interrupt_problems(rc, err, before, listing(directory), run.leftovers(grace), signum, prog)
     assert problems == [], problems
     return seconds
 
@@ -197,6 +265,9 @@ def check(run, directory, before, grace=5.0):
 
 def test_checker_rejects_wrong_variants():
     assert interrupt_problems(130, INTERRUPTED, [], [], []) == []
+    assert interrupt_problems(143, "symrender: terminated\n", [], [], [], signal.SIGTERM) == []
+    assert interrupt_problems(130, INTERRUPTED, [], [], [], signal.SIGTERM)   # SIGTERM reported as Ctrl-C
+    assert interrupt_problems(-15, "", [], [], [], signal.SIGTERM)          # killed by the signal, silently
     assert interrupt_problems(1, INTERRUPTED, [], [], [])
     assert interrupt_problems(-2, "", [], [], [])
     assert interrupt_problems(130, "", [], [], [])
@@ -232,89 +303,124 @@ def test_orphan_check_catches_a_leaked_process():
 # ------------------------------------------------------------------ start-up
 
 
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 @pytest.mark.parametrize("library, delay", [("_multiarray_umath", 0.1), ("kiwisolver", 0.0)])
-def test_interrupt_during_start_up_imports(tmp_path, library, delay):
-    """SIGINT while ``render`` imports numpy, sympy and the renderer, and
+def test_a_signal_during_start_up_imports(tmp_path, library, delay, signum):
+    """A signal while ``render`` imports numpy, sympy and the renderer, and
     later matplotlib: ``delay`` s after numpy's extension
-    module, or matplotlib's kiwisolver, has been mapped.  The one line, 130,
-    nothing written.
+    module, or matplotlib's kiwisolver, has been mapped.  The one line, 130
+    (143), nothing written.
 
     The clock starts inside `main`, not at the spawn: before `main` runs,
     Python itself starts (interpreter, site, the console script's ``import
-    renderer.cli``, which loads no numpy), and a SIGINT
+    renderer.cli``, which loads no numpy), and a signal
     then is Python's to report."""
     run = Run("render", "--size", "64x64", "-o", "out.png", cwd=tmp_path)
     run.wait_until(lambda: run.maps(library), 10, f"{library} being imported")
     time.sleep(delay)
-    run.interrupt()
-    check(run, tmp_path, [])
+    run.send(signum)
+    check(run, tmp_path, [], signum=signum)
+
+
+HEAVY = ("numpy", "sympy", "matplotlib", "numba", "renderer.kernel", "renderer.render")
+
+
+def heavy_modules_after(code):
+    """The heavy modules (`HEAVY`) loaded once ``code`` has run in a fresh interpreter."""
+    probe = f"import sys\n{code}\nprint(sorted(m for m in {HEAVY!r} if m in sys.modules))"
+    return subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout.strip()
 
 
 def test_importing_the_command_line_loads_no_numpy():
-    """``import renderer.cli`` loads neither numpy, sympy nor matplotlib, nor any
-    of the renderer (importing the package ``renderer`` loads numpy): the
-    command line starts at once, and `main` does the heavy imports where it
-    handles a Ctrl-C.  Wrong variant: once the command line touches numpy
-    (parsing ``--eps``), the same check sees it."""
-    code = ("import sys, renderer.cli as cli\n"
-            "heavy = ('numpy', 'sympy', 'matplotlib', 'renderer.kernel', 'renderer.render')\n"
-            "print(sorted(m for m in heavy if m in sys.modules))\n"
-            "cli.parse_eps('1e-2')\n"
-            "print(sorted(m for m in heavy if m in sys.modules))\n")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    first, then = out.splitlines()
-    assert first == "[]" and "'numpy'" in then and "'renderer.kernel'" in then, out
+    """``import renderer.cli`` (and its toolkit) loads neither numpy, sympy, matplotlib nor
+    numba, nor any of the renderer: the command line starts at once, and `main` does the
+    heavy imports where it handles a signal.  The probe sees a heavy import: a command line
+    that imported numpy at the top would show it."""
+    assert heavy_modules_after("import renderer.cli, renderer.cmdline") == "[]"
+    assert heavy_modules_after("import renderer.cli, numpy") == "['numpy']"
 
 
 # ------------------------------------------------------------------ commands at work
 
 
+SIGNALS = [signal.SIGINT, signal.SIGTERM]
+
+
+@pytest.mark.parametrize("signum", SIGNALS, ids=["SIGINT", "SIGTERM"])
 @pytest.mark.parametrize("args", [
-    ("render", "--size", "4096x4096", "-o", "big.png"),                          # two 4096^2 frames
-    ("sweep", "--size", "2048x2048", "--eps", "1e-1:1e-6:6", "--format", "csv"),
+    ("render", "--size", "256x256", "-o", "big.png"),
+    ("sweep", "--size", "64x64", "--eps", "1e-1:1e-6:6", "--format", "csv"),
 ], ids=["render", "sweep"])
-def test_interrupt_during_render_or_sweep(tmp_path, args):
-    """SIGINT once the compiled kernel's library is loaded.  A render under
-    way finishes first (compiled code does not check for signals); then no
-    PNG and no temporary file."""
-    run = Run(*args, cwd=tmp_path)
-    run.wait_until(lambda: run.maps("llvmlite"), 20, "numba being loaded")
-    time.sleep(0.5)
-    assert run.proc.poll() is None, f"{args[0]} ended before the interrupt; make it larger"
-    run.interrupt()
-    check(run, tmp_path, [])
+def test_a_signal_inside_the_band_loop(tmp_path, args, signum):
+    """The signal arrives while compiled bands run (they do not check for signals); the
+    exception comes between two bands; then no PNG and no temporary file."""
+    run = Run(*args, cwd=tmp_path, moment="band")
+    run.at_the_moment()
+    run.send(signum)
+    check(run, tmp_path, [], signum=signum)
+
+
+RENDER_8 = ("render", "--size", "8x8", "-o", "out.png")
+
+
+@pytest.mark.parametrize("args, moment, signum", [
+    *[(RENDER_8, moment, signum) for moment in ("write", "commit") for signum in SIGNALS],
+    (("ucurve", "--eps", "1e-3", "--plot", "out.png"), "commit", signal.SIGTERM),
+], ids=["render-write-SIGINT", "render-write-SIGTERM", "render-commit-SIGINT", "render-commit-SIGTERM",
+        "ucurve-commit-SIGTERM"])
+def test_a_signal_while_the_output_is_written_leaves_nothing(tmp_path, args, moment, signum):
+    """SIGTERM while the output's temporary file was written exited 143 silently and left
+    ``.out.png.XXXX.part`` behind; SIGINT was clean.  Both now: one line, nothing left, at
+    either moment of the write."""
+    run = Run(*args, cwd=tmp_path, moment=moment)
+    run.at_the_moment()
+    assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".part")], "no temporary file at the moment"
+    run.send(signum)
+    check(run, tmp_path, [], signum=signum)
+
+
+def test_an_old_output_stays_whole_when_the_write_is_stopped(tmp_path):
+    (tmp_path / "out.png").write_bytes(b"old")
+    run = Run("render", "--size", "8x8", "-o", "out.png", cwd=tmp_path, moment="commit")
+    run.at_the_moment()
+    run.send(signal.SIGTERM)
+    check(run, tmp_path, ["out.png"], signum=signal.SIGTERM)
+    assert (tmp_path / "out.png").read_bytes() == b"old"
 
 
 # ------------------------------------------------------------------ in-process and start-up path
 
 
-def test_main_in_process_restores_the_handler_and_ignores_a_second_ctrl_c(capsys, monkeypatch):
-    """main([...]) in this process: a SIGINT during the command gives 130 and
-    the one line; a second SIGINT during its clean-up is ignored (no second
-    line, the clean-up finishes); the previous handler is back afterwards."""
+@pytest.mark.parametrize("first, second", [(signal.SIGINT, signal.SIGINT), (signal.SIGTERM, signal.SIGINT),
+                                           (signal.SIGINT, signal.SIGTERM)], ids=["INT-INT", "TERM-INT", "INT-TERM"])
+def test_main_in_process_restores_the_handlers_and_ignores_a_second_signal(capsys, monkeypatch, first, second):
+    """main([...]) in this process: a signal during the command gives its code and
+    one line; a second signal during the clean-up is ignored (no second line, the
+    clean-up finishes); the previous handlers are back afterwards."""
     import renderer.cli as cli
 
     cleaned = []
 
     def command(args, out):
         try:
-            os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(1.0)                       # the KeyboardInterrupt comes here
-            pytest.fail("no KeyboardInterrupt")
+            os.kill(os.getpid(), first)
+            time.sleep(1.0)                       # the exception comes here
+            pytest.fail("no exception")
         finally:
-            os.kill(os.getpid(), signal.SIGINT)   # a second Ctrl-C during the clean-up
+            os.kill(os.getpid(), second)          # a second signal during the clean-up
             time.sleep(0.05)
             cleaned.append(True)
 
-    before = signal.getsignal(signal.SIGINT)
+    before = {sig: signal.getsignal(sig) for sig in SIGNALS}
     monkeypatch.setitem(cli._COMMANDS, "render", command)
-    assert cli.main(["render", "-o", "x.png"]) == 130
+    code, word = OUTCOME[first]
+    assert cli.main(["render", "-o", "x.png"]) == code
     assert cleaned == [True]
-    assert capsys.readouterr().err == INTERRUPTED
-    assert signal.getsignal(signal.SIGINT) is before
-    # Without a Ctrl-C: the handler is back too.
+    assert capsys.readouterr().err == f"symrender: {word}\n"
+    assert {sig: signal.getsignal(sig) for sig in SIGNALS} == before
+    # Without a signal: the handlers are back too.
     assert cli.main(["sweep", "--size", "8x8", "--eps", "1e-2"]) == 0
-    assert signal.getsignal(signal.SIGINT) is before
+    assert {sig: signal.getsignal(sig) for sig in SIGNALS} == before
     capsys.readouterr()
 
 
@@ -352,11 +458,12 @@ def test_a_ctrl_c_that_a_c_callback_drops_still_stops_the_command(tmp_path, caps
     """A Ctrl-C whose KeyboardInterrupt a C callback drops still ends the
     command with 130 and the one line, and writes nothing.  Wrong variants:
     without `_stop_if_interrupted` the command finishes, writes its PNG and
-    exits 0."""
+    exits 0 (`renderer.cmdline.check_signal`)."""
     import renderer.cli as cli
+    from renderer import cmdline
 
     if variant == "no check before writing":
-        monkeypatch.setattr(cli, "_stop_if_interrupted", lambda: None)
+        monkeypatch.setattr(cmdline, "check_signal", lambda: None)
     # Python's own hook, which prints the report (pytest's turns it into a warning).
     monkeypatch.setattr(sys, "unraisablehook", sys.__unraisablehook__)
     calls = _render_with_a_dropped_ctrl_c(monkeypatch)

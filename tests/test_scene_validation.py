@@ -77,13 +77,15 @@ for f in REAL_FIELDS:
     BAD += [(f, NAN, ValueError), (f, INF, ValueError), (f, -INF, ValueError),
             (f, True, TypeError), (f, False, TypeError), (f, "1.0", TypeError),
             (f, None, TypeError), (f, 1j, TypeError), (f, (1.0,), TypeError),
-            (f, np.float64(NAN), ValueError)]
+            (f, np.float64(NAN), ValueError), (f, np.True_, TypeError), (f, np.array([1.0]), TypeError),
+            (f, np.array(True), TypeError), (f, 10**400, ValueError)]
 for f in VECTOR_FIELDS:
     BAD += [(f, (0.1, 0.2), ValueError), (f, (0.1, 0.2, 0.3, 0.4), ValueError),
             (f, (), ValueError), (f, "abc", TypeError), (f, 0.5, TypeError), (f, None, TypeError),
             (f, (0.1, NAN, 0.3), ValueError), (f, (0.1, 0.2, INF), ValueError),
             (f, (0.1, True, 0.3), TypeError), (f, (0.1, "0.2", 0.3), TypeError),
-            (f, np.array([0.1, 0.2]), ValueError)]
+            (f, np.array([0.1, 0.2]), ValueError), (f, np.array(0.5), TypeError),
+            (f, np.zeros((3, 1)), TypeError), (f, (0.1, np.True_, 0.3), TypeError)]
 for f in ("sphere_b", "floor"):
     BAD += [(f, 1, TypeError), (f, 0, TypeError), (f, "yes", TypeError), (f, None, TypeError),
             (f, 1.0, TypeError)]
@@ -181,7 +183,8 @@ def test_bad_point_light_is_rejected_naming_the_field(field, value, error):
     dict(lights=(PointLight((1e6, -1e6, 0.0), (1e3, 1e3, 0.0)),)),
     dict(camera_z=1.0 + 2**-52), dict(radius_a=1e-3), dict(radius_b=1e-3),
     dict(center_b=np.array([0.5, 0.5, 1.3])), dict(center_b=[0.5, 0.5, 1.3]),
-    dict(beta=np.float64(0.5)), dict(k_u=np.int64(3)), dict(k_v=7),
+    dict(beta=np.float64(0.5)), dict(k_u=np.int64(3)), dict(k_v=7), dict(beta=np.float32(0.5)),
+    dict(kd=np.array(0.5)), dict(floor=np.False_), dict(albedo_a=np.array([1, 0, 0])),
     dict(lights=()), dict(lights=[PointLight()]), dict(model="phong"),
     dict(height_field="sine"), dict(height_field="rings"), dict(bump="surface", beta=0.99),
     dict(sphere_b=False, floor=False),
@@ -192,7 +195,7 @@ def test_valid_edge_values_are_accepted(kwargs):
         got = getattr(scene, key)
         if key == "lights":
             assert got == tuple(value)
-        elif isinstance(value, (tuple, list, np.ndarray)):
+        elif isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim):
             assert got == tuple(float(c) for c in value)
         else:
             assert got == value and not isinstance(got, np.generic)
@@ -397,8 +400,71 @@ def test_boundary_check_has_teeth():
 
 
 def test_an_integer_beyond_float_range_names_the_field():
-    with pytest.raises(ValueError, match=r"^Scene\.beta must be finite, got an integer of 401 digits"):
+    with pytest.raises(ValueError, match=r"^Scene\.beta must be in \[0, 100\], got an integer of 401 digits$"):
         Scene(beta=10**400)
+
+
+def test_a_0d_array_where_a_vector_belongs_names_the_field():
+    """``Scene(center_b=np.array(0.5))`` raised ``TypeError: len() of unsized object``."""
+    with pytest.raises(TypeError, match=r"^Scene\.center_b must be a sequence of 3 real numbers \(a tuple, list or "
+                                        r"1-D array\), got ndarray array\(0\.5\)$"):
+        Scene(center_b=np.array(0.5))
+
+
+# --- every range at its limit and one float past it ----------------------------------------
+
+def _past(x, direction):
+    return float(np.nextafter(x, direction))
+
+
+#: (field, the limit, one past it, the range as the message states it, other fields the limit needs).
+#: The camera must stay outside both spheres, which is what the extra fields arrange.
+FAR_B = dict(center_b=(1e6, 1e6, 0.0))
+LIMITS = [
+    ("radius_a", 1e-6, _past(1e-6, 0), "in [1e-06, 1e+06]", {}),
+    ("radius_b", 1e-6, _past(1e-6, 0), "in [1e-06, 1e+06]", {}),
+    ("radius_b", 1e6, _past(1e6, INF), "in [1e-06, 1e+06]", FAR_B),
+    ("camera_z", 1e6, _past(1e6, INF), "<= 1e+06", {}),
+    ("center_b", (-1e6, 0.5, 1.3), (_past(-1e6, -INF), 0.5, 1.3), "in [-1e+06, 1e+06]", {}),
+    ("center_b", (0.5, 1e6, 1.3), (0.5, _past(1e6, INF), 1.3), "in [-1e+06, 1e+06]", {}),
+    ("ambient", (0.0, 0.0, 1e3), (0.0, 0.0, _past(1e3, INF)), "in [0, 1000]", {}),
+    ("ambient", (0.0, 0.0, 0.0), (0.0, -5e-324, 0.0), "in [0, 1000]", {}),
+    ("albedo_a", (1.0, 0.5, 0.5), (_past(1.0, INF), 0.5, 0.5), "in [0, 1]", {}),
+    ("albedo_b", (0.0, 0.5, 0.5), (-5e-324, 0.5, 0.5), "in [0, 1]", {}),
+    *[(f, lim, p, "in [0, 1]", {}) for f in ("ka", "kd", "ks", "floor_tint") for lim, p in ((0.0, -5e-324),
+                                                                                        (1.0, _past(1.0, INF)))],
+    ("shininess", 1.0, _past(1.0, 0), "in [1, 10000]", {}),
+    ("shininess", 1e4, _past(1e4, INF), "in [1, 10000]", {}),
+    *[(f, lim, p, "in (0, 1000]", {}) for f in ("k_u", "k_v") for lim, p in ((5e-324, 0.0), (1e3, _past(1e3, INF)))],
+    ("beta", 0.0, -5e-324, "in [0, 100]", {}),
+    ("beta", 100.0, _past(100.0, INF), "in [0, 100]", {}),
+    ("eps", 1e-16, _past(1e-16, 0), "in [1e-16, 0.25]", {}),
+    ("eps", 0.25, _past(0.25, INF), "in [1e-16, 0.25]", {}),
+]
+
+
+@pytest.mark.parametrize("field, limit, beyond, accepted, extra", LIMITS,
+                         ids=[f"{f}-{lim}" for f, lim, *_ in LIMITS])
+def test_every_range_at_its_limit_and_one_past(field, limit, beyond, accepted, extra):
+    scene = Scene(**extra, **{field: limit})
+    assert getattr(scene, field) == limit
+    with pytest.raises(ValueError) as info:
+        Scene(**extra, **{field: beyond})
+    bad = [i for i in range(3) if beyond[i] != limit[i]] if isinstance(beyond, tuple) else []
+    name, value = (f"{field}[{bad[0]}]", beyond[bad[0]]) if bad else (field, beyond)
+    assert str(info.value) == f"Scene.{name} must be {accepted}, got {value!r}"
+
+
+@pytest.mark.parametrize("field, limit, beyond, accepted", [
+    ("position", (-1e6, 0.0, 1e6), (-1e6, 0.0, _past(1e6, INF)), "[-1e+06, 1e+06]"),
+    ("color", (1e3, 0.0, 1.0), (1e3, -5e-324, 1.0), "[0, 1000]"),
+])
+def test_point_light_ranges_at_the_limit_and_one_past(field, limit, beyond, accepted):
+    assert getattr(PointLight(**{field: limit}), field) == limit
+    i = next(i for i in range(3) if beyond[i] != limit[i])
+    with pytest.raises(ValueError, match=rf"^PointLight\.{field}\[{i}\] must be in {re.escape(accepted)}, "
+                                         rf"got {re.escape(repr(beyond[i]))}$"):
+        PointLight(**{field: beyond})
 
 
 # --- flags, sweep steps and compare's inputs -----------------------------------------------

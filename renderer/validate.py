@@ -1,0 +1,284 @@
+"""Argument validation: one function per kind of value, the same acceptance wherever it is used.
+
+`renderer.Scene` and `PointLight`, `renderer.pointwise`, `renderer.ucurve` and the
+command line (``symrender``) check their arguments with these functions:
+
+* a real scalar (`real`): a Python ``int`` or ``float``, a numpy integer or floating
+  scalar (``np.float32(0.5)``, ``np.int64(3)``), or a 0-d numeric array (numpy's own
+  spelling of a scalar), any other `numbers.Real` (``Fraction``); returned as a float;
+* a real array (`real_array`): anything numpy turns into a numeric array (scalars,
+  nested lists, arrays of any integer or floating dtype); returned as float64;
+* a 3-vector (`vector3`): a tuple, list or 1-D array of three real scalars;
+* a flag (`flag`): ``True`` or ``False`` (Python's or numpy's);
+* a choice (`choice`): one of a tuple of strings;
+* a positive integer (`positive_int`): an ``int`` or numpy integer >= 1;
+* steps (`steps`): a non-empty array of step sizes within a range.
+
+Refused everywhere: a bool where a number is asked (``True`` is not 1.0), complex
+numbers, strings (numpy would parse ``"0.5"``), containers without an order (a set,
+a dict), non-finite numbers, and an integer too large for a float (``10**400``).
+
+Each refusal is an `InvalidValue` (a ValueError) or an `InvalidType` (a
+TypeError); both are `InputError`, which the command line reports as an input
+error (exit 2) rather than a bug.  The message names the parameter, the value
+and what is accepted; ``parameter`` holds the name.
+"""
+
+from __future__ import annotations
+
+import numbers
+import sys
+
+import numpy as np
+
+__all__ = ["InputError", "InvalidValue", "InvalidType", "real", "real_array", "vector3", "flag",
+           "choice", "positive_int", "steps"]
+
+
+class InputError(Exception):
+    """An argument refused by validation: the caller's input, not a bug.
+
+    ``parameter`` is the name the message starts with."""
+
+    def __init__(self, message, parameter=None):
+        super().__init__(message)
+        self.parameter = parameter
+
+
+class InvalidValue(InputError, ValueError):
+    """An argument of the right type with a value outside what is accepted."""
+
+
+class InvalidType(InputError, TypeError):
+    """An argument of a type that is not accepted."""
+
+
+def _shown(value, limit=80):
+    """``value`` for a message: its type and repr, cut to ``limit`` characters (an int too
+    long for repr is described by its size)."""
+    if isinstance(value, int) and value.bit_length() > 3 * sys.get_int_max_str_digits():
+        return f"an integer of {value.bit_length():,} bits"
+    text = " ".join(repr(value).split())         # an array's repr spans lines
+    text = text if len(text) <= limit else text[:limit] + "..."
+    return f"{type(value).__name__} {text}"
+
+
+def _accepted(low, high, low_open, high_open):
+    """``in [low, high]``, ``> low``, ``<= high``, ... or ``finite``."""
+    if low is not None and high is not None:
+        return f"in {'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
+    if low is not None:
+        return f"{'>' if low_open else '>='} {low:g}"
+    if high is not None:
+        return f"{'<' if high_open else '<='} {high:g}"
+    return "finite"
+
+
+def _inside(x, low, high, low_open, high_open):
+    """Whether ``x`` (a float or a float64 array) is finite and within the range, elementwise."""
+    ok = np.isfinite(x)
+    if low is not None:
+        ok = ok & ((x > low) if low_open else (x >= low))
+    if high is not None:
+        ok = ok & ((x < high) if high_open else (x <= high))
+    return ok
+
+
+def _too_large(value):
+    """Digits of an int too large for a float, as words."""
+    try:
+        return f"an integer of {len(str(abs(value)))} digits"
+    except ValueError:                           # beyond Python's int-to-str limit
+        return f"an integer of more than {sys.get_int_max_str_digits()} digits"
+
+
+def real(name, value, *, low=None, high=None, low_open=False, high_open=False):
+    """``value`` as a finite float within a range.
+
+    Parameters
+    ----------
+    name : str
+        The parameter named in errors.
+    value : real scalar
+        A Python or numpy integer or floating scalar, a 0-d numeric array, or another
+        `numbers.Real`; not a bool.
+    low, high : float or None
+        The bounds (None: unbounded on that side); ``low_open``, ``high_open`` exclude them.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    InvalidType
+        ``value`` is not a real scalar (a bool, a string, a complex number, an array of
+        more than 0 dimensions, None, ...).
+    InvalidValue
+        ``value`` is not finite, too large for a float, or outside the range.
+    """
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InvalidType(f"{name} must be a real number, got {_shown(value)}", name)
+    accepted = _accepted(low, high, low_open, high_open)
+    try:
+        x = float(value)
+    except OverflowError:                        # an integer beyond float64's range
+        raise InvalidValue(f"{name} must be {accepted}, got {_too_large(int(value))}", name) from None
+    if not _inside(x, low, high, low_open, high_open):
+        raise InvalidValue(f"{name} must be {accepted}, got {value!r}", name)
+    return x
+
+
+def real_array(name, value, *, low=None, high=None, low_open=False, high_open=False):
+    """``value`` as a float64 array of finite numbers within a range.
+
+    Parameters
+    ----------
+    name : str
+    value : array_like of real numbers
+        Any shape; integer and floating dtypes (a nested list of numbers, a scalar).
+    low, high, low_open, high_open
+        As `real`.
+
+    Returns
+    -------
+    ndarray of float64, the shape of ``value`` (not a copy if it already is one).
+
+    Raises
+    ------
+    InvalidType
+        Not real numbers: a bool or bool array, complex numbers, strings, objects, a
+        ragged list.
+    InvalidValue
+        A non-finite entry, an integer too large for a float, or an entry outside the
+        range; the message gives the first such entry and its flat index.
+    """
+    def wrong_type():
+        return InvalidType(f"{name} must be real numbers (a scalar or an array), got {_shown(value, 60)}", name)
+
+    accepted = _accepted(low, high, low_open, high_open)
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError):              # a ragged list
+        raise wrong_type() from None
+    if raw.dtype.kind == "O" and all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
+                                     for x in raw.flat):
+        try:
+            raw = raw.astype(np.float64)         # Python ints beyond int64, Fractions
+        except OverflowError:
+            raise InvalidValue(f"{name} must be {accepted}, got an integer too large for a float", name) from None
+    if raw.dtype.kind not in "iuf":
+        raise wrong_type()
+    a = raw.astype(np.float64, copy=False)
+    bad = np.flatnonzero(~_inside(a, low, high, low_open, high_open))
+    if bad.size:
+        raise InvalidValue(f"{name} must be {accepted}, got {float(a.reshape(-1)[bad[0]])!r} "
+                           f"at flat index {bad[0]}", name)
+    return a
+
+
+def vector3(name, value, *, low=None, high=None):
+    """``value`` as a tuple of three finite floats, each within [low, high].
+
+    Accepted: a tuple, a list or a 1-D array of three real scalars (as `real`).
+
+    Raises
+    ------
+    InvalidType
+        Another container (a set, a dict, a string, a 0-d or 2-D array) or a component
+        that is not a real scalar (named ``name[i]``).
+    InvalidValue
+        Not three components, or a component not finite or outside the range (``name[i]``).
+    """
+    if not (isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim == 1)):
+        raise InvalidType(f"{name} must be a sequence of 3 real numbers (a tuple, list or 1-D array), "
+                          f"got {_shown(value)}", name)
+    if len(value) != 3:
+        raise InvalidValue(f"{name} must have exactly 3 components, got {len(value)}: {value!r:.80}", name)
+    return tuple(real(f"{name}[{i}]", c, low=low, high=high) for i, c in enumerate(value))
+
+
+def flag(name, value):
+    """``value`` as a bool: ``True`` or ``False``, Python's or numpy's (or a 0-d bool array).
+
+    Raises
+    ------
+    InvalidType
+        Anything else (``1``, ``"no"``, None): a number or a string would read as a truth value.
+    """
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidType(f"{name} must be True or False, got {_shown(value)}", name)
+    return bool(value)
+
+
+def choice(name, value, accepted):
+    """``value`` if it is one of the strings ``accepted`` (a tuple).
+
+    Raises
+    ------
+    InvalidType
+        ``value`` is not a string.
+    InvalidValue
+        ``value`` is a string not in ``accepted`` (matched exactly: case and spaces count).
+    """
+    if not isinstance(value, str):
+        raise InvalidType(f"{name} must be one of {accepted}, got {_shown(value)}", name)
+    if value not in accepted:
+        raise InvalidValue(f"{name} must be one of {accepted}, got {value!r:.80}", name)
+    return str(value)
+
+
+def positive_int(name, value, *, high=None):
+    """``value`` as an int in [1, high] (``high`` None: no upper bound).
+
+    Accepted: a Python or numpy integer (or a 0-d integer array); not a bool or a float.
+
+    Raises
+    ------
+    InvalidType
+        Not an integer.
+    InvalidValue
+        Below 1 or above ``high``.
+    """
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise InvalidType(f"{name} must be a positive integer, got {_shown(value)}", name)
+    n = int(value)
+    if n < 1 or (high is not None and n > high):
+        accepted = "a positive integer" if high is None else f"an integer in [1, {high}]"
+        raise InvalidValue(f"{name} must be {accepted}, got {_shown(n) if n.bit_length() > 64 else n}", name)
+    return n
+
+
+def steps(name, value, *, low, high, high_open=False, max_count=None):
+    """``value`` as a 1-D float64 array of step sizes, each in [low, high] (or [low, high)).
+
+    Parameters
+    ----------
+    name : str
+    value : array_like of real numbers
+        A scalar (one step) or an array of any shape (flattened, in order); not a set.
+    low, high : float
+        The accepted steps; ``high_open`` excludes ``high``.
+    max_count : int or None
+        Most steps accepted (None: any number).
+
+    Raises
+    ------
+    InvalidType
+        As `real_array`; or an unordered container (a set, a dict).
+    InvalidValue
+        No steps, more than ``max_count``, or a step outside the range (with its index).
+    """
+    if isinstance(value, (set, frozenset, dict)):
+        raise InvalidType(f"{name} must be ordered steps (a list, tuple or array), got {_shown(value)}", name)
+    a = real_array(name, value, low=low, high=high, high_open=high_open).reshape(-1)
+    if a.size == 0 or (max_count is not None and a.size > max_count):
+        count = "at least one step" if max_count is None else f"1 to {max_count} steps"
+        raise InvalidValue(f"{name} must hold {count}, got {a.size}", name)
+    return a
