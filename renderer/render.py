@@ -10,7 +10,6 @@ differences whose step is the pixel's footprint in the chart, pbrt-v4's rule).
 from __future__ import annotations
 
 import math
-import numbers
 import threading
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -18,7 +17,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from . import kernel
+from . import kernel, validate
 from .kernel import BACKGROUND, FLOOR, SPHERE_A, SPHERE_B
 from .scene import Scene
 
@@ -115,39 +114,18 @@ class GBuffer:
     y: np.ndarray
 
 
-def check_flag(name, value):
-    """``value`` as a bool if it is one (Python's or numpy's), else TypeError
-    naming the keyword ``name`` (``kink="no"`` would otherwise read as True)."""
-    if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{name} must be True or False, got {type(value).__name__} {value!r}")
-    return bool(value)
-
-
-def _check_size(name, value):
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer number of pixels, got {value!r}")
-    if not 1 <= value <= MAX_SIDE:
-        raise ValueError(f"{name} must be between 1 and {MAX_SIDE} pixels, got {value!r}")
-    return int(value)
-
-
 def check_args(scene, width, height, gradient, zoom):
-    """Validated (scene, width, height, gradient, zoom); raises as `render` says."""
+    """Validated (scene, width, height, gradient, zoom) by `renderer.validate`; raises as `render` says."""
     if not isinstance(scene, Scene):
-        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
-    width, height = _check_size("width", width), _check_size("height", height)
+        raise validate.InvalidType(f"scene must be a renderer.Scene, got {type(scene).__name__}", "scene")
+    width = validate.positive_int("width", width, high=MAX_SIDE)
+    height = validate.positive_int("height", height, high=MAX_SIDE)
     if width * height > MAX_PIXELS:
-        raise ValueError(f"width * height must be at most {MAX_PIXELS:,} pixels (4096 x 4096), "
-                         f"got {width} x {height} = {width * height:,}")
-    if not isinstance(gradient, str):
-        raise TypeError(f"gradient must be a string, one of {GRADIENTS}, got {type(gradient).__name__} {gradient!r}")
-    if gradient not in GRADIENTS:
-        raise ValueError(f"gradient must be one of {GRADIENTS}, got {gradient!r}")
-    if isinstance(zoom, bool) or not isinstance(zoom, numbers.Real):
-        raise TypeError(f"zoom must be a real number, got {type(zoom).__name__} {zoom!r}")
-    if not 1.0 <= zoom <= MAX_ZOOM:
-        raise ValueError(f"zoom must be between 1 and {MAX_ZOOM:g}, got {zoom!r}")
-    return scene, width, height, gradient, float(zoom)
+        raise validate.InvalidValue(f"width * height must be at most {MAX_PIXELS:,} pixels (4096 x 4096), "
+                                    f"got {width} x {height} = {width * height:,}", "width")
+    gradient = validate.choice("gradient", gradient, GRADIENTS)
+    zoom = validate.real("zoom", zoom, low=1.0, high=MAX_ZOOM)
+    return scene, width, height, gradient, zoom
 
 
 #: One kernel call at a time: numba's fallback threading layer, workqueue, may
@@ -156,12 +134,8 @@ _KERNEL_LOCK = threading.Lock()
 
 
 def check_workers(workers):
-    """``workers`` (None or an int in [1, 64]); TypeError or ValueError naming it."""
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, numbers.Integral)):
-        raise TypeError(f"workers must be None or an integer, got {type(workers).__name__} {workers!r}")
-    if workers is not None and not 1 <= workers <= 64:
-        raise ValueError(f"workers must be an integer from 1 to 64, got {workers!r}")
-    return workers
+    """``workers``: None or an integer in [1, 64] (`renderer.validate.positive_int`)."""
+    return None if workers is None else validate.positive_int("workers", workers, high=64)
 
 
 #: Pixels per call of the compiled kernel: a frame is rendered in bands of rows, so that a Ctrl-C
@@ -256,7 +230,7 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     with the corrections listed in the book's errata.
     """
     scene, width, height, gradient, zoom = check_args(scene, width, height, gradient, zoom)
-    kink, grad, skip = (check_flag(n, f) for n, f in (("kink", kink), ("grad", grad), ("skip", skip)))
+    kink, grad, skip = (validate.flag(n, f) for n, f in (("kink", kink), ("grad", grad), ("skip", skip)))
     check_workers(workers)
     _, _, out, _ = _run(scene, width, height, gradient, zoom, skip, kink, grad, False, workers)
     return Frame(out["image"], out["chamber"], out["kink"] if kink else None, out["grad"] if grad else None,

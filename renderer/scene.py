@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 
-from .validate import InvalidType, InvalidValue, choice, flag, real, vector3
+from .validate import InvalidType, InvalidValue, choice, flag, positive_int, real, vector3
 
 __all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS", "frame_label"]
 
@@ -246,15 +246,14 @@ def frame_label(scene, width, height) -> str:
     Raises
     ------
     TypeError
-        ``scene`` is not a `renderer.Scene`.
+        ``scene`` is not a `renderer.Scene`, or ``width`` or ``height`` is not an integer
+        (`renderer.validate.positive_int`).
     ValueError
-        ``width`` or ``height`` is not a positive integer.
+        ``width`` or ``height`` is below 1.
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
-    for name, n in (("width", width), ("height", height)):
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-            raise ValueError(f"{name} must be a positive integer number of pixels, got {n!r}")
+    width, height = positive_int("width", width), positive_int("height", height)
     default = Scene()
     changed = [_field_words(f.name, getattr(scene, f.name)) for f in fields(Scene)
                if getattr(scene, f.name) != getattr(default, f.name)]

@@ -14,13 +14,11 @@ from __future__ import annotations
 
 import collections.abc
 import itertools
-import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernel
+from . import kernel, validate
 from .ledger import compare
 from .render import Frame, bands, check_args, check_workers, image_plane, threads
 from .scene import MAX_EPS, MIN_EPS
@@ -63,21 +61,21 @@ def _check_steps(eps_values):
     ValueError for no steps, more than `MAX_STEPS`, or a step outside
     [`MIN_EPS`, `MAX_EPS`] (naming its index)."""
     if isinstance(eps_values, (str, bytes)) or not hasattr(eps_values, "__iter__"):
-        raise TypeError(f"eps_values must be a sequence of positive numbers, got {eps_values!r}")
+        raise validate.InvalidType(f"eps_values must be a sequence of positive numbers, got {eps_values!r:.80}",
+                                   "eps_values")
     if isinstance(eps_values, (collections.abc.Set, collections.abc.Mapping,
                                collections.abc.KeysView, collections.abc.ValuesView)):
-        raise TypeError(f"eps_values must be ordered (a list, tuple, array or iterator), got a "
-                        f"{type(eps_values).__name__}: the census follows the order of the steps")
+        raise validate.InvalidType(f"eps_values must be ordered (a list, tuple, array or iterator), got a "
+                                   f"{type(eps_values).__name__}: the census follows the order of the steps",
+                                   "eps_values")
     steps = []
     for i, e in enumerate(itertools.islice(eps_values, MAX_STEPS + 1)):
-        if isinstance(e, (bool, np.bool_)) or not isinstance(e, numbers.Real) or not math.isfinite(e) \
-                or not MIN_EPS <= e <= MAX_EPS:
-            raise ValueError(f"eps_values[{i}] must be a number in [{MIN_EPS:g}, {MAX_EPS:g}], got {e!r}")
-        steps.append(float(e))
+        steps.append(validate.real(f"eps_values[{i}]", e, low=MIN_EPS, high=MAX_EPS))
     if not steps:
-        raise ValueError(f"eps_values must hold 1 to {MAX_STEPS} steps, got none")
+        raise validate.InvalidValue(f"eps_values must hold 1 to {MAX_STEPS} steps, got none", "eps_values")
     if len(steps) > MAX_STEPS:
-        raise ValueError(f"eps_values must hold 1 to {MAX_STEPS} steps, got more than {MAX_STEPS}")
+        raise validate.InvalidValue(f"eps_values must hold 1 to {MAX_STEPS} steps, got more than {MAX_STEPS}",
+                                    "eps_values")
     return tuple(steps)
 
 

@@ -251,9 +251,13 @@ def test_frame_label_names_the_fields_that_differ_and_the_size():
         "the draft's scene with no sphere B, kᵥ = 2, the displaced sphere's normal, 8 × 8"
     with pytest.raises(TypeError, match="scene must be a renderer.Scene, got dict"):
         frame_label({}, 64, 64)
-    for bad in (0, 2.0, True):
-        with pytest.raises(ValueError, match=f"width must be a positive integer number of pixels, got {bad!r}"):
-            frame_label(Scene(), bad, 64)
+    with pytest.raises(ValueError, match=r"^width must be a positive integer, got 0$"):
+        frame_label(Scene(), 0, 64)
+    for bad in (2.0, True):                    # a float or a bool is not a count of pixels
+        with pytest.raises(TypeError, match=rf"^height must be a positive integer, got {type(bad).__name__} {bad!r}$"):
+            frame_label(Scene(), 64, bad)
+    import numpy as np
+    assert frame_label(Scene(), np.int64(8), 8) == "the draft's scene, 8 × 8"      # numpy integers count
 
 
 # ------------------------------------------------------------------- code a reader is shown

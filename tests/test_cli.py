@@ -23,7 +23,6 @@ import struct
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -369,19 +368,25 @@ BAD = [
 
 
 @pytest.mark.parametrize("argv, toml, word", BAD, ids=[" ".join(b[0])[:60] for b in BAD])
-def test_bad_input_one_line_no_file(tmp_path, capsys, argv, toml, word):
+def test_bad_input_one_line_no_file(tmp_path, capsys, monkeypatch, argv, toml, word):
+    """Each is refused in one line naming the input, before any work: the work itself (a render,
+    a sweep, a U-curve) is replaced by a failure that would show as an internal error."""
+    import importlib
+
+    def no_work(*a, **k):
+        raise AssertionError("the work started")
+    for module, name in (("renderer.render", "render"), ("renderer.render", "gbuffer"),
+                         ("renderer.sweep", "sweep"), ("renderer.ucurve", "measure")):
+        monkeypatch.setattr(importlib.import_module(module), name, no_work)
     (tmp_path / "file.txt").write_text("x")
     argv = [a.replace("OUT", str(tmp_path / "o.png")).replace("DIR", str(tmp_path)) for a in argv]
     if toml is not None:
         argv = [bad_toml(tmp_path, toml) if a == "TOML" else a for a in argv]
     before = sorted(p.name for p in tmp_path.iterdir())
-    t0 = time.perf_counter()
     rc, stdout, err = run(argv, capsys)
-    elapsed = time.perf_counter() - t0
     assert failure_problems(rc, err, before, sorted(p.name for p in tmp_path.iterdir())) == []
     assert word in err
     assert stdout == ""
-    assert elapsed < 2.0
 
 
 def test_huge_size_refused_before_allocating(tmp_path, capsys, monkeypatch):
@@ -395,10 +400,8 @@ def test_huge_size_refused_before_allocating(tmp_path, capsys, monkeypatch):
     for argv in (["render", "--size", "100000x100000", "-o", str(tmp_path / "o.png")],
                  ["render", "--size", "8192x8192", "-o", str(tmp_path / "o.png")],
                  ["sweep", "--size", "4096x4096"]):
-        t0 = time.perf_counter()
         rc, _, err = run(argv, capsys)
         assert rc == 2 and "--size" in err
-        assert time.perf_counter() - t0 < 0.2
     # Wrong variant: a size within the limits does reach render.
     rc, _, err = run(["render", "--size", "8x8", "-o", str(tmp_path / "o.png")], capsys)
     assert rc == 1 and "render called" in err and not (tmp_path / "o.png").exists()
@@ -823,7 +826,8 @@ def test_fuzz_main(command, tokens, toml):
                  else t for t in tokens]
         before = sorted(p.name for p in d.iterdir())
         out, err = io.StringIO(), io.StringIO()
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        # In the directory: a free token taken as a relative output path lands there.
+        with contextlib.chdir(d), contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             rc = main(argv)
         after = sorted(p.name for p in d.iterdir())
         err = err.getvalue()

@@ -77,7 +77,7 @@ def test_a_side_of_max_side_is_rendered(call):
 @pytest.mark.parametrize("call", sorted(CALLS))
 def test_a_side_one_past_max_side_is_refused_before_allocating(call, allocations):
     for name, (width, height) in (("width", (MAX_SIDE + 1, 1)), ("height", (1, MAX_SIDE + 1))):
-        with pytest.raises(ValueError, match=rf"^{name} must be between 1 and {MAX_SIDE} pixels, "
+        with pytest.raises(ValueError, match=rf"^{name} must be an integer in \[1, {MAX_SIDE}\], "
                                              rf"got {MAX_SIDE + 1}$"):
             CALLS[call](width, height)
     assert not any(np.prod(shape) > LARGE for shape in allocations)
