@@ -6,14 +6,15 @@ the notebook jupyter-cache holds for the page's current execution (the record
 of that page accessed last: the build touches the record it uses) and fails,
 naming the pages and values, if two pages glue different values under one name.
 
-A quantity has one source however many names it has.  `QUANTITIES` registers
-every glued name with the quantity it shows: the names of one quantity (its
-aliases) must show one value, and where the library holds the quantity (a
-constant, a measurement of `lab` or `renderer`) that value must be the
-library's, evaluated when this check runs (stored measurements are read from the
-build's store).  A glued name that is registered nowhere fails, so a second name
-for a quantity cannot appear without joining its family; a registered name that
-no page glues fails too.
+A quantity has one source however many names it has.  Every glued name is
+registered with the quantity it shows: in `QUANTITIES` if the quantity has
+another name or a value in the library, else in `ON_THE_PAGE`.  The names of one
+quantity (its aliases) must show one value, and where the library holds the
+quantity (a constant, a measurement of `lab` or `renderer`) that value must be
+the library's, evaluated when this check runs (stored measurements are read from
+the build's store).  A glued name registered nowhere fails, so a second name for
+a quantity cannot appear without saying which quantity it shows; a registered
+name that no page glues fails too.
 
 Names are for code; a reader sees words.  `NAMED` gives each quantity the prose
 names (the words it is called by, e.g. "RMS slope of the census").  In the built
@@ -72,9 +73,9 @@ def _ucurve():
     return _lib("renderer.ucurve").measure()
 
 
-#: Every glued name, by the quantity it shows: quantity -> (its glue names, its library value or
-#: None).  The library value is a callable evaluated when the check runs; None where a page computes
-#: the quantity from its own renders or counts (its names must still agree).  Figures are not here.
+#: The glued quantities with a value in the library or more than one name: quantity -> (its glue
+#: names, its library value or None).  The library value is a callable evaluated when the check runs;
+#: None where the pages compute the quantity from their own renders (its names must still agree).
 QUANTITIES = {
     # The scene and the renderer's constants.
     "the draft's step": (("ix_eps", "s1_eps"), lambda: _lib("renderer").Scene().eps),
