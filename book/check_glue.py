@@ -6,6 +6,16 @@ the notebook jupyter-cache holds for the page's current execution (the record
 of that page accessed last: the build touches the record it uses) and fails,
 naming the pages and values, if two pages glue different values under one name.
 
+A quantity has one source however many names it has.  Every glued name is
+registered with the quantity it shows: in `QUANTITIES` if the quantity has
+another name or a value in the library, else in `ON_THE_PAGE`.  The names of one
+quantity (its aliases) must show one value, and where the library holds the
+quantity (a constant, a measurement of `lab` or `renderer`) that value must be
+the library's, evaluated when this check runs (stored measurements are read from
+the build's store).  A glued name registered nowhere fails, so a second name for
+a quantity cannot appear without saying which quantity it shows; a registered
+name that no page glues fails too.
+
 Names are for code; a reader sees words.  `NAMED` gives each quantity the prose
 names (the words it is called by, e.g. "RMS slope of the census").  In the built
 HTML, wherever those words are followed in the same sentence by a number, that
@@ -21,9 +31,14 @@ Exit status 0 if every check passes, 1 if not, 2 if there is no cache or no site
 
 from __future__ import annotations
 
+import ast
+import importlib
 import json
+import math
+import os
 import re
 import sys
+from functools import lru_cache
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -45,6 +60,72 @@ NAMED = {
     "tilt_chart": "median tilt of the draft's normal",
     "tilt_surface": "median tilt of the displaced sphere's normal",
 }
+
+
+def _lib(module):
+    """A library module, imported when a source is evaluated."""
+    return importlib.import_module(module)
+
+
+@lru_cache(maxsize=None)
+def _ucurve():
+    """`renderer.ucurve.measure`'s default curve: the U-curve of Cell 2, whose fit gives the optimum."""
+    return _lib("renderer.ucurve").measure()
+
+
+#: The glued quantities with a value in the library or more than one name: quantity -> (its glue
+#: names, its library value or None).  The library value is a callable evaluated when the check runs;
+#: None where the pages compute the quantity from their own renders (its names must still agree).
+QUANTITIES = {
+    # The scene and the renderer's constants.
+    "the draft's step": (("ix_eps", "s1_eps"), lambda: _lib("renderer").Scene().eps),
+    "the draft's amplitude": (("s1_beta", "s2_beta"), lambda: _lib("renderer").Scene().beta),
+    "the draft's frequency in u": (("s2_k_u",), lambda: _lib("renderer").Scene().k_u),
+    "the draft's frequency in v": (("s2_k_v",), lambda: _lib("renderer").Scene().k_v),
+    "the draft's height field": (("s2_field",), lambda: _lib("renderer").Scene().height_field),
+    "the simulator's opening step": (("s4_eps",), lambda: _lib("renderer.ledger").SIMULATOR_SCENE.eps),
+    "the window's margin": (("s2_margin",), lambda: _lib("renderer.render").WINDOW_MARGIN),
+    "the window's offset": (("s2_offset",), lambda: _lib("renderer.render").WINDOW_OFFSET),
+    "the pole threshold of the frame": (("pole_sin_phi",), lambda: float(_lib("renderer.formulas").POLE_SIN_PHI)),
+    "the simulator's linear difference gain": (("s4_gain", "c3_gain"),
+                                               lambda: _lib("renderer.ledger").DIFFERENCE_LINEAR_GAIN),
+    "the simulator's log-scale black": (("s4_log_floor",),
+                                        lambda: 10.0 ** _lib("renderer.ledger").DIFFERENCE_LOG_FLOOR),
+    "the U-curve reference's digits": (("c2_digits", "s7_digits"), lambda: _lib("renderer.ucurve").DIGITS),
+    "the accuracy references' digits": (("c5_digits",), lambda: _lib("lab.accuracy").DIGITS),
+    # The U-curve of Cell 2: the optimum of the model fitted to it, and the model's prediction.
+    "the fitted optimal step": (("ucurve_eps_opt",), lambda: _ucurve().eps_opt_fitted),
+    "the model's error at the fitted step": (("ucurve_err_opt",), lambda: _ucurve().error_at_fitted_opt),
+    "the predicted optimal step": (("ucurve_eps_pred",), lambda: _ucurve().eps_opt_predicted),
+    "the U-curve's label": (("ucurve_label",), lambda: _lib("lab.accuracy").default_optimum()["label"]),
+    "the relative error at a step of 1e-9": (("ucurve_rel_1e9",), lambda: _lib("lab.claims").relative_error_at(1e-9)),
+    "the relative error at a step of 1e-11": (("ucurve_rel_1e11",),
+                                              lambda: _lib("lab.claims").relative_error_at(1e-11)),
+    # The census of Cell 3 and the measurements of Cell 5.
+    "the census's RMS slope": (("census_rms_slope",), lambda: _lib("lab.claims").census()["rms_slope"]),
+    "the census's off-band slope": (("census_off_slope",), lambda: _lib("lab.claims").census()["off_slope"]),
+    "the census's crease ratio": (("census_ratio",), lambda: _lib("lab.claims").census()["ratio"]),
+    "the census's frame": (("c3_label", "s6_census_label"), lambda: _lib("lab.claims").census()["label"]),
+    "the census's flips": (("s6_flips",), lambda: sum(_lib("lab.claims").census()["flips"])),
+    "the closed form's worst error": (("dn_residual",), lambda: _lib("lab.accuracy").normal_beta_derivative_residual()),
+    "the median order of the β-derivative": (("beta_median_order",),
+                                             lambda: _lib("lab.accuracy").image_beta_order()["median_slope"]),
+    "the RMS order of the β-derivative": (("beta_rms_order",),
+                                          lambda: _lib("lab.accuracy").image_beta_order()["rms_slope"]),
+    "the β-derivative's frame": (("c5_label",), lambda: _lib("lab.accuracy").image_beta_order()["label"]),
+    # Counted on two pages from their own renders.
+    "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1"), None),
+}
+#: Glued names each showing a quantity of its own that its page computes (from its renders, counts
+#: and choices), with no second name and no value in the library to agree with.
+ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
+               "ix_proved", "ix_verified", "ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata",
+               "tilt_chart", "tilt_surface", "s1_steep", "s1_steep_chart", "s1_steep_surface", "s1_flips_chart",
+               "s1_flips_surface", "s2_count_0", "s2_count_2", "s2_count_3",
+               "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
+               "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
+               "s7_crease_label", "s7_crease_err_min", "s7_crease_fd", "s7_crease_left", "s7_crease_right",
+               "s7_pole_zoom", "s8_radius", "s8_factor_theta", "s8_factor_phi")
 
 
 def page_glue(notebook: dict) -> dict:
@@ -90,6 +171,54 @@ def conflicts(names: dict) -> list:
     """One line per name glued with different values on different pages."""
     return [f"{name}: " + ", ".join(f"{page} = {value}" for page, value in sorted(pages.items()))
             for name, pages in sorted(names.items()) if len(set(pages.values())) > 1]
+
+
+def _parsed(shown):
+    """A glued value as shown (its text/plain repr, or a Markdown math string) as Python reads it."""
+    try:
+        return ast.literal_eval(shown)
+    except (ValueError, SyntaxError, TypeError):
+        return shown
+
+
+def _same(a, b):
+    """Whether two values are one: numbers within rounding (a relative 1e-9), anything else equal."""
+    number = (int, float)
+    if isinstance(a, number) and isinstance(b, number) and not isinstance(a, bool) and not isinstance(b, bool):
+        return math.isclose(a, b, rel_tol=1e-9)
+    return a == b
+
+
+def _is(shown, value):
+    """Whether the glued ``shown`` is the library's ``value`` (Markdown math as `glue_math` writes it)."""
+    if isinstance(shown, str) and shown.startswith("$"):
+        from chapter.theorems import tex_number
+        return shown == f"${tex_number(value)}$"
+    return _same(_parsed(shown), value)
+
+
+def quantity_conflicts(names: dict, quantities=None, own=None) -> list:
+    """One line per glued name registered nowhere (`QUANTITIES`, `ON_THE_PAGE`; figures aside), per
+    registered name glued nowhere, per quantity whose names show two values, and per quantity whose
+    shown value is not the library's.  ``names`` is `glued`'s."""
+    quantities = QUANTITIES if quantities is None else quantities
+    own = ON_THE_PAGE if own is None else own
+    registered = [n for aliases, _ in quantities.values() for n in aliases] + list(own)
+    bad = [f"{n}: the name is registered twice" for n in sorted({n for n in registered if registered.count(n) > 1})]
+    bad += [f"{n}: glued on {', '.join(sorted(pages))}, but registered nowhere (QUANTITIES or ON_THE_PAGE): "
+            f"say which quantity it shows" for n, pages in sorted(names.items())
+            if n not in registered and not all(str(v).startswith("<Figure") for v in pages.values())]
+    bad += [f"{n}: registered, but no page glues it" for n in registered if n not in names]
+    for quantity, (aliases, source) in quantities.items():
+        shown = [(page, n, v) for n in aliases for page, v in sorted(names.get(n, {}).items())]
+        listing = ", ".join(f"{page} {n} = {v}" for page, n, v in shown)
+        if any(not _same(_parsed(v), _parsed(shown[0][2])) for _, _, v in shown):
+            bad.append(f"{quantity}: one quantity, two values: {listing}")
+        elif shown and source is not None:
+            value = source()
+            if not _is(shown[0][2], value):
+                bad.append(f"{quantity}: {listing}, but the library's value is {value!r}")
+    return bad
 
 
 _SKIP = {"script", "style", "pre", "code", "mjx-container", "math"}
@@ -200,11 +329,20 @@ def main(argv=None) -> int:
         print("check_glue: the same name shows different values on different pages:\n  " + "\n  ".join(bad),
               file=sys.stderr)
         return 1
+    # The library's stored measurements are the build's (computed again where the code has changed).
+    os.environ.setdefault("SYMRENDER_STORE", str(cache_dir.parent / ".measurements"))
+    sourced = quantity_conflicts(names)
+    if sourced:
+        print("check_glue: a glued quantity is unregistered, or shows two values, or not the library's:\n  "
+              + "\n  ".join(sourced), file=sys.stderr)
+        return 1
     worded = words_conflicts(html_dir, names)
     if worded:
         print("check_glue: the same words carry different numbers:\n  " + "\n  ".join(worded), file=sys.stderr)
         return 1
     print(f"check_glue: {len(names)} glued names; {shared} shown on several pages, each with one value; "
+          f"{len(QUANTITIES)} quantities with one value under all their names, "
+          f"{sum(s is not None for _, s in QUANTITIES.values())} of them the library's; "
           f"{len(NAMED)} quantities named in prose, each with one value under its words")
     return 0
 

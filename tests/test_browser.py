@@ -10,7 +10,11 @@ error model (tests/test_js_parity.py) puts around the Python renderer's; an
 eps or beta move re-shading sphere A on kept geometry (the update times go to
 test-artifacts/, never asserted); each "Try this" preset's end state (its
 view, its scale, and what its canvases show); the hover readout's (u, v)
-within the model's chart bound of Python's; every control reachable and
+within the model's chart bound of Python's; every position of every control (each
+range input stepped from its own min to its max, each option, each preset) a scene that
+`renderer.Scene` and `render` accept, carrying the control's value, with every value the page
+prints (β, kᵤ, kᵥ, ε wherever it is written) the value computed with, and the frames Python's
+for that scene at the extremes of the controls; every control reachable and
 movable from the keyboard; the layout at 1280 x 900 (canvases, U-curve and
 readout in view together) and at 390 px (canvases stacked, at least 300 px
 wide, and a tap on a phone reading out the pixel tapped).  Screenshots go to
@@ -28,16 +32,19 @@ import dataclasses
 import functools
 import json
 import os
+import re
 import statistics
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from renderer import Scene, compare, gbuffer, render
+from renderer import PointLight, Scene, compare, gbuffer, render
 from renderer.jsgen import SIMULATOR_SCENE
+from renderer.render import check_args
 
 from .jsnode import ARTIFACTS, in_ci, require_tool
+from .test_check_glue import check_glue
 from .test_js_parity import CHART_TOL, image_bound
 
 CHROMIUM = "/usr/bin/chromium"
@@ -74,15 +81,21 @@ def browser():
 
 class Session:
     """One page of the built book, with the network blocked and errors recorded.
-    ``options`` go to the browser context (viewport, has_touch, is_mobile)."""
+    ``options`` go to the browser context (viewport, has_touch, is_mobile); ``bundle(text)``,
+    if given, changes the simulator's script as the page receives it (a wrong variant)."""
 
-    def __init__(self, browser, url, **options):
+    def __init__(self, browser, url, bundle=None, **options):
         options.setdefault("viewport", {"width": 1200, "height": 1400})
         self.context = browser.new_context(**options)
         self.blocked, self.errors = [], []
 
         def route(r):
-            if r.request.url.startswith("file://"):
+            path = r.request.url.split("?")[0]
+            if bundle is not None and path.startswith("file://") and path.endswith("_static/sim/simulator.js"):
+                from urllib.parse import unquote, urlparse
+                text = Path(unquote(urlparse(path).path)).read_text(encoding="utf-8")
+                r.fulfill(body=bundle(text), content_type="text/javascript")
+            elif r.request.url.startswith("file://"):
                 r.continue_()
             else:
                 self.blocked.append(r.request.url)
@@ -277,9 +290,11 @@ def test_the_u_curve_is_the_ledger_of_its_sample_and_follows_the_controls(sessio
     steps = [p["eps"] for p in curve["points"]]
     assert len(steps) == 27 and steps[0] == 1e-14 and steps[-1] == 0.1
     assert curve["here"]["eps"] == 1e-3
-    for eps in (1e-3, 3.2e-3):                    # where the model's bound is far below the differences
-        point = next(p for p in curve["points"] if p["eps"] == eps)
-        got = (point["rms"], point["max_abs"])
+    # Near 1e-3 and 10^-2.5, where the model's bound is far below the differences; each point against
+    # Python at its own step (which steps the page computes with is the control tests' business).
+    for near in (-3.0, -2.5):
+        point = min(curve["points"], key=lambda p: abs(np.log10(p["eps"]) - near))
+        eps, got = point["eps"], (point["rms"], point["max_abs"])
         assert _within(got, _python_ledger(SIMULATOR_SCENE, eps, stride)), eps
         assert not _within(got, _python_ledger(SIMULATOR_SCENE, eps, stride + 1)), eps
     plot = session.page.locator("#sim-curve")
@@ -364,6 +379,273 @@ def _readout_pixel(session, i, j):
         f"Math.abs(Number(document.getElementById('sim-readout').dataset.j) - {j}) <= 1", timeout=10_000)
     return (int(session.page.get_attribute("#sim-readout", "data-i")),
             int(session.page.get_attribute("#sim-readout", "data-j")))
+
+
+# ---- the controls held against the Python scene --------------------------------------------
+
+#: Run in the page with a list of moves [[element id, how], ...].  ``how`` is "min" or "max" (a
+#: range input's own min or max, a select's first or last option), a value, or "every": each
+#: position the control has (a range input from its min to its max by the browser's own stepUp,
+#: as the arrow keys move it; each option of a select; both states of a checkbox; a button's
+#: click).  Each move is made as a reader makes it (the input or change event a drag or a choice
+#: fires, or a click) and the update it schedules is awaited; the page's requestAnimationFrame is
+#: made to call back at the next task, so the test does not wait for the screen's refresh.  After
+#: each position of an "every" the page is recorded: every input's value, every range's printed
+#: value, the scene object the renderer was handed, the renderer's other arguments (width, height,
+#: numeric gradient, zoom: `render.check_args`'s order, read off its frame and G-buffer), and
+#: every text that prints ε (the numeric canvas's caption, the U-curve's label and marker, the
+#: readout's step at the centre pixel).  A move the page does not update after within 5 s (its
+#: renderer threw) is recorded as such and ends the run.  Returns the records.
+MOVES_JS = """async (moves) => {
+  const root = document.querySelector('[data-symrender-sim]'), sim = root.symrender;
+  window.requestAnimationFrame = (cb) => setTimeout(() => cb(performance.now()), 0);
+  const inputs = [...root.querySelectorAll('input, select')];
+  // Make a change and wait for the update it schedules; false if none comes within 5 s (it threw).
+  const act = async (change) => {
+    const n = Number(root.dataset.updates), t0 = performance.now();
+    change();
+    while (Number(root.dataset.updates) <= n) {
+      if (performance.now() - t0 > 5000) return false;
+      await new Promise((r) => setTimeout(r, 0));
+    }
+    return true;
+  };
+  const set = (e, value) => act(() => {
+    if (e.type === 'checkbox') e.checked = value; else e.value = String(value);
+    e.dispatchEvent(new Event(e.type === 'range' ? 'input' : 'change'));
+  });
+  const record = (id, updated) => {
+    const values = Object.fromEntries(inputs.map((e) => [e.id.slice(4), e.type === 'checkbox' ? e.checked : e.value]));
+    if (!updated) return { id, updated, inputs: values };
+    const f = sim.frames, res = f.numeric.width, plot = document.getElementById('sim-curve');
+    sim.show_probe(res >> 1, res >> 1);
+    const step = [...document.querySelectorAll('#sim-readout dt')].find((dt) => dt.textContent === 'step');
+    return { id, updated, inputs: values, scene: f.scene,
+             args: [f.numeric.width, f.numeric.height, f.numeric.gradient, sim.renderer.gb.zoom],
+             printed: Object.fromEntries(inputs.filter((e) => e.type === 'range').map((e) =>
+                                         [e.id.slice(4), document.getElementById(e.id + '-value').textContent])),
+             eps_texts: [document.getElementById('sim-caption-numeric').textContent, plot.getAttribute('aria-label'),
+                         'ε = ' + plot.dataset.eps, step ? step.nextElementSibling.textContent : ''] };
+  };
+  const out = [];
+  // Record a position; false (stop: the page is stuck) if it did not update.
+  const keep = (id, updated) => { out.push(record(id, updated)); return updated; };
+  for (const [id, how] of moves) {
+    const e = document.getElementById(id);
+    const options = e.tagName === 'SELECT' ? [...e.options].map((o) => o.value) : null;
+    let updated = true;
+    if (e.tagName === 'BUTTON') {
+      updated = await act(() => e.click());
+      if (how === 'every' && !keep(id, updated)) break;
+    } else if (how !== 'every') {
+      const [low, high] = options ? [options[0], options.at(-1)] : [e.min, e.max];
+      updated = await set(e, how === 'min' ? low : how === 'max' ? high : how);
+    } else if (e.type === 'range') {
+      if (!keep(id, await set(e, e.min))) break;
+      while (updated && Number(e.value) < Number(e.max)) {
+        const before = e.value;
+        updated = await act(() => { e.stepUp(); e.dispatchEvent(new Event('input')); });
+        if (e.value === before) break;
+        updated = keep(id, updated);
+      }
+    } else {
+      for (const value of options ?? [false, true]) if (!(updated = keep(id, await set(e, value)))) break;
+    }
+    if (!updated) { if (how !== 'every') keep(id, false); break; }
+  }
+  return out;
+}"""
+
+
+#: Where each control's value lands: a field of the scene object the simulator hands its renderer
+#: (``("scene", field)``; log_eps's value x lands as ε = 10^x), one of the renderer's other
+#: arguments (``("args", k)``: width, numeric gradient, zoom), or nowhere (``None``: how the frames
+#: are shown).  A control of the page missing here is a problem: a new one cannot go unchecked.
+LANDS = {"log_eps": ("scene", "eps"), "beta": ("scene", "beta"), "k_u": ("scene", "k_u"), "k_v": ("scene", "k_v"),
+         "height_field": ("scene", "height_field"), "model": ("scene", "model"), "bump": ("scene", "bump"),
+         "sphere_b": ("scene", "sphere_b"), "resolution": ("args", 0), "numeric": ("args", 2),
+         "zoom": ("args", 3), "view": None, "scale": None}
+#: ε as the page prints it in words ("ε = 1.3e-3"; the readout's "εᵤ = ..." of a footprint is not ε).
+EPS_TEXT = re.compile(r"ε = ([-+0-9.e]+)")
+
+
+def js_scene(obj):
+    """The `renderer.Scene` of the simulator's scene object (JSON); raises as `Scene` does."""
+    fields = {k: tuple(v) if isinstance(v, list) else v for k, v in obj.items()}
+    fields["lights"] = tuple(PointLight(tuple(light["position"]), tuple(light["color"])) for light in obj["lights"])
+    return Scene(**fields)
+
+
+def control_problems(records):
+    """Every way the recorded positions (`MOVES_JS`) depart from the Python scene, as strings: a
+    scene or renderer argument `renderer.Scene` or `render` refuses; a control whose value is not
+    what the scene object (or the renderer's arguments) carries; a printed value that is not the
+    value computed with; a printed ε that does not name 10^x to the digits it shows; ε not
+    strictly increasing along a sweep of its slider; a move the simulator did not update after."""
+    problems, sweep = [], []
+    for r in records:
+        at = f"{r['id']} at {', '.join(f'{k}={v}' for k, v in r['inputs'].items())}"
+        bad = problems.append
+        if not r["updated"]:
+            bad(f"{at}: the simulator did not update (its renderer threw)")
+            continue
+        try:
+            scene = js_scene(r["scene"])
+            check_args(scene, *r["args"])
+        except (TypeError, ValueError) as error:
+            bad(f"{at}: the Python renderer refuses what the simulator renders: {error}")
+            continue
+        for name, value in r["inputs"].items():
+            if name not in LANDS:
+                bad(f"{at}: the control {name!r} lands nowhere the test knows (LANDS)")
+                continue
+            if LANDS[name] is None:
+                continue
+            kind, key = LANDS[name]
+            landed = getattr(scene, key) if kind == "scene" else r["args"][key]
+            if name == "log_eps":
+                shown = [r["printed"][name]] + [m for text in r["eps_texts"] for m in EPS_TEXT.findall(text)]
+                if any(float(s) != landed for s in shown):
+                    bad(f"{at}: ε is printed as {shown} but computed with {landed!r}")
+                if not check_glue._matches(r["printed"][name], 10.0 ** float(value)):
+                    bad(f"{at}: ε printed {r['printed'][name]} is not 10^{value} to the digits it shows")
+            elif type(landed)(value) != landed or (name in r["printed"] and float(r["printed"][name]) != landed):
+                bad(f"{at}: {name} is {value!r} (printed {r['printed'].get(name)!r}) but the renderer gets {landed!r}")
+        if r["id"] == "sim-log_eps":
+            sweep.append((float(r["inputs"]["log_eps"]), scene.eps))
+    for (x0, e0), (x1, e1) in zip(sweep, sweep[1:]):
+        if x1 > x0 and not e1 > e0:
+            problems.append(f"ε does not increase from log_eps={x0:g} ({e0!r}) to {x1:g} ({e1!r})")
+    return problems
+
+
+def every_position(s):
+    """`MOVES_JS` over every position of every control of the page, presets and reset included, at
+    the smallest resolution (the largest once): β's range under each shading normal (its top
+    depends on it), the other ranges, each select and checkbox, then the buttons."""
+    layout = s.page.evaluate("""() => [...document.querySelectorAll('[data-symrender-sim] :is(input, select, button)')]
+        .map((e) => [e.id, e.tagName === 'SELECT' ? [...e.options].map((o) => o.value) : e.type])""")
+    moves = [("sim-resolution", "min")]
+    for bump in dict(layout)["sim-bump"]:
+        moves += [("sim-bump", bump), ("sim-beta", "every")]
+    moves += [(i, "every") for i, k in layout if k == "range" and i != "sim-beta"]
+    moves += [(i, "every") for i, k in layout if isinstance(k, list) or k == "checkbox"]
+    moves += [("sim-resolution", "min")] + [(i, "every") for i, k in layout if k in ("button", "submit")]
+    return s.page.evaluate(MOVES_JS, moves)
+
+
+def test_every_position_of_every_control_is_a_scene_python_renders_and_prints_what_it_computes_with(browser, book_html):
+    """Every slider position (ε, β under both shading normals, kᵤ, kᵥ; enumerated from each input's
+    own min, max and step), every option of every select, the checkbox and every preset: the scene
+    object the simulator hands its renderer is one `renderer.Scene` accepts and `render` renders
+    (size, zoom, numeric gradient), each control's value is what the scene carries, and each value
+    the page prints (β, kᵤ, kᵥ, and ε in its label, the numeric caption, the U-curve's label and
+    marker, the readout's step) is the value computed with; the printed ε names 10^x to its digits
+    and grows with x.  Wrong variants of the simulator are rejected below."""
+    s = Session(browser, _url(book_html))
+    try:
+        records = every_position(s)
+        problems = control_problems(records)
+        assert not problems, f"{len(problems)} problems, e.g. " + "\n".join(problems[:10])
+        assert len({r["id"] for r in records}) >= len(LANDS) + len(BUTTONS)         # every control was moved
+        assert s.errors == []
+    finally:
+        s.close()
+
+
+#: Positions at which the simulator's frames are held against Python's: each a list of moves
+#: (`MOVES_JS`) from the opening state at the smallest resolution: the extremes of every slider,
+#: under both shading normals for β, and of the selects that change what is rendered.
+FRAME_POSITIONS = {
+    "ε smallest": [("sim-log_eps", "min")],
+    "ε largest": [("sim-log_eps", "max")],
+    "β 0": [("sim-beta", "min")],
+    "β largest, the displaced sphere": [("sim-beta", "max")],
+    "β largest, the draft's normal": [("sim-bump", "chart"), ("sim-beta", "max")],
+    "kᵤ, kᵥ smallest, sine": [("sim-height_field", "sine"), ("sim-k_u", "min"), ("sim-k_v", "min")],
+    "kᵤ, kᵥ largest, rings": [("sim-height_field", "rings"), ("sim-k_u", "max"), ("sim-k_v", "max")],
+    "footprint, phong, no sphere B, the pole at its largest zoom": [
+        ("sim-numeric", "footprint"), ("sim-model", "phong"), ("sim-sphere_b", False), ("sim-zoom", "max")],
+}
+
+
+def frame_problems(s):
+    """Where the simulator's two frames depart from `render` of the scene object it rendered (at its
+    size, zoom and numeric gradient): a chamber code, or an image value beyond the JS-parity error
+    model's bound (`image_bound`)."""
+    at = s.sim("[sim.frames.scene, sim.frames.numeric.width, sim.frames.numeric.height, "
+               "sim.frames.numeric.gradient, sim.renderer.gb.zoom]")
+    scene, (w, h, numeric, zoom) = js_scene(at[0]), at[1:]
+    out = []
+    for key, gradient in (("numeric", numeric), ("symbolic", "exact")):
+        py = render(scene, w, h, gradient=gradient, zoom=zoom)
+        chamber = s.typed(f"({SIM}).frames.{key}.chamber").reshape(h, w)
+        image = s.typed(f"({SIM}).frames.{key}.image").reshape(h, w, 3)
+        if not np.array_equal(chamber, py.chamber):
+            out.append(f"{key}: {np.count_nonzero(chamber != py.chamber)} chamber codes differ")
+            continue
+        ratio = np.abs(image - py.image) / image_bound(scene, w, h, gradient, zoom)
+        if not ratio.max() <= 1.0:
+            out.append(f"{key} ({gradient}): {np.count_nonzero(~(ratio <= 1.0))} values beyond the bound, "
+                       f"worst |d| / bound {ratio.max():.3g}")
+    return out
+
+
+def test_the_simulators_frames_are_pythons_at_the_extremes_of_its_controls(browser, book_html):
+    """At each of `FRAME_POSITIONS`, both frames the simulator shows are `renderer.render`'s of the
+    Scene built from the simulator's own scene object, within the bound tests/test_js_parity.py
+    derives (chamber codes exactly)."""
+    s = Session(browser, _url(book_html))
+    try:
+        found = {}
+        for name, moves in FRAME_POSITIONS.items():
+            stuck = control_problems(s.page.evaluate(MOVES_JS, [("sim-reset", "click"), ("sim-resolution", "min"),
+                                                                *moves]))
+            found[name] = stuck or frame_problems(s)
+        assert not any(found.values()), found
+        assert s.errors == []
+    finally:
+        s.close()
+
+
+#: Wrong variants of the simulator's script, served to the page in place of the built one:
+#: (old text, new text, the moves that show it, what the problem says).
+WRONG_CONTROLS = {
+    "ε rounded to one significant digit": (
+        "Math.pow(10, log_eps).toPrecision(2)", "Math.pow(10, log_eps).toPrecision(1)",
+        [("sim-log_eps", "every")], "is not 10^"),
+    "ε computed unrounded, printed rounded": (
+        "eps: eps_of(state.log_eps)", "eps: Math.pow(10, state.log_eps)", [("sim-log_eps", "every")],
+        "but computed with"),
+    "β up to R under the displaced sphere's normal": (
+        "Math.round(100 * (SIMULATOR_SCENE.radius_a - BETA.step)) / 100", "SIMULATOR_SCENE.radius_a",
+        [("sim-bump", "surface"), ("sim-beta", "every")], "did not update"),
+    "kᵤ from 0": ('name: "k_u", label: "kᵤ, periods in u", kind: "range", min: 1',
+                 'name: "k_u", label: "kᵤ, periods in u", kind: "range", min: 0', [("sim-k_u", "every")], "refuses"),
+    "the renderer handed a β of its own": (
+        "this.renderer.update(scene,", "this.renderer.update({ ...scene, beta: 0.9 * scene.beta },", None,
+        "values beyond"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_CONTROLS))
+def test_the_control_checks_reject_a_wrong_simulator(browser, book_html, variant):
+    old, new, moves, message = WRONG_CONTROLS[variant]
+
+    def bundle(text):
+        assert text.count(old) == 1, f"variant {variant!r} no longer applies to the bundle"
+        return text.replace(old, new)
+
+    s = Session(browser, _url(book_html), bundle=bundle)
+    try:
+        if moves is None:
+            s.page.evaluate(MOVES_JS, [("sim-resolution", "min"), ("sim-beta", "max")])
+            found = frame_problems(s)
+        else:
+            found = control_problems(s.page.evaluate(MOVES_JS, [("sim-resolution", "min"), *moves]))
+        assert any(message in p for p in found), (variant, found[:5])
+    finally:
+        s.close()
 
 
 def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_html):

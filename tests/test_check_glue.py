@@ -1,7 +1,9 @@
-"""book/check_glue.py: a name glued on several pages must show one value.
+"""book/check_glue.py: a name glued on several pages must show one value, and a quantity
+one value under all its names, the library's where the library holds it.
 
 Pages are notebooks cached with jupyter-cache, as the book's build caches
-them; each check is shown failing on a wrong variant."""
+them; each check is shown failing on a wrong variant.  The registry of quantities
+(`check_glue.QUANTITIES`) is also checked against the built book's glue."""
 
 from __future__ import annotations
 
@@ -28,10 +30,16 @@ def _page(page="", **values):
     return nbformat.v4.new_notebook(cells=[cell])
 
 
+#: The registry's check, as the module defines it (the fixture below sets it aside for the other tests).
+quantity_conflicts = check_glue.quantity_conflicts
+
+
 @pytest.fixture(autouse=True)
 def _no_named(monkeypatch):
-    """The tests of names glue no named quantities (the words' tests set their own)."""
+    """The tests of names glue no named quantities and no registered ones (the words' and the
+    registry's tests set their own)."""
     monkeypatch.setattr(check_glue, "NAMED", {})
+    monkeypatch.setattr(check_glue, "quantity_conflicts", lambda names: [])
 
 
 def _cache(tmp_path, pages):
@@ -181,3 +189,49 @@ def test_main_fails_on_words_with_two_values(tmp_path, monkeypatch, capsys):
                                               ("1e-9", 1.4e-9, True), ("1.4e-9", 1.9e-8, False)])
 def test_a_number_matches_its_value_to_the_digits_shown(shown, value, ok):
     assert check_glue._matches(shown, value) is ok
+
+
+# --- the registry: one quantity, one source, whatever its names ---------------------------------------
+
+#: A registry of three quantities: one with two names and no library value, one with the library's
+#: value (plain), one shown as math; and a name of its own.
+REGISTRY = {"the gain": (("s4_gain", "c3_gain"), None), "the optimum": (("ucurve_eps_opt",), lambda: 4.03e-7),
+            "the black": (("s4_log_floor",), lambda: 1e-16)}
+OWN = ("s1_size",)
+SHOWN = {"s4_gain": {"s4_simulator": "100"}, "c3_gain": {"s5_lab": "100"}, "ucurve_eps_opt": {"s5_lab": "4.03e-07"},
+         "s4_log_floor": {"s4_simulator": "$10^{-16}$"}, "s1_size": {"s1_what_changes": "'256 × 256'"},
+         "fig-x": {"s5_lab": "<Figure size 640x380 with 1 Axes>"}}
+
+
+def test_a_registered_book_whose_names_agree_with_each_other_and_the_library_passes():
+    assert quantity_conflicts(SHOWN, REGISTRY, OWN) == []
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"c3_gain": {"s5_lab": "1000"}},
+     "the gain: one quantity, two values: s4_simulator s4_gain = 100, s5_lab c3_gain = 1000"),
+    ({"ucurve_eps_opt": {"s5_lab": "3.73e-07"}},
+     "the optimum: s5_lab ucurve_eps_opt = 3.73e-07, but the library's value is 4.03e-07"),
+    ({"s4_log_floor": {"s4_simulator": "$10^{-15}$"}}, "the library's value is 1e-16"),
+    ({"s7_eps_opt": {"s7_pitfalls": "3.73e-07"}}, "s7_eps_opt: glued on s7_pitfalls, but registered nowhere"),
+    ({"s1_size": {}}, "s1_size: registered, but no page glues it"),
+])
+def test_two_values_of_one_quantity_an_unregistered_name_or_a_value_off_the_library_fail(change, message):
+    shown = {k: v for k, v in {**SHOWN, **change}.items() if v}
+    found = quantity_conflicts(shown, REGISTRY, OWN)
+    assert any(message in line for line in found), found
+
+
+def test_a_name_registered_twice_fails():
+    assert quantity_conflicts(SHOWN, REGISTRY, OWN + ("c3_gain",)) == ["c3_gain: the name is registered twice"]
+
+
+def test_the_books_glue_is_the_registrys_and_its_fitted_optimum_not_the_argmin(book_html, monkeypatch):
+    """The built book: every glued name registered, every quantity one value under all its names and
+    the library's where it holds one (stored measurements read from the build's store).  The same
+    glue with the U-curve's optimum taken from its noisy argmin (the wrong variant) is caught."""
+    monkeypatch.setenv("SYMRENDER_STORE", str(book_html.parent / ".measurements"))
+    names = check_glue.glued(book_html.parent / ".jupyter_cache")
+    assert quantity_conflicts(names) == []
+    argmin = {**names, "ucurve_eps_opt": {"s5_lab": repr(check_glue._ucurve().eps_opt_measured)}}
+    assert [line.split(":")[0] for line in quantity_conflicts(argmin)] == ["the fitted optimal step"]

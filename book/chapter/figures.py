@@ -187,14 +187,15 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
 
 def ucurve_anatomy(curve):
     """The measured U-curve of a `renderer.ucurve.UCurve` (error, truncation and roundoff parts,
-    fitted model) with its regions named: truncation falling as eps^2, rounding rising as
-    1/eps, the fitted optimum between them."""
+    the model A eps^2 + B / eps fitted to the error) with its regions named: truncation falling as
+    eps^2, rounding rising as 1/eps, the fitted model's optimum between them."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
     ax.loglog(curve.eps, curve.error, lw=2, color=RED, label="|error| of the float64 quotient")
     ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="exact arithmetic at the rounded $u \\pm \\varepsilon$")
     ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="rounding of the float64 evaluation")
-    ax.loglog(curve.eps, curve.model, color=GREY, lw=1, label=r"model $A\varepsilon^2 + B/\varepsilon$")
+    fitted = curve.truncation_coeff * curve.eps**2 + curve.roundoff_coeff / curve.eps
+    ax.loglog(curve.eps, fitted, color=GREY, lw=1, label=r"model $A\varepsilon^2 + B/\varepsilon$")
     opt = curve.eps_opt_fitted
     ax.axvline(opt, color=GREY, lw=0.8, ls="-.")
     top = float(np.nanmax(curve.error))

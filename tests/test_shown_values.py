@@ -1,0 +1,412 @@
+"""What the reader sees, read back and compared with the number it names.
+
+A figure marks values, and its caption or the prose beside it names them with glued numbers.
+The book's pages are run here as the build runs them (`tests.pages.run_page` records the
+Figures each publishes and the values it glues), each figure is read back from its matplotlib
+artists (line, patch and image data; title, legend and annotation texts and positions), and
+each marked value is compared with the glued value its caption or prose names, or with the
+library's own (`renderer`, `lab`).  The classes of marked values, and where the book has them:
+
+* a line or a band at a named value: the U-curve's optimum (the glued fitted optimal step, and
+  the least of the model drawn beside it), its band of footprint steps, the stencil's crease;
+* a number in a legend: the stencil's two slopes (the library's central and exact hᵤ at the
+  stencil drawn), the band's percentiles (of the page's footprint steps);
+* a number in a title: the gain of a difference panel (index, §1, Cell 3), the β of a render
+  (§1, Cell 6), the normal diagram's β (that of the displaced curve it draws);
+* an annotation at a value: the optimum's, the crease's;
+* the data of a curve whose statistic the prose names: Cell 5's convergence orders, §7's floor of
+  the error at a crease, the model's error at the fitted step;
+* what a caption's glued numbers say a figure shows: §4's panels at its ε with its largest
+  difference, §2's fields at its frequencies and its chamber counts, §7's close-ups at its zoom;
+* directions a caption states in words: the normal diagram's arrows;
+* numbers typed into alt text, which cannot be glued: each is listed in `ALT_NUMBERS` with what
+  it names and checked; a number not listed fails;
+* the register of §6 and the front page's counts: each row's number is its claim's place in
+  `lab.claims.CLAIMS`, its quote and verdict the claim's, each verdict sentence links the row of
+  its own claim, and the counts on the front page are those of the lists they count.
+
+Pages run with a copy of the build's stored measurements when there is one (after ``make book``
+the pages cost seconds; without it minutes).  The register and the counts are read from the
+built site (`book_html`).
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import os
+import re
+import shutil
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from chapter import figures
+from renderer import Scene, compare, pointwise, render, to_srgb
+from renderer.scene import HEIGHT_FIELDS
+from renderer.ucurve import non_differentiable
+
+from .pages import run_page
+from .test_check_glue import check_glue
+
+ROOT = Path(__file__).parents[1]
+BOOK = ROOT / "book"
+#: A number as a figure or an alt text writes it ("-5.30", "+0.00", "1e-16", "10th", "−1").
+NUMBER = re.compile(r"[−+-]?\d+(?:\.\d+)?(?:e[−+-]?\d+)?")
+
+
+def numbers(text):
+    return [float(m.replace("−", "-")) for m in NUMBER.findall(text)]
+
+
+def shows(shown, value):
+    """Whether the number as written (``-5.30``, ``2``) is ``value`` to the digits it shows."""
+    return check_glue._matches(shown.replace("+", "").replace("−", "-"), float(value))
+
+
+@pytest.fixture(scope="module")
+def ran(tmp_path_factory):
+    """``ran(page)``: `run_page` of book/<page>.md, once per page, reading the build's stored
+    measurements (a copy of book/_build/.measurements, or of the store beside SYMRENDER_BOOK_HTML)."""
+    given = os.environ.get("SYMRENDER_BOOK_HTML")
+    built = (Path(given).parent if given else BOOK / "_build") / ".measurements"
+    store = tmp_path_factory.mktemp("store")
+    if built.is_dir():
+        shutil.copytree(built, store, dirs_exist_ok=True)
+    runs = {}
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("SYMRENDER_STORE", str(store))
+
+        def run(page):
+            if page not in runs:
+                runs[page] = run_page(BOOK / f"{page}.md")
+            return runs[page]
+        yield run
+
+
+def vertical_lines(ax):
+    """The x of every vertical line (``axvline``) of ``ax``."""
+    return [float(x[0]) for x in (line.get_xdata() for line in ax.get_lines()) if len(x) == 2 and x[0] == x[1]]
+
+
+def curve(ax, label):
+    """(x, y) of the one line of ``ax`` whose label starts with ``label``."""
+    found = [line for line in ax.get_lines() if line.get_label().startswith(label)]
+    assert len(found) == 1, (label, [line.get_label() for line in ax.get_lines()])
+    return np.asarray(found[0].get_xdata(), float), np.asarray(found[0].get_ydata(), float)
+
+
+def legend_entry(ax, label):
+    """The text of the legend entry (as the reader reads it) that starts with ``label``."""
+    (text,) = [t.get_text() for t in ax.get_legend().get_texts() if t.get_text().startswith(label)]
+    return text
+
+
+def image(ax):
+    return np.asarray(ax.get_images()[0].get_array())
+
+
+# ---- lines, bands, legends and annotations ---------------------------------------------------
+
+def test_the_u_curve_marks_the_fitted_optimum_of_the_model_it_draws_and_the_band_its_legend_names(ran):
+    """Cell 2's figure: its optimum line and annotation sit at the glued fitted optimal step, which
+    is the least of the model A ε² + B/ε drawn beside them (A and B read back from the model's line),
+    where the model's error is the glued one; the band of footprint steps spans the percentiles of
+    the page's steps that its legend names, right of the optimum as the alt text says, about the
+    glued median step, the glued ratio of which to the optimum is the two glued values'."""
+    ns, shown, glued = ran("s5_lab")
+    ax = shown["fig-c2-ucurve"].axes[0]
+    (opt,) = vertical_lines(ax)
+    assert math.isclose(opt, glued["ucurve_eps_opt"], rel_tol=1e-9), (opt, glued["ucurve_eps_opt"])
+    (note,) = [t for t in ax.texts if "optimum" in t.get_text()]
+    assert note.xy[0] == opt
+    eps, model = curve(ax, "model")
+    terms = np.stack([eps**2, 1 / eps], axis=1) / model[:, None]          # weighted: each step's error counts alike
+    scale = np.linalg.norm(terms, axis=0)
+    A, B = np.linalg.lstsq(terms / scale, np.ones_like(eps), rcond=None)[0] / scale
+    assert math.isclose((B / (2 * A)) ** (1 / 3), opt, rel_tol=1e-6), ((B / (2 * A)) ** (1 / 3), opt)
+    assert math.isclose(A * opt**2 + B / opt, glued["ucurve_err_opt"], rel_tol=1e-6)
+    (band,) = [p for p in ax.patches if p.get_label().startswith("footprint")]
+    lo, hi = np.percentile(ns["fp_u"], numbers(legend_entry(ax, "footprint")))
+    box = band.get_bbox()
+    assert np.allclose([box.x0, box.x1], [lo, hi], rtol=1e-12) and box.x0 > opt, (box, lo, hi, opt)
+    assert glued["c2_fp_u"] == np.median(ns["fp_u"]) and lo < glued["c2_fp_u"] < hi
+    assert math.isclose(glued["c2_fp_ratio"], glued["c2_fp_u"] / glued["ucurve_eps_opt"], rel_tol=1e-12)
+
+
+#: The stencil diagram as §3 draws it (its defaults), a stencil left of another crease, and one
+#: at another frequency and row.
+STENCILS = [{}, dict(k_u=5.0, v=0.3, eps=0.01, offset=-0.004), dict(k_u=12.0, k_v=3.0, v=0.8, eps=0.005, offset=0.002)]
+
+
+@pytest.mark.parametrize("kwargs", STENCILS)
+def test_the_stencil_legend_names_the_slopes_the_library_computes_at_the_stencil_drawn(kwargs):
+    """§3's stencil diagram: the legend's central slope is the library's central hᵤ
+    (`pointwise.central_gradient`) at the stencil drawn (its centre and half-width read back from
+    the red points) and the slope of the secant drawn; its exact slope is `pointwise.exact_gradient`
+    there and the slope of the blue line; the dotted line and its annotation sit on a crease
+    (`renderer.ucurve.non_differentiable`), between the stencil's points."""
+    p = {**{k: v.default for k, v in inspect.signature(figures.stencil_diagram).parameters.items()}, **kwargs}
+    ax = figures.stencil_diagram(**kwargs).axes[0]
+    (a, b), (h_a, h_b) = curve(ax, "central stencil")
+    u0, eps = (a + b) / 2, (b - a) / 2
+    central, exact = (NUMBER.findall(legend_entry(ax, label))[-1] for label in ("central stencil", "exact slope"))
+    library = pointwise.central_gradient("ridges", u0, p["v"], p["k_u"], p["k_v"], eps)[0]
+    assert shows(central, library) and shows(central, (h_b - h_a) / (b - a)), (central, library)
+    u, h = curve(ax, "exact slope")
+    library = pointwise.exact_gradient("ridges", u0, p["v"], p["k_u"], p["k_v"])[0]
+    assert shows(exact, library) and math.isclose((h[1] - h[0]) / (u[1] - u[0]), library, rel_tol=1e-9)
+    (crease,) = vertical_lines(ax)
+    assert non_differentiable("ridges", crease, p["v"], "u", p["k_u"], p["k_v"]) and a < crease < b
+    (note,) = [t for t in ax.texts if "crease" in t.get_text()]
+    assert note.xy[0] == crease
+
+
+# ---- numbers in titles -------------------------------------------------------------------------
+
+def _beta(title):
+    (beta,) = numbers(title.partition("beta")[2])
+    return beta
+
+
+@pytest.mark.parametrize("kwargs", [{}, dict(field="rings", beta=0.2), dict(field="sine", beta=0.05, theta=1.0)])
+def test_the_normal_diagram_draws_the_displacement_its_title_names_and_the_normals_its_caption_describes(kwargs):
+    """§1's diagram: the dashed curve is the sphere displaced by β h with the β and field of the
+    title ((r - R) / h read back from the curve); at the middle point (§1's figure, the rings
+    field) the displaced curve's own normal (green) covers the displaced sphere's (blue) and the
+    draft's (red) tilts the other way from N, and further, as the caption says."""
+    p = {**{k: v.default for k, v in inspect.signature(figures.normal_diagram).parameters.items()}, **kwargs}
+    ax = figures.normal_diagram(**kwargs).axes[0]
+    title = ax.get_title()
+    beta = _beta(title)
+    assert f"{p['field']} field" in title and beta == p["beta"]
+    (dashed,) = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
+    x, z = (np.asarray(c, float) for c in dashed.get_data())
+    scene = Scene(height_field=p["field"])
+    h = pointwise.height(p["field"], np.full_like(x, (p["theta"] + np.pi) / (2 * np.pi)), np.arctan2(x, z) / np.pi,
+                         scene.k_u, scene.k_v)
+    big = np.abs(h) > 0.1
+    assert np.allclose((np.hypot(x, z) - scene.radius_a)[big] / h[big], beta, rtol=1e-9)
+    if kwargs:
+        return
+    arrows = {}
+    for t in ax.texts:
+        if getattr(t, "arrow_patch", None) is not None:
+            arrows.setdefault((t.arrowprops["color"], t.arrowprops["lw"]), []).append(np.subtract(t.xy, t.xyann))
+    (wide,), (own,), (draft,) = (arrows[k] for k in ((figures.BLUE, 3.5), (figures.GREEN, 1.0), (figures.RED, 1.4)))
+    (flat,) = arrows[figures.GREY, 1.4]
+    angle = lambda a, b: np.degrees(np.arctan2(a[0] * b[1] - a[1] * b[0], a @ b))  # noqa: E731
+    assert abs(angle(own, wide)) < 1.0, angle(own, wide)
+    tilt, draft_tilt = angle(flat, wide), angle(flat, draft)
+    assert np.sign(draft_tilt) == -np.sign(tilt) and abs(draft_tilt) > abs(tilt), (tilt, draft_tilt)
+
+
+#: The difference panels: the page, the figure, and the (numeric, symbolic) frames of its rows,
+#: read from the page's namespace.
+DIFFERENCE_PANELS = {
+    "fig-hero": ("index", lambda ns: [(ns["numeric"], ns["symbolic"])]),
+    "fig-s1-bump": ("s1_what_changes", lambda ns: [(ns["frames"][b]["numeric"], ns["frames"][b]["symbolic"])
+                                                   for b in ("surface", "chart")]),
+    "fig-c3-panels": ("s5_lab", lambda ns: [(ns["numeric"], ns["symbolic"])]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(DIFFERENCE_PANELS))
+def test_a_difference_panel_is_the_difference_amplified_by_the_gain_its_title_names(ran, name):
+    """The panel titled "× g" shows min(1, g |ΔI|) of its row's frames, g is the simulator's linear
+    gain that §4 and Cell 3 glue, and Cell 3's caption names the same g."""
+    page, frames = DIFFERENCE_PANELS[name]
+    ns, shown, glued = ran(page)
+    axes = [ax for ax in shown[name].axes if "×" in ax.get_title()]
+    assert len(axes) == len(frames(ns))
+    for ax, (numeric, symbolic) in zip(axes, frames(ns)):
+        (gain,) = numbers(ax.get_title().partition("×")[2])
+        assert np.array_equal(image(ax), np.clip(gain * np.abs(numeric.image - symbolic.image), 0, 1)), ax.get_title()
+        assert gain == check_glue.QUANTITIES["the simulator's linear difference gain"][1]()
+        assert gain == glued.get("c3_gain", gain)
+
+
+@pytest.mark.parametrize("page, name, frames", [
+    ("s5_lab", "fig-c6-beta", lambda ns: [ns["flat"], ns["sine"]]),
+    ("s1_what_changes", "fig-s1-bump", lambda ns: [ns["frames"][b]["flat"] for b in ("surface", "chart")]),
+])
+def test_a_render_titled_with_its_beta_is_the_render_at_that_beta(ran, page, name, frames):
+    """Each panel whose title gives β shows its frame, rendered at that β (and, in Cell 6, on the
+    field the title names), and Cell 6's caption names the same β."""
+    ns, shown, glued = ran(page)
+    axes = [ax for ax in shown[name].axes if "beta" in ax.get_title()]
+    assert len(axes) == len(frames(ns))
+    for ax, frame in zip(axes, frames(ns)):
+        assert np.array_equal(image(ax), to_srgb(frame.image)) and _beta(ax.get_title()) == frame.scene.beta
+        assert "field" not in ax.get_title() or f"{frame.scene.height_field} field" in ax.get_title()
+    if name == "fig-c6-beta":
+        assert glued["c6_beta"] == frames(ns)[1].scene.beta
+
+
+# ---- the data of curves whose statistic the prose names -------------------------------------
+
+def test_the_orders_cell_5_names_are_the_slopes_of_its_lines(ran):
+    """Cell 5's figure: the log-log slope of its median line and of its RMS line are the glued
+    median and RMS orders of the β-derivative."""
+    _, shown, glued = ran("s5_lab")
+    ax = shown["fig-c5-order"].axes[0]
+    for label, name in (("median", "beta_median_order"), ("RMS", "beta_rms_order")):
+        x, y = curve(ax, label)
+        assert math.isclose(np.polyfit(np.log(x), np.log(y), 1)[0], glued[name], rel_tol=1e-9), label
+
+
+def test_the_crease_figure_bottoms_out_where_the_prose_says(ran):
+    """§7: "the error never falls below" the glued floor: the least of the error line drawn."""
+    _, shown, glued = ran("s7_pitfalls")
+    _, error = curve(shown["fig-crease"].axes[0], "error at the crease")
+    assert error.min() == glued["s7_crease_err_min"]
+
+
+# ---- what a caption's glued numbers say a figure shows --------------------------------------
+
+def test_the_simulators_static_panels_are_its_opening_frame_at_the_captions_step(ran):
+    """§4's panels are Python's frames of the simulator's opening scene at the ε the caption glues,
+    and the caption's largest difference and RMS are those frames' ledger."""
+    from chapter.theorems import tex_number
+    from renderer.ledger import SIMULATOR_SCENE
+    ns, shown, glued = ran("s4_simulator")
+    eps = ns["numeric"].scene.eps
+    assert glued["s4_eps"].data == f"${tex_number(eps)}$" and ns["numeric"].scene == SIMULATOR_SCENE.replace(eps=eps)
+    size = ns["numeric"].image.shape[0]
+    numeric = render(SIMULATOR_SCENE.replace(eps=eps), size, size, gradient="central")
+    symbolic = render(SIMULATOR_SCENE, size, size)
+    axes = shown["fig-s4-pipelines"].axes
+    assert np.array_equal(image(axes[0]), to_srgb(numeric.image))
+    assert np.array_equal(image(axes[1]), to_srgb(symbolic.image))
+    ledger = compare(numeric, symbolic)
+    assert (glued["s4_max"], glued["s4_rms"]) == (ledger.max_abs, ledger.rms)
+
+
+def test_the_scene_figures_show_the_fields_and_chambers_their_captions_name(ran):
+    """§2: each field panel is `pointwise.height` of the field its title names at the glued
+    frequencies; the chamber map's counts are the glued counts, and the render beside it is the
+    scene of the glued field, frequencies and β."""
+    _, shown, glued = ran("s2_scene")
+    fields = [ax for ax in shown["fig-s2-fields"].axes if ax.get_images()]
+    for ax in fields:
+        field, (x0, x1, y0, y1) = ax.get_title().partition(":")[0], ax.get_images()[0].get_extent()
+        u, v = np.meshgrid(np.linspace(x0, x1, image(ax).shape[1]), np.linspace(y0, y1, image(ax).shape[0]))
+        assert np.array_equal(image(ax), pointwise.height(field, u, v, glued["s2_k_u"], glued["s2_k_v"])), field
+    assert sorted(ax.get_title().partition(":")[0] for ax in fields) == sorted(HEIGHT_FIELDS)
+    scene_ax, chamber_ax = shown["fig-s2-chambers"].axes
+    counts = np.bincount(image(chamber_ax).ravel().astype(int), minlength=4)
+    assert [glued[f"s2_count_{code}"] for code in range(4)] == counts.tolist()
+    scene = Scene(height_field=glued["s2_field"], k_u=glued["s2_k_u"], k_v=glued["s2_k_v"], beta=glued["s2_beta"],
+                  bump="surface")
+    assert np.array_equal(image(scene_ax), to_srgb(render(scene, *image(chamber_ax).shape[::-1]).image))
+
+
+def test_the_pole_close_ups_are_the_normals_their_titles_name_at_the_captions_zoom(ran):
+    """§7: each close-up is the render, at the glued zoom, with the normal its title names."""
+    ns, shown, glued = ran("s7_pitfalls")
+    words = {"the draft's normal": "chart", "the displaced sphere's normal": "surface"}
+    for ax in shown["fig-pole-modes"].axes:
+        size = image(ax).shape[0]
+        frame = render(ns["scene"].replace(bump=words[ax.get_title()]), size, size, zoom=glued["s7_pole_zoom"])
+        assert np.array_equal(image(ax), to_srgb(frame.image)), ax.get_title()
+
+
+# ---- numbers typed into alt text ------------------------------------------------------------
+
+def _arm(side):
+    """The log-log slope of Cell 2's error line on one arm: steps 10 times the optimum or more
+    ("right"), a tenth of it or less ("left")."""
+    def slope(ns, shown, glued):
+        ax = shown["fig-c2-ucurve"].axes[0]
+        eps, error = curve(ax, "|error|")
+        (opt,) = vertical_lines(ax)
+        arm = eps >= 10 * opt if side == "right" else eps <= opt / 10
+        return np.polyfit(np.log10(eps[arm]), np.log10(error[arm]), 1)[0]
+    return slope
+
+
+#: (page, figure) -> {the words of its alt text that carry a number: what the number names}.
+ALT_NUMBERS = {
+    ("s5_lab", "fig-c2-ucurve"): {"along a line of slope 2": _arm("right"), "along a line of slope -1": _arm("left")},
+    ("s5_lab", "fig-c5-order"): {"with slope about 2": lambda ns, shown, glued: glued["beta_median_order"]},
+}
+_ALT = re.compile(r"```\{glue:figure\} (?P<name>\S+)\n(?:.*\n)*?:alt: (?P<alt>.*)")
+
+
+def test_every_number_typed_into_alt_text_is_the_value_it_names(ran):
+    """Every number in a figure's alt text lies in words listed in `ALT_NUMBERS`, and the number
+    names what they name, to the digits it shows."""
+    found = {}
+    for page in sorted(BOOK.glob("*.md")):
+        for m in _ALT.finditer(page.read_text(encoding="utf-8")):
+            listed = ALT_NUMBERS.get((page.stem, m["name"]), {})
+            alt = m["alt"]
+            for words in listed:
+                assert words in alt, (page.stem, m["name"], words)
+                alt = alt.replace(words, "")
+            found[page.stem, m["name"]] = NUMBER.findall(alt)
+    assert not any(found.values()), {k: v for k, v in found.items() if v}
+    for (page, _), listed in ALT_NUMBERS.items():
+        for words, value in listed.items():
+            (number,) = NUMBER.findall(words)
+            assert shows(number, value(*ran(page))), (words, value(*ran(page)))
+
+
+# ---- the register of §6 and the counts of the front page ------------------------------------
+
+def test_the_register_numbers_each_claim_by_its_place_in_the_register():
+    """`chapter.verdicts.register`: entry n is the n-th claim of `lab.claims.CLAIMS`, numbered n
+    from 1 (claims' measurements stubbed: their verdicts are the registered ones)."""
+    from chapter import verdicts
+    from lab.claims import CLAIMS
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(verdicts, "_results", lambda ids=None: {c.id: (c, "measured", c.registered) for c in CLAIMS})
+        markdown = verdicts.register()
+    rows = re.findall(r"^\(claim-(?P<id>[^)]+)\)=\n\*\*(?P<n>\d+)\. ", markdown, re.M)
+    assert rows == [(c.id, str(n)) for n, c in enumerate(CLAIMS, start=1)]
+
+
+def _soup(path):
+    from bs4 import BeautifulSoup
+    return BeautifulSoup(path.read_text(encoding="utf-8"), "html.parser")
+
+
+def test_the_built_register_its_links_and_the_front_pages_counts_agree_with_the_claims(book_html):
+    """The built §6: row n is `lab.claims.CLAIMS`[n - 1], numbered n, with its place, quote and
+    registered verdict, and it links to the section that measures it; every verdict sentence on
+    every page links to the row of the claim it quotes, with that row's verdict; the front page's
+    counts of claims (by verdict), errata and theorems (by status) are those of §6's lists."""
+    from chapter.verdicts import WORDS, place_of
+    from lab.claims import CLAIMS
+    quoted = lambda claim: f"“{claim.quote.replace('`', '')}”"  # noqa: E731  (its code spans set as code)
+    text = lambda element: element.get_text().replace("’", "'")  # noqa: E731  (Sphinx's typographic apostrophe)
+    s6 = _soup(book_html / "s6_ledger.html")
+    rows = s6.select("p[id^=claim-]")
+    assert [r["id"] for r in rows] == [f"claim-{c.id}" for c in CLAIMS]
+    for n, (row, claim) in enumerate(zip(rows, CLAIMS), start=1):
+        head, verdict = (b.get_text() for b in row.find_all("strong")[:2])
+        assert head == f"{n}. {claim.where}:" and quoted(claim) in text(row), (n, head)
+        assert verdict == WORDS[claim.registered], (claim.id, verdict)
+        assert row.find("a")["href"].endswith(f"#{place_of(claim.id)}"), (claim.id, row.find("a")["href"])
+    by_id = {c.id: c for c in CLAIMS}
+    linked = []
+    for page in sorted(book_html.glob("*.html")):
+        for sentence in _soup(page).select(".verdicts p"):
+            claim = by_id[sentence.find("a", href=re.compile("#claim-"))["href"].rpartition("#claim-")[2]]
+            assert quoted(claim) in text(sentence), (page.name, claim.id)
+            assert sentence.find_all("strong")[1].get_text() == WORDS[claim.registered] + ":", (page.name, claim.id)
+            linked.append(claim.id)
+    assert sorted(linked) == sorted(by_id)
+    counts = ("ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata", "ix_proved", "ix_verified")
+    cache = check_glue.glued(book_html.parent / ".jupyter_cache")
+    glued = {name: float(cache[name]["index"]) for name in counts}
+    verdicts = Counter(row.find_all("strong")[1].get_text() for row in rows)
+    section = lambda label: s6.find(id=label).find_parent("section")  # noqa: E731
+    errata = [p for p in section("errata").select("p") if re.match(r"E\d+\. ", p.get_text())]
+    statuses = Counter(b.get_text() for b in section("theorems").select("li > p > strong"))
+    assert glued == {"ix_claims": len(rows), "ix_holds": verdicts[WORDS["holds"]],
+                     "ix_corrected": verdicts[WORDS["holds with a correction"]],
+                     "ix_fails": verdicts[WORDS["does not hold"]], "ix_errata": len(errata),
+                     "ix_proved": statuses["PROVED"], "ix_verified": statuses["VERIFIED numerically"]}, glued
