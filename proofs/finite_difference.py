@@ -35,8 +35,8 @@ TAYLOR = written(sp.Add(*[eps**n / sp.factorial(n) * _d(n) for n in range(ORDER)
 #: The central quotient, as written.
 QUOTIENT = written(sp.Add(f(sp.Add(x, eps, evaluate=False)), -f(sp.Add(x, -eps, evaluate=False)), evaluate=False)
                    / (2 * eps))
-CLAIMED = (sp.diff(f(x), x) + eps**2 / 6 * sp.diff(f(x), x, 3)
-           + eps**4 / 120 * sp.diff(f(x), x, 5))
+#: The claimed series' terms, in the order written: h' + eps^2 h''' / 6 + eps^4 h^(5) / 120.
+CLAIMED = (sp.diff(f(x), x), eps**2 / 6 * sp.diff(f(x), x, 3), eps**4 / 120 * sp.diff(f(x), x, 5))
 
 a, b = sp.symbols("a b", real=True)
 #: A concrete analytic h for numerical sampling only (the proof is for any h).
@@ -170,12 +170,13 @@ def _kernel_cases():
                  for name, height in F.HEIGHT.items())
 
 
-def _truncation(claimed=CLAIMED, denominator=2, **stencil):
-    """Theorem central-difference-truncation with the series ``claimed``, the stencil's quotients over
-    ``denominator`` eps, and the evidence's ``stencil`` options (`_stencil_evidence`): wrong variants."""
+def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
+    """Theorem central-difference-truncation with the series of the terms ``claimed`` + O(eps^``order``)
+    (written as they stand: a term the O-term contains is refused, not absorbed), the stencil's quotients
+    over ``denominator`` eps, and the evidence's ``stencil`` options (`_stencil_evidence`): wrong variants."""
     kernel = sp.Tuple(CENTRAL_U(F.u, F.v), CENTRAL_V(F.u, F.v))
     quotients = sp.Tuple(*(quotient(h_uv(F.u, F.v), var, denominator) for var in (F.u, F.v)))
-    series = claimed + sp.O(eps**ORDER)
+    series = written(sp.Add(*claimed, sp.O(eps**order), evaluate=False))
     return Theorem(
         id="central-difference-truncation", title="Truncation error of the central difference",
         statement=(r"$⟦series⟧$. Away from the seam and the poles this quotient is the renderer's stencil "
@@ -199,10 +200,15 @@ def _truncation(claimed=CLAIMED, denominator=2, **stencil):
         domain={**SERIES_DOMAIN, **KERNEL_DOMAIN}, functions=INSTANCE,
         evidence=partial(_stencil_evidence, **stencil),
         wrong_variants=(("coefficient 1/3 instead of 1/6",
-                         lambda: _truncation(CLAIMED + eps**2 / 6 * sp.diff(f(x), x, 3)).check()),
+                         lambda: _truncation((CLAIMED[0], eps**2 / 3 * sp.diff(f(x), x, 3), CLAIMED[2])).check()),
                         ("eps^3 instead of eps^2",
-                         lambda: _truncation(CLAIMED - eps**2 / 6 * sp.diff(f(x), x, 3)
-                                             + eps**3 / 6 * sp.diff(f(x), x, 3)).check()),
+                         lambda: _truncation((CLAIMED[0], eps**3 / 6 * sp.diff(f(x), x, 3), CLAIMED[2])).check()),
+                        ("the highest written term with 1/60 instead of 1/120",
+                         lambda: _truncation(CLAIMED[:2] + (eps**4 / 60 * sp.diff(f(x), x, 5),)).check()),
+                        ("the highest written term at eps^5 instead of eps^4",
+                         lambda: _truncation(CLAIMED[:2] + (eps**5 / 120 * sp.diff(f(x), x, 5),)).check()),
+                        ("the remainder claimed O(eps^7): the eps^6 term is not zero",
+                         lambda: _truncation(order=ORDER + 1).check()),
                         ("the stencil read as a quotient over eps, not 2 eps",
                          lambda: _truncation(denominator=1).check()),
                         ("the footprint without pbrt's factor 1/2", lambda: _truncation(half=1.0).check()),

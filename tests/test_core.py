@@ -304,3 +304,142 @@ def test_square_roots_are_reduced_whatever_way_their_radicand_is_written():
     assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T)) == 0
     assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T + 1)) != 0
     assert core._radicals_reduced((x + 1) ** 2 - x**2 - 2 * x - 1) == 0          # no root: plain expansion
+
+
+# ------------------------------------------------------------------------- the soundness rules
+# Each test plants a violation of one rule of proofs/core.py's docstring and requires a refusal: no
+# correct theorem breaks a rule, so only a planted violation shows that the checker enforces it.
+
+@pytest.mark.parametrize("lemma, j", [(False, 1), (True, 2), (True, 0), (True, -1), (True, 3), (True, 1.0),
+                                      (True, True)],
+                         ids=["itself-as-step-1", "itself", "zero", "negative", "later", "float", "bool"])
+def test_rule_1_a_step_cites_earlier_steps_only(lemma, j):
+    """A step citing itself rewrites its name with its own false right side, and so "proves" anything
+    (f = a + 7 here, f being (a + b)^2 + 1); step 0 and negative numbers would index the steps from the end."""
+    e, f = sp.symbols("e f")
+    steps = [Step("name the square", e, a_**2 + 2 * a_ * b_ + b_**2)] * lemma + [Step("circular", f, a_ + 7, using=(j,))]
+    v = square_theorem(*steps, claims={}, where={e: SQUARE, f: e + 1}).check()
+    assert v.status == "refuted"
+    assert v.evidence == f"square, step {len(steps)} (circular) uses step {j}, which does not come before it"
+
+
+def test_rule_2_a_claim_is_reached_only_through_linked_steps():
+    """Two true steps, not linked: (a + b)^2 = (a + b) a + (a + b) b, and the expansion equals itself
+    written in another order.  Their ends are the claim's, but no chain runs between them."""
+    apart = (CHAIN[0], Step("the expansion, reordered", b_**2 + 2 * a_ * b_ + a_**2, a_**2 + 2 * a_ * b_ + b_**2))
+    assert [s.link for s in apart] == [False, False]
+    v = square_theorem(*apart).check()
+    assert v.status == "refuted" and "no chain of steps runs from the left side of the claim 'square'" in v.evidence
+    assert square_theorem(*CHAIN).check().status == "proved"      # the same ends, linked
+
+
+def _arctangents(domain, functions=None, where=None):
+    """A one-step theorem, atan(x) + atan(1/x) = pi/2 (true for x > 0 only, undecided by sympy)."""
+    step = Step("complementary angles", sp.atan(x) + sp.atan(1 / x), sp.pi / 2)
+    return Theorem("arc", "Arctangents", "", (step,), {}, domain=domain, functions=functions or {}, where=where or {})
+
+
+def _derivative_of_h(instance):
+    """A one-step theorem, d/dx h(x) = 2x, sampled through ``instance`` of h (true for x^2 only)."""
+    return Theorem("dh", "Derivative", "", (Step("differentiate", sp.Derivative(h(x), x), 2 * x),), {},
+                   domain={x: (0.5, 2.0)}, functions={h: sp.Lambda(x, instance)})
+
+
+def _maximum(cut):
+    """A one-step theorem, x + max(0, x - cut) = x on (0, 1): false, but only a sampled x above ``cut`` shows it."""
+    step = Step("no excess", x + sp.Max(0, x - cut), x)
+    return Theorem("max", "Maximum", "", (step,), {}, domain={x: (0, 1)})
+
+
+def _with(name, value, theorem):
+    """``theorem.check`` with core's ``name`` set to ``value`` for the check."""
+    def check():
+        with pytest.MonkeyPatch.context() as m:
+            m.setattr(core, name, value)
+            return theorem.check().status
+    return check
+
+
+CACHE_PAIRS = {
+    # Two checks with the same sides, one true and one false, differing in one part of the key only.
+    "functions": (_derivative_of_h(x**2).check, _derivative_of_h(x**3).check),
+    "domain": (_arctangents({x: (0.1, 10)}).check, _arctangents({x: (-10, -0.1)}).check),
+    "definitions": (lambda: square_theorem(Step("define", sp.Symbol("e"), SQUARE), claims={},
+                                           where={sp.Symbol("e"): a_**2 + 2 * a_ * b_ + b_**2}).check(),
+                    lambda: square_theorem(Step("define", sp.Symbol("e"), SQUARE), claims={},
+                                           where={sp.Symbol("e"): a_**2 + b_**2}).check()),
+    "cases": (lambda: square_theorem(Step("double", 2 * h(a_), h(a_) + a_**2, cases=(("square", {h: sp.Lambda(a_, a_**2)}),)),
+                                     claims={}).check(),
+              lambda: square_theorem(Step("double", 2 * h(a_), h(a_) + a_**2, cases=(("cube", {h: sp.Lambda(a_, a_**3)}),)),
+                                     claims={}).check()),
+    "seed": (_with("SEED", 6, _maximum(sp.Rational(96, 100))), _with("SEED", 0, _maximum(sp.Rational(96, 100)))),
+    "points": (_with("POINTS", 1, _maximum(sp.Rational(9, 10))), _with("POINTS", 24, _maximum(sp.Rational(9, 10)))),
+    "digits": (_with("DIGITS", 30, _arctangents({x: (0.1, 10)})), _with("DIGITS", 15, _arctangents({x: (0.1, 10)}))),
+}
+
+
+@pytest.mark.parametrize("first", [0, 1], ids=["holds-first", "fails-first"])
+@pytest.mark.parametrize("part", CACHE_PAIRS)
+def test_rule_3_the_cache_reuses_a_verdict_only_for_its_whole_key(monkeypatch, part, first):
+    """Checked in one process in either order (one cache), each check reaches the verdict it reaches alone:
+    the one that holds, and the one that does not, though their sides are the same."""
+    monkeypatch.setattr(core, "_DECIDED", {})
+    checks = CACHE_PAIRS[part]
+    status = {}
+    for i in (first, 1 - first):
+        v = checks[i]()
+        status[i] = v if isinstance(v, str) else v.status
+    assert status[0] in ("proved", "verified") and status[1] == "refuted", (part, status)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 6])
+def test_rule_4_a_series_step_is_checked_through_the_power_below_its_order(n):
+    """exp(x) = sum x^k/k! + O(x^n): true; with the x^(n-1) coefficient 1/(n-1)! + 1, refuted (it lies
+    below the O-term, so a check to order n - 1 alone would pass it)."""
+    x_ = sp.Symbol("x")
+    series = lambda last: sum(x_**k / sp.factorial(k) for k in range(n - 1)) + last * x_**(n - 1) + sp.O(x_**n)  # noqa: E731
+    t = lambda rhs: Theorem("exp", "exp", "", (Step("Taylor", sp.exp(x_), rhs),), {}, domain={x_: (-1, 1)})  # noqa: E731
+    assert t(series(1 / sp.factorial(n - 1))).check().status == "proved"
+    v = t(series(1 / sp.factorial(n - 1) + 1)).check()
+    assert v.status == "refuted" and v.evidence.startswith("exp, step 1 (Taylor): residual"), v.evidence
+
+
+@pytest.mark.parametrize("term", ["c*x**4", "x**4", "c*x**5", "x**4*sin(x)"])
+def test_rule_4_a_written_term_inside_the_order_is_refused_not_absorbed(term):
+    """sympy's O(x^4) absorbs c x^4 (and anything it contains): written unevaluated, the checker refuses it
+    rather than proving a statement the reader reads with the term."""
+    x_, c = sp.symbols("x c")
+    written_term = sp.sympify(term, locals={"x": x_, "c": c})
+    rhs = written(sp.Add(1, x_, x_**2 / 2, x_**3 / 6, written_term, sp.O(x_**4), evaluate=False))
+    t = Theorem("exp", "exp", "", (Step("Taylor", sp.exp(x_), rhs),), {}, domain={x_: (-1, 1), c: (1, 2)})
+    v = t.check()
+    assert v.status == "refuted", v.evidence
+    assert v.evidence == (f"exp, step 1 (Taylor): it writes {written_term} inside O(x**4), which would absorb it: "
+                          "state the series to a higher order or drop the term")
+    below = written(sp.Add(1, x_, x_**2 / 2, x_**3 / 6, sp.O(x_**4), evaluate=False))     # the same, without it
+    assert dataclasses.replace(t, steps=(Step("Taylor", sp.exp(x_), below),)).check().status == "proved"
+
+
+def test_rule_4_an_order_term_anywhere_but_ending_the_right_side_is_refused():
+    x_, y_ = sp.symbols("x y")
+    cases = {"its left side carries an O-term": (sp.O(x_**2), sp.O(x_**3)),
+             "must end in one O-term, a term of its sum": (sp.exp(x_), 1 + x_ * (1 + sp.O(x_))),
+             "is not O((x - x0)**n) in one variable": (sp.exp(x_ * y_), 1 + sp.O(x_ * y_)),
+             "about a finite point": (sp.exp(1 / x_), 1 + sp.O(1 / x_, (x_, sp.oo)))}
+    for why, (lhs, rhs) in cases.items():
+        t = Theorem("o", "o", "", (Step("series", lhs, rhs),), {}, domain={x_: (0.1, 1), y_: (0.1, 1)})
+        v = t.check()
+        assert v.status == "refuted" and why in v.evidence, (why, v.evidence)
+
+
+@pytest.mark.parametrize("returned, why", [
+    (None, "its evidence returned None, not a Verdict"),
+    (True, "its evidence returned True, not a Verdict"),
+    (Verdict("skipped", "renders skipped"), "renders skipped"),
+    (Verdict("verified", "no residual", None, None, 100), "states no finite residual and points"),
+    (Verdict("verified", "nan residual", float("nan"), 30, 24), "states no finite residual and points"),
+    (Verdict("verified", "no points", 0.0, 30, 0), "states no finite residual and points"),
+])
+def test_rule_5_evidence_is_a_verdict_that_holds_and_states_what_it_measured(returned, why):
+    v = square_theorem(*CHAIN, evidence=lambda: returned).check()
+    assert v.status == "refuted" and why in v.evidence, v
