@@ -173,12 +173,23 @@ def _on(frame, scene=None):
 
 def _err_at(eps):
     c = _ucurve()
-    return float(c.error[np.argmin(np.abs(np.log10(c.eps) - np.log10(eps)))])
+    k = np.argmin(np.abs(np.log10(c.eps) - np.log10(eps)))
+    if not abs(c.eps[k] / eps - 1) <= 0.01:
+        raise ValueError(f"eps={eps!r}: the U-curve's nearest step is {c.eps[k]:.3g}; a claim at a step is "
+                         "measured within 1 % of it")
+    return float(c.error[k])
 
 
 def relative_error_at(eps):
     """The central difference's relative error in hᵤ on the U-curve of Cell 2 (`renderer.ucurve.measure`'s
-    default curve) at its step nearest ``eps``: what the register's claims about 1e-9 and 1e-11 decide on."""
+    default curve) at ``eps``, its step within 1 % of it: what the register's claims about 1e-9 and 1e-11
+    decide on.
+
+    Raises
+    ------
+    ValueError
+        If no step of the curve lies within 1 % of ``eps``, naming it and the nearest step.
+    """
     return _err_at(eps) / abs(_ucurve().derivative)
 
 

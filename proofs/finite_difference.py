@@ -108,22 +108,29 @@ def _border_rule(u, v, eps, top=1.0):
     return u_p, u_m, v_p, v_m, (v_p - v_m) if (v + eps > 1 or v - eps < 0) else 2 * eps
 
 
+def border_points(samples=2000, seed=12):
+    """``samples`` seeded (u, v, step) triples, step log-uniform in [1e-6, 1e-1]: u within a step of 0,
+    within a step of 1, or anywhere in [0, 1), a third each (and v alike, within a step of 0 or 1 or in
+    [0, 1]), so that each border's wrap or clamp is taken at about a third of them."""
+    rng = random.Random(seed)
+    for _ in range(samples):
+        step = 10.0 ** rng.uniform(-6, -1)
+        u_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0 - 1e-12), rng.uniform(0, 1)))
+        v_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0), rng.uniform(0, 1)))
+        yield u_, v_, step
+
+
 def border_mismatches(samples=2000, seed=12, rule=_border_rule, stencil=F.STENCIL_POINTS):
-    """Seeded points within a step of the borders (u near 0 or 1, v near 0 or 1) at
-    which ``stencil`` (`formulas.STENCIL_POINTS`), or the v-denominator of `formulas.CENTRAL`
-    (read off its sine field, at ``stencil``), differ from ``rule``; evaluated in float64."""
+    """The `border_points` at which ``stencil`` (`formulas.STENCIL_POINTS`), or the v-denominator of
+    `formulas.CENTRAL` (read off its sine field, at ``stencil``), differ from ``rule``; evaluated in float64."""
     args = (F.u, F.v, F.eps_u, F.eps_v)
     points = sp.lambdify(args, [e for _, e in stencil], modules="math")
     h = F.HEIGHT["sine"].subs({F.k_u: 3, F.k_v: 2})
     central_v = sp.lambdify(args, F.CENTRAL["sine"][1].subs({F.k_u: 3, F.k_v: 2}).subs(dict(stencil)),
                             modules="math")
     h_of = sp.lambdify((F.u, F.v), h, modules="math")
-    rng = random.Random(seed)
     bad = 0
-    for _ in range(samples):
-        step = 10.0 ** rng.uniform(-6, -1)
-        u_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0 - 1e-12), rng.uniform(0, 1)))
-        v_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0), rng.uniform(0, 1)))
+    for u_, v_, step in border_points(samples, seed):
         want = rule(u_, v_, step)
         got = points(u_, v_, step, step)
         quotient = (h_of(u_, want[2]) - h_of(u_, want[3])) / want[4]

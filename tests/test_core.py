@@ -20,6 +20,13 @@ y = sp.Symbol("y")
 h = sp.Function("h")
 
 
+@pytest.fixture(autouse=True)
+def _fresh_cache(monkeypatch):
+    """Each test decides its equations itself: no verdict of another test (or of a process this one
+    was forked from, as mutmut's) is reused from core's cache."""
+    monkeypatch.setattr(core, "_DECIDED", {})
+
+
 def test_an_identity_sympy_reduces_is_proved_without_numbers():
     v = check_identities([Identity("square", (x + 1) ** 2, x**2 + 2 * x + 1, {x: (0.1, 2)})])
     assert (v.status, v.residual, v.holds) == ("proved", None, True)
