@@ -279,7 +279,11 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
                         ("both terms negated (the stationary point is a maximum)",
                          lambda: _optimal(-ERROR_MODEL).check()),
                         ("a model with stationary points 1, 3/2 and 2: a minimum at 1, but not the only one",
-                         lambda: _optimal((eps - 1)**2 * (eps - 2)**2, sp.Integer(1)).check())),
+                         lambda: _optimal((eps - 1)**2 * (eps - 2)**2, sp.Integer(1)).check()),
+                        ("the model's truncation term (its highest power) over 3, not 6",
+                         lambda: _optimal(eps**2 * H3 / 3 + u_round * H / eps).check()),
+                        ("the model's truncation term at eps^3, not eps^2",
+                         lambda: _optimal(eps**3 * H3 / 6 + u_round * H / eps).check())),
         pages=("s3", "s5", "s7"),
         seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
     )
