@@ -71,6 +71,12 @@ def test_rule_7_a_malformed_pin_is_an_error_naming_it(monkeypatch, bad):
             pinned_failure("chart", status, residual, 600)
 
 
+def test_a_theorem_without_renders_is_pinned_by_its_verdict_alone():
+    assert "optimal-step" not in RENDERED
+    assert pinned_failure("optimal-step", "proved", None, 0) is None
+    assert pinned_failure("optimal-step", "verified", 1e-30, 0) == "optimal-step is verified, pinned proved"
+
+
 def test_every_registered_pin_is_well_formed():
     assert {pin(t)[0] for t in PINNED} == {"proved", "verified"}
     assert pin("no-boundary") == ("verified", 0.0) and pin("optimal-step") == ("proved", None)

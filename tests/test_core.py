@@ -450,3 +450,193 @@ def test_rule_4_an_order_term_anywhere_but_ending_the_right_side_is_refused():
 def test_rule_5_evidence_is_a_verdict_that_holds_and_states_what_it_measured(returned, why):
     v = square_theorem(*CHAIN, evidence=lambda: returned).check()
     assert v.status == "refuted" and why in v.evidence, v
+
+
+# ----------------------------------------------------------- details the mutation run found untested
+def test_a_verdict_names_the_steps_and_points_it_rests_on():
+    """Refuted at a step or a link: the residual, digits and points of the check; the sentence less its final
+    "." or ":" (a sentence ending "X." keeps its X)."""
+    v = square_theorem(Step("Sum over X.", SQUARE, a_**2 + b_**2), claims={}).check()
+    assert v.evidence.startswith("square, step 1 (Sum over X): residual") and v.residual > 0.5
+    assert (v.status, v.digits, v.points) == ("refuted", core.DIGITS, core.POINTS)
+    broken = (CHAIN[0], Step("and again:", (a_ + b_) * a_ + b_**2 + a_ * b_ + 1, a_**2 + 2 * a_ * b_ + b_**2 + 1,
+                             link=True))
+    v = square_theorem(*broken, claims={}).check()
+    assert v.evidence.startswith("square, step 2 (and again) does not continue step 1") and v.residual == 1.0
+    assert (v.status, v.digits, v.points) == ("refuted", core.DIGITS, core.POINTS)
+    assert square_theorem(Step("first", SQUARE, SQUARE, link=True), claims={}).check().status == "refuted"
+    proved = square_theorem(*CHAIN).check()
+    assert (proved.residual, proved.digits, proved.points) == (None, None, None)
+
+
+def _complementary(*steps, **fields):
+    """A theorem about e = atan(a) + atan(1/a), which sympy does not reduce to pi/2 (so a step about e holds
+    numerically, and one about pi/2 is proved)."""
+    e = sp.Symbol("e")
+    return Theorem("arc", "Arctangents", "", steps, {}, domain={a_: (0.1, 10)},
+                   **{"where": {e: sp.atan(a_) + sp.atan(1 / a_)}, **fields})
+
+
+def test_a_cited_step_rewrites_the_step_and_its_link():
+    """With step 1's e = pi/2 substituted, step 2 and its link (whose left side e differs from step 1's right
+    side) are proved; without it each would hold only numerically.  A tuple of names takes a tuple of values."""
+    e = sp.Symbol("e")
+    v = _complementary(Step("complementary", e, sp.pi / 2),
+                       Step("the same, once more", e, sp.pi / 2, link=True, using=(1,))).check()
+    assert v.evidence.startswith("2 steps, reduced to 0 by sympy but for step 1, which holds numerically (worst "
+                                 "residual "), v.evidence
+    pair = sp.symbols("p q")
+    tuple_step = Step("two names at once", sp.Tuple(*pair), sp.Tuple(a_, b_))
+    uses = square_theorem(tuple_step, Step("use both", pair[0] * pair[1], a_ * b_, using=(1,)), claims={},
+                          where={pair[0]: a_, pair[1]: b_})
+    assert uses.check().status == "proved"
+    matrix_step = Step("two names, one vector", sp.Tuple(*pair), sp.ImmutableMatrix([a_, b_]))
+    refused = square_theorem(matrix_step, Step("use both", pair[0] * pair[1], a_ * b_, using=(1,)), claims={},
+                             where={pair[0]: a_, pair[1]: b_}).check()
+    assert refused.evidence == "square, step 2 (use both) uses step 1, whose left side is not a name"
+
+
+def test_two_steps_that_hold_numerically_are_both_named_with_the_worst_residual():
+    e, f = sp.symbols("e f")
+    t = _complementary(Step("complementary", e, sp.pi / 2), Step("doubled", 2 * f, sp.pi),
+                       where={e: sp.atan(a_) + sp.atan(1 / a_), f: sp.atan(a_ + 1) + sp.atan(1 / (a_ + 1))})
+    v = t.check()
+    assert v.evidence.startswith("2 steps, reduced to 0 by sympy but for steps 1, 2, which hold numerically (worst "
+                                 "residual "), v.evidence
+    assert (v.status, v.digits, v.points) == ("verified", core.DIGITS, core.POINTS) and 0 < v.residual < 1e-25
+    with_evidence = dataclasses.replace(t, evidence=lambda: Verdict("proved", "12 renders agree", rendered=12)).check()
+    assert (with_evidence.status, with_evidence.residual, with_evidence.digits, with_evidence.points,
+            with_evidence.rendered) == ("verified", v.residual, core.DIGITS, core.POINTS, 12)
+
+
+def test_a_step_in_several_cases_reports_its_weakest_case():
+    """A step proved in one case and verified in two reports the verified case with the larger residual."""
+    e = sp.Symbol("e")
+    step = Step("complementary, three ways", e, sp.pi / 2,
+                cases=(("exact", {e: sp.pi / 2}), ("small", {e: sp.atan(a_) + sp.atan(1 / a_) + sp.Float(1e-27, 40)}),
+                       ("larger", {e: sp.atan(a_) + sp.atan(1 / a_) + sp.Float(1e-24, 40)})))
+    v = _complementary(step).check()
+    assert v.status == "verified" and 0.9e-24 < v.residual < 1.1e-24, v
+
+
+def test_a_step_samples_its_own_domain_and_functions():
+    """A step's ``domain`` and ``functions`` replace the theorem's for that step."""
+    x_ = sp.Symbol("x")
+    arc = Step("complementary", sp.atan(x_) + sp.atan(1 / x_), sp.pi / 2, domain={x_: (0.1, 10)})
+    t = Theorem("arc", "Arctangents", "", (arc,), {}, domain={x_: (-10, -0.1)})
+    assert t.check().status == "verified"
+    square = Step("differentiate", sp.Derivative(h(x_), x_), 2 * x_, functions={h: sp.Lambda(x_, x_**2)})
+    t = Theorem("dh", "Derivative", "", (square,), {}, domain={x_: (0.5, 2)}, functions={h: sp.Lambda(x_, x_**3)})
+    assert t.check().status == "verified"
+
+
+@pytest.mark.parametrize("residual", [float("inf"), -1e-30])
+def test_rule_5_verified_evidence_with_an_impossible_residual_refutes(residual):
+    v = square_theorem(*CHAIN, evidence=lambda: Verdict("verified", "odd", residual, 30, 24)).check()
+    assert v.status == "refuted" and "states no finite residual and points" in v.evidence
+
+
+def test_the_probe_and_the_full_sampling_draw_from_their_documented_seeds():
+    """Component i's quick probe draws 3 points from Random(SEED + 1000 + i); the j-th undecided component's
+    full sampling POINTS points from Random(SEED + j): the counterexamples named are theirs."""
+    import random
+    def drawn(seed, n):
+        rng = random.Random(seed)
+        return [rng.uniform(0, 1) for _ in range(n)]
+    true = Identity("a", x, x, {x: (0, 1)})
+    probed = Identity("b", x + sp.Max(0, x - sp.Rational(7, 10)), x, {x: (0, 1)})
+    v = check_identities([true, probed])
+    point = max(drawn(1001, 3))
+    assert v.evidence == f"b: residual {point - 0.7:.3e} at x={point:.6g}", v.evidence
+    undecided = Identity("a", sp.atan(x) + sp.atan(1 / x), sp.pi / 2, {x: (0, 1)})
+    sampled = Identity("b", x + sp.Max(0, x - sp.Rational(9, 10)), x, {x: (0, 1)})
+    v = check_identities([undecided, sampled])
+    point = max(drawn(1, core.POINTS))
+    assert max(drawn(1001, 3)) < 0.9 < point              # the probe misses it, the full sampling finds it
+    assert v.evidence == f"b: residual {point - 0.9:.3e} at x={point:.6g}", v.evidence
+
+
+def test_a_point_that_cannot_be_evaluated_is_named_with_its_error():
+    import random
+    v = check_identities([Identity("inverse floor", 1 / sp.floor(x), 1, {x: (0.1, 0.9)})])
+    assert (v.status, v.digits, v.points) == ("refuted", core.DIGITS, core.POINTS)
+    first = random.Random(1000).uniform(0.1, 0.9)                 # the probe's first point
+    assert v.evidence == f"inverse floor: cannot be evaluated at x={first:.6g} (ZeroDivisionError: )", v
+
+
+def test_equal_worst_residuals_name_the_last_component():
+    ids = [Identity(k, sp.atan(x) + sp.atan(1 / x) + 1, sp.pi / 2, {x: (0.1, 10)}) for k in ("first", "second")]
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(core, "_exactly_zero", lambda expr: False)
+        m.setattr(core, "_numeric_residual", lambda ident, seed, points, digits: (1.0 if points > 3 else 0.0, {x: 1}))
+        assert check_identities(ids).evidence == "second: residual 1.000e+00 at x=1"
+
+
+def test_calc_links_each_step_to_the_one_before_and_applies_the_options():
+    d = {a_: (0, 1)}
+    steps = calc(a_, ("one", b_), ("two", a_ * b_, {"using": (1,)}), ("three", b_ + 1), domain=d)
+    assert steps == (Step("one", a_, b_, link=False, domain=d), Step("two", b_, a_ * b_, link=True, using=(1,), domain=d),
+                     Step("three", a_ * b_, b_ + 1, link=True, domain=d))
+
+
+def test_values_are_compared_as_columns_or_scalars():
+    assert core._value(sp.Tuple(sp.ImmutableMatrix([1, 2]), 3)) == sp.Matrix([1, 2, 3])
+    assert core._value(sp.Tuple(4)) == 4 and core._value(sp.ImmutableMatrix([[5]])) == 5
+    assert core._value(sp.ImmutableMatrix([[1, 2]])) == sp.Matrix([[1, 2]])
+    assert core._value(written(sp.Add(x, x, evaluate=False))) == 2 * x
+
+
+def test_dot_and_cross_evaluate_matrix_expressions_and_keep_names():
+    u_, v_ = sp.MatrixSymbol("u", 3, 1), sp.MatrixSymbol("v", 3, 1)
+    assert Dot(u_, v_).doit() == Dot(u_, v_) and Cross(u_, v_).doit() == Cross(u_, v_)
+    A, B = sp.ImmutableMatrix([1, 2, 3]), sp.ImmutableMatrix([0, 1, 0])
+    assert Dot(Cross(u_, A), B).doit() == Dot(Cross(u_, A), B)
+    assert Dot(u_, A).doit() == Dot(u_, A) and Cross(A, v_).doit() == Cross(A, v_)
+    assert Dot(sp.MatMul(2, A, evaluate=False), B).doit() == 4
+    assert Cross(sp.MatAdd(A, A, evaluate=False), B).doit() == sp.ImmutableMatrix([-6, 0, 2])
+    assert core._dense(sp.MatAdd(A, B, evaluate=False)) == sp.ImmutableMatrix([1, 3, 3])
+    assert core._dense(sp.MatMul(sp.ImmutableMatrix([[1, 2, 3]]), A, evaluate=False)) == sp.ImmutableMatrix([[14]])
+
+
+def test_named_symbols_print_their_definitions_in_the_statement():
+    E, f = sp.Function("E"), sp.Function("f")
+    M = sp.MatrixSymbol("M", 2, 1)
+    t = Theorem("t", "T", "$⟦E⟧$, $⟦f⟧$, $⟦M⟧$", (), {}, names={x: r"\chi"},
+                where={E(x): x**2, f: sp.Lambda(x, x**3), M: sp.Matrix([x, 1])})
+    assert t.statement_tex() == (r"$E\left(\chi\right) = \chi^{2}$, $f\left(\chi\right) = \chi^{3}$, "
+                                 r"$M = \left(\begin{matrix}\chi\\1\end{matrix}\right)$")
+    assert t.tex(x + 1) == r"\chi + 1"
+
+
+def test_a_variant_is_the_theorem_with_its_changes_checked_when_called():
+    called = []
+    wrong = core.variant(square_theorem(*CHAIN), steps=(Step("wrong", SQUARE, a_**2),), claims={},
+                         evidence=lambda: called.append(1))
+    assert not called and wrong().status == "refuted" and not called
+    assert core.variant(square_theorem(*CHAIN))().status == "proved"
+
+
+@pytest.mark.parametrize("rhs, status", [
+    ("log(x) = (x - 1) - (x - 1)**2/2 + O((x - 1)**3, (x, 1))", "proved"),
+    ("exp(x) = 1 + O(x)", "proved"),
+    ("exp(c*x) = 1 + c*x + c**2*x**2/2 + O(x**3)", "proved"),
+    ("exp(c*x) = 1 + c*x + c**2*x**2/3 + O(x**3)", "refuted"),
+])
+def test_rule_4_series_about_any_point_of_any_order_with_parameters(rhs, status):
+    x_, c = sp.symbols("x c")
+    lhs, rhs = (sp.sympify(s, locals={"x": x_, "c": c, "O": sp.O}) for s in rhs.split(" = "))
+    t = Theorem("s", "s", "", (Step("series", lhs, rhs),), {}, domain={x_: (0.5, 1.5), c: (1, 2)})
+    assert t.check().status == status
+
+
+def test_rule_4_refusals_say_exactly_why():
+    x_, y_ = sp.symbols("x y")
+    t = lambda lhs, rhs: Theorem("o", "o", "", (Step("series", lhs, rhs),), {}, domain={x_: (0.1, 1), y_: (0.1, 1)})  # noqa: E731,E501
+    assert t(sp.O(x_**2), sp.O(x_**3)).check().evidence == (
+        "o, step 1 (series): its left side carries an O-term; only a right side may end in + O(x**n)")
+    assert t(sp.exp(x_), sp.Add(1, sp.O(x_), sp.O(y_), evaluate=False)).check().evidence == (
+        "o, step 1 (series): its right side must end in one O-term, a term of its sum: it has ['O(x)', 'O(y)']")
+    two = written(sp.Add(1, x_, x_**3, x_**4, sp.O(x_**3), evaluate=False))
+    assert t(sp.exp(x_), two).check().evidence == (
+        "o, step 1 (series): it writes x**3, x**4 inside O(x**3), which would absorb them: state the series to a "
+        "higher order or drop the term")
