@@ -367,7 +367,7 @@ class _Printer(LatexPrinter):
 
     def _print_Pow(self, expr):
         if expr.exp.is_Rational and expr.exp.q > 2 and expr.exp.p == 1:
-            return rf"{self.parenthesize(expr.base, PRECEDENCE['Pow'], strict=True)}^{{1/{expr.exp.q}}}"
+            return rf"{self.parenthesize(expr.base, PRECEDENCE['Pow'])}^{{1/{expr.exp.q}}}"
         return super()._print_Pow(expr)
 
     def _print_atan2(self, expr):

@@ -640,3 +640,71 @@ def test_rule_4_refusals_say_exactly_why():
     assert t(sp.exp(x_), two).check().evidence == (
         "o, step 1 (series): it writes x**3, x**4 inside O(x**3), which would absorb them: state the series to a "
         "higher order or drop the term")
+
+
+def test_each_root_of_a_radicand_however_written_becomes_one_symbol_to_the_first_power():
+    """S^(k/2) is r^k, reduced to r^(k mod 2) S^(k div 2), for S written either way: what is left equals the
+    expression with r = sqrt(S), and holds r to the first power only."""
+    w = sp.Symbol("w", real=True)
+    S = x**2 + w**2
+    expr = (((x + w) ** 2 - 2 * x * w) ** sp.Rational(5, 2) + x * S ** sp.Rational(3, 2) + sp.sqrt(S)
+            + w / S ** sp.Rational(3, 2) + sp.sqrt(x + 1))
+    reduced = core._radicals_reduced(expr)
+    roots = {s for s in reduced.free_symbols if isinstance(s, sp.Dummy)}
+    assert len(roots) == 2 and not any(p.base in roots for p in reduced.atoms(sp.Pow))
+    first, second = roots
+    assert any(sp.simplify(reduced.subs({first: p, second: q}) - expr) == 0
+               for p, q in ((sp.sqrt(S), sp.sqrt(x + 1)), (sp.sqrt(x + 1), sp.sqrt(S))))
+    assert core._radicals_reduced(S ** sp.Rational(3, 2) - S * sp.sqrt(S)) == 0
+
+
+def test_an_identity_only_expanded_trigonometry_reduces_is_proved():
+    tangent = (3 * sp.tan(y) - sp.tan(y) ** 3) / (1 - 3 * sp.tan(y) ** 2)
+    assert sp.simplify(sp.tan(3 * y) - tangent) != 0 and sp.trigsimp(sp.tan(3 * y) - tangent) != 0
+    assert check_identities([Identity("triple tangent", sp.tan(3 * y), tangent, {y: (-0.3, 0.3)})]).status == "proved"
+
+
+def test_a_vector_step_names_its_failing_component_and_sides_may_be_plain_numbers():
+    v = square_theorem(Step("a vector", sp.Matrix([a_, b_]), sp.Matrix([a_, 2 * b_])), claims={}).check()
+    assert re.fullmatch(r"square, step 1 \(a vector\): component 1: residual \S+ at b=\S+", v.evidence), v
+    assert square_theorem(Step("plain numbers", 2, 1 + sp.Integer(1)), claims={}).check().status == "proved"
+
+
+def test_a_zero_matrix_is_compared_as_its_entries():
+    assert core._value(sp.ZeroMatrix(2, 3)) == sp.zeros(2, 3) and core._dense(sp.ZeroMatrix(2, 2)) == sp.zeros(2, 2)
+    assert core._value(1 + written(sp.Add(x, x, evaluate=False))) == 2 * x + 1
+
+
+def test_a_step_reports_a_verified_case_over_a_proved_one_and_the_larger_residual(monkeypatch):
+    """Two verdicts from a step's cases: the verified one (the step holds numerically there), and of two
+    verified ones the larger residual, a residual of 0.0 included."""
+    e = sp.Symbol("e")
+    cases = (("one", {e: a_}), ("two", {e: b_}))
+    for given, want in (((Verdict("proved", "p"), Verdict("verified", "v", 0.0, 30, 24)), ("verified", 0.0)),
+                        ((Verdict("verified", "v", 1e-30, 30, 24), Verdict("verified", "v", 0.0, 30, 24)),
+                         ("verified", 1e-30))):
+        verdicts = dict(zip((a_, b_), given))
+        monkeypatch.setattr(core, "_DECIDED", {})
+        monkeypatch.setattr(core, "check_identities", lambda ids, **k: verdicts[ids[0].lhs])
+        v = square_theorem(Step("cases", e, e, cases=cases), claims={}).check()
+        assert (v.status, v.residual) == want, v
+
+
+def test_another_seed_draws_other_points_for_each_component():
+    import random
+    undecided = Identity("a", sp.atan(x) + sp.atan(1 / x), sp.pi / 2, {x: (0, 1)})
+    sampled = Identity("b", x + sp.Max(0, x - sp.Rational(9, 10)), x, {x: (0, 1)})
+    sampled = Identity("b", x + sp.Max(0, x - sp.Rational(8, 10)), x, {x: (0, 1)})
+    rng = random.Random(5 + 1)                                  # seed 5, the second undecided component
+    point = max(rng.uniform(0, 1) for _ in range(core.POINTS))
+    v = check_identities([undecided, sampled], seed=5)
+    assert v.evidence == f"b: residual {point - 0.8:.3e} at x={point:.6g}", v.evidence
+
+
+def test_a_point_in_several_symbols_is_named_coordinate_by_coordinate():
+    import random
+    w = sp.Symbol("w")
+    v = check_identities([Identity("two", 1 / sp.floor(x) + w, 1, {x: (0.1, 0.9), w: (0, 1)})])
+    rng = random.Random(1000)
+    first = {"w": rng.uniform(0, 1), "x": rng.uniform(0.1, 0.9)}          # drawn in the symbols' order
+    assert v.evidence == f"two: cannot be evaluated at w={first['w']:.6g}, x={first['x']:.6g} (ZeroDivisionError: )"

@@ -10,7 +10,9 @@ After an intended change of notation, review the new text (it is printed) and re
 import hashlib
 
 import pytest
+import sympy as sp
 
+from proofs.core import tex, written
 from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
@@ -57,3 +59,34 @@ def test_every_theorem_has_a_recorded_print():
 if __name__ == "__main__":
     for theorem_id, t in THEOREMS.items():
         print(f'    "{theorem_id}": "{_digest(printed(t))}",')
+
+
+# The printer's forms that no theorem prints today, as a person writes them.
+x, y, theta = sp.symbols("x y theta")
+h, H = sp.Function("h"), sp.Function("H")
+A, B, C, M, N = (sp.MatrixSymbol(name, 3, 1) for name in "ABCMN")
+NORM = sp.Symbol(r"\lVert M\rVert", positive=True)
+
+
+@pytest.mark.parametrize("expr, names, latex", [
+    (sp.Derivative(x * y * sp.sin(x), (x, 2)), None, r"\frac{\partial^{2}}{\partial x^{2}} \left(x y \sin {x}\right)"),
+    (sp.Derivative(sp.sin(x * y), x, y), None,
+     r"\frac{\partial^{2}}{\partial x \partial y} \left(\sin{\left(x y \right)}\right)"),
+    (sp.Derivative(h(x), x), {h: "H"}, r"H'\left(x\right)"),
+    (-sp.Derivative(N, theta), None, r"- \frac{\partial N}{\partial \theta}"),
+    (2 * sp.Derivative(N, theta), None, r"2 \frac{\partial N}{\partial \theta}"),
+    (-M / NORM, None, r"- \frac{M}{\lVert M\rVert}"),
+    (sp.MatMul(2, A.T, sp.MatMul(B, C.T, evaluate=False), evaluate=False), None, r"2 A^{T} \left(B C^{T}\right)"),
+    (H(x, theta) ** 2, {H(x, theta): "H"}, "H^{2}"),
+    (sp.sin(x + 1) ** 2, None, r"\sin^{2}{\left(x + 1 \right)}"),
+    (sp.Pow(x**2, sp.Rational(1, 3), evaluate=False), None, r"\left(x^{2}\right)^{1/3}"),
+    (sp.Tuple(written(sp.Add(y, x, evaluate=False)), sp.Add(y, x, evaluate=False)), None,
+     r"\left( y + x, \  x + y\right)"),
+    (M, {M: r"\mathbf{M}"}, r"\mathbf{M}"),
+    (x ** sp.Rational(3, 2), None, "x^{3/2}"),
+    (sp.MatAdd(B, A, evaluate=False), None, "A + B"),
+], ids=["d2", "mixed", "named-function", "minus-named", "times-named", "minus-fraction", "nested-product",
+        "named-power", "function-power", "root-of-power", "written-then-sorted", "named-matrix", "half-power",
+        "sum-order"])
+def test_the_printer_writes_each_form_as_a_person_does(expr, names, latex):
+    assert tex(expr, names) == latex
