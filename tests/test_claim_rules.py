@@ -284,3 +284,51 @@ def test_the_numbers_are_read_from_the_words():
     assert _numbers("(π kᵤ)³ ≈ 2,000 at kᵤ = 8") == [2000.0, 8.0]
     assert _numbers("~10⁻⁹, 1e-6 and 100× at 256²") == [1e-9, 1e-6, 100.0, 256.0]
     assert _series_power() == 2
+
+
+def test_about_is_half_a_decade_either_way_or_one_way():
+    from lab.claims import about
+    assert about("q", 10.0) == Bound("q", 10 / ABOUT, 10 * ABOUT)
+    assert about("q", 1.0, lo=False) == Bound("q", None, ABOUT)
+    assert about("q", 1.0, hi=False) == Bound("q", 1 / ABOUT, None)
+
+
+@pytest.mark.parametrize("bound, text", [
+    (Bound("count", lo=1e6), "count ≥ 1e+06"), (Bound("count", lo=999_999), "count ≥ 999,999"),
+    (Bound("q", 2000 / 10**0.5, 2000 * 10**0.5), "632 ≤ q ≤ 6,325"), (Bound("q", lo=99.5), "q ≥ 99.5"),
+])
+def test_numbers_print_in_full_below_a_million_from_a_hundred(bound, text):
+    assert str(bound) == text
+
+
+def test_a_long_error_is_reported_in_300_characters():
+    c = Claim("long", "§1", "q", "m", HOLDS, lambda: (_ for _ in ()).throw(ValueError("x" * 400)), rule(HOLDS, Bound("q")))
+    measured, verdict = c.measure()
+    assert verdict == UNMEASURED and len(measured) == 300 and measured.startswith("not measured: ValueError: xxx")
+
+
+def test_the_frame_claim_measures_the_renderers_left_handed_frame():
+    claim = next(c for c in CLAIMS if c.id == "frame-aligned")
+    measured, verdict = claim.measure()
+    assert verdict == FAILS and "= -1$" in measured, measured
+
+
+def test_the_books_register_is_the_builds_one_measurement_checked(monkeypatch):
+    """Without results, `checked` reads the build's one "claims-register" measurement (`lab.store`), made
+    by `_register`, and returns it with each claim; a changed verdict is named with what to do."""
+    import lab.claims
+    import lab.store
+    asked = []
+
+    def measured(name, compute):
+        asked.append((name, compute))
+        return [[c.id, f"m-{c.id}", c.registered] for c in CLAIMS]
+    monkeypatch.setattr(lab.store, "measured", measured)
+    results = checked()
+    assert asked == [("claims-register", lab.claims._register)]
+    assert results == [(c, f"m-{c.id}", c.registered) for c in CLAIMS]
+    c = CLAIMS[0]
+    with pytest.raises(ClaimChanged) as raised:
+        checked([(c, "m", UNMEASURED)])
+    assert str(raised.value) == (f"{c.id}: registered {c.registered!r}, computed 'not measured' (m) (edit the "
+                                 "register in lab/claims.py with the change)")
