@@ -223,8 +223,8 @@ def _decide_components(components, seed, points, digits) -> Verdict:
 
     def refuted(r, label, at):
         where = ", ".join(f"{k}={float(v):.6g}" for k, v in (at or {}).items())
-        return Verdict("refuted", f"{label}: residual {r:.3e} at {where}", residual=r,
-                       digits=digits, points=points)
+        return Verdict("refuted", f"{label}: residual {r:.3e}" + (f" at {where}" if where else ", a constant"),
+                       residual=r, digits=digits, points=points)
 
     undecided = []
     for i, comp in enumerate(components):

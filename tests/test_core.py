@@ -708,3 +708,12 @@ def test_a_point_in_several_symbols_is_named_coordinate_by_coordinate():
     rng = random.Random(1000)
     first = {"w": rng.uniform(0, 1), "x": rng.uniform(0.1, 0.9)}          # drawn in the symbols' order
     assert v.evidence == f"two: cannot be evaluated at w={first['w']:.6g}, x={first['x']:.6g} (ZeroDivisionError: )"
+
+
+def test_a_nan_instance_refutes_even_where_sympy_reduces_the_symbols():
+    """(h + 1)^2 = h^2 + 2h + 1 for any h, so sympy proves it; sampled through an h that is NaN (a broken
+    formula's 0/0) it must be refuted: the quick probe runs before sympy is asked."""
+    ident = Identity("nan instance", (h(x) + 1) ** 2, h(x) ** 2 + 2 * h(x) + 1, {x: (0.5, 2)}, {h: sp.Lambda(x, sp.nan)})
+    assert core._exactly_zero(ident.lhs - ident.rhs)
+    v = check_identities([ident])
+    assert (v.status, v.evidence, v.digits) == ("refuted", "nan instance: residual nan, a constant", core.DIGITS), v
