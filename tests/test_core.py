@@ -337,6 +337,8 @@ def test_rule_2_a_claim_is_reached_only_through_linked_steps():
     assert [s.link for s in apart] == [False, False]
     v = square_theorem(*apart).check()
     assert v.status == "refuted" and "no chain of steps runs from the left side of the claim 'square'" in v.evidence
+    backwards = square_theorem(*apart, claims={"backwards": (apart[1].lhs, apart[0].rhs)}).check()
+    assert backwards.status == "refuted" and "the claim 'backwards'" in backwards.evidence
     assert square_theorem(*CHAIN).check().status == "proved"      # the same ends, linked
 
 
@@ -507,6 +509,8 @@ def test_two_steps_that_hold_numerically_are_both_named_with_the_worst_residual(
     with_evidence = dataclasses.replace(t, evidence=lambda: Verdict("proved", "12 renders agree", rendered=12)).check()
     assert (with_evidence.status, with_evidence.residual, with_evidence.digits, with_evidence.points,
             with_evidence.rendered) == ("verified", v.residual, core.DIGITS, core.POINTS, 12)
+    renders = dataclasses.replace(t, evidence=lambda: Verdict("verified", "no pixel differs", 0.0, None, 100, 100)).check()
+    assert (renders.residual, renders.digits, renders.points) == (v.residual, core.DIGITS, core.POINTS), renders
 
 
 def test_a_step_in_several_cases_reports_its_weakest_case():
@@ -592,7 +596,7 @@ def test_dot_and_cross_evaluate_matrix_expressions_and_keep_names():
     A, B = sp.ImmutableMatrix([1, 2, 3]), sp.ImmutableMatrix([0, 1, 0])
     assert Dot(Cross(u_, A), B).doit() == Dot(Cross(u_, A), B)
     assert Dot(u_, A).doit() == Dot(u_, A) and Cross(A, v_).doit() == Cross(A, v_)
-    assert Dot(sp.MatMul(2, A, evaluate=False), B).doit() == 4
+    assert Dot(sp.MatMul(2, A, evaluate=False), B).doit() == 4 and Dot(sp.MatMul(a_, A, evaluate=False), B).doit() == 2 * a_
     assert Cross(sp.MatAdd(A, A, evaluate=False), B).doit() == sp.ImmutableMatrix([-6, 0, 2])
     assert core._dense(sp.MatAdd(A, B, evaluate=False)) == sp.ImmutableMatrix([1, 3, 3])
     assert core._dense(sp.MatMul(sp.ImmutableMatrix([[1, 2, 3]]), A, evaluate=False)) == sp.ImmutableMatrix([[14]])
@@ -648,10 +652,11 @@ def test_each_root_of_a_radicand_however_written_becomes_one_symbol_to_the_first
     w = sp.Symbol("w", real=True)
     S = x**2 + w**2
     expr = (((x + w) ** 2 - 2 * x * w) ** sp.Rational(5, 2) + x * S ** sp.Rational(3, 2) + sp.sqrt(S)
-            + w / S ** sp.Rational(3, 2) + sp.sqrt(x + 1))
+            + w / S ** sp.Rational(3, 2) + sp.sqrt(x + 1) + x * sp.sqrt((x + w) ** 2 - 2 * x * w) * sp.sqrt(S)
+            + S ** sp.Rational(1, 3))
     reduced = core._radicals_reduced(expr)
     roots = {s for s in reduced.free_symbols if isinstance(s, sp.Dummy)}
-    assert len(roots) == 2 and not any(p.base in roots for p in reduced.atoms(sp.Pow))
+    assert len(roots) == 2 and not any(p.base in roots for p in reduced.atoms(sp.Pow)), reduced
     first, second = roots
     assert any(sp.simplify(reduced.subs({first: p, second: q}) - expr) == 0
                for p, q in ((sp.sqrt(S), sp.sqrt(x + 1)), (sp.sqrt(x + 1), sp.sqrt(S))))
@@ -717,3 +722,13 @@ def test_a_nan_instance_refutes_even_where_sympy_reduces_the_symbols():
     assert core._exactly_zero(ident.lhs - ident.rhs)
     v = check_identities([ident])
     assert (v.status, v.evidence, v.digits) == ("refuted", "nan instance: residual nan, a constant", core.DIGITS), v
+
+
+def test_a_residual_at_the_tolerance_is_not_below_it():
+    v = check_identities([Identity("at the tolerance", x + sp.Float(10.0 ** -core.TOLERANCE_DIGITS, 30), x, {x: (1, 2)})])
+    assert (v.status, v.evidence) == ("refuted", "at the tolerance: residual 1.000e-20, a constant")
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(core, "_exactly_zero", lambda expr: False)            # past the probe, in the full sampling
+        m.setattr(core, "_numeric_residual", lambda ident, seed, points, digits: (
+            10.0 ** -core.TOLERANCE_DIGITS if points > 3 else 0.0, {x: 1}))
+        assert check_identities([Identity("full", x, x, {x: (1, 2)})]).status == "refuted"
