@@ -1,8 +1,9 @@
 """The register's decision rules (lab/claims.py: `Bound`, `Criterion`,
 `rule`, `Claim.measure`): how a measured number becomes a verdict, and how the
-rule is printed in the book's table.
+rule is printed in the book's table; and each claim's criterion against the threshold its own
+words state.
 
-Fast on purpose: benchmarks/mutation_audit.py --mutmut runs this file once per
+Fast on purpose: mutmut (pyproject.toml's [tool.mutmut]) runs this file's tests once per
 mutant of lab/claims.py (its measurements are checked by pytest verify).
 """
 
