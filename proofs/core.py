@@ -29,6 +29,36 @@ After the steps, a theorem's ``evidence`` (the renderer's outputs compared with 
 statement) must hold too.  Each theorem carries *wrong variants* that the same check
 must refute: the checker has teeth.  (SymPy's ``sympy/vector`` tests and mpmath's
 precision discipline are the models.)
+
+The rules the checker enforces, no correct theorem breaking them being no evidence that
+they hold (tests/test_core.py and tests/test_checker.py plant a violation of each):
+
+1. *Citing.*  ``using`` names earlier steps only, ``1 <= j < k`` for step k (an int):
+   never the step itself, a later one or step 0; each cited left side is a name (or a
+   tuple of names), replaced by that step's right side.
+2. *Chains.*  A ``link`` continues the step before it, never step 1; its left side is
+   that step's right side, or is decided equal to it with the link's rewrites and cases.
+   A claim is reached by a run of one chain: its left side a step's, its right side the
+   same or a later step's, every step between them a link.
+3. *The cache.*  `_DECIDED` reuses a verdict only under the same key: both sides after
+   every substitution (``where``, the rewrites, the case), the domain, the sampled
+   functions, and the seed, points and digits of the numbers (`SEED`, `POINTS`, `DIGITS`).
+4. *Series.*  Only a right side may carry an O-term: one, a term of its sum, in one
+   variable about a finite point, ``O((x - x0)**n)``.  The step holds when the series of
+   lhs - rhs (less the O-term) vanishes through (x - x0)**(n - 1).  A written term that
+   the O-term contains (``c*x**4 + O(x**4)``, kept by `written` or ``evaluate=False``) is
+   refused, not absorbed.
+5. *Evidence.*  Asked only once every step holds and every claim is reached; it returns a
+   `Verdict`, and anything but proved or verified refutes; verified evidence states a
+   finite residual and its points; its ``rendered`` count is the theorem's.
+6. *Numbers.*  A residual counts as zero below 10**-`TOLERANCE_DIGITS` at `DIGITS`
+   digits, the worst of `POINTS` seeded points; a NaN, or a point where the difference
+   cannot be evaluated, refutes.
+7. *Pins* (proofs/registry.py).  A verdict passes its pin only as "proved" for a pin
+   "proved", or as "verified" with a residual at most ``bound`` for ("verified", bound),
+   bound 0.0 included; with at least its `RENDERED` count of renderer outputs.
+8. *Claims* (lab/claims.py).  A claim of the draft reaches its registered verdict from
+   finite measurements, by its criterion, whose thresholds are the ones its words state.
 """
 
 from __future__ import annotations
@@ -55,6 +85,8 @@ __all__ = ["Verdict", "Identity", "Step", "calc", "Theorem", "variant", "check_i
 DIGITS = 30
 #: Number of seeded random points for numerical verification.
 POINTS = 24
+#: The seed of a step's numerical check (the quick probe draws from SEED + 1000 on).
+SEED = 0
 #: A residual below 10**(-TOLERANCE_DIGITS) at DIGITS of precision counts as zero.
 TOLERANCE_DIGITS = 20
 
@@ -191,8 +223,8 @@ def _decide_components(components, seed, points, digits) -> Verdict:
 
     def refuted(r, label, at):
         where = ", ".join(f"{k}={float(v):.6g}" for k, v in (at or {}).items())
-        return Verdict("refuted", f"{label}: residual {r:.3e} at {where}", residual=r,
-                       digits=digits, points=points)
+        return Verdict("refuted", f"{label}: residual {r:.3e}" + (f" at {where}" if where else ", a constant"),
+                       residual=r, digits=digits, points=points)
 
     undecided = []
     for i, comp in enumerate(components):
@@ -335,7 +367,7 @@ class _Printer(LatexPrinter):
 
     def _print_Pow(self, expr):
         if expr.exp.is_Rational and expr.exp.q > 2 and expr.exp.p == 1:
-            return rf"{self.parenthesize(expr.base, PRECEDENCE['Pow'], strict=True)}^{{1/{expr.exp.q}}}"
+            return rf"{self.parenthesize(expr.base, PRECEDENCE['Pow'])}^{{1/{expr.exp.q}}}"
         return super()._print_Pow(expr)
 
     def _print_atan2(self, expr):
@@ -461,8 +493,8 @@ class Step:
     and instances of undefined functions for the numerical fallback (`Identity`),
     where they differ from the theorem's.
 
-    A side may end in ``+ O(x**n)``: the step then holds when the series of lhs - rhs
-    about the Order's point vanishes below that order.
+    The right side may end in ``+ O(x**n)``: the step then holds when the series of lhs - rhs
+    about the Order's point vanishes below that order (rule 4 of the module's docstring).
     """
 
     why: str
@@ -609,14 +641,46 @@ def _value(x):
 
 
 def _below_order(lhs, rhs):
-    """For ``rhs`` ending in ``+ O(x**n)`` (x -> x0): the series of lhs - (rhs without its O) about x0,
-    to order n (an expression that must vanish); else None."""
+    """For ``rhs`` ending in ``+ O((x - x0)**n)`` (`_series_refusal` has admitted it): the series of
+    lhs - (rhs without its O) about x0 through (x - x0)**(n - 1) (an expression that must vanish); else None."""
     orders = list(rhs.atoms(sp.Order)) if isinstance(rhs, sp.Expr) else []
     if not orders:
         return None
     (order,) = orders
     var, point = order.variables[0], order.point[0]
     return sp.series(lhs - rhs.removeO(), var, point, sp.degree(order.expr, var)).removeO()
+
+
+def _terms(x):
+    """The terms of ``x``'s sum as written: through `written` and unevaluated sums."""
+    if isinstance(x, sp.UnevaluatedExpr):
+        return _terms(x.args[0])
+    return [t for a in x.args for t in _terms(a)] if isinstance(x, sp.Add) else [x]
+
+
+def _series_refusal(lhs, rhs):
+    """Why a step's sides break rule 4 (an O-term only as a term of the right side's sum, one, in one
+    variable about a finite point, containing no written term), or None."""
+    def orders(x):
+        return x.atoms(sp.Order) if isinstance(x, sp.Basic) else set()
+    if orders(lhs):
+        return "its left side carries an O-term; only a right side may end in + O(x**n)"
+    found = orders(rhs)
+    if not found:
+        return None
+    terms = _terms(rhs)
+    order = next(iter(found))
+    if len(found) > 1 or order not in terms:
+        return f"its right side must end in one O-term, a term of its sum: it has {sorted(map(str, found))}"
+    var, point = order.variables[0], order.point[0]
+    n = sp.degree(order.expr, var) if len(order.variables) == 1 and order.expr.is_polynomial(var) else None
+    if n is None or not point.is_finite or n < 1 or order.expr != (var - point) ** n:
+        return f"its O-term {order} is not O((x - x0)**n) in one variable x about a finite point x0, n >= 1"
+    inside = [t for t in terms if t != order and order.contains(t) is True]
+    if inside:
+        return (f"it writes {', '.join(map(str, inside))} inside {order}, which would absorb "
+                f"{'them' if len(inside) > 1 else 'it'}: state the series to a higher order or drop the term")
+    return None
 
 
 #: Verdicts of the equations already decided in this process: a theorem, its wrong variants
@@ -627,21 +691,22 @@ _DECIDED = {}
 
 def _decide(theorem, step, lhs, rhs, rewrites=None):
     """`check_identities` on lhs = rhs, with ``rewrites`` (name -> what an earlier step proved) and the
-    theorem's named symbols substituted, in every case of ``step.cases`` (or once).  The verdict's
-    evidence names the case that fails."""
+    theorem's named symbols substituted, in every case of ``step.cases`` (or once), at `SEED`,
+    `POINTS` and `DIGITS`.  The verdict's evidence names the case that fails."""
     domain = theorem.domain if step.domain is None else step.domain
     functions = theorem.functions if step.functions is None else step.functions
+    numbers = dict(seed=SEED, points=POINTS, digits=DIGITS)
     verdicts = []
     for label, case in step.cases or (("", {}),):
         where = {**theorem.where, **(rewrites or {}), **case}
         a, b = _substitute(lhs, where), _substitute(rhs, where)
-        key = (a, b, frozenset(domain.items()), frozenset(functions.items()))
+        key = (a, b, frozenset(domain.items()), frozenset(functions.items()), tuple(numbers.items()))
         if key not in _DECIDED:
             a, b = _value(a), _value(b)
             series = _below_order(a, b)
             if series is not None:
                 a, b = series, sp.Integer(0)
-            _DECIDED[key] = check_identities([Identity("", a, b, domain, functions)])
+            _DECIDED[key] = check_identities([Identity("", a, b, domain, functions)], **numbers)
         v = _DECIDED[key]
         if not v.holds:      # "[k]: residual ..." of a vector's component k, ": residual ..." of a scalar
             where_ = re.sub(r"^\[(\d+)\]: ", r"component \1: ", v.evidence).removeprefix(": ")
@@ -671,7 +736,7 @@ def _rewrites(t, k, step):
     """{name: proved value} of the earlier steps ``step.using`` names, or a str saying why not."""
     out = {}
     for j in step.using:
-        if not 1 <= j < k:
+        if not (isinstance(j, int) and not isinstance(j, bool) and 1 <= j < k):
             return f"uses step {j}, which does not come before it"
         lhs, rhs = t.steps[j - 1].lhs, t.steps[j - 1].rhs
         pairs = zip(lhs, rhs) if isinstance(lhs, sp.Tuple) and isinstance(rhs, sp.Tuple) and len(lhs) == len(rhs) \
@@ -690,6 +755,9 @@ def _prove(t: Theorem) -> Verdict:
         rewrites = _rewrites(t, k, step)
         if isinstance(rewrites, str):
             return Verdict("refuted", f"{name} {rewrites}")
+        series = _series_refusal(step.lhs, step.rhs)
+        if series is not None:
+            return Verdict("refuted", f"{name}: {series}")
         if step.link:
             if k == 1:
                 return Verdict("refuted", f"{name}: continues a step that does not exist")
@@ -718,8 +786,13 @@ def _prove(t: Theorem) -> Verdict:
     if t.evidence is None:
         return Verdict("verified" if numeric else "proved", summary, residual, digits, points)
     e = t.evidence()
+    if not isinstance(e, Verdict):
+        return Verdict("refuted", f"{t.id}: its evidence returned {e!r:.80}, not a Verdict")
     if not e.holds:
-        return e
+        return e if e.status == "refuted" else dataclasses.replace(e, status="refuted")
+    if e.status == "verified" and not (e.residual is not None and 0 <= e.residual < float("inf") and e.points):
+        return Verdict("refuted", f"{t.id}: its evidence is verified but states no finite residual and points "
+                       f"(residual {e.residual}, points {e.points}): {e.evidence}")
     if e.status == "verified" and not numeric:
         residual, digits, points = e.residual, e.digits, e.points
     status = "verified" if numeric or e.status == "verified" else "proved"

@@ -182,9 +182,16 @@ def _evidence(kernel=KERNEL_COEFFS, integrable=INTEGRABLE, bump="surface", gradi
                    f"{float(F.POLE_SIN_PHI):g} left out)", rendered=compared)
 
 
-def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, **evidence):
-    """Theorem bump-vs-displacement claiming the cross product ``claim``, for the renderer's surface-bump
-    coefficients ``kernel``, with the evidence's options (wrong variants)."""
+def _displaced(weight=-beta / (R + beta * H_at)):
+    """The statement's cross product with the tangential term's weight ``weight`` (wrong variants)."""
+    return sp.MatMul((R + beta * H_at) ** 2 * sp.sin(phi),
+                     sp.MatAdd(N_S, sp.MatMul(weight, TANGENTIAL, evaluate=False), evaluate=False), evaluate=False)
+
+
+def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=OBSTRUCTION, **evidence):
+    """Theorem bump-vs-displacement claiming the cross product ``claim``, the chart coefficients ``chart``
+    and the curl -pi R ``obstruction``, for the renderer's surface-bump coefficients ``kernel``, with the
+    evidence's options (wrong variants)."""
     cross = Cross(sp.Derivative(P_S, phi), sp.Derivative(P_S, theta))
     coeffs = sp.Tuple(B_U, B_V)
     curl = written(sp.Add(sp.Derivative(G_T, phi), -sp.Derivative(G_P, theta), evaluate=False))
@@ -209,17 +216,17 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, **evidence):
                    r"-e_\theta$", claim)),
             Step(r"In chart terms $H_\theta = h_u/2\pi$ and $H_\varphi = h_v/\pi$ (theorem chart); the renderer's "
                  r"`bump='surface'` coefficients of $e_\theta$ and $e_\varphi$, off its pole floor, are the bracket's",
-                 coeffs, CHART_COEFFS),
+                 coeffs, chart),
             Step(r"To first order in $\beta$ the normal of $P = (R + \beta G)N$ tilts by $-\beta\,(G_\theta/(R\sin"
                  r"\varphi), G_\varphi/R)$; it is the seed's $\beta(h_u, h_v) = \beta(2\pi H_\theta, \pi H_\varphi)$ "
                  r"for", sp.Tuple(-G_T / (R * sp.sin(phi)), -G_P / R), sp.Tuple(2 * sp.pi * H_t, sp.pi * H_p),
                  defines=(G_T, G_P)),
-            Step("Such a $G$ exists only where this gradient is curl-free", curl, -sp.pi * R * OBSTRUCTION),
+            Step("Such a $G$ exists only where this gradient is curl-free", curl, -sp.pi * R * obstruction),
             Step(r"For the rings field $h$ depends on $\varphi$ alone, $H_\theta = 0$ and the curl vanishes: "
                  r"$G = -\pi R h$", sp.Tuple(G_T, G_P), potential,
                  cases=(("rings", {H: sp.Lambda((theta, phi), rings)}),)),
         ),
-        claims={"cross": (cross, claim), "kernel": (coeffs, CHART_COEFFS), "curl": (curl, -sp.pi * R * OBSTRUCTION)},
+        claims={"cross": (cross, claim), "kernel": (coeffs, chart), "curl": (curl, -sp.pi * R * obstruction)},
         where={N_S: sp.ImmutableMatrix(N), ET_S: sp.ImmutableMatrix(e_theta), EP_S: sp.ImmutableMatrix(e_phi),
                P_S: sp.MatMul(R + beta * H_at, N_S), B_U: kernel[0], B_V: kernel[1],
                G_T: SEED_DISPLACEMENT[0], G_P: SEED_DISPLACEMENT[1]},
@@ -238,7 +245,16 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, **evidence):
                         ("the numeric pipeline's bump='surface' normals (central differences) as exactly the "
                          "displaced surface's", lambda: _theorem(gradient="central").check()),
                         ("the seed's reading: the bump is the displaced normal (+ sign, no metric)",
-                         lambda: _theorem(SEED_READING).check())),
+                         lambda: _theorem(SEED_READING).check()),
+                        ("the tangential term's weight -beta / R, first order only",
+                         lambda: _theorem(_displaced(-beta / R)).check()),
+                        ("the tangential term at beta^2, not beta",
+                         lambda: _theorem(_displaced(-beta**2 / (R + beta * H_at))).check()),
+                        ("the chart coefficient of e_phi (the last) h_v / 2 pi, not h_v / pi",
+                         lambda: _theorem(chart=sp.Tuple(CHART_COEFFS[0], _w * F.h_v / (2 * sp.pi))).check()),
+                        ("the obstruction's last term with 2 sin(phi) + 1, not 2 sin(phi) - 1",
+                         lambda: _theorem(obstruction=2 * sp.cos(phi) * H_t
+                                          + (2 * sp.sin(phi) + 1) * sp.Derivative(H_at, theta, phi)).check())),
         pages=("s3", "s7"),
         seed_says="§3 and Cell 8 present the bump as the shading-side stand-in for displacement.",
     )

@@ -35,8 +35,8 @@ TAYLOR = written(sp.Add(*[eps**n / sp.factorial(n) * _d(n) for n in range(ORDER)
 #: The central quotient, as written.
 QUOTIENT = written(sp.Add(f(sp.Add(x, eps, evaluate=False)), -f(sp.Add(x, -eps, evaluate=False)), evaluate=False)
                    / (2 * eps))
-CLAIMED = (sp.diff(f(x), x) + eps**2 / 6 * sp.diff(f(x), x, 3)
-           + eps**4 / 120 * sp.diff(f(x), x, 5))
+#: The claimed series' terms, in the order written: h' + eps^2 h''' / 6 + eps^4 h^(5) / 120.
+CLAIMED = (sp.diff(f(x), x), eps**2 / 6 * sp.diff(f(x), x, 3), eps**4 / 120 * sp.diff(f(x), x, 5))
 
 a, b = sp.symbols("a b", real=True)
 #: A concrete analytic h for numerical sampling only (the proof is for any h).
@@ -108,22 +108,29 @@ def _border_rule(u, v, eps, top=1.0):
     return u_p, u_m, v_p, v_m, (v_p - v_m) if (v + eps > 1 or v - eps < 0) else 2 * eps
 
 
+def border_points(samples=2000, seed=12):
+    """``samples`` seeded (u, v, step) triples, step log-uniform in [1e-6, 1e-1]: u within a step of 0,
+    within a step of 1, or anywhere in [0, 1), a third each (and v alike, within a step of 0 or 1 or in
+    [0, 1]), so that each border's wrap or clamp is taken at about a third of them."""
+    rng = random.Random(seed)
+    for _ in range(samples):
+        step = 10.0 ** rng.uniform(-6, -1)
+        u_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0 - 1e-12), rng.uniform(0, 1)))
+        v_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0), rng.uniform(0, 1)))
+        yield u_, v_, step
+
+
 def border_mismatches(samples=2000, seed=12, rule=_border_rule, stencil=F.STENCIL_POINTS):
-    """Seeded points within a step of the borders (u near 0 or 1, v near 0 or 1) at
-    which ``stencil`` (`formulas.STENCIL_POINTS`), or the v-denominator of `formulas.CENTRAL`
-    (read off its sine field, at ``stencil``), differ from ``rule``; evaluated in float64."""
+    """The `border_points` at which ``stencil`` (`formulas.STENCIL_POINTS`), or the v-denominator of
+    `formulas.CENTRAL` (read off its sine field, at ``stencil``), differ from ``rule``; evaluated in float64."""
     args = (F.u, F.v, F.eps_u, F.eps_v)
     points = sp.lambdify(args, [e for _, e in stencil], modules="math")
     h = F.HEIGHT["sine"].subs({F.k_u: 3, F.k_v: 2})
     central_v = sp.lambdify(args, F.CENTRAL["sine"][1].subs({F.k_u: 3, F.k_v: 2}).subs(dict(stencil)),
                             modules="math")
     h_of = sp.lambdify((F.u, F.v), h, modules="math")
-    rng = random.Random(seed)
     bad = 0
-    for _ in range(samples):
-        step = 10.0 ** rng.uniform(-6, -1)
-        u_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0 - 1e-12), rng.uniform(0, 1)))
-        v_ = rng.choice((rng.uniform(0.0, step), rng.uniform(1.0 - step, 1.0), rng.uniform(0, 1)))
+    for u_, v_, step in border_points(samples, seed):
         want = rule(u_, v_, step)
         got = points(u_, v_, step, step)
         quotient = (h_of(u_, want[2]) - h_of(u_, want[3])) / want[4]
@@ -170,12 +177,13 @@ def _kernel_cases():
                  for name, height in F.HEIGHT.items())
 
 
-def _truncation(claimed=CLAIMED, denominator=2, **stencil):
-    """Theorem central-difference-truncation with the series ``claimed``, the stencil's quotients over
-    ``denominator`` eps, and the evidence's ``stencil`` options (`_stencil_evidence`): wrong variants."""
+def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
+    """Theorem central-difference-truncation with the series of the terms ``claimed`` + O(eps^``order``)
+    (written as they stand: a term the O-term contains is refused, not absorbed), the stencil's quotients
+    over ``denominator`` eps, and the evidence's ``stencil`` options (`_stencil_evidence`): wrong variants."""
     kernel = sp.Tuple(CENTRAL_U(F.u, F.v), CENTRAL_V(F.u, F.v))
     quotients = sp.Tuple(*(quotient(h_uv(F.u, F.v), var, denominator) for var in (F.u, F.v)))
-    series = claimed + sp.O(eps**ORDER)
+    series = written(sp.Add(*claimed, sp.O(eps**order), evaluate=False))
     return Theorem(
         id="central-difference-truncation", title="Truncation error of the central difference",
         statement=(r"$⟦series⟧$. Away from the seam and the poles this quotient is the renderer's stencil "
@@ -199,10 +207,15 @@ def _truncation(claimed=CLAIMED, denominator=2, **stencil):
         domain={**SERIES_DOMAIN, **KERNEL_DOMAIN}, functions=INSTANCE,
         evidence=partial(_stencil_evidence, **stencil),
         wrong_variants=(("coefficient 1/3 instead of 1/6",
-                         lambda: _truncation(CLAIMED + eps**2 / 6 * sp.diff(f(x), x, 3)).check()),
+                         lambda: _truncation((CLAIMED[0], eps**2 / 3 * sp.diff(f(x), x, 3), CLAIMED[2])).check()),
                         ("eps^3 instead of eps^2",
-                         lambda: _truncation(CLAIMED - eps**2 / 6 * sp.diff(f(x), x, 3)
-                                             + eps**3 / 6 * sp.diff(f(x), x, 3)).check()),
+                         lambda: _truncation((CLAIMED[0], eps**3 / 6 * sp.diff(f(x), x, 3), CLAIMED[2])).check()),
+                        ("the highest written term with 1/60 instead of 1/120",
+                         lambda: _truncation(CLAIMED[:2] + (eps**4 / 60 * sp.diff(f(x), x, 5),)).check()),
+                        ("the highest written term at eps^5 instead of eps^4",
+                         lambda: _truncation(CLAIMED[:2] + (eps**5 / 120 * sp.diff(f(x), x, 5),)).check()),
+                        ("the remainder claimed O(eps^7): the eps^6 term is not zero",
+                         lambda: _truncation(order=ORDER + 1).check()),
                         ("the stencil read as a quotient over eps, not 2 eps",
                          lambda: _truncation(denominator=1).check()),
                         ("the footprint without pbrt's factor 1/2", lambda: _truncation(half=1.0).check()),
@@ -266,7 +279,11 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
                         ("both terms negated (the stationary point is a maximum)",
                          lambda: _optimal(-ERROR_MODEL).check()),
                         ("a model with stationary points 1, 3/2 and 2: a minimum at 1, but not the only one",
-                         lambda: _optimal((eps - 1)**2 * (eps - 2)**2, sp.Integer(1)).check())),
+                         lambda: _optimal((eps - 1)**2 * (eps - 2)**2, sp.Integer(1)).check()),
+                        ("the model's truncation term (its highest power) over 3, not 6",
+                         lambda: _optimal(eps**2 * H3 / 3 + u_round * H / eps).check()),
+                        ("the model's truncation term at eps^3, not eps^2",
+                         lambda: _optimal(eps**3 * H3 / 6 + u_round * H / eps).check())),
         pages=("s3", "s5", "s7"),
         seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
     )

@@ -171,13 +171,14 @@ DRHO_SHOWN = written(sp.Mul(e, R, sp.Add(e * sp.cos(phi), -R, evaluate=False),
                             sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -2), evaluate=False))
 
 
-def _where(rho_):
-    return {X: x_img, Y: y_img, rho(phi): rho_, alpha_m: ALPHA_SHOWN, E_S: sp.ImmutableMatrix([0, 0, e]),
+def _where(rho_, alpha=ALPHA_SHOWN):
+    return {X: x_img, Y: y_img, rho(phi): rho_, alpha_m: alpha, E_S: sp.ImmutableMatrix([0, 0, e]),
             N_S: P / R, P_S: P}
 
 
-def _rays(rho_=RHO_SHOWN, **evidence):
-    """Theorem kink-loci-rays for the radius ``rho_`` and the evidence's options (wrong variants)."""
+def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
+    """Theorem kink-loci-rays for the radius ``rho_``, the ray's angle ``alpha`` and the evidence's options
+    (wrong variants)."""
     polar = sp.Tuple(rho(phi) * sp.cos(theta), rho(phi) * sp.sin(theta))
     ray = U_OF_THETA.subs(theta, alpha_m)
     return Theorem(
@@ -194,21 +195,24 @@ def _rays(rho_=RHO_SHOWN, **evidence):
                  defines=(alpha_m,)),
         ),
         claims={"polar": (sp.Tuple(X, Y), polar), "ray": (ray, m_sym / F.k_u)},
-        where=_where(rho_), names=NAMES, domain={**DOMAIN, m_sym: (0.0, 8.0), F.k_u: (0.5, 12.0)},
+        where=_where(rho_, alpha), names=NAMES, domain={**DOMAIN, m_sym: (0.0, 8.0), F.k_u: (0.5, 12.0)},
         evidence=partial(_loci, "rays", **evidence),
         wrong_variants=(("projection with a flipped sign: e + R cos(phi) in the denominator",
                          lambda: _rays(e * R * sp.sin(phi) / (e + R * sp.cos(phi))).check()),
                         ("the rays turned by half a period (alpha + pi/k_u)",
-                         lambda: _rays(shift=np.pi / Scene().k_u).check())),
+                         lambda: _rays(shift=np.pi / Scene().k_u).check()),
+                        ("the ray's angle with + pi (its last term), not - pi",
+                         lambda: _rays(alpha=written(sp.Add(2 * sp.pi * m_sym / F.k_u, sp.pi, evaluate=False))).check())),
         pages=("s3", "s4"),
         seed_says="§3: the zero lines u = m/k_u are rays 'by Chapter 5's longitude theorem'.",
     )
 
 
-def _circles(drho=DRHO_SHOWN, **evidence):
-    """Theorem kink-loci-circles claiming rho' = ``drho``, with the evidence's options (wrong variants)."""
+def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
+    """Theorem kink-loci-circles claiming rho' = ``drho`` and N . (E - P) = e cos(phi) + ``radius_term``, with
+    the evidence's options (wrong variants)."""
     radius, slope, facing = X**2 + Y**2, sp.Derivative(rho(phi), phi), Dot(N_S, E_S - P_S)
-    cap = written(sp.Add(e * sp.cos(phi), -R, evaluate=False))
+    cap = written(sp.Add(e * sp.cos(phi), radius_term, evaluate=False))
     return Theorem(
         id="kink-loci-circles", title="The v-creases are circles",
         statement=r"$v = \varphi/\pi$ depends on the image radius alone: $⟦radius⟧$, and "
@@ -227,6 +231,8 @@ def _circles(drho=DRHO_SHOWN, **evidence):
         where=_where(RHO_SHOWN), names=NAMES, domain=DOMAIN, evidence=partial(_loci, "circles", **evidence),
         wrong_variants=(("derivative with the factor e cos(phi) - R replaced by e - R cos(phi)",
                          lambda: _circles(e * R / (e - R * sp.cos(phi))).check()),
+                        ("the facing condition's last term -2R, not -R",
+                         lambda: _circles(radius_term=-2 * R).check()),
                         ("the circles moved by half a period (phi + pi/2k_v)",
                          lambda: _circles(shift=np.pi / (2 * Scene().k_v)).check()),
                         ("the circles' bands twice as wide as the renderer's (the loci right, their bands not)",

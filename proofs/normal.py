@@ -182,6 +182,11 @@ def _limit(tilt=None, **evidence):
                          lambda: _limit({"chart": F.h_v * ET_S + F.h_u * EP_S}).check()),
                         ("the surface tilt without the metric factor 2 pi R sin phi",
                          lambda: _limit({"surface": -F.h_u * ET_S - F.h_v / (sp.pi * F.R) * EP_S}).check()),
+                        ("the chart tilt's e_phi term (its last) with coefficient 2 h_v",
+                         lambda: _limit({"chart": F.h_u * ET_S + 2 * F.h_v * EP_S}).check()),
+                        ("the surface tilt's e_phi term (its last) over 2 pi R, not pi R",
+                         lambda: _limit({"surface": -(F.h_u / (2 * sp.pi * F.R * sp.sin(frame.phi))) * ET_S
+                                         - (F.h_v / (2 * sp.pi * F.R)) * EP_S}).check()),
                         ("a quadratic rate claimed", lambda: _limit(order=2.0).check()),
                         ("the beta = 0 reference rendered at beta = 1e-12, where the field reaches it",
                          lambda: _limit(reference_beta=TINY_BETA).check()),

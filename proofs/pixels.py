@@ -4,7 +4,7 @@ A theorem about `renderer.formulas` says what the kernel should compute; this
 module asks what it did.  For seeded random sphere-A pixels of G-buffers of
 the default scene (`renderer.gbuffer`: a full frame, two frames zoomed onto the
 pole, one of them inside the frame's fallback radius, and the pixels next to a
-crease of the ridges field), the renderer's chart (u, v), gradient (exact and
+crease of the ridges field: `SOURCES`), the renderer's chart (u, v), gradient (exact and
 central) and shading normal N' (both bump modes) are compared with the same
 sympy objects evaluated by mpmath at 30 digits, from the renderer's own inputs
 at that pixel (N for the chart; u, v for the gradient; N, its frame and the
@@ -34,6 +34,13 @@ __all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "footprint
 #: Pixels drawn per field, a third from each source (full frame, pole ring at zoom 300 and 3e4; crease
 #: neighbours as well for ridges): >= 200 outside the pole floor, the 3e4 frame being inside it.
 PER_FIELD = 300
+#: Crease neighbours (ridges): the full frame's sphere-A pixels whose chart point lies within CREASE_BAND / k_u
+#: of a zero line u = m / k_u, or CREASE_BAND / k_v of v = m / k_v: a twentieth of a ridge's width about it.
+CREASE_BAND = 0.05
+#: Where each source's pixels lie, by sin(phi) = |(N_x, N_y)| on sphere A: (source, zoom, lowest, highest).
+#: The pole frames are centred on the pole: at zoom 300 every pixel within 5e-3 of it, some inside the
+#: fallback radius POLE_SIN_PHI (1e-4); at zoom 3e4 every pixel within 5e-5, all inside it.
+SOURCES = (("frame", 1.0, 5e-3, 1.0), ("pole-300", 300.0, 0.0, 5e-3), ("pole-3e4", 3e4, 0.0, 5e-5))
 DIGITS = 30
 UNIT = 2.0**-53
 #: Absolute tolerances of the outputs at their scale (chart units; gradient per k; unit normal).
@@ -42,38 +49,46 @@ TOLERANCE = {"chart": 16 * UNIT, "gradient": 64 * UNIT, "normal": 64 * UNIT}
 
 @lru_cache(maxsize=None)
 def _frames(field, gradient, bump):
-    """G-buffers of the default scene (``field``, ``gradient``, ``bump``): 128², and
-    the pole at zoom 300 and 3e4 (sin phi down to ~1e-3 and ~1e-5)."""
+    """G-buffers of the default scene (``field``, ``gradient``, ``bump``), one per `SOURCES`: 128², and
+    the pole at zoom 300 and 3e4 (48²)."""
     scene = Scene(height_field=field, bump=bump, beta=0.35 if bump == "chart" else 0.3)
-    return scene, [gbuffer(scene, 128, 128, gradient=gradient),
-                   gbuffer(scene, 48, 48, gradient=gradient, zoom=300.0),
-                   gbuffer(scene, 48, 48, gradient=gradient, zoom=3e4)]
+    return scene, [gbuffer(scene, 48 if zoom > 1 else 128, 48 if zoom > 1 else 128, gradient=gradient, zoom=zoom)
+                   for _, zoom, _, _ in SOURCES]
+
+
+def crease_neighbours(uv, k_u, k_v):
+    """Whether each chart point (``uv``, float64 (..., 2)) is within `CREASE_BAND` / k of a zero line
+    of the ridges field, u = m / k_u or v = m / k_v (bool, ``uv``'s shape less its last axis)."""
+    u, v = uv[..., 0] * k_u, uv[..., 1] * k_v
+    return (np.abs(u - np.rint(u)) < CREASE_BAND) | (np.abs(v - np.rint(v)) < CREASE_BAND)
 
 
 def pixels(field, gradient="exact", bump="chart", seed=0):
     """The sampled sphere-A pixels as a dict of arrays (one row per pixel):
     N, Ns, P (k, 3), uv, grad (k, 2), xy (k, 4: the pixel centre x, y and
-    the spacings dx, dy), from the full frame, the two pole frames and
-    (ridges) the crease band of the full frame; and the `Scene`."""
+    the spacings dx, dy), and source (k,: the `SOURCES` name of the G-buffer the
+    pixel is from, or "crease" for the crease neighbours), from the full frame,
+    the two pole frames and (ridges) the crease neighbours of the full frame
+    (`crease_neighbours`); and the `Scene`."""
     scene, frames = _frames(field, gradient, bump)
     rng = np.random.default_rng(seed)
-    picked = {name: [] for name in ("N", "Ns", "uv", "grad", "P", "xy")}
-    for k, g in enumerate(frames):
+    picked = {name: [] for name in ("N", "Ns", "uv", "grad", "P", "xy", "source")}
+    for (source, *_), g in zip(SOURCES, frames):
         X, Y = np.meshgrid(g.x, g.y)
         spacing = (g.x[1] - g.x[0], g.y[0] - g.y[1])
         g = dict(N=g.N, Ns=g.Ns, uv=g.uv, grad=g.grad, P=g.P, chamber=g.chamber,
                  xy=np.stack([X, Y, np.full(X.shape, spacing[0]), np.full(X.shape, spacing[1])], axis=-1))
         on_a = g["chamber"] == SPHERE_A
-        where = [np.flatnonzero(on_a)]
-        if k == 0 and field == "ridges":
-            u, v = g["uv"][..., 0] * scene.k_u, g["uv"][..., 1] * scene.k_v
-            near = on_a & ((np.abs(u - np.rint(u)) < 0.05) | (np.abs(v - np.rint(v)) < 0.05))
-            where.append(np.flatnonzero(near))
-        for idx in where:
+        where = [(source, np.flatnonzero(on_a))]
+        if source == "frame" and field == "ridges":
+            where.append(("crease", np.flatnonzero(on_a & crease_neighbours(g["uv"], scene.k_u, scene.k_v))))
+        for name, idx in where:
             take = rng.choice(idx, size=min(PER_FIELD // 3, idx.size), replace=False)
-            for name in picked:
-                picked[name].append(g[name].reshape(-1, g[name].shape[-1])[take])
-    return scene, {name: np.concatenate(rows) for name, rows in picked.items()}
+            for key in picked:
+                picked[key].append(np.full((take.size, 1), name) if key == "source"
+                                   else g[key].reshape(-1, g[key].shape[-1])[take])
+    return scene, {name: np.concatenate(rows)[:, 0] if name == "source" else np.concatenate(rows)
+                   for name, rows in picked.items()}
 
 
 def worst_of(check, cases):

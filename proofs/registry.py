@@ -35,17 +35,41 @@ RENDERED = {
 }
 
 
-def pinned_failure(theorem_id, status, residual, rendered):
-    """Why the verdict (``status``, ``residual``, ``rendered``) differs from `PINNED` and
-    `RENDERED`, or None if it does not.
+def pin(theorem_id):
+    """(status, bound) of the theorem's `PINNED` verdict: ("proved", None), or ("verified", bound)
+    with bound a finite float >= 0 (0.0 included: then no residual but 0 passes).
 
     Raises
     ------
     KeyError
         If the theorem has no pinned verdict.
+    ValueError
+        If its pin is neither "proved" nor ("verified", bound) with a finite bound >= 0.
     """
-    pin = PINNED[theorem_id]
-    want, bound = (pin, None) if isinstance(pin, str) else pin
+    p = PINNED[theorem_id]
+    if p == "proved":
+        return "proved", None
+    if isinstance(p, tuple) and len(p) == 2 and p[0] == "verified" and isinstance(p[1], (int, float)) \
+            and not isinstance(p[1], bool) and 0 <= p[1] < float("inf"):
+        return "verified", float(p[1])
+    raise ValueError(f"PINNED[{theorem_id!r}] is {p!r}: a pin is \"proved\" or (\"verified\", bound), "
+                     "bound a finite number >= 0")
+
+
+def pinned_failure(theorem_id, status, residual, rendered):
+    """Why the verdict (``status``, ``residual``, ``rendered``) differs from `PINNED` and
+    `RENDERED`, or None if it does not: the status must be the pin's, a verified one's
+    residual a number at most the pin's bound (a missing or NaN residual never passes),
+    and at least `RENDERED` renderer outputs compared.
+
+    Raises
+    ------
+    KeyError
+        If the theorem has no pinned verdict.
+    ValueError
+        If its pin is malformed (`pin`).
+    """
+    want, bound = pin(theorem_id)
     if status != want:
         return f"{theorem_id} is {status}, pinned {want}"
     if bound is not None and not (residual is not None and residual <= bound):

@@ -11,7 +11,7 @@ import re
 import pytest
 import sympy as sp
 
-from proofs.registry import PINNED, RENDERED, THEOREMS, get, pinned_failure
+from proofs.registry import PINNED, RENDERED, THEOREMS, get, pin, pinned_failure
 from verify.test_theorems import _placed
 
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
@@ -35,6 +35,51 @@ def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
     assert why in pinned_failure("chart", status, residual, RENDERED["chart"])
     assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30)),
                           RENDERED["chart"]) is None
+
+
+@pytest.mark.parametrize("residual, passes", [(0.0, True), (1e-30, False), (5e-324, False), (None, False),
+                                              (float("nan"), False), (-0.0, True)])
+def test_rule_7_a_pin_of_zero_admits_only_a_zero_residual(monkeypatch, residual, passes):
+    """("verified", 0.0), as no-boundary's (its residual counts differing renderer outputs): a bound read
+    by truthiness (0.0 is false) would never be enforced."""
+    monkeypatch.setitem(PINNED, "no-boundary", ("verified", 0.0))
+    why = pinned_failure("no-boundary", "verified", residual, RENDERED["no-boundary"])
+    assert (why is None) is passes, why
+    if not passes:
+        assert why == f"no-boundary is verified with residual {residual}, pinned at most 0", why
+
+
+@pytest.mark.parametrize("bound", [1e-25, 1.0, 7])
+def test_rule_7_a_pin_bounds_the_residual_from_above_inclusively(monkeypatch, bound):
+    monkeypatch.setitem(PINNED, "chart", ("verified", bound))
+    assert pinned_failure("chart", "verified", bound, 600) is None
+    assert pinned_failure("chart", "verified", bound * (1 + 1e-9), 600) is not None
+    assert pinned_failure("chart", "verified", float("nan"), 600) is not None
+    assert "is proved, pinned verified" in pinned_failure("chart", "proved", None, 600)
+
+
+@pytest.mark.parametrize("bad", ["verified", ("verified",), ("verified", -1e-30), ("verified", float("inf")),
+                                 ("verified", float("nan")), ("verified", None), ("verified", True), ("proved", 0.0),
+                                 ("refuted", 0.0), "refuted", "Proved", None])
+def test_rule_7_a_malformed_pin_is_an_error_naming_it(monkeypatch, bad):
+    """Every pin kind is "proved" or ("verified", bound >= 0, finite): anything else names the theorem,
+    the pin and what is accepted, whatever verdict it is asked about."""
+    monkeypatch.setitem(PINNED, "chart", bad)
+    for status, residual in (("proved", None), ("verified", 0.0), ("refuted", None)):
+        with pytest.raises(ValueError, match=r"^PINNED\['chart'\] is .*: a pin is \"proved\" or \(\"verified\", bound\), "
+                                             r"bound a finite number >= 0$"):
+            pinned_failure("chart", status, residual, 600)
+
+
+def test_a_theorem_without_renders_is_pinned_by_its_verdict_alone():
+    assert "optimal-step" not in RENDERED
+    assert pinned_failure("optimal-step", "proved", None, 0) is None
+    assert pinned_failure("optimal-step", "verified", 1e-30, 0) == "optimal-step is verified, pinned proved"
+
+
+def test_every_registered_pin_is_well_formed():
+    assert {pin(t)[0] for t in PINNED} == {"proved", "verified"}
+    assert pin("no-boundary") == ("verified", 0.0) and pin("optimal-step") == ("proved", None)
 
 
 @pytest.mark.parametrize("theorem_id, description, variant", VARIANTS,

@@ -1,12 +1,17 @@
 """The register's decision rules (lab/claims.py: `Bound`, `Criterion`,
 `rule`, `Claim.measure`): how a measured number becomes a verdict, and how the
-rule is printed in the book's table.
+rule is printed in the book's table; and each claim's criterion against the threshold its own
+words state.
 
-Fast on purpose: benchmarks/mutation_audit.py --mutmut runs this file once per
+Fast on purpose: mutmut (pyproject.toml's [tool.mutmut]) runs this file's tests once per
 mutant of lab/claims.py (its measurements are checked by pytest verify).
 """
 
+import math
+import re
+
 import pytest
+import sympy as sp
 
 from lab.claims import (CLAIMS, CORRECTED, FAILS, HOLDS, UNMEASURED, Bound, Claim, ClaimChanged, Criterion,
                         Unmeasured, checked, rule)
@@ -142,3 +147,189 @@ def test_a_claim_whose_sympy_value_does_not_reduce_to_an_integer_is_not_measured
     monkeypatch.setattr(proofs.frame, "_orientation_value", lambda: sp.Symbol("s") - 1)
     measured, verdict = claim.measure()
     assert verdict == UNMEASURED and measured.startswith("not measured: TypeError"), measured
+
+
+# ----------------------------------------------------------------- the thresholds the words state
+# Each claim's criterion is tried just inside and just outside the threshold its own words state: the
+# numbers are read from its quotation (or the data it names), with the readings below, never copied from
+# its criterion, so a criterion made orders of magnitude too lenient or too strict fails here.
+ABOUT = 10 ** 0.5     # "≈ x", "~x", "near x", "at ~x": x's order of magnitude, half a decade either way
+SLOPE = 0.1           # an exponent "at" p (a quadratic, the truncation slope): within 10 % of p
+DECADE = 10.0         # a correction "within a decade" of the claimed value
+JUST = 1e-3           # just inside / outside a threshold t: t (1 -+ JUST); a count: t -+ 1
+HARDER = 2.0          # stacking, "no new integral": the bump may not double one sample's error
+FLOAT_EXACT = 1e-12   # blinn-exact, "exactly": a gap of O(1) slopes evaluated in float64 is rounding below this
+VISIBLE = 1e-6        # ... and the second-order gap a correction names is visible above this
+NONZERO = 1e-2        # bump-nonzero, "demonstrably nonzero": a hundredth of full scale (2.5 8-bit levels)
+FD_ZERO = 1e-6        # crease-fd-zero, "FD ≈ 0": six digits below the one-sided slopes (pi k_u ~ 25)
+MOST = 0.95           # try-creases, "exactly where": all but one large difference in twenty
+
+
+def _numbers(text):
+    """The numbers ``text`` states, in order: 2,000; 1e-6; 10⁻⁶; 100 (of 100×); 256 (of 256²)."""
+    sup = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")
+    return [10.0 ** int(m.group(1).translate(sup)) if m.group(1) else float(m.group(0).replace(",", ""))
+            for m in re.finditer(r"10([⁻⁰¹²³⁴⁵⁶⁷⁸⁹]+)|\d[\d,]*(?:\.\d+)?(?:e-?\d+)?", text)]
+
+
+def _edges(quantity, lo=None, hi=None, inside=HOLDS, outside=FAILS, **others):
+    """(values, verdict) just inside and just outside each finite end of [lo, hi], ``others`` fixed."""
+    probes = []
+    for end, sign in ((lo, -1), (hi, 1)):
+        if end is not None:
+            step = JUST * abs(end) if end else JUST
+            probes += [({**others, quantity: end - sign * step}, inside), ({**others, quantity: end + sign * step}, outside)]
+    return probes
+
+
+def _counts(quantity, exactly, inside=HOLDS, outside=FAILS, **others):
+    """(values, verdict) at the count ``exactly`` and one either side of it."""
+    return [({**others, quantity: exactly}, inside)] + [({**others, quantity: n}, outside)
+                                                       for n in (exactly - 1, exactly + 1) if n >= 0]
+
+
+def _series_power():
+    """The power of the central difference's truncation term, read off the theorem's series (2)."""
+    from proofs.finite_difference import CLAIMED, eps
+    return sp.degree(CLAIMED[1], eps)
+
+
+def _readings(claim):
+    """The probes (values, verdict) of ``claim`` from its words: its quotation's numbers ``n``."""
+    n, q = _numbers(claim.quote), claim.id
+    if q == "h3-scale":                                                 # "≈ 2,000"
+        return _edges("(π kᵤ)³", n[0] / ABOUT, n[0] * ABOUT)
+    if q in ("truncation-until-1e-6", "try-sweep", "cell5-fd-1e-9"):     # "~ 10⁻⁶", "near 1e-6", "~1e-9"
+        quantity = {"truncation-until-1e-6": "model optimum ε", "try-sweep": "best ε", "cell5-fd-1e-9": "worst component"}
+        return _edges(quantity[q], n[0] / ABOUT, n[0] * ABOUT)
+    if q in ("roundoff-drowns-1e-9", "noise-below-1e-11"):            # "drowns" / "noise" at that step: error ~1
+        return _edges("relative error at ε = " + re.sub(r"e-0*", "e-", f"{n[0]:g}"), lo=1 / ABOUT)
+    if q == "cell2-minimum":                                            # "near ε ≈ 1e-6, cliff beyond 1e-8"
+        return (_edges("fitted optimum ε", n[0] / ABOUT, n[0] * ABOUT, HOLDS, CORRECTED)
+                + _edges("fitted optimum ε", n[1], n[0] * DECADE, CORRECTED, FAILS))
+    if q == "frame-aligned":                                            # "aligned with N": +1
+        return [({"(eθ × eφ)·N": 1}, HOLDS), ({"(eθ × eφ)·N": -1}, FAILS), ({"(eθ × eφ)·N": 1 + JUST}, FAILS)]
+    if q == "flips-zero":                                               # "zero"
+        both = ("geometry values differing", "reach-mask pixels differing")
+        return [p for a, b in (both, both[::-1]) for p in _counts(a, 0, **{b: 0})]
+    if q == "shadow-curves-unchanged":                                  # "unchanged": no pair lit past it
+        return _counts("pairs lit past the terminator", 0, HOLDS, CORRECTED)
+    if q == "cell1-ripples":                                            # sphere A must show: B not the whole frame
+        return _edges("share of the frame on the draft's sphere B", hi=1.0, inside=HOLDS, outside=FAILS)[:1] + \
+            [({"share of the frame on the draft's sphere B": 1.0}, FAILS)]
+    if q == "census-slope":                                             # "descending the truncation slope"
+        p = _series_power() * (1 - SLOPE)
+        return (_edges("RMS slope", lo=p, inside=HOLDS, outside=CORRECTED, **{"off-band slope": 2.0})
+                + _edges("off-band slope", lo=p, inside=CORRECTED, outside=FAILS, **{"RMS slope": 1.0}))
+    if q == "census-flips":                                             # "flips = 0"
+        return _counts("flips", n[0])
+    if q == "cell3-runs":                                               # "print the table": a row at least
+        return [({"rows computed": 1}, HOLDS), ({"rows computed": 0}, FAILS)]
+    if q == "kink-order-of-magnitude":                                  # "an order of magnitude above"
+        return (_edges("on/off ratio", lo=10 / ABOUT) + _edges("on/off ratio", hi=10 * ABOUT, inside=HOLDS,
+                                                                outside=CORRECTED))
+    if q == "four-evals-vs-one":                                        # "4 evals vs 1" (fewer: a correction)
+        central, exact = "values of h, central", "values of h, exact"
+        return (_counts(central, n[0], **{exact: n[1]}) + [({central: n[0], exact: n[1] + 1}, FAILS),
+                                                           ({central: n[0], exact: n[1] - 1}, CORRECTED)])
+    if q == "cell4-counter":                                            # the counts of four-evals-vs-one's "4 vs 1"
+        n = _numbers(next(c for c in CLAIMS if c.id == "four-evals-vs-one").quote)
+        numeric, exact = "count printed, numeric", "count printed, exact"
+        return _counts(numeric, n[0], **{exact: n[1]}) + _counts(exact, n[1], **{numeric: n[0]})
+    if q == "stacking":
+        return _edges("one-sample error, with / without the bump", hi=HARDER, inside=HOLDS, outside=CORRECTED)
+    if q == "blinn-exact":
+        return (_edges("slope gap", hi=FLOAT_EXACT, inside=HOLDS, outside=FAILS, **{"first-order gap": 0.0})
+                + _edges("slope gap", lo=VISIBLE, inside=CORRECTED, outside=FAILS, **{"first-order gap": 0.0})
+                + _edges("first-order gap", hi=FLOAT_EXACT, inside=CORRECTED, outside=FAILS, **{"slope gap": 1.0}))
+    if q == "symbolic-not-slower":                                      # "at or under"
+        return [({"sin/cos calls, exact minus central": d}, HOLDS if d <= 0 else FAILS) for d in (-1, 0, 1)]
+    if q == "dn-verified-1e-12":                                        # "verified to 10⁻¹²"
+        return _edges("closed form's residual", hi=n[0], inside=CORRECTED, outside=FAILS)
+    if q == "beta-quadratic":                                           # "quadratic — 100× per decade"
+        p = math.log10(n[0])
+        return (_edges("median order", p * (1 - SLOPE), p * (1 + SLOPE), CORRECTED, FAILS, **{"RMS order": 1.0})
+                + _edges("RMS order", p * (1 - SLOPE), p * (1 + SLOPE), HOLDS, CORRECTED, **{"median order": p}))
+    if q == "beta0-1e-16":                                              # "agreement at ~1e-16"
+        return _edges("max |ΔI|", hi=n[1] * ABOUT)
+    if q == "bump-nonzero":
+        return _edges("mean |ΔI|", lo=NONZERO)
+    if q == "cell6-truncation":                                         # the truncation slope over ε 1e-3 → 1e-4
+        steps = _numbers(claim.measurement)
+        ratio = (steps[0] / steps[1]) ** _series_power()
+        return _edges("max |ΔI| ratio", ratio / ABOUT, ratio * ABOUT)
+    if q == "crease-fd-zero":                                           # "FD≈0 vs exact sign-ambiguity"
+        central, exact = "|central hᵤ|", "|exact hᵤ|"
+        return (_edges(central, hi=FD_ZERO, inside=CORRECTED, outside=FAILS, **{exact: 9.0})
+                + [({central: 0.0, exact: 0.0}, HOLDS), ({central: 0.0, exact: 1e-300}, CORRECTED)])
+    if q == "pole-pixels":                                              # "Pixels affected": at least one
+        return [({"fallback pixels": 1}, HOLDS), ({"fallback pixels": 0}, FAILS)]
+    if q == "try-creases":
+        return _edges("share in the band", lo=MOST)
+    if q == "try-pinch":                                                # opposite directions: more than a right angle
+        return _edges("angle (degrees)", lo=90.0)
+    if q == "try-beta0":                                                # "return Chapter 5": bit for bit
+        return _counts("values differing", 0)
+    raise KeyError(f"no reading of claim {q!r}'s words")
+
+
+@pytest.mark.parametrize("claim", CLAIMS, ids=[c.id for c in CLAIMS])
+def test_each_criterion_turns_where_the_claims_words_put_its_threshold(claim):
+    probes = _readings(claim)
+    assert len(probes) >= 2
+    for values, verdict in probes:
+        assert claim.criterion.decide(values) == verdict, (values, verdict)
+
+
+def test_the_numbers_are_read_from_the_words():
+    assert _numbers("(π kᵤ)³ ≈ 2,000 at kᵤ = 8") == [2000.0, 8.0]
+    assert _numbers("~10⁻⁹, 1e-6 and 100× at 256²") == [1e-9, 1e-6, 100.0, 256.0]
+    assert _series_power() == 2
+
+
+def test_about_is_half_a_decade_either_way_or_one_way():
+    from lab.claims import about
+    assert about("q", 10.0) == Bound("q", 10 / ABOUT, 10 * ABOUT)
+    assert about("q", 1.0, lo=False) == Bound("q", None, ABOUT)
+    assert about("q", 1.0, hi=False) == Bound("q", 1 / ABOUT, None)
+
+
+@pytest.mark.parametrize("bound, text", [
+    (Bound("count", lo=1e6), "count ≥ 1e+06"), (Bound("count", lo=999_999), "count ≥ 999,999"),
+    (Bound("q", 2000 / 10**0.5, 2000 * 10**0.5), "632 ≤ q ≤ 6,325"), (Bound("q", lo=99.5), "q ≥ 99.5"),
+])
+def test_numbers_print_in_full_below_a_million_from_a_hundred(bound, text):
+    assert str(bound) == text
+
+
+def test_a_long_error_is_reported_in_300_characters():
+    c = Claim("long", "§1", "q", "m", HOLDS, lambda: (_ for _ in ()).throw(ValueError("x" * 400)), rule(HOLDS, Bound("q")))
+    measured, verdict = c.measure()
+    assert verdict == UNMEASURED and len(measured) == 300 and measured.startswith("not measured: ValueError: xxx")
+
+
+def test_the_frame_claim_measures_the_renderers_left_handed_frame():
+    claim = next(c for c in CLAIMS if c.id == "frame-aligned")
+    measured, verdict = claim.measure()
+    assert verdict == FAILS and "= -1$" in measured, measured
+
+
+def test_the_books_register_is_the_builds_one_measurement_checked(monkeypatch):
+    """Without results, `checked` reads the build's one "claims-register" measurement (`lab.store`), made
+    by `_register`, and returns it with each claim; a changed verdict is named with what to do."""
+    import lab.claims
+    import lab.store
+    asked = []
+
+    def measured(name, compute):
+        asked.append((name, compute))
+        return [[c.id, f"m-{c.id}", c.registered] for c in CLAIMS]
+    monkeypatch.setattr(lab.store, "measured", measured)
+    results = checked()
+    assert asked == [("claims-register", lab.claims._register)]
+    assert results == [(c, f"m-{c.id}", c.registered) for c in CLAIMS]
+    c = CLAIMS[0]
+    with pytest.raises(ClaimChanged) as raised:
+        checked([(c, "m", UNMEASURED)])
+    assert str(raised.value) == (f"{c.id}: registered {c.registered!r}, computed 'not measured' (m) (edit the "
+                                 "register in lab/claims.py with the change)")

@@ -1,9 +1,9 @@
 """The proof checker's engine (proofs/core.py): what it calls proved, verified
 and refuted, on identities and small proofs whose truth is known without it; and
-how it prints them.
+how it prints them; and the soundness rules of its docstring, each refusing a planted violation.
 
-Fast on purpose (seconds): benchmarks/mutation_audit.py --mutmut runs this
-file once per mutant of proofs/core.py.
+Fast on purpose (seconds): mutmut (pyproject.toml's [tool.mutmut]) runs the tests of this
+file that reach a function once per mutant of it in proofs/core.py.
 """
 
 import dataclasses
@@ -18,6 +18,13 @@ from proofs.core import Cross, Dot, Identity, Jacobian, Step, Theorem, Verdict, 
 x = sp.Symbol("x", positive=True)
 y = sp.Symbol("y")
 h = sp.Function("h")
+
+
+@pytest.fixture(autouse=True)
+def _fresh_cache(monkeypatch):
+    """Each test decides its equations itself: no verdict of another test (or of a process this one
+    was forked from, as mutmut's) is reused from core's cache."""
+    monkeypatch.setattr(core, "_DECIDED", {})
 
 
 def test_an_identity_sympy_reduces_is_proved_without_numbers():
@@ -304,3 +311,424 @@ def test_square_roots_are_reduced_whatever_way_their_radicand_is_written():
     assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T)) == 0
     assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T + 1)) != 0
     assert core._radicals_reduced((x + 1) ** 2 - x**2 - 2 * x - 1) == 0          # no root: plain expansion
+
+
+# ------------------------------------------------------------------------- the soundness rules
+# Each test plants a violation of one rule of proofs/core.py's docstring and requires a refusal: no
+# correct theorem breaks a rule, so only a planted violation shows that the checker enforces it.
+
+@pytest.mark.parametrize("lemma, j", [(False, 1), (True, 2), (True, 0), (True, -1), (True, 3), (True, 1.0),
+                                      (True, True)],
+                         ids=["itself-as-step-1", "itself", "zero", "negative", "later", "float", "bool"])
+def test_rule_1_a_step_cites_earlier_steps_only(lemma, j):
+    """A step citing itself rewrites its name with its own false right side, and so "proves" anything
+    (f = a + 7 here, f being (a + b)^2 + 1); step 0 and negative numbers would index the steps from the end."""
+    e, f = sp.symbols("e f")
+    steps = [Step("name the square", e, a_**2 + 2 * a_ * b_ + b_**2)] * lemma + [Step("circular", f, a_ + 7, using=(j,))]
+    v = square_theorem(*steps, claims={}, where={e: SQUARE, f: e + 1}).check()
+    assert v.status == "refuted"
+    assert v.evidence == f"square, step {len(steps)} (circular) uses step {j}, which does not come before it"
+
+
+def test_rule_2_a_claim_is_reached_only_through_linked_steps():
+    """Two true steps, not linked: (a + b)^2 = (a + b) a + (a + b) b, and the expansion equals itself
+    written in another order.  Their ends are the claim's, but no chain runs between them."""
+    apart = (CHAIN[0], Step("the expansion, reordered", b_**2 + 2 * a_ * b_ + a_**2, a_**2 + 2 * a_ * b_ + b_**2))
+    assert [s.link for s in apart] == [False, False]
+    v = square_theorem(*apart).check()
+    assert v.status == "refuted" and "no chain of steps runs from the left side of the claim 'square'" in v.evidence
+    backwards = square_theorem(*apart, claims={"backwards": (apart[1].lhs, apart[0].rhs)}).check()
+    assert backwards.status == "refuted" and "the claim 'backwards'" in backwards.evidence
+    assert square_theorem(*CHAIN).check().status == "proved"      # the same ends, linked
+
+
+def _arctangents(domain, functions=None, where=None):
+    """A one-step theorem, atan(x) + atan(1/x) = pi/2 (true for x > 0 only, undecided by sympy)."""
+    step = Step("complementary angles", sp.atan(x) + sp.atan(1 / x), sp.pi / 2)
+    return Theorem("arc", "Arctangents", "", (step,), {}, domain=domain, functions=functions or {}, where=where or {})
+
+
+def _derivative_of_h(instance):
+    """A one-step theorem, d/dx h(x) = 2x, sampled through ``instance`` of h (true for x^2 only)."""
+    return Theorem("dh", "Derivative", "", (Step("differentiate", sp.Derivative(h(x), x), 2 * x),), {},
+                   domain={x: (0.5, 2.0)}, functions={h: sp.Lambda(x, instance)})
+
+
+def _maximum(cut):
+    """A one-step theorem, x + max(0, x - cut) = x on (0, 1): false, but only a sampled x above ``cut`` shows it."""
+    step = Step("no excess", x + sp.Max(0, x - cut), x)
+    return Theorem("max", "Maximum", "", (step,), {}, domain={x: (0, 1)})
+
+
+def _with(name, value, theorem):
+    """``theorem.check`` with core's ``name`` set to ``value`` for the check."""
+    def check():
+        with pytest.MonkeyPatch.context() as m:
+            m.setattr(core, name, value)
+            return theorem.check().status
+    return check
+
+
+CACHE_PAIRS = {
+    # Two checks with the same sides, one true and one false, differing in one part of the key only.
+    "functions": (_derivative_of_h(x**2).check, _derivative_of_h(x**3).check),
+    "domain": (_arctangents({x: (0.1, 10)}).check, _arctangents({x: (-10, -0.1)}).check),
+    "definitions": (lambda: square_theorem(Step("define", sp.Symbol("e"), SQUARE), claims={},
+                                           where={sp.Symbol("e"): a_**2 + 2 * a_ * b_ + b_**2}).check(),
+                    lambda: square_theorem(Step("define", sp.Symbol("e"), SQUARE), claims={},
+                                           where={sp.Symbol("e"): a_**2 + b_**2}).check()),
+    "cases": (lambda: square_theorem(Step("double", 2 * h(a_), h(a_) + a_**2, cases=(("square", {h: sp.Lambda(a_, a_**2)}),)),
+                                     claims={}).check(),
+              lambda: square_theorem(Step("double", 2 * h(a_), h(a_) + a_**2, cases=(("cube", {h: sp.Lambda(a_, a_**3)}),)),
+                                     claims={}).check()),
+    "seed": (_with("SEED", 6, _maximum(sp.Rational(96, 100))), _with("SEED", 0, _maximum(sp.Rational(96, 100)))),
+    "points": (_with("POINTS", 1, _maximum(sp.Rational(9, 10))), _with("POINTS", 24, _maximum(sp.Rational(9, 10)))),
+    "digits": (_with("DIGITS", 30, _arctangents({x: (0.1, 10)})), _with("DIGITS", 15, _arctangents({x: (0.1, 10)}))),
+}
+
+
+@pytest.mark.parametrize("first", [0, 1], ids=["holds-first", "fails-first"])
+@pytest.mark.parametrize("part", CACHE_PAIRS)
+def test_rule_3_the_cache_reuses_a_verdict_only_for_its_whole_key(monkeypatch, part, first):
+    """Checked in one process in either order (one cache), each check reaches the verdict it reaches alone:
+    the one that holds, and the one that does not, though their sides are the same."""
+    monkeypatch.setattr(core, "_DECIDED", {})
+    checks = CACHE_PAIRS[part]
+    status = {}
+    for i in (first, 1 - first):
+        v = checks[i]()
+        status[i] = v if isinstance(v, str) else v.status
+    assert status[0] in ("proved", "verified") and status[1] == "refuted", (part, status)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 6])
+def test_rule_4_a_series_step_is_checked_through_the_power_below_its_order(n):
+    """exp(x) = sum x^k/k! + O(x^n): true; with the x^(n-1) coefficient 1/(n-1)! + 1, refuted (it lies
+    below the O-term, so a check to order n - 1 alone would pass it)."""
+    x_ = sp.Symbol("x")
+    series = lambda last: sum(x_**k / sp.factorial(k) for k in range(n - 1)) + last * x_**(n - 1) + sp.O(x_**n)  # noqa: E731
+    t = lambda rhs: Theorem("exp", "exp", "", (Step("Taylor", sp.exp(x_), rhs),), {}, domain={x_: (-1, 1)})  # noqa: E731
+    assert t(series(1 / sp.factorial(n - 1))).check().status == "proved"
+    v = t(series(1 / sp.factorial(n - 1) + 1)).check()
+    assert v.status == "refuted" and v.evidence.startswith("exp, step 1 (Taylor): residual"), v.evidence
+
+
+@pytest.mark.parametrize("term", ["c*x**4", "x**4", "c*x**5", "x**4*sin(x)"])
+def test_rule_4_a_written_term_inside_the_order_is_refused_not_absorbed(term):
+    """sympy's O(x^4) absorbs c x^4 (and anything it contains): written unevaluated, the checker refuses it
+    rather than proving a statement the reader reads with the term."""
+    x_, c = sp.symbols("x c")
+    written_term = sp.sympify(term, locals={"x": x_, "c": c})
+    rhs = written(sp.Add(1, x_, x_**2 / 2, x_**3 / 6, written_term, sp.O(x_**4), evaluate=False))
+    t = Theorem("exp", "exp", "", (Step("Taylor", sp.exp(x_), rhs),), {}, domain={x_: (-1, 1), c: (1, 2)})
+    v = t.check()
+    assert v.status == "refuted", v.evidence
+    assert v.evidence == (f"exp, step 1 (Taylor): it writes {written_term} inside O(x**4), which would absorb it: "
+                          "state the series to a higher order or drop the term")
+    below = written(sp.Add(1, x_, x_**2 / 2, x_**3 / 6, sp.O(x_**4), evaluate=False))     # the same, without it
+    assert dataclasses.replace(t, steps=(Step("Taylor", sp.exp(x_), below),)).check().status == "proved"
+
+
+def test_rule_4_an_order_term_anywhere_but_ending_the_right_side_is_refused():
+    x_, y_ = sp.symbols("x y")
+    cases = {"its left side carries an O-term": (sp.O(x_**2), sp.O(x_**3)),
+             "must end in one O-term, a term of its sum": (sp.exp(x_), 1 + x_ * (1 + sp.O(x_))),
+             "is not O((x - x0)**n) in one variable": (sp.exp(x_ * y_), 1 + sp.O(x_ * y_)),
+             "about a finite point": (sp.exp(1 / x_), 1 + sp.O(1 / x_, (x_, sp.oo)))}
+    for why, (lhs, rhs) in cases.items():
+        t = Theorem("o", "o", "", (Step("series", lhs, rhs),), {}, domain={x_: (0.1, 1), y_: (0.1, 1)})
+        v = t.check()
+        assert v.status == "refuted" and why in v.evidence, (why, v.evidence)
+
+
+@pytest.mark.parametrize("returned, why", [
+    (None, "its evidence returned None, not a Verdict"),
+    (True, "its evidence returned True, not a Verdict"),
+    (Verdict("skipped", "renders skipped"), "renders skipped"),
+    (Verdict("verified", "no residual", None, None, 100), "states no finite residual and points"),
+    (Verdict("verified", "nan residual", float("nan"), 30, 24), "states no finite residual and points"),
+    (Verdict("verified", "no points", 0.0, 30, 0), "states no finite residual and points"),
+])
+def test_rule_5_evidence_is_a_verdict_that_holds_and_states_what_it_measured(returned, why):
+    v = square_theorem(*CHAIN, evidence=lambda: returned).check()
+    assert v.status == "refuted" and why in v.evidence, v
+
+
+# ----------------------------------------------------------- details the mutation run found untested
+def test_a_verdict_names_the_steps_and_points_it_rests_on():
+    """Refuted at a step or a link: the residual, digits and points of the check; the sentence less its final
+    "." or ":" (a sentence ending "X." keeps its X)."""
+    v = square_theorem(Step("Sum over X.", SQUARE, a_**2 + b_**2), claims={}).check()
+    assert v.evidence.startswith("square, step 1 (Sum over X): residual") and v.residual > 0.5
+    assert (v.status, v.digits, v.points) == ("refuted", core.DIGITS, core.POINTS)
+    broken = (CHAIN[0], Step("and again:", (a_ + b_) * a_ + b_**2 + a_ * b_ + 1, a_**2 + 2 * a_ * b_ + b_**2 + 1,
+                             link=True))
+    v = square_theorem(*broken, claims={}).check()
+    assert v.evidence.startswith("square, step 2 (and again) does not continue step 1") and v.residual == 1.0
+    assert (v.status, v.digits, v.points) == ("refuted", core.DIGITS, core.POINTS)
+    assert square_theorem(Step("first", SQUARE, SQUARE, link=True), claims={}).check().status == "refuted"
+    proved = square_theorem(*CHAIN).check()
+    assert (proved.residual, proved.digits, proved.points) == (None, None, None)
+
+
+def _complementary(*steps, **fields):
+    """A theorem about e = atan(a) + atan(1/a), which sympy does not reduce to pi/2 (so a step about e holds
+    numerically, and one about pi/2 is proved)."""
+    e = sp.Symbol("e")
+    return Theorem("arc", "Arctangents", "", steps, {}, domain={a_: (0.1, 10)},
+                   **{"where": {e: sp.atan(a_) + sp.atan(1 / a_)}, **fields})
+
+
+def test_a_cited_step_rewrites_the_step_and_its_link():
+    """With step 1's e = pi/2 substituted, step 2 and its link (whose left side e differs from step 1's right
+    side) are proved; without it each would hold only numerically.  A tuple of names takes a tuple of values."""
+    e = sp.Symbol("e")
+    v = _complementary(Step("complementary", e, sp.pi / 2),
+                       Step("the same, once more", e, sp.pi / 2, link=True, using=(1,))).check()
+    assert v.evidence.startswith("2 steps, reduced to 0 by sympy but for step 1, which holds numerically (worst "
+                                 "residual "), v.evidence
+    pair = sp.symbols("p q")
+    tuple_step = Step("two names at once", sp.Tuple(*pair), sp.Tuple(a_, b_))
+    uses = square_theorem(tuple_step, Step("use both", pair[0] * pair[1], a_ * b_, using=(1,)), claims={},
+                          where={pair[0]: a_, pair[1]: b_})
+    assert uses.check().status == "proved"
+    matrix_step = Step("two names, one vector", sp.Tuple(*pair), sp.ImmutableMatrix([a_, b_]))
+    refused = square_theorem(matrix_step, Step("use both", pair[0] * pair[1], a_ * b_, using=(1,)), claims={},
+                             where={pair[0]: a_, pair[1]: b_}).check()
+    assert refused.evidence == "square, step 2 (use both) uses step 1, whose left side is not a name"
+
+
+def test_two_steps_that_hold_numerically_are_both_named_with_the_worst_residual():
+    e, f = sp.symbols("e f")
+    t = _complementary(Step("complementary", e, sp.pi / 2), Step("doubled", 2 * f, sp.pi),
+                       where={e: sp.atan(a_) + sp.atan(1 / a_), f: sp.atan(a_ + 1) + sp.atan(1 / (a_ + 1))})
+    v = t.check()
+    assert v.evidence.startswith("2 steps, reduced to 0 by sympy but for steps 1, 2, which hold numerically (worst "
+                                 "residual "), v.evidence
+    assert (v.status, v.digits, v.points) == ("verified", core.DIGITS, core.POINTS) and 0 < v.residual < 1e-25
+    with_evidence = dataclasses.replace(t, evidence=lambda: Verdict("proved", "12 renders agree", rendered=12)).check()
+    assert (with_evidence.status, with_evidence.residual, with_evidence.digits, with_evidence.points,
+            with_evidence.rendered) == ("verified", v.residual, core.DIGITS, core.POINTS, 12)
+    renders = dataclasses.replace(t, evidence=lambda: Verdict("verified", "no pixel differs", 0.0, None, 100, 100)).check()
+    assert (renders.residual, renders.digits, renders.points) == (v.residual, core.DIGITS, core.POINTS), renders
+
+
+def test_a_step_in_several_cases_reports_its_weakest_case():
+    """A step proved in one case and verified in two reports the verified case with the larger residual."""
+    e = sp.Symbol("e")
+    step = Step("complementary, three ways", e, sp.pi / 2,
+                cases=(("exact", {e: sp.pi / 2}), ("small", {e: sp.atan(a_) + sp.atan(1 / a_) + sp.Float(1e-27, 40)}),
+                       ("larger", {e: sp.atan(a_) + sp.atan(1 / a_) + sp.Float(1e-24, 40)})))
+    v = _complementary(step).check()
+    assert v.status == "verified" and 0.9e-24 < v.residual < 1.1e-24, v
+
+
+def test_a_step_samples_its_own_domain_and_functions():
+    """A step's ``domain`` and ``functions`` replace the theorem's for that step."""
+    x_ = sp.Symbol("x")
+    arc = Step("complementary", sp.atan(x_) + sp.atan(1 / x_), sp.pi / 2, domain={x_: (0.1, 10)})
+    t = Theorem("arc", "Arctangents", "", (arc,), {}, domain={x_: (-10, -0.1)})
+    assert t.check().status == "verified"
+    square = Step("differentiate", sp.Derivative(h(x_), x_), 2 * x_, functions={h: sp.Lambda(x_, x_**2)})
+    t = Theorem("dh", "Derivative", "", (square,), {}, domain={x_: (0.5, 2)}, functions={h: sp.Lambda(x_, x_**3)})
+    assert t.check().status == "verified"
+
+
+@pytest.mark.parametrize("residual", [float("inf"), -1e-30])
+def test_rule_5_verified_evidence_with_an_impossible_residual_refutes(residual):
+    v = square_theorem(*CHAIN, evidence=lambda: Verdict("verified", "odd", residual, 30, 24)).check()
+    assert v.status == "refuted" and "states no finite residual and points" in v.evidence
+
+
+def test_the_probe_and_the_full_sampling_draw_from_their_documented_seeds():
+    """Component i's quick probe draws 3 points from Random(SEED + 1000 + i); the j-th undecided component's
+    full sampling POINTS points from Random(SEED + j): the counterexamples named are theirs."""
+    import random
+    def drawn(seed, n):
+        rng = random.Random(seed)
+        return [rng.uniform(0, 1) for _ in range(n)]
+    true = Identity("a", x, x, {x: (0, 1)})
+    probed = Identity("b", x + sp.Max(0, x - sp.Rational(7, 10)), x, {x: (0, 1)})
+    v = check_identities([true, probed])
+    point = max(drawn(1001, 3))
+    assert v.evidence == f"b: residual {point - 0.7:.3e} at x={point:.6g}", v.evidence
+    undecided = Identity("a", sp.atan(x) + sp.atan(1 / x), sp.pi / 2, {x: (0, 1)})
+    sampled = Identity("b", x + sp.Max(0, x - sp.Rational(9, 10)), x, {x: (0, 1)})
+    v = check_identities([undecided, sampled])
+    point = max(drawn(1, core.POINTS))
+    assert max(drawn(1001, 3)) < 0.9 < point              # the probe misses it, the full sampling finds it
+    assert v.evidence == f"b: residual {point - 0.9:.3e} at x={point:.6g}", v.evidence
+
+
+def test_a_point_that_cannot_be_evaluated_is_named_with_its_error():
+    import random
+    v = check_identities([Identity("inverse floor", 1 / sp.floor(x), 1, {x: (0.1, 0.9)})])
+    assert (v.status, v.digits, v.points) == ("refuted", core.DIGITS, core.POINTS)
+    first = random.Random(1000).uniform(0.1, 0.9)                 # the probe's first point
+    assert v.evidence == f"inverse floor: cannot be evaluated at x={first:.6g} (ZeroDivisionError: )", v
+
+
+def test_equal_worst_residuals_name_the_last_component():
+    ids = [Identity(k, sp.atan(x) + sp.atan(1 / x) + 1, sp.pi / 2, {x: (0.1, 10)}) for k in ("first", "second")]
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(core, "_exactly_zero", lambda expr: False)
+        m.setattr(core, "_numeric_residual", lambda ident, seed, points, digits: (1.0 if points > 3 else 0.0, {x: 1}))
+        assert check_identities(ids).evidence == "second: residual 1.000e+00 at x=1"
+
+
+def test_calc_links_each_step_to_the_one_before_and_applies_the_options():
+    d = {a_: (0, 1)}
+    steps = calc(a_, ("one", b_), ("two", a_ * b_, {"using": (1,)}), ("three", b_ + 1), domain=d)
+    assert steps == (Step("one", a_, b_, link=False, domain=d), Step("two", b_, a_ * b_, link=True, using=(1,), domain=d),
+                     Step("three", a_ * b_, b_ + 1, link=True, domain=d))
+
+
+def test_values_are_compared_as_columns_or_scalars():
+    assert core._value(sp.Tuple(sp.ImmutableMatrix([1, 2]), 3)) == sp.Matrix([1, 2, 3])
+    assert core._value(sp.Tuple(4)) == 4 and core._value(sp.ImmutableMatrix([[5]])) == 5
+    assert core._value(sp.ImmutableMatrix([[1, 2]])) == sp.Matrix([[1, 2]])
+    assert core._value(written(sp.Add(x, x, evaluate=False))) == 2 * x
+
+
+def test_dot_and_cross_evaluate_matrix_expressions_and_keep_names():
+    u_, v_ = sp.MatrixSymbol("u", 3, 1), sp.MatrixSymbol("v", 3, 1)
+    assert Dot(u_, v_).doit() == Dot(u_, v_) and Cross(u_, v_).doit() == Cross(u_, v_)
+    A, B = sp.ImmutableMatrix([1, 2, 3]), sp.ImmutableMatrix([0, 1, 0])
+    assert Dot(Cross(u_, A), B).doit() == Dot(Cross(u_, A), B)
+    assert Dot(u_, A).doit() == Dot(u_, A) and Cross(A, v_).doit() == Cross(A, v_)
+    assert Dot(sp.MatMul(2, A, evaluate=False), B).doit() == 4 and Dot(sp.MatMul(a_, A, evaluate=False), B).doit() == 2 * a_
+    assert Cross(sp.MatAdd(A, A, evaluate=False), B).doit() == sp.ImmutableMatrix([-6, 0, 2])
+    assert core._dense(sp.MatAdd(A, B, evaluate=False)) == sp.ImmutableMatrix([1, 3, 3])
+    assert core._dense(sp.MatMul(sp.ImmutableMatrix([[1, 2, 3]]), A, evaluate=False)) == sp.ImmutableMatrix([[14]])
+
+
+def test_named_symbols_print_their_definitions_in_the_statement():
+    E, f = sp.Function("E"), sp.Function("f")
+    M = sp.MatrixSymbol("M", 2, 1)
+    t = Theorem("t", "T", "$⟦E⟧$, $⟦f⟧$, $⟦M⟧$", (), {}, names={x: r"\chi"},
+                where={E(x): x**2, f: sp.Lambda(x, x**3), M: sp.Matrix([x, 1])})
+    assert t.statement_tex() == (r"$E\left(\chi\right) = \chi^{2}$, $f\left(\chi\right) = \chi^{3}$, "
+                                 r"$M = \left(\begin{matrix}\chi\\1\end{matrix}\right)$")
+    assert t.tex(x + 1) == r"\chi + 1"
+
+
+def test_a_variant_is_the_theorem_with_its_changes_checked_when_called():
+    called = []
+    wrong = core.variant(square_theorem(*CHAIN), steps=(Step("wrong", SQUARE, a_**2),), claims={},
+                         evidence=lambda: called.append(1))
+    assert not called and wrong().status == "refuted" and not called
+    assert core.variant(square_theorem(*CHAIN))().status == "proved"
+
+
+@pytest.mark.parametrize("rhs, status", [
+    ("log(x) = (x - 1) - (x - 1)**2/2 + O((x - 1)**3, (x, 1))", "proved"),
+    ("exp(x) = 1 + O(x)", "proved"),
+    ("exp(c*x) = 1 + c*x + c**2*x**2/2 + O(x**3)", "proved"),
+    ("exp(c*x) = 1 + c*x + c**2*x**2/3 + O(x**3)", "refuted"),
+])
+def test_rule_4_series_about_any_point_of_any_order_with_parameters(rhs, status):
+    x_, c = sp.symbols("x c")
+    lhs, rhs = (sp.sympify(s, locals={"x": x_, "c": c, "O": sp.O}) for s in rhs.split(" = "))
+    t = Theorem("s", "s", "", (Step("series", lhs, rhs),), {}, domain={x_: (0.5, 1.5), c: (1, 2)})
+    assert t.check().status == status
+
+
+def test_rule_4_refusals_say_exactly_why():
+    x_, y_ = sp.symbols("x y")
+    t = lambda lhs, rhs: Theorem("o", "o", "", (Step("series", lhs, rhs),), {}, domain={x_: (0.1, 1), y_: (0.1, 1)})  # noqa: E731,E501
+    assert t(sp.O(x_**2), sp.O(x_**3)).check().evidence == (
+        "o, step 1 (series): its left side carries an O-term; only a right side may end in + O(x**n)")
+    assert t(sp.exp(x_), sp.Add(1, sp.O(x_), sp.O(y_), evaluate=False)).check().evidence == (
+        "o, step 1 (series): its right side must end in one O-term, a term of its sum: it has ['O(x)', 'O(y)']")
+    two = written(sp.Add(1, x_, x_**3, x_**4, sp.O(x_**3), evaluate=False))
+    assert t(sp.exp(x_), two).check().evidence == (
+        "o, step 1 (series): it writes x**3, x**4 inside O(x**3), which would absorb them: state the series to a "
+        "higher order or drop the term")
+
+
+def test_each_root_of_a_radicand_however_written_becomes_one_symbol_to_the_first_power():
+    """S^(k/2) is r^k, reduced to r^(k mod 2) S^(k div 2), for S written either way: what is left equals the
+    expression with r = sqrt(S), and holds r to the first power only."""
+    w = sp.Symbol("w", real=True)
+    S = x**2 + w**2
+    expr = (((x + w) ** 2 - 2 * x * w) ** sp.Rational(5, 2) + x * S ** sp.Rational(3, 2) + sp.sqrt(S)
+            + w / S ** sp.Rational(3, 2) + sp.sqrt(x + 1) + x * sp.sqrt((x + w) ** 2 - 2 * x * w) * sp.sqrt(S)
+            + S ** sp.Rational(1, 3))
+    reduced = core._radicals_reduced(expr)
+    roots = {s for s in reduced.free_symbols if isinstance(s, sp.Dummy)}
+    assert len(roots) == 2 and not any(p.base in roots for p in reduced.atoms(sp.Pow)), reduced
+    first, second = roots
+    assert any(sp.simplify(reduced.subs({first: p, second: q}) - expr) == 0
+               for p, q in ((sp.sqrt(S), sp.sqrt(x + 1)), (sp.sqrt(x + 1), sp.sqrt(S))))
+    assert core._radicals_reduced(S ** sp.Rational(3, 2) - S * sp.sqrt(S)) == 0
+
+
+def test_an_identity_only_expanded_trigonometry_reduces_is_proved():
+    tangent = (3 * sp.tan(y) - sp.tan(y) ** 3) / (1 - 3 * sp.tan(y) ** 2)
+    assert sp.simplify(sp.tan(3 * y) - tangent) != 0 and sp.trigsimp(sp.tan(3 * y) - tangent) != 0
+    assert check_identities([Identity("triple tangent", sp.tan(3 * y), tangent, {y: (-0.3, 0.3)})]).status == "proved"
+
+
+def test_a_vector_step_names_its_failing_component_and_sides_may_be_plain_numbers():
+    v = square_theorem(Step("a vector", sp.Matrix([a_, b_]), sp.Matrix([a_, 2 * b_])), claims={}).check()
+    assert re.fullmatch(r"square, step 1 \(a vector\): component 1: residual \S+ at b=\S+", v.evidence), v
+    assert square_theorem(Step("plain numbers", 2, 1 + sp.Integer(1)), claims={}).check().status == "proved"
+
+
+def test_a_zero_matrix_is_compared_as_its_entries():
+    assert core._value(sp.ZeroMatrix(2, 3)) == sp.zeros(2, 3) and core._dense(sp.ZeroMatrix(2, 2)) == sp.zeros(2, 2)
+    assert core._value(1 + written(sp.Add(x, x, evaluate=False))) == 2 * x + 1
+
+
+def test_a_step_reports_a_verified_case_over_a_proved_one_and_the_larger_residual(monkeypatch):
+    """Two verdicts from a step's cases: the verified one (the step holds numerically there), and of two
+    verified ones the larger residual, a residual of 0.0 included."""
+    e = sp.Symbol("e")
+    cases = (("one", {e: a_}), ("two", {e: b_}))
+    for given, want in (((Verdict("proved", "p"), Verdict("verified", "v", 0.0, 30, 24)), ("verified", 0.0)),
+                        ((Verdict("verified", "v", 1e-30, 30, 24), Verdict("verified", "v", 0.0, 30, 24)),
+                         ("verified", 1e-30))):
+        verdicts = dict(zip((a_, b_), given))
+        monkeypatch.setattr(core, "_DECIDED", {})
+        monkeypatch.setattr(core, "check_identities", lambda ids, **k: verdicts[ids[0].lhs])
+        v = square_theorem(Step("cases", e, e, cases=cases), claims={}).check()
+        assert (v.status, v.residual) == want, v
+
+
+def test_another_seed_draws_other_points_for_each_component():
+    import random
+    undecided = Identity("a", sp.atan(x) + sp.atan(1 / x), sp.pi / 2, {x: (0, 1)})
+    sampled = Identity("b", x + sp.Max(0, x - sp.Rational(9, 10)), x, {x: (0, 1)})
+    sampled = Identity("b", x + sp.Max(0, x - sp.Rational(8, 10)), x, {x: (0, 1)})
+    rng = random.Random(5 + 1)                                  # seed 5, the second undecided component
+    point = max(rng.uniform(0, 1) for _ in range(core.POINTS))
+    v = check_identities([undecided, sampled], seed=5)
+    assert v.evidence == f"b: residual {point - 0.8:.3e} at x={point:.6g}", v.evidence
+
+
+def test_a_point_in_several_symbols_is_named_coordinate_by_coordinate():
+    import random
+    w = sp.Symbol("w")
+    v = check_identities([Identity("two", 1 / sp.floor(x) + w, 1, {x: (0.1, 0.9), w: (0, 1)})])
+    rng = random.Random(1000)
+    first = {"w": rng.uniform(0, 1), "x": rng.uniform(0.1, 0.9)}          # drawn in the symbols' order
+    assert v.evidence == f"two: cannot be evaluated at w={first['w']:.6g}, x={first['x']:.6g} (ZeroDivisionError: )"
+
+
+def test_a_nan_instance_refutes_even_where_sympy_reduces_the_symbols():
+    """(h + 1)^2 = h^2 + 2h + 1 for any h, so sympy proves it; sampled through an h that is NaN (a broken
+    formula's 0/0) it must be refuted: the quick probe runs before sympy is asked."""
+    ident = Identity("nan instance", (h(x) + 1) ** 2, h(x) ** 2 + 2 * h(x) + 1, {x: (0.5, 2)}, {h: sp.Lambda(x, sp.nan)})
+    assert core._exactly_zero(ident.lhs - ident.rhs)
+    v = check_identities([ident])
+    assert (v.status, v.evidence, v.digits) == ("refuted", "nan instance: residual nan, a constant", core.DIGITS), v
+
+
+def test_a_residual_at_the_tolerance_is_not_below_it():
+    v = check_identities([Identity("at the tolerance", x + sp.Float(10.0 ** -core.TOLERANCE_DIGITS, 30), x, {x: (1, 2)})])
+    assert (v.status, v.evidence) == ("refuted", "at the tolerance: residual 1.000e-20, a constant")
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(core, "_exactly_zero", lambda expr: False)            # past the probe, in the full sampling
+        m.setattr(core, "_numeric_residual", lambda ident, seed, points, digits: (
+            10.0 ** -core.TOLERANCE_DIGITS if points > 3 else 0.0, {x: 1}))
+        assert check_identities([Identity("full", x, x, {x: (1, 2)})]).status == "refuted"

@@ -1,9 +1,23 @@
 """Shared measurements of `pytest verify`, each computed once per session (and only
-when a test asks for it), and the theorem ledger printed at the end of the run."""
+when a test asks for it), and the theorem ledger printed at the end of the run.
+
+The ledger is collected from the test reports: test_theorem_holds records each verdict as
+its report's user property ``ledger``, which pytest-xdist carries from the worker that ran
+the test to the controller, where `pytest_runtest_logreport` files it and
+`pytest_terminal_summary` prints it; without xdist both run in the one process."""
 
 import pytest
 
+#: {theorem id: (status, evidence)} of the verdicts reported to this process.
 LEDGER = {}
+
+
+def pytest_runtest_logreport(report):
+    if report.when == "call":
+        for name, value in report.user_properties:
+            if name == "ledger":
+                theorem_id, status, evidence = value
+                LEDGER[theorem_id] = (status, evidence)
 
 
 @pytest.fixture(scope="session")
@@ -31,7 +45,9 @@ def pytest_terminal_summary(terminalreporter):
     if not LEDGER:
         return
     tr = terminalreporter
+    from proofs.registry import THEOREMS
     tr.section("theorem ledger")
     width = max(len(k) for k in LEDGER)
-    for theorem_id, verdict in LEDGER.items():
-        tr.write_line(f"{theorem_id:<{width}}  {verdict.status:<8}  {verdict.evidence}")
+    for theorem_id in sorted(LEDGER, key=list(THEOREMS).index):      # in the chapter's order
+        status, evidence = LEDGER[theorem_id]
+        tr.write_line(f"{theorem_id:<{width}}  {status:<8}  {evidence}")

@@ -1,6 +1,6 @@
 """`pytest verify`: each theorem of the chapter checked once, against the code that draws the
 figures.  A theorem passes when its check returns proved or verified with its pinned verdict;
-the ledger of verdicts is printed at the end of the run (see conftest.py).  That the checker
+the ledger of verdicts is printed at the end of the run, with or without xdist (see conftest.py).  That the checker
 refutes wrong variants and wrong steps is a property of the checker: tests/test_checker.py.
 """
 
@@ -10,15 +10,14 @@ from pathlib import Path
 import pytest
 
 from proofs.registry import PINNED, RENDERED, THEOREMS, pinned_failure
-from verify.conftest import LEDGER
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 
 @pytest.mark.parametrize("theorem_id", [pytest.param(t, marks=pytest.mark.cpu_dependent if t in RENDERED else ())
                                         for t in THEOREMS])
-def test_theorem_holds(theorem_id):
+def test_theorem_holds(theorem_id, record_property):
     verdict = THEOREMS[theorem_id].check()
-    LEDGER[theorem_id] = verdict
+    record_property("ledger", (theorem_id, verdict.status, verdict.evidence))      # printed by conftest.py
     assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
     assert isinstance(verdict.evidence, str) and verdict.evidence, "the ledger shows the evidence"
     assert pinned_failure(theorem_id, verdict.status, verdict.residual, verdict.rendered) is None

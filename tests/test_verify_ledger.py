@@ -1,0 +1,22 @@
+"""`pytest verify` prints the theorem ledger (README), also when xdist runs the theorems in worker
+processes, as `make test` does: each verdict travels in its test report to the process that prints."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("workers", [["-n", "2"], ["-p", "no:xdist"]], ids=["xdist", "one-process"])
+def test_the_ledger_is_printed_with_each_verdict(workers):
+    run = subprocess.run([sys.executable, "-m", "pytest", "verify/test_theorems.py", "-k", "frame-orientation",
+                          "-p", "no:cacheprovider", *workers], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+    ledger = run.stdout.split(" theorem ledger ", 1)
+    assert len(ledger) == 2, run.stdout[-2000:]
+    rows = [line for line in ledger[1].splitlines() if re.match(r"^[a-z]", line)]
+    assert rows == ["frame-orientation  proved    4 steps, each reduced to 0 by sympy"], rows
