@@ -21,7 +21,7 @@ def test_truncation_follows_eps_squared_h3_over_6_at_large_steps(curve):
 
 
 def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the_predicted_step(curve):
-    """`UCurve.model` (the curve the book plots): its truncation part is the measured truncation at
+    """`UCurve.model` (the predicted model, which ``symrender ucurve --plot`` draws): its truncation part is the measured truncation at
     large steps (a wrong 1/6 fails), and its minimum lies at the predicted optimum (a wrong roundoff
     coefficient moves it by the cube root of the error)."""
     big = (curve.eps > 1e-4) & (curve.eps < 1e-2)
