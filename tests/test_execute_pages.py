@@ -34,7 +34,11 @@ raise ClaimChanged("h3-scale: registered 'holds', computed 'does not hold' (rati
 """
 
 
-def test_a_page_that_fails_is_named_with_its_exception_on_the_console(tmp_path, caplog):
+def test_a_page_that_fails_is_named_with_its_exception_on_the_console(tmp_path, caplog, monkeypatch):
+    # _execute sets NUMBA_NUM_THREADS=1 for the page kernels (os.environ.setdefault); set here, it is
+    # undone after the test: left in this process, numba's next compilation would refuse the change of
+    # thread count once its threads run (RuntimeError in whichever test of this worker compiles next).
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "1")
     (tmp_path / "page.md").write_text(PAGE, encoding="utf-8")
     (tmp_path / "plain.md").write_text("# No code\n", encoding="utf-8")
     env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60),
