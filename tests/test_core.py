@@ -513,6 +513,18 @@ def test_two_steps_that_hold_numerically_are_both_named_with_the_worst_residual(
     assert (renders.residual, renders.digits, renders.points) == (v.residual, core.DIGITS, core.POINTS), renders
 
 
+def test_a_theorem_reports_its_worst_numerically_verified_step():
+    """Of two steps that hold numerically, the theorem's residual (which its pin bounds and the ledger
+    shows) is the larger one's, whichever step it is."""
+    e, f = sp.symbols("e f")
+    near = {e: sp.atan(a_) + sp.atan(1 / a_) + sp.Float(1e-24, 40), f: sp.atan(a_) + sp.atan(1 / a_)
+            + sp.Float(1e-27, 40)}
+    for first, second in ((e, f), (f, e)):
+        v = _complementary(Step("one", first, sp.pi / 2), Step("other", second, sp.pi / 2), where=near).check()
+        assert v.status == "verified" and 0.9e-24 < v.residual < 1.1e-24, v
+        assert "worst residual 1.0e-24" in v.evidence, v.evidence
+
+
 def test_a_step_in_several_cases_reports_its_weakest_case():
     """A step proved in one case and verified in two reports the verified case with the larger residual."""
     e = sp.Symbol("e")
