@@ -8,6 +8,7 @@ the checker (proofs/core.py, proofs/registry.py, chapter.theorems), run by ``mak
 import dataclasses
 import re
 
+import numpy as np
 import pytest
 import sympy as sp
 
@@ -232,6 +233,34 @@ def test_the_kink_loci_refuse_an_unknown_family():
     from proofs.kink_loci import locus_bands
     with pytest.raises(ValueError, match=r"kind must be one of \('rays', 'circles'\), got 'lines'"):
         locus_bands("lines", Scene(), 8, 8)
+
+
+@pytest.mark.parametrize("k_v", [0.9, 1.0, 4.0])
+def test_the_kink_loci_circles_are_every_zero_line_of_v(k_v):
+    """circle_angles lists phi = pi v for every zero line v = m / k_v of the chart [0, 1], the poles' included
+    (at k_v < 1 the north pole's is the only one, and its band is rendered): the theorem's check holds at these
+    frequencies, not only at the scene's."""
+    from renderer import Scene
+
+    from proofs.kink_loci import _loci, circle_angles
+    lines = np.arange(0.0, 1.0 + 1e-12, 1.0 / k_v)               # v = 0, 1/k_v, 2/k_v, ... <= 1
+    np.testing.assert_allclose(circle_angles(k_v) / np.pi, lines, rtol=0, atol=1e-15)
+    v = _loci("circles", scene=Scene(k_v=k_v))
+    assert v.status == "proved", v.evidence
+
+
+@pytest.mark.parametrize("k", [8.0, 4.0, 2.5])
+def test_the_predicted_crease_band_ends_where_the_renderers_flag_does(k):
+    """The kink loci's band half-width about a zero line of sin(pi k t) (_half_width) is where the kernel's
+    crease flag (pointwise.kink_band) switches: set a millionth inside it, clear a millionth outside, in u and
+    in v (the other factor 1)."""
+    from renderer import pointwise
+
+    from proofs.kink_loci import _half_width
+    edge = _half_width(k) * np.array([1 - 1e-6, 1 + 1e-6])
+    across_u = pointwise.kink_band("ridges", edge, 1 / (2 * 3.0), k, 3.0)
+    across_v = pointwise.kink_band("ridges", 1 / (2 * 3.0), edge, 3.0, k)
+    assert across_u.tolist() == across_v.tolist() == [True, False]
 
 
 @pytest.mark.parametrize("rhs, low", [(0, 0.1), (1, 0.5)], ids=["everywhere", "where-it-holds-elsewhere"])
