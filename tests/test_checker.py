@@ -227,6 +227,16 @@ def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
         book.theorem_block("chart")
 
 
+@pytest.mark.parametrize("order", [0.8, 1.2])
+def test_the_beta_limit_refutes_a_rate_off_by_a_fifth(order):
+    """beta-zero-regression's rendered rate is fitted to within 0.1 of the order claimed: an order off by a
+    fifth (either way) is refuted, the linear one the renders show proved."""
+    from proofs.normal import _rate_evidence
+    wrong, right = _rate_evidence(order=order), _rate_evidence()
+    assert (wrong.status, right.status) == ("refuted", "proved"), wrong.evidence
+    assert f"(claimed {order:g})" in wrong.evidence
+
+
 def test_the_kink_loci_refuse_an_unknown_family():
     from renderer import Scene
 
