@@ -78,3 +78,27 @@ def test_a_claim_at_a_step_is_measured_at_that_step(monkeypatch):
         claims.relative_error_at(1e-11)
     with pytest.raises(ValueError, match="eps=9e-07"):
         claims.relative_error_at(9e-7)
+
+
+def test_the_stacking_claim_compares_only_blocks_whose_samples_are_all_on_sphere_a(monkeypatch):
+    """Claim stacking measures the 4 x 4 box filter against one sample per pixel where all 16 samples of the
+    pixel lie on sphere A: a block with a sample off A averages another object in.  Planted frames: the one
+    sample misses the box by 0.02 with the bump and 0.01 without it on every block, and every block of the first
+    row has one sample off A (0 there), which would add its 1/32 to the miss were it compared."""
+    from types import SimpleNamespace
+
+    from lab import claims
+
+    def render(scene, width, height, **_):
+        chamber = np.ones((height, width), np.uint8)
+        image = np.full((height, width, 3), 0.5)
+        if width == 512:
+            chamber[0, ::4] = 0
+            image[0, ::4] = 0.0
+        else:
+            image += 0.02 if scene.beta else 0.01
+        return SimpleNamespace(image=image, chamber=chamber, scene=scene)
+    monkeypatch.setattr(claims, "render", render)
+    text, values = claims._stacking()
+    assert values["one-sample error, with / without the bump"] == pytest.approx(2.0, rel=1e-12)
+    assert "RMS 2.0e-02 with the bump, 1.0e-02 without" in text, text
