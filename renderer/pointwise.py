@@ -65,7 +65,7 @@ def _evaluate(loop, k, lead, names, args, ranges=RANGES):
         arrays = np.broadcast_arrays(*arrays)
     except ValueError:
         shapes = ", ".join(f"{n} {a.shape}" for n, a in zip(names, arrays))
-        raise InvalidValue(f"the arguments must broadcast to one shape, got {shapes}", names[0]) from None
+        raise InvalidValue(f"the arguments must broadcast to one shape, got {shapes}") from None
     shape = arrays[0].shape
     # Copies: numba warns on the read-only views broadcast_arrays returns.
     flat = [np.array(a, dtype=np.float64).reshape(-1) for a in arrays]
@@ -81,7 +81,7 @@ def _triple(name, value):
     except TypeError:
         parts = ()
     if len(parts) != 3:
-        raise InvalidValue(f"{name} must have three components (x, y, z), got {value!r:.60}", name)
+        raise InvalidValue(f"{name} must have three components (x, y, z), got {value!r:.60}")
     return parts
 
 
@@ -242,17 +242,17 @@ def reach(scene, gbuffer, *, gate=False):
         (H, W, 3) arrays of the same frame (the loop would read past them).
     """
     if not isinstance(scene, Scene):
-        raise InvalidType(f"scene must be a renderer.Scene, got {type(scene).__name__}", "scene")
+        raise InvalidType(f"scene must be a renderer.Scene, got {type(scene).__name__}")
     if not isinstance(gbuffer, GBuffer):
-        raise InvalidType(f"gbuffer must be a renderer.GBuffer, got {type(gbuffer).__name__}", "gbuffer")
+        raise InvalidType(f"gbuffer must be a renderer.GBuffer, got {type(gbuffer).__name__}")
     chamber = np.asarray(gbuffer.chamber)
     if chamber.ndim != 2:
-        raise InvalidValue(f"gbuffer.chamber must be an (H, W) array, got shape {chamber.shape}", "gbuffer")
+        raise InvalidValue(f"gbuffer.chamber must be an (H, W) array, got shape {chamber.shape}")
     for name in ("P", "N", "Ns"):
         shape = np.shape(getattr(gbuffer, name))
         if shape != chamber.shape + (3,):
             raise InvalidValue(f"gbuffer.{name} has shape {shape}, gbuffer.chamber {chamber.shape}: "
-                               f"the arrays must be one frame's, {chamber.shape + (3,)}", "gbuffer")
+                               f"the arrays must be one frame's, {chamber.shape + (3,)}")
     prm, lights = kernel.params(scene, skip=False)
     out = np.zeros((lights.shape[0],) + gbuffer.chamber.shape, dtype=bool)
     _reach_rows(prm, lights, gbuffer.chamber, gbuffer.P, gbuffer.N, gbuffer.Ns, flag("gate", gate), out)

@@ -117,12 +117,12 @@ class GBuffer:
 def check_args(scene, width, height, gradient, zoom):
     """Validated (scene, width, height, gradient, zoom) by `renderer.validate`; raises as `render` says."""
     if not isinstance(scene, Scene):
-        raise validate.InvalidType(f"scene must be a renderer.Scene, got {type(scene).__name__}", "scene")
+        raise validate.InvalidType(f"scene must be a renderer.Scene, got {type(scene).__name__}")
     width = validate.positive_int("width", width, high=MAX_SIDE)
     height = validate.positive_int("height", height, high=MAX_SIDE)
     if width * height > MAX_PIXELS:
         raise validate.InvalidValue(f"width * height must be at most {MAX_PIXELS:,} pixels (4096 x 4096), "
-                                    f"got {width} x {height} = {width * height:,}", "width")
+                                    f"got {width} x {height} = {width * height:,}")
     gradient = validate.choice("gradient", gradient, GRADIENTS)
     zoom = validate.real("zoom", zoom, low=1.0, high=MAX_ZOOM)
     return scene, width, height, gradient, zoom

@@ -177,29 +177,26 @@ class Scene:
         set_("camera_z", real("Scene.camera_z", self.camera_z, high=MAX_LENGTH))
         if not self.camera_z > self.radius_a:
             raise InvalidValue(f"Scene.camera_z must be > radius_a = {self.radius_a} (camera outside "
-                               f"sphere A), got {self.camera_z!r}", "Scene.camera_z")
+                               f"sphere A), got {self.camera_z!r}")
         set_("center_b", vector3("Scene.center_b", self.center_b, **COORDINATE))
         set_("radius_b", real("Scene.radius_b", self.radius_b, **RADIUS))
         # Camera outside sphere B: the nearest hit is then always a front face.
         d2 = self.center_b[0] ** 2 + self.center_b[1] ** 2 + (self.camera_z - self.center_b[2]) ** 2
         if not d2 > self.radius_b**2:
             raise InvalidValue(f"Scene.radius_b = {self.radius_b!r} puts the camera (0, 0, {self.camera_z}) "
-                               f"inside or on sphere B centred at {self.center_b}; the camera must be outside",
-                               "Scene.radius_b")
+                               f"inside or on sphere B centred at {self.center_b}; the camera must be outside")
         set_("sphere_b", flag("Scene.sphere_b", self.sphere_b))
         set_("floor", flag("Scene.floor", self.floor))
         lights = self.lights
         if isinstance(lights, PointLight):
-            raise InvalidType("Scene.lights must be a sequence of PointLight, got a single PointLight",
-                              "Scene.lights")
+            raise InvalidType("Scene.lights must be a sequence of PointLight, got a single PointLight")
         if not isinstance(lights, (tuple, list)):
-            raise InvalidType(f"Scene.lights must be a tuple of PointLight, got {lights!r:.80}", "Scene.lights")
+            raise InvalidType(f"Scene.lights must be a tuple of PointLight, got {lights!r:.80}")
         if len(lights) > MAX_LIGHTS:     # each light costs a shadow ray per pixel
-            raise InvalidValue(f"Scene.lights holds at most {MAX_LIGHTS} lights, got {len(lights):,}",
-                               "Scene.lights")
+            raise InvalidValue(f"Scene.lights holds at most {MAX_LIGHTS} lights, got {len(lights):,}")
         for i, light in enumerate(lights):
             if not isinstance(light, PointLight):
-                raise InvalidType(f"Scene.lights[{i}] must be a PointLight, got {light!r:.80}", "Scene.lights")
+                raise InvalidType(f"Scene.lights[{i}] must be a PointLight, got {light!r:.80}")
         set_("lights", tuple(lights))
         set_("ambient", vector3("Scene.ambient", self.ambient, **INTENSITY))
         set_("albedo_a", vector3("Scene.albedo_a", self.albedo_a, **UNIT))
@@ -216,7 +213,7 @@ class Scene:
         set_("bump", choice("Scene.bump", self.bump, BUMPS))
         if self.bump == "surface" and not self.beta < self.radius_a:
             raise InvalidValue(f"Scene.beta must be < radius_a = {self.radius_a} when bump='surface' (the "
-                               f"displaced radius R + beta h must stay positive), got {self.beta!r}", "Scene.beta")
+                               f"displaced radius R + beta h must stay positive), got {self.beta!r}")
 
     def replace(self, **changes) -> "Scene":
         """Return a copy with ``changes`` applied (and validated).
@@ -229,7 +226,7 @@ class Scene:
         names = {f.name for f in fields(self)}
         unknown = sorted(set(changes) - names)
         if unknown:
-            raise InvalidType(f"Scene has no field(s) {unknown}; fields are {sorted(names)}", "Scene")
+            raise InvalidType(f"Scene has no field(s) {unknown}; fields are {sorted(names)}")
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         values.update(changes)
         return Scene(**values)

@@ -61,21 +61,18 @@ def _check_steps(eps_values):
     ValueError for no steps, more than `MAX_STEPS`, or a step outside
     [`MIN_EPS`, `MAX_EPS`] (naming its index)."""
     if isinstance(eps_values, (str, bytes)) or not hasattr(eps_values, "__iter__"):
-        raise validate.InvalidType(f"eps_values must be a sequence of positive numbers, got {eps_values!r:.80}",
-                                   "eps_values")
+        raise validate.InvalidType(f"eps_values must be a sequence of positive numbers, got {eps_values!r:.80}")
     if isinstance(eps_values, (collections.abc.Set, collections.abc.Mapping,
                                collections.abc.KeysView, collections.abc.ValuesView)):
         raise validate.InvalidType(f"eps_values must be ordered (a list, tuple, array or iterator), got a "
-                                   f"{type(eps_values).__name__}: the census follows the order of the steps",
-                                   "eps_values")
+                                   f"{type(eps_values).__name__}: the census follows the order of the steps")
     steps = []
     for i, e in enumerate(itertools.islice(eps_values, MAX_STEPS + 1)):
         steps.append(validate.real(f"eps_values[{i}]", e, low=MIN_EPS, high=MAX_EPS))
     if not steps:
-        raise validate.InvalidValue(f"eps_values must hold 1 to {MAX_STEPS} steps, got none", "eps_values")
+        raise validate.InvalidValue(f"eps_values must hold 1 to {MAX_STEPS} steps, got none")
     if len(steps) > MAX_STEPS:
-        raise validate.InvalidValue(f"eps_values must hold 1 to {MAX_STEPS} steps, got more than {MAX_STEPS}",
-                                    "eps_values")
+        raise validate.InvalidValue(f"eps_values must hold 1 to {MAX_STEPS} steps, got more than {MAX_STEPS}")
     return tuple(steps)
 
 
@@ -117,8 +114,8 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
     check_workers(workers)
     n = len(steps) + 1
     if n * width * height > MAX_SWEEP_PIXELS:
-        raise ValueError(f"a sweep holds (steps + 1) x width x height <= {MAX_SWEEP_PIXELS:,} pixels in memory, "
-                         f"got {n} x {width} x {height} = {n * width * height:,}")
+        raise validate.InvalidValue(f"a sweep holds (steps + 1) x width x height <= {MAX_SWEEP_PIXELS:,} pixels "
+                                    f"in memory, got {n} x {width} x {height} = {n * width * height:,}")
     images, grads = np.zeros((n, height, width, 3)), np.zeros((n, height, width, 2))
     chamber, kink = np.zeros((height, width), np.uint8), np.zeros((height, width), bool)
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)

@@ -21,7 +21,7 @@ a dict), non-finite numbers, and an integer too large for a float (``10**400``).
 Each refusal is an `InvalidValue` (a ValueError) or an `InvalidType` (a
 TypeError); both are `InputError`, which the command line reports as an input
 error (exit 2) rather than a bug.  The message names the parameter, the value
-and what is accepted; ``parameter`` holds the name.
+and what is accepted.
 """
 
 from __future__ import annotations
@@ -36,13 +36,8 @@ __all__ = ["InputError", "InvalidValue", "InvalidType", "real", "real_array", "v
 
 
 class InputError(Exception):
-    """An argument refused by validation: the caller's input, not a bug.
-
-    ``parameter`` is the name the message starts with."""
-
-    def __init__(self, message, parameter=None):
-        super().__init__(message)
-        self.parameter = parameter
+    """An argument refused by validation: the caller's input, not a bug.  The message
+    starts with the parameter's name."""
 
 
 class InvalidValue(InputError, ValueError):
@@ -120,14 +115,14 @@ def real(name, value, *, low=None, high=None, low_open=False, high_open=False):
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise InvalidType(f"{name} must be a real number, got {_shown(value)}", name)
+        raise InvalidType(f"{name} must be a real number, got {_shown(value)}")
     accepted = _accepted(low, high, low_open, high_open)
     try:
         x = float(value)
     except OverflowError:                        # an integer beyond float64's range
-        raise InvalidValue(f"{name} must be {accepted}, got {_too_large(int(value))}", name) from None
+        raise InvalidValue(f"{name} must be {accepted}, got {_too_large(int(value))}") from None
     if not _inside(x, low, high, low_open, high_open):
-        raise InvalidValue(f"{name} must be {accepted}, got {value!r}", name)
+        raise InvalidValue(f"{name} must be {accepted}, got {value!r}")
     return x
 
 
@@ -156,7 +151,7 @@ def real_array(name, value, *, low=None, high=None, low_open=False, high_open=Fa
         range; the message gives the first such entry and its flat index.
     """
     def wrong_type():
-        return InvalidType(f"{name} must be real numbers (a scalar or an array), got {_shown(value, 60)}", name)
+        return InvalidType(f"{name} must be real numbers (a scalar or an array), got {_shown(value, 60)}")
 
     accepted = _accepted(low, high, low_open, high_open)
     try:
@@ -168,14 +163,14 @@ def real_array(name, value, *, low=None, high=None, low_open=False, high_open=Fa
         try:
             raw = raw.astype(np.float64)         # Python ints beyond int64, Fractions
         except OverflowError:
-            raise InvalidValue(f"{name} must be {accepted}, got an integer too large for a float", name) from None
+            raise InvalidValue(f"{name} must be {accepted}, got an integer too large for a float") from None
     if raw.dtype.kind not in "iuf":
         raise wrong_type()
     a = raw.astype(np.float64, copy=False)
     bad = np.flatnonzero(~_inside(a, low, high, low_open, high_open))
     if bad.size:
         raise InvalidValue(f"{name} must be {accepted}, got {float(a.reshape(-1)[bad[0]])!r} "
-                           f"at flat index {bad[0]}", name)
+                           f"at flat index {bad[0]}")
     return a
 
 
@@ -194,9 +189,9 @@ def vector3(name, value, *, low=None, high=None):
     """
     if not (isinstance(value, (tuple, list)) or (isinstance(value, np.ndarray) and value.ndim == 1)):
         raise InvalidType(f"{name} must be a sequence of 3 real numbers (a tuple, list or 1-D array), "
-                          f"got {_shown(value)}", name)
+                          f"got {_shown(value)}")
     if len(value) != 3:
-        raise InvalidValue(f"{name} must have exactly 3 components, got {len(value)}: {value!r:.80}", name)
+        raise InvalidValue(f"{name} must have exactly 3 components, got {len(value)}: {value!r:.80}")
     return tuple(real(f"{name}[{i}]", c, low=low, high=high) for i, c in enumerate(value))
 
 
@@ -211,7 +206,7 @@ def flag(name, value):
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if not isinstance(value, (bool, np.bool_)):
-        raise InvalidType(f"{name} must be True or False, got {_shown(value)}", name)
+        raise InvalidType(f"{name} must be True or False, got {_shown(value)}")
     return bool(value)
 
 
@@ -226,9 +221,9 @@ def choice(name, value, accepted):
         ``value`` is a string not in ``accepted`` (matched exactly: case and spaces count).
     """
     if not isinstance(value, str):
-        raise InvalidType(f"{name} must be one of {accepted}, got {_shown(value)}", name)
+        raise InvalidType(f"{name} must be one of {accepted}, got {_shown(value)}")
     if value not in accepted:
-        raise InvalidValue(f"{name} must be one of {accepted}, got {value!r:.80}", name)
+        raise InvalidValue(f"{name} must be one of {accepted}, got {value!r:.80}")
     return str(value)
 
 
@@ -247,11 +242,11 @@ def positive_int(name, value, *, high=None):
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise InvalidType(f"{name} must be a positive integer, got {_shown(value)}", name)
+        raise InvalidType(f"{name} must be a positive integer, got {_shown(value)}")
     n = int(value)
     if n < 1 or (high is not None and n > high):
         accepted = "a positive integer" if high is None else f"an integer in [1, {high}]"
-        raise InvalidValue(f"{name} must be {accepted}, got {_shown(n) if n.bit_length() > 64 else n}", name)
+        raise InvalidValue(f"{name} must be {accepted}, got {_shown(n) if n.bit_length() > 64 else n}")
     return n
 
 
@@ -276,9 +271,9 @@ def steps(name, value, *, low, high, high_open=False, max_count=None):
         No steps, more than ``max_count``, or a step outside the range (with its index).
     """
     if isinstance(value, (set, frozenset, dict)):
-        raise InvalidType(f"{name} must be ordered steps (a list, tuple or array), got {_shown(value)}", name)
+        raise InvalidType(f"{name} must be ordered steps (a list, tuple or array), got {_shown(value)}")
     a = real_array(name, value, low=low, high=high, high_open=high_open).reshape(-1)
     if a.size == 0 or (max_count is not None and a.size > max_count):
         count = "at least one step" if max_count is None else f"1 to {max_count} steps"
-        raise InvalidValue(f"{name} must hold {count}, got {a.size}", name)
+        raise InvalidValue(f"{name} must hold {count}, got {a.size}")
     return a

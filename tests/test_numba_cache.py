@@ -123,6 +123,7 @@ def test_a_cache_planted_by_another_user_is_refused_and_nothing_runs(tmp_path):
     assert not marker.exists(), f"the planted index ran as the victim: {marker.read_text()!r}"
     assert done.returncode == 0 and done.stdout == "ok\n", done.stderr[-2000:]
     lines = done.stderr.splitlines()
+    print(f"victim's stderr: {done.stderr!r}; planted by uid {uid}; {marker.name} exists: {marker.exists()}")
     assert len(lines) == 1 and f"refusing the cache directory {target}" in lines[0], done.stderr
     assert f"owned by uid {uid}" in lines[0] and "for this run only" in lines[0], lines[0]
 

@@ -500,7 +500,8 @@ def test_sweep_reads_an_endless_iterator_only_one_step_past_the_limit():
 
 @pytest.mark.parametrize("steps", [{1e-3, 1e-4}, frozenset({1e-3}), {1e-3: "a"}, {1e-3: 1}.keys()])
 def test_sweep_refuses_unordered_steps(steps):
-    with pytest.raises(TypeError, match="eps_values must be ordered"):
+    with pytest.raises(TypeError, match=rf"^eps_values must be ordered \(a list, tuple, array or iterator\), got a "
+                                        rf"{type(steps).__name__}: the census follows the order of the steps$"):
         sweep(Scene(), steps, 4, 4)
 
 

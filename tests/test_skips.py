@@ -217,14 +217,14 @@ def ledger_bytes(led):
     return np.array(dataclasses.astuple(led), dtype=np.float64).tobytes()
 
 
-def sweep_differences(scene, sw, size=SIZE):
-    """What differs between a sweep and separate renders of the same frames."""
+def sweep_differences(scene, sw, size=SIZE, zoom=1.0):
+    """What differs between a sweep and separate renders of the same frames (at ``zoom``)."""
     bad = []
-    exact = render(scene, *size)
+    exact = render(scene, *size, zoom=zoom)
     if differences(sw.symbolic, exact) or (sw.symbolic.scene, sw.symbolic.gradient) != (scene, "exact"):
         bad.append("symbolic")
     for i, (eps, frame, led) in enumerate(zip(sw.eps, sw.numeric, sw.census)):
-        alone = render(scene.replace(eps=eps), *size, gradient="central")
+        alone = render(scene.replace(eps=eps), *size, gradient="central", zoom=zoom)
         if differences(frame, alone) or (frame.scene, frame.gradient) != (alone.scene, "central"):
             bad.append(f"numeric[{i}]")
         if ledger_bytes(led) != ledger_bytes(compare(alone, exact)):
@@ -238,6 +238,15 @@ def test_sweep_frames_are_separate_renders(name):
     sw = sweep(scene, STEPS, *SIZE)
     assert sw.eps == STEPS and len(sw.numeric) == len(sw.census) == len(STEPS)
     assert sweep_differences(scene, sw) == []
+
+
+def test_a_zoomed_sweep_is_separate_renders_at_that_zoom():
+    """The sweep's image plane is the zoomed one (the pole at zoom 300, where the chart's frame
+    changes branch): a sweep that drew the unzoomed plane differs from every zoomed render."""
+    scene = Scene(beta=1.2)
+    sw = sweep(scene, STEPS[:2], *SIZE, zoom=300.0)
+    assert sweep_differences(scene, sw, zoom=300.0) == []
+    assert sweep_differences(scene, sw) == ["symbolic", "numeric[0]", "census[0]", "numeric[1]", "census[1]"]
 
 
 def test_the_sweep_check_rejects_a_frame_of_another_step_and_a_wrong_census():

@@ -180,7 +180,8 @@ def test_a_record_that_is_not_a_small_regular_file_is_never_served(fresh, monkey
         assert _stored(directory)["sha256"] == store._checksum(_stored(directory))
     else:
         from renderer.files import RefusedPath
-        with pytest.raises(RefusedPath, match="u-curve.json' is not a regular file"):
+        with pytest.raises(RefusedPath, match=r"u-curve.json' is not a regular file \(accepted: a record the "
+                                              r"store wrote, or no file\)$"):
             store.measured("u-curve", compute, size=256)
     assert len(calls) == 2
 
@@ -241,8 +242,12 @@ def test_pages_running_at_once_compute_a_measurement_once(tmp_path, variant):
     import os
     import subprocess
     import sys
+    from pathlib import Path
     log = tmp_path / "log"
-    env = {**os.environ, store.ENV: str(tmp_path / "store")}
+    # The processes import the store this test imported (a scratch copy under test, not the installed one).
+    here = str(Path(store.__file__).parents[1])
+    env = {**os.environ, store.ENV: str(tmp_path / "store"),
+           "PYTHONPATH": os.pathsep.join(filter(None, [here, os.environ.get("PYTHONPATH")]))}
     racers = [subprocess.Popen([sys.executable, "-c", _RACER, str(log), variant], env=env,
                                stdout=subprocess.PIPE, text=True) for _ in range(2)]
     outputs = [r.communicate(timeout=120)[0].strip() for r in racers]
@@ -279,3 +284,28 @@ def test_a_failed_write_leaves_no_temporary_file(fresh):
     with pytest.raises(RefusedPath, match="directory"):
         store.measured("u-curve", compute)
     assert sorted(p.name for p in directory.iterdir() if not p.name.endswith(".lock")) == ["u-curve.json"]
+
+
+def test_a_record_with_its_fields_in_another_order_is_served(fresh, monkeypatch):
+    """The checksum is of the record's content, not of how a tool happened to order its keys:
+    the same record rewritten with its fields and parameters in reverse order is served."""
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256, field="sine")
+    record = _stored(directory)
+    reordered = {k: record[k] for k in reversed(list(record))}
+    reordered["params"] = {k: record["params"][k] for k in reversed(list(record["params"]))}
+    assert list(reordered) != list(record)
+    (directory / "u-curve.json").write_text(json.dumps(reordered))
+    _new_process(monkeypatch)
+    store.measured("u-curve", compute, size=256, field="sine")
+    assert len(calls) == 1
+
+
+def test_the_digest_reads_the_packages_where_python_imports_them_from():
+    """`_roots` names each package's directory as imported (a checkout or an installed wheel)."""
+    import importlib
+    from pathlib import Path
+    roots = store._roots()
+    assert sorted(roots) == sorted(store.PACKAGES)
+    for package, root in roots.items():
+        assert root == Path(importlib.import_module(package).__file__).parent

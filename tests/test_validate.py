@@ -80,7 +80,7 @@ def past(x, direction):
 def test_each_kind_names_the_parameter_the_value_and_what_is_accepted(call, error, message):
     with pytest.raises(InputError) as info:
         call()
-    assert (type(info.value), str(info.value), info.value.parameter) == (error, message, message.split()[0])
+    assert (type(info.value), str(info.value)) == (error, message)
     assert isinstance(info.value, ValueError if error is InvalidValue else TypeError)
 
 
