@@ -227,6 +227,21 @@ def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
         book.theorem_block("chart")
 
 
+def test_a_calc_link_is_shown_by_its_right_side_alone(monkeypatch):
+    """In the theorem's box a step that continues the one before (a calc link) shows "= rhs", as a chain is
+    written; a step that starts afresh shows "lhs = rhs" (optimal-step has both)."""
+    from chapter import theorems as book
+    from proofs import registry
+    t = get("optimal-step")
+    monkeypatch.setattr(registry, "THEOREMS", {t.id: t})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    shown = re.findall(r"\*\*Step \d+\.\*\* [^\n]*\n\n\$\$\n(.*?)\n\$\$", book.theorem_block(t.id), re.S)
+    links = [s.link for s in t.steps]
+    assert len(shown) == len(t.steps) and True in links and False in links
+    assert [d.startswith("= ") for d in shown] == links, shown
+
+
 @pytest.mark.parametrize("order", [0.8, 1.2])
 def test_the_beta_limit_refutes_a_rate_off_by_a_fifth(order):
     """beta-zero-regression's rendered rate is fitted to within 0.1 of the order claimed: an order off by a

@@ -635,6 +635,7 @@ def test_sweep_formats_match_renderer_sweep(capsys):
                       "--set", "height_field=sine"], capsys)
     doc = json.loads(out)
     assert rc == 0 and [r["eps"] for r in doc["rows"]] == [1e-2, 1e-5]
+    assert doc["size"] == [40, 32] and doc["height_field"] == "sine"       # as --size says it: W, H
     assert doc["rows"][0]["mean_abs_kink"] is None  # sine has no crease band: nan -> null
     rc, out, _ = run(["sweep", "--eps", "1e-1:1e-6:6", "--size", "40x32"], capsys)
     lines = out.strip().splitlines()

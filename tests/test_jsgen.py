@@ -48,6 +48,23 @@ def test_the_book_uses_the_regenerated_bundle(tmp_path):
     assert (static / "sim" / "simulator.js").read_text(encoding="utf-8") == jsgen.bundle_source()
 
 
+def test_the_bundle_is_made_again_when_the_sources_change(tmp_path, monkeypatch):
+    """simulator_assets keeps the bundle while the source digest it was made from holds, and makes it again
+    when the digest changes (an edit of renderer/js or the formulas): a stale bundle is never served."""
+    spec = importlib.util.spec_from_file_location("simulator_assets", ROOT / "book" / "_ext" / "simulator_assets.py")
+    assets = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(assets)
+    app = SimpleNamespace(outdir=str(tmp_path / "_build" / "html"))
+    bundle = tmp_path / "_build" / "sim_static" / "sim" / "simulator.js"
+    for digest, kept in (("one", False), ("one", True), ("two", False)):
+        monkeypatch.setattr(assets, "source_digest", lambda digest=digest: digest)
+        if bundle.exists():
+            bundle.write_text("// what the build wrote before", encoding="utf-8")
+        assets._generate(app, SimpleNamespace(html_static_path=["_static"]))
+        want = "// what the build wrote before" if kept else jsgen.bundle_source()
+        assert bundle.read_text(encoding="utf-8") == want, (digest, kept)
+
+
 def test_a_built_book_carries_the_regenerated_bundle():
     """The simulator script of a built site (SYMRENDER_BOOK_HTML) is today's bundle."""
     html = os.environ.get("SYMRENDER_BOOK_HTML")

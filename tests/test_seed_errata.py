@@ -30,3 +30,25 @@ def test_a_pair_in_a_cast_shadow_does_not_leak(monkeypatch):
     assert (m["leak_pixels_default"], m["leak_pixels_beta_1_5"]) == (2, 2)
 
 
+def _facing_away(scene, P):
+    """A shading normal at P that faces away from the first light while its half vector with the eye leans
+    towards it: the draft adds a lobe there."""
+    L, E = np.asarray(scene.lights[0].position), np.array([0.0, 0.0, scene.camera_z])
+    w, v = (L - P) / np.linalg.norm(L - P), (E - P) / np.linalg.norm(E - P)
+    h = (w + v) / np.linalg.norm(w + v)
+    Ns = h - (h @ w) * w - 1e-3 * w
+    return Ns / np.linalg.norm(Ns)
+
+
+@pytest.mark.parametrize("codes, pairs", [((SPHERE_A, BACKGROUND), 1), ((BACKGROUND, SPHERE_B), 1),
+                                          ((SPHERE_A, SPHERE_B), 2), ((BACKGROUND, BACKGROUND), 0)])
+def test_the_ungated_lobe_is_counted_on_both_spheres(monkeypatch, codes, pairs):
+    """Erratum specular-ungated counts the pairs of sphere A and of sphere B (the draft shades both with the
+    same rule): a pixel of either, with a normal facing away from the light and a lobe, is one pair."""
+    scene = Scene(lights=Scene().lights[:1])
+    P = np.array([0.2, 0.3, 0.9])
+    Ns = _facing_away(scene, P)
+    g = SimpleNamespace(chamber=np.array([codes], dtype=np.uint8), P=np.array([[P, P]]), Ns=np.array([[Ns, Ns]]))
+    monkeypatch.setattr(seed_errata, "Scene", lambda: scene)
+    monkeypatch.setattr(seed_errata, "gbuffer", lambda scene, w, h: g)
+    assert seed_errata._specular_ungated(size=2)["pixels"] == pairs

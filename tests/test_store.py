@@ -54,6 +54,20 @@ def test_other_parameters_or_another_digest_compute_again(fresh, monkeypatch):
     assert len(calls) == 3
 
 
+def test_the_digest_reads_every_package_whose_code_stores_a_measurement():
+    """Each module of the project that stores a measurement (calls ``measured``: lab's, and the book's
+    helpers in book/chapter, whose theorem blocks the store holds) lies in a package the digest reads, so an
+    edit to the code that computes a stored value is never answered with the value it computed before."""
+    import re
+    from pathlib import Path
+    repo = Path(__file__).resolve().parents[1]
+    roots = [root.resolve() for root in store._roots().values()]
+    callers = [path for top in ("renderer", "proofs", "lab", "book") for path in (repo / top).rglob("*.py")
+               if "_build" not in path.parts and re.search(r"\bmeasured\(", path.read_text(encoding="utf-8"))]
+    assert any(path.parent.name == "chapter" for path in callers)       # the check sees the book's helpers
+    assert [str(p.relative_to(repo)) for p in callers if not any(p.resolve().is_relative_to(r) for r in roots)] == []
+
+
 def test_the_digest_follows_the_source_files(tmp_path, monkeypatch):
     """A changed byte in any file of the project's packages changes the digest."""
     for package in store.PACKAGES:

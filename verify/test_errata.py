@@ -59,6 +59,8 @@ def test_fallback_orientation_is_reflected(errata):
 def test_v_border_branch_fires_in_interior(errata):
     m = errata["v-border-branch"]
     assert 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"]
+    # The change is the rounding of v +- eps over the step: each smaller step changes the quotient more.
+    assert 0 < m["rel_change_1e-3"] < m["rel_change_1e-6"] < m["rel_change_1e-9"]
 
 
 def test_every_erratum_is_present_by_its_criterion(errata):

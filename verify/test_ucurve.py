@@ -71,6 +71,25 @@ def test_no_true_derivative_and_no_optimum_where_h_is_not_differentiable(kwargs,
     assert np.isnan([c.derivative, c.eps_opt_measured, c.eps_opt_predicted, c.error_at_measured_opt]).all()
 
 
+@pytest.mark.parametrize("component", ["u", "v"])
+def test_at_the_charts_edge_1_the_reference_is_the_slope_from_inside(component):
+    """u = 1 and v = 1 are creases of the ridges field (k = 8, 4): the one-sided reference the split is
+    measured against (the float64 quotient less its roundoff and truncation) is the slope from below, the
+    chart's side, as the kernel's own h shows it a step of 1e-7 inside; from beyond 1 it has the other sign."""
+    from renderer import pointwise
+    at = dict(u=1.0) if component == "u" else dict(v=1.0)
+    c = measure("ridges", component=component, eps=[1e-3], **at)
+    k = 0 if component == "u" else 1
+    fd = float(pointwise.central_gradient("ridges", c.u, c.v, 8.0, 4.0, 1e-3)[k])
+    reference = fd - c.roundoff[0] - c.truncation[0]
+    d = 1e-7
+    below = dict(u=c.u - d * (k == 0), v=c.v - d * (k == 1))
+    inside = (float(pointwise.height("ridges", c.u, c.v, 8.0, 4.0))
+              - float(pointwise.height("ridges", below["u"], below["v"], 8.0, 4.0))) / d
+    assert c.reason is not None and abs(inside) > 1.0
+    assert reference == pytest.approx(inside, rel=1e-5)
+
+
 @pytest.mark.parametrize("kwargs", [
     dict(field="ridges", u=0.1), dict(field="ridges", u=0.125, v=0.25),    # both factors vanish
     dict(field="ridges", u=0.125, component="v"), dict(field="sine", u=0.125),
