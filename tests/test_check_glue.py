@@ -115,7 +115,8 @@ def test_math_glue_is_compared_by_its_markdown(tmp_path, capsys):
 
 @pytest.mark.parametrize("x, tex", [(1e-3, "10^{-3}"), (1e-16, "10^{-16}"), (5e-4, r"5\cdot 10^{-4}"),
                                     (-1e-5, "-10^{-5}"), (2.5e-7, r"2.5\cdot 10^{-7}"), (0.47, "0.47"),
-                                    (1.5, "1.5"), (256, "256"), (0.0, "0")])
+                                    (1.5, "1.5"), (256, "256"), (0.0, "0"),
+                                    (1.25e-4, r"1.25\cdot 10^{-4}"), (-3.14159e-6, r"-3.14\cdot 10^{-6}")])
 def test_tex_number(x, tex):
     from chapter.theorems import tex_number
     assert tex_number(x) == tex
