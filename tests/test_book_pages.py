@@ -254,25 +254,45 @@ AUDIT = r"""async () => {
 }"""
 
 
-#: The book's length limits: words of prose in the whole book, and each page's height at 1280 px
-#: with folded material closed.
-MAX_WORDS, MAX_HEIGHT = 11_000, 12_000
+#: The book's length limits, in words of prose (code and mathematics do not count) and in each page's
+#: height at 1280 px with folded material closed.  The reading path is what a learner reads straight
+#: through: every page but the ledger, less what is folded (proofs, solutions: ``details``) or set
+#: beside the text (margin notes: ``aside``, ``.margin``).  Those, and the whole of the ledger page
+#: (the draft's audit: register, errata, theorem ledger), are the asides, with a budget of their own.
+MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_000, 8_000, 12_000
+#: The pages outside the reading path.
+LEDGER_PAGES = ("s6_ledger",)
 LENGTH = r"""() => {
   const art = document.querySelector('article.bd-article') || document.body;
   const prose = art.cloneNode(true);
   prose.querySelectorAll('pre, .highlight, mjx-container, .math, script, style, .cell_input').forEach(e => e.remove());
-  const words = (prose.textContent || '').split(/\s+/).filter(w => /\w/.test(w)).length;
-  return {height: document.documentElement.scrollHeight, words};
+  const count = (e) => (e.textContent || '').split(/\s+/).filter(w => /\w/.test(w)).length;
+  const ASIDE = 'details, aside, .margin';
+  const aside = [...prose.querySelectorAll(ASIDE)].filter(e => !e.parentElement.closest(ASIDE))
+    .reduce((n, e) => n + count(e), 0);
+  return {height: document.documentElement.scrollHeight, words: count(prose) - aside, aside};
 }"""
 
 
+def words_of(lengths):
+    """(reading-path words, aside words) of ``lengths``: {page: Page.length()}."""
+    reading = sum(v["words"] for n, v in lengths.items() if n not in LEDGER_PAGES)
+    aside = sum(v["aside"] + (v["words"] if n in LEDGER_PAGES else 0) for n, v in lengths.items())
+    return reading, aside
+
+
 def too_long(lengths):
-    """The length limits a site breaks: pages taller than `MAX_HEIGHT` at 1280 px, and the book's
-    words beyond `MAX_WORDS`.  ``lengths``: {page: Page.length() at 1280 px}."""
+    """The length limits a site breaks: pages taller than `MAX_HEIGHT` at 1280 px, the reading
+    path's words beyond `MAX_READING_WORDS` and the asides' beyond `MAX_ASIDE_WORDS`.
+    ``lengths``: {page: Page.length() at 1280 px}."""
     bad = [f"{n}: {v['height']} px tall at 1280 px (at most {MAX_HEIGHT})" for n, v in lengths.items()
            if v["height"] > MAX_HEIGHT]
-    words = sum(v["words"] for v in lengths.values())
-    return bad + ([f"{words} words of prose in the book (at most {MAX_WORDS})"] if words > MAX_WORDS else [])
+    reading, aside = words_of(lengths)
+    if reading > MAX_READING_WORDS:
+        bad.append(f"{reading} words on the reading path (at most {MAX_READING_WORDS})")
+    if aside > MAX_ASIDE_WORDS:
+        bad.append(f"{aside} words in folds, margins and the ledger (at most {MAX_ASIDE_WORDS})")
+    return bad
 
 
 @pytest.fixture(scope="module")
@@ -387,7 +407,8 @@ def site(browser, book_html):
                           "broken_words": sum(len(found[n, w]["broken"]) for n in PAGES),
                           "overflowing": sum(len(found[n, w]["overflow"]) for n in PAGES),
                           "scrolling_boxes": sum(len(found[n, w]["scrollers"]) for n in PAGES),
-                          "prose_words": sum(found[n, w]["length"]["words"] for n in PAGES),
+                          "reading_words": words_of({n: found[n, w]["length"] for n in PAGES})[0],
+                          "aside_words": words_of({n: found[n, w]["length"] for n in PAGES})[1],
                           "heights_closed": {n: found[n, w]["length"]["height"] for n in PAGES}}
                for w in WIDTHS}
     report = {"site": str(book_html), "ratio_tolerance": RATIO_TOL, "summary": summary,
@@ -456,8 +477,8 @@ def test_the_figure_check_catches_a_bare_image_and_a_blurred_one(browser, book_h
 
 
 def test_the_book_is_short_enough(site):
-    """At most `MAX_WORDS` words of prose in the whole book and no page over `MAX_HEIGHT` px at 1280 px,
-    folded material closed."""
+    """At most `MAX_READING_WORDS` words on the reading path and `MAX_ASIDE_WORDS` in the asides, and no
+    page over `MAX_HEIGHT` px at 1280 px, folded material closed."""
     bad = too_long({n: site[n, 1280]["length"] for n in PAGES})
     assert not bad, "\n".join(bad)
 
@@ -734,12 +755,15 @@ def test_the_books_diagrams_have_no_colliding_text():
 
 
 def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_html, tmp_path):
-    """Wrong variants: a page 13,000 px tall, and a page of 11,001 words; folded words count, a
-    folded block's height does not, and code does not count as prose."""
+    """Wrong variants: a page 13,000 px tall, a reading path of 12,001 words, asides of 8,001 words
+    (folded, in a margin, on the ledger page).  Folded and margin words are asides, not reading; the
+    ledger page is all aside; a folded block's height does not count; code counts nowhere."""
     tall = _synthetic(tmp_path, '<div style="height: 13000px"></div><details><summary>s</summary>'
                       '<div style="height: 20000px"></div></details>')
-    wordy = _synthetic(tmp_path, "<p>" + "word " * 10_000 + "</p><details><summary>fold </summary><p>"
-                       + "word " * 1000 + "</p></details><pre>" + "code " * 5000 + "</pre>")
+    wordy = _synthetic(tmp_path, "<p>" + "word " * 12_001 + "</p><details><summary>fold </summary><p>"
+                       + "word " * 3000 + "</p><aside class='margin'>" + "word " * 500 + "</aside></details>"
+                       + "<aside class='sidebar margin'><p>" + "word " * 1000 + "</p></aside><pre>"
+                       + "code " * 5000 + "</pre>")
     lengths = {}
     for name, url in (("tall", tall), ("wordy", wordy)):
         p = Page(browser, url, 1280)
@@ -748,7 +772,12 @@ def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_htm
         finally:
             p.close()
     assert 13_000 <= lengths["tall"]["height"] < 20_000          # the folded 20,000 px do not count
-    assert 11_001 <= lengths["wordy"]["words"] < 12_000          # the folded words count, the code does not
+    assert 12_001 <= lengths["wordy"]["words"] < 12_100          # the folded and margin words do not count,
+    assert lengths["wordy"]["aside"] == 4_501                    # they are asides (once each); code is neither
     bad = too_long(lengths)
-    assert any(b.startswith("tall:") for b in bad) and any("words of prose in the book" in b for b in bad)
-    assert too_long({"wordy": {"height": 100, "words": 10_999}}) == []
+    assert any(b.startswith("tall:") for b in bad) and any("on the reading path" in b for b in bad), bad
+    page = lambda words, aside=0: {"height": 100, "words": words, "aside": aside}  # noqa: E731
+    assert too_long({"a": page(12_000), "b": page(0, 8_000)}) == []
+    assert too_long({"a": page(12_000), "s6_ledger": page(7_000), "b": page(0, 1_000)}) == []  # the ledger is aside
+    assert too_long({"s6_ledger": page(7_000), "b": page(0, 1_001)}) == [
+        "8001 words in folds, margins and the ledger (at most 8000)"]
