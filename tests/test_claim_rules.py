@@ -333,3 +333,15 @@ def test_the_books_register_is_the_builds_one_measurement_checked(monkeypatch):
         checked([(c, "m", UNMEASURED)])
     assert str(raised.value) == (f"{c.id}: registered {c.registered!r}, computed 'not measured' (m) (edit the "
                                  "register in lab/claims.py with the change)")
+
+
+def test_the_cell5_sentence_compares_the_worst_error_with_the_drafts_expectation():
+    """The sentence states the draft's expected value as its quotation does, and the ratio it gives is
+    the printed worst error over that value (a ratio typed as "a hundred times" fails here)."""
+    claim = next(c for c in CLAIMS if c.id == "cell5-fd-1e-9")
+    measured, verdict = claim.measure()
+    m = re.search(r"worst component error of (\S+), about ([\d,]+) times the draft's expected (\S+)$", measured)
+    assert m and verdict == FAILS, measured
+    worst, ratio, expected = (float(g.replace(",", "")) for g in m.groups())
+    assert expected == _numbers(claim.quote)[0]
+    assert ratio == pytest.approx(worst / expected, rel=0.06)
