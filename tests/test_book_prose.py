@@ -85,6 +85,41 @@ def test_a_typed_step_is_found():
         Counter()
 
 
+
+#: A number in a code comment: a decimal, e-notation, or an integer other than a lone 0 or 1 (the
+#: 1 of "1/k_u" is a formula's, not a value's).
+COMMENT_NUMBER = re.compile(r"(?<![\w.])(?:\d+\.\d+|\d+e-?\d+|\d{2,}|[2-9])(?![\w.])")
+
+
+def commented_numbers(text):
+    """The numbers typed in the comments of ``text``'s code cells (a page that is no notebook has none)."""
+    import io
+    import tokenize
+    found = []
+    for source in code_cells(text) or []:
+        for token in tokenize.generate_tokens(io.StringIO(source).readline):
+            if token.type == tokenize.COMMENT:
+                found += COMMENT_NUMBER.findall(token.string)
+    return found
+
+
+@pytest.mark.parametrize("page", sorted(p.name for p in BOOK.glob("*.md")))
+def test_no_number_is_typed_into_a_code_comment(page):
+    """A comment repeats no value: the code that holds it is beside it, or the page glues it."""
+    assert commented_numbers((BOOK / page).read_text(encoding="utf-8")) == [], page
+
+
+def test_a_number_typed_into_a_comment_is_found():
+    """Wrong variants: a count, a size, a step and a decimal in a comment; a formula's 1 is none."""
+    page = (BOOK / "s5_lab.md").read_text(encoding="utf-8")
+    assert commented_numbers(page) == []
+    cell = "\n```{code-cell} ipython3\nx = 1   # %s\n```\n"
+    for typed, literal in (("197 steps", "197"), ("256 x 256", "256"), ("eps = 1e-3", "1e-3"),
+                           ("beta = 0.35", "0.35"), ("a 50-digit reference", "50"), ("at 4 points", "4")):
+        assert literal in commented_numbers(page + cell % typed), typed
+    assert commented_numbers(page + cell % "the crease u = 1/k_u") == []
+
+
 # ------------------------------------------------------------- scene and resolution labels
 ROOT = BOOK.parent
 #: A glue whose name ends so carries the scene or resolution of a render (e.g. "256 × 256",
