@@ -309,7 +309,8 @@ def _census_slope():
 
 def _cell3_runs():
     """The draft's Cell 3 reduces |num - sym| over the pixels both maps put on
-    sphere A; with its sphere B (erratum sphere-b-quadratic) no pixel is on A."""
+    sphere A; with its sphere B (erratum sphere-b-quadratic) no pixel of the draft's code's
+    map is on A, against this renderer's count on its frame of the same scene."""
     from .seed_errata import seed_chamber
     code = seed_chamber(256)
     on_a = (code & 3) == SPHERE_A
@@ -318,9 +319,10 @@ def _cell3_runs():
     try:
         np.abs(num.image - sym.image)[same & on_a].max()
     except ValueError as error:
-        return (f"the cell crashes before its first row: its sphere A covers {np.count_nonzero(on_a)} of "
-                f"{code.size:,} pixels{_on(sym)}, and a maximum over no pixels raises ValueError",
-                {"rows computed": 0})
+        return (f"the cell crashes before its first row: in the draft's code its sphere A covers "
+                f"{np.count_nonzero(on_a)} of the {code.size:,} pixels, where this renderer's frame of the same "
+                f"scene has {np.count_nonzero(sym.chamber == SPHERE_A):,} on sphere A{_on(sym)}, and a maximum "
+                "over no pixels raises ValueError", {"rows computed": 0})
     return "the sweep's first row is computed" + _on(sym), {"rows computed": 1}
 
 

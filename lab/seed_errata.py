@@ -97,8 +97,9 @@ _SEED_CHAMBER = {}
 
 
 def seed_chamber(size=SIZE):
-    """(size, size) uint8: the chamber map of the draft's scene, its sphere B
-    intersected with the draft's quadratic (erratum sphere-b-quadratic)."""
+    """(size, size) uint8: the chamber map the draft's code computes for its scene, its
+    sphere B intersected with the draft's quadratic (erratum sphere-b-quadratic); not
+    this renderer's map of the same scene (`renderer.gbuffer`)."""
     if size not in _SEED_CHAMBER:
         _sphere_b_seed_vs_true(size)
     return _SEED_CHAMBER[size]
