@@ -342,3 +342,26 @@ def test_a_long_cell_or_a_shown_glue_is_found():
     assert len(shown_defects(front + plain)) == 1
     removed = "```{code-cell} ipython3\n:tags: [remove-cell]\n" + "glue('a', 1)\n" * 30 + "```\n"
     assert shown_defects(front + removed) == []
+
+
+#: A page's reference to a theorem's box: {prf:ref}`Title <thm-id>`.
+THEOREM_REF = re.compile(r"\{prf:ref\}`([^`<]+?)\s*<thm-([\w-]+)>`")
+
+
+def theorem_refs(text):
+    """[(title, theorem id)] of the theorem references in ``text``."""
+    return [(m.group(1).strip(), m.group(2)) for m in THEOREM_REF.finditer(text)]
+
+
+def test_a_page_refers_to_a_theorem_by_its_id_and_its_title():
+    """Each {prf:ref} to a theorem names a registered theorem with the title its box shows; a wrong
+    id or title is found (wrong variants)."""
+    from proofs.registry import THEOREMS
+    refs = [r for p in sorted(BOOK.glob("*.md")) for r in theorem_refs(p.read_text(encoding="utf-8"))]
+    assert ("Bump versus displacement", "bump-vs-displacement") in refs          # §7, pitfall 7
+    for title, theorem_id in refs:
+        assert theorem_id in THEOREMS and THEOREMS[theorem_id].title == title, (title, theorem_id)
+    for wrong in ("{prf:ref}`Bump versus displacement <thm-bump-vs-displace>`",
+                  "{prf:ref}`Bump against displacement <thm-bump-vs-displacement>`"):
+        ((title, theorem_id),) = theorem_refs(wrong)
+        assert theorem_id not in THEOREMS or THEOREMS[theorem_id].title != title
