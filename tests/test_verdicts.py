@@ -73,3 +73,21 @@ def test_outside_a_book_build_only_the_places_claims_are_measured(monkeypatch):
     monkeypatch.delenv("SYMRENDER_BOOK_BUILD", raising=False)
     assert "**Holds" in verdicts.verdicts("s3-boundary")
     assert sorted(measured) == sorted(verdicts.PLACES["s3-boundary"])
+
+
+def glossary_terms(text):
+    """The terms of the book's glossary (each term line of its ``{glossary}`` block, split at commas), lower case."""
+    block = re.search(r"```\{glossary\}\n(.*?)\n```", text, re.S).group(1)
+    return {t.strip().lower() for line in block.splitlines() if line and not line[0].isspace()
+            for t in line.split(",")}
+
+
+def test_the_glossary_defines_every_verdict_word():
+    """Each verdict a claim or a theorem can be given, as the pages word it, is a glossary term
+    (`verdicts.WORDS`, the checker's statuses); a glossary without one is caught (wrong variant)."""
+    from chapter.theorems import BADGES
+    text = (BOOK / "glossary.md").read_text(encoding="utf-8")
+    words = {w.lower() for w in verdicts.WORDS.values()} | set(BADGES)
+    assert words == {"holds", "holds with a correction", "does not hold", "proved", "verified", "refuted"}
+    assert words <= glossary_terms(text)
+    assert not words <= glossary_terms(text.replace("\nrefuted\n", "\nrebutted\n"))
