@@ -175,7 +175,7 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
                    rf"$e_\varphi = {vector_latex(REGULAR[3:])}$, at $N(\theta, \varphi)$, satisfies "
                    r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
         steps=(
-            *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ (theorem chart), "
+            *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ by ⟪chart⟫, "
                          r"$e_\theta = (-N_y, N_x, 0)/\sin\varphi$ is", sp.Matrix([-sp.sin(theta), sp.cos(theta), 0])),
                   (r"This is $\partial N/\partial\theta = \sin\varphi\,(-\sin\theta, \cos\theta, 0)$ divided by "
                    r"$\sin\varphi$", d_theta)),
@@ -232,7 +232,7 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
                   rf"($\sin\varphi \le {tex(sp.Float(F.POLE_SIN_PHI, 2))}$) has $⟦fallback⟧$: right-handed at the "
                   r"north pole, where the outward normal is $+z$.",
         steps=(
-            Step(r"Cross the frame of theorem frame-orthonormal: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
+            Step(r"Cross the frame of ⟪frame-orthonormal⟫: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
                  r"\cos\theta, \cos\varphi\sin\theta, -\sin\varphi) = (-\sin\varphi\cos\theta, -\sin\varphi\sin\theta, "
                  r"-\cos\varphi)$", Cross(ET_S, EP_S), -N_S),
             *calc(triple, ("Dot both sides of step 1 with $N$", -Dot(N_S, N_S)),

@@ -60,7 +60,7 @@ def _ridges(jump_u, jump_v, band=BAND):
         id="ridges-kinks", title="The creases of the ridges field",
         statement=r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
                   r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
-                  r"(`RIDGE_FACTORS`) is differentiable wherever $s_1 s_2 \ne 0$ (theorem gradient-ridges). "
+                  r"(`RIDGE_FACTORS`) is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-ridges⟫. "
                   r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, the "
                   r"one-sided derivatives $h_u^\pm$ differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$, a crease. "
                   r"The renderer's crease flag (`KINK_BAND`) is set on every zero line, $⟦lines⟧$, and where "

@@ -7,6 +7,9 @@ THEOREMS = {t.id: t for mod in (frame, gradients, kinks, kink_loci, no_boundary,
                                         finite_difference, displacement, blinn)
             for t in mod.THEOREMS}
 
+#: id -> title of every theorem a statement or a step may cite (``⟪id⟫``, rule 8 of proofs.core).
+CITABLE = {theorem_id: t.title for theorem_id, t in THEOREMS.items()}
+
 #: The verdict each theorem must reach: "proved" (sympy decided every step
 #: of its proof, and its evidence holds) or ("verified", bound): sympy left a
 #: step undecided and mpmath found no residual above ``bound`` at the check's

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from proofs.registry import PINNED, RENDERED, THEOREMS, get, pin, pinned_failure
+from proofs.core import CITATION, plain
+from proofs.registry import CITABLE, PINNED, RENDERED, THEOREMS, get, pin, pinned_failure
 from verify.test_theorems import _placed
 
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
@@ -130,7 +131,8 @@ def test_a_wrong_step_is_refuted_and_named(theorem_id, k):
     steps[k - 1] = dataclasses.replace(steps[k - 1], rhs=_wrong(steps[k - 1].rhs))
     verdict = dataclasses.replace(t, steps=tuple(steps)).check()
     assert verdict.status == "refuted", verdict.evidence
-    assert verdict.evidence.startswith(f"{theorem_id}, step {k} ({t.steps[k - 1].why.rstrip('.:')})"), verdict.evidence
+    assert verdict.evidence.startswith(f"{theorem_id}, step {k} ({plain(t.steps[k - 1].why).rstrip('.:')})"), \
+        verdict.evidence
 
 
 def test_no_sentence_is_shared_between_theorems():
@@ -318,3 +320,47 @@ def test_a_theorem_step_that_cannot_be_evaluated_refutes_the_theorem():
                 domain={x: (0.1, 0.9)})
     v = dataclasses.replace(t, steps=(*t.steps, step), claims={}).check()
     assert v.status == "refuted" and "cannot be evaluated at x=" in v.evidence, v
+
+
+def _cite_in(t, k, text):
+    """``t`` with ``text`` appended to step k's sentence (k = 0: to the statement)."""
+    if k == 0:
+        return dataclasses.replace(t, statement=t.statement + " " + text)
+    steps = list(t.steps)
+    steps[k - 1] = dataclasses.replace(steps[k - 1], why=steps[k - 1].why + " " + text)
+    return dataclasses.replace(t, steps=tuple(steps))
+
+
+@pytest.mark.parametrize("k", [0, 1])
+def test_rule_8_a_citation_of_an_unknown_id_is_refuted(k):
+    """A statement or step citing ⟪id⟫ of no registered theorem is refuted, naming the id; the same
+    citation of a registered id holds."""
+    t = get("frame-orientation")
+    verdict = _cite_in(t, k, "by ⟪frame-orthonormals⟫").check()
+    assert verdict.status == "refuted" and "⟪frame-orthonormals⟫" in verdict.evidence, verdict.evidence
+    assert _cite_in(t, k, "by ⟪frame-orthonormal⟫").check().status == "proved"
+
+
+@pytest.mark.parametrize("words", ["theorem frame-orthonormal", "theorems `chart`"])
+def test_rule_8_a_theorem_named_by_its_id_in_words_is_refuted(words):
+    verdict = _cite_in(get("frame-orientation"), 1, f"(by {words})").check()
+    assert verdict.status == "refuted" and "by its id in words" in verdict.evidence, verdict.evidence
+
+
+def test_no_text_names_a_theorem_by_its_id_and_every_citation_is_known():
+    cited = set()
+    for t in THEOREMS.values():
+        for text in [t.statement] + [s.why for s in t.steps]:
+            cited |= set(CITATION.findall(text))
+            assert not re.search(r"\btheorems? `?(" + "|".join(map(re.escape, THEOREMS)) + r")\b", text), (t.id, text)
+    assert cited and cited <= set(THEOREMS)
+    assert set(CITABLE) == set(THEOREMS)
+
+
+def test_a_citation_prints_as_the_theorems_number_and_title_in_the_book_and_its_title_in_plain_text():
+    from chapter.theorems import _cited
+    assert _cited("by ⟪chart⟫, so") == f"by {{prf:ref}}`thm-chart` ({CITABLE['chart']}), so"
+    assert plain("by ⟪chart⟫, so") == f"by theorem “{CITABLE['chart']}”, so"
+    with pytest.raises(KeyError, match="no-such"):
+        _cited("by ⟪no-such⟫")
+    assert "⟪" not in plain("⟪chart⟫ and ⟪frame-orientation⟫")

@@ -66,6 +66,26 @@ def _prose(text):
     return "".join(p if p[:1] in "`$" and p else re.sub(r"([*_])", r"\\\1", p) for p in parts)
 
 
+def _cited(text):
+    """``text`` with each citation ``⟪id⟫`` (`proofs.core.CITATION`) as MyST: a bare
+    ``{prf:ref}`thm-<id>``` (sphinx-proof prints it "Theorem n", linked to the box) and the
+    theorem's title in parentheses.
+
+    Raises
+    ------
+    KeyError
+        A cited id that is no theorem of the registry (the check refutes it first).
+    """
+    from proofs.core import CITATION
+    from proofs.registry import CITABLE
+
+    def ref(m):
+        if m.group(1) not in CITABLE:
+            raise KeyError(f"no theorem {m.group(1)!r} to cite")
+        return f"{{prf:ref}}`thm-{m.group(1)}` ({CITABLE[m.group(1)]})"
+    return CITATION.sub(ref, text)
+
+
 def _proof_step(t, number, step):
     """One step of ``t``'s proof as MyST: "**Step k.** Sentence:" and the display ``lhs = rhs``
     (``= rhs`` where the step continues a calc chain), two aligned lines where both sides
@@ -74,7 +94,7 @@ def _proof_step(t, number, step):
     shown = f"= {rhs}" if step.link and step.lhs == t.steps[number - 2].rhs else f"{lhs} = {rhs}"
     if not shown.startswith("=") and len(lhs) + len(rhs) > 200:
         shown = f"\\begin{{aligned}}&{lhs}\\\\ &= {rhs}\\end{{aligned}}"
-    why = _prose(step.why.rstrip(".:"))
+    why = _prose(_cited(step.why.rstrip(".:")))
     where = ", ".join(f"${t.definition_tex(s)}$" for s in step.defines)
     return f"**Step {number}.** {why}:\n\n$$\n{shown}\n$$" + (f"\n\nwhere {where}." if where else "")
 
@@ -83,7 +103,7 @@ def _entry(t):
     from proofs.registry import pinned_failure
     v = t.check()
     steps = "\n\n".join(_proof_step(t, i, step) for i, step in enumerate(t.steps, 1))
-    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement_tex()}\n\n"
+    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{_cited(t.statement_tex())}\n\n"
              f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
