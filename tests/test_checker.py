@@ -364,3 +364,30 @@ def test_a_citation_prints_as_the_theorems_number_and_title_in_the_book_and_its_
     with pytest.raises(KeyError, match="no-such"):
         _cited("by ⟪no-such⟫")
     assert "⟪" not in plain("⟪chart⟫ and ⟪frame-orientation⟫")
+
+
+def _floats_shown(t):
+    """[(step number, Float)] of the float literals a step of ``t`` shows: in its two sides, or in the
+    definitions of the symbols it defines (`Step.defines`)."""
+    def floats(x):
+        x = sp.sympify(x)
+        return x.atoms(sp.Float) if isinstance(x, sp.Basic) else set()
+    return [(k, f) for k, s in enumerate(t.steps, 1)
+            for f in floats(s.lhs) | floats(s.rhs) | set().union(*[floats(t.where[d]) for d in s.defines])]
+
+
+def test_no_step_shows_a_float_literal_and_the_kink_margin_is_decided():
+    """A step states its numbers with symbols whose values its definitions give (ridges-kinks: the seed's
+    half-width w and the margin eta); the scan finds the float literal the step once showed, and the
+    margin's value is checked: eta = 0 puts u_- on the band's edge, where the flag is not set."""
+    from proofs.kinks import ETA, U_IN, W, k_u
+    assert {t.id: _floats_shown(t) for t in THEOREMS.values() if _floats_shown(t)} == {}
+    t = get("ridges-kinks")
+    k = next(k for k, s in enumerate(t.steps, 1) if U_IN in s.defines)
+    assert {W, ETA} <= set(t.steps[k - 1].defines)
+    old = sp.asin(sp.Float(0.03 * (1 - 1e-6), 8), evaluate=False) / (sp.pi * k_u)
+    planted = dataclasses.replace(t, where={**t.where, U_IN: old})
+    assert [j for j, _ in _floats_shown(planted)] == [k]
+    assert t.check().status == "proved"
+    verdict = dataclasses.replace(t, where={**t.where, ETA: sp.Integer(0)}).check()
+    assert verdict.status == "refuted" and verdict.evidence.startswith(f"ridges-kinks, step {k} "), verdict.evidence

@@ -23,7 +23,7 @@ PRINTED = {
     "gradient-sine": "a0d32e32db0c87fd",
     "gradient-ridges": "568dc8dac31dd110",
     "gradient-rings": "c57d5ee6dc25cc0d",
-    "ridges-kinks": "70b312278a292f23",
+    "ridges-kinks": "95eeaf03b0543a5d",
     "kink-loci-rays": "846041ddbb4c7b7a",
     "kink-loci-circles": "2ee79e7e99261d40",
     "no-boundary": "23e06e379e02c039",
