@@ -157,9 +157,9 @@ def _limit(tilt=None, **evidence):
                   r"chart and surface), on sphere A in the renderer's frame, orthonormal by ⟪frame-orthonormal⟫ "
                   r"and left-handed by ⟪frame-orientation⟫, satisfy $⟦limit⟧$ and "
                   r"$N'(\beta) = N + \beta\,\partial N'/\partial\beta|_{\beta=0} + O(\beta^2)$ with $⟦chart⟧$ and "
-                  r"$⟦surface⟧$: the regression is a limit of rate $\beta$.  The rendered images approach the "
-                  r"$\beta = 0$ image at that rate for both pipelines and every height field, and at $\beta = 0$ the "
-                  r"height field does not reach the image.",
+                  r"$⟦surface⟧$: at $\beta = 0$ neither normal depends on the height field, and each returns "
+                  r"to $N$ at rate $\beta$.  (This is about the normals; that the rendered images approach the "
+                  r"$\beta = 0$ image at that rate is measured, in the ledger's evidence, not proved.)",
         steps=(
             Step(r"Both normals are built from $N$, $e_\theta$, $e_\varphi$ by dot products, the same in every "
                  r"orthonormal frame, so take $e_\theta = x$, $e_\varphi = y$, $N = -z$; at $\beta = 0$ both bump "

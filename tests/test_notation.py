@@ -28,7 +28,7 @@ PRINTED = {
     "kink-loci-circles": "2ee79e7e99261d40",
     "no-boundary": "23e06e379e02c039",
     "normal-beta-derivative": "bfde89e2e383c5c0",
-    "beta-zero-regression": "5f38ba005d0ff8b2",
+    "beta-zero-regression": "b47aea0df169fda4",
     "central-difference-truncation": "15fa36211b297057",
     "optimal-step": "65312b82985eb69e",
     "bump-vs-displacement": "312f40d2df1d5e05",
