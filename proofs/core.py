@@ -121,6 +121,7 @@ class Verdict:
     digits: int | None = None
     points: int | None = None
     rendered: int = 0              # renderer outputs (pixels, or frames) the check compared
+    numeric: tuple = ()            # a theorem's steps (numbers) that sympy left and mpmath verified
 
     @property
     def holds(self) -> bool:
@@ -515,6 +516,10 @@ class Step:
 
     The right side may end in ``+ O(x**n)``: the step then holds when the series of lhs - rhs
     about the Order's point vanishes below that order (rule 4 of the module's docstring).
+
+    ``why_numeric``: why sympy does not reduce the step to 0, for a step it leaves to the numerical
+    check (`Verdict.numeric`); the book prints it in the theorem's box, and refuses a box of a
+    numerically verified step without it.
     """
 
     why: str
@@ -526,6 +531,7 @@ class Step:
     cases: tuple = ()
     domain: dict | None = None
     functions: dict | None = None
+    why_numeric: str = ""
 
 
 def calc(lhs, *links, **options):
@@ -819,8 +825,9 @@ def _prove(t: Theorem) -> Verdict:
                f"{', '.join(map(str, numeric))}, which hold{'' if len(numeric) > 1 else 's'} numerically (worst "
                f"residual {worst:.1e} at {POINTS} seeded points, {DIGITS} digits)")
     residual, digits, points = (worst, DIGITS, POINTS) if numeric else (None, None, None)
+    numeric = tuple(numeric)
     if t.evidence is None:
-        return Verdict("verified" if numeric else "proved", summary, residual, digits, points)
+        return Verdict("verified" if numeric else "proved", summary, residual, digits, points, numeric=numeric)
     e = t.evidence()
     if not isinstance(e, Verdict):
         return Verdict("refuted", f"{t.id}: its evidence returned {e!r:.80}, not a Verdict")
@@ -832,4 +839,4 @@ def _prove(t: Theorem) -> Verdict:
     if e.status == "verified" and not numeric:
         residual, digits, points = e.residual, e.digits, e.points
     status = "verified" if numeric or e.status == "verified" else "proved"
-    return Verdict(status, f"{summary}; {e.evidence}", residual, digits, points, e.rendered)
+    return Verdict(status, f"{summary}; {e.evidence}", residual, digits, points, e.rendered, numeric)

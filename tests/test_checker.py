@@ -391,3 +391,40 @@ def test_no_step_shows_a_float_literal_and_the_kink_margin_is_decided():
     assert t.check().status == "proved"
     verdict = dataclasses.replace(t, where={**t.where, ETA: sp.Integer(0)}).check()
     assert verdict.status == "refuted" and verdict.evidence.startswith(f"ridges-kinks, step {k} "), verdict.evidence
+
+
+def _chart_box(monkeypatch, t):
+    from chapter import theorems as book
+    from proofs import registry
+    monkeypatch.setattr(registry, "THEOREMS", {"chart": t})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    return book, (lambda: book.theorem_block("chart"))
+
+
+def test_a_verified_box_names_each_numeric_step_its_points_digits_and_why(monkeypatch):
+    """chart is VERIFIED: its box names the steps sympy left (the verdict's ``numeric``), the points and digits
+    of their check, and each one's reason (``Step.why_numeric``); a box of a proved theorem has none of it."""
+    from chapter.theorems import _cited, _numeric_note, _prose
+    from proofs.core import POINTS, DIGITS
+    t, proved = get("chart"), get("optimal-step")
+    v = t.check()
+    assert v.status == "verified" and v.numeric and all(t.steps[k - 1].why_numeric for k in v.numeric)
+    book, show = _chart_box(monkeypatch, t)
+    statement, _, proof = show().partition(":::{prf:proof}")
+    note = statement[statement.index("**VERIFIED numerically**"):]
+    assert f"{', '.join(map(str, v.numeric))} " in note and f"at {POINTS} seeded points to {DIGITS} digits" in note
+    assert [bool(s.why_numeric) and _prose(_cited(s.why_numeric)) in note for s in t.steps] == \
+        [k in v.numeric for k in range(1, len(t.steps) + 1)]
+    assert _numeric_note(proved, proved.check()) == (None, None)
+
+
+@pytest.mark.parametrize("plant", ["no reason on a numeric step", "a reason on a proved step"])
+def test_a_box_refuses_a_numeric_step_without_its_reason_or_a_reason_on_a_proved_step(monkeypatch, plant):
+    t = get("chart")
+    numeric, steps = t.check().numeric, list(t.steps)
+    k = numeric[-1] if plant.startswith("no") else next(j for j in range(1, len(steps) + 1) if j not in numeric)
+    steps[k - 1] = dataclasses.replace(steps[k - 1], why_numeric="" if plant.startswith("no") else "sympy cannot")
+    book, show = _chart_box(monkeypatch, dataclasses.replace(t, steps=tuple(steps)))
+    with pytest.raises(book.TheoremFailed, match=f"chart: step {k} "):
+        show()
