@@ -229,9 +229,10 @@ def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
         book.theorem_block("chart")
 
 
-def test_a_calc_link_is_shown_by_its_right_side_alone(monkeypatch):
-    """In the theorem's box a step that continues the one before (a calc link) shows "= rhs", as a chain is
-    written; a step that starts afresh shows "lhs = rhs" (optimal-step has both)."""
+def test_a_calc_link_repeats_its_left_side_and_no_display_starts_with_equals(monkeypatch):
+    """In the theorem's box every step shows "lhs = rhs" (or the two aligned lines "&lhs \\\\ &= rhs"), a step
+    that continues the one before (a calc link) too, its left side being that step's right side: no display
+    starts with "=" (optimal-step has links and fresh steps)."""
     from chapter import theorems as book
     from proofs import registry
     t = get("optimal-step")
@@ -241,7 +242,11 @@ def test_a_calc_link_is_shown_by_its_right_side_alone(monkeypatch):
     shown = re.findall(r"\*\*Step \d+\.\*\* [^\n]*\n\n\$\$\n(.*?)\n\$\$", book.theorem_block(t.id), re.S)
     links = [s.link for s in t.steps]
     assert len(shown) == len(t.steps) and True in links and False in links
-    assert [d.startswith("= ") for d in shown] == links, shown
+    sides = [(t.tex(s.lhs), t.tex(s.rhs)) for s in t.steps]
+    assert [d in (f"{a} = {b}", f"\\begin{{aligned}}&{a}\\\\ &= {b}\\end{{aligned}}") for d, (a, b) in zip(shown, sides)] \
+        == [True] * len(t.steps), shown
+    assert not any(d.lstrip().startswith("=") for d in shown)
+    assert all(t.steps[k].lhs == t.steps[k - 1].rhs for k, link in enumerate(links) if link)
 
 
 @pytest.mark.parametrize("order", [0.8, 1.2])

@@ -88,11 +88,12 @@ def _cited(text):
 
 def _proof_step(t, number, step):
     """One step of ``t``'s proof as MyST: "**Step k.** Sentence:" and the display ``lhs = rhs``
-    (``= rhs`` where the step continues a calc chain), two aligned lines where both sides
-    are long, then the definitions the step introduces (``where ...``)."""
+    (a step that continues a calc chain repeats its left side, the step before's right side:
+    no display starts with "="), two aligned lines where both sides are long, then the
+    definitions the step introduces (``where ...``)."""
     lhs, rhs = t.tex(step.lhs), t.tex(step.rhs)
-    shown = f"= {rhs}" if step.link and step.lhs == t.steps[number - 2].rhs else f"{lhs} = {rhs}"
-    if not shown.startswith("=") and len(lhs) + len(rhs) > 200:
+    shown = f"{lhs} = {rhs}"
+    if len(lhs) + len(rhs) > 200:
         shown = f"\\begin{{aligned}}&{lhs}\\\\ &= {rhs}\\end{{aligned}}"
     why = _prose(_cited(step.why.rstrip(".:")))
     where = ", ".join(f"${t.definition_tex(s)}$" for s in step.defines)
