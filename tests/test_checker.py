@@ -369,6 +369,8 @@ def test_a_citation_prints_as_the_theorems_number_and_title_in_the_book_and_its_
     with pytest.raises(KeyError, match="no-such"):
         _cited("by ⟪no-such⟫")
     assert "⟪" not in plain("⟪chart⟫ and ⟪frame-orientation⟫")
+    from chapter.page import plain_markdown       # a box outside the book (a notebook run by a reader)
+    assert plain_markdown(_cited("by ⟪chart⟫, so")) == f"by Theorem ({CITABLE['chart']}), so"
 
 
 def _floats_shown(t):
