@@ -59,7 +59,7 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
    bound 0.0 included; with at least its `RENDERED` count of renderer outputs.
 8. *Citations.*  A statement or a step's sentence names another theorem only by the marker
    ``⟪id⟫`` (`CITATION`), never by its id in words; the id must be a theorem of the registry
-   (`proofs.registry.CITABLE`), or the theorem is refuted.  The book prints the marker as
+   (`CITABLE`, which proofs/registry.py fills), or the theorem is refuted.  The book prints the marker as
    "Theorem n (title)", plain text (`plain`) as its title.
 9. *Claims* (lab/claims.py).  A claim of the draft reaches its registered verdict from
    finite measurements, by its criterion, whose thresholds are the ones its words state.
@@ -95,6 +95,9 @@ SEED = 0
 TOLERANCE_DIGITS = 20
 #: A citation of another theorem in a statement or a step's sentence: ``⟪frame-orthonormal⟫``.
 CITATION = re.compile(r"⟪([^⟫]*)⟫")
+#: id -> title of every theorem that may be cited: filled by proofs/registry.py when it is imported
+#: (this module imports no theorem); a citation while it is empty is refuted, as unknown.
+CITABLE = {}
 
 
 def citations(text) -> list:
@@ -104,10 +107,9 @@ def citations(text) -> list:
 
 def plain(text, titles=None) -> str:
     """``text`` with each citation ``⟪id⟫`` written as ``theorem “title”`` (``titles``: id -> title,
-    `proofs.registry.CITABLE` by default), for the plain text of a verdict or a ledger; an id
+    `CITABLE` by default), for the plain text of a verdict or a ledger; an id
     without a title is left as the marker.  (The book prints "Theorem n (title)".)"""
-    if titles is None:
-        from .registry import CITABLE as titles
+    titles = CITABLE if titles is None else titles
     return CITATION.sub(lambda m: f"theorem “{titles[m.group(1)]}”" if m.group(1) in titles else m.group(0), text)
 
 
@@ -776,11 +778,11 @@ def _rewrites(t, k, step):
 
 def _unknown_citation(t):
     """Why ``t`` breaks rule 8 (a citation ``⟪id⟫`` of an id the registry does not hold), or None."""
-    from .registry import CITABLE
     for where, text in [("its statement", t.statement)] + [(f"step {k}", s.why) for k, s in enumerate(t.steps, 1)]:
         unknown = [i for i in citations(text) if i not in CITABLE]
         if unknown:
-            return f"{t.id}: {where} cites ⟪{unknown[0]}⟫, which is no theorem of the registry"
+            return (f"{t.id}: {where} cites ⟪{unknown[0]}⟫, which is no theorem of the registry"
+                    + ("" if CITABLE else " (proofs.registry, which fills proofs.core.CITABLE, is not imported)"))
         for m in re.finditer(r"\btheorems?\s+`?([\w-]+)", text):
             if m.group(1) in CITABLE:
                 return f"{t.id}: {where} names theorem {m.group(1)} by its id in words: cite it as ⟪{m.group(1)}⟫"
