@@ -111,12 +111,12 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
             r"$(-2\pi R\sin\varphi, -\pi R)$, $⟦factors⟧$: the opposite sign, and the chart's metric factors "
             r"missing."),
         steps=(
-            Step(r"By the chain rule with $\theta = 2\pi u - \pi$ and $\varphi = \pi v$ (theorem chart), "
+            Step(r"By the chain rule with $\theta = 2\pi u - \pi$ and $\varphi = \pi v$ of ⟪chart⟫, "
                  r"$P_u = 2\pi\,\partial P/\partial\theta$ and $P_v = \pi\,\partial P/\partial\varphi$, with "
                  r"$\partial N/\partial\theta = \sin\varphi\, e_\theta$, $\partial N/\partial\varphi = e_\varphi$ "
-                 r"(theorem frame-orthonormal)", frame, sp.Tuple(2 * sp.pi * R * s * ET_S, sp.pi * R * EP_S)),
+                 r"by ⟪frame-orthonormal⟫", frame, sp.Tuple(2 * sp.pi * R * s * ET_S, sp.pi * R * EP_S)),
             Step(r"So $N_B = P_u \times P_v = 2\pi^2 R^2 \sin\varphi\,(e_\theta \times e_\varphi)$, and $e_\theta "
-                 r"\times e_\varphi = -N$ (theorem frame-orientation): Blinn's normal points into the sphere, "
+                 r"\times e_\varphi = -N$ by ⟪frame-orientation⟫: Blinn's normal points into the sphere, "
                  r"$\lvert N_B\rvert = 2\pi^2 R^2\sin\varphi$, and the outward displacement is $F = -\beta h$", NB_S,
                  inward, using=(1,)),
             Step(r"His $N'_B$, with $F_u = -\beta h_u$, $F_v = -\beta h_v$ and steps 1 and 2, is built from $N$, "

@@ -57,7 +57,11 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
 7. *Pins* (proofs/registry.py).  A verdict passes its pin only as "proved" for a pin
    "proved", or as "verified" with a residual at most ``bound`` for ("verified", bound),
    bound 0.0 included; with at least its `RENDERED` count of renderer outputs.
-8. *Claims* (lab/claims.py).  A claim of the draft reaches its registered verdict from
+8. *Citations.*  A statement or a step's sentence names another theorem only by the marker
+   ``⟪id⟫`` (`CITATION`), never by its id in words; the id must be a theorem of the registry
+   (`CITABLE`, which proofs/registry.py fills), or the theorem is refuted.  The book prints the marker as
+   "Theorem n (title)", plain text (`plain`) as its title.
+9. *Claims* (lab/claims.py).  A claim of the draft reaches its registered verdict from
    finite measurements, by its criterion, whose thresholds are the ones its words state.
 """
 
@@ -78,7 +82,7 @@ from sympy.printing.conventions import requires_partial
 from sympy.printing.latex import LatexPrinter
 from sympy.printing.precedence import PRECEDENCE
 
-__all__ = ["Verdict", "Identity", "Step", "calc", "Theorem", "variant", "check_identities", "tex", "written", "Dot",
+__all__ = ["CITATION", "citations", "plain", "Verdict", "Identity", "Step", "calc", "Theorem", "variant", "check_identities", "tex", "written", "Dot",
            "Cross", "Jacobian", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
@@ -89,6 +93,24 @@ POINTS = 24
 SEED = 0
 #: A residual below 10**(-TOLERANCE_DIGITS) at DIGITS of precision counts as zero.
 TOLERANCE_DIGITS = 20
+#: A citation of another theorem in a statement or a step's sentence: ``⟪frame-orthonormal⟫``.
+CITATION = re.compile(r"⟪([^⟫]*)⟫")
+#: id -> title of every theorem that may be cited: filled by proofs/registry.py when it is imported
+#: (this module imports no theorem); a citation while it is empty is refuted, as unknown.
+CITABLE = {}
+
+
+def citations(text) -> list:
+    """The theorem ids ``text`` cites (`CITATION`), in order."""
+    return CITATION.findall(text)
+
+
+def plain(text, titles=None) -> str:
+    """``text`` with each citation ``⟪id⟫`` written as ``theorem “title”`` (``titles``: id -> title,
+    `CITABLE` by default), for the plain text of a verdict or a ledger; an id
+    without a title is left as the marker.  (The book prints "Theorem n (title)".)"""
+    titles = CITABLE if titles is None else titles
+    return CITATION.sub(lambda m: f"theorem “{titles[m.group(1)]}”" if m.group(1) in titles else m.group(0), text)
 
 
 @dataclass(frozen=True)
@@ -101,6 +123,7 @@ class Verdict:
     digits: int | None = None
     points: int | None = None
     rendered: int = 0              # renderer outputs (pixels, or frames) the check compared
+    numeric: tuple = ()            # a theorem's steps (numbers) that sympy left and mpmath verified
 
     @property
     def holds(self) -> bool:
@@ -495,6 +518,10 @@ class Step:
 
     The right side may end in ``+ O(x**n)``: the step then holds when the series of lhs - rhs
     about the Order's point vanishes below that order (rule 4 of the module's docstring).
+
+    ``why_numeric``: why sympy does not reduce the step to 0, for a step it leaves to the numerical
+    check (`Verdict.numeric`); the book prints it in the theorem's box, and refuses a box of a
+    numerically verified step without it.
     """
 
     why: str
@@ -506,6 +533,7 @@ class Step:
     cases: tuple = ()
     domain: dict | None = None
     functions: dict | None = None
+    why_numeric: str = ""
 
 
 def calc(lhs, *links, **options):
@@ -748,10 +776,26 @@ def _rewrites(t, k, step):
     return out
 
 
+def _unknown_citation(t):
+    """Why ``t`` breaks rule 8 (a citation ``⟪id⟫`` of an id the registry does not hold), or None."""
+    for where, text in [("its statement", t.statement)] + [(f"step {k}", s.why) for k, s in enumerate(t.steps, 1)]:
+        unknown = [i for i in citations(text) if i not in CITABLE]
+        if unknown:
+            return (f"{t.id}: {where} cites ⟪{unknown[0]}⟫, which is no theorem of the registry"
+                    + ("" if CITABLE else " (proofs.registry, which fills proofs.core.CITABLE, is not imported)"))
+        for m in re.finditer(r"\btheorems?\s+`?([\w-]+)", text):
+            if m.group(1) in CITABLE:
+                return f"{t.id}: {where} names theorem {m.group(1)} by its id in words: cite it as ⟪{m.group(1)}⟫"
+    return None
+
+
 def _prove(t: Theorem) -> Verdict:
+    unknown = _unknown_citation(t)
+    if unknown:
+        return Verdict("refuted", unknown)
     decided = []                   # (step number, verdict) of every step and link
     for k, step in enumerate(t.steps, 1):
-        name = f"{t.id}, step {k} ({step.why.rstrip('.:')})"
+        name = f"{t.id}, step {k} ({plain(step.why).rstrip('.:')})"
         rewrites = _rewrites(t, k, step)
         if isinstance(rewrites, str):
             return Verdict("refuted", f"{name} {rewrites}")
@@ -783,8 +827,9 @@ def _prove(t: Theorem) -> Verdict:
                f"{', '.join(map(str, numeric))}, which hold{'' if len(numeric) > 1 else 's'} numerically (worst "
                f"residual {worst:.1e} at {POINTS} seeded points, {DIGITS} digits)")
     residual, digits, points = (worst, DIGITS, POINTS) if numeric else (None, None, None)
+    numeric = tuple(numeric)
     if t.evidence is None:
-        return Verdict("verified" if numeric else "proved", summary, residual, digits, points)
+        return Verdict("verified" if numeric else "proved", summary, residual, digits, points, numeric=numeric)
     e = t.evidence()
     if not isinstance(e, Verdict):
         return Verdict("refuted", f"{t.id}: its evidence returned {e!r:.80}, not a Verdict")
@@ -796,4 +841,4 @@ def _prove(t: Theorem) -> Verdict:
     if e.status == "verified" and not numeric:
         residual, digits, points = e.residual, e.digits, e.points
     status = "verified" if numeric or e.status == "verified" else "proved"
-    return Verdict(status, f"{summary}; {e.evidence}", residual, digits, points, e.rendered)
+    return Verdict(status, f"{summary}; {e.evidence}", residual, digits, points, e.rendered, numeric)

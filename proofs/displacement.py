@@ -208,13 +208,13 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
         steps=(
             *calc(cross,
                   (r"Differentiate $P = (R + \beta H)N$, with $\partial N/\partial\theta = \sin\varphi\, e_\theta$ and "
-                   r"$\partial N/\partial\varphi = e_\varphi$ (theorem frame-orthonormal)",
+                   r"$\partial N/\partial\varphi = e_\varphi$ by ⟪frame-orthonormal⟫",
                    Cross(beta * H_p * N_S + (R + beta * H_at) * EP_S,
                          beta * H_t * N_S + (R + beta * H_at) * sp.sin(phi) * ET_S)),
-                  (r"Expand: $N \times N = 0$, and the frame is left-handed (theorem frame-orientation), so "
+                  (r"Expand: $N \times N = 0$, and the frame is left-handed by ⟪frame-orientation⟫, so "
                    r"$e_\varphi \times e_\theta = N$, $N \times e_\theta = -e_\varphi$ and $e_\varphi \times N = "
                    r"-e_\theta$", claim)),
-            Step(r"In chart terms $H_\theta = h_u/2\pi$ and $H_\varphi = h_v/\pi$ (theorem chart); the renderer's "
+            Step(r"In chart terms $H_\theta = h_u/2\pi$ and $H_\varphi = h_v/\pi$ by ⟪chart⟫; the renderer's "
                  r"`bump='surface'` coefficients of $e_\theta$ and $e_\varphi$, off its pole floor, are the bracket's",
                  coeffs, chart),
             Step(r"To first order in $\beta$ the normal of $P = (R + \beta G)N$ tilts by $-\beta\,(G_\theta/(R\sin"

@@ -101,11 +101,17 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
                    r"derivatives of $h$."),
         steps=(
             Step(r"At $N(\theta, \varphi)$ the radicand is $\sin^2\varphi\,(\cos^2\theta + \sin^2\theta) = "
-                 r"\sin^2\varphi$, and $\sin\varphi > 0$ for $0 < \varphi < \pi$", sin_kernel, sp.sin(phi)),
+                 r"\sin^2\varphi$, and $\sin\varphi > 0$ for $0 < \varphi < \pi$", sin_kernel, sp.sin(phi),
+                 why_numeric=r"sympy leaves $\sqrt{\sin^2\varphi}$ as $\lvert\sin\varphi\rvert$: its symbol "
+                             r"$\varphi$ is real, with no interval to tell it $\sin\varphi > 0$"),
             Step(r"Both arguments of atan2 carry the factor $\sin\varphi > 0$, which leaves the angle unchanged, and "
-                 r"$\mathrm{atan2}(\sin\theta, \cos\theta) = \theta$ for $-\pi < \theta < \pi$", u_kernel, u_claim),
+                 r"$\mathrm{atan2}(\sin\theta, \cos\theta) = \theta$ for $-\pi < \theta < \pi$", u_kernel, u_claim,
+                 why_numeric=r"sympy simplifies neither the positive factor out of atan2 nor "
+                             r"$\mathrm{atan2}(\sin\theta, \cos\theta)$ to $\theta$, true on one branch only"),
             Step(r"By step 1 the first argument is $\sin\varphi$, and $\mathrm{atan2}(\sin\varphi, \cos\varphi) "
-                 r"= \varphi$ for $0 < \varphi < \pi$", v_kernel, V_OF_PHI),
+                 r"= \varphi$ for $0 < \varphi < \pi$", v_kernel, V_OF_PHI,
+                 why_numeric=r"as in step 2, sympy does not reduce $\mathrm{atan2}(\sin\varphi, \cos\varphi)$ "
+                             r"to $\varphi$, true on $0 < \varphi < \pi$ only"),
             Step("Differentiate $u$ and $v$", rates, sp.Tuple(*RATES_CLAIMED)),
         ),
         claims={"u": (u_kernel, u_claim), "v": (v_kernel, V_OF_PHI), "sin": (sin_kernel, sp.sin(phi)),
@@ -175,7 +181,7 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
                    rf"$e_\varphi = {vector_latex(REGULAR[3:])}$, at $N(\theta, \varphi)$, satisfies "
                    r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
         steps=(
-            *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ (theorem chart), "
+            *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ by ⟪chart⟫, "
                          r"$e_\theta = (-N_y, N_x, 0)/\sin\varphi$ is", sp.Matrix([-sp.sin(theta), sp.cos(theta), 0])),
                   (r"This is $\partial N/\partial\theta = \sin\varphi\,(-\sin\theta, \cos\theta, 0)$ divided by "
                    r"$\sin\varphi$", d_theta)),
@@ -232,7 +238,7 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
                   rf"($\sin\varphi \le {tex(sp.Float(F.POLE_SIN_PHI, 2))}$) has $⟦fallback⟧$: right-handed at the "
                   r"north pole, where the outward normal is $+z$.",
         steps=(
-            Step(r"Cross the frame of theorem frame-orthonormal: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
+            Step(r"Cross the frame of ⟪frame-orthonormal⟫: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
                  r"\cos\theta, \cos\varphi\sin\theta, -\sin\varphi) = (-\sin\varphi\cos\theta, -\sin\varphi\sin\theta, "
                  r"-\cos\varphi)$", Cross(ET_S, EP_S), -N_S),
             *calc(triple, ("Dot both sides of step 1 with $N$", -Dot(N_S, N_S)),

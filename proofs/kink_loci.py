@@ -190,8 +190,8 @@ def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
             Step(r"Project $P = R\,N(\theta, \varphi)$ from the eye $(0, 0, e)$ onto the image plane $z = 0$: its "
                  r"$x$ and $y$ scale by $e/(e - P_z)$, and $P_z = R\cos\varphi$", sp.Tuple(X, Y), polar,
                  defines=(rho(phi),)),
-            Step(r"So the image point's polar angle $\alpha$ is $\theta$, and $u = (\theta + \pi)/2\pi$ (theorem "
-                 r"chart) is a function of $\alpha$ alone; $u = m/k_u$ on the ray", ray, m_sym / F.k_u,
+            Step(r"So the image point's polar angle $\alpha$ is $\theta$, and $u = (\theta + \pi)/2\pi$, by ⟪chart⟫, "
+                 r"is a function of $\alpha$ alone; $u = m/k_u$ on the ray", ray, m_sym / F.k_u,
                  defines=(alpha_m,)),
         ),
         claims={"polar": (sp.Tuple(X, Y), polar), "ray": (ray, m_sym / F.k_u)},
@@ -219,7 +219,7 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
                   r"$⟦slope⟧ > 0$ on the visible cap, where $⟦facing⟧ > 0$. The crease $v = m/k_v$ is the circle of "
                   r"radius $\rho(\pi m/k_v)$, visible when $\cos(\pi m/k_v) > R/e$.",
         steps=(
-            Step(r"By theorem kink-loci-rays, $x^2 + y^2 = \rho(\varphi)^2 (\cos^2\theta + \sin^2\theta)$", radius,
+            Step(r"By ⟪kink-loci-rays⟫, $x^2 + y^2 = \rho(\varphi)^2 (\cos^2\theta + \sin^2\theta)$", radius,
                  rho(phi)**2),
             Step(r"Differentiate $\rho(\varphi) = eR\sin\varphi/(e - R\cos\varphi)$ with the quotient rule", slope,
                  drho),

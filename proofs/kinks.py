@@ -30,6 +30,11 @@ DOMAIN = {u: (0.0, 1.0), v: (0.0, 1.0), k_u: (0.5, 12.0), k_v: (0.5, 12.0), c: (
 #: The crease flag's half-width (seed Cell 1, ``height1``: |s1| < 0.03 or |s2| < 0.03).
 SEED_HALF_WIDTH = sp.Rational(3, 100)
 
+#: The seed's half-width and the relative margin of the points just inside and just outside it,
+#: named in the proof (their values in its ``where``: 3/100 and 10^-6).
+W, ETA = sp.symbols("w eta", positive=True)
+MARGIN = sp.Rational(1, 10**6)
+
 #: The one-sided derivatives the proof names: h_u^+, h_u^- on u = m/k_u, h_v^+, h_v^- on v = m/k_v.
 HU_P, HU_M, HV_P, HV_M = sp.symbols("h_u^+ h_u^- h_v^+ h_v^-")
 #: The renderer's crease flag as a function of (u, v): 1 where KINK_BAND holds, else 0.
@@ -51,16 +56,15 @@ def _ridges(jump_u, jump_v, band=BAND):
     on_v = one_sided(h.subs(FACTORS[0], c), v, m / k_v)
     jumps, values = sp.Tuple(HU_P - HU_M, HV_P - HV_M), sp.Tuple(jump_u, jump_v)
     on_lines = sp.Tuple(crease(m / k_u, v), crease(u, m / k_v))
-    # Just inside and just outside the seed's half-width: |s| = 0.03 (1 -+ 1e-6), where the other factor is 1.
-    w_in, w_out = (sp.asin(sp.Float(SEED_HALF_WIDTH * (1 + s * sp.Rational(1, 10**6)), 8), evaluate=False)
-                   for s in (-1, 1))
+    # Just inside and just outside the seed's half-width: |s| = w (1 -+ eta), where the other factor is 1.
+    w_in, w_out = (sp.asin(W * (1 + s * ETA), evaluate=False) for s in (-1, 1))
     edges = {"u": sp.Tuple(crease(U_IN, 1 / (2 * k_v)), crease(U_OUT, 1 / (2 * k_v))),
              "v": sp.Tuple(crease(1 / (2 * k_u), V_IN), crease(1 / (2 * k_u), V_OUT))}
     return Theorem(
         id="ridges-kinks", title="The creases of the ridges field",
         statement=r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
                   r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
-                  r"(`RIDGE_FACTORS`) is differentiable wherever $s_1 s_2 \ne 0$ (theorem gradient-ridges). "
+                  r"(`RIDGE_FACTORS`) is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-ridges⟫. "
                   r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, the "
                   r"one-sided derivatives $h_u^\pm$ differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$, a crease. "
                   r"The renderer's crease flag (`KINK_BAND`) is set on every zero line, $⟦lines⟧$, and where "
@@ -76,18 +80,18 @@ def _ridges(jump_u, jump_v, band=BAND):
             Step(r"So they differ by $2\pi k_u\lvert c\rvert$; the same limits with $u$ and $v$ exchanged give "
                  r"$h_v^\pm$ on $v = m/k_v$", jumps, values),
             Step("The crease flag is set on both lines, where one factor is 0", on_lines, sp.Tuple(1, 1)),
-            Step(r"Where $s_2 = 1$ it is set at $u_-$, where $\lvert s_1\rvert = 0.03\,(1 - 10^{-6})$ is just inside "
-                 r"the seed's half-width, and not at $u_+$, just outside", edges["u"], sp.Tuple(1, 0),
-                 defines=(U_IN, U_OUT)),
+            Step(r"Where $s_2 = 1$ it is set at $u_-$, where $\lvert s_1\rvert = w\,(1 - \eta)$ is just inside "
+                 r"the seed's half-width $w$, and not at $u_+$, just outside", edges["u"], sp.Tuple(1, 0),
+                 defines=(U_IN, U_OUT, W, ETA)),
             Step(r"Likewise across $v$, where $s_1 = 1$", edges["v"], sp.Tuple(1, 0), defines=(V_IN, V_OUT)),
         ),
         claims={"jumps": (jumps, values), "lines": (on_lines, sp.Tuple(1, 1))},
         where={HU_P: on_u[0], HU_M: on_u[1], HV_P: on_v[0], HV_M: on_v[1],
                crease: sp.Lambda((u, v), sp.Piecewise((1, band), (0, True))),
                U_IN: w_in / (sp.pi * k_u), U_OUT: w_out / (sp.pi * k_u), V_IN: w_in / (sp.pi * k_v),
-               V_OUT: w_out / (sp.pi * k_v)},
+               V_OUT: w_out / (sp.pi * k_v), W: SEED_HALF_WIDTH, ETA: MARGIN},
         names={HU_P: r"h_u^+", HU_M: r"h_u^-", HV_P: r"h_v^+", HV_M: r"h_v^-", crease: r"\mathrm{crease}",
-               U_IN: "u_-", U_OUT: "u_+", V_IN: "v_-", V_OUT: "v_+"},
+               U_IN: "u_-", U_OUT: "u_+", V_IN: "v_-", V_OUT: "v_+", ETA: r"\eta"},
         domain=DOMAIN,
         wrong_variants=(
             ("jump without the factor 2", lambda: _ridges(sp.pi * k_u * sp.Abs(c), JUMP_V).check()),

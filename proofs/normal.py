@@ -154,17 +154,17 @@ def _limit(tilt=None, **evidence):
     return Theorem(
         id="beta-zero-regression", title="The β → 0 limit",
         statement=r"Both of the renderer's perturbed normals (`renderer.formulas.PERTURBED_NORMAL`, bump modes "
-                  r"chart and surface), on sphere A in the renderer's frame (orthonormal and left-handed: theorems "
-                  r"frame-orthonormal, frame-orientation), satisfy $⟦limit⟧$ and "
+                  r"chart and surface), on sphere A in the renderer's frame, orthonormal by ⟪frame-orthonormal⟫ "
+                  r"and left-handed by ⟪frame-orientation⟫, satisfy $⟦limit⟧$ and "
                   r"$N'(\beta) = N + \beta\,\partial N'/\partial\beta|_{\beta=0} + O(\beta^2)$ with $⟦chart⟧$ and "
-                  r"$⟦surface⟧$: the regression is a limit of rate $\beta$.  The rendered images approach the "
-                  r"$\beta = 0$ image at that rate for both pipelines and every height field, and at $\beta = 0$ the "
-                  r"height field does not reach the image.",
+                  r"$⟦surface⟧$: at $\beta = 0$ neither normal depends on the height field, and each returns "
+                  r"to $N$ at rate $\beta$.  (This is about the normals; that the rendered images approach the "
+                  r"$\beta = 0$ image at that rate is measured, in the ledger's evidence, not proved.)",
         steps=(
             Step(r"Both normals are built from $N$, $e_\theta$, $e_\varphi$ by dot products, the same in every "
                  r"orthonormal frame, so take $e_\theta = x$, $e_\varphi = y$, $N = -z$; at $\beta = 0$ both bump "
                  r"modes leave $M = N$, a unit vector", at_zero, sp.Tuple(N_SPHERE, N_SPHERE)),
-            Step(r"By theorem normal-beta-derivative at $\beta = 0$, where $N' = N$ and $\lVert M\rVert = 1$, the "
+            Step(r"By ⟪normal-beta-derivative⟫ at $\beta = 0$, where $N' = N$ and $\lVert M\rVert = 1$, the "
                  r"chart mode tilts by the part of $g$ orthogonal to $N$, which is $g$ itself", slope["chart"],
                  tilt["chart"]),
             Step(r"The displaced sphere's $M = N - \frac{\beta}{R + \beta h}\bigl(\frac{h_u}{2\pi\sin\varphi} "

@@ -1,11 +1,16 @@
 """All theorems of the chapter, by id, and the verdict each must reach."""
 
-from . import blinn, displacement, finite_difference, frame, gradients, kink_loci, kinks, no_boundary, normal
+from . import blinn, core, displacement, finite_difference, frame, gradients, kink_loci, kinks, no_boundary, normal
 
 #: id -> Theorem, in the order the chapter uses them.
 THEOREMS = {t.id: t for mod in (frame, gradients, kinks, kink_loci, no_boundary, normal,
                                         finite_difference, displacement, blinn)
             for t in mod.THEOREMS}
+
+#: id -> title of every theorem a statement or a step may cite (``⟪id⟫``, rule 8 of proofs.core):
+#: proofs.core.CITABLE, filled here (the engine imports no theorem).
+CITABLE = core.CITABLE
+CITABLE.update({theorem_id: t.title for theorem_id, t in THEOREMS.items()})
 
 #: The verdict each theorem must reach: "proved" (sympy decided every step
 #: of its proof, and its evidence holds) or ("verified", bound): sympy left a

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from proofs.registry import PINNED, RENDERED, THEOREMS, get, pin, pinned_failure
+from proofs.core import CITATION, plain
+from proofs.registry import CITABLE, PINNED, RENDERED, THEOREMS, get, pin, pinned_failure
 from verify.test_theorems import _placed
 
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
@@ -130,7 +131,8 @@ def test_a_wrong_step_is_refuted_and_named(theorem_id, k):
     steps[k - 1] = dataclasses.replace(steps[k - 1], rhs=_wrong(steps[k - 1].rhs))
     verdict = dataclasses.replace(t, steps=tuple(steps)).check()
     assert verdict.status == "refuted", verdict.evidence
-    assert verdict.evidence.startswith(f"{theorem_id}, step {k} ({t.steps[k - 1].why.rstrip('.:')})"), verdict.evidence
+    assert verdict.evidence.startswith(f"{theorem_id}, step {k} ({plain(t.steps[k - 1].why).rstrip('.:')})"), \
+        verdict.evidence
 
 
 def test_no_sentence_is_shared_between_theorems():
@@ -227,9 +229,10 @@ def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
         book.theorem_block("chart")
 
 
-def test_a_calc_link_is_shown_by_its_right_side_alone(monkeypatch):
-    """In the theorem's box a step that continues the one before (a calc link) shows "= rhs", as a chain is
-    written; a step that starts afresh shows "lhs = rhs" (optimal-step has both)."""
+def test_a_calc_link_repeats_its_left_side_and_no_display_starts_with_equals(monkeypatch):
+    """In the theorem's box every step shows "lhs = rhs" (or the two aligned lines "&lhs \\\\ &= rhs"), a step
+    that continues the one before (a calc link) too, its left side being that step's right side: no display
+    starts with "=" (optimal-step has links and fresh steps)."""
     from chapter import theorems as book
     from proofs import registry
     t = get("optimal-step")
@@ -239,7 +242,11 @@ def test_a_calc_link_is_shown_by_its_right_side_alone(monkeypatch):
     shown = re.findall(r"\*\*Step \d+\.\*\* [^\n]*\n\n\$\$\n(.*?)\n\$\$", book.theorem_block(t.id), re.S)
     links = [s.link for s in t.steps]
     assert len(shown) == len(t.steps) and True in links and False in links
-    assert [d.startswith("= ") for d in shown] == links, shown
+    sides = [(t.tex(s.lhs), t.tex(s.rhs)) for s in t.steps]
+    assert [d in (f"{a} = {b}", f"\\begin{{aligned}}&{a}\\\\ &= {b}\\end{{aligned}}") for d, (a, b) in zip(shown, sides)] \
+        == [True] * len(t.steps), shown
+    assert not any(d.lstrip().startswith("=") for d in shown)
+    assert all(t.steps[k].lhs == t.steps[k - 1].rhs for k, link in enumerate(links) if link)
 
 
 @pytest.mark.parametrize("order", [0.8, 1.2])
@@ -318,3 +325,113 @@ def test_a_theorem_step_that_cannot_be_evaluated_refutes_the_theorem():
                 domain={x: (0.1, 0.9)})
     v = dataclasses.replace(t, steps=(*t.steps, step), claims={}).check()
     assert v.status == "refuted" and "cannot be evaluated at x=" in v.evidence, v
+
+
+def _cite_in(t, k, text):
+    """``t`` with ``text`` appended to step k's sentence (k = 0: to the statement)."""
+    if k == 0:
+        return dataclasses.replace(t, statement=t.statement + " " + text)
+    steps = list(t.steps)
+    steps[k - 1] = dataclasses.replace(steps[k - 1], why=steps[k - 1].why + " " + text)
+    return dataclasses.replace(t, steps=tuple(steps))
+
+
+@pytest.mark.parametrize("k", [0, 1])
+def test_rule_8_a_citation_of_an_unknown_id_is_refuted(k):
+    """A statement or step citing ⟪id⟫ of no registered theorem is refuted, naming the id; the same
+    citation of a registered id holds."""
+    t = get("frame-orientation")
+    verdict = _cite_in(t, k, "by ⟪frame-orthonormals⟫").check()
+    assert verdict.status == "refuted" and "⟪frame-orthonormals⟫" in verdict.evidence, verdict.evidence
+    assert _cite_in(t, k, "by ⟪frame-orthonormal⟫").check().status == "proved"
+
+
+@pytest.mark.parametrize("words", ["theorem frame-orthonormal", "theorems `chart`"])
+def test_rule_8_a_theorem_named_by_its_id_in_words_is_refuted(words):
+    verdict = _cite_in(get("frame-orientation"), 1, f"(by {words})").check()
+    assert verdict.status == "refuted" and "by its id in words" in verdict.evidence, verdict.evidence
+
+
+def test_no_text_names_a_theorem_by_its_id_and_every_citation_is_known():
+    cited = set()
+    for t in THEOREMS.values():
+        for text in [t.statement] + [s.why for s in t.steps]:
+            cited |= set(CITATION.findall(text))
+            assert not re.search(r"\btheorems? `?(" + "|".join(map(re.escape, THEOREMS)) + r")\b", text), (t.id, text)
+    assert cited and cited <= set(THEOREMS)
+    assert set(CITABLE) == set(THEOREMS)
+
+
+def test_a_citation_prints_as_the_theorems_number_and_title_in_the_book_and_its_title_in_plain_text():
+    from chapter.theorems import _cited
+    assert _cited("by ⟪chart⟫, so") == f"by {{prf:ref}}`thm-chart` ({CITABLE['chart']}), so"
+    assert plain("by ⟪chart⟫, so") == f"by theorem “{CITABLE['chart']}”, so"
+    with pytest.raises(KeyError, match="no-such"):
+        _cited("by ⟪no-such⟫")
+    assert "⟪" not in plain("⟪chart⟫ and ⟪frame-orientation⟫")
+    from chapter.page import plain_markdown       # a box outside the book (a notebook run by a reader)
+    assert plain_markdown(_cited("by ⟪chart⟫, so")) == f"by Theorem ({CITABLE['chart']}), so"
+
+
+def _floats_shown(t):
+    """[(step number, Float)] of the float literals a step of ``t`` shows: in its two sides, or in the
+    definitions of the symbols it defines (`Step.defines`)."""
+    def floats(x):
+        x = sp.sympify(x)
+        return x.atoms(sp.Float) if isinstance(x, sp.Basic) else set()
+    return [(k, f) for k, s in enumerate(t.steps, 1)
+            for f in floats(s.lhs) | floats(s.rhs) | set().union(*[floats(t.where[d]) for d in s.defines])]
+
+
+def test_no_step_shows_a_float_literal_and_the_kink_margin_is_decided():
+    """A step states its numbers with symbols whose values its definitions give (ridges-kinks: the seed's
+    half-width w and the margin eta); the scan finds the float literal the step once showed, and the
+    margin's value is checked: eta = 0 puts u_- on the band's edge, where the flag is not set."""
+    from proofs.kinks import ETA, U_IN, W, k_u
+    assert {t.id: _floats_shown(t) for t in THEOREMS.values() if _floats_shown(t)} == {}
+    t = get("ridges-kinks")
+    k = next(k for k, s in enumerate(t.steps, 1) if U_IN in s.defines)
+    assert {W, ETA} <= set(t.steps[k - 1].defines)
+    old = sp.asin(sp.Float(0.03 * (1 - 1e-6), 8), evaluate=False) / (sp.pi * k_u)
+    planted = dataclasses.replace(t, where={**t.where, U_IN: old})
+    assert [j for j, _ in _floats_shown(planted)] == [k]
+    assert t.check().status == "proved"
+    verdict = dataclasses.replace(t, where={**t.where, ETA: sp.Integer(0)}).check()
+    assert verdict.status == "refuted" and verdict.evidence.startswith(f"ridges-kinks, step {k} "), verdict.evidence
+
+
+def _chart_box(monkeypatch, t):
+    from chapter import theorems as book
+    from proofs import registry
+    monkeypatch.setattr(registry, "THEOREMS", {"chart": t})
+    monkeypatch.setattr(book.store, "_MEMORY", {})
+    monkeypatch.delenv(book.store.ENV, raising=False)
+    return book, (lambda: book.theorem_block("chart"))
+
+
+def test_a_verified_box_names_each_numeric_step_its_points_digits_and_why(monkeypatch):
+    """chart is VERIFIED: its box names the steps sympy left (the verdict's ``numeric``), the points and digits
+    of their check, and each one's reason (``Step.why_numeric``); a box of a proved theorem has none of it."""
+    from chapter.theorems import _cited, _numeric_note, _prose
+    from proofs.core import POINTS, DIGITS
+    t, proved = get("chart"), get("optimal-step")
+    v = t.check()
+    assert v.status == "verified" and v.numeric and all(t.steps[k - 1].why_numeric for k in v.numeric)
+    book, show = _chart_box(monkeypatch, t)
+    statement, _, proof = show().partition(":::{prf:proof}")
+    note = statement[statement.index("**VERIFIED numerically**"):]
+    assert f"{', '.join(map(str, v.numeric))} " in note and f"at {POINTS} seeded points to {DIGITS} digits" in note
+    assert [bool(s.why_numeric) and _prose(_cited(s.why_numeric)) in note for s in t.steps] == \
+        [k in v.numeric for k in range(1, len(t.steps) + 1)]
+    assert _numeric_note(proved, proved.check()) == (None, None)
+
+
+@pytest.mark.parametrize("plant", ["no reason on a numeric step", "a reason on a proved step"])
+def test_a_box_refuses_a_numeric_step_without_its_reason_or_a_reason_on_a_proved_step(monkeypatch, plant):
+    t = get("chart")
+    numeric, steps = t.check().numeric, list(t.steps)
+    k = numeric[-1] if plant.startswith("no") else next(j for j in range(1, len(steps) + 1) if j not in numeric)
+    steps[k - 1] = dataclasses.replace(steps[k - 1], why_numeric="" if plant.startswith("no") else "sympy cannot")
+    book, show = _chart_box(monkeypatch, dataclasses.replace(t, steps=tuple(steps)))
+    with pytest.raises(book.TheoremFailed, match=f"chart: step {k} "):
+        show()

@@ -222,6 +222,11 @@ def test_a_step_undecided_by_sympy_makes_the_theorem_verified_with_its_residual(
     assert v.status == "verified" and v.residual < 1e-25 and (v.digits, v.points) == (core.DIGITS, core.POINTS)
     assert v.evidence.startswith("1 steps, reduced to 0 by sympy but for step 1, which holds numerically (worst "
                                  "residual") and "; " not in v.evidence       # the ledger shows it up to a "; "
+    assert v.numeric == (1,)                     # the steps sympy left, for the book's box to name
+    proved = dataclasses.replace(t, steps=(Step("complementary angles", sp.atan(x_) + sp.atan(1 / x_),
+                                                sp.atan(x_) + sp.atan(1 / x_)),),
+                                 claims={"arc": (sp.atan(x_) + sp.atan(1 / x_), sp.atan(x_) + sp.atan(1 / x_))})
+    assert (proved.check().status, proved.check().numeric) == ("proved", ())
 
 
 def test_named_symbols_are_printed_and_substituted_when_checked():

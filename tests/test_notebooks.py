@@ -246,3 +246,27 @@ def test_a_downloaded_notebook_runs_in_a_new_environment_with_the_wheel(book_htm
                    for src in re.findall(r'<img[^>]* src="(_images/[^"]+\.png)"', html))
     drawn = Counter(hashlib.sha256(base64.b64decode(png)).hexdigest() for _, png in shown)
     assert drawn == site
+
+
+
+
+def test_a_citation_reads_as_the_theorems_number_and_title_on_the_page(book_html):
+    """A proof's citation ⟪id⟫ (proofs/core.py, rule 8) on the site: a link to the theorem's box reading
+    "Theorem n", n the number the box's heading shows, then its title in parentheses, as the heading reads.
+    (A notebook shows the box when its cell runs, outside the book: "Theorem (title)", unnumbered like the
+    box's heading there; tests/test_checker.py.)"""
+    from proofs.core import CITATION
+    from proofs.registry import CITABLE, THEOREMS
+    pages = {p.name: unescape(p.read_text(encoding="utf-8")) for p in book_html.glob("s[0-9]_*.html")}
+    cited = {i for t in THEOREMS.values() for text in [t.statement] + [s.why for s in t.steps]
+             for i in CITATION.findall(text)}
+    assert cited
+    for theorem_id in cited:
+        links = [(page or name, n, title) for name, html in pages.items() for page, n, title in
+                 re.findall(rf'href="([\w.]*)#thm-{re.escape(theorem_id)}">Theorem (\d+)</a> \(([^)]*)\)', html)]
+        assert links and {title for *_, title in links} == {CITABLE[theorem_id]}, (theorem_id, links)
+        home = {name for name, html in pages.items() if f'id="thm-{theorem_id}"' in html}
+        assert len(home) == 1 and {page for page, *_ in links} <= home, (theorem_id, links, home)
+        heading = re.search(rf'id="thm-{re.escape(theorem_id)}">\s*<p[^>]*><span[^>]*>Theorem (\d+) </span> '
+                            rf'\(([^)]*)\)', pages[home.pop()])
+        assert heading and heading[2] == CITABLE[theorem_id] and {n for _, n, _ in links} == {heading[1]}, theorem_id

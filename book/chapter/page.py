@@ -230,9 +230,13 @@ def plain_markdown(text, role=None, directive=None):
 
 def plain_role(name, content):
     """A role as plain Markdown without a book to resolve it in: ``{ref}`Title <target>```
-    shows its title, ``{math}`` its math, any other its content (a bare target's name)."""
+    shows its title, ``{math}`` its math, a bare ``{prf:ref}`thm-<id>``` "Theorem" (unnumbered, as
+    a theorem's box is outside the book; `chapter.theorems` follows it with the title), any other
+    its content (a bare target's name)."""
     if name == "math":
         return f"${content}$"
+    if name == "prf:ref" and content.startswith("thm-") and not TITLED.match(content):
+        return "Theorem"
     titled = TITLED.match(content)
     return escape(titled["title"] if titled else content)
 

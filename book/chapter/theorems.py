@@ -66,28 +66,79 @@ def _prose(text):
     return "".join(p if p[:1] in "`$" and p else re.sub(r"([*_])", r"\\\1", p) for p in parts)
 
 
+def _cited(text):
+    """``text`` with each citation ``⟪id⟫`` (`proofs.core.CITATION`) as MyST: a bare
+    ``{prf:ref}`thm-<id>``` (sphinx-proof prints it "Theorem n", linked to the box) and the
+    theorem's title in parentheses.
+
+    Raises
+    ------
+    KeyError
+        A cited id that is no theorem of the registry (the check refutes it first).
+    """
+    from proofs.core import CITATION
+    from proofs.registry import CITABLE
+
+    def ref(m):
+        if m.group(1) not in CITABLE:
+            raise KeyError(f"no theorem {m.group(1)!r} to cite")
+        return f"{{prf:ref}}`thm-{m.group(1)}` ({CITABLE[m.group(1)]})"
+    return CITATION.sub(ref, text)
+
+
 def _proof_step(t, number, step):
     """One step of ``t``'s proof as MyST: "**Step k.** Sentence:" and the display ``lhs = rhs``
-    (``= rhs`` where the step continues a calc chain), two aligned lines where both sides
-    are long, then the definitions the step introduces (``where ...``)."""
+    (a step that continues a calc chain repeats its left side, the step before's right side:
+    no display starts with "="), two aligned lines where both sides are long, then the
+    definitions the step introduces (``where ...``)."""
     lhs, rhs = t.tex(step.lhs), t.tex(step.rhs)
-    shown = f"= {rhs}" if step.link and step.lhs == t.steps[number - 2].rhs else f"{lhs} = {rhs}"
-    if not shown.startswith("=") and len(lhs) + len(rhs) > 200:
+    shown = f"{lhs} = {rhs}"
+    if len(lhs) + len(rhs) > 200:
         shown = f"\\begin{{aligned}}&{lhs}\\\\ &= {rhs}\\end{{aligned}}"
-    why = _prose(step.why.rstrip(".:"))
+    why = _prose(_cited(step.why.rstrip(".:")))
     where = ", ".join(f"${t.definition_tex(s)}$" for s in step.defines)
     return f"**Step {number}.** {why}:\n\n$$\n{shown}\n$$" + (f"\n\nwhere {where}." if where else "")
+
+
+def _numeric_note(t, v):
+    """What a VERIFIED badge rests on, as MyST, and why a box cannot say it (or None): each step
+    sympy left to mpmath (`Verdict.numeric`), with its points, digits, worst residual and the
+    reason its proof gives (`Step.why_numeric`); or, every step proved, the renderer evidence.
+    A numeric step without a reason, or a reason on a step sympy proved, is the second value."""
+    numeric = tuple(getattr(v, "numeric", ()))
+    stale = [k for k, s in enumerate(t.steps, 1) if s.why_numeric and k not in numeric]
+    unexplained = [k for k in numeric if not t.steps[k - 1].why_numeric]
+    if unexplained or (stale and v.status in ("proved", "verified")):
+        k = (unexplained or stale)[0]
+        return None, (f"{t.id}: step {k} was verified numerically but its proof does not say why "
+                      "(Step.why_numeric)" if unexplained else
+                      f"{t.id}: step {k} says why sympy cannot decide it (Step.why_numeric), but sympy proved it")
+    if v.status != "verified":
+        return None, None
+    if not numeric:
+        return (f"Every step was reduced to 0 by sympy; what is verified numerically is the evidence, "
+                f"{v.points} renderer outputs compared with worst difference {v.residual:g}."), None
+    steps = ", ".join(map(str, numeric))
+    head = (f"Step{'s' if len(numeric) > 1 else ''} {steps} {'were' if len(numeric) > 1 else 'was'} checked "
+            f"numerically at {v.points} seeded points to {v.digits} digits (worst residual {v.residual:.1e}), "
+            "not proved:")
+    reasons = "; ".join(f"{'step ' + str(k) + ', ' if len(numeric) > 1 else ''}"
+                        f"{_prose(_cited(t.steps[k - 1].why_numeric))}" for k in numeric)
+    return f"{head} {reasons}.", None
 
 
 def _entry(t):
     from proofs.registry import pinned_failure
     v = t.check()
     steps = "\n\n".join(_proof_step(t, i, step) for i, step in enumerate(t.steps, 1))
-    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{t.statement_tex()}\n\n"
-             f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`\n:::\n\n"
+    note, unexplained = _numeric_note(t, v)
+    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{_cited(t.statement_tex())}\n\n"
+             f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`"
+             f"{chr(10) * 2 + note if note else ''}\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
-                pages=list(t.pages), block=block, changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
+                pages=list(t.pages), block=block, unexplained=unexplained,
+                changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
 
 
 def _ledger():
@@ -106,14 +157,15 @@ def ledger():
 
 def theorem_block(theorem_id):
     """MyST markdown: a prf:theorem (label ``thm-<id>``) with the statement and the
-    badge, which links to the theorem's ledger row (``ledger-<id>``, `ledger_table`),
+    badge (a VERIFIED one followed by what was verified numerically, and why), which links to the theorem's ledger row (``ledger-<id>``, `ledger_table`),
     and a prf:proof with the steps, each a sentence and an equation.
 
     Raises
     ------
     TheoremFailed
         If the theorem's check does not return proved or verified, or not
-        the verdict `proofs.registry.PINNED` holds for it.
+        the verdict `proofs.registry.PINNED` holds for it, or a step verified
+        numerically does not say why (`Step.why_numeric`; `_numeric_note`).
     KeyError
         If the id is unknown.
     """
@@ -127,6 +179,8 @@ def theorem_block(theorem_id):
 def _refuse(theorem_id, entry):
     if entry["status"] not in ("proved", "verified"):
         raise TheoremFailed(f"{theorem_id} is {entry['status']}: {entry['evidence']}")
+    if entry.get("unexplained"):
+        raise TheoremFailed(entry["unexplained"])
     if entry["changed"]:
         raise TheoremFailed(f"{entry['changed']} (proofs.registry.PINNED, RENDERED): {entry['evidence']}")
 
