@@ -344,24 +344,42 @@ def test_a_long_cell_or_a_shown_glue_is_found():
     assert shown_defects(front + removed) == []
 
 
-#: A page's reference to a theorem's box: {prf:ref}`Title <thm-id>`.
-THEOREM_REF = re.compile(r"\{prf:ref\}`([^`<]+?)\s*<thm-([\w-]+)>`")
+#: A page's reference to a theorem's box, and the parenthesis after it: {prf:ref}`thm-id` (Title, ...).
+#: Sphinx-proof prints a bare reference as the theorem's number ("Theorem 4").
+THEOREM_REF = re.compile(r"\{prf:ref\}`([^`]*)`(?:\s*\(([^)]*)\))?")
 
 
-def theorem_refs(text):
-    """[(title, theorem id)] of the theorem references in ``text``."""
-    return [(m.group(1).strip(), m.group(2)) for m in THEOREM_REF.finditer(text)]
-
-
-def test_a_page_refers_to_a_theorem_by_its_id_and_its_title():
-    """Each {prf:ref} to a theorem names a registered theorem with the title its box shows; a wrong
-    id or title is found (wrong variants)."""
+def theorem_ref_problems(text):
+    """What is wrong with the theorem references in ``text``: each must be bare (so that it shows the
+    theorem's number), name a registered theorem, and be followed by a parenthesis that opens with
+    the title its box shows.  Returns ([(theorem id, title)] found, [problems])."""
     from proofs.registry import THEOREMS
-    refs = [r for p in sorted(BOOK.glob("*.md")) for r in theorem_refs(p.read_text(encoding="utf-8"))]
-    assert ("Bump versus displacement", "bump-vs-displacement") in refs          # §7, pitfall 7
-    for title, theorem_id in refs:
-        assert theorem_id in THEOREMS and THEOREMS[theorem_id].title == title, (title, theorem_id)
-    for wrong in ("{prf:ref}`Bump versus displacement <thm-bump-vs-displace>`",
-                  "{prf:ref}`Bump against displacement <thm-bump-vs-displacement>`"):
-        ((title, theorem_id),) = theorem_refs(wrong)
-        assert theorem_id not in THEOREMS or THEOREMS[theorem_id].title != title
+    found, problems = [], []
+    for m in THEOREM_REF.finditer(text):
+        target, after = m.group(1), " ".join((m.group(2) or "").split())
+        theorem_id = target.removeprefix("thm-")
+        if not target.startswith("thm-") or theorem_id not in THEOREMS:
+            problems.append(f"{m.group(0)!r}: not a bare reference to a registered theorem")
+            continue
+        title = THEOREMS[theorem_id].title
+        if not (after == title or after.startswith(title + ",")):
+            problems.append(f"{m.group(0)!r}: not followed by its title ({title!r})")
+        found.append((theorem_id, title))
+    return found, problems
+
+
+def test_a_page_refers_to_a_theorem_by_its_number_and_its_title():
+    """Each {prf:ref} to a theorem on a page is bare (sphinx-proof shows its number) and followed by
+    the title its box shows; a wrong id, a wrong title, a missing title or a reference shown by a
+    title instead of the number is found (wrong variants)."""
+    found = []
+    for path in sorted(BOOK.glob("*.md")):
+        refs, problems = theorem_ref_problems(path.read_text(encoding="utf-8"))
+        assert problems == [], (path.name, problems)
+        found += refs
+    assert ("bump-vs-displacement", "Bump versus displacement") in found           # §7, pitfall 7
+    for wrong in ("{prf:ref}`thm-bump-vs-displace` (Bump versus displacement)",
+                  "{prf:ref}`thm-bump-vs-displacement` (Bump against displacement)",
+                  "{prf:ref}`thm-bump-vs-displacement` proves",
+                  "{prf:ref}`Bump versus displacement <thm-bump-vs-displacement>` (Bump versus displacement)"):
+        assert len(theorem_ref_problems(wrong)[1]) == 1, wrong
