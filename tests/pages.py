@@ -4,6 +4,19 @@ from __future__ import annotations
 
 import ast
 
+#: The front matter that makes a MyST page a notebook myst-nb executes (for miniature books).
+NOTEBOOK_FRONT_MATTER = """---
+jupytext:
+  text_representation:
+    extension: .md
+    format_name: myst
+kernelspec:
+  display_name: Python 3
+  language: python
+  name: python3
+---
+"""
+
 
 def code_cells(text: str) -> list[str] | None:
     """The code cells of a MyST notebook page, in order; None for a page that is not a notebook."""

@@ -30,6 +30,8 @@ from pathlib import Path
 import psutil
 import pytest
 
+from .pages import NOTEBOOK_FRONT_MATTER
+
 pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -81,18 +83,7 @@ def setup(app):
     return {"parallel_read_safe": True}
 '''
 
-PAGE = '''\
----
-jupytext:
-  text_representation:
-    extension: .md
-    format_name: myst
-kernelspec:
-  display_name: Python 3
-  language: python
-  name: python3
----
-
+PAGE = NOTEBOOK_FRONT_MATTER + '''
 # Page {page}
 
 ```{{code-cell}}

@@ -8,22 +8,14 @@ import logging
 from pathlib import Path
 from types import SimpleNamespace
 
+from .pages import NOTEBOOK_FRONT_MATTER
+
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("execute_pages", ROOT / "book" / "_ext" / "execute_pages.py")
 execute_pages = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(execute_pages)
 
-PAGE = """---
-jupytext:
-  text_representation:
-    extension: .md
-    format_name: myst
-kernelspec:
-  display_name: Python 3
-  language: python
-  name: python3
----
-
+PAGE = NOTEBOOK_FRONT_MATTER + """
 # A page
 
 ```{code-cell}

@@ -105,7 +105,7 @@ def _numeric_note(t, v):
     sympy left to mpmath (`Verdict.numeric`), with its points, digits, worst residual and the
     reason its proof gives (`Step.why_numeric`); or, every step proved, the renderer evidence.
     A numeric step without a reason, or a reason on a step sympy proved, is the second value."""
-    numeric = tuple(getattr(v, "numeric", ()))
+    numeric = v.numeric
     stale = [k for k, s in enumerate(t.steps, 1) if s.why_numeric and k not in numeric]
     unexplained = [k for k in numeric if not t.steps[k - 1].why_numeric]
     if unexplained or (stale and v.status in ("proved", "verified")):
@@ -157,7 +157,8 @@ def ledger():
 
 def theorem_block(theorem_id):
     """MyST markdown: a prf:theorem (label ``thm-<id>``) with the statement and the
-    badge (a VERIFIED one followed by what was verified numerically, and why), which links to the theorem's ledger row (``ledger-<id>``, `ledger_table`),
+    badge (a VERIFIED one followed by what was verified numerically, and why), which
+    links to the theorem's ledger row (``ledger-<id>``, `ledger_table`),
     and a prf:proof with the steps, each a sentence and an equation.
 
     Raises
