@@ -14,14 +14,14 @@ equation ``lhs = rhs`` between sympy objects, and each is decided on its own by
 Steps form calc chains, as in Lean's ``calc``: a step with ``link=True`` continues
 the one before it, its lhs being that step's rhs (`calc` builds such chains; a link
 whose lhs is not the previous rhs must be decided equal to it, or the proof is
-refuted).  A theorem's ``claims`` are the equations its statement makes, printed into
-the statement from these same objects; each must be the two ends of a run of one
+refuted).  A theorem's ``claims`` are the equations its statement makes, which the book
+prints into the statement (``⟦key⟧``) from these same objects; each must be the two ends of a run of one
 chain, so the steps are checked to reach the statement, not trusted to.
 
 A step may name a quantity by a symbol (``E``, ``N``, ``\\varepsilon^\\ast``) that the
 theorem's ``where`` defines: the step prints the name, and is checked with the
-definition substituted.  `Dot`, `Cross` and `Jacobian` print as a person writes them
-and evaluate when checked; unevaluated sympy forms (``Derivative``, ``Limit``,
+definition substituted.  `Dot`, `Cross` and `Jacobian` stay as written (the book prints
+them, book/chapter/latex.py) and evaluate when checked; unevaluated sympy forms (``Derivative``, ``Limit``,
 ``Subs``, ``UnevaluatedExpr``) likewise, so that a theorem module builds its steps
 cheaply and the check does the work.
 
@@ -63,6 +63,9 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
    "Theorem n (title)", plain text (`plain`) as its title.
 9. *Claims* (lab/claims.py).  A claim of the draft reaches its registered verdict from
    finite measurements, by its criterion, whose thresholds are the ones its words state.
+10. *Placeholders.*  A statement shows mathematics only through ``⟦key⟧`` (`PLACEHOLDER`): a claim,
+   a named symbol of ``where`` or an object of ``shown``, which the book prints
+   (book/chapter/latex.py); a key that is none of these refutes.
 """
 
 from __future__ import annotations
@@ -78,11 +81,8 @@ from typing import Callable
 import mpmath
 import sympy as sp
 from sympy.core.function import AppliedUndef
-from sympy.printing.conventions import requires_partial
-from sympy.printing.latex import LatexPrinter
-from sympy.printing.precedence import PRECEDENCE
 
-__all__ = ["CITATION", "citations", "plain", "Verdict", "Identity", "Step", "calc", "Theorem", "variant", "check_identities", "tex", "written", "Dot",
+__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "Verdict", "Identity", "Step", "calc", "Theorem", "variant", "check_identities", "written", "Dot",
            "Cross", "Jacobian", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
@@ -95,6 +95,8 @@ SEED = 0
 TOLERANCE_DIGITS = 20
 #: A citation of another theorem in a statement or a step's sentence: ``⟪frame-orthonormal⟫``.
 CITATION = re.compile(r"⟪([^⟫]*)⟫")
+#: What a statement prints from the theorem's objects (the book fills it in): ``⟦key⟧``.
+PLACEHOLDER = re.compile(r"⟦([^⟧]+)⟧")
 #: id -> title of every theorem that may be cited: filled by proofs/registry.py when it is imported
 #: (this module imports no theorem); a citation while it is empty is refuted, as unknown.
 CITABLE = {}
@@ -310,9 +312,6 @@ class Dot(sp.Expr):
             return sp.Matrix(a).dot(sp.Matrix(b))
         return Dot(a, b)
 
-    def _latex(self, printer):
-        return r" \cdot ".join(rf"\left({printer._print(x)}\right)" if isinstance(x, (Cross, sp.MatAdd, sp.Add))
-                               else printer._print(x) for x in self.args)
 
 
 class Cross(sp.MatrixExpr):
@@ -331,9 +330,6 @@ class Cross(sp.MatrixExpr):
             return sp.ImmutableMatrix(sp.Matrix(a).cross(sp.Matrix(b)))
         return Cross(a, b)
 
-    def _latex(self, printer):
-        return r" \times ".join(rf"\left({printer._print(x)}\right)" if isinstance(x, sp.MatAdd) else printer._print(x)
-                                 for x in self.args)
 
 
 class Jacobian(sp.MatrixExpr):
@@ -351,152 +347,13 @@ class Jacobian(sp.MatrixExpr):
         fs, xs = self.args
         return sp.ImmutableMatrix(sp.Matrix([f.doit(**hints) for f in fs]).jacobian(list(xs)))
 
-    def _latex(self, printer):
-        fs, xs = (", ".join(printer._print(a) for a in t) for t in self.args)
-        return rf"\frac{{\partial({fs})}}{{\partial({xs})}}"
 
 
-# ------------------------------------------------------------------------------- printing
-#: LaTeX of symbols by name, wherever they appear: the book writes the colatitude varphi.
-NAMES_BY_NAME = {"phi": r"\varphi", "sin_phi": r"\sin\varphi", "varepsilon": r"\varepsilon",
-                 "eps_u": r"\varepsilon_u", "eps_v": r"\varepsilon_v"}
-
-
-class _Printer(LatexPrinter):
-    """sympy's LaTeX as a person writes it: ``\\sin\\varphi`` (no brackets around a plain
-    argument), round parentheses around vectors, 0 for a float zero, a `written` form
-    in the order it was written, ``a \\cdot b`` for a
-    dot product, ``(a)^{1/3}`` for a cube root, ``h'''(x)`` and ``H_\\theta`` for
-    derivatives of a function, ``\\frac{dE}{d\\varepsilon}`` for the derivative of a name."""
-
-    def __init__(self, names):
-        super().__init__({"fold_func_brackets": True, "mat_delim": "(", "fold_frac_powers": True})
-        self.names = names
-
-    def _print_Symbol(self, expr, style="plain"):
-        if expr in self.names:
-            return self.names[expr]
-        return NAMES_BY_NAME.get(expr.name) or super()._print_Symbol(expr, style)
-
-    def _needs_function_brackets(self, expr):
-        """Only a plain argument goes without brackets: sin φ, but sin(πk_u u)."""
-        return not expr.is_Symbol
-
-    def _print_MatrixSymbol(self, expr):
-        return self.names.get(expr) or super()._print_MatrixSymbol(expr)
-
-    def _print_Float(self, expr):
-        return self._print(sp.Integer(int(expr))) if float(expr).is_integer() else super()._print_Float(expr)
-
-    def _print_Pow(self, expr):
-        if expr.exp.is_Rational and expr.exp.q > 2 and expr.exp.p == 1:
-            return rf"{self.parenthesize(expr.base, PRECEDENCE['Pow'])}^{{1/{expr.exp.q}}}"
-        return super()._print_Pow(expr)
-
-    def _print_atan2(self, expr):
-        return rf"\mathrm{{atan2}}\left({self._print(expr.args[0])}, {self._print(expr.args[1])}\right)"
-
-    def _print_ZeroMatrix(self, expr):
-        return "0"
-
-    def _print_UnevaluatedExpr(self, expr):
-        """A written form (`written`): its sums and products in the order written."""
-        order, self._settings["order"] = self._settings["order"], "none"
-        try:
-            return self._print(expr.args[0])
-        finally:
-            self._settings["order"] = order
-
-    def _print_Mul(self, expr):
-        """A coefficient times the derivative of a name: ``\\frac{1}{\\sin\\varphi} \\frac{\\partial N}{\\partial\\theta}``."""
-        named = [a for a in expr.args if isinstance(a, sp.Derivative) and isinstance(a.expr, (sp.Symbol, sp.MatrixSymbol))]
-        if len(named) == 1 and len(expr.args) > 1:
-            rest = sp.Mul(*[a for a in expr.args if a is not named[0]])
-            coefficient = "-" if rest == -1 else self.parenthesize(rest, PRECEDENCE["Mul"])
-            return f"{coefficient} {self._print(named[0])}"
-        return super()._print_Mul(expr)
-
-    def _print_MatAdd(self, expr):
-        """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), then by their vectors' names."""
-        def negative(t):
-            return isinstance(t, sp.MatMul) and t.as_coeff_matrices()[0].could_extract_minus_sign()
-        out = ""
-        for i, t in enumerate(sorted(expr.args, key=lambda t: (negative(t), self._print(sp.MatMul(
-                *t.as_coeff_matrices()[1])) if isinstance(t, sp.MatMul) else self._print(t)))):
-            shown = self.parenthesize(-t if negative(t) else t, PRECEDENCE["Add"])
-            out += (" - " if negative(t) else " + " if i else "") + shown
-        return out.lstrip()
-
-    def _print_Identity(self, expr):
-        return "I"
-
-    def _print_MatMul(self, expr):
-        """A scalar coefficient, then the matrices; a vector over a scalar as a fraction:
-        ``\\frac{M}{\\lVert M\\rVert}``, ``\\frac{(I - N'N'^T) g}{\\lVert M\\rVert}``."""
-        coeff, matrices = expr.as_coeff_matrices()
-        coeff = sp.Mul(*coeff) if isinstance(coeff, (list, tuple)) else coeff
-        numer, denom = sp.fraction(coeff)
-        mats = " ".join(self.parenthesize(m, PRECEDENCE["Mul"], strict=False) if not isinstance(m, sp.MatAdd)
-                        else rf"\left({self._print(m)}\right)" for m in matrices)
-        if numer == -1:
-            top = f"- {mats}"
-        elif numer == 1:
-            top = mats
-        else:
-            shown = self._print(numer)
-            top = (rf"\left({shown}\right)" if numer.is_Add or isinstance(numer, Dot) else shown) + f" {mats}"
-        return top if denom == 1 else (rf"- \frac{{{top[2:]}}}{{{self._print(denom)}}}" if top.startswith("- ")
-                                       else rf"\frac{{{top}}}{{{self._print(denom)}}}")
-
-    def _print_Function(self, expr, exp=None):
-        if expr in self.names:                                     # H(theta, phi) written H
-            return self.names[expr] + (f"^{{{exp}}}" if exp else "")
-        if expr.func in self.names or isinstance(expr, AppliedUndef):     # h(x), always with its brackets
-            name = self.names.get(expr.func) or self._print(sp.Symbol(expr.func.__name__))
-            args = ", ".join(self._print(a) for a in expr.args)
-            return rf"{name}\left({args}\right)" + (f"^{{{exp}}}" if exp else "")
-        return super()._print_Function(expr, exp)
-
-    def _print_Subs(self, expr):
-        """E'(x) at x = a as E'(a)."""
-        f, (var,), (point,) = expr.args
-        if isinstance(f, sp.Derivative) and isinstance(f.expr, AppliedUndef) and f.expr.args == (var,):
-            return self._print(f).replace(rf"\left({self._print(var)}\right)", rf"\left({self._print(point)}\right)")
-        return super()._print_Subs(expr)
-
-    def _print_Derivative(self, expr):
-        f, counts = expr.expr, expr.variable_count
-        n = sum(c for _, c in counts)
-        if isinstance(f, AppliedUndef) and all(isinstance(a, sp.Symbol) for a in f.args):
-            name = self.names.get(f.func) or self._print(sp.Symbol(f.func.__name__))
-            if len(f.args) == 1:                              # h'(x), h'''(x), h^{(5)}(x)
-                return name + ("'" * n if n <= 3 else f"^{{({n})}}") + rf"\left({self._print(f.args[0])}\right)"
-            if all(c == 1 for _, c in counts):               # H_\theta, H_{\theta\varphi}
-                return f"{name}_{{{' '.join(self._print(v) for v, _ in counts)}}}"
-        named = isinstance(f, (sp.Symbol, sp.MatrixSymbol))       # dE/d(eps), dN/d(theta): a named quantity
-        d = r"\partial" if named or requires_partial(f) else "d"
-        below = " ".join(f"{d} {self._print(v)}" + (f"^{{{c}}}" if c > 1 else "") for v, c in counts)
-        top = d + ("" if n == 1 else f"^{{{n}}}")
-        if named:
-            return rf"\frac{{{top} {self._print(f)}}}{{{below}}}"
-        return rf"\frac{{{top}}}{{{below}}} \left({self._print(f)}\right)"         # d/du (expression)
-
-
+# ------------------------------------------------------------------------------- written forms
 def written(expr):
     """``expr`` (built with ``evaluate=False``) kept as written: printed in the order written
     (``3 u |h|``, not sympy's ``3 |h| u``), evaluated when checked."""
     return sp.UnevaluatedExpr(expr)
-
-
-def tex(expr, names=None) -> str:
-    """LaTeX of a sympy object as the book prints it (see `_Printer`); a str is LaTeX already.
-
-    ``names``: {symbol or MatrixSymbol: LaTeX}, for the symbols whose name is not
-    their notation (``H_3`` printed ``\\lvert h'''\\rvert``).
-    """
-    if isinstance(expr, str):
-        return expr
-    return _Printer(names or {}).doprint(sp.sympify(expr))
 
 
 # ----------------------------------------------------------------------------- the proofs
@@ -555,8 +412,9 @@ class Theorem:
     ----------
     id : str            stable identifier (cited by the book and verify/)
     title : str
-    statement : str     MyST with LaTeX; ``⟦key⟧`` prints ``claims[key]`` as lhs = rhs, or the
-                        named symbol whose name is ``key`` as name = definition (``where``)
+    statement : str     MyST with LaTeX; ``⟦key⟧`` is printed by the book (book/chapter/latex.py):
+                        ``claims[key]`` as lhs = rhs, the named symbol whose name is ``key`` as
+                        name = definition (``where``), or ``shown[key]`` as itself
     steps : tuple       the proof, `Step` objects in order
     claims : dict       key -> (lhs, rhs): the equations the statement makes; each must be the
                         two ends of a run of one calc chain of ``steps``
@@ -564,6 +422,7 @@ class Theorem:
     where : dict        named symbol (Symbol, MatrixSymbol or undefined function) -> its
                         definition, substituted before a step is checked
     names : dict        symbol -> LaTeX, for symbols whose name is not their notation
+    shown : dict        key -> sympy object the statement shows as ``⟦key⟧`` (a vector, a constant)
     domain : dict       symbol -> (lo, hi): sampling intervals for the steps
     functions : dict    undefined function -> Lambda, substituted only for sampling
     evidence : callable () -> Verdict, or None: the renderer's outputs (or code) against the
@@ -581,6 +440,7 @@ class Theorem:
     wrong_variants: tuple = ()
     where: dict = field(default_factory=dict)
     names: dict = field(default_factory=dict)
+    shown: dict = field(default_factory=dict)
     domain: dict = field(default_factory=dict)
     functions: dict = field(default_factory=dict)
     evidence: Callable[[], Verdict] | None = None
@@ -592,39 +452,12 @@ class Theorem:
         first failure refutes, naming the theorem and the step (number and sentence) or claim."""
         return _prove(self)
 
-    def tex(self, expr) -> str:
-        """LaTeX of ``expr`` with this theorem's ``names`` (`tex`)."""
-        return tex(expr, self.names)
-
-    def definition_tex(self, symbol) -> str:
-        """``name = definition`` of a named symbol of ``where`` (``E(x) = ...`` for a function), in LaTeX."""
-        d = self.where[symbol]
-        if isinstance(d, sp.Lambda):
-            return f"{self.tex(symbol(*d.variables))} = {self.tex(d.expr)}"
-        return f"{self.tex(symbol)} = {self.tex(d)}"
-
-    def statement_tex(self) -> str:
-        """The statement with each ``⟦key⟧`` printed from its claim or named symbol.
-
-        Raises
-        ------
-        KeyError
-            A ``⟦key⟧`` that is neither a claim nor the name of a ``where`` symbol.
-        """
-        named = {_name(s): s for s in self.where}
-
-        def fill(m):
-            key = m.group(1)
-            if key in self.claims:
-                return " = ".join(self.tex(x) for x in self.claims[key])
-            if key in named:
-                return self.definition_tex(named[key])
-            raise KeyError(f"theorem {self.id!r}: the statement names ⟦{key}⟧, neither a claim "
-                           f"{sorted(self.claims)} nor a named symbol {sorted(named)}")
-        return re.sub(r"⟦([^⟧]+)⟧", fill, self.statement)
+    def placeholders(self) -> list:
+        """The keys of the statement's ``⟦key⟧`` placeholders, in order."""
+        return PLACEHOLDER.findall(self.statement)
 
 
-def _name(s):
+def placeholder_key(s):
     """The key ``⟦key⟧`` names a named symbol by: its name, or its function's (E for E(x))."""
     return s.func.__name__ if isinstance(s, AppliedUndef) else getattr(s, "__name__", None) or str(s)
 
@@ -789,8 +622,18 @@ def _unknown_citation(t):
     return None
 
 
+def _unknown_placeholder(t):
+    """Why ``t`` breaks rule 10 (a statement's ``⟦key⟧`` that names no claim, named symbol or
+    shown object), or None."""
+    known = set(t.claims) | {placeholder_key(s) for s in t.where} | set(t.shown)
+    unknown = [k for k in t.placeholders() if k not in known]
+    return (f"{t.id}: its statement shows ⟦{unknown[0]}⟧, which is neither a claim {sorted(t.claims)}, a named "
+            f"symbol {sorted(placeholder_key(s) for s in t.where)} nor a shown object {sorted(t.shown)}"
+            if unknown else None)
+
+
 def _prove(t: Theorem) -> Verdict:
-    unknown = _unknown_citation(t)
+    unknown = _unknown_citation(t) or _unknown_placeholder(t)
     if unknown:
         return Verdict("refuted", unknown)
     decided = []                   # (step number, verdict) of every step and link

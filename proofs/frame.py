@@ -14,7 +14,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Dot, Step, Theorem, Verdict, calc, tex
+from .core import Cross, Dot, Step, Theorem, Verdict, calc
 
 theta, phi = sp.symbols("theta phi", real=True)
 #: The unit normal in spherical coordinates (the independent side).
@@ -52,11 +52,6 @@ REGULAR = tuple(regular_branch(c) for c in F.TANGENT_FRAME)
 #: ... and at N(theta, phi).
 e_theta = sp.Matrix(REGULAR[:3]).subs(ON_SPHERE)
 e_phi = sp.Matrix(REGULAR[3:]).subs(ON_SPHERE)
-
-
-def vector_latex(components):
-    """LaTeX of a row vector of the renderer's expressions (sin_phi as sin(varphi), a float 0 as 0)."""
-    return tex(sp.Matrix(components).T)
 
 
 def _where(et=REGULAR[:3], ep=REGULAR[3:]):
@@ -177,8 +172,8 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
     return Theorem(
         id="frame-orthonormal", title="The tangent frame is orthonormal and tangent",
         statement=(r"For $0 < \varphi < \pi$ the renderer's frame (`renderer.formulas.TANGENT_FRAME`, "
-                   rf"regular branch) $e_\theta = {vector_latex(REGULAR[:3])}$ and "
-                   rf"$e_\varphi = {vector_latex(REGULAR[3:])}$, at $N(\theta, \varphi)$, satisfies "
+                   r"regular branch) $e_\theta = ⟦kernel_e_theta⟧$ and "
+                   r"$e_\varphi = ⟦kernel_e_phi⟧$, at $N(\theta, \varphi)$, satisfies "
                    r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
         steps=(
             *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ by ⟪chart⟫, "
@@ -195,6 +190,7 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
         ),
         claims={"e_theta": (ET_S, d_theta), "e_phi": (EP_S, d_phi), "tangent": (tangent, sp.Tuple(0, 0)),
                 "unit": (unit, sp.Tuple(1, 1, 0))},
+        shown={"kernel_e_theta": sp.Matrix(REGULAR[:3]).T, "kernel_e_phi": sp.Matrix(REGULAR[3:]).T},
         where=_where(et, ep), names=VECTOR_NAMES, domain=DOMAIN, evidence=partial(_frame_evidence, **evidence),
         wrong_variants=(("e_phi multiplied by sin(phi)", lambda: _orthonormal(ep=[c * F.sin_phi for c in REGULAR[3:]]).check()),
                         ("e_theta with a flipped sign", lambda: _orthonormal(et=[-c for c in REGULAR[:3]]).check()),
@@ -235,7 +231,7 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
         id="frame-orientation", title="Orientation of the tangent frame",
         statement=r"$⟦orientation⟧$: the pair $(e_\theta, e_\varphi)$ is left-handed about the outward normal, "
                   r"$e_\theta\times e_\varphi = -N$. The pole fallback "
-                  rf"($\sin\varphi \le {tex(sp.Float(F.POLE_SIN_PHI, 2))}$) has $⟦fallback⟧$: right-handed at the "
+                  r"($\sin\varphi \le ⟦pole⟧$) has $⟦fallback⟧$: right-handed at the "
                   r"north pole, where the outward normal is $+z$.",
         steps=(
             Step(r"Cross the frame of ⟪frame-orthonormal⟫: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
@@ -247,6 +243,7 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
                  r"whose cross product is $+z$, the outward normal at the north pole", poles, CLAIMED_FALLBACK_CROSS),
         ),
         claims={"orientation": (triple, sp.Integer(claimed)), "fallback": (poles, CLAIMED_FALLBACK_CROSS)},
+        shown={"pole": sp.Float(F.POLE_SIN_PHI, 2)},
         where=_where(et, ep), names=VECTOR_NAMES, domain=DOMAIN,
         wrong_variants=(("the seed's reading: aligned with N (+1)", lambda: _orientation(1).check()),
                         ("the frame with e_theta and e_phi swapped",

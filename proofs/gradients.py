@@ -17,7 +17,7 @@ import sympy as sp
 from renderer import formulas as F
 from renderer import pointwise
 
-from .core import DIGITS, POINTS, Theorem, Verdict, calc, tex, written
+from .core import DIGITS, POINTS, Theorem, Verdict, calc, written
 
 u, v, k_u, k_v = F.u, F.v, F.k_u, F.k_v
 s1, s2 = F.RIDGE_FACTORS
@@ -125,7 +125,7 @@ def _theorem(name, closed_form=None, **evidence):
     gradient = sp.Tuple(F.h_u, F.h_v)
     return Theorem(
         id=f"gradient-{name}", title=f"The gradient of the {name} field",
-        statement=(rf"For $h = {tex(SHOWN[name])}$" + (", $⟦s_1⟧$, $⟦s_2⟧$" if name != "rings" else "")
+        statement=(r"For $h = ⟦h⟧$" + (", $⟦s_1⟧$, $⟦s_2⟧$" if name != "rings" else "")
                    + r" (`renderer.formulas.HEIGHT`): $⟦gradient⟧$, and the renderer's generated code evaluates it "
                    r"to float64 accuracy."),
         steps=calc(gradient,
@@ -133,7 +133,7 @@ def _theorem(name, closed_form=None, **evidence):
                     "sympy's derivative of its $h$",
                     sp.Tuple(sp.Derivative(SHOWN[name], u), sp.Derivative(SHOWN[name], v))),
                    *_argument(name, closed_form)),
-        claims={"gradient": (gradient, sp.Tuple(*closed_form))},
+        claims={"gradient": (gradient, sp.Tuple(*closed_form))}, shown={"h": SHOWN[name]},
         where={F.h_u: F.GRADIENT[name][0], F.h_v: F.GRADIENT[name][1], **FACTORS}, domain=DOMAIN,
         evidence=partial(_gradient_evidence, name, closed_form, **evidence),
         wrong_variants=((description, lambda: _theorem(name, wrong).check()),

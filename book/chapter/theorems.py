@@ -18,6 +18,8 @@ from collections import Counter
 
 from lab import store
 
+from . import latex
+
 __all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math"]
 
 BADGES = {"proved": "PROVED", "verified": "VERIFIED numerically", "refuted": "REFUTED"}
@@ -86,18 +88,32 @@ def _cited(text):
     return CITATION.sub(ref, text)
 
 
-def _proof_step(t, number, step):
-    """One step of ``t``'s proof as MyST: "**Step k.** Sentence:" and the display ``lhs = rhs``
-    (a step that continues a calc chain repeats its left side, the step before's right side:
-    no display starts with "="), two aligned lines where both sides are long, then the
-    definitions the step introduces (``where ...``)."""
-    lhs, rhs = t.tex(step.lhs), t.tex(step.rhs)
-    shown = f"{lhs} = {rhs}"
-    if len(lhs) + len(rhs) > 200:
-        shown = f"\\begin{{aligned}}&{lhs}\\\\ &= {rhs}\\end{{aligned}}"
-    why = _prose(_cited(step.why.rstrip(".:")))
-    where = ", ".join(f"${t.definition_tex(s)}$" for s in step.defines)
-    return f"**Step {number}.** {why}:\n\n$$\n{shown}\n$$" + (f"\n\nwhere {where}." if where else "")
+def _chains(steps):
+    """The proof's calc chains: lists of (number, step), each step after a chain's first a link."""
+    runs = []
+    for k, step in enumerate(steps, 1):
+        if step.link and runs:
+            runs[-1].append((k, step))
+        else:
+            runs.append([(k, step)])
+    return runs
+
+
+def _proof(t):
+    """``t``'s proof as MyST: each step "**Step k.** Sentence" with the definitions it introduces
+    (``where ...``), and after the steps of each calc chain one display of the chain
+    (`chapter.latex.chain`): one relation a line, each "=" of a chain of several steps marked
+    "(k)" with the step that proves it; no display starts with "="."""
+    out = []
+    for run in _chains(t.steps):
+        numbers = [k for k, _ in run] if len(run) > 1 else None
+        for k, step in run:
+            why = _prose(_cited(step.why.rstrip(".:")))
+            where = ", ".join(f"${latex.definition(t, s)}$" for s in step.defines)
+            out.append(f"**Step {k}.** {why}" + (f", where {where}" if where else "")
+                       + ("." if numbers and k != run[-1][0] else ":"))
+        out.append(f"$$\n{latex.chain(t, [s for _, s in run], numbers)}\n$$")
+    return "\n\n".join(out)
 
 
 def _numeric_note(t, v):
@@ -130,9 +146,9 @@ def _numeric_note(t, v):
 def _entry(t):
     from proofs.registry import pinned_failure
     v = t.check()
-    steps = "\n\n".join(_proof_step(t, i, step) for i, step in enumerate(t.steps, 1))
+    steps = _proof(t)
     note, unexplained = _numeric_note(t, v)
-    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{_cited(t.statement_tex())}\n\n"
+    block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{_cited(latex.statement(t))}\n\n"
              f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`"
              f"{chr(10) * 2 + note if note else ''}\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
