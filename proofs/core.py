@@ -633,7 +633,7 @@ def _unknown_placeholder(t):
 
 
 def _prove(t: Theorem) -> Verdict:
-    unknown = _unknown_citation(t) or _unknown_placeholder(t)
+    unknown = _unknown_citation(t)
     if unknown:
         return Verdict("refuted", unknown)
     decided = []                   # (step number, verdict) of every step and link
@@ -663,6 +663,9 @@ def _prove(t: Theorem) -> Verdict:
         if not _reaches(t.steps, lhs, rhs):
             return Verdict("refuted", f"{t.id}: no chain of steps runs from the left side of the claim {key!r} "
                            "to its right side: the proof does not reach the statement")
+    unknown = _unknown_placeholder(t)
+    if unknown:
+        return Verdict("refuted", unknown)
     numeric = sorted({k for k, v in decided if v.status == "verified"})
     worst = max((v.residual for _, v in decided if v.status == "verified"), default=None)
     summary = (f"{len(t.steps)} steps, each reduced to 0 by sympy" if not numeric else

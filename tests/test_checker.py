@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from chapter import latex
 from proofs.core import CITATION, plain
 from proofs.registry import CITABLE, PINNED, RENDERED, THEOREMS, get, pin, pinned_failure
 from verify.test_theorems import _placed
@@ -192,7 +193,7 @@ def test_the_box_shows_statement_badge_and_steps_and_links_its_ledger_row(monkey
     monkeypatch.setattr(book.store, "_MEMORY", {})
     monkeypatch.delenv(book.store.ENV, raising=False)
     block, row = book.theorem_block(t.id), book.ledger_table()
-    places = [block.index(t.statement_tex()), block.index("**PROVED** · evidence: {ref}`§6 <ledger-optimal-step>`"),
+    places = [block.index(latex.statement(t)), block.index("**PROVED** · evidence: {ref}`§6 <ledger-optimal-step>`"),
               block.index(":::{prf:proof}")] + [block.index(f"**Step {k}.** ") for k in range(1, len(t.steps) + 1)]
     assert places == sorted(places)
     assert r"\varepsilon^\ast = \left(\frac{3 \mathrm{u} \lvert h\rvert}{\lvert h'''\rvert}\right)^{1/3}" in block
@@ -229,34 +230,25 @@ def test_book_block_refuses_a_check_without_its_renders(monkeypatch):
         book.theorem_block("chart")
 
 
-def test_a_calc_link_repeats_its_left_side_and_no_display_starts_with_equals(monkeypatch):
-    """In the theorem's box every step shows "lhs = rhs" (or the two aligned lines "&lhs \\\\ &= rhs"), a step
-    that continues the one before (a calc link) too, its left side being that step's right side: no display
-    starts with "=" (optimal-step has links and fresh steps)."""
+def test_a_calc_chain_is_one_display_a_relation_a_line_and_no_display_starts_with_equals(monkeypatch):
+    """In the theorem's box each calc chain is one display after its steps' sentences: its left side once,
+    then one line per step, each "=" marked with the step's number; a single step is "lhs = rhs"; no
+    display starts with "=" (optimal-step has a chain of two steps and two single steps)."""
     from chapter import theorems as book
     from proofs import registry
     t = get("optimal-step")
     monkeypatch.setattr(registry, "THEOREMS", {t.id: t})
     monkeypatch.setattr(book.store, "_MEMORY", {})
     monkeypatch.delenv(book.store.ENV, raising=False)
-    shown = re.findall(r"\*\*Step \d+\.\*\* [^\n]*\n\n\$\$\n(.*?)\n\$\$", book.theorem_block(t.id), re.S)
-    links = [s.link for s in t.steps]
-    assert len(shown) == len(t.steps) and True in links and False in links
-    sides = [(t.tex(s.lhs), t.tex(s.rhs)) for s in t.steps]
-    assert [d in (f"{a} = {b}", f"\\begin{{aligned}}&{a}\\\\ &= {b}\\end{{aligned}}") for d, (a, b) in zip(shown, sides)] \
-        == [True] * len(t.steps), shown
+    shown = re.findall(r"\$\$\n(.*?)\n\$\$", book.theorem_block(t.id), re.S)
+    runs = book._chains(t.steps)
+    assert [len(r) for r in runs] == [2, 1, 1] and len(shown) == len(runs)
+    lines = shown[0].removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}").split(r"\\ ")
+    assert [re.findall(r"\\overset\{\((\d+)\)\}\{=\}", line) for line in lines] == [["1"], ["2"]]
+    assert lines[0].startswith(latex.tex(t.steps[0].lhs, t.names))
+    assert lines[1].endswith(latex.tex(t.steps[1].rhs, t.names))
+    assert shown[1:] == [f"{latex.tex(s.lhs, t.names)} = {latex.tex(s.rhs, t.names)}" for s in t.steps[2:]]
     assert not any(d.lstrip().startswith("=") for d in shown)
-    assert all(t.steps[k].lhs == t.steps[k - 1].rhs for k, link in enumerate(links) if link)
-
-
-@pytest.mark.parametrize("order", [0.8, 1.2])
-def test_the_beta_limit_refutes_a_rate_off_by_a_fifth(order):
-    """beta-zero-regression's rendered rate is fitted to within 0.1 of the order claimed: an order off by a
-    fifth (either way) is refuted, the linear one the renders show proved."""
-    from proofs.normal import _rate_evidence
-    wrong, right = _rate_evidence(order=order), _rate_evidence()
-    assert (wrong.status, right.status) == ("refuted", "proved"), wrong.evidence
-    assert f"(claimed {order:g})" in wrong.evidence
 
 
 def test_the_kink_loci_refuse_an_unknown_family():

@@ -13,7 +13,8 @@ import pytest
 import sympy as sp
 
 from proofs import core
-from proofs.core import Cross, Dot, Identity, Jacobian, Step, Theorem, Verdict, calc, check_identities, tex, written
+from chapter.latex import statement, tex
+from proofs.core import Cross, Dot, Identity, Jacobian, Step, Theorem, Verdict, calc, check_identities, written
 
 x = sp.Symbol("x", positive=True)
 y = sp.Symbol("y")
@@ -166,7 +167,8 @@ SQUARE = (a_ + b_) ** 2
 
 def square_theorem(*steps, claims=None, **fields):
     """(a + b)^2 = a^2 + 2ab + b^2, by the steps given."""
-    return Theorem("square", "A square", "$⟦square⟧$", steps,
+    return Theorem("square", "A square", " ".join(f"$⟦{key}⟧$" for key in claims) if claims else "$⟦square⟧$"
+                   if claims is None else "", steps,
                    {"square": (SQUARE, a_**2 + 2 * a_ * b_ + b_**2)} if claims is None else claims,
                    domain={a_: (0.5, 2.0), b_: (0.5, 2.0)}, **fields)
 
@@ -233,11 +235,15 @@ def test_named_symbols_are_printed_and_substituted_when_checked():
     e = sp.Symbol("e")
     t = square_theorem(Step("by definition", e, a_**2 + 2 * a_ * b_ + b_**2),
                        claims={"square": (e, a_**2 + 2 * a_ * b_ + b_**2)}, where={e: SQUARE})
-    assert t.check().status == "proved" and t.statement_tex() == "$e = a^{2} + 2 a b + b^{2}$"
+    assert t.check().status == "proved" and statement(t) == "$e = a^{2} + 2 a b + b^{2}$"
     wrong = square_theorem(Step("by definition", e, a_**2 + b_**2), claims={}, where={e: SQUARE})
     assert wrong.check().evidence.startswith("square, step 1 (by definition): residual")
-    with pytest.raises(KeyError, match=r"⟦cube⟧, neither a claim \['square'\] nor a named symbol"):
-        dataclasses.replace(square_theorem(*CHAIN), statement="⟦cube⟧").statement_tex()
+    unknown = dataclasses.replace(square_theorem(*CHAIN), statement="⟦cube⟧")
+    with pytest.raises(KeyError, match=r"⟦cube⟧, neither a claim \['square'\], a named symbol"):
+        statement(unknown)
+    assert unknown.check().status == "refuted" and "⟦cube⟧" in unknown.check().evidence
+    shown = dataclasses.replace(square_theorem(*CHAIN), statement="$⟦cube⟧$", shown={"cube": a_**3})
+    assert shown.check().status == "proved" and statement(shown) == "$a^{3}$"
 
 
 def test_using_rewrites_with_an_earlier_step_and_only_an_earlier_named_one():
@@ -624,9 +630,9 @@ def test_named_symbols_print_their_definitions_in_the_statement():
     M = sp.MatrixSymbol("M", 2, 1)
     t = Theorem("t", "T", "$⟦E⟧$, $⟦f⟧$, $⟦M⟧$", (), {}, names={x: r"\chi"},
                 where={E(x): x**2, f: sp.Lambda(x, x**3), M: sp.Matrix([x, 1])})
-    assert t.statement_tex() == (r"$E\left(\chi\right) = \chi^{2}$, $f\left(\chi\right) = \chi^{3}$, "
+    assert statement(t) == (r"$E\left(\chi\right) = \chi^{2}$, $f\left(\chi\right) = \chi^{3}$, "
                                  r"$M = \left(\begin{matrix}\chi\\1\end{matrix}\right)$")
-    assert t.tex(x + 1) == r"\chi + 1"
+    assert tex(x + 1, t.names) == r"\chi + 1"
 
 
 def test_a_variant_is_the_theorem_with_its_changes_checked_when_called():

@@ -1,5 +1,5 @@
-"""The theorems print as the book shows them: each theorem's statement, its steps (lhs = rhs) and the
-definitions its steps introduce, in LaTeX from proofs/core.py's printer, are the text the chapter was
+"""The theorems print as the book shows them: each theorem's statement, the display of each of its calc
+chains and the definitions its steps introduce, in LaTeX from book/chapter/latex.py, are the text the chapter was
 reviewed in.  A printer that drops a prime, a sign or a bracket states a theorem other than the one
 checked; this fails, naming the theorem and printing its new text.
 
@@ -12,34 +12,38 @@ import hashlib
 import pytest
 import sympy as sp
 
-from proofs.core import tex, written
+from chapter import latex
+from chapter.latex import tex
+from chapter.theorems import _chains
+from proofs.core import written
 from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "chart": "281377454e137b4f",
-    "frame-orthonormal": "5e2d3ba9660f0dfc",
-    "frame-orientation": "ecd7762812643c2c",
-    "gradient-sine": "a0d32e32db0c87fd",
-    "gradient-ridges": "568dc8dac31dd110",
-    "gradient-rings": "c57d5ee6dc25cc0d",
-    "ridges-kinks": "95eeaf03b0543a5d",
-    "kink-loci-rays": "846041ddbb4c7b7a",
+    "chart": "bb112cbbf510a670",
+    "frame-orthonormal": "fdce80aa257101b7",
+    "frame-orientation": "53938665d5568ab7",
+    "gradient-sine": "2ef054cc542efc09",
+    "gradient-ridges": "4a1319521f2a4d3d",
+    "gradient-rings": "ef856a761119f337",
+    "ridges-kinks": "8980813d765a5fc0",
+    "kink-loci-rays": "dc6aa08f514eb71e",
     "kink-loci-circles": "2ee79e7e99261d40",
     "no-boundary": "23e06e379e02c039",
-    "normal-beta-derivative": "bfde89e2e383c5c0",
-    "beta-zero-regression": "b47aea0df169fda4",
-    "central-difference-truncation": "15fa36211b297057",
-    "optimal-step": "65312b82985eb69e",
-    "bump-vs-displacement": "312f40d2df1d5e05",
-    "blinn-perturbation": "df041990cdcbf0d2",
+    "normal-beta-derivative": "8cb14d3a193c7b83",
+    "beta-zero-regression": "0a3b18b8b4052c4d",
+    "central-difference-truncation": "87eb719c0c66e095",
+    "optimal-step": "88bd98b1422a37bf",
+    "bump-vs-displacement": "11d4ed60c904f69e",
+    "blinn-perturbation": "38f9ac6bc0cd9f89",
 }
 
 
 def printed(t):
-    """The theorem's text as the book prints it: statement, each step's equation, each defined symbol."""
-    return "\n".join([t.statement_tex()] + [f"{t.tex(s.lhs)} = {t.tex(s.rhs)}" for s in t.steps]
-                     + [t.definition_tex(d) for s in t.steps for d in s.defines])
+    """The theorem's text as the book prints it: statement, each calc chain's display, each defined symbol."""
+    return "\n".join([latex.statement(t)] + [latex.chain(t, [s for _, s in run], [k for k, _ in run])
+                                               for run in _chains(t.steps)]
+                     + [latex.definition(t, d) for s in t.steps for d in s.defines])
 
 
 def _digest(text):
@@ -90,3 +94,39 @@ NORM = sp.Symbol(r"\lVert M\rVert", positive=True)
         "sum-order"])
 def test_the_printer_writes_each_form_as_a_person_does(expr, names, latex):
     assert tex(expr, names) == latex
+
+
+def test_every_line_of_every_proof_display_fits_a_phone_column():
+    """Each line of each chain's display is within a phone's proof column (`latex.PROOF_COLUMN_PX`) by the
+    width estimate (the browser measures the rendered scale); sides that do not fit break at + - × · ."""
+    for t in THEOREMS.values():
+        for run in _chains(t.steps):
+            shown = latex.chain(t, [s for _, s in run], [k for k, _ in run])
+            body = shown.removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}")
+            widest = max(latex.width(line) for line in body.split(r"\\ "))
+            limit = latex.PROOF_COLUMN_PX * (1.2 if "lim" in body else 1.0)   # a one-sided limit has no break point
+            assert widest <= limit, (t.id, run[0][0], round(widest), shown)
+
+
+def test_a_tuple_chain_prints_a_component_a_line_and_a_long_sum_breaks():
+    u, v, w = sp.symbols("u v w")
+    from proofs.core import Step, Theorem, calc
+    long = sum(sp.Symbol(f"x_{k}") ** k / (k + 1) for k in range(1, 12))
+    t = Theorem("t", "T", "", (*calc(sp.Tuple(u, v), ("why", sp.Tuple(w, 2 * w)), ("then", sp.Tuple(1, 2))),
+                               Step("long", w, long)), {})
+    pair = latex.chain(t, t.steps[:2], [1, 2])
+    assert pair == (r"\begin{aligned}u &\overset{(1)}{=} w\\ &\overset{(2)}{=} 1\\ "
+                    r"v &\overset{(1)}{=} 2 w\\ &\overset{(2)}{=} 2\end{aligned}")
+    lines = latex.chain(t, t.steps[2:], [3]).removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}").split(r"\\ ")
+    assert len(lines) > 2 and all(latex.width(line) <= latex.COLUMN_PX for line in lines)
+    assert all(line.startswith((r"&\qquad + ", r"&\qquad - ")) for line in lines[1:])
+    assert "".join(line.split("&", 1)[1].removeprefix(r"\qquad") for line in lines[1:]).replace(" ", "") in \
+        tex(long).replace(" ", "")
+
+
+@pytest.mark.parametrize("latex_, px", [(r"x^{2} + y^{2} = \rho\left(\varphi\right)^{2}", 110),
+                                        (r"N' = \frac{M}{\lVert M\rVert}", 81),
+                                        (r"e_\theta \times e_\varphi = - N", 98)])
+def test_the_width_estimate_is_within_a_fifth_of_mathjax(latex_, px):
+    """Widths MathJax 3 gave these displays in the built book at 390 px (natural size, CSS px)."""
+    assert 0.78 * px <= latex.width(latex_) <= 1.22 * px, latex.width(latex_)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from chapter import latex
 from proofs.registry import PINNED, RENDERED, THEOREMS, pinned_failure
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
@@ -62,4 +63,4 @@ def test_every_claim_is_stated_and_every_statement_prints():
         assert t.claims, t.id
         for key in t.claims:
             assert f"⟦{key}⟧" in t.statement, (t.id, key)
-        assert "⟦" not in t.statement_tex(), t.id
+        assert "⟦" not in latex.statement(t), t.id

@@ -23,15 +23,17 @@ from sympy.printing.precedence import PRECEDENCE
 
 from proofs.core import PLACEHOLDER, Cross, Dot, Jacobian, placeholder_key
 
-__all__ = ["tex", "definition", "statement", "chain", "width", "COLUMN_PX", "NAMES_BY_NAME"]
+__all__ = ["tex", "definition", "statement", "chain", "width", "COLUMN_PX", "PROOF_COLUMN_PX", "NAMES_BY_NAME"]
 
 #: LaTeX of symbols by name, wherever they appear: the book writes the colatitude varphi.
 NAMES_BY_NAME = {"phi": r"\varphi", "sin_phi": r"\sin\varphi", "varepsilon": r"\varepsilon",
                  "eps_u": r"\varepsilon_u", "eps_v": r"\varepsilon_v"}
 
-#: The width a line of a proof's display may take, in CSS px: a proof's column is 278 px in a
-#: 390-px viewport (the 358-px column less the dropdown's and the proof box's padding), and
-#: `width` underestimates by up to a fifth.
+#: A proof's column in a 390-px viewport, in CSS px (the 358-px column less the dropdown's and the
+#: proof box's padding; measured in the built book).
+PROOF_COLUMN_PX = 278
+#: The width a line of a proof's display may take, in CSS px: `PROOF_COLUMN_PX` less a margin,
+#: `width` underestimating by up to a fifth.
 COLUMN_PX = 240
 
 
@@ -297,8 +299,8 @@ def width(latex) -> float:
 
 def _group(tokens, i, end):
     """The end of the brace group (or single token) that starts at ``tokens[i]``."""
-    if tokens[i] != "{":
-        return i + 1
+    if i >= end or tokens[i] != "{":
+        return min(i + 1, end)
     depth = 0
     for j in range(i, end):
         depth += {"{": 1, "}": -1}.get(tokens[j], 0)
@@ -372,30 +374,32 @@ def _relation(k):
 
 
 def _rows(printer, blocks, marks, column, left):
-    """The lines of `chain`'s display, and whether each is within ``column``: each block's left side,
+    """The lines of `chain`'s display, and by how many px the widest overflows ``column`` (<= 0: none):
+    each block's left side,
     then its relations; aligned at "=" after a left side ``left`` px wide, or (``left`` None) each left
     side on a line of its own."""
-    rows, fits = [], True
+    rows, excess = [], -column
     for block in blocks:
         if left is not None:
             head, indent, room = printer._print(block[0]) + " &", r"&\qquad ", column - left - 30
         else:
             lines = _lines(printer, block[0], column)
             rows += [r"&" + line for line in lines]
-            fits = fits and max(map(width, lines)) <= column
-            head, indent, room = r"&\quad ", r"&\qquad\quad ", column - 35
+            excess = max(excess, max(map(width, lines)) - column)
+            head, indent, room = r"&\quad ", r"&\qquad\quad ", column - 48
         for mark, rhs in zip(marks, block[1:]):
             first, *rest = lines = _lines(printer, rhs, room)
-            fits = fits and max(map(width, lines)) <= room
+            excess = max(excess, max(map(width, lines)) - room)
             rows.append(f"{head}{_relation(mark)} {first}")
             rows += [indent + line for line in rest]
             head = "&" if left is not None else r"&\quad "
-    return rows, fits
+    return rows, excess
 
 
 def chain(t, steps, numbers=None, column=COLUMN_PX) -> str:
     """One calc chain of theorem ``t`` as one LaTeX ``aligned`` display: ``lhs = r_1 = r_2 ...`` one
-    relation a line, each "=" marked with its step's number (``numbers``; unmarked if None);
+    relation a line, each "=" marked with its step's number (``numbers``; unmarked if None or
+    the chain is one step);
     a chain of tuples one block of lines per component; a line wider than ``column`` px
     broken (`_Printer.pieces`), continued indented.  A step whose left side is not the right
     side of the one before (a link decided equal to it) adds that left side as a line.
@@ -416,7 +420,7 @@ def chain(t, steps, numbers=None, column=COLUMN_PX) -> str:
         ``\\begin{aligned} ... \\end{aligned}``, or a bare ``lhs = rhs`` where it fits one line.
     """
     printer = _Printer(t.names)
-    numbers = list(numbers) if numbers is not None else [None] * len(steps)
+    numbers = list(numbers) if numbers is not None and len(steps) > 1 else [None] * len(steps)
     # (lhs, [(number, rhs), ...]): the relations of the chain, left sides shown only where they change.
     sides = [steps[0].lhs]
     marks = []
@@ -431,8 +435,8 @@ def chain(t, steps, numbers=None, column=COLUMN_PX) -> str:
     if len(blocks) == 1 and len(sides) == 2 and width(printer._print(sides[0]) + " = " + printer._print(sides[1])) <= column:
         return f"{printer._print(sides[0])} {_relation(marks[0])} {printer._print(sides[1])}"
     left = max(width(printer._print(b[0])) for b in blocks)
-    rows, fits = _rows(printer, blocks, marks, column, left)      # aligned at "=" if every line fits,
-    if not fits:                                                    # else under the left side, if
-        under, fits = _rows(printer, blocks, marks, column, None)   # that fits
-        rows = under if fits else rows
+    rows, excess = _rows(printer, blocks, marks, column, left)    # aligned at "=" if every line fits,
+    if excess > 0:                                                  # else under the left side if that
+        under, less = _rows(printer, blocks, marks, column, None)   # overflows less
+        rows = under if less < excess else rows
     return r"\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}"

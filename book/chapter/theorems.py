@@ -106,12 +106,12 @@ def _proof(t):
     "(k)" with the step that proves it; no display starts with "="."""
     out = []
     for run in _chains(t.steps):
-        numbers = [k for k, _ in run] if len(run) > 1 else None
+        numbers = [k for k, _ in run]
         for k, step in run:
             why = _prose(_cited(step.why.rstrip(".:")))
             where = ", ".join(f"${latex.definition(t, s)}$" for s in step.defines)
             out.append(f"**Step {k}.** {why}" + (f", where {where}" if where else "")
-                       + ("." if numbers and k != run[-1][0] else ":"))
+                       + ("." if k != run[-1][0] else ":"))
         out.append(f"$$\n{latex.chain(t, [s for _, s in run], numbers)}\n$$")
     return "\n\n".join(out)
 
