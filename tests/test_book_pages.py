@@ -745,7 +745,8 @@ def test_the_formula_check_catches_a_display_too_wide_for_a_phone(browser, book_
 
 def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record(browser, book_html, tmp_path):
     """Wrong variants: a figure with 5-pt text shown at its size (5 pt at 100 dpi: 5 x 100/72 = 6.9 CSS
-    px, under 8) and a PNG without the record; a figure at 10 pt passes, one without text is not
+    px, under 8), a figure with 10-pt text twice as wide as the 300-px column (shown at half its size:
+    6.9 px), and a PNG without the record; the 10-pt figure that fits passes, one without text is not
     measured."""
     import base64
 
@@ -754,9 +755,9 @@ def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record
     import matplotlib.pyplot as plt
     from chapter.figures import figure_png
 
-    def shown(size=None):
-        fig, ax = plt.subplots(figsize=(2.4, 1.6), dpi=100)
-        ax.imshow([[0, 1], [1, 0]])
+    def shown(size=None, inches=2.4):
+        fig, ax = plt.subplots(figsize=(inches, 1.6), dpi=100)
+        ax.imshow([[0, 1], [1, 0]], aspect="auto")
         if size is None:
             ax.axis("off")
         else:
@@ -765,14 +766,18 @@ def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record
         plt.close(fig)
         return (f'<img src="data:image/png;base64,{base64.b64encode(png).decode()}" '
                 f'width="{size_css["width"]}" height="{size_css["height"]}">')
-    page = _synthetic(tmp_path, shown(5) + shown(10) + shown() + f'<img src="{_png(300, 150)}">', book_html)
-    found = _audit(browser, page)["figure_text"]
-    assert [f["recorded"] for f in found] == [True, True, True, False]
-    assert [f["png_px"] is None for f in found] == [False, False, True, True]
-    small = small_figure_text({"figure_text": found}, MIN_FIGURE_TEXT_PX[390])
-    assert len(small) == 1 and small[0] is found[0], found
-    assert small[0]["css_px"] == pytest.approx(5 * 100 / 72, rel=0.01)
+    page = _synthetic(tmp_path, shown(5) + shown(10) + shown() + f'<img src="{_png(300, 150)}">' + shown(10, 6.4),
+                      book_html)
+    audit = _audit(browser, page)
+    found = audit["figure_text"]
+    assert [f["recorded"] for f in found] == [True, True, True, False, True]
+    assert [f["png_px"] is None for f in found] == [False, False, True, True, False]
+    assert [f is found[0] or f is found[4] for f in small_figure_text(audit, MIN_FIGURE_TEXT_PX[390])] == [True, True], found
+    assert found[0]["css_px"] == pytest.approx(5 * 100 / 72, rel=0.01)
     assert found[1]["css_px"] == pytest.approx(10 * 100 / 72, rel=0.01)
+    wide = audit["images"][4]
+    assert wide["shown"][0] == 300 and found[4]["css_px"] == pytest.approx(
+        10 * 100 / 72 * 300 / (wide["natural"][0] / 2), rel=0.01)
 
 
 def test_figure_png_records_the_smallest_text_drawn(figure):
