@@ -17,7 +17,8 @@ prints (β, kᵤ, kᵥ, ε wherever it is written) the value computed with, and 
 for that scene at the extremes of the controls; every control reachable and
 movable from the keyboard; the layout at 1280 x 900 (canvases, U-curve and
 readout in view together) and at 390 px (canvases stacked, at least 300 px
-wide, and a tap on a phone reading out the pixel tapped).  Screenshots go to
+wide, and a tap on a phone reading out the pixel tapped), and at both widths, scrolled through
+the simulator, no control, readout, plot or caption covering another.  Screenshots go to
 test-artifacts/.  Each check is shown rejecting a wrong variant.
 
 The book is built into a temporary directory for the test unless
@@ -1001,3 +1002,126 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
         assert s.errors == []
     finally:
         s.close()
+
+
+#: Run in the page with the name of a reading position: scrolls there and returns [target,
+#: what covers it] for each point of a target that something else covers (document.elementFromPoint
+#: at a 5 x 5 grid of points inside the target's box, within the viewport).  The positions: "top"
+#: (the simulator just below the theme's sticky header), "canvases" (the symbolic canvas in the
+#: middle of the screen), "ucurve_bottom" and "ucurve_middle" (the U-curve's plot with its
+#: caption at the bottom of the screen, as it comes into view, and in the middle) and "ledger" (the
+#: ledger in the middle).  The targets: the main controls (the field,
+#: ε and β: at every position where they stick to the screen, else at "top"), the readout (its
+#: part below what sticks at the top: a box scrolled under a bar is not covered by it), and at
+#: both "ucurve" positions the plot and its caption, which must also lie wholly on the screen.
+COVERED_JS = """async (where) => {
+  const sticky = el => getComputedStyle(el).position === 'sticky';
+  const main = document.querySelector('.sim-main'), readout = document.getElementById('sim-readout');
+  const header = () => Math.max(0, ...[...document.querySelectorAll('header, .bd-header-article')]
+    .map(h => h.getBoundingClientRect().bottom));
+  const bar = () => Math.max(header(), sticky(main) ? main.getBoundingClientRect().bottom : 0);
+  const settle = () => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
+  const [at, block] = {top: ['[data-symrender-sim]', 'start'], canvases: ['#sim-canvas-symbolic', 'center'],
+                        ucurve_bottom: ['.sim-curve', 'end'], ucurve_middle: ['.sim-curve', 'center'],
+                        ledger: ['.sim-ledger', 'center']}[where];
+  document.querySelector(at).scrollIntoView({block});
+  await settle();
+  if (where === 'top') { window.scrollBy(0, -header() - 8); await settle(); }
+  // What covers a point: the theme's header, or the nearest element with an id (the simulator's parts).
+  const name = hit => {
+    if (!hit) return 'nothing (off the screen)';
+    const el = hit.closest('.bd-header-article, header, [id]') || hit;
+    return el.tagName.toLowerCase() + (el.id ? '#' + el.id : '.' + [...el.classList].slice(0, 1).join('.'));
+  };
+  const found = [];
+  const check = (el, label, from = 0, whole = false) => {
+    const r = el.getBoundingClientRect();
+    for (let a = 0; a < 5; a++) for (let b = 0; b < 5; b++) {
+      const x = r.left + 2 + (r.width - 4) * a / 4, y = r.top + 2 + (r.height - 4) * b / 4;
+      const on = x >= 0 && x < innerWidth && y >= 0 && y < innerHeight;
+      if (!on) { if (whole) found.push([label, name(null)]); continue; }
+      if (y < from) continue;
+      const hit = document.elementFromPoint(x, y);
+      if (hit !== el && !el.contains(hit)) found.push([label, name(hit)]);
+    }
+  };
+  if (where === 'top' || sticky(main))
+    for (const id of ['sim-height_field', 'sim-log_eps', 'sim-beta']) check(document.getElementById(id), '#' + id);
+  check(readout, '#sim-readout', bar());
+  if (where.startsWith('ucurve')) {
+    check(document.getElementById('sim-curve'), '#sim-curve', 0, true);
+    check(document.getElementById('sim-curve-caption'), '#sim-curve-caption', 0, true);
+  }
+  return [...new Set(found.map(f => f.join(' covered by ')))];
+}"""
+READING_POSITIONS = ("top", "canvases", "ucurve_bottom", "ucurve_middle", "ledger")
+
+
+def _layout(browser, book_html, width, bundle=None, shots=None):
+    """{position: what covers the controls, the readout, the plot or its caption there} at ``width``
+    px (844 px tall on a phone, with touch; 900 on a desktop), with a pixel of sphere A read out
+    (tapped on a phone, hovered over at 1280); with ``shots``, a screenshot of each position
+    to test-artifacts/s4_<width>px_<position><shots>.png."""
+    phone = width < 720
+    options = dict(viewport={"width": width, "height": 844 if phone else 900})
+    if phone:
+        options.update(has_touch=True, is_mobile=True, device_scale_factor=2)
+    s = Session(browser, _url(book_html), bundle=bundle, **options)
+    try:
+        gb = gbuffer(Scene(), SIZE, SIZE)
+        rows, cols = np.nonzero(gb.chamber == 1)
+        i, j = int(cols[len(rows) // 2]), int(rows[len(rows) // 2])
+        canvas = s.page.locator("#sim-canvas-symbolic")
+        canvas.evaluate("c => c.scrollIntoView({block: 'center'})")
+        box = canvas.bounding_box()
+        point = {"x": (i + 0.5) * box["width"] / SIZE, "y": (j + 0.5) * box["height"] / SIZE}
+        if phone:
+            s.page.tap("#sim-canvas-symbolic", position=point)
+        else:
+            s.page.hover("#sim-canvas-symbolic", position=point)
+        _readout_pixel(s, i, j)
+        found = {}
+        for where in READING_POSITIONS:
+            found[where] = s.page.evaluate(COVERED_JS, where)
+            if shots is not None:
+                ARTIFACTS.mkdir(parents=True, exist_ok=True)
+                s.page.screenshot(path=str(ARTIFACTS / f"s4_{width}px_{where}{shots}.png"))
+        assert s.errors == []
+        return found
+    finally:
+        s.close()
+
+
+@pytest.mark.parametrize("width", [390, 1280])
+def test_the_controls_readout_and_u_curve_never_cover_each_other(browser, book_html, width):
+    """Scrolled to the simulator's top, its canvases, its U-curve and its ledger, with a pixel read
+    out: the main controls are never under the theme's header or the readout, the readout is
+    under nothing but what sticks at the top, and the U-curve's plot with its caption, at the
+    bottom of the screen and in its middle, lies on the screen covered by nothing (`COVERED_JS`).  Screenshots of each
+    position go to test-artifacts/s4_<width>px_<position>.png."""
+    found = _layout(browser, book_html, width, shots="")
+    assert found == dict.fromkeys(READING_POSITIONS, []), found
+
+
+#: Wrong layouts of the simulator on a phone: (the STYLE text replaced, its replacement, a
+#: finding the layout check must report at 390 px).
+WRONG_LAYOUTS = {
+    "the sticky controls under the theme's header": (
+        "position: sticky; top: 3.5rem;", "position: sticky; top: 0;", "#sim-height_field covered by div.bd-header-article"),
+    "the sticky readout below the U-curve, over its caption": (
+        ".symrender-sim .sim-curve { order: 1; }", "", "#sim-curve-caption covered by dl#sim-readout"),
+    "the readout scrolled over the sticky controls": (
+        "z-index: 3; /* above the readout */", "z-index: 1;", "covered by dl#sim-readout"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_LAYOUTS))
+def test_the_layout_check_catches_overlapping_controls(browser, book_html, variant):
+    old, new, message = WRONG_LAYOUTS[variant]
+
+    def bundle(text):
+        assert text.count(old) == 1, f"variant {variant!r} no longer applies to the bundle"
+        return text.replace(old, new)
+
+    found = _layout(browser, book_html, 390, bundle=bundle)
+    assert any(message in f for where in found.values() for f in where), (variant, found)

@@ -2,7 +2,10 @@
 
 `style` sets matplotlib for every figure of the book: PNG at twice the CSS
 size (for high-density screens), mathematical labels in mathtext, and no
-creation date in the file, so that a rebuild writes the same bytes.  The
+creation date in the file, so that a rebuild writes the same bytes; inside
+IPython a figure is displayed as `figure_png` makes it, which records in the
+PNG the smallest font size the figure draws (for the browser test of the
+figures' text on a phone).  The
 diagrams draw what the text asks the reader to picture, from the renderer's
 own functions (`renderer.pointwise`, generated from `renderer.formulas`):
 
@@ -23,26 +26,100 @@ annotation and its axes' frame); `chapter.page.show` refuses a figure with any.
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 
 from renderer import Scene, pointwise
 
-__all__ = ["style", "frame_diagram", "normal_diagram", "stencil_diagram", "ucurve_anatomy", "text_overlaps"]
+__all__ = ["style", "figure_png", "SMALLEST_TEXT_KEY", "frame_diagram", "normal_diagram", "stencil_diagram", "ucurve_anatomy", "text_overlaps"]
 
 #: The book's colours: measured (dark red), exact (dark blue), third quantity (green), guides (grey).
 RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
 
 
+#: The PNG text chunk (tEXt) in which `figure_png` records the smallest font size of a figure's drawn
+#: text, in the PNG's pixels ("none": the figure draws no text); the browser test of the built pages
+#: turns it into CSS pixels at the width each image is shown.
+SMALLEST_TEXT_KEY = "symrender:smallest-text-px"
+
+
 def style():
-    """Set matplotlib (and, inside IPython, the inline backend) for the book's figures."""
+    """Set matplotlib (and, inside IPython, the inline backend) for the book's figures: a Figure
+    displayed in IPython becomes `figure_png`'s PNG."""
     import matplotlib as mpl
     mpl.rcParams.update({"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8,
                          "savefig.bbox": "tight", "svg.hashsalt": "symrender", "image.interpolation": "nearest"})
     try:
+        from IPython.core.interactiveshell import InteractiveShell
+        from matplotlib.figure import Figure
         from matplotlib_inline.backend_inline import set_matplotlib_formats
         set_matplotlib_formats("retina", metadata={"Software": None})
+        if InteractiveShell.initialized():
+            InteractiveShell.instance().display_formatter.formatters["image/png"].for_type(Figure, figure_png)
     except (ImportError, AttributeError, NameError):
         pass                                            # outside IPython: nothing to configure
+
+
+def _drawn_texts(fig):
+    """The text artists of ``fig`` that drawing it draws (visible, not blank, not transparent), in
+    drawing order; ``fig`` is drawn once, with an Agg canvas if it has none (a closed pyplot figure).
+    Only a drawing tells which are drawn (ticks out of view keep labels that are not) and where
+    (layout engines move them)."""
+    from matplotlib.text import Text
+    if not hasattr(fig.canvas, "get_renderer"):      # a closed pyplot figure keeps a bare canvas
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        FigureCanvasAgg(fig)
+    drawn, draw = [], Text.draw
+
+    def recording(text, renderer):
+        draw(text, renderer)
+        if text.get_visible() and text.get_text().strip() and (text.get_alpha() is None or text.get_alpha() > 0):
+            drawn.append(text)
+    Text.draw = recording
+    try:
+        fig.canvas.draw()
+    finally:
+        Text.draw = draw
+    return drawn
+
+
+def figure_png(fig):
+    """``fig`` as the book's PNG, the way IPython's "retina" format makes it (drawn at twice
+    ``fig.dpi``: two device pixels per CSS pixel; cropped to its content), without a software
+    name, and with the smallest font size of its drawn text recorded under `SMALLEST_TEXT_KEY`.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+
+    Returns
+    -------
+    (bytes, dict) or None
+        The PNG file, and {"width": w, "height": h}, its size in CSS pixels (half its pixels;
+        IPython's image metadata); None for a figure with nothing in it, as IPython's own
+        formatter.  The chunk holds the smallest font size drawn (``Text.get_fontsize`` of every
+        text drawn: titles, labels, tick labels in view, legend entries, annotations), in the
+        PNG's pixels (``2 * dpi / 72`` per point), as a decimal with two places, or "none" when
+        the figure draws no text.
+
+    Raises
+    ------
+    TypeError
+        ``fig`` is not a Figure.
+    """
+    from IPython.core.pylabtools import print_figure
+    from matplotlib.figure import Figure
+    from PIL import Image
+    if not isinstance(fig, Figure):
+        raise TypeError(f"fig must be a matplotlib.figure.Figure, got {type(fig).__name__}")
+    sizes = [t.get_fontsize() * 2 * fig.dpi / 72 for t in _drawn_texts(fig)]
+    smallest = f"{min(sizes):.2f}" if sizes else "none"
+    png = print_figure(fig, "retina", metadata={"Software": None, SMALLEST_TEXT_KEY: smallest})
+    if png is None:
+        return None
+    width, height = Image.open(io.BytesIO(png)).size
+    return png, {"width": width // 2, "height": height // 2}
 
 
 def _sphere_point(theta, phi):
@@ -253,22 +330,7 @@ def text_overlaps(fig, gap=0.5):
         raise TypeError(f"fig must be a matplotlib.figure.Figure, got {type(fig).__name__}")
     if not (isinstance(gap, (int, float)) and math.isfinite(gap) and gap >= 0):
         raise ValueError(f"gap must be a finite number >= 0 (font sizes), got {gap!r}")
-    if not hasattr(fig.canvas, "get_renderer"):      # a closed pyplot figure keeps a bare canvas
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        FigureCanvasAgg(fig)
-    # Record the texts as they are drawn: only then is it known which are (ticks out of
-    # view keep labels that are not drawn) and where (layout engines move them).
-    drawn, draw = [], Text.draw
-
-    def recording(text, renderer):
-        draw(text, renderer)
-        if text.get_visible() and text.get_text().strip() and (text.get_alpha() is None or text.get_alpha() > 0):
-            drawn.append(text)
-    Text.draw = recording
-    try:
-        fig.canvas.draw()
-    finally:
-        Text.draw = draw
+    drawn = _drawn_texts(fig)
     renderer = fig.canvas.get_renderer()
     px = fig.dpi / 72                                       # pixels per point
     boxes = [t.get_window_extent(renderer) for t in drawn]

@@ -141,11 +141,16 @@ const STYLE = `
 .symrender-sim table { font-variant-numeric: tabular-nums; margin: 0.4rem 0; }
 .symrender-sim td, .symrender-sim th { padding: 0.1rem 0.7rem; }
 .symrender-sim .sim-main { grid-template-columns: repeat(3, minmax(0, 1fr)); margin: 0.4rem 0; }
+/* On a phone: one column; the main controls stick just below the theme's sticky header (3.5rem high
+   below 768 px, sphinx-book-theme), the readout to the bottom of the screen while the canvases scroll
+   by.  The readout comes before the U-curve: a box sticking to the bottom covers only what precedes
+   it, so the canvases and never the plot or its caption; it scrolls on under the controls. */
 @media (max-width: 720px) {
-  .symrender-sim .sim-main { grid-template-columns: minmax(0, 1fr); position: sticky; top: 0; z-index: 2;
-    background: var(--pst-color-background, #fff); padding: 0.3rem 0; }
+  .symrender-sim .sim-main { grid-template-columns: minmax(0, 1fr); position: sticky; top: 3.5rem;
+    z-index: 3; /* above the readout */ background: var(--pst-color-background, #fff); padding: 0.3rem 0; }
   .symrender-sim .sim-stage { grid-template-columns: minmax(0, 1fr); }
   .symrender-sim .sim-curve, .symrender-sim .sim-readout { grid-column: 1; }
+  .symrender-sim .sim-curve { order: 1; }
   .symrender-sim .sim-readout { position: sticky; bottom: 0; z-index: 2; padding: 0.3rem 0.4rem;
     border-top: 1px solid currentColor; max-height: 40vh; overflow-y: auto; }
 }
