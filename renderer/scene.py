@@ -232,8 +232,14 @@ class Scene:
         return Scene(**values)
 
     def changes(self) -> dict:
-        """{field name: value} of the fields that differ from `Scene`'s defaults: the keyword
-        arguments that build this scene, ``Scene(**scene.changes()) == scene`` (JSON-safe
-        unless ``lights`` differ), so a stored measurement can say which scene it used."""
+        """The fields that differ from `Scene`'s defaults: the keyword arguments that build
+        this scene, so a stored measurement can say which scene it used.
+
+        Returns
+        -------
+        dict
+            {field name: value}; ``Scene(**scene.changes()) == scene``.  JSON-safe (str,
+            float, bool, tuples of floats) unless ``lights`` differ (a tuple of `PointLight`).
+        """
         default = Scene()
         return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) != getattr(default, f.name)}

@@ -45,7 +45,7 @@ def frame_label(scene, width, height) -> str:
     TypeError
         ``scene`` is neither a `renderer.Scene` nor a dict, or ``width`` or ``height``
         is not an integer (`renderer.validate.positive_int`); a dict key that is not a
-        Scene field (`renderer.Scene`).
+        Scene field (`renderer.Scene.replace`).
     ValueError
         ``width`` or ``height`` is below 1, or a dict value `renderer.Scene` refuses.
     """
@@ -59,7 +59,20 @@ def frame_label(scene, width, height) -> str:
 
 
 def ucurve_label(curve) -> str:
-    """Where the U-curve of `lab.accuracy.default_optimum` (``curve``, its dict) is measured,
-    in words: the field, the point, the frequencies and the steps."""
+    """Where the U-curve of `lab.accuracy.default_optimum` is measured, in words: the field,
+    the point, the frequencies and the steps.
+
+    Parameters
+    ----------
+    curve : dict
+        `lab.accuracy.default_optimum`'s dict: ``field`` (str), ``u``, ``v`` (chart
+        coordinates), ``k_u``, ``k_v`` (periods over the chart), ``steps`` (int), ``eps_max``,
+        ``eps_min`` (chart units).
+
+    Raises
+    ------
+    KeyError
+        If ``curve`` lacks one of those keys.
+    """
     return (f"{curve['field']} field, hᵤ at (u, v) = ({curve['u']}, {curve['v']}), kᵤ = {curve['k_u']:g}, "
             f"kᵥ = {curve['k_v']:g}, {curve['steps']} steps from {curve['eps_max']:.0e} to {curve['eps_min']:.0e}")

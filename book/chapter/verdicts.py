@@ -100,7 +100,7 @@ def register():
         claim, measured, verdict = results[c.id]
         entries.append(
             f"(claim-{c.id})=\n"
-            f"**{n}. {claim.where}:** “{claim.quote}”. **{{term}}`{WORDS[verdict]}`:** "
-            f"{measured_text(c.id, measured)}; by the rule: {rule_text(claim.criterion)}. "
-            f"Noted in {{ref}}`{place_of(c.id)}`.\n")
+            f"**{n}. {claim.where}:** “{claim.quote}” (noted in {{ref}}`{place_of(c.id)}`). "
+            f"**{{term}}`{WORDS[verdict]}`**: {measured_text(c.id, measured)}; by the rule: "
+            f"{rule_text(claim.criterion)}.\n")
     return "\n".join(entries)
