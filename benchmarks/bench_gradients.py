@@ -19,8 +19,9 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+sys.path[:0] = [str(ROOT), str(ROOT / "book")]          # book/ for the book's `chapter` (its table)
 
+from chapter.benchmark import markdown_table  # noqa: E402
 from lab import gradient_methods as gm  # noqa: E402
 
 
@@ -50,10 +51,10 @@ def main(argv=None):
         f"Machine: {m.machine}. Wall time of the run: {m.seconds:.0f} s.",
         "",
     ]
-    front = "\n".join(head + ["## Pareto front (max error)", "", gm.markdown_table(m, rows="front"), ""])
+    front = "\n".join(head + ["## Pareto front (max error)", "", markdown_table(m, rows="front"), ""])
     best = "\n".join(["## The best step of each method, and the renderer's step 1e-3", "",
-                      gm.markdown_table(m, rows="best", include=("central 1e-03",)), ""])
-    full = "\n".join(["## Every method", "", gm.markdown_table(m, rows="all"), ""])
+                      markdown_table(m, rows="best", include=("central 1e-03",)), ""])
+    full = "\n".join(["## Every method", "", markdown_table(m, rows="all"), ""])
     print(front)
     print(best)
     print(full)

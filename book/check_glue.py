@@ -97,7 +97,8 @@ QUANTITIES = {
     "the fitted optimal step": (("ucurve_eps_opt",), lambda: _ucurve().eps_opt_fitted),
     "the model's error at the fitted step": (("ucurve_err_opt",), lambda: _ucurve().error_at_fitted_opt),
     "the predicted optimal step": (("ucurve_eps_pred",), lambda: _ucurve().eps_opt_predicted),
-    "the U-curve's label": (("ucurve_label",), lambda: _lib("lab.accuracy").default_optimum()["label"]),
+    "the U-curve's label": (("ucurve_label",), lambda: _lib("chapter.labels").ucurve_label(
+        _lib("lab.accuracy").default_optimum())),
     "the relative error at a step of 1e-9": (("ucurve_rel_1e9",), lambda: _lib("lab.claims").relative_error_at(1e-9)),
     "the relative error at a step of 1e-11": (("ucurve_rel_1e11",),
                                               lambda: _lib("lab.claims").relative_error_at(1e-11)),
@@ -105,14 +106,16 @@ QUANTITIES = {
     "the census's RMS slope": (("census_rms_slope",), lambda: _lib("lab.claims").census()["rms_slope"]),
     "the census's off-band slope": (("census_off_slope",), lambda: _lib("lab.claims").census()["off_slope"]),
     "the census's crease ratio": (("census_ratio",), lambda: _lib("lab.claims").census()["ratio"]),
-    "the census's frame": (("c3_label", "s6_census_label"), lambda: _lib("lab.claims").census()["label"]),
+    "the census's frame": (("c3_label", "s6_census_label"), lambda: _lib("chapter.labels").frame_label(
+        _lib("lab.claims").census()["scene"], *_lib("lab.claims").census()["size"])),
     "the census's flips": (("s6_flips",), lambda: sum(_lib("lab.claims").census()["flips"])),
     "the closed form's worst error": (("dn_residual",), lambda: _lib("lab.accuracy").normal_beta_derivative_residual()),
     "the median order of the β-derivative": (("beta_median_order",),
                                              lambda: _lib("lab.accuracy").image_beta_order()["median_slope"]),
     "the RMS order of the β-derivative": (("beta_rms_order",),
                                           lambda: _lib("lab.accuracy").image_beta_order()["rms_slope"]),
-    "the β-derivative's frame": (("c5_label",), lambda: _lib("lab.accuracy").image_beta_order()["label"]),
+    "the β-derivative's frame": (("c5_label",), lambda: _lib("chapter.labels").frame_label(
+        _lib("lab.accuracy").image_beta_order()["scene"], *[_lib("lab.accuracy").image_beta_order()["size"]] * 2)),
     # Counted on two pages from their own renders.
     "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1"), None),
 }

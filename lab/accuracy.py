@@ -18,7 +18,6 @@ from renderer import Scene, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
-from renderer import frame_label
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
            "image_beta_order", "default_optimum", "DIGITS"]
@@ -147,7 +146,7 @@ def _image_beta_order(size, beta, steps):
     Returns
     -------
     dict with "median_slope", "rms_slope", "median_errors", "rms_errors", "steps", and
-    "label", the scene and resolution (`chapter.theorems.frame_label`).
+    "scene" (`renderer.Scene.changes`) and "size", the frame's side in pixels.
     """
     scene = Scene(height_field="sine", beta=beta)
 
@@ -164,7 +163,7 @@ def _image_beta_order(size, beta, steps):
     rms = np.array([np.sqrt(np.mean(d**2)) for d in diffs])
     fit = lambda e: float(np.polyfit(np.log(steps), np.log(e), 1)[0])  # noqa: E731
     return {"median_slope": fit(median), "rms_slope": fit(rms), "median_errors": median.tolist(),
-            "rms_errors": rms.tolist(), "steps": list(steps), "label": frame_label(scene, size, size)}
+            "rms_errors": rms.tolist(), "steps": list(steps), "scene": scene.changes(), "size": size}
 
 
 def default_optimum():
@@ -174,7 +173,8 @@ def default_optimum():
     fitted optimum ``eps`` and the model's ``error`` there, the measured
     errors ``band`` (min, max) within a factor 2 of it, the coefficients
     ``A`` and ``B``, the model's prediction ``eps_predicted`` and, for
-    comparison, the curve's ``argmin`` and ``min``, and a ``label``."""
+    comparison, the curve's ``argmin`` and ``min``, and where it is measured: ``field``, ``u``, ``v``, ``k_u``, ``k_v``, the
+    number of ``steps`` and their range ``eps_max``, ``eps_min``."""
     from .store import measured
     return measured("ucurve.default-optimum", _default_optimum)
 
@@ -186,6 +186,5 @@ def _default_optimum():
     return dict(eps=c.eps_opt_fitted, error=c.error_at_fitted_opt, band=[float(near.min()), float(near.max())],
                 A=c.truncation_coeff, B=c.roundoff_coeff, eps_predicted=c.eps_opt_predicted,
                 argmin=c.eps_opt_measured, min=c.error_at_measured_opt,
-                label=f"sine field, hᵤ at (u, v) = ({c.u}, {c.v}), kᵤ = {SEED_FREQUENCIES[0]:g}, "
-                      f"kᵥ = {SEED_FREQUENCIES[1]:g}, {c.eps.size} steps "
-                      f"from {c.eps.max():.0e} to {c.eps.min():.0e}")
+                field="sine", u=c.u, v=c.v, k_u=SEED_FREQUENCIES[0], k_v=SEED_FREQUENCIES[1], steps=int(c.eps.size),
+                eps_max=float(c.eps.max()), eps_min=float(c.eps.min()))

@@ -2,7 +2,7 @@
 
 Each `Claim` records where the seed says it, what it says (a short quotation),
 how it is measured, and the verdict registered for it.  ``measure()``
-recomputes the evidence at build time and returns (measured, verdict); the
+recomputes the evidence at build time and returns (values, verdict); the
 verdict is one of HOLDS, FAILS ("does not hold") and CORRECTED ("holds with a
 correction").  `pytest verify` fails when a computed verdict differs from the
 registered one, so a verdict cannot change silently: the register must be
@@ -10,14 +10,14 @@ edited with it.  The one timing claim is decided by a count (the sine and
 cosine calls per pixel of the generated gradients); its timings are reported
 beside it and decide nothing.  Each claim's pass criterion is data (a
 `Criterion`: bounds on the numbers its measurement returns, tried in order),
-applied by `Claim.measure` and shown in the book's table as written
-(`CRITERIA`).
+applied by `Claim.measure`.  Only numbers, verdicts and the draft's own words
+(``quote``, ``where``) live here: the book words the measurements and the rules
+(book/chapter/claim_words.py).
 """
 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable
@@ -27,10 +27,9 @@ import numpy as np
 from renderer import Scene, compare, gbuffer, pointwise, render
 from renderer.render import SPHERE_A
 
-from renderer import frame_label
-
-__all__ = ["Bound", "Criterion", "rule", "about", "ABOUT", "Claim", "CLAIMS", "CRITERIA", "HOLDS", "FAILS", "CORRECTED",
-           "UNMEASURED", "Unmeasured", "evaluate", "checked", "ClaimChanged", "crease_band_ratio"]
+__all__ = ["Bound", "Criterion", "rule", "about", "ABOUT", "Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED",
+           "UNMEASURED", "Unmeasured", "evaluate", "checked", "ClaimChanged", "crease_band_ratio", "census",
+           "relative_error_at", "CELL5_EXPECTED"]
 
 HOLDS, FAILS, CORRECTED = "holds", "does not hold", "holds with a correction"
 #: The verdict of a claim whose measurement raised or gave no finite number for a quantity its
@@ -42,16 +41,11 @@ class Unmeasured(ValueError):
     """A quantity a criterion reads is missing or not a finite number."""
 
 
-def _number(x):
-    x = float(x)
-    return f"{x:,.0f}" if abs(x) < 1e6 and (x.is_integer() or abs(x) >= 100) else f"{x:.3g}"
-
-
 @dataclass(frozen=True)
 class Bound:
     """A test on one measured quantity: ``lo <= value <= hi`` (``<`` where ``strict``);
     ``None`` leaves that side open.  ``quantity`` names the value in the dict a
-    claim's measurement returns, and is how the table shows it."""
+    claim's measurement returns (the book words the bound, `chapter.claim_words.rule_text`)."""
 
     quantity: str
     lo: float | None = None
@@ -63,16 +57,6 @@ class Bound:
         x = values[self.quantity]
         below = (lambda a, b: a < b) if self.strict else (lambda a, b: a <= b)
         return (self.lo is None or below(self.lo, x)) and (self.hi is None or below(x, self.hi))
-
-    def __str__(self):
-        le, ge = ("<", ">") if self.strict else ("≤", "≥")
-        if self.lo is not None and self.lo == self.hi:
-            return f"{self.quantity} = {_number(self.lo)}"
-        if self.lo is not None and self.hi is not None:
-            return f"{_number(self.lo)} {le} {self.quantity} {le} {_number(self.hi)}"
-        if self.lo is not None:
-            return f"{self.quantity} {ge} {_number(self.lo)}"
-        return f"{self.quantity} {le} {_number(self.hi)}"
 
 
 @dataclass(frozen=True)
@@ -105,10 +89,6 @@ class Criterion:
                 return verdict
         return self.otherwise
 
-    def __str__(self):
-        return "; ".join([f"{verdict} if {' and '.join(map(str, bounds))}" for verdict, bounds in self.cases]
-                         + [f"otherwise {self.otherwise}"])
-
 
 #: How the register reads "≈ x", "~x", "near x": x's order of magnitude, within half a decade either way.
 ABOUT = 10 ** 0.5
@@ -132,8 +112,10 @@ class Claim:
 
     ``where`` is the seed section or cell, ``quote`` the claim in the seed's
     words (short), ``measurement`` how it is tested, ``registered`` the verdict
-    on record; ``quantify()`` returns (measured text, {quantity: number}) and
-    ``criterion`` decides the verdict from those numbers.
+    on record; ``quantify()`` returns the measured values, a JSON-safe dict: the numbers
+    ``criterion`` decides the verdict from ({quantity: number}), and the numbers and short
+    tokens the book's sentence about the claim shows (the frame's ``scene`` and ``size``, say;
+    `chapter.claim_words` words them).
     """
 
     id: str
@@ -145,14 +127,15 @@ class Claim:
     criterion: Criterion
 
     def measure(self):
-        """(measured text, computed verdict): the measurement, decided by the criterion; or
-        ("not measured: <the error>", `UNMEASURED`) when measuring or deciding raised, so
-        that one broken claim neither passes nor hides the verdicts of the others."""
+        """(values, computed verdict): the measured values (a dict, `quantify`), decided by the
+        criterion; or ({"error": "<type>: <message>"} (at most 300 characters), `UNMEASURED`)
+        when measuring or deciding raised, so that one broken claim neither passes nor hides the
+        verdicts of the others."""
         try:
-            text, values = self.quantify()
-            return text, self.criterion.decide(values)
+            values = self.quantify()
+            return values, self.criterion.decide(values)
         except Exception as e:          # noqa: BLE001 - reported as the claim's verdict, never passed
-            return f"not measured: {type(e).__name__}: {e}"[:300], UNMEASURED
+            return {"error": f"{type(e).__name__}: {e}"[:300]}, UNMEASURED
 
 
 @lru_cache(maxsize=None)
@@ -174,11 +157,12 @@ def _frames(field="ridges", beta=0.35, eps=1e-3, size=128):
 
 
 def _on(frame, scene=None):
-    """' (label)': the scene and size of the frame a measurement used (`chapter.theorems.frame_label`),
-    read from the frame itself.  ``frame``: a `renderer.Frame` or `renderer.GBuffer`; ``scene``:
-    the scene to name when the frame carries none (a GBuffer) or a sweep varies it."""
+    """{"scene": its fields that differ from the defaults (`renderer.Scene.changes`), "size": [width,
+    height]}: the frame a measurement used, read from the frame itself.  ``frame``: a `renderer.Frame`
+    or `renderer.GBuffer`; ``scene``: the scene to name when the frame carries none (a GBuffer) or a
+    sweep varies it."""
     height, width = frame.chamber.shape
-    return f" ({frame_label(scene or frame.scene, width, height)})"
+    return {"scene": (scene or frame.scene).changes(), "size": [width, height]}
 
 
 def _err_at(eps):
@@ -205,53 +189,46 @@ def relative_error_at(eps):
 
 def _h3_scale():
     value = (np.pi * 8.0) ** 3
-    return f"$(\\pi k_u)^3 =$ {value:,.0f} at $k_u = 8$", {"(π kᵤ)³": value}
+    return {"(π kᵤ)³": value, "k_u": 8.0}
 
 
 def _truncation_until():
     c = _ucurve()
-    return (f"the predicted optimal step is {c.eps_opt_predicted:.1e}, from $h'''$ and the unit roundoff "
-            f"alone (the measured curve's lowest point is {c.eps_opt_measured:.1e})",
-            {"model optimum ε": c.eps_opt_predicted})
+    return {"model optimum ε": c.eps_opt_predicted, "measured_optimum": c.eps_opt_measured}
 
 
 def _drowns_below_1e9():
     rel = relative_error_at(1e-9)
-    return (f"the quotient's relative error at a step of 1e-9 is {rel:.1e}: {int(-np.log10(rel))} digits still right",
-            {"relative error at ε = 1e-9": rel})
+    return {"relative error at ε = 1e-9": rel, "step": 1e-9, "digits": int(-np.log10(rel))}
 
 
 def _cell2_minimum():
     from .accuracy import default_optimum
     opt = default_optimum()
-    return (f"the fitted optimal step is {opt['eps']:.1e}, where the model's error is {opt['error']:.1e}",
-            {"fitted optimum ε": opt["eps"]})
+    return {"fitted optimum ε": opt["eps"], "error": opt["error"]}
 
 
 def _orientation():
     from proofs.frame import _orientation_value
     value = int(_orientation_value())
-    return (f"$(e_\\theta \\times e_\\varphi)\\cdot N = {value}$: the frame is left-handed about the outward normal",
-            {"(eθ × eφ)·N": value})
+    return {"(eθ × eφ)·N": value}
 
 
 def _flips_zero():
     from proofs.no_boundary import render_flips
     frames, values, masks, _ = render_flips()
-    return (f"over {frames} independent G-buffers, {values} geometry values (chamber, $t$, $P$, $N$) and {masks} "
-            "reach-mask pixels differ", {"geometry values differing": values, "reach-mask pixels differing": masks})
+    return {"geometry values differing": values, "reach-mask pixels differing": masks, "gbuffers": frames}
 
 
 def _shadow_curves_unchanged():
     leak = _errata()["terminator-leak"]["leak_pixels_default"]
-    return (f"true of the renderer, not of the draft's code: its shading lights {leak:,} (pixel, light) pairs "
-            "past the terminator", {"pairs lit past the terminator": leak})
+    return {"pairs lit past the terminator": leak}
 
 
 def _cell1_ripples():
     m = _errata()["sphere-b-quadratic"]
-    return (f"the draft's sphere B covers {m['seed_pixels_b']:,} of the {m['pixels']:,} pixels, so sphere A "
-            "never appears", {"share of the frame on the draft's sphere B": m["seed_pixels_b"] / m["pixels"]})
+    return {"share of the frame on the draft's sphere B": m["seed_pixels_b"] / m["pixels"],
+            "pixels_b": m["seed_pixels_b"], "pixels": m["pixels"]}
 
 
 #: The draft's Cell 3 sweep of steps, and the frame it renders.
@@ -270,7 +247,7 @@ def census():
     stencil straddles a crease); the fitted exponents p of RMS ~ eps^p and of the
     off-band mean ~ eps^p over all the steps (``rms_slope``, ``off_slope``); the
     crease ratio at the default step (``ratio``, on-band over off-band mean); and
-    the frame's ``label``.
+    the frame's ``scene`` (`renderer.Scene.changes`) and ``size`` ([width, height]).
     """
     from .store import measured
     return measured("census", _census, size=CENSUS_SIZE)
@@ -296,15 +273,13 @@ def _census(size):
     return dict(out, steps=list(CENSUS_STEPS),
                 rms_slope=float(np.polyfit(logs, np.log(out["rms"]), 1)[0]),
                 off_slope=float(np.polyfit(logs, np.log(out["off_band"]), 1)[0]),
-                ratio=out["on_band"][default] / out["off_band"][default],
-                label=frame_label(scene, size, size))
+                ratio=out["on_band"][default] / out["off_band"][default], scene=scene.changes(), size=[size, size])
 
 
 def _census_slope():
     c = census()
-    return (f"the RMS slope is {c['rms_slope']:.2f}, the off-band slope {c['off_slope']:.2f} (fitted over "
-            f"the six steps, {c['label']}): only the pixels off the crease band descend at second order",
-            {"RMS slope": c["rms_slope"], "off-band slope": c["off_slope"]})
+    return {"RMS slope": c["rms_slope"], "off-band slope": c["off_slope"], "steps": len(c["steps"]),
+            "scene": c["scene"], "size": c["size"]}
 
 
 def _cell3_runs():
@@ -319,32 +294,31 @@ def _cell3_runs():
     try:
         np.abs(num.image - sym.image)[same & on_a].max()
     except ValueError as error:
-        return (f"the cell crashes before its first row: in the draft's code its sphere A covers "
-                f"{np.count_nonzero(on_a)} of the {code.size:,} pixels, where this renderer's frame of the same "
-                f"scene has {np.count_nonzero(sym.chamber == SPHERE_A):,} on sphere A{_on(sym)}, and a maximum "
-                "over no pixels raises ValueError", {"rows computed": 0})
-    return "the sweep's first row is computed" + _on(sym), {"rows computed": 1}
+        return {"rows computed": 0, "code_pixels_a": int(np.count_nonzero(on_a)), "pixels": int(code.size),
+                "pixels_a": int(np.count_nonzero(sym.chamber == SPHERE_A)), "error": type(error).__name__,
+                **_on(sym)}
+    return {"rows computed": 1, **_on(sym)}
 
 
 def _census_flips():
     c = census()
-    return (f"{sum(c['flips'])} flips over the six steps ({c['label']})", {"flips": sum(c["flips"])})
+    return {"flips": sum(c["flips"]), "steps": len(c["steps"]), "scene": c["scene"], "size": c["size"]}
 
 
 def crease_band_ratio():
     """The crease ratio of the census at the default step (`census`): mean |ΔI| on the
-    crease band over the mean off it, with the two means (``on``, ``off``) and the label."""
+    crease band over the mean off it, with the two means (``on``, ``off``) and the frame (``scene``,
+    ``size``)."""
     c = census()
     default = c["steps"].index(Scene().eps)
-    return dict(on=c["on_band"][default], off=c["off_band"][default], ratio=c["ratio"], label=c["label"])
+    return dict(on=c["on_band"][default], off=c["off_band"][default], ratio=c["ratio"], scene=c["scene"],
+                size=c["size"])
 
 
 def _kink_order_of_magnitude():
     band = crease_band_ratio()
-    return (f"the crease ratio is {band['ratio']:,.0f}, far more than an order of magnitude: mean "
-            f"$\\lvert\\Delta I\\rvert$ {band['on']:.1e} on the band against {band['off']:.1e} off it at "
-            f"the default step ({band['label']})",
-            {"on/off ratio": band["ratio"]})
+    return {"on/off ratio": band["ratio"], "on": band["on"], "off": band["off"], "scene": band["scene"],
+            "size": band["size"]}
 
 
 def _evals():
@@ -353,10 +327,8 @@ def _evals():
     from the sympy objects the kernel is generated from, `gradient_methods.evaluations`)."""
     from .gradient_methods import evaluations
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
-    return (f"the central stencil evaluates $h$ {central.h:g} times per pixel ({central.trig:g} sines once "
-            f"common factors are shared); the exact gradient evaluates $h$ {exact.h:g} times, and its "
-            f"generated code calls {exact.trig:g} sines and cosines",
-            {"values of h, central": central.h, "values of h, exact": exact.h})
+    return {"values of h, central": central.h, "values of h, exact": exact.h, "trig_central": central.trig,
+            "trig_exact": exact.trig}
 
 
 def _cell4_counter():
@@ -383,9 +355,7 @@ def _cell4_counter():
         gradient()
         counts.append(Counter.n)
     numeric, exact, wired = counts
-    return (f"the counter prints {numeric} and {exact}: the gradients call the unwrapped $h$, so the wrapper "
-            f"never runs (wired into the central gradient it counts {wired})",
-            {"count printed, numeric": numeric, "count printed, exact": exact})
+    return {"count printed, numeric": numeric, "count printed, exact": exact, "wired": wired}
 
 
 def _stacking():
@@ -401,9 +371,8 @@ def _stacking():
         d = (box - one.image)[all_a & (one.chamber == SPHERE_A)]
         err[beta] = float(np.sqrt(np.mean(d ** 2)))
     ratio = err[0.35] / err[0.0]
-    return (f"no new integral, but a harder integrand: one sample per pixel misses the 4 × 4 box filter "
-            f"by RMS {err[0.35]:.1e} with the bump, {err[0.0]:.1e} without{_on(one, Scene())}",
-            {"one-sample error, with / without the bump": ratio})
+    return {"one-sample error, with / without the bump": ratio, "bumped": err[0.35], "flat": err[0.0],
+            **_on(one, Scene())}
 
 
 def _blinn_exact():
@@ -417,10 +386,7 @@ def _blinn_exact():
     at = {F.R: 1.0, F.beta: 0.35, F.h: 0.5, F.h_u: 3.0, F.h_v: -2.0, phi: 1.1, theta: 0.4}
     gap = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE))
     first = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE).diff(F.beta).subs(F.beta, 0))
-    return (f"derived from the surface, but exact only to first order in $\\beta$: at $\\beta = 0.35$ "
-            f"($h = 0.5$, $h_u = 3$, $h_v = -2$, $\\varphi = 1.1$) his slopes differ from the displaced "
-            f"sphere's by {gap:.2e}, while their first-order terms agree exactly",
-            {"slope gap": gap, "first-order gap": first})
+    return {"slope gap": gap, "first-order gap": first, "point": {str(k): v for k, v in at.items() if k != F.R}}
 
 
 def _timing():
@@ -449,10 +415,9 @@ def _timing():
     f_central = best(lambda: render(Scene(), 128, 128, gradient="central"), 7)
     stage = t_central / t_exact
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
-    return (f"by count: the exact gradient calls {exact.trig:g} sines and cosines per pixel, the central "
-            f"stencil {central.trig:g}; timed, deciding nothing, the central stage takes {stage:.1f} times as "
-            f"long, the whole frame {f_central / f_exact:.2f} times{_on(g, Scene())}",
-            {"sin/cos calls, exact minus central": exact.trig - central.trig})
+    return {"sin/cos calls, exact minus central": exact.trig - central.trig, "trig_exact": exact.trig,
+            "trig_central": central.trig, "stage_ratio": stage, "frame_ratio": f_central / f_exact,
+            **_on(g, Scene())}
 
 
 #: The draft's expected worst component error of its Cell 5 check ("~1e-9"): its criterion's centre,
@@ -472,82 +437,64 @@ def _cell5_fd():
         exact = (g - Np * (Np @ g)) / np.linalg.norm(M)
         M2 = N + (0.35 + step) * g
         worst = max(worst, float(np.abs(exact - (M2 / np.linalg.norm(M2) - Np) / step).max()))
-    ratio = worst / CELL5_EXPECTED
-    return (f"the draft's own check, a forward difference with step {_power(step)} over {trials:,} random cases, has a "
-            f"worst component error of {worst:.1e}, about {float(f'{ratio:.2g}'):,.0f} times the draft's "
-            f"expected {_power(CELL5_EXPECTED)}",
-            {"worst component": worst})
-
-
-def _power(x):
-    """A power of ten as the draft writes it: 1e-9."""
-    return re.sub(r"e([-+])0*", lambda m: "e" + m.group(1).replace("+", ""), f"{x:.0e}")
+    return {"worst component": worst, "expected": CELL5_EXPECTED, "ratio": worst / CELL5_EXPECTED, "step": step,
+            "trials": trials}
 
 
 def _dn_1e12():
     from .accuracy import normal_beta_derivative_residual
     r = normal_beta_derivative_residual()
-    return (f"the closed form's worst error is {r:.1e} against a 50-digit mpmath derivative, which the "
-            "draft's forward difference cannot show", {"closed form's residual": r})
+    return {"closed form's residual": r}
 
 
 def _beta_order():
     from .accuracy import image_beta_order
     o = image_beta_order()
-    return (f"the median order of the image's β-derivative is {o['median_slope']:.2f}, but its RMS order "
-            f"{o['rms_slope']:.2f}: second order at most pixels, not where a clip or a max(0, ·) switches "
-            f"({o['label']})", {"median order": o["median_slope"], "RMS order": o["rms_slope"]})
+    return {"median order": o["median_slope"], "RMS order": o["rms_slope"], "scene": o["scene"],
+            "size": [o["size"], o["size"]]}
 
 
 def _beta0():
     a, b = _frames(beta=0.0)
     d = float(np.abs(a.image - b.image).max())
-    return (f"the two pipelines differ by at most {d:g} at $\\beta = 0$: exactly zero, since the gradient is "
-            f"never used there{_on(b)}", {"max |ΔI|": d})
+    return {"max |ΔI|": d, **_on(b)}
 
 
 def _bump_nonzero():
     s = Scene(height_field="sine", beta=1.5)
     bumped = render(s, 128, 128)
     d = float(np.abs(bumped.image - render(s.replace(beta=0.0), 128, 128).image).mean())
-    return (f"the sine bump at $\\beta = 1.5$ moves the frame by a mean $\\lvert\\Delta I\\rvert$ of {d:.3f}"
-            + _on(bumped), {"mean |ΔI|": d})
+    return {"mean |ΔI|": d, **_on(bumped)}
 
 
 def _cell6_truncation():
     a = compare(*_frames("sine", 1.5, 1e-3)).max_abs
     b = compare(*_frames("sine", 1.5, 1e-4)).max_abs
-    return (f"the largest $\\lvert\\Delta I\\rvert$ falls from {a:.1e} at a step of 1e-3 to {b:.1e} at 1e-4, "
-            f"{a / b:.0f} times, as a second-order error should" + _on(_frames("sine", 1.5, 1e-3)[1]),
-            {"max |ΔI| ratio": a / b})
+    return {"max |ΔI| ratio": a / b, "coarse": a, "fine": b, "coarse_step": 1e-3, "fine_step": 1e-4,
+            **_on(_frames("sine", 1.5, 1e-3)[1])}
 
 
 def _noise_below_1e11():
     rel = relative_error_at(1e-11)
-    return (f"the quotient's relative error at a step of 1e-11 is {rel:.1e}: digits lost, not noise",
-            {"relative error at ε = 1e-11": rel})
+    return {"relative error at ε = 1e-11": rel, "step": 1e-11}
 
 
 def _crease_values():
     fd = float(pointwise.central_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0, 1e-4)[0])
     ex = float(pointwise.exact_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0)[0])
-    return (f"the central difference gives {fd:+.1e} on the crease, but the exact gradient {ex:+.3f}: "
-            f"$\\sin(\\pi k_u u)$ at the float nearest $1/k_u$ is not zero, so the sign picks a side",
-            {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex)})
+    return {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex), "central": fd, "exact": ex}
 
 
 def _pole_pixels():
     g = gbuffer(Scene(), 256, 256)
     n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= 1e-4)))
-    return (f"{n} pixels use the fallback{_on(g, Scene())}; the draft counts points of a grid of "
-            "$N_z$ values unrelated to the image", {"fallback pixels": n})
+    return {"fallback pixels": n, **_on(g, Scene())}
 
 
 def _sweep_best():
     a = {eps: compare(*_frames("sine", 0.35, eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
     best = min(a, key=a.get)
-    return (f"of the steps tried, {best:.0e} gives the smallest RMS difference"
-            + _on(_frames("sine")[1], Scene(height_field="sine")), {"best ε": best})
+    return {"best ε": best, **_on(_frames("sine")[1], Scene(height_field="sine"))}
 
 
 def _creases_part():
@@ -555,8 +502,7 @@ def _creases_part():
     diff = np.abs(num.image - sym.image).max(axis=-1)
     big = diff > 1e-3
     share = float(np.count_nonzero(big & sym.kink) / max(1, np.count_nonzero(big)))
-    return (f"{share:.0%} of the pixels whose $\\lvert\\Delta I\\rvert$ exceeds 1e-3 lie in the crease band"
-            + _on(sym), {"share in the band": share})
+    return {"share in the band": share, "threshold": 1e-3, **_on(sym)}
 
 
 def _rings_pinch():
@@ -571,16 +517,14 @@ def _rings_pinch():
         M = N + 0.35 * float(hv) * np.array([float(c) for c in e_phi])
         out.append(M / np.linalg.norm(M))
     angle = float(np.degrees(np.arccos(np.clip(out[0] @ out[1], -1, 1))))
-    return (f"with the draft's formula, $N'$ on opposite sides of the pole ($\\sin\\varphi = 10^{{-3}}$, "
-            f"rings, $\\beta = 0.35$) differ by {angle:.0f}°", {"angle (degrees)": angle})
+    return {"angle (degrees)": angle, "sin_phi": float(np.sin(phi)), "field": "rings", "beta": 0.35}
 
 
 def _beta_zero_slider():
     flat = render(Scene(beta=0.0), 96, 96)
     b = render(Scene(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
     n = int(np.count_nonzero(flat.image != b))
-    return (f"at $\\beta = 0$, renders of two fields by the two pipelines differ in {n} values" + _on(flat),
-            {"values differing": n})
+    return {"values differing": n, **_on(flat)}
 
 
 CLAIMS = (
@@ -681,12 +625,8 @@ CLAIMS = (
 )
 
 
-#: Each claim's decision rule, as the table shows it (generated from the `Criterion` it applies).
-CRITERIA = {c.id: str(c.criterion) for c in CLAIMS}
-
-
 def evaluate():
-    """[(claim, measured text, computed verdict)] for every claim."""
+    """[(claim, measured values, computed verdict)] for every claim (`Claim.measure`)."""
     return [(c, *c.measure()) for c in CLAIMS]
 
 

@@ -41,8 +41,8 @@ methods as they are available here, not as each could best be compiled.
 
 `FAST` is the configuration the book runs when it is built; `FULL` the one the
 benchmark runs for a release (every pixel in the reference, more steps, more
-repeats).  `pareto_front`, `pareto_figure` and `markdown_table` present a
-`Measurement`.
+repeats).  `pareto_front` picks a `Measurement`'s non-dominated methods; the book
+draws and tabulates it (book/chapter/benchmark.py).
 
 References
 ----------
@@ -76,7 +76,7 @@ __all__ = [
     "FIELDS", "ANALYTIC", "Config", "FAST", "FULL", "Evaluations", "MethodResult", "Measurement",
     "is_analytic", "chart_points", "forward_gradient", "complex_step_gradient",
     "richardson_gradient", "reference_gradient", "trig_calls", "stencil_values", "evaluations",
-    "methods", "measure", "pareto_front", "pareto_figure", "markdown_table", "to_json",
+    "methods", "measure", "pareto_front", "to_json",
 ]
 
 FIELDS = ("sine", "ridges", "rings")
@@ -704,151 +704,6 @@ def pareto_front(results, *, error="max"):
     errs = [r.max_error if error == "max" else r.rms_error for r in results]
     keep = _non_dominated([r.median for r in results], errs)
     return sorted((results[i] for i in keep), key=lambda r: r.median)
-
-
-_STYLE = {"exact": ("#1b5e20", "*", 12), "central": ("#7a1f1f", "o", 5), "forward": ("#b26b00", "s", 5),
-          "complex step": ("#1f4e7a", "D", 6), "complex step, |z| continued": ("#5b7fa6", "d", 7),
-          "richardson": ("#6a1b9a", "^", 8)}
-
-
-def _floor(e):
-    # An error of exactly 0 cannot sit on a log axis; plotted at 1e-18 (marked in the legend).
-    return max(e, 1e-18)
-
-
-def pareto_figure(measurement, *, error="max"):
-    """Log-log plot of time per frame against error, one panel per field.
-
-    Each point is a method at its median time, with a horizontal bar from the
-    fastest to the slowest run; difference sweeps are joined in order of eps
-    (unlabelled: neighbouring steps' labels would collide); the Pareto front is the
-    grey staircase.  Methods whose premise fails on a field are drawn hollow.
-    An error of exactly 0 would be drawn at 1e-18.
-
-    Parameters
-    ----------
-    measurement : Measurement
-    error : {"max", "rms"}, keyword-only
-
-    Returns
-    -------
-    matplotlib.figure.Figure (not shown; the caller shows or saves it).
-    """
-    from matplotlib.figure import Figure
-    from matplotlib.ticker import LogLocator, NullLocator
-    names = list(dict.fromkeys(r.field for r in measurement.results))
-    fig = Figure(figsize=(2.8 * len(names), 3.8))
-    fig.subplots_adjust(left=0.09, right=0.99, top=0.92, bottom=0.3, wspace=0.06)
-    axes = fig.subplots(1, len(names), sharey=True, squeeze=False)[0]
-    pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
-    handles = {}
-    for ax, name in zip(axes, names):
-        rs = measurement.of(name)
-        front = pareto_front(rs, error=error)
-        ft = [1e3 * r.median for r in front]
-        fe = [_floor(pick(r)) for r in front]
-        t_lo, t_hi = 0.5e3 * min(r.t_min for r in rs), 2e3 * max(r.t_max for r in rs)
-        handles["Pareto front"], = ax.step(ft + [t_hi], fe + [fe[-1]], where="post", color="0.75",
-                                           lw=4, zorder=0)
-        for method in dict.fromkeys(r.method for r in rs):
-            group = [r for r in rs if r.method == method]
-            color, marker, ms = _STYLE.get(method, ("k", "x", 5))
-            t = np.array([1e3 * r.median for r in group])
-            e = np.array([_floor(pick(r)) for r in group])
-            ax.hlines(e, [1e3 * r.t_min for r in group], [1e3 * r.t_max for r in group], color=color,
-                      lw=0.8)
-            ok = np.array([r.valid for r in group])
-            line, = ax.plot(t, e, color=color, lw=0.8 if len(group) > 1 else 0, alpha=0.7,
-                            marker=marker, ms=ms, markevery=list(np.flatnonzero(ok)))
-            ax.plot(t[~ok], e[~ok], ls="none", marker=marker, ms=ms, color=color, mfc="white")
-            handles.setdefault(method, line)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        # Decades only: minor ticks on log axes cost most of the drawing time.
-        for axis in (ax.xaxis, ax.yaxis):
-            axis.set_major_locator(LogLocator(base=10.0, numticks=9))
-            axis.set_minor_locator(NullLocator())
-        ax.set_xlim(t_lo, t_hi)
-        ax.set_title(name + ("" if ANALYTIC[name] else " (off the crease band)"), fontsize=10)
-        ax.set_xlabel("time per frame, ms", fontsize=9.5)
-        ax.tick_params(labelsize=8.5)
-        ax.grid(alpha=0.3, lw=0.3)
-    axes[0].set_ylabel(f"{error} $|$error$|$ of $(h_u, h_v)$", fontsize=9.5)
-    fig.legend(list(handles.values()), [{"richardson": "SciPy (Richardson)"}.get(m, m) for m in handles],
-               loc="lower center", ncols=4, fontsize=8,
-               frameon=False)
-    return fig
-
-
-def _fmt_ms(r):
-    return f"{1e3 * r.median:.2f} ({1e3 * r.t_min:.2f}–{1e3 * r.t_max:.2f})"
-
-
-def _fmt_evals(r):
-    parts = []
-    if r.h_evals:
-        parts.append(f"{r.h_evals:.4g} h")
-    if r.h_complex_evals:
-        parts.append(f"{r.h_complex_evals:.4g} complex h")
-    if r.gradient_evals:
-        parts.append(f"{r.gradient_evals:.4g} ∇h")
-    text = ", ".join(parts) or "0"
-    return f"{text} ({r.trig_evals:.4g} sin/cos)" if r.trig_evals else text
-
-
-def markdown_table(measurement, *, rows="all", error="max", include=()):
-    """The measurement as a Markdown table, one row per (field, method).
-
-    Parameters
-    ----------
-    measurement : Measurement
-    rows : {"all", "front", "best"}, keyword-only
-        "all": every result; "front": the Pareto front of each field;
-        "best": per field, the exact gradient and, of every other method, the
-        step with the smallest error (plus any result on the front).
-    error : {"max", "rms"}, keyword-only
-        The error that defines the front and "best".
-    include : sequence of str, keyword-only
-        Labels (`MethodResult.label`, e.g. ``"central 1e-03"``) shown in
-        every field even when ``rows`` would leave them out.
-
-    Returns
-    -------
-    str (GitHub-flavoured Markdown; ``|`` inside cells is escaped).
-
-    Raises
-    ------
-    ValueError
-        If ``rows`` is not one of the three choices.
-    """
-    if rows not in ("all", "front", "best"):
-        raise ValueError(f"rows must be 'all', 'front' or 'best', got {rows!r}")
-    head = ("field", "method", "evaluations per pixel", "time per frame, ms: median (min–max)",
-            "max error", "RMS error", "on the front", "note")
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    key = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
-    for name in dict.fromkeys(r.field for r in measurement.results):
-        rs = measurement.of(name)
-        front = pareto_front(rs, error=error)
-        if rows == "front":
-            chosen = list(front)
-        elif rows == "best":
-            chosen = []
-            for method in dict.fromkeys(r.method for r in rs):
-                group = [r for r in rs if r.method == method]
-                chosen.append(min(group, key=key))
-        else:
-            chosen = list(rs)
-        for r in front + [r for r in rs if r.label in include]:
-            if r not in chosen:
-                chosen.append(r)
-        chosen.sort(key=rs.index)
-        for r in chosen:
-            note = r.note if r.valid else ("**not valid**: " + r.note)
-            cells = (name, r.label, _fmt_evals(r), _fmt_ms(r), f"{r.max_error:.2e}", f"{r.rms_error:.2e}",
-                     "yes" if r in front else "", note)
-            lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
-    return "\n".join(lines)
 
 
 def to_json(measurement):

@@ -1,10 +1,10 @@
 """Errata of the seed's renderer code, each measured on the project's scene.
 
 Every record names where the seed says it (section or cell), what the seed's
-code does, what the project does instead, the test in ``tests/`` that exposes
-the defect, and a ``measure()`` that recomputes the evidence from scratch at
-build time.  The book's errata section renders these records; nothing in it is
-typed by hand.
+code does, the test in ``tests/`` that exposes the defect, and a ``measure()``
+that recomputes the evidence from scratch at build time.  The book's errata
+section words these records (book/chapter/errata_words.py) from the numbers;
+none of them is typed by hand.
 
 The seed variants below re-derive the seed's formulas in vectorized form for
 measurement only; the renderer never uses them.
@@ -29,24 +29,19 @@ SIZE = 256
 
 @dataclass(frozen=True)
 class Erratum:
-    """One defect of the seed's code, with its measured evidence."""
+    """One defect of the seed's code, with its measured evidence (a dict of numbers); the
+    book's sentences about it (its title, the correction, the finding) are in
+    book/chapter/errata_words.py."""
 
     id: str
     where: str
-    title: str
-    seed: str          # what the seed's code does (LaTeX allowed)
-    correction: str    # what the renderer does instead
+    seed: str          # what the seed's code does, as the draft writes it (LaTeX allowed)
     exposed_by: str    # the test that fails on the seed's variant
     measure: Callable[[], dict] = field(repr=False)
-    finding: str = ""  # str.format template over the measured dict
-    #: When the defect counts as still there, in words (the book shows it) and
+    #: When the defect counts as still there, as `reproduced`'s error message states it, and
     #: as a test of the measured dict (`reproduced` applies it).
     criterion: str = ""
     present: Callable[[dict], bool] = field(default=lambda m: False, repr=False)
-
-    def report(self, measured=None):
-        """The finding with the measured numbers filled in (measures if not given)."""
-        return self.finding.format(**(measured if measured is not None else self.measure()))
 
 
 def _rays(scene, size=SIZE):
@@ -236,104 +231,57 @@ ERRATA = (
     Erratum(
         id="sphere-b-quadratic",
         where="Cell 1 and Cell 3 (render loops)",
-        title="Sphere B is intersected from the wrong origin",
         seed=r"constant term $c = |C_B|^2 - r_B^2$",
-        correction=r"$c = |E - C_B|^2 - r_B^2$ for the ray from the eye $E$, roots by the stable pair $q/a,\ c/q$",
         exposed_by="tests/test_geometry_invariants.py (hit points on the surface)",
         measure=_sphere_b_seed_vs_true,
         criterion="the draft's hit points lie over one radius off sphere B, which covers over 5 times the true pixels",
         present=lambda m: m["off_surface_relative"] > 1.0 and m["seed_pixels_b"] > 5 * m["true_pixels_b"],
-        finding=(
-            "In the default frame of {pixels:,} pixels every ray hits the draft's sphere B: it "
-                "covers {seed_pixels_b:,} pixels where the true sphere covers {true_pixels_b:,}, so "
-                "{chamber_flips:,} pixels change chamber and sphere A is not visible at all. Its "
-                "'hit points' lie up to {off_surface_max:.3f} scene units ({off_surface_relative:.1f} "
-                "radii) off the sphere."
-        ),
     ),
     Erratum(
         id="terminator-leak",
         where="Cell 1, `shade1`, used by Cells 1, 3, 5 and 6",
-        title="Lights leak past the terminator of the bumped sphere",
         seed=r"a light counts wherever $N'\cdot\hat w > 0$; the geometric normal is never asked",
-        correction=r"a light reaches $P$ only if $N\cdot w > 0$ (geometric) and no blocker cuts the segment; $N'$ then only weights Lambert and the lobe",
         exposed_by="tests/test_parity.py (scalar reference with geometric shadow predicate)",
         measure=_terminator_leak,
         criterion="the draft's rule lights a pair beyond the terminator at the default β, by more than one 8-bit level",
         present=lambda m: m["leak_pixels_default"] > 0 and m["leak_diffuse_max_default"] > 1 / 255,
-        finding=(
-            "At the default $\\beta$ the draft's rule lights {leak_pixels_default:,} (pixel, light) "
-                "pairs on sphere A whose geometric normal faces away from the light (Lambert term up "
-                "to {leak_diffuse_max_default:.2f}); at $\\beta = 1.5$, {leak_pixels_beta_1_5:,}; at "
-                "$\\beta = 0$, none. The lit region's boundary moves with $\\beta$, against the "
-                "draft's own theorem."
-        ),
     ),
     Erratum(
         id="specular-ungated",
         where="Cell 1, `shade1`",
-        title="The specular lobe is added where the surface faces away from the light",
         seed=r"$k_s \max(0, N'\cdot h)^{n}$ added for every unshadowed light",
-        correction=r"the lobe is zero where $N'\cdot\hat w \le 0$",
         exposed_by="verify/test_errata.py (lobe where the bumped normal faces away)",
         measure=_specular_ungated,
         criterion="some pair facing away from its light receives a nonzero lobe",
         present=lambda m: m["pixels"] > 0 and m["max_specular_added"] > 0,
-        finding=(
-            "In the default frame {pixels:,} (pixel, light) pairs face away from the light yet "
-                "receive a lobe; the largest is {max_specular_added:.1e}, far below one 8-bit level: "
-                "invisible here, wrong in principle."
-        ),
     ),
     Erratum(
         id="v-border-branch",
         where="Cell 1, `grad_numeric`",
-        title="The one-sided v-difference fires in the interior",
         seed=r"one-sided quotient whenever $\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border",
-        correction=r"one-sided only where $v \pm \varepsilon$ leaves $[0, 1]$; elsewhere divide by $2\varepsilon$",
         exposed_by="verify/test_theorems.py (central-difference-truncation: interior points take the 2 eps branch)",
         measure=_v_border_branch,
         criterion="the branch fires at some interior pixels at a step of 1e-3, and at more at 1e-9",
         present=lambda m: 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"],
-        finding=(
-            "At a step of 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
-                "sphere-A pixels (relative change of the quotient up to {rel_change_1e-3:.1e}); at "
-                "1e-6 at {fraction_interior_1e-6:.0%} ({rel_change_1e-6:.1e}); at 1e-9 at "
-                "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e})."
-        ),
     ),
     Erratum(
         id="acos-pole",
         where="Cell 1, `chartA1`",
-        title="The polar angle loses digits near the pole",
         seed=r"$\varphi = \arccos N_z$ and $\sin\varphi = \sqrt{1 - N_z^2}$",
-        correction=r"$\varphi = \operatorname{atan2}(\operatorname{hypot}(N_x, N_y), N_z)$ and $\sin\varphi = \operatorname{hypot}(N_x, N_y)$",
         exposed_by="verify/test_errata.py (mpmath reference)",
         measure=_acos_pole,
         criterion="arccos loses more than 1e-3 (relative) while atan2 stays within 1e-14",
         present=lambda m: m["max_rel_error_acos"] > 1e-3 and m["max_rel_error_atan2"] < 1e-14,
-        finding=(
-            "For unit normals with $\\sin\\varphi$ between 1e-8 and 1e-2 the relative error of "
-                "$\\arccos N_z$ reaches {max_rel_error_acos:.1e} against mpmath; atan2 stays within "
-                "{max_rel_error_atan2:.1e}."
-        ),
     ),
     Erratum(
         id="fallback-orientation",
         where="Cell 1, `tangent_frame`, and §7 item 4",
-        title="The pole fallback frame has the opposite orientation",
         seed=r"fallback $e_\theta = (1,0,0)$, $e_\varphi = (0,1,0)$",
-        correction="kept as the seed has it (the convention is the seed's); measured and disclosed",
         exposed_by="verify/test_errata.py",
         measure=_fallback_orientation,
         criterion="the fallback's orientation is +1, the regular frame's -1 to 1e-12",
         present=lambda m: (m["orientation_fallback"] == 1.0
                          and max(abs(m["orientation_regular_min"] + 1), abs(m["orientation_regular_max"] + 1)) <= 1e-12),
-        finding=(
-            "$(e_\\theta \\times e_\\varphi)\\cdot N$ is {orientation_regular_min:.0f} on the "
-                "regular frame (to rounding) and {orientation_fallback:+.0f} on the fallback: the "
-                "fallback pair is a reflection of the frame it replaces, not a rotation."
-        ),
     ),
 )
 

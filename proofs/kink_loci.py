@@ -133,7 +133,6 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False,
     exactly the loci claimed visible have crease pixels; else refuted.  ``shift``, ``rho``,
     ``drho``, ``band_scale`` (`locus_bands`) and ``all_visible`` (claim every circle visible):
     wrong variants."""
-    from renderer import frame_label
     mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho, band_scale)
     if kind == "rays":
         seen = np.ones(len(per_locus), dtype=bool)             # every ray crosses the visible cap
@@ -152,7 +151,7 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False,
                        f"claimed visible are {seen.tolist()}")
     return Verdict("proved", f"{what}; the bands about these loci (closed form alone) equal the rendered crease "
                    f"flag on all {compared} sphere-A pixels off the other family, and exactly the visible loci have "
-                   f"crease pixels ({', '.join(map(str, per_locus))}) ({frame_label(scene, SIZE, SIZE)})",
+                   f"crease pixels ({', '.join(map(str, per_locus))}) ({SIZE} × {SIZE})",
                    rendered=compared)
 
 

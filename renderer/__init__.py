@@ -24,7 +24,7 @@ from pathlib import Path
 #: digest guard would refuse the generated file it is about to rewrite.
 _WHERE = {
     "Scene": "scene", "PointLight": "scene", "BUMPS": "scene", "HEIGHT_FIELDS": "scene",
-    "MODELS": "scene", "frame_label": "scene",
+    "MODELS": "scene",
     "render": "render", "gbuffer": "render", "Frame": "render", "GBuffer": "render",
     "GRADIENTS": "render", "CHAMBER_NAMES": "render",
     "Ledger": "ledger", "compare": "ledger", "to_srgb": "ledger",

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 
-from .validate import InvalidType, InvalidValue, choice, flag, positive_int, real, vector3
+from .validate import InvalidType, InvalidValue, choice, flag, real, vector3
 
-__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS", "frame_label"]
+__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
 
 #: Largest accepted magnitude of a length or coordinate (scene units): squares of
 #: lengths are formed everywhere, and 1e6 keeps them far from overflow.
@@ -231,40 +231,15 @@ class Scene:
         values.update(changes)
         return Scene(**values)
 
+    def changes(self) -> dict:
+        """The fields that differ from `Scene`'s defaults: the keyword arguments that build
+        this scene, so a stored measurement can say which scene it used.
 
-def frame_label(scene, width, height) -> str:
-    """The label a number measured on a render carries: its scene and resolution, in words.
-
-    ``"the draft's scene, 256 × 256"``, or with the fields that differ from
-    `renderer.Scene`'s defaults (the draft's scene): ``"the draft's scene with the
-    sine field, β = 1.5, 64 × 64"``.  ``scene`` is a `renderer.Scene`; ``width``,
-    ``height`` in pixels.
-
-    Raises
-    ------
-    TypeError
-        ``scene`` is not a `renderer.Scene`, or ``width`` or ``height`` is not an integer
-        (`renderer.validate.positive_int`).
-    ValueError
-        ``width`` or ``height`` is below 1.
-    """
-    if not isinstance(scene, Scene):
-        raise TypeError(f"scene must be a renderer.Scene, got {type(scene).__name__}")
-    width, height = positive_int("width", width), positive_int("height", height)
-    default = Scene()
-    changed = [_field_words(f.name, getattr(scene, f.name)) for f in fields(Scene)
-               if getattr(scene, f.name) != getattr(default, f.name)]
-    return "the draft's scene" + (" with " + ", ".join(changed) if changed else "") + f", {width} × {height}"
-
-
-#: How `frame_label` words a field of `renderer.Scene` that differs from the draft's.
-_WORDS = {"height_field": "the {} field", "beta": "β = {:g}", "eps": "ε = {:g}", "k_u": "kᵤ = {:g}",
-          "k_v": "kᵥ = {:g}", "radius_a": "R = {:g}", "model": "{} shading", "shininess": "shininess {:g}"}
-
-
-def _field_words(name, value):
-    if name == "bump":
-        return {"surface": "the displaced sphere's normal", "chart": "the draft's normal"}[value]
-    if name in ("sphere_b", "floor") and isinstance(value, bool):
-        return f"{'with' if value else 'no'} {'sphere B' if name == 'sphere_b' else name}"
-    return _WORDS.get(name, name.replace("_", " ") + " {}").format(value)
+        Returns
+        -------
+        dict
+            {field name: value}; ``Scene(**scene.changes()) == scene``.  JSON-safe (str,
+            float, bool, tuples of floats) unless ``lights`` differ (a tuple of `PointLight`).
+        """
+        default = Scene()
+        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) != getattr(default, f.name)}

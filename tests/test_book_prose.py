@@ -123,7 +123,7 @@ def test_a_number_typed_into_a_comment_is_found():
 # ------------------------------------------------------------- scene and resolution labels
 ROOT = BOOK.parent
 #: A glue whose name ends so carries the scene or resolution of a render (e.g. "256 × 256",
-#: `chapter.theorems.frame_label`'s "the draft's scene with the sine field, 64 × 64").
+#: `chapter.labels.frame_label`'s "the draft's scene with the sine field, 64 × 64").
 #: A glue ``*_measured`` is a claim's measurement text, which ends with its frame (`lab.claims`).
 LABEL = re.compile(r"(_size|_label|_measured)$")
 CELL = re.compile(r"```\{code-cell\}[^\n]*\n(.*?)\n```", re.S)      # to drop cells from the prose
@@ -274,25 +274,6 @@ def test_an_unlabelled_rendered_number_is_found():
            "```{code-cell} ipython3\nfor k in (1, 2):\n    glue(\"x_k\", k)\n```\n\n"
            "```{code-cell} ipython3\nglue(\"x_n\", int(fr.chamber.sum()))\n```\n\n")
     assert unlabelled(two + "It has {glue:text}`x_n`.\n\nAnd {glue:text}`x_k`.\n", renders) == [["x_n"]]
-
-
-def test_frame_label_names_the_fields_that_differ_and_the_size():
-    from renderer import frame_label
-    from renderer import Scene
-    assert frame_label(Scene(), 256, 128) == "the draft's scene, 256 × 128"
-    assert frame_label(Scene(height_field="sine", beta=1.5), 64, 64) == \
-        "the draft's scene with the sine field, β = 1.5, 64 × 64"
-    assert frame_label(Scene(bump="surface", sphere_b=False, k_v=2.0), 8, 8) == \
-        "the draft's scene with no sphere B, kᵥ = 2, the displaced sphere's normal, 8 × 8"
-    with pytest.raises(TypeError, match="scene must be a renderer.Scene, got dict"):
-        frame_label({}, 64, 64)
-    with pytest.raises(ValueError, match=r"^width must be a positive integer, got 0$"):
-        frame_label(Scene(), 0, 64)
-    for bad in (2.0, True):                    # a float or a bool is not a count of pixels
-        with pytest.raises(TypeError, match=rf"^height must be a positive integer, got {type(bad).__name__} {bad!r}$"):
-            frame_label(Scene(), 64, bad)
-    import numpy as np
-    assert frame_label(Scene(), np.int64(8), 8) == "the draft's scene, 8 × 8"      # numpy integers count
 
 
 # ------------------------------------------------------------------- code a reader is shown

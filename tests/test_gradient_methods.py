@@ -283,12 +283,21 @@ def test_measure_small_run_and_its_presentations():
     assert not plain.valid and plain.max_error > 1.0
     assert m.get("ridges", "complex step, |z| continued 1e-20").max_error <= FLOAT64_EVAL
     assert m.get("sine", "central 1e-06").max_error > 1e4 * FLOAT64_EVAL
-    table = gm.markdown_table(m, rows="best", include=("central 1e-03",))
-    assert "central 1e-03" in table and "**not valid**" in table
+    from chapter.benchmark import markdown_table, pareto_figure
+    table = markdown_table(m, rows="best", include=("central 1e-03",))
+    rows = [[c.strip() for c in line.strip("|").split(" | ")] for line in table.splitlines()[2:]]
     # "best": per field one row per method (5 on sine and rings, 6 on ridges) + central 1e-03.
-    assert len(table.splitlines()) == 2 + (5 + 1) + (6 + 1) + (5 + 1)
-    with pytest.raises(ValueError, match="rows must be"):
-        gm.markdown_table(m, rows="some")
-    fig = gm.pareto_figure(m)
+    assert [r[0] for r in rows] == ["sine"] * 6 + ["ridges"] * 7 + ["rings"] * 6
+    assert all(len(r) == len(rows[0]) == 8 for r in rows)
+    assert {"exact", "central 1e-03"} <= {r[1] for r in rows if r[0] == "ridges"}
+    shown = {(r[0], r[1]): r for r in rows}
+    for f in gm.FIELDS:                                        # the numbers are the measurement's
+        exact = m.get(f, "exact")
+        assert float(shown[f, "exact"][4]) == pytest.approx(exact.max_error, rel=1e-2, abs=1e-300)
+        assert float(shown[f, "exact"][5]) == pytest.approx(exact.rms_error, rel=1e-2, abs=1e-300)
+    assert [r[1] for r in rows if r[0] == "ridges" and "not valid" in r[7]] == ["complex step 1e-20"]
+    with pytest.raises(ValueError, match="rows must be 'all', 'front' or 'best', got 'some'"):
+        markdown_table(m, rows="some")
+    fig = pareto_figure(m)
     assert len(fig.axes) == 3
     assert '"label": "exact"' in gm.to_json(m)

@@ -112,9 +112,9 @@ def test_bad_arguments_are_named(calls, call, error, match):
 #: MyST a plain Jupyter would show as written: a role, a fenced directive, a target line.
 MYST = re.compile(r"\{[A-Za-z][\w:.+-]*\}`|`{3,}\s*\{|:{3,}\s*\{|^\s*(?:[*+-]\s+)?\([^()\s]+\)=\s*$", re.M)
 
-#: What the book's helpers hand `markdown`: a claim's verdict, a theorem box, a ledger item.
-MYST_OUTPUT = (":::{container} verdicts\n**§1:** “No pixel changes chamber”. **Holds:** 0 pixels. "
-               "{ref}`Register <claim-flips-zero>`.\n:::\n\n"
+#: What the book's helpers hand `markdown`: a claim's margin note, a theorem box, a ledger item.
+MYST_OUTPUT = ("```{margin}\n**§1** · “No pixel changes chamber” — {term}`Holds` "
+               "({ref}`in the register <claim-flips-zero>`)\n```\n\n"
                ":::{prf:theorem} The bump moves no boundary\n:label: thm-no-boundary\n\n"
                "For every pixel, $c(\\beta) = c(0)$.\n\n**PROVED** · evidence: {ref}`§6 <ledger-no-boundary>`\n:::\n\n"
                ":::{prf:proof}\n**Step 1.** The chamber is computed first.\n:::\n\n"
@@ -123,13 +123,13 @@ MYST_OUTPUT = (":::{container} verdicts\n**§1:** “No pixel changes chamber”
 
 
 def test_markdown_is_myst_in_a_build_and_plain_markdown_elsewhere(monkeypatch):
-    assert len(MYST.findall(MYST_OUTPUT)) == 10             # the scan sees every piece of MyST in it
+    assert len(MYST.findall(MYST_OUTPUT)) == 11             # the scan sees every piece of MyST in it
     monkeypatch.setenv(page.BUILD_ENV, "1")
     assert page.markdown(MYST_OUTPUT).data == MYST_OUTPUT
     monkeypatch.delenv(page.BUILD_ENV)
     shown = page.markdown(MYST_OUTPUT).data
     assert MYST.findall(shown) == []
-    assert shown == ("**§1:** “No pixel changes chamber”. **Holds:** 0 pixels. Register.\n\n"
+    assert shown == ("**§1** · “No pixel changes chamber” — Holds (in the register)\n\n"
                      "**Theorem (The bump moves no boundary).** For every pixel, $c(\\beta) = c(0)$.\n\n"
                      "**PROVED** · evidence: §6\n\n*Proof.* **Step 1.** The chamber is computed first.\n\n"
                      "*\n  The bump moves no boundary: used on s3.\n\n**Why**\n\nBecause:\n\n$$\nc = c_0\n$$")

@@ -52,3 +52,29 @@ def test_the_ungated_lobe_is_counted_on_both_spheres(monkeypatch, codes, pairs):
     monkeypatch.setattr(seed_errata, "Scene", lambda: scene)
     monkeypatch.setattr(seed_errata, "gbuffer", lambda scene, w, h: g)
     assert seed_errata._specular_ungated(size=2)["pixels"] == pairs
+
+
+# ----------------------------------------------------------------------- the book's words for them
+def test_each_erratum_is_worded_once_from_its_own_numbers():
+    """book/chapter/errata_words.py: one title, correction and finding per erratum, in the register's
+    order; each finding shows its own erratum's counts (a template reading another erratum's number,
+    or a count typed in, fails here), and the errata are numbered E1, E2, ... with the draft's data."""
+    import re
+
+    from chapter.errata_words import WORDS, errata, finding
+    assert list(WORDS) == [e.id for e in seed_errata.ERRATA]
+    measured = seed_errata.measure_all()
+    for e in seed_errata.ERRATA:
+        text = finding(e.id, measured[e.id])
+        read = re.findall(r"\{([^:}]+)", WORDS[e.id]["finding"])
+        assert read and "{" not in text, e.id                  # every finding shows a measured number
+        for key, x in measured[e.id].items():              # every count it measured, but one the book omits
+            if isinstance(x, int) and (e.id, key) != ("sphere-b-quadratic", "seed_pixels_a"):
+                assert f"{x:,}" in text, (e.id, key)
+    md = errata(measured)
+    assert re.findall(r"\*\*E(\d+)\. ", md) == [str(i) for i in range(1, len(seed_errata.ERRATA) + 1)]
+    assert all(e.seed in md and e.where in md for e in seed_errata.ERRATA)
+    with pytest.raises(KeyError, match="seed_pixels_b"):
+        finding("sphere-b-quadratic", {"pixels": 1})
+    with pytest.raises(KeyError, match="erratum_id must be one of"):
+        finding("no-such-erratum", {})

@@ -1,5 +1,5 @@
 """book/chapter/verdicts.py: every claim of the draft is shown once, where the book discusses it,
-and the register's row and the place link to each other."""
+as a margin note, and the register's row and the note link to each other."""
 
 from __future__ import annotations
 
@@ -32,54 +32,70 @@ def test_a_claim_placed_twice_or_nowhere_is_caught():
         verdicts.place_of("no-such-claim")
 
 
-def test_every_place_is_a_label_of_a_page_that_shows_its_verdicts():
+def test_every_place_is_a_label_of_a_page_that_shows_its_margin_notes():
     """Each place is a MyST label of the book, and the page holding the label calls
-    verdicts(place): a claim cannot be placed where no page shows it."""
+    margin_notes(place): a claim cannot be placed where no page shows it."""
     pages = {p: p.read_text(encoding="utf-8") for p in BOOK.glob("*.md")}
     for place in verdicts.PLACES:
         holders = [p for p, text in pages.items() if re.search(rf"^\({re.escape(place)}\)=$", text, re.M)]
         assert len(holders) == 1, (place, holders)
-        assert re.search(rf"verdicts\([\"']{re.escape(place)}[\"']\)", pages[holders[0]]), (place, holders[0])
+        assert re.search(rf"margin_notes\([\"']{re.escape(place)}[\"']\)", pages[holders[0]]), (place, holders[0])
 
 
-def test_a_verdict_sentence_names_the_claim_the_verdict_and_links_its_register_row(monkeypatch):
-    claim = next(c for c in CLAIMS if c.id == "h3-scale")
-    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {"h3-scale": (claim, "measured text", FAILS)})
-    monkeypatch.setitem(verdicts.PLACES, "s3-ucurve", ("h3-scale",))
-    md = verdicts.verdicts("s3-ucurve")
-    assert md.startswith(":::{container} verdicts") and f"“{claim.quote}”" in md
-    assert "**Does not hold:** measured text." in md and "{ref}`Register <claim-h3-scale>`" in md
-    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {"h3-scale": (claim, "measured text", HOLDS)})
-    assert "**Holds:**" in verdicts.verdicts("s3-ucurve")
+MARGIN = re.compile(r"```\{margin\}\n(.*?)\n```", re.S)
 
 
-def test_the_register_gives_each_claim_a_target_and_a_link_back(monkeypatch):
-    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {c.id: (c, f"m-{c.id}", c.registered) for c in CLAIMS})
+def test_a_margin_note_quotes_the_claim_links_its_verdict_term_and_its_register_row(monkeypatch):
+    """One ``margin`` directive per claim of the place, in order, each with the draft's words, the
+    verdict as a glossary ``{term}`` and a ``{ref}`` to the claim's row; the measurement stays in §6."""
+    claims = [c for c in CLAIMS if c.id in ("h3-scale", "truncation-until-1e-6")]
+    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {c.id: (c, {"x": 1}, FAILS) for c in claims})
+    monkeypatch.setitem(verdicts.PLACES, "s3-ucurve", tuple(c.id for c in claims))
+    notes = MARGIN.findall(verdicts.margin_notes("s3-ucurve"))
+    assert len(notes) == 2
+    for claim, note in zip(claims, notes):
+        assert f"“{claim.quote}”" in note and claim.where in note
+        assert re.findall(r"\{term\}`([^`]+)`", note) == [verdicts.WORDS[FAILS]]
+        assert re.findall(r"\{ref\}`[^`<]*<([^>]+)>`", note) == [f"claim-{claim.id}"]
+    monkeypatch.setattr(verdicts, "_results", lambda ids=None: {c.id: (c, {}, HOLDS) for c in claims})
+    assert re.findall(r"\{term\}`([^`]+)`", verdicts.margin_notes("s3-ucurve")) == [verdicts.WORDS[HOLDS]] * 2
+
+
+def test_the_register_gives_each_claim_a_target_its_measurement_its_rule_and_a_link_back():
+    """Each row: the target, the verdict term, the claim's own numbers (its sentence), and the link to
+    its place; read from one evaluation of the register (the real one: the build's measurement)."""
+    from chapter.claim_words import measured_text, rule_text
+    results = verdicts._results()
     md = verdicts.register()
-    for c in CLAIMS:
-        assert f"(claim-{c.id})=\n" in md
-    assert md.count("Measured in {ref}`cell3`") == len(verdicts.PLACES["cell3"])
+    rows = md.split("(claim-")[1:]
+    assert [r.split(")=", 1)[0] for r in rows] == [c.id for c in CLAIMS]
+    for c, row in zip(CLAIMS, rows):
+        _, measured, verdict = results[c.id]
+        assert f"{{term}}`{verdicts.WORDS[verdict]}`" in row
+        assert measured_text(c.id, measured) in row and rule_text(c.criterion) in row
+        assert f"{{ref}}`{verdicts.place_of(c.id)}`" in row
+    assert md.count("{ref}`cell3`") == len(verdicts.PLACES["cell3"])
 
 
 def test_an_unknown_place_is_refused():
     with pytest.raises(KeyError, match="place must be one of"):
-        verdicts.verdicts("cell9")
+        verdicts.margin_notes("cell9")
 
 
 def test_outside_a_book_build_only_the_places_claims_are_measured(monkeypatch):
     """A downloaded notebook measures the two claims of its section, not the register (wrong variant: all)."""
     measured = []
-    monkeypatch.setattr("lab.claims.Claim.measure", lambda self: measured.append(self.id) or ("m", self.registered))
+    monkeypatch.setattr("lab.claims.Claim.measure", lambda self: measured.append(self.id) or ({}, self.registered))
     monkeypatch.delenv("SYMRENDER_BOOK_BUILD", raising=False)
-    assert "**Holds" in verdicts.verdicts("s3-boundary")
+    assert len(MARGIN.findall(verdicts.margin_notes("s3-boundary"))) == len(verdicts.PLACES["s3-boundary"])
     assert sorted(measured) == sorted(verdicts.PLACES["s3-boundary"])
 
 
 def glossary_terms(text):
-    """The terms of the book's glossary (each term line of its ``{glossary}`` block, split at commas), lower case."""
+    """The terms of the book's glossary (each term line of its ``{glossary}`` block, as Sphinx reads it:
+    a whole line, commas included), lower case: what a ``{term}`` role can link to."""
     block = re.search(r"```\{glossary\}\n(.*?)\n```", text, re.S).group(1)
-    return {t.strip().lower() for line in block.splitlines() if line and not line[0].isspace()
-            for t in line.split(",")}
+    return {line.strip().lower() for line in block.splitlines() if line and not line[0].isspace()}
 
 
 def test_the_glossary_defines_every_verdict_word():
@@ -91,3 +107,4 @@ def test_the_glossary_defines_every_verdict_word():
     assert words == {"holds", "holds with a correction", "does not hold", "proved", "verified", "refuted"}
     assert words <= glossary_terms(text)
     assert not words <= glossary_terms(text.replace("\nrefuted\n", "\nrebutted\n"))
+    assert not words <= glossary_terms(text.replace("\nproved\n", "\nproved, shown\n"))   # one term, not two

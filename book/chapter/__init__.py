@@ -2,6 +2,9 @@
 
 `page` (glue a value, show a figure, show MyST), `figures` (the figure style, the
 explanatory diagrams, the text-overlap check), `theorems` (a theorem's box and the
-§6 ledger), `verdicts` (the draft's claims where the reader meets them, and the
-register).  The top layer: imports `lab`, `proofs` and `renderer`.
+§6 ledger), `verdicts` (the draft's claims as margin notes where the reader meets
+them, and the register), and the book's words for what the lower layers return:
+`labels` (a measurement's scene and size), `claim_words` (the claims' sentences and
+rules), `errata_words` (the errata's sentences) and `benchmark` (the gradient
+methods' table and figure).  The top layer: imports `lab`, `proofs` and `renderer`.
 """

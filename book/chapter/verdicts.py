@@ -1,20 +1,22 @@
-"""The draft's claims on the book's pages: a verdict where the reader meets each claim,
+"""The draft's claims on the book's pages: a margin note where the reader meets each claim,
 and the register of §6 that collects them.
 
 Every claim of `lab.claims.CLAIMS` is *placed* on exactly one page section
-(`PLACES`): there `verdicts(place)` shows it in one sentence (the draft's words,
-the verdict, the measurement) linked to its row of the register, and the
-register row links back.  Both read the same evaluation of the register
-(`lab.claims.checked`), so a verdict cannot read one way in §5 and another
-in §6, and the build fails, as `pytest verify` does, when a computed verdict
-is not the registered one.
+(`PLACES`): there `margin_notes(place)` shows it in a margin note (the draft's words,
+the verdict linked to its glossary term) linked to its row of the register; the row
+holds the measurement in words (`chapter.claim_words`) and the rule, and links back.
+Both read the same evaluation of the register (`lab.claims.checked`), so a verdict
+cannot read one way in §5 and another in §6, and the build fails, as `pytest verify`
+does, when a computed verdict is not the registered one.
 """
 
 from __future__ import annotations
 
-from lab.claims import CLAIMS, CORRECTED, CRITERIA, FAILS, HOLDS, checked
+from lab.claims import CLAIMS, checked
 
-__all__ = ["PLACES", "verdicts", "register", "place_of"]
+from .claim_words import WORDS, measured_text, rule_text
+
+__all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of"]
 
 #: Book section label -> the claims shown there, in the order the section meets them.
 PLACES = {
@@ -31,10 +33,6 @@ PLACES = {
     "s6": ("stacking",),
     "s8": ("blinn-exact",),
 }
-
-#: How a verdict reads in a sentence.
-WORDS = {HOLDS: "Holds", CORRECTED: "Holds with a correction", FAILS: "Does not hold"}
-
 
 def place_of(claim_id):
     """The section label where ``claim_id`` is shown.
@@ -60,14 +58,16 @@ def _results(ids=None):
     return {c.id: (c, m, v) for c, m, v in checked([(c, *c.measure()) for c in CLAIMS if c.id in ids])}
 
 
-def _sentence(claim, measured, verdict):
-    return (f"**{claim.where}:** “{claim.quote}”. **{WORDS[verdict]}:** {measured}. "
-            f"{{ref}}`Register <claim-{claim.id}>`.")
+def _note(claim, verdict):
+    return (f"```{{margin}}\n**{claim.where}** · “{claim.quote}” — {{term}}`{WORDS[verdict]}` "
+            f"({{ref}}`in the register <claim-{claim.id}>`)\n```")
 
 
-def verdicts(place):
-    """MyST markdown for the section labelled ``place``: one paragraph per claim placed
-    there (`PLACES`), in a container of class ``verdicts``.
+def margin_notes(place):
+    """MyST markdown for the section labelled ``place``: one margin note (sphinx-book-theme's
+    ``margin`` directive) per claim placed there (`PLACES`), in order: the draft's words
+    (``where``, ``quote``), the verdict as a ``{term}`` link to the glossary, and a ``{ref}``
+    link to the claim's row of the register (`register`).
 
     Raises
     ------
@@ -79,14 +79,15 @@ def verdicts(place):
     if place not in PLACES:
         raise KeyError(f"place must be one of {sorted(PLACES)}, got {place!r}")
     results = _results(PLACES[place])
-    body = "\n\n".join(_sentence(*results[i]) for i in PLACES[place])
-    return f":::{{container}} verdicts\n{body}\n:::\n"
+    return "\n\n".join(_note(claim, verdict) for claim, _, verdict in (results[i] for i in PLACES[place])) + "\n"
 
 
 def register():
     """MyST markdown: the register of §6, one entry per claim in `lab.claims.CLAIMS`
-    order, each with the target ``claim-<id>``, its verdict, the rule that decided it, and
-    a link to the section that shows the measurement (`verdicts`).
+    order, each with the target ``claim-<id>``, its verdict (a ``{term}`` link), the
+    measurement in words (`chapter.claim_words.measured_text`), the rule that decided it
+    (`chapter.claim_words.rule_text`), and a link to the section whose margin note shows it
+    (`margin_notes`).
 
     Raises
     ------
@@ -99,6 +100,7 @@ def register():
         claim, measured, verdict = results[c.id]
         entries.append(
             f"(claim-{c.id})=\n"
-            f"**{n}. {claim.where}:** “{claim.quote}”. **{WORDS[verdict]}**, by the rule: {CRITERIA[c.id]}. "
-            f"Measured in {{ref}}`{place_of(c.id)}`.\n")
+            f"**{n}. {claim.where}:** “{claim.quote}” (noted in {{ref}}`{place_of(c.id)}`). "
+            f"**{{term}}`{WORDS[verdict]}`**: {measured_text(c.id, measured)}; by the rule: "
+            f"{rule_text(claim.criterion)}.\n")
     return "\n".join(entries)

@@ -1,0 +1,102 @@
+"""The book's words about the errata of the draft's code (`lab.seed_errata.ERRATA`): each
+erratum's title, what this renderer does instead, and its finding, a template formatted
+from the erratum's measured dict.  The draft's own code (``seed``) and where it stands
+(``where``) are data of `lab.seed_errata`."""
+
+from __future__ import annotations
+
+from lab.seed_errata import ERRATA
+
+__all__ = ["WORDS", "finding", "errata"]
+
+#: Erratum id -> {"title", "correction" (this renderer's way), "finding" (str.format over the measured dict)}.
+WORDS = {
+    "sphere-b-quadratic": dict(
+        title="Sphere B is intersected from the wrong origin",
+        correction=r"$c = |E - C_B|^2 - r_B^2$ for the ray from the eye $E$, roots by the stable pair $q/a,\ c/q$",
+        finding=(
+            "In the default frame of {pixels:,} pixels every ray hits the draft's sphere B: it "
+            "covers {seed_pixels_b:,} pixels where the true sphere covers {true_pixels_b:,}, so "
+            "{chamber_flips:,} pixels change chamber and sphere A is not visible at all. Its "
+            "'hit points' lie up to {off_surface_max:.3f} scene units ({off_surface_relative:.1f} "
+            "radii) off the sphere."
+        ),
+    ),
+    "terminator-leak": dict(
+        title="Lights leak past the terminator of the bumped sphere",
+        correction=r"a light reaches $P$ only if $N\cdot w > 0$ (geometric) and no blocker cuts the segment; $N'$ then only weights Lambert and the lobe",
+        finding=(
+            "At the default $\\beta$ the draft's rule lights {leak_pixels_default:,} (pixel, light) "
+            "pairs on sphere A whose geometric normal faces away from the light (Lambert term up "
+            "to {leak_diffuse_max_default:.2f}); at $\\beta = 1.5$, {leak_pixels_beta_1_5:,}; at "
+            "$\\beta = 0$, none. The lit region's boundary moves with $\\beta$, against the "
+            "draft's own theorem."
+        ),
+    ),
+    "specular-ungated": dict(
+        title="The specular lobe is added where the surface faces away from the light",
+        correction=r"the lobe is zero where $N'\cdot\hat w \le 0$",
+        finding=(
+            "In the default frame {pixels:,} (pixel, light) pairs face away from the light yet "
+            "receive a lobe; the largest is {max_specular_added:.1e}, far below one 8-bit level: "
+            "invisible here, wrong in principle."
+        ),
+    ),
+    "v-border-branch": dict(
+        title="The one-sided v-difference fires in the interior",
+        correction=r"one-sided only where $v \pm \varepsilon$ leaves $[0, 1]$; elsewhere divide by $2\varepsilon$",
+        finding=(
+            "At a step of 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
+            "sphere-A pixels (relative change of the quotient up to {rel_change_1e-3:.1e}); at "
+            "1e-6 at {fraction_interior_1e-6:.0%} ({rel_change_1e-6:.1e}); at 1e-9 at "
+            "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e})."
+        ),
+    ),
+    "acos-pole": dict(
+        title="The polar angle loses digits near the pole",
+        correction=r"$\varphi = \operatorname{atan2}(\operatorname{hypot}(N_x, N_y), N_z)$ and $\sin\varphi = \operatorname{hypot}(N_x, N_y)$",
+        finding=(
+            "For unit normals with $\\sin\\varphi$ between 1e-8 and 1e-2 the relative error of "
+            "$\\arccos N_z$ reaches {max_rel_error_acos:.1e} against mpmath; atan2 stays within "
+            "{max_rel_error_atan2:.1e}."
+        ),
+    ),
+    "fallback-orientation": dict(
+        title="The pole fallback frame has the opposite orientation",
+        correction="kept as the seed has it (the convention is the seed's); measured and disclosed",
+        finding=(
+            "$(e_\\theta \\times e_\\varphi)\\cdot N$ is {orientation_regular_min:.0f} on the "
+            "regular frame (to rounding) and {orientation_fallback:+.0f} on the fallback: the "
+            "fallback pair is a reflection of the frame it replaces, not a rotation."
+        ),
+    ),
+}
+
+
+def finding(erratum_id, measured) -> str:
+    """The finding of erratum ``erratum_id`` with its ``measured`` numbers (its dict) filled in.
+
+    Raises
+    ------
+    KeyError
+        If ``erratum_id`` has no words in `WORDS`, or the finding reads a number ``measured`` lacks.
+    """
+    if erratum_id not in WORDS:
+        raise KeyError(f"erratum_id must be one of {sorted(WORDS)}, got {erratum_id!r}")
+    return WORDS[erratum_id]["finding"].format(**measured)
+
+
+def errata(measured) -> str:
+    """MyST markdown for §6's errata: one paragraph per erratum of `lab.seed_errata.ERRATA`, in order,
+    numbered E1, E2, ...: its title, where the draft stands, the draft's code, this renderer's
+    correction and the finding.  ``measured``: {erratum id: measured dict}
+    (`lab.seed_errata.reproduced`).
+
+    Raises
+    ------
+    KeyError
+        If an erratum has no words or no measurement.
+    """
+    return "\n\n".join(f"**E{i}. {WORDS[e.id]['title']}** ({e.where}). The draft: {e.seed}. This renderer: "
+                        f"{WORDS[e.id]['correction']}. {finding(e.id, measured[e.id])}"
+                        for i, e in enumerate(ERRATA, start=1))

@@ -1,0 +1,88 @@
+"""The book's words for the draft's claims (book/chapter/claim_words.py): each claim's sentence is
+formatted from its own values, and each rule is shown with its cases in order.  Checked by the
+numbers and the structure they show, not by their wording."""
+
+import re
+
+import pytest
+
+from chapter.claim_words import SENTENCES, WORDS, bound_text, measured_text, rule_text
+from chapter.labels import frame_label
+from lab.claims import CLAIMS, CORRECTED, FAILS, HOLDS, Bound, Criterion
+
+
+@pytest.mark.parametrize("bound, text", [
+    (Bound("ratio", 1, 2), "1 ≤ ratio ≤ 2"), (Bound("ratio", 1, 2, strict=True), "1 < ratio < 2"),
+    (Bound("flips", 0, 0), "flips = 0"), (Bound("error", hi=1e-9), "error ≤ 1e-09"),
+    (Bound("error", hi=2.5e-7, strict=True), "error < 2.5e-07"), (Bound("count", lo=15875), "count ≥ 15,875"),
+    (Bound("count", lo=2e6), "count ≥ 2e+06"), (Bound("slope", lo=1.23456), "slope ≥ 1.23"),
+    (Bound("slope", lo=0.5, strict=True), "slope > 0.5"), (Bound("count", lo=1e6), "count ≥ 1e+06"),
+    (Bound("count", lo=999_999), "count ≥ 999,999"), (Bound("q", lo=99.5), "q ≥ 99.5"),
+    (Bound("q", 2000 / 10**0.5, 2000 * 10**0.5), "632 ≤ q ≤ 6,325"),
+])
+def test_a_bound_is_shown_as_its_inequality(bound, text):
+    assert bound_text(bound) == text
+
+
+def test_a_rule_shows_its_cases_in_order_then_its_default():
+    a, b, c = Bound("a", hi=1), Bound("b", lo=2), Bound("a", hi=10)
+    cases = rule_text(Criterion(((HOLDS, (a, b)), (CORRECTED, (c,))))).split("; ")
+    assert len(cases) == 3
+    assert cases[0].startswith(WORDS[HOLDS].lower()) and cases[0].endswith(f"{bound_text(a)} and {bound_text(b)}")
+    assert cases[1].startswith(WORDS[CORRECTED].lower()) and cases[1].endswith(bound_text(c))
+    assert cases[2].endswith(WORDS[FAILS].lower()) and bound_text(a) not in cases[2]
+
+
+def test_every_claim_has_one_sentence_and_every_sentence_a_claim():
+    ids = {c.id for c in CLAIMS}
+    assert {k.split("/")[0] for k in SENTENCES} == ids
+
+
+#: Counts a rule decides on that a sentence shows otherwise, and how.
+SHOWN_AS = {"rows computed": "the crash or the row (cell3-runs's two sentences)",
+            "sin/cos calls, exact minus central": "the two counts it is the difference of"}
+
+
+@pytest.fixture(scope="module")
+def register():
+    from chapter.verdicts import _results
+    return _results()
+
+
+@pytest.mark.parametrize("claim", CLAIMS, ids=[c.id for c in CLAIMS])
+def test_each_sentence_shows_its_claims_numbers_and_frame(claim, register):
+    """Formatted from the claim's measured values: no field left unfilled, the frame's label where
+    the values carry a frame, and each count the rule decides on, as a number in the sentence."""
+    _, values, _ = register[claim.id]
+    text = measured_text(claim.id, values)
+    assert "{" not in text.replace("{-", "")
+    if "scene" in values:
+        assert frame_label(values["scene"], *values["size"]) in text
+    shown = {float(n.replace(",", "")) for n in re.findall(r"-?\d[\d,]*(?:\.\d+)?(?:e[-+]?\d+)?", text)}
+    for b in {b.quantity for _, bounds in claim.criterion.cases for b in bounds}:
+        if isinstance(values[b], int) and b not in SHOWN_AS:
+            assert float(values[b]) in shown, (b, values[b], text)
+
+
+def test_a_sentence_follows_its_values_and_refuses_a_missing_one():
+    values = {"(π kᵤ)³": 3375.0, "k_u": 4.0}
+    text = measured_text("h3-scale", values)
+    assert "3,375" in text and "4" in text
+    with pytest.raises(KeyError, match="k_u"):
+        measured_text("h3-scale", {"(π kᵤ)³": 1.0})
+    with pytest.raises(KeyError, match="claim_id must be one of"):
+        measured_text("no-such-claim", values)
+
+
+def test_the_cell3_sentence_tells_a_crash_from_a_row():
+    frame = {"scene": {}, "size": [8, 8]}
+    crashed = measured_text("cell3-runs", {"rows computed": 0, "code_pixels_a": 0, "pixels": 64, "pixels_a": 21,
+                                           "error": "ValueError", **frame})
+    ran = measured_text("cell3-runs", {"rows computed": 1, **frame})
+    assert "ValueError" in crashed and "21" in crashed and "ValueError" not in ran and ran != crashed
+
+
+def test_the_cell5_sentence_shows_the_ratio_to_two_digits_and_the_drafts_powers():
+    text = measured_text("cell5-fd-1e-9", {"worst component": 1.63e-5, "expected": 1e-9, "ratio": 16300.0,
+                                           "step": 1e-7, "trials": 2000})
+    assert "16,000" in text and "1e-9" in text and "1e-7" in text and "2,000" in text
