@@ -43,7 +43,7 @@ def run_page(path):
     """Run a book page's code cells in order in one namespace, as the build's kernel runs them, with
     `chapter.page.glue` and `chapter.page.show` recording what the page glues and publishes instead.
 
-    The draft's claims are not measured (`chapter.verdicts.verdicts` returns an empty string: the
+    The draft's claims are not measured (`chapter.verdicts.margin_notes` returns an empty string: the
     register has its own tests).  A measurement the page asks `lab.store` for is read from the
     store SYMRENDER_STORE names, if it holds a current one.  Returns (the namespace, {figure
     name: matplotlib Figure, closed}, {glue name: value}), in the order the page made them.
@@ -64,7 +64,7 @@ def run_page(path):
 
     namespace = {"__name__": "__main__"}
     with mock.patch("chapter.page.glue", glued.__setitem__), mock.patch("chapter.page.show", show), \
-            mock.patch("chapter.verdicts.verdicts", lambda place: ""):
+            mock.patch("chapter.verdicts.margin_notes", lambda place: ""):
         for k, source in enumerate(code_cells(Path(path).read_text(encoding="utf-8"))):
             exec(compile(TransformerManager().transform_cell(source), f"{Path(path).name}, cell {k + 1}", "exec"),
                  namespace)

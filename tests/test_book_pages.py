@@ -231,7 +231,8 @@ AUDIT = r"""async () => {
     if (r.width === 0 && r.height === 0) return;
     const c = clipper(owner);
     if (c && scrolls(c)) return;
-    const edge = c ? c.getBoundingClientRect() : col;
+    // A margin note (sphinx-book-theme's aside.margin) stands beside the column from 992 px: the window bounds it.
+    const edge = c ? c.getBoundingClientRect() : owner.closest('aside.margin') ? {left: 0, right: window.innerWidth} : col;
     const by = Math.max(r.right - edge.right, edge.left - r.left);
     if (by > 1) found.push({kind: c ? 'cut off' : 'wider than the column', by: Math.round(by), owner, text});
   };

@@ -362,7 +362,8 @@ def test_the_register_numbers_each_claim_by_its_place_in_the_register():
     from chapter import verdicts
     from lab.claims import CLAIMS
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(verdicts, "_results", lambda ids=None: {c.id: (c, "measured", c.registered) for c in CLAIMS})
+        patch.setattr(verdicts, "_results", lambda ids=None: {c.id: (c, {}, c.registered) for c in CLAIMS})
+        patch.setattr(verdicts, "measured_text", lambda claim_id, values: "measured")
         markdown = verdicts.register()
     rows = re.findall(r"^\(claim-(?P<id>[^)]+)\)=\n\*\*(?P<n>\d+)\. ", markdown, re.M)
     assert rows == [(c.id, str(n)) for n, c in enumerate(CLAIMS, start=1)]
@@ -393,10 +394,13 @@ def test_the_built_register_its_links_and_the_front_pages_counts_agree_with_the_
     by_id = {c.id: c for c in CLAIMS}
     linked = []
     for page in sorted(book_html.glob("*.html")):
-        for sentence in _soup(page).select(".verdicts p"):
+        for sentence in _soup(page).select("aside.margin p"):
+            if not sentence.find("a", href=re.compile("#claim-")):
+                continue
             claim = by_id[sentence.find("a", href=re.compile("#claim-"))["href"].rpartition("#claim-")[2]]
             assert quoted(claim) in text(sentence), (page.name, claim.id)
-            assert sentence.find_all("strong")[1].get_text() == WORDS[claim.registered] + ":", (page.name, claim.id)
+            term = sentence.find("a", href=re.compile("glossary.html#term-"))
+            assert term.get_text() == WORDS[claim.registered], (page.name, claim.id)
             linked.append(claim.id)
     assert sorted(linked) == sorted(by_id)
     counts = ("ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata", "ix_proved", "ix_verified")

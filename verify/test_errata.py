@@ -10,8 +10,9 @@ from renderer import Scene, gbuffer
 
 def test_every_erratum_is_measured_and_reported(errata):
     assert [e.id for e in ERRATA] == list(errata)
+    from chapter.errata_words import finding
     for e in ERRATA:
-        text = e.report(errata[e.id])
+        text = finding(e.id, errata[e.id])
         assert text and "{" not in text
 
 
@@ -84,8 +85,9 @@ def test_a_vanished_erratum_fails_the_book(erratum_id, key, fixed, errata):
 
 
 def test_report_rejects_a_missing_measurement():
+    from chapter.errata_words import finding
     with pytest.raises(KeyError):
-        ERRATA[0].report({})
+        finding(ERRATA[0].id, {})
 
 
 def test_specular_lobe_is_gated_by_the_shading_normal():
