@@ -4,5 +4,6 @@
 `gradient_methods` (five ways of differentiating h, timed against their error),
 `seed_errata` (the defects of the draft's code, re-measured), `claims` (the draft's
 checkable claims, each decided by a stated rule), and `store` (one measurement per
-build, shared by the book's pages).  Imports `proofs` and `renderer`, never the book.
+build, shared by the book's pages); `displaced` (sphere A truly displaced, against the
+bumped render) and `inverse` (β fitted to a normal map).  Imports `proofs` and `renderer`, never the book.
 """

@@ -32,7 +32,8 @@ import numpy as np
 
 from renderer import Scene, pointwise
 
-__all__ = ["style", "figure_png", "SMALLEST_TEXT_KEY", "frame_diagram", "normal_diagram", "stencil_diagram", "ucurve_anatomy", "text_overlaps"]
+__all__ = ["style", "figure_png", "SMALLEST_TEXT_KEY", "frame_diagram", "normal_diagram", "stencil_diagram",
+           "ucurve_anatomy", "text_overlaps", "displacement_figure"]
 
 #: The book's colours: measured (dark red), exact (dark blue), third quantity (green), guides (grey).
 RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
@@ -366,3 +367,48 @@ def text_overlaps(fig, gap=0.5):
                 label = ax.get_title() or f"{fig.axes.index(ax) + 1} of {len(fig.axes)}"
                 out.append(f"{name(t)} / axes {label!r}")
     return out
+
+
+def displacement_figure(result):
+    """The displaced sphere beside the bumped one, and where their silhouettes and shadows differ.
+
+    ``result`` is a `lab.displaced.Displaced`.  Top: the bumped render and the displaced one
+    (sRGB), each with the other's silhouette outlined.  Bottom: coverage of sphere A (grey in
+    both, red only displaced, blue only bumped) and cast shadows (red only displaced, blue only
+    bumped, green where the bumps shadow each other and the bumped render is lit).  5 in wide,
+    text at least 9 pt.  Returns a matplotlib Figure.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_rgb
+    from matplotlib.patches import Patch
+    from renderer import to_srgb
+    covered, bumped_covered = result.covered, result.bumped.chamber == 1
+    fig, axes = plt.subplots(2, 2, figsize=(5.0, 5.6), layout="constrained")
+
+    def panel(ax, rgb, title, outline=None):
+        ax.imshow(rgb)
+        if outline is not None:
+            ax.contour(outline.astype(float), levels=[0.5], colors="white", linewidths=0.8)
+        ax.set_title(title, fontsize=10)
+        ax.set_xticks([])
+        ax.set_yticks([])
+
+    def categories(shape, layers):
+        out = np.ones(shape + (3,))
+        for mask, colour in layers:
+            out[mask] = to_rgb(colour)
+        return out
+
+    panel(axes[0, 0], to_srgb(result.bumped.image), "bumped", covered)
+    panel(axes[0, 1], to_srgb(result.image), "displaced", bumped_covered)
+    shape = covered.shape
+    panel(axes[1, 0], categories(shape, [(covered & bumped_covered, "#bbbbbb"), (covered & ~bumped_covered, RED),
+                                         (~covered & bumped_covered, BLUE)]), "silhouette")
+    self_shadow = result.shadow & covered & bumped_covered & ~result.bumped_shadow
+    panel(axes[1, 1], categories(shape, [(result.shadow & ~result.bumped_shadow, RED),
+                                         (~result.shadow & result.bumped_shadow, BLUE), (self_shadow, GREEN)]),
+          "cast shadow")
+    fig.legend(handles=[Patch(color=RED, label="displaced only"), Patch(color=BLUE, label="bumped only"),
+                        Patch(color=GREEN, label="self-shadow")], loc="outside lower center", ncols=3, fontsize=9,
+               frameon=False)
+    return fig

@@ -1,0 +1,163 @@
+"""β fitted to a normal map: Gauss–Newton on the perturbed normals of sphere A.
+
+A render's G-buffer holds, per pixel of sphere A, the perturbed normal N'(β)
+(`renderer.gbuffer`'s ``Ns``).  Given such a map made with an unknown β and
+otherwise the same scene, `fit_beta` recovers β: the residual is
+N'(β) - target over sphere A's pixels, and its Jacobian ∂N'/∂β is sympy's
+derivative of `renderer.formulas.PERTURBED_NORMAL` for the scene's bump mode
+(`JACOBIAN`).  Everything else N' depends on (N, the tangent frame, h and its
+exact gradient) is geometry and does not depend on β (the bump moves no
+boundary), so it is read once from a G-buffer of the scene.
+
+In the chart mode M = N + β g (g = h_u e_θ + h_v e_φ) is linear in β, and the
+Jacobian is the closed form (I − N'N'ᵀ) g / |M|: the derivative of a unit
+vector lies in its tangent plane.  In the surface mode the coefficients of M
+depend on β through 1 / (R + β h), and only sympy's derivative holds.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+from renderer import formulas, gbuffer, pointwise
+from renderer.render import MAX_SIDE, check_args
+from renderer.scene import MAX_BETA
+from renderer.validate import InvalidType, InvalidValue, positive_int, real
+
+__all__ = ["Fit", "fit_beta", "JACOBIAN", "normal_and_jacobian", "MAX_STEPS"]
+
+#: Most Gauss–Newton steps `fit_beta` accepts.
+MAX_STEPS = 100
+#: ∂N'/∂β per bump mode: sympy's derivative of each component of `formulas.PERTURBED_NORMAL`.
+JACOBIAN = {mode: tuple(sp.diff(c, formulas.beta) for c in normal)
+            for mode, normal in formulas.PERTURBED_NORMAL.items()}
+#: The arguments of both modes' normals and Jacobians (the chart mode ignores h, R, sin φ).
+_ARGS = ((formulas.N_x, formulas.N_y, formulas.N_z) + formulas.e_theta + formulas.e_phi
+         + (formulas.h_u, formulas.h_v, formulas.beta, formulas.h, formulas.R, formulas.sin_phi))
+
+
+@functools.lru_cache(maxsize=None)
+def _lambdified(mode):
+    return sp.lambdify(_ARGS, [list(formulas.PERTURBED_NORMAL[mode]), list(JACOBIAN[mode])], "numpy", cse=True)
+
+
+def normal_and_jacobian(mode, geometry, beta):
+    """N'(β) and ∂N'/∂β at sphere-A points.
+
+    Parameters
+    ----------
+    mode : {"chart", "surface"}
+    geometry : tuple of 14 float64 arrays of one shape (n,)
+        N (3), e_θ (3), e_φ (3), h_u, h_v, h, R, sin φ, as `formulas._ARGS` orders them without β.
+    beta : float
+
+    Returns
+    -------
+    (normal, jacobian) : two (n, 3) float64 arrays (dimensionless; the Jacobian per unit β).
+    """
+    N, et, ep, hu, hv, h, R, sin_phi = geometry[:3], geometry[3:6], geometry[6:9], *geometry[9:]
+    normal, jac = _lambdified(mode)(*N, *et, *ep, hu, hv, beta, h, R, sin_phi)
+    n = hu.shape[0]
+    return (np.stack([np.broadcast_to(c, (n,)) for c in normal], -1),
+            np.stack([np.broadcast_to(c, (n,)) for c in jac], -1))
+
+
+@dataclass(frozen=True)
+class Fit:
+    """The result of `fit_beta`.
+
+    Attributes
+    ----------
+    beta : float
+        The last iterate.
+    iterates : tuple of (float, float)
+        (β_k, |r(β_k)|) for k = 0 (the start), 1, ..., the residual's 2-norm over all
+        components of sphere A's pixels (dimensionless).
+    pixels : int
+        Sphere-A pixels fitted.
+    converged : bool
+        The last step moved β by at most ``tol``.
+    """
+
+    beta: float
+    iterates: tuple
+    pixels: int
+    converged: bool
+
+
+def _geometry(scene, width, height):
+    """The β-independent inputs of N' on sphere A's pixels, as `normal_and_jacobian` takes them."""
+    g = gbuffer(scene, width, height, gradient="exact")
+    on_a = g.chamber == 1
+    N = g.N[on_a]
+    _, _, sin_phi = pointwise.chart(*N.T)
+    et, ep = pointwise.tangent_frame(*N.T, sin_phi)
+    uv, grad = g.uv[on_a], g.grad[on_a]
+    h = pointwise.height(scene.height_field, uv[:, 0], uv[:, 1], scene.k_u, scene.k_v)
+    return on_a, (*N.T, *et, *ep, grad[:, 0], grad[:, 1], h, np.full(h.shape, scene.radius_a), sin_phi)
+
+
+def fit_beta(target, scene, *, beta0=0.1, steps=20, tol=1e-12):
+    """Recover β from a normal map by Gauss–Newton.
+
+    Parameters
+    ----------
+    target : (H, W, 3) array_like of float
+        Perturbed unit normals (``renderer.gbuffer(scene', W, H).Ns``) of a render of
+        ``scene`` with an unknown β; read on sphere A's pixels only, which must be finite.
+    scene : renderer.Scene
+        The scene (its ``beta`` is ignored; its ``bump`` mode decides the formula).
+    beta0 : float in [0, 100], keyword-only
+        The starting β (below ``radius_a`` for ``bump="surface"``).
+    steps : int in [1, 100], keyword-only
+        Most Gauss–Newton steps.
+    tol : float in (0, 1], keyword-only
+        Stop when a step moves β by at most ``tol``.
+
+    Returns
+    -------
+    Fit
+
+    Raises
+    ------
+    TypeError
+        ``scene`` not a Scene; ``target`` not numbers; ``steps`` not an integer; ``beta0`` or
+        ``tol`` not real.
+    ValueError
+        ``target`` not of shape (H, W, 3) with H, W in [1, 8192], or not finite on sphere A;
+        ``beta0``, ``steps`` or ``tol`` out of range.
+    """
+    try:
+        target = np.asarray(target, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InvalidType(f"target must be an (H, W, 3) array of floats, got {type(target).__name__}") from None
+    if target.ndim != 3 or target.shape[2] != 3 or not 1 <= min(target.shape[:2]) <= max(target.shape[:2]) <= MAX_SIDE:
+        raise InvalidValue(f"target must be an (H, W, 3) normal map with H, W in [1, {MAX_SIDE}], "
+                           f"got shape {target.shape}")
+    scene, width, height, _, _ = check_args(scene, target.shape[1], target.shape[0], "exact", 1.0)
+    high = scene.radius_a if scene.bump == "surface" else MAX_BETA
+    beta = real("beta0", beta0, low=0.0, high=high, high_open=scene.bump == "surface")
+    steps = positive_int("steps", steps, high=MAX_STEPS)
+    tol = real("tol", tol, low=0.0, low_open=True, high=1.0)
+    on_a, geometry = _geometry(scene, width, height)
+    want = target[on_a]
+    if not np.isfinite(want).all():
+        raise InvalidValue(f"target must be finite on sphere A's {on_a.sum():,} pixels, got "
+                           f"{np.count_nonzero(~np.isfinite(want).all(axis=1)):,} pixels with a NaN or inf")
+    iterates, converged = [], False
+    for _ in range(steps + 1):
+        normal, jac = normal_and_jacobian(scene.bump, geometry, beta)
+        r = (normal - want).ravel()
+        iterates.append((beta, float(np.linalg.norm(r))))
+        if converged or len(iterates) > steps:
+            break
+        J = jac.ravel()
+        step = -float(J @ r) / float(J @ J)
+        # Keep β in the scene's range (surface: R + β h > 0).
+        new = min(max(beta + step, 0.0), np.nextafter(high, 0.0) if scene.bump == "surface" else high)
+        converged, beta = abs(new - beta) <= tol, new
+    return Fit(beta, tuple(iterates), int(on_a.sum()), converged)
