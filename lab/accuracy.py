@@ -14,7 +14,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, gbuffer, pointwise, render
+from renderer import DRAFT_SCENE, Scene, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
@@ -149,7 +149,7 @@ def _image_beta_order(size, beta, steps):
     dict with "median_slope", "rms_slope", "median_errors", "rms_errors", "steps", and
     "label", the scene and resolution (`chapter.theorems.frame_label`).
     """
-    scene = Scene(height_field="sine", beta=beta)
+    scene = DRAFT_SCENE.replace(height_field="sine", beta=beta)   # the draft's scene: its chart normal
 
     def D(db):
         hi = render(scene.replace(beta=beta + db), size, size).image

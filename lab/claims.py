@@ -24,7 +24,7 @@ from typing import Callable
 
 import numpy as np
 
-from renderer import Scene, compare, gbuffer, pointwise, render
+from renderer import DRAFT_SCENE, compare, gbuffer, pointwise, render
 from renderer.render import SPHERE_A
 
 from renderer import frame_label
@@ -169,7 +169,7 @@ def _errata():
 
 @lru_cache(maxsize=None)
 def _frames(field="ridges", beta=0.35, eps=1e-3, size=128):
-    scene = Scene(height_field=field, beta=beta, eps=eps)
+    scene = DRAFT_SCENE.replace(height_field=field, beta=beta, eps=eps)
     return render(scene, size, size, gradient="central"), render(scene, size, size)
 
 
@@ -277,7 +277,7 @@ def census():
 
 
 def _census(size):
-    scene = Scene()
+    scene = DRAFT_SCENE
     symbolic = render(scene, size, size)
     on_a = symbolic.chamber == SPHERE_A
     uv = gbuffer(scene, size, size).uv[on_a]
@@ -335,7 +335,7 @@ def crease_band_ratio():
     """The crease ratio of the census at the default step (`census`): mean |ΔI| on the
     crease band over the mean off it, with the two means (``on``, ``off``) and the label."""
     c = census()
-    default = c["steps"].index(Scene().eps)
+    default = c["steps"].index(DRAFT_SCENE.eps)
     return dict(on=c["on_band"][default], off=c["off_band"][default], ratio=c["ratio"], label=c["label"])
 
 
@@ -394,7 +394,7 @@ def _stacking():
     are all on A, with the bump and without it."""
     err = {}
     for beta in (0.35, 0.0):
-        scene = Scene(beta=beta)
+        scene = DRAFT_SCENE.replace(beta=beta)
         fine, one = render(scene, 512, 512).image, render(scene, 128, 128)
         box = fine.reshape(128, 4, 128, 4, 3).mean(axis=(1, 3))
         all_a = (render(scene, 512, 512, kink=False, grad=False).chamber == SPHERE_A).reshape(128, 4, 128, 4).all(axis=(1, 3))
@@ -402,7 +402,7 @@ def _stacking():
         err[beta] = float(np.sqrt(np.mean(d ** 2)))
     ratio = err[0.35] / err[0.0]
     return (f"no new integral, but a harder integrand: one sample per pixel misses the 4 × 4 box filter "
-            f"by RMS {err[0.35]:.1e} with the bump, {err[0.0]:.1e} without{_on(one, Scene())}",
+            f"by RMS {err[0.35]:.1e} with the bump, {err[0.0]:.1e} without{_on(one, DRAFT_SCENE)}",
             {"one-sample error, with / without the bump": ratio})
 
 
@@ -431,7 +431,7 @@ def _timing():
     import time
 
     from .gradient_methods import evaluations
-    g = gbuffer(Scene(), 128, 128)
+    g = gbuffer(DRAFT_SCENE, 128, 128)
     uv = g.uv[g.chamber == SPHERE_A]
     u, v = uv[:, 0].copy(), uv[:, 1].copy()
 
@@ -445,13 +445,13 @@ def _timing():
 
     t_exact = best(lambda: pointwise.exact_gradient("ridges", u, v, 8.0, 4.0))
     t_central = best(lambda: pointwise.central_gradient("ridges", u, v, 8.0, 4.0, 1e-3))
-    f_exact = best(lambda: render(Scene(), 128, 128), 7)
-    f_central = best(lambda: render(Scene(), 128, 128, gradient="central"), 7)
+    f_exact = best(lambda: render(DRAFT_SCENE, 128, 128), 7)
+    f_central = best(lambda: render(DRAFT_SCENE, 128, 128, gradient="central"), 7)
     stage = t_central / t_exact
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
     return (f"by count: the exact gradient calls {exact.trig:g} sines and cosines per pixel, the central "
             f"stencil {central.trig:g}; timed, deciding nothing, the central stage takes {stage:.1f} times as "
-            f"long, the whole frame {f_central / f_exact:.2f} times{_on(g, Scene())}",
+            f"long, the whole frame {f_central / f_exact:.2f} times{_on(g, DRAFT_SCENE)}",
             {"sin/cos calls, exact minus central": exact.trig - central.trig})
 
 
@@ -507,7 +507,7 @@ def _beta0():
 
 
 def _bump_nonzero():
-    s = Scene(height_field="sine", beta=1.5)
+    s = DRAFT_SCENE.replace(height_field="sine", beta=1.5)
     bumped = render(s, 128, 128)
     d = float(np.abs(bumped.image - render(s.replace(beta=0.0), 128, 128).image).mean())
     return (f"the sine bump at $\\beta = 1.5$ moves the frame by a mean $\\lvert\\Delta I\\rvert$ of {d:.3f}"
@@ -537,9 +537,9 @@ def _crease_values():
 
 
 def _pole_pixels():
-    g = gbuffer(Scene(), 256, 256)
+    g = gbuffer(DRAFT_SCENE, 256, 256)
     n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= 1e-4)))
-    return (f"{n} pixels use the fallback{_on(g, Scene())}; the draft counts points of a grid of "
+    return (f"{n} pixels use the fallback{_on(g, DRAFT_SCENE)}; the draft counts points of a grid of "
             "$N_z$ values unrelated to the image", {"fallback pixels": n})
 
 
@@ -547,7 +547,7 @@ def _sweep_best():
     a = {eps: compare(*_frames("sine", 0.35, eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
     best = min(a, key=a.get)
     return (f"of the steps tried, {best:.0e} gives the smallest RMS difference"
-            + _on(_frames("sine")[1], Scene(height_field="sine")), {"best ε": best})
+            + _on(_frames("sine")[1], DRAFT_SCENE.replace(height_field="sine")), {"best ε": best})
 
 
 def _creases_part():
@@ -576,8 +576,8 @@ def _rings_pinch():
 
 
 def _beta_zero_slider():
-    flat = render(Scene(beta=0.0), 96, 96)
-    b = render(Scene(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
+    flat = render(DRAFT_SCENE.replace(beta=0.0), 96, 96)
+    b = render(DRAFT_SCENE.replace(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
     n = int(np.count_nonzero(flat.image != b))
     return (f"at $\\beta = 0$, renders of two fields by the two pipelines differ in {n} values" + _on(flat),
             {"values differing": n})

@@ -280,10 +280,10 @@ def test_frame_label_names_the_fields_that_differ_and_the_size():
     from renderer import frame_label
     from renderer import Scene
     assert frame_label(Scene(), 256, 128) == "the draft's scene, 256 × 128"
-    assert frame_label(Scene(height_field="sine", beta=1.5), 64, 64) == \
-        "the draft's scene with the sine field, β = 1.5, 64 × 64"
-    assert frame_label(Scene(bump="surface", sphere_b=False, k_v=2.0), 8, 8) == \
-        "the draft's scene with no sphere B, kᵥ = 2, the displaced sphere's normal, 8 × 8"
+    assert frame_label(Scene(height_field="sine", beta=0.5), 64, 64) == \
+        "the draft's scene with the sine field, β = 0.5, 64 × 64"
+    assert frame_label(Scene(bump="chart", sphere_b=False, k_v=2.0), 8, 8) == \
+        "the draft's scene with no sphere B, kᵥ = 2, the draft's normal, 8 × 8"
     with pytest.raises(TypeError, match="scene must be a renderer.Scene, got dict"):
         frame_label({}, 64, 64)
     with pytest.raises(ValueError, match=r"^width must be a positive integer, got 0$"):

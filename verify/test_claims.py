@@ -29,7 +29,7 @@ def test_cell3_runs_tells_the_drafts_code_from_this_renderers_frame(claim_result
 
     import numpy as np
 
-    from renderer import Scene, gbuffer
+    from renderer import DRAFT_SCENE, gbuffer
     from renderer.render import SPHERE_A
 
     measured, _ = claim_results["cell3-runs"]
@@ -37,5 +37,5 @@ def test_cell3_runs_tells_the_drafts_code_from_this_renderers_frame(claim_result
                   r"renderer's frame of the same scene has ([\d,]+) on sphere A", measured)
     assert m, measured
     code, pixels, ours = (int(g.replace(",", "")) for g in m.groups())
-    chamber = gbuffer(Scene(), 256, 256).chamber
+    chamber = gbuffer(DRAFT_SCENE, 256, 256).chamber
     assert (code, pixels, ours) == (0, chamber.size, int(np.count_nonzero(chamber == SPHERE_A)))
