@@ -210,9 +210,9 @@ def _h3_scale():
 
 def _truncation_until():
     c = _ucurve()
-    return (f"the predicted optimal step is {c.eps_opt_predicted:.1e}, from $h'''$ and the unit roundoff "
-            f"alone (the measured curve's lowest point is {c.eps_opt_measured:.1e})",
-            {"model optimum ε": c.eps_opt_predicted})
+    return (f"the predicted optimal step is {c.eps_model:.1e}, from $h'''$ and the unit roundoff "
+            f"alone (the measured curve's lowest point is {c.eps_measured_min:.1e})",
+            {"model optimum ε": c.eps_model})
 
 
 def _drowns_below_1e9():
@@ -222,10 +222,10 @@ def _drowns_below_1e9():
 
 
 def _cell2_minimum():
-    from .accuracy import default_optimum
-    opt = default_optimum()
-    return (f"the fitted optimal step is {opt['eps']:.1e}, where the model's error is {opt['error']:.1e}",
-            {"fitted optimum ε": opt["eps"]})
+    from .accuracy import optima
+    opt = optima()["sine"]
+    return (f"the fitted optimal step is {opt['eps_fitted']:.1e}, where the model's error is "
+            f"{opt['error_at_fitted']:.1e}", {"fitted optimum ε": opt["eps_fitted"]})
 
 
 def _orientation():
