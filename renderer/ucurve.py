@@ -321,8 +321,10 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     x = u if component == "u" else v
     T, C, G = abs(h3f) / 6, UNIT_ROUNDOFF * abs(h0f), UNIT_ROUNDOFF * abs(x * float(true))
     model = T * steps**2 + (C + G) / steps
-    # E'(eps) = 2 T eps - (C + G) / eps^2 = 0; no truncation (T = 0): the model falls forever.
+    # E'(eps) = 2 T eps - (C + G) / eps^2 = 0.  No truncation (T = 0): E falls towards 0 as eps grows
+    # (eps* infinite); no rounding (C + G = 0, h = 0 at x = 0): E is least, 0, at eps* = 0.
     star = ((C + G) / (2 * T)) ** (1 / 3) if T > 0 else float("inf")
+    least = T * star**2 + (C + G) / star if 0 < star < float("inf") else 0.0
     try:
         A, B = fit_model(steps, error, start=(max(T, 1e-300), max(C + G, 1e-300)))
     except ValueError:              # an exact quotient (h_u of rings: zero error) has no U to fit
@@ -330,7 +332,7 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     eps_fit = (B / (2 * A)) ** (1 / 3)
     return UCurve(**measured, model=model, derivative=float(true), third_derivative=h3f,
                   model_truncation=T, model_cancellation=C, model_argument=G, eps_model=star,
-                  error_model=T * star**2 + (C + G) / star if T > 0 else 0.0,
+                  error_model=least,
                   eps_measured_min=float(steps[best]), error_at_measured_min=float(error[best]),
                   fitted_truncation=A, fitted_roundoff=B, eps_fitted=float(eps_fit),
                   error_at_fitted=float(A * eps_fit**2 + B / eps_fit))
