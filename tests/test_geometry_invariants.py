@@ -267,14 +267,14 @@ U = 2.0**-53
 
 #: Scenes at the limits of renderer/scene.py (R, e up to MAX_LENGTH, radii down to MIN_RADIUS).
 EXTREME_SCENES = {
-    "least sphere from the farthest camera": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH),
+    "least sphere from the farthest camera": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH, bump="chart"),
     "unit sphere from the farthest camera": Scene(radius_a=1.0, camera_z=S.MAX_LENGTH),
     "camera one ulp outside sphere A": Scene(radius_a=0.3, camera_z=math.nextafter(0.3, 1.0),
-                                             center_b=(0.5, 0.5, 5.0)),
+                                             center_b=(0.5, 0.5, 5.0), bump="chart"),
     "largest sphere A": Scene(radius_a=math.nextafter(S.MAX_LENGTH, 0.0), camera_z=S.MAX_LENGTH,
                               center_b=(0.0, 0.0, -S.MAX_LENGTH), radius_b=1.0),
     "least sphere B, far from all": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH,
-                                          center_b=(0.0, 0.0, 1e5), radius_b=S.MIN_RADIUS),
+                                          center_b=(0.0, 0.0, 1e5), radius_b=S.MIN_RADIUS, bump="chart"),
 }
 
 

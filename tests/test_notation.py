@@ -30,7 +30,7 @@ PRINTED = {
     "normal-beta-derivative": "bfde89e2e383c5c0",
     "beta-zero-regression": "b47aea0df169fda4",
     "central-difference-truncation": "15fa36211b297057",
-    "optimal-step": "65312b82985eb69e",
+    "optimal-step": "729b6a1ff9f9973f",
     "bump-vs-displacement": "312f40d2df1d5e05",
     "blinn-perturbation": "df041990cdcbf0d2",
 }

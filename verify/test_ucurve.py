@@ -20,10 +20,10 @@ def test_truncation_follows_eps_squared_h3_over_6_at_large_steps(curve):
     assert not np.allclose(curve.truncation[big], 2 * predicted, rtol=2e-2)
 
 
-def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the_predicted_step(curve):
-    """`UCurve.model` (the predicted model, which ``symrender ucurve --plot`` draws): its truncation part is the measured truncation at
-    large steps (a wrong 1/6 fails), and its minimum lies at the predicted optimum (a wrong roundoff
-    coefficient moves it by the cube root of the error)."""
+def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the_model_optimal_step(curve):
+    """`UCurve.model` (the error model E, which ``symrender ucurve --plot`` draws): its truncation part is the
+    measured truncation at large steps (a wrong 1/6 fails), and its minimum lies at the model-optimal step
+    (a wrong roundoff coefficient moves it by the cube root of the error)."""
     big = (curve.eps > 1e-4) & (curve.eps < 1e-2)
     assert np.allclose(curve.model[big], np.abs(curve.truncation[big]), rtol=2e-2)
     around = measure(eps=curve.eps_model * np.array([0.75, 0.9, 1.0, 1.1, 1.3]))
@@ -45,7 +45,7 @@ def test_at_the_v_border_the_split_divides_by_the_kernels_own_denominator():
     assert np.all(np.abs(c.roundoff) <= 4 * UNIT_ROUNDOFF * (1 + abs(c.derivative)) / c.eps)
 
 
-def test_measured_optimum_near_predicted(curve):
+def test_measured_minimum_near_the_model_optimal_step(curve):
     ratio = curve.eps_measured_min / curve.eps_model
     assert 0.05 < ratio < 20
     assert curve.error_at_measured_min < 1e-9
@@ -117,7 +117,7 @@ def test_the_fitted_optimum_does_not_depend_on_the_grid(curve):
     curves = [measure(eps=g) for g in grids]
     fitted = [c.eps_fitted for c in curves]
     assert max(fitted) / min(fitted) < 1.2
-    # and it sits on the measured curve: within a factor 3 of the model's prediction
+    # and it sits on the measured curve: within a factor 3 of the model-optimal step
     assert 1 / 3 < curve.eps_fitted / curve.eps_model < 3
 
 
