@@ -1,6 +1,6 @@
 """Check a built book: one value per quantity, under its name and under its words.
 
-A quantity shown on several pages is glued under one name (``ucurve_eps_opt``,
+A quantity shown on several pages is glued under one name (``eps_fitted_sine``,
 say) and computed once per build (`lab.store`).  This reads, for each page,
 the notebook jupyter-cache holds for the page's current execution (the record
 of that page accessed last: the build touches the record it uses) and fails,
@@ -51,8 +51,8 @@ NAMED = {
     "census_off_slope": "off-band slope",
     "census_ratio": "crease ratio",
     "dn_residual": "closed form's worst error",
-    "ucurve_eps_opt": "fitted optimal step",
-    "ucurve_eps_pred": "predicted optimal step",
+    "eps_fitted_sine": "fitted optimal step",
+    "eps_model_sine": "model-optimal step",
     "ucurve_rel_1e9": "relative error at a step of 1e-9",
     "ucurve_rel_1e11": "relative error at a step of 1e-11",
     "beta_median_order": "median order",
@@ -78,11 +78,11 @@ def _ucurve():
 #: None where the pages compute the quantity from their own renders (its names must still agree).
 QUANTITIES = {
     # The scene and the renderer's constants.
-    "the draft's step": (("ix_eps", "s1_eps"), lambda: _lib("renderer").Scene().eps),
-    "the draft's amplitude": (("s1_beta", "s2_beta"), lambda: _lib("renderer").Scene().beta),
-    "the draft's frequency in u": (("s2_k_u",), lambda: _lib("renderer").Scene().k_u),
-    "the draft's frequency in v": (("s2_k_v",), lambda: _lib("renderer").Scene().k_v),
-    "the draft's height field": (("s2_field",), lambda: _lib("renderer").Scene().height_field),
+    "the draft's step": (("ix_eps", "s1_eps"), lambda: _lib("renderer").DRAFT_SCENE.eps),
+    "the draft's amplitude": (("s1_beta", "s2_beta"), lambda: _lib("renderer").DRAFT_SCENE.beta),
+    "the draft's frequency in u": (("s2_k_u",), lambda: _lib("renderer").DRAFT_SCENE.k_u),
+    "the draft's frequency in v": (("s2_k_v",), lambda: _lib("renderer").DRAFT_SCENE.k_v),
+    "the draft's height field": (("s2_field",), lambda: _lib("renderer").DRAFT_SCENE.height_field),
     "the simulator's opening step": (("s4_eps",), lambda: _lib("renderer.ledger").SIMULATOR_SCENE.eps),
     "the window's margin": (("s2_margin",), lambda: _lib("renderer.render").WINDOW_MARGIN),
     "the window's offset": (("s2_offset",), lambda: _lib("renderer.render").WINDOW_OFFSET),
@@ -93,12 +93,13 @@ QUANTITIES = {
                                         lambda: 10.0 ** _lib("renderer.ledger").DIFFERENCE_LOG_FLOOR),
     "the U-curve reference's digits": (("c2_digits", "s7_digits"), lambda: _lib("renderer.ucurve").DIGITS),
     "the accuracy references' digits": (("c5_digits",), lambda: _lib("lab.accuracy").DIGITS),
-    # The U-curve of Cell 2: the optimum of the model fitted to it, and the model's prediction.
-    "the fitted optimal step": (("ucurve_eps_opt",), lambda: _ucurve().eps_opt_fitted),
-    "the model's error at the fitted step": (("ucurve_err_opt",), lambda: _ucurve().error_at_fitted_opt),
-    "the predicted optimal step": (("ucurve_eps_pred",), lambda: _ucurve().eps_opt_predicted),
+    # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
+    "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
+    "the fitted model's error at the fitted optimal step": (("error_at_fitted_sine",),
+                                                            lambda: _ucurve().error_at_fitted),
+    "the model-optimal step": (("eps_model_sine",), lambda: _ucurve().eps_model),
     "the U-curve's label": (("ucurve_label",), lambda: _lib("chapter.labels").ucurve_label(
-        _lib("lab.accuracy").default_optimum())),
+        "sine", _lib("lab.accuracy").optima()["sine"])),
     "the relative error at a step of 1e-9": (("ucurve_rel_1e9",), lambda: _lib("lab.claims").relative_error_at(1e-9)),
     "the relative error at a step of 1e-11": (("ucurve_rel_1e11",),
                                               lambda: _lib("lab.claims").relative_error_at(1e-11)),

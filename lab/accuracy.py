@@ -14,13 +14,13 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, gbuffer, pointwise, render
+from renderer import DRAFT_SCENE, Scene, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
-           "image_beta_order", "default_optimum", "DIGITS"]
+           "image_beta_order", "optima", "crease_distance", "crease_share", "OPTIMUM_POINTS", "DIGITS"]
 
 DIGITS = 50
 STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
@@ -148,7 +148,7 @@ def _image_beta_order(size, beta, steps):
     dict with "median_slope", "rms_slope", "median_errors", "rms_errors", "steps", and
     "scene" (`renderer.Scene.changes`) and "size", the frame's side in pixels.
     """
-    scene = Scene(height_field="sine", beta=beta)
+    scene = DRAFT_SCENE.replace(height_field="sine", beta=beta)   # the draft's scene: its chart normal
 
     def D(db):
         hi = render(scene.replace(beta=beta + db), size, size).image
@@ -166,25 +166,87 @@ def _image_beta_order(size, beta, steps):
             "rms_errors": rms.tolist(), "steps": list(steps), "scene": scene.changes(), "size": size}
 
 
-def default_optimum():
-    """The U-curve optimum the book shows, one measurement of the build
-    (`lab.store`): `renderer.ucurve.measure`'s default curve (sine, (u, v) = (0.31, 0.47),
-    h_u, k_u = 8, k_v = 4, `DEFAULT_STEPS`), as a dict: the
-    fitted optimum ``eps`` and the model's ``error`` there, the measured
-    errors ``band`` (min, max) within a factor 2 of it, the coefficients
-    ``A`` and ``B``, the model's prediction ``eps_predicted`` and, for
-    comparison, the curve's ``argmin`` and ``min``, and where it is measured: ``field``, ``u``, ``v``, ``k_u``, ``k_v``, the
-    number of ``steps`` and their range ``eps_max``, ``eps_min``."""
+#: Where `optima` measures each field's U-curve, with the seed's frequencies (k_u, k_v) = (8, 4):
+#: (u, v, component).  The seed's sine point; ridges at the same point, whose distance to every
+#: crease line (u = m / k_u, v = m / k_v) exceeds `RIDGES_LARGEST_STEP` (no stencil of the curve
+#: straddles a crease; `optima` checks it); rings in v, since its h_u is 0 everywhere.
+OPTIMUM_POINTS = {"sine": (0.31, 0.47, "u"), "ridges": (0.31, 0.47, "u"), "rings": (0.31, 0.47, "v")}
+#: The ridges curve's largest step (chart units): the default steps up to it.
+RIDGES_LARGEST_STEP = 1e-2
+#: The steps and frame of `crease_share` (the draft's Cell 3 census: its steps, 256 x 256).
+CREASE_STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
+CREASE_SIZE = 256
+
+
+def crease_distance(u, v, k_u, k_v):
+    """Chart distance from (u, v) to the nearest crease line of the ridges field, u = m / k_u or
+    v = m / k_v (m an integer): a central difference with a step beyond it straddles a crease.
+    ``u``, ``v``: floats or arrays of one shape (chart units); ``k_u``, ``k_v`` > 0.  Returns
+    float64 of that shape."""
+    u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+    return np.minimum(np.abs(u * k_u - np.rint(u * k_u)) / k_u, np.abs(v * k_v - np.rint(v * k_v)) / k_v)
+
+
+def optima():
+    """The optimum of the central difference for each height field, one measurement of the
+    build (`lab.store`).
+
+    For each field at its point of `OPTIMUM_POINTS` (curve of `renderer.ucurve.measure` over
+    its default steps; on ridges those up to `RIDGES_LARGEST_STEP`), a dict of floats (steps
+    in chart units, errors in height per chart unit): ``u``, ``v``, ``component``, ``k_u``,
+    ``k_v``, ``steps`` (how many), ``largest_step``, ``smallest_step``; ``h`` = |h|,
+    ``h1`` = |h'|, ``x_h1`` = |x h'| (x the component's coordinate), ``h3`` = |h'''|;
+    ``eps_model`` the model-optimal step eps* and ``error_model`` the model's error E(eps*);
+    ``eps_fitted`` the fitted optimal step eps^, ``error_at_fitted`` the fitted model's error
+    there and ``measured_at_fitted`` the float64 quotient's measured error at eps^;
+    ``fitted_over_model`` = eps^ / eps*; ``argument_share``, the argument-rounding term's
+    share of the model's rounding coefficient, |x h'| / (|h| + |x h'|).  The ridges entry
+    also holds ``crease_distance``, its point's (`crease_distance`).
+
+    Raises
+    ------
+    RuntimeError
+        The ridges point is within `RIDGES_LARGEST_STEP` of a crease.
+    """
     from .store import measured
-    return measured("ucurve.default-optimum", _default_optimum)
+    return measured("ucurve.optima", _optima, points=OPTIMUM_POINTS, ridges_largest=RIDGES_LARGEST_STEP)
 
 
-def _default_optimum():
-    from renderer.ucurve import SEED_FREQUENCIES, measure
-    c = measure()
-    near = c.error[(c.eps >= c.eps_opt_fitted / 2) & (c.eps <= 2 * c.eps_opt_fitted)]
-    return dict(eps=c.eps_opt_fitted, error=c.error_at_fitted_opt, band=[float(near.min()), float(near.max())],
-                A=c.truncation_coeff, B=c.roundoff_coeff, eps_predicted=c.eps_opt_predicted,
-                argmin=c.eps_opt_measured, min=c.error_at_measured_opt,
-                field="sine", u=c.u, v=c.v, k_u=SEED_FREQUENCIES[0], k_v=SEED_FREQUENCIES[1], steps=int(c.eps.size),
-                eps_max=float(c.eps.max()), eps_min=float(c.eps.min()))
+def _optima(points, ridges_largest):
+    from renderer.ucurve import DEFAULT_STEPS, SEED_FREQUENCIES, UNIT_ROUNDOFF, measure
+    k_u, k_v = SEED_FREQUENCIES
+    out = {}
+    for field, (u, v, component) in points.items():
+        steps = DEFAULT_STEPS[DEFAULT_STEPS <= ridges_largest] if field == "ridges" else DEFAULT_STEPS
+        c = measure(field, u, v, component, eps=steps, k_u=k_u, k_v=k_v)
+        at_fitted = float(measure(field, u, v, component, eps=[c.eps_fitted], k_u=k_u, k_v=k_v).error[0])
+        out[field] = dict(u=u, v=v, component=component, k_u=k_u, k_v=k_v, steps=int(steps.size),
+                          largest_step=float(steps.max()), smallest_step=float(steps.min()),
+                          h=abs(c.height), h1=abs(c.derivative), x_h1=c.model_argument / UNIT_ROUNDOFF,
+                          h3=abs(c.third_derivative), eps_model=c.eps_model, error_model=c.error_model,
+                          eps_fitted=c.eps_fitted, error_at_fitted=c.error_at_fitted,
+                          measured_at_fitted=at_fitted, fitted_over_model=c.eps_fitted / c.eps_model,
+                          argument_share=c.model_argument / (c.model_cancellation + c.model_argument))
+    ridges = out["ridges"]
+    ridges["crease_distance"] = float(crease_distance(ridges["u"], ridges["v"], k_u, k_v))
+    if not ridges["crease_distance"] > ridges["largest_step"]:
+        raise RuntimeError(f"the ridges point ({ridges['u']}, {ridges['v']}) is {ridges['crease_distance']:g} "
+                           f"from a crease, within the largest step {ridges['largest_step']:g}")
+    return out
+
+
+def crease_share():
+    """What the crease does on the ridges field, one measurement of the build (`lab.store`): in
+    the draft's scene at `CREASE_SIZE` squared, the share of sphere-A pixels whose stencil
+    straddles a crease (chart distance to one below the step, `crease_distance`) at each step
+    of `CREASE_STEPS`.  Returns a dict: ``steps``, ``share`` (list of floats in [0, 1], step
+    order) and ``pixels`` (sphere-A pixels of the frame)."""
+    from .store import measured
+    return measured("crease-share", _crease_share, size=CREASE_SIZE, steps=list(CREASE_STEPS))
+
+
+def _crease_share(size, steps):
+    g = gbuffer(DRAFT_SCENE, size, size)
+    uv = g.uv[g.chamber == SPHERE_A]
+    dist = crease_distance(uv[:, 0], uv[:, 1], DRAFT_SCENE.k_u, DRAFT_SCENE.k_v)
+    return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps], pixels=int(dist.size))

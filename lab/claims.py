@@ -24,7 +24,7 @@ from typing import Callable
 
 import numpy as np
 
-from renderer import Scene, compare, gbuffer, pointwise, render
+from renderer import DRAFT_SCENE, compare, gbuffer, pointwise, render
 from renderer.render import SPHERE_A
 
 __all__ = ["Bound", "Criterion", "rule", "about", "ABOUT", "Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED",
@@ -152,7 +152,7 @@ def _errata():
 
 @lru_cache(maxsize=None)
 def _frames(field="ridges", beta=0.35, eps=1e-3, size=128):
-    scene = Scene(height_field=field, beta=beta, eps=eps)
+    scene = DRAFT_SCENE.replace(height_field=field, beta=beta, eps=eps)
     return render(scene, size, size, gradient="central"), render(scene, size, size)
 
 
@@ -194,7 +194,7 @@ def _h3_scale():
 
 def _truncation_until():
     c = _ucurve()
-    return {"model optimum ε": c.eps_opt_predicted, "measured_optimum": c.eps_opt_measured}
+    return {"model optimum ε": c.eps_model, "measured_optimum": c.eps_measured_min}
 
 
 def _drowns_below_1e9():
@@ -203,9 +203,9 @@ def _drowns_below_1e9():
 
 
 def _cell2_minimum():
-    from .accuracy import default_optimum
-    opt = default_optimum()
-    return {"fitted optimum ε": opt["eps"], "error": opt["error"]}
+    from .accuracy import optima
+    opt = optima()["sine"]
+    return {"fitted optimum ε": opt["eps_fitted"], "error": opt["error_at_fitted"]}
 
 
 def _orientation():
@@ -254,7 +254,7 @@ def census():
 
 
 def _census(size):
-    scene = Scene()
+    scene = DRAFT_SCENE
     symbolic = render(scene, size, size)
     on_a = symbolic.chamber == SPHERE_A
     uv = gbuffer(scene, size, size).uv[on_a]
@@ -310,7 +310,7 @@ def crease_band_ratio():
     crease band over the mean off it, with the two means (``on``, ``off``) and the frame (``scene``,
     ``size``)."""
     c = census()
-    default = c["steps"].index(Scene().eps)
+    default = c["steps"].index(DRAFT_SCENE.eps)
     return dict(on=c["on_band"][default], off=c["off_band"][default], ratio=c["ratio"], scene=c["scene"],
                 size=c["size"])
 
@@ -364,7 +364,7 @@ def _stacking():
     are all on A, with the bump and without it."""
     err = {}
     for beta in (0.35, 0.0):
-        scene = Scene(beta=beta)
+        scene = DRAFT_SCENE.replace(beta=beta)
         fine, one = render(scene, 512, 512).image, render(scene, 128, 128)
         box = fine.reshape(128, 4, 128, 4, 3).mean(axis=(1, 3))
         all_a = (render(scene, 512, 512, kink=False, grad=False).chamber == SPHERE_A).reshape(128, 4, 128, 4).all(axis=(1, 3))
@@ -372,7 +372,7 @@ def _stacking():
         err[beta] = float(np.sqrt(np.mean(d ** 2)))
     ratio = err[0.35] / err[0.0]
     return {"one-sample error, with / without the bump": ratio, "bumped": err[0.35], "flat": err[0.0],
-            **_on(one, Scene())}
+            **_on(one, DRAFT_SCENE)}
 
 
 def _blinn_exact():
@@ -397,7 +397,7 @@ def _timing():
     import time
 
     from .gradient_methods import evaluations
-    g = gbuffer(Scene(), 128, 128)
+    g = gbuffer(DRAFT_SCENE, 128, 128)
     uv = g.uv[g.chamber == SPHERE_A]
     u, v = uv[:, 0].copy(), uv[:, 1].copy()
 
@@ -411,13 +411,13 @@ def _timing():
 
     t_exact = best(lambda: pointwise.exact_gradient("ridges", u, v, 8.0, 4.0))
     t_central = best(lambda: pointwise.central_gradient("ridges", u, v, 8.0, 4.0, 1e-3))
-    f_exact = best(lambda: render(Scene(), 128, 128), 7)
-    f_central = best(lambda: render(Scene(), 128, 128, gradient="central"), 7)
+    f_exact = best(lambda: render(DRAFT_SCENE, 128, 128), 7)
+    f_central = best(lambda: render(DRAFT_SCENE, 128, 128, gradient="central"), 7)
     stage = t_central / t_exact
     central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
     return {"sin/cos calls, exact minus central": exact.trig - central.trig, "trig_exact": exact.trig,
             "trig_central": central.trig, "stage_ratio": stage, "frame_ratio": f_central / f_exact,
-            **_on(g, Scene())}
+            **_on(g, DRAFT_SCENE)}
 
 
 #: The draft's expected worst component error of its Cell 5 check ("~1e-9"): its criterion's centre,
@@ -461,7 +461,7 @@ def _beta0():
 
 
 def _bump_nonzero():
-    s = Scene(height_field="sine", beta=1.5)
+    s = DRAFT_SCENE.replace(height_field="sine", beta=1.5)
     bumped = render(s, 128, 128)
     d = float(np.abs(bumped.image - render(s.replace(beta=0.0), 128, 128).image).mean())
     return {"mean |ΔI|": d, **_on(bumped)}
@@ -486,15 +486,15 @@ def _crease_values():
 
 
 def _pole_pixels():
-    g = gbuffer(Scene(), 256, 256)
+    g = gbuffer(DRAFT_SCENE, 256, 256)
     n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= 1e-4)))
-    return {"fallback pixels": n, **_on(g, Scene())}
+    return {"fallback pixels": n, **_on(g, DRAFT_SCENE)}
 
 
 def _sweep_best():
     a = {eps: compare(*_frames("sine", 0.35, eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
     best = min(a, key=a.get)
-    return {"best ε": best, **_on(_frames("sine")[1], Scene(height_field="sine"))}
+    return {"best ε": best, **_on(_frames("sine")[1], DRAFT_SCENE.replace(height_field="sine"))}
 
 
 def _creases_part():
@@ -521,8 +521,8 @@ def _rings_pinch():
 
 
 def _beta_zero_slider():
-    flat = render(Scene(beta=0.0), 96, 96)
-    b = render(Scene(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
+    flat = render(DRAFT_SCENE.replace(beta=0.0), 96, 96)
+    b = render(DRAFT_SCENE.replace(beta=0.0, height_field="sine"), 96, 96, gradient="central").image
     n = int(np.count_nonzero(flat.image != b))
     return {"values differing": n, **_on(flat)}
 

@@ -68,7 +68,7 @@ import numpy as np
 import sympy as sp
 from scipy.differentiate import derivative
 
-from renderer import Scene, gbuffer, pointwise
+from renderer import DRAFT_SCENE, gbuffer, pointwise
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
@@ -170,7 +170,7 @@ def chart_points(field="ridges", size=256):
     -------
     (u, v) : two (n,) float64 arrays, contiguous, in row-major pixel order.
     """
-    g = gbuffer(Scene(height_field=field), size, size)
+    g = gbuffer(DRAFT_SCENE.replace(height_field=field), size, size)
     uv = g.uv[g.chamber == SPHERE_A]
     return np.ascontiguousarray(uv[:, 0]), np.ascontiguousarray(uv[:, 1])
 
@@ -595,7 +595,7 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     t_start = time.perf_counter()
     load_start = os.getloadavg() if hasattr(os, "getloadavg") else None
     rng = np.random.default_rng(config.seed)
-    scene = Scene()
+    scene = DRAFT_SCENE
     ku, kv = float(scene.k_u), float(scene.k_v)
     results, n_ref, n_excl, h_times = [], {}, {}, {}
     pixels = None

@@ -17,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-from renderer import Scene, gbuffer
+from renderer import DRAFT_SCENE, gbuffer
 from renderer.pointwise import chart, tangent_frame
 from renderer.render import FLOOR, SPHERE_A, SPHERE_B, image_plane
 
@@ -51,7 +51,7 @@ def _rays(scene, size=SIZE):
 
 def _sphere_b_seed_vs_true(size=SIZE):
     """The seed's sphere-B quadratic uses c = |C_B|^2 - r^2 instead of |E - C_B|^2 - r^2."""
-    scene = Scene()
+    scene = DRAFT_SCENE
     X, Y = _rays(scene, size)
     e = scene.camera_z
     C = np.asarray(scene.center_b)
@@ -130,7 +130,7 @@ def _terminator_leak(size=SIZE):
     res = {}
     leaked_by_beta = {}
     for beta in (0.35, 1.5):
-        scene = Scene(beta=beta)  # at beta = 0, N' = N and nothing can leak
+        scene = DRAFT_SCENE.replace(beta=beta)  # at beta = 0, N' = N and nothing can leak
         count = 0
         worst = 0.0
         for light, cos_geo, cos_bump, cast in _light_terms(scene, size):
@@ -147,7 +147,7 @@ def _terminator_leak(size=SIZE):
 
 def _specular_ungated(size=SIZE):
     """The seed adds a Blinn lobe where the shading normal faces away from the light."""
-    scene = Scene()
+    scene = DRAFT_SCENE
     g = gbuffer(scene, size, size)
     E = np.array([0.0, 0.0, scene.camera_z])
     worst, count = 0.0, 0
@@ -172,7 +172,7 @@ def _specular_ungated(size=SIZE):
 
 def _v_border_branch(size=SIZE):
     """The seed's border test ``vp - vm < 2 eps`` also fires in the interior."""
-    scene = Scene()
+    scene = DRAFT_SCENE
     g = gbuffer(scene, size, size)
     v = g.uv[..., 1][g.chamber == SPHERE_A]
     out = {}

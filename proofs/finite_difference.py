@@ -235,16 +235,21 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
 CENTRAL_DIFFERENCE_TRUNCATION = _truncation()
 
 # ----------------------------------------------------------------------------- the optimal step
-H3, H, u_round = sp.symbols("H_3 H u", positive=True)
+H3, H, HX, u_round = sp.symbols("H_3 H H_x u", positive=True)
 E = sp.Function("E")
 eps_star = sp.Symbol("eps_star", positive=True)
-#: The error model, truncation plus roundoff, as written: eps^2 |h'''| / 6 + u |h| / eps.
+#: The error model, truncation plus roundoff, as written: eps^2 |h'''| / 6 + u (|h| + |x h'|) / eps.
+#: Roundoff has two sources: the rounded values h(x +- eps) (each off by at most about u |h|, so
+#: u |h| / eps in the quotient) and the rounded abscissae fl(x +- eps) (each off by at most u |x|,
+#: which moves h by |h'| u |x|, so u |x h'| / eps in the quotient).
+ROUNDOFF = sp.Add(H, HX, evaluate=False)
 ERROR_MODEL = written(sp.Add(sp.Mul(sp.Rational(1, 6), eps**2, H3, evaluate=False),
-                             sp.Mul(u_round, H, 1 / eps, evaluate=False), evaluate=False))
-#: The optimal step, as written: (3 u |h| / |h'''|)^(1/3).
-EPS_STAR = written(sp.Pow(sp.Mul(3, u_round, H, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
-NAMES = {H: r"\lvert h\rvert", H3: r"\lvert h'''\rvert", u_round: r"\mathrm{u}", eps_star: r"\varepsilon^\ast"}
-STEP_DOMAIN = {eps: (0.05, 2.0), H: (0.1, 10.0), H3: (0.1, 10.0), u_round: (1e-3, 0.1)}
+                             sp.Mul(u_round, ROUNDOFF, 1 / eps, evaluate=False), evaluate=False))
+#: The optimal step, as written: (3 u (|h| + |x h'|) / |h'''|)^(1/3).
+EPS_STAR = written(sp.Pow(sp.Mul(3, u_round, ROUNDOFF, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
+NAMES = {H: r"\lvert h\rvert", HX: r"\lvert x h'\rvert", H3: r"\lvert h'''\rvert", u_round: r"\mathrm{u}",
+         eps_star: r"\varepsilon^\ast"}
+STEP_DOMAIN = {eps: (0.05, 2.0), H: (0.1, 10.0), HX: (0.1, 10.0), H3: (0.1, 10.0), u_round: (1e-3, 0.1)}
 
 
 def _optimal(model=ERROR_MODEL, star=EPS_STAR):
@@ -253,37 +258,40 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
     stationary, minimum = sp.Subs(slope, eps, eps_star), sp.Subs(curvature, eps, eps_star)
     return Theorem(
         id="optimal-step", title="The optimal central-difference step",
-        statement=r"The error model $⟦E⟧$ ($\mathrm{u}$ the unit roundoff) has one stationary point on "
+        statement=r"The error model $⟦E⟧$ ($\mathrm{u}$ the unit roundoff, $x$ the point) has one stationary point on "
                   r"$\varepsilon > 0$, $⟦eps_star⟧$, and it is the minimum: $⟦stationary⟧$, $⟦minimum⟧ > 0$.",
         steps=(
             *calc(slope,
                   ("Differentiate the model term by term",
                    written(sp.Add(sp.Mul(sp.Rational(1, 3), eps, H3, evaluate=False),
-                                  sp.Mul(-1, u_round, H, eps**-2, evaluate=False), evaluate=False))),
-                  (r"Put it over the common denominator $3\varepsilon^2$ and write $3\mathrm{u}\lvert h\rvert/"
-                   r"\lvert h'''\rvert$ as $\varepsilon^{\ast 3}$",
+                                  sp.Mul(-1, u_round, ROUNDOFF, eps**-2, evaluate=False), evaluate=False))),
+                  (r"Put it over the common denominator $3\varepsilon^2$ and write $3\mathrm{u}(\lvert h\rvert + "
+                   r"\lvert x h'\rvert)/\lvert h'''\rvert$ as $\varepsilon^{\ast 3}$",
                    written(sp.Mul(sp.Rational(1, 3), H3, sp.Add(eps**3, -eps_star**3, evaluate=False), eps**-2,
                                   evaluate=False)))),
             Step(r"For $\varepsilon > 0$ the factor $\varepsilon^3 - \varepsilon^{\ast 3}$ vanishes only at "
                  r"$\varepsilon = \varepsilon^\ast$, negative below it and positive above", stationary, sp.Integer(0)),
-            Step(r"Differentiate again: $E'' = \lvert h'''\rvert/3 + 2\mathrm{u}\lvert h\rvert/\varepsilon^3$, which at "
+            Step(r"Differentiate again: $E'' = \lvert h'''\rvert/3 + 2\mathrm{u}(\lvert h\rvert + \lvert x h'\rvert)/"
+                 r"\varepsilon^3$, which at "
                  r"$\varepsilon^\ast$ is $\lvert h'''\rvert/3 + 2\lvert h'''\rvert/3 > 0$: $\varepsilon^\ast$ is the "
                  r"minimum", minimum, H3),
         ),
         claims={"stationary": (stationary, sp.Integer(0)), "minimum": (minimum, H3)},
         where={E(eps): model, eps_star: star}, names=NAMES, domain=STEP_DOMAIN,
         wrong_variants=(("exponent 1/2 instead of 1/3",
-                         lambda: _optimal(star=(3 * u_round * H / H3) ** sp.Rational(1, 2)).check()),
+                         lambda: _optimal(star=(3 * u_round * (H + HX) / H3) ** sp.Rational(1, 2)).check()),
+                        ("the optimum without the argument-rounding term, (3 u |h| / |h'''|)^(1/3)",
+                         lambda: _optimal(star=(3 * u_round * H / H3) ** sp.Rational(1, 3)).check()),
                         ("the roundoff term added with the wrong sign (no stationary point)",
-                         lambda: _optimal(eps**2 * H3 / 6 - u_round * H / eps).check()),
+                         lambda: _optimal(eps**2 * H3 / 6 - u_round * (H + HX) / eps).check()),
                         ("both terms negated (the stationary point is a maximum)",
                          lambda: _optimal(-ERROR_MODEL).check()),
                         ("a model with stationary points 1, 3/2 and 2: a minimum at 1, but not the only one",
                          lambda: _optimal((eps - 1)**2 * (eps - 2)**2, sp.Integer(1)).check()),
                         ("the model's truncation term (its highest power) over 3, not 6",
-                         lambda: _optimal(eps**2 * H3 / 3 + u_round * H / eps).check()),
+                         lambda: _optimal(eps**2 * H3 / 3 + u_round * (H + HX) / eps).check()),
                         ("the model's truncation term at eps^3, not eps^2",
-                         lambda: _optimal(eps**3 * H3 / 6 + u_round * H / eps).check())),
+                         lambda: _optimal(eps**3 * H3 / 6 + u_round * (H + HX) / eps).check())),
         pages=("s3", "s5", "s7"),
         seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
     )

@@ -305,7 +305,7 @@ def load_scene(path=None, sets=()):
         A TOML file whose top-level keys are `Scene` field names; ``lights``
         is an array of tables ``[[lights]]``, each with ``position`` and
         ``color``.  Missing fields keep the Scene's defaults (the seed's,
-        Cell 1).  It must be a regular file (a symbolic link to one is
+        Cell 1, with the displaced sphere's normal ``bump="surface"``).  It must be a regular file (a symbolic link to one is
         followed) of at most `MAX_SCENE_BYTES` = 1 MiB, UTF-8 (a leading
         byte-order mark is accepted).
     sets : sequence of str
@@ -515,8 +515,10 @@ def _cmd_sweep(args, outputs):
 
 
 def _measure_ucurve(args, steps):
+    import dataclasses
+
     import numpy as np
-    from renderer.ucurve import UNIT_ROUNDOFF, UCurve, fit_model, measure
+    from renderer.ucurve import fit_model, measure
     kw = dict(field=args.field, u=args.u, v=args.v, component=args.component, k_u=args.k_u, k_v=args.k_v)
     if not cmdline.show_progress() or steps.size < 50:
         return measure(eps=steps, **kw)
@@ -527,21 +529,24 @@ def _measure_ucurve(args, steps):
             bar.update(chunk.size)
     cat = lambda name: np.concatenate([getattr(p, name) for p in parts])  # noqa: E731
     error = cat("error")
+    nan = float("nan")
+    # The model's coefficients are the point's, the same in every part; the steps named by
+    # the whole curve (its measured minimum and fitted optimal step) are found on all of it.
+    uc = dataclasses.replace(parts[0], eps=steps, error=error, truncation=cat("truncation"),
+                             roundoff=cat("roundoff"), model=cat("model"), fitted_truncation=nan,
+                             fitted_roundoff=nan, eps_fitted=nan, error_at_fitted=nan)
+    if uc.reason is not None:
+        return uc
     best = int(np.argmin(error))
-    p0 = parts[0]
-    reason = getattr(p0, "reason", None)
-    opt = (float("nan"),) * 2 if reason is not None else (float(steps[best]), float(error[best]))
-    fit = (float("nan"),) * 4
-    if reason is None:
-        try:
-            A, B = fit_model(steps, error, start=(max(abs(p0.third_derivative), 1e-300) / 6, UNIT_ROUNDOFF))
-        except ValueError:
-            pass
-        else:
-            e_fit = (B / (2 * A)) ** (1 / 3)
-            fit = (A, B, e_fit, A * e_fit**2 + B / e_fit)
-    return UCurve(p0.field, p0.u, p0.v, p0.component, steps, error, cat("truncation"), cat("roundoff"),
-                  cat("model"), p0.derivative, p0.third_derivative, p0.eps_opt_predicted, *opt, reason, *fit)
+    uc = dataclasses.replace(uc, eps_measured_min=float(steps[best]), error_at_measured_min=float(error[best]))
+    try:
+        A, B = fit_model(steps, error, start=(max(uc.model_truncation, 1e-300),
+                                              max(uc.model_cancellation + uc.model_argument, 1e-300)))
+    except ValueError:
+        return uc
+    e_fit = (B / (2 * A)) ** (1 / 3)
+    return dataclasses.replace(uc, fitted_truncation=A, fitted_roundoff=B, eps_fitted=e_fit,
+                               error_at_fitted=A * e_fit**2 + B / e_fit)
 
 
 def _ucurve_png(uc):
@@ -556,9 +561,11 @@ def _ucurve_png(uc):
         ax.loglog(uc.eps, np.maximum(uc.error, floor), "k.-", label="measured |error|")
         ax.loglog(uc.eps, np.maximum(np.abs(uc.truncation), floor), "C0--", label="|truncation|")
         ax.loglog(uc.eps, np.maximum(np.abs(uc.roundoff), floor), "C3--", label="|roundoff|")
-        ax.loglog(uc.eps, uc.model, "C2:", label="model eps^2|h'''|/6 + u|h|/eps")
-        if math.isfinite(uc.eps_opt_predicted):
-            ax.axvline(uc.eps_opt_predicted, color="0.6", lw=0.8, label="predicted eps*")
+        ax.loglog(uc.eps, uc.model, "C2:", label="model E = eps^2|h'''|/6 + u(|h| + |x h'|)/eps")
+        if math.isfinite(uc.eps_model):
+            ax.axvline(uc.eps_model, color="0.6", lw=0.8, label="model-optimal step eps*")
+        if math.isfinite(uc.eps_fitted):
+            ax.axvline(uc.eps_fitted, color="0.3", lw=0.8, ls="--", label="fitted optimal step eps^")
         ax.set_xlabel("eps (chart units)")
         ax.set_ylabel(f"|error| of h_{uc.component}")
         ax.set_title(f"U-curve: {uc.field} at (u, v) = ({uc.u:g}, {uc.v:g})"
@@ -572,6 +579,7 @@ def _ucurve_png(uc):
 
 def _cmd_ucurve(args, outputs):
     from renderer import pointwise, validate
+    from renderer.ucurve import UNIT_ROUNDOFF
     if args.plot is not None:
         _check_output(args.plot, "--plot")
         outputs.to_stderr = cmdline.is_stdout(args.plot)   # the plot takes stdout: the table goes to stderr
@@ -593,13 +601,15 @@ def _cmd_ucurve(args, outputs):
             print(f"{uc.eps[i]:9.2e}  {uc.truncation[i]:11.3e}  {uc.roundoff[i]:11.3e}  "
                   f"{uc.error[i]:10.3e}", file=out)
     else:
-        print(f"true derivative {uc.derivative:.17g}; |h'''| = {abs(uc.third_derivative):.6g}", file=out)
+        print(f"true derivative {uc.derivative:.17g}; |h'''| = {abs(uc.third_derivative):.6g}; "
+              f"|h| = {abs(uc.height):.6g}; |{uc.component} h'| = {uc.model_argument / UNIT_ROUNDOFF:.6g}", file=out)
         print(f"{'eps':>9}  {'truncation':>11}  {'roundoff':>11}  {'|error|':>10}  {'model':>10}", file=out)
         for i in range(uc.eps.size):
             print(f"{uc.eps[i]:9.2e}  {uc.truncation[i]:11.3e}  {uc.roundoff[i]:11.3e}  "
                   f"{uc.error[i]:10.3e}  {uc.model[i]:10.3e}", file=out)
-        print(f"eps* predicted {uc.eps_opt_predicted:.3e}; measured minimum {uc.error_at_measured_opt:.3e} "
-              f"at eps {uc.eps_opt_measured:.3e}", file=out)
+        print(f"model-optimal step eps* {uc.eps_model:.3e}, model error there {uc.error_model:.3e}", file=out)
+        print(f"fitted optimal step eps^ {uc.eps_fitted:.3e}, fitted error there {uc.error_at_fitted:.3e}", file=out)
+        print(f"measured minimum {uc.error_at_measured_min:.3e} at eps {uc.eps_measured_min:.3e}", file=out)
     if args.plot is not None:
         outputs.stage_bytes(args.plot, _ucurve_png(uc), "--plot")
         print(f"wrote {'standard output' if args.plot == STDOUT else args.plot}", file=out)
@@ -648,7 +658,9 @@ def build_parser():
     def scene_opts(sp):
         sp.add_argument("--scene", metavar="FILE.toml",
                         help="TOML file with Scene field names ([[lights]] tables with position, color); "
-                             "unknown keys are errors")
+                             "unknown keys are errors; missing fields keep the defaults: the draft's "
+                             "scene with the displaced sphere's normal (bump=surface; the draft's own "
+                             "normal is bump=chart)")
         sp.add_argument("--set", action="append", default=[], metavar="key=value",
                         help="override a Scene field; value is TOML (a bare word is a string); repeatable")
 

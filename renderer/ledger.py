@@ -14,10 +14,10 @@ from .scene import Scene
 
 __all__ = ["Ledger", "compare", "to_srgb", "SIMULATOR_SCENE", "DIFFERENCE_LOG_FLOOR", "DIFFERENCE_LINEAR_GAIN"]
 
-#: The scene the simulator opens on: the draft's (`Scene()`), shaded with the
-#: displaced sphere's normal (``formulas.PERTURBED_NORMAL["surface"]``), the bump a
-#: reader expects; the draft's chart formula is one control away.
-SIMULATOR_SCENE = Scene(bump="surface")
+#: The scene the simulator opens on: the default `Scene()` (the draft's scene shaded with the
+#: displaced sphere's normal, ``formulas.PERTURBED_NORMAL["surface"]``, the bump a reader
+#: expects); the draft's chart formula is one control away.
+SIMULATOR_SCENE = Scene()
 
 #: The simulator's difference canvas (§4): log10 |difference| is drawn from this floor (black)
 #: to 0 (white), about the rounding level of float64; the linear scale multiplies by the gain.

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field, fields
 
 from .validate import InvalidType, InvalidValue, choice, flag, real, vector3
 
-__all__ = ["PointLight", "Scene", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
+__all__ = ["PointLight", "Scene", "DRAFT_SCENE", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
 
 #: Largest accepted magnitude of a length or coordinate (scene units): squares of
 #: lengths are formed everywhere, and 1e6 keeps them far from overflow.
@@ -97,7 +97,7 @@ _DEFAULT_LIGHTS = (
 
 @dataclass(frozen=True)
 class Scene:
-    """The Chapter-9 scene; the defaults are the seed's (Cell 1, ``SC9``).
+    """The Chapter-9 scene; the defaults are the seed's (Cell 1, ``SC9``) but for the normal.
 
     Geometry.  Sphere A (radius ``radius_a`` [R]) is centred at the origin and
     carries the bump.  The pinhole camera sits at ``(0, 0, camera_z)`` [e] and
@@ -117,11 +117,12 @@ class Scene:
     frequencies ``k_u`` [ku] and ``k_v`` [kv] (seed §2); ``beta`` [beta] >= 0 is
     the bump amplitude; ``eps`` [eps] > 0 is the central-difference step of the
     numeric pipeline, in chart units (u and v both run over [0, 1]).
-    ``bump`` selects the perturbed normal: "chart" (default) is the seed's
-    N' = normalize(N + beta (h_u e_theta + h_v e_phi)); "surface" is the exact
+    ``bump`` selects the perturbed normal: "surface" (default) is the exact
     normal of the displaced sphere P = (R + beta h) N,
     N' = normalize(N - beta / (R + beta h) (h_u / (2 pi sin phi) e_theta + h_v / pi e_phi)),
-    which needs beta < radius_a (|h| <= 1 keeps R + beta h > 0).
+    which needs beta < radius_a (|h| <= 1 keeps R + beta h > 0); "chart" is the
+    seed's N' = normalize(N + beta (h_u e_theta + h_v e_phi)), the normal of the
+    draft's scene `DRAFT_SCENE`.  Every other default is the seed's.
 
     Raises
     ------
@@ -144,8 +145,10 @@ class Scene:
 
     Examples
     --------
-    >>> Scene(height_field="sine", beta=1.5).beta
-    1.5
+    >>> Scene(height_field="sine", beta=0.5).bump
+    'surface'
+    >>> DRAFT_SCENE.replace(height_field="sine", beta=1.5).bump
+    'chart'
     """
 
     radius_a: float = 1.0
@@ -169,7 +172,7 @@ class Scene:
     k_v: float = 4.0
     beta: float = 0.35
     eps: float = 1e-3
-    bump: str = "chart"
+    bump: str = "surface"
 
     def __post_init__(self):
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -213,7 +216,8 @@ class Scene:
         set_("bump", choice("Scene.bump", self.bump, BUMPS))
         if self.bump == "surface" and not self.beta < self.radius_a:
             raise InvalidValue(f"Scene.beta must be < radius_a = {self.radius_a} when bump='surface' (the "
-                               f"displaced radius R + beta h must stay positive), got {self.beta!r}")
+                               f"default; the displaced radius R + beta h must stay positive), got "
+                               f"{self.beta!r}; bump='chart' (the draft's normal) accepts beta up to {MAX_BETA:g}")
 
     def replace(self, **changes) -> "Scene":
         """Return a copy with ``changes`` applied (and validated).
@@ -243,3 +247,8 @@ class Scene:
         """
         default = Scene()
         return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) != getattr(default, f.name)}
+
+
+#: The draft's scene: the seed's Cell-1 scene with its own perturbed normal, the chart
+#: formula (``bump="chart"``).  Every measurement of a claim or erratum of the draft uses it.
+DRAFT_SCENE = Scene(bump="chart")

@@ -12,9 +12,17 @@ of steps eps, `measure` returns
   kernel's `renderer.formulas.STENCIL_POINTS`, evaluated in float64) and the
   same denominator, minus the true derivative; and *roundoff*, the rest
   (the rounding of the two values of h and of the subtraction and division);
-* the model eps^2 |h'''| / 6 + u_round |h| / eps (u_round = 2^-53, the unit
-  roundoff), its minimiser eps* = (3 u_round |h| / |h'''|)^(1/3), and the
-  measured minimiser.
+* the error model E(eps) = eps^2 |h'''| / 6 + u_round (|h| + |x h'|) / eps
+  (u_round = 2^-53, the unit roundoff; x the point's coordinate u or v): truncation
+  from Taylor's series, cancellation (each value h(x +- eps) rounded, off by up to
+  u_round |h|) and argument rounding (each abscissa fl(x +- eps) off by up to
+  u_round |x|, which moves h by |h'| u_round |x|); each of the quotient's two
+  rounding terms is half their difference over 2 eps, hence the weights 1.  Its
+  minimiser, the *model-optimal step* eps* = (3 u_round (|h| + |x h'|) / |h'''|)^(1/3),
+  and the model's error there;
+* the *fitted optimal step* eps^ = (B / 2A)^(1/3) of A eps^2 + B / eps fitted to
+  the measured error (`fit_model`), and the *measured minimum*, the noisy curve's
+  lowest point on the grid of steps.
 
 Working precision: 50 digits, so that the reference's own error (~1e-50) is
 far below the float64 quantities measured (>= 1e-17).
@@ -103,8 +111,16 @@ class UCurve:
     Where the derivative does not exist (``reason`` is not None, see
     `non_differentiable`), ``error`` and ``truncation`` are measured against
     the one-sided derivative from the interior side named in ``reason``'s
-    place (from above, or from below at 1), and ``derivative`` and the three
-    optimum fields are NaN: there is no true derivative and no optimal step.
+    place (from above, or from below at 1), and ``derivative``, the model and
+    every step and error named below are NaN: there is no true derivative and
+    no optimal step.
+
+    Three steps have names, one each (the book's, the command line's and the
+    glue's): ``eps_model`` the *model-optimal step* eps*, minimiser of the error
+    model E; ``eps_fitted`` the *fitted optimal step* eps^, minimiser of
+    A eps^2 + B / eps fitted to the measured error; ``eps_measured_min`` the
+    *measured minimum*, the lowest point of the noisy measured curve.  Steps in
+    chart units; errors in units of the derivative (height per chart unit).
     """
 
     field: str
@@ -115,21 +131,27 @@ class UCurve:
     error: np.ndarray          # |float64 FD - true derivative|
     truncation: np.ndarray     # exact-arithmetic FD at the float64 abscissae - true (signed)
     roundoff: np.ndarray       # float64 FD - exact-arithmetic FD (signed)
-    model: np.ndarray          # eps^2 |h'''| / 6 + u_round |h| / eps
-    derivative: float          # the true derivative, rounded to float64
-    third_derivative: float
-    eps_opt_predicted: float
-    eps_opt_measured: float
-    error_at_measured_opt: float
+    model: np.ndarray          # E(eps) = model_truncation eps^2 + (model_cancellation + model_argument) / eps
+    derivative: float          # the true derivative h', rounded to float64
+    third_derivative: float    # h''' at the point
+    height: float              # h at the point
+    #: The error model's three coefficients: |h'''| / 6, u_round |h| and u_round |x h'|.
+    model_truncation: float
+    model_cancellation: float
+    model_argument: float
+    eps_model: float           # model-optimal step eps* = (3 u_round (|h| + |x h'|) / |h'''|)^(1/3)
+    error_model: float         # E(eps*)
+    eps_measured_min: float    # the step of least measured error on the grid
+    error_at_measured_min: float
     reason: str | None = None  # why h has no derivative here (`non_differentiable`), or None
     #: The model A eps^2 + B / eps fitted to the measured error (`fit_model`),
-    #: its optimum (B / 2A)^(1/3) and the model's error there: the statistics
-    #: the book shows, as they move little with the grid of steps (the argmin
-    #: of a noisy curve jumps between its dips).
-    truncation_coeff: float = float("nan")
-    roundoff_coeff: float = float("nan")
-    eps_opt_fitted: float = float("nan")
-    error_at_fitted_opt: float = float("nan")
+    #: its minimiser (B / 2A)^(1/3) (the fitted optimal step) and the fitted
+    #: model's error there: they move little with the grid of steps (the
+    #: measured minimum of a noisy curve jumps between its dips).
+    fitted_truncation: float = float("nan")
+    fitted_roundoff: float = float("nan")
+    eps_fitted: float = float("nan")
+    error_at_fitted: float = float("nan")
 
 
 def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
@@ -288,18 +310,29 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
             error.append(float(abs(mpmath.mpf(fd) - true)))
     error = np.array(error)
     h0f, h3f = float(h0), float(h3)
-    model = steps**2 * abs(h3f) / 6 + UNIT_ROUNDOFF * abs(h0f) / steps
-    predicted = (3 * UNIT_ROUNDOFF * abs(h0f) / abs(h3f)) ** (1 / 3) if h3f != 0 else float("inf")
+    measured = dict(field=field, u=u, v=v, component=component, eps=steps, error=error,
+                    truncation=np.array(trunc), roundoff=np.array(roundoff), height=h0f)
     best = int(np.argmin(error))
     nan = float("nan")
     if reason is not None:
-        return UCurve(field, u, v, component, steps, error, np.array(trunc), np.array(roundoff),
-                      np.full(steps.shape, nan), nan, nan, nan, nan, nan, reason)
+        return UCurve(**measured, model=np.full(steps.shape, nan), derivative=nan, third_derivative=nan,
+                      model_truncation=nan, model_cancellation=nan, model_argument=nan, eps_model=nan,
+                      error_model=nan, eps_measured_min=nan, error_at_measured_min=nan, reason=reason)
+    x = u if component == "u" else v
+    T, C, G = abs(h3f) / 6, UNIT_ROUNDOFF * abs(h0f), UNIT_ROUNDOFF * abs(x * float(true))
+    model = T * steps**2 + (C + G) / steps
+    # E'(eps) = 2 T eps - (C + G) / eps^2 = 0.  No truncation (T = 0): E falls towards 0 as eps grows
+    # (eps* infinite); no rounding (C + G = 0, h = 0 at x = 0): E is least, 0, at eps* = 0.
+    star = ((C + G) / (2 * T)) ** (1 / 3) if T > 0 else float("inf")
+    least = T * star**2 + (C + G) / star if 0 < star < float("inf") else 0.0
     try:
-        A, B = fit_model(steps, error, start=(max(abs(h3f), 1e-300) / 6, UNIT_ROUNDOFF * max(abs(h0f), 1e-300)))
+        A, B = fit_model(steps, error, start=(max(T, 1e-300), max(C + G, 1e-300)))
     except ValueError:              # an exact quotient (h_u of rings: zero error) has no U to fit
         A = B = nan
     eps_fit = (B / (2 * A)) ** (1 / 3)
-    return UCurve(field, u, v, component, steps, error, np.array(trunc), np.array(roundoff), model,
-                  float(true), h3f, predicted, float(steps[best]), float(error[best]), None,
-                  A, B, float(eps_fit), float(A * eps_fit**2 + B / eps_fit))
+    return UCurve(**measured, model=model, derivative=float(true), third_derivative=h3f,
+                  model_truncation=T, model_cancellation=C, model_argument=G, eps_model=star,
+                  error_model=least,
+                  eps_measured_min=float(steps[best]), error_at_measured_min=float(error[best]),
+                  fitted_truncation=A, fitted_roundoff=B, eps_fitted=float(eps_fit),
+                  error_at_fitted=float(A * eps_fit**2 + B / eps_fit))

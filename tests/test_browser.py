@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from renderer import PointLight, Scene, compare, gbuffer, render
+from renderer import DRAFT_SCENE, PointLight, Scene, compare, gbuffer, render
 from renderer.jsgen import SIMULATOR_SCENE
 from renderer.render import check_args
 
@@ -239,8 +239,8 @@ def _within(got, python):
 
 
 def test_the_simulator_opens_on_the_displaced_sphere_normal(session):
-    """The opening scene is the draft's with bump="surface" (renderer.jsgen.SIMULATOR_SCENE), and
-    its ledger is Python's for that scene; Python's ledger of the draft's chart formula (the wrong
+    """The opening scene is the default `Scene()`, the draft's with bump="surface"
+    (renderer.jsgen.SIMULATOR_SCENE), and its ledger is Python's for that scene; Python's ledger of the draft's chart formula (the wrong
     variant: a simulator that ignored the bump control) lies outside the bounds."""
     session.set_eps(-3)
     assert session.page.input_value("#sim-bump") == "surface"
@@ -248,10 +248,10 @@ def test_the_simulator_opens_on_the_displaced_sphere_normal(session):
     opened = session.sim("sim.frames.scene")
     want = json.loads(json.dumps(dataclasses.asdict(SIMULATOR_SCENE)))
     assert opened == want
-    assert dataclasses.replace(SIMULATOR_SCENE, bump="chart") == Scene()        # the rest is the draft's
+    assert SIMULATOR_SCENE == Scene() and SIMULATOR_SCENE.replace(bump="chart") == DRAFT_SCENE   # the rest is the draft's
     got = (session.ledger("rms"), session.ledger("max"))
     assert _within(got, _python_ledger(SIMULATOR_SCENE, 1e-3))
-    assert not _within(got, _python_ledger(Scene(), 1e-3))
+    assert not _within(got, _python_ledger(DRAFT_SCENE, 1e-3))
 
 
 def test_eps_slider_moves_the_ledger_as_python_predicts(session):
@@ -309,6 +309,32 @@ def test_the_u_curve_is_the_ledger_of_its_sample_and_follows_the_controls(sessio
     assert plot.locator("#sim-curve-rms").get_attribute("points") != rms_line          # recomputed
     session.fill("beta", SIMULATOR_SCENE.beta)
     assert plot.locator("#sim-curve-rms").get_attribute("points") == rms_line
+    assert session.errors == []
+
+
+def test_the_curve_marks_its_image_best_step_and_names_its_right_arm_per_field(session):
+    """The triangle stands at the step of least RMS among the curve's points (a marker at the largest
+    RMS, the wrong variant, stands elsewhere) and is labelled; at beta = 0 every RMS is 0 and there is
+    none.  The caption names the right arm per field: crease error on ridges, truncation on sine and
+    rings (whose captions agree)."""
+    session.select("height_field", "ridges")
+    session.fill("beta", SIMULATOR_SCENE.beta)
+    session.set_eps(-3)
+    points = session.sim("sim.curve")["points"]
+    best, worst = min(points, key=lambda p: p["rms"]), max(points, key=lambda p: p["rms"])
+    plot = session.page.locator("#sim-curve")
+    eps = float(plot.locator("#sim-curve-best").get_attribute("data-eps"))
+    assert eps == best["eps"] and eps != worst["eps"]
+    assert plot.locator("#sim-curve-best-label").text_content() == "image-best step"
+    captions = {}
+    for field in ("ridges", "sine", "rings"):
+        session.select("height_field", field)
+        captions[field] = session.page.text_content("#sim-curve-caption")
+    assert "crease" in captions["ridges"] and "truncation" in captions["sine"]
+    assert "crease" not in captions["sine"] and captions["sine"] == captions["rings"]
+    session.fill("beta", 0)
+    assert plot.locator("#sim-curve-best").count() == 0
+    session.fill("beta", SIMULATOR_SCENE.beta)
     assert session.errors == []
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from chapter.labels import frame_label, ucurve_label
-from renderer import Scene
+from renderer import DRAFT_SCENE, Scene
 
 
 def test_a_frame_label_names_the_size_and_exactly_the_fields_that_differ():
@@ -15,8 +15,10 @@ def test_a_frame_label_names_the_size_and_exactly_the_fields_that_differ():
     sine = frame_label(Scene(height_field="sine", beta=1.5), 64, 64)
     assert "sine" in sine and "β = 1.5" in sine and sine.endswith("64 × 64")
     assert "ridges" not in sine and "ε" not in sine and "kᵥ" not in sine      # unchanged fields unnamed
-    other = frame_label(Scene(bump="surface", sphere_b=False, k_v=2.0), 8, 8)
-    assert "kᵥ = 2" in other and "sphere B" in other and "normal" in other and "kᵤ" not in other
+    other = frame_label(Scene(bump="chart", sphere_b=False, k_v=2.0), 8, 8)
+    assert "kᵥ = 2" in other and "sphere B" in other and "draft" in other and "kᵤ" not in other
+    assert "draft" not in plain and "draft" in frame_label(DRAFT_SCENE, 8, 8) != frame_label(Scene(), 8, 8)
+    assert "normal" not in frame_label(DRAFT_SCENE.replace(beta=0.5), 8, 8)   # the draft's own normal is not a change
     assert frame_label(Scene(), np.int64(8), 8).endswith("8 × 8")          # numpy integers count
 
 
@@ -41,6 +43,9 @@ def test_a_frame_label_refuses_what_is_not_a_scene_or_a_size():
 
 
 def test_the_ucurve_label_shows_the_point_the_frequencies_and_the_steps():
-    label = ucurve_label(dict(field="sine", u=0.31, v=0.47, k_u=8.0, k_v=4.0, steps=97, eps_max=0.1, eps_min=1e-16))
-    for shown in ("sine", "0.31", "0.47", "kᵤ = 8", "kᵥ = 4", "97", "1e-01", "1e-16"):
+    label = ucurve_label("sine", dict(component="u", u=0.31, v=0.47, k_u=8.0, k_v=4.0, steps=97, largest_step=0.1,
+                                      smallest_step=1e-16))
+    for shown in ("sine", "hᵤ", "0.31", "0.47", "kᵤ = 8", "kᵥ = 4", "97", "1e-01", "1e-16"):
         assert shown in label, shown
+    assert "hᵥ" in ucurve_label("rings", dict(component="v", u=0.31, v=0.47, k_u=8.0, k_v=4.0, steps=97,
+                                              largest_step=0.1, smallest_step=1e-16))

@@ -52,25 +52,25 @@ def _cache(tmp_path, pages):
 
 
 def test_one_value_per_shared_name_passes(tmp_path, capsys):
-    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(ucurve_eps_opt=4.3e-7, c2_cube=16000.0)),
-                              ("/b/s7_pitfalls.md", _page(ucurve_eps_opt=4.3e-7))])
-    assert check_glue.glued(cache)["ucurve_eps_opt"] == {"s5_lab": "4.3e-07", "s7_pitfalls": "4.3e-07"}
+    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(eps_fitted_sine=4.3e-7, c2_cube=16000.0)),
+                              ("/b/s7_pitfalls.md", _page(eps_fitted_sine=4.3e-7))])
+    assert check_glue.glued(cache)["eps_fitted_sine"] == {"s5_lab": "4.3e-07", "s7_pitfalls": "4.3e-07"}
     assert check_glue.main([str(cache)]) == 0
     assert "1 shown on several pages" in capsys.readouterr().out
 
 
 def test_two_values_under_one_name_fail_naming_pages_and_values(tmp_path, capsys):
-    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(ucurve_eps_opt=3.9e-7)),
-                              ("/b/s7_pitfalls.md", _page(ucurve_eps_opt=1.0e-7))])
+    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(eps_fitted_sine=3.9e-7)),
+                              ("/b/s7_pitfalls.md", _page(eps_fitted_sine=1.0e-7))])
     assert check_glue.main([str(cache)]) == 1
-    assert "ucurve_eps_opt: s5_lab = 3.9e-07, s7_pitfalls = 1e-07" in capsys.readouterr().err
+    assert "eps_fitted_sine: s5_lab = 3.9e-07, s7_pitfalls = 1e-07" in capsys.readouterr().err
 
 
 def test_only_the_record_a_page_used_last_counts(tmp_path):
     """A stale execution of a page (an earlier version, still cached) is not the page."""
-    cache = _cache(tmp_path, [("/b/s7_pitfalls.md", _page(ucurve_eps_opt=1.0e-7)),
-                              ("/b/s7_pitfalls.md", _page(ucurve_eps_opt=4.3e-7)),
-                              ("/b/s5_lab.md", _page("s5", ucurve_eps_opt=4.3e-7))])
+    cache = _cache(tmp_path, [("/b/s7_pitfalls.md", _page(eps_fitted_sine=1.0e-7)),
+                              ("/b/s7_pitfalls.md", _page(eps_fitted_sine=4.3e-7)),
+                              ("/b/s5_lab.md", _page("s5", eps_fitted_sine=4.3e-7))])
     assert check_glue.conflicts(check_glue.glued(cache)) == []
     # A wrong variant that reads every record sees the stale value and fails.
     records = get_cache(str(cache)).list_cache_records()
@@ -196,10 +196,10 @@ def test_a_number_matches_its_value_to_the_digits_shown(shown, value, ok):
 
 #: A registry of three quantities: one with two names and no library value, one with the library's
 #: value (plain), one shown as math; and a name of its own.
-REGISTRY = {"the gain": (("s4_gain", "c3_gain"), None), "the optimum": (("ucurve_eps_opt",), lambda: 4.03e-7),
+REGISTRY = {"the gain": (("s4_gain", "c3_gain"), None), "the optimum": (("eps_fitted_sine",), lambda: 4.03e-7),
             "the black": (("s4_log_floor",), lambda: 1e-16)}
 OWN = ("s1_size",)
-SHOWN = {"s4_gain": {"s4_simulator": "100"}, "c3_gain": {"s5_lab": "100"}, "ucurve_eps_opt": {"s5_lab": "4.03e-07"},
+SHOWN = {"s4_gain": {"s4_simulator": "100"}, "c3_gain": {"s5_lab": "100"}, "eps_fitted_sine": {"s5_lab": "4.03e-07"},
          "s4_log_floor": {"s4_simulator": "$10^{-16}$"}, "s1_size": {"s1_what_changes": "'256 × 256'"},
          "fig-x": {"s5_lab": "<Figure size 640x380 with 1 Axes>"}}
 
@@ -211,8 +211,8 @@ def test_a_registered_book_whose_names_agree_with_each_other_and_the_library_pas
 @pytest.mark.parametrize("change, message", [
     ({"c3_gain": {"s5_lab": "1000"}},
      "the gain: one quantity, two values: s4_simulator s4_gain = 100, s5_lab c3_gain = 1000"),
-    ({"ucurve_eps_opt": {"s5_lab": "3.73e-07"}},
-     "the optimum: s5_lab ucurve_eps_opt = 3.73e-07, but the library's value is 4.03e-07"),
+    ({"eps_fitted_sine": {"s5_lab": "3.73e-07"}},
+     "the optimum: s5_lab eps_fitted_sine = 3.73e-07, but the library's value is 4.03e-07"),
     ({"s4_log_floor": {"s4_simulator": "$10^{-15}$"}}, "the library's value is 1e-16"),
     ({"s7_eps_opt": {"s7_pitfalls": "3.73e-07"}}, "s7_eps_opt: glued on s7_pitfalls, but registered nowhere"),
     ({"s1_size": {}}, "s1_size: registered, but no page glues it"),
@@ -234,5 +234,5 @@ def test_the_books_glue_is_the_registrys_and_its_fitted_optimum_not_the_argmin(b
     monkeypatch.setenv("SYMRENDER_STORE", str(book_html.parent / ".measurements"))
     names = check_glue.glued(book_html.parent / ".jupyter_cache")
     assert quantity_conflicts(names) == []
-    argmin = {**names, "ucurve_eps_opt": {"s5_lab": repr(check_glue._ucurve().eps_opt_measured)}}
+    argmin = {**names, "eps_fitted_sine": {"s5_lab": repr(check_glue._ucurve().eps_measured_min)}}
     assert [line.split(":")[0] for line in quantity_conflicts(argmin)] == ["the fitted optimal step"]

@@ -245,7 +245,7 @@ def test_render_with_scene_file_and_set(tmp_path, capsys):
 
 @pytest.mark.parametrize("text, value", [
     ("height_field=sine", "sine"), ('height_field="sine"', "sine"), ("model=phong", "phong"),
-    ("floor=false", False), ("beta=1", 1.0), ("center_b=[0.5, 0.5, 1.4]", (0.5, 0.5, 1.4)),
+    ("floor=false", False), ("beta=0", 0.0), ("center_b=[0.5, 0.5, 1.4]", (0.5, 0.5, 1.4)),
 ])
 def test_set_parses_toml_and_bare_words(text, value):
     key = text.partition("=")[0]
@@ -674,11 +674,16 @@ def test_ucurve_table_matches_measure(tmp_path, capsys):
     for i, row in enumerate(rows):                # each column under its own label
         assert agrees(row["eps"], uc.eps[i], rel=1e-2)
         assert all(agrees(row[f], float(getattr(uc, f)[i])) for f in ("truncation", "roundoff", "error", "model"))
-    m = re.search(r"^true derivative (\S+); \|h'''\| = (\S+)$", out, re.M)
+    m = re.search(r"^true derivative (\S+); \|h'''\| = (\S+); \|h\| = (\S+); \|u h'\| = (\S+)$", out, re.M)
     assert float(m[1]) == uc.derivative and agrees(float(m[2]), abs(uc.third_derivative))
-    m = re.search(r"^eps\* predicted (\S+); measured minimum (\S+) at eps (\S+)$", out, re.M)
-    assert all(agrees(float(m[i]), getattr(uc, f)) for i, f in enumerate(
-        ("eps_opt_predicted", "error_at_measured_opt", "eps_opt_measured"), 1))
+    assert agrees(float(m[3]), abs(uc.height)) and agrees(float(m[4]), abs(uc.u * uc.derivative))
+    # One name per step: the model-optimal step, the fitted optimal step, the measured minimum.
+    for pattern, names in ((r"model-optimal step eps\* (\S+), model error there (\S+)", ("eps_model", "error_model")),
+                           (r"fitted optimal step eps\^ (\S+), fitted error there (\S+)",
+                            ("eps_fitted", "error_at_fitted")),
+                           (r"measured minimum (\S+) at eps (\S+)", ("error_at_measured_min", "eps_measured_min"))):
+        m = re.search(f"^{pattern}$", out, re.M)
+        assert all(agrees(float(m[i]), getattr(uc, f)) for i, f in enumerate(names, 1)), pattern
     first = plot.read_bytes()
     assert varying_chunks(first) == []
     rc, _, _ = run(["ucurve", "--eps", "1e-1:1e-12:12", "--plot", str(plot)], capsys)
@@ -695,12 +700,13 @@ def test_ucurve_says_where_the_field_is_not_differentiable(argv, where, tmp_path
     assert rc == 0 and err == ""
     assert "not differentiable: " in out and where in out
     # Neither a "true derivative" nor an optimum is printed; the table still is.
-    assert not any(line.startswith(("true derivative", "eps* predicted")) for line in out.splitlines())
+    assert not any(line.startswith(("true derivative", "model-optimal", "fitted optimal", "measured minimum"))
+                   for line in out.splitlines())
     assert len([line for line in out.splitlines() if line.split()[0][:1].isdigit()]) == 5
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     # At a smooth point of the same field the derivative and optimum are printed.
     rc, out, _ = run(["ucurve", "--field", "ridges", "--u", "0.1", "--eps", "1e-2:1e-10:5"], capsys)
-    assert rc == 0 and "true derivative" in out and "eps* predicted" in out and "not differentiable" not in out
+    assert rc == 0 and "true derivative" in out and "model-optimal step" in out and "not differentiable" not in out
 
 
 def test_ucurve_in_chunks_for_progress_equals_one_measure(capsys, monkeypatch):
@@ -708,7 +714,7 @@ def test_ucurve_in_chunks_for_progress_equals_one_measure(capsys, monkeypatch):
     rc, plain, _ = run(argv, capsys)
     monkeypatch.setattr(cmdline, "show_progress", lambda: True)
     rc2, chunked, _ = run(argv, capsys)
-    assert rc == rc2 == 0 and plain == chunked and len(plain.splitlines()) == 3 + 120 + 1
+    assert rc == rc2 == 0 and plain == chunked and len(plain.splitlines()) == 3 + 120 + 3
 
 
 # ------------------------------------------------------------------ verify, help, entry points

@@ -618,7 +618,7 @@ def pixel_differences(scene, size, gradient, frame, g, **kw):
 
 
 POINTWISE_SCENES = {
-    "ridges": Scene(beta=1.2),
+    "ridges": Scene(beta=1.2, bump="chart"),
     "sine, surface bump": Scene(height_field="sine", bump="surface", beta=0.6, k_u=3.3, k_v=7.1),
     "rings, eps 0.05": Scene(height_field="rings", eps=0.05, camera_z=2.5),
     "ridges, beta 0": Scene(beta=0.0),
@@ -637,7 +637,7 @@ def test_pointwise_gives_the_renderers_bits(name, gradient):
 
 @pytest.mark.parametrize("gradient, wrong", [
     ("exact", dict(gradient="central")), ("central", dict(eps=1.001e-3)), ("footprint", dict(dy_sign=-1.0)),
-    ("exact", dict(k_v=4.5)), ("exact", dict(beta=0.36)), ("exact", dict(bump="surface")),
+    ("exact", dict(k_v=4.5)), ("exact", dict(beta=0.36)), ("exact", dict(bump="chart")),
 ])
 def test_the_pointwise_check_rejects_another_pipeline(gradient, wrong):
     scene, size, wrong = Scene(), (24, 20), dict(wrong)

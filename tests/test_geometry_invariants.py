@@ -43,7 +43,7 @@ SCENES = {
     "default": Scene(),
     "no sphere B": Scene(sphere_b=False),
     "no floor": Scene(floor=False),
-    "bumpy sine, phong": Scene(height_field="sine", beta=1.5, model="phong"),
+    "bumpy sine, phong": Scene(height_field="sine", beta=1.5, model="phong", bump="chart"),
     "camera close, sphere B moved": Scene(camera_z=2.5, radius_a=0.8, center_b=(-0.6, 0.2, 0.9),
                                           radius_b=0.4),
     "sphere B through the floor": Scene(center_b=(0.9, -0.3, 0.2), radius_b=0.5,
@@ -267,14 +267,14 @@ U = 2.0**-53
 
 #: Scenes at the limits of renderer/scene.py (R, e up to MAX_LENGTH, radii down to MIN_RADIUS).
 EXTREME_SCENES = {
-    "least sphere from the farthest camera": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH),
+    "least sphere from the farthest camera": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH, bump="chart"),
     "unit sphere from the farthest camera": Scene(radius_a=1.0, camera_z=S.MAX_LENGTH),
     "camera one ulp outside sphere A": Scene(radius_a=0.3, camera_z=math.nextafter(0.3, 1.0),
-                                             center_b=(0.5, 0.5, 5.0)),
+                                             center_b=(0.5, 0.5, 5.0), bump="chart"),
     "largest sphere A": Scene(radius_a=math.nextafter(S.MAX_LENGTH, 0.0), camera_z=S.MAX_LENGTH,
                               center_b=(0.0, 0.0, -S.MAX_LENGTH), radius_b=1.0),
     "least sphere B, far from all": Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH,
-                                          center_b=(0.0, 0.0, 1e5), radius_b=S.MIN_RADIUS),
+                                          center_b=(0.0, 0.0, 1e5), radius_b=S.MIN_RADIUS, bump="chart"),
 }
 
 
@@ -538,7 +538,7 @@ def test_reach_masks_are_where_a_lone_diffuse_light_lights_the_image(scene):
 
 
 def test_reach_gate_adds_the_shading_normal_and_bad_arguments_are_named():
-    scene = Scene(beta=1.5, height_field="sine")
+    scene = Scene(beta=1.5, height_field="sine", bump="chart")
     g = gbuffer(scene, 64, 48)
     plain, gated = pointwise.reach(scene, g), pointwise.reach(scene, g, gate=True)
     assert np.all(gated <= plain) and np.count_nonzero(plain & ~gated) > 0

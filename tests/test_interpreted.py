@@ -52,14 +52,15 @@ SCENES = {
     "beta 0, floor and sphere B off": (Scene(beta=0.0, floor=False, sphere_b=False), 8, 8),
     "frequencies at their limits": (Scene(k_u=S.MAX_FREQUENCY, k_v=5e-324, height_field="sine"), 8, 8),
     "the largest beta, shininess and intensities": (
-        Scene(beta=S.MAX_BETA, shininess=S.MAX_SHININESS, ambient=(S.MAX_INTENSITY,) * 3,
+        Scene(beta=S.MAX_BETA, bump="chart", shininess=S.MAX_SHININESS, ambient=(S.MAX_INTENSITY,) * 3,
               lights=(PointLight((5.0, 5.0, 10.0), (S.MAX_INTENSITY,) * 3),)), 8, 8),
     "a shininess that is not an integer": (Scene(shininess=1.5, model="phong", kd=0.0), 8, 8),
     "the least eps, the surface bump": (Scene(eps=S.MIN_EPS, bump="surface", beta=0.99), 8, 8),
-    "the least sphere from the farthest camera": (Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH), 8, 8),
+    "the least sphere from the farthest camera": (Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH, bump="chart"),
+                                                  8, 8),
     "the camera one ulp outside sphere A": (Scene(radius_a=1.0, camera_z=1.0 + 2.0**-52), 8, 8),
     "the least sphere B, far from all": (Scene(radius_a=S.MIN_RADIUS, camera_z=S.MAX_LENGTH,
-                                              center_b=(0.0, 0.0, 1e5), radius_b=S.MIN_RADIUS), 8, 8),
+                                              center_b=(0.0, 0.0, 1e5), radius_b=S.MIN_RADIUS, bump="chart"), 8, 8),
 }
 STEPS = (S.MIN_EPS, 1e-3, S.MAX_EPS)
 

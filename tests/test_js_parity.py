@@ -138,7 +138,7 @@ CASES = [
     ("default-exact", Scene(), 96, 80, "exact", 1.0),
     ("default-footprint", Scene(), 96, 80, "footprint", 1.0),
     ("sine-phong-eps1e-1", Scene(height_field="sine", model="phong", eps=1e-1), 96, 80, "central", 1.0),
-    ("sine-exact-beta1.5", Scene(height_field="sine", beta=1.5), 96, 80, "exact", 1.0),
+    ("sine-exact-beta1.5", Scene(height_field="sine", beta=1.5, bump="chart"), 96, 80, "exact", 1.0),
     ("rings-eps1e-10-noB", Scene(height_field="rings", eps=1e-10, sphere_b=False), 96, 80, "central", 1.0),
     ("rings-phong-exact-nofloor", Scene(height_field="rings", model="phong", floor=False), 96, 80, "exact", 1.0),
     ("ridges-eps1e-6-beta0", Scene(eps=1e-6, beta=0.0), 96, 80, "central", 1.0),

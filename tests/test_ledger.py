@@ -59,7 +59,7 @@ def ledger_differences(led, want):
 
 
 SCENES = {"default": Scene(), "sine-1e-9": Scene(height_field="sine", eps=1e-9),
-          "beta1.5": Scene(beta=1.5, eps=1e-1), "rings-alone": Scene(height_field="rings", sphere_b=False, floor=False)}
+          "beta1.5": Scene(beta=1.5, eps=1e-1, bump="chart"), "rings-alone": Scene(height_field="rings", sphere_b=False, floor=False)}
 
 
 @pytest.mark.parametrize("gradient", ["central", "footprint"])

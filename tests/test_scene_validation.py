@@ -16,7 +16,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from renderer import GRADIENTS, PointLight, Scene, compare, gbuffer, render, sweep
+from renderer import DRAFT_SCENE, GRADIENTS, PointLight, Scene, compare, gbuffer, render, sweep
 
 NAN, INF = float("nan"), float("inf")
 
@@ -56,8 +56,10 @@ def seed_mismatches(scene):
 def test_defaults_are_the_seeds():
     assert seed_mismatches(Scene()) == []
     assert all(isinstance(light, PointLight) for light in Scene().lights)
-    # The project's addition: the default perturbed normal is the seed's chart formula.
-    assert Scene().bump == "chart"
+    # The project's addition: the default perturbed normal is the displaced sphere's; the
+    # draft's own scene, with its chart formula, is DRAFT_SCENE and differs in nothing else.
+    assert Scene().bump == "surface"
+    assert DRAFT_SCENE.bump == "chart" and DRAFT_SCENE.replace(bump="surface") == Scene()
 
 
 def test_defaults_check_has_teeth():
@@ -179,9 +181,9 @@ def test_bad_point_light_is_rejected_naming_the_field(field, value, error):
     dict(beta=0.0), dict(floor_tint=0.0), dict(floor_tint=1.0), dict(ka=0.0, kd=0.0, ks=0.0),
     dict(albedo_a=(1.0, 1.0, 1.0)), dict(albedo_b=(0.0, 0.0, 0.0)), dict(ambient=(0.0, 0.0, 0.0)),
     dict(eps=1e-16), dict(eps=0.25), dict(shininess=1.0), dict(shininess=1e4), dict(k_u=5e-324),
-    dict(k_v=1e3), dict(beta=100.0), dict(ka=1.0, kd=1.0, ks=1.0), dict(ambient=(1e3, 0.0, 1e3)),
+    dict(k_v=1e3), dict(beta=100.0, bump="chart"), dict(ka=1.0, kd=1.0, ks=1.0), dict(ambient=(1e3, 0.0, 1e3)),
     dict(lights=(PointLight((1e6, -1e6, 0.0), (1e3, 1e3, 0.0)),)),
-    dict(camera_z=1.0 + 2**-52), dict(radius_a=1e-3), dict(radius_b=1e-3),
+    dict(camera_z=1.0 + 2**-52), dict(radius_a=1e-3, bump="chart"), dict(radius_b=1e-3),
     dict(center_b=np.array([0.5, 0.5, 1.3])), dict(center_b=[0.5, 0.5, 1.3]),
     dict(beta=np.float64(0.5)), dict(k_u=np.int64(3)), dict(k_v=7), dict(beta=np.float32(0.5)),
     dict(kd=np.array(0.5)), dict(floor=np.False_), dict(albedo_a=np.array([1, 0, 0])),
@@ -346,7 +348,7 @@ def test_replace_rejects_unknown_fields(changes, bad):
 
 
 def test_replace_validates_and_keeps_the_rest():
-    scene = Scene().replace(beta=1.5, height_field="sine")
+    scene = Scene(bump="chart").replace(beta=1.5, height_field="sine")
     assert (scene.beta, scene.height_field, scene.k_u) == (1.5, "sine", 8.0)
     with pytest.raises(ValueError, match=names("beta")):
         Scene().replace(beta=-1.0)
@@ -421,7 +423,7 @@ def _past(x, direction):
 #: The camera must stay outside both spheres, which is what the extra fields arrange.
 FAR_B = dict(center_b=(1e6, 1e6, 0.0))
 LIMITS = [
-    ("radius_a", 1e-6, _past(1e-6, 0), "in [1e-06, 1e+06]", {}),
+    ("radius_a", 1e-6, _past(1e-6, 0), "in [1e-06, 1e+06]", {"bump": "chart"}),
     ("radius_b", 1e-6, _past(1e-6, 0), "in [1e-06, 1e+06]", {}),
     ("radius_b", 1e6, _past(1e6, INF), "in [1e-06, 1e+06]", FAR_B),
     ("camera_z", 1e6, _past(1e6, INF), "<= 1e+06", {}),
@@ -437,7 +439,7 @@ LIMITS = [
     ("shininess", 1e4, _past(1e4, INF), "in [1, 10000]", {}),
     *[(f, lim, p, "in (0, 1000]", {}) for f in ("k_u", "k_v") for lim, p in ((5e-324, 0.0), (1e3, _past(1e3, INF)))],
     ("beta", 0.0, -5e-324, "in [0, 100]", {}),
-    ("beta", 100.0, _past(100.0, INF), "in [0, 100]", {}),
+    ("beta", 100.0, _past(100.0, INF), "in [0, 100]", {"bump": "chart"}),
     ("eps", 1e-16, _past(1e-16, 0), "in [1e-16, 0.25]", {}),
     ("eps", 0.25, _past(0.25, INF), "in [1e-16, 0.25]", {}),
 ]

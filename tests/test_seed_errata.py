@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from lab import seed_errata
-from renderer import Scene
+from renderer import DRAFT_SCENE
 from renderer.render import BACKGROUND, SPHERE_A, SPHERE_B
 
 
@@ -45,11 +45,11 @@ def _facing_away(scene, P):
 def test_the_ungated_lobe_is_counted_on_both_spheres(monkeypatch, codes, pairs):
     """Erratum specular-ungated counts the pairs of sphere A and of sphere B (the draft shades both with the
     same rule): a pixel of either, with a normal facing away from the light and a lobe, is one pair."""
-    scene = Scene(lights=Scene().lights[:1])
+    scene = DRAFT_SCENE.replace(lights=DRAFT_SCENE.lights[:1])
     P = np.array([0.2, 0.3, 0.9])
     Ns = _facing_away(scene, P)
     g = SimpleNamespace(chamber=np.array([codes], dtype=np.uint8), P=np.array([[P, P]]), Ns=np.array([[Ns, Ns]]))
-    monkeypatch.setattr(seed_errata, "Scene", lambda: scene)
+    monkeypatch.setattr(seed_errata, "DRAFT_SCENE", scene)
     monkeypatch.setattr(seed_errata, "gbuffer", lambda scene, w, h: g)
     assert seed_errata._specular_ungated(size=2)["pixels"] == pairs
 

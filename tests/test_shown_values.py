@@ -119,21 +119,21 @@ def test_the_u_curve_marks_the_fitted_optimum_of_the_model_it_draws_and_the_band
     ns, shown, glued = ran("s5_lab")
     ax = shown["fig-c2-ucurve"].axes[0]
     (opt,) = vertical_lines(ax)
-    assert math.isclose(opt, glued["ucurve_eps_opt"], rel_tol=1e-9), (opt, glued["ucurve_eps_opt"])
-    (note,) = [t for t in ax.texts if "optimum" in t.get_text()]
-    assert note.xy[0] == opt
+    assert math.isclose(opt, glued["eps_fitted_sine"], rel_tol=1e-9), (opt, glued["eps_fitted_sine"])
+    (note,) = [t for t in ax.texts if r"\hat\varepsilon" in t.get_text()]     # the fitted step's symbol
+    assert note.xy[0] == opt and "optimum" not in note.get_text() and r"\ast" not in note.get_text()
     eps, model = curve(ax, "model")
     terms = np.stack([eps**2, 1 / eps], axis=1) / model[:, None]          # weighted: each step's error counts alike
     scale = np.linalg.norm(terms, axis=0)
     A, B = np.linalg.lstsq(terms / scale, np.ones_like(eps), rcond=None)[0] / scale
     assert math.isclose((B / (2 * A)) ** (1 / 3), opt, rel_tol=1e-6), ((B / (2 * A)) ** (1 / 3), opt)
-    assert math.isclose(A * opt**2 + B / opt, glued["ucurve_err_opt"], rel_tol=1e-6)
+    assert math.isclose(A * opt**2 + B / opt, glued["error_at_fitted_sine"], rel_tol=1e-6)
     (band,) = [p for p in ax.patches if p.get_label().startswith("footprint")]
     lo, hi = np.percentile(ns["fp_u"], numbers(legend_entry(ax, "footprint")))
     box = band.get_bbox()
     assert np.allclose([box.x0, box.x1], [lo, hi], rtol=1e-12) and box.x0 > opt, (box, lo, hi, opt)
     assert glued["c2_fp_u"] == np.median(ns["fp_u"]) and lo < glued["c2_fp_u"] < hi
-    assert math.isclose(glued["c2_fp_ratio"], glued["c2_fp_u"] / glued["ucurve_eps_opt"], rel_tol=1e-12)
+    assert math.isclose(glued["c2_fp_ratio"], glued["c2_fp_u"] / glued["eps_fitted_sine"], rel_tol=1e-12)
 
 
 #: The stencil diagram as §3 draws it (its defaults), a stencil left of another crease, and one

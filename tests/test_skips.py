@@ -46,7 +46,7 @@ SCENES = {
     # Lights behind sphere A and below the floor: attached shadows and the floor plane.
     "lights behind": Scene(lights=(PointLight((0.5, -1.0, -6.0)), PointLight((3.0, -2.0, -4.0), (0.5, 0.6, 0.7)))),
     # A strong bump turns many N' away from lights the geometric normal faces.
-    "strong bump": Scene(height_field="sine", beta=1.5),
+    "strong bump": Scene(height_field="sine", beta=1.5, bump="chart"),
     "surface bump, phong": Scene(height_field="sine", bump="surface", beta=0.6, model="phong"),
     "rings, eps 0.05": Scene(height_field="rings", eps=0.05),
 }
@@ -243,7 +243,7 @@ def test_sweep_frames_are_separate_renders(name):
 def test_a_zoomed_sweep_is_separate_renders_at_that_zoom():
     """The sweep's image plane is the zoomed one (the pole at zoom 300, where the chart's frame
     changes branch): a sweep that drew the unzoomed plane differs from every zoomed render."""
-    scene = Scene(beta=1.2)
+    scene = Scene(beta=1.2, bump="chart")
     sw = sweep(scene, STEPS[:2], *SIZE, zoom=300.0)
     assert sweep_differences(scene, sw, zoom=300.0) == []
     assert sweep_differences(scene, sw) == ["symbolic", "numeric[0]", "census[0]", "numeric[1]", "census[1]"]
@@ -274,7 +274,7 @@ def test_sweep_rejects_bad_steps(bad, match):
 
 @pytest.mark.parametrize("gradient", GRADIENTS)
 def test_the_number_of_threads_changes_no_bit(gradient):
-    scene, size = Scene(beta=1.2), (96, 80)
+    scene, size = Scene(beta=1.2, bump="chart"), (96, 80)
     before = numba.get_num_threads()
     one = render(scene, *size, gradient=gradient, workers=1)
     assert numba.get_num_threads() == before                # restored
@@ -297,7 +297,7 @@ def test_bad_workers_are_refused(bad, error):
 def test_renders_from_several_threads_at_once_give_the_serial_bits():
     """Four Python threads render at once (the kernel runs one call at a time,
     `renderer.render._KERNEL_LOCK`); each frame is the serial frame, bit for bit."""
-    scenes = [Scene(beta=b) for b in (0.0, 0.35, 1.2, 3.0)]
+    scenes = [Scene(beta=b, bump="chart") for b in (0.0, 0.35, 1.2, 3.0)]
     serial = [render(s, 40, 32) for s in scenes]
     with concurrent.futures.ThreadPoolExecutor(4) as pool:
         for _ in range(3):

@@ -34,7 +34,7 @@ def test_pole_fallback_engages_only_where_a_pixel_centre_hits_the_pole():
     for w, h in ((256, 256), (255, 255), (128, 96), (512, 512)):
         assert fallback_pixels(Scene(), w, h) == 0
     for gradient in GRADIENTS:
-        frame = render(Scene(height_field="sine", beta=1.5), 21, 20, gradient=gradient)
+        frame = render(Scene(height_field="sine", beta=1.5, bump="chart"), 21, 20, gradient=gradient)
         assert np.isfinite(frame.image).all() and np.isfinite(frame.grad).all()
 
 
@@ -59,7 +59,7 @@ def test_size_of_the_jump_across_the_fallback():
 
 
 @pytest.mark.parametrize("kwargs", [
-    dict(beta=100.0), dict(beta=100.0, height_field="sine"), dict(k_u=1e3, k_v=1e3),
+    dict(beta=100.0, bump="chart"), dict(beta=100.0, height_field="sine", bump="chart"), dict(k_u=1e3, k_v=1e3),
     dict(camera_z=1.0 + 1e-9), dict(camera_z=1.0 + 1e-9, center_b=(3.0, 3.0, 0.5)),
     dict(eps=1e-16), dict(eps=1e-16, height_field="sine"), dict(eps=0.25), dict(shininess=1e4),
 ])

@@ -24,3 +24,34 @@ def test_image_beta_derivative_is_second_order_in_the_median():
     assert 1.8 < result["median_slope"] < 2.3
     # The RMS is dominated by pixels where max(0, .) or the clip switches: not second order.
     assert result["rms_slope"] < 1.5
+
+
+def test_each_fields_optimum_at_its_stated_point():
+    """`optima`: every field's entry is its curve's (the same `measure` at the same point and
+    steps); the ridges point is farther from every crease than the curve's largest step; rings is
+    measured in v; the fitted optimal step lies below the model-optimal one (measured rounding
+    errors are below their bound) and its measured error within a factor 3 of the fitted model's."""
+    from lab.accuracy import OPTIMUM_POINTS, crease_distance, optima
+    from renderer.ucurve import DEFAULT_STEPS, measure
+    opt = optima()
+    assert opt["rings"]["component"] == "v" and opt["ridges"]["largest_step"] < opt["ridges"]["crease_distance"]
+    assert opt["ridges"]["crease_distance"] == pytest.approx(float(crease_distance(0.31, 0.47, 8.0, 4.0)))
+    for field, (u, v, component) in OPTIMUM_POINTS.items():
+        o = opt[field]
+        steps = DEFAULT_STEPS[DEFAULT_STEPS <= o["largest_step"]]
+        c = measure(field, u, v, component, eps=steps)
+        assert (o["steps"], o["eps_model"], o["eps_fitted"]) == (steps.size, c.eps_model, c.eps_fitted), field
+        assert o["fitted_over_model"] == o["eps_fitted"] / o["eps_model"] < 1, field
+        assert 1 / 3 < o["measured_at_fitted"] / o["error_at_fitted"] < 3, field
+        assert o["h"] + o["x_h1"] == pytest.approx(c.model_argument / o["argument_share"] / 2.0**-53), field
+
+
+def test_the_crease_share_is_the_census_straddling_count():
+    """Two routes to the pixels whose stencil straddles a crease: `crease_share` (share of
+    sphere-A pixels) times its pixel count is the census's count at each step."""
+    from lab.accuracy import crease_share
+    from lab.claims import census
+    share, c = crease_share(), census()
+    assert share["steps"] == c["steps"]
+    assert [round(s * share["pixels"]) for s in share["share"]] == c["straddling"]
+    assert share["share"][-1] < share["share"][0]

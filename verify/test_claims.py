@@ -27,10 +27,10 @@ def test_cell3_runs_tells_the_drafts_code_from_this_renderers_frame(claim_result
     as whose it is: the draft's map has no sphere-A pixel, this renderer's frame has them all."""
     import numpy as np
 
-    from renderer import Scene, gbuffer
+    from renderer import DRAFT_SCENE, gbuffer
     from renderer.render import SPHERE_A
 
     measured, _ = claim_results["cell3-runs"]
     code, pixels, ours = measured["code_pixels_a"], measured["pixels"], measured["pixels_a"]
-    chamber = gbuffer(Scene(), 256, 256).chamber
+    chamber = gbuffer(DRAFT_SCENE, 256, 256).chamber
     assert (code, pixels, ours) == (0, chamber.size, int(np.count_nonzero(chamber == SPHERE_A)))

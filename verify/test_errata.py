@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lab.seed_errata import ERRATA, ErratumVanished, reproduced
-from renderer import Scene, gbuffer
+from renderer import DRAFT_SCENE, gbuffer
 
 def test_every_erratum_is_measured_and_reported(errata):
     assert [e.id for e in ERRATA] == list(errata)
@@ -21,7 +21,7 @@ def test_sphere_b_seed_variant_is_off_the_surface(errata):
     assert m["off_surface_relative"] > 1.0            # seed: points far off sphere B
     assert m["seed_pixels_b"] > 5 * m["true_pixels_b"]
     # The renderer's own sphere-B hit points are on the surface.
-    scene = Scene()
+    scene = DRAFT_SCENE
     g = gbuffer(scene, 128, 128)
     b = g.chamber == 2
     dist = np.linalg.norm(g.P[b] - np.asarray(scene.center_b), axis=-1)
@@ -34,8 +34,8 @@ def test_terminator_leak_exists_in_seed_rule_only(errata):
     # The renderer: with one light and no ambient, every sphere-A pixel whose
     # geometric normal faces away from the light is exactly black.
     from renderer import render
-    light = Scene().lights[0]
-    scene = Scene(lights=(light,), ka=0.0, beta=1.5)
+    light = DRAFT_SCENE.lights[0]
+    scene = DRAFT_SCENE.replace(lights=(light,), ka=0.0, beta=1.5)
     g = gbuffer(scene, 128, 128)
     image = render(scene, 128, 128).image
     a = g.chamber == 1
@@ -95,8 +95,8 @@ def test_specular_lobe_is_gated_by_the_shading_normal():
     pixels lit geometrically but whose bumped normal faces away from the light
     are exactly black; the seed's rule would add ks (N'.h)^n there."""
     from renderer import render
-    light = Scene().lights[0]
-    scene = Scene(lights=(light,), ka=0.0, kd=0.0, ks=1.0, shininess=1.0, beta=1.5,
+    light = DRAFT_SCENE.lights[0]
+    scene = DRAFT_SCENE.replace(lights=(light,), ka=0.0, kd=0.0, ks=1.0, shininess=1.0, beta=1.5,
                   sphere_b=False)
     g = gbuffer(scene, 128, 128)
     image = render(scene, 128, 128).image

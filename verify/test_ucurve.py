@@ -20,13 +20,13 @@ def test_truncation_follows_eps_squared_h3_over_6_at_large_steps(curve):
     assert not np.allclose(curve.truncation[big], 2 * predicted, rtol=2e-2)
 
 
-def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the_predicted_step(curve):
-    """`UCurve.model` (the predicted model, which ``symrender ucurve --plot`` draws): its truncation part is the measured truncation at
-    large steps (a wrong 1/6 fails), and its minimum lies at the predicted optimum (a wrong roundoff
-    coefficient moves it by the cube root of the error)."""
+def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the_model_optimal_step(curve):
+    """`UCurve.model` (the error model E, which ``symrender ucurve --plot`` draws): its truncation part is the
+    measured truncation at large steps (a wrong 1/6 fails), and its minimum lies at the model-optimal step
+    (a wrong roundoff coefficient moves it by the cube root of the error)."""
     big = (curve.eps > 1e-4) & (curve.eps < 1e-2)
     assert np.allclose(curve.model[big], np.abs(curve.truncation[big]), rtol=2e-2)
-    around = measure(eps=curve.eps_opt_predicted * np.array([0.75, 0.9, 1.0, 1.1, 1.3]))
+    around = measure(eps=curve.eps_model * np.array([0.75, 0.9, 1.0, 1.1, 1.3]))
     assert np.argmin(around.model) == 2, around.model
 
 
@@ -45,18 +45,18 @@ def test_at_the_v_border_the_split_divides_by_the_kernels_own_denominator():
     assert np.all(np.abs(c.roundoff) <= 4 * UNIT_ROUNDOFF * (1 + abs(c.derivative)) / c.eps)
 
 
-def test_measured_optimum_near_predicted(curve):
-    ratio = curve.eps_opt_measured / curve.eps_opt_predicted
+def test_measured_minimum_near_the_model_optimal_step(curve):
+    ratio = curve.eps_measured_min / curve.eps_model
     assert 0.05 < ratio < 20
-    assert curve.error_at_measured_opt < 1e-9
-    assert curve.error[curve.eps < 1e-13].min() > 100 * curve.error_at_measured_opt
+    assert curve.error_at_measured_min < 1e-9
+    assert curve.error[curve.eps < 1e-13].min() > 100 * curve.error_at_measured_min
 
 
 def test_crease_does_not_converge():
     crease = measure("ridges", u=0.125)                   # u = 1/k_u
     assert np.all(crease.error > 9.0)                     # no step gets within 9 of a one-sided slope
     smooth = measure("ridges", u=0.1)
-    assert smooth.error_at_measured_opt < 1e-8
+    assert smooth.error_at_measured_min < 1e-8
 
 
 @pytest.mark.parametrize("kwargs, where", [
@@ -68,7 +68,7 @@ def test_crease_does_not_converge():
 def test_no_true_derivative_and_no_optimum_where_h_is_not_differentiable(kwargs, where):
     c = measure(eps=[1e-3, 1e-6], **kwargs)
     assert where in c.reason and "not differentiable" in c.reason
-    assert np.isnan([c.derivative, c.eps_opt_measured, c.eps_opt_predicted, c.error_at_measured_opt]).all()
+    assert np.isnan([c.derivative, c.eps_measured_min, c.eps_model, c.error_at_measured_min]).all()
 
 
 @pytest.mark.parametrize("component", ["u", "v"])
@@ -106,8 +106,8 @@ def test_the_fitted_model_recovers_a_synthetic_curve_and_the_truncation_coeffici
     A, B = fit_model(eps, 61.0 * eps**2 + 1e-17 / eps)
     assert A == pytest.approx(61.0, rel=1e-9) and B == pytest.approx(1e-17, rel=1e-9)
     # On the measured curve, A is |h'''| / 6 (the truncation term), not twice or half of it.
-    assert curve.truncation_coeff == pytest.approx(abs(curve.third_derivative) / 6, rel=0.1)
-    assert curve.truncation_coeff != pytest.approx(abs(curve.third_derivative) / 3, rel=0.1)
+    assert curve.fitted_truncation == pytest.approx(abs(curve.third_derivative) / 6, rel=0.1)
+    assert curve.fitted_truncation != pytest.approx(abs(curve.third_derivative) / 3, rel=0.1)
 
 
 def test_the_fitted_optimum_does_not_depend_on_the_grid(curve):
@@ -115,12 +115,49 @@ def test_the_fitted_optimum_does_not_depend_on_the_grid(curve):
     grids = [np.logspace(-1, -15, 200), np.logspace(-1, -12, 60), np.logspace(-1, -14, 120),
              np.logspace(-1, -13, 37)]
     curves = [measure(eps=g) for g in grids]
-    fitted = [c.eps_opt_fitted for c in curves]
+    fitted = [c.eps_fitted for c in curves]
     assert max(fitted) / min(fitted) < 1.2
-    # and it sits on the measured curve: within a factor 3 of the model's prediction
-    assert 1 / 3 < curve.eps_opt_fitted / curve.eps_opt_predicted < 3
+    # and it sits on the measured curve: within a factor 3 of the model-optimal step
+    assert 1 / 3 < curve.eps_fitted / curve.eps_model < 3
 
 
 def test_an_exact_quotient_has_no_fitted_optimum():
     flat = measure("rings", u=0.3, v=0.31)          # h_u = 0 for rings: every quotient is exact
-    assert np.all(flat.error == 0) and np.isnan(flat.eps_opt_fitted)
+    assert np.all(flat.error == 0) and np.isnan(flat.eps_fitted)
+
+
+def test_the_argument_rounding_coefficient_is_the_rounded_abscissae_measured(curve):
+    """fl(u +- eps) is off by up to half an ulp of u +- eps; the exact quotient at the rounded
+    abscissae less the one at the exact ones (mpmath, 50 digits) is at most |h'| u_round |u| / eps,
+    the model's argument term, and comes within a factor 2 of it (half an ulp of 0.31 is 0.81 of
+    u_round |0.31|): a coefficient twice or half as large fails one side."""
+    import mpmath
+    from renderer.formulas import HEIGHT, k_u, k_v, u, v
+    import sympy as sp
+    h = sp.lambdify(u, HEIGHT["sine"].subs({k_u: 8, k_v: 4, v: sp.Rational(47, 100)}), modules="mpmath")
+    steps = curve.eps[(curve.eps < 1e-4) & (curve.eps > 1e-14)]
+    ratios = []
+    with mpmath.workdps(50):
+        U = mpmath.mpf(curve.u)
+        for e in steps:
+            E = mpmath.mpf(float(e))
+            rounded = (h(mpmath.mpf(curve.u + float(e))) - h(mpmath.mpf(curve.u - float(e)))) / (2 * E)
+            exact = (h(U + E) - h(U - E)) / (2 * E)
+            ratios.append(float(abs(rounded - exact) * E) / curve.model_argument)
+    assert 0.5 < max(ratios) <= 1.0, max(ratios)
+
+
+def test_the_model_optimal_step_from_an_independent_derivative(curve):
+    """eps* = (3 u_round (|h| + |u h'|) / |h'''|)^(1/3), with h, h' and h''' of the sine field
+    (8, 4) at (0.31, 0.47) from mpmath's numerical differentiation of its closed form
+    sin(8 pi u) sin(4 pi v); without the argument term (|u h'|) it is 13 % smaller and fails."""
+    import mpmath
+    with mpmath.workdps(40):
+        h = lambda x: mpmath.sin(8 * mpmath.pi * x) * mpmath.sin(4 * mpmath.pi * mpmath.mpf("0.47"))  # noqa: E731
+        x = mpmath.mpf(0.31)
+        h0, h1, h3 = (float(abs(mpmath.diff(h, x, n))) for n in (0, 1, 3))
+    star = (3 * UNIT_ROUNDOFF * (h0 + 0.31 * h1) / h3) ** (1 / 3)
+    assert curve.eps_model == pytest.approx(star, rel=1e-9)
+    assert curve.error_model == pytest.approx(h3 / 6 * star**2 + UNIT_ROUNDOFF * (h0 + 0.31 * h1) / star, rel=1e-9)
+    assert curve.model == pytest.approx(h3 / 6 * curve.eps**2 + UNIT_ROUNDOFF * (h0 + 0.31 * h1) / curve.eps,
+                                        rel=1e-9)

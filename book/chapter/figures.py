@@ -266,20 +266,21 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
 def ucurve_anatomy(curve):
     """The measured U-curve of a `renderer.ucurve.UCurve` (error, truncation and roundoff parts,
     the model A eps^2 + B / eps fitted to the error) with its regions named: truncation falling as
-    eps^2, rounding rising as 1/eps, the fitted model's optimum between them."""
+    eps^2, rounding rising as 1/eps, the fitted optimal step eps^ (the fitted model's minimiser)
+    between them."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
     ax.loglog(curve.eps, curve.error, lw=2, color=RED, label="|error| of the float64 quotient")
     ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="exact arithmetic at the rounded $u \\pm \\varepsilon$")
     ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="rounding of the float64 evaluation")
-    fitted = curve.truncation_coeff * curve.eps**2 + curve.roundoff_coeff / curve.eps
+    fitted = curve.fitted_truncation * curve.eps**2 + curve.fitted_roundoff / curve.eps
     ax.loglog(curve.eps, fitted, color=GREY, lw=1, label=r"model $A\varepsilon^2 + B/\varepsilon$")
-    opt = curve.eps_opt_fitted
+    opt = curve.eps_fitted
     ax.axvline(opt, color=GREY, lw=0.8, ls="-.")
     top = float(np.nanmax(curve.error))
     ax.annotate(r"truncation falls as $\varepsilon^2$", (3e-3, top), (3e-3, top * 30), ha="center", fontsize=8)
     ax.annotate(r"rounding rises as $1/\varepsilon$", (1e-11, top), (1e-11, top * 30), ha="center", fontsize=8)
-    ax.annotate(r"optimum $\varepsilon^\ast$", (opt, 1e-17), (opt * 3, 1e-17), fontsize=8)
+    ax.annotate(r"fitted $\hat\varepsilon$", (opt, 1e-17), (opt * 3, 1e-17), fontsize=8)
     ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $h_u$"); ax.set_ylim(1e-18, 1e3)
     ax.legend(loc="lower left", frameon=False); ax.grid(alpha=0.3)
     return fig

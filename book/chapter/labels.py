@@ -7,12 +7,12 @@ and the U-curve's point and steps.
 
 from __future__ import annotations
 
-from renderer import Scene
+from renderer import DRAFT_SCENE, Scene
 from renderer.validate import positive_int
 
 __all__ = ["frame_label", "ucurve_label"]
 
-#: How `frame_label` words a field of `renderer.Scene` that differs from the draft's.
+#: How `frame_label` words a field of `renderer.Scene` that differs from its reference scene.
 _WORDS = {"height_field": "the {} field", "beta": "β = {:g}", "eps": "ε = {:g}", "k_u": "kᵤ = {:g}",
           "k_v": "kᵥ = {:g}", "radius_a": "R = {:g}", "model": "{} shading", "shininess": "shininess {:g}"}
 
@@ -28,9 +28,10 @@ def _field_words(name, value):
 def frame_label(scene, width, height) -> str:
     """The label a number measured on a render carries: its scene and resolution, in words.
 
-    ``"the draft's scene, 256 × 256"``, or with the fields that differ from
-    `renderer.Scene`'s defaults (the draft's scene): ``"the draft's scene with the
-    sine field, β = 1.5, 64 × 64"``.
+    ``"the chapter's scene, 256 × 256"`` (`renderer.Scene`'s defaults: the displaced
+    sphere's normal), ``"the draft's scene, 256 × 256"`` (`renderer.DRAFT_SCENE`: the
+    draft's chart normal), or either with the fields that differ from it: ``"the draft's
+    scene with the sine field, β = 1.5, 64 × 64"``.
 
     Parameters
     ----------
@@ -54,25 +55,33 @@ def frame_label(scene, width, height) -> str:
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a renderer.Scene or a dict of its fields, got {type(scene).__name__}")
     width, height = positive_int("width", width), positive_int("height", height)
-    changed = [_field_words(name, value) for name, value in scene.changes().items()]
-    return "the draft's scene" + (" with " + ", ".join(changed) if changed else "") + f", {width} × {height}"
+    draft = scene.bump == DRAFT_SCENE.bump
+    reference = DRAFT_SCENE if draft else Scene()
+    changed = [_field_words(name, getattr(scene, name)) for name in scene.changes()
+               if getattr(scene, name) != getattr(reference, name)]
+    return (("the draft's scene" if draft else "the chapter's scene") + (" with " + ", ".join(changed) if changed else "")
+            + f", {width} × {height}")
 
 
-def ucurve_label(curve) -> str:
-    """Where the U-curve of `lab.accuracy.default_optimum` is measured, in words: the field,
-    the point, the frequencies and the steps.
+def ucurve_label(field, curve) -> str:
+    """Where a U-curve of `lab.accuracy.optima` is measured, in words: the field, the
+    component and the point, the frequencies and the steps.
 
     Parameters
     ----------
+    field : str
+        The height field's name (a key of `lab.accuracy.optima`'s dict).
     curve : dict
-        `lab.accuracy.default_optimum`'s dict: ``field`` (str), ``u``, ``v`` (chart
-        coordinates), ``k_u``, ``k_v`` (periods over the chart), ``steps`` (int), ``eps_max``,
-        ``eps_min`` (chart units).
+        Its entry: ``component`` ("u" or "v"), ``u``, ``v`` (chart coordinates), ``k_u``,
+        ``k_v`` (periods over the chart), ``steps`` (int), ``largest_step``, ``smallest_step``
+        (chart units).
 
     Raises
     ------
     KeyError
         If ``curve`` lacks one of those keys.
     """
-    return (f"{curve['field']} field, hᵤ at (u, v) = ({curve['u']}, {curve['v']}), kᵤ = {curve['k_u']:g}, "
-            f"kᵥ = {curve['k_v']:g}, {curve['steps']} steps from {curve['eps_max']:.0e} to {curve['eps_min']:.0e}")
+    sub = {"u": "ᵤ", "v": "ᵥ"}[curve["component"]]
+    return (f"{field} field, h{sub} at (u, v) = ({curve['u']}, {curve['v']}), kᵤ = {curve['k_u']:g}, "
+            f"kᵥ = {curve['k_v']:g}, {curve['steps']} steps from {curve['largest_step']:.0e} to "
+            f"{curve['smallest_step']:.0e}")

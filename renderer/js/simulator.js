@@ -86,6 +86,16 @@ const CONTROLS = [
   { name: "sphere_b", label: "sphere B", kind: "checkbox" },
 ];
 
+// What the right arm of the U-curve (the larger steps) is made of, per height field; the left
+// arm is rounding on every field.  Shown in the curve's caption.
+export const RIGHT_ARM = {
+  sine: "Right arm: truncation error, which shrinks as ε² when ε shrinks; left arm: rounding, which grows as 1/ε.",
+  rings: "Right arm: truncation error, which shrinks as ε² when ε shrinks; left arm: rounding, which grows as 1/ε.",
+  ridges: "Right arm: crease error — at the pixels within ε of a crease the stencil straddles it and the " +
+          "quotient is off by the slope's jump; it shrinks only as fewer pixels lie that near, slower than " +
+          "truncation. Left arm: rounding, which grows as 1/ε.",
+};
+
 // The draft's four "Try this" experiments (§4), applied on top of the defaults,
 // each opening on the view and scale that show its point; `hint` says what to look at.
 export const PRESETS = [
@@ -468,6 +478,15 @@ class Simulator {
                                    "stroke-dasharray": key === "max" ? "6 3" : "none",
                                    points: points.map((p, i) => `${X(CURVE_LOG_EPS[i]).toFixed(1)},${Y(value(p)).toFixed(1)}`).join(" ") }));
     }
+    // The image-best step: of the curve's steps, the one of least RMS |ΔI| over sphere A in this
+    // frame (none when every RMS is 0, as at β = 0).
+    const best = points.reduce((b, p, i) => (p.rms < points[b].rms ? i : b), 0);
+    if (points[best].rms < Math.max(...points.map((p) => p.rms))) {
+      const xb = X(CURVE_LOG_EPS[best]), yb = Math.min(Y(points[best].rms) + 6, H - m.bottom - 22);
+      nodes.push(svg("path", { id: "sim-curve-best", d: `M ${xb.toFixed(1)} ${yb.toFixed(1)} l -5 9 l 10 0 z`,
+                               fill: CURVE_COLOURS.rms, stroke: "currentColor", "data-eps": String(eps_of(CURVE_LOG_EPS[best])) }));
+      nodes.push(svg("text", { id: "sim-curve-best-label", x: xb, y: yb + 21, "text-anchor": "middle" }, "image-best step"));
+    }
     const here = this.curve.here, x = X(Math.log10(here.eps));
     nodes.push(svg("line", { id: "sim-curve-marker", x1: x, x2: x, y1: m.top, y2: H - m.bottom, stroke: "currentColor",
                              "stroke-dasharray": "2 2" }));
@@ -489,7 +508,8 @@ class Simulator {
     plot.dataset.eps = String(here.eps);
     this.root.querySelector("#sim-curve-caption").textContent =
       `The U-curve of central differences, on ${sample}, at half-decade steps of ε; the dashed line and ` +
-      `the dots: the current ε. An exact zero lies on the bottom axis.`;
+      `the dots: the current ε; the triangle: the image-best step, the one of these steps with the least RMS. ` +
+      `An exact zero lies on the bottom axis. ${RIGHT_ARM[this.state.height_field]}`;
   }
 
   pointer(canvas, ev) {
