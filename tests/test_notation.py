@@ -33,7 +33,7 @@ PRINTED = {
     "normal-beta-derivative": "8cb14d3a193c7b83",
     "beta-zero-regression": "0a3b18b8b4052c4d",
     "central-difference-truncation": "87eb719c0c66e095",
-    "optimal-step": "88bd98b1422a37bf",
+    "optimal-step": "ef2a0615d08b564d",
     "bump-vs-displacement": "11d4ed60c904f69e",
     "blinn-perturbation": "38f9ac6bc0cd9f89",
 }
