@@ -27,9 +27,7 @@ NUMBER = re.compile(r"10\^\{-?\d+\}|\d+(?:\.\d+)?e-?\d+|\d+\.\d+|\d{1,3}(?:,\d{3
 
 #: Literals that stay typed, per page, with how often they occur and why.  (The draft's
 #: claims are quoted from the register, `lab.claims`, not typed into the pages.)
-QUOTED = {
-    "s8_history.md": {"1978": (1, "Blinn's paper's year")},
-}
+QUOTED: dict[str, dict[str, tuple[int, str]]] = {}
 
 
 def prose(text):
