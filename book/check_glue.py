@@ -98,9 +98,6 @@ QUANTITIES = {
     "the model's error at the fitted step": (("ucurve_err_opt",), lambda: _ucurve().error_at_fitted_opt),
     "the predicted optimal step": (("ucurve_eps_pred", "s3_ex_eps"), lambda: _ucurve().eps_opt_predicted),
     "the third derivative at the U-curve's point": (("s3_ex_h3",), lambda: abs(_ucurve().third_derivative)),
-    "the U-curve's point, u": (("s3_ex_u",), lambda: _lib("renderer.ucurve").SEED_POINT[0]),
-    "the U-curve's point, v": (("s3_ex_v",), lambda: _lib("renderer.ucurve").SEED_POINT[1]),
-    "the U-curve's frequency k_u": (("s3_ex_ku",), lambda: _lib("renderer.ucurve").SEED_FREQUENCIES[0]),
     "the U-curve's label": (("ucurve_label",), lambda: _lib("lab.accuracy").default_optimum()["label"]),
     "the relative error at a step of 1e-9": (("ucurve_rel_1e9",), lambda: _lib("lab.claims").relative_error_at(1e-9)),
     "the relative error at a step of 1e-11": (("ucurve_rel_1e11",),
@@ -129,7 +126,7 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
                "s7_crease_label", "s7_crease_err_min", "s7_crease_fd", "s7_crease_left", "s7_crease_right",
-               "s7_pole_zoom", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_h", "s3_ex_err")
+               "s7_pole_zoom", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_label", "s3_ex_h", "s3_ex_err")
 
 
 def page_glue(notebook: dict) -> dict:
