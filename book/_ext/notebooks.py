@@ -19,7 +19,10 @@ An HTML build puts into the site, beside the pages:
   computed (myst-nb's glue data of the page), each cross-reference its text
   ("§3 · The mathematics", "Fig. 2"), a ``glue:figure`` its numbered caption
   (the figure is drawn by the code cell that calls `chapter.page.show`), a
-  ``literalinclude`` the code it includes (Sphinx's own reader), and so on.
+  ``literalinclude`` the code it includes (Sphinx's own reader), a margin note a quoted
+  aside, an exercise its numbered heading with its solution folded below it, a citation
+  its author-year text and the bibliography its list (sphinxcontrib-bibtex's entries,
+  formatted by pybtex), and so on.
   A first cell says how to install the project to run the notebook.
 
 Each notebook page gets a line under its title linking its notebook, the wheel
@@ -72,10 +75,22 @@ def _author_year(entry):
 
 
 def cite_text(kind, entries):
-    """A citation as the site writes it (sphinxcontrib-bibtex's author-year style, its brackets and
-    separators, the works in the bibliography's order): ``kind`` "t" (textual) gives "Blinn [1978]",
-    "p" (parenthetical) "[Martins et al., 2003, Squire and Trapp, 1998]".  ``entries`` are pybtex
-    entries with authors and a year."""
+    """A citation as the site writes it: sphinxcontrib-bibtex's author-year style, with its brackets
+    and separators, the works in the bibliography's (author) order.
+
+    Parameters
+    ----------
+    kind : {"t", "p"}
+        Textual (``{cite:t}``: "Blinn [1978]") or parenthetical (``{cite:p}``:
+        "[Martins et al., 2003, Squire and Trapp, 1998]").
+    entries : list of pybtex.database.Entry
+        The works cited, each with an ``author`` and a ``year``.
+
+    Returns
+    -------
+    str
+        Plain text (not yet Markdown-escaped).
+    """
     pairs = sorted(_author_year(entry) for entry in entries)
     if kind == "t":
         return ", ".join(f"{names} [{year}]" for names, year in pairs)
@@ -260,15 +275,12 @@ class PageMarkdown:
         """The entries a ``bibliography`` lists (all with ``:all:``, else those cited in the book),
         formatted by pybtex's plain style, as a Markdown list."""
         from pybtex.plugin import find_plugin
-        domain = self.env.get_domain("cite")
-        data = domain.bibdata.data
-        if "all" in options:
-            keys = list(data.entries)
-        else:
-            cited = {key for ref in domain.citation_refs for key in ref.keys}
-            keys = [key for key in data.entries if key in cited]
         if set(options) - {"all"}:
             self.fail(what, f"options {sorted(set(options) - {'all'})} have no notebook form (only :all:)")
+        domain = self.env.get_domain("cite")
+        data = domain.bibdata.data
+        cited = {key for ref in domain.citation_refs for key in ref.keys}
+        keys = [key for key in data.entries if "all" in options or key in cited]
         style = find_plugin("pybtex.style.formatting", "plain")()
         formatted = style.format_entries(sorted((data.entries[k] for k in keys), key=_author_year))
         return "\n".join(f"- {entry.text.render_as('markdown')}" for entry in formatted)

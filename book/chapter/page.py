@@ -295,10 +295,26 @@ def _headed(head, body):
 
 
 def plain_exercise(name, heading, body, convert):
-    """One of `EXERCISE_FORMS` as plain Markdown under ``heading`` (Markdown: "Exercise 2 (Title)",
-    "Solution to Exercise 2"; a solution's is shown as text): an exercise as a bold heading and its body, a solution folded in an HTML
-    ``<details>`` (Jupyter renders the Markdown inside).  A gated solution spans cells, which no
-    ``<details>`` can: its start is a heading and its end a closing line; an ``exercise-end`` is ""."""
+    """One of sphinx-exercise's directives as plain Markdown.
+
+    Parameters
+    ----------
+    name : str
+        One of `EXERCISE_FORMS`.
+    heading : str
+        Markdown: "Exercise 2 (Title)", "Solution to Exercise 2" (a solution's is shown as text).
+    body : str
+        The directive's MyST body ("" for the gated forms, whose content is the cells that follow).
+    convert : callable
+        MyST str -> Markdown str, for the body.
+
+    Returns
+    -------
+    str
+        An exercise: its heading in bold, then its body.  A solution: folded in an HTML ``<details>``
+        under its heading (Jupyter renders the Markdown inside).  A gated solution spans cells, which
+        no ``<details>`` can: its start is a heading, its end a closing line; an ``exercise-end`` is "".
+    """
     from html import escape as html_escape
     if name == "exercise-end":
         return ""
