@@ -348,3 +348,20 @@ def test_the_bibliography_lists_every_work_on_the_site_and_in_the_notebook(book_
     items = re.findall(r"^- ", text, re.M)
     assert len(items) >= len(keys)
     assert sorted(dois) == sorted(e.fields["doi"] for e in keys.values() if "doi" in e.fields)
+
+
+def test_a_bibliography_lists_the_cited_works_or_with_all_every_work():
+    from sphinxcontrib.bibtex.citation_target import CitationTarget
+    from sphinxcontrib.bibtex.roles import CitationRef
+    bib = _bib()
+    cited = [CitationRef("id1", "s8_history", 1, [CitationTarget("squire-trapp", "", ""),
+                                                  CitationTarget("blinn-wrinkled", "", "")])]
+    domain = SimpleNamespace(bibdata=SimpleNamespace(data=SimpleNamespace(entries=bib)), citation_refs=cited)
+    env = SimpleNamespace(doc2path=lambda d: f"book/{d}.md", get_domain=lambda name: domain)
+    page = notebooks.PageMarkdown(SimpleNamespace(env=env), "s8_x")
+    items = page("```{bibliography}\n```").split("\n- ")
+    assert [bib[k].fields["doi"] in item for item, k in zip(items, ("blinn-wrinkled", "squire-trapp"))] == [True] * 2
+    assert len(items) == 2
+    assert len(page("```{bibliography}\n:all:\n```").split("\n- ")) == len(bib)
+    with pytest.raises(notebooks.NotebookError, match=r"\{bibliography\}: options \['filter'\] have no notebook"):
+        page("```{bibliography}\n:filter: docname in docnames\n```")

@@ -279,7 +279,7 @@ class PageMarkdown:
             self.fail(what, f"options {sorted(set(options) - {'all'})} have no notebook form (only :all:)")
         domain = self.env.get_domain("cite")
         data = domain.bibdata.data
-        cited = {key for ref in domain.citation_refs for key in ref.keys}
+        cited = {target.key for ref in domain.citation_refs for target in ref.targets}
         keys = [key for key in data.entries if "all" in options or key in cited]
         style = find_plugin("pybtex.style.formatting", "plain")()
         formatted = style.format_entries(sorted((data.entries[k] for k in keys), key=_author_year))
