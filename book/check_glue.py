@@ -97,9 +97,10 @@ QUANTITIES = {
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
     "the fitted model's error at the fitted optimal step": (("error_at_fitted_sine",),
                                                             lambda: _ucurve().error_at_fitted),
-    "the model-optimal step": (("eps_model_sine",), lambda: _ucurve().eps_model),
+    "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),
     "the U-curve's label": (("ucurve_label",), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
+    "the third derivative at the U-curve's point": (("s3_ex_h3",), lambda: abs(_ucurve().third_derivative)),
     "the relative error at a step of 1e-9": (("ucurve_rel_1e9",), lambda: _lib("lab.claims").relative_error_at(1e-9)),
     "the relative error at a step of 1e-11": (("ucurve_rel_1e11",),
                                               lambda: _lib("lab.claims").relative_error_at(1e-11)),
@@ -129,7 +130,7 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
                "s7_crease_label", "s7_crease_err_min", "s7_crease_fd", "s7_crease_left", "s7_crease_right",
-               "s7_pole_zoom", "s8_radius", "s8_factor_theta", "s8_factor_phi")
+               "s7_pole_zoom", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_label", "s3_ex_h", "s3_ex_xh1", "s3_ex_err")
 
 
 def page_glue(notebook: dict) -> dict:

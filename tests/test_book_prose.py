@@ -6,8 +6,9 @@ The scan reads each page's Markdown outside code cells, drops glue roles,
 inline code, cross-references and link targets, and looks for numeric
 literals: powers of ten (``10^{-6}``), e-notation, decimals, and integers of
 three or more digits.  What is left must be in `QUOTED`: the draft's own
-claims quoted in order to check them, and a year.  Wrong variant: a typed step
-added to a page is found.
+claims quoted in order to check them (a cited work's year comes from
+book/references.bib through a ``{cite:t}``/``{cite:p}`` role, whose keys have no
+digits).  Wrong variant: a typed step added to a page is found.
 """
 
 from __future__ import annotations
@@ -27,9 +28,7 @@ NUMBER = re.compile(r"10\^\{-?\d+\}|\d+(?:\.\d+)?e-?\d+|\d+\.\d+|\d{1,3}(?:,\d{3
 
 #: Literals that stay typed, per page, with how often they occur and why.  (The draft's
 #: claims are quoted from the register, `lab.claims`, not typed into the pages.)
-QUOTED = {
-    "s8_history.md": {"1978": (1, "Blinn's paper's year")},
-}
+QUOTED: dict[str, dict[str, tuple[int, str]]] = {}
 
 
 def prose(text):

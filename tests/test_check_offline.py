@@ -38,3 +38,22 @@ def test_a_site_that_loads_only_its_own_files_passes(tmp_path):
 def test_a_site_that_would_fetch_or_miss_a_script_fails(tmp_path, head, found):
     problems = check_offline.problems(_site(tmp_path, head))
     assert len(problems) == 1 and found in problems[0]
+
+
+#: What the learning aids put on a page: a margin note citing a work, an exercise with its folded
+#: solution (sphinx-exercise, sphinx-togglebutton) and the bibliography's entries with their DOI links.
+AIDS = ('<aside class="sidebar margin"><p>Goldberg [<a class="reference internal" href="s8_history.html#id11">'
+        '1991</a>]</p></aside><div class="exercise admonition" id="ex-a"><p class="admonition-title">Exercise 1'
+        '</p></div><div class="solution dropdown admonition"><p>6.9e-07</p></div>'
+        '<div class="citation" role="doc-biblioentry"><p>D. Goldberg. <a class="reference external" '
+        'href="https://doi.org/10.1145/103162.103163">doi:10.1145/103162.103163</a>.</p></div>')
+
+
+def test_exercises_margin_notes_and_doi_links_are_read_offline_but_a_fetch_beside_them_is_not(tmp_path):
+    site = _site(tmp_path, '<link rel="stylesheet" href="_static/exercise.css">')
+    (site / "_static" / "exercise.css").write_text('div.exercise p.admonition-title::after { content: "\\f303"; }')
+    page = site / "index.html"
+    page.write_text(page.read_text().replace("<p>text</p>", AIDS))
+    assert check_offline.problems(site) == []
+    page.write_text(page.read_text().replace("</div></body>", '<img src="https://doi.org/cover.png"></div></body>'))
+    assert check_offline.problems(site) == ["index.html: img loads https://doi.org/cover.png"]

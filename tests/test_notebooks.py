@@ -270,3 +270,98 @@ def test_a_citation_reads_as_the_theorems_number_and_title_on_the_page(book_html
         heading = re.search(rf'id="thm-{re.escape(theorem_id)}">\s*<p[^>]*><span[^>]*>Theorem (\d+) </span> '
                             rf'\(([^)]*)\)', pages[home.pop()])
         assert heading and heading[2] == CITABLE[theorem_id] and {n for _, n, _ in links} == {heading[1]}, theorem_id
+
+
+# --- the learning aids: exercises, margin notes, citations, the bibliography ----------------------
+
+def _bib():
+    from pybtex.database import parse_file
+    return parse_file(ROOT / "book" / "references.bib").entries
+
+
+def test_a_citation_reads_as_the_site_writes_it_author_year():
+    bib = _bib()
+    one, two, three = (next(e for e in bib.values() if len(e.persons["author"]) == n) for n in (1, 2, 3))
+    last = [[" ".join(p.last_names) for p in e.persons["author"]] for e in (one, two, three)]
+    year = [e.fields["year"] for e in (one, two, three)]
+    assert notebooks.cite_text("t", [one]) == f"{last[0][0]} [{year[0]}]"
+    assert notebooks.cite_text("p", [two]) == f"[{last[1][0]} and {last[1][1]}, {year[1]}]"
+    # Several works: in the bibliography's (author) order whatever the order cited, "et al." past two.
+    both = sorted([(f"{last[1][0]} and {last[1][1]}", year[1]), (f"{last[2][0]} et al.", year[2])])
+    assert notebooks.cite_text("p", [two, three]) == notebooks.cite_text("p", [three, two]) == \
+        "[" + ", ".join(f"{n}, {y}" for n, y in both) + "]"
+
+
+def test_every_work_in_the_bibliography_has_what_a_reader_needs_to_find_it():
+    required = {"article": {"journal", "volume", "pages"}, "book": {"publisher", "edition"},
+                "inproceedings": {"booktitle", "pages"}}
+    for key, entry in _bib().items():
+        fields = {f.lower() for f in entry.fields}
+        assert entry.persons.get("author") and {"title", "year"} <= fields, key
+        assert required[entry.type] <= fields and fields & {"doi", "isbn"}, (key, required[entry.type] - fields)
+        assert not re.search(r"\d", key), f"{key}: a key with a digit reads as a typed number in the prose scan"
+
+
+def test_the_writer_refuses_an_unknown_citation_or_exercise_naming_the_page():
+    bib = SimpleNamespace(data=SimpleNamespace(entries=_bib()))
+    env = SimpleNamespace(doc2path=lambda d: f"book/{d}.md", get_domain=lambda name: SimpleNamespace(bibdata=bib),
+                          sphinx_exercise_registry={})
+    page = notebooks.PageMarkdown(SimpleNamespace(env=env), "s9_x")
+    assert page("As {cite:t}`blinn-wrinkled` shows.").startswith("As Blinn \\[")
+    with pytest.raises(notebooks.NotebookError, match=r"book/s9_x.md: \{cite:p\}`nobody`: no entry 'nobody'"):
+        page("Shown {cite:p}`nobody`.")
+    with pytest.raises(notebooks.NotebookError, match=r"book/s9_x.md: \{solution\} ex-none: no exercise labelled"):
+        page("```{solution} ex-none\nIt is 2.\n```")
+
+
+def _html_exercises(html):
+    """[(number, title)] of the exercises a built page shows (sphinx-exercise's headings)."""
+    return [(n, unescape(t).translate(str.maketrans("‘’", "''"))) for n, t in re.findall(
+        r'<div class="exercise[^"]*" id="[^"]+">\s*<p class="admonition-title"><span class="caption-number">'
+        r'Exercise (\d+) </span> \(([^)]*)\)</p>', html)]
+
+
+def test_each_exercise_of_the_site_is_in_its_notebook_numbered_with_its_solution(book_html):
+    found = 0
+    for page in PAGES:
+        html = (book_html / f"{page.stem}.html").read_text(encoding="utf-8")
+        shown = _html_exercises(html)
+        text = re.sub(r"\\(.)", r"\1", "\n\n".join("".join(c["source"]) for c in
+                                                   _notebook(book_html, page.stem)["cells"]))
+        written = re.findall(r"^\*\*Exercise (\d+) \((.*)\)\.\*\*$", text, re.M)
+        assert written == shown, page.stem
+        # Each solution follows its exercise: folded in a <details>, or a gated one opened by its heading.
+        solutions = re.findall(r"(?:<summary>|^\*\*)Solution to Exercise (\d+)", text, re.M)
+        assert solutions == [n for n, _ in shown], page.stem
+        assert html.count('class="solution dropdown') == len(shown), f"{page.stem}: a solution is not folded"
+        found += len(shown)
+    assert found >= 1
+
+
+def test_the_bibliography_lists_every_work_on_the_site_and_in_the_notebook(book_html):
+    keys = _bib()
+    html = (book_html / "s8_history.html").read_text(encoding="utf-8")
+    listed = re.findall(r'<div class="citation" id="[^"]+" role="doc-biblioentry">', html)
+    assert len(listed) == len(keys)
+    text = "".join("".join(c["source"]) for c in _notebook(book_html, "s8_history")["cells"])
+    dois = re.findall(r"^- .*?\(https://doi\.org/([^)\s]+)\)", text, re.M | re.S)
+    items = re.findall(r"^- ", text, re.M)
+    assert len(items) >= len(keys)
+    assert sorted(dois) == sorted(e.fields["doi"] for e in keys.values() if "doi" in e.fields)
+
+
+def test_a_bibliography_lists_the_cited_works_or_with_all_every_work():
+    from sphinxcontrib.bibtex.citation_target import CitationTarget
+    from sphinxcontrib.bibtex.roles import CitationRef
+    bib = _bib()
+    cited = [CitationRef("id1", "s8_history", 1, [CitationTarget("squire-trapp", "", ""),
+                                                  CitationTarget("blinn-wrinkled", "", "")])]
+    domain = SimpleNamespace(bibdata=SimpleNamespace(data=SimpleNamespace(entries=bib)), citation_refs=cited)
+    env = SimpleNamespace(doc2path=lambda d: f"book/{d}.md", get_domain=lambda name: domain)
+    page = notebooks.PageMarkdown(SimpleNamespace(env=env), "s8_x")
+    items = page("```{bibliography}\n```").split("\n- ")
+    assert [bib[k].fields["doi"] in item for item, k in zip(items, ("blinn-wrinkled", "squire-trapp"))] == [True] * 2
+    assert len(items) == 2
+    assert len(page("```{bibliography}\n:all:\n```").split("\n- ")) == len(bib)
+    with pytest.raises(notebooks.NotebookError, match=r"\{bibliography\}: options \['filter'\] have no notebook"):
+        page("```{bibliography}\n:filter: docname in docnames\n```")

@@ -151,3 +151,34 @@ def test_plain_markdown_keeps_code_and_hands_roles_and_directives_to_its_callbac
         "# Title\n\nSee <ref:s3>, not ``{ref}`x` `` in code, and <numref:Fig. %s <fig-a>>.\n\n"
         "[glue:figure|fig-a|[('name', 'fig-a')]|Caption.]\n\n```python\ny = '{ref}`z`'\n```\n\n"
         "[note||[]|A note.]")
+
+
+#: A page's learning aids: a margin note, an exercise with its folded solution, and the gated form whose
+#: solution holds a code cell (here a fence standing for the cell between start and end).
+AIDS = ("```{margin}\nA note on {ref}`u <s3>`.\n```\n\n"
+        ":::{exercise} Find $\\varepsilon^\\ast$\n:label: ex-a\n\nMinimise $E$.\n:::\n\n"
+        "::::{solution} ex-a\n:class: dropdown\n\nAt the root of $E'$.\n::::\n\n"
+        "````{exercise-start}\n:label: ex-b\n````\n\nCount them.\n\n````{exercise-end}\n````\n\n"
+        "````{solution-start} ex-b\n:class: dropdown\n````\n\n```python\nlen(x)\n```\n\n````{solution-end}\n````\n")
+
+
+def test_margin_notes_and_exercises_become_plain_markdown():
+    shown = page.plain_markdown(AIDS)
+    assert MYST.findall(shown) == []
+    blocks = shown.split("\n\n")
+    assert blocks[0] == "> **Aside.** A note on u."                       # a quoted aside
+    assert blocks[1:3] == ["**Exercise (Find $\\varepsilon^\\ast$).**", "Minimise $E$."]
+    # The solution folded below its exercise, its Markdown rendered inside the <details>.
+    assert blocks[3:6] == ["<details>\n<summary>Solution</summary>", "At the root of $E'$.", "</details>"]
+    # The gated forms span cells: a heading where each starts, a closing line where the solution ends.
+    assert blocks[6:] == ["**Exercise.**", "Count them.", "**Solution.**", "```python\nlen(x)\n```",
+                          "*(End of the solution.)*"]
+
+
+@pytest.mark.parametrize("body, shown", [
+    ("Text.", "> **Note.** Text."),
+    ("- one;\n- two.", "> **Note**\n>\n> - one;\n> - two."),        # a list stays a list
+    ("$$\nx\n$$", "> **Note**\n>\n> $$\n> x\n> $$"),
+])
+def test_an_admonition_is_a_quotation_headed_by_its_title(body, shown):
+    assert page.plain_markdown(f":::{{note}}\n{body}\n:::") == shown

@@ -19,7 +19,10 @@ An HTML build puts into the site, beside the pages:
   computed (myst-nb's glue data of the page), each cross-reference its text
   ("§3 · The mathematics", "Fig. 2"), a ``glue:figure`` its numbered caption
   (the figure is drawn by the code cell that calls `chapter.page.show`), a
-  ``literalinclude`` the code it includes (Sphinx's own reader), and so on.
+  ``literalinclude`` the code it includes (Sphinx's own reader), a margin note a quoted
+  aside, an exercise its numbered heading with its solution folded below it, a citation
+  its author-year text and the bibliography its list (sphinxcontrib-bibtex's entries,
+  formatted by pybtex), and so on.
   A first cell says how to install the project to run the notebook.
 
 Each notebook page gets a line under its title linking its notebook, the wheel
@@ -46,7 +49,8 @@ from docutils import nodes
 
 from lab.store import source_digest
 from renderer import files
-from chapter.page import TITLED, escape, fenced, plain_directive, plain_markdown
+from chapter.page import (TITLED, escape, fenced, plain_directive, plain_exercise,
+                          plain_markdown)
 
 #: The site folder that holds the notebooks, and the one that holds the wheel and constraints.txt.
 FOLDER, DOWNLOADS = "_notebooks", "_downloads"
@@ -58,6 +62,39 @@ ROOT = Path(__file__).resolve().parents[2]
 
 class NotebookError(Exception):
     """Something the site's notebooks or the files beside them need could not be made."""
+
+
+def _names(entry):
+    """The author part of an author-year citation: "Blinn", "Squire and Trapp", "Martins et al."."""
+    last = [" ".join(person.last_names).replace("{", "").replace("}", "") for person in entry.persons["author"]]
+    return last[0] if len(last) == 1 else " and ".join(last) if len(last) == 2 else f"{last[0]} et al."
+
+
+def _author_year(entry):
+    return _names(entry), entry.fields.get("year", "")
+
+
+def cite_text(kind, entries):
+    """A citation as the site writes it: sphinxcontrib-bibtex's author-year style, with its brackets
+    and separators, the works in the bibliography's (author) order.
+
+    Parameters
+    ----------
+    kind : {"t", "p"}
+        Textual (``{cite:t}``: "Blinn [1978]") or parenthetical (``{cite:p}``:
+        "[Martins et al., 2003, Squire and Trapp, 1998]").
+    entries : list of pybtex.database.Entry
+        The works cited, each with an ``author`` and a ``year``.
+
+    Returns
+    -------
+    str
+        Plain text (not yet Markdown-escaped).
+    """
+    pairs = sorted(_author_year(entry) for entry in entries)
+    if kind == "t":
+        return ", ".join(f"{names} [{year}]" for names, year in pairs)
+    return "[" + ", ".join(f"{names}, {year}" for names, year in pairs) + "]"
 
 
 # --- files of the site -------------------------------------------------------------------------
@@ -225,7 +262,28 @@ class PageMarkdown:
             return escape(title or target)
         if name == "math":
             return f"${content}$"
+        if name in ("cite:p", "cite:t"):
+            return escape(cite_text(name[5:], [self.bib_entry(k.strip(), what) for k in content.split(",")]))
         self.fail(what, "this role has no plain-Markdown form in the notebook")
+
+    # citations (sphinxcontrib-bibtex's data: the entries of the build's .bib files) -------------
+    def bib_entry(self, key, what):
+        entries = self.env.get_domain("cite").bibdata.data.entries
+        return entries[key] if key in entries else self.fail(what, f"no entry {key!r} in the bibliography")
+
+    def bibliography(self, options, what):
+        """The entries a ``bibliography`` lists (all with ``:all:``, else those cited in the book),
+        formatted by pybtex's plain style, as a Markdown list."""
+        from pybtex.plugin import find_plugin
+        if set(options) - {"all"}:
+            self.fail(what, f"options {sorted(set(options) - {'all'})} have no notebook form (only :all:)")
+        domain = self.env.get_domain("cite")
+        data = domain.bibdata.data
+        cited = {target.key for ref in domain.citation_refs for target in ref.targets}
+        keys = [key for key in data.entries if "all" in options or key in cited]
+        style = find_plugin("pybtex.style.formatting", "plain")()
+        formatted = style.format_entries(sorted((data.entries[k] for k in keys), key=_author_year))
+        return "\n".join(f"- {entry.text.render_as('markdown')}" for entry in formatted)
 
     def proof_title(self, label, what):
         """'Theorem 3' for a sphinx-proof label, as sphinx-proof's own references write it."""
@@ -258,11 +316,28 @@ class PageMarkdown:
             return f"**{kind}{f' ({self(arg)})' if arg else ''}.** {self(body)}"
         if name == "raw":
             return "*(Here the page on the site shows interactive content that a notebook cannot.)*"
+        if name == "bibliography":
+            return self.bibliography(options, what)
+        if name in ("exercise", "exercise-start", "solution", "solution-start"):
+            return plain_exercise(name, self.exercise_heading(name, arg, options, what), body, self)
         if name == "tableofcontents":
             docs = self.env.toctree_includes.get(self.docname, [])
             return "\n".join(f"- {escape(self.env.titles[d].astext())}" for d in docs if d in self.env.titles)
-        return plain_directive(name, arg, options, body, self) or self.fail(
+        plain = plain_directive(name, arg, options, body, self)
+        return plain if plain is not None else self.fail(
             what, "this directive has no plain-Markdown form in the notebook")
+
+    def exercise_heading(self, name, arg, options, what):
+        """'Exercise 2 (Title)', or 'Solution to Exercise 2', numbered as sphinx-exercise numbers them."""
+        label = options.get("label", "") if name.startswith("exercise") else arg
+        entry = getattr(self.env, "sphinx_exercise_registry", {}).get(label)
+        if name.startswith("solution") and entry is None:
+            self.fail(what, f"no exercise labelled {label!r}")
+        number = self.number(entry["docname"], label) if entry else None      # None: :nonumber:
+        exercise = "Exercise" + (f" {number[1]}" if number else "")
+        if name.startswith("solution"):
+            return f"Solution to {exercise}"
+        return exercise + (f" ({self(arg)})" if arg else "")
 
 
 # --- the notebook ------------------------------------------------------------------------------

@@ -22,7 +22,8 @@ from __future__ import annotations
 import os
 import re
 
-__all__ = ["glue", "show", "markdown", "plain_markdown", "plain_role", "plain_directive", "BUILD_ENV",
+__all__ = ["glue", "show", "markdown", "plain_markdown", "plain_role", "plain_directive", "plain_exercise",
+           "EXERCISE_FORMS", "BUILD_ENV",
            "in_book_build", "FigureLayoutError"]
 
 #: Set (to "1") by the book build (book/_ext/measurement_store.py) for the kernels it starts.
@@ -245,9 +246,10 @@ def plain_directive(name, argument, options, body, convert=None):
     """A directive as plain Markdown, or None for one this knows no form for: code
     (``code-block``, ``code``) as a fence, ``math`` as a display, ``prf:proof`` as
     *Proof.*, another ``prf:`` kind as **Kind (argument).**, an admonition as a
-    quotation, a ``dropdown`` as its title in bold and its body, and a
-    ``container`` or ``div`` as its body.  ``convert`` turns the
-    body's MyST into Markdown (default `plain_markdown`)."""
+    quotation, a ``dropdown`` as its title in bold and its body, a
+    ``container`` or ``div`` as its body, a ``margin`` note as a quoted aside, and
+    sphinx-exercise's forms (`EXERCISE_FORMS`) unnumbered as `plain_exercise` writes them.
+    ``convert`` turns the body's MyST into Markdown (default `plain_markdown`)."""
     convert = convert or plain_markdown
     if name in ("code-block", "code", "sourcecode"):
         return fenced(body, argument)
@@ -259,9 +261,65 @@ def plain_directive(name, argument, options, body, convert=None):
         return f"**{name[4:].title()}{f' ({convert(argument)})' if argument else ''}.** {convert(body)}"
     if name in _ADMONITIONS:
         head = convert(argument) if name == "admonition" else name.title()
-        return "\n".join(f"> {line}".rstrip() for line in f"**{head}.** {convert(body)}".split("\n"))
+        return _quoted(_headed(head, convert(body)))
     if name in ("dropdown", "toggle"):                    # folded on the page, open in a notebook
         return f"**{convert(argument)}**\n\n{convert(body)}" if argument else convert(body)
     if name in ("container", "div"):
         return convert(body)
+    if name == "margin":                                  # sphinx-book-theme's margin note: an aside
+        return _quoted(_headed(convert(argument) if argument else "Aside", convert(body)))
+    if name in EXERCISE_FORMS:
+        title = f" ({convert(argument)})" if argument and name.startswith("exercise") else ""
+        return plain_exercise(name, ("Exercise" if name.startswith("exercise") else "Solution") + title, body,
+                              convert)
     return None
+
+
+#: sphinx-exercise's directives: an exercise and its solution, and the gated forms whose content is the
+#: cells between a ``*-start`` and its ``*-end`` (a solution with a code cell).
+EXERCISE_FORMS = ("exercise", "solution", "exercise-start", "exercise-end", "solution-start", "solution-end")
+
+
+def _quoted(text):
+    return "\n".join(f"> {line}".rstrip() for line in text.split("\n"))
+
+
+#: Markdown that opens a block of its own (a list item, a quotation, a display, a fence, a heading).
+_BLOCK = re.compile(r"\s*(?:[-*+]\s|\d+[.)]\s|>|\$\$|`{3,}|#)")
+
+
+def _headed(head, body):
+    """``body`` under a bold ``head``: run in ("**Note.** Text") before a paragraph, a line of its own
+    before a block (a list would otherwise start inside the heading's paragraph)."""
+    return f"**{head}**\n\n{body}" if _BLOCK.match(body) else f"**{head}.** {body}"
+
+
+def plain_exercise(name, heading, body, convert):
+    """One of sphinx-exercise's directives as plain Markdown.
+
+    Parameters
+    ----------
+    name : str
+        One of `EXERCISE_FORMS`.
+    heading : str
+        Markdown: "Exercise 2 (Title)", "Solution to Exercise 2" (a solution's is shown as text).
+    body : str
+        The directive's MyST body ("" for the gated forms, whose content is the cells that follow).
+    convert : callable
+        MyST str -> Markdown str, for the body.
+
+    Returns
+    -------
+    str
+        An exercise: its heading in bold, then its body.  A solution: folded in an HTML ``<details>``
+        under its heading (Jupyter renders the Markdown inside).  A gated solution spans cells, which
+        no ``<details>`` can: its start is a heading, its end a closing line; an ``exercise-end`` is "".
+    """
+    from html import escape as html_escape
+    if name == "exercise-end":
+        return ""
+    if name == "solution-end":
+        return "*(End of the solution.)*"
+    if name == "solution":
+        return f"<details>\n<summary>{html_escape(heading)}</summary>\n\n{convert(body)}\n\n</details>"
+    return f"**{heading}.**" + (f"\n\n{convert(body)}" if body.strip() else "")
