@@ -44,8 +44,11 @@ def _derivative(claimed=CLAIMED_DERIVATIVE, m=M_CLAIMED):
     slope = sp.Derivative(NP_S, F.beta)
     return Theorem(
         id="normal-beta-derivative", title="The β-derivative of the perturbed normal",
-        statement=r"The renderer's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`) is "
-                  r"$⟦normal⟧$ with $⟦M⟧$, $⟦g⟧$, and $⟦derivative⟧$, for any $N$, frame and gradient.",
+        statement=r"The draft's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`, the chart mode, "
+                  r"whose $M$ is linear in $\beta$) is $⟦normal⟧$ with $⟦M⟧$, $⟦g⟧$, and $⟦derivative⟧$, for any "
+                  r"$N$, frame and gradient: the derivative of the unit vector $N'$ is $g$ projected onto the plane "
+                  r"perpendicular to $N'$, divided by $\lVert M\rVert$.  (In the surface mode $M$ is not linear in "
+                  r"$\beta$, and this closed form does not apply.)",
         steps=(
             Step("The renderer's $N'$ is $M$ normalised", NP_S, M_S / NORM_M_S),
             Step(r"$M$ is linear in $\beta$, and $N$, the frame, $h_u$ and $h_v$ do not depend on $\beta$",

@@ -82,7 +82,7 @@ def test_displacement_moves_silhouette_and_shadows(displaced):
 
 @pytest.mark.parametrize("kwargs, words", [
     (dict(samples=0), "samples"), (dict(samples="8"), "samples"), (dict(samples=5000), "samples"),
-    (dict(scene=Scene(beta=1.0)), "beta"), (dict(scene=Scene(beta=0.35, camera_z=1.2)), "camera_z"),
+    (dict(scene=Scene(bump="chart", beta=1.0)), "beta"), (dict(scene=Scene(beta=0.35, camera_z=1.2)), "camera_z"),
     (dict(scene="scene"), "scene"), (dict(width=0), "width")])
 def test_bad_input_is_refused(kwargs, words):
     args = dict(scene=Scene(), width=8, height=8) | kwargs

@@ -30,7 +30,7 @@ PRINTED = {
     "kink-loci-rays": "dc6aa08f514eb71e",
     "kink-loci-circles": "2ee79e7e99261d40",
     "no-boundary": "23e06e379e02c039",
-    "normal-beta-derivative": "8cb14d3a193c7b83",
+    "normal-beta-derivative": "5f8bf6562cc221df",
     "beta-zero-regression": "0a3b18b8b4052c4d",
     "central-difference-truncation": "87eb719c0c66e095",
     "optimal-step": "ef2a0615d08b564d",

@@ -129,7 +129,7 @@ def test_markdown_is_myst_in_a_build_and_plain_markdown_elsewhere(monkeypatch):
     monkeypatch.delenv(page.BUILD_ENV)
     shown = page.markdown(MYST_OUTPUT).data
     assert MYST.findall(shown) == []
-    assert shown == ("**§1** · “No pixel changes chamber” — Holds (in the register)\n\n"
+    assert shown == ("> **Aside.** **§1** · “No pixel changes chamber” — Holds (in the register)\n\n"
                      "**Theorem (The bump moves no boundary).** For every pixel, $c(\\beta) = c(0)$.\n\n"
                      "**PROVED** · evidence: §6\n\n*Proof.* **Step 1.** The chamber is computed first.\n\n"
                      "*\n  The bump moves no boundary: used on s3.\n\n**Why**\n\nBecause:\n\n$$\nc = c_0\n$$")
