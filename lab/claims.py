@@ -258,9 +258,8 @@ def _census(size):
     symbolic = render(scene, size, size)
     on_a = symbolic.chamber == SPHERE_A
     uv = gbuffer(scene, size, size).uv[on_a]
-    # Chart distance of each sphere-A pixel to the nearest ridge zero line, in u or in v.
-    dist = np.minimum(np.abs(uv[:, 0] * scene.k_u - np.rint(uv[:, 0] * scene.k_u)) / scene.k_u,
-                      np.abs(uv[:, 1] * scene.k_v - np.rint(uv[:, 1] * scene.k_v)) / scene.k_v)
+    from .accuracy import crease_distance
+    dist = crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v)
     out = {k: [] for k in ("max", "rms", "on_band", "off_band", "flips", "straddling")}
     for eps in CENSUS_STEPS:
         led = compare(render(scene.replace(eps=eps), size, size, gradient="central"), symbolic)
