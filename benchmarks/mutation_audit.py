@@ -102,7 +102,7 @@ MUTANTS = [
      "return np.where(c <= 0.04045, 12.92 * c,", "the sRGB breakpoint of the decoding side"),
     ("camera-offset", "renderer/render.py", "WINDOW_MARGIN, WINDOW_OFFSET = 1.25, 0.15",
      "WINDOW_MARGIN, WINDOW_OFFSET = 1.25, -0.15", "the window shifted up, not down"),
-    ("model-coefficient", "renderer/ucurve.py", "model = steps**2 * abs(h3f) / 6 +", "model = steps**2 * abs(h3f) / 2 +",
+    ("model-coefficient", "renderer/ucurve.py", "T, C, G = abs(h3f) / 6,", "T, C, G = abs(h3f) / 2,",
      "the plotted U-curve model's truncation term over 2, not 6"),
 ]
 
@@ -230,9 +230,9 @@ SECOND = [
      "Math.max(1, Math.ceil(resolution / CURVE_SAMPLE))", "Math.max(1, Math.floor(resolution / CURVE_SAMPLE))",
      "the U-curve's sampling stride rounded down: more than CURVE_SAMPLE pixels a side"),
     # ------------------------------------------------------------------ book/
-    ("book-proof-link-shown-bare", "book/chapter/theorems.py",
-     'shown = f"{lhs} = {rhs}"', 'shown = f"= {rhs}" if step.link else f"{lhs} = {rhs}"',
-     "a calc link printed as a bare \"= rhs\", its left side dropped"),
+    ("book-proof-link-shown-bare", "book/chapter/latex.py",
+     "        if step.lhs != sides[-1]:", "        if False:",
+     "a calc link's rewritten left side dropped: the chain shows the step proving the rewrite"),
     ("core-citation-unchecked", "proofs/core.py",
      "unknown = [i for i in citations(text) if i not in CITABLE]", "unknown = []",
      "a citation of an id that is no theorem passes"),

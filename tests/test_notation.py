@@ -130,3 +130,19 @@ def test_a_tuple_chain_prints_a_component_a_line_and_a_long_sum_breaks():
 def test_the_width_estimate_is_within_a_fifth_of_mathjax(latex_, px):
     """Widths MathJax 3 gave these displays in the built book at 390 px (natural size, CSS px)."""
     assert 0.78 * px <= latex.width(latex_) <= 1.22 * px, latex.width(latex_)
+
+
+def test_a_link_whose_left_side_is_rewritten_shows_that_side_on_an_unmarked_line():
+    """A link's left side may differ in form from the step before's right side (decided equal with
+    the link's rewrites): the chain then shows it, joined by an "=" no step number marks, so the
+    display never asserts that a step proved the rewrite."""
+    from proofs.core import Step
+    x = sp.Symbol("x")
+    t = THEOREMS["optimal-step"]
+    steps = [Step("expand", x * (x + 2) + 1, x**2 + 2 * x + 1),
+             Step("factor", sp.Pow(x + 1, 2, evaluate=False), sp.Symbol("y"), link=True)]
+    shown = latex.chain(t, steps, [1, 2])
+    lines = shown.removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}").split(r"\\ ")
+    assert len(lines) == 3, shown
+    assert r"\overset{(1)}{=}" in lines[0] and r"\overset{(2)}{=}" in lines[2]
+    assert r"\left(x + 1\right)^{2}" in lines[1] and r"\overset" not in lines[1]
