@@ -108,9 +108,8 @@ QUANTITIES = {
     "the census's RMS slope": (("census_rms_slope",), lambda: _lib("lab.claims").census()["rms_slope"]),
     "the census's off-band slope": (("census_off_slope",), lambda: _lib("lab.claims").census()["off_slope"]),
     "the census's crease ratio": (("census_ratio",), lambda: _lib("lab.claims").census()["ratio"]),
-    "the census's frame": (("c3_label", "s6_census_label"), lambda: _lib("chapter.labels").frame_label(
+    "the census's frame": (("c3_label",), lambda: _lib("chapter.labels").frame_label(
         _lib("lab.claims").census()["scene"], *_lib("lab.claims").census()["size"])),
-    "the census's flips": (("s6_flips",), lambda: sum(_lib("lab.claims").census()["flips"])),
     "the closed form's worst error": (("dn_residual",), lambda: _lib("lab.accuracy").normal_beta_derivative_residual()),
     "the median order of the β-derivative": (("beta_median_order",),
                                              lambda: _lib("lab.accuracy").image_beta_order()["median_slope"]),
@@ -130,7 +129,13 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
                "s7_crease_label", "s7_crease_err_min", "s7_crease_fd", "s7_crease_left", "s7_crease_right",
-               "s7_pole_zoom", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_label", "s3_ex_h", "s3_ex_xh1", "s3_ex_err")
+               "s7_crease_half_jump", "s7_tiny_step", "s7_pole_zoom",
+               "s7_disp_label", "s7_disp_beta", "s7_disp_pixels", "s7_disp_silhouette", "s7_disp_shadow",
+               "s7_disp_self", "s7_disp_samples", "s7_disp_newton_mean", "s7_disp_newton_max", "s7_disp_seconds",
+               "s7_render_seconds", "s7_disp_cost_ratio", "s7_ex_size", "s7_ex_pitch", "s7_ex_camera",
+               "s7_ex_radius", "s7_ex_magnify", "s7_ex_disc", "s7_ex_expected", "s7_ex_count", "s7_ex_min_sin",
+               "s7_ex_half_label", "s7_ex_half_beta", "s7_ex_half_predicted", "s7_ex_half_silhouette",
+               "s7_ex_half_ratio", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_label", "s3_ex_h", "s3_ex_xh1", "s3_ex_err")
 
 
 def page_glue(notebook: dict) -> dict:
