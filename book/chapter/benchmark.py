@@ -50,7 +50,7 @@ def pareto_figure(measurement, *, error="max"):
     if error not in ("max", "rms"):
         raise ValueError(f"error must be 'max' or 'rms', got {error!r}")
     names = list(dict.fromkeys(r.field for r in measurement.results))
-    fig = Figure(figsize=(5.0, 1.9 * len(names) + 1.6), layout="constrained")
+    fig = Figure(figsize=(5.0, 1.55 * len(names) + 1.3), layout="constrained")
     axes = fig.subplots(len(names), 1, sharex=True, squeeze=False)[:, 0]
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
     t_lo = 0.5e3 * min(r.t_min for r in measurement.results)
