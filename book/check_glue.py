@@ -95,8 +95,6 @@ QUANTITIES = {
     "the accuracy references' digits": (("c5_digits",), lambda: _lib("lab.accuracy").DIGITS),
     # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
-    "the fitted model's error at the fitted optimal step": (("error_at_fitted_sine",),
-                                                            lambda: _ucurve().error_at_fitted),
     "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),
     "the U-curve's label": (("ucurve_label",), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
@@ -117,6 +115,21 @@ QUANTITIES = {
                                           lambda: _lib("lab.accuracy").image_beta_order()["rms_slope"]),
     "the β-derivative's frame": (("c5_label",), lambda: _lib("chapter.labels").frame_label(
         _lib("lab.accuracy").image_beta_order()["scene"], *[_lib("lab.accuracy").image_beta_order()["size"]] * 2)),
+    # Cell 4's counts per pixel (from the sympy objects) and the complex step's step; Cell 5's β.
+    "values of h per pixel in the sine field's central difference": (
+        ("c4_central_h",), lambda: _lib("lab.gradient_methods").stencil_values("sine")),
+    "values of h per pixel in the rings field's central difference": (
+        ("c4_rings_h",), lambda: _lib("lab.gradient_methods").stencil_values("rings")),
+    "sines and cosines per value of the sine field": (
+        ("c4_h_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "h").trig),
+    "sines and cosines per pixel of the sine field's central difference": (
+        ("c4_central_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "central").trig),
+    "sines and cosines per pixel of the sine field's exact gradient": (
+        ("c4_exact_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "exact").trig),
+    "the benchmark's complex step": (("c4_cs_step",), lambda: _lib("lab.gradient_methods").FAST.complex_steps[0]),
+    "the rings field's model-optimal step": (("ex_rings_model",),
+                                             lambda: _lib("lab.accuracy").optima()["rings"]["eps_model"]),
+    "the chapter's amplitude": (("c5_fit_beta",), lambda: _lib("renderer").Scene().beta),
     # Counted on two pages from their own renders.
     "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1"), None),
 }
@@ -128,6 +141,9 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s1_flips_surface", "s2_count_0", "s2_count_2", "s2_count_3",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
+               "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err",
+               "ex_fwd_err_1e8", "ex_fwd_err_1e3", "ex_cen_err_1e6", "ex_cs_err", "ex_exact_err", "ex_gn_jr0",
+               "ex_gn_jj0", "ex_gn_jr1", "ex_gn_jj1", "ex_gn_b1", "ex_gn_b2", "ex_rings_best", "ex_rings_label",
                "s7_crease_label", "s7_crease_err_min", "s7_crease_fd", "s7_crease_left", "s7_crease_right",
                "s7_crease_half_jump", "s7_tiny_step", "s7_pole_zoom",
                "s7_disp_label", "s7_disp_beta", "s7_disp_pixels", "s7_disp_silhouette", "s7_disp_shadow",

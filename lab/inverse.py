@@ -28,7 +28,7 @@ from renderer.render import MAX_SIDE, check_args
 from renderer.scene import MAX_BETA
 from renderer.validate import InvalidType, InvalidValue, positive_int, real
 
-__all__ = ["Fit", "fit_beta", "JACOBIAN", "normal_and_jacobian", "MAX_STEPS"]
+__all__ = ["Fit", "fit_beta", "geometry", "JACOBIAN", "normal_and_jacobian", "MAX_STEPS"]
 
 #: Most Gauss–Newton steps `fit_beta` accepts.
 MAX_STEPS = 100
@@ -89,8 +89,24 @@ class Fit:
     converged: bool
 
 
-def _geometry(scene, width, height):
-    """The β-independent inputs of N' on sphere A's pixels, as `normal_and_jacobian` takes them."""
+def geometry(scene, width, height):
+    """The β-independent inputs of N' on sphere A's pixels, as `normal_and_jacobian` takes them.
+
+    Parameters
+    ----------
+    scene : renderer.Scene
+    width, height : int in [1, 8192]
+
+    Returns
+    -------
+    (on_a, inputs) : a (height, width) bool array (the sphere-A pixels) and a tuple of 14
+        float64 arrays of shape (n,), n = on_a.sum(): N (3), e_θ (3), e_φ (3), h_u, h_v, h, R, sin φ.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As `renderer.gbuffer` for a bad scene or size.
+    """
     g = gbuffer(scene, width, height, gradient="exact")
     on_a = g.chamber == 1
     N = g.N[on_a]
@@ -143,14 +159,14 @@ def fit_beta(target, scene, *, beta0=0.1, steps=20, tol=1e-12):
     beta = real("beta0", beta0, low=0.0, high=high, high_open=scene.bump == "surface")
     steps = positive_int("steps", steps, high=MAX_STEPS)
     tol = real("tol", tol, low=0.0, low_open=True, high=1.0)
-    on_a, geometry = _geometry(scene, width, height)
+    on_a, inputs = geometry(scene, width, height)
     want = target[on_a]
     if not np.isfinite(want).all():
         raise InvalidValue(f"target must be finite on sphere A's {on_a.sum():,} pixels, got "
                            f"{np.count_nonzero(~np.isfinite(want).all(axis=1)):,} pixels with a NaN or inf")
     iterates, converged = [], False
     for _ in range(steps + 1):
-        normal, jac = normal_and_jacobian(scene.bump, geometry, beta)
+        normal, jac = normal_and_jacobian(scene.bump, inputs, beta)
         r = (normal - want).ravel()
         iterates.append((beta, float(np.linalg.norm(r))))
         if converged or len(iterates) > steps:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from renderer import Scene, gbuffer
-from lab.inverse import _geometry, fit_beta, normal_and_jacobian
+from lab.inverse import fit_beta, geometry, normal_and_jacobian
 
 SIZE, BETA = 40, 0.35
 
@@ -30,12 +30,26 @@ def test_jacobian_is_the_beta_derivative_of_the_renderers_normal(mode):
     # Independent route: central differences of the kernel's own Ns in beta (step 1e-5:
     # truncation ~1e-10 x |N'''|, rounding ~1e-16 / 1e-5).
     scene, d = Scene(height_field="sine", bump=mode, beta=BETA), 1e-5
-    on_a, geometry = _geometry(scene, SIZE, SIZE)
-    _, jac = normal_and_jacobian(mode, geometry, BETA)
+    on_a, inputs = geometry(scene, SIZE, SIZE)
+    _, jac = normal_and_jacobian(mode, inputs, BETA)
     fd = (gbuffer(scene.replace(beta=BETA + d), SIZE, SIZE).Ns - gbuffer(scene.replace(beta=BETA - d), SIZE, SIZE).Ns)
     fd = fd[on_a] / (2 * d)
     assert np.abs(jac - fd).max() <= 1e-7 * np.abs(fd).max()
     assert np.abs(fd).max() > 0.1
+
+
+@pytest.mark.parametrize("mode", ["chart", "surface"])
+def test_a_gauss_newton_step_from_the_public_geometry_is_the_fits_step(mode):
+    """`geometry` is what the fit reads: beta_1 = beta_0 - J.r / J.J from its inputs is the fit's
+    second iterate (the book's exercise takes this step by hand)."""
+    scene = Scene(height_field="sine", bump=mode, beta=BETA)
+    target = gbuffer(scene, SIZE, SIZE).Ns
+    fit = fit_beta(target, scene, beta0=0.1, steps=1)
+    on_a, inputs = geometry(scene, SIZE, SIZE)
+    normal, jac = normal_and_jacobian(mode, inputs, 0.1)
+    r, J = (normal - target[on_a]).ravel(), jac.ravel()
+    assert on_a.sum() == fit.pixels and np.isclose(np.linalg.norm(r), fit.iterates[0][1], rtol=1e-12)
+    assert np.isclose(0.1 - (J @ r) / (J @ J), fit.iterates[1][0], rtol=1e-12, atol=0)
 
 
 def test_chart_jacobian_is_the_closed_form():

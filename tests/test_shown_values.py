@@ -7,8 +7,8 @@ artists (line, patch and image data; title, legend and annotation texts and posi
 each marked value is compared with the glued value its caption or prose names, or with the
 library's own (`renderer`, `lab`).  The classes of marked values, and where the book has them:
 
-* a line or a band at a named value: the U-curve's optimum (the glued fitted optimal step, and
-  the least of the model drawn beside it), its band of footprint steps, the stencil's crease;
+* a line at a named value: Cell 2's fitted and model-optimal steps beside the histogram of the
+  footprint steps it counts, the stencil's crease;
 * a number in a legend: the stencil's two slopes (the library's central and exact hᵤ at the
   stencil drawn), the band's percentiles (of the page's footprint steps);
 * a number in a title: the gain of a difference panel (index, §1, Cell 3), the β of a render
@@ -110,30 +110,32 @@ def image(ax):
 
 # ---- lines, bands, legends and annotations ---------------------------------------------------
 
-def test_the_u_curve_marks_the_fitted_optimum_of_the_model_it_draws_and_the_band_its_legend_names(ran):
-    """Cell 2's figure: its optimum line and annotation sit at the glued fitted optimal step, which
-    is the least of the model A ε² + B/ε drawn beside them (A and B read back from the model's line),
-    where the model's error is the glued one; the band of footprint steps spans the percentiles of
-    the page's steps that its legend names, right of the optimum as the alt text says, about the
-    glued median step, the glued ratio of which to the optimum is the two glued values'."""
+def test_the_footprint_histogram_counts_the_pages_steps_against_the_glued_optimal_steps(ran):
+    """Cell 2's figure: its two vertical lines sit at the glued fitted and model-optimal steps (the
+    library's, `lab.accuracy.optima`), its bars count every sphere-A pixel's footprint step once, the
+    glued median step is the median of those steps, right of both lines as the alt text says, and
+    the glued ratio is the median over the fitted optimal step."""
+    from lab.accuracy import optima
     ns, shown, glued = ran("s5_lab")
-    ax = shown["fig-c2-ucurve"].axes[0]
-    (opt,) = vertical_lines(ax)
-    assert math.isclose(opt, glued["eps_fitted_sine"], rel_tol=1e-9), (opt, glued["eps_fitted_sine"])
-    (note,) = [t for t in ax.texts if r"\hat\varepsilon" in t.get_text()]     # the fitted step's symbol
-    assert note.xy[0] == opt and "optimum" not in note.get_text() and r"\ast" not in note.get_text()
-    eps, model = curve(ax, "model")
-    terms = np.stack([eps**2, 1 / eps], axis=1) / model[:, None]          # weighted: each step's error counts alike
-    scale = np.linalg.norm(terms, axis=0)
-    A, B = np.linalg.lstsq(terms / scale, np.ones_like(eps), rcond=None)[0] / scale
-    assert math.isclose((B / (2 * A)) ** (1 / 3), opt, rel_tol=1e-6), ((B / (2 * A)) ** (1 / 3), opt)
-    assert math.isclose(A * opt**2 + B / opt, glued["error_at_fitted_sine"], rel_tol=1e-6)
-    (band,) = [p for p in ax.patches if p.get_label().startswith("footprint")]
-    lo, hi = np.percentile(ns["fp_u"], numbers(legend_entry(ax, "footprint")))
-    box = band.get_bbox()
-    assert np.allclose([box.x0, box.x1], [lo, hi], rtol=1e-12) and box.x0 > opt, (box, lo, hi, opt)
-    assert glued["c2_fp_u"] == np.median(ns["fp_u"]) and lo < glued["c2_fp_u"] < hi
+    ax = shown["fig-c2-footprint"].axes[0]
+    opt = optima()["sine"]
+    assert sorted(vertical_lines(ax)) == sorted([glued["eps_fitted_sine"], glued["eps_model_sine"]])
+    assert (glued["eps_fitted_sine"], glued["eps_model_sine"]) == (opt["eps_fitted"], opt["eps_model"])
+    heights = [p.get_height() for p in ax.patches]
+    assert sum(heights) == ns["fp_u"].size == np.count_nonzero(ns["on_a"])
+    assert glued["c2_fp_u"] == np.median(ns["fp_u"]) and glued["c2_fp_u"] > max(vertical_lines(ax))
     assert math.isclose(glued["c2_fp_ratio"], glued["c2_fp_u"] / glued["eps_fitted_sine"], rel_tol=1e-12)
+
+
+def test_the_gauss_newton_exercise_is_solved_by_its_own_numbers(ran):
+    """Cell 5's exercise: a step beta - J.r / J.J from the glued sums lands on the glued answers,
+    which are the fit's iterates (to the digits the solution shows), and the fit converges to the
+    glued true beta."""
+    _, _, glued = ran("s5_lab")
+    b1 = glued["c5_fit_beta_0"] - glued["ex_gn_jr0"] / glued["ex_gn_jj0"]
+    b2 = glued["ex_gn_b1"] - glued["ex_gn_jr1"] / glued["ex_gn_jj1"]
+    assert math.isclose(b1, glued["ex_gn_b1"], rel_tol=1e-9) and math.isclose(b2, glued["ex_gn_b2"], rel_tol=1e-9)
+    assert abs(glued["ex_gn_b2"] - glued["c5_fit_beta"]) < abs(glued["ex_gn_b1"] - glued["c5_fit_beta"])
 
 
 #: The stencil diagram as §3 draws it (its defaults), a stencil left of another crease, and one
@@ -315,21 +317,8 @@ def test_the_pole_close_ups_are_the_normals_their_titles_name_at_the_captions_zo
 
 # ---- numbers typed into alt text ------------------------------------------------------------
 
-def _arm(side):
-    """The log-log slope of Cell 2's error line on one arm: steps 10 times the optimum or more
-    ("right"), a tenth of it or less ("left")."""
-    def slope(ns, shown, glued):
-        ax = shown["fig-c2-ucurve"].axes[0]
-        eps, error = curve(ax, "|error|")
-        (opt,) = vertical_lines(ax)
-        arm = eps >= 10 * opt if side == "right" else eps <= opt / 10
-        return np.polyfit(np.log10(eps[arm]), np.log10(error[arm]), 1)[0]
-    return slope
-
-
 #: (page, figure) -> {the words of its alt text that carry a number: what the number names}.
 ALT_NUMBERS = {
-    ("s5_lab", "fig-c2-ucurve"): {"along a line of slope 2": _arm("right"), "along a line of slope -1": _arm("left")},
     ("s5_lab", "fig-c5-order"): {"with slope about 2": lambda ns, shown, glued: glued["beta_median_order"]},
 }
 _ALT = re.compile(r"```\{glue:figure\} (?P<name>\S+)\n(?:.*\n)*?:alt: (?P<alt>.*)")
