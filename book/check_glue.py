@@ -80,6 +80,7 @@ QUANTITIES = {
     # The scene and the renderer's constants.
     "the draft's step": (("ix_eps", "s1_eps"), lambda: _lib("renderer").DRAFT_SCENE.eps),
     "the draft's amplitude": (("s1_beta", "s2_beta"), lambda: _lib("renderer").DRAFT_SCENE.beta),
+    "sphere A's radius in the book's scene": (("s1_ex_radius",), lambda: _lib("renderer").Scene().radius_a),
     "the draft's frequency in u": (("s2_k_u",), lambda: _lib("renderer").DRAFT_SCENE.k_u),
     "the draft's frequency in v": (("s2_k_v",), lambda: _lib("renderer").DRAFT_SCENE.k_v),
     "the draft's height field": (("s2_field",), lambda: _lib("renderer").DRAFT_SCENE.height_field),
@@ -138,7 +139,7 @@ QUANTITIES = {
 ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "ix_proved", "ix_verified", "ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata",
                "tilt_chart", "tilt_surface", "s1_steep", "s1_steep_chart", "s1_steep_surface", "s1_flips_chart",
-               "s1_flips_surface", "s2_count_0", "s2_count_2", "s2_count_3",
+               "s1_flips_surface", "s1_ex_factor", "s2_count_0", "s2_count_2", "s2_count_3",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
                "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err",

@@ -205,7 +205,7 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
         hh = float(pointwise.height(field, u, phi / np.pi, scene.k_u, scene.k_v))
         return in_plane @ np.array(normal[mode](*N3, *e_t, *e_p, hu, hv, beta, hh, r0, sin_phi), float).ravel()
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig, ax = plt.subplots(figsize=(4.2, 5.4))          # for a phone's column: at most 5 in wide, text >= 9 pt
     ax.plot(*base.T, color=GREY, lw=1.5)
     ax.plot(*bumped.T, color=GREY, lw=1.0, ls="--")
     length = 0.22
@@ -230,7 +230,7 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
     ax.legend(handles, ["sphere A: the geometry, unchanged", r"the sphere displaced by $\beta h$",
                         "shading normal: the displaced sphere's", "the displaced curve's own normal",
                         "the draft's formula", r"$N$, no bump"],
-              loc="upper center", bbox_to_anchor=(0.5, -0.02), ncols=2, frameon=False, fontsize=8.5)
+              loc="upper center", bbox_to_anchor=(0.5, -0.01), ncols=1, frameon=False, fontsize=9.5)
     ax.set_aspect("equal"); ax.axis("off")
     ax.set_title(rf"one meridian, {field} field, $\beta = {beta:g}$")
     return fig
