@@ -145,7 +145,7 @@ def frame_diagram(theta=-0.35, phi=0.8):
     def project(p):
         return view @ p
 
-    fig, ax = plt.subplots(figsize=(4.6, 4.6))
+    fig, ax = plt.subplots(figsize=(4.0, 4.0))
     t = np.linspace(0, 2 * np.pi, 400)
     ax.plot(np.cos(t), np.sin(t), color=GREY, lw=1)
     for k in range(12):                                               # meridians: u = k / 12
@@ -252,7 +252,7 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     (h_m, h_0, h_p) = pointwise.height("ridges", np.array([u0 - eps, u0, u0 + eps]), np.full(3, v), k_u, k_v)
     secant = (h_p - h_m) / (2 * eps)
     exact = float(np.asarray(pointwise.exact_gradient("ridges", u0, v, k_u, k_v)[0]).ravel()[0])
-    fig, ax = plt.subplots(figsize=(5.0, 3.4))
+    fig, ax = plt.subplots(figsize=(5.0, 2.9))
     ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
     ax.axvline(crease, color=GREY, lw=0.8, ls=":")
     ax.annotate(r"crease $u = 1/k_u$", (crease, 1), xycoords=("data", "axes fraction"), xytext=(-4, -4),
@@ -281,7 +281,7 @@ def ucurve_anatomy(curve):
     Steps in chart units, errors in height per chart unit.  Returns the Figure.
     """
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(5.0, 3.4))
+    fig, ax = plt.subplots(figsize=(5.0, 3.1))
     ax.loglog(curve.eps, curve.error, lw=2, color=RED, label="|error| of the float64 quotient")
     ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="exact arithmetic at the rounded $u \\pm \\varepsilon$")
     ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="rounding of the float64 evaluation")
