@@ -153,7 +153,8 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s3_ridges_crease_dist", "s3_ridges_largest", "s3_share_size", "s3_share_estimate", "s3_rings_label",
                "s3_rings_h", "s3_rings_xh1", "s3_rings_h3", "s3_rings_C", "s3_k16_ku", "s3_k16_h", "s3_k16_xh1",
                "s3_k16_h3", "s3_k16_eps", "s3_k16_fit", "s3_k16_fit_ratio", "s3_arg_ratio", "s3_ulp_ratio",
-               "s3_metric_v", "s3_metric_R", "s3_metric_theta", "s3_metric_phi")
+               "s3_metric_v", "s3_metric_R", "s3_metric_theta", "s3_metric_phi", "s3_tiny_step", "s3_step_e2",
+               "s3_step_e3", "s3_step_e4", "s3_arg_hi", "s3_arg_lo")
 
 
 def page_glue(notebook: dict) -> dict:
