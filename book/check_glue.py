@@ -73,6 +73,12 @@ def _ucurve():
     return _lib("renderer.ucurve").measure()
 
 
+def _crease_share(step):
+    """`lab.accuracy.crease_share`'s share of straddling stencils at ``step``."""
+    share = _lib("lab.accuracy").crease_share()
+    return dict(zip(share["steps"], share["share"]))[step]
+
+
 #: The glued quantities with a value in the library or more than one name: quantity -> (its glue
 #: names, its library value or None).  The library value is a callable evaluated when the check runs;
 #: None where the pages compute the quantity from their own renders (its names must still agree).
@@ -81,8 +87,8 @@ QUANTITIES = {
     "the draft's step": (("ix_eps", "s1_eps"), lambda: _lib("renderer").DRAFT_SCENE.eps),
     "the draft's amplitude": (("s1_beta", "s2_beta"), lambda: _lib("renderer").DRAFT_SCENE.beta),
     "sphere A's radius in the book's scene": (("s1_ex_radius",), lambda: _lib("renderer").Scene().radius_a),
-    "the draft's frequency in u": (("s2_k_u",), lambda: _lib("renderer").DRAFT_SCENE.k_u),
-    "the draft's frequency in v": (("s2_k_v",), lambda: _lib("renderer").DRAFT_SCENE.k_v),
+    "the draft's frequency in u": (("s2_k_u", "s3_ku"), lambda: _lib("renderer").DRAFT_SCENE.k_u),
+    "the draft's frequency in v": (("s2_k_v", "s3_kv"), lambda: _lib("renderer").DRAFT_SCENE.k_v),
     "the draft's height field": (("s2_field",), lambda: _lib("renderer").DRAFT_SCENE.height_field),
     "the simulator's opening step": (("s4_eps",), lambda: _lib("renderer.ledger").SIMULATOR_SCENE.eps),
     "the window's margin": (("s2_margin",), lambda: _lib("renderer.render").WINDOW_MARGIN),
@@ -97,8 +103,20 @@ QUANTITIES = {
     # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
     "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),
-    "the U-curve's label": (("ucurve_label",), lambda: _lib("chapter.labels").ucurve_label(
+    "the U-curve's label": (("ucurve_label", "s3_ex_label"), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
+    "the unit roundoff": (("s3_unit_roundoff",), lambda: _lib("renderer.ucurve").UNIT_ROUNDOFF),
+    "the rings field's model-optimal step": (("s3_rings_eps",), lambda: _lib("lab.accuracy").optima()["rings"]["eps_model"]),
+    "the rings field's model error at its model-optimal step": (
+        ("s3_rings_err",), lambda: _lib("lab.accuracy").optima()["rings"]["error_model"]),
+    "the fitted over the model-optimal step (sine)": (
+        ("s3_fit_ratio",), lambda: _lib("lab.accuracy").optima()["sine"]["fitted_over_model"]),
+    # What the crease does on ridges: the share of sphere-A pixels whose stencil straddles a crease.
+    "the straddling share at a step of 1e-2": (("s3_share_e2",), lambda: _crease_share(1e-2)),
+    "the straddling share at a step of 1e-3": (("s3_share_e3",), lambda: _crease_share(1e-3)),
+    "the straddling share at a step of 1e-4": (("s3_share_e4",), lambda: _crease_share(1e-4)),
+    "the straddling census's sphere-A pixels": (("s3_share_pixels",),
+                                                lambda: _lib("lab.accuracy").crease_share()["pixels"]),
     "the third derivative at the U-curve's point": (("s3_ex_h3",), lambda: abs(_ucurve().third_derivative)),
     "the relative error at a step of 1e-9": (("ucurve_rel_1e9",), lambda: _lib("lab.claims").relative_error_at(1e-9)),
     "the relative error at a step of 1e-11": (("ucurve_rel_1e11",),
@@ -152,7 +170,13 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s7_render_seconds", "s7_disp_cost_ratio", "s7_ex_size", "s7_ex_pitch", "s7_ex_camera",
                "s7_ex_radius", "s7_ex_magnify", "s7_ex_disc", "s7_ex_expected", "s7_ex_count", "s7_ex_min_sin",
                "s7_ex_half_label", "s7_ex_half_beta", "s7_ex_half_predicted", "s7_ex_half_silhouette",
-               "s7_ex_half_ratio", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_label", "s3_ex_h", "s3_ex_xh1", "s3_ex_err")
+               "s7_ex_half_ratio", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_h", "s3_ex_xh1", "s3_ex_err",
+               "s3_ex_C", "s3_ex_arg_share", "s3_rel_model", "s3_fit_B_share", "s3_optima_table",
+               "s3_ridges_crease_dist", "s3_ridges_largest", "s3_share_size", "s3_share_estimate", "s3_rings_label",
+               "s3_rings_h", "s3_rings_xh1", "s3_rings_h3", "s3_rings_C", "s3_k16_ku", "s3_k16_h", "s3_k16_xh1",
+               "s3_k16_h3", "s3_k16_eps", "s3_k16_fit", "s3_k16_fit_ratio", "s3_arg_ratio", "s3_ulp_ratio",
+               "s3_metric_v", "s3_metric_R", "s3_metric_theta", "s3_metric_phi", "s3_tiny_step", "s3_step_e2",
+               "s3_step_e3", "s3_step_e4", "s3_arg_hi", "s3_arg_lo")
 
 
 def page_glue(notebook: dict) -> dict:

@@ -138,6 +138,43 @@ def test_the_gauss_newton_exercise_is_solved_by_its_own_numbers(ran):
     assert abs(glued["ex_gn_b2"] - glued["c5_fit_beta"]) < abs(glued["ex_gn_b1"] - glued["c5_fit_beta"])
 
 
+def test_the_u_curve_of_s3_draws_slope_guides_parallel_to_its_arms_with_the_slopes_they_name(ran):
+    """§3's figure: each guide line (kept out of the legend) has, on log-log axes, exactly the slope
+    its annotation names; it lies above the measured error by a factor between 3 and 300 over its
+    span, along an arm of the measured error whose own slope is within 0.2 of it; the vertical line
+    is the fitted optimal step of the curve drawn."""
+    ns, shown, glued = ran("s3_math")
+    ax = shown["fig-ucurve"].axes[0]
+    assert vertical_lines(ax) == [ns["curve"].eps_fitted]
+    eps, error = curve(ax, "|error|")
+    guides = [line for line in ax.get_lines() if line.get_label().startswith("_guide")]
+    assert len(guides) == 2 and not any(t.get_text().startswith("_") for t in ax.get_legend().get_texts())
+    for line in guides:
+        x, y = (np.log10(np.asarray(d, float)) for d in line.get_data())
+        slope, _ = np.polyfit(x, y, 1)
+        (note,) = [t for t in ax.texts if np.isclose(np.log10(t.xy[0]), (x[0] + x[-1]) / 2)]
+        (named,) = numbers(note.get_text().split("\n")[0])
+        assert math.isclose(slope, named, abs_tol=1e-9), (slope, note.get_text())
+        arm = (eps >= 10 ** x[0]) & (eps <= 10 ** x[-1]) & (error > 0)
+        measured = np.polyfit(np.log10(eps[arm]), np.log10(error[arm]), 1)[0]
+        assert abs(measured - slope) < 0.2, (measured, slope)
+        above = 10 ** np.interp(np.log10(eps[arm]), x, y) / error[arm]
+        assert 3 < np.median(above) < 300, np.median(above)
+
+
+def test_s3s_worked_example_and_exercise_redo_by_hand_from_the_numbers_the_page_gives(ran):
+    """The model-optimal step and its error, recomputed from the glued givens as the reader would
+    (ε* = (3uC/|h‴|)^(1/3), E(ε*) = ε*²|h‴|/2), are the glued answers, to the digits shown."""
+    ns, shown, glued = ran("s3_math")
+    u = glued["s3_unit_roundoff"]
+    for given in ("s3_ex", "s3_rings"):
+        C = glued[f"{given}_h"] + glued[f"{given}_xh1"]
+        eps = (3 * u * C / glued[f"{given}_h3"]) ** (1 / 3)
+        assert math.isclose(eps, glued[f"{given}_eps"], rel_tol=1e-9), (given, eps)
+        assert math.isclose(eps**2 * glued[f"{given}_h3"] / 2, glued[f"{given}_err"], rel_tol=1e-9), given
+    assert shows(f"{glued['s3_ex_eps']:.2e}", ns["curve"].eps_model)
+
+
 #: The stencil diagram as §3 draws it (its defaults), a stencil left of another crease, and one
 #: at another frequency and row.
 STENCILS = [{}, dict(k_u=5.0, v=0.3, eps=0.01, offset=-0.004), dict(k_u=12.0, k_v=3.0, v=0.8, eps=0.005, offset=0.002)]
@@ -317,8 +354,22 @@ def test_the_pole_close_ups_are_the_normals_their_titles_name_at_the_captions_zo
 
 # ---- numbers typed into alt text ------------------------------------------------------------
 
+def _arm(side, figure):
+    """The log-log slope of a U-curve figure's error line on one arm: steps 10 times the optimum
+    or more ("right"), a tenth of it or less ("left")."""
+    def slope(ns, shown, glued):
+        ax = shown[figure].axes[0]
+        eps, error = curve(ax, "|error|")
+        (opt,) = vertical_lines(ax)
+        arm = eps >= 10 * opt if side == "right" else eps <= opt / 10
+        return np.polyfit(np.log10(eps[arm]), np.log10(error[arm]), 1)[0]
+    return slope
+
+
 #: (page, figure) -> {the words of its alt text that carry a number: what the number names}.
 ALT_NUMBERS = {
+    ("s3_math", "fig-ucurve"): {"labelled slope +2": _arm("right", "fig-ucurve"),
+                                "labelled slope −1": _arm("left", "fig-ucurve")},
     ("s5_lab", "fig-c5-order"): {"with slope about 2": lambda ns, shown, glued: glued["beta_median_order"]},
 }
 _ALT = re.compile(r"```\{glue:figure\} (?P<name>\S+)\n(?:.*\n)*?:alt: (?P<alt>.*)")

@@ -15,7 +15,8 @@ own functions (`renderer.pointwise`, generated from `renderer.formulas`):
   bumped meridian, beside the normal of the displaced curve itself;
 * `stencil_diagram`: the central-difference stencil straddling a crease of the
   ridges field, its secant, and the two one-sided slopes;
-* `ucurve_anatomy` (in §7, on the measured curve): the regions of the U-curve.
+* `ucurve_anatomy` (in §3, on the measured curve): the regions of the U-curve and its
+  slope guides +2 and -1.
 
 Each returns a matplotlib Figure (the caller glues and closes it).
 
@@ -43,6 +44,9 @@ RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
 #: text, in the PNG's pixels ("none": the figure draws no text); the browser test of the built pages
 #: turns it into CSS pixels at the width each image is shown.
 SMALLEST_TEXT_KEY = "symrender:smallest-text-px"
+
+#: How far above the fitted model's arm `ucurve_anatomy` draws each slope guide (a factor in error).
+GUIDE_OFFSET = 30.0
 
 
 def style():
@@ -141,7 +145,7 @@ def frame_diagram(theta=-0.35, phi=0.8):
     def project(p):
         return view @ p
 
-    fig, ax = plt.subplots(figsize=(4.6, 4.6))
+    fig, ax = plt.subplots(figsize=(4.0, 4.0))
     t = np.linspace(0, 2 * np.pi, 400)
     ax.plot(np.cos(t), np.sin(t), color=GREY, lw=1)
     for k in range(12):                                               # meridians: u = k / 12
@@ -248,7 +252,7 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     (h_m, h_0, h_p) = pointwise.height("ridges", np.array([u0 - eps, u0, u0 + eps]), np.full(3, v), k_u, k_v)
     secant = (h_p - h_m) / (2 * eps)
     exact = float(np.asarray(pointwise.exact_gradient("ridges", u0, v, k_u, k_v)[0]).ravel()[0])
-    fig, ax = plt.subplots(figsize=(5.6, 3.4))
+    fig, ax = plt.subplots(figsize=(5.0, 2.9))
     ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
     ax.axvline(crease, color=GREY, lw=0.8, ls=":")
     ax.annotate(r"crease $u = 1/k_u$", (crease, 1), xycoords=("data", "axes fraction"), xytext=(-4, -4),
@@ -258,31 +262,47 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     ax.plot(u0 + du, h_0 + exact * du, color=BLUE, lw=1.5, label=rf"exact slope at $u_0$: {exact:+.2f}")
     ax.plot([u0], [h_0], "o", color=BLUE)
     ax.set_xlabel(r"$u$"); ax.set_ylabel(r"$h$")
-    ax.legend(loc="lower right", frameon=False)
+    ax.legend(loc="lower right", frameon=False, fontsize=9)
     ax.set_title(r"the stencil $u_0 \pm \varepsilon$ straddles the crease")
     return fig
 
 
 def ucurve_anatomy(curve):
-    """The measured U-curve of a `renderer.ucurve.UCurve` (error, truncation and roundoff parts,
-    the model A eps^2 + B / eps fitted to the error) with its regions named: truncation falling as
-    eps^2, rounding rising as 1/eps, the fitted optimal step eps^ (the fitted model's minimiser)
-    between them."""
+    """The measured U-curve of a `renderer.ucurve.UCurve`, drawn for the narrow column (5 in wide,
+    text at 9 pt or more).
+
+    Lines: the float64 quotient's error (label ``|error| ...``), its exact split into exact
+    arithmetic at the rounded u +- eps (dashed) and the rounding of the float64 evaluation
+    (dotted), the model A eps^2 + B / eps fitted to the error (label ``model ...``), a vertical
+    line at its minimiser, the fitted optimal step eps^, and two slope guides (labels
+    ``_guide slope +2`` and ``_guide slope -1``, kept out of the legend), each parallel to one
+    arm of the fitted model (A eps^2 on steps of 100 eps^ and more, B / eps on steps of
+    eps^ / 100 and less) a factor `GUIDE_OFFSET` above it, with its slope written beside it.
+    Steps in chart units, errors in height per chart unit.  Returns the Figure.
+    """
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    fig, ax = plt.subplots(figsize=(5.0, 3.1))
     ax.loglog(curve.eps, curve.error, lw=2, color=RED, label="|error| of the float64 quotient")
     ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="exact arithmetic at the rounded $u \\pm \\varepsilon$")
     ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="rounding of the float64 evaluation")
-    fitted = curve.fitted_truncation * curve.eps**2 + curve.fitted_roundoff / curve.eps
-    ax.loglog(curve.eps, fitted, color=GREY, lw=1, label=r"model $A\varepsilon^2 + B/\varepsilon$")
+    A, B = curve.fitted_truncation, curve.fitted_roundoff
+    ax.loglog(curve.eps, A * curve.eps**2 + B / curve.eps, color=GREY, lw=1,
+              label=r"model $A\varepsilon^2 + B/\varepsilon$ fitted to it")
     opt = curve.eps_fitted
     ax.axvline(opt, color=GREY, lw=0.8, ls="-.")
-    top = float(np.nanmax(curve.error))
-    ax.annotate(r"truncation falls as $\varepsilon^2$", (3e-3, top), (3e-3, top * 30), ha="center", fontsize=8)
-    ax.annotate(r"rounding rises as $1/\varepsilon$", (1e-11, top), (1e-11, top * 30), ha="center", fontsize=8)
-    ax.annotate(r"fitted $\hat\varepsilon$", (opt, 1e-17), (opt * 3, 1e-17), fontsize=8)
-    ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $h_u$"); ax.set_ylim(1e-18, 1e3)
-    ax.legend(loc="lower left", frameon=False); ax.grid(alpha=0.3)
+    right = np.geomspace(100 * opt, curve.eps.max(), 20)
+    left = np.geomspace(curve.eps.min(), opt / 100, 20)
+    for steps, arm, slope, words in ((right, lambda e: A * e**2, "+2", r"truncation $\propto\varepsilon^2$"),
+                                     (left, lambda e: B / e, "\u22121", r"rounding $\propto 1/\varepsilon$")):
+        ax.loglog(steps, GUIDE_OFFSET * arm(steps), color="k", lw=1.2, label=f"_guide slope {slope}")
+        mid = np.sqrt(steps[0] * steps[-1])                      # the guide's middle on log axes
+        ax.annotate(f"slope {slope}\n{words}", (mid, GUIDE_OFFSET * arm(mid)), (mid, 60 * GUIDE_OFFSET * arm(mid)),
+                    ha="center", va="bottom", fontsize=9, arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
+    ax.annotate(r"fitted $\hat\varepsilon$", (opt, 1e-17), (opt * 3, 1e-17), fontsize=9)
+    ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $h_u$"); ax.set_ylim(1e-18, 1e5)
+    ax.yaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=7))
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False, fontsize=9)   # below the axes
+    ax.grid(alpha=0.3)
     return fig
 
 
