@@ -106,7 +106,7 @@ QUANTITIES = {
     "the U-curve's label": (("ucurve_label", "s3_ex_label"), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
     "the unit roundoff": (("s3_unit_roundoff",), lambda: _lib("renderer.ucurve").UNIT_ROUNDOFF),
-    "the rings field's model-optimal step": (("s3_rings_eps",), lambda: _lib("lab.accuracy").optima()["rings"]["eps_model"]),
+    "the rings field's model-optimal step": (("s3_rings_eps", "ex_rings_model"), lambda: _lib("lab.accuracy").optima()["rings"]["eps_model"]),
     "the rings field's model error at its model-optimal step": (
         ("s3_rings_err",), lambda: _lib("lab.accuracy").optima()["rings"]["error_model"]),
     "the fitted over the model-optimal step (sine)": (
@@ -146,8 +146,6 @@ QUANTITIES = {
     "sines and cosines per pixel of the sine field's exact gradient": (
         ("c4_exact_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "exact").trig),
     "the benchmark's complex step": (("c4_cs_step",), lambda: _lib("lab.gradient_methods").FAST.complex_steps[0]),
-    "the rings field's model-optimal step": (("ex_rings_model",),
-                                             lambda: _lib("lab.accuracy").optima()["rings"]["eps_model"]),
     "the chapter's amplitude": (("c5_fit_beta",), lambda: _lib("renderer").Scene().beta),
     # Counted on two pages from their own renders.
     "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1"), None),

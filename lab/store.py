@@ -30,7 +30,6 @@ import hashlib
 import json
 import os
 import re
-import tempfile
 from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path

@@ -561,18 +561,12 @@ def test_every_figure_records_the_size_of_its_smallest_text(site):
     assert not missing, f"figures whose PNG records no text size:\n{_listing(missing)}"
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="long displays (§3's most) are shrunk below the limit at 390 px until they are broken "
-                          "into lines or rewritten for a phone; remove this mark when the test passes")
 def test_no_display_formula_is_shrunk_below_the_limit_on_a_phone(site):
     """At 390 px, every proof unfolded, fit.js shrinks no display formula below `MIN_FORMULA_SCALE`."""
     bad = [dict(d, page=n) for n in PAGES for d in small_formulas(site[n, 390])]
     assert not bad, f"display formulas under {MIN_FORMULA_SCALE:.0%} at 390 px:\n{_listing(bad)}"
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="the figures are drawn for a wide column: their text is under the limit at 390 px "
-                          "(some at 1280 px) until they are redrawn; remove this mark when the test passes")
 def test_the_text_in_every_figure_is_large_enough_at_both_widths(site):
     """No figure's smallest text under `MIN_FIGURE_TEXT_PX` CSS px: 8 at 390 px, 10 at 1280 px."""
     bad = [dict(f, page=n, width=w) for w in WIDTHS for n in PAGES

@@ -311,7 +311,7 @@ def test_an_identity_that_cannot_be_evaluated_is_refuted_naming_the_point(rhs, l
 
 
 def test_a_theorem_step_that_cannot_be_evaluated_refutes_the_theorem():
-    from proofs.core import Step, Theorem
+    from proofs.core import Step
     t = get("optimal-step")
     x = sp.Symbol("x")
     step = Step("A step whose sides raise at every sampled point", 1 / sp.floor(x), sp.Integer(0),

@@ -34,7 +34,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from renderer import Scene, jsgen
+from renderer import jsgen
 
 from .jsnode import DRIVERS, read_frame, require_tool, scene_json, write_modules
 

@@ -21,7 +21,7 @@ from sympy.printing.conventions import requires_partial
 from sympy.printing.latex import LatexPrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from proofs.core import PLACEHOLDER, Cross, Dot, Jacobian, placeholder_key
+from proofs.core import PLACEHOLDER, Cross, Dot, placeholder_key
 
 __all__ = ["tex", "definition", "statement", "chain", "width", "COLUMN_PX", "PROOF_COLUMN_PX", "NAMES_BY_NAME"]
 
