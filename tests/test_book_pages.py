@@ -322,7 +322,9 @@ def smallest(values):
 #: through: every page but the ledger, less what is folded (proofs, solutions: ``details``) or set
 #: beside the text (margin notes: ``aside``, ``.margin``).  Those, and the whole of the ledger page
 #: (the draft's audit: register, errata, theorem ledger), are the asides, with a budget of their own.
-MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_000, 8_000, 12_000
+#: An exercise's statement stays open (a learner scans them), only its solution folds: §3, with six,
+#: is the tallest page.
+MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_000, 8_000, 13_000
 #: The pages outside the reading path.
 LEDGER_PAGES = ("s6_ledger",)
 LENGTH = r"""() => {
