@@ -59,8 +59,8 @@ def _results(ids=None):
 
 
 def _note(claim, verdict):
-    return (f"```{{margin}}\n**{claim.where}** · “{claim.quote}” — {{term}}`{WORDS[verdict]}` "
-            f"({{ref}}`in the register <claim-{claim.id}>`)\n```")
+    return (f"```{{margin}}\n**The draft** ({claim.where}): “{claim.quote}” — {{term}}`{WORDS[verdict]}` "
+            f"({{ref}}`why <claim-{claim.id}>`)\n```")
 
 
 def margin_notes(place):
