@@ -82,7 +82,7 @@ import mpmath
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "Verdict", "Identity", "Step", "calc", "Theorem", "variant", "check_identities", "written", "Dot",
+__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "Verdict", "Identity", "Step", "calc", "chains", "Theorem", "variant", "check_identities", "written", "Dot",
            "Cross", "Jacobian", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
@@ -576,8 +576,9 @@ def _decide(theorem, step, lhs, rhs, rewrites=None):
     return max(verdicts, key=lambda v: (v.status == "verified", v.residual or 0.0))
 
 
-def _chains(steps):
-    """[first, last] step indices of each maximal calc chain."""
+def chains(steps):
+    """[first, last] step indices (0-based) of each maximal calc chain of ``steps``: a run of a
+    step and the links (`Step.link`) after it."""
     runs = []
     for k, s in enumerate(steps):
         if s.link and runs:
@@ -590,7 +591,7 @@ def _chains(steps):
 def _reaches(steps, lhs, rhs):
     """Whether a run a..b of one chain goes from ``lhs`` (step a's left side) to ``rhs`` (step b's right)."""
     return any(steps[a].lhs == lhs and steps[b].rhs == rhs
-               for first, last in _chains(steps) for a in range(first, last + 1) for b in range(a, last + 1))
+               for first, last in chains(steps) for a in range(first, last + 1) for b in range(a, last + 1))
 
 
 def _rewrites(t, k, step):

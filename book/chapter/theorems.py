@@ -89,14 +89,9 @@ def _cited(text):
 
 
 def _chains(steps):
-    """The proof's calc chains: lists of (number, step), each step after a chain's first a link."""
-    runs = []
-    for k, step in enumerate(steps, 1):
-        if step.link and runs:
-            runs[-1].append((k, step))
-        else:
-            runs.append([(k, step)])
-    return runs
+    """The proof's calc chains (`proofs.core.chains`): lists of (step number, step)."""
+    from proofs.core import chains
+    return [[(k + 1, steps[k]) for k in range(first, last + 1)] for first, last in chains(steps)]
 
 
 def _proof(t):
