@@ -742,7 +742,8 @@ def test_the_formula_check_catches_a_display_too_wide_for_a_phone(browser, book_
 
 def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record(browser, book_html, tmp_path):
     """Wrong variants: a figure with 5-pt text shown at its size (5 pt at 100 dpi: 5 x 100/72 = 6.9 CSS
-    px, under 8), a figure with 10-pt text twice as wide as the 300-px column (shown at half its size:
+    px, under 8), a figure whose only small text is the superscript of a 7.2-pt ``10^{-6}`` (the label at
+    10 CSS px, its exponent drawn at 0.7 x 7.2 = 5 pt: 7 px), a figure with 10-pt text twice as wide as the 300-px column (shown at half its size:
     6.9 px), and a PNG without the record; the 10-pt figure that fits passes, one without text is not
     measured."""
     import base64
@@ -752,34 +753,35 @@ def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record
     import matplotlib.pyplot as plt
     from chapter.figures import figure_png
 
-    def shown(size=None, inches=2.4):
+    def shown(size=None, inches=2.4, title="a title"):
         fig, ax = plt.subplots(figsize=(inches, 1.6), dpi=100)
         ax.imshow([[0, 1], [1, 0]], aspect="auto")
         if size is None:
             ax.axis("off")
         else:
-            ax.set_title("a title", fontsize=size); ax.tick_params(labelsize=size)
+            ax.set_title(title, fontsize=size); ax.tick_params(labelsize=max(size, 10))
         png, size_css = figure_png(fig)
         plt.close(fig)
         return (f'<img src="data:image/png;base64,{base64.b64encode(png).decode()}" '
                 f'width="{size_css["width"]}" height="{size_css["height"]}">')
-    page = _synthetic(tmp_path, shown(5) + shown(10) + shown() + f'<img src="{_png(300, 150)}">' + shown(10, 6.4),
-                      book_html)
+    page = _synthetic(tmp_path, shown(5) + shown(10) + shown() + f'<img src="{_png(300, 150)}">' + shown(10, 6.4)
+                      + shown(7.2, title="$10^{-6}$"), book_html)
     audit = _audit(browser, page)
     found = audit["figure_text"]
-    assert [f["recorded"] for f in found] == [True, True, True, False, True]
-    assert [f["png_px"] is None for f in found] == [False, False, True, True, False]
-    assert [f is found[0] or f is found[4] for f in small_figure_text(audit, MIN_FIGURE_TEXT_PX[390])] == [True, True], found
+    assert [f["recorded"] for f in found] == [True, True, True, False, True, True]
+    assert [f["png_px"] is None for f in found] == [False, False, True, True, False, False]
+    assert [found.index(f) for f in small_figure_text(audit, MIN_FIGURE_TEXT_PX[390])] == [0, 4, 5], found
     assert found[0]["css_px"] == pytest.approx(5 * 100 / 72, rel=0.01)
     assert found[1]["css_px"] == pytest.approx(10 * 100 / 72, rel=0.01)
     wide = audit["images"][4]
     assert wide["shown"][0] == 300 and found[4]["css_px"] == pytest.approx(
         10 * 100 / 72 * 300 / (wide["natural"][0] / 2), rel=0.01)
+    assert found[5]["css_px"] == pytest.approx(0.7 * 7.2 * 100 / 72, rel=0.01)
 
 
 def test_figure_png_records_the_smallest_text_drawn(figure):
-    """The record is the smallest font size drawn, in PNG pixels (two per point at 72 dpi); a figure
-    without text records "none"."""
+    """The record is the smallest glyph size drawn, in PNG pixels (two per point at 72 dpi), a mathtext
+    superscript at its drawn size; a figure without text records "none"."""
     from chapter.figures import SMALLEST_TEXT_KEY, figure_png
     from PIL import Image
     fig, ax = figure(figsize=(3, 2), dpi=72)
@@ -788,11 +790,46 @@ def test_figure_png_records_the_smallest_text_drawn(figure):
     assert record() == "18.00"
     ax.set_xlabel("small", fontsize=6)
     assert record() == "12.00"
+    ax.set_xlabel("small", fontsize=9)
+    ax.set_title("$t^2$", fontsize=12)                  # the superscript drawn at 0.7 x 12 = 8.4 pt
+    assert record() == "16.80"
     fig2, ax2 = figure(figsize=(3, 2))
     ax2.imshow([[0, 1], [1, 0]]); ax2.axis("off")
     assert Image.open(io.BytesIO(figure_png(fig2)[0])).text[SMALLEST_TEXT_KEY] == "none"
     with pytest.raises(TypeError, match="fig must be a matplotlib.figure.Figure"):
         figure_png(ax)
+
+
+def test_drawn_size_is_the_smallest_glyph_mathtext_draws(figure):
+    """Plain text: its font size; mathtext: its smallest glyph (a script 0.7, a script's script 0.49 of
+    the size, a fraction's parts a level down); only the lines that are mathtext count."""
+    from chapter.figures import drawn_size
+    fig, ax = figure()
+    size = lambda s, parse_math=True: drawn_size(ax.text(0, 0, s, fontsize=10, parse_math=parse_math))  # noqa: E731
+    assert size("1e-6") == 10
+    assert size("$x$") == 10
+    assert size("$10^{-6}$") == pytest.approx(7)
+    assert size("$e^{x_y}$") == pytest.approx(4.9)
+    assert size(r"$\frac{a}{b}$") == pytest.approx(7)
+    assert size("$x^2$", parse_math=False) == 10
+    assert size("plain\n$x_u$") == pytest.approx(7)
+    with pytest.raises(TypeError, match="text must be a matplotlib.text.Text"):
+        drawn_size("$x$")
+
+
+def test_the_books_log_axes_label_their_ticks_in_plain_numbers(figure):
+    """After `chapter.figures.style`, a log axis's labels are plain text ("1e-6", "0.01", "1", "100":
+    every glyph at the label's size), minor ticks included where matplotlib labels them."""
+    from chapter.figures import drawn_size, style
+    style()
+    fig, ax = figure()
+    ax.loglog([1e-8, 1e3], [0.2, 0.9])
+    fig.canvas.draw()
+    x = [t.get_text() for t in ax.get_xticklabels()]
+    assert {"1e\u22126", "0.01", "1", "100"} <= set(x) and not any("$" in t for t in x), x
+    minor = [t.get_text() for t in ax.get_yticklabels(minor=True) if t.get_text()]
+    assert "0.3" in minor and not any("$" in t for t in minor), minor
+    assert min(drawn_size(t) for t in ax.get_xticklabels() + ax.get_yticklabels(minor=True)) == ax.xaxis.get_ticklabels()[0].get_fontsize()
 
 
 # --- figures: chapter.figures.text_overlaps, which chapter.page.show runs before publishing ---------

@@ -2,10 +2,12 @@
 
 `style` sets matplotlib for every figure of the book: PNG at twice the CSS
 size (for high-density screens), mathematical labels in mathtext, and no
-creation date in the file, so that a rebuild writes the same bytes; inside
-IPython a figure is displayed as `figure_png` makes it, which records in the
-PNG the smallest font size the figure draws (for the browser test of the
-figures' text on a phone).  The
+creation date in the file, so that a rebuild writes the same bytes; log axes
+labelled in plain numbers (``1e-6``, `PlainLogFormatter`: mathtext's ``10^{-6}``
+draws its exponent at 70 % of the label's size); inside IPython a figure is
+displayed as `figure_png` makes it, which records in the PNG the smallest text
+size the figure draws, sub- and superscripts at their drawn size (for the
+browser test of the figures' text on a phone).  The
 diagrams draw what the text asks the reader to picture, from the renderer's
 own functions (`renderer.pointwise`, generated from `renderer.formulas`):
 
@@ -15,8 +17,8 @@ own functions (`renderer.pointwise`, generated from `renderer.formulas`):
   bumped meridian, beside the normal of the displaced curve itself;
 * `stencil_diagram`: the central-difference stencil straddling a crease of the
   ridges field, its secant, and the two one-sided slopes;
-* `ucurve_anatomy` (in §3, on the measured curve): the regions of the U-curve and its
-  slope guides +2 and -1.
+* `ucurve_anatomy` (in §3, on the measured curve): the regions of the U-curve, its
+  slope guides +2 and -1, the model-optimal and the fitted optimal steps.
 
 Each returns a matplotlib Figure (the caller glues and closes it).
 
@@ -30,18 +32,20 @@ from __future__ import annotations
 import io
 
 import numpy as np
+from matplotlib.scale import LogScale
+from matplotlib.ticker import LogFormatter
 
 from renderer import Scene, pointwise
 
-__all__ = ["style", "figure_png", "SMALLEST_TEXT_KEY", "frame_diagram", "normal_diagram", "stencil_diagram",
+__all__ = ["style", "figure_png", "drawn_size", "PlainLogFormatter", "SMALLEST_TEXT_KEY", "frame_diagram", "normal_diagram", "stencil_diagram",
            "ucurve_anatomy", "text_overlaps", "displacement_figure"]
 
 #: The book's colours: measured (dark red), exact (dark blue), third quantity (green), guides (grey).
 RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
 
 
-#: The PNG text chunk (tEXt) in which `figure_png` records the smallest font size of a figure's drawn
-#: text, in the PNG's pixels ("none": the figure draws no text); the browser test of the built pages
+#: The PNG text chunk (tEXt) in which `figure_png` records the smallest size of a figure's drawn
+#: glyphs (`drawn_size`), in the PNG's pixels ("none": the figure draws no text); the browser test of the built pages
 #: turns it into CSS pixels at the width each image is shown.
 SMALLEST_TEXT_KEY = "symrender:smallest-text-px"
 
@@ -50,11 +54,14 @@ GUIDE_OFFSET = 30.0
 
 
 def style():
-    """Set matplotlib (and, inside IPython, the inline backend) for the book's figures: a Figure
-    displayed in IPython becomes `figure_png`'s PNG."""
+    """Set matplotlib (and, inside IPython, the inline backend) for the book's figures: log axes
+    labelled by `PlainLogFormatter` (every ``set_xscale("log")``, ``loglog`` ... of the session);
+    a Figure displayed in IPython becomes `figure_png`'s PNG."""
     import matplotlib as mpl
+    from matplotlib.scale import register_scale
     mpl.rcParams.update({"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8,
                          "savefig.bbox": "tight", "svg.hashsalt": "symrender", "image.interpolation": "nearest"})
+    register_scale(_PlainLogScale)
     try:
         from IPython.core.interactiveshell import InteractiveShell
         from matplotlib.figure import Figure
@@ -64,6 +71,63 @@ def style():
             InteractiveShell.instance().display_formatter.formatters["image/png"].for_type(Figure, figure_png)
     except (ImportError, AttributeError, NameError):
         pass                                            # outside IPython: nothing to configure
+
+
+class PlainLogFormatter(LogFormatter):
+    """Log-axis tick labels as plain numbers, every character at the label's size: ``0.01`` to
+    ``1000`` as decimals, others as ``1e-6``, ``2e5`` (matplotlib's default, mathtext's
+    ``10^{-6}``, draws the exponent at 70 % of the label's size: 6-7 CSS px on a phone)."""
+
+    def _num_to_string(self, x, vmin, vmax):
+        if 1e-2 <= x < 1e4:
+            return f"{x:g}"
+        mantissa, exponent = f"{x:.0e}".split("e")
+        return f"{mantissa}e{int(exponent)}"
+
+
+class _PlainLogScale(LogScale):
+    """The "log" scale with `PlainLogFormatter` on its major and minor ticks (`style` registers it)."""
+
+    def __init__(self, *, base=10, subs=None, nonpositive="clip"):     # no axis: matplotlib >= 3.11's form
+        super().__init__(base=base, subs=subs, nonpositive=nonpositive)
+
+    def set_default_locators_and_formatters(self, axis):
+        super().set_default_locators_and_formatters(axis)
+        axis.set_major_formatter(PlainLogFormatter())
+        axis.set_minor_formatter(PlainLogFormatter(labelOnlyBase=self.subs is not None))
+
+
+def drawn_size(text):
+    """The smallest font size, in points, at which ``text`` draws a glyph: its font size, or, for a
+    line of mathtext (``$...$``), the size of its smallest glyph (a sub- or superscript is drawn at
+    0.7 of its base, a script of a script at 0.49; matplotlib's mathtext layout, as it draws it).
+
+    Parameters
+    ----------
+    text : matplotlib.text.Text
+
+    Returns
+    -------
+    float
+        Points; ``text.get_fontsize()`` for a text with no mathtext or no glyph.
+
+    Raises
+    ------
+    TypeError
+        ``text`` is not a matplotlib Text.
+    """
+    from matplotlib.cbook import is_math_text
+    from matplotlib.mathtext import MathTextParser
+    from matplotlib.text import Text
+    if not isinstance(text, Text):
+        raise TypeError(f"text must be a matplotlib.text.Text, got {type(text).__name__}")
+    sizes = [text.get_fontsize()]
+    if text.get_parse_math() and not text.get_usetex():
+        for line in text.get_text().split("\n"):
+            if is_math_text(line):
+                glyphs = MathTextParser("path").parse(line, 72, text.get_fontproperties()).glyphs
+                sizes += [g[1] for g in glyphs]
+    return float(min(sizes))
 
 
 def _drawn_texts(fig):
@@ -92,7 +156,7 @@ def _drawn_texts(fig):
 def figure_png(fig):
     """``fig`` as the book's PNG, the way IPython's "retina" format makes it (drawn at twice
     ``fig.dpi``: two device pixels per CSS pixel; cropped to its content), without a software
-    name, and with the smallest font size of its drawn text recorded under `SMALLEST_TEXT_KEY`.
+    name, and with the smallest size of its drawn glyphs recorded under `SMALLEST_TEXT_KEY`.
 
     Parameters
     ----------
@@ -103,9 +167,9 @@ def figure_png(fig):
     (bytes, dict) or None
         The PNG file, and {"width": w, "height": h}, its size in CSS pixels (half its pixels;
         IPython's image metadata); None for a figure with nothing in it, as IPython's own
-        formatter.  The chunk holds the smallest font size drawn (``Text.get_fontsize`` of every
-        text drawn: titles, labels, tick labels in view, legend entries, annotations), in the
-        PNG's pixels (``2 * dpi / 72`` per point), as a decimal with two places, or "none" when
+        formatter.  The chunk holds the smallest glyph size drawn (`drawn_size` of every
+        text drawn: titles, labels, tick labels in view, legend entries, annotations; a
+        mathtext superscript at its drawn 70 %), in the PNG's pixels (``2 * dpi / 72`` per point), as a decimal with two places, or "none" when
         the figure draws no text.
 
     Raises
@@ -118,7 +182,7 @@ def figure_png(fig):
     from PIL import Image
     if not isinstance(fig, Figure):
         raise TypeError(f"fig must be a matplotlib.figure.Figure, got {type(fig).__name__}")
-    sizes = [t.get_fontsize() * 2 * fig.dpi / 72 for t in _drawn_texts(fig)]
+    sizes = [drawn_size(t) * 2 * fig.dpi / 72 for t in _drawn_texts(fig)]
     smallest = f"{min(sizes):.2f}" if sizes else "none"
     png = print_figure(fig, "retina", metadata={"Software": None, SMALLEST_TEXT_KEY: smallest})
     if png is None:
@@ -273,35 +337,45 @@ def ucurve_anatomy(curve):
 
     Lines: the float64 quotient's error (label ``|error| ...``), its exact split into exact
     arithmetic at the rounded u +- eps (dashed) and the rounding of the float64 evaluation
-    (dotted), the model A eps^2 + B / eps fitted to the error (label ``model ...``), a vertical
-    line at its minimiser, the fitted optimal step eps^, and two slope guides (labels
-    ``_guide slope +2`` and ``_guide slope -1``, kept out of the legend), each parallel to one
-    arm of the fitted model (A eps^2 on steps of 100 eps^ and more, B / eps on steps of
-    eps^ / 100 and less) a factor `GUIDE_OFFSET` above it, with its slope written beside it.
-    Steps in chart units, errors in height per chart unit.  Returns the Figure.
+    (dotted), over a wide translucent band, the model A eps^2 + B / eps fitted to the error
+    (label ``model ...``: a band, so that it shows on both sides of the measured curve it
+    follows), two vertical lines, at the model-optimal step eps* (dotted, labelled right of
+    it) and the fitted optimal step eps^ (dash-dotted, labelled left of it), and two slope
+    guides (labels ``_guide slope +2`` and ``_guide slope -1``, kept out of the legend), each
+    parallel to one arm of the fitted model (A eps^2 on steps of 100 eps^ and more, B / eps
+    on steps of eps^ / 100 and less) a factor `GUIDE_OFFSET` above it, with its slope written
+    beside it.  No sub- or superscript anywhere (mathtext draws them at 70 %: under 8 CSS px
+    on a phone).  Steps in chart units, errors in height per chart unit.  Returns the Figure.
     """
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(5.0, 3.1))
-    ax.loglog(curve.eps, curve.error, lw=2, color=RED, label="|error| of the float64 quotient")
-    ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, label="exact arithmetic at the rounded $u \\pm \\varepsilon$")
-    ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, label="rounding of the float64 evaluation")
     A, B = curve.fitted_truncation, curve.fitted_roundoff
-    ax.loglog(curve.eps, A * curve.eps**2 + B / curve.eps, color=GREY, lw=1,
-              label=r"model $A\varepsilon^2 + B/\varepsilon$ fitted to it")
-    opt = curve.eps_fitted
-    ax.axvline(opt, color=GREY, lw=0.8, ls="-.")
-    right = np.geomspace(100 * opt, curve.eps.max(), 20)
-    left = np.geomspace(curve.eps.min(), opt / 100, 20)
-    for steps, arm, slope, words in ((right, lambda e: A * e**2, "+2", r"truncation $\propto\varepsilon^2$"),
-                                     (left, lambda e: B / e, "\u22121", r"rounding $\propto 1/\varepsilon$")):
+    ax.loglog(curve.eps, A * curve.eps**2 + B / curve.eps, color=GREY, lw=7, alpha=0.4, solid_capstyle="butt",
+              label="model fitted to the error", zorder=1)
+    ax.loglog(curve.eps, curve.error, lw=1.6, color=RED, label="|error| of the float64 quotient", zorder=3)
+    ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, lw=1.2,
+              label="exact arithmetic at the rounded $u \\pm \\varepsilon$", zorder=4)
+    ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, lw=1.2, label="rounding of the float64 evaluation",
+              zorder=4)
+    fitted, model = curve.eps_fitted, curve.eps_model
+    ax.axvline(fitted, color=GREY, lw=0.9, ls="-.")
+    ax.axvline(model, color="k", lw=0.9, ls=":")
+    right = np.geomspace(100 * fitted, curve.eps.max(), 20)
+    left = np.geomspace(curve.eps.min(), fitted / 100, 20)
+    for steps, arm, slope, words in ((right, lambda e: A * e**2, "+2", "truncation"),
+                                     (left, lambda e: B / e, "\u22121", "rounding")):
         ax.loglog(steps, GUIDE_OFFSET * arm(steps), color="k", lw=1.2, label=f"_guide slope {slope}")
         mid = np.sqrt(steps[0] * steps[-1])                      # the guide's middle on log axes
         ax.annotate(f"slope {slope}\n{words}", (mid, GUIDE_OFFSET * arm(mid)), (mid, 60 * GUIDE_OFFSET * arm(mid)),
                     ha="center", va="bottom", fontsize=9, arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
-    ax.annotate(r"fitted $\hat\varepsilon$", (opt, 1e-17), (opt * 3, 1e-17), fontsize=9)
-    ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $h_u$"); ax.set_ylim(1e-18, 1e5)
+    ax.annotate(r"fitted $\hat\varepsilon$", (fitted / 1.6, 1e-17), ha="right", fontsize=9)
+    ax.annotate("model-optimal \u03b5*", (model * 1.6, 1e-17), ha="left", fontsize=9)
+    ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $\partial h/\partial u$"); ax.set_ylim(1e-18, 1e5)
+    ax.xaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=6))
     ax.yaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=7))
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False, fontsize=9)   # below the axes
+    handles, labels = ax.get_legend_handles_labels()                 # the measured curves first, the model last
+    ax.legend(handles[1:] + handles[:1], labels[1:] + labels[:1], loc="upper center", bbox_to_anchor=(0.5, -0.2),
+              frameon=False, fontsize=9)                             # below the axes
     ax.grid(alpha=0.3)
     return fig
 
