@@ -426,6 +426,30 @@ class Page:
 
 #: Every image of the article: in a numbered, captioned figure, with alt text, at
 #: ``sharpness`` device pixels per CSS pixel or more.
+#: Run in a page: each table of the article (shown ones) as {"where", "rows": rows shown, "split_rows":
+#: rows whose shown cells do not share a top (a row stacked into a card), "scrolls": whether the box
+#: around it (or the table itself) scrolls sideways, "right": the right edge of that box, "window": the window's width}.
+TABLES = r"""() => [...document.querySelectorAll('article.bd-article table')].filter(t => t.getClientRects().length)
+  .map(t => {
+    const shown = el => el.getClientRects().length > 0, s = t.closest('section[id]');
+    const rows = [...t.rows].filter(shown);
+    const split = rows.filter(r => {
+      const tops = [...r.cells].filter(shown).map(c => c.getBoundingClientRect().top);
+      return tops.length > 1 && Math.max(...tops) - Math.min(...tops) > 1;
+    });
+    const box = ['auto', 'scroll'].includes(getComputedStyle(t).overflowX) ? t : t.parentElement;
+    return {where: s ? '#' + s.id : '', rows: rows.length, split_rows: split.length,
+            scrolls: ['auto', 'scroll'].includes(getComputedStyle(box).overflowX),
+            right: box.getBoundingClientRect().right, window: document.documentElement.clientWidth};
+  })"""
+
+
+def split_tables(tables):
+    """The tables of a page (`TABLES`) that are not tables as shown: a row's cells stacked, or the box
+    around the table reaching past the window."""
+    return [t for t in tables if t["split_rows"] or t["right"] > t["window"] + 0.5]
+
+
 FIGURES = """(sharpness) => {
   const main = document.querySelector('article.bd-article');
   return [...main.querySelectorAll('img')].map(img => {
@@ -462,6 +486,7 @@ def site(browser, book_html):
                 found[name, width] = p.audit()
                 found[name, width]["length"] = lengths
                 found[name, width]["figures"] = p.page.evaluate(FIGURES, 2)
+                found[name, width]["tables"] = p.page.evaluate(TABLES)
                 if os.environ.get("SYMRENDER_SHOTS") == "1":
                     p.screenshot(shots / f"{name}_{width}.png")
         finally:
@@ -521,6 +546,35 @@ def test_no_word_or_number_broken_across_lines(site, name, width):
 def test_nothing_wider_than_its_column(site, name, width):
     bad = site[name, width]["overflow"]
     assert not bad, f"{name} at {width} px: wider than the column or cut off:\n{_listing(bad)}"
+
+
+def test_every_table_keeps_its_rows_as_rows_at_both_widths(site):
+    """At 390 and 1280 px every table of the book (§3's optima, §5's census and iterates, ...) is shown
+    as a table: the cells of each row side by side (one top), inside a box that scrolls sideways and
+    ends within the window; and no page is wider than the window."""
+    tables = {w: [dict(t, page=n) for n in PAGES for t in site[n, w]["tables"]] for w in WIDTHS}
+    assert min(len(found) for found in tables.values()) >= 4
+    for width, found in tables.items():
+        assert all(t["scrolls"] and t["rows"] >= 2 for t in found), _listing(found)
+        assert not split_tables(found), f"tables not shown as tables at {width} px:\n{_listing(split_tables(found))}"
+        wide = [n for n in PAGES for f in site[n, width]["overflow"] if f["kind"] == "page wider than the window"]
+        assert not wide, (width, wide)
+
+
+def test_the_table_check_catches_rows_stacked_into_cards(browser, book_html):
+    """Wrong variant: the old phone rule that set each cell of a row as a block of its own (a card per
+    row); §3's optima table and §5's tables are then caught at 390 px, and pass without it."""
+    cards = ("article.bd-article table, article.bd-article tbody, article.bd-article tr, article.bd-article th,"
+             " article.bd-article td { display: block; width: auto !important; }")
+    for name in ("s3_math", "s5_lab"):
+        p = Page(browser, (book_html / f"{name}.html").as_uri(), 390)
+        try:
+            assert p.page.evaluate(TABLES) and not split_tables(p.page.evaluate(TABLES))
+            p.page.add_style_tag(content=cards)
+            found = p.page.evaluate(TABLES)
+            assert found and len(split_tables(found)) == len(found), found
+        finally:
+            p.close()
 
 
 def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_size(site):

@@ -1,10 +1,10 @@
 // Keeps every page within its column without breaking a word or a number (see fit.css):
-// - each table cell carries its column's header as data-label (fit.css shows it in a narrow window);
 // - a number with a hyphen in it (1e-16, 2-3) is kept on one line: Chromium breaks after that hyphen;
 // - a long identifier or code line gets <wbr> break points between its parts (after . _ / ( [ , = and
 //   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word;
 // - typeset maths (MathJax 3 has no automatic line breaking) and tables wider than their column are
-//   scaled down to fit, tables to no less than MIN_TABLE; a wider table scrolls inside its box.
+//   scaled down to fit, tables to no less than MIN_TABLE; a wider table scrolls sideways inside the
+//   theme's box around it (fit.css).
 // Scaling is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
@@ -70,19 +70,6 @@
     });
   }
 
-  function label(root) {
-    root.querySelectorAll("table").forEach(function (t) {
-      var heads = Array.prototype.map.call(t.querySelectorAll("thead th"), function (th) {
-        return th.textContent.trim();
-      });
-      t.querySelectorAll("tbody tr").forEach(function (tr) {
-        Array.prototype.forEach.call(tr.children, function (td, i) {
-          if (heads[i]) td.setAttribute("data-label", heads[i]);
-        });
-      });
-    });
-  }
-
   // The width the content of block-level element el may take.
   function room(el) {
     while (el && /^(inline|contents)/.test(getComputedStyle(el).display)) el = el.parentElement;
@@ -128,7 +115,6 @@
     else done();
   }
 
-  window.addEventListener("DOMContentLoaded", function () { if (article()) label(article()); });
   window.addEventListener("load", whenTypeset);
   // Whenever the article changes size: the window resized, a sidebar slid in or out (the column
   // settles after the resize event), a <details> opened (its maths and tables have a width only now).

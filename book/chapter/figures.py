@@ -232,7 +232,8 @@ def frame_diagram(theta=-0.35, phi=0.8):
                                (e_p, GREEN, r"$e_\varphi$ (along $v$)")):
         tip = project(N + 0.45 * vec)
         ax.annotate("", tip, base, arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.8))
-        ax.text(*(tip + 0.04 * (tip - base) / max(np.linalg.norm(tip - base), 1e-9)), label, color=colour)
+        ax.text(*(tip + 0.04 * (tip - base) / max(np.linalg.norm(tip - base), 1e-9)), label, color=colour,
+                fontsize=11)                                     # its subscript drawn at 0.7 x 11 = 7.7 pt
     ax.plot(*project(_sphere_point(0.0, 0.0)), "o", color="k", ms=3)
     ax.text(*(project(_sphere_point(0.0, 0.0)) + [0.03, 0.03]), r"pole $\varphi = 0$")
     ax.set_aspect("equal"); ax.axis("off")
@@ -306,8 +307,8 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
 
 def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     """h along u across the crease u = 1/k_u of the ridges field, the central stencil
-    u0 +- eps with u0 just beside the crease, its secant (the central difference), and the
-    exact one-sided slope at u0 (`pointwise.height`, `pointwise.exact_gradient`)."""
+    u0 +- eps with its centre u0 just beside the crease, its secant (the central difference),
+    and the exact one-sided slope at u0 (`pointwise.height`, `pointwise.exact_gradient`)."""
     import matplotlib.pyplot as plt
     crease = 1.0 / k_u
     u = np.linspace(crease - 3 * eps, crease + 3 * eps, 400)
@@ -319,15 +320,15 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     fig, ax = plt.subplots(figsize=(5.0, 2.9))
     ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
     ax.axvline(crease, color=GREY, lw=0.8, ls=":")
-    ax.annotate(r"crease $u = 1/k_u$", (crease, 1), xycoords=("data", "axes fraction"), xytext=(-4, -4),
+    ax.annotate("crease", (crease, 1), xycoords=("data", "axes fraction"), xytext=(-4, -4),
                 textcoords="offset points", ha="right", va="top")      # inside the axes, clear of the title
     ax.plot([u0 - eps, u0 + eps], [h_m, h_p], "o-", color=RED, label=rf"central stencil: slope {secant:+.2f}")
     du = np.array([-1.5 * eps, 1.5 * eps])
-    ax.plot(u0 + du, h_0 + exact * du, color=BLUE, lw=1.5, label=rf"exact slope at $u_0$: {exact:+.2f}")
+    ax.plot(u0 + du, h_0 + exact * du, color=BLUE, lw=1.5, label=rf"exact slope at the centre: {exact:+.2f}")
     ax.plot([u0], [h_0], "o", color=BLUE)
     ax.set_xlabel(r"$u$"); ax.set_ylabel(r"$h$")
     ax.legend(loc="lower right", frameon=False, fontsize=9)
-    ax.set_title(r"the stencil $u_0 \pm \varepsilon$ straddles the crease")
+    ax.set_title("a central stencil straddles the crease")           # no sub- or superscripts: 9 pt and up
     return fig
 
 
