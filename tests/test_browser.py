@@ -1039,7 +1039,8 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
 #: ledger in the middle).  The targets: the main controls (the field,
 #: ε and β: at every position where they stick to the screen, else at "top"), the readout (its
 #: part below what sticks at the top: a box scrolled under a bar is not covered by it), and at
-#: both "ucurve" positions the plot and its caption, which must also lie wholly on the screen.
+#: both "ucurve" positions the plot and its caption, which must also lie wholly on the screen,
+#: and on a phone (under 720 px) the ε slider, wholly on the screen with them.
 COVERED_JS = """async (where) => {
   const sticky = el => getComputedStyle(el).position === 'sticky';
   const main = document.querySelector('.sim-main'), readout = document.getElementById('sim-readout');
@@ -1075,6 +1076,8 @@ COVERED_JS = """async (where) => {
     for (const id of ['sim-height_field', 'sim-log_eps', 'sim-beta']) check(document.getElementById(id), '#' + id);
   check(readout, '#sim-readout', bar());
   if (where.startsWith('ucurve')) {
+    // On a phone the ε slider must be on the screen with the plot, so that moving it shows the curve move.
+    if (innerWidth < 720) check(document.getElementById('sim-log_eps'), '#sim-log_eps beside the plot', 0, true);
     check(document.getElementById('sim-curve'), '#sim-curve', 0, true);
     check(document.getElementById('sim-curve-caption'), '#sim-curve-caption', 0, true);
   }
@@ -1123,7 +1126,7 @@ def test_the_controls_readout_and_u_curve_never_cover_each_other(browser, book_h
     """Scrolled to the simulator's top, its canvases, its U-curve and its ledger, with a pixel read
     out: the main controls are never under the theme's header or the readout, the readout is
     under nothing but what sticks at the top, and the U-curve's plot with its caption, at the
-    bottom of the screen and in its middle, lies on the screen covered by nothing (`COVERED_JS`).  Screenshots of each
+    bottom of the screen and in its middle, lies on the screen covered by nothing, on a phone with the ε slider (`COVERED_JS`).  Screenshots of each
     position go to test-artifacts/s4_<width>px_<position>.png."""
     found = _layout(browser, book_html, width, shots="")
     assert found == dict.fromkeys(READING_POSITIONS, []), found
@@ -1136,6 +1139,8 @@ WRONG_LAYOUTS = {
         "position: sticky; top: 3.5rem;", "position: sticky; top: 0;", "#sim-height_field covered by div.bd-header-article"),
     "the sticky readout below the U-curve, over its caption": (
         ".symrender-sim .sim-curve { order: 1; }", "", "#sim-curve-caption covered by dl#sim-readout"),
+    "the controls scrolled away from the U-curve": (
+        "position: sticky; top: 3.5rem;", "position: static;", "#sim-log_eps beside the plot covered by nothing (off the screen)"),
     "the readout scrolled over the sticky controls": (
         "z-index: 3; /* above the readout */", "z-index: 1;", "covered by dl#sim-readout"),
 }
