@@ -187,7 +187,7 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
     return Theorem(
         id="central-difference-truncation", title="Truncation error of the central difference",
         statement=(r"$⟦series⟧$. Away from the seam and the poles this quotient is the renderer's central-difference "
-                   r"stencil, in $u$ and in $v$, for every height field: $⟦stencil⟧$; at the "
+                   r"stencil $D_u$, $D_v$, in $u$ and in $v$, for every height field: $⟦stencil⟧$; at the "
                    r"borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
                    r"clamped distance.  The footprint steps are pbrt-v4's "
                    r"$\tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ (likewise $v$)."),
@@ -203,7 +203,7 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
                  quotients, cases=_kernel_cases()),
         ),
         claims={"series": (QUOTIENT, series), "stencil": (kernel, quotients)},
-        names={CENTRAL_U: r"\mathrm{CENTRAL}_u", CENTRAL_V: r"\mathrm{CENTRAL}_v"},
+        names={CENTRAL_U: "D_u", CENTRAL_V: "D_v"},
         domain={**SERIES_DOMAIN, **KERNEL_DOMAIN}, functions=INSTANCE,
         evidence=partial(_stencil_evidence, **stencil),
         wrong_variants=(("coefficient 1/3 instead of 1/6",

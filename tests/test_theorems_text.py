@@ -5,16 +5,21 @@ was proved and what was checked numerically."""
 
 import pytest
 
-from chapter.theorems import BADGE_STEPS_PROVED, BADGES, badge, code_words
+from chapter import latex
+from chapter.theorems import BADGE_STEPS_PROVED, BADGES, _chains, badge, code_words
 from proofs.registry import THEOREMS
 
 
 def _texts(t):
+    """Each text the book prints of ``t``, with where it stands."""
     yield "title", t.title
-    yield "statement", t.statement
+    yield "statement", latex.statement(t)
     for k, step in enumerate(t.steps, 1):
         yield f"step {k}", step.why
         yield f"step {k} (why numeric)", step.why_numeric or ""
+    for run in _chains(t.steps):
+        yield (f"display of steps {run[0][0]}-{run[-1][0]}",
+               "$$" + latex.chain(t, [s for _, s in run], [k for k, _ in run]) + "$$")
 
 
 @pytest.mark.parametrize("theorem_id", list(THEOREMS))
@@ -29,6 +34,7 @@ def test_theorem_text_names_no_code(theorem_id):
     ("the renderer's bump (renderer.formulas.BUMP['surface'])", ["renderer.formulas"]),
     ("kernel.reach gives each light the same mask", ["kernel.reach"]),
     ("against `GRADIENT`", ["`GRADIENT`"]),
+    ("$(\\mathrm{CENTRAL}_u, \\mathrm{crease}, t_{\\mathrm{floor}})$", ["\\mathrm{CENTRAL}"]),
     ("the seed's half-width", ["seed"]),
     ("at 24 seeded points, $s_1 = \\sin\\pi k_u u$, $N_x$, width 0.03, the draft's `bump=\"surface\"`", []),
 ])

@@ -48,14 +48,17 @@ def badge(status, numeric=()):
 #: set as code (`GRADIENT`), or "seed" (the book calls the source document "the draft").
 _CODE_WORD = re.compile(r"\b[A-Z][A-Z0-9]*_[A-Z0-9_]*\b|\b[A-Za-z_]\w+\.[A-Za-z_]\w+|`[^`]*\b[A-Z]{2,}\b[^`]*`")
 _SEED = re.compile(r"\bseed\b", re.IGNORECASE)
+#: ... and, in mathematics too, a constant's name set upright (\mathrm{CENTRAL}).
+_UPRIGHT_CONSTANT = re.compile(r"\\mathrm\{[A-Z][A-Z0-9_]+\}")
 _MATH = re.compile(r"\$\$.*?\$\$|\$[^$]*\$", re.S)
 
 
 def code_words(text):
     """The tokens of ``text`` (a theorem's title, statement, step sentence or evidence) that
-    read as code or audit vocabulary, outside its ``$...$`` mathematics: constant-shaped
+    read as code or audit vocabulary: outside its ``$...$`` mathematics, constant-shaped
     names (``KINK_BAND``), dotted paths (``renderer.formulas``), code spans holding a
-    constant (```GRADIENT```) and the word "seed".  An empty list is text a reader can read.
+    constant (```GRADIENT```) and the word "seed"; anywhere, a constant's name set upright
+    (``\\mathrm{CENTRAL}``).  An empty list is text a reader can read.
 
     Parameters
     ----------
@@ -67,7 +70,8 @@ def code_words(text):
         The offending tokens, in order.
     """
     prose = _MATH.sub(" ", text)
-    return [m.group(0) for m in _CODE_WORD.finditer(prose)] + [m.group(0) for m in _SEED.finditer(prose)]
+    return ([m.group(0) for m in _CODE_WORD.finditer(prose)] + [m.group(0) for m in _SEED.finditer(prose)]
+            + _UPRIGHT_CONSTANT.findall(text))
 
 
 def tex_number(x) -> str:
