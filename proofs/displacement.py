@@ -225,8 +225,8 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                  r"surface bump's coefficients of $e_\theta$ and $e_\varphi$, away from the poles, are the bracket's",
                  coeffs, chart),
             Step(r"Suppose the draft's bump were, to first order in $\beta$, the normal of a displaced sphere "
-                 r"$P = (R + \beta G)N$. By step 2 with $G$ for $H$, that normal tilts by "
-                 r"$-\beta\,(G_\theta/(R\sin\varphi), G_\varphi/R)$ to first order; the draft's tilts by "
+                 r"$P = (R + \beta G)N$: by step 2 with $G$ for $H$, that normal tilts by "
+                 r"$-\beta\,(G_\theta/(R\sin\varphi), G_\varphi/R)$ to first order, and the draft's by "
                  r"$\beta(h_u, h_v) = \beta(2\pi H_\theta, \pi H_\varphi)$. The two agree when $G$ has the partial "
                  r"derivatives $G_\theta$ and $G_\varphi$", sp.Tuple(-G_T / (R * sp.sin(phi)), -G_P / R),
                  sp.Tuple(2 * sp.pi * H_t, sp.pi * H_p), defines=(G_T, G_P)),

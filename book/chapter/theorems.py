@@ -196,7 +196,7 @@ def _entry(t):
              f"**{badge(v.status, v.numeric)}** · evidence: {{ref}}`§6 <ledger-{t.id}>`"
              f"{chr(10) * 2 + note if note else ''}\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
-    return dict(title=t.title, status=v.status, numeric=list(v.numeric), evidence=v.evidence, seed_says=t.seed_says,
+    return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
                 pages=list(t.pages), block=block, unexplained=unexplained,
                 changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
 
@@ -274,7 +274,7 @@ def ledger_table():
     for theorem_id, e in ledger().items():
         _refuse(theorem_id, e)
         items.append(f"* (ledger-{theorem_id})=\n  {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
-                     f"**{badge(e['status'], e['numeric'])}**.\n\n"
+                     f"**{BADGES[e['status']]}**.\n\n"
                      f"  {_folded('Evidence', e['evidence'])}")
     return "\n".join(items)
 
