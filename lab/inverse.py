@@ -5,7 +5,7 @@ A render's G-buffer holds, per pixel of sphere A, the perturbed normal N'(β)
 otherwise the same scene, `fit_beta` recovers β: the residual is
 N'(β) - target over sphere A's pixels, and its Jacobian ∂N'/∂β is sympy's
 derivative of `renderer.formulas.PERTURBED_NORMAL` for the scene's bump mode
-(`JACOBIAN`).  Everything else N' depends on (N, the tangent frame, h and its
+(`jacobian`).  Everything else N' depends on (N, the tangent frame, h and its
 exact gradient) is geometry and does not depend on β (the bump moves no
 boundary), so it is read once from a G-buffer of the scene.
 
@@ -28,21 +28,42 @@ from renderer.render import MAX_SIDE, check_args
 from renderer.scene import MAX_BETA
 from renderer.validate import InvalidType, InvalidValue, positive_int, real
 
-__all__ = ["Fit", "fit_beta", "geometry", "JACOBIAN", "normal_and_jacobian", "MAX_STEPS"]
+__all__ = ["Fit", "fit_beta", "geometry", "jacobian", "normal_and_jacobian", "MAX_STEPS"]
 
 #: Most Gauss–Newton steps `fit_beta` accepts.
 MAX_STEPS = 100
-#: ∂N'/∂β per bump mode: sympy's derivative of each component of `formulas.PERTURBED_NORMAL`.
-JACOBIAN = {mode: tuple(sp.diff(c, formulas.beta) for c in normal)
-            for mode, normal in formulas.PERTURBED_NORMAL.items()}
 #: The arguments of both modes' normals and Jacobians (the chart mode ignores h, R, sin φ).
 _ARGS = ((formulas.N_x, formulas.N_y, formulas.N_z) + formulas.e_theta + formulas.e_phi
          + (formulas.h_u, formulas.h_v, formulas.beta, formulas.h, formulas.R, formulas.sin_phi))
 
 
 @functools.lru_cache(maxsize=None)
+def jacobian(mode):
+    """∂N'/∂β for one bump mode: sympy's derivative of each component of
+    `formulas.PERTURBED_NORMAL[mode]`, taken on first use (not at import).
+
+    Parameters
+    ----------
+    mode : {"chart", "surface"}
+
+    Returns
+    -------
+    tuple of 3 sympy expressions
+        In the symbols of `renderer.formulas` (dimensionless, per unit β).
+
+    Raises
+    ------
+    KeyError
+        If ``mode`` is not a bump mode of `formulas.PERTURBED_NORMAL`.
+    """
+    if mode not in formulas.PERTURBED_NORMAL:
+        raise KeyError(f"mode must be one of {sorted(formulas.PERTURBED_NORMAL)}, got {mode!r}")
+    return tuple(sp.diff(c, formulas.beta) for c in formulas.PERTURBED_NORMAL[mode])
+
+
+@functools.lru_cache(maxsize=None)
 def _lambdified(mode):
-    return sp.lambdify(_ARGS, [list(formulas.PERTURBED_NORMAL[mode]), list(JACOBIAN[mode])], "numpy", cse=True)
+    return sp.lambdify(_ARGS, [list(formulas.PERTURBED_NORMAL[mode]), list(jacobian(mode))], "numpy", cse=True)
 
 
 def normal_and_jacobian(mode, geometry, beta):

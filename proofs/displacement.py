@@ -169,14 +169,14 @@ def _evidence(kernel=KERNEL_COEFFS, integrable=INTEGRABLE, bump="surface", gradi
     obstruction = {f: integrability_obstruction(f) for f in ("sine", "ridges", "rings")}
     found = tuple(f for f, o in obstruction.items() if o == 0)
     if set(found) != set(integrable):
-        return Verdict("refuted", f"the seed's bump is a displaced sphere's normal for {found or 'no field'}, "
+        return Verdict("refuted", f"the draft's bump is a displaced sphere's normal for {found or 'no field'}, "
                        f"not {integrable}: integrability obstructions {obstruction}")
     worst, compared, left_out = surface_normal_residual(bump, gradient)
     if worst > 1e-12:
         return Verdict("refuted", f"renderer's bump={bump!r}, gradient={gradient!r} normal differs from the displaced "
                        f"surface's by {worst:.2e}", worst, rendered=compared)
-    return Verdict("proved", f"the obstruction is 0 for {', '.join(found)} only (the seed's bump is the normal of no "
-                   f"displaced sphere for the others); the renderer's bump='surface' Ns within {worst:.1e} of the "
+    return Verdict("proved", f"the obstruction is 0 for {', '.join(found)} only (the draft's bump is the normal of no "
+                   f"displaced sphere for the others); the renderer's surface-bump normals within {worst:.1e} of the "
                    f"displaced normal (mpmath, {compared} seeded sphere-A pixels of the three fields, pole ring and "
                    f"crease neighbours included; {left_out} inside the pole floor sin phi <= "
                    f"{float(F.POLE_SIN_PHI):g} left out)", rendered=compared)
@@ -199,12 +199,19 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
     potential = sp.Tuple(sp.Derivative(-sp.pi * R * H_at, theta), sp.Derivative(-sp.pi * R * H_at, phi))
     return Theorem(
         id="bump-vs-displacement", title="Bump versus displacement",
-        statement=r"For $⟦P⟧$: $⟦cross⟧$. In chart terms ($H_\theta = h_u/2\pi$, $H_\varphi = h_v/\pi$) the "
-                  r"displaced normal's tangential coefficients are the renderer's `bump='surface'` "
-                  r"(`renderer.formulas.BUMP['surface']`): $⟦kernel⟧$, against the seed's $\beta(h_u, h_v)$: opposite "
-                  r"sign, and the chart's metric factors missing. The seed's bump is, to first order, the normal of a "
-                  r"displaced sphere $(R + \beta G)N$ only if $⟦curl⟧$ vanishes identically: it does for the rings "
-                  r"field, with $G = -\pi R h$, and not for the sine and ridges fields.",
+        statement=r"Displace sphere A (radius $R$) along its normal $N(\theta, \varphi)$ by $\beta$ times the "
+                  r"height $H(\theta, \varphi)$: the height field $h$ at the chart point of the angles $\theta$, "
+                  r"$\varphi$, with partial derivatives $H_\theta = \partial H/\partial\theta$ and "
+                  r"$H_\varphi = \partial H/\partial\varphi$. The displaced surface $⟦P⟧$ has $⟦cross⟧$, and its "
+                  r"unit normal is the bracket normalised. In chart terms ($H_\theta = h_u/2\pi$, "
+                  r"$H_\varphi = h_v/\pi$) the bracket's tangential coefficients are the renderer's surface bump, "
+                  r"the book's " '(`bump="surface"`)' r": $⟦kernel⟧$. The draft's bump $\beta(h_u, h_v)$ has the "
+                  r"opposite sign and lacks the chart's metric factors. Nor is the draft's bump, to first order in "
+                  r"$\beta$, the normal of another displaced sphere $(R + \beta G)N$, except on one field: it would "
+                  r"need $G$ to have the partial derivatives $⟦G_theta⟧$ and $⟦G_phi⟧$. Partial derivatives of one "
+                  r"function have zero curl (its mixed partials commute), and here $⟦curl⟧$. This vanishes "
+                  r"identically for the rings field, with $G = -\pi R h$; it does not for the sine and ridges "
+                  r"fields, where the draft's bump is the normal of no displaced sphere.",
         steps=(
             *calc(cross,
                   (r"Differentiate $P = (R + \beta H)N$, with $\partial N/\partial\theta = \sin\varphi\, e_\theta$ and "
@@ -215,15 +222,21 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                    r"$e_\varphi \times e_\theta = N$, $N \times e_\theta = -e_\varphi$ and $e_\varphi \times N = "
                    r"-e_\theta$", claim)),
             Step(r"In chart terms $H_\theta = h_u/2\pi$ and $H_\varphi = h_v/\pi$ by ⟪chart⟫; the renderer's "
-                 r"`bump='surface'` coefficients of $e_\theta$ and $e_\varphi$, off its pole floor, are the bracket's",
+                 r"surface bump's coefficients of $e_\theta$ and $e_\varphi$, away from the poles, are the bracket's",
                  coeffs, chart),
-            Step(r"To first order in $\beta$ the normal of $P = (R + \beta G)N$ tilts by $-\beta\,(G_\theta/(R\sin"
-                 r"\varphi), G_\varphi/R)$; it is the seed's $\beta(h_u, h_v) = \beta(2\pi H_\theta, \pi H_\varphi)$ "
-                 r"for", sp.Tuple(-G_T / (R * sp.sin(phi)), -G_P / R), sp.Tuple(2 * sp.pi * H_t, sp.pi * H_p),
-                 defines=(G_T, G_P)),
-            Step("Such a $G$ exists only where this gradient is curl-free", curl, -sp.pi * R * obstruction),
-            Step(r"For the rings field $h$ depends on $\varphi$ alone, $H_\theta = 0$ and the curl vanishes: "
-                 r"$G = -\pi R h$", sp.Tuple(G_T, G_P), potential,
+            Step(r"Suppose the draft's bump were, to first order in $\beta$, the normal of a displaced sphere "
+                 r"$P = (R + \beta G)N$: by step 2 with $G$ for $H$, that normal tilts by "
+                 r"$-\beta\,(G_\theta/(R\sin\varphi), G_\varphi/R)$ to first order, and the draft's by "
+                 r"$\beta(h_u, h_v) = \beta(2\pi H_\theta, \pi H_\varphi)$. The two agree when $G$ has the partial "
+                 r"derivatives $G_\theta$ and $G_\varphi$", sp.Tuple(-G_T / (R * sp.sin(phi)), -G_P / R),
+                 sp.Tuple(2 * sp.pi * H_t, sp.pi * H_p), defines=(G_T, G_P)),
+            Step(r"A function $G$ with these partial derivatives exists only if its mixed partials agree, "
+                 r"$\partial G_\theta/\partial\varphi = \partial G_\varphi/\partial\theta$: the curl of a "
+                 r"gradient is zero. Here the curl is", curl, -sp.pi * R * obstruction),
+            Step(r"For the sine and ridges fields $H_\theta$ is not zero, nor is the curl (the evidence evaluates "
+                 r"it where it is not), so no $G$ exists. For the rings field $h$ depends on $\varphi$ alone, so "
+                 r"$H_\theta = 0$, the curl vanishes, and $G = -\pi R h$ has the partial derivatives of step 4",
+                 sp.Tuple(G_T, G_P), potential,
                  cases=(("rings", {H: sp.Lambda((theta, phi), rings)}),)),
         ),
         claims={"cross": (cross, claim), "kernel": (coeffs, chart), "curl": (curl, -sp.pi * R * obstruction)},

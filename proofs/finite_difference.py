@@ -161,7 +161,7 @@ def _stencil_evidence(rule=_border_rule, half=0.5, stencil=F.STENCIL_POINTS):
         return Verdict("refuted", f"the kernel's footprint steps differ from pbrt-v4's rule by {fp:.2g} (relative)")
     return Verdict("proved", "the stencil takes its interior branch at 2,000 seeded interior points, and at "
                    "2,000 points near the borders wraps u, clamps v and divides by the clamped distance; the "
-                   f"footprint steps (FOOTPRINT, compiled) equal pbrt-v4's least-squares rule within {fp:.1e} "
+                   f"footprint steps, compiled, equal pbrt-v4's least-squares rule within {fp:.1e} "
                    f"(relative) at {pixels} sphere-A pixels", rendered=pixels)
 
 
@@ -186,8 +186,8 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
     series = written(sp.Add(*claimed, sp.O(eps**order), evaluate=False))
     return Theorem(
         id="central-difference-truncation", title="Truncation error of the central difference",
-        statement=(r"$⟦series⟧$. Away from the seam and the poles this quotient is the renderer's stencil "
-                   r"(`renderer.formulas.CENTRAL`), in $u$ and in $v$, for every height field: $⟦stencil⟧$; at the "
+        statement=(r"$⟦series⟧$. Away from the seam and the poles this quotient is the renderer's central-difference "
+                   r"stencil $D_u$, $D_v$, in $u$ and in $v$, for every height field: $⟦stencil⟧$; at the "
                    r"borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
                    r"clamped distance.  The footprint steps are pbrt-v4's "
                    r"$\tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ (likewise $v$)."),
@@ -198,12 +198,12 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
             Step(r"Write the same series for $h(x - \varepsilon)$: in the difference the even powers of "
                  r"$\varepsilon$ cancel and the odd ones double; divide by $2\varepsilon$", QUOTIENT, series),
             Step(r"Away from the seam and the poles the kernel's stencil points are $u \pm \varepsilon_u$ and "
-                 r"$v \pm \varepsilon_v$ (the interior branches of `STENCIL_POINTS`) and its $v$-denominator is "
+                 r"$v \pm \varepsilon_v$ (its branch away from the borders) and its $v$-denominator is "
                  r"$2\varepsilon_v$, so for each height field $h$ the stencil is the central quotient", kernel,
                  quotients, cases=_kernel_cases()),
         ),
         claims={"series": (QUOTIENT, series), "stencil": (kernel, quotients)},
-        names={CENTRAL_U: r"\mathrm{CENTRAL}_u", CENTRAL_V: r"\mathrm{CENTRAL}_v"},
+        names={CENTRAL_U: "D_u", CENTRAL_V: "D_v"},
         domain={**SERIES_DOMAIN, **KERNEL_DOMAIN}, functions=INSTANCE,
         evidence=partial(_stencil_evidence, **stencil),
         wrong_variants=(("coefficient 1/3 instead of 1/6",

@@ -80,8 +80,8 @@ def _chart_evidence(corrupt=None):
     if worst > TOLERANCE["chart"]:
         return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
                        f"{count} sphere-A pixels")
-    return Verdict("proved", f"the renderer's (u, v) (GBuffer.uv) at {count} seeded sphere-A pixels (pole ring and "
-                   f"fallback included) within {worst:.1e} of mpmath's CHART at its N", rendered=count)
+    return Verdict("proved", f"the renderer's (u, v) at {count} seeded sphere-A pixels (pole ring and "
+                   f"fallback included) within {worst:.1e} of the chart, evaluated by mpmath at its N", rendered=count)
 
 
 def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
@@ -91,7 +91,7 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
     return Theorem(
         id="chart", title="The chart is the spherical angles",
         statement=(r"For $-\pi < \theta < \pi$ and $0 < \varphi < \pi$ the renderer's chart "
-                   r"(`renderer.formulas.CHART`) at $N = (N_x, N_y, N_z) = N(\theta, \varphi)$ is "
+                   r"at $N = (N_x, N_y, N_z) = N(\theta, \varphi)$ is "
                    r"$u$: $⟦u⟧$, $v$: $⟦v⟧$ and $⟦sin⟧$; so $⟦rates⟧$, the factors between chart and angular "
                    r"derivatives of $h$."),
         steps=(
@@ -159,10 +159,10 @@ def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
     if worst > TOLERANCE["normal"]:
         return Verdict("refuted", f"the renderer's N' differs from PERTURBED_NORMAL in this frame by {worst:.1e} "
                        f"at some of {count} sphere-A pixels")
-    return Verdict("proved", f"TANGENT_FRAME is (regular, sin phi > {float(F.POLE_SIN_PHI):g}), (fallback) in each "
-                   f"component; the renderer's N' (GBuffer.Ns, both bump modes, 3 fields) at {count} seeded sphere-A "
-                   f"pixels (pole ring and fallback included) within {worst:.1e} of mpmath's PERTURBED_NORMAL in "
-                   "this frame", rendered=count)
+    return Verdict("proved", f"the tangent frame is its regular branch where sin phi > {float(F.POLE_SIN_PHI):g} and its "
+                   f"fallback elsewhere, in each component; the renderer's N' (both bump modes, 3 fields) at {count} seeded sphere-A "
+                   f"pixels (pole ring and fallback included) within {worst:.1e} of the perturbed normal evaluated "
+                   "by mpmath in this frame", rendered=count)
 
 
 def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
@@ -171,8 +171,8 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
     tangent, unit = sp.Tuple(Dot(ET_S, N_S), Dot(EP_S, N_S)), sp.Tuple(Dot(ET_S, ET_S), Dot(EP_S, EP_S), Dot(ET_S, EP_S))
     return Theorem(
         id="frame-orthonormal", title="The tangent frame is orthonormal and tangent",
-        statement=(r"For $0 < \varphi < \pi$ the renderer's frame (`renderer.formulas.TANGENT_FRAME`, "
-                   r"regular branch) $e_\theta = ⟦kernel_e_theta⟧$ and "
+        statement=(r"For $0 < \varphi < \pi$ the renderer's tangent frame (its "
+                   r"branch away from the poles) $e_\theta = ⟦kernel_e_theta⟧$ and "
                    r"$e_\varphi = ⟦kernel_e_phi⟧$, at $N(\theta, \varphi)$, satisfies "
                    r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
         steps=(

@@ -98,10 +98,11 @@ def _gradient_evidence(name, closed_form, corrupt=None, compiled=None):
         return Verdict("refuted", "the renderer's gradient leaves its tolerance by "
                        + ", ".join(f"{m} {r:.2g}x" for m, (r, _) in rendered.items()))
     return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath ({DIGITS} digits, {POINTS} "
-                   f"points); the renderer's exact, central and footprint gradients (GBuffer.grad) at "
+                   f"points); the renderer's exact, central and footprint gradients at "
                    f"{rendered['exact'][1]} seeded sphere-A pixels within {rendered['exact'][0]:.2f}, "
                    f"{rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} of their tolerances against "
-                   "GRADIENT, CENTRAL (stencil included) and CENTRAL with FOOTPRINT's steps at its (u, v)",
+                   "the exact gradient, the central difference (stencil included) and the central difference with "
+                   "the footprint's steps at its (u, v)",
                    rendered=rendered["exact"][1])
 
 
@@ -126,10 +127,10 @@ def _theorem(name, closed_form=None, **evidence):
     return Theorem(
         id=f"gradient-{name}", title=f"The gradient of the {name} field",
         statement=(r"For $h = ⟦h⟧$" + (", $⟦s_1⟧$, $⟦s_2⟧$" if name != "rings" else "")
-                   + r" (`renderer.formulas.HEIGHT`): $⟦gradient⟧$, and the renderer's generated code evaluates it "
+                   + f" (the renderer's {name} field): $⟦gradient⟧$, and the renderer's generated code evaluates it "
                    r"to float64 accuracy."),
         steps=calc(gradient,
-                   (f"The renderer's gradient of the {name} field (`GRADIENT`, compiled into the kernel) is "
+                   (f"The renderer's gradient of the {name} field (the formula compiled into its kernel) is "
                     "sympy's derivative of its $h$",
                     sp.Tuple(sp.Derivative(SHOWN[name], u), sp.Derivative(SHOWN[name], v))),
                    *_argument(name, closed_form)),

@@ -9,7 +9,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Step, Theorem, calc
+from .core import Step, Theorem, calc, written
 
 u, v = F.u, F.v
 #: The frequencies are positive in the scene (Scene validates k_u, k_v > 0): the
@@ -43,11 +43,22 @@ crease = sp.Function("crease")
 U_IN, U_OUT, V_IN, V_OUT = sp.symbols("u_in u_out v_in v_out")
 
 
+def _at(expr, var, point):
+    """``expr`` with ``var`` replaced by ``point``, rebuilt unevaluated and kept as written
+    (`written`): sin(pi k_u (m/k_u - delta)), not sympy's -sin(pi k_u (delta - m/k_u))."""
+    def rebuild(e):
+        if e == var or not e.args:
+            return point if e == var else e
+        args = map(rebuild, e.args)
+        return e.func(*(sorted(args, key=lambda a: a.has(point)) if e.is_Mul else args), evaluate=False)
+    return written(rebuild(expr))
+
+
 def one_sided(expr, var, at):
     """(right, left) derivatives of ``expr`` in ``var`` at ``var = at``, as unevaluated limits."""
     base = expr.subs(var, at)
-    return (sp.Limit((expr.subs(var, at + delta) - base) / delta, delta, 0, "+"),
-            sp.Limit((base - expr.subs(var, at - delta)) / delta, delta, 0, "+"))
+    return tuple(sp.Limit(sign * (_at(expr, var, sp.Add(at, sign * delta, evaluate=False)) - base) / delta,
+                          delta, 0, "+") for sign in (1, -1))
 
 
 def _ridges(jump_u, jump_v, band=BAND):
@@ -62,14 +73,14 @@ def _ridges(jump_u, jump_v, band=BAND):
              "v": sp.Tuple(crease(1 / (2 * k_u), V_IN), crease(1 / (2 * k_u), V_OUT))}
     return Theorem(
         id="ridges-kinks", title="The creases of the ridges field",
-        statement=r"The renderer's ridges field (`renderer.formulas.HEIGHT['ridges']`) "
-                  r"$h = \lvert s_1 s_2\rvert$ with $s_1 = \sin\pi k_u u$, $s_2 = \sin\pi k_v v$ "
-                  r"(`RIDGE_FACTORS`) is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-ridges⟫. "
+        statement=r"The renderer's ridges field "
+                  r"$h = \lvert s_1 s_2\rvert$, the product of its two factors $s_1 = \sin\pi k_u u$ and "
+                  r"$s_2 = \sin\pi k_v v$, is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-ridges⟫. "
                   r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, the "
                   r"one-sided derivatives $h_u^\pm$ differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$, a crease. "
-                  r"The renderer's crease flag (`KINK_BAND`) is set on every zero line, $⟦lines⟧$, and where "
+                  r"The renderer's crease flag is set on every zero line, $⟦lines⟧$, and where "
                   rf"$\lvert s_1\rvert < {float(SEED_HALF_WIDTH):g}$ or $\lvert s_2\rvert < {float(SEED_HALF_WIDTH):g}$ "
-                  r"(the seed's half-width) only.",
+                  r"(the draft's half-width) only.",
         steps=(
             *calc(sp.Tuple(HU_P, HU_M),
                   (r"On the line $u = m/k_u$ the factor $s_1 = \sin\pi k_u u$ vanishes; with $c \ne 0$ the value of "
@@ -81,7 +92,7 @@ def _ridges(jump_u, jump_v, band=BAND):
                  r"$h_v^\pm$ on $v = m/k_v$", jumps, values),
             Step("The crease flag is set on both lines, where one factor is 0", on_lines, sp.Tuple(1, 1)),
             Step(r"Where $s_2 = 1$ it is set at $u_-$, where $\lvert s_1\rvert = w\,(1 - \eta)$ is just inside "
-                 r"the seed's half-width $w$, and not at $u_+$, just outside", edges["u"], sp.Tuple(1, 0),
+                 r"the draft's half-width $w$, and not at $u_+$, just outside", edges["u"], sp.Tuple(1, 0),
                  defines=(U_IN, U_OUT, W, ETA)),
             Step(r"Likewise across $v$, where $s_1 = 1$", edges["v"], sp.Tuple(1, 0), defines=(V_IN, V_OUT)),
         ),

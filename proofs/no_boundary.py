@@ -201,8 +201,8 @@ def _evidence(gate=False, reach=None, root=0):
     return Verdict("verified", f"the near roots t_A, t_B are the renderer's t (to 1e-9) at its {on_spheres} sphere "
                    f"pixels; {frames} independent G-buffers (3 fields x eps 1e-1..1e-8 x 2 pipelines x beta {BETAS} "
                    f"(chart) or {SURFACE_BETAS} (surface), 64x64) have the chamber, t, P and N of the beta = 0 frame "
-                   "bit for bit, and kernel.reach gives each light the same mask "
-                   f"({shadings} distinct shading normals Ns: every parameter reaches them); kernel.reach equals "
+                   "bit for bit, and the kernel's reach predicate gives each light the same mask "
+                   f"({shadings} distinct shading normals: every parameter reaches them); that predicate equals "
                    f"the predicates, evaluated at the hit points, at all {compared} decided (pixel, light) pairs (of "
                    f"{pairs}) of {len(REACH_SCENES)} scenes (128x128; a light inside sphere B, lights behind A, below "
                    "the floor, and beside A just above it)",

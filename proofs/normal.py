@@ -44,7 +44,7 @@ def _derivative(claimed=CLAIMED_DERIVATIVE, m=M_CLAIMED):
     slope = sp.Derivative(NP_S, F.beta)
     return Theorem(
         id="normal-beta-derivative", title="The β-derivative of the perturbed normal",
-        statement=r"The draft's shading normal (`renderer.formulas.PERTURBED_NORMAL['chart']`, the chart mode, "
+        statement=r"The draft's shading normal (the renderer's chart mode, "
                   r"whose $M$ is linear in $\beta$) is $⟦normal⟧$ with $⟦M⟧$, $⟦g⟧$, and $⟦derivative⟧$, for any "
                   r"$N$, frame and gradient: the derivative of the unit vector $N'$ is $g$ projected onto the plane "
                   r"perpendicular to $N'$, divided by $\lVert M\rVert$.  (In the surface mode $M$ is not linear in "
@@ -156,7 +156,7 @@ def _limit(tilt=None, **evidence):
     slope = {mode: sp.Subs(sp.Derivative(NP_MODE[mode], F.beta), F.beta, 0) for mode in NP_MODE}
     return Theorem(
         id="beta-zero-regression", title="The β → 0 limit",
-        statement=r"Both of the renderer's perturbed normals (`renderer.formulas.PERTURBED_NORMAL`, bump modes "
+        statement=r"Both of the renderer's perturbed normals (bump modes "
                   r"chart and surface), on sphere A in the renderer's frame, orthonormal by ⟪frame-orthonormal⟫ "
                   r"and left-handed by ⟪frame-orientation⟫, satisfy $⟦limit⟧$ and "
                   r"$N'(\beta) = N + \beta\,\partial N'/\partial\beta|_{\beta=0} + O(\beta^2)$ with $⟦chart⟧$ and "

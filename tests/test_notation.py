@@ -20,21 +20,21 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "chart": "bb112cbbf510a670",
-    "frame-orthonormal": "fdce80aa257101b7",
+    "chart": "f98bedd6a50dc2a5",
+    "frame-orthonormal": "013c609b1719b2b5",
     "frame-orientation": "53938665d5568ab7",
-    "gradient-sine": "2ef054cc542efc09",
-    "gradient-ridges": "4a1319521f2a4d3d",
-    "gradient-rings": "ef856a761119f337",
-    "ridges-kinks": "8980813d765a5fc0",
+    "gradient-sine": "faaddaa732ebb897",
+    "gradient-ridges": "d8bdfc1a2bf44e8c",
+    "gradient-rings": "13a4180051f9c661",
+    "ridges-kinks": "909a2b2266fde930",
     "kink-loci-rays": "dc6aa08f514eb71e",
     "kink-loci-circles": "2ee79e7e99261d40",
     "no-boundary": "23e06e379e02c039",
-    "normal-beta-derivative": "5f8bf6562cc221df",
-    "beta-zero-regression": "0a3b18b8b4052c4d",
-    "central-difference-truncation": "87eb719c0c66e095",
+    "normal-beta-derivative": "13f2285b41f4b5dd",
+    "beta-zero-regression": "6526a1ea175b3206",
+    "central-difference-truncation": "029e68e719540bac",
     "optimal-step": "ef2a0615d08b564d",
-    "bump-vs-displacement": "11d4ed60c904f69e",
+    "bump-vs-displacement": "b994271b133f4452",
     "blinn-perturbation": "38f9ac6bc0cd9f89",
 }
 

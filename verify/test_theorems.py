@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from chapter import latex
+from chapter.theorems import code_words
 from proofs.registry import PINNED, RENDERED, THEOREMS, pinned_failure
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
@@ -21,6 +22,7 @@ def test_theorem_holds(theorem_id, record_property):
     record_property("ledger", (theorem_id, verdict.status, verdict.evidence))      # printed by conftest.py
     assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
     assert isinstance(verdict.evidence, str) and verdict.evidence, "the ledger shows the evidence"
+    assert not code_words(verdict.evidence), f"§6 shows the evidence to the reader: {code_words(verdict.evidence)}"
     assert pinned_failure(theorem_id, verdict.status, verdict.residual, verdict.rendered) is None
     if verdict.status == "verified":      # mpmath at >= 30 digits, or >= 100 renders without a difference
         assert (verdict.digits is not None and verdict.digits >= 30 and verdict.points >= 20) or \

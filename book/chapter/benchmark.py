@@ -8,7 +8,9 @@ import numpy as np
 
 from lab import gradient_methods as gm
 
-__all__ = ["pareto_figure", "markdown_table"]
+__all__ = ["pareto_figure", "markdown_table", "fastest_on", "share_in_words"]
+
+_NUMBER_WORDS = ("none", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 #: Each method's colour, marker and marker size in `pareto_figure`.
 _STYLE = {"exact": ("#1b5e20", "*", 12), "central": ("#7a1f1f", "o", 5), "forward": ("#b26b00", "s", 5),
@@ -163,3 +165,37 @@ def markdown_table(measurement, *, rows="all", error="max", include=()):
                      "yes" if r in front else "", note)
             lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
     return "\n".join(lines)
+
+
+def share_in_words(count, total):
+    """``count`` of ``total`` as prose says it: "all three", "two of the three", "none of the three".
+
+    Raises
+    ------
+    ValueError
+        If ``count`` and ``total`` are not integers with 0 <= count <= total, 1 <= total <= 10.
+    """
+    if not (isinstance(count, (int, np.integer)) and isinstance(total, (int, np.integer))
+            and 1 <= total <= 10 and 0 <= count <= total):
+        raise ValueError(f"count and total must be integers with 0 <= count <= total <= 10 and total >= 1, "
+                         f"got count={count!r}, total={total!r}")
+    whole = "both" if total == 2 else f"all {_NUMBER_WORDS[total]}"
+    return whole if count == total else f"{_NUMBER_WORDS[count]} of the {_NUMBER_WORDS[total]}"
+
+
+def fastest_on(measurement, method="exact"):
+    """On how many fields ``method`` has the least median time of the methods measured, in words
+    (`share_in_words`): "all three" in "the exact gradient is the fastest method on all three fields".
+
+    Parameters
+    ----------
+    measurement : lab.gradient_methods.Measurement
+    method : str
+        A method's name as the measurement's rows carry it.
+
+    Returns
+    -------
+    str
+    """
+    wins = sum(min(measurement.of(f), key=lambda r: r.median).method == method for f in gm.FIELDS)
+    return share_in_words(int(wins), len(gm.FIELDS))

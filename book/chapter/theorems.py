@@ -20,9 +20,58 @@ from lab import store
 
 from . import latex
 
-__all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math"]
+__all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math",
+           "badge", "code_words"]
 
 BADGES = {"proved": "PROVED", "verified": "VERIFIED numerically", "refuted": "REFUTED"}
+#: The badge of a verified theorem whose steps sympy all proved: what is numeric is its evidence.
+BADGE_STEPS_PROVED = "STEPS PROVED · VERIFIED on the renderer's outputs"
+
+
+def badge(status, numeric=()):
+    """The badge a verdict earns: `BADGES` by ``status``, but for a ``"verified"`` verdict
+    with no step left to mpmath (``numeric``, `Verdict.numeric`, empty) `BADGE_STEPS_PROVED`:
+    sympy proved every step, and what was checked numerically is the renderer evidence.
+
+    Raises
+    ------
+    KeyError
+        If ``status`` is not proved, verified or refuted.
+    """
+    if status not in BADGES:
+        raise KeyError(f"status must be one of {sorted(BADGES)}, got {status!r}")
+    return BADGE_STEPS_PROVED if status == "verified" and not numeric else BADGES[status]
+
+
+#: What reader-facing text must not contain (`code_words`): a name from the code, constant-shaped
+#: (KINK_BAND, STENCIL_POINTS) or a dotted path (renderer.formulas, kernel.reach), a constant
+#: set as code (`GRADIENT`), or "seed" (the book calls the source document "the draft").
+_CODE_WORD = re.compile(r"\b[A-Z][A-Z0-9]*_[A-Z0-9_]*\b|\b[A-Za-z_]\w+\.[A-Za-z_]\w+|`[^`]*\b[A-Z]{2,}\b[^`]*`")
+_SEED = re.compile(r"\bseed\b", re.IGNORECASE)
+#: ... and, in mathematics too, a constant's name set upright (\mathrm{CENTRAL}).
+_UPRIGHT_CONSTANT = re.compile(r"\\mathrm\{[A-Z][A-Z0-9_]+\}")
+_MATH = re.compile(r"\$\$.*?\$\$|\$[^$]*\$", re.S)
+
+
+def code_words(text):
+    """The tokens of ``text`` (a theorem's title, statement, step sentence or evidence) that
+    read as code or audit vocabulary: outside its ``$...$`` mathematics, constant-shaped
+    names (``KINK_BAND``), dotted paths (``renderer.formulas``), code spans holding a
+    constant (```GRADIENT```) and the word "seed"; anywhere, a constant's name set upright
+    (``\\mathrm{CENTRAL}``).  An empty list is text a reader can read.
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    list of str
+        The offending tokens, in order.
+    """
+    prose = _MATH.sub(" ", text)
+    return ([m.group(0) for m in _CODE_WORD.finditer(prose)] + [m.group(0) for m in _SEED.finditer(prose)]
+            + _UPRIGHT_CONSTANT.findall(text))
 
 
 def tex_number(x) -> str:
@@ -144,7 +193,7 @@ def _entry(t):
     steps = _proof(t)
     note, unexplained = _numeric_note(t, v)
     block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{_cited(latex.statement(t))}\n\n"
-             f"**{BADGES[v.status]}** · evidence: {{ref}}`§6 <ledger-{t.id}>`"
+             f"**{badge(v.status, v.numeric)}** · evidence: {{ref}}`§6 <ledger-{t.id}>`"
              f"{chr(10) * 2 + note if note else ''}\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
