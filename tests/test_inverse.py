@@ -84,3 +84,15 @@ def test_bad_input_is_refused(args, kwargs, words):
     args = args + (Scene(),) if len(args) == 1 else args
     with pytest.raises((TypeError, ValueError), match=words):
         fit_beta(*args, **kwargs)
+
+
+def test_importing_takes_no_derivative_and_an_unknown_mode_is_named():
+    # The Jacobian is sympy's work on first use, not at import (it cost 75 ms of every import).
+    import subprocess
+    import sys
+    code = "import lab.inverse as m; print(m.jacobian.cache_info().currsize)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "0"
+    from lab.inverse import jacobian
+    with pytest.raises(KeyError, match=r"mode must be one of \['chart', 'surface'\], got 'bump'"):
+        jacobian("bump")

@@ -63,7 +63,7 @@ WORDS = {
     ),
     "fallback-orientation": dict(
         title="The pole fallback frame has the opposite orientation",
-        correction="kept as the seed has it (the convention is the seed's); measured and disclosed",
+        correction="kept as the draft has it (the convention is the draft's); measured and disclosed",
         finding=(
             "$(e_\\theta \\times e_\\varphi)\\cdot N$ is {orientation_regular_min:.0f} on the "
             "regular frame (to rounding) and {orientation_fallback:+.0f} on the fallback: the "
