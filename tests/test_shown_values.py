@@ -249,6 +249,7 @@ DIFFERENCE_PANELS = {
     "fig-s1-bump": ("s1_what_changes", lambda ns: [(ns["frames"][b]["numeric"], ns["frames"][b]["symbolic"])
                                                    for b in ("surface", "chart")]),
     "fig-c3-panels": ("s5_lab", lambda ns: [(ns["numeric"], ns["symbolic"])]),
+    "fig-s4-pipelines": ("s4_simulator", lambda ns: [(ns["numeric"], ns["symbolic"])]),   # the opening scale
 }
 
 
@@ -457,3 +458,24 @@ def test_the_built_register_its_links_and_the_front_pages_counts_agree_with_the_
                      "ix_corrected": verdicts[WORDS["holds with a correction"]],
                      "ix_fails": verdicts[WORDS["does not hold"]], "ix_errata": len(errata),
                      "ix_proved": statuses["PROVED"], "ix_verified": statuses["VERIFIED numerically"]}, glued
+
+
+#: The glued errors §5's exercises 8 and 9 compare with, and the row of Cell 4's table (method, step)
+#: each must be read from.
+EXERCISE_ROWS = {"ex_fwd_err_1e8": ("forward", "1e-08"), "ex_fwd_err_1e3": ("forward", "1e-03"),
+                 "ex_cen_err_1e6": ("central", "1e-06"), "ex_cs_err": ("complex step", "1e-20"),
+                 "ex_exact_err": ("exact", "")}
+
+
+def test_the_exercises_compare_with_numbers_cell_4s_table_shows(ran, book_html):
+    """Exercises 8 and 9 ask for Cell 4's errors on the sine field: the built Cell 4 shows a table
+    of the sine panel's points (method, step, largest error), one row per measured method, and
+    each error the solutions glue is the one its row shows, to the digits shown."""
+    ns, _, glued = ran("s5_lab")
+    cell4 = _soup(book_html / "s5_lab.html").find(id="cell4")
+    (table,) = [t for t in cell4.find_all("table") if "largest error" in t.get_text()]
+    rows = {tuple(td.get_text().strip() for td in tr.find_all("td")[:2]): tr.find_all("td")[2].get_text().strip()
+            for tr in table.find_all("tr") if tr.find_all("td")}
+    assert len(rows) == len(ns["fast"].of("sine"))
+    for name, row in EXERCISE_ROWS.items():
+        assert shows(rows[row], glued[name]), (name, rows[row], glued[name])
