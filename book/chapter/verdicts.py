@@ -21,8 +21,8 @@ __all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of", "section_o
 #: Place -> the claims noted there, in the order the text meets them.  A place is a section label
 #: of the book (``"cell3"``) or a paragraph within it (``"cell3/flips"``: the section label, a slash,
 #: a name), and the page calls ``margin_notes(place)`` once, right before the paragraph that discusses
-#: those claims: the theme floats a margin note beside what follows it.  A claim that no paragraph of the reading path discusses is placed nowhere: it
-#: appears only in §6's register.
+#: those claims: the theme floats a margin note beside what follows it.  A claim that no paragraph
+#: of the reading path discusses is placed nowhere: it appears only in §6's register.
 PLACES = {
     "s3-frame": ("frame-aligned",),
     "s3-boundary": ("flips-zero",),
