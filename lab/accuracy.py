@@ -20,7 +20,8 @@ from renderer.render import SPHERE_A
 
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
-           "image_beta_order", "optima", "crease_distance", "crease_share", "OPTIMUM_POINTS", "DIGITS"]
+           "image_beta_order", "optima", "crease_distance", "crease_share", "image_best_step", "OPTIMUM_POINTS",
+           "DIGITS", "HALF_DECADES"]
 
 DIGITS = 50
 STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
@@ -250,3 +251,45 @@ def _crease_share(size, steps):
     uv = g.uv[g.chamber == SPHERE_A]
     dist = crease_distance(uv[:, 0], uv[:, 1], DRAFT_SCENE.k_u, DRAFT_SCENE.k_v)
     return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps], pixels=int(dist.size))
+
+
+#: The steps of the simulator's U-curve (``CURVE_LOG_EPS`` in renderer/js/simulator.js): half decades
+#: from 1e-14 to 1e-1, chart units.
+HALF_DECADES = tuple(float(x) for x in 10.0 ** (np.arange(-28, -1) / 2))
+
+
+def image_best_step(field, size=256):
+    """The image-best step of the simulator's scene (`renderer.ledger.SIMULATOR_SCENE`) with the
+    height field ``field``: of the steps `HALF_DECADES`, the one whose central-difference frame has
+    the least RMS |ΔI| over sphere A against the exact frame, every pixel of a ``size`` × ``size``
+    frame counted; one measurement of the build (`lab.store`).
+
+    Returns
+    -------
+    dict
+        ``best`` (float, chart units), ``steps`` and ``rms`` (lists of floats, one per step, RMS in
+        linear colour units), ``scene`` (the fields that differ from `renderer.Scene`'s defaults,
+        `renderer.Scene.changes`) and ``size`` ([width, height], pixels).
+
+    Raises
+    ------
+    ValueError
+        ``field`` is not a height field of `renderer.Scene`, or ``size`` is below 1.
+    TypeError
+        ``size`` is not an integer.
+    """
+    from renderer.ledger import SIMULATOR_SCENE
+    from renderer.validate import positive_int
+
+    from .store import measured
+    SIMULATOR_SCENE.replace(height_field=field)              # the scene's own error for a bad field
+    return measured("image-best-step", _image_best_step, field=field, size=positive_int("size", size),
+                    steps=list(HALF_DECADES))
+
+
+def _image_best_step(field, size, steps):
+    from renderer import sweep
+    from renderer.ledger import SIMULATOR_SCENE
+    scene = SIMULATOR_SCENE.replace(height_field=field)
+    rms = [float(led.rms) for led in sweep(scene, steps, size, size).census]
+    return dict(best=steps[int(np.argmin(rms))], steps=steps, rms=rms, scene=scene.changes(), size=[size, size])

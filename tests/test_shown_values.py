@@ -249,6 +249,7 @@ DIFFERENCE_PANELS = {
     "fig-s1-bump": ("s1_what_changes", lambda ns: [(ns["frames"][b]["numeric"], ns["frames"][b]["symbolic"])
                                                    for b in ("surface", "chart")]),
     "fig-c3-panels": ("s5_lab", lambda ns: [(ns["numeric"], ns["symbolic"])]),
+    "fig-s4-pipelines": ("s4_simulator", lambda ns: [(ns["numeric"], ns["symbolic"])]),   # the opening scale
 }
 
 
@@ -419,7 +420,7 @@ def test_the_built_register_its_links_and_the_front_pages_counts_agree_with_the_
     registered verdict, and it links to the section that measures it; every verdict sentence on
     every page links to the row of the claim it quotes, with that row's verdict; the front page's
     counts of claims (by verdict), errata and theorems (by status) are those of §6's lists."""
-    from chapter.verdicts import WORDS, place_of
+    from chapter.verdicts import WORDS, place_of, section_of
     from lab.claims import CLAIMS
     quoted = lambda claim: f"“{claim.quote.replace('`', '')}”"  # noqa: E731  (its code spans set as code)
     text = lambda element: element.get_text().replace("’", "'")  # noqa: E731  (Sphinx's typographic apostrophe)
@@ -430,7 +431,10 @@ def test_the_built_register_its_links_and_the_front_pages_counts_agree_with_the_
         head, verdict = (b.get_text() for b in row.find_all("strong")[:2])
         assert head == f"{n}. {claim.where}:" and quoted(claim) in text(row), (n, head)
         assert verdict == WORDS[claim.registered], (claim.id, verdict)
-        assert row.find("a")["href"].endswith(f"#{place_of(claim.id)}"), (claim.id, row.find("a")["href"])
+        place, first = place_of(claim.id), row.find("a")["href"]
+        # A claim with a margin note links first to its section; one without, first to its verdict's term.
+        expected = f"#{section_of(place)}" if place else "#term-" + WORDS[claim.registered].replace(" ", "-")
+        assert first.lower().endswith(expected.lower()), (claim.id, first)
     by_id = {c.id: c for c in CLAIMS}
     linked = []
     for page in sorted(book_html.glob("*.html")):
@@ -442,7 +446,7 @@ def test_the_built_register_its_links_and_the_front_pages_counts_agree_with_the_
             term = sentence.find("a", href=re.compile("glossary.html#term-"))
             assert term.get_text() == WORDS[claim.registered], (page.name, claim.id)
             linked.append(claim.id)
-    assert sorted(linked) == sorted(by_id)
+    assert sorted(linked) == sorted(i for i in by_id if place_of(i))
     counts = ("ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata", "ix_proved", "ix_verified")
     cache = check_glue.glued(book_html.parent / ".jupyter_cache")
     glued = {name: float(cache[name]["index"]) for name in counts}
@@ -454,3 +458,24 @@ def test_the_built_register_its_links_and_the_front_pages_counts_agree_with_the_
                      "ix_corrected": verdicts[WORDS["holds with a correction"]],
                      "ix_fails": verdicts[WORDS["does not hold"]], "ix_errata": len(errata),
                      "ix_proved": statuses["PROVED"], "ix_verified": statuses["VERIFIED numerically"]}, glued
+
+
+#: The glued errors §5's exercises 8 and 9 compare with, and the row of Cell 4's table (method, step)
+#: each must be read from.
+EXERCISE_ROWS = {"ex_fwd_err_1e8": ("forward", "1e-08"), "ex_fwd_err_1e3": ("forward", "1e-03"),
+                 "ex_cen_err_1e6": ("central", "1e-06"), "ex_cs_err": ("complex step", "1e-20"),
+                 "ex_exact_err": ("exact", "")}
+
+
+def test_the_exercises_compare_with_numbers_cell_4s_table_shows(ran, book_html):
+    """Exercises 8 and 9 ask for Cell 4's errors on the sine field: the built Cell 4 shows a table
+    of the sine panel's points (method, step, largest error), one row per measured method, and
+    each error the solutions glue is the one its row shows, to the digits shown."""
+    ns, _, glued = ran("s5_lab")
+    cell4 = _soup(book_html / "s5_lab.html").find(id="cell4").find_parent("section")     # the label's section
+    (table,) = [t for t in cell4.find_all("table") if "largest error" in t.get_text()]
+    rows = {tuple(td.get_text().strip() for td in tr.find_all("td")[:2]): tr.find_all("td")[2].get_text().strip()
+            for tr in table.find_all("tr") if tr.find_all("td")}
+    assert len(rows) == len(ns["fast"].of("sine"))
+    for name, row in EXERCISE_ROWS.items():
+        assert shows(rows[row], glued[name]), (name, rows[row], glued[name])

@@ -18,28 +18,64 @@ def _placed(places):
     return [i for ids in places.values() for i in ids]
 
 
-def test_every_claim_is_placed_exactly_once():
-    placed = _placed(verdicts.PLACES)
-    assert sorted(placed) == sorted(c.id for c in CLAIMS)
+def placement_faults(places):
+    """What is wrong with a `verdicts.PLACES`: claims placed twice, and ids that are no claim."""
+    placed, ids = _placed(places), {c.id for c in CLAIMS}
+    return sorted({i for i in placed if placed.count(i) > 1}) + sorted(set(placed) - ids)
 
 
-def test_a_claim_placed_twice_or_nowhere_is_caught():
-    twice = {**verdicts.PLACES, "s9": ("h3-scale",)}
-    assert sorted(_placed(twice)) != sorted(c.id for c in CLAIMS)
-    nowhere = {k: tuple(i for i in v if i != "stacking") for k, v in verdicts.PLACES.items()}
-    assert sorted(_placed(nowhere)) != sorted(c.id for c in CLAIMS)
-    with pytest.raises(KeyError, match="placed in no section"):
+def test_every_placed_claim_exists_and_is_placed_once():
+    assert placement_faults(verdicts.PLACES) == []
+
+
+def test_a_claim_placed_twice_or_no_claim_placed_is_caught():
+    assert placement_faults({**verdicts.PLACES, "s9": ("h3-scale",)}) == ["h3-scale"]
+    assert placement_faults({**verdicts.PLACES, "s9": ("no-such-claim",)}) == ["no-such-claim"]
+    assert verdicts.place_of("h3-scale") == "s3-ucurve"
+    assert verdicts.place_of("cell6-truncation") is None         # in §6's register only
+    with pytest.raises(KeyError, match="claim_id must be"):
         verdicts.place_of("no-such-claim")
 
 
-def test_every_place_is_a_label_of_a_page_that_shows_its_margin_notes():
-    """Each place is a MyST label of the book, and the page holding the label calls
-    margin_notes(place): a claim cannot be placed where no page shows it."""
-    pages = {p: p.read_text(encoding="utf-8") for p in BOOK.glob("*.md")}
+CALL = re.compile(r"margin_notes\([\"']([^\"']+)[\"']\)")
+
+
+def place_faults(pages):
+    """What is wrong with the pages' margin-note calls against `verdicts.PLACES`: {place: what}.
+    Each place is called exactly once over the pages (none: "unused", more: "N calls"), on the page
+    that holds its section's label ("section label on no page" / "not on the page of <label>"), and
+    no page calls a place `PLACES` lacks ("not in PLACES")."""
+    calls = [(p, m.group(1)) for p, text in pages.items() for m in CALL.finditer(text)]
+    faults = {place: "not in PLACES" for _, place in calls if place not in verdicts.PLACES}
     for place in verdicts.PLACES:
-        holders = [p for p, text in pages.items() if re.search(rf"^\({re.escape(place)}\)=$", text, re.M)]
-        assert len(holders) == 1, (place, holders)
-        assert re.search(rf"margin_notes\([\"']{re.escape(place)}[\"']\)", pages[holders[0]]), (place, holders[0])
+        section = verdicts.section_of(place)
+        holders = [p for p, text in pages.items() if re.search(rf"^\({re.escape(section)}\)=$", text, re.M)]
+        where = [p for p, called in calls if called == place]
+        if len(holders) != 1:
+            faults[place] = "section label on no page" if not holders else "section label on several pages"
+        elif len(where) != 1:
+            faults[place] = "unused" if not where else f"{len(where)} calls"
+        elif where != holders:
+            faults[place] = f"not on the page of {section}"
+    return faults
+
+
+def test_every_place_is_used_exactly_once_on_the_page_of_its_section():
+    """Each place is a section label (or a paragraph in one: ``cell3/flips``) of a page that calls
+    margin_notes(place) once; no page calls a place that is not in PLACES."""
+    pages = {p.name: p.read_text(encoding="utf-8") for p in BOOK.glob("*.md")}
+    assert place_faults(pages) == {}
+
+
+def test_a_missing_duplicated_or_unknown_place_is_caught():
+    pages = {p.name: p.read_text(encoding="utf-8") for p in BOOK.glob("*.md")}
+    s5 = pages["s5_lab.md"]
+    call = 'markdown(margin_notes("cell3/flips"))'
+    assert place_faults({**pages, "s5_lab.md": s5.replace(call, "")}) == {"cell3/flips": "unused"}
+    assert place_faults({**pages, "s5_lab.md": s5 + call}) == {"cell3/flips": "2 calls"}
+    assert place_faults({**pages, "s5_lab.md": s5 + 'margin_notes("cell9")'}) == {"cell9": "not in PLACES"}
+    moved = {**pages, "s5_lab.md": s5.replace(call, ""), "s7_pitfalls.md": pages["s7_pitfalls.md"] + call}
+    assert place_faults(moved) == {"cell3/flips": "not on the page of cell3"}
 
 
 MARGIN = re.compile(r"```\{margin\}\n(.*?)\n```", re.S)
@@ -73,8 +109,10 @@ def test_the_register_gives_each_claim_a_target_its_measurement_its_rule_and_a_l
         _, measured, verdict = results[c.id]
         assert f"{{term}}`{verdicts.WORDS[verdict]}`" in row
         assert measured_text(c.id, measured) in row and rule_text(c.criterion) in row
-        assert f"{{ref}}`{verdicts.place_of(c.id)}`" in row
-    assert md.count("{ref}`cell3`") == len(verdicts.PLACES["cell3"])
+        place = verdicts.place_of(c.id)
+        assert (f"{{ref}}`{verdicts.section_of(place)}`" in row) if place else ("noted in" not in row)
+    in_cell3 = [i for p, ids in verdicts.PLACES.items() if verdicts.section_of(p) == "cell3" for i in ids]
+    assert md.count("{ref}`cell3`") == len(in_cell3) == 4
 
 
 def test_an_unknown_place_is_refused():

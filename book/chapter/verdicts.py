@@ -16,36 +16,58 @@ from lab.claims import CLAIMS, checked
 
 from .claim_words import WORDS, measured_text, rule_text
 
-__all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of"]
+__all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of", "section_of"]
 
-#: Book section label -> the claims shown there, in the order the section meets them.
+#: Place -> the claims noted there, in the order the text meets them.  A place is a section label
+#: of the book (``"cell3"``) or a paragraph within it (``"cell3/flips"``: the section label, a slash,
+#: a name), and the page calls ``margin_notes(place)`` once, right before the paragraph that discusses
+#: those claims: the theme floats a margin note beside what follows it.  A claim that no paragraph
+#: of the reading path discusses is placed nowhere: it appears only in §6's register.
 PLACES = {
-    "s3-boundary": ("flips-zero", "shadow-curves-unchanged"),
-    "s3-ucurve": ("h3-scale", "truncation-until-1e-6", "roundoff-drowns-1e-9"),
-    "sim": ("try-sweep", "try-creases", "try-pinch", "try-beta0"),
+    "s3-frame": ("frame-aligned",),
+    "s3-boundary": ("flips-zero",),
+    "s3-boundary/gate": ("shadow-curves-unchanged",),
+    "s3-ucurve": ("h3-scale", "truncation-until-1e-6"),
+    "s3-ucurve/tiny": ("roundoff-drowns-1e-9",),
+    "sim": ("try-sweep",),
+    "sim/creases": ("try-creases",),
+    "sim/pinch": ("try-pinch",),
+    "sim/beta0": ("try-beta0",),
     "cell1": ("cell1-ripples",),
-    "cell2": ("frame-aligned", "cell2-minimum"),
-    "cell3": ("cell3-runs", "census-flips", "census-slope", "kink-order-of-magnitude"),
-    "cell4": ("cell4-counter", "four-evals-vs-one", "symbolic-not-slower"),
-    "cell5": ("cell5-fd-1e-9", "dn-verified-1e-12", "beta-quadratic"),
-    "cell6": ("beta0-1e-16", "bump-nonzero", "cell6-truncation"),
-    "cell7": ("noise-below-1e-11", "crease-fd-zero", "pole-pixels"),
+    "cell2": ("cell2-minimum",),
+    "cell3/census": ("cell3-runs",),
+    "cell3": ("census-slope", "kink-order-of-magnitude"),
+    "cell3/flips": ("census-flips",),
+    "cell4": ("four-evals-vs-one", "cell4-counter"),
+    "cell4/trig": ("symbolic-not-slower",),
+    "cell5": ("dn-verified-1e-12", "cell5-fd-1e-9"),
+    "cell5/order": ("beta-quadratic",),
+    "cell6": ("beta0-1e-16", "bump-nonzero"),
+    "cell7": ("noise-below-1e-11",),
+    "cell7/crease": ("crease-fd-zero",),
+    "cell7/pole": ("pole-pixels",),
     "s6": ("stacking",),
     "s8": ("blinn-exact",),
 }
 
+
+def section_of(place):
+    """The section label of ``place``: the place itself, or the part before its ``/``."""
+    return place.split("/", 1)[0]
+
+
 def place_of(claim_id):
-    """The section label where ``claim_id`` is shown.
+    """The place (a key of `PLACES`) where ``claim_id``'s margin note is shown, or None if the
+    claim is shown only in §6's register.
 
     Raises
     ------
     KeyError
-        If the claim is placed nowhere (or is not a claim).
+        If ``claim_id`` is not the id of a claim of `lab.claims.CLAIMS`.
     """
-    for place, ids in PLACES.items():
-        if claim_id in ids:
-            return place
-    raise KeyError(f"claim {claim_id!r} is placed in no section of PLACES")
+    if claim_id not in {c.id for c in CLAIMS}:
+        raise KeyError(f"claim_id must be the id of a claim of lab.claims.CLAIMS, got {claim_id!r}")
+    return next((place for place, ids in PLACES.items() if claim_id in ids), None)
 
 
 def _results(ids=None):
@@ -86,8 +108,8 @@ def register():
     """MyST markdown: the register of §6, one entry per claim in `lab.claims.CLAIMS`
     order, each with the target ``claim-<id>``, its verdict (a ``{term}`` link), the
     measurement in words (`chapter.claim_words.measured_text`), the rule that decided it
-    (`chapter.claim_words.rule_text`), and a link to the section whose margin note shows it
-    (`margin_notes`).
+    (`chapter.claim_words.rule_text`), and, for a claim with a margin note (`margin_notes`),
+    a link to the section that shows it.
 
     Raises
     ------
@@ -98,9 +120,11 @@ def register():
     entries = []
     for n, c in enumerate(CLAIMS, start=1):
         claim, measured, verdict = results[c.id]
+        place = place_of(c.id)
+        noted = f" (noted in {{ref}}`{section_of(place)}`)" if place else ""
         entries.append(
             f"(claim-{c.id})=\n"
-            f"**{n}. {claim.where}:** “{claim.quote}” (noted in {{ref}}`{place_of(c.id)}`). "
+            f"**{n}. {claim.where}:** “{claim.quote}”{noted}. "
             f"**{{term}}`{WORDS[verdict]}`**: {measured_text(c.id, measured)}; by the rule: "
             f"{rule_text(claim.criterion)}.\n")
     return "\n".join(entries)
