@@ -25,7 +25,7 @@ __all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed
 
 BADGES = {"proved": "PROVED", "verified": "VERIFIED numerically", "refuted": "REFUTED"}
 #: The badge of a verified theorem whose steps sympy all proved: what is numeric is its evidence.
-BADGE_STEPS_PROVED = "STEPS PROVED · VERIFIED on the renderer's outputs"
+BADGE_STEPS_PROVED = "STEPS PROVED · VERIFIED on renders"
 
 
 def badge(status, numeric=()):
@@ -196,7 +196,8 @@ def _entry(t):
              f"**{badge(v.status, v.numeric)}** · evidence: {{ref}}`§6 <ledger-{t.id}>`"
              f"{chr(10) * 2 + note if note else ''}\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
-    return dict(title=t.title, status=v.status, evidence=v.evidence, seed_says=t.seed_says,
+    return dict(title=t.title, status=v.status, badge=badge(v.status, v.numeric), evidence=v.evidence,
+                seed_says=t.seed_says,
                 pages=list(t.pages), block=block, unexplained=unexplained,
                 changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
 
@@ -274,7 +275,7 @@ def ledger_table():
     for theorem_id, e in ledger().items():
         _refuse(theorem_id, e)
         items.append(f"* (ledger-{theorem_id})=\n  {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
-                     f"**{BADGES[e['status']]}**.\n\n"
+                     f"**{e['badge']}**.\n\n"
                      f"  {_folded('Evidence', e['evidence'])}")
     return "\n".join(items)
 
