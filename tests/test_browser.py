@@ -83,19 +83,22 @@ def browser():
 class Session:
     """One page of the built book, with the network blocked and errors recorded.
     ``options`` go to the browser context (viewport, has_touch, is_mobile); ``bundle(text)``,
-    if given, changes the simulator's script as the page receives it (a wrong variant)."""
+    if given, changes the simulator's script as the page receives it (a wrong variant), and
+    ``css(text)`` the book's layout sheet, _static/fit.css."""
 
-    def __init__(self, browser, url, bundle=None, **options):
+    def __init__(self, browser, url, bundle=None, css=None, **options):
         options.setdefault("viewport", {"width": 1200, "height": 1400})
         self.context = browser.new_context(**options)
         self.blocked, self.errors = [], []
 
         def route(r):
             path = r.request.url.split("?")[0]
-            if bundle is not None and path.startswith("file://") and path.endswith("_static/sim/simulator.js"):
+            change = {"_static/sim/simulator.js": (bundle, "text/javascript"), "_static/fit.css": (css, "text/css")}
+            wrong = next((c for end, c in change.items() if c[0] is not None and path.endswith(end)), None)
+            if wrong is not None and path.startswith("file://"):
                 from urllib.parse import unquote, urlparse
                 text = Path(unquote(urlparse(path).path)).read_text(encoding="utf-8")
-                r.fulfill(body=bundle(text), content_type="text/javascript")
+                r.fulfill(body=wrong[0](text), content_type=wrong[1])
             elif r.request.url.startswith("file://"):
                 r.continue_()
             else:
@@ -990,6 +993,36 @@ def test_at_1280_the_readout_and_the_u_curve_sit_beside_the_canvases(browser, bo
         s.close()
 
 
+#: Run in the page: for each margin note, how far (px) its top lies below the top of what it annotates
+#: (the element after the cell that prints it: the theme floats a note beside what follows it).
+MARGIN_DRIFT_JS = """() => [...document.querySelectorAll('article aside.margin')].map(note => {
+  const next = note.closest('.cell').nextElementSibling;
+  return [next.textContent.trim().slice(0, 40), note.getBoundingClientRect().top - next.getBoundingClientRect().top];
+})"""
+
+
+@pytest.mark.parametrize("variant", [None, "the theme's blank title line above each note"])
+def test_at_1280_each_margin_note_stands_beside_its_item(browser, book_html, variant):
+    """At 1280 px the theme floats §4's margin notes beside the Try-this items they annotate; each
+    note's top lies within half a line (8 px) of its item's, none pushed down beside the next item.
+    With the empty title paragraph's space kept above each note (the wrong variant) the first note
+    starts a line low and the rest drift further."""
+    def css(text):
+        old = "aside.margin p.sidebar-title:empty + p { margin-top: 0; }"
+        assert text.count(old) == 1
+        return text.replace(old, "") if variant else text
+
+    s = Session(browser, _url(book_html), css=css, viewport={"width": 1280, "height": 900})
+    try:
+        drift = s.page.evaluate(MARGIN_DRIFT_JS)
+        assert len(drift) == 4, drift
+        beside = all(abs(d) <= 8 for _, d in drift)
+        assert beside != bool(variant), drift
+        assert s.errors == []
+    finally:
+        s.close()
+
+
 def _canvases_stacked(s):
     """(whether the three canvases are stacked one above the other, each at least 300 px wide; boxes)."""
     boxes = [_box(s, f"#sim-canvas-{n}") for n in ("numeric", "symbolic", "difference")]
@@ -1034,13 +1067,18 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
 #: what covers it] for each point of a target that something else covers (document.elementFromPoint
 #: at a 5 x 5 grid of points inside the target's box, within the viewport).  The positions: "top"
 #: (the simulator just below the theme's sticky header), "canvases" (the symbolic canvas in the
-#: middle of the screen), "ucurve_bottom" and "ucurve_middle" (the U-curve's plot with its
-#: caption at the bottom of the screen, as it comes into view, and in the middle) and "ledger" (the
-#: ledger in the middle).  The targets: the main controls (the field,
-#: ε and β: at every position where they stick to the screen, else at "top"), the readout (its
-#: part below what sticks at the top: a box scrolled under a bar is not covered by it), and at
+#: middle of the screen), "difference" (the difference canvas in the middle), "ucurve_bottom" and
+#: "ucurve_middle" (the U-curve's plot with its caption at the bottom of the screen, as it comes into
+#: view, and in the middle) and "ledger" (the ledger in the middle).  The targets: the main controls
+#: (the field, ε and β: at every position where they stick to the screen, else at "top"), the readout
+#: (its part below what sticks at the top: a box scrolled under a bar is not covered by it), and at
 #: both "ucurve" positions the plot and its caption, which must also lie wholly on the screen,
-#: and on a phone (under 720 px) the ε slider, wholly on the screen with them.
+#: and on a phone (under 720 px) the ε slider, wholly on the screen with them; on a phone at
+#: "difference", the ε slider and the difference canvas wholly on the screen, uncovered (dragging ε
+#: shows the difference change).  Besides covering, the check measures what a reader must read:
+#: at the "ucurve" positions the caption's font at least 12 px and every text of the plot at least
+#: 10 px as drawn (its font size times the plot's scale), and at "ledger" every column of the
+#: ledger inside the ledger's visible box (none cut off, no sideways scrolling).
 COVERED_JS = """async (where) => {
   const sticky = el => getComputedStyle(el).position === 'sticky';
   const main = document.querySelector('.sim-main'), readout = document.getElementById('sim-readout');
@@ -1049,7 +1087,7 @@ COVERED_JS = """async (where) => {
   const bar = () => Math.max(header(), sticky(main) ? main.getBoundingClientRect().bottom : 0);
   const settle = () => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
   const [at, block] = {top: ['[data-symrender-sim]', 'start'], canvases: ['#sim-canvas-symbolic', 'center'],
-                        ucurve_bottom: ['.sim-curve', 'end'], ucurve_middle: ['.sim-curve', 'center'],
+                        difference: ['#sim-canvas-difference', 'center'], ucurve_bottom: ['.sim-curve', 'end'], ucurve_middle: ['.sim-curve', 'center'],
                         ledger: ['.sim-ledger', 'center']}[where];
   document.querySelector(at).scrollIntoView({block});
   await settle();
@@ -1066,10 +1104,10 @@ COVERED_JS = """async (where) => {
     for (let a = 0; a < 5; a++) for (let b = 0; b < 5; b++) {
       const x = r.left + 2 + (r.width - 4) * a / 4, y = r.top + 2 + (r.height - 4) * b / 4;
       const on = x >= 0 && x < innerWidth && y >= 0 && y < innerHeight;
-      if (!on) { if (whole) found.push([label, name(null)]); continue; }
+      if (!on) { if (whole) found.push(label + ' covered by ' + name(null)); continue; }
       if (y < from) continue;
       const hit = document.elementFromPoint(x, y);
-      if (hit !== el && !el.contains(hit)) found.push([label, name(hit)]);
+      if (hit !== el && !el.contains(hit)) found.push(label + ' covered by ' + name(hit));
     }
   };
   if (where === 'top' || sticky(main))
@@ -1080,13 +1118,29 @@ COVERED_JS = """async (where) => {
     if (innerWidth < 720) check(document.getElementById('sim-log_eps'), '#sim-log_eps beside the plot', 0, true);
     check(document.getElementById('sim-curve'), '#sim-curve', 0, true);
     check(document.getElementById('sim-curve-caption'), '#sim-curve-caption', 0, true);
+    const px = el => parseFloat(getComputedStyle(el).fontSize);
+    const caption = px(document.getElementById('sim-curve-caption'));
+    if (caption < 12) found.push(`#sim-curve-caption's font ${caption} px (under 12)`);
+    const plot = document.getElementById('sim-curve'), scale = plot.getScreenCTM().a;
+    for (const t of plot.querySelectorAll('text'))
+      if (px(t) * scale < 10) found.push(`#sim-curve's text at ${(px(t) * scale).toFixed(1)} px (under 10)`);
   }
-  return [...new Set(found.map(f => f.join(' covered by ')))];
+  if (where === 'difference' && innerWidth < 720) {
+    check(document.getElementById('sim-log_eps'), '#sim-log_eps beside the difference canvas', 0, true);
+    check(document.getElementById('sim-canvas-difference'), '#sim-canvas-difference', 0, true);
+  }
+  if (where === 'ledger') {
+    const ledger = document.querySelector('.sim-ledger'), box = ledger.getBoundingClientRect();
+    if (ledger.scrollWidth > ledger.clientWidth + 1) found.push('.sim-ledger scrolls sideways');
+    for (const th of ledger.querySelectorAll('th'))
+      if (th.getBoundingClientRect().right > box.left + ledger.clientWidth + 1) found.push(`ledger column "${th.textContent}" cut off`);
+  }
+  return [...new Set(found)];
 }"""
-READING_POSITIONS = ("top", "canvases", "ucurve_bottom", "ucurve_middle", "ledger")
+READING_POSITIONS = ("top", "canvases", "difference", "ucurve_bottom", "ucurve_middle", "ledger")
 
 
-def _layout(browser, book_html, width, bundle=None, shots=None):
+def _layout(browser, book_html, width, bundle=None, css=None, shots=None):
     """{position: what covers the controls, the readout, the plot or its caption there} at ``width``
     px (844 px tall on a phone, with touch; 900 on a desktop), with a pixel of sphere A read out
     (tapped on a phone, hovered over at 1280); with ``shots``, a screenshot of each position
@@ -1095,7 +1149,7 @@ def _layout(browser, book_html, width, bundle=None, shots=None):
     options = dict(viewport={"width": width, "height": 844 if phone else 900})
     if phone:
         options.update(has_touch=True, is_mobile=True, device_scale_factor=2)
-    s = Session(browser, _url(book_html), bundle=bundle, **options)
+    s = Session(browser, _url(book_html), bundle=bundle, css=css, **options)
     try:
         gb = gbuffer(Scene(), SIZE, SIZE)
         rows, cols = np.nonzero(gb.chamber == 1)
@@ -1126,33 +1180,47 @@ def test_the_controls_readout_and_u_curve_never_cover_each_other(browser, book_h
     """Scrolled to the simulator's top, its canvases, its U-curve and its ledger, with a pixel read
     out: the main controls are never under the theme's header or the readout, the readout is
     under nothing but what sticks at the top, and the U-curve's plot with its caption, at the
-    bottom of the screen and in its middle, lies on the screen covered by nothing, on a phone with the ε slider (`COVERED_JS`).  Screenshots of each
+    bottom of the screen and in its middle, lies on the screen covered by nothing, on a phone with the ε slider;
+    on a phone the ε slider is on the screen with the difference canvas; the caption and the plot's
+    text are large enough to read and the ledger shows every column (`COVERED_JS`).  Screenshots of each
     position go to test-artifacts/s4_<width>px_<position>.png."""
     found = _layout(browser, book_html, width, shots="")
     assert found == dict.fromkeys(READING_POSITIONS, []), found
 
 
-#: Wrong layouts of the simulator on a phone: (the STYLE text replaced, its replacement, a
-#: finding the layout check must report at 390 px).
+#: Wrong layouts of the simulator on a phone: (the sheet changed: "bundle", the simulator's STYLE, or
+#: "css", the book's _static/fit.css; the text replaced, its replacement, a finding the layout check
+#: must report at 390 px).
 WRONG_LAYOUTS = {
-    "the sticky controls under the theme's header": (
+    "the sticky controls under the theme's header": ("bundle",
         "position: sticky; top: 3.5rem;", "position: sticky; top: 0;", "#sim-height_field covered by div.bd-header-article"),
-    "the sticky readout below the U-curve, over its caption": (
+    "the sticky readout below the U-curve, over its caption": ("bundle",
         ".symrender-sim .sim-curve { order: 1; }", "", "#sim-curve-caption covered by dl#sim-readout"),
-    "the controls scrolled away from the U-curve": (
+    "the controls scrolled away from the U-curve": ("bundle",
         "position: sticky; top: 3.5rem;", "position: static;", "#sim-log_eps beside the plot covered by nothing (off the screen)"),
-    "the readout scrolled over the sticky controls": (
+    "the controls scrolled away from the difference canvas": ("bundle",
+        "position: sticky; top: 3.5rem;", "position: static;",
+        "#sim-log_eps beside the difference canvas covered by nothing (off the screen)"),
+    "the readout scrolled over the sticky controls": ("bundle",
         "z-index: 3; /* above the readout */", "z-index: 1;", "covered by dl#sim-readout"),
+    "the plot's labels drawn small": ("bundle",
+        ".sim-curve text { fill: currentColor; font-size: 11px; }", ".sim-curve text { fill: currentColor; font-size: 8px; }",
+        "#sim-curve's text at 8.0 px (under 10)"),
+    "the U-curve's caption in small print": ("css",
+        "#sim-curve-caption { font-size: 0.875rem;", "#sim-curve-caption { font-size: 0.7rem;",
+        "#sim-curve-caption's font 11.2 px (under 12)"),
+    "the ledger's wide cells on a phone": ("css",
+        "table.sim-ledger td { padding: 0.1rem 0.25rem; }", "table.sim-ledger td { }", 'ledger column "last update" cut off'),
 }
 
 
 @pytest.mark.parametrize("variant", sorted(WRONG_LAYOUTS))
 def test_the_layout_check_catches_overlapping_controls(browser, book_html, variant):
-    old, new, message = WRONG_LAYOUTS[variant]
+    sheet, old, new, message = WRONG_LAYOUTS[variant]
 
-    def bundle(text):
-        assert text.count(old) == 1, f"variant {variant!r} no longer applies to the bundle"
+    def wrong(text):
+        assert text.count(old) == 1, f"variant {variant!r} no longer applies to the {sheet}"
         return text.replace(old, new)
 
-    found = _layout(browser, book_html, 390, bundle=bundle)
+    found = _layout(browser, book_html, 390, **{sheet: wrong})
     assert any(message in f for where in found.values() for f in where), (variant, found)
