@@ -354,6 +354,18 @@ def test_the_pole_close_ups_are_the_normals_their_titles_name_at_the_captions_zo
         assert np.array_equal(image(ax), to_srgb(frame.image)), ax.get_title()
 
 
+
+def test_the_displaced_frame_cuts_the_lobes_and_the_silhouette_count_scales_with_beta_inside_it(ran):
+    """§7: the caption says the frame cuts the displaced lobes at its top and sides (the bumped
+    sphere stays inside), and the exercise says the silhouette count inside that frame halves with
+    β: the measured ratio is within a tenth of one half."""
+    ns, _, glued = ran("s7_pitfalls")
+    covered, bumped = ns["disp"].covered, ns["disp"].bumped.chamber == 1
+    assert covered[0].any() and covered[:, 0].any() and covered[:, -1].any()
+    assert not (bumped[0].any() or bumped[-1].any() or bumped[:, 0].any() or bumped[:, -1].any())
+    assert glued["s7_ex_half_beta"] == glued["s7_disp_beta"] / 2
+    assert abs(glued["s7_ex_half_ratio"] - 0.5) < 0.05
+
 # ---- numbers typed into alt text ------------------------------------------------------------
 
 def _arm(side, figure):

@@ -18,6 +18,10 @@ _STYLE = {"exact": ("#1b5e20", "*", 12), "central": ("#7a1f1f", "o", 5), "forwar
           "richardson": ("#6a1b9a", "^", 8)}
 
 
+#: The error axis starts this factor below the panel's lowest point.
+_Y_ROOM = 30.0
+
+
 def _floor(e):
     # An error of exactly 0 cannot sit on a log axis; plotted at 1e-18 (marked in the legend).
     return max(e, 1e-18)
@@ -30,7 +34,8 @@ def pareto_figure(measurement, *, error="max"):
     Each point is a method at its median time, with a horizontal bar from the
     fastest to the slowest run; difference sweeps are joined in order of eps
     (unlabelled: neighbouring steps' labels would collide); the Pareto front is the
-    grey staircase.  Methods whose premise fails on a field are drawn hollow.
+    grey staircase; each error axis starts `_Y_ROOM` times below its panel's
+    lowest point, so no marker sits on the frame.  Methods whose premise fails on a field are drawn hollow.
     An error of exactly 0 would be drawn at 1e-18.
 
     Parameters
@@ -64,7 +69,7 @@ def pareto_figure(measurement, *, error="max"):
         ft = [1e3 * r.median for r in front]
         fe = [_floor(pick(r)) for r in front]
         handles["Pareto front"], = ax.step(ft + [t_hi], fe + [fe[-1]], where="post", color="0.75",
-                                           lw=4, zorder=0)
+                                           lw=2.5, zorder=0)
         for method in dict.fromkeys(r.method for r in rs):
             group = [r for r in rs if r.method == method]
             color, marker, ms = _STYLE.get(method, ("k", "x", 5))
@@ -86,6 +91,7 @@ def pareto_figure(measurement, *, error="max"):
         for axis in (ax.xaxis, ax.yaxis):
             axis.set_minor_locator(NullLocator())
         ax.set_xlim(t_lo, t_hi)
+        ax.set_ylim(min(_floor(pick(r)) for r in rs) / _Y_ROOM, None)
         ax.set_title(name + ("" if gm.ANALYTIC[name] else " (off the crease band)"), fontsize=10)
         ax.set_ylabel(f"{error} error", fontsize=10)
         ax.tick_params(labelsize=9)
