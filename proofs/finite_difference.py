@@ -186,11 +186,14 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
     series = written(sp.Add(*claimed, sp.O(eps**order), evaluate=False))
     return Theorem(
         id="central-difference-truncation", title="Truncation error of the central difference",
-        statement=(r"$⟦series⟧$. Away from the seam and the poles this quotient is the renderer's central-difference "
-                   r"stencil $D_u$, $D_v$, in $u$ and in $v$, for every height field: $⟦stencil⟧$; at the "
-                   r"borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
-                   r"clamped distance.  The footprint steps are pbrt-v4's "
-                   r"$\tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ (likewise $v$)."),
+        statement=(r"For a smooth $h$, $$⟦series⟧$$ Away from the seam and the poles this quotient is the renderer's "
+                   r"central-difference stencil $D_u$, $D_v$, in $u$ and in $v$, for every height field: $$⟦stencil⟧$$ At "
+                   r"the borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
+                   r"clamped distance.  Here $\varepsilon_u$ and $\varepsilon_v$ are the steps in $u$ and in $v$: "
+                   r"both the one fixed step $\varepsilon$ by default, or, if the renderer is asked for footprint "
+                   r"steps, each pixel's own, half the change of $u$ (of $v$) from the pixel to its neighbours, "
+                   r"$\varepsilon_u = \tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ "
+                   r"with $x$, $y$ in pixels (pbrt-v4's rule; likewise $\varepsilon_v$)."),
         steps=(
             Step(r"Taylor's theorem: $h$ is smooth, so $h(x + \varepsilon)$ is its Taylor polynomial of degree 5 "
                  r"about $x$, up to a remainder of order $\varepsilon^6$", written(f(sp.Add(x, eps, evaluate=False))),

@@ -127,8 +127,7 @@ def _theorem(name, closed_form=None, **evidence):
     return Theorem(
         id=f"gradient-{name}", title=f"The gradient of the {name} field",
         statement=(r"For $h = ⟦h⟧$" + (", $⟦s_1⟧$, $⟦s_2⟧$" if name != "rings" else "")
-                   + f" (the renderer's {name} field): $⟦gradient⟧$, and the renderer's generated code evaluates it "
-                   r"to float64 accuracy."),
+                   + f" (the renderer's {name} field): $⟦gradient⟧$."),
         steps=calc(gradient,
                    (f"The renderer's gradient of the {name} field (the formula compiled into its kernel) is "
                     "sympy's derivative of its $h$",

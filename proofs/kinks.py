@@ -76,11 +76,17 @@ def _ridges(jump_u, jump_v, band=BAND):
         statement=r"The renderer's ridges field "
                   r"$h = \lvert s_1 s_2\rvert$, the product of its two factors $s_1 = \sin\pi k_u u$ and "
                   r"$s_2 = \sin\pi k_v v$, is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-ridges⟫. "
-                  r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, the "
-                  r"one-sided derivatives $h_u^\pm$ differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$, a crease. "
-                  r"The renderer's crease flag is set on every zero line, $⟦lines⟧$, and where "
-                  rf"$\lvert s_1\rvert < {float(SEED_HALF_WIDTH):g}$ or $\lvert s_2\rvert < {float(SEED_HALF_WIDTH):g}$ "
-                  r"(the draft's half-width) only.",
+                  r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, its graph "
+                  r"has a crease: the one-sided derivatives $h_u^+$ and $h_u^-$ (the slopes just right and just "
+                  r"left of the line) differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$."
+                  "\n\n"
+                  r"*Corollary (the renderer's crease band).* A central difference whose two points straddle a "
+                  r"crease returns neither one-sided slope, so the renderer flags the pixels near a crease, and "
+                  r"the book reports their error apart. Its crease flag is 1 on every zero line, $⟦lines⟧$, and "
+                  rf"exactly where $\lvert s_1\rvert < {float(SEED_HALF_WIDTH):g}$ or "
+                  rf"$\lvert s_2\rvert < {float(SEED_HALF_WIDTH):g}$: a band about "
+                  rf"${float(SEED_HALF_WIDTH):g}/\pi k_u$ wide in $u$ on each side of a line (likewise in $v$), "
+                  r"the half-width the draft chose.",
         steps=(
             *calc(sp.Tuple(HU_P, HU_M),
                   (r"On the line $u = m/k_u$ the factor $s_1 = \sin\pi k_u u$ vanishes; with $c \ne 0$ the value of "
@@ -90,9 +96,12 @@ def _ridges(jump_u, jump_v, band=BAND):
                    sp.Tuple(k_u * sp.pi * sp.Abs(c), -k_u * sp.pi * sp.Abs(c)))),
             Step(r"So they differ by $2\pi k_u\lvert c\rvert$; the same limits with $u$ and $v$ exchanged give "
                  r"$h_v^\pm$ on $v = m/k_v$", jumps, values),
-            Step("The crease flag is set on both lines, where one factor is 0", on_lines, sp.Tuple(1, 1)),
-            Step(r"Where $s_2 = 1$ it is set at $u_-$, where $\lvert s_1\rvert = w\,(1 - \eta)$ is just inside "
-                 r"the draft's half-width $w$, and not at $u_+$, just outside", edges["u"], sp.Tuple(1, 0),
+            Step("For the corollary: on both lines one factor is 0, inside the band, so the flag is set",
+                 on_lines, sp.Tuple(1, 1)),
+            Step(r"The band's edge is the half-width $w$: on the line where $s_2 = 1$, take $u_-$ where "
+                 r"$\lvert s_1\rvert = w\,(1 - \eta)$, a hair (the relative margin $\eta$) inside the band, and "
+                 r"$u_+$ where $\lvert s_1\rvert = w\,(1 + \eta)$, a hair outside; the flag is 1 at $u_-$ and "
+                 r"0 at $u_+$", edges["u"], sp.Tuple(1, 0),
                  defines=(U_IN, U_OUT, W, ETA)),
             Step(r"Likewise across $v$, where $s_1 = 1$", edges["v"], sp.Tuple(1, 0), defines=(V_IN, V_OUT)),
         ),

@@ -228,9 +228,12 @@ def _no_boundary(attached=None, **evidence):
         id="no-boundary", title="The bump moves no boundary",
         statement=r"The chamber of every pixel and every shadow predicate (attached: "
                   r"$N\cdot(L - P) > 0$; cast: a root of the segment quadratic in $(0, 1)$; the floor "
-                  r"plane between $P$ and $L$) are functions of the geometry alone: $⟦chamber⟧$ and $⟦shadow⟧$. "
+                  r"plane between $P$ and $L$) are functions of the geometry alone, of none of the bump's parameters: "
+                  r"its strength $\beta$, its frequencies $k_u$, $k_v$ and the central difference's steps "
+                  r"$\varepsilon_u$, $\varepsilon_v$ in $u$ and in $v$ (both the one fixed step $\varepsilon$ by "
+                  r"default, or each pixel's footprint steps): $⟦chamber⟧$ and $⟦shadow⟧$. "
                   r"Hence no pixel changes chamber, and no shadow boundary moves, when the bump's parameters "
-                  r"change: the renderer's G-buffers and its own reach predicate agree bit for bit across them.",
+                  r"change: the renderer's per-pixel hits and shadow tests come out bit for bit the same.",
         steps=(
             Step(r"The chamber is the nearest hit: the near roots $t_A$, $t_B$ of $\lvert E + t d - C\rvert^2 = r^2$ "
                  r"for spheres A and B and the floor plane's $t_{\mathrm{floor}}$, with $E = (0, 0, e)$ the eye and "

@@ -402,19 +402,22 @@ def _chart_box(monkeypatch, t):
     return book, (lambda: book.theorem_block("chart"))
 
 
-def test_a_verified_box_names_each_numeric_step_its_points_digits_and_why(monkeypatch):
-    """chart is VERIFIED: its box names the steps sympy left (the verdict's ``numeric``), the points and digits
-    of their check, and each one's reason (``Step.why_numeric``); a box of a proved theorem has none of it."""
+def test_a_verified_box_shows_its_badge_and_its_proof_each_numeric_step_its_points_digits_and_why(monkeypatch):
+    """chart is VERIFIED: its box holds the statement and the badge line only; the folded proof opens with the
+    steps sympy left (the verdict's ``numeric``), the points and digits of their check, and each such step
+    carries its reason (``Step.why_numeric``); a proved theorem's proof has none of it."""
     from chapter.theorems import _cited, _numeric_note, _prose
     from proofs.core import POINTS, DIGITS
     t, proved = get("chart"), get("optimal-step")
     v = t.check()
     assert v.status == "verified" and v.numeric and all(t.steps[k - 1].why_numeric for k in v.numeric)
     book, show = _chart_box(monkeypatch, t)
-    statement, _, proof = show().partition(":::{prf:proof}")
-    note = statement[statement.index("**VERIFIED numerically**"):]
-    assert f"{', '.join(map(str, v.numeric))} " in note and f"at {POINTS} seeded points to {DIGITS} digits" in note
-    assert [bool(s.why_numeric) and _prose(_cited(s.why_numeric)) in note for s in t.steps] == \
+    box, _, proof = show().partition(":::{prf:proof}")
+    assert box.split("**VERIFIED numerically**", 1)[1].split("\n")[1:] == [":::", "", "::::{dropdown} Proof", ""]
+    opening, _, steps = proof.partition("**Step 1.**")
+    assert f"{', '.join(map(str, v.numeric))} " in opening and f"at {POINTS} random points to {DIGITS} digits" in opening
+    by_step = steps.split("**Step ")
+    assert [bool(s.why_numeric) and _prose(_cited(s.why_numeric)) in by_step[k] for k, s in enumerate(t.steps)] == \
         [k in v.numeric for k in range(1, len(t.steps) + 1)]
     assert _numeric_note(proved, proved.check()) == (None, None)
 

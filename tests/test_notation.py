@@ -8,6 +8,7 @@ After an intended change of notation, review the new text (it is printed) and re
 """
 
 import hashlib
+import re
 
 import pytest
 import sympy as sp
@@ -23,18 +24,18 @@ PRINTED = {
     "chart": "f98bedd6a50dc2a5",
     "frame-orthonormal": "013c609b1719b2b5",
     "frame-orientation": "53938665d5568ab7",
-    "gradient-sine": "faaddaa732ebb897",
-    "gradient-ridges": "d8bdfc1a2bf44e8c",
-    "gradient-rings": "13a4180051f9c661",
-    "ridges-kinks": "909a2b2266fde930",
+    "gradient-sine": "bf2dcc2a1665f090",
+    "gradient-ridges": "b2695ea68698fc11",
+    "gradient-rings": "10fd2b5cafd8b6b4",
+    "ridges-kinks": "d0166a6d10c118b7",
     "kink-loci-rays": "dc6aa08f514eb71e",
     "kink-loci-circles": "2ee79e7e99261d40",
-    "no-boundary": "23e06e379e02c039",
+    "no-boundary": "d919e9d5b4854d2f",
     "normal-beta-derivative": "13f2285b41f4b5dd",
     "beta-zero-regression": "6526a1ea175b3206",
-    "central-difference-truncation": "029e68e719540bac",
+    "central-difference-truncation": "f8a9229c7ca65527",
     "optimal-step": "ef2a0615d08b564d",
-    "bump-vs-displacement": "b994271b133f4452",
+    "bump-vs-displacement": "3345ce68138271df",
     "blinn-perturbation": "38f9ac6bc0cd9f89",
 }
 
@@ -146,3 +147,36 @@ def test_a_link_whose_left_side_is_rewritten_shows_that_side_on_an_unmarked_line
     assert len(lines) == 3, shown
     assert r"\overset{(1)}{=}" in lines[0] and r"\overset{(2)}{=}" in lines[2]
     assert r"\left(x + 1\right)^{2}" in lines[1] and r"\overset" not in lines[1]
+
+
+def _fraction_in_fraction(math):
+    """Whether ``math`` has a ``\\frac`` within the numerator or denominator of another."""
+    for start in (m.end() for m in re.finditer(r"\\frac(?=\{)", math)):
+        depth, i = 0, start
+        for arg in range(2):
+            begin = i
+            while True:
+                depth += {"{": 1, "}": -1}.get(math[i], 0)
+                i += 1
+                if depth == 0:
+                    break
+            if r"\frac" in math[begin:i]:
+                return True
+    return False
+
+
+def test_no_statement_sets_a_fraction_in_a_fraction_inline_and_its_displays_fit_a_phone():
+    """A fraction within a fraction in running text is set at half size (unreadable on a phone): a statement
+    sets such a claim apart (``$$⟦key⟧$$``), laid out one relation a line within the column, its fractions at
+    full size."""
+    assert _fraction_in_fraction(r"\frac{\beta \left(\frac{H}{s}\right)}{R}") and not _fraction_in_fraction(r"\frac{a}{b} \frac{c}{d}")
+    for t in THEOREMS.values():
+        text = latex.statement(t)
+        displays = re.findall(r"\$\$(.*?)\$\$", text, re.S)
+        inline = re.findall(r"\$([^$]+)\$", re.sub(r"\$\$.*?\$\$", " ", text, flags=re.S))
+        assert not [m for m in inline if _fraction_in_fraction(m)], t.id
+        for shown in displays:
+            body = shown.strip().removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}")
+            assert max(latex.width(line) for line in body.split(r"\\ ")) <= latex.PROOF_COLUMN_PX, (t.id, shown)
+    shown = latex.statement(THEOREMS["bump-vs-displacement"])
+    assert re.search(r"\$\$\s*\\begin\{aligned\}", shown) and r"\dfrac{H_{\theta} e_\theta}" in shown

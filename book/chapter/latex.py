@@ -254,8 +254,16 @@ def definition(t, symbol) -> str:
     return f"{tex(symbol, t.names)} = {tex(d, t.names)}"
 
 
+class _Relation:
+    """One relation ``lhs = rhs``, as `chain` reads a step."""
+
+    def __init__(self, lhs, rhs):
+        self.lhs, self.rhs = lhs, rhs
+
+
 def statement(t) -> str:
-    """Theorem ``t``'s statement with each ``⟦key⟧`` printed: a claim as ``lhs = rhs``, a named
+    """Theorem ``t``'s statement with each ``⟦key⟧`` printed: a claim as ``lhs = rhs`` (one set
+    apart, ``$$⟦key⟧$$``, as a display laid out for a phone's column by `chain`), a named
     symbol of ``where`` as ``name = definition``, an object of ``shown`` as itself.
 
     Raises
@@ -264,6 +272,15 @@ def statement(t) -> str:
         A ``⟦key⟧`` that is none of these (the check refutes such a theorem first).
     """
     named = {placeholder_key(s): s for s in t.where}
+
+    def display(m):
+        """A claim set apart, ``$$⟦key⟧$$``: laid out as `chain` lays out a proof's display, each
+        fraction at full size (``\\dfrac``: one within another is otherwise set at 70 %)."""
+        if m.group(1) not in t.claims:
+            return m.group(0)
+        lhs, rhs = t.claims[m.group(1)]
+        shown = chain(t, [_Relation(lhs, rhs)]).replace(r"\frac{", r"\dfrac{")
+        return f"\n\n$$\n{shown}\n$$\n\n"
 
     def fill(m):
         key = m.group(1)
@@ -275,7 +292,7 @@ def statement(t) -> str:
             return tex(t.shown[key], t.names)
         raise KeyError(f"theorem {t.id!r}: the statement names ⟦{key}⟧, neither a claim {sorted(t.claims)}, "
                        f"a named symbol {sorted(named)} nor a shown object {sorted(t.shown)}")
-    return PLACEHOLDER.sub(fill, t.statement)
+    return PLACEHOLDER.sub(fill, re.sub(rf"\$\$\s*{PLACEHOLDER.pattern}\s*\$\$", display, t.statement))
 
 
 # ------------------------------------------------------------------------------- widths

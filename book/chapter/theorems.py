@@ -143,28 +143,31 @@ def _chains(steps):
     return [[(k + 1, steps[k]) for k in range(first, last + 1)] for first, last in chains(steps)]
 
 
-def _proof(t):
-    """``t``'s proof as MyST: each step "**Step k.** Sentence" with the definitions it introduces
-    (``where ...``), and after the steps of each calc chain one display of the chain
-    (`chapter.latex.chain`): one relation a line, each "=" of a chain of several steps marked
+def _proof(t, numeric=(), note=None):
+    """``t``'s proof as MyST: ``note`` (what was checked numerically, `_numeric_note`) first, then each
+    step "**Step k.** Sentence" with the definitions it introduces (``where ...``), a step of ``numeric``
+    followed by why sympy left it (`Step.why_numeric`), and after the steps of each calc chain one display
+    of the chain (`chapter.latex.chain`): one relation a line, each "=" of a chain of several steps marked
     "(k)" with the step that proves it; no display starts with "="."""
-    out = []
+    out = [note] if note else []
     for run in _chains(t.steps):
         numbers = [k for k, _ in run]
         for k, step in run:
             why = _prose(_cited(step.why.rstrip(".:")))
             where = ", ".join(f"${latex.definition(t, s)}$" for s in step.defines)
+            aside = (f" (Checked numerically: {_prose(_cited(step.why_numeric))}.)" if k in numeric else "")
             out.append(f"**Step {k}.** {why}" + (f", where {where}" if where else "")
-                       + ("." if k != run[-1][0] else ":"))
+                       + ("." if k != run[-1][0] else ":") + aside)
         out.append(f"$$\n{latex.chain(t, [s for _, s in run], numbers)}\n$$")
     return "\n\n".join(out)
 
 
 def _numeric_note(t, v):
-    """What a VERIFIED badge rests on, as MyST, and why a box cannot say it (or None): each step
-    sympy left to mpmath (`Verdict.numeric`), with its points, digits, worst residual and the
-    reason its proof gives (`Step.why_numeric`); or, every step proved, the renderer evidence.
-    A numeric step without a reason, or a reason on a step sympy proved, is the second value."""
+    """The proof's opening sentence for the steps sympy left to mpmath (`Verdict.numeric`): which,
+    at how many points, to how many digits and the worst residual (each step then says why,
+    `Step.why_numeric`; `_proof`), as MyST, or None; and why the box cannot be shown (or None):
+    a numeric step without a reason, or a reason on a step sympy proved.  The renderer evidence
+    is §6's (`ledger_table`), not the box's."""
     numeric = v.numeric
     stale = [k for k, s in enumerate(t.steps, 1) if s.why_numeric and k not in numeric]
     unexplained = [k for k in numeric if not t.steps[k - 1].why_numeric]
@@ -173,28 +176,22 @@ def _numeric_note(t, v):
         return None, (f"{t.id}: step {k} was verified numerically but its proof does not say why "
                       "(Step.why_numeric)" if unexplained else
                       f"{t.id}: step {k} says why sympy cannot decide it (Step.why_numeric), but sympy proved it")
-    if v.status != "verified":
+    if v.status != "verified" or not numeric:
         return None, None
-    if not numeric:
-        return (f"Every step was reduced to 0 by sympy; what is verified numerically is the evidence, "
-                f"{v.points} renderer outputs compared with worst difference {v.residual:g}."), None
-    steps = ", ".join(map(str, numeric))
-    head = (f"Step{'s' if len(numeric) > 1 else ''} {steps} {'were' if len(numeric) > 1 else 'was'} checked "
-            f"numerically at {v.points} seeded points to {v.digits} digits (worst residual {v.residual:.1e}), "
-            "not proved:")
-    reasons = "; ".join(f"{'step ' + str(k) + ', ' if len(numeric) > 1 else ''}"
-                        f"{_prose(_cited(t.steps[k - 1].why_numeric))}" for k in numeric)
-    return f"{head} {reasons}.", None
+    many = len(numeric) > 1
+    return (f"*Step{'s' if many else ''} {', '.join(map(str, numeric))} {'are' if many else 'is'} checked "
+            f"numerically, not proved:* sympy cannot decide {'them' if many else 'it'} (each says why), so "
+            f"{'they were' if many else 'it was'} evaluated at {v.points} random points to {v.digits} digits, "
+            f"with worst residual {v.residual:.1e}."), None
 
 
 def _entry(t):
     from proofs.registry import pinned_failure
     v = t.check()
-    steps = _proof(t)
     note, unexplained = _numeric_note(t, v)
+    steps = _proof(t, v.numeric if v.status == "verified" else (), note)
     block = (f":::{{prf:theorem}} {t.title}\n:label: thm-{t.id}\n\n{_cited(latex.statement(t))}\n\n"
-             f"**{badge(v.status, v.numeric)}** · evidence: {{ref}}`§6 <ledger-{t.id}>`"
-             f"{chr(10) * 2 + note if note else ''}\n:::\n\n"
+             f"**{badge(v.status, v.numeric)}** · evidence: {{ref}}`§6 <ledger-{t.id}>`\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, badge=badge(v.status, v.numeric), evidence=v.evidence,
                 seed_says=t.seed_says,
@@ -218,9 +215,9 @@ def ledger():
 
 def theorem_block(theorem_id):
     """MyST markdown: a prf:theorem (label ``thm-<id>``) with the statement and the
-    badge (a VERIFIED one followed by what was verified numerically, and why), which
-    links to the theorem's ledger row (``ledger-<id>``, `ledger_table`),
-    and a prf:proof with the steps, each a sentence and an equation.
+    badge line, which links to the theorem's ledger row (``ledger-<id>``, `ledger_table`),
+    and a folded prf:proof with the steps, each a sentence and an equation (a VERIFIED
+    theorem's opening with what was checked numerically, each such step saying why).
 
     Raises
     ------
