@@ -236,7 +236,7 @@ def test_the_normal_diagram_draws_the_displacement_its_title_names_and_the_norma
         if getattr(t, "arrow_patch", None) is not None:
             arrows.setdefault((t.arrowprops["color"], t.arrowprops["lw"]), []).append(np.subtract(t.xy, t.xyann))
     (wide,), (own,), (draft,) = (arrows[k] for k in ((figures.BLUE, 3.5), (figures.GREEN, 1.0), (figures.RED, 1.4)))
-    (flat,) = arrows[figures.GREY, 1.4]
+    (flat,) = arrows["black", 1.4]
     angle = lambda a, b: np.degrees(np.arctan2(a[0] * b[1] - a[1] * b[0], a @ b))  # noqa: E731
     assert abs(angle(own, wide)) < 1.0, angle(own, wide)
     tilt, draft_tilt = angle(flat, wide), angle(flat, draft)
