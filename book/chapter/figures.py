@@ -317,7 +317,7 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     (h_m, h_0, h_p) = pointwise.height("ridges", np.array([u0 - eps, u0, u0 + eps]), np.full(3, v), k_u, k_v)
     secant = (h_p - h_m) / (2 * eps)
     exact = float(np.asarray(pointwise.exact_gradient("ridges", u0, v, k_u, k_v)[0]).ravel()[0])
-    fig, ax = plt.subplots(figsize=(5.0, 3.4), layout="constrained")
+    fig, ax = plt.subplots(figsize=(5.0, 3.2), layout="constrained")
     ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
     ax.axvline(crease, color=GREY, lw=0.8, ls=":")
     ax.annotate("crease", (crease, 1), xycoords=("data", "axes fraction"), xytext=(-4, -4),
