@@ -106,6 +106,7 @@ QUANTITIES = {
     "the U-curve's label": (("ucurve_label", "s3_ex_label"), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
     "the unit roundoff": (("s3_unit_roundoff",), lambda: _lib("renderer.ucurve").UNIT_ROUNDOFF),
+    "the book's default step": (("s3_eps_default",), lambda: _lib("renderer").Scene().eps),
     "the rings field's model-optimal step": (("s3_rings_eps", "ex_rings_model"), lambda: _lib("lab.accuracy").optima()["rings"]["eps_model"]),
     "the rings field's model error at its model-optimal step": (
         ("s3_rings_err",), lambda: _lib("lab.accuracy").optima()["rings"]["error_model"]),
@@ -156,7 +157,8 @@ QUANTITIES = {
 #: and choices), with no second name and no value in the library to agree with.
 ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "ix_proved", "ix_verified", "ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata",
-               "tilt_chart", "tilt_surface", "s1_steep", "s1_steep_chart", "s1_steep_surface", "s1_flips_chart",
+               "tilt_chart", "tilt_surface", "s1_steep", "s1_steep_chart", "s1_steep_surface", "s1_away_chart",
+               "s1_away_surface", "s1_flips_chart",
                "s1_flips_surface", "s1_ex_factor", "s2_count_0", "s2_count_2", "s2_count_3",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
@@ -172,7 +174,7 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s7_ex_half_label", "s7_ex_half_beta", "s7_ex_half_predicted", "s7_ex_half_silhouette",
                "s7_ex_half_ratio", "s8_radius", "s8_factor_theta", "s8_factor_phi", "s3_ex_h", "s3_ex_xh1", "s3_ex_err",
                "s3_ex_C", "s3_ex_arg_share", "s3_rel_model", "s3_fit_B_share", "s3_optima_table",
-               "s3_steps_table", "s3_points_label", "c2_point_label", "s3_ridges_crease_dist", "s3_ridges_largest", "s3_share_size", "s3_share_estimate", "s3_rings_label",
+               "s3_steps_table", "s3_points_label", "c2_point_label", "s3_ridges_crease_dist", "s3_ridges_largest", "s3_share_size", "s3_share_estimate", "s3_rel_model_tiny",
                "s3_rings_h", "s3_rings_xh1", "s3_rings_h3", "s3_rings_C", "s3_k16_ku", "s3_k16_h", "s3_k16_xh1",
                "s3_k16_h3", "s3_k16_eps", "s3_k16_fit", "s3_k16_fit_ratio", "s3_arg_ratio", "s3_ulp_ratio",
                "s3_metric_v", "s3_metric_R", "s3_metric_theta", "s3_metric_phi", "s3_tiny_step", "s3_step_e2",

@@ -176,6 +176,39 @@ def test_s3s_worked_example_and_exercise_redo_by_hand_from_the_numbers_the_page_
     assert shows(f"{glued['s3_ex_eps']:.2e}", ns["curve"].eps_model)
 
 
+def test_s3s_tiny_step_sets_the_measured_error_against_the_model_at_that_same_step(ran):
+    """"Why not a tiny step": the model's relative error at the tiny step, redone from the worked
+    example's glued givens (E(ε)/|h'| with |h'| = E(ε*) / (E(ε*)/|h'|)), is the glued one, and the
+    measured relative error there lies within it (the model bounds each rounding error)."""
+    ns, shown, glued = ran("s3_math")
+    t, u = glued["s3_tiny_step"], glued["s3_unit_roundoff"]
+    h1 = glued["s3_ex_err"] / glued["s3_rel_model"]
+    model = (t**2 * glued["s3_ex_h3"] / 6 + u * (glued["s3_ex_h"] + glued["s3_ex_xh1"]) / t) / h1
+    assert math.isclose(model, glued["s3_rel_model_tiny"], rel_tol=1e-9), (model, glued["s3_rel_model_tiny"])
+    assert glued["ucurve_rel_1e11"] <= glued["s3_rel_model_tiny"]
+
+
+def test_s1s_pixels_facing_away_from_both_lights_are_counted_and_shade_as_if_unlit(ran):
+    """§1's count of sphere-A pixels tilted past the glued angle and facing away from both lights
+    (N'·(L − P) <= 0 for each light) is the glued share, at most the tilted share, and each such
+    pixel of the exact render is the pixel of the same scene with no lights: they are the black
+    wedges the caption names, for both normals."""
+    ns, shown, glued = ran("s1_what_changes")
+    for bump in ("surface", "chart"):
+        f = ns["frames"][bump]
+        g, on_a = f["geometry"], f["geometry"].chamber == 1
+        tilt = np.degrees(np.arccos(np.clip(np.sum(g.N * g.Ns, axis=-1), -1.0, 1.0)))
+        scene = f["symbolic"].scene
+        away = np.all([np.sum(g.Ns * (np.asarray(light.position) - g.P), axis=-1) <= 0 for light in scene.lights],
+                      axis=0)
+        counted = on_a & away & (tilt > glued["s1_steep"])
+        assert math.isclose(100 * counted.sum() / on_a.sum(), glued[f"s1_away_{bump}"], rel_tol=1e-12), bump
+        assert glued[f"s1_away_{bump}"] <= glued[f"s1_steep_{bump}"]
+        unlit = render(scene.replace(lights=()), *on_a.shape[::-1], gradient="exact").image
+        assert np.array_equal(f["symbolic"].image[counted], unlit[counted]), bump
+    assert glued["s1_away_chart"] > glued["s1_away_surface"]
+
+
 #: The stencil diagram as §3 draws it (its defaults), a stencil left of another crease, and one
 #: at another frequency and row.
 STENCILS = [{}, dict(k_u=5.0, v=0.3, eps=0.01, offset=-0.004), dict(k_u=12.0, k_v=3.0, v=0.8, eps=0.005, offset=0.002)]
@@ -202,6 +235,11 @@ def test_the_stencil_legend_names_the_slopes_the_library_computes_at_the_stencil
     assert non_differentiable("ridges", crease, p["v"], "u", p["k_u"], p["k_v"]) and a < crease < b
     (note,) = [t for t in ax.texts if "crease" in t.get_text()]
     assert note.xy[0] == crease
+    # The legend's markers must not read as data: the legend stands wholly below the plotting area.
+    fig = ax.figure
+    fig.canvas.draw()
+    legend, area = ax.get_legend().get_window_extent(), ax.get_window_extent()
+    assert legend.y1 < area.y0, (legend, area)
 
 
 # ---- numbers in titles -------------------------------------------------------------------------
@@ -236,7 +274,7 @@ def test_the_normal_diagram_draws_the_displacement_its_title_names_and_the_norma
         if getattr(t, "arrow_patch", None) is not None:
             arrows.setdefault((t.arrowprops["color"], t.arrowprops["lw"]), []).append(np.subtract(t.xy, t.xyann))
     (wide,), (own,), (draft,) = (arrows[k] for k in ((figures.BLUE, 3.5), (figures.GREEN, 1.0), (figures.RED, 1.4)))
-    (flat,) = arrows[figures.GREY, 1.4]
+    (flat,) = arrows["black", 1.4]
     angle = lambda a, b: np.degrees(np.arctan2(a[0] * b[1] - a[1] * b[0], a @ b))  # noqa: E731
     assert abs(angle(own, wide)) < 1.0, angle(own, wide)
     tilt, draft_tilt = angle(flat, wide), angle(flat, draft)

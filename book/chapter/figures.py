@@ -289,13 +289,13 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
     mid = len(phis) // 2
     arrow(base[mid], shading("surface", phis[mid]), BLUE, lw=3.5)     # wide, under the displaced curve's normal
     at = base[mid]
-    arrow(at, in_plane @ _sphere_point(theta, phis[mid]), GREY)
+    arrow(at, in_plane @ _sphere_point(theta, phis[mid]), "black")     # not grey: the geometry is grey
     arrow(at, shading("chart", phis[mid]), RED)
     tangent = np.gradient(bumped, axis=0)[mid]
     own = np.array([tangent[1], -tangent[0]]) * np.sign(np.array([tangent[1], -tangent[0]]) @ bumped[mid])
     arrow(bumped[mid], own, GREEN, lw=1.0)
     handles = [plt.Line2D([], [], color=c, lw=lw, ls=ls) for c, lw, ls in
-               ((GREY, 1.5, "-"), (GREY, 1.0, "--"), (BLUE, 1.4, "-"), (GREEN, 1.0, "-"), (RED, 1.4, "-"), (GREY, 1.4, "-"))]
+               ((GREY, 1.5, "-"), (GREY, 1.0, "--"), (BLUE, 1.4, "-"), (GREEN, 1.0, "-"), (RED, 1.4, "-"), ("black", 1.4, "-"))]
     ax.legend(handles, ["sphere A: the geometry, unchanged", r"the sphere displaced by $\beta h$",
                         "shading normal: the displaced sphere's", "the displaced curve's own normal",
                         "the draft's formula", r"$N$, no bump"],
@@ -317,7 +317,7 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     (h_m, h_0, h_p) = pointwise.height("ridges", np.array([u0 - eps, u0, u0 + eps]), np.full(3, v), k_u, k_v)
     secant = (h_p - h_m) / (2 * eps)
     exact = float(np.asarray(pointwise.exact_gradient("ridges", u0, v, k_u, k_v)[0]).ravel()[0])
-    fig, ax = plt.subplots(figsize=(5.0, 2.9))
+    fig, ax = plt.subplots(figsize=(5.0, 3.2), layout="constrained")
     ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
     ax.axvline(crease, color=GREY, lw=0.8, ls=":")
     ax.annotate("crease", (crease, 1), xycoords=("data", "axes fraction"), xytext=(-4, -4),
@@ -327,7 +327,7 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     ax.plot(u0 + du, h_0 + exact * du, color=BLUE, lw=1.5, label=rf"exact slope at the centre: {exact:+.2f}")
     ax.plot([u0], [h_0], "o", color=BLUE)
     ax.set_xlabel(r"$u$"); ax.set_ylabel(r"$h$")
-    ax.legend(loc="lower right", frameon=False, fontsize=9)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False, fontsize=9)   # below: clear of the data
     ax.set_title("a central stencil straddles the crease")           # no sub- or superscripts: 9 pt and up
     return fig
 
