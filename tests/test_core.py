@@ -304,9 +304,9 @@ def test_vectors_dot_cross_and_jacobians_evaluate_when_checked():
 def test_printing_as_a_person_writes():
     phi = sp.Symbol("phi")
     H3, H, u_round = sp.symbols("H_3 H u", positive=True)
-    names = {H: r"\lvert h\rvert", H3: r"\lvert h'''\rvert", u_round: r"\mathrm{u}"}
+    names = {H: r"\lvert h\rvert", H3: r"\lvert h'''\rvert", u_round: r"u_{\mathrm{round}}"}
     star = written(sp.Pow(sp.Mul(3, u_round, H, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
-    assert tex(star, names) == r"\left(\frac{3 \mathrm{u} \lvert h\rvert}{\lvert h'''\rvert}\right)^{1/3}"
+    assert tex(star, names) == r"\left(\frac{3 u_{\mathrm{round}} \lvert h\rvert}{\lvert h'''\rvert}\right)^{1/3}"
     assert tex(sp.Symbol("sin_phi", nonnegative=True)) == r"\sin\varphi"
     assert tex(sp.sin(phi) * sp.cos(sp.pi * phi)) == r"\sin {\varphi} \cos{\left(\pi \varphi \right)}"
     assert tex(sp.Matrix([sp.Float(0.0), 1])) == r"\left(\begin{matrix}0\\1\end{matrix}\right)"

@@ -34,7 +34,7 @@ PRINTED = {
     "normal-beta-derivative": "13f2285b41f4b5dd",
     "beta-zero-regression": "6526a1ea175b3206",
     "central-difference-truncation": "f8a9229c7ca65527",
-    "optimal-step": "ef2a0615d08b564d",
+    "optimal-step": "4bfd517039cfa6cb",
     "bump-vs-displacement": "3345ce68138271df",
     "blinn-perturbation": "38f9ac6bc0cd9f89",
 }
