@@ -319,14 +319,15 @@ def smallest(values):
 
 #: The book's length limits, in words of prose (code and mathematics do not count) and in each page's
 #: height at 1280 px with folded material closed.  The reading path is what a learner reads straight
-#: through: every page but the ledger, less what is folded (proofs, solutions: ``details``) or set
-#: beside the text (margin notes: ``aside``, ``.margin``).  Those, and the whole of the ledger page
-#: (the draft's audit: register, errata, theorem ledger), are the asides, with a budget of their own.
+#: through: every page but the two a reader looks things up in, less what is folded (proofs,
+#: solutions: ``details``) or set beside the text (margin notes: ``aside``, ``.margin``).  Those, and
+#: the whole of the ledger page (the draft's audit: register, errata, theorem ledger) and of the
+#: glossary, are the asides, with a budget of their own.
 #: An exercise's statement stays open (a learner scans them), only its solution folds: §3, with six
 #: and the table of best steps, is the tallest page.
 MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_000, 8_000, 13_500
-#: The pages outside the reading path.
-LEDGER_PAGES = ("s6_ledger",)
+#: The pages outside the reading path: looked up, not read through.
+LOOKUP_PAGES = ("s6_ledger", "glossary")
 LENGTH = r"""() => {
   const art = document.querySelector('article.bd-article') || document.body;
   const prose = art.cloneNode(true);
@@ -341,8 +342,8 @@ LENGTH = r"""() => {
 
 def words_of(lengths):
     """(reading-path words, aside words) of ``lengths``: {page: Page.length()}."""
-    reading = sum(v["words"] for n, v in lengths.items() if n not in LEDGER_PAGES)
-    aside = sum(v["aside"] + (v["words"] if n in LEDGER_PAGES else 0) for n, v in lengths.items())
+    reading = sum(v["words"] for n, v in lengths.items() if n not in LOOKUP_PAGES)
+    aside = sum(v["aside"] + (v["words"] if n in LOOKUP_PAGES else 0) for n, v in lengths.items())
     return reading, aside
 
 
@@ -1042,5 +1043,7 @@ def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_htm
     page = lambda words, aside=0: {"height": 100, "words": words, "aside": aside}  # noqa: E731
     assert too_long({"a": page(12_000), "b": page(0, 8_000)}) == []
     assert too_long({"a": page(12_000), "s6_ledger": page(7_000), "b": page(0, 1_000)}) == []  # the ledger is aside
+    assert too_long({"a": page(11_000), "glossary": page(1_500)}) == []                      # so is the glossary
+    assert too_long({"a": page(11_000), "b": page(1_500)}) != []
     assert too_long({"s6_ledger": page(7_000), "b": page(0, 1_001)}) == [
         "8001 words in folds, margins and the ledger (at most 8000)"]
