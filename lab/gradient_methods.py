@@ -645,7 +645,7 @@ class MethodResult:
     note: str = ""
     trig_evals: float = 0.0     # real sines and cosines per pixel
     h_tangent_evals: float = 0.0        # forward-mode passes through h per pixel (AD)
-    compile_seconds: float | None = None    # AD: the first call at the frame's size (trace, compile, run)
+    compile_seconds: float | None = None    # AD: its first call in the process at the frame's size (trace, compile, run)
 
     @property
     def label(self):
@@ -789,6 +789,11 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
 
         # Errors: one run of every method at the reference pixels; the work per pixel.
         for method, eps, valid, fn, note in methods(name, config, ku, kv):
+            compile_s = None
+            if method == AD:        # the first call at the frame's size traces and compiles: timed apart
+                t0 = time.perf_counter()
+                fn(u, v)
+                compile_s = time.perf_counter() - t0
             if method == "richardson":
                 info = {}
                 approx = richardson_gradient(name, ru, rv, ku, kv, info=info)
@@ -799,11 +804,6 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
             else:
                 approx = fn(ru, rv)
                 work = evaluations(name, method)
-            compile_s = None
-            if method == AD:        # the first call at the frame's size compiles: timed apart
-                t0 = time.perf_counter()
-                fn(u, v)
-                compile_s = time.perf_counter() - t0
             checked.append((name, method, eps, valid, note, work, _errors(approx, hi, lo), compile_s))
             timed.append((fn, u, v, config.richardson_repeats if method == "richardson" else config.repeats))
         # One evaluation of h alone, timed with the methods as a unit of cost.
