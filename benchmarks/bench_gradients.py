@@ -2,7 +2,7 @@
 
 Runs `lab.gradient_methods.measure` with the FULL configuration (all sphere-A
 pixels of a 256^2 frame in the mpmath reference, twelve steps per difference
-sweep, fifteen interleaved repeats), prints the Pareto front of each height
+sweep, fifteen interleaved repeats; forward-mode AD with its compile time apart), prints the Pareto front of each height
 field, the best step of every method and the full table (medians with the
 min-max of the runs: these machines are noisy), and writes them as Markdown and
 the raw results, every run kept, as JSON.
@@ -48,6 +48,9 @@ def main(argv=None):
         f"(ridges: {m.excluded_pixels['ridges']:,} pixels on the crease band left out). "
         f"One evaluation of h at all pixels: "
         + ", ".join(f"{f} {ms:.2f} ms" for f, ms in h_ms.items()) + ". "
+        f"{gm.AD} (jax.jvp, jit-compiled by XLA): its first call at the frame's size traces and compiles, "
+        "timed apart and not in its times: "
+        + ", ".join(f"{f} {1e3 * m.get(f, gm.AD).compile_seconds:.0f} ms" for f in m.h_times) + ". "
         f"Machine: {m.machine}. Wall time of the run: {m.seconds:.0f} s.",
         "",
     ]

@@ -17,6 +17,12 @@ frame, this module measures five ways of computing (h_u, h_v):
   a real number, so the plain complex step returns 0.  The usual repair
   (Martins, Sturdza and Alonso 2003) continues |f| as f sign(Re f); that
   variant is measured too, as ``complex step, |z| continued``;
+* ``forward-mode AD``: automatic differentiation in forward mode, ``jax.jvp``
+  (Griewank and Walther 2008), of the program that evaluates h, printed from
+  the sympy expression by ``sympy.lambdify(..., modules="jax")``
+  (`ad_gradient`).  AD differentiates that program, operation by operation;
+  sympy differentiates the expression.  Its one choice that is not a
+  derivative is JAX's slope of |x| at x = 0 (`abs_slope_at_zero`, measured);
 * ``richardson``: `scipy.differentiate.derivative`, an adaptive
   finite-difference differentiator that raises the order of accuracy by
   combining nested steps (Richardson's idea, as in numdifftools and
@@ -35,8 +41,11 @@ timings still cover every pixel.
 
 The exact and central gradients and h itself are the kernel's compiled
 functions; forward differences call the compiled h three times from numpy;
-the complex step evaluates h in complex numpy (lambdify), and Richardson
-calls the compiled h from scipy's iteration.  So the times compare the
+the complex step evaluates h in complex numpy (lambdify), Richardson
+calls the compiled h from scipy's iteration, and AD runs JAX's jit-compiled
+(XLA) program on the arrays.  Compiling is not in AD's times: the first call
+at the frame's size traces and compiles, and is timed on its own
+(`MethodResult.compile_seconds`).  So the times compare the
 methods as they are available here, not as each could best be compiled.
 
 `FAST` is the configuration the book runs when it is built; `FULL` the one the
@@ -51,6 +60,7 @@ References
 .. [2] J. R. R. A. Martins, P. Sturdza and J. J. Alonso, "The complex-step
    derivative approximation", ACM Trans. Math. Softw. 29(3), 245-262, 2003.
 .. [3] SciPy 1.17, ``scipy.differentiate.derivative``.
+.. [4] A. Griewank and A. Walther, *Evaluating Derivatives*, 2nd ed., SIAM, 2008.
 """
 
 from __future__ import annotations
@@ -76,10 +86,13 @@ __all__ = [
     "FIELDS", "ANALYTIC", "Config", "FAST", "FULL", "Evaluations", "MethodResult", "Measurement",
     "is_analytic", "chart_points", "forward_gradient", "complex_step_gradient",
     "richardson_gradient", "reference_gradient", "trig_calls", "stencil_values", "evaluations",
-    "methods", "measure", "pareto_front", "to_json",
+    "methods", "measure", "pareto_front", "to_json", "AD", "ad_gradient", "ad_trig_calls",
+    "abs_slope_at_zero", "crease_values",
 ]
 
 FIELDS = ("sine", "ridges", "rings")
+#: The name of forward-mode automatic differentiation in the results.
+AD = "forward-mode AD"
 
 #: sympy functions that are not holomorphic in their argument: an expression
 #: containing one of them cannot be differentiated by the complex step.
@@ -322,6 +335,156 @@ def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
     return res.df[:n].reshape(uu.shape), res.df[n:].reshape(uu.shape)
 
 
+# --- automatic differentiation (JAX, forward mode) -----------------------------------------
+
+@lru_cache(maxsize=None)
+def _ad_program(height):
+    """The jit-compiled forward-mode gradient of the program that evaluates ``height``.
+
+    ``height`` (a sympy expression in u, v, k_u, k_v) is printed as a JAX
+    function by ``sympy.lambdify``; ``jax.jvp`` pushes the tangent 1 through
+    it once along u (v held) and once along v.  JAX is imported here, not
+    with the module: only this method needs it.
+    """
+    import jax
+    import jax.numpy as jnp
+    h = sp.lambdify((F.u, F.v, F.k_u, F.k_v), height, modules="jax")
+
+    def gradient(uu, vv, ku, kv):
+        one = jnp.ones_like(uu)
+        h_u = jax.jvp(lambda x: h(x, vv, ku, kv), (uu,), (one,))[1]
+        h_v = jax.jvp(lambda y: h(uu, y, ku, kv), (vv,), (one,))[1]
+        return h_u, h_v
+    return jax.jit(gradient)
+
+
+def ad_gradient(name, uu, vv, ku, kv, *, height=None):
+    """Chart gradient by forward-mode automatic differentiation (``jax.jvp``).
+
+    The program differentiated is h as `renderer.formulas.HEIGHT` writes it,
+    printed for JAX by ``sympy.lambdify`` and jit-compiled by XLA, in float64
+    (``jax.enable_x64`` around the call only; JAX's global setting is left
+    as it is).  Two forward passes per point, one tangent each.  No step, no
+    truncation: the result is the derivative of the program, rounded as the
+    program's operations round.  Where the program takes |x| of x = 0 it
+    uses JAX's slope of |x| there (`abs_slope_at_zero`).  The first call at a
+    new array shape compiles (tens of milliseconds); later calls reuse it.
+
+    Parameters
+    ----------
+    name : {"sine", "ridges", "rings"}
+    uu, vv : (n,) float64 chart coordinates
+    ku, kv : float
+    height : sympy expression or None, keyword-only
+        The program to differentiate, in `renderer.formulas` u, v, k_u, k_v;
+        None (the default) for the field's ``HEIGHT[name]``.  A test hands
+        in a wrong one to see it caught.
+
+    Returns
+    -------
+    (h_u, h_v) : two (n,) float64 numpy arrays.
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is unknown.
+    """
+    import jax
+    _check_name(name)
+    fn = _ad_program(F.HEIGHT[name] if height is None else height)
+    uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
+    with jax.enable_x64(True):
+        h_u, h_v = fn(uu, vv, float(ku), float(kv))
+        return np.asarray(h_u), np.asarray(h_v)
+
+
+@lru_cache(maxsize=None)
+def ad_trig_calls(name):
+    """Sines and cosines per point in the program XLA compiled for `ad_gradient` of ``name``.
+
+    Counted in the optimised HLO text, after XLA's common-subexpression
+    elimination has merged what it could of the two passes, at a small
+    array size (the program is the same at every size).
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is unknown.
+    """
+    import re
+
+    import jax
+    _check_name(name)
+    x = np.zeros(4)
+    with jax.enable_x64(True):
+        text = _ad_program(F.HEIGHT[name]).lower(x, x, 1.0, 1.0).compile().as_text()
+    return len(re.findall(r"\b(?:sine|cosine)\(", text))
+
+
+def abs_slope_at_zero():
+    """JAX's forward-mode slope of |x| at x = +0.0 and x = -0.0, measured: (float, float).
+
+    |x| has no derivative at 0; an AD tool must still return a number there,
+    and which one is its convention.
+    """
+    import jax
+    import jax.numpy as jnp
+    with jax.enable_x64(True):
+        return tuple(float(jax.jvp(jnp.abs, (jnp.float64(x),), (jnp.float64(1.0),))[1]) for x in (0.0, -0.0))
+
+
+def crease_values(*, v=None, eps=None, ku=None, kv=None):
+    """h_u of the ridges field on two of its creases in u, by three methods, beside the one-sided slopes.
+
+    The creases are u = 0, where the factor sin(pi k_u u) is exactly 0 in
+    float64, and u = 1/k_u as float64 holds it, where the float64 factor is
+    a rounding residue, not 0, so the sign of f picks a side.
+
+    Parameters
+    ----------
+    v : float or None, keyword-only
+        The chart v of both points; None for the U-curve's point
+        (`renderer.ucurve.SEED_POINT`), off the creases in v.
+    eps : float > 0 or None, keyword-only
+        The central difference's step in chart units; None for the draft
+        scene's step.
+    ku, kv : float or None, keyword-only
+        The frequencies; None for the U-curve's (`renderer.ucurve.SEED_FREQUENCIES`).
+
+    Returns
+    -------
+    list of two dicts of floats: ``u``; ``factor``, sin(pi k_u u) in float64;
+    ``exact``, the generated gradient (sign(0) = 0); ``ad``, `ad_gradient`;
+    ``central``, the kernel's central difference at ``eps``; ``left`` and
+    ``right``, the one-sided slopes of |f| in u, -|f_u| and +|f_u| with f_u
+    sympy's derivative of the product evaluated by mpmath.
+
+    Raises
+    ------
+    ValueError
+        If ``eps`` is not a positive finite number.
+    """
+    from renderer import ucurve
+    v = ucurve.SEED_POINT[1] if v is None else float(v)
+    ku0, kv0 = ucurve.SEED_FREQUENCIES
+    ku, kv = float(ku0 if ku is None else ku), float(kv0 if kv is None else kv)
+    eps = float(DRAFT_SCENE.eps) if eps is None else eps
+    if not (np.isfinite(eps) and eps > 0):
+        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
+    f_u = sp.lambdify((F.u, F.v, F.k_u, F.k_v), sp.diff(F.RIDGE_FACTORS[0] * F.RIDGE_FACTORS[1], F.u),
+                      modules="mpmath")
+    out = []
+    for u0 in (0.0, 1.0 / ku):
+        uu, vv = np.array([u0]), np.array([v])
+        slope = abs(float(f_u(mpmath.mpf(u0), mpmath.mpf(v), mpmath.mpf(ku), mpmath.mpf(kv))))
+        out.append(dict(u=u0, factor=float(np.sin(np.pi * ku * u0)),
+                        exact=float(pointwise.exact_gradient("ridges", uu, vv, ku, kv)[0][0]),
+                        ad=float(ad_gradient("ridges", uu, vv, ku, kv)[0][0]),
+                        central=float(pointwise.central_gradient("ridges", uu, vv, ku, kv, eps)[0][0]),
+                        left=-slope, right=slope))
+    return out
+
+
 # --- the reference -------------------------------------------------------------------------
 
 @lru_cache(maxsize=None)
@@ -403,12 +566,14 @@ def stencil_values(name):
 @dataclass(frozen=True)
 class Evaluations:
     """Work per pixel: real values of h, complex values of h, evaluations of the
-    generated gradient, and the real sines and cosines all of them cost."""
+    generated gradient, forward-mode passes through h's program (a value and
+    one tangent each), and the real sines and cosines all of them cost."""
 
     h: float = 0.0
     h_complex: float = 0.0
     gradient: float = 0.0
     trig: float = 0.0
+    h_tangent: float = 0.0
 
 
 def evaluations(name, method, *, h_per_pixel=None):
@@ -419,7 +584,9 @@ def evaluations(name, method, *, h_per_pixel=None):
     name : {"sine", "ridges", "rings"}
     method : str
         "exact", "central", "forward", "complex step", "complex step, |z|
-        continued", "richardson" or "h" (one evaluation of h alone).
+        continued", "richardson", `AD` (its sines and cosines counted in
+        the compiled program, `ad_trig_calls`) or "h" (one evaluation of h
+        alone).
     h_per_pixel : float, keyword-only
         For "richardson" only: the values of h per pixel scipy reported (its
         iteration adapts, so the count is measured, not derived).
@@ -445,6 +612,8 @@ def evaluations(name, method, *, h_per_pixel=None):
         return Evaluations(h_complex=2.0)
     if method == "h":
         return Evaluations(h=1.0, trig=float(per_h))
+    if method == AD:
+        return Evaluations(h_tangent=2.0, trig=float(ad_trig_calls(name)))
     if method == "richardson":
         if h_per_pixel is None:
             raise ValueError("richardson's evaluations are measured: pass h_per_pixel")
@@ -475,6 +644,8 @@ class MethodResult:
     rms_error: float
     note: str = ""
     trig_evals: float = 0.0     # real sines and cosines per pixel
+    h_tangent_evals: float = 0.0        # forward-mode passes through h per pixel (AD)
+    compile_seconds: float | None = None    # AD: its first call in the process at the frame's size (trace, compile, run)
 
     @property
     def label(self):
@@ -558,6 +729,7 @@ def methods(name, config, ku, kv):
                     "|f| evaluated as f sign(Re f); one-sided on the crease"))
     out.append(("richardson", None, True, lambda u, v: richardson_gradient(name, u, v, ku, kv),
                 f"scipy.differentiate.derivative, order {RICHARDSON['order']}"))
+    out.append((AD, None, True, lambda u, v: ad_gradient(name, u, v, ku, kv), "jax.jvp, jit-compiled"))
     return out
 
 
@@ -588,8 +760,9 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     Per field, one run of every method at the reference pixels gives the
     errors; the work per pixel is `evaluations` (for scipy's adaptive
     iteration, its own count at those pixels, a sample's mean in `FAST`).
-    Then ``config.repeats`` rounds time every (field, method) pair on all
-    pixels, in an order shuffled each round, so that drifts of the
+    AD is then called once on all pixels, which compiles its program for
+    that size (`MethodResult.compile_seconds`).  Then ``config.repeats``
+    rounds time every (field, method) pair on all pixels, in an order shuffled each round, so that drifts of the
     machine's speed fall on all of them alike.
     """
     t_start = time.perf_counter()
@@ -616,6 +789,11 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
 
         # Errors: one run of every method at the reference pixels; the work per pixel.
         for method, eps, valid, fn, note in methods(name, config, ku, kv):
+            compile_s = None
+            if method == AD:        # the first call at the frame's size traces and compiles: timed apart
+                t0 = time.perf_counter()
+                fn(u, v)
+                compile_s = time.perf_counter() - t0
             if method == "richardson":
                 info = {}
                 approx = richardson_gradient(name, ru, rv, ku, kv, info=info)
@@ -626,7 +804,7 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
             else:
                 approx = fn(ru, rv)
                 work = evaluations(name, method)
-            checked.append((name, method, eps, valid, note, work, _errors(approx, hi, lo)))
+            checked.append((name, method, eps, valid, note, work, _errors(approx, hi, lo), compile_s))
             timed.append((fn, u, v, config.richardson_repeats if method == "richardson" else config.repeats))
         # One evaluation of h alone, timed with the methods as a unit of cost.
         timed.append((lambda uu, vv, name=name: pointwise.height(name, uu, vv, ku, kv), u, v, config.repeats))
@@ -645,12 +823,13 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
     it = iter(times)            # same order as `timed`: per field, its methods, then h
     for name in fields_:
         for entry in [c for c in checked if c[0] == name]:
-            _, method, eps, valid, note, work, (emax, erms) = entry
+            _, method, eps, valid, note, work, (emax, erms), compile_s = entry
             results.append(MethodResult(name, method, eps, valid, tuple(next(it)), work.h, work.h_complex,
-                                        work.gradient, emax, erms, note, work.trig))
+                                        work.gradient, emax, erms, note, work.trig, work.h_tangent, compile_s))
         h_times[name] = tuple(next(it))
     machine = {"python": platform.python_version(), "numpy": np.__version__,
-               "scipy": sys.modules["scipy"].__version__, "cpus": os.cpu_count(),
+               "scipy": sys.modules["scipy"].__version__,
+               "jax": sys.modules["jax"].__version__ if "jax" in sys.modules else None, "cpus": os.cpu_count(),
                "processor": platform.processor() or platform.machine(),
                "load_average_1_5_15_min_at_start": load_start}
     return Measurement(config, tuple(results), int(pixels), n_ref, n_excl, h_times,

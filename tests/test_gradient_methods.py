@@ -13,6 +13,8 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from lab import gradient_methods as gm
 from renderer import formulas as F
@@ -283,11 +285,15 @@ def test_measure_small_run_and_its_presentations():
     assert not plain.valid and plain.max_error > 1.0
     assert m.get("ridges", "complex step, |z| continued 1e-20").max_error <= FLOAT64_EVAL
     assert m.get("sine", "central 1e-06").max_error > 1e4 * FLOAT64_EVAL
+    for f in gm.FIELDS:                   # AD: exact to rounding, compile time kept apart from the runs
+        ad = m.get(f, gm.AD)
+        assert ad.max_error <= FLOAT64_EVAL and len(ad.times) == 2 and ad.compile_seconds > 0
+        assert ad.h_tangent_evals == 2.0 and ad.trig_evals == gm.ad_trig_calls(f)
     from chapter.benchmark import markdown_table, pareto_figure
     table = markdown_table(m, rows="best", include=("central 1e-03",))
     rows = [[c.strip() for c in line.strip("|").split(" | ")] for line in table.splitlines()[2:]]
-    # "best": per field one row per method (5 on sine and rings, 6 on ridges) + central 1e-03.
-    assert [r[0] for r in rows] == ["sine"] * 6 + ["ridges"] * 7 + ["rings"] * 6
+    # "best": per field one row per method (6 on sine and rings, 7 on ridges) + central 1e-03.
+    assert [r[0] for r in rows] == ["sine"] * 7 + ["ridges"] * 8 + ["rings"] * 7
     assert all(len(r) == len(rows[0]) == 8 for r in rows)
     assert {"exact", "central 1e-03"} <= {r[1] for r in rows if r[0] == "ridges"}
     shown = {(r[0], r[1]): r for r in rows}
@@ -328,3 +334,78 @@ def test_a_figure_not_drawn_for_a_phone_is_caught():
             ax.tick_params(labelsize=size)
         with pytest.raises(AssertionError):
             assert_drawn_for_a_phone(fig, panels=3)
+
+
+# --- forward-mode automatic differentiation ------------------------------------------------
+
+def ad_agrees_with_exact(name, u, v, height=None):
+    """|AD - exact gradient| within float64 evaluation error (`FLOAT64_EVAL`) in both components."""
+    uu, vv = np.array([u]), np.array([v])
+    ad = np.ravel(gm.ad_gradient(name, uu, vv, KU, KV, height=height))
+    ex = np.ravel(pointwise.exact_gradient(name, uu, vv, KU, KV))
+    return bool(np.all(np.abs(ad - ex) <= FLOAT64_EVAL))
+
+
+CHART = st.floats(0.0, 1.0, allow_nan=False)
+
+
+@settings(max_examples=60, deadline=None)
+@given(field=st.sampled_from(gm.FIELDS), u=CHART, v=CHART)
+def test_ad_is_the_exact_gradient_to_rounding_at_random_points(field, u, v):
+    # Off the ridges' crease band: on a crease the two take different sides (next test).
+    if pointwise.kink_band(field, np.array([u]), np.array([v]), KU, KV)[0]:
+        return
+    assert ad_agrees_with_exact(field, u, v)
+
+
+#: Wrong programs AD could be handed: a frequency off by a part in 1e9, and the ridges' |f|
+#: written as sqrt(f^2), the same function, whose program's derivative on the crease is 0/0.
+_f = F.RIDGE_FACTORS[0] * F.RIDGE_FACTORS[1]
+WRONG_PROGRAMS = {
+    "sine": F.HEIGHT["sine"].subs(F.k_u, F.k_u * (1 + sp.Rational(1, 10**9))),
+    "ridges": sp.Pow(_f**2, sp.S.Half, evaluate=False),
+}
+
+
+def test_ad_of_a_wrong_program_is_caught():
+    assert not ad_agrees_with_exact("sine", 0.31, 0.47, height=WRONG_PROGRAMS["sine"])
+    # sqrt(f^2) equals |f| everywhere, and AD agrees off the crease ...
+    assert ad_agrees_with_exact("ridges", 0.31, 0.47, height=WRONG_PROGRAMS["ridges"])
+    # ... but on it AD differentiates the program, sqrt at 0: no number at all.
+    h_u, _ = gm.ad_gradient("ridges", np.array([0.0]), np.array([0.47]), KU, KV, height=WRONG_PROGRAMS["ridges"])
+    assert not np.isfinite(h_u[0])
+    assert not ad_agrees_with_exact("ridges", 0.0, 0.47, height=WRONG_PROGRAMS["ridges"])
+
+
+def test_ad_on_the_crease_beside_the_exact_gradient_and_the_central_difference():
+    at_zero, at_residue = gm.crease_values()
+    slope = at_zero["right"]
+    assert at_zero["factor"] == 0.0 and at_residue["factor"] != 0.0
+    assert at_zero["left"] == -slope and slope > 1.0
+    # Where the factor is exactly 0: the exact gradient's sign(0) = 0; AD takes JAX's slope of |x| at
+    # f = -0.0 (f = 0 times a negative factor here) times f_u, which is one of the one-sided slopes.
+    assert at_zero["exact"] == 0.0
+    f_u = -slope if np.sin(np.pi * KV * 0.47) < 0 else slope
+    assert at_zero["ad"] == pytest.approx(gm.abs_slope_at_zero()[1] * f_u, rel=1e-12)
+    assert at_zero["ad"] in (pytest.approx(-slope, rel=1e-12), pytest.approx(slope, rel=1e-12))
+    # Where the factor is a rounding residue, both take the side its sign picks: the same one.
+    assert at_residue["exact"] == pytest.approx(at_residue["ad"], rel=1e-12)
+    assert abs(at_residue["exact"]) == pytest.approx(slope, rel=1e-12)
+    # The central difference averages the two sides: ~0.
+    for c in (at_zero, at_residue):
+        assert abs(c["central"]) < 1e-9 * slope
+
+
+def test_jax_slope_of_abs_at_zero_is_measured_and_x64_stays_local():
+    import jax
+    slopes = gm.abs_slope_at_zero()
+    assert all(s in (-1.0, 0.0, 1.0) for s in slopes)
+    assert gm.ad_gradient("sine", np.array([0.31]), np.array([0.47]), KU, KV)[0].dtype == np.float64
+    assert not jax.config.jax_enable_x64          # the float64 switch was a context, not global
+
+
+def test_crease_values_rejects_a_bad_step():
+    with pytest.raises(ValueError, match="eps must be a positive finite number, got -1"):
+        gm.crease_values(eps=-1.0)
+    with pytest.raises(ValueError, match="height_field must be one of"):
+        gm.ad_gradient("bumps", np.array([0.1]), np.array([0.1]), KU, KV)

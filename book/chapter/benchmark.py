@@ -15,7 +15,7 @@ _NUMBER_WORDS = ("none", "one", "two", "three", "four", "five", "six", "seven", 
 #: Each method's colour, marker and marker size in `pareto_figure`.
 _STYLE = {"exact": ("#1b5e20", "*", 12), "central": ("#7a1f1f", "o", 5), "forward": ("#b26b00", "s", 5),
           "complex step": ("#1f4e7a", "D", 6), "complex step, |z| continued": ("#5b7fa6", "d", 7),
-          "richardson": ("#6a1b9a", "^", 8)}
+          "richardson": ("#6a1b9a", "^", 8), gm.AD: ("#00838f", "P", 8)}
 
 
 #: The error axis starts this factor below the panel's lowest point.
@@ -114,6 +114,8 @@ def _fmt_evals(r):
         parts.append(f"{r.h_complex_evals:.4g} complex h")
     if r.gradient_evals:
         parts.append(f"{r.gradient_evals:.4g} ∇h")
+    if r.h_tangent_evals:
+        parts.append(f"{r.h_tangent_evals:.4g} h with tangent")
     text = ", ".join(parts) or "0"
     return f"{text} ({r.trig_evals:.4g} sin/cos)" if r.trig_evals else text
 
