@@ -223,7 +223,7 @@ def _blocked_by_a(scene, P, L, samples):
 def _surfaces(prm, xs, ys, tA, PA, NA, chamber, P, N, albedo):
     """Nearest hit per pixel among the displaced A (t, point, normal given), B and the floor (ties
     as `renderer.kernel.nearest_hit`), with the kernel's `surface` for B and the floor."""
-    s = kernel.unpack(prm)
+    s = prm[0]
     for j in range(ys.shape[0]):
         for i in range(xs.shape[0]):
             x, y = xs[i], ys[j]
@@ -252,15 +252,15 @@ def _shade(prm, prm_no_b, lights, chamber, P, N, albedo, blocked, image):
     a light blocked by the displaced A is passed with colour 0; the kernel tests the rest (the
     normal faces the light, the floor plane, sphere B).  Called as for a point of sphere A, so
     that the kernel does not test its undisplaced sphere A; on sphere B with sphere B off."""
-    s, s_no_b = kernel.unpack(prm), kernel.unpack(prm_no_b)
+    s, s_no_b = prm[0], prm_no_b[0]
     masked = lights.copy()
     for j in range(chamber.shape[0]):
         for i in range(chamber.shape[1]):
             if chamber[j, i] == kernel.BACKGROUND:
                 continue
             for k in range(lights.shape[0]):
-                for c in range(3, 6):
-                    masked[k, c] = 0.0 if blocked[k, j, i] else lights[k, c]
+                for c in range(3):
+                    masked[k].color[c] = 0.0 if blocked[k, j, i] else lights[k].color[c]
             p, n = (P[j, i, 0], P[j, i, 1], P[j, i, 2]), (N[j, i, 0], N[j, i, 1], N[j, i, 2])
             a = (albedo[j, i, 0], albedo[j, i, 1], albedo[j, i, 2])
             rgb = kernel.shade(s_no_b if chamber[j, i] == kernel.SPHERE_B else s, masked, p, n, n, a,
@@ -277,7 +277,7 @@ def _compile(prm, lights):
 
 def _cast_shadow(lights, chamber, P, N, reach):
     """(H, W) bool: some light the geometric normal N faces does not reach P (``reach`` (n, H, W))."""
-    facing = np.einsum("hwc,khwc->khw", N, lights[:, None, None, :3] - P[None]) > 0.0
+    facing = np.einsum("hwc,khwc->khw", N, lights.position[:, None, None, :] - P[None]) > 0.0
     return (facing & ~reach).any(axis=0) & (chamber != kernel.BACKGROUND)
 
 
@@ -338,7 +338,7 @@ def render_displaced(scene, width, height, *, samples=64):
               NA.reshape(shape + (3,)), chamber, P, N, albedo)
     # Sphere A's blocking of every light, at every lit-facing point that is not the background.
     blocked = np.zeros((lights.shape[0],) + shape, bool)
-    for k, L in enumerate(lights[:, :3]):
+    for k, L in enumerate(lights.position):
         facing = (np.einsum("hwc,hwc->hw", N, L - P) > 0.0) & (chamber != kernel.BACKGROUND)
         blocked[k][facing] = _blocked_by_a(scene, P[facing], L, samples)
     image = np.zeros(shape + (3,))

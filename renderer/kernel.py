@@ -38,6 +38,7 @@ from pathlib import Path
 import numba
 import numpy as np
 from numba import njit, prange
+from numba.extending import overload
 
 from .generated import (FIELD_CODES, central_gradient, chart, exact_gradient, footprint, height,
                         kink_band, perturbed_normal_chart, perturbed_normal_surface, tangent_frame)
@@ -52,10 +53,28 @@ TINY = 1e-300
 #: The smallest positive float64 (a subnormal) and the smallest normal one.
 SUBNORMAL_MIN, NORMAL_MIN = 2.0**-1074, 2.0**-1022
 
-#: The scene as the pixel code reads it: floats, bools, triples, int codes
-#: (the lights are a separate array, see `params`).
-Params = namedtuple("Params", "camera_z radius_a center_b radius_b sphere_b floor ambient albedo_a "
-                              "albedo_b ka kd ks shininess phong floor_tint field k_u k_v beta surface")
+#: The scene as the pixel code reads it, by name (a numba Record: ``s.camera_z``,
+#: ``s.center_b[0]``): floats, bools, triples, the height field's code.  `params`
+#: fills each field from the `renderer.Scene` attribute of its name, or from
+#: `DERIVED` (the lights are a separate array of `LIGHT`).
+SCENE = np.dtype([("camera_z", "f8"), ("radius_a", "f8"), ("center_b", "f8", (3,)), ("radius_b", "f8"),
+                  ("sphere_b", "?"), ("floor", "?"), ("ambient", "f8", (3,)), ("albedo_a", "f8", (3,)),
+                  ("albedo_b", "f8", (3,)), ("ka", "f8"), ("kd", "f8"), ("ks", "f8"), ("shininess", "f8"),
+                  ("phong", "?"), ("floor_tint", "f8"), ("field", "i8"), ("k_u", "f8"), ("k_v", "f8"),
+                  ("beta", "f8"), ("surface", "?")], align=True)
+#: The fields of `SCENE` that are not a Scene attribute of their name, as functions of the Scene.
+DERIVED = {"phong": lambda scene: scene.model == "phong",
+           "field": lambda scene: FIELD_CODES[scene.height_field],
+           "surface": lambda scene: scene.bump == "surface"}
+#: A point light: position and colour (linear RGB intensities).
+LIGHT = np.dtype([("position", "f8", (3,)), ("color", "f8", (3,))], align=True)
+#: Per light, `sweep_row`'s geometry of one pixel: the unit vector ``w`` to the light, its
+#: `specular_axis` (``axis``, ``wv``), and whether the light reaches the pixel (``lit``).
+LIGHT_GEOMETRY = np.dtype([("w", "f8", (3,)), ("axis", "f8", (3,)), ("wv", "f8"), ("lit", "?")], align=True)
+#: What `render_rows` computes, and how (see its docstring).
+Job = namedtuple("Job", "method eps skip want_kink want_grad want_geo dx dy")
+#: The arrays `render_rows` writes (see its docstring).
+Outputs = namedtuple("Outputs", "image chamber kink grad t P N Ns uv")
 
 
 def _threading_layer():
@@ -172,7 +191,7 @@ def surface(s, x, y, t, code, checker):
     if code == SPHERE_A:
         r = s.radius_a
         P = sphere_a_point(x, y, s.camera_z, r)
-        return P, (P[0] / r, P[1] / r, P[2] / r), s.albedo_a
+        return P, (P[0] / r, P[1] / r, P[2] / r), (s.albedo_a[0], s.albedo_a[1], s.albedo_a[2])
     P = (t * x, t * y, s.camera_z * (1.0 - t))
     if code == SPHERE_B:
         # P - C carries the rounding of E - C, u |E - C|, against a radius
@@ -181,7 +200,7 @@ def surface(s, x, y, t, code, checker):
         c = s.center_b
         nx, ny, nz = P[0] - c[0], P[1] - c[1], P[2] - c[2]
         inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-        return P, (nx * inv, ny * inv, nz * inv), s.albedo_b
+        return P, (nx * inv, ny * inv, nz * inv), (s.albedo_b[0], s.albedo_b[1], s.albedo_b[2])
     # Checker: light squares where sin(pi x) sin(pi y) >= 0 (seed Cell 1).
     base = FLOOR_LIGHT if checker >= 0.0 else FLOOR_DARK
     rg = base * (1.0 - s.floor_tint)
@@ -306,13 +325,13 @@ def shade(s, lights, P, N, Ns, albedo, code, skip):
     r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
     view = (0.0, 0.0, 0.0)
     for k in range(lights.shape[0]):
-        L, color = (lights[k, 0], lights[k, 1], lights[k, 2]), (lights[k, 3], lights[k, 4], lights[k, 5])
-        w, lit = reach(s, L, P, N, code, skip, skip, Ns)
+        light = lights[k]
+        w, lit = reach(s, light.position, P, N, code, skip, skip, Ns)
         if lit:
             if view[2] == 0.0:          # > 0 once computed: P is below the eye
                 view = view_vector(s, P)
             axis, wv = specular_axis(s, w, view)
-            dr, dg, db = light_term(s, color, w, axis, wv, Ns, albedo)
+            dr, dg, db = light_term(s, light.color, w, axis, wv, Ns, albedo)
             r, g, b = r + dr, g + dg, b + db
     # + 0.0: a -0.0 (a -0.0 albedo times a light) leaves as 0.0, not as a negative zero pixel.
     return min(max(r, 0.0), 1.0) + 0.0, min(max(g, 0.0), 1.0) + 0.0, min(max(b, 0.0), 1.0) + 0.0
@@ -344,33 +363,53 @@ def shading_normal(s, N, frame, hu, hv, u, v, sin_phi):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def render_rows(prm, lights, xs, ys, first, last, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
-                image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out):
-    """Render the pixels of rows ``first`` to ``last - 1`` (in parallel) into the preallocated
-    outputs: xs (W,), ys (H,): pixel centres on the image plane; image (H, W, 3),
-    chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2) when wanted;
-    t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) when ``want_geo`` (the GBuffer);
-    the caller allocates them with these shapes (nothing is checked here).
+def render_rows(scene, lights, xs, ys, first, last, job, out):
+    """Render the pixels of rows ``first`` to ``last - 1`` (in parallel) into the preallocated outputs.
+
+    Parameters
+    ----------
+    scene : (1,) `SCENE` record array
+        From `params` (one record: numba's parallel loop takes arrays, not records).
+    lights : (n,) `LIGHT` record array
+        From `params`.
+    xs, ys : (W,), (H,) float64
+        Pixel centres on the image plane (scene units).
+    first, last : int
+        The rows to render, 0 <= first <= last <= H.
+    job : Job
+        ``method`` (int: `EXACT`, `CENTRAL` or `FOOTPRINT`), ``eps`` (float, the central
+        step), ``skip`` (bool, see the module), ``want_kink``, ``want_grad``, ``want_geo``
+        (bool: which optional outputs to write), ``dx``, ``dy`` (float, the pixel spacing).
+    out : Outputs
+        image (H, W, 3) float64, chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2)
+        float64 when wanted; t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) float64 when
+        ``want_geo`` (the GBuffer).  Written in place.
+
+    Notes
+    -----
+    Nothing is checked here: the caller allocates the outputs with these shapes and dtypes
+    (a wrong one is read or written out of bounds, or compiles another specialization).
     """
     sin_x = np.sin(np.pi * xs)
     for j in prange(first, last):
-        render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
-                   image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out)
+        render_row(j, scene, lights, xs, ys, sin_x, job, out)
 
 
 # A row is a function of its own: numba's parallel loop cannot take the
 # steps inlined (inline="always", 1.3x: LLVM leaves them as calls).
 @njit(cache=True, error_model="numpy")
-def render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_kink, want_grad, want_geo,
-               image, chamber, kink, grad, t_out, P_out, N_out, Ns_out, uv_out):
+def render_row(j, scene, lights, xs, ys, sin_x, job, out):
     """Row j of `render_rows`."""
-    s, y, sin_y = unpack(prm), ys[j], math.sin(math.pi * ys[j])
+    s, y, sin_y = scene[0], ys[j], math.sin(math.pi * ys[j])
+    method, eps, skip, dx, dy = job.method, job.eps, job.skip, job.dx, job.dy
+    want_kink, want_grad, want_geo = job.want_kink, job.want_grad, job.want_geo
+    image, chamber, kink, grad = out.image, out.chamber, out.kink, out.grad
     for i in range(xs.shape[0]):
         x = xs[i]
         t, code = nearest_hit(s, x, y, skip)
         chamber[j, i] = code
         if want_geo:
-            t_out[j, i] = t
+            out.t[j, i] = t
         if code == BACKGROUND:
             continue
         P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
@@ -389,33 +428,32 @@ def render_row(j, prm, lights, xs, ys, sin_x, dx, dy, method, eps, skip, want_ki
             if want_kink:
                 kink[j, i] = flag
             if want_geo:
-                uv_out[j, i, 0], uv_out[j, i, 1] = u, v
+                out.uv[j, i, 0], out.uv[j, i, 1] = u, v
         image[j, i, 0], image[j, i, 1], image[j, i, 2] = shade(s, lights, P, N, Ns, albedo, code, skip)
         for c in range(3 if want_geo else 0):
-            P_out[j, i, c], N_out[j, i, c], Ns_out[j, i, c] = P[c], N[c], Ns[c]
+            out.P[j, i, c], out.N[j, i, c], out.Ns[j, i, c] = P[c], N[c], Ns[c]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def sweep_rows(prm, lights, xs, ys, first, last, steps, images, chamber, kink, grads):
+def sweep_rows(scene, lights, xs, ys, first, last, steps, images, chamber, kink, grads):
     """Rows ``first`` to ``last - 1`` of the exact frame (index 0) and of one central frame per
     step (1, 2, ...).
     Per pixel the geometry and the shadow rays are computed once (they do not
     depend on the gradient); sphere A is re-shaded per step, crease flag kept.
-    images (S+1, H, W, 3), grads (S+1, H, W, 2); chamber, kink (H, W).
+    scene, lights, xs, ys as `render_rows`; steps (S,) float64; images (S+1, H, W, 3),
+    grads (S+1, H, W, 2) float64; chamber (H, W) uint8, kink (H, W) bool.
     The caller allocates the outputs with these shapes (nothing is checked here).
     """
     sin_x = np.sin(np.pi * xs)
     for j in prange(first, last):
-        sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads)
+        sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads)
 
 
 @njit(cache=True, error_model="numpy")
-def sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads):
+def sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads):
     """Row j of `sweep_rows`."""
-    s, y, sin_y, n = unpack(prm), ys[j], math.sin(math.pi * ys[j]), lights.shape[0]
-    # Per light: the unit vector w to it, its specular axis and w . v, and
-    # whether it reaches the pixel (1.0) or not (0.0).
-    geo = np.zeros((n, 8))
+    s, y, sin_y, n = scene[0], ys[j], math.sin(math.pi * ys[j]), lights.shape[0]
+    geo = light_geometry(n)
     for i in range(xs.shape[0]):
         x = xs[i]
         t, code = nearest_hit(s, x, y, True)
@@ -433,10 +471,11 @@ def sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads
         view = view_vector(s, P)
         for k in range(n):
             # Every shadow ray of an attached light, once (Ns varies with the step).
-            w, lit = reach(s, (lights[k, 0], lights[k, 1], lights[k, 2]), P, N, code, True, False, N)
-            axis, wv = specular_axis(s, w, view)
-            geo[k, 0], geo[k, 1], geo[k, 2], geo[k, 3], geo[k, 4], geo[k, 5] = w + axis
-            geo[k, 6], geo[k, 7] = wv, 1.0 if lit else 0.0
+            g = geo[k]
+            w, g.lit = reach(s, lights[k].position, P, N, code, True, False, N)
+            axis, g.wv = specular_axis(s, w, view)
+            g.w[0], g.w[1], g.w[2] = w
+            g.axis[0], g.axis[1], g.axis[2] = axis
         for f in range(images.shape[0]):
             method, eps = (EXACT, 0.0) if f == 0 else (CENTRAL, steps[f - 1])
             hu, hv, flag = gradient(s, method, eps, u, v, x, y, 0.0, 0.0, P, N, frame, sin_phi)
@@ -445,34 +484,55 @@ def sweep_row(j, prm, lights, xs, ys, sin_x, steps, images, chamber, kink, grads
             Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
             r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
             for k in range(n):
-                if geo[k, 7] != 0.0:
-                    color = (lights[k, 3], lights[k, 4], lights[k, 5])
-                    dr, dg, db = light_term(s, color, (geo[k, 0], geo[k, 1], geo[k, 2]),
-                                            (geo[k, 3], geo[k, 4], geo[k, 5]), geo[k, 6], Ns, albedo)
+                light = geo[k]
+                if light.lit:
+                    dr, dg, db = light_term(s, lights[k].color, light.w, light.axis, light.wv, Ns, albedo)
                     r, g, b = r + dr, g + dg, b + db
             images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0) + 0.0, min(max(g, 0.0), 1.0) + 0.0
             images[f, j, i, 2] = min(max(b, 0.0), 1.0) + 0.0
             grads[f, j, i, 0], grads[f, j, i, 1] = hu, hv
 
 
+def light_geometry(n):
+    """An (n,) `LIGHT_GEOMETRY` record array of zeros, fields read by name (compiled: the
+    array; interpreted, NUMBA_DISABLE_JIT=1: its ``np.recarray`` view, as numpy's plain
+    structured array has no attribute access)."""
+    return np.zeros(n, LIGHT_GEOMETRY).view(np.recarray)
+
+
+@overload(light_geometry, jit_options=dict(cache=True))
+def _light_geometry(n):
+    return lambda n: np.zeros(n, LIGHT_GEOMETRY)
+
+
 def params(scene, skip=True):
-    """The kernel's arguments for a validated `renderer.Scene`: the `Params`
-    flattened to a float64 array (`unpack` reads it back inside the kernel)
-    and the lights as an (n, 6) float64 array of position and colour.  With
-    ``skip`` the lights of zero colour are left out (they add exactly 0)."""
-    p = Params(scene.camera_z, scene.radius_a, scene.center_b, scene.radius_b, scene.sphere_b, scene.floor,
-               scene.ambient, scene.albedo_a, scene.albedo_b, scene.ka, scene.kd, scene.ks, scene.shininess,
-               scene.model == "phong", scene.floor_tint, FIELD_CODES[scene.height_field], scene.k_u,
-               scene.k_v, scene.beta, scene.bump == "surface")
-    flat = [c for f in p for c in (f if isinstance(f, tuple) else (f,))]
-    lights = [tuple(l.position) + tuple(l.color) for l in scene.lights if any(l.color) or not skip]
-    return np.array(flat, dtype=np.float64), np.array(lights, dtype=np.float64).reshape(-1, 6)
+    """The kernel's scene and lights, by name, for a validated `renderer.Scene`.
 
+    Parameters
+    ----------
+    scene : renderer.Scene
+    skip : bool
+        Leave out the lights of zero colour (they add exactly 0).
 
-@njit(cache=True, error_model="numpy")
-def unpack(a):
-    """The `Params` of the flat array `params` made (scalars and triples:
-    numba's parallel loops take arrays, the pixel code reads fields)."""
-    return Params(a[0], a[1], (a[2], a[3], a[4]), a[5], a[6] != 0.0, a[7] != 0.0, (a[8], a[9], a[10]),
-                  (a[11], a[12], a[13]), (a[14], a[15], a[16]), a[17], a[18], a[19], a[20], a[21] != 0.0,
-                  a[22], int(a[23]), a[24], a[25], a[26], a[27] != 0.0)
+    Returns
+    -------
+    scene : (1,) `SCENE` record array (``np.recarray``)
+        Each field the Scene attribute of its name, or its `DERIVED` value.
+    lights : (n,) `LIGHT` record array (``np.recarray``)
+        The lights in order.
+
+    Raises
+    ------
+    AttributeError
+        A field of `SCENE` that is neither a Scene attribute nor in `DERIVED` (its name).
+    """
+    prm = np.zeros(1, SCENE).view(np.recarray)
+    for name in SCENE.names:
+        if name in DERIVED:
+            prm[name] = DERIVED[name](scene)
+        elif hasattr(scene, name):
+            prm[name] = getattr(scene, name)
+        else:
+            raise AttributeError(f"kernel.SCENE field {name!r} is neither a Scene attribute nor in kernel.DERIVED")
+    lights = [(l.position, l.color) for l in scene.lights if any(l.color) or not skip]
+    return prm, np.array(lights, dtype=LIGHT).view(np.recarray)

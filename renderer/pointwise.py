@@ -263,7 +263,7 @@ def reach(scene, gbuffer, *, gate=False):
 # kernel's reach inlined as it was when first compiled after kernel.py changes.
 @njit(error_model="numpy")
 def _reach_rows(prm, lights, chamber, P, N, Ns, gate, out):
-    s = kernel.unpack(prm)
+    s = prm[0]
     for j in range(chamber.shape[0]):
         for i in range(chamber.shape[1]):
             code = chamber[j, i]
@@ -272,5 +272,4 @@ def _reach_rows(prm, lights, chamber, P, N, Ns, gate, out):
             p, n, ns = (P[j, i, 0], P[j, i, 1], P[j, i, 2]), (N[j, i, 0], N[j, i, 1], N[j, i, 2]), \
                 (Ns[j, i, 0], Ns[j, i, 1], Ns[j, i, 2])
             for k in range(lights.shape[0]):
-                out[k, j, i] = kernel.reach(s, (lights[k, 0], lights[k, 1], lights[k, 2]), p, n, code,
-                                            True, gate, ns)[1]
+                out[k, j, i] = kernel.reach(s, lights[k].position, p, n, code, True, gate, ns)[1]

@@ -177,10 +177,12 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     dx = float(x[1] - x[0]) if width > 1 else window
     dy = float(y[0] - y[1]) if height > 1 else window
     prm, lights = kernel.params(scene, skip)
+    job = kernel.Job(method=GRADIENTS.index(gradient), eps=float(scene.eps), skip=skip, want_kink=want_kink,
+                     want_grad=want_grad, want_geo=want_geo, dx=dx, dy=dy)
+    outputs = kernel.Outputs(**out, **geo)
     with threads(workers):
         for first, last in bands(height, width):
-            kernel.render_rows(prm, lights, x, y, first, last, dx, dy, GRADIENTS.index(gradient),
-                               float(scene.eps), skip, want_kink, want_grad, want_geo, *out.values(), *geo.values())
+            kernel.render_rows(prm, lights, x, y, first, last, job, outputs)
     return x, y, out, geo
 
 
