@@ -147,6 +147,11 @@ QUANTITIES = {
     "sines and cosines per pixel of the sine field's exact gradient": (
         ("c4_exact_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "exact").trig),
     "the benchmark's complex step": (("c4_cs_step",), lambda: _lib("lab.gradient_methods").FAST.complex_steps[0]),
+    # The price of fast math (Cell 4): the ulp sample, its quantile, libm's sine.
+    "the fast-math sample per function": (("c4_fm_points",), lambda: _lib("lab.fastmath").SAMPLES),
+    "the fast-math quantile (%)": (("c4_fm_quantile",), lambda: 100 * _lib("lab.fastmath").QUANTILE),
+    "libm's largest sine error (ulp)": (
+        ("c4_fm_libm_sin",), lambda: _lib("lab.fastmath").ulp_table()["errors"]["numba"]["sin"]["max"]),
     "the chapter's amplitude": (("c5_fit_beta",), lambda: _lib("renderer").Scene().beta),
     "the rings field's image-best step (the simulator's scene and steps, 256 × 256)": (
         ("ex_rings_best",), lambda: _lib("lab.accuracy").image_best_step("rings", 256)["best"]),
@@ -161,7 +166,8 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s1_away_surface", "s1_flips_chart",
                "s1_flips_surface", "s1_ex_factor", "s2_count_0", "s2_count_2", "s2_count_3",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
-               "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c6_beta",
+               "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c4_fm_ulps",
+               "c4_fm_floors", "c4_fm_drjit", "c6_beta",
                "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err",
                "ex_fwd_err_1e8", "ex_fwd_err_1e3", "ex_cen_err_1e6", "ex_cs_err", "ex_exact_err", "ex_gn_jr0",
                "ex_gn_jj0", "ex_gn_jr1", "ex_gn_jj1", "ex_gn_b1", "ex_gn_b2", "ex_rings_label",
