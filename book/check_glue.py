@@ -103,7 +103,7 @@ QUANTITIES = {
     # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
     "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),
-    "the U-curve's label": (("ucurve_label", "s3_ex_label"), lambda: _lib("chapter.labels").ucurve_label(
+    "the U-curve's label": (("ucurve_label", "s3_ex_label", "c4_fm_label"), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
     "the unit roundoff": (("s3_unit_roundoff",), lambda: _lib("renderer.ucurve").UNIT_ROUNDOFF),
     "the book's default step": (("s3_eps_default",), lambda: _lib("renderer").Scene().eps),

@@ -27,6 +27,7 @@ relative) is far below the 2^-53 measured.
 from __future__ import annotations
 
 import math
+import os
 from functools import lru_cache
 
 import mpmath
@@ -101,8 +102,10 @@ def _numpy():
 
 
 def _drjit():
-    from renderer.backends import drjit_llvm
-    llvm = drjit_llvm()
+    from renderer.backends import drjit_llvm, llvm_library
+    # A library path that is no file: no Dr.Jit (importing it would print its failed load to stderr).
+    path = llvm_library()
+    llvm = drjit_llvm() if path is not None and os.path.isfile(path) else None
     if llvm is None:
         return None
     import drjit as dr
@@ -392,10 +395,15 @@ def floors():
     """The U-curve's roundoff floor with each available backend's sine, one measurement of the
     build (`lab.store`).
 
-    At the U-curve of `renderer.ucurve.measure`'s defaults (the sine field, h_u at its
-    `renderer.ucurve.SEED_POINT`, the seed's frequencies, `renderer.ucurve.DEFAULT_STEPS`),
+    At the book's U-curve (`lab.accuracy.optima`'s sine field: h_u at its point, the seed's
+    frequencies, `renderer.ucurve.DEFAULT_STEPS`),
     the central difference `central_differences` with each backend's sine, its error
     against the true derivative (mpmath, 50 digits) at every step.
+
+    Raises
+    ------
+    RuntimeError
+        `lab.accuracy.optima`'s sine curve is no longer h_u over the default steps.
 
     Returns
     -------
@@ -414,9 +422,14 @@ def floors():
 
 
 def _floors(versions):
-    from renderer.ucurve import DEFAULT_STEPS, SEED_FREQUENCIES, SEED_POINT, fit_model, measure
-    (u, v), (k_u, k_v) = SEED_POINT, SEED_FREQUENCIES
-    curve = measure("sine", u, v, "u", eps=DEFAULT_STEPS, k_u=k_u, k_v=k_v)
+    from renderer.ucurve import DEFAULT_STEPS, UNIT_ROUNDOFF, fit_model
+
+    from .accuracy import optima
+    o = optima()["sine"]                   # the book's U-curve: its point and the error model's optimum
+    u, v, k_u, k_v = o["u"], o["v"], o["k_u"], o["k_v"]
+    if o["component"] != "u" or o["steps"] != DEFAULT_STEPS.size:
+        raise RuntimeError(f"the sine field's U-curve is no longer h_u over the default steps: {o}")
+    roundoff = UNIT_ROUNDOFF * (o["h"] + o["x_h1"])
     true = sp.lambdify((F.u, F.v), F.GRADIENT["sine"][0].subs({F.k_u: sp.nsimplify(k_u),
                                                                  F.k_v: sp.nsimplify(k_v)}), modules="mpmath")
     out, libm = {}, central_differences("numba", DEFAULT_STEPS, u, v, k_u, k_v)
@@ -426,13 +439,11 @@ def _floors(versions):
             fd = central_differences(name, DEFAULT_STEPS, u, v, k_u, k_v)
             error = np.array([float(abs(mpmath.mpf(float(y)) - t)) for y in fd])
             best = int(np.argmin(error))
-            A, B = fit_model(DEFAULT_STEPS, error, start=(curve.model_truncation,
-                                                          curve.model_cancellation + curve.model_argument))
+            A, B = fit_model(DEFAULT_STEPS, error, start=(o["h3"] / 6, roundoff))
             fitted = (B / (2 * A)) ** (1 / 3)
             out[name] = {"error": float(error[best]), "step": float(DEFAULT_STEPS[best]), "fitted_step": fitted,
                          "fitted_error": A * fitted**2 + B / fitted, "fitted_roundoff": B,
                          "differ": int(np.count_nonzero(fd != libm))}
     return {"backends": list(versions), "missing": [b for b in BACKENDS if b not in versions], "u": u, "v": v,
             "k_u": k_u, "k_v": k_v, "steps": int(DEFAULT_STEPS.size),
-            "model": {"step": curve.eps_model, "error": curve.error_model,
-                      "roundoff": curve.model_cancellation + curve.model_argument}, "floors": out}
+            "model": {"step": o["eps_model"], "error": o["error_model"], "roundoff": roundoff}, "floors": out}
