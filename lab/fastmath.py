@@ -7,7 +7,8 @@ element, through small `numba.njit` loops compiled as the kernel is);
 ``numpy``, numpy's ufuncs (which dispatch to SIMD code where the CPU has it);
 ``drjit``, Dr.Jit's LLVM backend on ``Float64`` arrays (only where
 `renderer.backends.drjit_llvm` finds the system's LLVM); ``jax``, jax.numpy in
-float64 under ``jax.jit`` (XLA on the CPU).
+float64 under ``jax.jit`` (XLA on the CPU).  (The kernel takes an integral shininess by
+repeated squaring, ``renderer.kernel.int_power``; pow here is what it calls for any other.)
 
 Accuracy is counted in ulps: |y - t| / ulp(t), t the true value of the function
 at the float64 argument (mpmath at `DIGITS` digits) and ulp(t) the spacing of
@@ -92,7 +93,11 @@ def _numba_pow(base, e, out):
 
 def _numba():
     def call(loop):
-        return lambda *args: (loop(*args, out := np.empty_like(args[0])), out)[1]
+        def run(*args):
+            out = np.empty_like(args[0])
+            loop(*args, out)
+            return out
+        return run
     return {"sin": call(_numba_sin), "cos": call(_numba_cos), "atan2": call(_numba_atan2),
             "acos": call(_numba_acos), "pow": call(_numba_pow)}
 
