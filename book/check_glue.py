@@ -103,7 +103,7 @@ QUANTITIES = {
     # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
     "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),
-    "the U-curve's label": (("ucurve_label", "s3_ex_label"), lambda: _lib("chapter.labels").ucurve_label(
+    "the U-curve's label": (("ucurve_label", "s3_ex_label", "c4_fm_label"), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
     "the unit roundoff": (("s3_unit_roundoff",), lambda: _lib("renderer.ucurve").UNIT_ROUNDOFF),
     "the book's default step": (("s3_eps_default",), lambda: _lib("renderer").Scene().eps),
@@ -152,6 +152,11 @@ QUANTITIES = {
     "JAX's forward-mode slope of |x| at x = 0": (
         ("c4_abs_slope",), lambda: _lib("lab.gradient_methods").abs_slope_at_zero()[0]),
     "the U-curve's chart v": (("c4_crease_v",), lambda: _lib("renderer.ucurve").SEED_POINT[1]),
+    # The price of fast math (Cell 4): the ulp sample, its quantile, libm's sine.
+    "the fast-math sample per function": (("c4_fm_points",), lambda: _lib("lab.fastmath").SAMPLES),
+    "the fast-math quantile (%)": (("c4_fm_quantile",), lambda: 100 * _lib("lab.fastmath").QUANTILE),
+    "libm's largest sine error (ulp)": (
+        ("c4_fm_libm_sin",), lambda: _lib("lab.fastmath").ulp_table()["errors"]["numba"]["sin"]["max"]),
     "the chapter's amplitude": (("c5_fit_beta",), lambda: _lib("renderer").Scene().beta),
     "the rings field's image-best step (the simulator's scene and steps, 256 × 256)": (
         ("ex_rings_best",), lambda: _lib("lab.accuracy").image_best_step("rings", 256)["best"]),
@@ -167,7 +172,7 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s1_flips_surface", "s1_ex_factor", "s2_count_0", "s2_count_2", "s2_count_3",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c4_ad_ratio", "c4_ad_err_ratio",
-               "c4_ad_compile_ms", "c6_beta",
+               "c4_ad_compile_ms", "c4_fm_ulps", "c4_fm_floors", "c4_fm_drjit", "c6_beta",
                "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err",
                "ex_fwd_err_1e8", "ex_fwd_err_1e3", "ex_cen_err_1e6", "ex_cs_err", "ex_exact_err", "ex_gn_jr0",
                "ex_gn_jj0", "ex_gn_jr1", "ex_gn_jj1", "ex_gn_b1", "ex_gn_b2", "ex_rings_label",
