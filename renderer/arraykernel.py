@@ -251,15 +251,9 @@ def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad):
     chamber = xp.select(on_a, 1.0, 0.0)
     for mask, code in ((on_b, 2.0), (on_floor, 3.0)):
         chamber = chamber if mask is None else xp.select(mask, code, chamber)
-    outputs = rgb + [chamber]
+    groups = {"image": (rgb, np.float64), "chamber": ([chamber], np.uint8)}
     if kink:
-        outputs.append(on_a & G.kink_band(xp, field, u, v, s.k_u, s.k_v))
+        groups["kink"] = ([on_a & G.kink_band(xp, field, u, v, s.k_u, s.k_v)], np.bool_)
     if grad:
-        outputs += [xp.select(on_a, hu, 0.0), xp.select(on_a, hv, 0.0)]
-    arrays = xp.numpy(outputs)
-    out = {"image": np.stack(arrays[:3], axis=-1), "chamber": arrays[3].astype(np.uint8)}
-    if kink:
-        out["kink"] = arrays[4]
-    if grad:
-        out["grad"] = np.stack(arrays[-2:], axis=-1)
-    return out
+        groups["grad"] = ([xp.select(on_a, hu, 0.0), xp.select(on_a, hv, 0.0)], np.float64)
+    return dict(zip(groups, xp.numpy(list(groups.values()))))

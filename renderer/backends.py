@@ -103,9 +103,11 @@ class NumpyNamespace:
         return np.tile(cols, len(rows)), np.repeat(rows, len(cols))
 
     @staticmethod
-    def numpy(arrays):
-        """The arrays as numpy arrays (a Python float or bool is broadcast by the caller)."""
-        return [np.asarray(a) for a in arrays]
+    def numpy(groups):
+        """Numpy arrays of ``groups``, pairs (arrays of n values, dtype): one array each,
+        (n,) for one array, else (n, k) with the k arrays side by side."""
+        return [(np.stack(a, axis=-1) if len(a) > 1 else np.broadcast_to(a[0], a[0].shape)).astype(d, copy=False)
+                for a, d in groups]
 
 
 class DrJitNamespace:
@@ -118,7 +120,7 @@ class DrJitNamespace:
 
     def __init__(self, llvm):
         import drjit as dr
-        self.dr, self.Float64, self.UInt32 = dr, llvm.Float64, llvm.UInt32
+        self.dr, self.Float64, self.UInt32, self.UInt8 = dr, llvm.Float64, llvm.UInt32, llvm.UInt8
         self.sin, self.cos, self.atan2, self.sqrt, self.abs = dr.sin, dr.cos, dr.atan2, dr.sqrt, dr.abs
         self.copysign, self.minimum, self.maximum, self.power = dr.copysign, dr.minimum, dr.maximum, dr.power
 
@@ -141,11 +143,24 @@ class DrJitNamespace:
         return (self.dr.gather(self.Float64, self.Float64(cols), index % width),
                 self.dr.gather(self.Float64, self.Float64(rows), index // width))
 
-    def numpy(self, arrays):
-        """Evaluate the arrays in one kernel launch and return them as numpy arrays."""
-        arrays = [a for a in arrays]
-        self.dr.eval(*[a for a in arrays if isinstance(a, self.dr.ArrayBase)])
-        return [np.asarray(a) for a in arrays]
+    def numpy(self, groups):
+        """As `NumpyNamespace.numpy`, all groups evaluated in one kernel launch: a group
+        of k arrays is scattered into one array of k n values inside the kernel, and
+        the results are numpy views of Dr.Jit's memory (no copy)."""
+        dr, out = self.dr, []
+        for arrays, dtype in groups:
+            if len(arrays) == 1:
+                a = arrays[0]
+                out.append(self.UInt8(a) if dtype == np.uint8 else a)
+                continue
+            n, k = dr.width(arrays[0]), len(arrays)
+            index = dr.arange(self.UInt32, n) * k
+            target = dr.zeros(self.Float64, n * k)
+            for c, a in enumerate(arrays):
+                dr.scatter(target, a, index + c)
+            out.append(target)
+        dr.eval(*out)
+        return [np.asarray(a).reshape((-1, len(g[0])) if len(g[0]) > 1 else (-1,)) for a, g in zip(out, groups)]
 
 
 def missing(name):
