@@ -139,7 +139,8 @@ class DrJitNamespace:
     def grid(self, cols, rows):
         """As `NumpyNamespace.grid`, gathered inside the kernel from the two short arrays."""
         index = self.dr.arange(self.UInt32, len(cols) * len(rows))
-        width = len(cols)
+        # The width as a kernel argument, not a literal: frames of any size share one compiled kernel.
+        width = self.dr.opaque(self.UInt32, len(cols))
         return (self.dr.gather(self.Float64, self.Float64(cols), index % width),
                 self.dr.gather(self.Float64, self.Float64(rows), index // width))
 
