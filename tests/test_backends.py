@@ -131,3 +131,27 @@ def test_int_power_is_the_numba_kernels(n):
     base = np.random.default_rng(n).uniform(0.0, 1.0, 64)
     got = np.broadcast_to(arraykernel.int_power(base, n), base.shape)
     assert np.array_equal(got, [kernel.int_power.py_func(float(b), n) for b in base])
+
+
+def extreme_cases():
+    """(scene name, gradient, backend): the accepted extremes of tests/test_interpreted.py, numpy
+    with every pipeline, Dr.Jit (a compiled kernel per scene) with the exact one."""
+    from tests.test_interpreted import SCENES
+    return [(name, g, b) for name in SCENES for g in ("exact", "central", "footprint")
+            for b in ARRAY_BACKENDS if b == "numpy" or g == "exact"]
+
+
+@pytest.mark.parametrize("name, gradient, backend", extreme_cases())
+def test_array_backends_render_the_extreme_scenes_as_numba_does(name, gradient, backend):
+    """Lights within 1e-170 of a point, the pole on a pixel, the limits of every field.  At the
+    least eps (1e-12) a central quotient turns the libraries' few-ulp differences of sin into
+    O(1) gradients (the U-curve's roundoff floor): there only chambers and creases are compared."""
+    from tests.test_interpreted import SCENES
+    require_backend(backend)
+    scene, width, height = SCENES[name]
+    d_image, chambers, creases, _ = frame_differences(render(scene, width, height, gradient=gradient,
+                                                             backend=backend),
+                                                      render(scene, width, height, gradient=gradient))
+    assert (chambers, creases) == (0, 0)
+    if gradient == "exact" or scene.eps >= 1e-6:
+        assert d_image <= IMAGE_TOL
