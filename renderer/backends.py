@@ -58,7 +58,7 @@ def drjit_llvm():
     Never raises: a missing wheel or library is None.
     """
     path = llvm_library()
-    if path is None:
+    if path is None or not os.path.isfile(path):    # Dr.Jit would print its own failure on stderr
         return None
     os.environ.setdefault("DRJIT_LIBLLVM_PATH", path)
     try:
@@ -171,8 +171,10 @@ def missing(name):
     path = llvm_library()
     if path is None:
         found = "no libLLVM shared library was found (" + ", ".join(LIBRARY_PATTERNS) + ")"
+    elif not os.path.isfile(path):
+        found = f"DRJIT_LIBLLVM_PATH is {path!r}, not a file"
     else:
-        found = f"Dr.Jit could not load the LLVM library {path!r} (DRJIT_LIBLLVM_PATH or the newest found)"
+        found = f"Dr.Jit could not load the LLVM library {path!r}"
     return (f"Dr.Jit's LLVM backend is unavailable: {found}; install the system's LLVM (Debian: "
             f"apt-get install libllvm19) or set DRJIT_LIBLLVM_PATH to a libLLVM-*.so, or use backend "
             f"'numba' or 'auto'")

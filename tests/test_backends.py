@@ -155,3 +155,17 @@ def test_array_backends_render_the_extreme_scenes_as_numba_does(name, gradient, 
     assert (chambers, creases) == (0, 0)
     if gradient == "exact" or scene.eps >= 1e-6:
         assert d_image <= IMAGE_TOL
+
+
+def test_the_command_line_renders_with_drjit_or_says_what_is_missing(tmp_path):
+    """``symrender render --backend``: where the LLVM library is missing, one line and exit 2
+    (an input error) and no file; with ``auto`` there, the numba frame."""
+    env = {**os.environ, "DRJIT_LIBLLVM_PATH": "/nonexistent"}
+    argv = [sys.executable, "-m", "renderer.cli", "render", "--size", "16x12", "-o"]
+    refused = subprocess.run(argv + [str(tmp_path / "a.png"), "--backend", "drjit"], capture_output=True,
+                             text=True, env=env, timeout=300)
+    assert (refused.returncode, len(refused.stderr.splitlines())) == (2, 1), refused.stderr
+    assert "backend" in refused.stderr and not (tmp_path / "a.png").exists()
+    auto = subprocess.run(argv + [str(tmp_path / "b.png"), "--backend", "auto"], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert auto.returncode == 0 and (tmp_path / "b.png").exists(), auto.stderr
