@@ -106,7 +106,7 @@ class NumpyNamespace:
     def numpy(groups):
         """Numpy arrays of ``groups``, pairs (arrays of n values, dtype): one array each,
         (n,) for one array, else (n, k) with the k arrays side by side."""
-        return [(np.stack(a, axis=-1) if len(a) > 1 else np.broadcast_to(a[0], a[0].shape)).astype(d, copy=False)
+        return [(np.stack(a, axis=-1) if len(a) > 1 else np.asarray(a[0])).astype(d, copy=False)
                 for a, d in groups]
 
 

@@ -74,7 +74,8 @@ def test_a_frame_taller_than_one_block_is_the_blocks_in_order(backend, monkeypat
     """Blocks of rows (`render.ARRAY_BLOCK_PIXELS`) put together: the frame of one block."""
     require_backend(backend)
     whole = render(Scene(), 24, 20, backend=backend)
-    monkeypatch.setitem(sys.modules["renderer.render"].ARRAY_BLOCK_PIXELS, backend, 24 * 3)     # 7 blocks, the last of 2 rows
+    # 7 blocks, the last of 2 rows
+    monkeypatch.setitem(sys.modules["renderer.render"].ARRAY_BLOCK_PIXELS, backend, 24 * 3)
     parts = render(Scene(), 24, 20, backend=backend)
     for name in ("image", "chamber", "kink", "grad"):
         assert np.array_equal(getattr(parts, name), getattr(whole, name)), name
