@@ -54,7 +54,7 @@ _NJIT = '@njit(cache=True, error_model="numpy")'
 #: at 1024² central); LLVM's own inliner finds the function too large.
 INLINE = ("central_gradient",)
 _PY = PythonCodePrinter({"fully_qualified_modules": True, "standard": "python3"})
-ARRAY_HEADER = HEADER.replace("\nfrom numba import njit\n\n", "") \
+ARRAY_HEADER = HEADER.replace("from numba import njit\n\n", "") \
     .replace("fresh.\n", "fresh.\nBranch-free: each function takes an array namespace ``xp`` first "
                          "(`renderer.backends`).\n")
 
@@ -91,7 +91,9 @@ class _ArrayPrinter(PythonCodePrinter):
         return f"xp.select({arg} == 0, 0.0, xp.copysign(1.0, {arg}))"
 
     def _logic(self, expr, op):
-        return f" {op} ".join(f"({self._print(a)})" for a in sorted(expr.args, key=sp.default_sort_key))
+        # A relation prints in parentheses of its own; & and | bind tighter than a comparison.
+        return f" {op} ".join(self._print(a) if isinstance(a, sp.core.relational.Relational) else f"({self._print(a)})"
+                              for a in sorted(expr.args, key=sp.default_sort_key))
 
     def _print_And(self, expr):
         return self._logic(expr, "&")

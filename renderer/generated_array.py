@@ -5,6 +5,7 @@ Branch-free: each function takes an array namespace ``xp`` first (`renderer.back
 """
 
 import math
+
 FIELD_CODES = {'sine': 0, 'ridges': 1, 'rings': 2}
 
 
@@ -50,7 +51,7 @@ def central_gradient(xp, field, u, v, k_u, k_v, eps_u, eps_v):
         x1 = math.pi*k_v
         x2 = xp.sin(v*x1)
         x3 = xp.sin(u*x0)
-        return (1/2)*(-x2*xp.sin(u_m*x0) + x2*xp.sin(u_p*x0))/eps_u, (-x3*xp.sin(v_m*x1) + x3*xp.sin(v_p*x1))*xp.select(((eps_v - v > 0)) | ((eps_v + v > 1)), 1/(-v_m + v_p), (1/2)/eps_v)
+        return (1/2)*(-x2*xp.sin(u_m*x0) + x2*xp.sin(u_p*x0))/eps_u, (-x3*xp.sin(v_m*x1) + x3*xp.sin(v_p*x1))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v)
     if field == 1:  # ridges
         u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
         u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
@@ -60,14 +61,14 @@ def central_gradient(xp, field, u, v, k_u, k_v, eps_u, eps_v):
         x1 = math.pi*k_v
         x2 = xp.sin(v*x1)
         x3 = xp.sin(u*x0)
-        return (1/2)*(-xp.abs(x2*xp.sin(u_m*x0)) + xp.abs(x2*xp.sin(u_p*x0)))/eps_u, (-xp.abs(x3*xp.sin(v_m*x1)) + xp.abs(x3*xp.sin(v_p*x1)))*xp.select(((eps_v - v > 0)) | ((eps_v + v > 1)), 1/(-v_m + v_p), (1/2)/eps_v)
+        return (1/2)*(-xp.abs(x2*xp.sin(u_m*x0)) + xp.abs(x2*xp.sin(u_p*x0)))/eps_u, (-xp.abs(x3*xp.sin(v_m*x1)) + xp.abs(x3*xp.sin(v_p*x1)))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v)
     if field == 2:  # rings
         u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
         u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
         v_p = xp.minimum(1, eps_v + v)
         v_m = xp.maximum(0, -eps_v + v)
         x0 = 2*math.pi*k_v
-        return 0.0, (-xp.sin(v_m*x0) + xp.sin(v_p*x0))*xp.select(((eps_v - v > 0)) | ((eps_v + v > 1)), 1/(-v_m + v_p), (1/2)/eps_v)
+        return 0.0, (-xp.sin(v_m*x0) + xp.sin(v_p*x0))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v)
     raise ValueError(f"field must be one of 0 (sine), 1 (ridges), 2 (rings), got {field!r}")
 
 
@@ -75,7 +76,7 @@ def kink_band(xp, field, u, v, k_u, k_v):
     if field == 0:  # sine
         return False
     if field == 1:  # ridges
-        return ((xp.abs(xp.sin(math.pi*k_u*u)) < 0.03)) | ((xp.abs(xp.sin(math.pi*k_v*v)) < 0.03))
+        return (xp.abs(xp.sin(math.pi*k_u*u)) < 0.03) | (xp.abs(xp.sin(math.pi*k_v*v)) < 0.03)
     if field == 2:  # rings
         return False
     raise ValueError(f"field must be one of 0 (sine), 1 (ridges), 2 (rings), got {field!r}")
@@ -136,4 +137,4 @@ def footprint(xp, x, y, dx, dy, camera_z, P_x, P_y, P_z, N_x, N_y, N_z, et_x, et
     x16 = x10*xp.abs(x0*(et_x*x14 + et_y*x13 + et_z*x15)) + x10*xp.abs(x0*(et_x*x6 + et_y*x7 + et_z*x8))
     x17 = (1/2)*x9
     x18 = x17*xp.abs(x0*(ep_x*x14 + ep_y*x13 + ep_z*x15)) + x17*xp.abs(x0*(ep_x*x6 + ep_y*x7 + ep_z*x8))
-    return xp.select(((x16 > 0)) & ((x16 < 100000000.0)), xp.minimum(0.25, x16), 0.0005), xp.select(((x18 > 0)) & ((x18 < 100000000.0)), xp.minimum(0.25, x18), 0.0005)
+    return xp.select((x16 > 0) & (x16 < 100000000.0), xp.minimum(0.25, x16), 0.0005), xp.select((x18 > 0) & (x18 < 100000000.0), xp.minimum(0.25, x18), 0.0005)

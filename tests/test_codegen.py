@@ -53,6 +53,7 @@ from renderer import generated_array as GA
 
 from . import scalar_reference
 from .jsnode import require_tool
+from .test_parity import require_backend
 
 #: Unit roundoff of float64.
 U = 2.0**-53
@@ -387,8 +388,7 @@ def array_outputs(module, points, xp):
 def test_generated_array_functions_agree_with_the_sympy_objects(points, references, backend):
     """renderer/generated_array.py under each namespace: every Piecewise became a select
     that keeps the right side, and Dr.Jit's sin, cos and atan2 stay within the bound."""
-    if backends.missing(backend):
-        pytest.skip(backends.missing(backend))
+    require_backend(backend)
     xp = backends.namespace(backend)
     with xp.scope():
         bad = mismatches(array_outputs(GA, points, xp), references, points)
