@@ -9,6 +9,11 @@ serve).  The library is found through the environment variable
 switch the backend off), else the newest ``libLLVM-*.so*`` in the system's
 library directories.  Without one, `drjit_llvm` returns None and the numba
 kernel renders.
+
+The array namespaces (`NumpyNamespace`, `DrJitNamespace`) are what the
+branch-free array kernel (`renderer.arraykernel`) and the generated array
+formulas (renderer/generated_array.py) compute with: a few elementwise
+functions, ``select`` and the conversion of a frame's outputs to numpy.
 """
 
 from __future__ import annotations
@@ -17,6 +22,10 @@ import functools
 import glob
 import os
 import re
+
+import numpy as np
+
+from .validate import InvalidValue
 
 #: Where Debian and its derivatives put libLLVM (multiarch directory, then llvm-N/lib).
 LIBRARY_PATTERNS = ("/usr/lib/*/libLLVM*.so*", "/usr/lib/llvm-*/lib/libLLVM*.so*", "/usr/lib64/libLLVM*.so*")
@@ -49,7 +58,7 @@ def drjit_llvm():
     Never raises: a missing wheel or library is None.
     """
     path = llvm_library()
-    if path is None:
+    if path is None or not os.path.isfile(path):    # Dr.Jit would print its own failure on stderr
         return None
     os.environ.setdefault("DRJIT_LIBLLVM_PATH", path)
     try:
@@ -60,3 +69,140 @@ def drjit_llvm():
     except (ImportError, OSError, RuntimeError):
         return None
     return drjit.llvm
+
+
+# ------------------------------------------------------------------ array namespaces
+#: Backends of `renderer.render` (``backend=``): the numba kernel, the array kernel
+#: (`renderer.arraykernel`) on numpy or on Dr.Jit's LLVM backend, and "auto".
+BACKENDS = ("numba", "numpy", "drjit", "auto")
+
+
+class NumpyNamespace:
+    """The array namespace ``xp`` of `renderer.arraykernel` and `renderer.generated_array` on numpy.
+
+    Always available: it runs the array kernel on any machine (the tests
+    check its logic with it).  Arrays are 1-D float64 or bool numpy arrays;
+    Python floats broadcast.  ``select(cond, a, b)`` is `numpy.where`.
+    """
+
+    name = "numpy"
+    sin, cos, atan2, sqrt, abs = np.sin, np.cos, np.arctan2, np.sqrt, np.abs
+    copysign, minimum, maximum, power = np.copysign, np.minimum, np.maximum, np.power
+    select = staticmethod(np.where)
+
+    @staticmethod
+    def scope():
+        """Context of a render: numpy's floating-point warnings off (a select computes
+        both sides, and the side it drops may divide by 0)."""
+        return np.errstate(all="ignore")
+
+    @staticmethod
+    def grid(cols, rows):
+        """Per pixel of a block of ``len(rows)`` rows of ``len(cols)`` pixels, row-major:
+        (cols[i], rows[j]), two float64 arrays of len(cols) * len(rows)."""
+        return np.tile(cols, len(rows)), np.repeat(rows, len(cols))
+
+    @staticmethod
+    def numpy(groups):
+        """Numpy arrays of ``groups``, pairs (arrays of n values, dtype): one array each,
+        (n,) for one array, else (n, k) with the k arrays side by side."""
+        return [(np.stack(a, axis=-1) if len(a) > 1 else np.asarray(a[0])).astype(d, copy=False)
+                for a, d in groups]
+
+
+class DrJitNamespace:
+    """The array namespace on Dr.Jit's LLVM backend: ``drjit.llvm`` Float64 and Bool
+    arrays, ``select`` is `drjit.select`.  Operations are traced, not run: `numpy`
+    evaluates all outputs with one `drjit.eval`, so Dr.Jit compiles the frame into
+    one kernel (cached in ~/.drjit after its first compile)."""
+
+    name = "drjit"
+
+    def __init__(self, llvm):
+        import drjit as dr
+        self.dr, self.Float64, self.UInt32, self.UInt8 = dr, llvm.Float64, llvm.UInt32, llvm.UInt8
+        self.sin, self.cos, self.atan2, self.sqrt, self.abs = dr.sin, dr.cos, dr.atan2, dr.sqrt, dr.abs
+        self.copysign, self.minimum, self.maximum, self.power = dr.copysign, dr.minimum, dr.maximum, dr.power
+
+    def select(self, cond, a, b):
+        """`drjit.select`, with a Float64 result where both values are Python floats
+        (drjit.select would give single precision)."""
+        if isinstance(a, float) and isinstance(b, float):
+            a = self.Float64(a)
+        return self.dr.select(cond, a, b)
+
+    def scope(self):
+        """Context of a render: Dr.Jit's FastMath off while the frame is traced (it
+        would fold a * 0 to 0 also where a is inf or NaN; IEEE arithmetic, as numba's)."""
+        return self.dr.scoped_set_flag(self.dr.JitFlag.FastMath, False)
+
+    def grid(self, cols, rows):
+        """As `NumpyNamespace.grid`, gathered inside the kernel from the two short arrays."""
+        index = self.dr.arange(self.UInt32, len(cols) * len(rows))
+        # The width as a kernel argument, not a literal: frames of any size share one compiled kernel.
+        width = self.dr.opaque(self.UInt32, len(cols))
+        return (self.dr.gather(self.Float64, self.Float64(cols), index % width),
+                self.dr.gather(self.Float64, self.Float64(rows), index // width))
+
+    def numpy(self, groups):
+        """As `NumpyNamespace.numpy`: all groups evaluated in one kernel launch, then a
+        group of k arrays scattered into one array of k n values (a copy per group, in
+        Dr.Jit's threads); the results are numpy views of Dr.Jit's memory."""
+        dr, out = self.dr, []
+        groups = [([self.UInt8(a) if dtype == np.uint8 else a for a in arrays], dtype) for arrays, dtype in groups]
+        # The frame's program in one kernel first: scattered directly, each target was a
+        # kernel of its own that recomputed the whole program (4 kernels a frame, 2x slower).
+        dr.eval(*[a for arrays, _ in groups for a in arrays if isinstance(a, dr.ArrayBase)])
+        for arrays, _ in groups:
+            if len(arrays) == 1:
+                out.append(arrays[0])
+                continue
+            n, k = dr.width(arrays[0]), len(arrays)
+            index = dr.arange(self.UInt32, n) * k
+            target = dr.empty(self.Float64, n * k)          # every element is written below
+            for c, a in enumerate(arrays):
+                dr.scatter(target, a, index + c)
+            out.append(target)
+        dr.eval(*out)
+        return [np.asarray(a).reshape((-1, len(g[0])) if len(g[0]) > 1 else (-1,)) for a, g in zip(out, groups)]
+
+
+def missing(name):
+    """Why backend ``name`` cannot run here and how to get it (a sentence), or None when it can."""
+    if name != "drjit" or drjit_llvm() is not None:
+        return None
+    path = llvm_library()
+    if path is None:
+        found = "no libLLVM shared library was found (" + ", ".join(LIBRARY_PATTERNS) + ")"
+    elif not os.path.isfile(path):
+        found = f"DRJIT_LIBLLVM_PATH is {path!r}, not a file"
+    else:
+        found = f"Dr.Jit could not load the LLVM library {path!r}"
+    return (f"Dr.Jit's LLVM backend is unavailable: {found}; install the system's LLVM (Debian: "
+            f"apt-get install libllvm19) or set DRJIT_LIBLLVM_PATH to a libLLVM-*.so, or use backend "
+            f"'numba' or 'auto'")
+
+
+def resolve(name):
+    """The backend that renders for an accepted ``name`` of `BACKENDS`: "auto" is
+    "drjit" where Dr.Jit's LLVM backend works, else "numba".
+
+    Raises
+    ------
+    renderer.validate.InvalidValue
+        ``name`` is "drjit" and Dr.Jit's LLVM backend is unavailable (the
+        message says what is missing and how to get it).
+    """
+    if name == "auto":
+        return "drjit" if drjit_llvm() is not None else "numba"
+    why = missing(name)
+    if why is not None:
+        raise InvalidValue(f"backend must be one of {', '.join(map(repr, BACKENDS))} available on this "
+                           f"machine, got {name!r}: {why}")
+    return name
+
+
+@functools.cache
+def namespace(name):
+    """The array namespace of backend "numpy" or "drjit" (`resolve` first)."""
+    return NumpyNamespace() if name == "numpy" else DrJitNamespace(drjit_llvm())

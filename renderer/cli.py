@@ -3,7 +3,8 @@
 Subcommands (``symrender <command> --help`` for each)::
 
     symrender render  [--scene FILE.toml] [--set key=value ...] --size WxH
-                      --gradient exact|central|footprint --view shaded|difference|bump|kink -o out.png
+                      --gradient exact|central|footprint --view shaded|difference|bump|kink
+                      [--backend numba|drjit|auto] -o out.png
     symrender sweep   --eps 1e-1:1e-8:8 [--scene ...] [--set ...] [--size WxH] [--format text|csv|json]
     symrender ucurve  --field sine --u 0.31 --v 0.47 --component u [--eps ...] [--plot out.png]
 
@@ -458,16 +459,18 @@ def _cmd_render(args, outputs):
     footprint = args.gradient == "footprint" and args.view != "difference"
     with cmdline.progress(total=2 + footprint, desc="render", unit="frame") as bar:
         numeric = render(scene, width, height, gradient="central", kink=False,
-                         grad=bump and args.gradient == "central")
+                         grad=bump and args.gradient == "central", backend=args.backend)
         bar.update()
-        symbolic = render(scene, width, height, gradient="exact", grad=bump)   # its kink: the ledger's band
+        symbolic = render(scene, width, height, gradient="exact", grad=bump,   # its kink: the ledger's band
+                          backend=args.backend)
         bar.update()
         ledger = compare(numeric, symbolic)
         selected = symbolic if args.gradient == "exact" else numeric
         if footprint:
             # The footprint frame takes the central frame's place: two frames at a time.
             numeric = selected = None
-            selected = render(scene, width, height, gradient="footprint", kink=False, grad=bump)
+            selected = render(scene, width, height, gradient="footprint", kink=False, grad=bump,
+                              backend=args.backend)
             bar.update()
     _stage_png(outputs, args.output, view_image(args.view, selected, numeric, symbolic), "-o")
     where = "standard output" if args.output == STDOUT else args.output
@@ -672,6 +675,9 @@ def build_parser():
                    help=f"image size, each side 1..{MAX_SIDE}, W*H <= {MAX_PIXELS:,} (default 256x256)")
     r.add_argument("--gradient", choices=("exact", "central", "footprint"), default="exact",
                    help="pipeline shown by the shaded, bump and kink views (default exact)")
+    r.add_argument("--backend", choices=("numba", "drjit", "auto"), default="numba",
+                   help="renderer: numba (default), drjit (Dr.Jit's LLVM backend; needs the system's "
+                        "libLLVM), auto (drjit where available, else numba)")
     r.add_argument("--view", choices=VIEWS, default="shaded",
                    help="shaded image; difference clip(100|dI|); bump |grad h|; kink band over dimmed image")
     r.add_argument("-o", "--output", required=True, metavar="out.png", help="PNG to write (atomically)")

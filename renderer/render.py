@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from . import kernel, validate
+from . import backends, kernel, validate
 from .kernel import BACKGROUND, FLOOR, SPHERE_A, SPHERE_B
 from .scene import Scene
 
@@ -186,8 +186,30 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     return x, y, out, geo
 
 
+#: Pixels per launch of the array kernel, per backend (bounds its working memory: numpy holds
+#: some forty temporaries per pixel, Dr.Jit fuses them and holds the outputs).
+ARRAY_BLOCK_PIXELS = {"numpy": 1 << 16, "drjit": 1 << 22}
+
+
+def _render_array(scene, width, height, gradient, zoom, want_kink, want_grad, backend):
+    """The outputs of `render` from the array kernel (`renderer.arraykernel`) on ``backend``."""
+    from . import arraykernel
+    xp = backends.namespace(backend)
+    x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
+    window = window_width(scene.radius_a, scene.camera_z, zoom)
+    dx = float(x[1] - x[0]) if width > 1 else window
+    dy = float(y[0] - y[1]) if height > 1 else window
+    rows = max(1, ARRAY_BLOCK_PIXELS[backend] // width)
+    with xp.scope():
+        blocks = [arraykernel.render_block(xp, scene, x, y[j:j + rows], method=gradient, eps=float(scene.eps),
+                                           dx=dx, dy=dy, kink=want_kink, grad=want_grad)
+                  for j in range(0, height, rows)]
+    out = {k: blocks[0][k] if len(blocks) == 1 else np.concatenate([b[k] for b in blocks]) for k in blocks[0]}
+    return {k: a.reshape((height, width) + a.shape[1:]) for k, a in out.items()}
+
+
 def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=True, skip=True,
-           workers=None):
+           workers=None, backend="numba"):
     """Render the Chapter-9 scene.
 
     Parameters
@@ -211,6 +233,19 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     workers : int in [1, 64] or None, keyword-only
         Threads rendering rows side by side (None: numba's default, the
         machine's cores).  The image is the same bits for any number.
+        The numba backend's; Dr.Jit runs on its own thread pool.
+    backend : {"numba", "drjit", "auto", "numpy"}, keyword-only
+        "numba": the per-pixel kernel (`renderer.kernel`), the book's.
+        "drjit": the branch-free array kernel (`renderer.arraykernel`, the
+        same steps and generated formulas) compiled by Dr.Jit's LLVM backend,
+        which evaluates sin, cos and atan2 for several pixels per instruction;
+        it needs the system's libLLVM (`renderer.backends`).  Its own sin,
+        cos and atan2 are a few ulp from libm's: the frame agrees with
+        numba's to the parity tests' tolerance, not bit for bit.  "auto":
+        "drjit" where available, else "numba".  "numpy": the array kernel on
+        numpy (slow; it checks the array kernel on any machine).  The array
+        kernel ignores ``skip`` (it computes what a render of the outputs
+        needs, the same values either way).
 
     Returns
     -------
@@ -219,11 +254,13 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     Raises
     ------
     TypeError
-        ``scene`` is not a Scene; a size, ``gradient``, ``zoom`` or ``workers``
-        of the wrong type; a flag not a bool.
+        ``scene`` is not a Scene; a size, ``gradient``, ``zoom``,
+        ``workers`` or ``backend`` of the wrong type; a flag not a bool.
     ValueError
-        A size outside [1, 8192], an unknown ``gradient``, ``zoom`` outside
-        [1, 1e6], ``workers`` outside [1, 64].
+        A size outside [1, 8192], an unknown ``gradient`` or ``backend``,
+        ``zoom`` outside [1, 1e6], ``workers`` outside [1, 64];
+        ``backend="drjit"`` where Dr.Jit's LLVM backend is unavailable (the
+        message says what is missing and how to install it).
 
     Notes
     -----
@@ -234,7 +271,11 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     scene, width, height, gradient, zoom = check_args(scene, width, height, gradient, zoom)
     kink, grad, skip = (validate.flag(n, f) for n, f in (("kink", kink), ("grad", grad), ("skip", skip)))
     check_workers(workers)
-    _, _, out, _ = _run(scene, width, height, gradient, zoom, skip, kink, grad, False, workers)
+    backend = backends.resolve(validate.choice("backend", backend, backends.BACKENDS))
+    if backend == "numba":
+        _, _, out, _ = _run(scene, width, height, gradient, zoom, skip, kink, grad, False, workers)
+    else:
+        out = _render_array(scene, width, height, gradient, zoom, kink, grad, backend)
     return Frame(out["image"], out["chamber"], out["kink"] if kink else None, out["grad"] if grad else None,
                  scene, gradient)
 

@@ -1,8 +1,9 @@
 """renderer/codegen.py: the generated formulas are fresh, faithful to the sympy
 objects of `renderer.formulas`, and the bits the renderer uses.
 
-(a) Freshness: `codegen.targets()` equals renderer/generated.py and
-    renderer/kernel.py (what ``python -m renderer.codegen --check`` checks),
+(a) Freshness: `codegen.targets()` equals renderer/generated.py,
+    renderer/generated_array.py and renderer/kernel.py (what
+    ``python -m renderer.codegen --check`` checks),
     and a tampered generated.py or digest line is caught; the generator runs
     where the kernel's import guard refuses a hand-edited generated.py.
 (b) The JavaScript `codegen.js_source()` runs under node and computes the
@@ -45,12 +46,14 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from renderer import GRADIENTS, Scene, codegen, gbuffer, pointwise, render
+from renderer import GRADIENTS, Scene, backends, codegen, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer import generated as G
+from renderer import generated_array as GA
 
 from . import scalar_reference
 from .jsnode import require_tool
+from .test_parity import require_backend
 
 #: Unit roundoff of float64.
 U = 2.0**-53
@@ -364,6 +367,48 @@ def test_the_printed_source_run_as_python_agrees_too(points, references):
     assert bad == [], bad[:5]
 
 
+def array_outputs(module, points, xp):
+    """`outputs_of` for the branch-free array functions of ``module`` (generated_array.py
+    or its printed text run): each function called once on all points of a key, as columns."""
+    column = xp.Float64 if xp.name == "drjit" else np.asarray
+    results = {}
+    for (name, field), pts in points.items():
+        fn = module[name] if isinstance(module, dict) else getattr(module, name)
+        lead = (F.FIELD_CODES[field],) if field else ()
+        out = fn(xp, *lead, *(column(np.array(c, dtype=np.float64)) for c in zip(*pts)))
+        out = out if isinstance(out, tuple) else (out,)
+        arrays = [o for o in out if not isinstance(o, (bool, float))]     # a constant output is a Python value
+        values = iter(xp.numpy([([a], np.float64) for a in arrays]))
+        cols = [np.full(len(pts), o) if isinstance(o, (bool, float)) else next(values) for o in out]
+        results[name, field] = [tuple(c[i].item() for c in cols) for i in range(len(pts))]
+    return results
+
+
+@pytest.mark.parametrize("backend", ["numpy", "drjit"])
+def test_generated_array_functions_agree_with_the_sympy_objects(points, references, backend):
+    """renderer/generated_array.py under each namespace: every Piecewise became a select
+    that keeps the right side, and Dr.Jit's sin, cos and atan2 stay within the bound."""
+    require_backend(backend)
+    xp = backends.namespace(backend)
+    with xp.scope():
+        bad = mismatches(array_outputs(GA, points, xp), references, points)
+    assert bad == [], bad[:5]
+
+
+@pytest.mark.parametrize("old, new", [
+    ("xp.select(x2, -x1, 1.0)", "xp.select(x2, 1.0, -x1)"),        # a select's sides swapped
+    ("xp.minimum(1, eps_v + v)", "xp.maximum(1, eps_v + v)"),      # the clamp of v inverted
+    ("xp.select(x2*x5 == 0, 0.0,", "xp.select(x2*x5 != 0, 0.0,"),  # sign(0) taken as the other case
+])
+def test_the_array_check_rejects_a_tampered_line_of_the_printed_source(old, new, points, references):
+    source = codegen.array_source()
+    assert old in source
+    namespace = {}
+    exec(compile(source.replace(old, new), "<variant>", "exec"), namespace)
+    with np.errstate(all="ignore"):
+        assert mismatches(array_outputs(namespace, points, backends.namespace("numpy")), references, points)
+
+
 # ---- (e) wrong variants, printed by the same generator -----------------------------------
 
 def plain_python(source):
@@ -448,9 +493,10 @@ def test_excess_rejects_a_value_one_bound_away():
 
 @pytest.fixture
 def copies(tmp_path, monkeypatch):
-    """generated.py and kernel.py copied to a temporary directory and made the generator's targets."""
+    """generated.py, generated_array.py and kernel.py copied to a temporary directory and made
+    the generator's targets."""
     paths = {}
-    for attr in ("GENERATED", "KERNEL"):
+    for attr in ("GENERATED", "GENERATED_ARRAY", "KERNEL"):
         src = getattr(codegen, attr)
         paths[attr] = tmp_path / src.name
         paths[attr].write_bytes(src.read_bytes())
@@ -461,6 +507,7 @@ def copies(tmp_path, monkeypatch):
 @pytest.mark.parametrize("target, old, new", [
     ("GENERATED", "math.sin(", "math.cos("),
     ("GENERATED", "0.03", "0.031"),
+    ("GENERATED_ARRAY", "xp.sin(", "xp.cos("),
     ("KERNEL", 'FORMULAS_DIGEST = "', 'FORMULAS_DIGEST = "0'),
 ])
 def test_check_catches_a_tampered_file_and_the_generator_restores_it(copies, capsys, target, old, new):
@@ -487,7 +534,8 @@ def test_python_m_renderer_codegen_check_exits_0():
     result = subprocess.run([sys.executable, "-m", "renderer.codegen", "--check"], capture_output=True,
                             text=True, timeout=300, cwd=codegen.GENERATED.parents[1])
     assert (result.returncode, result.stderr) == (0, "")
-    assert G.__doc__.startswith("GENERATED by renderer/codegen.py from renderer/formulas.py; do not edit.")
+    for module in (G, GA):
+        assert module.__doc__.startswith("GENERATED by renderer/codegen.py from renderer/formulas.py; do not edit.")
 
 
 def test_the_generator_runs_where_the_kernel_refuses_a_hand_edited_generated_file(tmp_path):

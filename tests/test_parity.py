@@ -10,6 +10,14 @@ three small frames chosen for what they hit:
   sphere A's pole: sin(phi) = 4e-17, the frame fallback and the one-sided v
   difference (v = 1.3e-17 < eps) are exercised.
 
+Each frame is rendered by every backend of `renderer.render`: the numba
+kernel, the array kernel on numpy (everywhere) and on Dr.Jit's LLVM backend
+(where the system's libLLVM is; skipped without it, failed when CI=true).
+Dr.Jit runs the program numpy runs, with its own sin, cos and atan2, so it
+is checked on a subset that still covers every field, model, pipeline and
+scene variant (see `with_backends`' callers): each new scene is a new compiled kernel
+(a fifth of a second), which the whole matrix would pay some 700 times.
+
 Checks per frame: identical chamber codes, identical crease flags,
 |dI| <= 1e-12 per channel (the issue's tolerance), and the gradient within the
 tolerance of `grad_tolerance` (justified there).  The footprint pipeline's
@@ -24,14 +32,16 @@ the end of the file.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 
 import numpy as np
 import pytest
 
-from renderer import PointLight, Scene, render
+from renderer import PointLight, Scene, backends, render
 from tests import scalar_reference as ref
+from tests.jsnode import in_ci
 
 pytestmark = pytest.mark.cpu_dependent     # make test-baseline-simd runs the file again
 
@@ -233,11 +243,13 @@ def footprint_allowances(scene, width, height, chamber, grad_ref):
     return tol, extra, int(np.count_nonzero((delta > WIDE_DELTA).any(axis=-1)))
 
 
-def parity_failures(scene, width, height, gradient, *, frame=None):
-    """Compare one render with the reference; return a list of failure strings (empty: parity)."""
+def parity_failures(scene, width, height, gradient, *, frame=None, backend="numba", reference=None):
+    """Compare one render (``frame``, else rendered by ``backend``) with the reference
+    (``reference``, else `scalar_reference.render_reference`'s); return a list of failure
+    strings (empty: parity)."""
     if frame is None:
-        frame = render(scene, width, height, gradient=gradient)
-    image, chamber, kink, grad = ref.render_reference(scene, width, height, gradient=gradient)
+        frame = render(scene, width, height, gradient=gradient, backend=backend)
+    image, chamber, kink, grad = reference or ref.render_reference(scene, width, height, gradient=gradient)
     failures = []
     n = int(np.count_nonzero(frame.chamber != chamber))
     if n:
@@ -271,24 +283,54 @@ def parity_failures(scene, width, height, gradient, *, frame=None):
 
 # --- the full matrix --------------------------------------------------------------------
 
+BACKENDS = ("numba", "numpy", "drjit")
+
+
+def with_backends(cases, drjit_subset):
+    """``cases`` (tuples) each with every backend appended; "drjit" only where ``drjit_subset(case)``."""
+    return [case + (b,) for case in cases for b in BACKENDS if b != "drjit" or drjit_subset(case)]
+
+
+def require_backend(backend):
+    """Skip a Dr.Jit case where its LLVM backend is missing, and fail it when CI=true."""
+    why = backends.missing(backend)
+    if why is not None:
+        if in_ci():
+            pytest.fail(why + " (CI=true: this test may not skip)")
+        pytest.skip(why)
+
+
+@functools.lru_cache(maxsize=32)
+def cached_reference(scene, width, height, gradient):
+    """`scalar_reference.render_reference`, computed once for the backends of one case."""
+    return ref.render_reference(scene, width, height, gradient=gradient)
+
+
+def assert_parity(scene, gradient, backend):
+    require_backend(backend)
+    for width, height in SIZES:
+        reference = cached_reference(scene, width, height, gradient)
+        assert parity_failures(scene, width, height, gradient, backend=backend, reference=reference) == [], \
+            (width, height)
+
+
 MATRIX = list(itertools.product(FIELDS, MODELS, GRADIENTS, (True, False), (True, False),
                                 (0.0, 0.35, 1.5)))
 
 
-@pytest.mark.parametrize("field, model, gradient, sphere_b, floor, beta", MATRIX)
-def test_matches_reference(field, model, gradient, sphere_b, floor, beta):
+@pytest.mark.parametrize("field, model, gradient, sphere_b, floor, beta, backend",
+                         with_backends(MATRIX, lambda case: case[3:] == (True, True, 0.35)))
+def test_matches_reference(field, model, gradient, sphere_b, floor, beta, backend):
     scene = Scene(height_field=field, model=model, sphere_b=sphere_b, floor=floor, beta=beta, bump="chart")
-    for width, height in SIZES:
-        assert parity_failures(scene, width, height, gradient) == [], (width, height)
+    assert_parity(scene, gradient, backend)
 
 
-@pytest.mark.parametrize("field, model, gradient, beta",
-                         list(itertools.product(FIELDS, MODELS, GRADIENTS, (0.35, 0.9))))
-def test_matches_reference_displaced_surface_normal(field, model, gradient, beta):
+@pytest.mark.parametrize("field, model, gradient, beta, backend",
+                         with_backends(list(itertools.product(FIELDS, MODELS, GRADIENTS, (0.35, 0.9))),
+                                       lambda case: case[3] == 0.9))
+def test_matches_reference_displaced_surface_normal(field, model, gradient, beta, backend):
     """Scene.bump = "surface": the displaced sphere's normal, derived by hand in the reference."""
-    scene = Scene(height_field=field, model=model, beta=beta, bump="surface")
-    for width, height in SIZES:
-        assert parity_failures(scene, width, height, gradient) == [], (width, height)
+    assert_parity(Scene(height_field=field, model=model, beta=beta, bump="surface"), gradient, backend)
 
 
 # Scenes that exercise what the default scene does not.
@@ -312,13 +354,12 @@ VARIANTS = {
 }
 
 
-@pytest.mark.parametrize("gradient", GRADIENTS)
-@pytest.mark.parametrize("field", FIELDS)
-@pytest.mark.parametrize("name", sorted(VARIANTS))
-def test_matches_reference_scene_variants(name, field, gradient):
-    scene = Scene(height_field=field, **VARIANTS[name])
-    for width, height in SIZES:
-        assert parity_failures(scene, width, height, gradient) == [], (width, height)
+@pytest.mark.parametrize("name, field, gradient, backend",
+                         with_backends(list(itertools.product(sorted(VARIANTS), FIELDS, GRADIENTS)),
+                                       lambda case: case[1] == "ridges"))
+def test_matches_reference_scene_variants(name, field, gradient, backend):
+    assert_parity(Scene(height_field=field, **VARIANTS[name]), gradient, backend)
+
 
 
 def test_frame_sizes_reach_the_pole():

@@ -1,0 +1,172 @@
+"""renderer.backends and render(backend=...): the array kernel beside the numba kernel.
+
+* Dr.Jit against numba on the default scene at 256 x 256, exact and central:
+  the same chambers and crease flags, |dI| within the parity tolerance (the
+  parity matrix of tests/test_parity.py checks every backend against the
+  scalar reference on small frames; this is the frame the benchmark times).
+* The choice of backend: validated like every keyword; "drjit" where
+  Dr.Jit's LLVM backend is missing is refused with what is missing, and
+  "auto" falls back to numba (checked in a process without libLLVM).
+* The namespaces' building blocks: the pixel grid's order and the
+  repeated-squaring power give the numba kernel's values.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from renderer import Scene, arraykernel, backends, kernel, render, validate
+from tests.test_parity import IMAGE_TOL, grad_tolerance, require_backend
+
+ARRAY_BACKENDS = ("numpy", "drjit")
+
+
+@pytest.fixture(scope="module")
+def numba_frames():
+    return {g: render(Scene(), 256, 256, gradient=g) for g in ("exact", "central")}
+
+
+def frame_differences(a, b):
+    """(max |dI|, chamber pixels that differ, crease pixels that differ, max |d grad|)."""
+    return (float(np.abs(a.image - b.image).max()), int(np.count_nonzero(a.chamber != b.chamber)),
+            int(np.count_nonzero(a.kink != b.kink)), float(np.abs(a.grad - b.grad).max()))
+
+
+@pytest.mark.parametrize("gradient", ["exact", "central"])
+def test_drjit_renders_the_numba_frame_at_256(numba_frames, gradient):
+    require_backend("drjit")
+    frame = render(Scene(), 256, 256, gradient=gradient, backend="drjit")
+    d_image, chambers, creases, d_grad = frame_differences(frame, numba_frames[gradient])
+    assert (chambers, creases) == (0, 0)
+    assert d_image <= IMAGE_TOL
+    # The parity tests' gradient tolerance (the central quotient divides the few-ulp differences
+    # of the sines by 2 eps).
+    grad = numba_frames[gradient].grad
+    assert np.all(np.abs(frame.grad - grad) <= grad_tolerance(Scene(), gradient, grad))
+
+
+def test_the_frame_comparison_rejects_another_scene(numba_frames):
+    frame = render(Scene(beta=0.51), 256, 256, gradient="exact", backend="numpy")
+    assert frame_differences(frame, numba_frames["exact"])[0] > IMAGE_TOL
+    frame = render(Scene(center_b=(0.5, 0.45, 1.3)), 256, 256, gradient="exact", backend="numpy")
+    assert frame_differences(frame, numba_frames["exact"])[1] > 0
+
+
+@pytest.mark.parametrize("backend", ARRAY_BACKENDS)
+def test_array_backends_return_the_frames_types_and_shapes(backend):
+    require_backend(backend)
+    frame = render(Scene(), 7, 5, backend=backend)
+    assert (frame.image.shape, frame.image.dtype, frame.chamber.shape, frame.chamber.dtype) == \
+        ((5, 7, 3), np.float64, (5, 7), np.uint8)
+    assert (frame.kink.dtype, frame.grad.shape, frame.grad.dtype) == (np.bool_, (5, 7, 2), np.float64)
+    bare = render(Scene(), 7, 5, backend=backend, kink=False, grad=False)
+    assert bare.kink is None and bare.grad is None
+    assert np.array_equal(bare.image, frame.image)
+
+
+@pytest.mark.parametrize("backend", ARRAY_BACKENDS)
+def test_a_frame_taller_than_one_block_is_the_blocks_in_order(backend, monkeypatch):
+    """Blocks of rows (`render.ARRAY_BLOCK_PIXELS`) put together: the frame of one block."""
+    require_backend(backend)
+    whole = render(Scene(), 24, 20, backend=backend)
+    # 7 blocks, the last of 2 rows
+    monkeypatch.setitem(sys.modules["renderer.render"].ARRAY_BLOCK_PIXELS, backend, 24 * 3)
+    parts = render(Scene(), 24, 20, backend=backend)
+    for name in ("image", "chamber", "kink", "grad"):
+        assert np.array_equal(getattr(parts, name), getattr(whole, name)), name
+
+
+@pytest.mark.parametrize("value, error", [("cuda", ValueError), ("Numba", ValueError), (None, TypeError),
+                                          (1, TypeError)])
+def test_backend_is_validated(value, error):
+    with pytest.raises(error, match="^backend"):
+        render(Scene(), 4, 4, backend=value)
+
+
+def test_drjit_without_llvm_is_refused_with_what_is_missing(monkeypatch):
+    monkeypatch.setattr(backends, "drjit_llvm", lambda: None)
+    monkeypatch.setattr(backends, "llvm_library", lambda: None)
+    with pytest.raises(validate.InvalidValue, match="^backend") as info:
+        render(Scene(), 4, 4, backend="drjit")
+    assert "DRJIT_LIBLLVM_PATH" in str(info.value) and "libllvm19" in str(info.value)
+    assert backends.resolve("auto") == "numba"
+
+
+def test_without_the_system_llvm_auto_renders_with_numba_and_drjit_is_refused():
+    """In a fresh process with DRJIT_LIBLLVM_PATH pointing nowhere (a machine without libLLVM)."""
+    code = ("from renderer import Scene, render, backends, validate\n"
+            "import numpy as np\n"
+            "assert backends.drjit_llvm() is None and backends.resolve('auto') == 'numba'\n"
+            "a, b = render(Scene(), 9, 7, backend='auto'), render(Scene(), 9, 7)\n"
+            "assert np.array_equal(a.image, b.image)\n"
+            "try:\n    render(Scene(), 9, 7, backend='drjit')\nexcept validate.InvalidValue as e:\n"
+            "    print('refused:', e)\n")
+    env = {**os.environ, "DRJIT_LIBLLVM_PATH": "/nonexistent"}
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("refused: backend") and "/nonexistent" in result.stdout
+
+
+def test_auto_is_drjit_where_it_is_available():
+    require_backend("drjit")
+    assert backends.resolve("auto") == "drjit"
+
+
+@pytest.mark.parametrize("backend", ARRAY_BACKENDS)
+def test_the_grid_is_row_major(backend):
+    require_backend(backend)
+    xp = backends.namespace(backend)
+    x, y = xp.grid(np.array([1.0, 2.0, 3.0]), np.array([10.0, 20.0]))
+    got = xp.numpy([([x], np.float64), ([y], np.float64)])
+    assert got[0].tolist() == [1.0, 2.0, 3.0] * 2 and got[1].tolist() == [10.0] * 3 + [20.0] * 3
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 3, 7, 32, 33, 100])
+def test_int_power_is_the_numba_kernels(n):
+    """The same multiplications in the same order: bit for bit the kernel's (interpreted)."""
+    base = np.random.default_rng(n).uniform(0.0, 1.0, 64)
+    got = np.broadcast_to(arraykernel.int_power(base, n), base.shape)
+    assert np.array_equal(got, [kernel.int_power.py_func(float(b), n) for b in base])
+
+
+def extreme_cases():
+    """(scene name, gradient, backend): the accepted extremes of tests/test_interpreted.py, numpy
+    with every pipeline, Dr.Jit (a compiled kernel per scene) with the exact one."""
+    from tests.test_interpreted import SCENES
+    return [(name, g, b) for name in SCENES for g in ("exact", "central", "footprint")
+            for b in ARRAY_BACKENDS if b == "numpy" or g == "exact"]
+
+
+@pytest.mark.parametrize("name, gradient, backend", extreme_cases())
+def test_array_backends_render_the_extreme_scenes_as_numba_does(name, gradient, backend):
+    """Lights within 1e-170 of a point, the pole on a pixel, the limits of every field.  At the
+    least eps (1e-12) a central quotient turns the libraries' few-ulp differences of sin into
+    O(1) gradients (the U-curve's roundoff floor): there only chambers and creases are compared."""
+    from tests.test_interpreted import SCENES
+    require_backend(backend)
+    scene, width, height = SCENES[name]
+    d_image, chambers, creases, _ = frame_differences(render(scene, width, height, gradient=gradient,
+                                                             backend=backend),
+                                                      render(scene, width, height, gradient=gradient))
+    assert (chambers, creases) == (0, 0)
+    if gradient == "exact" or scene.eps >= 1e-6:
+        assert d_image <= IMAGE_TOL
+
+
+def test_the_command_line_renders_with_drjit_or_says_what_is_missing(tmp_path):
+    """``symrender render --backend``: where the LLVM library is missing, one line and exit 2
+    (an input error) and no file; with ``auto`` there, the numba frame."""
+    env = {**os.environ, "DRJIT_LIBLLVM_PATH": "/nonexistent"}
+    argv = [sys.executable, "-m", "renderer.cli", "render", "--size", "16x12", "-o"]
+    refused = subprocess.run(argv + [str(tmp_path / "a.png"), "--backend", "drjit"], capture_output=True,
+                             text=True, env=env, timeout=300)
+    assert (refused.returncode, len(refused.stderr.splitlines())) == (2, 1), refused.stderr
+    assert "backend" in refused.stderr and not (tmp_path / "a.png").exists()
+    auto = subprocess.run(argv + [str(tmp_path / "b.png"), "--backend", "auto"], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert auto.returncode == 0 and (tmp_path / "b.png").exists(), auto.stderr
