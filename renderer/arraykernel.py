@@ -215,8 +215,20 @@ def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad):
         ``image`` (n, 3) float64 in [0, 1], ``chamber`` (n,) uint8, and when
         asked ``kink`` (n,) bool and ``grad`` (n, 2) float64 (0 off sphere A).
     """
+    return xp.run(program, s, (xs, ys, np.sin(np.pi * xs), np.sin(np.pi * ys)), OUTPUTS,
+                  method=method, eps=eps, dx=dx, dy=dy, kink=kink, grad=grad)
+
+
+#: Each output of `program`: (values per pixel, numpy dtype).
+OUTPUTS = {"image": (3, np.float64), "chamber": (1, np.uint8), "kink": (1, np.bool_), "grad": (2, np.float64)}
+
+
+def program(xp, s, xs, ys, sin_xs, sin_ys, *, method, eps, dx, dy, kink, grad):
+    """The frame's array program: `render_block`'s outputs as a dict name -> list of
+    arrays of the namespace (k arrays for k values per pixel, `OUTPUTS`), unevaluated
+    on Dr.Jit; xs, ys and their sines sin(pi xs), sin(pi ys) as arrays of ``xp``."""
     x, y = xp.grid(xs, ys)
-    sin_x, sin_y = xp.grid(np.sin(np.pi * xs), np.sin(np.pi * ys))
+    sin_x, sin_y = xp.grid(sin_xs, sin_ys)
     t, on_a, on_b, on_floor = nearest_hit(xp, s, x, y)
     P, N, albedo, N_a = surface(xp, s, x, y, t, on_a, on_b, sin_x * sin_y)
 
@@ -251,9 +263,9 @@ def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad):
     chamber = xp.select(on_a, 1.0, 0.0)
     for mask, code in ((on_b, 2.0), (on_floor, 3.0)):
         chamber = chamber if mask is None else xp.select(mask, code, chamber)
-    groups = {"image": (rgb, np.float64), "chamber": ([chamber], np.uint8)}
+    out = {"image": rgb, "chamber": [chamber]}
     if kink:
-        groups["kink"] = ([on_a & G.kink_band(xp, field, u, v, s.k_u, s.k_v)], np.bool_)
+        out["kink"] = [on_a & G.kink_band(xp, field, u, v, s.k_u, s.k_v)]
     if grad:
-        groups["grad"] = ([xp.select(on_a, hu, 0.0), xp.select(on_a, hv, 0.0)], np.float64)
-    return dict(zip(groups, xp.numpy(list(groups.values()))))
+        out["grad"] = [xp.select(on_a, hu, 0.0), xp.select(on_a, hv, 0.0)]
+    return out

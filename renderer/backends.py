@@ -102,12 +102,24 @@ class NumpyNamespace:
         (cols[i], rows[j]), two float64 arrays of len(cols) * len(rows)."""
         return np.tile(cols, len(rows)), np.repeat(rows, len(cols))
 
+    @classmethod
+    def run(cls, program, s, arrays, outputs, **options):
+        """``program(xp, s, *arrays, **options)`` (a dict name -> list of arrays) as
+        numpy arrays, (n, k) for k values per pixel, (n,) for one, of the dtypes of
+        ``outputs`` (name -> (k, dtype))."""
+        out = program(cls, s, *arrays, **options)
+        return dict(zip(out, cls.numpy([(a, outputs[name][1]) for name, a in out.items()])))
+
     @staticmethod
     def numpy(groups):
         """Numpy arrays of ``groups``, pairs (arrays of n values, dtype): one array each,
         (n,) for one array, else (n, k) with the k arrays side by side."""
         return [(np.stack(a, axis=-1) if len(a) > 1 else np.asarray(a[0])).astype(d, copy=False)
                 for a, d in groups]
+
+
+#: Configurations (scene, options, block shape) of a frozen frame program Dr.Jit keeps.
+FROZEN_CONFIGURATIONS = 32
 
 
 class DrJitNamespace:
@@ -121,6 +133,8 @@ class DrJitNamespace:
     def __init__(self, llvm):
         import drjit as dr
         self.dr, self.Float64, self.UInt32, self.UInt8 = dr, llvm.Float64, llvm.UInt32, llvm.UInt8
+        self.vector = {2: llvm.Array2f64, 3: llvm.Array3f64}
+        self._frozen = {}
         self.sin, self.cos, self.atan2, self.sqrt, self.abs = dr.sin, dr.cos, dr.atan2, dr.sqrt, dr.abs
         self.copysign, self.minimum, self.maximum, self.power = dr.copysign, dr.minimum, dr.maximum, dr.power
 
@@ -144,27 +158,50 @@ class DrJitNamespace:
         return (self.dr.gather(self.Float64, self.Float64(cols), index % width),
                 self.dr.gather(self.Float64, self.Float64(rows), index // width))
 
+    def run(self, program, s, arrays, outputs, **options):
+        """As `NumpyNamespace.run`, with the traced program frozen (`drjit.freeze`):
+        the first call per configuration traces it and records its kernel launch;
+        a later call with the same scene, options and array lengths (the key, so
+        that no length is baked into a replayed kernel) replays the launch without
+        tracing.  At most `FROZEN_CONFIGURATIONS` are kept (least recently used)."""
+        frozen = self._frozen.get(program)
+        if frozen is None:
+            def record(arrays, key):
+                out = program(self, key[0], *arrays, **dict(key[1]))
+                return self.store([(a, outputs[name][1]) for name, a in out.items()], names=list(out))
+            frozen = self._frozen[program] = self.dr.freeze(record, limit=FROZEN_CONFIGURATIONS,
+                                                            warn_after=FROZEN_CONFIGURATIONS + 1)
+        key = (s, tuple(sorted(options.items())), tuple(len(a) for a in arrays))
+        targets = frozen(tuple(self.Float64(a) for a in arrays), key)
+        return {name: np.asarray(t).view(outputs[name][1]).reshape((-1, outputs[name][0]) if outputs[name][0] > 1
+                                                                    else (-1,)) for name, t in targets.items()}
+
+    def store(self, groups, names):
+        """Every group (arrays, dtype) scattered into a buffer of its own, a dict names -> buffer
+        (unevaluated): a group of k arrays as one k-vector per pixel, interleaved."""
+        dr, out = self.dr, {}
+        n = max(dr.width(a) for arrays, _ in groups for a in arrays if isinstance(a, dr.ArrayBase))
+        index = dr.arange(self.UInt32, n)
+        for name, (arrays, dtype) in zip(names, groups):
+            k = len(arrays)
+            kind = self.UInt8 if dtype in (np.uint8, np.bool_) else self.Float64
+            values = [kind(a) if isinstance(a, dr.ArrayBase) else dr.full(kind, a, n) for a in arrays]
+            target = dr.empty(kind, n * k)                  # every element is written below
+            dr.scatter(target, values[0] if k == 1 else self.vector[k](*values), index)
+            out[name] = target
+        return out
+
     def numpy(self, groups):
-        """As `NumpyNamespace.numpy`: all groups evaluated in one kernel launch, then a
-        group of k arrays scattered into one array of k n values (a copy per group, in
-        Dr.Jit's threads); the results are numpy views of Dr.Jit's memory."""
-        dr, out = self.dr, []
-        groups = [([self.UInt8(a) if dtype == np.uint8 else a for a in arrays], dtype) for arrays, dtype in groups]
-        # The frame's program in one kernel first: scattered directly, each target was a
-        # kernel of its own that recomputed the whole program (4 kernels a frame, 2x slower).
-        dr.eval(*[a for arrays, _ in groups for a in arrays if isinstance(a, dr.ArrayBase)])
-        for arrays, _ in groups:
-            if len(arrays) == 1:
-                out.append(arrays[0])
-                continue
-            n, k = dr.width(arrays[0]), len(arrays)
-            index = dr.arange(self.UInt32, n) * k
-            target = dr.empty(self.Float64, n * k)          # every element is written below
-            for c, a in enumerate(arrays):
-                dr.scatter(target, a, index + c)
-            out.append(target)
-        dr.eval(*out)
-        return [np.asarray(a).reshape((-1, len(g[0])) if len(g[0]) > 1 else (-1,)) for a, g in zip(out, groups)]
+        """As `NumpyNamespace.numpy`, in one kernel launch: every output is scattered into
+        a buffer of its own (a group of k arrays as one k-vector per pixel, interleaved),
+        and one `drjit.eval` runs the frame's program and the stores together; the
+        results are numpy views of Dr.Jit's memory (no copy)."""
+        if not groups:
+            return []
+        out = list(self.store(groups, names=range(len(groups))).values())
+        self.dr.eval(*out)
+        return [np.asarray(a).view(d).reshape((-1, len(g)) if len(g) > 1 else (-1,))
+                for a, (g, d) in zip(out, groups)]
 
 
 def missing(name):
