@@ -57,8 +57,11 @@ def pareto_figure(measurement, *, error="max"):
     if error not in ("max", "rms"):
         raise ValueError(f"error must be 'max' or 'rms', got {error!r}")
     names = list(dict.fromkeys(r.field for r in measurement.results))
-    fig = Figure(figsize=(5.0, 1.55 * len(names) + 1.3), layout="constrained")
-    axes = fig.subplots(len(names), 1, sharex=True, squeeze=False)[:, 0]
+    # Two columns (a phone's column holds two panels of 2.5 in); the legend fills an empty cell.
+    rows = (len(names) + 2) // 2
+    fig = Figure(figsize=(5.0, 2.05 * rows), layout="constrained")
+    grid = fig.subplots(rows, 2, sharex=True, squeeze=False).ravel()
+    axes, spare = grid[:len(names)], grid[len(names):]
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
     t_lo = 0.5e3 * min(r.t_min for r in measurement.results)
     t_hi = 2e3 * max(r.t_max for r in measurement.results)
@@ -93,12 +96,19 @@ def pareto_figure(measurement, *, error="max"):
         ax.set_xlim(t_lo, t_hi)
         ax.set_ylim(min(_floor(pick(r)) for r in rs) / _Y_ROOM, None)
         ax.set_title(name + ("" if gm.ANALYTIC[name] else " (off the crease band)"), fontsize=10)
-        ax.set_ylabel(f"{error} error", fontsize=10)
+        ax.set_ylabel(f"{error} error" if ax in grid[::2] else "", fontsize=10)
         ax.tick_params(labelsize=9)
         ax.grid(alpha=0.3, lw=0.3)
-    axes[-1].set_xlabel("time per frame, ms", fontsize=10)
-    fig.legend(list(handles.values()), [{"richardson": "SciPy (Richardson)"}.get(m, m) for m in handles],
-               loc="outside lower center", ncols=2, fontsize=9, frameon=False)
+    for ax in axes[-2:]:                # the lowest panel of each column
+        ax.set_xlabel("time per frame, ms", fontsize=10)
+        ax.xaxis.set_tick_params(labelbottom=True)
+    labels = [{"richardson": "SciPy (Richardson)"}.get(m, m) for m in handles]
+    if len(spare):
+        for ax in spare:
+            ax.axis("off")
+        spare[0].legend(list(handles.values()), labels, loc="center", fontsize=9, frameon=False)
+    else:
+        fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, fontsize=9, frameon=False)
     return fig
 
 
