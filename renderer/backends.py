@@ -160,19 +160,23 @@ class DrJitNamespace:
 
     def run(self, program, s, arrays, outputs, **options):
         """As `NumpyNamespace.run`, with the traced program frozen (`drjit.freeze`):
-        the first call per configuration traces it and records its kernel launch;
-        a later call with the same scene, options and array lengths (the key, so
-        that no length is baked into a replayed kernel) replays the launch without
-        tracing.  At most `FROZEN_CONFIGURATIONS` are kept (least recently used)."""
-        frozen = self._frozen.get(program)
+        one frozen function per configuration (program, scene, options, array
+        lengths), which traces the program on its first call and replays the
+        recorded kernel launch after.  A frozen function never sees a second
+        configuration: a replay keeps the buffer sizes and constants it was
+        recorded with.  At most `FROZEN_CONFIGURATIONS` are kept (least
+        recently used first out)."""
+        key = (program, s, tuple(sorted(options.items())), tuple(len(a) for a in arrays))
+        frozen = self._frozen.pop(key, None)
         if frozen is None:
-            def record(arrays, key):
-                out = program(self, key[0], *arrays, **dict(key[1]))
+            def record(arrays):
+                out = program(self, s, *arrays, **options)
                 return self.store([(a, outputs[name][1]) for name, a in out.items()], names=list(out))
-            frozen = self._frozen[program] = self.dr.freeze(record, limit=FROZEN_CONFIGURATIONS,
-                                                            warn_after=FROZEN_CONFIGURATIONS + 1)
-        key = (s, tuple(sorted(options.items())), tuple(len(a) for a in arrays))
-        targets = frozen(tuple(self.Float64(a) for a in arrays), key)
+            frozen = self.dr.freeze(record)
+            while len(self._frozen) >= FROZEN_CONFIGURATIONS:
+                self._frozen.pop(next(iter(self._frozen)))
+        self._frozen[key] = frozen                          # the most recent last
+        targets = frozen(tuple(self.Float64(a) for a in arrays))
         return {name: np.asarray(t).view(outputs[name][1]).reshape((-1, outputs[name][0]) if outputs[name][0] > 1
                                                                     else (-1,)) for name, t in targets.items()}
 

@@ -170,3 +170,20 @@ def test_the_command_line_renders_with_drjit_or_says_what_is_missing(tmp_path):
     auto = subprocess.run(argv + [str(tmp_path / "b.png"), "--backend", "auto"], capture_output=True, text=True,
                           env=env, timeout=300)
     assert auto.returncode == 0 and (tmp_path / "b.png").exists(), auto.stderr
+
+
+def test_frozen_programs_past_the_cache_limit_replay_only_their_own_configuration(monkeypatch):
+    """More configurations than `backends.FROZEN_CONFIGURATIONS` (set to 3 here), then a frame in
+    blocks of two shapes: each block is its own configuration's frame (Dr.Jit's own LRU of
+    recordings, ``drjit.freeze(limit=...)``, replayed a 3-row recording for the 2-row block)."""
+    require_backend("drjit")
+    monkeypatch.setattr(backends, "FROZEN_CONFIGURATIONS", 3)
+    xp = backends.namespace("drjit")
+    for beta in (0.1, 0.2, 0.3, 0.4, 0.5):
+        render(Scene(beta=beta), 24, 20, backend="drjit")
+    assert len(xp._frozen) <= 3
+    monkeypatch.setitem(sys.modules["renderer.render"].ARRAY_BLOCK_PIXELS, "drjit", 24 * 3)
+    parts = render(Scene(beta=0.2), 24, 20, backend="drjit")
+    reference = render(Scene(beta=0.2), 24, 20)
+    assert np.array_equal(parts.chamber, reference.chamber)
+    assert np.abs(parts.image - reference.image).max() < 1e-12
