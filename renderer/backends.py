@@ -3,12 +3,13 @@
 Dr.Jit (Jakob et al., "Dr.Jit: A Just-In-Time Compiler for Differentiable
 Rendering", SIGGRAPH 2022) compiles array programs with LLVM at run time.  Its
 pip wheel carries no LLVM: it loads the system's shared library (Debian's
-``libllvm19`` or another version; llvmlite's statically linked LLVM cannot
-serve).  The library is found through the environment variable
-``DRJIT_LIBLLVM_PATH`` when it is set (set it to a path that does not exist to
-switch the backend off), else the newest ``libLLVM-*.so*`` in the system's
-library directories.  Without one, `drjit_llvm` returns None and the numba
-kernel renders.
+``libllvm19``, or any version from `MIN_LLVM_VERSION` on; llvmlite's
+statically linked LLVM cannot serve).  The library is found through the
+environment variable ``DRJIT_LIBLLVM_PATH`` when it is set (set it to a path
+that does not exist to switch the backend off), else the newest
+``libLLVM-*.so*`` of at least that version in the system's library
+directories.  Without one, `drjit_llvm` returns None and the numba kernel
+renders.
 
 The array namespaces (`NumpyNamespace`, `DrJitNamespace`) are what the
 branch-free array kernel (`renderer.arraykernel`) and the generated array
@@ -30,6 +31,18 @@ from .validate import InvalidValue
 #: Where Debian and its derivatives put libLLVM (multiarch directory, then llvm-N/lib).
 LIBRARY_PATTERNS = ("/usr/lib/*/libLLVM*.so*", "/usr/lib/llvm-*/lib/libLLVM*.so*", "/usr/lib64/libLLVM*.so*")
 
+#: The oldest LLVM the backend uses.  Dr.Jit itself accepts 15, but its double-precision
+#: ``atan2`` emits ``llvm.maximum``, which the x86 code generator of LLVM 15 and 16
+#: cannot select: the process aborts ("LLVM ERROR: Cannot select ... fmaximum"; measured
+#: with Debian's 15.0.6 and 16.0.6).  19.1 renders every frame of the test suite.
+MIN_LLVM_VERSION = 17
+
+
+def library_version(path):
+    """The major version in an LLVM library's file name (``libLLVM-19.so.1`` -> 19), or None."""
+    m = re.search(r"libLLVM[-.]?(\d+)", os.path.basename(path))
+    return int(m.group(1)) if m else None
+
 
 def llvm_library():
     """Path of the LLVM shared library Dr.Jit should load, or None.
@@ -37,16 +50,13 @@ def llvm_library():
     ``DRJIT_LIBLLVM_PATH`` when set (even to a missing file: that is how a
     user turns the backend off); else the newest major version among
     `LIBRARY_PATTERNS` (by the number in the name, ``libLLVM-19.so.1`` over
-    ``libLLVM-15.so``).
+    ``libLLVM-17.so``) that is at least `MIN_LLVM_VERSION`.
     """
     if "DRJIT_LIBLLVM_PATH" in os.environ:
         return os.environ["DRJIT_LIBLLVM_PATH"]
-    found = [p for pattern in LIBRARY_PATTERNS for p in glob.glob(pattern) if os.path.isfile(p)]
-
-    def version(path):
-        m = re.search(r"libLLVM[-.]?(\d+)", os.path.basename(path))
-        return int(m.group(1)) if m else -1
-    return max(found, key=lambda p: (version(p), p), default=None)
+    found = [p for pattern in LIBRARY_PATTERNS for p in glob.glob(pattern)
+             if os.path.isfile(p) and (library_version(p) or 0) >= MIN_LLVM_VERSION]
+    return max(found, key=lambda p: (library_version(p), p), default=None)
 
 
 @functools.cache
@@ -55,7 +65,8 @@ def drjit_llvm():
 
     Sets ``DRJIT_LIBLLVM_PATH`` to `llvm_library` (if unset) before Dr.Jit
     is first imported, then asks Dr.Jit whether the backend initialised.
-    Never raises: a missing wheel or library is None.
+    Never raises: a missing wheel or library, or an LLVM older than
+    `MIN_LLVM_VERSION` (which would abort the process on the first frame), is None.
     """
     path = llvm_library()
     if path is None or not os.path.isfile(path):    # Dr.Jit would print its own failure on stderr
@@ -63,7 +74,7 @@ def drjit_llvm():
     os.environ.setdefault("DRJIT_LIBLLVM_PATH", path)
     try:
         import drjit
-        if not drjit.has_backend(drjit.JitBackend.LLVM):
+        if not drjit.has_backend(drjit.JitBackend.LLVM) or drjit.detail.llvm_version()[0] < MIN_LLVM_VERSION:
             return None
         import drjit.llvm
     except (ImportError, OSError, RuntimeError):
@@ -214,14 +225,17 @@ def missing(name):
         return None
     path = llvm_library()
     if path is None:
-        found = "no libLLVM shared library was found (" + ", ".join(LIBRARY_PATTERNS) + ")"
+        found = (f"no libLLVM shared library of LLVM {MIN_LLVM_VERSION} or newer was found ("
+                 + ", ".join(LIBRARY_PATTERNS) + ")")
     elif not os.path.isfile(path):
         found = f"DRJIT_LIBLLVM_PATH is {path!r}, not a file"
+    elif (library_version(path) or MIN_LLVM_VERSION) < MIN_LLVM_VERSION:
+        found = f"the LLVM library {path!r} is older than LLVM {MIN_LLVM_VERSION}"
     else:
         found = f"Dr.Jit could not load the LLVM library {path!r}"
     return (f"Dr.Jit's LLVM backend is unavailable: {found}; install the system's LLVM (Debian: "
-            f"apt-get install libllvm19) or set DRJIT_LIBLLVM_PATH to a libLLVM-*.so, or use backend "
-            f"'numba' or 'auto'")
+            f"apt-get install libllvm19) or set DRJIT_LIBLLVM_PATH to a libLLVM-*.so of LLVM "
+            f"{MIN_LLVM_VERSION} or newer, or use backend 'numba' or 'auto'")
 
 
 def resolve(name):

@@ -112,6 +112,44 @@ def test_without_the_system_llvm_auto_renders_with_numba_and_drjit_is_refused():
     assert result.stdout.startswith("refused: backend") and "/nonexistent" in result.stdout
 
 
+def test_discovery_takes_the_newest_llvm_that_is_new_enough(tmp_path, monkeypatch):
+    """LLVM 15 and 16 abort the process on Dr.Jit's atan2: an older library is never chosen,
+    however it is spelled, and a newer one is chosen over an older usable one."""
+    monkeypatch.delenv("DRJIT_LIBLLVM_PATH", raising=False)
+    monkeypatch.setattr(backends, "LIBRARY_PATTERNS", (str(tmp_path / "*" / "libLLVM*.so*"),))
+    old = backends.MIN_LLVM_VERSION - 1
+    for name in (f"a/libLLVM-{old}.so", f"b/libLLVM.so.{old}.0", f"c/libLLVM-{old}.so.1"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_bytes(b"")
+    assert backends.llvm_library() is None
+    for version in (backends.MIN_LLVM_VERSION, backends.MIN_LLVM_VERSION + 2):
+        (tmp_path / "d" / f"libLLVM-{version}.so.1").parent.mkdir(exist_ok=True)
+        (tmp_path / "d" / f"libLLVM-{version}.so.1").write_bytes(b"")
+    assert backends.llvm_library() == str(tmp_path / "d" / f"libLLVM-{backends.MIN_LLVM_VERSION + 2}.so.1")
+
+
+def test_a_loaded_llvm_older_than_the_minimum_is_refused(tmp_path):
+    """DRJIT_LIBLLVM_PATH may name any library: the version Dr.Jit loaded decides (here
+    Dr.Jit is told it loaded one version below and then the minimum), and the refusal
+    names the library and the minimum.  In a fresh process: Dr.Jit loads LLVM once."""
+    path = tmp_path / "libLLVM-15.so"
+    path.write_bytes(b"")
+    code = ("import drjit\n"
+            "from renderer import backends\n"
+            "drjit.has_backend = lambda backend: True\n"
+            "for version in (backends.MIN_LLVM_VERSION - 1, backends.MIN_LLVM_VERSION):\n"
+            "    drjit.detail.llvm_version = lambda: (version, 0, 6)\n"
+            "    print(backends.drjit_llvm.__wrapped__() is not None)\n"
+            "backends.drjit_llvm = lambda: None\n"
+            "print(backends.missing('drjit'))\n")
+    env = {**os.environ, "DRJIT_LIBLLVM_PATH": str(path)}
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert result.returncode == 0, result.stderr
+    usable_below, usable_at, refusal = result.stdout.splitlines()
+    assert (usable_below, usable_at) == ("False", "True")
+    assert f"{str(path)!r} is older than LLVM {backends.MIN_LLVM_VERSION}" in refusal
+
+
 def test_auto_is_drjit_where_it_is_available():
     require_backend("drjit")
     assert backends.resolve("auto") == "drjit"
