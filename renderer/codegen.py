@@ -158,6 +158,28 @@ def _body(name, outputs, printer, indent):
     return [f"{indent}{s} = {printer(e)}" for s, e in prelude + subs], [printer(e) for e in reduced]
 
 
+def _cases(name, outputs, printer, joined, numba):
+    """Lines of a generated function's body: the outputs of ``name`` computed and
+    returned (``joined`` prints several values as one), one ``if field == code``
+    branch per height field where the entry is per field, then the refusal of an
+    unknown field (with the value given, except under numba, which has no f-strings)."""
+    per_field = isinstance(outputs, dict)
+    lines = []
+    for field, exprs in (outputs.items() if per_field else [(None, outputs)]):
+        ind = "    "
+        if field is not None:
+            lines.append(f"    if field == {F.FIELD_CODES[field]}:  # {field}\n")
+            ind = "        "
+        body, values = _body(name, exprs, printer, ind)
+        lines.extend(line + "\n" for line in body)
+        lines.append(f"{ind}return {values[0] if len(values) == 1 else joined(values)}\n")
+    if per_field:
+        accepted = ", ".join(f"{i} ({n})" for n, i in F.FIELD_CODES.items())
+        given = "" if numba else ", got {field!r}"
+        lines.append(f"    raise ValueError({'' if numba else 'f'}\"field must be one of {accepted}{given}\")\n")
+    return lines
+
+
 def _entries():
     for name, (args, outputs) in F.FUNCTIONS.items():
         yield name, [str(a) for a in args], outputs
@@ -172,19 +194,7 @@ def python_source():
         lead = ["field"] if per_field else []
         njit = _NJIT[:-1] + ', inline="always")' if name in INLINE else _NJIT
         out.append(f"\n\n{njit}\ndef {name}({', '.join(lead + args)}):\n")
-        cases = outputs.items() if per_field else [(None, outputs)]
-        for field, exprs in cases:
-            ind = "    "
-            if field is not None:
-                out.append(f"    if field == {F.FIELD_CODES[field]}:  # {field}\n")
-                ind = "        "
-            lines, values = _body(name, exprs, _py, ind)
-            value = values[0] if len(values) == 1 else f"({', '.join(values)})"
-            out.extend(line + "\n" for line in lines)
-            out.append(f"{ind}return {value}\n")
-        if per_field:
-            accepted = ", ".join(f"{i} ({n})" for n, i in F.FIELD_CODES.items())
-            out.append(f"    raise ValueError(\"field must be one of {accepted}\")\n")
+        out.extend(_cases(name, outputs, _py, lambda values: f"({', '.join(values)})", numba=True))
         k = len(next(iter(outputs.values())) if per_field else outputs)
         targets = ", ".join(f"out[{c}, i]" for c in range(k))
         call = f"{name}({', '.join(lead + [f'{a}[i]' for a in args])})"
@@ -204,18 +214,7 @@ def array_source():
         per_field = isinstance(outputs, dict)
         lead = ["xp"] + (["field"] if per_field else [])
         out.append(f"\n\ndef {name}({', '.join(lead + args)}):\n")
-        cases = outputs.items() if per_field else [(None, outputs)]
-        for field, exprs in cases:
-            ind = "    "
-            if field is not None:
-                out.append(f"    if field == {F.FIELD_CODES[field]}:  # {field}\n")
-                ind = "        "
-            lines, values = _body(name, exprs, _array, ind)
-            out.extend(line + "\n" for line in lines)
-            out.append(f"{ind}return {values[0] if len(values) == 1 else ', '.join(values)}\n")
-        if per_field:
-            accepted = ", ".join(f"{i} ({n})" for n, i in F.FIELD_CODES.items())
-            out.append(f"    raise ValueError(f\"field must be one of {accepted}, got {{field!r}}\")\n")
+        out.extend(_cases(name, outputs, _array, ", ".join, numba=False))
     return "".join(out)
 
 
