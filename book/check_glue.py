@@ -161,7 +161,7 @@ QUANTITIES = {
     "the rings field's image-best step (the simulator's scene and steps, 256 × 256)": (
         ("ex_rings_best",), lambda: _lib("lab.accuracy").image_best_step("rings", 256)["best"]),
     # Counted on two pages from their own renders.
-    "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1"), None),
+    "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1", "c4_pixels"), None),
 }
 #: Glued names each showing a quantity of its own that its page computes (from its renders, counts
 #: and choices), with no second name and no value in the library to agree with.
@@ -172,7 +172,7 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s1_flips_surface", "s1_ex_factor", "s2_count_0", "s2_count_2", "s2_count_3",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c4_ad_ratio", "c4_ad_err_ratio",
-               "c4_ad_compile_ms", "c4_fm_ulps", "c4_fm_floors", "c4_fm_drjit", "c6_beta",
+               "c4_ad_compile_ms", "c4_sine_points", "c4_fm_ulps", "c4_fm_floors", "c4_fm_drjit", "c6_beta",
                "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err",
                "ex_fwd_err_1e8", "ex_fwd_err_1e3", "ex_cen_err_1e6", "ex_cs_err", "ex_exact_err", "ex_gn_jr0",
                "ex_gn_jj0", "ex_gn_jr1", "ex_gn_jj1", "ex_gn_b1", "ex_gn_b2", "ex_rings_label",

@@ -525,7 +525,7 @@ def test_the_exercises_compare_with_numbers_cell_4s_table_shows(ran, book_html):
     each error the solutions glue is the one its row shows, to the digits shown."""
     ns, _, glued = ran("s5_lab")
     cell4 = _soup(book_html / "s5_lab.html").find(id="cell4").find_parent("section")     # the label's section
-    (table,) = [t for t in cell4.find_all("table") if "largest error" in t.get_text()]
+    (table,) = [t for t in cell4.find_all("table") if "largest absolute error" in t.get_text()]
     rows = {tuple(td.get_text().strip() for td in tr.find_all("td")[:2]): tr.find_all("td")[2].get_text().strip()
             for tr in table.find_all("tr") if tr.find_all("td")}
     assert len(rows) == len(ns["fast"].of("sine"))
