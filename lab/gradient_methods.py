@@ -421,6 +421,73 @@ def ad_trig_calls(name):
     return len(re.findall(r"\b(?:sine|cosine)\(", text))
 
 
+@lru_cache(maxsize=None)
+def _xla_exact_program(name):
+    """The exact gradient `renderer.formulas.GRADIENT` of field ``name`` printed for JAX by
+    ``sympy.lambdify`` (common subexpressions shared) and jit-compiled by XLA, as
+    `_ad_program` compiles the program AD differentiates."""
+    import jax
+    fn = sp.lambdify((F.u, F.v, F.k_u, F.k_v), list(F.GRADIENT[name]), modules="jax", cse=True)
+    return jax.jit(lambda uu, vv, ku, kv: tuple(fn(uu, vv, ku, kv)))
+
+
+def xla_exact_gradient(name, uu, vv, ku, kv):
+    """The exact chart gradient compiled by XLA, AD's compiler: (h_u, h_v), two (n,) float64
+    arrays for (n,) float64 ``uu``, ``vv``.  `same_compiler_times` times it beside
+    `ad_gradient`.  Raises ValueError if ``name`` is unknown."""
+    import jax
+    _check_name(name)
+    uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
+    with jax.enable_x64(True):
+        h_u, h_v = _xla_exact_program(name)(uu, vv, float(ku), float(kv))
+        return np.broadcast_to(np.asarray(h_u), uu.shape), np.broadcast_to(np.asarray(h_v), uu.shape)
+
+
+def same_compiler_times(uu, vv, *, ku=None, kv=None, rounds=21, fields_=FIELDS):
+    """AD and the exact gradient through one compiler (XLA), and the exact gradient
+    compiled by numba, timed side by side.
+
+    Per field, after one call of each (which compiles), ``rounds`` interleaved
+    rounds of `xla_exact_gradient`, `ad_gradient` and
+    `renderer.pointwise.exact_gradient` (numba) on the chart points ``uu``,
+    ``vv`` ((n,) float64); ``ku``, ``kv`` default to the draft's scene's.
+    Separates what the method costs from what the compiler costs: §5's
+    benchmark sets AD (XLA) beside the exact gradient compiled by numba.
+
+    Returns
+    -------
+    dict field -> {"exact": seconds, "ad": seconds, "numba": seconds, "ratio": ad / exact,
+    "compiler": exact / numba}, medians.
+
+    Raises
+    ------
+    ValueError
+        If ``rounds`` is not a positive int or a field is unknown.
+    """
+    import jax
+    if not isinstance(rounds, int) or isinstance(rounds, bool) or rounds < 1:
+        raise ValueError(f"rounds must be a positive int, got {rounds!r}")
+    ku = float(DRAFT_SCENE.k_u if ku is None else ku)
+    kv = float(DRAFT_SCENE.k_v if kv is None else kv)
+    out = {}
+    for name in fields_:
+        _check_name(name)
+        calls = {"exact": lambda: xla_exact_gradient(name, uu, vv, ku, kv),
+                 "ad": lambda: ad_gradient(name, uu, vv, ku, kv),
+                 "numba": lambda: pointwise.exact_gradient(name, uu, vv, ku, kv)}
+        times = {k: [] for k in calls}
+        for k in calls:
+            jax.block_until_ready(calls[k]())
+        for _ in range(rounds):
+            for k, call in calls.items():
+                t0 = time.perf_counter()
+                call()                               # returns numpy arrays: the work is done
+                times[k].append(time.perf_counter() - t0)
+        exact, ad, numba = (float(np.median(times[k])) for k in ("exact", "ad", "numba"))
+        out[name] = {"exact": exact, "ad": ad, "numba": numba, "ratio": ad / exact, "compiler": exact / numba}
+    return out
+
+
 def abs_slope_at_zero():
     """JAX's forward-mode slope of |x| at x = +0.0 and x = -0.0, measured: (float, float).
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import inspect
 import re
+import time
 
 import mpmath
 import numpy as np
@@ -411,3 +412,38 @@ def test_crease_values_rejects_a_bad_step():
         gm.crease_values(eps=-1.0)
     with pytest.raises(ValueError, match="height_field must be one of"):
         gm.ad_gradient("bumps", np.array([0.1]), np.array([0.1]), KU, KV)
+
+
+# --- AD and the exact gradient through one compiler ---------------------------------------------
+
+@pytest.mark.parametrize("field", gm.FIELDS)
+def test_the_xla_exact_gradient_is_the_exact_gradient(field):
+    """What `same_compiler_times` times as "exact" computes the exact gradient (the numba one)."""
+    rng = np.random.default_rng(7)
+    u, v = rng.random(257), rng.random(257)
+    got = gm.xla_exact_gradient(field, u, v, KU, KV)
+    want = pointwise.exact_gradient(field, u, v, KU, KV)
+    for g, w in zip(got, want):
+        assert np.allclose(g, w, rtol=1e-13, atol=1e-13)
+
+
+def test_same_compiler_times_report_each_side_and_their_ratio(monkeypatch):
+    u = v = np.linspace(0.1, 0.9, 64)
+    fast = gm.same_compiler_times(u, v, rounds=3, fields_=("rings",))["rings"]
+    assert fast["exact"] > 0 and fast["ad"] > 0 and fast["numba"] > 0
+    assert fast["ratio"] == fast["ad"] / fast["exact"] and fast["compiler"] == fast["exact"] / fast["numba"]
+    # A planted slow AD (5 ms a call, the exact gradient of 64 points takes microseconds) shows.
+    real = gm.ad_gradient
+
+    def slow(*args, **kwargs):
+        time.sleep(0.005)
+        return real(*args, **kwargs)
+    monkeypatch.setattr(gm, "ad_gradient", slow)
+    assert gm.same_compiler_times(u, v, rounds=3, fields_=("rings",))["rings"]["ratio"] > 5
+
+
+@pytest.mark.parametrize("kwargs, match", [({"rounds": 0}, "^rounds"), ({"rounds": 2.0}, "^rounds"),
+                                           ({"rounds": True}, "^rounds"), ({"fields_": ("waves",)}, "waves")])
+def test_same_compiler_times_refuses_bad_input(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        gm.same_compiler_times(np.zeros(4), np.zeros(4), **kwargs)
