@@ -16,6 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 import pytest
+from numba.core.caching import NullCache
 
 from renderer import PointLight, Scene, kernel, render
 
@@ -46,13 +47,23 @@ def reference():
     return render(SCENE, 12, 10, gradient="footprint")
 
 
+@pytest.fixture
+def uncached(monkeypatch):
+    """The kernel's functions compiled in memory only while a test changes the record: its
+    specializations stay out of numba's cache on disk, which two processes writing at once
+    can leave naming one layout's code under another's signature."""
+    for obj in vars(kernel).values():
+        if isinstance(obj, numba.core.registry.CPUDispatcher):
+            monkeypatch.setattr(obj, "_cache", NullCache())
+
+
 def _layout(names, extra=()):
     """`kernel.SCENE` with its fields in the order of ``names``, ``extra`` (name, dtype) pairs first."""
     return np.dtype([*extra, *((n, kernel.SCENE.fields[n][0]) for n in names)], align=True)
 
 
 @pytest.mark.parametrize("layout", ["a field inserted first", "fields reversed"])
-def test_the_layout_changes_no_bit(monkeypatch, reference, layout):
+def test_the_layout_changes_no_bit(monkeypatch, reference, uncached, layout):
     names = kernel.SCENE.names
     changed = _layout(names, [("unused", "f8")]) if layout == "a field inserted first" else _layout(names[::-1])
     assert [changed.fields[n][1] for n in names] != [kernel.SCENE.fields[n][1] for n in names]    # offsets moved
@@ -71,7 +82,7 @@ def test_a_misnamed_field_is_refused_by_name(monkeypatch):
         render(SCENE, 4, 4)
 
 
-def test_a_field_the_kernel_reads_and_the_record_lacks_stops_the_compilation(monkeypatch):
+def test_a_field_the_kernel_reads_and_the_record_lacks_stops_the_compilation(monkeypatch, uncached):
     monkeypatch.setattr(kernel, "SCENE", _layout([n for n in kernel.SCENE.names if n != "beta"]))
     with pytest.raises((numba.core.errors.TypingError, KeyError), match="beta"):
         render(SCENE, 4, 4)
