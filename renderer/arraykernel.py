@@ -9,6 +9,9 @@ them from `renderer.formulas`) -> `shade` (per light: `reach`, then
 computed and one is kept, so a pixel gets the value the numba kernel's branch
 gives it.  What is a constant of the render (the scene, the field, the
 gradient method, the outputs wanted) is branched on in Python, once.
+The scene's numbers enter as values (`scene_values`), not as constants of
+the program: Dr.Jit compiles one kernel per `structure` of a scene (its
+Python-level branches), and scenes that differ only in numbers share it.
 
 ``xp`` is a namespace of `renderer.backends`: numpy (any machine; the tests
 check this program's logic with it) or Dr.Jit's LLVM backend, which traces
@@ -20,6 +23,7 @@ numba kernel's to the parity tolerance, not bit for bit).
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -45,13 +49,13 @@ def sphere_hit(xp, x, y, e, cx, cy, cz, r):
     return xp.select(disc >= 0.0, t, math.inf)
 
 
-def nearest_hit(xp, s, x, y):
+def nearest_hit(xp, s, v, x, y):
     """(t, on_a, on_b, on_floor): the nearest positive hit and one mask per chamber
     (None for an object that is off); ties go to A, then B, then the floor."""
-    t = sphere_hit(xp, x, y, s.camera_z, 0.0, 0.0, 0.0, s.radius_a)
+    t = sphere_hit(xp, x, y, v.camera_z, 0.0, 0.0, 0.0, v.radius_a)
     on_a, on_b, on_floor = t < math.inf, None, None
     if s.sphere_b:
-        t_b = sphere_hit(xp, x, y, s.camera_z, *s.center_b, s.radius_b)
+        t_b = sphere_hit(xp, x, y, v.camera_z, *v.center_b, v.radius_b)
         on_b = t_b < t
         t = xp.select(on_b, t_b, t)
         on_a = on_a & ~on_b
@@ -77,24 +81,24 @@ def _pick(xp, mask, a, b):
     return b if mask is None else tuple(xp.select(mask, p, q) for p, q in zip(a, b))
 
 
-def surface(xp, s, x, y, t, on_a, on_b, checker):
+def surface(xp, v, x, y, t, on_a, on_b, checker):
     """(P, N, albedo, N_a): hit point, unit geometric normal and albedo of every
     pixel's chamber (garbage on the background), and sphere A's normal P / R."""
-    r, e = s.radius_a, s.camera_z
+    r, e = v.radius_a, v.camera_z
     P_a = sphere_a_point(xp, x, y, e, r)
     N_a = (P_a[0] / r, P_a[1] / r, P_a[2] / r)
     P = (t * x, t * y, e * (1.0 - t))
     # The floor, unless B or A replaces it: checker light where sin(pi x) sin(pi y) >= 0.
     base = xp.select(checker >= 0.0, FLOOR_LIGHT, FLOOR_DARK)
-    rg = base * (1.0 - s.floor_tint)
+    rg = base * (1.0 - v.floor_tint)
     N, albedo = (0.0, 0.0, 1.0), (rg, rg, base)
     if on_b is not None:
-        c = s.center_b
+        c = v.center_b
         nx, ny, nz = P[0] - c[0], P[1] - c[1], P[2] - c[2]
         inv = 1.0 / xp.sqrt(nx * nx + ny * ny + nz * nz)
         N = _pick(xp, on_b, (nx * inv, ny * inv, nz * inv), N)
-        albedo = _pick(xp, on_b, s.albedo_b, albedo)
-    return (_pick(xp, on_a, P_a, P), _pick(xp, on_a, N_a, N), _pick(xp, on_a, s.albedo_a, albedo), N_a)
+        albedo = _pick(xp, on_b, v.albedo_b, albedo)
+    return (_pick(xp, on_a, P_a, P), _pick(xp, on_a, N_a, N), _pick(xp, on_a, v.albedo_a, albedo), N_a)
 
 
 def unit_vector(xp, wx, wy, wz, w2):
@@ -108,42 +112,51 @@ def unit_vector(xp, wx, wy, wz, w2):
     return wx * inv, wy * inv, wz * inv
 
 
-def segment_blocked(xp, wx, wy, wz, w2, L, c, r):
-    """`renderer.kernel.segment_blocked`; the light L and the sphere (c, r) are constants,
-    so the case of the light (inside, on, outside the sphere) is a Python branch."""
+def light_case(L, c, r):
+    """Where the light L is against the sphere (c, r): -1 inside, 0 on it, 1 outside
+    (Python floats; the sign of `segment_blocked`'s k, computed as it computes k)."""
     dx, dy, dz = L[0] - c[0], L[1] - c[1], L[2] - c[2]
     k = dx * dx + dy * dy + dz * dz - r * r
-    if k < 0.0:
+    return (k > 0.0) - (k < 0.0)
+
+
+def segment_blocked(xp, wx, wy, wz, w2, case, L, c, r):
+    """`renderer.kernel.segment_blocked` for the light L and the sphere (c, r), values of
+    the render; the case of the light (`light_case`) is a Python branch."""
+    if case < 0:
         return True
+    dx, dy, dz = L[0] - c[0], L[1] - c[1], L[2] - c[2]
+    k = dx * dx + dy * dy + dz * dz - r * r
     g = wx * dx + wy * dy + wz * dz
-    if k == 0.0:
+    if case == 0:
         return (g > 0.0) & (2.0 * g < w2)
     return (g > 0.0) & (g < w2) & (g * g >= w2 * k)
 
 
-def reach(xp, s, L, P, N, Ns, on_a, on_b, on_floor):
-    """(w, mu, lit): unit vector to the light L, Ns . w and whether the light adds
+def reach(xp, s, v, i, P, N, Ns, on_a, on_b, on_floor):
+    """(w, mu, lit): unit vector to light i, Ns . w and whether the light adds
     light (`renderer.kernel.reach` with its gate: N and Ns face it, the floor
     plane does not separate them, no blocker sphere cuts the segment)."""
+    L, Lz = v.lights[i].position, s.lights[i].position[2]     # values; the side of z = 0 decides
     wx, wy, wz = L[0] - P[0], L[1] - P[1], L[2] - P[2]
     lit = N[0] * wx + N[1] * wy + N[2] * wz > 0.0
-    if on_floor is not None and L[2] != 0.0:
-        separated = (P[2] > 0.0) if L[2] < 0.0 else (P[2] < 0.0)
+    if on_floor is not None and Lz != 0.0:
+        separated = (P[2] > 0.0) if Lz < 0.0 else (P[2] < 0.0)
         lit = lit & (on_floor | ~separated)
     w2 = wx * wx + wy * wy + wz * wz
     w = unit_vector(xp, wx, wy, wz, w2)
     mu = Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2]
     lit = lit & (mu > 0.0)
-    blockers = [((0.0, 0.0, 0.0), s.radius_a, on_a)] + ([(s.center_b, s.radius_b, on_b)] if s.sphere_b else [])
-    for centre, radius, on_it in blockers:          # a sphere does not block its own points
-        blocked = segment_blocked(xp, wx, wy, wz, w2, L, centre, radius)
+    blockers = [((0.0, 0.0, 0.0), v.radius_a, on_a)] + ([(v.center_b, v.radius_b, on_b)] if s.sphere_b else [])
+    for case, (centre, radius, on_it) in zip(_light_cases(s, i), blockers):   # not its own points
+        blocked = segment_blocked(xp, wx, wy, wz, w2, case, L, centre, radius)
         lit = lit & on_it if blocked is True else lit & (on_it | ~blocked)
     return w, mu, lit
 
 
-def view_vector(xp, s, P):
+def view_vector(xp, v, P):
     """Unit vector from P to the eye (0, 0, camera_z)."""
-    vx, vy, vz = -P[0], -P[1], s.camera_z - P[2]
+    vx, vy, vz = -P[0], -P[1], v.camera_z - P[2]
     inv = 1.0 / xp.sqrt(vx * vx + vy * vy + vz * vz)
     return vx * inv, vy * inv, vz * inv
 
@@ -169,27 +182,79 @@ def int_power(base, n):
     return 1.0 if r is None else r
 
 
-def light_term(xp, s, color, mu, axis, wv, Ns, albedo):
+def light_term(xp, s, v, color, mu, axis, wv, Ns, albedo):
     """`renderer.kernel.light_term` where the light reaches (mu = Ns . w > 0)."""
     spec_cos = Ns[0] * axis[0] + Ns[1] * axis[1] + Ns[2] * axis[2]
     if s.model == "phong":
         spec_cos = 2.0 * mu * spec_cos - wv
     base = xp.minimum(xp.maximum(spec_cos, 0.0), 1.0)
     n = int(s.shininess)
-    spec = (int_power(base, n) if n == s.shininess else xp.power(base, s.shininess)) * s.ks
-    diffuse = mu * s.kd
+    spec = (int_power(base, n) if n == s.shininess else xp.power(base, v.shininess)) * v.ks
+    diffuse = mu * v.kd
     return tuple(color[c] * (diffuse * albedo[c] + spec) for c in range(3))
 
 
-def gradient(xp, s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi):
-    """(h_u, h_v) on sphere A by ``method`` ("exact", "central", "footprint")."""
+def gradient(xp, s, q, method, u, v, x, y, P, N, frame, sin_phi):
+    """(h_u, h_v) on sphere A by ``method`` ("exact", "central", "footprint"); ``q`` the
+    render's values (`scene_values`)."""
     field = G.FIELD_CODES[s.height_field]
     if method == "exact":
-        return G.exact_gradient(xp, field, u, v, s.k_u, s.k_v)
-    eu = ev = eps
+        return G.exact_gradient(xp, field, u, v, q.k_u, q.k_v)
+    eu = ev = q.eps
     if method == "footprint":
-        eu, ev = G.footprint(xp, x, y, dx, dy, s.camera_z, *P, *N, *frame, s.radius_a, sin_phi)
-    return G.central_gradient(xp, field, u, v, s.k_u, s.k_v, eu, ev)
+        eu, ev = G.footprint(xp, x, y, q.dx, q.dy, q.camera_z, *P, *N, *frame, q.radius_a, sin_phi)
+    return G.central_gradient(xp, field, u, v, q.k_u, q.k_v, eu, ev)
+
+
+#: The numbers of a scene the program computes with (a tuple attribute: its components),
+#: then each light's position and colour, then the render's eps, dx, dy: `scene_values`.
+NUMBERS = ("camera_z", "radius_a", "radius_b", "center_b", "albedo_a", "albedo_b", "floor_tint", "ka", "kd",
+           "ks", "ambient", "shininess", "k_u", "k_v", "beta")
+
+
+def scene_values(s, eps, dx, dy):
+    """The render's numbers as one flat tuple of Python floats: `NUMBERS` of the scene,
+    each light's position and colour, eps, dx, dy (`values` reads it back)."""
+    flat = []
+    for name in NUMBERS:
+        value = getattr(s, name)
+        flat.extend(map(float, value) if isinstance(value, tuple) else [float(value)])
+    for light in s.lights:
+        flat.extend(map(float, (*light.position, *light.color)))
+    return tuple(flat) + (float(eps), float(dx), float(dy))
+
+
+def values(s, flat):
+    """`scene_values`' tuple read back as a namespace with the scene's attribute names
+    (``lights`` a list of namespaces with ``position``, ``color``; ``eps``, ``dx``,
+    ``dy``), its entries whatever ``flat`` holds: Python floats, or Dr.Jit values."""
+    it = iter(flat)
+    out = {}
+    for name in NUMBERS:
+        n = len(getattr(s, name)) if isinstance(getattr(s, name), tuple) else 0
+        out[name] = tuple(next(it) for _ in range(n)) if n else next(it)
+    out["lights"] = [SimpleNamespace(position=tuple(next(it) for _ in range(3)), color=tuple(next(it) for _ in range(3)))
+                     for _ in s.lights]
+    out["eps"], out["dx"], out["dy"] = next(it), next(it), next(it)
+    return SimpleNamespace(**out)
+
+
+def _light_cases(s, i):
+    """Light i against each blocker sphere (A, then B when on): `light_case`."""
+    L = s.lights[i].position
+    spheres = [((0.0, 0.0, 0.0), s.radius_a)] + ([(s.center_b, s.radius_b)] if s.sphere_b else [])
+    return tuple(light_case(L, c, r) for c, r in spheres)
+
+
+def structure(s):
+    """Every property of scene ``s`` that `program` branches on in Python: two scenes with
+    the same structure run the same program on different values (`scene_values`), so
+    Dr.Jit replays one compiled kernel for both."""
+    n = int(s.shininess)
+    return (s.height_field, s.bump, s.model, s.sphere_b, s.floor, s.beta == 0.0,
+            n if n == s.shininess else None,
+            tuple((any(light.color), (light.position[2] > 0.0) - (light.position[2] < 0.0), _light_cases(s, i))
+                  for i, light in enumerate(s.lights)))
 
 
 def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad):
@@ -215,22 +280,25 @@ def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad):
         ``image`` (n, 3) float64 in [0, 1], ``chamber`` (n,) uint8, and when
         asked ``kink`` (n,) bool and ``grad`` (n, 2) float64 (0 off sphere A).
     """
-    return xp.run(program, s, (xs, ys, np.sin(np.pi * xs), np.sin(np.pi * ys)), OUTPUTS,
-                  method=method, eps=eps, dx=dx, dy=dy, kink=kink, grad=grad)
+    return xp.run(program, s, structure(s), scene_values(s, eps, dx, dy),
+                  (xs, ys, np.sin(np.pi * xs), np.sin(np.pi * ys)), OUTPUTS, method=method, kink=kink, grad=grad)
 
 
 #: Each output of `program`: (values per pixel, numpy dtype).
 OUTPUTS = {"image": (3, np.float64), "chamber": (1, np.uint8), "kink": (1, np.bool_), "grad": (2, np.float64)}
 
 
-def program(xp, s, xs, ys, sin_xs, sin_ys, *, method, eps, dx, dy, kink, grad):
+def program(xp, s, flat, xs, ys, sin_xs, sin_ys, *, method, kink, grad):
     """The frame's array program: `render_block`'s outputs as a dict name -> list of
     arrays of the namespace (k arrays for k values per pixel, `OUTPUTS`), unevaluated
-    on Dr.Jit; xs, ys and their sines sin(pi xs), sin(pi ys) as arrays of ``xp``."""
+    on Dr.Jit.  ``s`` decides the branches (only through `structure`), ``flat`` (its
+    `scene_values`, as floats or values of ``xp``) gives the numbers; xs, ys and their
+    sines sin(pi xs), sin(pi ys) as arrays of ``xp``."""
+    q = values(s, flat)
     x, y = xp.grid(xs, ys)
     sin_x, sin_y = xp.grid(sin_xs, sin_ys)
-    t, on_a, on_b, on_floor = nearest_hit(xp, s, x, y)
-    P, N, albedo, N_a = surface(xp, s, x, y, t, on_a, on_b, sin_x * sin_y)
+    t, on_a, on_b, on_floor = nearest_hit(xp, s, q, x, y)
+    P, N, albedo, N_a = surface(xp, q, x, y, t, on_a, on_b, sin_x * sin_y)
 
     # Sphere A: chart, frame, gradient, shading normal (the generated formulas).
     field = G.FIELD_CODES[s.height_field]
@@ -239,23 +307,23 @@ def program(xp, s, xs, ys, sin_xs, sin_ys, *, method, eps, dx, dy, kink, grad):
     frame = G.tangent_frame(xp, *N_a, sin_phi)
     hu = hv = 0.0
     if grad or s.beta != 0.0:           # beta = 0: the gradient moves nothing
-        hu, hv = gradient(xp, s, method, eps, u, v, x, y, dx, dy, P, N_a, frame, sin_phi)
+        hu, hv = gradient(xp, s, q, method, u, v, x, y, P, N_a, frame, sin_phi)
     if s.bump == "surface":
-        h = G.height(xp, field, u, v, s.k_u, s.k_v)
-        Ns_a = G.perturbed_normal_surface(xp, *N_a, *frame, hu, hv, s.beta, h, s.radius_a, sin_phi)
+        h = G.height(xp, field, u, v, q.k_u, q.k_v)
+        Ns_a = G.perturbed_normal_surface(xp, *N_a, *frame, hu, hv, q.beta, h, q.radius_a, sin_phi)
     else:
-        Ns_a = G.perturbed_normal_chart(xp, *N_a, *frame, hu, hv, s.beta)
+        Ns_a = G.perturbed_normal_chart(xp, *N_a, *frame, hu, hv, q.beta)
     Ns = _pick(xp, on_a, Ns_a, N)
 
     # Ambient plus every light that reaches the point.
-    rgb = tuple(s.ka * a for a in s.ambient)
-    view = view_vector(xp, s, P)
-    for light in s.lights:
+    rgb = tuple(q.ka * a for a in q.ambient)
+    view = view_vector(xp, q, P)
+    for i, light in enumerate(s.lights):
         if not any(light.color):        # a black light adds exactly 0
             continue
-        w, mu, lit = reach(xp, s, tuple(light.position), P, N, Ns, on_a, on_b, on_floor)
+        w, mu, lit = reach(xp, s, q, i, P, N, Ns, on_a, on_b, on_floor)
         axis, wv = specular_axis(xp, s, w, view)
-        term = light_term(xp, s, light.color, mu, axis, wv, Ns, albedo)
+        term = light_term(xp, s, q, q.lights[i].color, mu, axis, wv, Ns, albedo)
         rgb = tuple(xp.select(lit, c + d, c) for c, d in zip(rgb, term))
     hit = t < math.inf
     # + 0.0: a -0.0 leaves as 0.0, as in the numba kernel.
@@ -265,7 +333,7 @@ def program(xp, s, xs, ys, sin_xs, sin_ys, *, method, eps, dx, dy, kink, grad):
         chamber = chamber if mask is None else xp.select(mask, code, chamber)
     out = {"image": rgb, "chamber": [chamber]}
     if kink:
-        out["kink"] = [on_a & G.kink_band(xp, field, u, v, s.k_u, s.k_v)]
+        out["kink"] = [on_a & G.kink_band(xp, field, u, v, q.k_u, q.k_v)]
     if grad:
         out["grad"] = [xp.select(on_a, hu, 0.0), xp.select(on_a, hv, 0.0)]
     return out

@@ -114,11 +114,12 @@ class NumpyNamespace:
         return np.tile(cols, len(rows)), np.repeat(rows, len(cols))
 
     @classmethod
-    def run(cls, program, s, arrays, outputs, **options):
-        """``program(xp, s, *arrays, **options)`` (a dict name -> list of arrays) as
-        numpy arrays, (n, k) for k values per pixel, (n,) for one, of the dtypes of
-        ``outputs`` (name -> (k, dtype))."""
-        out = program(cls, s, *arrays, **options)
+    def run(cls, program, s, structure, numbers, arrays, outputs, **options):
+        """``program(xp, s, numbers, *arrays, **options)`` (a dict name -> list of arrays)
+        as numpy arrays, (n, k) for k values per pixel, (n,) for one, of the dtypes of
+        ``outputs`` (name -> (k, dtype)).  ``numbers`` (Python floats) are the values the
+        program computes with, ``structure`` what of ``s`` it branches on (unused here)."""
+        out = program(cls, s, numbers, *arrays, **options)
         return dict(zip(out, cls.numpy([(a, outputs[name][1]) for name, a in out.items()])))
 
     @staticmethod
@@ -169,25 +170,29 @@ class DrJitNamespace:
         return (self.dr.gather(self.Float64, self.Float64(cols), index % width),
                 self.dr.gather(self.Float64, self.Float64(rows), index // width))
 
-    def run(self, program, s, arrays, outputs, **options):
+    def run(self, program, s, structure, numbers, arrays, outputs, **options):
         """As `NumpyNamespace.run`, with the traced program frozen (`drjit.freeze`):
-        one frozen function per configuration (program, scene, options, array
-        lengths), which traces the program on its first call and replays the
-        recorded kernel launch after.  A frozen function never sees a second
-        configuration: a replay keeps the buffer sizes and constants it was
+        one frozen function per configuration (program, ``structure``, options,
+        array lengths), which traces the program on its first call and replays
+        the recorded kernel launch after.  ``numbers`` and ``arrays`` are the
+        frozen function's inputs (``numbers`` as opaque Float64 values, not
+        constants of the kernel): scenes of one structure differ only in them
+        and share the kernel.  A frozen function never sees a second
+        configuration: a replay keeps the buffer sizes and the branches it was
         recorded with.  At most `FROZEN_CONFIGURATIONS` are kept (least
         recently used first out)."""
-        key = (program, s, tuple(sorted(options.items())), tuple(len(a) for a in arrays))
+        key = (program, structure, tuple(sorted(options.items())), tuple(len(a) for a in arrays))
         frozen = self._frozen.pop(key, None)
         if frozen is None:
-            def record(arrays):
-                out = program(self, s, *arrays, **options)
+            def record(numbers, arrays):
+                out = program(self, s, numbers, *arrays, **options)
                 return self.store([(a, outputs[name][1]) for name, a in out.items()], names=list(out))
             frozen = self.dr.freeze(record)
             while len(self._frozen) >= FROZEN_CONFIGURATIONS:
                 self._frozen.pop(next(iter(self._frozen)))
         self._frozen[key] = frozen                          # the most recent last
-        targets = frozen(tuple(self.Float64(a) for a in arrays))
+        targets = frozen(tuple(self.dr.opaque(self.Float64, x) for x in numbers),
+                         tuple(self.Float64(a) for a in arrays))
         return {name: np.asarray(t).view(outputs[name][1]).reshape((-1, outputs[name][0]) if outputs[name][0] > 1
                                                                     else (-1,)) for name, t in targets.items()}
 

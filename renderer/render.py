@@ -242,10 +242,11 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
         it needs the system's libLLVM (`renderer.backends`).  Its own sin,
         cos and atan2 are a few ulp from libm's: the frame agrees with
         numba's to the parity tests' tolerance, not bit for bit.  The scene's
-        values are constants of the compiled kernel: a frame of a scene not
-        rendered before in the process compiles one (tens of ms at 256², the
-        frame itself a few), so a sweep over many scene values is faster on
-        numba; repeated scenes replay their kernel.  "auto":
+        numbers are inputs of the compiled kernel: scenes that differ only in
+        them replay one kernel; a new `renderer.arraykernel.structure`
+        (field, bump, model, which objects are on, where each light is
+        against the spheres and the floor, an integer shininess) compiles one
+        (tens of ms).  "auto":
         "drjit" where available, else "numba".  "numpy": the array kernel on
         numpy (slow; it checks the array kernel on any machine).  The array
         kernel ignores ``skip`` (it computes what a render of the outputs

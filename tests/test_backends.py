@@ -20,8 +20,8 @@ import sys
 import numpy as np
 import pytest
 
-from renderer import Scene, arraykernel, backends, kernel, render, validate
-from tests.test_parity import IMAGE_TOL, grad_tolerance, require_backend
+from renderer import PointLight, Scene, arraykernel, backends, kernel, render, validate
+from tests.test_parity import IMAGE_TOL, LIGHT_2, grad_tolerance, require_backend
 
 ARRAY_BACKENDS = ("numpy", "drjit")
 
@@ -217,11 +217,94 @@ def test_frozen_programs_past_the_cache_limit_replay_only_their_own_configuratio
     require_backend("drjit")
     monkeypatch.setattr(backends, "FROZEN_CONFIGURATIONS", 3)
     xp = backends.namespace("drjit")
-    for beta in (0.1, 0.2, 0.3, 0.4, 0.5):
-        render(Scene(beta=beta), 24, 20, backend="drjit")
-    assert len(xp._frozen) <= 3
+    for shininess in (10.0, 20.0, 30.0, 40.0, 50.0):      # five structures (int_power's multiplications)
+        render(Scene(shininess=shininess), 24, 20, backend="drjit")
+    assert len(xp._frozen) == 3
     monkeypatch.setitem(sys.modules["renderer.render"].ARRAY_BLOCK_PIXELS, "drjit", 24 * 3)
-    parts = render(Scene(beta=0.2), 24, 20, backend="drjit")
-    reference = render(Scene(beta=0.2), 24, 20)
+    parts = render(Scene(shininess=20.0), 24, 20, backend="drjit")
+    reference = render(Scene(shininess=20.0), 24, 20)
     assert np.array_equal(parts.chamber, reference.chamber)
     assert np.abs(parts.image - reference.image).max() < 1e-12
+
+
+# --- One compiled kernel per structure ------------------------------------------------------------
+#: Pairs of scenes that differ in one branch of `arraykernel.program` (the first rendered
+#: first), by the part of `arraykernel.structure` that tells them apart.
+_OUT, _INSIDE_B, _ON_A = (4.0, 5.0, 6.0), (0.5, 0.5, 1.3), (0.0, 0.0, 1.0)
+STRUCTURE_PAIRS = {
+    "height field": (Scene(), Scene(height_field="sine")),
+    "bump": (Scene(), Scene(bump="chart")),
+    "model": (Scene(), Scene(model="phong")),
+    "sphere B": (Scene(lights=()), Scene(lights=(), sphere_b=False)),   # with lights, their cases differ too
+    "floor": (Scene(), Scene(floor=False)),
+    "beta = 0": (Scene(beta=0.0), Scene(beta=0.35)),
+    "shininess": (Scene(shininess=32.0), Scene(shininess=33.0)),
+    "black light": (Scene(lights=(PointLight(_OUT, (0.0, 0.0, 0.0)),)), Scene(lights=(PointLight(_OUT, (1.0, 1.0, 1.0)),))),
+    "light below the floor": (Scene(lights=(PointLight(_OUT, (1.0, 1.0, 1.0)),)),
+                              Scene(lights=(PointLight((4.0, 5.0, -6.0), (1.0, 1.0, 1.0)),))),
+    "light inside a sphere": (Scene(lights=(PointLight(_OUT, (1.0, 1.0, 1.0)),)),
+                              Scene(lights=(PointLight(_INSIDE_B, (1.0, 1.0, 1.0)),))),
+    "light on a sphere": (Scene(lights=(PointLight(_OUT, (1.0, 1.0, 1.0)),)),
+                          Scene(lights=(PointLight(_ON_A, (1.0, 1.0, 1.0)),))),
+}
+
+
+def _replays_right(pair):
+    """Render the pair's first scene, then its second, on Dr.Jit (grad=False, so that beta = 0
+    skips the gradient): whether the second is the numba kernel's frame."""
+    first, second = pair
+    render(first, 24, 20, backend="drjit", grad=False)
+    got, want = render(second, 24, 20, backend="drjit", grad=False), render(second, 24, 20, grad=False)
+    return bool(np.array_equal(got.chamber, want.chamber) and np.abs(got.image - want.image).max() <= IMAGE_TOL)
+
+
+@pytest.mark.parametrize("name", STRUCTURE_PAIRS)
+def test_each_branch_of_the_array_program_has_a_kernel_of_its_own(name, monkeypatch):
+    require_backend("drjit")
+    monkeypatch.setattr(backends.namespace("drjit"), "_frozen", {})
+    first, second = STRUCTURE_PAIRS[name]
+    assert arraykernel.structure(first) != arraykernel.structure(second)
+    assert _replays_right(STRUCTURE_PAIRS[name])
+
+
+def test_scenes_that_differ_only_in_numbers_share_one_kernel(monkeypatch):
+    """Every number of a scene is a value of the compiled kernel, not a constant: one frozen
+    function renders them all, each as the numba kernel does."""
+    require_backend("drjit")
+    xp = backends.namespace("drjit")
+    monkeypatch.setattr(xp, "_frozen", {})
+    scenes = [Scene(), Scene(beta=0.2, k_u=5.0, k_v=3.0, shininess=32.0, ks=0.3, kd=0.6, ka=0.2, floor_tint=0.5,
+                             center_b=(0.4, 0.6, 1.2), radius_b=0.3, radius_a=0.9, camera_z=3.5,
+                             ambient=(0.1, 0.2, 0.3), albedo_a=(0.2, 0.3, 0.4), albedo_b=(0.5, 0.4, 0.3),
+                             lights=(PointLight((3.0, 4.0, 5.0), (0.7, 0.8, 0.9)), LIGHT_2), eps=2e-3)]
+    assert arraykernel.structure(scenes[0]) == arraykernel.structure(scenes[1])
+    for gradient in ("exact", "central", "footprint"):
+        for s in scenes:
+            got, want = render(s, 24, 20, backend="drjit", gradient=gradient), render(s, 24, 20, gradient=gradient)
+            assert np.array_equal(got.chamber, want.chamber) and np.abs(got.image - want.image).max() <= IMAGE_TOL
+    assert len(xp._frozen) == 3                                  # one per gradient method
+
+
+def _without(part):
+    """`arraykernel.structure` with one part left out (a planted incomplete key)."""
+    real = arraykernel.structure
+
+    def structure(s):
+        key = real(s)
+        if isinstance(part, int):
+            return key[:part] + key[part + 1:]
+        return key[:-1] + (tuple(light[:part[1]] + light[part[1] + 1:] for light in key[-1]),)
+    return structure
+
+
+@pytest.mark.parametrize("part, name", [(0, "height field"), (1, "bump"), (2, "model"), (3, "sphere B"),
+                                        (4, "floor"), (5, "beta = 0"), (6, "shininess"),
+                                        (("light", 0), "black light"), (("light", 1), "light below the floor"),
+                                        (("light", 2), "light inside a sphere")])
+def test_a_structure_without_one_branch_replays_the_wrong_kernel(part, name, monkeypatch):
+    """Planted: the key without one part; the pair that part tells apart then replays the first
+    scene's kernel for the second, and the frame is wrong."""
+    require_backend("drjit")
+    monkeypatch.setattr(backends.namespace("drjit"), "_frozen", {})
+    monkeypatch.setattr(arraykernel, "structure", _without(part))
+    assert not _replays_right(STRUCTURE_PAIRS[name])
