@@ -166,7 +166,9 @@ def backend(name):
     name = choice("backend", name, BACKENDS)
     functions = _functions(name)
     if functions is None:
-        raise ValueError(f"backend 'drjit' is not available on this machine (no system libLLVM for Dr.Jit); "
+        from renderer.backends import missing
+        why = missing("drjit") or "Dr.Jit's LLVM backend did not load"
+        raise ValueError(f"backend 'drjit' is not available on this machine ({why}); "
                          f"available: {', '.join(available())}")
     return functions
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from lab import fastmath as fm
-from renderer import pointwise
+from renderer import backends, pointwise
 from renderer.ucurve import DEFAULT_STEPS, SEED_FREQUENCIES, SEED_POINT
 from tests.jsnode import in_ci
 
@@ -174,14 +174,14 @@ def test_bad_input_names_the_parameter(call, match):
 def test_a_missing_drjit_is_refused_by_name(monkeypatch):
     monkeypatch.setattr(fm, "_functions", lambda name: None if name == "drjit" else {})
     assert "drjit" not in fm.available()
-    with pytest.raises(ValueError, match="drjit"):
+    with pytest.raises(ValueError, match=r"^backend 'drjit' is not available on this machine \(\S.*\); available"):
         fm.backend("drjit")
 
 
 @pytest.fixture
 def drjit_backend():
     if "drjit" not in fm.available():
-        message = "Dr.Jit's LLVM backend is not available (no system libLLVM)"
+        message = backends.missing("drjit") or "Dr.Jit's LLVM backend is not available"
         if in_ci():
             pytest.fail(message + " (CI=true: this test may not skip)")
         pytest.skip(message)
