@@ -27,6 +27,18 @@ def in_ci():
     return os.environ.get("CI", "").lower() == "true"
 
 
+#: node's V8 runs no background tasks.  Without this, node 20 deadlocked now and then on exit
+#: (about one run in 80 with another process busy): the main thread, draining V8's tasks,
+#: waited for a background compile that itself waited for a garbage collection only the main
+#: thread runs.
+NODE_FLAGS = ("--single-threaded",)
+
+
+def node_command(why):
+    """[node, *NODE_FLAGS], to which a test appends its script and arguments (`require_tool`)."""
+    return [require_tool("node", why), *NODE_FLAGS]
+
+
 def require_tool(path_or_name, why):
     """Return the tool's path; skip (locally) or fail (CI=true) if it is missing."""
     found = shutil.which(path_or_name) or (Path(path_or_name).exists() and str(path_or_name))
@@ -70,13 +82,13 @@ def run_render_cases(module_dir, cases, out_dir):
 
     Returns {id: ms} and leaves the frames in ``out_dir`` (read them with `read_frame`).
     """
-    node = require_tool("node", "the JS parity tests run the renderer core under node")
+    node = node_command("the JS parity tests run the renderer core under node")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     payload = [dict(c, scene=scene_json(c["scene"])) for c in cases]
     cases_path = out_dir / "cases.json"
     cases_path.write_text(json.dumps(payload), encoding="utf-8")
-    proc = subprocess.run([node, str(DRIVERS / "parity_driver.mjs"), str(module_dir), str(cases_path),
+    proc = subprocess.run([*node, str(DRIVERS / "parity_driver.mjs"), str(module_dir), str(cases_path),
                            str(out_dir)], capture_output=True, text=True, timeout=600)
     if proc.returncode != 0:
         raise RuntimeError(f"node parity driver failed:\n{proc.stderr}")

@@ -52,7 +52,7 @@ from renderer import generated as G
 from renderer import generated_array as GA
 
 from . import scalar_reference
-from .jsnode import require_tool
+from .jsnode import node_command
 from .test_parity import require_backend
 
 #: Unit roundoff of float64.
@@ -578,7 +578,7 @@ process.stdout.write(JSON.stringify(out));
 
 def run_js(source, points, tmp_path):
     """Outputs of the JavaScript ``source``'s functions at ``points``, run by node."""
-    node = require_tool("node", "runs the generated JavaScript formulas")
+    node = node_command("runs the generated JavaScript formulas")
     (tmp_path / "formulas.mjs").write_text(source, encoding="utf-8")
     (tmp_path / "driver.mjs").write_text(_NODE_DRIVER, encoding="utf-8")
     jobs = {}
@@ -586,7 +586,7 @@ def run_js(source, points, tmp_path):
         outputs = F.FUNCTIONS[name][1]
         k = len(outputs[field] if field else outputs)
         jobs[f"{name}/{field}"] = dict(name=name, field=field, outputs=k, points=[list(map(float, p)) for p in pts])
-    result = subprocess.run([node, str(tmp_path / "driver.mjs"), (tmp_path / "formulas.mjs").as_uri()],
+    result = subprocess.run([*node, str(tmp_path / "driver.mjs"), (tmp_path / "formulas.mjs").as_uri()],
                             input=json.dumps(jobs), capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]
     got = json.loads(result.stdout)

@@ -36,7 +36,7 @@ import pytest
 
 from renderer import jsgen
 
-from .jsnode import DRIVERS, read_frame, require_tool, scene_json, write_modules
+from .jsnode import DRIVERS, node_command, read_frame, scene_json, write_modules
 
 WIDTH, HEIGHT = 48, 40                      # non-square: a transposed image shows
 SIM = jsgen.SIMULATOR_SCENE
@@ -81,12 +81,12 @@ ARRAYS = ("image", "grad", "chamber", "kink", "uv")
 def run(module_dir, out_dir, steps=STEPS, strides=(1,)):
     """Run the driver, the U-curve at each of ``strides`` per step; {id: its JSON line}.
     Raises RuntimeError if node fails."""
-    node = require_tool("node", "the re-shade test runs the simulator's renderer under node")
+    node = node_command("the re-shade test runs the simulator's renderer under node")
     out_dir.mkdir(parents=True, exist_ok=True)
     spec = dict(width=WIDTH, height=HEIGHT, curve=CURVE, strides=list(strides),
                 steps=[dict(id=i, scene=scene_json(s), zoom=z, numeric=n) for i, s, z, n, _, _ in steps])
     (out_dir / "spec.json").write_text(json.dumps(spec), encoding="utf-8")
-    proc = subprocess.run([node, str(DRIVERS / "reshade_driver.mjs"), str(module_dir), str(out_dir / "spec.json"),
+    proc = subprocess.run([*node, str(DRIVERS / "reshade_driver.mjs"), str(module_dir), str(out_dir / "spec.json"),
                            str(out_dir)], capture_output=True, text=True, timeout=600)
     if proc.returncode != 0:
         raise RuntimeError(f"node re-shade driver failed:\n{proc.stderr}")
@@ -166,7 +166,7 @@ def test_reshaded_frames_are_full_renders_bit_for_bit(modules, tmp_path):
 def test_the_sampled_curve_is_the_ledger_of_its_pixels(modules, tmp_path):
     """The U-curve's sample (every SAMPLE_STRIDE-th column and row) against the ledger of those
     pixels computed here from a full central render at each step."""
-    node = require_tool("node", "the re-shade test runs the simulator's renderer under node")
+    node = node_command("the re-shade test runs the simulator's renderer under node")
     step_id, scene = "sample", SIM.replace(height_field="sine")
     spec = []
     for eps in CURVE:
@@ -175,7 +175,7 @@ def test_the_sampled_curve_is_the_ledger_of_its_pixels(modules, tmp_path):
     spec.append(dict(id=f"{step_id}.exact", scene=scene_json(scene), width=WIDTH, height=HEIGHT, gradient="exact",
                      zoom=1.0))
     (tmp_path / "cases.json").write_text(json.dumps(spec), encoding="utf-8")
-    subprocess.run([node, str(DRIVERS / "parity_driver.mjs"), str(modules), str(tmp_path / "cases.json"),
+    subprocess.run([*node, str(DRIVERS / "parity_driver.mjs"), str(modules), str(tmp_path / "cases.json"),
                     str(tmp_path)], check=True, capture_output=True, timeout=600)
     records = run(modules, tmp_path / "seq", [(step_id, scene, 1.0, "central", True, ["symbolic", "numeric"])],
                   strides=(1, SAMPLE_STRIDE))
@@ -193,7 +193,7 @@ def test_the_sampled_curve_is_the_ledger_of_its_pixels(modules, tmp_path):
 
 def test_a_geometry_field_cannot_be_reshaded(modules, tmp_path):
     """shade_a refuses a scene whose geometry is not the G-buffer's, naming the field."""
-    node = require_tool("node", "the re-shade test runs the simulator's renderer under node")
+    node = node_command("the re-shade test runs the simulator's renderer under node")
     script = tmp_path / "refuse.mjs"
     script.write_text(
         f'import {{ gbuffer, shade_a, PairRenderer }} from "{(modules / "render.js").as_uri()}";\n'
@@ -206,7 +206,7 @@ def test_a_geometry_field_cannot_be_reshaded(modules, tmp_path):
         "  try { f(); out.push('accepted'); } catch (e) { out.push(`${e.name}: ${e.message}`); }\n"
         "}\n"
         "console.log(JSON.stringify(out));\n", encoding="utf-8")
-    proc = subprocess.run([node, str(script)], capture_output=True, text=True, timeout=60, check=True)
+    proc = subprocess.run([*node, str(script)], capture_output=True, text=True, timeout=60, check=True)
     sphere_b, beta, exact = json.loads(proc.stdout)
     assert sphere_b.startswith("RangeError: scene.sphere_b is false, but the G-buffer was made with true")
     assert beta.startswith("RangeError: beta must be < radius_a = 1 when bump is \"surface\", got 1")

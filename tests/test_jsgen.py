@@ -16,13 +16,13 @@ import pytest
 from renderer import codegen, generated, jsgen, pointwise
 from renderer import formulas as F
 
-from .jsnode import require_tool
+from .jsnode import node_command
 
 ROOT = Path(__file__).parents[1]
 
 
 def _node():
-    return require_tool("node", "the generated JavaScript is run under node")
+    return node_command("the generated JavaScript is run under node")
 
 
 # ---- the generated modules -------------------------------------------------------------
@@ -101,7 +101,7 @@ def _js_values(tmp_path, calls):
         "  out[key] = typeof r === 'object' ? Array.from(r) : r;\n"
         "}\n"
         "console.log(JSON.stringify(out));\n", encoding="utf-8")
-    proc = subprocess.run([_node(), str(driver)], capture_output=True, text=True, timeout=60)
+    proc = subprocess.run([*_node(), str(driver)], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout)
 
@@ -180,7 +180,7 @@ def test_the_renderer_core_retypes_no_formula():
 
 def test_bundle_is_valid_javascript(tmp_path):
     path = jsgen.write_bundle(tmp_path / "simulator.js")
-    subprocess.run([_node(), "--check", str(path)], check=True, timeout=60)
+    subprocess.run([*_node(), "--check", str(path)], check=True, timeout=60)
     text = path.read_text()
     assert "import " not in text.replace("// ", "") and "\nexport " not in text
     assert "http://" not in text and "https://" not in text

@@ -149,10 +149,10 @@ def test_the_simulators_to_srgb_is_the_iec_curve(tmp_path):
     import json
     import subprocess
 
-    from tests.jsnode import require_tool, write_modules
-    node = require_tool("node", "the simulator's sRGB curve runs under node")
+    from tests.jsnode import node_command, write_modules
+    node = node_command("the simulator's sRGB curve runs under node")
     modules = write_modules(tmp_path)
     script = (f"import('{(modules / 'ledger.js').as_uri()}').then(m => "
               f"console.log(JSON.stringify({json.dumps(list(SRGB))}.map(m.to_srgb))))")
-    out = subprocess.run([node, "--input-type=module", "-e", script], capture_output=True, text=True, check=True)
+    out = subprocess.run([*node, "--input-type=module", "-e", script], capture_output=True, text=True, check=True)
     np.testing.assert_allclose(json.loads(out.stdout), list(SRGB.values()), rtol=0, atol=1e-6)
