@@ -220,6 +220,24 @@ def test_a_signal_stops_the_build_at_once_with_one_line_and_nothing_left(tmp_pat
     shows(book, "v1")
 
 
+def test_the_pools_processes_leave_a_ctrl_c_to_the_build_and_die_with_it(tmp_path, token):
+    """A terminal's Ctrl-C goes to the build's process group.  The pool's processes are each a
+    process group of their own, so that only the build's process sees it (nbclient in a pool
+    process would shut its kernel down, racing the build's freeze, and the kernel could log a
+    traceback on stderr).  Out of the group, they still die with the build's process: here it
+    alone is killed with SIGKILL."""
+    book = make_book(tmp_path / "book")
+    build = Build(book, token, hold="execute:a")
+    held(book, build)
+    me = psutil.Process(build.proc.pid)
+    pool = [p for p in me.children() if p.cmdline() == me.cmdline()]      # forked from the build's process
+    assert pool and all(os.getpgid(p.pid) == p.pid != os.getpgid(me.pid) for p in pool)
+    os.kill(me.pid, signal.SIGKILL)
+    build.wait()
+    _, alive = psutil.wait_procs(pool, timeout=10)
+    assert alive == []
+
+
 # ------------------------------------------------------------------ SIGKILL, then a build
 
 

@@ -34,8 +34,12 @@ alone, and executes the pages it has to one after another.  This extension:
 4. Stops on SIGINT (Ctrl-C) or SIGTERM.  The build's process freezes every process it
    started (the pool's, their kernels, a kernel myst-nb runs), so that none starts another,
    kills them, removes their kernels' connection files, prints one line and exits with
-   128 + the signal's number; the pool's processes leave the signal to it, and one the pool
-   forks meanwhile (to replace one it lost) ends at once.  It leaves what
+   128 + the signal's number.  The pool's processes are each a process group of their own,
+   so that a terminal's Ctrl-C reaches the build's process only (nbclient in a pool process
+   would otherwise shut its kernel down at once, and the kernel log its broken reply on
+   stderr before the build freezes it); they die with the build's process (Linux's
+   ``PR_SET_PDEATHSIG``), as they would with its process group, and one the pool forks
+   meanwhile (to replace one it lost) ends at once.  It leaves what
    a killed build leaves, which 2. does not trust.  ``make book`` runs this file
    (jupyter-book's command line) so that this holds from the first instant of the build,
    not only once Sphinx has loaded its extensions.  A signal the build was started with
@@ -183,7 +187,7 @@ def _stop(signum, frame):
         signal.signal(other, signal.SIG_IGN)
     import psutil
     _build["stopping"] = True                 # a process forked from now on (the pool replacing
-    me, frozen = psutil.Process(), {}         # one it lost) ends at once: `_stillborn`
+    me, frozen = psutil.Process(), {}         # one it lost) ends at once: `_forked`
     while new := [p for p in me.children(recursive=True) if p.pid not in frozen]:
         for p in new:
             frozen[p.pid] = p
@@ -206,15 +210,27 @@ def _stop(signum, frame):
     os._exit(128 + signum)
 
 
-def _stillborn():
+def _forked():
+    """In a process forked from the build's (the pool's): ends at once if the build is
+    stopping; else leaves the build's process group and dies when the build's process does.
+    A process its children fork is left alone."""
+    if os.getppid() != _build.get("pid"):
+        return
     if _build.get("stopping"):
         os._exit(128 + signal.SIGKILL)
+    os.setpgid(0, 0)
+    if sys.platform.startswith("linux"):
+        import ctypes
+        PR_SET_PDEATHSIG = 1
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != _build.get("pid"):          # the build ended before prctl took effect
+            os._exit(128 + signal.SIGKILL)
 
 
 def _handle_signals():
     """`_stop` on SIGINT and SIGTERM in this process, the build's (a signal it ignores stays ignored)."""
     if "pid" not in _build:
-        os.register_at_fork(after_in_child=_stillborn)
+        os.register_at_fork(after_in_child=_forked)
     _build["pid"] = os.getpid()
     for signum in (signal.SIGINT, signal.SIGTERM):
         if signal.getsignal(signum) is not signal.SIG_IGN:
