@@ -33,14 +33,9 @@ POINTS = 2**20
 
 def timers(name, args):
     """{function: a callable running it once on ``args[function]``, synchronised} for backend ``name``."""
-    if name == "numba":
-        loops = {"sin": fm._numba_sin, "cos": fm._numba_cos, "atan2": fm._numba_atan2, "acos": fm._numba_acos,
-                 "pow": fm._numba_pow}
-        out = np.empty(POINTS)
-        return {f: (lambda f=f: loops[f](*args[f], out)) for f in fm.FUNCTIONS}
-    if name == "numpy":
-        out = np.empty(POINTS)
-        return {f: (lambda f=f: fm._numpy()[f](*args[f], out=out)) for f in fm.FUNCTIONS}
+    if name in ("numba", "numpy"):                  # ufuncs both
+        ufuncs, out = (fm._numba if name == "numba" else fm._numpy)(), np.empty(POINTS)
+        return {f: (lambda f=f: ufuncs[f](*args[f], out=out)) for f in fm.FUNCTIONS}
     if name == "drjit":
         import drjit as dr
         from renderer.backends import drjit_llvm

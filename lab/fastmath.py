@@ -3,7 +3,7 @@ and the U-curve's roundoff floor with each backend's sine.
 
 Four backends evaluate the kernel's transcendental functions on float64 arrays
 (`BACKENDS`): ``numba``, the scalar libm the compiled kernel calls (one call per
-element, through small `numba.njit` loops compiled as the kernel is);
+element, through `numba.vectorize` ufuncs compiled as the kernel is);
 ``numpy``, numpy's ufuncs (which dispatch to SIMD code where the CPU has it);
 ``drjit``, Dr.Jit's LLVM backend on ``Float64`` arrays (only where
 `renderer.backends.drjit_llvm` finds the system's LLVM); ``jax``, jax.numpy in
@@ -34,7 +34,7 @@ from functools import lru_cache
 import mpmath
 import numpy as np
 import sympy as sp
-from numba import njit
+from numba import vectorize
 
 from renderer import formulas as F
 from renderer.scene import MAX_FREQUENCY, MAX_SHININESS, MIN_SHININESS
@@ -61,45 +61,34 @@ MIN_POWER_LOG2 = -1021.0
 
 
 # ----------------------------------------------------------------- backends
-@njit(cache=True, error_model="numpy")
-def _numba_sin(x, out):
-    for i in range(x.shape[0]):
-        out[i] = math.sin(x[i])
+# libm through numba: ufuncs whose loops call math.sin etc. once per value, as the kernel does.
+@vectorize(["float64(float64)"], cache=True)
+def _numba_sin(x):
+    return math.sin(x)
 
 
-@njit(cache=True, error_model="numpy")
-def _numba_cos(x, out):
-    for i in range(x.shape[0]):
-        out[i] = math.cos(x[i])
+@vectorize(["float64(float64)"], cache=True)
+def _numba_cos(x):
+    return math.cos(x)
 
 
-@njit(cache=True, error_model="numpy")
-def _numba_atan2(y, x, out):
-    for i in range(x.shape[0]):
-        out[i] = math.atan2(y[i], x[i])
+@vectorize(["float64(float64, float64)"], cache=True)
+def _numba_atan2(y, x):
+    return math.atan2(y, x)
 
 
-@njit(cache=True, error_model="numpy")
-def _numba_acos(x, out):
-    for i in range(x.shape[0]):
-        out[i] = math.acos(x[i])
+@vectorize(["float64(float64)"], cache=True)
+def _numba_acos(x):
+    return math.acos(x)
 
 
-@njit(cache=True, error_model="numpy")
-def _numba_pow(base, e, out):
-    for i in range(base.shape[0]):
-        out[i] = base[i] ** e[i]
+@vectorize(["float64(float64, float64)"], cache=True)
+def _numba_pow(base, e):
+    return base ** e
 
 
 def _numba():
-    def call(loop):
-        def run(*args):
-            out = np.empty_like(args[0])
-            loop(*args, out)
-            return out
-        return run
-    return {"sin": call(_numba_sin), "cos": call(_numba_cos), "atan2": call(_numba_atan2),
-            "acos": call(_numba_acos), "pow": call(_numba_pow)}
+    return {"sin": _numba_sin, "cos": _numba_cos, "atan2": _numba_atan2, "acos": _numba_acos, "pow": _numba_pow}
 
 
 def _numpy():

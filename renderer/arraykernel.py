@@ -112,11 +112,16 @@ def unit_vector(xp, wx, wy, wz, w2):
     return wx * inv, wy * inv, wz * inv
 
 
+def _light_offset(L, c, r):
+    """(d, k): the light L less the sphere's centre c, and |d|^2 - r^2 (k < 0: L inside)."""
+    d = (L[0] - c[0], L[1] - c[1], L[2] - c[2])
+    return d, d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - r * r
+
+
 def light_case(L, c, r):
-    """Where the light L is against the sphere (c, r): -1 inside, 0 on it, 1 outside
-    (Python floats; the sign of `segment_blocked`'s k, computed as it computes k)."""
-    dx, dy, dz = L[0] - c[0], L[1] - c[1], L[2] - c[2]
-    k = dx * dx + dy * dy + dz * dz - r * r
+    """Where the light L is against the sphere (c, r), Python floats: -1 inside, 0 on it,
+    1 outside (the sign of `segment_blocked`'s k)."""
+    k = _light_offset(L, c, r)[1]
     return (k > 0.0) - (k < 0.0)
 
 
@@ -125,8 +130,7 @@ def segment_blocked(xp, wx, wy, wz, w2, case, L, c, r):
     the render; the case of the light (`light_case`) is a Python branch."""
     if case < 0:
         return True
-    dx, dy, dz = L[0] - c[0], L[1] - c[1], L[2] - c[2]
-    k = dx * dx + dy * dy + dz * dz - r * r
+    (dx, dy, dz), k = _light_offset(L, c, r)
     g = wx * dx + wy * dy + wz * dz
     if case == 0:
         return (g > 0.0) & (2.0 * g < w2)
