@@ -27,6 +27,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from . import fieldcode
 from . import generated_array as G
 from .kernel import FLOOR_DARK, FLOOR_LIGHT, NORMAL_MIN, SUBNORMAL_MIN, TINY
 
@@ -198,16 +199,16 @@ def light_term(xp, s, v, color, mu, axis, wv, Ns, albedo):
     return tuple(color[c] * (diffuse * albedo[c] + spec) for c in range(3))
 
 
-def gradient(xp, s, q, method, u, v, x, y, P, N, frame, sin_phi):
-    """(h_u, h_v) on sphere A by ``method`` ("exact", "central", "footprint"); ``q`` the
-    render's values (`scene_values`)."""
-    field = G.FIELD_CODES[s.height_field]
+def gradient(xp, code, q, method, u, v, x, y, P, N, frame, sin_phi):
+    """(h, h_u, h_v, crease flag) on sphere A of the field whose array functions are ``code``
+    (`renderer.fieldcode.array_code`) by ``method`` ("exact", "central", "footprint"); ``q``
+    the render's values (`scene_values`)."""
     if method == "exact":
-        return G.exact_gradient(xp, field, u, v, q.k_u, q.k_v)
+        return code.exact(xp, u, v, q.k_u, q.k_v)
     eu = ev = q.eps
     if method == "footprint":
         eu, ev = G.footprint(xp, x, y, q.dx, q.dy, q.camera_z, *P, *N, *frame, q.radius_a, sin_phi)
-    return G.central_gradient(xp, field, u, v, q.k_u, q.k_v, eu, ev)
+    return code.central(xp, u, v, q.k_u, q.k_v, eu, ev)
 
 
 #: The numbers of a scene the program computes with (a tuple attribute: its components),
@@ -305,15 +306,15 @@ def program(xp, s, flat, xs, ys, sin_xs, sin_ys, *, method, kink, grad):
     P, N, albedo, N_a = surface(xp, q, x, y, t, on_a, on_b, sin_x * sin_y)
 
     # Sphere A: chart, frame, gradient, shading normal (the generated formulas).
-    field = G.FIELD_CODES[s.height_field]
+    code = fieldcode.array_code(s.field)
     u, v, sin_phi = G.chart(xp, *N_a)
     sin_phi = xp.maximum(sin_phi, SUBNORMAL_MIN)
     frame = G.tangent_frame(xp, *N_a, sin_phi)
-    hu = hv = 0.0
+    h = hu = hv = 0.0
+    flag = None
     if grad or s.beta != 0.0:           # beta = 0: the gradient moves nothing
-        hu, hv = gradient(xp, s, q, method, u, v, x, y, P, N_a, frame, sin_phi)
+        h, hu, hv, flag = gradient(xp, code, q, method, u, v, x, y, P, N_a, frame, sin_phi)
     if s.bump == "surface":
-        h = G.height(xp, field, u, v, q.k_u, q.k_v)
         Ns_a = G.perturbed_normal_surface(xp, *N_a, *frame, hu, hv, q.beta, h, q.radius_a, sin_phi)
     else:
         Ns_a = G.perturbed_normal_chart(xp, *N_a, *frame, hu, hv, q.beta)
@@ -337,7 +338,7 @@ def program(xp, s, flat, xs, ys, sin_xs, sin_ys, *, method, kink, grad):
         chamber = chamber if mask is None else xp.select(mask, code, chamber)
     out = {"image": rgb, "chamber": [chamber]}
     if kink:
-        out["kink"] = [on_a & G.kink_band(xp, field, u, v, q.k_u, q.k_v)]
+        out["kink"] = [on_a & (code.kink(xp, u, v, q.k_u, q.k_v) if flag is None else flag)]
     if grad:
         out["grad"] = [xp.select(on_a, hu, 0.0), xp.select(on_a, hv, 0.0)]
     return out

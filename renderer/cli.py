@@ -649,7 +649,7 @@ def build_parser():
     """The argparse parser of ``symrender`` (one subparser per command)."""
     from renderer.pointwise import MIN_STEP
     from renderer.render import MAX_SIDE
-    from renderer.scene import HEIGHT_FIELDS, MAX_EPS, MAX_FREQUENCY, MIN_EPS
+    from renderer.scene import MAX_EPS, MAX_FREQUENCY, MIN_EPS
     from renderer.sweep import MAX_STEPS
     limits = (f"Limits: each side 1..{MAX_SIDE}; render at most {MAX_PIXELS:,} pixels (4096^2); "
               f"sweep at most (steps + 1) * W * H <= {FRAME_PIXEL_BUDGET:,}; refused before allocating.")
@@ -700,7 +700,7 @@ def build_parser():
     u = sub.add_parser("ucurve", help="the measured finite-difference U-curve at one chart point",
                        description="Central-difference error against a 50-digit mpmath reference, split "
                                    "into truncation and roundoff, per step (renderer/ucurve.py).")
-    u.add_argument("--field", choices=HEIGHT_FIELDS, default="sine")
+    u.add_argument("--field", default="sine", help="a height field's name or an expression in u, v, k_u, k_v")
     u.add_argument("--u", type=_float_arg, default=0.31, help="chart u in [0, 1] (default 0.31)")
     u.add_argument("--v", type=_float_arg, default=0.47, help="chart v in [0, 1] (default 0.47)")
     u.add_argument("--component", choices=("u", "v"), default="u", help="h_u or h_v (default u)")

@@ -5,16 +5,20 @@ gradients, stencil, crease band, chart, frame, perturbed normals, footprint);
 the ray-sphere hit, the shadow test and the shading are written by hand in
 renderer/kernel.py and renderer/js/render.js, held together by tests.  Nothing
 imports it at render time: `renderer.codegen` prints each entry of
-`FUNCTIONS` as a scalar Python function that numba compiles
-(renderer/generated.py, which the kernel calls) and as a JavaScript function
-of the §4 simulator (``formulas.js``, generated when the simulator is
-bundled); tests/test_codegen.py regenerates both and compares.
+`FUNCTIONS`, and of `FIELD_FUNCTIONS` for each height field, as scalar Python
+functions that numba compiles (renderer/generated.py for the fields defined here,
+`renderer.fieldcode` for the others), as branch-free array functions and as the
+JavaScript of the §4 simulator; tests/test_codegen.py regenerates them and compares.
 proofs/ proves its theorems about these same objects.
 
 What lives here (seed §2, §3 and Cell 1, with the project's corrections):
 
-* the three height fields h(u, v) and their exact gradients (sympy's
-  derivatives), and the ridges' crease band;
+* the height fields, one `HeightField` record each in `FIELDS` (sine, ridges
+  and rings of seed §2, and any field registered later): the expression, and
+  derived from it the exact gradient, the central difference, the creases and
+  the seed's crease band about them; `field` also makes a record of a reader's
+  own expression in u, v, k_u, k_v;
+* a reader's function of one variable (`Univariate`), for U-curves at any point;
 * the chart (u, v) of a unit normal N of sphere A, and sin(phi);
 * the tangent frame (e_theta, e_phi) with its pole fallback;
 * the perturbed normal of both bump modes ("chart": the seed's formula;
@@ -26,44 +30,219 @@ What lives here (seed §2, §3 and Cell 1, with the project's corrections):
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import cached_property
+
 import sympy as sp
 
 __all__ = [
-    "u", "v", "k_u", "k_v", "HEIGHT", "GRADIENT", "RIDGE_FACTORS", "KINK_BAND",
-    "KINK_BAND_HALF_WIDTH", "N_x", "N_y", "N_z", "sin_phi", "CHART", "POLE_SIN_PHI",
+    "u", "v", "k_u", "k_v", "FIELD_SYMBOLS", "ELEMENTARY", "KINK_BAND_HALF_WIDTH", "SEED_POINT", "HeightField",
+    "FIELDS", "BUILTIN", "register", "field", "Univariate", "univariate", "x_var", "step",
+    "N_x", "N_y", "N_z", "sin_phi", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
-    "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL", "FOOTPRINT",
-    "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FUNCTIONS", "FIELD_CODES",
+    "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
+    "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FUNCTIONS", "FIELD_FUNCTIONS",
+    "UNIVARIATE_FUNCTIONS",
 ]
 
 # ---------------------------------------------------------------- height fields
 #: Chart coordinates and frequencies.  Real, so that d|f|/du = sign(f) f'.
 u, v, k_u, k_v = sp.symbols("u v k_u k_v", real=True)
-
-#: The ridges' two factors; their zero lines u = m/k_u, v = m/k_v are its creases.
-RIDGE_FACTORS = (sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v))
-
-#: The three height fields of seed §2.
-HEIGHT = {
-    "sine": RIDGE_FACTORS[0] * RIDGE_FACTORS[1],
-    "ridges": sp.Abs(RIDGE_FACTORS[0] * RIDGE_FACTORS[1]),
-    "rings": sp.sin(2 * sp.pi * k_v * v),
-}
-#: The kernel's integer code of each field (its order in `HEIGHT`).
-FIELD_CODES = {name: i for i, name in enumerate(HEIGHT)}
-
-#: (h_u, h_v) of each field: sympy's derivatives of `HEIGHT`.  For ridges
-#: sign(f) f', which on the creases is one of the one-sided derivatives (or 0
-#: where the float64 factor is exactly 0).
-GRADIENT = {name: (sp.diff(f, u), sp.diff(f, v)) for name, f in HEIGHT.items()}
-
+#: The symbols a height field may use.
+FIELD_SYMBOLS = (u, v, k_u, k_v)
+#: The functions a height field (or a function of one variable) may be built from: the ones
+#: every printer of `renderer.codegen` (numba, array namespaces, JavaScript) has.  Powers and
+#: roots are ``Pow``; ``sign`` arises only in derivatives of ``Abs``.
+ELEMENTARY = (sp.sin, sp.cos, sp.tan, sp.asin, sp.acos, sp.atan, sp.sinh, sp.cosh, sp.tanh,
+              sp.exp, sp.log, sp.Abs)
 #: Half-width of the seed's crease band (seed Cell 1, ``height1``).
 KINK_BAND_HALF_WIDTH = sp.Float(0.03)
-#: The crease flag: within the band around a zero line of either factor.
-#: Only ridges has creases; the other fields' flag is false.
-KINK_BAND = {name: (sp.Or(sp.Abs(RIDGE_FACTORS[0]) < KINK_BAND_HALF_WIDTH,
-                          sp.Abs(RIDGE_FACTORS[1]) < KINK_BAND_HALF_WIDTH)
-                    if name == "ridges" else sp.false) for name in HEIGHT}
+#: The seed's chart point (u, v) of Cell 2's U-curve, where a field's optimal step is measured.
+SEED_POINT = (0.31, 0.47)
+
+# ------------------------------------------------------ central-difference stencil
+eps_u, eps_v = sp.symbols("eps_u eps_v", positive=True)
+u_p, u_m, v_p, v_m = sp.symbols("u_p u_m v_p v_m", real=True)
+#: The stencil's sample points for u, v in [0, 1] and steps in (0, 1): u wraps
+#: (one exact subtraction or addition: the chart is periodic in u), v clamps
+#: to [0, 1] (seed Cell 1, ``grad_numeric``).
+STENCIL_POINTS = (
+    (u_p, sp.Piecewise((u + eps_u - 1, u + eps_u >= 1), (u + eps_u, True))),
+    (u_m, sp.Piecewise((u - eps_u + 1, u - eps_u < 0), (u - eps_u, True))),
+    (v_p, sp.Min(1, v + eps_v)),
+    (v_m, sp.Max(0, v - eps_v)),
+)
+#: The central quotients' denominators (u, v): where v clamps the quotient is one-sided,
+#: divided by the clamped distance.
+CENTRAL_DENOMINATORS = (2 * eps_u, sp.Piecewise((v_p - v_m, sp.Or(v + eps_v > 1, v - eps_v < 0)), (2 * eps_v, True)))
+
+
+def _check_expression(name, expr, symbols):
+    """``expr`` if it is a real sympy expression in ``symbols`` built from `ELEMENTARY`, else ValueError."""
+    if not isinstance(expr, sp.Expr):
+        raise TypeError(f"{name} must be a sympy expression, got {type(expr).__name__}")
+    extra = expr.free_symbols - set(symbols)
+    if extra:
+        raise ValueError(f"{name} may use only {', '.join(map(str, symbols))}; it uses "
+                         f"{', '.join(sorted(map(str, extra)))}")
+    unknown = {type(f).__name__ for f in expr.atoms(sp.Function) if not isinstance(f, ELEMENTARY)}
+    if unknown:
+        raise ValueError(f"{name} may call only {', '.join(f.__name__ for f in ELEMENTARY)}; it calls "
+                         f"{', '.join(sorted(unknown))}")
+    if expr.has(sp.I, sp.zoo, sp.oo, sp.nan) or any(not a.is_real for a in expr.atoms(sp.Number)):
+        raise ValueError(f"{name} must be real: it holds {expr.atoms(sp.Number, sp.NumberSymbol) - {sp.pi, sp.E}}"
+                         f" or an imaginary unit or infinity")
+    return expr
+
+
+@dataclass(frozen=True, eq=False)
+class HeightField:
+    """One height field h(u, v; k_u, k_v) of sphere A's chart (seed §2): the one record a field is.
+
+    Everything other layers need of a field is its expression or derived from it here:
+    the exact gradient (sympy's derivative), the central difference at the kernel's stencil,
+    its creases (the zero lines of the factors under an ``Abs``) and the seed's crease band
+    about them, whether the complex step applies, where its optimal step is measured.
+    `renderer.codegen` prints the kernel's, the array backends' and the simulator's code
+    from these objects; `FIELDS` holds the registered fields by name.
+
+    Parameters
+    ----------
+    name : str
+        How scenes, the command line and the book name it (a registered field's name is a
+        Python identifier; a reader's expression is named by its printed form).
+    expr : sympy expression
+        h in `u`, `v` and optionally `k_u`, `k_v`, built from `ELEMENTARY` functions,
+        real and finite on the chart [0, 1]^2.
+    optimum : (u, v, component) or None
+        Where its U-curve and optimal step are measured; None for `SEED_POINT` and the
+        first component whose derivative is not identically 0.
+
+    Raises
+    ------
+    TypeError, ValueError
+        A name that is not a non-empty string, or an expression outside the above.
+    """
+
+    name: str
+    expr: sp.Expr
+    optimum: tuple | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise TypeError(f"a height field's name must be a non-empty string, got {self.name!r}")
+        _check_expression(f"height field {self.name!r}", self.expr, FIELD_SYMBOLS)
+
+    @cached_property
+    def gradient(self):
+        """(h_u, h_v): sympy's derivatives.  Where h = |f|, sign(f) f', which on a crease
+        is one of the one-sided derivatives (or 0 where the float64 factor is exactly 0)."""
+        return tuple(sp.diff(self.expr, x) for x in (u, v))
+
+    @cached_property
+    def crease_factors(self):
+        """The factors under each ``Abs`` that vary on the chart: h has a crease (its slope
+        jumps) where one of them changes sign.  () for a field without creases."""
+        out = []
+        for a in sorted(self.expr.atoms(sp.Abs), key=sp.default_sort_key):
+            out.extend(f for f in sp.Mul.make_args(a.args[0]) if f.free_symbols & {u, v} and f not in out)
+        return tuple(out)
+
+    @cached_property
+    def kink_band(self):
+        """The crease flag: within `KINK_BAND_HALF_WIDTH` of a zero of a crease factor
+        (seed Cell 1's band); false for a field without creases."""
+        return sp.Or(*(sp.Abs(f) < KINK_BAND_HALF_WIDTH for f in self.crease_factors))
+
+    @cached_property
+    def central(self):
+        """(h_u, h_v) by central differences at the stencil points `STENCIL_POINTS`."""
+        return tuple((self.expr.subs(x, plus) - self.expr.subs(x, minus)) / den
+                     for x, plus, minus, den in ((u, u_p, u_m, CENTRAL_DENOMINATORS[0]),
+                                                 (v, v_p, v_m, CENTRAL_DENOMINATORS[1])))
+
+    @cached_property
+    def analytic(self):
+        """Whether h is built from functions holomorphic in their argument (no ``Abs``), so
+        that its complex evaluation is the continuation the complex step needs."""
+        return not self.expr.has(sp.Abs)
+
+    @cached_property
+    def optimum_at(self):
+        """(u, v, component): `optimum`, or `SEED_POINT` and the first component whose
+        derivative is not identically 0 ("u" if both are)."""
+        if self.optimum is not None:
+            return tuple(self.optimum)
+        component = next((c for c, d in zip("uv", self.gradient) if d != 0), "u")
+        return (*SEED_POINT, component)
+
+
+#: The registered height fields by name, in the order menus and tables list them.  Every
+#: list of fields anywhere is derived from it.
+FIELDS = {}
+
+
+def register(field):
+    """Add ``field`` (a `HeightField` named by an identifier) to `FIELDS`, and return it.
+
+    Raises
+    ------
+    TypeError
+        ``field`` is not a HeightField.
+    ValueError
+        Its name is not an identifier, or names another registered field.
+    """
+    if not isinstance(field, HeightField):
+        raise TypeError(f"register takes a HeightField, got {type(field).__name__}")
+    if not field.name.isidentifier():
+        raise ValueError(f"a registered field's name must be an identifier, got {field.name!r}")
+    if field.name in FIELDS and FIELDS[field.name] is not field:
+        raise ValueError(f"a height field named {field.name!r} is registered already")
+    FIELDS[field.name] = field
+    return field
+
+
+_s1, _s2 = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
+register(HeightField("sine", _s1 * _s2))
+register(HeightField("ridges", sp.Abs(_s1 * _s2)))
+register(HeightField("rings", sp.sin(2 * sp.pi * k_v * v)))
+#: The fields defined here, which renderer/generated.py holds compiled; others (registered later,
+#: or a reader's expression) are printed and compiled when first used (`renderer.fieldcode`).
+BUILTIN = tuple(FIELDS)
+
+#: A reader's fields by their printed expression, so that a name finds the same record again.
+_EXPRESSIONS = {}
+
+
+def field(spec, name="height_field"):
+    """The `HeightField` ``spec`` names: a registered name, a `HeightField`, or a reader's
+    sympy expression (or its text, parsed by `renderer.validate.expression`) in u, v, k_u, k_v.
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming ``name``: not one of those, or an expression refused by `HeightField`.
+    """
+    from .validate import InvalidType, InvalidValue, expression
+    if isinstance(spec, HeightField):
+        known = FIELDS.get(spec.name, _EXPRESSIONS.get(spec.name))
+        if known is not None and known is not spec:
+            raise InvalidValue(f"{name}: another height field is named {spec.name!r}")
+        return spec if known is not None else _EXPRESSIONS.setdefault(spec.name, spec)
+    if isinstance(spec, str) and spec in FIELDS:
+        return FIELDS[spec]
+    if isinstance(spec, str) and spec in _EXPRESSIONS:
+        return _EXPRESSIONS[spec]
+    if not isinstance(spec, (str, sp.Expr)):
+        raise InvalidType(f"{name} must be one of {tuple(FIELDS)}, a HeightField or a sympy expression in "
+                          f"u, v, k_u, k_v, got {type(spec).__name__}")
+    expr = expression(name, spec, FIELD_SYMBOLS, fields=tuple(FIELDS)) if isinstance(spec, str) else spec
+    try:
+        record = HeightField(str(expr), expr)
+    except (TypeError, ValueError) as exc:
+        raise InvalidValue(f"{name}: {exc}") from None
+    return _EXPRESSIONS.setdefault(record.name, record)
+
 
 # ------------------------------------------------------------------------ chart
 #: Components of sphere A's unit normal N = P / R, and sin(phi) = |(N_x, N_y)|.
@@ -110,24 +289,6 @@ for _mode, (_bu, _bv) in BUMP.items():
     _norm = sp.sqrt(sum(m * m for m in _M))
     PERTURBED_NORMAL[_mode] = tuple(m / _norm for m in _M)
 
-# ------------------------------------------------------ central-difference stencil
-eps_u, eps_v = sp.symbols("eps_u eps_v", positive=True)
-u_p, u_m, v_p, v_m = sp.symbols("u_p u_m v_p v_m", real=True)
-#: The stencil's sample points for u, v in [0, 1] and steps in (0, 1): u wraps
-#: (one exact subtraction or addition: the chart is periodic in u), v clamps
-#: to [0, 1] (seed Cell 1, ``grad_numeric``).
-STENCIL_POINTS = (
-    (u_p, sp.Piecewise((u + eps_u - 1, u + eps_u >= 1), (u + eps_u, True))),
-    (u_m, sp.Piecewise((u - eps_u + 1, u - eps_u < 0), (u - eps_u, True))),
-    (v_p, sp.Min(1, v + eps_v)),
-    (v_m, sp.Max(0, v - eps_v)),
-)
-#: Where v clamps the quotient is one-sided, divided by the clamped distance.
-_den_v = sp.Piecewise((v_p - v_m, sp.Or(v + eps_v > 1, v - eps_v < 0)), (2 * eps_v, True))
-#: Central differences (h_u, h_v) of each field in terms of the stencil points.
-CENTRAL = {name: ((f.subs(u, u_p) - f.subs(u, u_m)) / (2 * eps_u),
-                  (f.subs(v, v_p) - f.subs(v, v_m)) / _den_v) for name, f in HEIGHT.items()}
-
 # ------------------------------------------------------------------- footprint
 x, y, dx, dy, camera_z = sp.symbols("x y dx dy camera_z", real=True)
 P = sp.symbols("P_x P_y P_z", real=True)
@@ -173,16 +334,10 @@ def _footprint():
 #: the row below, the same footprint to first order.
 FOOTPRINT = _footprint()
 
-#: What the generator prints: name -> (arguments, outputs).  A per-field entry
-#: maps each field to its outputs and becomes one function with the field's
-#: code (`FIELD_CODES`) as first argument.
+#: What the generator prints once: name -> (arguments, outputs), each a scalar function.
 _UV = (u, v, k_u, k_v)
 _N = (N_x, N_y, N_z)
 FUNCTIONS = {
-    "height": (_UV, {n: (f,) for n, f in HEIGHT.items()}),
-    "exact_gradient": (_UV, GRADIENT),
-    "central_gradient": (_UV + (eps_u, eps_v), CENTRAL),
-    "kink_band": (_UV, {n: (f,) for n, f in KINK_BAND.items()}),
     "chart": (_N, CHART),
     "tangent_frame": (_N + (sin_phi,), TANGENT_FRAME),
     "perturbed_normal_chart": (_N + e_theta + e_phi + (h_u, h_v, beta),
@@ -191,5 +346,96 @@ FUNCTIONS = {
                                  PERTURBED_NORMAL["surface"]),
     "footprint": ((x, y, dx, dy, camera_z) + P + _N + e_theta + e_phi + (R, sin_phi), FOOTPRINT),
 }
+#: What the generator prints per height field: name -> (arguments, outputs of a `HeightField`).
+#: ``exact`` and ``central`` return (h, h_u, h_v, crease flag) together, so that one call per
+#: pixel shares their sines (the kernel calls a field's functions through pointers).
+FIELD_FUNCTIONS = {
+    "height": (_UV, lambda f: (f.expr,)),
+    "exact": (_UV, lambda f: (f.expr, *f.gradient, f.kink_band)),
+    "central": (_UV + (eps_u, eps_v), lambda f: (f.expr, *f.central, f.kink_band)),
+    "kink": (_UV, lambda f: (f.kink_band,)),
+}
 #: Assignments printed before a function's outputs (the stencil's points).
-PRELUDE = {"central_gradient": STENCIL_POINTS}
+PRELUDE = {"central": STENCIL_POINTS}
+
+
+# ------------------------------------------------------- a function of one variable
+#: The variable of a reader's function of one variable, and the step.
+x_var, step = sp.Symbol("x", real=True), sp.Symbol("step", positive=True)
+x_p, x_m = sp.symbols("x_p x_m", real=True)
+
+
+@dataclass(frozen=True, eq=False)
+class Univariate:
+    """A reader's function f(x) of one real variable, for U-curves and the gradient methods
+    at any real point where it is defined (Squire and Trapp 1998's test function, say).
+
+    Parameters
+    ----------
+    name : str
+        Its printed form.
+    expr : sympy expression
+        f in `x_var` alone, built from `ELEMENTARY` functions, real.
+
+    Raises
+    ------
+    TypeError, ValueError
+        An expression outside the above.
+    """
+
+    name: str
+    expr: sp.Expr
+
+    def __post_init__(self):
+        _check_expression(f"function {self.name!r}", self.expr, (x_var,))
+
+    @cached_property
+    def derivative(self):
+        """f' (sympy's derivative)."""
+        return sp.diff(self.expr, x_var)
+
+    @cached_property
+    def analytic(self):
+        """As `HeightField.analytic`."""
+        return not self.expr.has(sp.Abs)
+
+
+#: What the generator prints for a `Univariate`: f, and its central and forward differences
+#: at the float64 abscissae x +- step.
+UNIVARIATE_FUNCTIONS = {
+    "value": ((x_var,), lambda f: (f.expr,)),
+    "central": ((x_var, step), lambda f: ((f.expr.subs(x_var, x_p) - f.expr.subs(x_var, x_m)) / (2 * step),)),
+    "forward": ((x_var, step), lambda f: ((f.expr.subs(x_var, x_p) - f.expr) / step,)),
+}
+UNIVARIATE_PRELUDE = {"central": ((x_p, x_var + step), (x_m, x_var - step)), "forward": ((x_p, x_var + step),)}
+
+
+def univariate(spec, name="function"):
+    """The `Univariate` ``spec`` is: one, a sympy expression of one symbol (renamed `x_var`), or
+    its text in ``x`` (parsed by `renderer.validate.expression`).
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming ``name``.
+    """
+    from .validate import InvalidType, InvalidValue, expression
+    if isinstance(spec, Univariate):
+        return spec
+    if isinstance(spec, str):
+        spec = expression(name, spec, (x_var,))
+    if not isinstance(spec, sp.Expr):
+        raise InvalidType(f"{name} must be a sympy expression of one variable or its text in x, "
+                          f"got {type(spec).__name__}")
+    free = spec.free_symbols
+    if len(free) != 1:
+        raise InvalidValue(f"{name} must depend on exactly one variable, got {len(free)}: {spec}")
+    expr = spec.xreplace({free.pop(): x_var})
+    try:
+        record = Univariate(str(expr), expr)
+    except (TypeError, ValueError) as exc:
+        raise InvalidValue(f"{name}: {exc}") from None
+    return _UNIVARIATES.setdefault(record.name, record)
+
+
+_UNIVARIATES = {}

@@ -7,120 +7,6 @@ import math
 
 from numba import njit
 
-FIELD_CODES = {'sine': 0, 'ridges': 1, 'rings': 2}
-
-
-@njit(cache=True, error_model="numpy")
-def height(field, u, v, k_u, k_v):
-    if field == 0:  # sine
-        return math.sin(math.pi*k_u*u)*math.sin(math.pi*k_v*v)
-    if field == 1:  # ridges
-        return abs(math.sin(math.pi*k_u*u)*math.sin(math.pi*k_v*v))
-    if field == 2:  # rings
-        return math.sin(2*math.pi*k_v*v)
-    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
-
-
-@njit(cache=True, error_model="numpy")
-def height_array(field, u, v, k_u, k_v, out):
-    """`height` at each index i of 1-D float64 arrays; out: (1, n) float64."""
-    if out.shape[0] != 1:
-        raise ValueError("out must have 1 rows")
-    for i in range(out.shape[1]):
-        out[0, i] = height(field, u[i], v[i], k_u[i], k_v[i])
-
-
-@njit(cache=True, error_model="numpy")
-def exact_gradient(field, u, v, k_u, k_v):
-    if field == 0:  # sine
-        x0 = math.pi*k_u
-        x1 = u*x0
-        x2 = math.pi*k_v
-        x3 = v*x2
-        return (x0*math.sin(x3)*math.cos(x1), x2*math.sin(x1)*math.cos(x3))
-    if field == 1:  # ridges
-        x0 = math.pi*k_v
-        x1 = v*x0
-        x2 = math.sin(x1)
-        x3 = math.pi*k_u
-        x4 = u*x3
-        x5 = math.sin(x4)
-        x6 = (0.0 if x2*x5 == 0 else math.copysign(1, x2*x5))
-        return (x2*x3*x6*math.cos(x4), x0*x5*x6*math.cos(x1))
-    if field == 2:  # rings
-        x0 = 2*math.pi*k_v
-        return (0.0, x0*math.cos(v*x0))
-    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
-
-
-@njit(cache=True, error_model="numpy")
-def exact_gradient_array(field, u, v, k_u, k_v, out):
-    """`exact_gradient` at each index i of 1-D float64 arrays; out: (2, n) float64."""
-    if out.shape[0] != 2:
-        raise ValueError("out must have 2 rows")
-    for i in range(out.shape[1]):
-        out[0, i], out[1, i] = exact_gradient(field, u[i], v[i], k_u[i], k_v[i])
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def central_gradient(field, u, v, k_u, k_v, eps_u, eps_v):
-    if field == 0:  # sine
-        u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
-        u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
-        v_p = min(1, eps_v + v)
-        v_m = max(0, -eps_v + v)
-        x0 = math.pi*k_u
-        x1 = math.pi*k_v
-        x2 = math.sin(v*x1)
-        x3 = math.sin(u*x0)
-        return ((1/2)*(-x2*math.sin(u_m*x0) + x2*math.sin(u_p*x0))/eps_u, (-x3*math.sin(v_m*x1) + x3*math.sin(v_p*x1))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
-    if field == 1:  # ridges
-        u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
-        u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
-        v_p = min(1, eps_v + v)
-        v_m = max(0, -eps_v + v)
-        x0 = math.pi*k_u
-        x1 = math.pi*k_v
-        x2 = math.sin(v*x1)
-        x3 = math.sin(u*x0)
-        return ((1/2)*(-abs(x2*math.sin(u_m*x0)) + abs(x2*math.sin(u_p*x0)))/eps_u, (-abs(x3*math.sin(v_m*x1)) + abs(x3*math.sin(v_p*x1)))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
-    if field == 2:  # rings
-        u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
-        u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
-        v_p = min(1, eps_v + v)
-        v_m = max(0, -eps_v + v)
-        x0 = 2*math.pi*k_v
-        return (0.0, (-math.sin(v_m*x0) + math.sin(v_p*x0))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)))
-    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
-
-
-@njit(cache=True, error_model="numpy")
-def central_gradient_array(field, u, v, k_u, k_v, eps_u, eps_v, out):
-    """`central_gradient` at each index i of 1-D float64 arrays; out: (2, n) float64."""
-    if out.shape[0] != 2:
-        raise ValueError("out must have 2 rows")
-    for i in range(out.shape[1]):
-        out[0, i], out[1, i] = central_gradient(field, u[i], v[i], k_u[i], k_v[i], eps_u[i], eps_v[i])
-
-
-@njit(cache=True, error_model="numpy")
-def kink_band(field, u, v, k_u, k_v):
-    if field == 0:  # sine
-        return False
-    if field == 1:  # ridges
-        return (abs(math.sin(math.pi*k_u*u)) < 0.03) or (abs(math.sin(math.pi*k_v*v)) < 0.03)
-    if field == 2:  # rings
-        return False
-    raise ValueError("field must be one of 0 (sine), 1 (ridges), 2 (rings)")
-
-
-@njit(cache=True, error_model="numpy")
-def kink_band_array(field, u, v, k_u, k_v, out):
-    """`kink_band` at each index i of 1-D float64 arrays; out: (1, n) float64."""
-    if out.shape[0] != 1:
-        raise ValueError("out must have 1 rows")
-    for i in range(out.shape[1]):
-        out[0, i] = kink_band(field, u[i], v[i], k_u[i], k_v[i])
 
 
 @njit(cache=True, error_model="numpy")
@@ -229,3 +115,102 @@ def footprint_array(x, y, dx, dy, camera_z, P_x, P_y, P_z, N_x, N_y, N_z, et_x, 
         raise ValueError("out must have 2 rows")
     for i in range(out.shape[1]):
         out[0, i], out[1, i] = footprint(x[i], y[i], dx[i], dy[i], camera_z[i], P_x[i], P_y[i], P_z[i], N_x[i], N_y[i], N_z[i], et_x[i], et_y[i], et_z[i], ep_x[i], ep_y[i], ep_z[i], R[i], sin_phi[i])
+
+
+# ---- the sine field
+
+def sine_height(u, v, k_u, k_v):
+    return math.sin(math.pi*k_u*u)*math.sin(math.pi*k_v*v)
+
+
+def sine_exact(u, v, k_u, k_v):
+    x0 = math.pi*k_u
+    x1 = u*x0
+    x2 = math.sin(x1)
+    x3 = math.pi*k_v
+    x4 = v*x3
+    x5 = math.sin(x4)
+    return (x2*x5, x0*x5*math.cos(x1), x2*x3*math.cos(x4), False)
+
+
+def sine_central(u, v, k_u, k_v, eps_u, eps_v):
+    u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
+    u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
+    v_p = min(1, eps_v + v)
+    v_m = max(0, -eps_v + v)
+    x0 = math.pi*k_u
+    x1 = math.sin(u*x0)
+    x2 = math.pi*k_v
+    x3 = math.sin(v*x2)
+    return (x1*x3, (1/2)*(-x3*math.sin(u_m*x0) + x3*math.sin(u_p*x0))/eps_u, (-x1*math.sin(v_m*x2) + x1*math.sin(v_p*x2))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), False)
+
+
+def sine_kink(u, v, k_u, k_v):
+    return False
+
+
+# ---- the ridges field
+
+def ridges_height(u, v, k_u, k_v):
+    return abs(math.sin(math.pi*k_u*u)*math.sin(math.pi*k_v*v))
+
+
+def ridges_exact(u, v, k_u, k_v):
+    x0 = math.pi*k_u
+    x1 = u*x0
+    x2 = math.sin(x1)
+    x3 = math.pi*k_v
+    x4 = v*x3
+    x5 = math.sin(x4)
+    x6 = x2*x5
+    x7 = (0.0 if x6 == 0 else math.copysign(1, x6))
+    return (abs(x6), x0*x5*x7*math.cos(x1), x2*x3*x7*math.cos(x4), (abs(x2) < 0.03) or (abs(x5) < 0.03))
+
+
+def ridges_central(u, v, k_u, k_v, eps_u, eps_v):
+    u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
+    u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
+    v_p = min(1, eps_v + v)
+    v_m = max(0, -eps_v + v)
+    x0 = math.pi*k_u
+    x1 = math.sin(u*x0)
+    x2 = math.pi*k_v
+    x3 = math.sin(v*x2)
+    return (abs(x1*x3), (1/2)*(-abs(x3*math.sin(u_m*x0)) + abs(x3*math.sin(u_p*x0)))/eps_u, (-abs(x1*math.sin(v_m*x2)) + abs(x1*math.sin(v_p*x2)))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), (abs(x1) < 0.03) or (abs(x3) < 0.03))
+
+
+def ridges_kink(u, v, k_u, k_v):
+    return (abs(math.sin(math.pi*k_u*u)) < 0.03) or (abs(math.sin(math.pi*k_v*v)) < 0.03)
+
+
+# ---- the rings field
+
+def rings_height(u, v, k_u, k_v):
+    return math.sin(2*math.pi*k_v*v)
+
+
+def rings_exact(u, v, k_u, k_v):
+    x0 = 2*math.pi*k_v
+    x1 = v*x0
+    return (math.sin(x1), 0.0, x0*math.cos(x1), False)
+
+
+def rings_central(u, v, k_u, k_v, eps_u, eps_v):
+    u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
+    u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
+    v_p = min(1, eps_v + v)
+    v_m = max(0, -eps_v + v)
+    x0 = 2*math.pi*k_v
+    return (math.sin(v*x0), 0.0, (-math.sin(v_m*x0) + math.sin(v_p*x0))*((1/(-v_m + v_p)) if (eps_v - v > 0) or (eps_v + v > 1) else ((1/2)/eps_v)), False)
+
+
+def rings_kink(u, v, k_u, k_v):
+    return False
+
+
+#: The built-in fields' functions (height, exact, central, kink), compiled by renderer/fieldcode.py.
+FIELDS = {
+    'sine': (sine_height, sine_exact, sine_central, sine_kink),
+    'ridges': (ridges_height, ridges_exact, ridges_central, ridges_kink),
+    'rings': (rings_height, rings_exact, rings_central, rings_kink),
+}

@@ -6,86 +6,12 @@ Branch-free: each function takes an array namespace ``xp`` first (`renderer.back
 
 import math
 
-FIELD_CODES = {'sine': 0, 'ridges': 1, 'rings': 2}
-
-
-def height(xp, field, u, v, k_u, k_v):
-    if field == 0:  # sine
-        return xp.sin(math.pi*k_u*u)*xp.sin(math.pi*k_v*v)
-    if field == 1:  # ridges
-        return xp.abs(xp.sin(math.pi*k_u*u)*xp.sin(math.pi*k_v*v))
-    if field == 2:  # rings
-        return xp.sin(2*math.pi*k_v*v)
-    raise ValueError(f"field must be one of 0 (sine), 1 (ridges), 2 (rings), got {field!r}")
-
-
-def exact_gradient(xp, field, u, v, k_u, k_v):
-    if field == 0:  # sine
-        x0 = math.pi*k_u
-        x1 = u*x0
-        x2 = math.pi*k_v
-        x3 = v*x2
-        return x0*xp.sin(x3)*xp.cos(x1), x2*xp.sin(x1)*xp.cos(x3)
-    if field == 1:  # ridges
-        x0 = math.pi*k_v
-        x1 = v*x0
-        x2 = xp.sin(x1)
-        x3 = math.pi*k_u
-        x4 = u*x3
-        x5 = xp.sin(x4)
-        x6 = xp.select(x2*x5 == 0, 0.0, xp.copysign(1.0, x2*x5))
-        return x2*x3*x6*xp.cos(x4), x0*x5*x6*xp.cos(x1)
-    if field == 2:  # rings
-        x0 = 2*math.pi*k_v
-        return 0.0, x0*xp.cos(v*x0)
-    raise ValueError(f"field must be one of 0 (sine), 1 (ridges), 2 (rings), got {field!r}")
-
-
-def central_gradient(xp, field, u, v, k_u, k_v, eps_u, eps_v):
-    if field == 0:  # sine
-        u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
-        u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
-        v_p = xp.minimum(1, eps_v + v)
-        v_m = xp.maximum(0, -eps_v + v)
-        x0 = math.pi*k_u
-        x1 = math.pi*k_v
-        x2 = xp.sin(v*x1)
-        x3 = xp.sin(u*x0)
-        return (1/2)*(-x2*xp.sin(u_m*x0) + x2*xp.sin(u_p*x0))/eps_u, (-x3*xp.sin(v_m*x1) + x3*xp.sin(v_p*x1))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v)
-    if field == 1:  # ridges
-        u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
-        u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
-        v_p = xp.minimum(1, eps_v + v)
-        v_m = xp.maximum(0, -eps_v + v)
-        x0 = math.pi*k_u
-        x1 = math.pi*k_v
-        x2 = xp.sin(v*x1)
-        x3 = xp.sin(u*x0)
-        return (1/2)*(-xp.abs(x2*xp.sin(u_m*x0)) + xp.abs(x2*xp.sin(u_p*x0)))/eps_u, (-xp.abs(x3*xp.sin(v_m*x1)) + xp.abs(x3*xp.sin(v_p*x1)))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v)
-    if field == 2:  # rings
-        u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
-        u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
-        v_p = xp.minimum(1, eps_v + v)
-        v_m = xp.maximum(0, -eps_v + v)
-        x0 = 2*math.pi*k_v
-        return 0.0, (-xp.sin(v_m*x0) + xp.sin(v_p*x0))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v)
-    raise ValueError(f"field must be one of 0 (sine), 1 (ridges), 2 (rings), got {field!r}")
-
-
-def kink_band(xp, field, u, v, k_u, k_v):
-    if field == 0:  # sine
-        return False
-    if field == 1:  # ridges
-        return (xp.abs(xp.sin(math.pi*k_u*u)) < 0.03) | (xp.abs(xp.sin(math.pi*k_v*v)) < 0.03)
-    if field == 2:  # rings
-        return False
-    raise ValueError(f"field must be one of 0 (sine), 1 (ridges), 2 (rings), got {field!r}")
 
 
 def chart(xp, N_x, N_y, N_z):
     x0 = 1/math.pi
     x1 = xp.sqrt(N_x**2 + N_y**2)
-    return (1/2)*x0*(xp.atan2(N_y, N_x) + math.pi), x0*xp.atan2(x1, N_z), x1
+    return ((1/2)*x0*(xp.atan2(N_y, N_x) + math.pi), x0*xp.atan2(x1, N_z), x1)
 
 
 def tangent_frame(xp, N_x, N_y, N_z, sin_phi):
@@ -93,7 +19,7 @@ def tangent_frame(xp, N_x, N_y, N_z, sin_phi):
     x1 = N_y*x0
     x2 = (sin_phi > 0.0001)
     x3 = N_x*x0
-    return xp.select(x2, -x1, 1.0), xp.select(x2, x3, 0.0), 0.0, xp.select(x2, N_z*x3, 0.0), xp.select(x2, N_z*x1, 1.0), xp.select(x2, -sin_phi, 0.0)
+    return (xp.select(x2, -x1, 1.0), xp.select(x2, x3, 0.0), 0.0, xp.select(x2, N_z*x3, 0.0), xp.select(x2, N_z*x1, 1.0), xp.select(x2, -sin_phi, 0.0))
 
 
 def perturbed_normal_chart(xp, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, h_u, h_v, beta):
@@ -103,7 +29,7 @@ def perturbed_normal_chart(xp, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z
     x3 = N_y + ep_y*x0 + et_y*x1
     x4 = N_z + ep_z*x0 + et_z*x1
     x5 = 1/xp.sqrt(x2**2 + x3**2 + x4**2)
-    return x2*x5, x3*x5, x4*x5
+    return (x2*x5, x3*x5, x4*x5)
 
 
 def perturbed_normal_surface(xp, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, h_u, h_v, beta, h, R, sin_phi):
@@ -114,7 +40,7 @@ def perturbed_normal_surface(xp, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep
     x4 = N_y - ep_y*x1 - et_y*x2
     x5 = N_z - ep_z*x1 - et_z*x2
     x6 = 1/xp.sqrt(x3**2 + x4**2 + x5**2)
-    return x3*x6, x4*x6, x5*x6
+    return (x3*x6, x4*x6, x5*x6)
 
 
 def footprint(xp, x, y, dx, dy, camera_z, P_x, P_y, P_z, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, R, sin_phi):
@@ -137,4 +63,103 @@ def footprint(xp, x, y, dx, dy, camera_z, P_x, P_y, P_z, N_x, N_y, N_z, et_x, et
     x16 = x10*xp.abs(x0*(et_x*x14 + et_y*x13 + et_z*x15)) + x10*xp.abs(x0*(et_x*x6 + et_y*x7 + et_z*x8))
     x17 = (1/2)*x9
     x18 = x17*xp.abs(x0*(ep_x*x14 + ep_y*x13 + ep_z*x15)) + x17*xp.abs(x0*(ep_x*x6 + ep_y*x7 + ep_z*x8))
-    return xp.select((x16 > 0) & (x16 < 100000000.0), xp.minimum(0.25, x16), 0.0005), xp.select((x18 > 0) & (x18 < 100000000.0), xp.minimum(0.25, x18), 0.0005)
+    return (xp.select((x16 > 0) & (x16 < 100000000.0), xp.minimum(0.25, x16), 0.0005), xp.select((x18 > 0) & (x18 < 100000000.0), xp.minimum(0.25, x18), 0.0005))
+
+
+# ---- the sine field
+
+def sine_height(xp, u, v, k_u, k_v):
+    return xp.sin(math.pi*k_u*u)*xp.sin(math.pi*k_v*v)
+
+
+def sine_exact(xp, u, v, k_u, k_v):
+    x0 = math.pi*k_u
+    x1 = u*x0
+    x2 = xp.sin(x1)
+    x3 = math.pi*k_v
+    x4 = v*x3
+    x5 = xp.sin(x4)
+    return (x2*x5, x0*x5*xp.cos(x1), x2*x3*xp.cos(x4), False)
+
+
+def sine_central(xp, u, v, k_u, k_v, eps_u, eps_v):
+    u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
+    u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
+    v_p = xp.minimum(1, eps_v + v)
+    v_m = xp.maximum(0, -eps_v + v)
+    x0 = math.pi*k_u
+    x1 = xp.sin(u*x0)
+    x2 = math.pi*k_v
+    x3 = xp.sin(v*x2)
+    return (x1*x3, (1/2)*(-x3*xp.sin(u_m*x0) + x3*xp.sin(u_p*x0))/eps_u, (-x1*xp.sin(v_m*x2) + x1*xp.sin(v_p*x2))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v), False)
+
+
+def sine_kink(xp, u, v, k_u, k_v):
+    return False
+
+
+# ---- the ridges field
+
+def ridges_height(xp, u, v, k_u, k_v):
+    return xp.abs(xp.sin(math.pi*k_u*u)*xp.sin(math.pi*k_v*v))
+
+
+def ridges_exact(xp, u, v, k_u, k_v):
+    x0 = math.pi*k_u
+    x1 = u*x0
+    x2 = xp.sin(x1)
+    x3 = math.pi*k_v
+    x4 = v*x3
+    x5 = xp.sin(x4)
+    x6 = x2*x5
+    x7 = xp.select(x6 == 0, 0.0, xp.copysign(1.0, x6))
+    return (xp.abs(x6), x0*x5*x7*xp.cos(x1), x2*x3*x7*xp.cos(x4), (xp.abs(x2) < 0.03) | (xp.abs(x5) < 0.03))
+
+
+def ridges_central(xp, u, v, k_u, k_v, eps_u, eps_v):
+    u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
+    u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
+    v_p = xp.minimum(1, eps_v + v)
+    v_m = xp.maximum(0, -eps_v + v)
+    x0 = math.pi*k_u
+    x1 = xp.sin(u*x0)
+    x2 = math.pi*k_v
+    x3 = xp.sin(v*x2)
+    return (xp.abs(x1*x3), (1/2)*(-xp.abs(x3*xp.sin(u_m*x0)) + xp.abs(x3*xp.sin(u_p*x0)))/eps_u, (-xp.abs(x1*xp.sin(v_m*x2)) + xp.abs(x1*xp.sin(v_p*x2)))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v), (xp.abs(x1) < 0.03) | (xp.abs(x3) < 0.03))
+
+
+def ridges_kink(xp, u, v, k_u, k_v):
+    return (xp.abs(xp.sin(math.pi*k_u*u)) < 0.03) | (xp.abs(xp.sin(math.pi*k_v*v)) < 0.03)
+
+
+# ---- the rings field
+
+def rings_height(xp, u, v, k_u, k_v):
+    return xp.sin(2*math.pi*k_v*v)
+
+
+def rings_exact(xp, u, v, k_u, k_v):
+    x0 = 2*math.pi*k_v
+    x1 = v*x0
+    return (xp.sin(x1), 0.0, x0*xp.cos(x1), False)
+
+
+def rings_central(xp, u, v, k_u, k_v, eps_u, eps_v):
+    u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
+    u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
+    v_p = xp.minimum(1, eps_v + v)
+    v_m = xp.maximum(0, -eps_v + v)
+    x0 = 2*math.pi*k_v
+    return (xp.sin(v*x0), 0.0, (-xp.sin(v_m*x0) + xp.sin(v_p*x0))*xp.select((eps_v - v > 0) | (eps_v + v > 1), 1/(-v_m + v_p), (1/2)/eps_v), False)
+
+
+def rings_kink(xp, u, v, k_u, k_v):
+    return False
+
+
+#: The built-in fields' functions (height, exact, central, kink), compiled by renderer/fieldcode.py.
+FIELDS = {
+    'sine': (sine_height, sine_exact, sine_central, sine_kink),
+    'ridges': (ridges_height, ridges_exact, ridges_central, ridges_kink),
+    'rings': (rings_height, rings_exact, rings_central, rings_kink),
+}

@@ -30,7 +30,7 @@ import json
 import re
 from pathlib import Path
 
-from . import codegen, kernel, scene
+from . import codegen, formulas, kernel, scene
 from .files import atomic_write
 from .ledger import DIFFERENCE_LINEAR_GAIN, DIFFERENCE_LOG_FLOOR, SIMULATOR_SCENE
 from .render import CHAMBER_NAMES, GRADIENTS, MAX_SIDE, MAX_ZOOM, WINDOW_MARGIN, WINDOW_OFFSET
@@ -63,7 +63,8 @@ def constants_js():
     consts = {
         "DEFAULT_SCENE": dataclasses.asdict(scene.Scene()),
         "SIMULATOR_SCENE": dataclasses.asdict(SIMULATOR_SCENE),
-        "HEIGHT_FIELDS": list(scene.HEIGHT_FIELDS),
+        "HEIGHT_FIELDS": list(formulas.FIELDS),
+        "FIELD_CREASES": {name: bool(f.crease_factors) for name, f in formulas.FIELDS.items()},
         "MODELS": list(scene.MODELS),
         "BUMPS": list(scene.BUMPS),
         "GRADIENTS": list(GRADIENTS),

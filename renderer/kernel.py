@@ -40,8 +40,7 @@ import numpy as np
 from numba import njit, prange
 from numba.extending import overload
 
-from .generated import (FIELD_CODES, central_gradient, chart, exact_gradient, footprint, height,
-                        kink_band, perturbed_normal_chart, perturbed_normal_surface, tangent_frame)
+from .generated import chart, footprint, perturbed_normal_chart, perturbed_normal_surface, tangent_frame
 
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
 #: Codes of the gradient methods (`renderer.render.GRADIENTS`, in order).
@@ -54,17 +53,17 @@ TINY = 1e-300
 SUBNORMAL_MIN, NORMAL_MIN = 2.0**-1074, 2.0**-1022
 
 #: The scene as the pixel code reads it, by name (a numba Record: ``s.camera_z``,
-#: ``s.center_b[0]``): floats, bools, triples, the height field's code.  `params`
+#: ``s.center_b[0]``): floats, bools, triples (the height field is its code,
+#: `renderer.fieldcode.FieldCode`, an argument of its own).  `params`
 #: fills each field from the `renderer.Scene` attribute of its name, or from
 #: `DERIVED` (the lights are a separate array of `LIGHT`).
 SCENE = np.dtype([("camera_z", "f8"), ("radius_a", "f8"), ("center_b", "f8", (3,)), ("radius_b", "f8"),
                   ("sphere_b", "?"), ("floor", "?"), ("ambient", "f8", (3,)), ("albedo_a", "f8", (3,)),
                   ("albedo_b", "f8", (3,)), ("ka", "f8"), ("kd", "f8"), ("ks", "f8"), ("shininess", "f8"),
-                  ("phong", "?"), ("floor_tint", "f8"), ("field", "i8"), ("k_u", "f8"), ("k_v", "f8"),
+                  ("phong", "?"), ("floor_tint", "f8"), ("k_u", "f8"), ("k_v", "f8"),
                   ("beta", "f8"), ("surface", "?")], align=True)
 #: The fields of `SCENE` that are not a Scene attribute of their name, as functions of the Scene.
 DERIVED = {"phong": lambda scene: scene.model == "phong",
-           "field": lambda scene: FIELD_CODES[scene.height_field],
            "surface": lambda scene: scene.bump == "surface"}
 #: A point light: position and colour (linear RGB intensities).
 LIGHT = np.dtype([("position", "f8", (3,)), ("color", "f8", (3,))], align=True)
@@ -96,7 +95,7 @@ def _threading_layer():
 
 _threading_layer()
 
-FORMULAS_DIGEST = "f1242c2779f566abdd5b06780eac20c047d2c7d070b352427ab8e3bfa15efac8"  # of generated.py, written by renderer/codegen.py
+FORMULAS_DIGEST = "04306c56add9729c1024dd62f815ced199709bd41036093f1ed6a2e668beed04"  # of generated.py, written by renderer/codegen.py
 if hashlib.sha256(Path(__file__).with_name("generated.py").read_bytes()).hexdigest() != FORMULAS_DIGEST:
     raise ImportError("renderer/generated.py does not match the digest kernel.py holds: it was edited by "
                       "hand or not regenerated; run python -m renderer.codegen")
@@ -338,32 +337,32 @@ def shade(s, lights, P, N, Ns, albedo, code, skip):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi):
-    """(h_u, h_v, crease flag) by ``method``: exact, central with step eps, or
-    central with the pixel's footprint as steps (pixel spacing dx, dy).  The
-    flag is taken beside the gradient, so that LLVM shares their sines."""
+def gradient(s, field, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi):
+    """(h, h_u, h_v, crease flag) of the field whose functions are ``field``
+    (`renderer.fieldcode.FieldCode`) by ``method``: exact, central with step
+    eps, or central with the pixel's footprint as steps (pixel spacing dx, dy).
+    One call of the field's code, which shares the sines of all four."""
     if method == EXACT:
-        return exact_gradient(s.field, u, v, s.k_u, s.k_v) + (kink_band(s.field, u, v, s.k_u, s.k_v),)
+        return field.exact(u, v, s.k_u, s.k_v)
     eu = ev = eps
     if method == FOOTPRINT:
         eu, ev = footprint(x, y, dx, dy, s.camera_z, P[0], P[1], P[2], N[0], N[1], N[2],
                            frame[0], frame[1], frame[2], frame[3], frame[4], frame[5], s.radius_a, sin_phi)
-    return central_gradient(s.field, u, v, s.k_u, s.k_v, eu, ev) + (kink_band(s.field, u, v, s.k_u, s.k_v),)
+    return field.central(u, v, s.k_u, s.k_v, eu, ev)
 
 
 @njit(cache=True, error_model="numpy")
-def shading_normal(s, N, frame, hu, hv, u, v, sin_phi):
-    """N' of sphere A (`formulas.PERTURBED_NORMAL`)."""
+def shading_normal(s, N, frame, h, hu, hv, sin_phi):
+    """N' of sphere A (`formulas.PERTURBED_NORMAL`) for the height h and gradient (hu, hv)."""
     et0, et1, et2, ep0, ep1, ep2 = frame
     if s.surface:
-        h = height(s.field, u, v, s.k_u, s.k_v)
         return perturbed_normal_surface(N[0], N[1], N[2], et0, et1, et2, ep0, ep1, ep2, hu, hv, s.beta,
                                         h, s.radius_a, sin_phi)
     return perturbed_normal_chart(N[0], N[1], N[2], et0, et1, et2, ep0, ep1, ep2, hu, hv, s.beta)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def render_rows(scene, lights, xs, ys, first, last, job, out):
+def render_rows(scene, lights, xs, ys, first, last, job, out, field):
     """Render the pixels of rows ``first`` to ``last - 1`` (in parallel) into the preallocated outputs.
 
     Parameters
@@ -380,6 +379,8 @@ def render_rows(scene, lights, xs, ys, first, last, job, out):
         ``method`` (int: `EXACT`, `CENTRAL` or `FOOTPRINT`), ``eps`` (float, the central
         step), ``skip`` (bool, see the module), ``want_kink``, ``want_grad``, ``want_geo``
         (bool: which optional outputs to write), ``dx``, ``dy`` (float, the pixel spacing).
+    field : FieldCode
+        The height field's compiled functions (`renderer.fieldcode.compiled`).
     out : Outputs
         image (H, W, 3) float64, chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2)
         float64 when wanted; t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) float64 when
@@ -392,13 +393,13 @@ def render_rows(scene, lights, xs, ys, first, last, job, out):
     """
     sin_x = np.sin(np.pi * xs)
     for j in prange(first, last):
-        render_row(j, scene, lights, xs, ys, sin_x, job, out)
+        render_row(j, scene, lights, xs, ys, sin_x, job, out, field)
 
 
 # A row is a function of its own: numba's parallel loop cannot take the
 # steps inlined (inline="always", 1.3x: LLVM leaves them as calls).
 @njit(cache=True, error_model="numpy")
-def render_row(j, scene, lights, xs, ys, sin_x, job, out):
+def render_row(j, scene, lights, xs, ys, sin_x, job, out, field):
     """Row j of `render_rows`."""
     s, y, sin_y = scene[0], ys[j], math.sin(math.pi * ys[j])
     method, eps, skip, dx, dy = job.method, job.eps, job.skip, job.dx, job.dy
@@ -417,12 +418,12 @@ def render_row(j, scene, lights, xs, ys, sin_x, job, out):
         if code == SPHERE_A:
             u, v, sin_phi = chart_of(N)
             frame = tangent_frame(N[0], N[1], N[2], sin_phi)
-            hu, hv, flag = 0.0, 0.0, False
+            h, hu, hv, flag = 0.0, 0.0, 0.0, False
             if want_grad or want_geo or s.beta != 0.0 or not skip:
-                hu, hv, flag = gradient(s, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
+                h, hu, hv, flag = gradient(s, field, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
             elif want_kink:
-                flag = kink_band(s.field, u, v, s.k_u, s.k_v)
-            Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
+                flag = field.kink(u, v, s.k_u, s.k_v)
+            Ns = shading_normal(s, N, frame, h, hu, hv, sin_phi)
             if want_grad:
                 grad[j, i, 0], grad[j, i, 1] = hu, hv
             if want_kink:
@@ -435,22 +436,22 @@ def render_row(j, scene, lights, xs, ys, sin_x, job, out):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def sweep_rows(scene, lights, xs, ys, first, last, steps, images, chamber, kink, grads):
+def sweep_rows(scene, lights, xs, ys, first, last, steps, images, chamber, kink, grads, field):
     """Rows ``first`` to ``last - 1`` of the exact frame (index 0) and of one central frame per
     step (1, 2, ...).
     Per pixel the geometry and the shadow rays are computed once (they do not
     depend on the gradient); sphere A is re-shaded per step, crease flag kept.
     scene, lights, xs, ys as `render_rows`; steps (S,) float64; images (S+1, H, W, 3),
-    grads (S+1, H, W, 2) float64; chamber (H, W) uint8, kink (H, W) bool.
+    grads (S+1, H, W, 2) float64; chamber (H, W) uint8, kink (H, W) bool; field as `render_rows`.
     The caller allocates the outputs with these shapes (nothing is checked here).
     """
     sin_x = np.sin(np.pi * xs)
     for j in prange(first, last):
-        sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads)
+        sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads, field)
 
 
 @njit(cache=True, error_model="numpy")
-def sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads):
+def sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads, field):
     """Row j of `sweep_rows`."""
     s, y, sin_y, n = scene[0], ys[j], math.sin(math.pi * ys[j]), lights.shape[0]
     geo = light_geometry(n)
@@ -478,10 +479,10 @@ def sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, gra
             g.axis[0], g.axis[1], g.axis[2] = axis
         for f in range(images.shape[0]):
             method, eps = (EXACT, 0.0) if f == 0 else (CENTRAL, steps[f - 1])
-            hu, hv, flag = gradient(s, method, eps, u, v, x, y, 0.0, 0.0, P, N, frame, sin_phi)
+            h, hu, hv, flag = gradient(s, field, method, eps, u, v, x, y, 0.0, 0.0, P, N, frame, sin_phi)
             if f == 0:
                 kink[j, i] = flag
-            Ns = shading_normal(s, N, frame, hu, hv, u, v, sin_phi)
+            Ns = shading_normal(s, N, frame, h, hu, hv, sin_phi)
             r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
             for k in range(n):
                 light = geo[k]

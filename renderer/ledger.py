@@ -44,8 +44,8 @@ class Ledger:
         frame's crease band.  A mean over no pixel is ``nan`` (numpy's mean
         of an empty array, and a float like the others, so that a census is
         an array of floats): mean_abs_kink is nan where the band holds no
-        pixel of sphere A, always for "sine" and "rings", which have no
-        creases; mean_abs_off_kink where the band holds every one; both
+        pixel of sphere A, always for a field without creases (sine, rings),
+        which has none; mean_abs_off_kink where the band holds every one; both
         where pixels_a is 0.  Otherwise they are finite (the images are), so
         ``math.isnan`` tells exactly whether the set was empty.
     """

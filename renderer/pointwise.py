@@ -5,8 +5,10 @@ renderer/generated.py holds beside the kernel's scalar function, and reshapes:
 the same machine code as a render, so a value here is the bits the renderer
 uses at the same point (tests/test_codegen.py checks it against `render`).
 
-Fields are named as in `renderer.Scene.height_field`: "sine", "ridges",
-"rings".  Arguments are real scalars or arrays that broadcast together (as
+A height field is given as `renderer.Scene.height_field` takes it (a registered name, one of
+`renderer.formulas.FIELDS`; a `renderer.formulas.HeightField`; or a reader's expression in
+u, v, k_u, k_v, `renderer.formulas.field`), and evaluated by its compiled code
+(`renderer.fieldcode.compiled`).  Arguments are real scalars or arrays that broadcast together (as
 `renderer.validate.real_array` accepts them: integer or floating, not bool);
 results are float64 arrays of the broadcast shape.
 
@@ -24,11 +26,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from . import fieldcode, kernel
+from . import formulas as F
 from . import generated as G
-from . import kernel
 from .render import GBuffer
 from .scene import COORDINATE, FREQUENCY, RADIUS, UNIT, Scene
-from .validate import InvalidType, InvalidValue, choice, flag, real_array
+from .validate import InvalidType, InvalidValue, flag, real_array
 
 __all__ = ["height", "exact_gradient", "central_gradient", "kink_band", "chart", "tangent_frame",
            "footprint", "reach", "RANGES", "RANGES_CENTRAL", "MIN_STEP"]
@@ -52,7 +55,26 @@ RANGES_CENTRAL = {**RANGES, "u": UNIT, "v": UNIT, "eps_v": RANGES["eps"]}
 
 
 def _field(name):
-    return G.FIELD_CODES[choice("height_field", name, tuple(G.FIELD_CODES))]
+    return fieldcode.compiled(F.field(name))
+
+
+# The loops that call a field's compiled function (`renderer.fieldcode.compiled`) through its pointer.
+@njit(cache=True, error_model="numpy")
+def _scalar_loop(fn, u, v, k_u, k_v, out):
+    for i in range(out.shape[1]):
+        out[0, i] = fn(u[i], v[i], k_u[i], k_v[i])
+
+
+@njit(cache=True, error_model="numpy")
+def _sample_loop(fn, u, v, k_u, k_v, out):
+    for i in range(out.shape[1]):
+        out[0, i], out[1, i], out[2, i], out[3, i] = fn(u[i], v[i], k_u[i], k_v[i])
+
+
+@njit(cache=True, error_model="numpy")
+def _central_loop(fn, u, v, k_u, k_v, eps_u, eps_v, out):
+    for i in range(out.shape[1]):
+        out[0, i], out[1, i], out[2, i], out[3, i] = fn(u[i], v[i], k_u[i], k_v[i], eps_u[i], eps_v[i])
 
 
 def _evaluate(loop, k, lead, names, args, ranges=RANGES):
@@ -93,7 +115,8 @@ def height(name, u, v, k_u, k_v):
 
     Parameters
     ----------
-    name : {"sine", "ridges", "rings"}
+    name : str, HeightField or sympy expression
+        The height field (`renderer.formulas.field`).
     u, v : array_like of float in [-1, 2]
         Chart coordinates (chart units), broadcast together with ``k_u``, ``k_v``.
     k_u, k_v : array_like of float in (0, 1e3]
@@ -108,7 +131,7 @@ def height(name, u, v, k_u, k_v):
     TypeError, ValueError
         As the module says (`RANGES`).
     """
-    return _evaluate(G.height_array, 1, (_field(name),), _UV, (u, v, k_u, k_v))[0]
+    return _evaluate(_scalar_loop, 1, (_field(name).height,), _UV, (u, v, k_u, k_v))[0]
 
 
 def exact_gradient(name, u, v, k_u, k_v):
@@ -118,7 +141,7 @@ def exact_gradient(name, u, v, k_u, k_v):
     where the float64 factor is exactly 0).  Arguments as `height`; returns
     two float64 arrays of the broadcast shape (per chart unit); raises as `height`.
     """
-    return tuple(_evaluate(G.exact_gradient_array, 2, (_field(name),), _UV, (u, v, k_u, k_v)))
+    return tuple(_evaluate(_sample_loop, 4, (_field(name).exact,), _UV, (u, v, k_u, k_v))[1:3])
 
 
 def central_gradient(name, u, v, k_u, k_v, eps, eps_v=None):
@@ -146,14 +169,14 @@ def central_gradient(name, u, v, k_u, k_v, eps, eps_v=None):
         As the module says (`RANGES`; u, v in [0, 1] here).
     """
     eps_v = eps if eps_v is None else eps_v
-    return tuple(_evaluate(G.central_gradient_array, 2, (_field(name),), _UV + ("eps", "eps_v"),
-                           (u, v, k_u, k_v, eps, eps_v), RANGES_CENTRAL))
+    return tuple(_evaluate(_central_loop, 4, (_field(name).central,), _UV + ("eps", "eps_v"),
+                           (u, v, k_u, k_v, eps, eps_v), RANGES_CENTRAL)[1:3])
 
 
 def kink_band(name, u, v, k_u, k_v):
     """The seed's crease flag (`renderer.formulas.KINK_BAND`): a bool array of the
     broadcast shape; arguments and errors as `height`."""
-    return _evaluate(G.kink_band_array, 1, (_field(name),), _UV, (u, v, k_u, k_v))[0] != 0.0
+    return _evaluate(_scalar_loop, 1, (_field(name).kink,), _UV, (u, v, k_u, k_v))[0] != 0.0
 
 
 def chart(N_x, N_y, N_z):

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from . import backends, kernel, validate
+from . import backends, fieldcode, kernel, validate
 from .kernel import BACKGROUND, FLOOR, SPHERE_A, SPHERE_B
 from .scene import Scene
 
@@ -76,7 +76,7 @@ class Frame:
     ----------
     image : (H, W, 3) float64     linear RGB, clipped to [0, 1]
     chamber : (H, W) uint8        0 background, 1 sphere A, 2 sphere B, 3 floor
-    kink : (H, W) bool or None    the seed's crease band on sphere A (ridges only)
+    kink : (H, W) bool or None    the seed's crease band on sphere A (fields with creases only)
     grad : (H, W, 2) float64 or None   (h_u, h_v) used on sphere A; 0 elsewhere
     scene : Scene
     gradient : {"exact", "central", "footprint"}
@@ -180,9 +180,10 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     job = kernel.Job(method=GRADIENTS.index(gradient), eps=float(scene.eps), skip=skip, want_kink=want_kink,
                      want_grad=want_grad, want_geo=want_geo, dx=dx, dy=dy)
     outputs = kernel.Outputs(**out, **geo)
+    code = fieldcode.compiled(scene.field)
     with threads(workers):
         for first, last in bands(height, width):
-            kernel.render_rows(prm, lights, x, y, first, last, job, outputs)
+            kernel.render_rows(prm, lights, x, y, first, last, job, outputs, code)
     return x, y, out, geo
 
 

@@ -8,10 +8,12 @@ downstream can then trust its inputs.  Seed names are given in brackets in the
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
+from functools import lru_cache
 
+from . import formulas
 from .validate import InvalidType, InvalidValue, choice, flag, real, vector3
 
-__all__ = ["PointLight", "Scene", "DRAFT_SCENE", "HEIGHT_FIELDS", "MODELS", "BUMPS"]
+__all__ = ["PointLight", "Scene", "DRAFT_SCENE", "MODELS", "BUMPS"]
 
 #: Largest accepted magnitude of a length or coordinate (scene units): squares of
 #: lengths are formed everywhere, and 1e6 keeps them far from overflow.
@@ -43,8 +45,6 @@ MAX_LIGHTS = 16
 #: about 0.7 degrees, already close to a mirror's.
 MIN_SHININESS, MAX_SHININESS = 1.0, 1e4
 
-#: Names accepted for ``Scene.height_field`` (seed §2).
-HEIGHT_FIELDS = ("sine", "ridges", "rings")
 #: Names accepted for ``Scene.model`` (seed Cell 1, ``shade1``).
 MODELS = ("blinn", "phong")
 #: Names accepted for ``Scene.bump``: the seed's chart formula, or the normal
@@ -113,8 +113,13 @@ class Scene:
     albedos; ``floor_tint`` [alpha] in [0, 1] removes that fraction of red and
     green from the floor's checker squares.
 
-    Bump.  ``height_field`` [hf] is one of "sine", "ridges", "rings" with
-    frequencies ``k_u`` [ku] and ``k_v`` [kv] (seed §2); ``beta`` [beta] >= 0 is
+    Bump.  ``height_field`` [hf] is the name of a registered field (one of
+    `renderer.formulas.FIELDS`: the seed's "sine", "ridges", "rings" of §2), a
+    `renderer.formulas.HeightField`, or a reader's own field: a sympy expression, or its
+    text (``"sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2"``), in u, v and the frequencies
+    ``k_u`` [ku] and ``k_v`` [kv] (kept as its printed text); a field other than the
+    built-in ones must be finite, with its gradient, on the chart [0, 1]^2 (checked on a
+    grid, `_check_on_chart`); ``beta`` [beta] >= 0 is
     the bump amplitude; ``eps`` [eps] > 0 is the central-difference step of the
     numeric pipeline, in chart units (u and v both run over [0, 1]).
     ``bump`` selects the perturbed normal: "surface" (default) is the exact
@@ -208,16 +213,23 @@ class Scene:
             set_(name, real(f"Scene.{name}", getattr(self, name), **UNIT))
         set_("shininess", real("Scene.shininess", self.shininess, low=MIN_SHININESS, high=MAX_SHININESS))
         set_("model", choice("Scene.model", self.model, MODELS))
-        set_("height_field", choice("Scene.height_field", self.height_field, HEIGHT_FIELDS))
+        set_("height_field", formulas.field(self.height_field, "Scene.height_field").name)
         set_("k_u", real("Scene.k_u", self.k_u, **FREQUENCY))
         set_("k_v", real("Scene.k_v", self.k_v, **FREQUENCY))
         set_("beta", real("Scene.beta", self.beta, low=0.0, high=MAX_BETA))
         set_("eps", real("Scene.eps", self.eps, low=MIN_EPS, high=MAX_EPS))
         set_("bump", choice("Scene.bump", self.bump, BUMPS))
+        if self.height_field not in formulas.BUILTIN:
+            _check_on_chart(self)
         if self.bump == "surface" and not self.beta < self.radius_a:
             raise InvalidValue(f"Scene.beta must be < radius_a = {self.radius_a} when bump='surface' (the "
                                f"default; the displaced radius R + beta h must stay positive), got "
                                f"{self.beta!r}; bump='chart' (the draft's normal) accepts beta up to {MAX_BETA:g}")
+
+    @property
+    def field(self):
+        """The `renderer.formulas.HeightField` record of ``height_field``."""
+        return formulas.field(self.height_field)
 
     def replace(self, **changes) -> "Scene":
         """Return a copy with ``changes`` applied (and validated).
@@ -247,6 +259,38 @@ class Scene:
         """
         default = Scene()
         return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) != getattr(default, f.name)}
+
+
+#: Points per side of the grid of the chart [0, 1]^2 on which a field other than the built-in
+#: ones is checked when a scene is made (`_check_on_chart`).
+CHART_CHECK_POINTS = 65
+
+
+@lru_cache(maxsize=64)
+def _on_chart(field, k_u, k_v):
+    """(least h, whether h and its gradient are finite) on a grid of the chart, numpy float64."""
+    import numpy as np
+    import sympy as sp
+    fn = sp.lambdify(formulas.FIELD_SYMBOLS, [field.expr, *field.gradient], modules="numpy")
+    t = np.linspace(0.0, 1.0, CHART_CHECK_POINTS)
+    uu, vv = np.meshgrid(t, t)
+    with np.errstate(all="ignore"):
+        values = [np.broadcast_to(np.asarray(a, dtype=np.float64), uu.shape) for a in fn(uu, vv, k_u, k_v)]
+    return float(np.min(values[0])), all(np.all(np.isfinite(a)) for a in values)
+
+
+def _check_on_chart(scene):
+    """A field other than the built-in ones: h and its gradient finite at every point of a
+    `CHART_CHECK_POINTS`-square grid of the chart, and with ``bump="surface"`` the displaced
+    radius radius_a + beta h positive there."""
+    low, finite = _on_chart(scene.field, scene.k_u, scene.k_v)
+    if not finite:
+        raise InvalidValue(f"Scene.height_field {scene.height_field!r} or its gradient is not finite at every "
+                           f"point of the chart [0, 1]^2 (k_u = {scene.k_u:g}, k_v = {scene.k_v:g})")
+    if scene.bump == "surface" and not scene.radius_a + scene.beta * low > 0.0:
+        raise InvalidValue(f"Scene.beta = {scene.beta!r} with height_field {scene.height_field!r} (least value "
+                           f"{low:.3g}) puts the displaced radius radius_a + beta h at or below 0; bump='surface' "
+                           f"needs radius_a + beta h > 0")
 
 
 #: The draft's scene: the seed's Cell-1 scene with its own perturbed normal, the chart

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernel, validate
+from . import fieldcode, kernel, validate
 from .ledger import compare
 from .render import Frame, bands, check_args, check_workers, image_plane, threads
 from .scene import MAX_EPS, MIN_EPS
@@ -120,9 +120,10 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
     chamber, kink = np.zeros((height, width), np.uint8), np.zeros((height, width), bool)
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     prm, lights = kernel.params(scene)
+    code = fieldcode.compiled(scene.field)
     with threads(workers):
         for first, last in bands(height, width):       # a Ctrl-C stops the sweep between two bands
-            kernel.sweep_rows(prm, lights, x, y, first, last, np.array(steps), images, chamber, kink, grads)
+            kernel.sweep_rows(prm, lights, x, y, first, last, np.array(steps), images, chamber, kink, grads, code)
     frames = [Frame(images[f], chamber.copy(), kink.copy(), grads[f], scene.replace(eps=e) if f else scene,
                     "central" if f else "exact") for f, e in enumerate((scene.eps,) + steps)]
     census = tuple(compare(frame, frames[0]) for frame in frames[1:])

@@ -38,11 +38,11 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from renderer import fieldcode, pointwise, validate
 from renderer import formulas as F
-from renderer import pointwise, validate
 
-__all__ = ["UCurve", "measure", "fit_model", "non_differentiable", "UNIT_ROUNDOFF", "DIGITS",
-           "SEED_POINT", "SEED_FREQUENCIES"]
+__all__ = ["UCurve", "measure", "measure_function", "fit_model", "non_differentiable", "UNIT_ROUNDOFF",
+           "DIGITS", "SEED_POINT", "SEED_FREQUENCIES", "DEFAULT_STEPS", "MAX_FUNCTION_STEP"]
 
 #: Unit roundoff of IEEE double precision (round to nearest).
 UNIT_ROUNDOFF = 2.0**-53
@@ -50,10 +50,35 @@ UNIT_ROUNDOFF = 2.0**-53
 DIGITS = 50
 #: The seed's chart point (u, v) of Cell 2's U-curve (sine field), and its
 #: frequencies (k_u, k_v), the default scene's.
-SEED_POINT = (0.31, 0.47)
+SEED_POINT = F.SEED_POINT
 SEED_FREQUENCIES = (8.0, 4.0)
 #: The default steps: 14 per decade from 1e-1 to 1e-15, so that every power of ten is one of them.
 DEFAULT_STEPS = np.logspace(-1, -15, 14 * 14 + 1)
+
+
+def _rational(x):
+    """``x`` (a float) as an exact sympy Rational."""
+    return sp.Rational(*Fraction(x).as_integer_ratio())
+
+
+def _crease(expr, var, at, x0):
+    """The factor under an ``Abs`` of ``expr`` (of the product there, the one in ``var``) that
+    changes sign at x0 as ``var`` moves (the other
+    variables at ``at``: {symbol: value}), or None.  A zero within one ulp of x0 counts (no float64
+    step can tell its two sides apart): |F(x0)| <= |F'(x0)| spacing(x0), with F'(x0) != 0 (where
+    F' vanishes too, |F| is flat there: both factors of the ridges vanish, say)."""
+    for a in sorted(expr.atoms(sp.Abs), key=sp.default_sort_key):
+        inner = a.args[0]
+        f = sp.lambdify(var, inner.subs(at), modules="mpmath")
+        df = sp.lambdify(var, sp.diff(inner, var).subs(at), modules="mpmath")
+        with mpmath.workdps(DIGITS):
+            X = mpmath.mpf(x0)
+            slope = abs(df(X))
+            # |F / F'| is the distance to the zero to first order; 1 + 1e-9 covers the second.
+            if slope > mpmath.mpf(10) ** (-DIGITS // 2) and \
+                    abs(f(X)) <= slope * abs(float(np.spacing(x0))) * (1 + mpmath.mpf(10) ** -9):
+                return next((f for f in sp.Mul.make_args(inner) if var in f.free_symbols), inner)
+    return None
 
 
 def non_differentiable(field, u, v, component, k_u, k_v):
@@ -63,16 +88,18 @@ def non_differentiable(field, u, v, component, k_u, k_v):
     Two cases (seed §3 and §7): the pole v = 0 or v = 1, where the chart is
     singular (every u names the same point of the sphere, so a chart
     derivative there is not a derivative of a function on the sphere); and a
-    crease of the ridges field h = |sin(pi k_u u) sin(pi k_v v)|, the line
-    u = m / k_u (or v = m / k_v) for an integer m, across which the slope
-    jumps from -s to +s.  A point within one ulp of a crease counts as on
-    it: no float64 step can tell its two sides apart.  Where both factors
-    vanish, h is 0 along the component's line and the partial derivative
-    exists (it is 0).  Exact rational arithmetic on the float64 inputs.
+    crease, where a factor under an ``Abs`` of h changes sign as the component
+    moves (the ridges field h = |sin(pi k_u u) sin(pi k_v v)| on u = m / k_u
+    or v = m / k_v), so that the slope jumps.  A point within one ulp of a
+    crease counts as on it: no float64 step can tell its two sides apart.
+    Where both factors vanish, h is 0 along the component's line and the
+    partial derivative exists (it is 0).  mpmath at `DIGITS` digits, the
+    frequencies and the point as exact rationals.
 
     Parameters
     ----------
-    field : {"sine", "ridges", "rings"}
+    field : str, HeightField or sympy expression
+        As `renderer.formulas.field` takes it.
     u, v : float
         The chart point (`measure` accepts [0, 1]).
     component : {"u", "v"}
@@ -87,21 +114,15 @@ def non_differentiable(field, u, v, component, k_u, k_v):
     if v in (0.0, 1.0):
         return (f"v = {v!r} is a pole of the chart: every u names the same point of the sphere, "
                 f"so the field is not differentiable there as a function on the sphere")
-    if field != "ridges":
+    record = F.field(field)
+    var, x0 = (F.u, u) if component == "u" else (F.v, v)
+    at = {F.k_u: _rational(k_u), F.k_v: _rational(k_v)}
+    at[F.v if component == "u" else F.u] = _rational(v if component == "u" else u)
+    inner = _crease(record.expr, var, at, x0)
+    if inner is None:
         return None
-
-    def near_crease(x, k):
-        m = round(Fraction(k) * Fraction(x))
-        return m, abs(Fraction(x) - m / Fraction(k)) <= Fraction(abs(float(np.spacing(x))))
-
-    (mu, on_u), (mv, on_v) = near_crease(u, k_u), near_crease(v, k_v)
-    if component == "u" and on_u and not on_v:
-        return (f"u = {u!r} lies on the crease u = {mu}/k_u of the ridges field (k_u = {k_u:g}): "
-                f"h is not differentiable in u there (its slope jumps sign)")
-    if component == "v" and on_v and not on_u:
-        return (f"v = {v!r} lies on the crease v = {mv}/k_v of the ridges field (k_v = {k_v:g}): "
-                f"h is not differentiable in v there (its slope jumps sign)")
-    return None
+    return (f"{component} = {x0!r} lies on a crease of the {record.name} field, where {inner} changes sign "
+            f"(k_u = {k_u:g}, k_v = {k_v:g}): h is not differentiable in {component} there (its slope jumps)")
 
 
 @dataclass(frozen=True)
@@ -199,43 +220,85 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
                      "convergence in 100 Gauss-Newton steps)")
 
 
-def _mp_functions(field, component, ku, kv):
-    var = F.u if component == "u" else F.v
-    # Exact rational frequencies so that mpmath does not inherit float64 rounding.
-    h = F.HEIGHT[field].subs({F.k_u: sp.nsimplify(ku), F.k_v: sp.nsimplify(kv)})
-    args = (F.u, F.v)
-    # d sign(f) / du = 2 DiracDelta(f) f' vanishes off the crease: drop it.
+def _line(expr, var, at):
+    """h, h' and h''' as mpmath functions of ``var`` alone (the others at ``at``), the derivative
+    of |f| as sign(f) f' (its DiracDelta, which vanishes off the crease, dropped)."""
+    g = expr.subs(at)
     smooth = lambda e: e.replace(lambda x: isinstance(x, sp.DiracDelta), lambda x: 0)  # noqa: E731
-    return (sp.lambdify(args, h, modules="mpmath"),
-            sp.lambdify(args, smooth(sp.diff(h, var)), modules="mpmath"),
-            sp.lambdify(args, smooth(sp.diff(h, var, 3)), modules="mpmath"))
+    return tuple(sp.lambdify(var, smooth(sp.diff(g, var, n)), modules="mpmath") for n in (0, 1, 3))
 
 
 @lru_cache(maxsize=None)
 def _stencil():
-    """(u_p, u_m, v_p, v_m, den_u, den_v) as float64 functions of (u, v, eps_u, eps_v):
-    the kernel's stencil points (`formulas.STENCIL_POINTS`) and the denominators of
-    `formulas.CENTRAL`, read off its sine field (CENTRAL = (h(+) - h(-)) / den)."""
+    """(u_p, u_m, v_p, v_m, den_u, den_v) as float64 functions of (u, v, eps_u, eps_v): the
+    kernel's stencil points (`formulas.STENCIL_POINTS`) and its quotients' denominators
+    (`formulas.CENTRAL_DENOMINATORS`)."""
     points = dict(F.STENCIL_POINTS)
-    dens = []
-    for k, var in enumerate((F.u, F.v)):
-        plus, minus = ((F.u_p, F.u_m), (F.v_p, F.v_m))[k]
-        h = F.HEIGHT["sine"]
-        den = sp.simplify((h.subs(var, plus) - h.subs(var, minus)) / F.CENTRAL["sine"][k])
-        if not den.free_symbols <= {F.u, F.v, F.eps_u, F.eps_v, plus, minus}:
-            raise RuntimeError(f"formulas.CENTRAL is not (h(+) - h(-)) / den: den = {den}")
-        dens.append(den.subs(points))
+    dens = [d.subs(points) for d in F.CENTRAL_DENOMINATORS]
     args = (F.u, F.v, F.eps_u, F.eps_v)
     return sp.lambdify(args, [points[p] for p in (F.u_p, F.u_m, F.v_p, F.v_m)] + dens, modules="math")
 
 
+def _curve(label, x, steps, quotient, line, reason, point):
+    """The U-curve of the float64 quotients ``quotient(eps) -> (value, x_plus, x_minus, den)`` of the
+    function ``line`` = (h, h', h''') of one variable at x: `UCurve`'s fields (``label`` and
+    ``point`` fill its field, u, v, component)."""
+    h_mp, dh_mp, d3h_mp = line
+    with mpmath.workdps(DIGITS):
+        X = mpmath.mpf(x)
+        if reason is None:
+            true = dh_mp(X)
+        else:
+            # The one-sided derivative: the derivative 1e-40 inside (smaller x at the chart's
+            # edge 1), where the field is smooth and within ~1e-39 of the one-sided limit.
+            true = dh_mp(X + mpmath.mpf(10) ** -(DIGITS - 10) * (-1 if x == 1.0 else 1))
+        h0, h3 = h_mp(X), d3h_mp(X)
+        error, trunc, roundoff = [], [], []
+        for e in steps:
+            fd, plus, minus, den = quotient(float(e))
+            # The abscissae and the denominator, exactly as float64 made them.
+            exact_fd = (h_mp(mpmath.mpf(plus)) - h_mp(mpmath.mpf(minus))) / mpmath.mpf(den)
+            trunc.append(float(exact_fd - true))
+            roundoff.append(float(mpmath.mpf(fd) - exact_fd))
+            error.append(float(abs(mpmath.mpf(fd) - true)))
+    error = np.array(error)
+    h0f, h3f = float(h0), float(h3)
+    measured = dict(field=label, **point, eps=steps, error=error, truncation=np.array(trunc),
+                    roundoff=np.array(roundoff), height=h0f)
+    best = int(np.argmin(error))
+    nan = float("nan")
+    if reason is not None:
+        return UCurve(**measured, model=np.full(steps.shape, nan), derivative=nan, third_derivative=nan,
+                      model_truncation=nan, model_cancellation=nan, model_argument=nan, eps_model=nan,
+                      error_model=nan, eps_measured_min=nan, error_at_measured_min=nan, reason=reason)
+    T, C, G = abs(h3f) / 6, UNIT_ROUNDOFF * abs(h0f), UNIT_ROUNDOFF * abs(x * float(true))
+    model = T * steps**2 + (C + G) / steps
+    # E'(eps) = 2 T eps - (C + G) / eps^2 = 0.  No truncation (T = 0): E falls towards 0 as eps grows
+    # (eps* infinite); no rounding (C + G = 0, h = 0 at x = 0): E is least, 0, at eps* = 0.
+    star = ((C + G) / (2 * T)) ** (1 / 3) if T > 0 else float("inf")
+    least = T * star**2 + (C + G) / star if 0 < star < float("inf") else 0.0
+    try:
+        A, B = fit_model(steps, error, start=(max(T, 1e-300), max(C + G, 1e-300)))
+    except ValueError:              # an exact quotient (h_u of rings: zero error) has no U to fit
+        A = B = nan
+    eps_fit = (B / (2 * A)) ** (1 / 3)
+    return UCurve(**measured, model=model, derivative=float(true), third_derivative=h3f,
+                  model_truncation=T, model_cancellation=C, model_argument=G, eps_model=star,
+                  error_model=least,
+                  eps_measured_min=float(steps[best]), error_at_measured_min=float(error[best]),
+                  fitted_truncation=A, fitted_roundoff=B, eps_fitted=float(eps_fit),
+                  error_at_fitted=float(A * eps_fit**2 + B / eps_fit))
+
+
 def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=None,
             k_u=SEED_FREQUENCIES[0], k_v=SEED_FREQUENCIES[1]):
-    """Measure the central-difference U-curve at one chart point.
+    """Measure the central-difference U-curve of a height field at one chart point.
 
     Parameters
     ----------
-    field : {"sine", "ridges", "rings"}
+    field : str, HeightField or sympy expression
+        A registered field's name (one of `renderer.formulas.FIELDS`), or a reader's
+        field in u, v, k_u, k_v (`renderer.formulas.field`).
     u, v : float in [0, 1]
         Chart point (default `SEED_POINT`, the seed's).
     component : {"u", "v"}
@@ -264,75 +327,94 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
 
     Notes
     -----
-    At a crease of the ridges field, or at a pole, there is no derivative
-    (`non_differentiable`): the result's ``reason`` says why, the reference
-    is the one-sided derivative from the side of larger u or v (smaller, at
-    1), ``truncation`` does not vanish as eps -> 0, and the derivative and
-    the optimal step are NaN.
+    At a crease (`non_differentiable`: a factor under an ``Abs`` changes sign), or
+    at a pole, there is no derivative: the result's ``reason`` says why, the
+    reference is the one-sided derivative from the side of larger u or v
+    (smaller, at 1), ``truncation`` does not vanish as eps -> 0, and the
+    derivative and the optimal step are NaN.
     """
-    field = validate.choice("field", field, tuple(F.HEIGHT))
+    record = F.field(field, "field")
     component = validate.choice("component", component, ("u", "v"))
     # The ranges of `pointwise.central_gradient`, which the measurement calls.
     u, v, k_u, k_v = (validate.real(name, x, **pointwise.RANGES_CENTRAL[name])
                       for name, x in (("u", u), ("v", v), ("k_u", k_u), ("k_v", k_v)))
     steps = DEFAULT_STEPS if eps is None else validate.steps("eps", eps, **pointwise.RANGES["eps"])
-
-    reason = non_differentiable(field, u, v, component, k_u, k_v)
-    h_mp, dh_mp, d3h_mp = _mp_functions(field, component, k_u, k_v)
+    k = 0 if component == "u" else 1
+    var, x = (F.u, u) if k == 0 else (F.v, v)
+    at = {F.k_u: _rational(k_u), F.k_v: _rational(k_v), (F.v if k == 0 else F.u): _rational(v if k == 0 else u)}
     stencil = _stencil()
+
+    def quotient(e):
+        points = stencil(u, v, e, e)
+        fd = float(pointwise.central_gradient(record, u, v, k_u, k_v, e)[k])
+        return fd, points[2 * k], points[2 * k + 1], points[4 + k]
+
+    return _curve(record.name, x, steps, quotient, _line(record.expr, var, at),
+                  non_differentiable(record, u, v, component, k_u, k_v), dict(u=u, v=v, component=component))
+
+
+#: The largest step `measure_function` accepts (its smallest is `renderer.pointwise.MIN_STEP`).
+MAX_FUNCTION_STEP = 1e3
+
+
+def measure_function(function, x, eps=None):
+    """Measure the central-difference U-curve of a reader's function of one variable at x.
+
+    The float64 quotient is (f(fl(x + eps)) - f(fl(x - eps))) / (2 eps), f compiled by numba
+    from the printed expression (`renderer.fieldcode.univariate_code`), split as `measure`
+    splits it (the abscissae as float64 made them).
+
+    Parameters
+    ----------
+    function : sympy expression of one symbol, its text in ``x``, or `renderer.formulas.Univariate`
+        E.g. ``"exp(x) / sqrt(sin(x)**3 + cos(x)**3)"`` (Squire and Trapp 1998).
+    x : float
+        Any real point where f is defined and differentiable, and f(x +- eps) too.
+    eps : array_like of float in [`renderer.pointwise.MIN_STEP`, `MAX_FUNCTION_STEP`], optional
+        Steps; default `DEFAULT_STEPS`.
+
+    Returns
+    -------
+    UCurve
+        With ``field`` the function's printed form, ``u`` = x, ``v`` NaN and ``component`` "x".
+
+    Raises
+    ------
+    renderer.validate.InputError
+        Naming the argument: an expression refused by `renderer.formulas.univariate`, a point
+        or a step that is not a finite float in range, a point where f or f' is not a finite
+        real number or f has a crease (|g| where g changes sign), a step at which f(x +- eps)
+        is not finite.
+    """
+    record = F.univariate(function, "function")
+    x = validate.real("x", x)
+    steps = DEFAULT_STEPS if eps is None else validate.steps("eps", eps, low=pointwise.MIN_STEP,
+                                                              high=MAX_FUNCTION_STEP)
+    line = _line(record.expr, F.x_var, {})
+    if not all(_finite_real(fn, x) for fn in line[:2]):
+        raise validate.InvalidValue(f"function {record.name} must be defined and differentiable at x = {x!r}, "
+                                    f"where it or its derivative is not a finite real number")
+    if _crease(record.expr, F.x_var, {}, x) is not None:
+        raise validate.InvalidValue(f"function {record.name} is not differentiable at x = {x!r}: it has a "
+                                    f"crease there (the argument of an abs changes sign)")
+    code = fieldcode.univariate_code(record)
+    fd = np.array([code.central(x, float(e)) for e in steps])
+    bad = np.flatnonzero(~np.isfinite(fd))
+    if bad.size:
+        raise validate.InvalidValue(f"eps must keep f finite at x +- eps; f({x!r} +- {steps[bad[0]]!r}) is not "
+                                    f"(step {bad[0]})")
+
+    def quotient(e):
+        return code.central(x, e), x + e, x - e, 2 * e
+
+    return _curve(record.name, x, steps, quotient, line, None, dict(u=x, v=float("nan"), component="x"))
+
+
+def _finite_real(fn, x):
+    """Whether the mpmath function ``fn`` is a finite real number at x (at `DIGITS` digits)."""
     with mpmath.workdps(DIGITS):
-        U, V = mpmath.mpf(u), mpmath.mpf(v)
-        if reason is None:
-            true = dh_mp(U, V)
-        else:
-            # The one-sided derivative: the derivative 1e-40 inside, where
-            # the field is smooth and within ~1e-39 of the one-sided limit.
-            x = u if component == "u" else v
-            side = mpmath.mpf(10) ** -(DIGITS - 10) * (-1 if x == 1.0 else 1)
-            true = dh_mp(U + side, V) if component == "u" else dh_mp(U, V + side)
-        h0 = h_mp(U, V)
-        h3 = d3h_mp(U, V)
-        error, trunc, roundoff = [], [], []
-        for e in steps:
-            e = float(e)
-            fd = float(pointwise.central_gradient(field, u, v, k_u, k_v, e)[0 if component == "u" else 1])
-            # The abscissae and the denominator, exactly as float64 made them.
-            u_p, u_m, v_p, v_m, den_u, den_v = stencil(u, v, e, e)
-            if component == "u":
-                den = den_u
-                f_plus, f_minus = h_mp(mpmath.mpf(u_p), V), h_mp(mpmath.mpf(u_m), V)
-            else:
-                den = den_v
-                f_plus, f_minus = h_mp(U, mpmath.mpf(v_p)), h_mp(U, mpmath.mpf(v_m))
-            exact_fd = (f_plus - f_minus) / mpmath.mpf(den)
-            trunc.append(float(exact_fd - true))
-            roundoff.append(float(mpmath.mpf(fd) - exact_fd))
-            error.append(float(abs(mpmath.mpf(fd) - true)))
-    error = np.array(error)
-    h0f, h3f = float(h0), float(h3)
-    measured = dict(field=field, u=u, v=v, component=component, eps=steps, error=error,
-                    truncation=np.array(trunc), roundoff=np.array(roundoff), height=h0f)
-    best = int(np.argmin(error))
-    nan = float("nan")
-    if reason is not None:
-        return UCurve(**measured, model=np.full(steps.shape, nan), derivative=nan, third_derivative=nan,
-                      model_truncation=nan, model_cancellation=nan, model_argument=nan, eps_model=nan,
-                      error_model=nan, eps_measured_min=nan, error_at_measured_min=nan, reason=reason)
-    x = u if component == "u" else v
-    T, C, G = abs(h3f) / 6, UNIT_ROUNDOFF * abs(h0f), UNIT_ROUNDOFF * abs(x * float(true))
-    model = T * steps**2 + (C + G) / steps
-    # E'(eps) = 2 T eps - (C + G) / eps^2 = 0.  No truncation (T = 0): E falls towards 0 as eps grows
-    # (eps* infinite); no rounding (C + G = 0, h = 0 at x = 0): E is least, 0, at eps* = 0.
-    star = ((C + G) / (2 * T)) ** (1 / 3) if T > 0 else float("inf")
-    least = T * star**2 + (C + G) / star if 0 < star < float("inf") else 0.0
-    try:
-        A, B = fit_model(steps, error, start=(max(T, 1e-300), max(C + G, 1e-300)))
-    except ValueError:              # an exact quotient (h_u of rings: zero error) has no U to fit
-        A = B = nan
-    eps_fit = (B / (2 * A)) ** (1 / 3)
-    return UCurve(**measured, model=model, derivative=float(true), third_derivative=h3f,
-                  model_truncation=T, model_cancellation=C, model_argument=G, eps_model=star,
-                  error_model=least,
-                  eps_measured_min=float(steps[best]), error_at_measured_min=float(error[best]),
-                  fitted_truncation=A, fitted_roundoff=B, eps_fitted=float(eps_fit),
-                  error_at_fitted=float(A * eps_fit**2 + B / eps_fit))
+        try:
+            y = fn(mpmath.mpf(x))
+        except (ValueError, ZeroDivisionError, TypeError):
+            return False
+        return isinstance(y, mpmath.mpf) and mpmath.isfinite(y)

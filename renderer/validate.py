@@ -277,3 +277,81 @@ def steps(name, value, *, low, high, high_open=False, max_count=None):
         count = "at least one step" if max_count is None else f"1 to {max_count} steps"
         raise InvalidValue(f"{name} must hold {count}, got {a.size}")
     return a
+
+
+#: Longest expression text accepted (characters): a height field or a function is a formula, not a program.
+MAX_EXPRESSION_CHARS = 500
+
+
+def expression(name, text, symbols, *, fields=()):
+    """The sympy expression written in ``text``, in the variables ``symbols``.
+
+    ``text`` is parsed by ``sympy.parse_expr`` in a namespace of the variables, ``pi``,
+    ``E`` and the functions `renderer.formulas.ELEMENTARY` (``abs`` and ``sqrt`` too), and
+    nothing else: every name is checked against it first, so no other name (no builtin,
+    no attribute, no sympy function outside it) can be reached.  ``^`` is a power.
+
+    Parameters
+    ----------
+    name : str
+        The parameter named in errors.
+    text : str
+        The expression, e.g. ``"sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2"``.
+    symbols : tuple of sympy.Symbol
+        The variables it may use, by their names.
+    fields : tuple of str
+        Names that would also have been accepted (listed in the error of an unknown name).
+
+    Returns
+    -------
+    sympy.Expr
+
+    Raises
+    ------
+    InvalidType
+        ``text`` is not a string.
+    InvalidValue
+        Empty, longer than `MAX_EXPRESSION_CHARS`, a name outside the namespace, an
+        operator other than + - * / ** ^ and parentheses, or text that is not an expression.
+    """
+    import io
+    import keyword
+    import tokenize
+
+    import sympy as sp
+    from sympy.parsing.sympy_parser import auto_number, convert_xor, parse_expr
+
+    from .formulas import ELEMENTARY
+
+    if not isinstance(text, str):
+        raise InvalidType(f"{name} must be a string, got {_shown(text)}")
+    if not text.strip() or len(text) > MAX_EXPRESSION_CHARS:
+        raise InvalidValue(f"{name} must be an expression of 1 to {MAX_EXPRESSION_CHARS} characters, "
+                           f"got {len(text)}")
+    namespace = {str(s): s for s in symbols}
+    namespace.update({f.__name__: f for f in ELEMENTARY}, abs=sp.Abs, sqrt=sp.sqrt, pi=sp.pi, E=sp.E)
+    functions = sorted(k for k, f in namespace.items() if callable(f) and not isinstance(f, sp.Basic))
+    accepted = (f"an expression in {', '.join(map(str, symbols))} (with pi, E, + - * / ** and "
+                f"{', '.join(functions)})" + (f" or one of {', '.join(fields)}" if fields else ""))
+    try:
+        tokens = list(tokenize.generate_tokens(io.StringIO(text).readline))
+    except (tokenize.TokenError, SyntaxError, IndentationError):
+        raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} does not parse") from None
+    for tok in tokens:
+        if tok.type == tokenize.NAME and (tok.string not in namespace or keyword.iskeyword(tok.string)):
+            raise InvalidValue(f"{name} must be {accepted}; {tok.string!r} is not one of its names")
+        if tok.type == tokenize.OP and tok.string not in ("+", "-", "*", "/", "**", "^", "(", ")", ","):
+            raise InvalidValue(f"{name} must be {accepted}; {tok.string!r} is not one of its operators")
+        if tok.type not in (tokenize.NAME, tokenize.OP, tokenize.NUMBER, tokenize.NEWLINE, tokenize.NL,
+                            tokenize.ENDMARKER):
+            raise InvalidValue(f"{name} must be {accepted}; {tok.string!r} is not part of one")
+        if tok.type == tokenize.NUMBER and tok.string[-1] in "jJ":
+            raise InvalidValue(f"{name} must be real; {tok.string!r} is imaginary")
+    glob = {"__builtins__": {}, "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational}
+    try:
+        expr = parse_expr(text, local_dict=namespace, global_dict=glob, transformations=(auto_number, convert_xor))
+    except (SyntaxError, TypeError, ValueError, AttributeError, ZeroDivisionError) as exc:
+        raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} is not one ({exc})") from None
+    if not isinstance(expr, sp.Expr):
+        raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} is a {type(expr).__name__}")
+    return expr

@@ -2,7 +2,7 @@
 // readout, the controls and the ledger, wired to the renderer in render.js.
 // Only this module touches the DOM; the renderer core runs the same under node
 // (tests/test_js_parity.py, tests/test_js_reshade.py).
-import { SIMULATOR_SCENE, HEIGHT_FIELDS, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES,
+import { SIMULATOR_SCENE, HEIGHT_FIELDS, FIELD_CREASES, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES,
          LOG_FLOOR, LINEAR_GAIN } from "./constants.js";
 import { PairRenderer, probe_pixel } from "./render.js";
 import { compare, to_srgb } from "./ledger.js";
@@ -86,12 +86,12 @@ const CONTROLS = [
   { name: "sphere_b", label: "sphere B", kind: "checkbox" },
 ];
 
-// What the right arm of the U-curve (the larger steps) is made of, per height field; the left
-// arm is rounding on every field.  Shown in the curve's caption.
+// What the right arm of the U-curve (the larger steps) is made of, for a smooth height field
+// and for one with creases (FIELD_CREASES); the left arm is rounding on every field.  Shown in
+// the curve's caption.
 export const RIGHT_ARM = {
-  sine: "Right arm: truncation error, which shrinks as ε² when ε shrinks; left arm: rounding, which grows as 1/ε.",
-  rings: "Right arm: truncation error, which shrinks as ε² when ε shrinks; left arm: rounding, which grows as 1/ε.",
-  ridges: "Right arm: crease error — at the pixels within ε of a crease the stencil straddles it and the " +
+  smooth: "Right arm: truncation error, which shrinks as ε² when ε shrinks; left arm: rounding, which grows as 1/ε.",
+  creased: "Right arm: crease error — at the pixels within ε of a crease the stencil straddles it and the " +
           "quotient is off by the slope's jump; it shrinks only as fewer pixels lie that near, slower than " +
           "truncation. Left arm: rounding, which grows as 1/ε.",
 };
@@ -509,7 +509,7 @@ class Simulator {
     this.root.querySelector("#sim-curve-caption").textContent =
       `The U-curve of central differences, on ${sample}, at half-decade steps of ε; the dashed line and ` +
       `the dots: the current ε; the triangle: the image-best step, the one of these steps with the least RMS. ` +
-      `An exact zero lies on the bottom axis. ${RIGHT_ARM[this.state.height_field]}`;
+      `An exact zero lies on the bottom axis. ${RIGHT_ARM[FIELD_CREASES[this.state.height_field] ? "creased" : "smooth"]}`;
   }
 
   pointer(canvas, ev) {
