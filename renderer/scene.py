@@ -293,6 +293,8 @@ def _check_on_chart(scene):
                            f"needs radius_a + beta h > 0")
 
 
-#: The draft's scene: the seed's Cell-1 scene with its own perturbed normal, the chart
-#: formula (``bump="chart"``).  Every measurement of a claim or erratum of the draft uses it.
-DRAFT_SCENE = Scene(bump="chart")
+#: The draft's scene (seed Cell 1, ``SC9``): its field, frequencies, amplitude and step spelled
+#: here, and its own perturbed normal, the chart formula (``bump="chart"``).  Every measurement of
+#: a claim or erratum of the draft reads the draft's values from it, never from `Scene`'s defaults
+#: (the book's, which may change).
+DRAFT_SCENE = Scene(height_field="ridges", k_u=8.0, k_v=4.0, beta=0.35, eps=1e-3, bump="chart")
