@@ -331,21 +331,37 @@ def _footprint():
 #: |dudy|), 0.0005 where that is 0), the fallback also where it is not below
 #: `FOOTPRINT_LIMIT`, and at most 0.25.  The neighbours are the next column
 #: (x + dx) and, dy being the row spacing, the row above (y + dy); pbrt takes
-#: the row below, the same footprint to first order.
-FOOTPRINT = _footprint()
+#: the row below, the same footprint to first order.  Built when first read (`__getattr__`):
+#: a fifth of this module's import time, and only the generator and the checks read it.
+FOOTPRINT: tuple
 
 #: What the generator prints once: name -> (arguments, outputs), each a scalar function.
 _UV = (u, v, k_u, k_v)
 _N = (N_x, N_y, N_z)
-FUNCTIONS = {
-    "chart": (_N, CHART),
-    "tangent_frame": (_N + (sin_phi,), TANGENT_FRAME),
-    "perturbed_normal_chart": (_N + e_theta + e_phi + (h_u, h_v, beta),
-                               PERTURBED_NORMAL["chart"]),
-    "perturbed_normal_surface": (_N + e_theta + e_phi + (h_u, h_v, beta, h, R, sin_phi),
-                                 PERTURBED_NORMAL["surface"]),
-    "footprint": ((x, y, dx, dy, camera_z) + P + _N + e_theta + e_phi + (R, sin_phi), FOOTPRINT),
-}
+FUNCTIONS: dict            # built with FOOTPRINT, when first read (`__getattr__`)
+
+
+def _functions():
+    footprint = globals().get("FOOTPRINT") or __getattr__("FOOTPRINT")
+    return {
+        "chart": (_N, CHART),
+        "tangent_frame": (_N + (sin_phi,), TANGENT_FRAME),
+        "perturbed_normal_chart": (_N + e_theta + e_phi + (h_u, h_v, beta), PERTURBED_NORMAL["chart"]),
+        "perturbed_normal_surface": (_N + e_theta + e_phi + (h_u, h_v, beta, h, R, sin_phi),
+                                     PERTURBED_NORMAL["surface"]),
+        "footprint": ((x, y, dx, dy, camera_z) + P + _N + e_theta + e_phi + (R, sin_phi), footprint),
+    }
+
+
+_LAZY = {"FOOTPRINT": _footprint, "FUNCTIONS": _functions}
+
+
+def __getattr__(name):
+    """`FOOTPRINT` and `FUNCTIONS`, built on first read and kept (PEP 562)."""
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value = _LAZY[name]()
+    return value
 #: What the generator prints per height field: name -> (arguments, outputs of a `HeightField`).
 #: ``exact`` and ``central`` return (h, h_u, h_v, crease flag) together, so that one call per
 #: pixel shares their sines (the kernel calls a field's functions through pointers).
