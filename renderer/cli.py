@@ -4,20 +4,19 @@ An input error (a bad option, a malformed scene file, an output directory that d
 exist, a value the library refuses with `renderer.validate.InputError`) prints ONE line
 ``symrender: error: ...`` and returns 2; anything else is a bug: one line ``symrender:
 internal error: ...`` and 1, never a traceback.  Ctrl-C prints ``symrender: interrupted``
-and returns 130, SIGTERM ``symrender: terminated`` and 143.  The report (ledger, census,
-U-curve table) is printed first, then the output is put in place by
-`renderer.files.write_bytes`: an error or a signal at any moment leaves no output and no
-temporary file.  ``-o -`` (``--plot -``) writes the PNG to standard output and the report
-to standard error.  PNGs carry no varying metadata.
+and returns 130, SIGTERM ``symrender: terminated`` and 143.  The report is printed first,
+then the output is put in place by `renderer.files.write_bytes`: an error or a signal at
+any moment leaves no output and no temporary file.  ``-o -`` (``--plot -``) writes the
+PNG to stdout and the report to stderr.  PNGs carry no varying metadata.
 
-Not special-cased, by design (a plain error, or Python's and the library's own behaviour):
+Not special-cased, by design (a plain error, or Python's or the library's own behaviour):
 closed standard descriptors; ``/dev/stdout`` as the output (the report is not moved to
 stderr); ``-o -`` on a terminal; option abbreviations, and negative values after a space
 (``--eps=-1e-3`` works); digits of other scripts; huge values repeated in messages; TOML
-nested thousands deep, and integers beyond a float (the library names them); scene files
-that are FIFOs, devices or huge; unwritable directories (found at the write); file names
-standard output cannot encode; a bad ``NUMBA_NUM_THREADS``; matplotlib's warnings about
-an unwritable home.  There are no progress bars.
+nested thousands deep (a RecursionError, exit 1); integers beyond a float (the library
+names them); scene files that are FIFOs, devices or huge; unwritable directories (found
+at the write); file names stdout cannot encode; a bad ``NUMBA_NUM_THREADS``; matplotlib's
+warnings about an unwritable home. There are no progress bars.
 """
 
 from __future__ import annotations
@@ -237,7 +236,7 @@ def _png(rgb):
 
 
 def view_image(view, selected, numeric, symbolic):
-    """The (H, W, 3) float64 display image in [0, 1] of a view, as the §4 simulator draws it.
+    """The (H, W, 3) float64 display image of a view, as the §4 simulator draws it (1 is white).
 
     shaded: ``to_srgb(selected.image)``.  difference: ``clip(100 |I_central - I_exact|)``
     per channel (not sRGB-encoded).  bump: ``to_srgb(|grad h| / max over A of the exact
@@ -253,7 +252,7 @@ def view_image(view, selected, numeric, symbolic):
         return np.clip(100.0 * np.abs(numeric.image - symbolic.image), 0.0, 1.0)
     if view == "bump":
         gmax = float(np.hypot(*np.moveaxis(symbolic.grad, 2, 0))[symbolic.chamber == SPHERE_A].max(initial=0.0))
-        g = to_srgb(np.hypot(*np.moveaxis(selected.grad, 2, 0)) / (gmax or 1.0))    # above 1: clipped by the PNG
+        g = to_srgb(np.hypot(*np.moveaxis(selected.grad, 2, 0)) / (gmax or 1.0))    # above 1: white in the PNG
         return np.repeat(np.where(selected.chamber == SPHERE_A, g, 0.0)[..., None], 3, axis=2)
     out = 0.4 * to_srgb(selected.image)
     out[symbolic.kink] = 1.0
