@@ -30,6 +30,7 @@ import hashlib
 import json
 import os
 import re
+import stat
 from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
@@ -154,12 +155,18 @@ def _served(record, name, params):
 
 
 def _read(path):
-    """The parsed JSON of ``path``, or None when there is none or it cannot be read or parsed."""
+    """The parsed JSON of ``path``, or None when there is none or it cannot be read or parsed:
+    only a regular file of at most `MAX_RECORD_BYTES` is read (not through a link, and a FIFO
+    does not block the open)."""
     if path is None:
         return None
     try:
-        return json.loads(files.read_regular(path, MAX_RECORD_BYTES, follow=False).decode("utf-8"))
-    except (OSError, ValueError, RecursionError):      # absent, not a regular file, too big, not JSON
+        with open(os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK), "rb") as f:
+            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                return None
+            data = f.read(MAX_RECORD_BYTES + 1)
+        return json.loads(data.decode("utf-8")) if len(data) <= MAX_RECORD_BYTES else None
+    except (OSError, ValueError, RecursionError):      # absent, a link, not JSON
         return None
 
 
@@ -169,11 +176,10 @@ def _write(path, record):
 
     Raises
     ------
-    renderer.files.RefusedPath
+    ValueError
         ``path`` exists and is not a regular file (a symbolic link, a FIFO, a device, a
         directory): a record replaces only a record, and is never written through to
         something else."""
-    if files.output_route(path) != "replace":
-        raise files.RefusedPath(f"{str(path)!r} is not a regular file (accepted: a record the store "
-                                "wrote, or no file)")
+    if os.path.islink(path) or (os.path.lexists(path) and not os.path.isfile(path)):
+        raise ValueError(f"{str(path)!r} is not a regular file (accepted: a record the store wrote, or no file)")
     files.write_bytes(path, json.dumps(record).encode("utf-8"))   # key order kept: reads back as written

@@ -310,10 +310,10 @@ def main(argv=None):
         for path in stale:
             print(f"{path} is stale: run python -m renderer.codegen", file=sys.stderr)
         return 1 if stale else 0
-    from .files import atomic_write
+    from .files import write_bytes
     for path, text in targets().items():
         if path in stale:
-            atomic_write(path, lambda f, t=text: f.write(t.encode("utf-8")))
+            write_bytes(path, text.encode("utf-8"))
             print(f"wrote {path}")
     return 0
 

@@ -31,7 +31,7 @@ import re
 from pathlib import Path
 
 from . import codegen, formulas, kernel, scene
-from .files import atomic_write
+from .files import write_bytes
 from .ledger import DIFFERENCE_LINEAR_GAIN, DIFFERENCE_LOG_FLOOR, SIMULATOR_SCENE
 from .render import CHAMBER_NAMES, GRADIENTS, MAX_SIDE, MAX_ZOOM, WINDOW_MARGIN, WINDOW_OFFSET
 
@@ -100,7 +100,7 @@ def sources():
 
 def _atomic_write(path: Path, text: str):
     path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write(path, lambda f: f.write(text.encode("utf-8")))
+    write_bytes(path, text.encode("utf-8"))
 
 
 def write_modules(directory):

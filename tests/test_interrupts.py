@@ -1,5 +1,4 @@
-"""Ctrl-C and SIGTERM at any moment of a ``symrender`` command (renderer/cli.py and
-`renderer.cmdline.main`).
+"""Ctrl-C and SIGTERM at any moment of a ``symrender`` command (`renderer.cli.main`).
 
 Each test starts the command in a session of its own (as a shell starts a
 foreground job), waits for a chosen moment, and sends SIGINT to the child's
@@ -12,8 +11,8 @@ session nor anywhere else: every run carries a marker in its environment,
 which all its descendants inherit, and any live process with that marker
 after the run is a leftover (a notebook kernel starts a session of its own).
 
-The moments: during the start-up imports (numpy, the renderer, then
-matplotlib), found by watching the child's memory maps; and moments a harness
+The moments: during the start-up imports (numpy, then numba's
+llvmlite), found by watching the child's memory maps; and moments a harness
 in the child announces by writing a file (`HARNESS`): inside the render's or
 the sweep's band loop (compiled bands run again and again until the signal
 comes), while the output's temporary file is being written, and after the
@@ -304,11 +303,11 @@ def test_orphan_check_catches_a_leaked_process():
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
-@pytest.mark.parametrize("library, delay", [("_multiarray_umath", 0.1), ("kiwisolver", 0.0)])
+@pytest.mark.parametrize("library, delay", [("_multiarray_umath", 0.1), ("libllvmlite", 0.0)])
 def test_a_signal_during_start_up_imports(tmp_path, library, delay, signum):
-    """A signal while ``render`` imports numpy, sympy and the renderer, and
-    later matplotlib: ``delay`` s after numpy's extension
-    module, or matplotlib's kiwisolver, has been mapped.  The one line, 130
+    """A signal while ``render`` imports numpy and the renderer: ``delay`` s
+    after numpy's extension module, or numba's llvmlite library, has been
+    mapped.  The one line, 130
     (143), nothing written.
 
     The clock starts inside `main`, not at the spawn: before `main` runs,
@@ -332,11 +331,11 @@ def heavy_modules_after(code):
 
 
 def test_importing_the_command_line_loads_no_numpy():
-    """``import renderer.cli`` (and its toolkit) loads neither numpy, sympy, matplotlib nor
+    """``import renderer.cli`` loads neither numpy, sympy, matplotlib nor
     numba, nor any of the renderer: the command line starts at once, and `main` does the
     heavy imports where it handles a signal.  The probe sees a heavy import: a command line
     that imported numpy at the top would show it."""
-    assert heavy_modules_after("import renderer.cli, renderer.cmdline") == "[]"
+    assert heavy_modules_after("import renderer.cli") == "[]"
     assert heavy_modules_after("import renderer.cli, numpy") == "['numpy']"
 
 
@@ -401,7 +400,7 @@ def test_main_in_process_restores_the_handlers_and_ignores_a_second_signal(capsy
 
     cleaned = []
 
-    def command(args, out):
+    def command(args):
         try:
             os.kill(os.getpid(), first)
             time.sleep(1.0)                       # the exception comes here
@@ -457,13 +456,12 @@ def _render_with_a_dropped_ctrl_c(monkeypatch):
 def test_a_ctrl_c_that_a_c_callback_drops_still_stops_the_command(tmp_path, capsys, monkeypatch, variant):
     """A Ctrl-C whose KeyboardInterrupt a C callback drops still ends the
     command with 130 and the one line, and writes nothing.  Wrong variants:
-    without `_stop_if_interrupted` the command finishes, writes its PNG and
-    exits 0 (`renderer.cmdline.check_signal`)."""
+    without `renderer.cli._stop_if_signalled` the command finishes, writes its PNG
+    and exits 0."""
     import renderer.cli as cli
-    from renderer import cmdline
 
     if variant == "no check before writing":
-        monkeypatch.setattr(cmdline, "check_signal", lambda: None)
+        monkeypatch.setattr(cli, "_stop_if_signalled", lambda: None)
     # Python's own hook, which prints the report (pytest's turns it into a warning).
     monkeypatch.setattr(sys, "unraisablehook", sys.__unraisablehook__)
     calls = _render_with_a_dropped_ctrl_c(monkeypatch)

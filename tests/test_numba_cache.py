@@ -161,3 +161,15 @@ def test_a_private_directory_of_another_user_is_refused(tmp_path):
     theirs.mkdir(mode=0o700)
     os.chown(theirs, uid, gid)
     assert renderer._private_cache(theirs) == f"is owned by uid {uid}, not by this user (uid {os.getuid()})"
+
+
+def test_a_read_only_install_without_a_writable_home_compiles_in_the_fallback(tmp_path):
+    """numba refuses to compile where it can cache neither beside the package nor in the user's
+    cache ("no locator available"): the kernel loads (importing it decorates every compiled
+    function), with one line of notice, and the cache lands in the temporary directory."""
+    env, shared = _install(tmp_path)
+    done = subprocess.run([sys.executable, "-c", f"import renderer.kernel; {PROBE}"], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0 and done.stdout == "ok\n", done.stderr[-2000:]
+    assert done.stderr.count("\n") == 1 and "compiled functions are cached in" in done.stderr, done.stderr
+    assert list((shared / f"symrender-numba-{os.getuid()}").rglob("*.nbi"))
