@@ -334,8 +334,8 @@ def program(xp, s, flat, xs, ys, sin_xs, sin_ys, *, method, kink, grad):
     # + 0.0: a -0.0 leaves as 0.0, as in the numba kernel.
     rgb = [xp.select(hit, xp.minimum(xp.maximum(c, 0.0), 1.0) + 0.0, 0.0) for c in rgb]
     chamber = xp.select(on_a, 1.0, 0.0)
-    for mask, code in ((on_b, 2.0), (on_floor, 3.0)):
-        chamber = chamber if mask is None else xp.select(mask, code, chamber)
+    for mask, number in ((on_b, 2.0), (on_floor, 3.0)):
+        chamber = chamber if mask is None else xp.select(mask, number, chamber)
     out = {"image": rgb, "chamber": [chamber]}
     if kink:
         out["kink"] = [on_a & (code.kink(xp, u, v, q.k_u, q.k_v) if flag is None else flag)]

@@ -236,7 +236,7 @@ def field(spec, name="height_field"):
     if not isinstance(spec, (str, sp.Expr)):
         raise InvalidType(f"{name} must be one of {tuple(FIELDS)}, a HeightField or a sympy expression in "
                           f"u, v, k_u, k_v, got {type(spec).__name__}")
-    expr = expression(name, spec, FIELD_SYMBOLS, fields=tuple(FIELDS)) if isinstance(spec, str) else spec
+    expr = expression(name, spec, FIELD_SYMBOLS, ELEMENTARY, fields=tuple(FIELDS)) if isinstance(spec, str) else spec
     try:
         record = HeightField(str(expr), expr)
     except (TypeError, ValueError) as exc:
@@ -439,7 +439,7 @@ def univariate(spec, name="function"):
     if isinstance(spec, Univariate):
         return spec
     if isinstance(spec, str):
-        spec = expression(name, spec, (x_var,))
+        spec = expression(name, spec, (x_var,), ELEMENTARY)
     if not isinstance(spec, sp.Expr):
         raise InvalidType(f"{name} must be a sympy expression of one variable or its text in x, "
                           f"got {type(spec).__name__}")

@@ -283,11 +283,11 @@ def steps(name, value, *, low, high, high_open=False, max_count=None):
 MAX_EXPRESSION_CHARS = 500
 
 
-def expression(name, text, symbols, *, fields=()):
+def expression(name, text, symbols, functions, *, fields=()):
     """The sympy expression written in ``text``, in the variables ``symbols``.
 
     ``text`` is parsed by ``sympy.parse_expr`` in a namespace of the variables, ``pi``,
-    ``E`` and the functions `renderer.formulas.ELEMENTARY` (``abs`` and ``sqrt`` too), and
+    ``E`` and the ``functions`` (``abs`` and ``sqrt`` too), and
     nothing else: every name is checked against it first, so no other name (no builtin,
     no attribute, no sympy function outside it) can be reached.  ``^`` is a power.
 
@@ -299,6 +299,8 @@ def expression(name, text, symbols, *, fields=()):
         The expression, e.g. ``"sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2"``.
     symbols : tuple of sympy.Symbol
         The variables it may use, by their names.
+    functions : tuple of sympy function classes
+        The functions it may call, by their names (`renderer.formulas.ELEMENTARY`).
     fields : tuple of str
         Names that would also have been accepted (listed in the error of an unknown name).
 
@@ -321,15 +323,13 @@ def expression(name, text, symbols, *, fields=()):
     import sympy as sp
     from sympy.parsing.sympy_parser import auto_number, convert_xor, parse_expr
 
-    from .formulas import ELEMENTARY
-
     if not isinstance(text, str):
         raise InvalidType(f"{name} must be a string, got {_shown(text)}")
     if not text.strip() or len(text) > MAX_EXPRESSION_CHARS:
         raise InvalidValue(f"{name} must be an expression of 1 to {MAX_EXPRESSION_CHARS} characters, "
                            f"got {len(text)}")
     namespace = {str(s): s for s in symbols}
-    namespace.update({f.__name__: f for f in ELEMENTARY}, abs=sp.Abs, sqrt=sp.sqrt, pi=sp.pi, E=sp.E)
+    namespace.update({f.__name__: f for f in functions}, abs=sp.Abs, sqrt=sp.sqrt, pi=sp.pi, E=sp.E)
     functions = sorted(k for k, f in namespace.items() if callable(f) and not isinstance(f, sp.Basic))
     accepted = (f"an expression in {', '.join(map(str, symbols))} (with pi, E, + - * / ** and "
                 f"{', '.join(functions)})" + (f" or one of {', '.join(fields)}" if fields else ""))
