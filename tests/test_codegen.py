@@ -84,7 +84,9 @@ def evaluate(expr, env):
     value is exact to ``MP_DPS`` digits; bound is a first-order bound on the
     error of evaluating the same tree in float64 with inputs carrying the
     given bounds: a sum adds its terms' bounds and (n - 1) u times the sum of
-    their magnitudes; a product its factors' relative bounds and (n - 1) u;
+    their magnitudes; a product prod (|a| + b) - prod |a| (its factors' relative
+    bounds, and their products, which alone remain where factors vanish) and
+    (n - 1) u, a positive integer power likewise;
     1/x, sqrt, sin, cos, atan2 and pow their derivative times the argument's
     bound and one rounding (two for the libm functions, which are within an
     ulp); pi and decimal constants one rounding.  A branch (Piecewise, sign,
@@ -113,7 +115,9 @@ def _evaluate(expr, env):
     if isinstance(expr, sp.Mul):
         vals = [a for a, _ in args]
         value = mpmath.fprod(vals)
-        bound = sum(b * abs(mpmath.fprod(vals[:i] + vals[i + 1:])) for i, (_, b) in enumerate(args))
+        # prod (|a| + b) - prod |a|: first order, and the products of the errors (a product of
+        # two factors near their zeros, sin^2 at a multiple of pi, has only those).
+        bound = mpmath.fprod(abs(a) + b for a, b in args) - abs(value)
         return value, bound + (len(args) - 1) * U * abs(value)
     if isinstance(expr, sp.Pow):
         (x, bx), n = args[0], expr.exp
@@ -125,6 +129,8 @@ def _evaluate(expr, env):
                 return mpmath.mpf(0), mpmath.mpf(0)
             raise Ambiguous(f"{expr} at 0")
         value = x ** n if mpmath.isint(n) or x > 0 else mpmath.nan
+        if mpmath.isint(n) and n > 0:            # (|x| + b)^n - |x|^n: every order, as for a product
+            return value, (abs(x) + bx) ** n - abs(x) ** n + 2 * U * abs(value)
         return value, abs(n) * abs(x) ** (n - 1) * bx + 2 * U * abs(value)
     if isinstance(expr, (sp.sin, sp.cos)):
         (x, bx), = args
