@@ -6,7 +6,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: book test test-baseline-simd bench clean
+.PHONY: book test audit test-baseline-simd bench clean
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -26,9 +26,14 @@ book: $(STAMP)
 	@$(UNINTERRUPTED) book/check_glue.py book/_build/.jupyter_cache book/_build/html
 	@echo "$(CURDIR)/book/_build/html/index.html"
 
-# The book first (the browser tests read it), then the checker and the tests on every CPU.
+# The book first, then the checker and the tests on every CPU; the audits of the built site
+# (marked "audit": the tests that read it, tests/conftest.py) are `make audit`'s.
 test: book
-	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadscope verify tests
+	$(BIN)/python -m pytest -n auto --dist loadscope -m "not audit" verify tests
+
+# The built site's audits: the browser tests (Chromium) and the checks that read book/_build/html.
+audit: book
+	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadscope -m audit tests
 
 # The checks whose numbers could depend on the CPU's code paths (marked cpu_dependent: the theorems
 # whose checks compare the renderer's outputs with mpmath, and parity with the scalar reference)

@@ -1,4 +1,4 @@
-"""Fixtures shared by the tests of the built site."""
+"""Fixtures shared by the tests of the built site, and their mark ``audit``."""
 
 from __future__ import annotations
 
@@ -10,6 +10,18 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).parents[1]
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "audit: reads the built site (the book_html fixture); `make audit` runs these")
+
+
+def pytest_collection_modifyitems(items):
+    """Every test that reads the built site (it takes `book_html`) is an audit: `make test`
+    leaves it to `make audit`."""
+    for item in items:
+        if "book_html" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.audit)
 
 
 @pytest.fixture(scope="session")

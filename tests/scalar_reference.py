@@ -19,7 +19,13 @@ pixel's footprint in the chart), written in `footprint_steps` from pbrt-v4's
 rule (``SurfaceInteraction::ComputeDifferentials`` and ``BumpMap``) with
 pbrt's least-squares solve, not the renderer's projections.
 
-Nothing here imports renderer code: the only contact with the renderer is
+The height fields are the one thing read from the renderer: each field's record
+(`renderer.formulas.HeightField`, sympy objects only) gives its expression, sympy's
+derivative and its crease factors, printed here by ``sympy.lambdify`` for the
+``math`` module, not by renderer/codegen.py nor compiled by numba; so a field
+registered later, or a reader's expression, renders here too.  The seed's three
+fields are also written by hand (`seed_height`, `seed_gradient`), only to
+cross-check the records.  Otherwise the only contact with the renderer is
 reading attribute values off a ``renderer.Scene``.  The structure is
 deliberately different from ``renderer/`` (one pixel at a time, plain tuples,
 textbook quadratic formula) so that a shared mistake is unlikely.
@@ -30,14 +36,19 @@ wrong variant (``monkeypatch.setattr``) and check that parity notices.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
+import sympy as sp
+
+from renderer import formulas as F
 
 __all__ = [
     "BACKGROUND", "SPHERE_A", "SPHERE_B", "FLOOR",
     "pixel_point", "ray_point", "nearest_positive_root", "sphere_a_t", "sphere_b_t",
     "nearest_hit", "chart_a", "tangent_frame_a", "chart_tangents", "height_value", "grad_exact",
+    "seed_height", "seed_gradient", "SEED_FIELDS",
     "stencil_u", "stencil_v", "grad_central", "in_kink_band", "chart_bump_vector", "perturb",
     "perturb_surface", "segment_blocked", "shade", "tangent_plane_offset", "footprint_steps",
     "footprint_neighbours", "sphere_a_colour", "render_pixel", "render_reference",
@@ -165,35 +176,58 @@ def chart_tangents(R, sin_phi, e_th, e_ph):
     return scale(TWO_PI * R * sin_phi, e_th), scale(math.pi * R, e_ph)
 
 
-# --- height fields and their gradients (hand-written, seed §2 and §3) ---------------
+# --- height fields and their gradients ------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def _field_functions(record):
+    """(h, (h_u, h_v), crease factors) of a `renderer.formulas.HeightField` record as functions
+    of (u, v, k_u, k_v), printed by ``sympy.lambdify`` for the ``math`` module."""
+    args = F.FIELD_SYMBOLS
+    return (sp.lambdify(args, record.expr, "math"), sp.lambdify(args, list(record.gradient), "math"),
+            sp.lambdify(args, list(record.crease_factors), "math"))
+
 
 def height_value(field, u, v, ku, kv):
-    """h(u, v) of seed §2."""
-    if field == "sine":
-        return math.sin(math.pi * ku * u) * math.sin(math.pi * kv * v)
-    if field == "ridges":
-        return abs(math.sin(math.pi * ku * u) * math.sin(math.pi * kv * v))
-    if field == "rings":
-        return math.sin(TWO_PI * kv * v)
-    raise ValueError(f"unknown height field {field!r}")
+    """h(u, v) of the height field ``field`` (a Scene's ``height_field``): its record's expression."""
+    return _field_functions(F.field(field))[0](u, v, ku, kv)
 
+
+def grad_exact(field, u, v, ku, kv):
+    """(h_u, h_v): the record's sympy derivatives (where h = |f|, sign(f) f', 0 on a zero of f)."""
+    return tuple(_field_functions(F.field(field))[1](u, v, ku, kv))
+
+
+def in_kink_band(field, u, v, ku, kv):
+    """The seed's crease flag: a crease factor of the record within the band about its zero."""
+    return any(abs(f) < KINK_HALF_WIDTH for f in _field_functions(F.field(field))[2](u, v, ku, kv))
+
+
+# The seed's three fields as it writes them (seed §2 and §3), by hand: only a cross-check of
+# the records at random points (tests/test_codegen.py), never what the reference renders with.
 
 def sign(x):
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
 
 
-def grad_exact(field, u, v, ku, kv):
-    """Closed-form (h_u, h_v) of seed §3."""
+def seed_height(field, u, v, ku, kv):
+    """h(u, v) of seed §2."""
+    s1, s2 = math.sin(math.pi * ku * u), math.sin(math.pi * kv * v)
+    return {"sine": s1 * s2, "ridges": abs(s1 * s2), "rings": math.sin(TWO_PI * kv * v)}[field]
+
+
+def seed_gradient(field, u, v, ku, kv):
+    """Closed-form (h_u, h_v) of seed §3 (ridges: the sign factor 0 on the zero lines, as the
+    seed's grad_exact)."""
     s1, c1 = math.sin(math.pi * ku * u), math.cos(math.pi * ku * u)
     s2, c2 = math.sin(math.pi * kv * v), math.cos(math.pi * kv * v)
-    if field == "sine":
-        return math.pi * ku * c1 * s2, math.pi * kv * s1 * c2
-    if field == "ridges":
-        sigma = sign(s1 * s2)          # 0 on the zero lines, as the seed's grad_exact
+    sigma = {"sine": 1.0, "ridges": sign(s1 * s2)}.get(field)
+    if sigma is not None:
         return math.pi * ku * c1 * s2 * sigma, math.pi * kv * s1 * c2 * sigma
-    if field == "rings":
-        return 0.0, TWO_PI * kv * math.cos(TWO_PI * kv * v)
-    raise ValueError(f"unknown height field {field!r}")
+    return {"rings": (0.0, TWO_PI * kv * math.cos(TWO_PI * kv * v))}[field]
+
+
+#: The fields `seed_height` and `seed_gradient` know.
+SEED_FIELDS = ("sine", "ridges", "rings")
 
 
 def stencil_u(u, eps):
@@ -219,14 +253,6 @@ def grad_central(field, u, v, ku, kv, eps, eps_v=None):
     v_plus, v_minus, step = stencil_v(v, eps_v)
     hv = (h(u, v_plus) - h(u, v_minus)) / step
     return hu, hv
-
-
-def in_kink_band(field, u, v, ku, kv):
-    """The seed's crease flag (ridges only)."""
-    if field != "ridges":
-        return False
-    return (abs(math.sin(math.pi * ku * u)) < KINK_HALF_WIDTH
-            or abs(math.sin(math.pi * kv * v)) < KINK_HALF_WIDTH)
 
 
 def chart_bump_vector(N, e_th, e_ph, hu, hv, beta):

@@ -30,7 +30,8 @@ import pytest
 from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
-from renderer import BUMPS, GRADIENTS, HEIGHT_FIELDS, MODELS, PointLight, Scene, gbuffer, pointwise, render, sweep
+from renderer import BUMPS, GRADIENTS, MODELS, PointLight, Scene, gbuffer, pointwise, render, sweep
+from renderer import formulas as F
 from renderer import scene as S
 from renderer.render import MAX_ZOOM
 
@@ -64,7 +65,7 @@ def accepted_scenes(draw):
         shininess=draw(st.floats(S.MIN_SHININESS, S.MAX_SHININESS)),
         model=draw(st.sampled_from(MODELS)),
         floor_tint=draw(st.floats(0.0, 1.0)),
-        height_field=draw(st.sampled_from(HEIGHT_FIELDS)),
+        height_field=draw(st.sampled_from(tuple(F.FIELDS))),
         k_u=draw(st.floats(0.0, S.MAX_FREQUENCY, exclude_min=True)),
         k_v=draw(st.floats(0.0, S.MAX_FREQUENCY, exclude_min=True)),
         beta=draw(st.floats(0.0, S.MAX_BETA)),

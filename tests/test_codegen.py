@@ -46,18 +46,17 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from renderer import GRADIENTS, Scene, backends, codegen, gbuffer, pointwise, render
+from renderer import GRADIENTS, Scene, backends, codegen, fieldcode, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer import generated as G
 from renderer import generated_array as GA
 
 from . import scalar_reference
 from .jsnode import node_command
-from .test_parity import require_backend
+from .test_parity import field_bounds, require_backend
 
 #: Unit roundoff of float64.
 U = 2.0**-53
-FIELDS = tuple(F.FIELD_CODES)
 #: 60 digits: inputs are exact binary numbers and the worst cancellation in
 #: these formulas (a central quotient at a step of 1e-12 of a point of size 1,
 #: or a ray differential of a grazing ray) loses fewer than 20 of them, so
@@ -85,7 +84,9 @@ def evaluate(expr, env):
     value is exact to ``MP_DPS`` digits; bound is a first-order bound on the
     error of evaluating the same tree in float64 with inputs carrying the
     given bounds: a sum adds its terms' bounds and (n - 1) u times the sum of
-    their magnitudes; a product its factors' relative bounds and (n - 1) u;
+    their magnitudes; a product prod (|a| + b) - prod |a| (its factors' relative
+    bounds, and their products, which alone remain where factors vanish) and
+    (n - 1) u, a positive integer power likewise;
     1/x, sqrt, sin, cos, atan2 and pow their derivative times the argument's
     bound and one rounding (two for the libm functions, which are within an
     ulp); pi and decimal constants one rounding.  A branch (Piecewise, sign,
@@ -114,7 +115,9 @@ def _evaluate(expr, env):
     if isinstance(expr, sp.Mul):
         vals = [a for a, _ in args]
         value = mpmath.fprod(vals)
-        bound = sum(b * abs(mpmath.fprod(vals[:i] + vals[i + 1:])) for i, (_, b) in enumerate(args))
+        # prod (|a| + b) - prod |a|: first order, and the products of the errors (a product of
+        # two factors near their zeros, sin^2 at a multiple of pi, has only those).
+        bound = mpmath.fprod(abs(a) + b for a, b in args) - abs(value)
         return value, bound + (len(args) - 1) * U * abs(value)
     if isinstance(expr, sp.Pow):
         (x, bx), n = args[0], expr.exp
@@ -126,6 +129,8 @@ def _evaluate(expr, env):
                 return mpmath.mpf(0), mpmath.mpf(0)
             raise Ambiguous(f"{expr} at 0")
         value = x ** n if mpmath.isint(n) or x > 0 else mpmath.nan
+        if mpmath.isint(n) and n > 0:            # (|x| + b)^n - |x|^n: every order, as for a product
+            return value, (abs(x) + bx) ** n - abs(x) ** n + 2 * U * abs(value)
         return value, abs(n) * abs(x) ** (n - 1) * bx + 2 * U * abs(value)
     if isinstance(expr, (sp.sin, sp.cos)):
         (x, bx), = args
@@ -180,10 +185,18 @@ def decide(condition, env):
     return ops[type(condition)](lhs, rhs)
 
 
+def signature(name, field):
+    """(arguments, outputs) of a generated function: the entry ``name`` of `formulas.FUNCTIONS`
+    (``field`` ''), or of `formulas.FIELD_FUNCTIONS` for the registered field ``field``."""
+    if not field:
+        return F.FUNCTIONS[name]
+    args, outputs = F.FIELD_FUNCTIONS[name]
+    return args, outputs(F.FIELDS[field])
+
+
 def reference(name, field, point):
     """[(value, bound) or None (ambiguous) or bool] per output of ``name`` at ``point``."""
-    args, outputs = F.FUNCTIONS[name]
-    exprs = outputs[field] if field else outputs
+    args, exprs = signature(name, field)
     with mpmath.workdps(MP_DPS):
         env = {s: (mpmath.mpf(x), mpmath.mpf(0)) for s, x in zip(args, point)}
         try:
@@ -203,7 +216,7 @@ def reference(name, field, point):
 
 def excess(got, want):
     """How far ``got`` lies outside the allowance around ``want`` (<= 0: inside)."""
-    if want is None:
+    if want is None or got is None:          # ambiguous, or an output not computed (JavaScript)
         return -1.0
     if isinstance(want, bool):
         is_flag = isinstance(got, (bool, np.bool_)) or got in (0.0, 1.0)
@@ -251,9 +264,9 @@ def _steps(rng, n, low=-12):
 
 def sample(name, rng, n=160):
     """Argument tuples for ``name`` (by its formulas.FUNCTIONS signature)."""
-    if name in ("height", "exact_gradient", "kink_band"):
+    if name in ("height", "exact", "kink"):
         return list(zip(*_chart_points(rng, n)))
-    if name == "central_gradient":
+    if name == "central":
         u, v, ku, kv = _chart_points(rng, n)
         eu, ev = _steps(rng, n), _steps(rng, n)
         # A quarter within a step of the border v = 0 or 1, where the quotient is one-sided.
@@ -299,12 +312,14 @@ def footprint_points(rng, n):
     return [(x[i], y[i], dx[i], dy[i], e[i], *P[i], *N[i], *et[i], *ep[i], R[i], s[i]) for i in range(n)]
 
 
-def _points():
-    """{(name, field): [args]}, field '' for functions of no field; one seed each."""
-    out = {}
-    for i, (name, (_, outputs)) in enumerate(F.FUNCTIONS.items()):
-        for j, field in enumerate(outputs if isinstance(outputs, dict) else [""]):
-            out[name, field] = sample(name, np.random.default_rng([2026, i, j]))
+def _points(fields=None):
+    """{(name, field): [args]}: field '' for the functions of no field (`formulas.FUNCTIONS`), and
+    each entry of `formulas.FIELD_FUNCTIONS` per field of ``fields`` (every registered one); one
+    seed each."""
+    out = {(name, ""): sample(name, np.random.default_rng([2026, i])) for i, name in enumerate(F.FUNCTIONS)}
+    for i, name in enumerate(F.FIELD_FUNCTIONS):
+        for field in F.FIELDS if fields is None else fields:
+            out[name, field] = sample(name, np.random.default_rng([2026, 100 + i, *map(ord, field)]))
     return out
 
 
@@ -318,11 +333,20 @@ def references(points):
     return {key: [reference(key[0], key[1], p) for p in pts] for key, pts in points.items()}
 
 
+def function(namespace, name, field):
+    """The generated ``name`` (of ``field``) in ``namespace``: a dict of printed functions (a field's
+    named ``<field>_<name>``; a field the namespace lacks, one not built in, is `fieldcode`'s), or
+    None for the compiled code the kernel runs (generated.py's, and `fieldcode.compiled`'s)."""
+    if not field:
+        return namespace[name] if namespace is not None else getattr(G, name)
+    if namespace is not None and f"{field}_{name}" in namespace:
+        return namespace[f"{field}_{name}"]
+    return getattr(fieldcode.compiled(F.FIELDS[field]), name)
+
+
 def call(namespace, name, field, point):
-    """Outputs (a tuple) of the generated ``name`` from ``namespace`` (module or dict)."""
-    fn = namespace[name] if isinstance(namespace, dict) else getattr(namespace, name)
-    lead = (F.FIELD_CODES[field],) if field else ()
-    out = fn(*lead, *(float(a) for a in point))
+    """Outputs (a tuple) of the generated ``name`` from ``namespace`` (`function`)."""
+    out = function(namespace, name, field)(*(float(a) for a in point))
     return out if isinstance(out, tuple) else (out,)
 
 
@@ -351,12 +375,13 @@ def mismatches(results, references, points):
 
 
 def test_every_generated_function_has_samples_of_each_field(points):
-    assert {name for name, _ in points} == set(F.FUNCTIONS)
+    assert set(points) == {(n, "") for n in F.FUNCTIONS} | {(n, f) for n in F.FIELD_FUNCTIONS for f in F.FIELDS}
     assert all(len(p) >= 100 for p in points.values())
 
 
 def test_generated_functions_agree_with_the_sympy_objects(points, references):
-    bad = mismatches(outputs_of(G, points), references, points)
+    """The compiled code the kernel calls: generated.py's functions and each field's cfuncs."""
+    bad = mismatches(outputs_of(None, points), references, points)
     assert bad == [], bad[:5]
 
 
@@ -373,9 +398,11 @@ def array_outputs(module, points, xp):
     column = xp.Float64 if xp.name == "drjit" else np.asarray
     results = {}
     for (name, field), pts in points.items():
-        fn = module[name] if isinstance(module, dict) else getattr(module, name)
-        lead = (F.FIELD_CODES[field],) if field else ()
-        out = fn(xp, *lead, *(column(np.array(c, dtype=np.float64)) for c in zip(*pts)))
+        if module is not None and (not field or f"{field}_{name}" in module):
+            fn = module[f"{field}_{name}" if field else name]
+        else:
+            fn = getattr(fieldcode.array_code(F.FIELDS[field]), name) if field else getattr(GA, name)
+        out = fn(xp, *(column(np.array(c, dtype=np.float64)) for c in zip(*pts)))
         out = out if isinstance(out, tuple) else (out,)
         arrays = [o for o in out if not isinstance(o, (bool, float))]     # a constant output is a Python value
         values = iter(xp.numpy([([a], np.float64) for a in arrays]))
@@ -391,14 +418,14 @@ def test_generated_array_functions_agree_with_the_sympy_objects(points, referenc
     require_backend(backend)
     xp = backends.namespace(backend)
     with xp.scope():
-        bad = mismatches(array_outputs(GA, points, xp), references, points)
+        bad = mismatches(array_outputs(None, points, xp), references, points)
     assert bad == [], bad[:5]
 
 
 @pytest.mark.parametrize("old, new", [
     ("xp.select(x2, -x1, 1.0)", "xp.select(x2, 1.0, -x1)"),        # a select's sides swapped
     ("xp.minimum(1, eps_v + v)", "xp.maximum(1, eps_v + v)"),      # the clamp of v inverted
-    ("xp.select(x2*x5 == 0, 0.0,", "xp.select(x2*x5 != 0, 0.0,"),  # sign(0) taken as the other case
+    ("xp.select(x6 == 0, 0.0,", "xp.select(x6 != 0, 0.0,"),        # sign(0) taken as the other case
 ])
 def test_the_array_check_rejects_a_tampered_line_of_the_printed_source(old, new, points, references):
     source = codegen.array_source()
@@ -419,17 +446,17 @@ def plain_python(source):
 
 
 def _replace_output(name, field, index, new):
-    args, outputs = F.FUNCTIONS[name]
-    if field:
-        outputs = dict(outputs)
-        exprs = list(outputs[field])
-        exprs[index] = new(exprs[index])
-        outputs[field] = tuple(exprs)
-    else:
+    """The entry ``name`` of `formulas.FUNCTIONS` (or of `FIELD_FUNCTIONS`, for ``field`` only)
+    with its output ``index`` replaced by ``new(output)``."""
+    def changed(outputs):
         outputs = list(outputs)
         outputs[index] = new(outputs[index])
-        outputs = tuple(outputs)
-    return args, outputs
+        return tuple(outputs)
+    if not field:
+        args, outputs = F.FUNCTIONS[name]
+        return args, changed(outputs)
+    args, outputs = F.FIELD_FUNCTIONS[name]
+    return args, lambda record: changed(outputs(record)) if record.name == field else outputs(record)
 
 
 def _doubled_footprint(expr):
@@ -440,20 +467,20 @@ def _doubled_footprint(expr):
 
 def _two_sided(expr):
     """rings' h_v over 2 eps_v everywhere, also where v was clamped (the seed's slip)."""
-    h = F.HEIGHT["rings"]
+    h = F.FIELDS["rings"].expr
     return (h.xreplace({F.v: F.v_p}) - h.xreplace({F.v: F.v_m})) / (2 * F.eps_v)
 
 
 VARIANTS = {
-    "h_u of sine with its sign flipped": ("exact_gradient", "sine", 0, lambda e: -e),
+    "h_u of sine with its sign flipped": ("exact", "sine", 1, lambda e: -e),
     "the chart's u from atan2(N_x, N_y)": ("chart", "", 0, lambda e: e.xreplace({F.N_x: F.N_y, F.N_y: F.N_x})),
     "the pole cut-off at 1e-3": ("tangent_frame", "", 3,
                                  lambda e: e.xreplace({F.POLE_SIN_PHI: sp.Float(1e-3)})),
     "the surface normal with pi halved": ("perturbed_normal_surface", "", 0,
                                             lambda e: e.xreplace({sp.pi: sp.pi / 2})),
     "the footprint without pbrt's half": ("footprint", "", 1, _doubled_footprint),
-    "a two-sided v quotient at the border": ("central_gradient", "rings", 1, _two_sided),
-    "the crease band twice as wide": ("kink_band", "ridges", 0,
+    "a two-sided v quotient at the border": ("central", "rings", 2, _two_sided),
+    "the crease band twice as wide": ("kink", "ridges", 0,
                                       lambda e: e.xreplace({F.KINK_BAND_HALF_WIDTH: sp.Float(0.06)})),
 }
 
@@ -461,11 +488,12 @@ VARIANTS = {
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
 def test_the_checks_reject_a_wrong_formula(variant, points, references, monkeypatch):
     name, field, index, change = VARIANTS[variant]
-    original = F.FUNCTIONS[name]
-    monkeypatch.setitem(F.FUNCTIONS, name, _replace_output(name, field, index, change))
+    table = F.FIELD_FUNCTIONS if field else F.FUNCTIONS
+    original = table[name]
+    monkeypatch.setitem(table, name, _replace_output(name, field, index, change))
     source = codegen.python_source()
     assert codegen.targets()[codegen.GENERATED] != codegen.GENERATED.read_text(encoding="utf-8")
-    monkeypatch.setitem(F.FUNCTIONS, name, original)
+    monkeypatch.setitem(table, name, original)
     bad = mismatches(outputs_of(plain_python(source), points, {name}), references, points)
     assert {(b[0], b[1]) for b in bad} == {(name, field)}, bad[:3]
 
@@ -576,22 +604,32 @@ process.stdout.write(JSON.stringify(out));
 """
 
 
+#: The JavaScript function of each entry of `formulas.FIELD_FUNCTIONS`, and the outputs it returns.
+JS_OF_ENTRY = {entry: (name, keep) for name, (entry, keep) in codegen.JS_FIELD_FUNCTIONS.items()}
+
+
 def run_js(source, points, tmp_path):
-    """Outputs of the JavaScript ``source``'s functions at ``points``, run by node."""
+    """Outputs of the JavaScript ``source``'s functions at ``points``, run by node: a field's
+    function gives the outputs its JavaScript twin returns (`codegen.JS_FIELD_FUNCTIONS`), None
+    in the place of the others."""
     node = node_command("runs the generated JavaScript formulas")
     (tmp_path / "formulas.mjs").write_text(source, encoding="utf-8")
     (tmp_path / "driver.mjs").write_text(_NODE_DRIVER, encoding="utf-8")
-    jobs = {}
+    jobs, places = {}, {}
     for (name, field), pts in points.items():
-        outputs = F.FUNCTIONS[name][1]
-        k = len(outputs[field] if field else outputs)
-        jobs[f"{name}/{field}"] = dict(name=name, field=field, outputs=k, points=[list(map(float, p)) for p in pts])
+        n = len(signature(name, field)[1])
+        js, keep = JS_OF_ENTRY[name] if field else (name, tuple(range(n)))
+        places[name, field] = (n, keep)
+        jobs[f"{name}/{field}"] = dict(name=js, field=field, outputs=len(keep), points=[list(map(float, p)) for p in pts])
     result = subprocess.run([*node, str(tmp_path / "driver.mjs"), (tmp_path / "formulas.mjs").as_uri()],
                             input=json.dumps(jobs), capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]
-    got = json.loads(result.stdout)
-    return {tuple(k.split("/")): [tuple(math.nan if x is None else x for x in row) for row in rows]
-            for k, rows in got.items()}
+    out = {}
+    for key, rows in json.loads(result.stdout).items():
+        n, keep = places[tuple(key.split("/"))]
+        placed = [{i: math.nan if x is None else x for i, x in zip(keep, row)} for row in rows]
+        out[tuple(key.split("/"))] = [tuple(row.get(i) for i in range(n)) for row in placed]
+    return out
 
 
 def test_javascript_formulas_agree_with_the_sympy_objects(points, references, tmp_path):
@@ -612,8 +650,10 @@ def test_javascript_signatures_are_the_python_ones():
     source = codegen.js_source()
     for name, (args, outputs) in F.FUNCTIONS.items():
         params = list(inspect.signature(getattr(G, name).py_func).parameters)
-        many = len(next(iter(outputs.values())) if isinstance(outputs, dict) else outputs) > 1
-        assert f"export function {name}({', '.join(params + (['out'] if many else []))}) {{" in source, name
+        assert f"export function {name}({', '.join(params + (['out'] if len(outputs) > 1 else []))}) {{" in source, name
+    for entry, (name, keep) in JS_OF_ENTRY.items():
+        params = ["field", *map(str, F.FIELD_FUNCTIONS[entry][0]), *(["out"] if len(keep) > 1 else [])]
+        assert f"export function {name}({', '.join(params)}) {{" in source, name
     assert codegen.js_source() == source                   # regenerated, the same text
 
 
@@ -697,16 +737,17 @@ def test_the_pointwise_check_rejects_another_pipeline(gradient, wrong):
 # ---- the height fields ------------------------------------
 
 def closed_form_excess(exprs, field, points):
-    """`excess` of seed §3's closed form (h_u, h_v), as tests/scalar_reference.py
-    types it (`grad_exact`, float64), over the mpmath value of ``exprs`` (sympy
-    expressions in u, v, k_u, k_v; a shorter tuple compares its first
+    """`excess` of the seed's closed forms (h, h_u, h_v), as tests/scalar_reference.py
+    types them by hand (`seed_height`, `seed_gradient`, float64), over the mpmath value of
+    ``exprs`` (sympy expressions in u, v, k_u, k_v; a shorter tuple compares its first
     components) at each chart point; an ambiguous sign is left out."""
     out = []
     for point in points:
         point = tuple(map(float, point))
+        seed = (scalar_reference.seed_height(field, *point), *scalar_reference.seed_gradient(field, *point))
         with mpmath.workdps(MP_DPS):
             env = {s: (mpmath.mpf(x), mpmath.mpf(0)) for s, x in zip((F.u, F.v, F.k_u, F.k_v), point)}
-            for expr, got in zip(exprs, scalar_reference.grad_exact(field, *point)):
+            for expr, got in zip(exprs, seed):
                 try:
                     out.append(excess(got, evaluate(sp.sympify(expr), env)))
                 except Ambiguous:
@@ -718,24 +759,26 @@ def _closed_form_points(n=200, seed=102):
     return list(zip(*_chart_points(np.random.default_rng(seed), n)))
 
 
-@pytest.mark.parametrize("field", FIELDS)
-def test_sympys_gradient_is_the_seeds_closed_form(field):
-    """sympy's derivative (`formulas.GRADIENT`) agrees with seed §3's closed
-    form, written independently in tests/scalar_reference.py, at seeded chart
-    points: the float64 closed form lies within the forward error bound of
-    the mpmath value (numerical, at points, not a proof)."""
+@pytest.mark.parametrize("field", scalar_reference.SEED_FIELDS)
+def test_the_records_are_the_seeds_closed_forms(field):
+    """The record of each of the seed's fields (its expression and sympy's derivative) agrees
+    with seed §2 and §3's closed forms, written by hand in tests/scalar_reference.py, at seeded
+    chart points: the float64 closed form lies within the forward error bound of the mpmath
+    value (numerical, at points, not a proof)."""
     points = _closed_form_points()
-    ex = closed_form_excess(F.GRADIENT[field], field, points)
-    assert len(ex) >= (1 - MAX_AMBIGUOUS) * 2 * len(points)
+    record = F.FIELDS[field]
+    ex = closed_form_excess((record.expr, *record.gradient), field, points)
+    assert len(ex) >= (1 - MAX_AMBIGUOUS) * 3 * len(points)
     assert ex.max() <= 0.0
 
 
 def test_closed_form_check_rejects_swapped_frequencies():
     points = _closed_form_points()
-    swapped = F.GRADIENT["sine"][0].xreplace({F.k_u: F.k_v, F.k_v: F.k_u})
-    assert np.mean(closed_form_excess((swapped,), "sine", points) > 0) > 0.5
-    # ridges' h_u in place of sine's: wrong wherever the sign factor is -1.
-    assert np.mean(closed_form_excess((F.GRADIENT["ridges"][0],), "sine", points) > 0) > 0.2
+    sine, ridges = F.FIELDS["sine"], F.FIELDS["ridges"]
+    swapped = sine.gradient[0].xreplace({F.k_u: F.k_v, F.k_v: F.k_u})
+    assert np.mean(closed_form_excess((sine.expr, swapped), "sine", points) > 0) > 0.25
+    # ridges' h and h_u in place of sine's: wrong wherever the sign factor is -1.
+    assert np.mean(closed_form_excess((ridges.expr, ridges.gradient[0]), "sine", points) > 0) > 0.2
 
 
 EPS_SWEEP = np.logspace(-2, -4, 9)
@@ -757,7 +800,8 @@ def _interior_v(n=400, seed=95):
     return np.random.default_rng(seed).uniform(0.05, 0.95, n)   # no clamp at eps <= 1e-2
 
 
-@pytest.mark.parametrize("field, component", [("sine", 0), ("sine", 1), ("rings", 1)])
+@pytest.mark.parametrize("field, component", [(name, c) for name, record in F.FIELDS.items() if record.analytic
+                                               for c in (0, 1) if record.gradient[c] != 0])
 def test_central_difference_converges_at_second_order(field, component):
     assert abs(convergence_order(pointwise.central_gradient, field, component, _interior_v()) - 2.0) <= 0.2
 
@@ -791,17 +835,16 @@ def reference_quotient(field, u, v, ku, kv, eps, component):
                      for a, b in zip(u, v)])
 
 
-def quotient_tolerance(ku, kv, eps):
+def quotient_tolerance(field, ku, kv, eps):
     """Rounding allowance of a difference quotient of h: each of the two
     samples carries a few ulp of its argument times h's Lipschitz constant
-    pi max(k_u, 2 k_v), plus an ulp of h (<= 1), over the step."""
-    return 4 * (np.pi * max(ku, 2 * kv) + 1) * 2 * U / eps
+    (tests/test_parity.py's `field_bounds`), plus an ulp of h (<= 1), over the step."""
+    return 4 * (field_bounds(field, ku, kv)[0] + 1) * 2 * U / eps
 
 
-@pytest.mark.parametrize("field", FIELDS)
-@pytest.mark.parametrize("eps", [1e-3, 0.05])
-def test_v_clamp_is_one_sided_at_the_poles(field, eps):
-    ku, kv = 3.3, 7.1
+@pytest.mark.parametrize("field", tuple(F.FIELDS))
+def test_v_clamp_is_one_sided_at_the_poles(field):
+    ku, kv, eps = 3.3, 7.1, float(np.random.default_rng(97).uniform(1e-3, 0.05))
     u = np.random.default_rng(98).random(50)
     at0 = pointwise.central_gradient(field, u, np.zeros_like(u), ku, kv, eps)[1]
     at1 = pointwise.central_gradient(field, u, np.ones_like(u), ku, kv, eps)[1]
@@ -810,7 +853,7 @@ def test_v_clamp_is_one_sided_at_the_poles(field, eps):
     assert scalar_reference.stencil_v(1.0, eps) == (1.0, 1.0 - eps, 1.0 - (1.0 - eps))
     one_sided_0 = reference_quotient(field, u, 0.0, ku, kv, eps, 1)
     one_sided_1 = reference_quotient(field, u, 1.0, ku, kv, eps, 1)
-    tol = quotient_tolerance(ku, kv, eps)
+    tol = quotient_tolerance(field, ku, kv, eps)
     assert np.all(np.abs(at0 - one_sided_0) <= tol) and np.all(np.abs(at1 - one_sided_1) <= tol)
     # The two-sided quotient over the clamped points (divided by 2 eps) is half that: rejected.
     nonzero = np.abs(one_sided_0) > 1e3 * tol
@@ -824,8 +867,9 @@ def test_v_clamp_just_inside_the_border():
     got = pointwise.central_gradient("sine", u, v0, ku, kv, eps)[1]
     assert scalar_reference.stencil_v(v0, eps) == (v0 + eps, 0.0, v0 + eps)
     want = reference_quotient("sine", u, v0, ku, kv, eps, 1)
-    assert np.all(np.abs(got - want) <= quotient_tolerance(ku, kv, eps))
-    assert np.all(np.abs(got - want * (v0 + eps) / (2 * eps)) > quotient_tolerance(ku, kv, eps))
+    tol = quotient_tolerance("sine", ku, kv, eps)
+    assert np.all(np.abs(got - want) <= tol)
+    assert np.all(np.abs(got - want * (v0 + eps) / (2 * eps)) > tol)
 
 
 def test_u_wraps_at_the_seam(monkeypatch):
@@ -841,7 +885,7 @@ def test_u_wraps_at_the_seam(monkeypatch):
     # The wrong variant: the reference's quotient with its u stencil not wrapped.
     monkeypatch.setattr(scalar_reference, "stencil_u", lambda uu, e: (uu + e, uu - e))
     unwrapped = reference_quotient("sine", u, v, ku, kv, eps, 0)
-    tol = quotient_tolerance(ku, kv, eps)
+    tol = quotient_tolerance("sine", ku, kv, eps)
     assert np.all(np.abs(got - want) <= tol)
     assert np.all(np.abs(unwrapped - want) > 1e6 * tol)
 
@@ -863,16 +907,18 @@ def test_interior_v_difference_divides_by_two_eps(monkeypatch):
     assert abs(hv - want * (2 * eps) / ((v + eps) - (v - eps))) > 1e3 * tol
 
 
-@pytest.mark.parametrize("eps", [1e-3, 0.37, 1e-16])
-def test_rings_h_u_is_exactly_zero(eps):
-    """rings has no u: its h_u is the literal 0 in both pipelines and in frames."""
+@pytest.mark.parametrize("field, component", [(name, c) for name, record in F.FIELDS.items()
+                                               for c in (0, 1) if record.gradient[c] == 0])
+def test_a_component_that_is_identically_zero_is_exactly_zero(field, component):
+    """A field without u (rings): its h_u is the literal 0 in both pipelines and in frames."""
     u, v, ku, kv = _chart_points(np.random.default_rng(96), 2000)
-    assert np.all(pointwise.exact_gradient("rings", u, v, ku, kv)[0] == 0.0)
-    assert np.all(pointwise.central_gradient("rings", u, v, ku, kv, eps)[0] == 0.0)
+    assert np.all(pointwise.exact_gradient(field, u, v, ku, kv)[component] == 0.0)
+    for eps in (1e-3, 0.37, 1e-16):
+        assert np.all(pointwise.central_gradient(field, u, v, ku, kv, eps)[component] == 0.0)
     for gradient in GRADIENTS:
-        frame = render(Scene(height_field="rings"), 48, 48, gradient=gradient)
+        frame = render(Scene(height_field=field), 48, 48, gradient=gradient)
         on_a = frame.chamber == 1
-        assert np.all(frame.grad[on_a, 0] == 0.0) and np.any(frame.grad[on_a, 1] != 0.0)
+        assert np.all(frame.grad[on_a, component] == 0.0) and np.any(frame.grad[on_a, 1 - component] != 0.0)
 
 
 def test_zero_check_rejects_sine():
@@ -880,17 +926,16 @@ def test_zero_check_rejects_sine():
     assert np.count_nonzero(frame.grad[frame.chamber == 1, 0]) > 500
 
 
-@pytest.mark.parametrize("field", FIELDS)
-@pytest.mark.parametrize("eps", [F.FOOTPRINT_FALLBACK, 1e-16, 1e-12, 0.25, 0.5, 1 - 2**-53])
-def test_central_gradient_is_finite_at_the_border_points(field, eps):
+@pytest.mark.parametrize("field", tuple(F.FIELDS))
+def test_central_gradient_is_finite_at_the_border_points(field):
     """Steps from the scene's smallest to just below 1, at the chart's borders."""
     grid = np.array([0.0, 5e-324, 1e-300, 2**-60, 0.5, 1 - 2**-53, 1.0, 0.999, 1e-3])
     u, v = (a.ravel() for a in np.meshgrid(grid, grid))
-    hu, hv = pointwise.central_gradient(field, u, v, 8.0, 4.0, float(eps))
-    assert np.all(np.isfinite(hu)) and np.all(np.isfinite(hv))
+    for eps in (float(F.FOOTPRINT_FALLBACK), 1e-16, 1e-12, 0.25, 0.5, 1 - 2**-53):
+        hu, hv = pointwise.central_gradient(field, u, v, 8.0, 4.0, eps)
+        assert np.all(np.isfinite(hu)) and np.all(np.isfinite(hv)), eps
 
 
-def test_smooth_fields_have_no_crease_band_and_ridges_has_one():
-    for field in ("sine", "rings"):
-        assert not np.any(render(Scene(height_field=field), 48, 48).kink)
-    assert np.any(render(Scene(height_field="ridges"), 48, 48).kink)
+@pytest.mark.parametrize("field", tuple(F.FIELDS))
+def test_a_field_has_a_crease_band_where_its_record_has_creases(field):
+    assert np.any(render(Scene(height_field=field), 48, 48).kink) == bool(F.FIELDS[field].crease_factors)

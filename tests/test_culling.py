@@ -29,6 +29,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from renderer import PointLight, Scene, kernel, render
+from renderer import formulas as F
 
 EPS = 2.0**-52
 #: 40 digits: the float64 inputs are exact binary numbers and a grazing ray's
@@ -234,7 +235,7 @@ def scenes(draw):
                    for _ in range(draw(st.integers(1, 3))))
     kw = dict(center_b=cb, radius_b=rb, lights=lights, camera_z=draw(st.floats(2.5, 8.0)),
               sphere_b=draw(st.booleans()), floor=draw(st.booleans()),
-              height_field=draw(st.sampled_from(["sine", "ridges", "rings"])),
+              height_field=draw(st.sampled_from(tuple(F.FIELDS))),
               beta=draw(st.sampled_from([0.0, 0.35, 1.5])), model=draw(st.sampled_from(["blinn", "phong"])),
               bump=draw(st.sampled_from(["chart", "surface"])))
     if kw["bump"] == "surface":

@@ -128,8 +128,6 @@ def _bump_functions():
 
 
 BUMP = _bump_functions()
-#: The arguments a_u, a_v of the ridges' two sines (`formulas.RIDGE_FACTORS`), as numpy functions.
-RIDGE_ARGUMENTS = [sp.lambdify((F.u, F.v, F.k_u, F.k_v), factor.args[0], "numpy") for factor in F.RIDGE_FACTORS]
 
 #: (id, scene, width, height, gradient, zoom); non-square sizes catch a transposed
 #: image, odd widths put a pixel column exactly on x = 0 (the seam's meridian).
@@ -264,11 +262,18 @@ def image_tolerance(scene, on_a, P, Ns, d_ns):
 NEAR = 1e-6
 
 
-def ridge_arguments(scene, uv):
-    """The float arguments a_u = (pi k_u) u, a_v = (pi k_v) v of the ridges' two
-    sines (`formulas.RIDGE_FACTORS`), rounded as formulas.js and generated.py
-    round them: pi k first."""
-    return tuple(a(uv[..., 0], uv[..., 1], scene.k_u, scene.k_v) for a in RIDGE_ARGUMENTS)
+def crease_arguments(scene, uv):
+    """[(a, c)] per crease factor sin(a) of the scene's field (its record's ``crease_factors``;
+    the ridges': a_u = (pi k_u) u, a_v = (pi k_v) v): the float arguments a, rounded as
+    formulas.js and generated.py round them (pi k first), and the chart coordinate c (0: u,
+    1: v) a depends on."""
+    out = []
+    for factor in scene.field.crease_factors:
+        assert isinstance(factor, sp.sin), f"the error model knows crease factors sin(a), not {factor}"
+        (c,) = [i for i, x in enumerate((F.u, F.v)) if x in factor.free_symbols]
+        a = sp.lambdify(F.FIELD_SYMBOLS, factor.args[0], "numpy")
+        out.append((a(uv[..., 0], uv[..., 1], scene.k_u, scene.k_v), c))
+    return out
 
 
 def crease_margins(args):
@@ -333,14 +338,14 @@ def error_model(scene, gradient, py, moved):
     uv_py, g_py = gb.uv[on_a], frame.grad[on_a]
     n = len(uv_py)
     sign_ratio, edge_ratio = np.full(n, np.inf), np.full(n, np.inf)
-    if scene.height_field == "ridges":
-        # Where u (v) is the same bits on both sides, so is a_u (a_v).
-        for moves, a in zip(np.moveaxis(moved, -1, 0), ridge_arguments(scene, uv_py)):
-            to_pi, to_edge = crease_margins(a[moves])
-            if gradient == "exact":
-                sign_ratio[moves] = np.minimum(sign_ratio[moves], to_pi / arg_tol(scene))
-            edge_ratio[moves] = np.minimum(edge_ratio[moves],
-                                           to_edge / (arg_tol(scene) + 2.0 * math.ulp(KINK_BAND_HALF_WIDTH)))
+    # Where u (v) is the same bits on both sides, so is a_u (a_v).
+    for a, c in crease_arguments(scene, uv_py):
+        moves = moved[:, c]
+        to_pi, to_edge = crease_margins(a[moves])
+        if gradient == "exact":
+            sign_ratio[moves] = np.minimum(sign_ratio[moves], to_pi / arg_tol(scene))
+        edge_ratio[moves] = np.minimum(edge_ratio[moves],
+                                       to_edge / (arg_tol(scene) + 2.0 * math.ulp(KINK_BAND_HALF_WIDTH)))
     branch_ratio = (stencil_margin(uv_py, extra["steps"]) / (32.0 * U) if gradient != "exact"
                     else np.full(n, np.inf))
     g_tol = grad_tolerance(scene, gradient, g_py, uv_py, extra["steps"])
@@ -438,7 +443,7 @@ def rows(modules, tmp_path_factory):
 
 def test_parity_cover_the_acceptance_grid():
     scenes = [c[1] for c in CASES]
-    assert {s.height_field for s in scenes} == {"sine", "ridges", "rings"}
+    assert {bool(s.field.crease_factors) for s in scenes} == {True, False}
     assert {s.model for s in scenes} == {"blinn", "phong"}
     assert {s.bump for s in scenes} == {"chart", "surface"}
     assert {c[4] for c in CASES} == set(GRADIENTS)

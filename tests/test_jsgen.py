@@ -5,7 +5,6 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
-import os
 import re
 import subprocess
 from pathlib import Path
@@ -13,7 +12,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from renderer import codegen, generated, jsgen, pointwise
+from renderer import codegen, fieldcode, generated, jsgen, pointwise
 from renderer import formulas as F
 
 from .jsnode import node_command
@@ -65,12 +64,9 @@ def test_the_bundle_is_made_again_when_the_sources_change(tmp_path, monkeypatch)
         assert bundle.read_text(encoding="utf-8") == want, (digest, kept)
 
 
-def test_a_built_book_carries_the_regenerated_bundle():
-    """The simulator script of a built site (SYMRENDER_BOOK_HTML) is today's bundle."""
-    html = os.environ.get("SYMRENDER_BOOK_HTML")
-    if not html:
-        pytest.skip("SYMRENDER_BOOK_HTML names no built site")
-    script = Path(html) / "_static" / "sim" / "simulator.js"
+def test_a_built_book_carries_the_regenerated_bundle(book_html):
+    """The simulator script of the built site (an audit: `make audit`) is today's bundle."""
+    script = book_html / "_static" / "sim" / "simulator.js"
     assert script.read_text(encoding="utf-8") == jsgen.bundle_source(), \
         f"{script} is stale: rebuild the book"
 
@@ -112,14 +108,16 @@ def test_every_generated_function_runs_in_javascript_and_agrees_with_python(tmp_
     returns, to rounding: a handful of libm-vs-V8 ulps, amplified by at most
     1/eps = 1e3 in the central quotient, stays far inside 1e-9 relative."""
     calls, expect = {}, {}
-    for name, (args, outputs) in F.FUNCTIONS.items():
+    for name, (args, _) in F.FUNCTIONS.items():
         values = [ARGS[str(a)] for a in args]
-        fields = F.FIELD_CODES.items() if isinstance(outputs, dict) else [(None, None)]
-        for field, code in fields:
-            lead = [] if code is None else [code]
-            key = f"{name}[{field}]" if field else name
-            calls[key] = (name, lead + values)
-            expect[key] = getattr(generated, name)(*lead, *values)
+        calls[name], expect[name] = (name, values), getattr(generated, name)(*values)
+    for code, (field, record) in enumerate(F.FIELDS.items()):       # formulas.js's FIELD_CODES
+        for name, (entry, keep) in codegen.JS_FIELD_FUNCTIONS.items():
+            values = [ARGS[str(a)] for a in F.FIELD_FUNCTIONS[entry][0]]
+            out = getattr(fieldcode.compiled(record), entry)(*values)
+            out = out if isinstance(out, tuple) else (out,)
+            calls[f"{name}[{field}]"] = (name, [code] + values)
+            expect[f"{name}[{field}]"] = tuple(out[i] for i in keep)
     got = _js_values(tmp_path, calls)
     assert set(got) == set(calls)
     for key, want in expect.items():

@@ -5,8 +5,8 @@ Scene attribute of its name (or `DERIVED`), and the lights into `LIGHT`
 records.  Checked here:
 
 * every field holds its own quantity, on a scene whose quantities all differ;
-* a field inserted before the others or the fields in another order change no
-  bit of the image (positions do not matter);
+* the fields in another order, with one inserted before them, change no bit
+  of the image (positions do not matter);
 * a misnamed field is refused by `params`, naming it, and a field the kernel
   reads that the record lacks stops the compilation: neither renders.
 """
@@ -28,7 +28,7 @@ SCENE = Scene(camera_z=4.5, radius_a=1.1, center_b=(1.3, -0.4, 0.2), radius_b=0.
                       PointLight((1.0, -2.0, 7.0), (0.3, 0.4, 0.5))))
 EXPECTED = dict(camera_z=4.5, radius_a=1.1, center_b=(1.3, -0.4, 0.2), radius_b=0.35, sphere_b=True, floor=True,
                 ambient=(0.11, 0.12, 0.13), albedo_a=(0.61, 0.62, 0.63), albedo_b=(0.71, 0.72, 0.73), ka=0.21,
-                kd=0.66, ks=0.31, shininess=17.0, phong=True, floor_tint=0.07, field=2, k_u=9.0, k_v=5.0,
+                kd=0.66, ks=0.31, shininess=17.0, phong=True, floor_tint=0.07, k_u=9.0, k_v=5.0,
                 beta=0.45, surface=False)
 
 
@@ -62,10 +62,10 @@ def _layout(names, extra=()):
     return np.dtype([*extra, *((n, kernel.SCENE.fields[n][0]) for n in names)], align=True)
 
 
-@pytest.mark.parametrize("layout", ["a field inserted first", "fields reversed"])
-def test_the_layout_changes_no_bit(monkeypatch, reference, uncached, layout):
+def test_the_layout_changes_no_bit(monkeypatch, reference, uncached):
+    """The fields reversed and one inserted before them (one compilation: each costs a minute)."""
     names = kernel.SCENE.names
-    changed = _layout(names, [("unused", "f8")]) if layout == "a field inserted first" else _layout(names[::-1])
+    changed = _layout(names[::-1], [("unused", "f8")])
     assert [changed.fields[n][1] for n in names] != [kernel.SCENE.fields[n][1] for n in names]    # offsets moved
     monkeypatch.setattr(kernel, "SCENE", changed)
     monkeypatch.setattr(kernel, "DERIVED", dict(kernel.DERIVED, unused=lambda scene: 123.0))

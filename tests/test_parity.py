@@ -1,8 +1,17 @@
 """Parity: `renderer.render` against the scalar oracle `scalar_reference`.
 
-Every height field x both models x the three pipelines (exact, central,
-footprint) x sphere B on/off x floor on/off x beta in {0, 0.35, 1.5}, on
-three small frames chosen for what they hit:
+The scenes cover, not enumerate.  The settings (every registered height field,
+`renderer.formulas.FIELDS`; both models; the three pipelines, exact, central
+and footprint; both bump modes; beta; sphere B and the floor on and off; the
+frame; the backend; and the scene variants of `VARIANTS`, which exercise what
+the default scene does not) are drawn from a pairwise covering array
+(`allpairspy`): every pair of values of any two settings is rendered in some
+scene, which finds any bug that two settings make together (a wrong term only
+for phong and central differences, say) in some fifty scenes instead of the
+full product's thousands.  Random scenes (`test_random_scenes_match_the_reference`,
+seeded) move every number of a scene off the values the array uses.
+
+The frames, chosen for what they hit:
 
 * 24 x 20: even width, non-square;
 * 17 x 13: odd width (column 8 lies on x = 0), odd height;
@@ -10,24 +19,22 @@ three small frames chosen for what they hit:
   sphere A's pole: sin(phi) = 4e-17, the frame fallback and the one-sided v
   difference (v = 1.3e-17 < eps) are exercised.
 
-Each frame is rendered by every backend of `renderer.render`: the numba
-kernel, the array kernel on numpy (everywhere) and on Dr.Jit's LLVM backend
-(where the system's libLLVM is; skipped without it, failed when CI=true).
-Dr.Jit runs the program numpy runs, with its own sin, cos and atan2, so it
-is checked on a subset that still covers every field, model, pipeline and
-scene variant (see `with_backends`' callers): each new scene is a new compiled kernel
-(a fifth of a second), which the whole matrix would pay some 700 times.
+The backends are those of `renderer.render`: the numba kernel, the array
+kernel on numpy (everywhere) and on Dr.Jit's LLVM backend (where the system's
+libLLVM is; skipped without it, failed when CI=true).
 
 Checks per frame: identical chamber codes, identical crease flags,
 |dI| <= 1e-12 per channel (the issue's tolerance), and the gradient within the
-tolerance of `grad_tolerance` (justified there).  The footprint pipeline's
-step is computed by both routes from the pixel's geometry, so its gradient
-carries the step's rounding too: `footprint_bound` bounds that, and the
-image tolerance of that pipeline grows by what the gradient tolerance can
-move the reference's own shading (`footprint_allowances`).  The only
-exemption is a ray tangent to a sphere (`grazing_mask`: at most two pixels,
-checked at 1e-6).  Each kind of check is shown to reject a wrong variant at
-the end of the file.
+tolerance of `grad_tolerance`, derived from bounds of the field's first and
+second derivatives over the chart (`field_bounds`, interval arithmetic on the
+record's expression, so that any registered field or a reader's expression
+gets its own).  The footprint pipeline's step is computed by both routes from
+the pixel's geometry, so its gradient carries the step's rounding too:
+`footprint_bound` bounds that.  The image tolerance of the central and footprint
+pipelines grows by what their gradient tolerance can move the reference's own
+shading (`shading_allowance`: at small steps the quotient's rounding is large).  The only exemption is a ray tangent to a sphere
+(`grazing_mask`: at most two pixels, checked at 1e-6).  Each kind of check is
+shown to reject a wrong variant at the end of the file.
 """
 
 from __future__ import annotations
@@ -35,11 +42,18 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+from collections import OrderedDict
 
+import mpmath
 import numpy as np
 import pytest
+import sympy as sp
+from allpairspy import AllPairs
+from mpmath import iv
 
-from renderer import PointLight, Scene, backends, render
+from renderer import GRADIENTS, MODELS, PointLight, Scene, backends, render
+from renderer import formulas as F
+from renderer.validate import InputError
 from tests import scalar_reference as ref
 from tests.jsnode import in_ci
 
@@ -47,23 +61,65 @@ pytestmark = pytest.mark.cpu_dependent     # make test-baseline-simd runs the fi
 
 SIZES = ((24, 20), (17, 13), (17, 20))
 IMAGE_TOL = 1e-12          # per channel, required by the issue
-FIELDS = ("sine", "ridges", "rings")
-MODELS = ("blinn", "phong")
-GRADIENTS = ("exact", "central", "footprint")
 LIGHT_2 = PointLight((-6.0, 2.0, 8.0), (0.9, 0.65, 0.25))     # the seed's second light
 U = 2.0**-53               # unit roundoff
+#: How far the two routes' chart points (u, v) may lie apart: a few ulp of 1 (their own
+#: hit points and atan2 sequences; measured within 2^-52).
+CHART_SHIFT = 2.0**-50
+
+def _monotonic(f):
+    """An interval version of the monotonic function ``f`` (an mpmath function): f at the ends."""
+    return lambda x: iv.mpf(sorted((f(iv.mpf(x).a), f(iv.mpf(x).b))))
+
+
+def _cosh(x):
+    x = iv.mpf(x)
+    low = 1 if x.a <= 0 <= x.b else min(mpmath.cosh(x.a), mpmath.cosh(x.b))
+    return iv.mpf([low, max(mpmath.cosh(x.a), mpmath.cosh(x.b))])
+
+
+#: Interval versions (``mpmath.iv``) of the functions a field may use (`formulas.ELEMENTARY`):
+#: mpmath's own where it has one, else the function at the interval's ends (each monotonic;
+#: cosh even, increasing on [0, inf)).
+_INTERVAL = {"sin": iv.sin, "cos": iv.cos, "tan": iv.tan, "exp": iv.exp, "log": iv.log, "sqrt": iv.sqrt,
+             "pi": iv.pi, "E": iv.e, "Abs": abs, "cosh": _cosh,
+             **{name: _monotonic(getattr(mpmath, name)) for name in ("asin", "acos", "atan", "sinh", "tanh")}}
+
+
+@functools.lru_cache(maxsize=None)
+def field_bounds(field, k_u, k_v):
+    """(L1, L2): bounds on |h_u|, |h_v| and on the four second derivatives of the height field
+    ``field`` (a Scene's ``height_field``) over the chart [0, 1]^2, where they exist.
+
+    Interval arithmetic (``mpmath.iv``) on the record's expression with its ``Abs`` taken off
+    (|f| has the slope of f up to its sign, away from f's zeros, where h has a crease and no
+    second derivative): an upper bound, not an estimate; the product of intervals
+    overestimates a product of sines, which only widens the tolerance a little.
+    """
+    record = F.field(field)
+    smooth = record.expr.replace(sp.Abs, lambda a: a)
+    first = [sp.diff(smooth, x) for x in (F.u, F.v)]
+    second = [sp.diff(d, x) for d in first for x in (F.u, F.v)]
+    fn = sp.lambdify(F.FIELD_SYMBOLS, [*first, *second], modules=[_INTERVAL])
+    chart = iv.mpf([0, 1])
+    values = [abs(iv.mpf(b)).b for b in fn(chart, chart, iv.mpf(k_u), iv.mpf(k_v))]
+    return float(max(values[:2])), float(max(values[2:]))
 
 
 def lipschitz(scene):
-    """Bound on |h_u| and |h_v| of every field: pi max(k_u, 2 k_v)."""
-    return math.pi * max(scene.k_u, 2.0 * scene.k_v)
+    """L1 of `field_bounds`: a Lipschitz constant of h in each chart variable."""
+    return field_bounds(scene.height_field, scene.k_u, scene.k_v)[0]
 
 
 def grad_tolerance(scene, gradient, grad_ref, steps=None, delta=None):
     """Allowed |grad_renderer - grad_reference|, per component.
 
-    Both routes evaluate the same closed forms, so 1e-12 (1 + |g|) covers
-    rounding for the exact pipeline (measured worst on these frames: 4.7e-14 relative).
+    Both routes evaluate the same sympy expressions (the kernel the printed and
+    compiled ones, the reference sympy's ``math`` printing), so 1e-12 (1 + |g|)
+    covers their roundings (measured worst on these frames: 4.7e-14 relative),
+    and the chart points of the two routes lie up to `CHART_SHIFT` apart, which
+    moves the exact gradient by at most L2 CHART_SHIFT (L2 bounds h's second
+    derivatives, `field_bounds`).
 
     The central pipeline needs an absolute slack on top.  The two routes
     compute the chart (u, v) of a hit point differently (textbook vs
@@ -71,9 +127,9 @@ def grad_tolerance(scene, gradient, grad_ref, steps=None, delta=None):
     and the results differ by a few ulp.  The common shift cancels in
     h(u + eps) - h(u - eps), but u + eps and u - eps are each rounded
     afresh, so the two samples can sit up to 2^-52 apart per side.  h is
-    Lipschitz with constant LIP = pi max(k_u, 2 k_v) in each chart variable,
-    so the quotient can move by 2 LIP 2^-52 / (2 eps) = LIP 2^-52 / eps
-    (5.6e-12 at the defaults).
+    Lipschitz with constant LIP = L1 in each chart variable, so the quotient
+    can move by 2 LIP 2^-52 / (2 eps) = LIP 2^-52 / eps (5.6e-12 for the
+    ridges at the defaults).
 
     The footprint pipeline is the central one with steps ``steps`` (H, W, 2),
     the reference's, per component; the renderer's own steps differ from
@@ -83,9 +139,11 @@ def grad_tolerance(scene, gradient, grad_ref, steps=None, delta=None):
     (also for the one-sided quotient at the v border), so a relative change
     delta of the step moves the quotient by at most 2 LIP delta.
     """
+    lip, second = field_bounds(scene.height_field, scene.k_u, scene.k_v)
     tol = 1e-12 * (1.0 + np.abs(grad_ref))
-    lip = lipschitz(scene)
-    if gradient == "central":
+    if gradient == "exact":
+        tol = tol + second * CHART_SHIFT
+    elif gradient == "central":
         tol = tol + lip * 2.0**-52 / scene.eps
     elif gradient == "footprint":
         tol = tol + lip * 2.0**-52 / steps + 2.0 * lip * delta
@@ -103,7 +161,7 @@ GRAZING_REL_T = 1e-12      # eps * condition number of t above which a hit count
 MAX_GRAZING = 2            # per frame: the exemption cannot swallow a silhouette
 GRAZING_TOL = 1e-6         # |dI| still bounded there, and the chart point within this
                            # distance; h's gradient then moves by at most its second
-                           # derivative bound (pi max(k_u, 2 k_v))^2 times that.
+                           # derivatives' bound (L2 of `field_bounds`) times that.
 
 
 def hit_condition(scene, x, y, C, r):
@@ -123,14 +181,16 @@ def hit_condition(scene, x, y, C, r):
     return (b * b + abs(a * c)) / (a * math.sqrt(D) * t)
 
 
-def grazing_mask(scene, width, height, chamber):
-    """Pixels whose sphere hit is ill-conditioned by input rounding alone."""
-    mask = np.zeros(chamber.shape, dtype=bool)
+def grazing_mask(scene, width, height, *chambers):
+    """Pixels whose sphere hit, in any of ``chambers`` (the reference's, the renderer's), is
+    ill-conditioned by input rounding alone."""
+    mask = np.zeros(chambers[0].shape, dtype=bool)
     spheres = {ref.SPHERE_A: ((0.0, 0.0, 0.0), scene.radius_a),
                ref.SPHERE_B: (scene.center_b, scene.radius_b)}
-    for j, i in zip(*np.nonzero(np.isin(chamber, list(spheres)))):
-        x, y = ref.pixel_point(scene, i, j, width, height)
-        mask[j, i] = 2.0**-52 * hit_condition(scene, x, y, *spheres[int(chamber[j, i])]) > GRAZING_REL_T
+    for chamber in chambers:
+        for j, i in zip(*np.nonzero(np.isin(chamber, list(spheres)))):
+            x, y = ref.pixel_point(scene, i, j, width, height)
+            mask[j, i] |= 2.0**-52 * hit_condition(scene, x, y, *spheres[int(chamber[j, i])]) > GRAZING_REL_T
     return mask
 
 
@@ -211,24 +271,13 @@ def footprint_bound(scene, i, j, width, height):
 WIDE_DELTA = 1e-6
 
 
-def footprint_allowances(scene, width, height, chamber, grad_ref):
-    """(grad tolerance, extra image tolerance, pixels with delta > WIDE_DELTA) of the footprint pipeline.
-
-    The image allowance is how far the reference's own shading of the pixel
-    moves when its gradient moves by the gradient tolerance (the largest
-    change over the four corners of the tolerance box, first order).  Where
-    delta > WIDE_DELTA the step may be anything the cap and the fallback
-    allow, and first order bounds nothing: the image is not compared there
-    (no more than MAX_GRAZING such pixels, `parity_failures`).
-    """
-    steps, delta = np.ones(grad_ref.shape), np.zeros(grad_ref.shape)
+def shading_allowance(scene, width, height, chamber, grad_ref, tol):
+    """Extra image tolerance per pixel of sphere A: how far the reference's own shading of the
+    pixel moves when its gradient moves by the gradient tolerance ``tol`` (the largest change
+    over the four corners of the tolerance box, first order); inf where ``tol`` is not finite."""
     extra = np.zeros(chamber.shape)
-    on_a = np.argwhere(chamber == ref.SPHERE_A)
-    for j, i in on_a:
-        steps[j, i], delta[j, i] = footprint_bound(scene, i, j, width, height)
-    tol = grad_tolerance(scene, "footprint", grad_ref, steps, delta)
-    for j, i in on_a:
-        if not np.all(np.isfinite(tol[j, i])) or np.any(delta[j, i] > WIDE_DELTA):
+    for j, i in np.argwhere(chamber == ref.SPHERE_A):
+        if not np.all(np.isfinite(tol[j, i])):
             extra[j, i] = math.inf
             continue
         x, y = ref.pixel_point(scene, i, j, width, height)
@@ -240,7 +289,23 @@ def footprint_allowances(scene, width, height, chamber, grad_ref):
         base = colour(grad_ref[j, i])
         extra[j, i] = max(float(np.abs(colour(grad_ref[j, i] + np.array(s) * tol[j, i]) - base).max())
                           for s in itertools.product((-1.0, 1.0), repeat=2))
-    return tol, extra, int(np.count_nonzero((delta > WIDE_DELTA).any(axis=-1)))
+    return extra
+
+
+def footprint_allowances(scene, width, height, chamber, grad_ref):
+    """(grad tolerance, extra image tolerance, pixels with delta > WIDE_DELTA) of the footprint
+    pipeline (the image's, `shading_allowance`).  Where delta > WIDE_DELTA the step may be
+    anything the cap and the fallback allow, and first order bounds nothing: the image is not
+    compared there (no more than MAX_GRAZING such pixels, `parity_failures`).
+    """
+    steps, delta = np.ones(grad_ref.shape), np.zeros(grad_ref.shape)
+    for j, i in np.argwhere(chamber == ref.SPHERE_A):
+        steps[j, i], delta[j, i] = footprint_bound(scene, i, j, width, height)
+    tol = grad_tolerance(scene, "footprint", grad_ref, steps, delta)
+    wide = (delta > WIDE_DELTA).any(axis=-1)
+    extra = shading_allowance(scene, width, height, chamber, grad_ref, tol)
+    extra[wide] = math.inf
+    return tol, extra, int(np.count_nonzero(wide))
 
 
 def parity_failures(scene, width, height, gradient, *, frame=None, backend="numba", reference=None):
@@ -251,44 +316,47 @@ def parity_failures(scene, width, height, gradient, *, frame=None, backend="numb
         frame = render(scene, width, height, gradient=gradient, backend=backend)
     image, chamber, kink, grad = reference or ref.render_reference(scene, width, height, gradient=gradient)
     failures = []
-    n = int(np.count_nonzero(frame.chamber != chamber))
+    # A tangent ray's hit is decided by rounding: where the chambers differ there, nothing else
+    # of the pixel compares either.
+    tangent = grazing_mask(scene, width, height, chamber, frame.chamber)
+    if np.count_nonzero(tangent) > MAX_GRAZING:            # then no pixel is exempt
+        failures.append(f"{np.count_nonzero(tangent)} tangent pixels > {MAX_GRAZING}")
+        tangent[:] = False
+    hit_differs = frame.chamber != chamber
+    n = int(np.count_nonzero(hit_differs & ~tangent))
     if n:
         failures.append(f"chamber differs at {n} pixels")
-    n = int(np.count_nonzero(frame.kink != kink))
+    n = int(np.count_nonzero((frame.kink != kink) & ~hit_differs))
     if n:
         failures.append(f"kink differs at {n} pixels")
-    tangent = grazing_mask(scene, width, height, chamber)
-    if np.count_nonzero(tangent) > MAX_GRAZING:
-        failures.append(f"{np.count_nonzero(tangent)} tangent pixels > {MAX_GRAZING}")
+    tangent &= ~hit_differs
     if gradient == "footprint":
         tol, extra, wide = footprint_allowances(scene, width, height, chamber, grad)
         if wide > MAX_GRAZING:
             failures.append(f"{wide} pixels with an ill-conditioned footprint > {MAX_GRAZING}")
+    elif gradient == "central":
+        tol = grad_tolerance(scene, gradient, grad)
+        extra = shading_allowance(scene, width, height, chamber, grad, tol)
     else:
         tol, extra = grad_tolerance(scene, gradient, grad), np.zeros(chamber.shape)
     d_image = np.abs(frame.image - image).max(axis=-1)
     excess = (np.abs(frame.grad - grad) - tol).max(axis=-1)
-    lip = lipschitz(scene)
-    for where, image_tol, what in ((~tangent, IMAGE_TOL, ""), (tangent, GRAZING_TOL, " (tangent)")):
+    second = field_bounds(scene.height_field, scene.k_u, scene.k_v)[1]
+    for where, image_tol, what in ((~tangent & ~hit_differs, IMAGE_TOL, ""), (tangent, GRAZING_TOL, " (tangent)")):
         if not where.any():
             continue
         worst = float((d_image - extra)[where].max())
         if not worst <= image_tol:                       # also catches NaN
             failures.append(f"max |dI|{what} beyond the allowance = {worst:.3e} > {image_tol}")
         worst = float(excess[where].max())
-        if not worst <= (0.0 if what == "" else GRAZING_TOL * lip * lip):
+        if not worst <= (0.0 if what == "" else GRAZING_TOL * second):
             failures.append(f"grad{what} differs beyond tolerance by up to {worst:.3e}")
     return failures
 
 
-# --- the full matrix --------------------------------------------------------------------
+# --- the scenes: a pairwise covering array of the settings, and random scenes ---------------
 
 BACKENDS = ("numba", "numpy", "drjit")
-
-
-def with_backends(cases, drjit_subset):
-    """``cases`` (tuples) each with every backend appended; "drjit" only where ``drjit_subset(case)``."""
-    return [case + (b,) for case in cases for b in BACKENDS if b != "drjit" or drjit_subset(case)]
 
 
 def require_backend(backend):
@@ -300,66 +368,150 @@ def require_backend(backend):
         pytest.skip(why)
 
 
-@functools.lru_cache(maxsize=32)
-def cached_reference(scene, width, height, gradient):
-    """`scalar_reference.render_reference`, computed once for the backends of one case."""
-    return ref.render_reference(scene, width, height, gradient=gradient)
-
-
-def assert_parity(scene, gradient, backend):
+def assert_parity(scene, gradient, backend, sizes=SIZES):
     require_backend(backend)
-    for width, height in SIZES:
-        reference = cached_reference(scene, width, height, gradient)
-        assert parity_failures(scene, width, height, gradient, backend=backend, reference=reference) == [], \
-            (width, height)
+    for width, height in sizes:
+        assert parity_failures(scene, width, height, gradient, backend=backend) == [], (width, height)
 
 
-MATRIX = list(itertools.product(FIELDS, MODELS, GRADIENTS, (True, False), (True, False),
-                                (0.0, 0.35, 1.5)))
-
-
-@pytest.mark.parametrize("field, model, gradient, sphere_b, floor, beta, backend",
-                         with_backends(MATRIX, lambda case: case[3:] == (True, True, 0.35)))
-def test_matches_reference(field, model, gradient, sphere_b, floor, beta, backend):
-    scene = Scene(height_field=field, model=model, sphere_b=sphere_b, floor=floor, beta=beta, bump="chart")
-    assert_parity(scene, gradient, backend)
-
-
-@pytest.mark.parametrize("field, model, gradient, beta, backend",
-                         with_backends(list(itertools.product(FIELDS, MODELS, GRADIENTS, (0.35, 0.9))),
-                                       lambda case: case[3] == 0.9))
-def test_matches_reference_displaced_surface_normal(field, model, gradient, beta, backend):
-    """Scene.bump = "surface": the displaced sphere's normal, derived by hand in the reference."""
-    assert_parity(Scene(height_field=field, model=model, beta=beta, bump="surface"), gradient, backend)
-
-
-# Scenes that exercise what the default scene does not.
+#: Scenes that exercise what the default scene does not: name -> (Scene fields, the values of the
+#: other settings it is drawn with, where it means something only with those).
 VARIANTS = {
     # Sphere points are lit from below the floor plane only if the plane does not separate them.
-    "light below the floor": dict(lights=(PointLight((5.0, 5.0, 10.0)),
-                                          PointLight((3.0, -2.0, -4.0), (0.5, 0.6, 0.7)))),
-    "black light skipped": dict(lights=(PointLight((5.0, 5.0, 10.0), (0.0, 0.0, 0.0)), LIGHT_2)),
-    "no lights": dict(lights=()),
-    "light inside sphere B": dict(lights=(PointLight((0.5, 0.5, 1.3)), LIGHT_2)),
+    "light below the floor": (dict(lights=(PointLight((5.0, 5.0, 10.0)),
+                                           PointLight((3.0, -2.0, -4.0), (0.5, 0.6, 0.7)))), dict(floor=(True,))),
+    "black light skipped": (dict(lights=(PointLight((5.0, 5.0, 10.0), (0.0, 0.0, 0.0)), LIGHT_2)), {}),
+    "no lights": (dict(lights=()), {}),
+    "light inside sphere B": (dict(lights=(PointLight((0.5, 0.5, 1.3)), LIGHT_2)), dict(sphere_b=(True,))),
     # k_u = 7: the pole pixel of 17 x 20 has h_v != 0, so the fallback frame matters.
-    "pole with nonzero gradient": dict(k_u=7.0, beta=1.5, bump="chart"),
-    "non-integer frequencies": dict(k_u=3.3, k_v=7.1, beta=1.0, bump="chart"),
-    "large eps": dict(eps=0.25),
-    "eps 0.05": dict(eps=0.05),
-    "camera close, sphere B moved": dict(camera_z=2.5, radius_a=0.8, center_b=(-0.6, 0.2, 0.9),
-                                         radius_b=0.4),
-    "saturated (clipping)": dict(kd=1.0, ks=1.0, shininess=1.0, floor_tint=1.0,
-                                 lights=(PointLight((5.0, 5.0, 10.0), (3.0, 3.0, 3.0)), LIGHT_2)),
-    "sphere B through the floor": dict(center_b=(0.9, -0.3, 0.2), radius_b=0.5, floor_tint=0.0),
+    "pole with nonzero gradient": (dict(k_u=7.0), dict(size=((17, 20),), beta=(0.35, 0.9, 1.5))),
+    "non-integer frequencies": (dict(k_u=3.3, k_v=7.1), {}),
+    "large eps": (dict(eps=0.25), dict(gradient=("central",))),
+    "eps 0.05": (dict(eps=0.05), dict(gradient=("central",))),
+    "camera close, sphere B moved": (dict(camera_z=2.5, radius_a=0.8, center_b=(-0.6, 0.2, 0.9), radius_b=0.4), {}),
+    "saturated (clipping)": (dict(kd=1.0, ks=1.0, shininess=1.0, floor_tint=1.0,
+                                  lights=(PointLight((5.0, 5.0, 10.0), (3.0, 3.0, 3.0)), LIGHT_2)), {}),
+    "sphere B through the floor": (dict(center_b=(0.9, -0.3, 0.2), radius_b=0.5, floor_tint=0.0), {}),
 }
+#: The settings and their values (every registered field, derived from the records); the scene's
+#: own settings first, so that a partial row can already be checked by `Scene`.
+SETTINGS = OrderedDict(
+    variant=("default", *VARIANTS), bump=("chart", "surface"), beta=(0.0, 0.35, 0.9, 1.5),
+    field=tuple(F.FIELDS), model=MODELS, sphere_b=(True, False), floor=(True, False),
+    gradient=GRADIENTS, size=SIZES, backend=BACKENDS)
+_SCENE_SETTINGS = dict(field="height_field", bump="bump", beta="beta", model="model", sphere_b="sphere_b",
+                       floor="floor")
 
 
-@pytest.mark.parametrize("name, field, gradient, backend",
-                         with_backends(list(itertools.product(sorted(VARIANTS), FIELDS, GRADIENTS)),
-                                       lambda case: case[1] == "ridges"))
-def test_matches_reference_scene_variants(name, field, gradient, backend):
-    assert_parity(Scene(height_field=field, **VARIANTS[name]), gradient, backend)
+def scene_of(row):
+    """The Scene of a (complete or partial) row {setting: value}; raises InputError if refused."""
+    fields, _ = VARIANTS.get(row.get("variant"), ({}, {}))
+    return Scene(**{**fields, **{_SCENE_SETTINGS[k]: v for k, v in row.items() if k in _SCENE_SETTINGS}})
 
+
+def admissible(values):
+    """Whether a partial row (the first settings' values, in order) is admissible so far: the
+    variant's requirements hold, and once the scene's settings are all known `Scene` accepts
+    them (a surface bump needs beta below the radius)."""
+    row = dict(zip(SETTINGS, values))
+    _, needs = VARIANTS.get(row["variant"], ({}, {}))
+    if any(k in row and row[k] not in allowed for k, allowed in needs.items()):
+        return False
+    return not set(_SCENE_SETTINGS) <= set(row) or _accepted(*(row[k] for k in ("variant", *_SCENE_SETTINGS)))
+
+
+@functools.lru_cache(maxsize=None)
+def _accepted(variant, *values):
+    try:
+        scene_of(dict(zip(("variant", *_SCENE_SETTINGS), (variant, *values))))
+    except InputError:
+        return False
+    return True
+
+
+def completion(fixed, prefix=()):
+    """An admissible row (a dict) holding the values ``fixed`` {setting: value}, or None: depth
+    first over `SETTINGS`, each prefix checked by `admissible`."""
+    if len(prefix) == len(SETTINGS):
+        return dict(zip(SETTINGS, prefix))
+    key = list(SETTINGS)[len(prefix)]
+    for value in (fixed[key],) if key in fixed else SETTINGS[key]:
+        if admissible([*prefix, value]) and (row := completion(fixed, (*prefix, value))) is not None:
+            return row
+    return None
+
+
+def pairs(row):
+    return {(a, row[a], b, row[b]) for a, b in itertools.combinations(SETTINGS, 2)}
+
+
+def covering_array():
+    """The rows of a pairwise covering array of `SETTINGS` under `admissible`, as dicts:
+    allpairspy's, then a row for each pair it left out (it stops at the first row that adds no
+    pair, which under a filter can come before the last pair)."""
+    rows = [dict(row._asdict()) for row in AllPairs(SETTINGS, filter_func=admissible)]
+    seen = set().union(*map(pairs, rows))
+    for a, b in itertools.combinations(SETTINGS, 2):
+        for x, y in itertools.product(SETTINGS[a], SETTINGS[b]):
+            if (a, x, b, y) not in seen and (row := completion({a: x, b: y})) is not None:
+                rows.append(row)
+                seen |= pairs(row)
+    return rows
+
+
+ROWS = covering_array()
+
+
+@pytest.mark.parametrize("row", ROWS, ids=["-".join(map(str, r.values())).replace(" ", "_") for r in ROWS])
+def test_covering_array_matches_reference(row):
+    assert_parity(scene_of(row), row["gradient"], row["backend"], (row["size"],))
+
+
+def test_the_covering_array_holds_every_admissible_pair():
+    """Every pair of values of two settings that an admissible row can hold is in some row, and
+    the array is a small fraction of the full product."""
+    seen = set().union(*map(pairs, ROWS))
+    missing = [(a, x, b, y) for a, b in itertools.combinations(SETTINGS, 2)
+               for x, y in itertools.product(SETTINGS[a], SETTINGS[b])
+               if (a, x, b, y) not in seen and completion({a: x, b: y}) is not None]
+    assert missing == [], missing[:5]
+    assert all(admissible(list(row.values())) for row in ROWS)
+    assert len(ROWS) <= math.prod(map(len, SETTINGS.values())) / 500, len(ROWS)
+
+
+def random_scene(rng):
+    """A scene whose every number is drawn (within ranges the frames still show): geometry,
+    lights, frequencies, amplitude, step; settings drawn as well."""
+    while True:
+        radius_a = rng.uniform(0.5, 1.5)
+        bump = rng.choice(["chart", "surface"])
+        lights = tuple(PointLight(tuple(rng.uniform([-8, -8, 1], [8, 8, 12])), tuple(rng.uniform(0.2, 1.0, 3)))
+                       for _ in range(rng.integers(1, 3)))
+        kw = dict(radius_a=radius_a, camera_z=rng.uniform(2.5, 5.0) * radius_a,
+                  center_b=tuple(rng.uniform([-1, -1, 0], [1, 1, 2])), radius_b=rng.uniform(0.1, 0.6),
+                  sphere_b=bool(rng.integers(2)), floor=bool(rng.integers(2)), lights=lights,
+                  albedo_a=tuple(rng.uniform(0, 1, 3)), ka=rng.uniform(0, 0.3), kd=rng.uniform(0.2, 1.0),
+                  ks=rng.uniform(0, 1), shininess=float(rng.choice([rng.uniform(1, 100), rng.integers(1, 64)])),
+                  model=str(rng.choice(MODELS)), floor_tint=rng.uniform(0, 1),
+                  height_field=str(rng.choice(list(F.FIELDS))), k_u=rng.uniform(0.5, 12.0), k_v=rng.uniform(0.5, 12.0),
+                  beta=rng.uniform(0.0, 0.95 * radius_a if bump == "surface" else 1.5),
+                  eps=10.0 ** rng.uniform(-7, math.log10(0.25)), bump=str(bump))
+        try:
+            return Scene(**kw)
+        except InputError:                       # the camera inside sphere B: draw again
+            continue
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_scenes_match_the_reference(seed):
+    rng = np.random.default_rng([2026, 9, seed])
+    scene = random_scene(rng)
+    gradient, backend = str(rng.choice(GRADIENTS)), str(rng.choice(BACKENDS))
+    assert_parity(scene, gradient, backend, (SIZES[seed % len(SIZES)],))
+
+
+#: The pole frame's scene with a bump that shows there (the draft's chart normal, beta 1.5).
+POLE_SCENE = Scene(**VARIANTS["pole with nonzero gradient"][0], beta=1.5, bump="chart")
 
 
 def test_frame_sizes_reach_the_pole():
@@ -367,7 +519,7 @@ def test_frame_sizes_reach_the_pole():
     width, height = 17, 20
     x, y = ref.pixel_point(Scene(), 8, 8, width, height)
     assert x == 0.0 and abs(y) < 1e-16
-    _, _, _, grad = ref.render_reference(Scene(**VARIANTS["pole with nonzero gradient"]),
+    _, _, _, grad = ref.render_reference(POLE_SCENE,
                                          width, height)
     assert abs(grad[8, 8, 1]) > 1.0
 
@@ -435,7 +587,7 @@ def test_parity_rejects_the_seeds_sphere_b_quadratic(monkeypatch):
 
 def test_parity_rejects_a_reference_without_the_floor_plane_shadow(monkeypatch):
     monkeypatch.setattr(ref, "floor_separates", lambda P, L: False)
-    scene = Scene(**VARIANTS["light below the floor"])
+    scene = Scene(**VARIANTS["light below the floor"][0])
     assert any("|dI|" in f for f in parity_failures(scene, 24, 20, "exact"))
 
 
@@ -455,7 +607,7 @@ def test_parity_rejects_a_different_pole_fallback(monkeypatch):
         return (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)
 
     monkeypatch.setattr(ref, "tangent_frame_a", swapped)
-    scene = Scene(**VARIANTS["pole with nonzero gradient"])
+    scene = POLE_SCENE
     assert any("|dI|" in f for f in parity_failures(scene, 17, 20, "exact"))
 
 
@@ -463,7 +615,7 @@ def test_parity_rejects_a_two_sided_quotient_at_the_pole(monkeypatch):
     """Dividing by 2 eps even where v was clamped (v = 1.3e-17 at the pole pixel)."""
     stencil = ref.stencil_v
     monkeypatch.setattr(ref, "stencil_v", lambda v, eps: stencil(v, eps)[:2] + (2.0 * eps,))
-    scene = Scene(**VARIANTS["pole with nonzero gradient"])
+    scene = POLE_SCENE
     assert any("grad" in f for f in parity_failures(scene, 17, 20, "central"))
 
 

@@ -10,7 +10,7 @@ Checked here, each against a wrong variant:
 * over a grid of scenes x gradient methods x output flags, the two paths
   give the same bytes (image, chamber, kink, grad);
 * the grid does exercise every skip: the kernel's own Python source
-  (numba's ``py_func``), run interpreted with its steps counted, skips on
+  (numba's ``py_func``), run interpreted with its steps and the field's code counted, skips on
   the grid's scenes and does the work with ``skip=False``;
 * every frame of `sweep` is the bytes of a separate `render` call, and its
   census is `compare` of those renders;
@@ -30,7 +30,7 @@ import numba
 import numpy as np
 import pytest
 
-from renderer import GRADIENTS, PointLight, Scene, compare, kernel, render, sweep
+from renderer import GRADIENTS, PointLight, Scene, compare, fieldcode, kernel, render, sweep
 
 SIZE = (40, 32)
 LIGHT_1, LIGHT_2 = Scene().lights
@@ -117,14 +117,24 @@ def interpreted(monkeypatch):
     module (its steps and the generated formulas it calls) replaced by its
     ``py_func``, with the arguments of every call recorded by name."""
     calls = collections.defaultdict(list)
+
+    def counted(name, fn):
+        def step(*args):
+            calls[name].append(args)
+            return fn(*args)
+        return step
+
     for name, obj in list(vars(kernel).items()):
         if isinstance(obj, numba.core.dispatcher.Dispatcher):
-            def step(*args, _fn=obj.py_func, _name=name):
-                calls[_name].append(args)
-                return _fn(*args)
-            monkeypatch.setattr(kernel, name, step)
-    assert {"render_rows", "sphere_hit", "segment_blocked", "exact_gradient", "central_gradient",
-            "footprint", "kink_band"} <= set(vars(kernel)) and calls == {}
+            monkeypatch.setattr(kernel, name, counted(name, obj.py_func))
+    rows = kernel.render_rows
+
+    def render_rows(*args):                    # the field's code (cfuncs the kernel calls) counted too
+        field = fieldcode.FieldCode(*(counted(f"field.{n}", f) for n, f in args[-1]._asdict().items()))
+        return rows(*args[:-1], field)
+    monkeypatch.setattr(kernel, "render_rows", render_rows)
+    assert {"render_rows", "sphere_hit", "segment_blocked", "gradient", "footprint"} <= set(vars(kernel)) \
+        and calls == {}
     return calls
 
 
@@ -137,8 +147,8 @@ def _work(calls, scene):
         b_blocks=sum(tuple(a[-4:]) == b for a in calls["segment_blocked"]),
         shadow_rays=len(calls["segment_blocked"]),
         dark_rays=sum(tuple(a[4]) in dark for a in calls["segment_blocked"]),
-        gradients=sum(len(calls[n]) for n in ("exact_gradient", "central_gradient", "footprint")),
-        creases=sum(len(calls[n]) for n in ("exact_gradient", "central_gradient", "footprint", "kink_band")),
+        gradients=len(calls["gradient"]),
+        creases=len(calls["gradient"]) + len(calls["field.kink"]),
     )
 
 
