@@ -258,15 +258,7 @@ def _replays_right(pair):
     return bool(np.array_equal(got.chamber, want.chamber) and np.abs(got.image - want.image).max() <= IMAGE_TOL)
 
 
-#: renderer/arraykernel.py, `program`: the chamber loop ``for mask, code in ...`` rebinds ``code``
-#: (the field's array code) to a float, so that the crease flag of a frame rendered with beta = 0 and
-#: grad=False calls ``code.kink`` on 3.0 (AttributeError; any array backend:
-#: ``render(Scene(beta=0.0), 8, 8, backend="numpy", grad=False)``).  Left to renderer/'s owner.
-BETA_0_KINK = pytest.mark.xfail(strict=True, reason="arraykernel.program rebinds `code` before the crease flag")
-
-
-@pytest.mark.parametrize("name", [pytest.param(n, marks=BETA_0_KINK) if n == "beta = 0" else n
-                                  for n in STRUCTURE_PAIRS])
+@pytest.mark.parametrize("name", STRUCTURE_PAIRS)
 def test_each_branch_of_the_array_program_has_a_kernel_of_its_own(name, monkeypatch):
     require_backend("drjit")
     monkeypatch.setattr(backends.namespace("drjit"), "_frozen", {})
@@ -306,7 +298,7 @@ def _without(part):
 
 
 @pytest.mark.parametrize("part, name", [(0, "height field"), (1, "bump"), (2, "model"), (3, "sphere B"),
-                                        (4, "floor"), pytest.param(5, "beta = 0", marks=BETA_0_KINK), (6, "shininess"),
+                                        (4, "floor"), (5, "beta = 0"), (6, "shininess"),
                                         (("light", 0), "black light"), (("light", 1), "light below the floor"),
                                         (("light", 2), "light inside a sphere")])
 def test_a_structure_without_one_branch_replays_the_wrong_kernel(part, name, monkeypatch):

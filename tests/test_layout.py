@@ -76,8 +76,6 @@ def test_no_module_imports_a_higher_layer():
     assert upward(graph()) == []
 
 
-@pytest.mark.xfail(strict=True, reason="renderer.formulas.field imports renderer.validate.expression, which "
-                                       "imports renderer.formulas.ELEMENTARY (both inside functions)")
 def test_no_import_cycle():
     assert cycle(graph()) is None
 
