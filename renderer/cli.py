@@ -47,6 +47,11 @@ class UsageError(Exception):
     """A bad argument or input: one line, exit code 2."""
 
 
+#: The library's `renderer.render.MAX_PIXELS`, for the help (not imported: the command line starts
+#: without numpy; a test holds them equal).
+MAX_PIXELS = 4096 * 4096
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):          # one line, not the usage and the message
         raise UsageError(message)
@@ -97,7 +102,7 @@ def build_parser():
     p = _Parser(prog="symrender", description="Render, sweep and measure the Chapter-9 scene.")
     p.add_argument("--version", action="version", version=f"symrender {_version()}")
     sub = p.add_subparsers(dest="command", metavar="command", required=True)
-    size = "image size WxH (default 256x256); each side in [1, 8192], W*H <= 16,777,216 (4096x4096)"
+    size = f"image size WxH (default 256x256); each side in [1, 8192], W*H <= {MAX_PIXELS:,} (4096x4096)"
 
     def scene_options(sp):
         sp.add_argument("--scene", metavar="FILE.toml",
