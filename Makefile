@@ -8,10 +8,13 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: book test audit test-baseline-simd bench clean
 
-$(STAMP): pyproject.toml constraints.txt
+# MathJax 4, which the site serves itself, comes from the npm registry's tarballs, checked against pinned
+# sha512 digests (book/fetch_mathjax.py; no node needed), into book/_vendor.
+$(STAMP): pyproject.toml constraints.txt book/fetch_mathjax.py
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet -c constraints.txt uv
 	$(BIN)/uv pip install --quiet --python $(BIN)/python --compile-bytecode -c constraints.txt -e '.[book,test]'
+	$(BIN)/python book/fetch_mathjax.py
 	touch $(STAMP)
 
 # book/_ext/execute_pages.py runs jupyter-book's command line (`jupyter-book build`) with the

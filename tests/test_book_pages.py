@@ -12,8 +12,7 @@ Each page (index, §1-§9, glossary) is opened offline from the built site, its 
     client rects, then the character where the line changes);
 (d) width: nothing wider than the article's column, nothing cut off by a box that hides its
     overflow (a box that scrolls may hold wider content), the page no wider than the window;
-(e) display formulas: the scale fit.js shrank each to (its font size over its parent's), at least
-    `MIN_FORMULA_SCALE` on a phone;
+(e) formulas: tests/test_browser.py measures each, inline and displayed (full size, within the column);
 (f) text in figures: each figure's PNG records the smallest font size it draws, in its own pixels
     (`chapter.figures.figure_png`); shown at a rendered over natural width, that is
     ``png px * rendered / natural`` CSS px, at least `MIN_FIGURE_TEXT_PX` at each width.
@@ -257,19 +256,13 @@ AUDIT = r"""async () => {
   const scrollers = [...new Set([...clips.values()])].filter(c => c && scrolls(c) && c.scrollWidth > c.clientWidth + 1)
     .map(c => ({tag: c.tagName.toLowerCase(), scrolls_by: c.scrollWidth - c.clientWidth, text: short(c.textContent),
                 where: where(c)}));
-  // (e) each display formula's scale: its font size over its parent's (fit.js shrinks a display wider
-  // than its column by setting its font size), with the text MathJax gives assistive technology.
-  const displays = [...root.querySelectorAll('mjx-container[display="true"]')].map((m, k) => ({
-    index: k + 1, scale: +(parseFloat(style(m).fontSize) / parseFloat(style(m.parentElement).fontSize)).toFixed(3),
-    text: short((m.querySelector('mjx-assistive-mml') || m).textContent).slice(0, 60), where: where(m)}));
-  return {images, text_nodes: texts.length, words: words.length, source, broken, overflow, scrollers, displays,
+  return {images, text_nodes: texts.length, words: words.length, source, broken, overflow, scrollers,
           column: [Math.round(col.left), Math.round(col.right)]};
 }"""
 
 
-#: The least scale of a display formula on a phone (390 px), and the least size of a figure's text
-#: in CSS px at each width: the sizes a reader holding a phone, or at a desk, reads without zooming.
-MIN_FORMULA_SCALE = 0.85
+#: The least size of a figure's text in CSS px at each width: the sizes a reader holding a phone, or
+#: at a desk, reads without zooming.
 MIN_FIGURE_TEXT_PX = {390: 8.0, 1280: 10.0}
 
 
@@ -299,11 +292,6 @@ def figure_texts(images):
         out.append({"src": i["src"], "where": i["where"], "recorded": record is not None, "png_px": px,
                     "css_px": css})
     return out
-
-
-def small_formulas(audit, limit=MIN_FORMULA_SCALE):
-    """The display formulas of ``audit`` that fit.js scaled below ``limit``."""
-    return [d for d in audit["displays"] if d["scale"] < limit]
 
 
 def small_figure_text(audit, limit):
@@ -503,8 +491,6 @@ def site(browser, book_html):
                           "reading_words": words_of({n: found[n, w]["length"] for n in PAGES})[0],
                           "aside_words": words_of({n: found[n, w]["length"] for n in PAGES})[1],
                           "heights_closed": {n: found[n, w]["length"]["height"] for n in PAGES},
-                          "smallest_formula_scale": {n: smallest(d["scale"] for d in found[n, w]["displays"])
-                                                     for n in PAGES},
                           "smallest_figure_text_px": {n: smallest(f["css_px"] for f in found[n, w]["figure_text"])
                                                       for n in PAGES}}
                for w in WIDTHS}
@@ -616,12 +602,6 @@ def test_every_figure_records_the_size_of_its_smallest_text(site):
     assert len(figures) >= 2 * 12
     missing = [f for f in figures if not f["recorded"]]
     assert not missing, f"figures whose PNG records no text size:\n{_listing(missing)}"
-
-
-def test_no_display_formula_is_shrunk_below_the_limit_on_a_phone(site):
-    """At 390 px, every proof unfolded, fit.js shrinks no display formula below `MIN_FORMULA_SCALE`."""
-    bad = [dict(d, page=n) for n in PAGES for d in small_formulas(site[n, 390])]
-    assert not bad, f"display formulas under {MIN_FORMULA_SCALE:.0%} at 390 px:\n{_listing(bad)}"
 
 
 def test_the_text_in_every_figure_is_large_enough_at_both_widths(site):
@@ -767,30 +747,6 @@ def test_the_width_check_catches_an_overwide_block_in_details(browser, book_html
             c.innerHTML = '<p style="white-space:nowrap">Theorem 11: a statement longer than the phone is wide</p>';
             document.querySelector('article.bd-article section').append(c); }""")
         assert [(f["kind"], f["tag"]) for f in p.audit()["overflow"]] == [("cut off", "p")]
-    finally:
-        p.close()
-
-
-def test_the_formula_check_catches_a_display_too_wide_for_a_phone(browser, book_html):
-    """Wrong variant: a display of twenty terms added to a built page at 390 px, which fit.js shrinks
-    below the limit; a short display beside it keeps its size."""
-    p = Page(browser, (book_html / "glossary.html").as_uri(), 390)
-    try:
-        before = p.audit()["displays"]
-        assert small_formulas({"displays": before}) == []
-        p.page.evaluate("""() => {
-            const a = document.querySelector('article.bd-article section');
-            const wide = document.createElement('div'), short = document.createElement('div');
-            wide.className = short.className = 'math notranslate nohighlight';
-            wide.textContent = '\\\\[' + [...Array(20).keys()].map(k => `a_{${k}} x^{${k}}`).join(' + ') + '\\\\]';
-            short.textContent = '\\\\[x = 1\\\\]';
-            a.append(wide, short); return MathJax.typesetPromise([wide, short]); }""")
-        p.page.evaluate("() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => "
-                        "setTimeout(r, 100))))")                    # fit.js refits on the article's resize
-        found = p.audit()
-        assert len(found["displays"]) == len(before) + 2
-        assert [d["index"] for d in small_formulas(found)] == [len(before) + 1], found["displays"][len(before):]
-        assert found["displays"][-1]["scale"] == 1
     finally:
         p.close()
 

@@ -18,8 +18,10 @@ for that scene at the extremes of the controls; every control reachable and
 movable from the keyboard; the layout at 1280 x 900 (canvases, U-curve and
 readout in view together) and at 390 px (canvases stacked, at least 300 px
 wide, and a tap on a phone reading out the pixel tapped), and at both widths, scrolled through
-the simulator, no control, readout, plot or caption covering another.  Screenshots go to
-test-artifacts/.  Each check is shown rejecting a wrong variant.
+the simulator, no control, readout, plot or caption covering another; and on every page of the
+book each formula, inline and displayed, at the text's size or larger and within the column at 390
+and 1280 px, every dropdown open (MathJax 4 breaks the lines), its fonts from the site.  Screenshots go
+to test-artifacts/.  Each check is shown rejecting a wrong variant.
 
 The book is built into a temporary directory for the test unless
 SYMRENDER_BOOK_HTML names a freshly built site (.ci/run builds the book first
@@ -45,6 +47,7 @@ from renderer.jsgen import SIMULATOR_SCENE
 from renderer.render import check_args
 
 from .jsnode import ARTIFACTS, in_ci, require_tool
+from .test_book_pages import PAGES
 from .test_check_glue import check_glue
 from .test_js_parity import CHART_TOL, image_bound
 
@@ -1224,3 +1227,147 @@ def test_the_layout_check_catches_overlapping_controls(browser, book_html, varia
 
     found = _layout(browser, book_html, 390, **{sheet: wrong})
     assert any(message in f for where in found.values() for f in where), (variant, found)
+
+
+# ---- every formula of the book: at full size, within the column ---------------------------------
+
+#: Run in a page once MathJax and fit.js are done: every dropdown opened (fit.js then breaks their
+#: displays again, if their width has changed), each typeset formula of the article, inline or displayed, as {"display", "scale": its
+#: font size over the font size of the text around it (the element around its span.math or div.math),
+#: times any CSS transform of it or of an element around it within the article, "px": its font size as
+#: drawn, "over": how far (px) its typeset box
+#: reaches past the article's column, 0 if it ends within, "error": whether MathJax set a TeX error,
+#: "text", "where"}.
+FORMULAS_JS = r"""async () => {
+  const root = document.querySelector('article.bd-article');
+  const folded = [...root.querySelectorAll('details:not([open])')];
+  if (folded.length) {
+    // fit.js refits on each toggle event, in its own listener (on the document, capturing): the last
+    // dropdown's own listener runs after all of them.
+    const last = new Promise(r => folded[folded.length - 1].addEventListener('toggle', r, {once: true}));
+    folded.forEach(d => { d.open = true; });
+    await last;
+  }
+  const cs = getComputedStyle(root), box = root.getBoundingClientRect();
+  const left = box.left + parseFloat(cs.paddingLeft), right = box.right - parseFloat(cs.paddingRight);
+  const px = el => parseFloat(getComputedStyle(el).fontSize);
+  return [...root.querySelectorAll('mjx-container')].filter(m => m.getClientRects().length).map(m => {
+    const around = (m.closest('.math') || m).parentElement;        // the text the formula stands in
+    let scale = px(m) / px(around);
+    for (let e = m; e !== root; e = e.parentElement) {
+      const t = getComputedStyle(e).transform;
+      if (t !== 'none') { const d = new DOMMatrix(t); scale *= Math.hypot(d.a, d.b); }
+    }
+    const rects = [m, ...m.querySelectorAll('mjx-math')].flatMap(e => [...e.getClientRects()]).filter(r => r.width);
+    const over = Math.max(0, ...rects.map(r => Math.max(r.right - right, left - r.left)));
+    const section = m.closest('section[id]');
+    return {display: m.getAttribute('display') === 'true', scale: +scale.toFixed(3),
+            px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror'),
+            text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
+            where: section ? '#' + section.id : ''};
+  });
+}"""
+
+
+class Formulas:
+    """A page of the built book opened at ``width`` px, the network blocked and recorded (its fonts
+    must come from the site); ``change(path, text)``, if given, rewrites each file the page loads from
+    the site (a wrong variant).  ``measure()`` is FORMULAS_JS's list; ``resize(width)`` turns the
+    window, and waits for fit.js."""
+
+    def __init__(self, browser, url, width, change=None):
+        self.context = browser.new_context(viewport={"width": width, "height": 900})
+        self.blocked, self.errors = [], []
+
+        def route(r):
+            if not r.request.url.startswith("file://"):
+                self.blocked.append(r.request.url)
+                return r.abort()
+            if change is None or not r.request.url.split("?")[0].endswith((".html", ".css")):
+                return r.continue_()
+            from urllib.parse import unquote, urlparse
+            path = Path(unquote(urlparse(r.request.url).path))
+            r.fulfill(body=change(path, path.read_text(encoding="utf-8")),
+                      content_type="text/css" if path.suffix == ".css" else "text/html")
+
+        self.context.route("**/*", route)
+        self.page = self.context.new_page()
+        self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
+        self.page.goto(url)
+        self.page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise : null")
+        self.page.wait_for_function("document.documentElement.dataset.fit === 'done'", timeout=30_000)
+
+    def measure(self):
+        return self.page.evaluate(FORMULAS_JS)
+
+    def resize(self, width):
+        self.page.evaluate("document.documentElement.removeAttribute('data-fit')")
+        self.page.set_viewport_size({"width": width, "height": 900})
+        self.page.wait_for_function("document.documentElement.dataset.fit === 'done'", timeout=30_000)
+
+    def close(self):
+        self.context.close()
+
+
+def formula_findings(found):
+    """The formulas of a FORMULAS_JS list that a reader cannot read whole: set below the text's size
+    (scale under 1), reaching past the column by more than a pixel, or a TeX error."""
+    return [f for f in found if f["scale"] < 0.999 or f["over"] > 1 or f["error"]]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_every_formula_is_at_full_size_within_the_column(browser, book_html, name):
+    """Every formula of every page, inline and displayed, every dropdown open, is typeset at the size of
+    the text around it or larger, and ends within the article's column: the page opened at 390 px, and
+    opened at 1280 px, then the window narrowed to 390 (fit.js breaks the displays typeset for 1280
+    again); MathJax breaks the lines, nothing scales a formula down.  Nothing is fetched from off the
+    site.  The measurements go to test-artifacts/formulas_<page>.json."""
+    report = []
+    for widths in ((390,), (1280, 390)):
+        s = Formulas(browser, (book_html / f"{name}.html").as_uri(), widths[0])
+        try:
+            for k, width in enumerate(widths):
+                if k:
+                    s.resize(width)
+                found, at = s.measure(), " then ".join(f"{w} px" for w in widths[:k + 1])
+                bad = formula_findings(found)
+                report.append({"at": at, "formulas": len(found), "displays": sum(f["display"] for f in found),
+                               "smallest_scale": min((f["scale"] for f in found), default=None),
+                               "widest_overflow_px": max((f["over"] for f in found), default=None), "findings": bad})
+                ARTIFACTS.mkdir(parents=True, exist_ok=True)
+                (ARTIFACTS / f"formulas_{name}.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
+                assert not bad, f"{name} at {at}:\n" + "\n".join(json.dumps(f, ensure_ascii=False) for f in bad)
+            assert s.blocked == [] and s.errors == [], (s.blocked, s.errors)
+        finally:
+            s.close()
+
+
+#: Wrong variants of the site (the file changed, its text replaced, its replacement), each of which the
+#: formula check must catch on §3 at 390 px: MathJax left to let formulas run past the column (its
+#: default), and formulas set at 62 % of the text (as fit.js once shrank them to fit).
+WRONG_FORMULAS = {
+    "MathJax breaking no line": ("s3_math.html", '"displayOverflow": "linebreak", "linebreaks": {"inline": true',
+                                 '"displayOverflow": "overflow", "linebreaks": {"inline": false'),
+    "formulas shrunk to 62 %": ("fit.css", "article.bd-article span.math { display: inline; }",
+                                "article.bd-article span.math { display: inline; font-size: 62%; }"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_FORMULAS))
+def test_the_formula_check_catches_formulas_shrunk_or_running_past_the_column(browser, book_html, variant):
+    file, old, new = WRONG_FORMULAS[variant]
+
+    def change(path, text):
+        if path.name != file:
+            return text
+        assert text.count(old) == 1, f"variant {variant!r} no longer applies to {file}"
+        return text.replace(old, new)
+
+    s = Formulas(browser, (book_html / "s3_math.html").as_uri(), 390, change=change)
+    try:
+        found = formula_findings(s.measure())
+    finally:
+        s.close()
+    kind = "over" if "line" in variant else "scale"
+    assert found and all((f["over"] > 1) if kind == "over" else (f["scale"] < 0.999) for f in found), (variant, found)

@@ -21,22 +21,22 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "chart": "f98bedd6a50dc2a5",
-    "frame-orthonormal": "013c609b1719b2b5",
-    "frame-orientation": "53938665d5568ab7",
-    "gradient-sine": "bf2dcc2a1665f090",
-    "gradient-ridges": "b2695ea68698fc11",
-    "gradient-rings": "10fd2b5cafd8b6b4",
-    "ridges-kinks": "d0166a6d10c118b7",
-    "kink-loci-rays": "dc6aa08f514eb71e",
+    "chart": "a103b721422aac5e",
+    "frame-orthonormal": "59d20494cb0bbe94",
+    "frame-orientation": "f8fe212f89933948",
+    "gradient-sine": "446824a80459dae6",
+    "gradient-ridges": "648c16419819b0d8",
+    "gradient-rings": "b1acf10d08155001",
+    "ridges-kinks": "e06d16f37c7e46c2",
+    "kink-loci-rays": "fc46f38ecffc176a",
     "kink-loci-circles": "2ee79e7e99261d40",
     "no-boundary": "d919e9d5b4854d2f",
-    "normal-beta-derivative": "13f2285b41f4b5dd",
-    "beta-zero-regression": "6526a1ea175b3206",
-    "central-difference-truncation": "f8a9229c7ca65527",
-    "optimal-step": "4bfd517039cfa6cb",
-    "bump-vs-displacement": "3345ce68138271df",
-    "blinn-perturbation": "38f9ac6bc0cd9f89",
+    "normal-beta-derivative": "981715b4a04fc96b",
+    "beta-zero-regression": "c4518fa8e48664ba",
+    "central-difference-truncation": "05f661094aca9560",
+    "optimal-step": "f19b14484882cf81",
+    "bump-vs-displacement": "249c17bf6edc985e",
+    "blinn-perturbation": "d4efd2be264375e2",
 }
 
 
@@ -86,7 +86,7 @@ NORM = sp.Symbol(r"\lVert M\rVert", positive=True)
     (sp.sin(x + 1) ** 2, None, r"\sin^{2}{\left(x + 1 \right)}"),
     (sp.Pow(x**2, sp.Rational(1, 3), evaluate=False), None, r"\left(x^{2}\right)^{1/3}"),
     (sp.Tuple(written(sp.Add(y, x, evaluate=False)), sp.Add(y, x, evaluate=False)), None,
-     r"\left( y + x, \  x + y\right)"),
+     r"({y + x},\ \allowbreak {x + y})"),
     (M, {M: r"\mathbf{M}"}, r"\mathbf{M}"),
     (x ** sp.Rational(3, 2), None, "x^{3/2}"),
     (sp.MatAdd(B, A, evaluate=False), None, "A + B"),
@@ -97,40 +97,14 @@ def test_the_printer_writes_each_form_as_a_person_does(expr, names, latex):
     assert tex(expr, names) == latex
 
 
-def test_every_line_of_every_proof_display_fits_a_phone_column():
-    """Each line of each chain's display is within a phone's proof column (`latex.PROOF_COLUMN_PX`) by the
-    width estimate (the browser measures the rendered scale); sides that do not fit break at + - × · ."""
-    for t in THEOREMS.values():
-        for run in _chains(t.steps):
-            shown = latex.chain(t, [s for _, s in run], [k for k, _ in run])
-            body = shown.removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}")
-            widest = max(latex.width(line) for line in body.split(r"\\ "))
-            limit = latex.PROOF_COLUMN_PX * (1.2 if "lim" in body else 1.0)   # a one-sided limit has no break point
-            assert widest <= limit, (t.id, run[0][0], round(widest), shown)
-
-
-def test_a_tuple_chain_prints_a_component_a_line_and_a_long_sum_breaks():
+def test_a_tuple_chain_prints_a_component_a_line():
+    """A chain of tuples is one block per component, its left side once, one relation a line; MathJax
+    breaks a line too wide for the reader's column (tests/test_browser.py measures the typeset pages)."""
     u, v, w = sp.symbols("u v w")
-    from proofs.core import Step, Theorem, calc
-    long = sum(sp.Symbol(f"x_{k}") ** k / (k + 1) for k in range(1, 12))
-    t = Theorem("t", "T", "", (*calc(sp.Tuple(u, v), ("why", sp.Tuple(w, 2 * w)), ("then", sp.Tuple(1, 2))),
-                               Step("long", w, long)), {})
-    pair = latex.chain(t, t.steps[:2], [1, 2])
-    assert pair == (r"\begin{aligned}u &\overset{(1)}{=} w\\ &\overset{(2)}{=} 1\\ "
-                    r"v &\overset{(1)}{=} 2 w\\ &\overset{(2)}{=} 2\end{aligned}")
-    lines = latex.chain(t, t.steps[2:], [3]).removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}").split(r"\\ ")
-    assert len(lines) > 2 and all(latex.width(line) <= latex.COLUMN_PX for line in lines)
-    assert all(line.startswith((r"&\qquad + ", r"&\qquad - ")) for line in lines[1:])
-    assert "".join(line.split("&", 1)[1].removeprefix(r"\qquad") for line in lines[1:]).replace(" ", "") in \
-        tex(long).replace(" ", "")
-
-
-@pytest.mark.parametrize("latex_, px", [(r"x^{2} + y^{2} = \rho\left(\varphi\right)^{2}", 110),
-                                        (r"N' = \frac{M}{\lVert M\rVert}", 81),
-                                        (r"e_\theta \times e_\varphi = - N", 98)])
-def test_the_width_estimate_is_within_a_fifth_of_mathjax(latex_, px):
-    """Widths MathJax 3 gave these displays in the built book at 390 px (natural size, CSS px)."""
-    assert 0.78 * px <= latex.width(latex_) <= 1.22 * px, latex.width(latex_)
+    from proofs.core import Theorem, calc
+    t = Theorem("t", "T", "", calc(sp.Tuple(u, v), ("why", sp.Tuple(w, 2 * w)), ("then", sp.Tuple(1, 2))), {})
+    assert latex.chain(t, t.steps, [1, 2]) == (r"\begin{aligned}\raise 0em{u} &\overset{(1)}{=} w\\ &\overset{(2)}{=} 1\\ "
+                                               r"\raise 0em{v} &\overset{(1)}{=} 2 w\\ &\overset{(2)}{=} 2\end{aligned}")
 
 
 def test_a_link_whose_left_side_is_rewritten_shows_that_side_on_an_unmarked_line():
@@ -165,18 +139,13 @@ def _fraction_in_fraction(math):
     return False
 
 
-def test_no_statement_sets_a_fraction_in_a_fraction_inline_and_its_displays_fit_a_phone():
+def test_no_statement_sets_a_fraction_in_a_fraction_inline():
     """A fraction within a fraction in running text is set at half size (unreadable on a phone): a statement
-    sets such a claim apart (``$$⟦key⟧$$``), laid out one relation a line within the column, its fractions at
-    full size."""
+    sets such a claim apart (``$$⟦key⟧$$``), its fractions at full size."""
     assert _fraction_in_fraction(r"\frac{\beta \left(\frac{H}{s}\right)}{R}") and not _fraction_in_fraction(r"\frac{a}{b} \frac{c}{d}")
     for t in THEOREMS.values():
         text = latex.statement(t)
-        displays = re.findall(r"\$\$(.*?)\$\$", text, re.S)
         inline = re.findall(r"\$([^$]+)\$", re.sub(r"\$\$.*?\$\$", " ", text, flags=re.S))
         assert not [m for m in inline if _fraction_in_fraction(m)], t.id
-        for shown in displays:
-            body = shown.strip().removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}")
-            assert max(latex.width(line) for line in body.split(r"\\ ")) <= latex.PROOF_COLUMN_PX, (t.id, shown)
     shown = latex.statement(THEOREMS["bump-vs-displacement"])
-    assert re.search(r"\$\$\s*\\begin\{aligned\}", shown) and r"\dfrac{H_{\theta} e_\theta}" in shown
+    assert re.search(r"\$\$\s*\\dfrac\{\\partial P\}", shown) and r"\dfrac{H_{\theta} e_\theta}" in shown

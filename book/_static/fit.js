@@ -2,10 +2,11 @@
 // - a number with a hyphen in it (1e-16, 2-3) is kept on one line: Chromium breaks after that hyphen;
 // - a long identifier or code line gets <wbr> break points between its parts (after . _ / ( [ , = and
 //   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word;
-// - typeset maths (MathJax 3 has no automatic line breaking) and tables wider than their column are
-//   scaled down to fit, tables to no less than MIN_TABLE; a wider table scrolls sideways inside the
-//   theme's box around it (fit.css).
-// Scaling is redone whenever the article changes size (window, sidebars, an opened <details>).
+// - tables wider than their column are scaled down to fit, to no less than MIN_TABLE; a wider table
+//   scrolls sideways inside the theme's box around it (fit.css);
+// - a display formula is broken again when its column's width changes: MathJax 4 breaks a display for
+//   the width its column has when it is typeset (none inside a closed <details>, which has no width).
+// This is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
   // Not inside maths (MathJax reads its source from these nodes), a piece already kept whole, or the
@@ -70,27 +71,30 @@
     });
   }
 
-  // The width the content of block-level element el may take.
-  function room(el) {
-    while (el && /^(inline|contents)/.test(getComputedStyle(el).display)) el = el.parentElement;
-    if (!el) return 0;
-    var cs = getComputedStyle(el);
-    return el.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight);
+  // Each display formula typeset for its column's present width: those whose column (the element
+  // around the formula) has another width than when they were last broken are typeset again, at that
+  // width.  `broken` maps each of MathJax's math items to that width (0: it had none).
+  var broken = new WeakMap();
+  function rebreak(root, record) {
+    var mj = window.MathJax, doc = mj && mj.startup && mj.startup.document;
+    if (!doc || !doc.getMathItemsWithin) return;
+    doc.getMathItemsWithin(root).forEach(function (item) {
+      var box = item.display && item.typesetRoot && item.typesetRoot.parentNode;
+      var width = box ? box.clientWidth : 0;
+      if (!box || broken.get(item) === width || (!record && !width)) return;
+      broken.set(item, width);
+      if (record) return;
+      var m = doc.outputJax.getMetricsFor(box, true);
+      item.setMetrics(m.em, m.ex, m.containerWidth, m.scale);
+      item.rerender(doc);
+    });
   }
 
+  var typeset = false;      // MathJax has typeset the page, and `broken` holds its displays' widths
   function fit() {
     var root = article();
     if (!root) return;
-    // MathJax's output scales with its font size, so a formula's full width is its width over its
-    // scale: all measured first, then only the changed sizes set (one layout, not one per formula).
-    Array.prototype.map.call(root.querySelectorAll("mjx-container"), function (m) {
-      var display = m.getAttribute("display") === "true", math = m.querySelector("mjx-math");
-      var scale = parseFloat(m.style.fontSize) / 100 || 1, width = math ? math.getBoundingClientRect().width : 0;
-      if (display && m.scrollWidth > m.clientWidth) width = Math.max(width, m.scrollWidth);
-      var need = width / scale;
-      var space = display ? m.parentElement.clientWidth : room(m.parentElement);
-      return [m, need > space && space > 0 ? Math.floor(1000 * space / need) / 10 + "%" : ""];
-    }).forEach(function (f) { if (f[0].style.fontSize !== f[1]) f[0].style.fontSize = f[1]; });
+    if (typeset) rebreak(root, false);
     root.querySelectorAll("table").forEach(function (t) {
       t.style.fontSize = "";
       var space = t.parentElement.clientWidth, need = t.getBoundingClientRect().width, scale = 1;
@@ -101,15 +105,17 @@
         need = t.getBoundingClientRect().width;
       }
     });
+    if (typeset) document.documentElement.setAttribute("data-fit", "done");     // for the browser tests
   }
 
-  // Once MathJax has typeset the page (its source text is then out of the way): break points, then scaling.
+  // Once MathJax has typeset the page (its source text is then out of the way): break points, the
+  // widths the displays were broken for, then the tables.
   function whenTypeset() {
     var mj = window.MathJax, root = article();
     function done() {
-      if (root) { keepNumbersWhole(root); breakLongWords(root); }
+      if (root) { keepNumbersWhole(root); breakLongWords(root); rebreak(root, true); }
+      typeset = true;
       fit();
-      document.documentElement.setAttribute("data-fit", "done");     // for the browser tests
     }
     if (mj && mj.startup && mj.startup.promise) mj.startup.promise.then(done);
     else done();
