@@ -60,7 +60,7 @@ def pareto_figure(measurement, *, error="max"):
     names = list(dict.fromkeys(r.field for r in measurement.results))
     # Two columns (a phone's column holds two panels of 2.5 in); the legend fills an empty cell.
     rows = (len(names) + 2) // 2
-    fig = Figure(figsize=(5.0, 2.05 * rows), layout="constrained")
+    fig = Figure(figsize=(5.0, 1.9 * rows), layout="constrained")
     grid = fig.subplots(rows, 2, sharex=True, squeeze=False).ravel()
     axes, spare = grid[:len(names)], grid[len(names):]
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
@@ -267,7 +267,7 @@ def univariate_figure(errors):
     1e-18.  Returns a matplotlib Figure (not shown)."""
     from matplotlib.figure import Figure
     from matplotlib.ticker import LogLocator, NullLocator
-    fig = Figure(figsize=(4.6, 4.4), layout="constrained")
+    fig = Figure(figsize=(4.6, 3.0), layout="constrained")
     ax = fig.subplots()
     steps = [r.eps for r in errors.rows if r.eps is not None]
     for name in dict.fromkeys(r.method for r in errors.rows):
