@@ -141,7 +141,7 @@ QUANTITIES = {
     "values of h per pixel in the rings field's central difference": (
         ("c4_rings_h",), lambda: _lib("lab.gradient_methods").stencil_values("rings")),
     "sines and cosines per value of the sine field": (
-        ("c4_h_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "h").trig),
+        ("c4_h_trig",), lambda: _lib("lab.gradient_methods").height_work("sine").trig),
     "sines and cosines per pixel of the sine field's central difference": (
         ("c4_central_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "central").trig),
     "sines and cosines per pixel of the sine field's exact gradient": (
@@ -152,6 +152,8 @@ QUANTITIES = {
     "JAX's forward-mode slope of |x| at x = 0": (
         ("c4_abs_slope",), lambda: _lib("lab.gradient_methods").abs_slope_at_zero()[0]),
     "the U-curve's chart v": (("c4_crease_v",), lambda: _lib("renderer.ucurve").SEED_POINT[1]),
+    "the classic complex-step test function's point": (("c4_classic_x",),
+                                                       lambda: _lib("lab.gradient_methods").TEST_FUNCTION.x),
     # The price of fast math (Cell 4): the ulp sample, its quantile, libm's sine.
     "the fast-math sample per function": (("c4_fm_points",), lambda: _lib("lab.fastmath").SAMPLES),
     "the fast-math quantile (%)": (("c4_fm_quantile",), lambda: 100 * _lib("lab.fastmath").QUANTILE),
@@ -173,6 +175,9 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s4_label", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c4_ad_ratio", "c4_ad_err_ratio",
                "c4_ad_compile_ms", "c4_xla_ad_lo", "c4_xla_ad_hi", "c4_xla_numba_lo", "c4_xla_numba_hi", "c4_sine_points", "c4_fm_ulps", "c4_fm_floors", "c4_fm_drjit", "c6_beta",
+               "c4_methods", "c4_classic_derivative", "c4_classic_table", "c4_classic_published", "c4_classic_cs_from",
+               "c4_classic_cs_max", "c4_classic_ad_err", "c4_classic_eps_model", "c4_classic_eps_fitted",
+               "c4_classic_central_step", "c4_classic_richardson_f", "c4_crease_table", "c5_iterates",
                "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err",
                "ex_fwd_err_1e8", "ex_fwd_err_1e3", "ex_cen_err_1e6", "ex_cs_err", "ex_exact_err", "ex_gn_jr0",
                "ex_gn_jj0", "ex_gn_jr1", "ex_gn_jj1", "ex_gn_b1", "ex_gn_b2", "ex_rings_label",

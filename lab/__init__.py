@@ -1,7 +1,8 @@
 """Measurements against high-precision references, and the register of the draft's claims.
 
 `accuracy` (the gradients and the β-derivative against mpmath, the U-curve's optimum),
-`gradient_methods` (five ways of differentiating h, timed against their error),
+`gradient_methods` (the ways of differentiating a height field or a reader's f(x), one record
+each, timed against their error),
 `seed_errata` (the defects of the draft's code, re-measured), `claims` (the draft's
 checkable claims, each decided by a stated rule), and `store` (one measurement per
 build, shared by the book's pages); `displaced` (sphere A truly displaced, against the

@@ -43,7 +43,7 @@ class GradientAccuracy:
 @lru_cache(maxsize=None)
 def _reference(field, ku, kv):
     # First derivatives carry sign(.) but no DiracDelta: usable as they are.
-    exprs = [g.subs({F.k_u: sp.nsimplify(ku), F.k_v: sp.nsimplify(kv)}) for g in F.GRADIENT[field]]
+    exprs = [g.subs({F.k_u: sp.nsimplify(ku), F.k_v: sp.nsimplify(kv)}) for g in field.gradient]
     return sp.lambdify((F.u, F.v), exprs, modules="mpmath")
 
 
@@ -55,20 +55,25 @@ def _sample(scene, size, count, seed):
     return uv[pick, 0].copy(), uv[pick, 1].copy()
 
 
-def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=8.0, k_v=4.0):
+def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=None, k_v=None):
     """Accuracy of the exact and the central gradient at ``count`` sphere-A pixels.
 
-    Pixels within 1e-9 of a ridges crease are excluded (the sign there depends
-    on the last bit of the float64 sine, and the derivative does not exist).
+    ``field`` is a height field as `renderer.formulas.field` takes it; ``k_u``, ``k_v`` default
+    to the draft's.  Pixels where a crease factor of the field is within 1e-9 of 0 are excluded
+    (the sign there depends on the last bit of the float64 factor, and the derivative does not
+    exist).
 
     Returns
     -------
     list of GradientAccuracy: the exact pipeline first, then one per step.
     """
+    field = F.field(field)
+    k_u = float(DRAFT_SCENE.k_u if k_u is None else k_u)
+    k_v = float(DRAFT_SCENE.k_v if k_v is None else k_v)
     scene = Scene(height_field=field, k_u=k_u, k_v=k_v)
     uu, vv = _sample(scene, size, count, seed)
-    if field == "ridges":
-        keep = ((np.abs(np.sin(np.pi * k_u * uu)) > 1e-9) & (np.abs(np.sin(np.pi * k_v * vv)) > 1e-9))
+    for factor in field.crease_factors:
+        keep = np.abs(sp.lambdify(F.FIELD_SYMBOLS, factor, modules="numpy")(uu, vv, k_u, k_v)) > 1e-9
         uu, vv = uu[keep], vv[keep]
     ref_fn = _reference(field, k_u, k_v)
     with mpmath.workdps(DIGITS):
@@ -81,7 +86,7 @@ def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=8
         # In units of the float64 spacing at the gradient's natural scale pi max(k_u, 2 k_v):
         # the spacing of each reference value would inflate wherever it passes near 0.
         ulps = err / np.spacing(np.pi * max(k_u, 2 * k_v))
-        return GradientAccuracy(field, method, len(uu), float(err.max()), float(np.sqrt((err**2).mean())),
+        return GradientAccuracy(field.name, method, len(uu), float(err.max()), float(np.sqrt((err**2).mean())),
                                 float(ulps.max()), float(np.sqrt((ulps**2).mean())))
 
     # Through the module attribute, so that a test can put a wrong gradient there.
@@ -127,10 +132,12 @@ def _normal_beta_derivative_residual(trials, seed):
     return worst
 
 
-def image_beta_order(size=64, beta=0.35, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e-3)):
-    """`_image_beta_order`, one measurement of the build (`lab.store`; arrays come back as lists)."""
+def image_beta_order(size=64, beta=None, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e-3)):
+    """`_image_beta_order` (``beta`` None: the draft's), one measurement of the build (`lab.store`;
+    arrays come back as lists)."""
     from .store import measured
-    return measured("image-beta-order", _image_beta_order, size=size, beta=beta, steps=list(steps))
+    return measured("image-beta-order", _image_beta_order, size=size,
+                    beta=float(DRAFT_SCENE.beta if beta is None else beta), steps=list(steps))
 
 
 def _image_beta_order(size, beta, steps):
@@ -167,72 +174,127 @@ def _image_beta_order(size, beta, steps):
             "rms_errors": rms.tolist(), "steps": list(steps), "scene": scene.changes(), "size": size}
 
 
-#: Where `optima` measures each field's U-curve, with the seed's frequencies (k_u, k_v) = (8, 4):
-#: (u, v, component).  The seed's sine point; ridges at the same point, whose distance to every
-#: crease line (u = m / k_u, v = m / k_v) exceeds `RIDGES_LARGEST_STEP` (no stencil of the curve
-#: straddles a crease; `optima` checks it); rings in v, since its h_u is 0 everywhere.
-OPTIMUM_POINTS = {"sine": (0.31, 0.47, "u"), "ridges": (0.31, 0.47, "u"), "rings": (0.31, 0.47, "v")}
-#: The ridges curve's largest step (chart units): the default steps up to it.
-RIDGES_LARGEST_STEP = 1e-2
 #: The steps and frame of `crease_share` (the draft's Cell 3 census: its steps, 256 x 256).
 CREASE_STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 CREASE_SIZE = 256
+#: How far `crease_distance` looks along u and v (chart units), and its samples on each side.
+CREASE_REACH, CREASE_SAMPLES = 0.25, 64
 
 
-def crease_distance(u, v, k_u, k_v):
-    """Chart distance from (u, v) to the nearest crease line of the ridges field, u = m / k_u or
-    v = m / k_v (m an integer): a central difference with a step beyond it straddles a crease.
-    ``u``, ``v``: floats or arrays of one shape (chart units); ``k_u``, ``k_v`` > 0.  Returns
-    float64 of that shape."""
-    u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
-    return np.minimum(np.abs(u * k_u - np.rint(u * k_u)) / k_u, np.abs(v * k_v - np.rint(v * k_v)) / k_v)
+def __getattr__(name):
+    # OPTIMUM_POINTS: each registered field's `HeightField.optimum_at`, read from the records at each
+    # access (verify/test_accuracy.py reads them by this name).
+    if name == "OPTIMUM_POINTS":
+        return {f.name: f.optimum_at for f in F.FIELDS.values()}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def crease_distance(u, v, k_u, k_v, field=None):
+    """Chart distance from (u, v) to the nearest crease of a height field along u or along v: a
+    central difference with a larger step straddles one (its stencil reaches u +- eps, v +- eps).
+
+    A crease is a sign change of one of the field's crease factors
+    (`renderer.formulas.HeightField.crease_factors`).  Along each chart direction a factor depends
+    on, it is sampled at `CREASE_SAMPLES` points on each side out to `CREASE_REACH`, and the first
+    sign change is bracketed there and located to float64 precision
+    (`scipy.optimize.elementwise.find_root`): two sign changes closer together than the samples
+    (``CREASE_REACH / CREASE_SAMPLES``) may be missed.
+
+    Parameters
+    ----------
+    u, v : float or array_like, broadcast together
+        Chart coordinates.
+    k_u, k_v : float > 0
+    field : height field or None
+        As `renderer.formulas.field` takes it; None for the draft's (`renderer.DRAFT_SCENE`).
+
+    Returns
+    -------
+    float64 array of the broadcast shape (chart units); ``inf`` where no crease lies within
+    `CREASE_REACH` (for a field without creases, everywhere).
+    """
+    record = DRAFT_SCENE.field if field is None else F.field(field)
+    u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
+    shape, u, v = u.shape, u.ravel(), v.ravel()
+    out = np.full(u.shape, np.inf)
+    for factor in record.crease_factors:
+        g = sp.lambdify((F.u, F.v, F.k_u, F.k_v), factor, modules="numpy")
+        for along_u in (True, False):
+            if (F.u if along_u else F.v) in factor.free_symbols:
+                def g_at(s, at=slice(None), along_u=along_u, g=g):   # s: offsets (n,) or (n, m) at u[at], v[at]
+                    uu, vv = (u[at, None], v[at, None]) if np.ndim(s) == 2 else (u[at], v[at])
+                    value = g(uu + s, vv, k_u, k_v) if along_u else g(uu, vv + s, k_u, k_v)
+                    return np.broadcast_to(value, np.shape(s))
+                out = np.minimum(out, _sign_change(g_at, u.size))
+    return out.reshape(shape)
+
+
+def _sign_change(g_at, n):
+    """The least |s| <= `CREASE_REACH` at which g_at(s) differs in sign from g_at(0), for each of
+    n points (``g_at(s, at)``: offsets s of shape (n,) or (n, m), or at the points of the index
+    array ``at``); 0 where g_at(0) is 0, inf where the sign does not change."""
+    from scipy.optimize.elementwise import find_root
+    sign0 = np.sign(g_at(np.zeros(n)))
+    best = np.where(sign0 == 0, 0.0, np.inf)
+    grid = np.linspace(0.0, CREASE_REACH, CREASE_SAMPLES + 1)
+    for side in (1.0, -1.0):
+        changed = np.sign(g_at(np.broadcast_to(side * grid[1:], (n, CREASE_SAMPLES)))) != sign0[:, None]
+        found = np.flatnonzero(changed.any(axis=1) & (sign0 != 0))
+        if found.size:
+            first = changed[found].argmax(axis=1)       # the first sample past the first sign change
+            # find_root passes the points still iterating with their index (its args are subset alike).
+            root = find_root(lambda s, at: g_at(side * s, at), (grid[first], grid[first + 1]), args=(found,)).x
+            best[found] = np.minimum(best[found], root)
+    return best
 
 
 def optima():
-    """The optimum of the central difference for each height field, one measurement of the
-    build (`lab.store`).
+    """The optimum of the central difference for each registered height field, one measurement of
+    the build (`lab.store`).
 
-    For each field at its point of `OPTIMUM_POINTS` (curve of `renderer.ucurve.measure` over
-    its default steps; on ridges those up to `RIDGES_LARGEST_STEP`), a dict of floats (steps
-    in chart units, errors in height per chart unit): ``u``, ``v``, ``component``, ``k_u``,
-    ``k_v``, ``steps`` (how many), ``largest_step``, ``smallest_step``; ``h`` = |h|,
+    For each field at its point (`renderer.formulas.HeightField.optimum_at`), the curve of
+    `renderer.ucurve.measure` over its default steps below the point's distance to the field's
+    nearest crease (`crease_distance`: no stencil of the curve straddles one), with the draft's
+    frequencies; a dict of floats (steps in chart units, errors in height per chart unit): ``u``,
+    ``v``, ``component``, ``k_u``, ``k_v``, ``steps`` (how many), ``largest_step``,
+    ``smallest_step``, ``crease_distance`` (inf for a field without creases); ``h`` = |h|,
     ``h1`` = |h'|, ``x_h1`` = |x h'| (x the component's coordinate), ``h3`` = |h'''|;
     ``eps_model`` the model-optimal step eps* and ``error_model`` the model's error E(eps*);
-    ``eps_fitted`` the fitted optimal step eps^, ``error_at_fitted`` the fitted model's error
-    there and ``measured_at_fitted`` the float64 quotient's measured error at eps^;
-    ``fitted_over_model`` = eps^ / eps*; ``argument_share``, the argument-rounding term's
-    share of the model's rounding coefficient, |x h'| / (|h| + |x h'|).  The ridges entry
-    also holds ``crease_distance``, its point's (`crease_distance`).
+    ``eps_fitted`` the fitted optimal step eps^, ``error_at_fitted`` the fitted model's error there
+    and ``measured_at_fitted`` the float64 quotient's measured error at eps^;
+    ``fitted_over_model`` = eps^ / eps*; ``argument_share``, the argument-rounding term's share of
+    the model's rounding coefficient, |x h'| / (|h| + |x h'|).
 
     Raises
     ------
     RuntimeError
-        The ridges point is within `RIDGES_LARGEST_STEP` of a crease.
+        A field's point lies so close to a crease that fewer than two default steps are below it.
     """
     from .store import measured
-    return measured("ucurve.optima", _optima, points=OPTIMUM_POINTS, ridges_largest=RIDGES_LARGEST_STEP)
+    return measured("ucurve.optima", _optima,
+                    fields={f.name: [str(f.expr), list(f.optimum_at)] for f in F.FIELDS.values()})
 
 
-def _optima(points, ridges_largest):
-    from renderer.ucurve import DEFAULT_STEPS, SEED_FREQUENCIES, UNIT_ROUNDOFF, measure
-    k_u, k_v = SEED_FREQUENCIES
+def _optima(fields):
+    from renderer.ucurve import DEFAULT_STEPS, UNIT_ROUNDOFF, measure
+    k_u, k_v = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
     out = {}
-    for field, (u, v, component) in points.items():
-        steps = DEFAULT_STEPS[DEFAULT_STEPS <= ridges_largest] if field == "ridges" else DEFAULT_STEPS
+    for field, (_, (u, v, component)) in fields.items():
+        distance = float(crease_distance(u, v, k_u, k_v, field))
+        steps = DEFAULT_STEPS[DEFAULT_STEPS < distance]
+        if steps.size < 2:
+            raise RuntimeError(f"the {field} field's point ({u}, {v}) is {distance:g} from a crease: fewer "
+                               "than two of the default steps lie below that")
         c = measure(field, u, v, component, eps=steps, k_u=k_u, k_v=k_v)
         at_fitted = float(measure(field, u, v, component, eps=[c.eps_fitted], k_u=k_u, k_v=k_v).error[0])
         out[field] = dict(u=u, v=v, component=component, k_u=k_u, k_v=k_v, steps=int(steps.size),
                           largest_step=float(steps.max()), smallest_step=float(steps.min()),
-                          h=abs(c.height), h1=abs(c.derivative), x_h1=c.model_argument / UNIT_ROUNDOFF,
-                          h3=abs(c.third_derivative), eps_model=c.eps_model, error_model=c.error_model,
-                          eps_fitted=c.eps_fitted, error_at_fitted=c.error_at_fitted,
-                          measured_at_fitted=at_fitted, fitted_over_model=c.eps_fitted / c.eps_model,
+                          crease_distance=distance, h=abs(c.height), h1=abs(c.derivative),
+                          x_h1=c.model_argument / UNIT_ROUNDOFF, h3=abs(c.third_derivative),
+                          eps_model=c.eps_model, error_model=c.error_model, eps_fitted=c.eps_fitted,
+                          error_at_fitted=c.error_at_fitted, measured_at_fitted=at_fitted,
+                          fitted_over_model=c.eps_fitted / c.eps_model,
                           argument_share=c.model_argument / (c.model_cancellation + c.model_argument))
-    ridges = out["ridges"]
-    ridges["crease_distance"] = float(crease_distance(ridges["u"], ridges["v"], k_u, k_v))
-    if not ridges["crease_distance"] > ridges["largest_step"]:
-        raise RuntimeError(f"the ridges point ({ridges['u']}, {ridges['v']}) is {ridges['crease_distance']:g} "
-                           f"from a crease, within the largest step {ridges['largest_step']:g}")
     return out
 
 

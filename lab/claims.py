@@ -25,7 +25,10 @@ from typing import Callable
 import numpy as np
 
 from renderer import DRAFT_SCENE, compare, gbuffer, pointwise, render
+from renderer import formulas as F
 from renderer.render import SPHERE_A
+
+from .seed_errata import CELL6_BETA
 
 __all__ = ["Bound", "Criterion", "rule", "about", "ABOUT", "Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED",
            "UNMEASURED", "Unmeasured", "evaluate", "checked", "ClaimChanged", "crease_band_ratio", "census",
@@ -151,8 +154,11 @@ def _errata():
 
 
 @lru_cache(maxsize=None)
-def _frames(field="ridges", beta=0.35, eps=1e-3, size=128):
-    scene = DRAFT_SCENE.replace(height_field=field, beta=beta, eps=eps)
+def _frames(field=None, beta=None, eps=None, size=128):
+    """(central, exact) frames of the draft's scene, ``size`` squared, with its field, β and step
+    replaced where given."""
+    changes = {"height_field": field, "beta": beta, "eps": eps}
+    scene = DRAFT_SCENE.replace(**{k: x for k, x in changes.items() if x is not None})
     return render(scene, size, size, gradient="central"), render(scene, size, size)
 
 
@@ -188,8 +194,8 @@ def relative_error_at(eps):
 
 
 def _h3_scale():
-    value = (np.pi * 8.0) ** 3
-    return {"(π kᵤ)³": value, "k_u": 8.0}
+    k_u = DRAFT_SCENE.k_u
+    return {"(π kᵤ)³": (np.pi * k_u) ** 3, "k_u": k_u}
 
 
 def _truncation_until():
@@ -259,7 +265,7 @@ def _census(size):
     on_a = symbolic.chamber == SPHERE_A
     uv = gbuffer(scene, size, size).uv[on_a]
     from .accuracy import crease_distance
-    dist = crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v)
+    dist = crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field)
     out = {k: [] for k in ("max", "rms", "on_band", "off_band", "flips", "straddling")}
     for eps in CENSUS_STEPS:
         led = compare(render(scene.replace(eps=eps), size, size, gradient="central"), symbolic)
@@ -269,7 +275,7 @@ def _census(size):
             out[key].append(value)
     logs = np.log(CENSUS_STEPS)
     default = CENSUS_STEPS.index(scene.eps)
-    return dict(out, steps=list(CENSUS_STEPS),
+    return dict(out, steps=list(CENSUS_STEPS), step=scene.eps,
                 rms_slope=float(np.polyfit(logs, np.log(out["rms"]), 1)[0]),
                 off_slope=float(np.polyfit(logs, np.log(out["off_band"]), 1)[0]),
                 ratio=out["on_band"][default] / out["off_band"][default], scene=scene.changes(), size=[size, size])
@@ -310,22 +316,22 @@ def crease_band_ratio():
     ``size``)."""
     c = census()
     default = c["steps"].index(DRAFT_SCENE.eps)
-    return dict(on=c["on_band"][default], off=c["off_band"][default], ratio=c["ratio"], scene=c["scene"],
-                size=c["size"])
+    return dict(on=c["on_band"][default], off=c["off_band"][default], ratio=c["ratio"], step=c["step"],
+                scene=c["scene"], size=c["size"])
 
 
 def _kink_order_of_magnitude():
     band = crease_band_ratio()
-    return {"on/off ratio": band["ratio"], "on": band["on"], "off": band["off"], "scene": band["scene"],
-            "size": band["size"]}
+    return {"on/off ratio": band["ratio"], "on": band["on"], "off": band["off"], "step": band["step"],
+            "scene": band["scene"], "size": band["size"]}
 
 
 def _evals():
-    """Values of h per pixel in the kernel's formulas: the stencil points at which
-    `formulas.CENTRAL` evaluates h, against none in `formulas.GRADIENT` (counted
-    from the sympy objects the kernel is generated from, `gradient_methods.evaluations`)."""
+    """Values of h per pixel in the kernel's formulas for the draft's field: the stencil points at
+    which its central difference (`HeightField.central`) evaluates h, against none in its gradient
+    (counted from the sympy objects the kernel is generated from, `gradient_methods.evaluations`)."""
     from .gradient_methods import evaluations
-    central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
+    central, exact = evaluations(DRAFT_SCENE.field, "central"), evaluations(DRAFT_SCENE.field, "exact")
     return {"values of h, central": central.h, "values of h, exact": exact.h, "trig_central": central.trig,
             "trig_exact": exact.trig}
 
@@ -336,41 +342,43 @@ def _cell4_counter():
     class Counter:
         n = 0
 
+    d = DRAFT_SCENE
+
     def h(u, v):
-        return float(pointwise.height("ridges", np.array([u]), np.array([v]), 8.0, 4.0)[0])
+        return float(pointwise.height(d.field, np.array([u]), np.array([v]), d.k_u, d.k_v)[0])
 
     def h_counted(u, v):
         Counter.n += 1
         return h(u, v)
 
-    def central(u, v, height, eps=1e-3):
+    def central(u, v, height, eps=d.eps):
         return ((height(u + eps, v) - height(u - eps, v)) / (2 * eps),
                 (height(u, v + eps) - height(u, v - eps)) / (2 * eps))
 
     counts = []
-    for gradient in (lambda: central(0.3, 0.4, h), lambda: pointwise.exact_gradient("ridges", 0.3, 0.4, 8.0, 4.0),
+    for gradient in (lambda: central(0.3, 0.4, h), lambda: pointwise.exact_gradient(d.field, 0.3, 0.4, d.k_u, d.k_v),
                      lambda: central(0.3, 0.4, h_counted)):
         Counter.n = 0
         gradient()
         counts.append(Counter.n)
     numeric, exact, wired = counts
-    return {"count printed, numeric": numeric, "count printed, exact": exact, "wired": wired}
+    return {"count printed, numeric": numeric, "count printed, exact": exact, "wired": wired, "step": d.eps}
 
 
 def _stacking():
     """Bump under a pixel filter: a 4 x 4 box filter (a 512² render averaged to
     128²) against one sample per pixel, on sphere-A pixels whose 16 samples
     are all on A, with the bump and without it."""
-    err = {}
-    for beta in (0.35, 0.0):
+    err, bumped = {}, DRAFT_SCENE.beta
+    for beta in (bumped, 0.0):
         scene = DRAFT_SCENE.replace(beta=beta)
         fine, one = render(scene, 512, 512).image, render(scene, 128, 128)
         box = fine.reshape(128, 4, 128, 4, 3).mean(axis=(1, 3))
         all_a = (render(scene, 512, 512, kink=False, grad=False).chamber == SPHERE_A).reshape(128, 4, 128, 4).all(axis=(1, 3))
         d = (box - one.image)[all_a & (one.chamber == SPHERE_A)]
         err[beta] = float(np.sqrt(np.mean(d ** 2)))
-    ratio = err[0.35] / err[0.0]
-    return {"one-sample error, with / without the bump": ratio, "bumped": err[0.35], "flat": err[0.0],
+    ratio = err[bumped] / err[0.0]
+    return {"one-sample error, with / without the bump": ratio, "bumped": err[bumped], "flat": err[0.0],
             **_on(one, DRAFT_SCENE)}
 
 
@@ -382,7 +390,7 @@ def _blinn_exact():
     from renderer import formulas as F
 
     from proofs.blinn import BLINN, SURFACE, phi, theta
-    at = {F.R: 1.0, F.beta: 0.35, F.h: 0.5, F.h_u: 3.0, F.h_v: -2.0, phi: 1.1, theta: 0.4}
+    at = {F.R: 1.0, F.beta: DRAFT_SCENE.beta, F.h: 0.5, F.h_u: 3.0, F.h_v: -2.0, phi: 1.1, theta: 0.4}
     gap = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE))
     first = max(abs(float(sp.N(e.subs(at)))) for e in (BLINN - SURFACE).diff(F.beta).subs(F.beta, 0))
     return {"slope gap": gap, "first-order gap": first, "point": {str(k): v for k, v in at.items() if k != F.R}}
@@ -408,15 +416,16 @@ def _timing():
             times.append(time.perf_counter() - t0)
         return min(times)
 
-    t_exact = best(lambda: pointwise.exact_gradient("ridges", u, v, 8.0, 4.0))
-    t_central = best(lambda: pointwise.central_gradient("ridges", u, v, 8.0, 4.0, 1e-3))
-    f_exact = best(lambda: render(DRAFT_SCENE, 128, 128), 7)
-    f_central = best(lambda: render(DRAFT_SCENE, 128, 128, gradient="central"), 7)
+    d = DRAFT_SCENE
+    t_exact = best(lambda: pointwise.exact_gradient(d.field, u, v, d.k_u, d.k_v))
+    t_central = best(lambda: pointwise.central_gradient(d.field, u, v, d.k_u, d.k_v, d.eps))
+    f_exact = best(lambda: render(d, 128, 128), 7)
+    f_central = best(lambda: render(d, 128, 128, gradient="central"), 7)
     stage = t_central / t_exact
-    central, exact = evaluations("ridges", "central"), evaluations("ridges", "exact")
+    central, exact = evaluations(d.field, "central"), evaluations(d.field, "exact")
     return {"sin/cos calls, exact minus central": exact.trig - central.trig, "trig_exact": exact.trig,
             "trig_central": central.trig, "stage_ratio": stage, "frame_ratio": f_central / f_exact,
-            **_on(g, DRAFT_SCENE)}
+            "step": d.eps, **_on(g, DRAFT_SCENE)}
 
 
 #: The draft's expected worst component error of its Cell 5 check ("~1e-9"): its criterion's centre,
@@ -426,15 +435,15 @@ CELL5_EXPECTED = 1e-9
 
 def _cell5_fd():
     rng, trials, step = np.random.default_rng(5), 2000, 1e-7      # the draft's check, as its cell runs it
-    worst = 0.0
+    beta, worst = DRAFT_SCENE.beta, 0.0
     for _ in range(trials):
         N = rng.normal(size=3)
         N /= np.linalg.norm(N)
         g = rng.normal(size=3) * 4.0
-        M = N + 0.35 * g
+        M = N + beta * g
         Np = M / np.linalg.norm(M)
         exact = (g - Np * (Np @ g)) / np.linalg.norm(M)
-        M2 = N + (0.35 + step) * g
+        M2 = N + (beta + step) * g
         worst = max(worst, float(np.abs(exact - (M2 / np.linalg.norm(M2) - Np) / step).max()))
     return {"worst component": worst, "expected": CELL5_EXPECTED, "ratio": worst / CELL5_EXPECTED, "step": step,
             "trials": trials}
@@ -460,17 +469,19 @@ def _beta0():
 
 
 def _bump_nonzero():
-    s = DRAFT_SCENE.replace(height_field="sine", beta=1.5)
+    s = DRAFT_SCENE.replace(height_field="sine", beta=CELL6_BETA)
     bumped = render(s, 128, 128)
     d = float(np.abs(bumped.image - render(s.replace(beta=0.0), 128, 128).image).mean())
     return {"mean |ΔI|": d, **_on(bumped)}
 
 
 def _cell6_truncation():
-    a = compare(*_frames("sine", 1.5, 1e-3)).max_abs
-    b = compare(*_frames("sine", 1.5, 1e-4)).max_abs
-    return {"max |ΔI| ratio": a / b, "coarse": a, "fine": b, "coarse_step": 1e-3, "fine_step": 1e-4,
-            **_on(_frames("sine", 1.5, 1e-3)[1])}
+    """The draft's Cell 6 at its step and at a tenth of it (the sine field, its strong bump)."""
+    coarse, fine = DRAFT_SCENE.eps, DRAFT_SCENE.eps / 10
+    a = compare(*_frames("sine", CELL6_BETA, coarse)).max_abs
+    b = compare(*_frames("sine", CELL6_BETA, fine)).max_abs
+    return {"max |ΔI| ratio": a / b, "coarse": a, "fine": b, "coarse_step": coarse, "fine_step": fine,
+            **_on(_frames("sine", CELL6_BETA, coarse)[1])}
 
 
 def _noise_below_1e11():
@@ -478,20 +489,27 @@ def _noise_below_1e11():
     return {"relative error at ε = 1e-11": rel, "step": 1e-11}
 
 
+#: The step of the draft's Cell 7b (its crease: ``{**SCr, 'eps': 1e-4}``).
+CELL7B_STEP = 1e-4
+
+
 def _crease_values():
-    fd = float(pointwise.central_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0, 1e-4)[0])
-    ex = float(pointwise.exact_gradient("ridges", 1.0 / 8.0, 0.47, 8.0, 4.0)[0])
-    return {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex), "central": fd, "exact": ex}
+    """Cell 7b: the draft's field at u = 1/k_u (its first crease in u) and the U-curve's v."""
+    d = DRAFT_SCENE
+    u, v = 1.0 / d.k_u, F.SEED_POINT[1]
+    fd = float(pointwise.central_gradient(d.field, u, v, d.k_u, d.k_v, CELL7B_STEP)[0])
+    ex = float(pointwise.exact_gradient(d.field, u, v, d.k_u, d.k_v)[0])
+    return {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex), "central": fd, "exact": ex, "step": CELL7B_STEP}
 
 
 def _pole_pixels():
     g = gbuffer(DRAFT_SCENE, 256, 256)
-    n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= 1e-4)))
+    n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= float(F.POLE_SIN_PHI))))
     return {"fallback pixels": n, **_on(g, DRAFT_SCENE)}
 
 
 def _sweep_best():
-    a = {eps: compare(*_frames("sine", 0.35, eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
+    a = {eps: compare(*_frames("sine", eps=eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
     best = min(a, key=a.get)
     return {"best ε": best, **_on(_frames("sine")[1], DRAFT_SCENE.replace(height_field="sine"))}
 
@@ -499,24 +517,30 @@ def _sweep_best():
 def _creases_part():
     num, sym = _frames()
     diff = np.abs(num.image - sym.image).max(axis=-1)
-    big = diff > 1e-3
+    big = diff > LARGE_DIFFERENCE
     share = float(np.count_nonzero(big & sym.kink) / max(1, np.count_nonzero(big)))
-    return {"share in the band": share, "threshold": 1e-3, **_on(sym)}
+    return {"share in the band": share, "threshold": LARGE_DIFFERENCE, "step": num.scene.eps, **_on(sym)}
+
+
+#: Where `_rings_pinch` looks either side of the pole: the polar angle φ (radians).
+PINCH_PHI = 1e-3
+#: A difference of the frames in linear colour that `_creases_part` counts as large.
+LARGE_DIFFERENCE = 1e-3
 
 
 def _rings_pinch():
     """rings: h_v = 2 pi k_v cos(2 pi k_v v) is nonzero at the pole while e_phi turns
     with theta, so N' points in opposite directions on opposite sides of the pole."""
-    phi = 1e-3
+    phi, d = PINCH_PHI, DRAFT_SCENE
     out = []
     for theta in (0.0, np.pi):
         N = np.array([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)])
-        _, hv = pointwise.exact_gradient("rings", (theta + np.pi) / (2 * np.pi), phi / np.pi, 8.0, 4.0)
+        _, hv = pointwise.exact_gradient("rings", (theta + np.pi) / (2 * np.pi), phi / np.pi, d.k_u, d.k_v)
         _, e_phi = pointwise.tangent_frame(*N, np.sin(phi))
-        M = N + 0.35 * float(hv) * np.array([float(c) for c in e_phi])
+        M = N + d.beta * float(hv) * np.array([float(c) for c in e_phi])
         out.append(M / np.linalg.norm(M))
     angle = float(np.degrees(np.arccos(np.clip(out[0] @ out[1], -1, 1))))
-    return {"angle (degrees)": angle, "sin_phi": float(np.sin(phi)), "field": "rings", "beta": 0.35}
+    return {"angle (degrees)": angle, "sin_phi": float(np.sin(phi)), "field": "rings", "beta": d.beta}
 
 
 def _beta_zero_slider():
@@ -563,7 +587,8 @@ CLAIMS = (
           rule(HOLDS, Bound("rows computed", lo=1))),
     Claim("kink-order-of-magnitude", "Cell 3, Expect",
           "the kink-loci error an order of magnitude above the smooth interior",
-          "mean |ΔI| on / off the crease band at ε = 1e-3, 256²", CORRECTED, _kink_order_of_magnitude,
+          f"mean |ΔI| on / off the crease band at ε = {DRAFT_SCENE.eps:g}, 256²", CORRECTED,
+          _kink_order_of_magnitude,
           rule(HOLDS, about("on/off ratio", 10), CORRECTED, Bound("on/off ratio", lo=10 * ABOUT, strict=True))),
     Claim("four-evals-vs-one", "Cell 4, Expect; §6", "4 evals vs 1",
           "values of h in the kernel's formulas (sympy objects)", CORRECTED, _evals,
@@ -577,7 +602,7 @@ CLAIMS = (
           _stacking,
           rule(CORRECTED, Bound("one-sample error, with / without the bump", lo=2, strict=True), otherwise=HOLDS)),
     Claim("blinn-exact", "§8", "Blinn computed his perturbation exactly",
-          "Blinn's slopes against the displaced sphere's, exact at β = 0.35", CORRECTED, _blinn_exact,
+          f"Blinn's slopes against the displaced sphere's, exact at β = {DRAFT_SCENE.beta:g}", CORRECTED, _blinn_exact,
           rule(CORRECTED, (Bound("slope gap", lo=1e-6, strict=True), Bound("first-order gap", hi=1e-12, strict=True)), HOLDS, Bound("slope gap", hi=1e-12))),
     Claim("symbolic-not-slower", "Cell 4, Expect", "the symbolic column at or under the numeric",
           "transcendental calls in the generated gradients; timings beside", HOLDS, _timing,
@@ -598,7 +623,8 @@ CLAIMS = (
           "mean |ΔI| between β = 1.5 and β = 0", HOLDS, _bump_nonzero,
           rule(HOLDS, Bound("mean |ΔI|", lo=1e-2, strict=True))),
     Claim("cell6-truncation", "Cell 6, Expect", "the FD error sitting at its truncation-slope value",
-          "max |ΔI| at ε = 1e-3 and 1e-4 (sine, β = 1.5)", HOLDS, _cell6_truncation,
+          f"max |ΔI| at ε = {DRAFT_SCENE.eps:g} and {DRAFT_SCENE.eps / 10:g} (sine, β = {CELL6_BETA:g})", HOLDS,
+          _cell6_truncation,
           rule(HOLDS, about("max |ΔI| ratio", 10 ** 2))),
     Claim("noise-below-1e-11", "Cell 7a", "below eps ~ 1e-11 the difference quotient is noise",
           "relative error at ε = 1e-11", FAILS, _noise_below_1e11,

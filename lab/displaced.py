@@ -11,7 +11,7 @@ bracketed between the spheres of radius R +- beta max|h| (`H_MAX`): ``samples``
 evenly spaced points of the ray inside the outer sphere, up to where it enters
 the inner one, find the first sign change, and safeguarded Newton steps
 (bisection when a step leaves the bracket) converge to it.  F and its gradient
-are sympy's, lambdified from `renderer.formulas.HEIGHT` and `CHART`; the
+are sympy's, lambdified from the field's expression and `renderer.formulas.CHART`; the
 normal is grad F / |grad F|.  A shadow ray is blocked by sphere A where one of
 ``samples`` points of its segment inside the outer sphere has F < 0, and by
 sphere B as in the renderer.  The shading is the kernel's own
@@ -38,8 +38,11 @@ from renderer.validate import InvalidValue, positive_int
 
 __all__ = ["Displaced", "render_displaced", "surface_function", "H_MAX", "MAX_SAMPLES"]
 
-#: max |h| of every field of `renderer.formulas.HEIGHT` (sines and their products, |.| of one).
+#: The bound on |h| the bracketing assumes (the built-in fields are sines, their products and |.| of
+#: one); `render_displaced` refuses a field that exceeds it on a grid of the chart (`_check_bounded`).
 H_MAX = 1.0
+#: Points per side of the chart grid on which a field is held to `H_MAX`.
+BOUND_CHECK_POINTS = 257
 #: Most samples per ray (the root-bracketing march and the shadow segments).
 MAX_SAMPLES = 4096
 #: Newton-bisection stops when the step is below this fraction of t, or after `MAX_NEWTON` steps.
@@ -58,11 +61,12 @@ def surface_function(field):
     """F and grad F of the displaced sphere for one height field, as numpy functions.
 
     F(P) = |P| - R - beta h(u, v), (u, v) the chart (`renderer.formulas.CHART`) of P / |P|,
-    h `renderer.formulas.HEIGHT[field]`; its gradient by sympy.  F < 0 inside the surface.
+    h the field's expression; its gradient by sympy.  F < 0 inside the surface.
 
     Parameters
     ----------
-    field : {"sine", "ridges", "rings"}
+    field : height field
+        As `renderer.formulas.field` takes it.
 
     Returns
     -------
@@ -71,15 +75,14 @@ def surface_function(field):
 
     Raises
     ------
-    ValueError
-        ``field`` is not one of the three names.
+    renderer.validate.InputError
+        ``field`` is refused (`renderer.formulas.field`, naming "field").
     """
-    if field not in formulas.HEIGHT:
-        raise InvalidValue(f"field must be one of {tuple(formulas.HEIGHT)}, got {field!r}")
+    h = formulas.field(field, "field").expr
     r = sp.sqrt(_X**2 + _Y**2 + _Z**2)
     uv = {formulas.N_x: _X / r, formulas.N_y: _Y / r, formulas.N_z: _Z / r}
     chart = {formulas.u: formulas.CHART[0].xreplace(uv), formulas.v: formulas.CHART[1].xreplace(uv)}
-    F = r - formulas.R - formulas.beta * formulas.HEIGHT[field].xreplace(chart)
+    F = r - formulas.R - formulas.beta * h.xreplace(chart)
     args = (_X, _Y, _Z, formulas.R, formulas.beta, formulas.k_u, formulas.k_v)
     return (sp.lambdify(args, F, "numpy", cse=True),
             sp.lambdify(args, [sp.diff(F, s) for s in (_X, _Y, _Z)], "numpy", cse=True))
@@ -281,6 +284,17 @@ def _cast_shadow(lights, chamber, P, N, reach):
     return (facing & ~reach).any(axis=0) & (chamber != kernel.BACKGROUND)
 
 
+def _check_bounded(scene):
+    """InvalidValue unless |h| <= `H_MAX` at every point of a `BOUND_CHECK_POINTS`-square grid of the
+    chart: the bracketing shells lie at R +- beta `H_MAX`."""
+    t = np.linspace(0.0, 1.0, BOUND_CHECK_POINTS)
+    uu, vv = np.meshgrid(t, t)
+    largest = float(np.max(np.abs(pointwise.height(scene.field, uu, vv, scene.k_u, scene.k_v))))
+    if not largest <= H_MAX:
+        raise InvalidValue(f"Scene.height_field {scene.height_field!r} reaches |h| = {largest:.3g} on the chart; "
+                           f"a displaced sphere brackets its surface for |h| <= {H_MAX:g}")
+
+
 def render_displaced(scene, width, height, *, samples=64):
     """Render the scene with sphere A displaced, r = R + beta h(u, v), and compare with the bumped render.
 
@@ -305,10 +319,12 @@ def render_displaced(scene, width, height, *, samples=64):
     ValueError
         A size out of range; ``samples`` outside [1, 4096]; ``beta * max|h|`` not below
         ``radius_a`` (the displaced radius must stay positive); the camera not outside the
-        displaced sphere (``camera_z > radius_a + beta``).
+        displaced sphere (``camera_z > radius_a + beta``); a height field whose |h| exceeds
+        `H_MAX` on a grid of the chart.
     """
     scene, width, height, _, _ = check_args(scene, width, height, "exact", 1.0)
     samples = positive_int("samples", samples, high=MAX_SAMPLES)
+    _check_bounded(scene)
     reach_a = scene.beta * H_MAX
     if not reach_a < scene.radius_a:
         raise InvalidValue(f"Scene.beta = {scene.beta!r} times max|h| = {H_MAX:g} must be < radius_a = "

@@ -350,12 +350,12 @@ def _ulp_table(count, seed, versions):
 def _quotient(sin):
     """The sine field's central difference h_u as renderer/generated.py computes it, as a
     numpy function of (u, v, k_u, k_v, eps) with ``sin`` as the sine: the stencil points
-    of `renderer.formulas.STENCIL_POINTS` and the quotient of `renderer.formulas.CENTRAL`
+    of `renderer.formulas.STENCIL_POINTS` and the quotient of `renderer.formulas.HeightField.central`
     through the same common subexpressions (sympy.cse) and so the same operations."""
     points = dict(F.STENCIL_POINTS)
     plus, minus = (sp.lambdify((F.u, F.eps_u), points[p], modules="numpy") for p in (F.u_p, F.u_m))
     args = (F.u_p, F.u_m, F.u, F.v, F.k_u, F.k_v, F.eps_u)
-    quotient = sp.lambdify(args, F.CENTRAL["sine"][0], modules=[{"sin": sin}, "numpy"], cse=True)
+    quotient = sp.lambdify(args, F.FIELDS["sine"].central[0], modules=[{"sin": sin}, "numpy"], cse=True)
 
     def h_u(u, v, k_u, k_v, eps):
         eps = np.asarray(eps, dtype=np.float64)
@@ -426,7 +426,7 @@ def _floors(versions):
     if o["component"] != "u" or o["steps"] != DEFAULT_STEPS.size:
         raise RuntimeError(f"the sine field's U-curve is no longer h_u over the default steps: {o}")
     roundoff = UNIT_ROUNDOFF * (o["h"] + o["x_h1"])
-    true = sp.lambdify((F.u, F.v), F.GRADIENT["sine"][0].subs({F.k_u: sp.nsimplify(k_u),
+    true = sp.lambdify((F.u, F.v), F.FIELDS["sine"].gradient[0].subs({F.k_u: sp.nsimplify(k_u),
                                                                  F.k_v: sp.nsimplify(k_v)}), modules="mpmath")
     out, libm = {}, central_differences("numba", DEFAULT_STEPS, u, v, k_u, k_v)
     with mpmath.workdps(DIGITS):

@@ -1,64 +1,64 @@
-"""Run time against error for the ways of computing the chart gradient.
+"""Run time against error for the ways of computing a derivative: of a height field's chart
+gradient over a frame, and of a reader's function of one variable at a point.
 
-For each height field, over the sphere-A pixels of a 256 x 256 default-scene
-frame, this module measures five ways of computing (h_u, h_v):
+Each way is one `Method` record in `METHODS`, in the order tables and legends list them:
 
 * ``exact``: the kernel's generated gradient (sympy's derivative,
-  `renderer.formulas.GRADIENT`), `renderer.pointwise.exact_gradient`;
-* ``central``: the kernel's central difference (`renderer.formulas.CENTRAL`),
+  `renderer.formulas.HeightField.gradient`), `renderer.pointwise.exact_gradient`;
+* ``central``: the kernel's central difference (`HeightField.central`),
   `renderer.pointwise.central_gradient`, at each step of a sweep;
-* ``forward``: the one-sided difference (h(u + eps) - h(u)) / eps, at each
-  step of a sweep (`forward_gradient`);
-* ``complex step``: Im h(u + i eps) / eps (Squire and Trapp 1998), with h the
-  sympy expression evaluated in complex numpy by ``sympy.lambdify``
-  (`complex_step_gradient`).  It needs h to be analytic; `ANALYTIC` says for
-  which fields it is, decided from the expression.  The ridges field is
-  |f|, which is not: lambdify's ``abs`` of a complex number is its modulus,
-  a real number, so the plain complex step returns 0.  The usual repair
-  (Martins, Sturdza and Alonso 2003) continues |f| as f sign(Re f); that
-  variant is measured too, as ``complex step, |z| continued``;
-* ``forward-mode AD``: automatic differentiation in forward mode, ``jax.jvp``
-  (Griewank and Walther 2008), of the program that evaluates h, printed from
-  the sympy expression by ``sympy.lambdify(..., modules="jax")``
-  (`ad_gradient`).  AD differentiates that program, operation by operation;
-  sympy differentiates the expression.  Its one choice that is not a
-  derivative is JAX's slope of |x| at x = 0 (`abs_slope_at_zero`, measured);
-* ``richardson``: `scipy.differentiate.derivative`, an adaptive
-  finite-difference differentiator that raises the order of accuracy by
-  combining nested steps (Richardson's idea, as in numdifftools and
-  DERIVEST), vectorised over pixels (`richardson_gradient`).
+* ``forward``: the one-sided difference (h(u + eps) - h(u)) / eps (`forward_gradient`);
+* ``complex step``: Im h(u + i eps) / eps [1]_, h evaluated in complex numpy by
+  ``sympy.lambdify`` (`complex_step_gradient`); it applies where h is analytic
+  (`HeightField.analytic`, no ``Abs``): lambdify's ``abs`` of a complex number is its
+  modulus, a real number, and the plain complex step of |f| returns 0;
+* ``complex step, |z| continued``: the usual repair for |f| [2]_, which continues |z| as
+  z sign(Re z); it applies to the fields with an ``Abs``;
+* ``richardson``: `scipy.differentiate.derivative` [3]_, an adaptive differentiator that
+  raises the order of accuracy by combining nested steps (`richardson_gradient`);
+* ``forward-mode AD``: ``jax.jvp`` [4]_ of the program that evaluates h, printed from the
+  sympy expression by ``sympy.lambdify(..., modules="jax")`` (`ad_gradient`).  AD
+  differentiates that program, operation by operation; its one choice that is not a
+  derivative is JAX's slope of |x| at x = 0 (`abs_slope_at_zero`, measured).
 
-For each method and field it records the time per frame (median, minimum and
-maximum over repeats, methods interleaved), the work per pixel (`evaluations`:
-the values of h, or evaluations of the generated gradient, and the sines and
-cosines they cost, counted from the sympy objects the kernel is generated
-from, since compiled code cannot be instrumented; scipy counts its own
-evaluations), and the largest and RMS error of the two components against an
-mpmath reference of the exact gradient (`reference_gradient`).  On the ridges
-field the derivative does not exist on the crease lines, so errors there are
-measured off the seed's crease band (`renderer.pointwise.kink_band`); the
-timings still cover every pixel.
+A record holds everything the measurement, the tables and the figures need of its method:
+its function (over chart points of a field, and over one real point of a function of one
+variable), its work per pixel, which steps of a `Config` it runs at, its label and style,
+where it applies, its sources.  `measure`, `univariate_errors` and book/chapter/benchmark.py
+read only the records: adding a method is one record appended to `METHODS`, and nothing
+else changes (tests/test_gradient_methods.py appends a backward difference and sees it
+measured and drawn).
 
-The exact and central gradients and h itself are the kernel's compiled
-functions; forward differences call the compiled h three times from numpy;
-the complex step evaluates h in complex numpy (lambdify), Richardson
-calls the compiled h from scipy's iteration, and AD runs JAX's jit-compiled
-(XLA) program on the arrays.  Compiling is not in AD's times: the first call
-at the frame's size traces and compiles, and is timed on its own
-(`MethodResult.compile_seconds`).  So the times compare the
-methods as they are available here, not as each could best be compiled.
+`measure` times every method that applies to a field over the sphere-A pixels of a
+256 x 256 frame of the draft's scene (median, minimum and maximum over repeats, methods
+interleaved), counts its work per pixel (`Evaluations`: values of h, evaluations of the
+generated gradient, and the sines and cosines they cost, counted from the sympy objects the
+kernel is generated from; scipy counts its own evaluations), and measures the largest and
+RMS error of both components against an mpmath reference of the exact gradient
+(`reference_gradient`).  Where a field has creases the derivative does not exist on them, so
+errors are measured off the crease band (`renderer.pointwise.kink_band`); the timings cover
+every pixel.  The exact and central gradients and h itself are the kernel's compiled
+functions; forward differences call the compiled h three times from numpy; the complex
+step evaluates h in complex numpy; Richardson calls the compiled h from scipy's iteration;
+AD runs JAX's jit-compiled (XLA) program, whose first call at a frame's size compiles and
+is timed apart (`MethodResult.compile_seconds`).  So the times compare the methods as they
+are available here, not as each could best be compiled.
 
-`FAST` is the configuration the book runs when it is built; `FULL` the one the
-benchmark runs for a release (every pixel in the reference, more steps, more
-repeats).  `pareto_front` picks a `Measurement`'s non-dominated methods; the book
+`univariate_errors` runs the methods on a reader's f(x) (`renderer.formulas.univariate`) at
+any real x where it is differentiable, at each step of a grid, against the mpmath value of
+its derivative; the central difference's row is `renderer.ucurve.measure_function`'s
+U-curve.  `PUBLISHED` holds what the complex-step papers report about their test function.
+
+`FAST` is the configuration the book runs when it is built; `FULL` the one the benchmark
+runs for a release.  `pareto_front` picks a `Measurement`'s non-dominated methods; the book
 draws and tabulates it (book/chapter/benchmark.py).
 
 References
 ----------
-.. [1] W. Squire and G. Trapp, "Using complex variables to estimate
-   derivatives of real functions", SIAM Review 40(1), 110-112, 1998.
-.. [2] J. R. R. A. Martins, P. Sturdza and J. J. Alonso, "The complex-step
-   derivative approximation", ACM Trans. Math. Softw. 29(3), 245-262, 2003.
+.. [1] W. Squire and G. Trapp, "Using complex variables to estimate derivatives of real
+   functions", SIAM Review 40(1), 110-112, 1998.
+.. [2] J. R. R. A. Martins, P. Sturdza and J. J. Alonso, "The complex-step derivative
+   approximation", ACM Trans. Math. Softw. 29(3), 245-262, 2003.
 .. [3] SciPy 1.17, ``scipy.differentiate.derivative``.
 .. [4] A. Griewank and A. Walther, *Evaluating Derivatives*, 2nd ed., SIAM, 2008.
 """
@@ -66,54 +66,108 @@ References
 from __future__ import annotations
 
 import json
+import math
 import os
 import platform
+import re
 import sys
 import time
 from dataclasses import asdict, dataclass, field as dc_field
 from functools import lru_cache
+from typing import Callable
 
 import mpmath
 import numpy as np
 import sympy as sp
 from scipy.differentiate import derivative
 
-from renderer import DRAFT_SCENE, gbuffer, pointwise
+from renderer import DRAFT_SCENE, fieldcode, gbuffer, pointwise, ucurve, validate
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 
 __all__ = [
-    "FIELDS", "ANALYTIC", "Config", "FAST", "FULL", "Evaluations", "MethodResult", "Measurement",
-    "is_analytic", "chart_points", "forward_gradient", "complex_step_gradient",
-    "richardson_gradient", "reference_gradient", "trig_calls", "stencil_values", "evaluations",
-    "methods", "measure", "pareto_front", "to_json", "AD", "ad_gradient", "ad_trig_calls",
-    "abs_slope_at_zero", "crease_values",
+    "Style", "Method", "METHODS", "method", "Config", "FAST", "FULL", "Evaluations", "MethodResult",
+    "Measurement", "chart_points", "forward_gradient", "complex_step_gradient", "richardson_gradient",
+    "ad_gradient", "reference_gradient", "trig_calls", "stencil_values", "height_work", "evaluations",
+    "measure", "pareto_front", "to_json", "AD", "ad_trig_calls", "abs_slope_at_zero", "crease_values",
+    "xla_exact_gradient", "same_compiler_times", "UNIVARIATE_STEPS", "UnivariateRow", "UnivariateErrors",
+    "univariate_errors", "Published", "Example", "TEST_FUNCTION", "PUBLISHED", "RICHARDSON",
 ]
 
-FIELDS = ("sine", "ridges", "rings")
 #: The name of forward-mode automatic differentiation in the results.
 AD = "forward-mode AD"
 
-#: sympy functions that are not holomorphic in their argument: an expression
-#: containing one of them cannot be differentiated by the complex step.
-_NON_ANALYTIC = (sp.Abs, sp.sign, sp.re, sp.im, sp.conjugate, sp.arg, sp.Heaviside,
-                 sp.Piecewise, sp.Max, sp.Min, sp.floor, sp.ceiling)
+
+# --- the records ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Style:
+    """How a method is drawn: ``colour`` (a matplotlib colour), ``marker`` (a matplotlib marker),
+    ``size`` (its size, points) and ``line`` (the matplotlib line style joining a sweep's steps,
+    or drawn across the plot by a method without a step)."""
+
+    colour: str
+    marker: str
+    size: float
+    line: str = "-"
 
 
-def is_analytic(expr):
-    """Whether the sympy expression ``expr`` is built from holomorphic functions only.
+def _always(field):
+    return True
 
-    True when ``expr`` contains none of Abs, sign, re, im, conjugate, arg,
-    Heaviside, Piecewise, Max, Min, floor, ceiling: then its lambdified
-    complex evaluation is the analytic continuation the complex step needs.
-    This is a syntactic test (sufficient, not necessary): |x|^2 written with
-    Abs would be reported as not analytic.
+
+@dataclass(frozen=True)
+class Method:
+    """One way of computing a derivative: the one record a method is.
+
+    Attributes
+    ----------
+    name : str
+        How results name it (`MethodResult.method`).
+    gradient : callable
+        ``gradient(field, u, v, k_u, k_v, eps, info) -> (h_u, h_v)``: the chart gradient of
+        ``field`` (a `renderer.formulas.HeightField`) at (n,) float64 chart points, two (n,)
+        float64 arrays; ``eps`` the step (None for a method without one); ``info`` a dict it
+        may fill with what it measured of itself (``"h_per_pixel"``, ``"not_converged"``).
+    work : callable
+        ``work(field, info) -> Evaluations``: its work per pixel, ``info`` as ``gradient`` left it.
+    label : str
+        Its name in a legend or a sentence.
+    style : Style
+    steps : str or None
+        The `Config` attribute listing its steps; None for a method without a step.
+    repeats : str
+        The `Config` attribute saying how many times it is timed.
+    applies : callable
+        ``applies(record) -> bool`` for a `HeightField` or a `renderer.formulas.Univariate`:
+        whether its premise holds there; it is measured only where it does.
+    compiles : bool
+        Its first call at a new array size compiles: that call is timed apart.
+    note : str
+        Shown beside its results in the benchmark's table.
+    sources : tuple of str
+        Keys of book/references.bib.
+    derivative : callable or None
+        ``derivative(function, x, eps, info) -> float``: f'(x) of a `Univariate` at a float x
+        (`univariate_errors`); None where the method has no one-variable form.
     """
-    return not expr.has(*_NON_ANALYTIC)
 
+    name: str
+    gradient: Callable
+    work: Callable
+    label: str
+    style: Style
+    steps: str | None = None
+    repeats: str = "repeats"
+    applies: Callable = _always
+    compiles: bool = False
+    note: str = ""
+    sources: tuple = ()
+    derivative: Callable | None = None
 
-#: For each field: may the complex step be used?  Computed from `renderer.formulas.HEIGHT`.
-ANALYTIC = {name: is_analytic(expr) for name, expr in F.HEIGHT.items()}
+    def steps_in(self, config):
+        """Its steps in ``config`` (a tuple of floats), or (None,) for a method without a step."""
+        return (None,) if self.steps is None else tuple(getattr(config, self.steps))
 
 
 @dataclass(frozen=True)
@@ -124,15 +178,15 @@ class Config:
     ----------
     name : str
     central_steps, forward_steps, complex_steps : tuple of float
-        The steps eps (chart units) of each sweep.
+        The steps eps (chart units) of each sweep (`Method.steps` names them).
     repeats : int
         Timed runs of every method (each run: all pixels of the frame) ...
     richardson_repeats : int
-        ... except ``richardson``, ten to twenty times slower than the rest,
-        which is timed this many times.
+        ... except ``richardson``, ten to twenty times slower than the rest, which is timed
+        this many times (`Method.repeats`).
     reference_pixels : int or None
-        Pixels per field at which errors are measured against mpmath (a
-        seeded sample of the pixels where the gradient exists); None for all.
+        Pixels per field at which errors are measured against mpmath (a seeded sample of the
+        pixels where the gradient exists); None for all.
     digits : int
         mpmath working precision of the reference, in decimal digits.
     size : int
@@ -155,9 +209,9 @@ class Config:
 
 #: Book build (§5, Cell 4, which reports the time it took): a few hundred reference pixels
 #: at 34 digits and one Richardson run per field keep it to about a second.
-#: Steps: the renderer's default 1e-3, near each quotient's optimum (central
-#: 1e-6, forward 1e-8), and one past the central optimum, where rounding rules.
-FAST = Config("fast", central_steps=(1e-3, 1e-6, 1e-9), forward_steps=(1e-3, 1e-8),
+#: Steps: the draft's step, near each quotient's optimum (central 1e-6, forward 1e-8),
+#: and one past the central optimum, where rounding rules.
+FAST = Config("fast", central_steps=(DRAFT_SCENE.eps, 1e-6, 1e-9), forward_steps=(DRAFT_SCENE.eps, 1e-8),
               complex_steps=(1e-20,), repeats=3, richardson_repeats=1, reference_pixels=100)
 #: Release: every pixel in the reference, twelve steps per sweep, more repeats.
 FULL = Config("full", central_steps=tuple(10.0 ** -np.arange(1, 13)),
@@ -168,14 +222,14 @@ FULL = Config("full", central_steps=tuple(10.0 ** -np.arange(1, 13)),
 
 # --- chart points --------------------------------------------------------------------------
 
-def chart_points(field="ridges", size=256):
-    """Chart coordinates (u, v) of the sphere-A pixels of a default-scene frame.
+def chart_points(field=None, size=256):
+    """Chart coordinates (u, v) of the sphere-A pixels of a frame of the draft's scene.
 
     Parameters
     ----------
-    field : {"sine", "ridges", "rings"}
-        The scene's height field (the chart does not depend on it: it is
-        computed from the geometry before any gradient).
+    field : height field or None
+        As `renderer.formulas.field` takes it; None for the draft's.  The chart does not depend
+        on it (it is computed from the geometry before any gradient).
     size : int
         Frame side in pixels.
 
@@ -183,26 +237,34 @@ def chart_points(field="ridges", size=256):
     -------
     (u, v) : two (n,) float64 arrays, contiguous, in row-major pixel order.
     """
-    g = gbuffer(DRAFT_SCENE.replace(height_field=field), size, size)
+    scene = DRAFT_SCENE if field is None else DRAFT_SCENE.replace(height_field=field)
+    g = gbuffer(scene, size, size)
     uv = g.uv[g.chamber == SPHERE_A]
     return np.ascontiguousarray(uv[:, 0]), np.ascontiguousarray(uv[:, 1])
 
 
-# --- the methods ---------------------------------------------------------------------------
+# --- the methods over a field --------------------------------------------------------------
 
-def forward_gradient(name, uu, vv, ku, kv, eps):
+def _positive_step(eps):
+    if not (isinstance(eps, (int, float, np.floating)) and np.isfinite(eps) and eps > 0):
+        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
+    return float(eps)
+
+
+def forward_gradient(field, uu, vv, ku, kv, eps):
     """One-sided (forward) difference chart gradient.
 
-    h_u = (h(u + eps, v) - h(u, v)) / eps with u + eps wrapped modulo 1 (the
-    chart is periodic in u), and h_v the same in v, except where v + eps > 1,
-    where the step is taken backwards, (h(u, v) - h(u, v - eps)) / eps.  The
-    quotient is divided by the nominal step, as the kernel's central difference does.
-    h(u, v) is shared by both components: three evaluations of h per point.
-    Truncation error O(eps); h is the kernel's, `renderer.pointwise.height`.
+    h_u = (h(u + eps, v) - h(u, v)) / eps with u + eps wrapped modulo 1 (the chart is periodic
+    in u), and h_v the same in v, except where v + eps > 1, where the step is taken backwards,
+    (h(u, v) - h(u, v - eps)) / eps.  The quotient is divided by the nominal step, as the
+    kernel's central difference does.  h(u, v) is shared by both components: three
+    evaluations of h per point.  Truncation error O(eps); h is the kernel's,
+    `renderer.pointwise.height`.
 
     Parameters
     ----------
-    name : {"sine", "ridges", "rings"}
+    field : height field
+        As `renderer.formulas.field` takes it.
     uu, vv : (n,) float64 chart coordinates in [0, 1]
     ku, kv : float
     eps : float > 0, the step in chart units
@@ -214,15 +276,13 @@ def forward_gradient(name, uu, vv, ku, kv, eps):
     Raises
     ------
     ValueError
-        If ``eps`` is not a positive finite number or ``name`` is unknown.
+        If ``eps`` is not a positive finite number or ``field`` is refused.
     """
-    if not (np.isfinite(eps) and eps > 0):
-        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
-    h0 = pointwise.height(name, uu, vv, ku, kv)
-    hu = (pointwise.height(name, np.mod(uu + eps, 1.0), vv, ku, kv) - h0) / eps
-    back = vv + eps > 1.0
-    step = np.where(back, -eps, eps)
-    hv = (pointwise.height(name, uu, vv + step, ku, kv) - h0) / step
+    eps = _positive_step(eps)
+    h0 = pointwise.height(field, uu, vv, ku, kv)
+    hu = (pointwise.height(field, np.mod(uu + eps, 1.0), vv, ku, kv) - h0) / eps
+    step = np.where(vv + eps > 1.0, -eps, eps)
+    hv = (pointwise.height(field, uu, vv + step, ku, kv) - h0) / step
     return hu, hv
 
 
@@ -232,32 +292,27 @@ def _abs_continued(z):
 
 
 @lru_cache(maxsize=None)
-def _complex_height_fn(name, continued):
-    modules = [{"Abs": _abs_continued}, "numpy"] if continued else "numpy"
-    # With "Abs" in a user namespace, lambdify prints Abs(...) and calls that function.
-    return sp.lambdify((F.u, F.v, F.k_u, F.k_v), F.HEIGHT[name], modules=modules)
+def _complex_fn(expr, symbols, continued):
+    """``expr`` as a complex numpy function of ``symbols``; with ``continued`` its Abs is
+    `_abs_continued` (with "Abs" in a user namespace, lambdify prints Abs(...) and calls it)."""
+    return sp.lambdify(symbols, expr, modules=[{"Abs": _abs_continued}, "numpy"] if continued else "numpy")
 
 
-def _complex_height(name, uu, vv, ku, kv, continued):
-    """h at complex chart points, from the sympy expression."""
-    return _complex_height_fn(name, continued)(uu, vv, ku, kv)
-
-
-def complex_step_gradient(name, uu, vv, ku, kv, eps, *, continued=False):
+def complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
     """Complex-step chart gradient, h_u = Im h(u + i eps, v) / eps, h_v likewise.
 
-    h is the sympy expression of `renderer.formulas.HEIGHT` evaluated in
-    complex128 numpy by ``sympy.lambdify``.  No difference is taken, so there
-    is no cancellation and eps may be tiny (1e-20 is usual); the truncation
-    error is O(eps^2).  Two complex evaluations of h per point.  Valid only
-    where h is analytic (`ANALYTIC`): for "ridges" numpy's abs of a complex
-    number is its modulus, a real number, and the result is 0.  With
-    ``continued=True`` the expression's Abs is evaluated as z sign(Re z)
-    [Martins et al. 2003], which gives the one-sided derivative of |f|.
+    h is the field's sympy expression evaluated in complex128 numpy by ``sympy.lambdify``.
+    No difference is taken, so there is no cancellation and eps may be tiny (1e-20 is
+    usual); the truncation error is O(eps^2).  Two complex evaluations of h per point.
+    Valid only where h is analytic (`renderer.formulas.HeightField.analytic`): numpy's abs of
+    a complex number is its modulus, a real number, and the result is 0.  With
+    ``continued=True`` the expression's Abs is evaluated as z sign(Re z) [Martins et al.
+    2003], which gives the one-sided derivative of |f|.
 
     Parameters
     ----------
-    name : {"sine", "ridges", "rings"}
+    field : height field
+        As `renderer.formulas.field` takes it.
     uu, vv : (n,) float64 chart coordinates
     ku, kv : float
     eps : float > 0, the imaginary step in chart units
@@ -270,43 +325,40 @@ def complex_step_gradient(name, uu, vv, ku, kv, eps, *, continued=False):
     Raises
     ------
     ValueError
-        If ``eps`` is not a positive finite number or ``name`` is unknown.
+        If ``eps`` is not a positive finite number or ``field`` is refused.
     """
-    if not (np.isfinite(eps) and eps > 0):
-        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
-    _check_name(name)
+    eps = _positive_step(eps)
+    h = _complex_fn(F.field(field).expr, F.FIELD_SYMBOLS, continued)
     shape = np.broadcast(uu, vv).shape
-    hu = np.imag(_complex_height(name, uu + 1j * eps, vv, ku, kv, continued)) / eps
-    hv = np.imag(_complex_height(name, uu, vv + 1j * eps, ku, kv, continued)) / eps
+    hu = np.imag(h(uu + 1j * eps, vv, ku, kv)) / eps
+    hv = np.imag(h(uu, vv + 1j * eps, ku, kv)) / eps
     return np.broadcast_to(hu, shape), np.broadcast_to(hv, shape)
 
 
-#: scipy.differentiate.derivative's settings.  The first step is half a radian of
-#: phase at the highest frequency of the default scene (pi k_u = 8 pi);
-#: atol lets it stop where a component is exactly 0 (rings: h_u = 0), which its
-#: default (the smallest normal float) never does.
-RICHARDSON = dict(initial_step=0.02, order=8, step_factor=2.0, maxiter=10,
-                  tolerances=dict(atol=1e-12))
+#: scipy.differentiate.derivative's settings over a field.  The first step is half a radian of
+#: phase at the highest frequency of the draft's scene (pi k_u = 8 pi); atol lets it stop where a
+#: component is exactly 0 (rings: h_u = 0), which its default (the smallest normal float) never does.
+RICHARDSON = dict(initial_step=0.02, order=8, step_factor=2.0, maxiter=10, tolerances=dict(atol=1e-12))
 
 
-def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
+def richardson_gradient(field, uu, vv, ku, kv, *, info=None):
     """Chart gradient by `scipy.differentiate.derivative` (settings `RICHARDSON`).
 
-    Both components are computed in one vectorised call: the 2n abscissae are
-    u (moving u) followed by v (moving v).  h is `renderer.pointwise.height`,
-    evaluated at whatever steps scipy chooses (the chart formula is defined for
-    every real u and v, so no wrapping or clamping).  Elements whose
-    iteration did not converge (scipy status != 0) keep scipy's last estimate.
+    Both components are computed in one vectorised call: the 2n abscissae are u (moving u)
+    followed by v (moving v).  h is `renderer.pointwise.height`, evaluated at whatever steps
+    scipy chooses.  Elements whose iteration did not converge (scipy status != 0) keep
+    scipy's last estimate.
 
     Parameters
     ----------
-    name : {"sine", "ridges", "rings"}
+    field : height field
+        As `renderer.formulas.field` takes it.
     uu, vv : (n,) float64 chart coordinates
     ku, kv : float
     info : dict or None, keyword-only
         If given, receives ``"not_converged"`` (int, elements with status != 0),
-        ``"iterations"`` (float, mean iterations per element) and ``"nfev"``
-        (int, scipy's own count of points evaluated, summed over elements).
+        ``"iterations"`` (float, mean iterations per element) and ``"h_per_pixel"`` (float,
+        scipy's own count of points evaluated per pixel, both components).
 
     Returns
     -------
@@ -315,9 +367,9 @@ def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
     Raises
     ------
     ValueError
-        If ``name`` is unknown.
+        If ``field`` is refused.
     """
-    _check_name(name)
+    record = F.field(field)
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     n = uu.size
     x = np.concatenate([uu.ravel(), vv.ravel()])
@@ -325,30 +377,26 @@ def richardson_gradient(name, uu, vv, ku, kv, *, info=None):
     moves_v = np.repeat(np.array([False, True]), n)
 
     def h(x, other, moves_v):
-        return pointwise.height(name, np.where(moves_v, other, x), np.where(moves_v, x, other), ku, kv)
+        return pointwise.height(record, np.where(moves_v, other, x), np.where(moves_v, x, other), ku, kv)
 
     res = derivative(h, x, args=(other, moves_v), **RICHARDSON)
     if info is not None:
-        info["not_converged"] = int(np.count_nonzero(res.status != 0))
-        info["iterations"] = float(np.mean(res.nit))
-        info["nfev"] = int(np.sum(res.nfev))
+        info.update(not_converged=int(np.count_nonzero(res.status != 0)), iterations=float(np.mean(res.nit)),
+                    h_per_pixel=float(np.sum(res.nfev)) / max(n, 1))
     return res.df[:n].reshape(uu.shape), res.df[n:].reshape(uu.shape)
 
-
-# --- automatic differentiation (JAX, forward mode) -----------------------------------------
 
 @lru_cache(maxsize=None)
 def _ad_program(height):
     """The jit-compiled forward-mode gradient of the program that evaluates ``height``.
 
-    ``height`` (a sympy expression in u, v, k_u, k_v) is printed as a JAX
-    function by ``sympy.lambdify``; ``jax.jvp`` pushes the tangent 1 through
-    it once along u (v held) and once along v.  JAX is imported here, not
-    with the module: only this method needs it.
+    ``height`` (a sympy expression in u, v, k_u, k_v) is printed as a JAX function by
+    ``sympy.lambdify``; ``jax.jvp`` pushes the tangent 1 through it once along u (v held)
+    and once along v.  JAX is imported here, not with the module: only AD needs it.
     """
     import jax
     import jax.numpy as jnp
-    h = sp.lambdify((F.u, F.v, F.k_u, F.k_v), height, modules="jax")
+    h = sp.lambdify(F.FIELD_SYMBOLS, height, modules="jax")
 
     def gradient(uu, vv, ku, kv):
         one = jnp.ones_like(uu)
@@ -358,27 +406,26 @@ def _ad_program(height):
     return jax.jit(gradient)
 
 
-def ad_gradient(name, uu, vv, ku, kv, *, height=None):
+def ad_gradient(field, uu, vv, ku, kv, *, height=None):
     """Chart gradient by forward-mode automatic differentiation (``jax.jvp``).
 
-    The program differentiated is h as `renderer.formulas.HEIGHT` writes it,
-    printed for JAX by ``sympy.lambdify`` and jit-compiled by XLA, in float64
-    (``jax.enable_x64`` around the call only; JAX's global setting is left
-    as it is).  Two forward passes per point, one tangent each.  No step, no
-    truncation: the result is the derivative of the program, rounded as the
-    program's operations round.  Where the program takes |x| of x = 0 it
-    uses JAX's slope of |x| there (`abs_slope_at_zero`).  The first call at a
-    new array shape compiles (tens of milliseconds); later calls reuse it.
+    The program differentiated is h as the field's expression writes it, printed for JAX by
+    ``sympy.lambdify`` and jit-compiled by XLA, in float64 (``jax.enable_x64`` around the call
+    only; JAX's global setting is left as it is).  Two forward passes per point, one tangent
+    each.  No step, no truncation: the result is the derivative of the program, rounded as the
+    program's operations round.  Where the program takes |x| of x = 0 it uses JAX's slope of
+    |x| there (`abs_slope_at_zero`).  The first call at a new array shape compiles (tens of
+    milliseconds); later calls reuse it.
 
     Parameters
     ----------
-    name : {"sine", "ridges", "rings"}
+    field : height field
+        As `renderer.formulas.field` takes it.
     uu, vv : (n,) float64 chart coordinates
     ku, kv : float
     height : sympy expression or None, keyword-only
-        The program to differentiate, in `renderer.formulas` u, v, k_u, k_v;
-        None (the default) for the field's ``HEIGHT[name]``.  A test hands
-        in a wrong one to see it caught.
+        The program to differentiate, in u, v, k_u, k_v; None (the default) for the field's
+        expression.  A test hands in a wrong one to see it caught.
 
     Returns
     -------
@@ -387,11 +434,10 @@ def ad_gradient(name, uu, vv, ku, kv, *, height=None):
     Raises
     ------
     ValueError
-        If ``name`` is unknown.
+        If ``field`` is refused.
     """
     import jax
-    _check_name(name)
-    fn = _ad_program(F.HEIGHT[name] if height is None else height)
+    fn = _ad_program(F.field(field).expr if height is None else height)
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     with jax.enable_x64(True):
         h_u, h_v = fn(uu, vv, float(ku), float(kv))
@@ -399,81 +445,69 @@ def ad_gradient(name, uu, vv, ku, kv, *, height=None):
 
 
 @lru_cache(maxsize=None)
-def ad_trig_calls(name):
-    """Sines and cosines per point in the program XLA compiled for `ad_gradient` of ``name``.
-
-    Counted in the optimised HLO text, after XLA's common-subexpression
-    elimination has merged what it could of the two passes, at a small
-    array size (the program is the same at every size).
-
-    Raises
-    ------
-    ValueError
-        If ``name`` is unknown.
-    """
-    import re
-
+def ad_trig_calls(field):
+    """Sines and cosines per point in the program XLA compiled for `ad_gradient` of ``field`` (a
+    `renderer.formulas.HeightField`), counted in the optimised HLO text, after XLA's
+    common-subexpression elimination has merged what it could of the two passes, at a small
+    array size (the program is the same at every size)."""
     import jax
-    _check_name(name)
     x = np.zeros(4)
     with jax.enable_x64(True):
-        text = _ad_program(F.HEIGHT[name]).lower(x, x, 1.0, 1.0).compile().as_text()
+        text = _ad_program(F.field(field).expr).lower(x, x, 1.0, 1.0).compile().as_text()
     return len(re.findall(r"\b(?:sine|cosine)\(", text))
 
 
 @lru_cache(maxsize=None)
-def _xla_exact_program(name):
-    """The exact gradient `renderer.formulas.GRADIENT` of field ``name`` printed for JAX by
-    ``sympy.lambdify`` (common subexpressions shared) and jit-compiled by XLA, as
-    `_ad_program` compiles the program AD differentiates."""
+def _xla_exact_program(field):
+    """The exact gradient of ``field`` printed for JAX by ``sympy.lambdify`` (common
+    subexpressions shared) and jit-compiled by XLA, as `_ad_program` compiles the program AD
+    differentiates."""
     import jax
-    fn = sp.lambdify((F.u, F.v, F.k_u, F.k_v), list(F.GRADIENT[name]), modules="jax", cse=True)
+    fn = sp.lambdify(F.FIELD_SYMBOLS, list(field.gradient), modules="jax", cse=True)
     return jax.jit(lambda uu, vv, ku, kv: tuple(fn(uu, vv, ku, kv)))
 
 
-def xla_exact_gradient(name, uu, vv, ku, kv):
+def xla_exact_gradient(field, uu, vv, ku, kv):
     """The exact chart gradient compiled by XLA, AD's compiler: (h_u, h_v), two (n,) float64
     arrays for (n,) float64 ``uu``, ``vv``.  `same_compiler_times` times it beside
-    `ad_gradient`.  Raises ValueError if ``name`` is unknown."""
+    `ad_gradient`.  Raises ValueError if ``field`` is refused (`renderer.formulas.field`)."""
     import jax
-    _check_name(name)
+    program = _xla_exact_program(F.field(field))
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     with jax.enable_x64(True):
-        h_u, h_v = _xla_exact_program(name)(uu, vv, float(ku), float(kv))
+        h_u, h_v = program(uu, vv, float(ku), float(kv))
         return np.broadcast_to(np.asarray(h_u), uu.shape), np.broadcast_to(np.asarray(h_v), uu.shape)
 
 
-def same_compiler_times(uu, vv, *, ku=None, kv=None, rounds=21, fields_=FIELDS):
-    """AD and the exact gradient through one compiler (XLA), and the exact gradient
-    compiled by numba, timed side by side.
+def same_compiler_times(uu, vv, *, ku=None, kv=None, rounds=21, fields_=None):
+    """AD and the exact gradient through one compiler (XLA), and the exact gradient compiled
+    by numba, timed side by side.
 
-    Per field, after one call of each (which compiles), ``rounds`` interleaved
-    rounds of `xla_exact_gradient`, `ad_gradient` and
-    `renderer.pointwise.exact_gradient` (numba) on the chart points ``uu``,
-    ``vv`` ((n,) float64); ``ku``, ``kv`` default to the draft's scene's.
-    Separates what the method costs from what the compiler costs: §5's
-    benchmark sets AD (XLA) beside the exact gradient compiled by numba.
+    Per field, after one call of each (which compiles), ``rounds`` interleaved rounds of
+    `xla_exact_gradient`, `ad_gradient` and `renderer.pointwise.exact_gradient` (numba) on the
+    chart points ``uu``, ``vv`` ((n,) float64); ``ku``, ``kv`` default to the draft's scene's,
+    ``fields_`` to every registered field.  Separates what the method costs from what the
+    compiler costs: §5's benchmark sets AD (XLA) beside the exact gradient compiled by numba.
 
     Returns
     -------
-    dict field -> {"exact": seconds, "ad": seconds, "numba": seconds, "ratio": ad / exact,
+    dict field name -> {"exact": seconds, "ad": seconds, "numba": seconds, "ratio": ad / exact,
     "compiler": exact / numba}, medians.
 
     Raises
     ------
     ValueError
-        If ``rounds`` is not a positive int or a field is unknown.
+        If ``rounds`` is not a positive int or a field is refused.
     """
     if not isinstance(rounds, int) or isinstance(rounds, bool) or rounds < 1:
         raise ValueError(f"rounds must be a positive int, got {rounds!r}")
     ku = float(DRAFT_SCENE.k_u if ku is None else ku)
     kv = float(DRAFT_SCENE.k_v if kv is None else kv)
     out = {}
-    for name in fields_:
-        _check_name(name)
-        calls = {"exact": lambda: xla_exact_gradient(name, uu, vv, ku, kv),
-                 "ad": lambda: ad_gradient(name, uu, vv, ku, kv),
-                 "numba": lambda: pointwise.exact_gradient(name, uu, vv, ku, kv)}
+    for record in (F.field(f) for f in (tuple(F.FIELDS) if fields_ is None else fields_)):
+        calls = {"exact": lambda: xla_exact_gradient(record, uu, vv, ku, kv),
+                 "ad": lambda: ad_gradient(record, uu, vv, ku, kv),
+                 "numba": lambda: pointwise.exact_gradient(record, uu, vv, ku, kv)}
         times = {k: [] for k in calls}
         for call in calls.values():                  # the first call compiles
             call()
@@ -483,15 +517,16 @@ def same_compiler_times(uu, vv, *, ku=None, kv=None, rounds=21, fields_=FIELDS):
                 call()                               # returns numpy arrays: the work is done
                 times[k].append(time.perf_counter() - t0)
         exact, ad, numba = (float(np.median(times[k])) for k in ("exact", "ad", "numba"))
-        out[name] = {"exact": exact, "ad": ad, "numba": numba, "ratio": ad / exact, "compiler": exact / numba}
+        out[record.name] = {"exact": exact, "ad": ad, "numba": numba, "ratio": ad / exact,
+                            "compiler": exact / numba}
     return out
 
 
 def abs_slope_at_zero():
     """JAX's forward-mode slope of |x| at x = +0.0 and x = -0.0, measured: (float, float).
 
-    |x| has no derivative at 0; an AD tool must still return a number there,
-    and which one is its convention.
+    |x| has no derivative at 0; an AD tool must still return a number there, and which one
+    is its convention.
     """
     import jax
     import jax.numpy as jnp
@@ -500,53 +535,49 @@ def abs_slope_at_zero():
 
 
 def crease_values(*, v=None, eps=None, ku=None, kv=None):
-    """h_u of the ridges field on two of its creases in u, by three methods, beside the one-sided slopes.
+    """h_u of the draft's field (ridges, |f| with f the product of its crease factors) on two of
+    its creases in u, by three methods, beside the one-sided slopes.
 
-    The creases are u = 0, where the factor sin(pi k_u u) is exactly 0 in
-    float64, and u = 1/k_u as float64 holds it, where the float64 factor is
-    a rounding residue, not 0, so the sign of f picks a side.
+    The creases are u = 0, where the factor sin(pi k_u u) is exactly 0 in float64, and u = 1/k_u
+    as float64 holds it, where the float64 factor is a rounding residue, not 0, so the sign of f
+    picks a side.
 
     Parameters
     ----------
     v : float or None, keyword-only
-        The chart v of both points; None for the U-curve's point
-        (`renderer.ucurve.SEED_POINT`), off the creases in v.
+        The chart v of both points; None for the U-curve's point (`renderer.ucurve.SEED_POINT`),
+        off the creases in v.
     eps : float > 0 or None, keyword-only
-        The central difference's step in chart units; None for the draft
-        scene's step.
+        The central difference's step in chart units; None for the draft's step.
     ku, kv : float or None, keyword-only
         The frequencies; None for the U-curve's (`renderer.ucurve.SEED_FREQUENCIES`).
 
     Returns
     -------
-    list of two dicts of floats: ``u``; ``factor``, sin(pi k_u u) in float64;
-    ``exact``, the generated gradient (sign(0) = 0); ``ad``, `ad_gradient`;
-    ``central``, the kernel's central difference at ``eps``; ``left`` and
-    ``right``, the one-sided slopes of |f| in u, -|f_u| and +|f_u| with f_u
-    sympy's derivative of the product evaluated by mpmath.
+    list of two dicts of floats: ``u``; ``factor``, sin(pi k_u u) in float64; ``exact``, the
+    generated gradient (sign(0) = 0); ``ad``, `ad_gradient`; ``central``, the kernel's central
+    difference at ``eps``; ``left`` and ``right``, the one-sided slopes of |f| in u, -|f_u| and
+    +|f_u| with f_u sympy's derivative of the product evaluated by mpmath.
 
     Raises
     ------
     ValueError
         If ``eps`` is not a positive finite number.
     """
-    from renderer import ucurve
+    record = DRAFT_SCENE.field
     v = ucurve.SEED_POINT[1] if v is None else float(v)
     ku0, kv0 = ucurve.SEED_FREQUENCIES
     ku, kv = float(ku0 if ku is None else ku), float(kv0 if kv is None else kv)
-    eps = float(DRAFT_SCENE.eps) if eps is None else eps
-    if not (np.isfinite(eps) and eps > 0):
-        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
-    f_u = sp.lambdify((F.u, F.v, F.k_u, F.k_v), sp.diff(F.RIDGE_FACTORS[0] * F.RIDGE_FACTORS[1], F.u),
-                      modules="mpmath")
+    eps = _positive_step(DRAFT_SCENE.eps if eps is None else eps)
+    f_u = sp.lambdify(F.FIELD_SYMBOLS, sp.diff(sp.Mul(*record.crease_factors), F.u), modules="mpmath")
     out = []
     for u0 in (0.0, 1.0 / ku):
         uu, vv = np.array([u0]), np.array([v])
         slope = abs(float(f_u(mpmath.mpf(u0), mpmath.mpf(v), mpmath.mpf(ku), mpmath.mpf(kv))))
         out.append(dict(u=u0, factor=float(np.sin(np.pi * ku * u0)),
-                        exact=float(pointwise.exact_gradient("ridges", uu, vv, ku, kv)[0][0]),
-                        ad=float(ad_gradient("ridges", uu, vv, ku, kv)[0][0]),
-                        central=float(pointwise.central_gradient("ridges", uu, vv, ku, kv, eps)[0][0]),
+                        exact=float(pointwise.exact_gradient(record, uu, vv, ku, kv)[0][0]),
+                        ad=float(ad_gradient(record, uu, vv, ku, kv)[0][0]),
+                        central=float(pointwise.central_gradient(record, uu, vv, ku, kv, eps)[0][0]),
                         left=-slope, right=slope))
     return out
 
@@ -554,29 +585,28 @@ def crease_values(*, v=None, eps=None, ku=None, kv=None):
 # --- the reference -------------------------------------------------------------------------
 
 @lru_cache(maxsize=None)
-def _reference_fn(name, ku, kv):
+def _reference_fn(field, ku, kv):
     # Exact rational frequencies, so that mpmath does not inherit float64 rounding.
     # First derivatives of |f| carry sign(f), no DiracDelta: usable as they are.
     ks = {F.k_u: sp.nsimplify(ku), F.k_v: sp.nsimplify(kv)}
-    exprs = [g.subs(ks) for g in F.GRADIENT[name]]
-    return sp.lambdify((F.u, F.v), exprs, modules="mpmath", cse=True)
+    return sp.lambdify((F.u, F.v), [g.subs(ks) for g in field.gradient], modules="mpmath", cse=True)
 
 
-def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
+def reference_gradient(field, uu, vv, ku, kv, *, digits=34):
     """The exact gradient at float64 chart points, evaluated by mpmath.
 
-    sympy's derivative of the field (`renderer.formulas.GRADIENT`) is
-    evaluated with mpmath at ``digits`` decimal digits, at the chart points
-    exactly as float64 represents them, and returned as a double-double: the
-    value rounded to float64 (``hi``) and the rounding residual (``lo``).  An
-    error |x - ref| of a float64 estimate x is then ``|(x - hi) - lo|``, exact
-    up to one rounding of the error itself.  Working precision: 34 digits
-    put the reference's own error (~1e-33 relative) sixteen orders below the
-    float64 spacing it judges; ``lo`` needs only 32.
+    sympy's derivative of the field (`renderer.formulas.HeightField.gradient`) is evaluated
+    with mpmath at ``digits`` decimal digits, at the chart points exactly as float64
+    represents them, and returned as a double-double: the value rounded to float64 (``hi``)
+    and the rounding residual (``lo``).  An error |x - ref| of a float64 estimate x is then
+    ``|(x - hi) - lo|``, exact up to one rounding of the error itself.  Working precision: 34
+    digits put the reference's own error (~1e-33 relative) sixteen orders below the float64
+    spacing it judges; ``lo`` needs only 32.
 
     Parameters
     ----------
-    name : {"sine", "ridges", "rings"}
+    field : height field
+        As `renderer.formulas.field` takes it.
     uu, vv : (n,) float64
     ku, kv : float (converted to exact rationals)
     digits : int, keyword-only
@@ -585,8 +615,7 @@ def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
     -------
     (hi, lo) : two (2, n) float64 arrays; row 0 is h_u, row 1 is h_v.
     """
-    _check_name(name)
-    fn = _reference_fn(name, float(ku), float(kv))
+    fn = _reference_fn(F.field(field), float(ku), float(kv))
     uu, vv = np.broadcast_arrays(np.ravel(uu), np.ravel(vv))
     hi = np.empty((2, uu.size))
     lo = np.empty((2, uu.size))
@@ -600,40 +629,11 @@ def reference_gradient(name, uu, vv, ku, kv, *, digits=34):
 
 # --- the work per pixel -------------------------------------------------------------------
 
-def _check_name(name):
-    if name not in F.HEIGHT:
-        raise ValueError(f"height_field must be one of {tuple(F.HEIGHT)}, got {name!r}")
-
-
-def trig_calls(exprs):
-    """Sines and cosines evaluated per point by the code generated from ``exprs``.
-
-    ``renderer.codegen`` prints a function's outputs after one common-subexpression
-    elimination over all of them (``sympy.cse``); a sine or cosine left in the
-    eliminated code is computed once per point, so this counts the sin and cos
-    nodes of the replacements and the reduced outputs.  The numba kernel calls
-    exactly these (tests/test_gradient_methods.py compares the count with the
-    text of renderer/generated.py).
-    """
-    subs, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols("x"))
-    return sum(isinstance(node, (sp.sin, sp.cos))
-               for e in [x for _, x in subs] + list(reduced) for node in sp.preorder_traversal(e))
-
-
-def stencil_values(name):
-    """Values of h per point in the kernel's central difference of field ``name``:
-    the stencil points (`formulas.STENCIL_POINTS`) that `formulas.CENTRAL` reads.
-    4 for sine and ridges; 2 for rings, whose u-difference sympy reduced to 0."""
-    _check_name(name)
-    used = set().union(*(c.free_symbols for c in F.CENTRAL[name]))
-    return sum(p in used for p, _ in F.STENCIL_POINTS)
-
-
 @dataclass(frozen=True)
 class Evaluations:
-    """Work per pixel: real values of h, complex values of h, evaluations of the
-    generated gradient, forward-mode passes through h's program (a value and
-    one tangent each), and the real sines and cosines all of them cost."""
+    """Work per pixel: real values of h, complex values of h, evaluations of the generated
+    gradient, forward-mode passes through h's program (a value and one tangent each), and
+    the real sines and cosines all of them cost."""
 
     h: float = 0.0
     h_complex: float = 0.0
@@ -642,68 +642,151 @@ class Evaluations:
     h_tangent: float = 0.0
 
 
-def evaluations(name, method, *, h_per_pixel=None):
-    """The work per pixel of ``method`` on field ``name``, from the sympy objects.
+def trig_calls(exprs):
+    """Sines and cosines evaluated per point by the code generated from ``exprs``.
 
-    Parameters
-    ----------
-    name : {"sine", "ridges", "rings"}
-    method : str
-        "exact", "central", "forward", "complex step", "complex step, |z|
-        continued", "richardson", `AD` (its sines and cosines counted in
-        the compiled program, `ad_trig_calls`) or "h" (one evaluation of h
-        alone).
-    h_per_pixel : float, keyword-only
-        For "richardson" only: the values of h per pixel scipy reported (its
-        iteration adapts, so the count is measured, not derived).
-
-    Returns
-    -------
-    Evaluations
-
-    Raises
-    ------
-    ValueError
-        An unknown field or method, or ``h_per_pixel`` missing for "richardson".
+    ``renderer.codegen`` prints a function's outputs after one common-subexpression
+    elimination over all of them (``sympy.cse``); a sine or cosine left in the eliminated code
+    is computed once per point, so this counts the sin and cos nodes of the replacements and
+    the reduced outputs.  The numba kernel calls exactly these (tests/test_gradient_methods.py
+    compares the count with the text of renderer/generated.py).
     """
-    _check_name(name)
-    per_h = trig_calls((F.HEIGHT[name],))
-    if method == "exact":
-        return Evaluations(gradient=1.0, trig=float(trig_calls(F.GRADIENT[name])))
-    if method == "central":
-        return Evaluations(h=float(stencil_values(name)), trig=float(trig_calls(F.CENTRAL[name])))
-    if method == "forward":
-        return Evaluations(h=3.0, trig=3.0 * per_h)
-    if method in ("complex step", "complex step, |z| continued"):
-        return Evaluations(h_complex=2.0)
-    if method == "h":
-        return Evaluations(h=1.0, trig=float(per_h))
-    if method == AD:
-        return Evaluations(h_tangent=2.0, trig=float(ad_trig_calls(name)))
-    if method == "richardson":
-        if h_per_pixel is None:
-            raise ValueError("richardson's evaluations are measured: pass h_per_pixel")
-        return Evaluations(h=float(h_per_pixel), trig=float(h_per_pixel) * per_h)
-    raise ValueError(f"unknown method {method!r}")
+    exprs = [e for e in exprs if isinstance(e, sp.Basic)]
+    subs, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"))
+    return sum(isinstance(node, (sp.sin, sp.cos))
+               for e in [x for _, x in subs] + list(reduced) for node in sp.preorder_traversal(e))
 
 
-# --- the measurement -----------------------------------------------------------------------
+def _generated(kind, field):
+    """The outputs of the generated function ``kind`` (a key of `formulas.FIELD_FUNCTIONS`) of a field."""
+    return F.FIELD_FUNCTIONS[kind][1](field)
+
+
+def stencil_values(field):
+    """Values of h per point in the kernel's central difference of ``field``: the stencil points
+    (`formulas.STENCIL_POINTS`) that its quotients read.  4 for sine and ridges; 2 for rings,
+    whose u-difference sympy reduced to 0."""
+    used = set().union(*(c.free_symbols for c in F.field(field).central))
+    return sum(p in used for p, _ in F.STENCIL_POINTS)
+
+
+def height_work(field):
+    """One value of h per pixel, with the sines and cosines it costs: the unit of cost."""
+    return Evaluations(h=1.0, trig=float(trig_calls((F.field(field).expr,))))
+
+
+def _measured_h(info):
+    if "h_per_pixel" not in info:
+        raise ValueError("richardson's evaluations are measured: pass the info its gradient filled")
+    return info["h_per_pixel"]
+
+
+def method(name):
+    """The record of `METHODS` named ``name``; ValueError naming the names if there is none."""
+    for m in METHODS:
+        if m.name == name:
+            return m
+    raise ValueError(f"method must be one of {[m.name for m in METHODS]}, got {name!r}")
+
+
+def evaluations(field, name, info=None):
+    """The work per pixel of the method ``name`` on ``field`` (`Method.work`), an `Evaluations`.
+    ``info``: what the method's gradient measured of itself (Richardson's count of values of h).
+    Raises ValueError for an unknown method, or Richardson without ``info``."""
+    return method(name).work(F.field(field), info or {})
+
+
+# --- the methods over a function of one variable ---------------------------------------------
+
+def _exact_1d(function, x, eps, info):
+    return float(sp.lambdify(F.x_var, function.derivative, modules="math")(x))
+
+
+def _central_1d(function, x, eps, info):
+    return float(fieldcode.univariate_code(function).central(x, eps))
+
+
+def _forward_1d(function, x, eps, info):
+    return float(fieldcode.univariate_code(function).forward(x, eps))
+
+
+def _complex_1d(continued):
+    def derivative_(function, x, eps, info):
+        return float(np.imag(_complex_fn(function.expr, (F.x_var,), continued)(complex(x, eps))) / eps)
+    return derivative_
+
+
+def _richardson_1d(function, x, eps, info):
+    res = derivative(_complex_fn(function.expr, (F.x_var,), False), np.float64(x))
+    info["h_per_pixel"] = float(res.nfev)
+    return float(res.df)
+
+
+def _ad_1d(function, x, eps, info):
+    import jax
+    import jax.numpy as jnp
+    f = sp.lambdify(F.x_var, function.expr, modules="jax")
+    with jax.enable_x64(True):
+        return float(jax.jvp(f, (jnp.float64(x),), (jnp.float64(1.0),))[1])
+
+
+# --- the list of methods ------------------------------------------------------------------
+
+def _has_abs(record):
+    return record.expr.has(sp.Abs)
+
+
+def _ad_work(field, info):
+    return Evaluations(h_tangent=2.0, trig=float(ad_trig_calls(field)))
+
+
+#: The methods, in the order tables and legends list them.  Adding a method is one record here.
+METHODS = [
+    Method("exact", lambda f, u, v, ku, kv, eps, info: pointwise.exact_gradient(f, u, v, ku, kv),
+           lambda f, info: Evaluations(gradient=1.0, trig=float(trig_calls(_generated("exact", f)))),
+           "exact (sympy)", Style("#1b5e20", "*", 12, "-"), derivative=_exact_1d),
+    Method("central", lambda f, u, v, ku, kv, eps, info: pointwise.central_gradient(f, u, v, ku, kv, eps),
+           lambda f, info: Evaluations(h=float(stencil_values(f)), trig=float(trig_calls(_generated("central", f)))),
+           "central difference", Style("#7a1f1f", "o", 5, "-"), steps="central_steps", derivative=_central_1d),
+    Method("forward", lambda f, u, v, ku, kv, eps, info: forward_gradient(f, u, v, ku, kv, eps),
+           lambda f, info: Evaluations(h=3.0, trig=3.0 * trig_calls((f.expr,))),
+           "forward difference", Style("#b26b00", "s", 5, "--"), steps="forward_steps", derivative=_forward_1d),
+    Method("complex step", lambda f, u, v, ku, kv, eps, info: complex_step_gradient(f, u, v, ku, kv, eps),
+           lambda f, info: Evaluations(h_complex=2.0), "complex step", Style("#1f4e7a", "D", 6, ":"),
+           steps="complex_steps", applies=lambda f: f.analytic, sources=("squire-trapp", "martins-complex-step"),
+           derivative=_complex_1d(False)),
+    Method("complex step, |z| continued",
+           lambda f, u, v, ku, kv, eps, info: complex_step_gradient(f, u, v, ku, kv, eps, continued=True),
+           lambda f, info: Evaluations(h_complex=2.0), "complex step, |z| continued",
+           Style("#5b7fa6", "d", 7, "-."), steps="complex_steps", applies=_has_abs,
+           note="|f| evaluated as f sign(Re f); one-sided on the crease", sources=("martins-complex-step",),
+           derivative=_complex_1d(True)),
+    Method("richardson", lambda f, u, v, ku, kv, eps, info: richardson_gradient(f, u, v, ku, kv, info=info),
+           lambda f, info: Evaluations(h=_measured_h(info), trig=_measured_h(info) * trig_calls((f.expr,))),
+           "SciPy (Richardson)", Style("#6a1b9a", "^", 8, (0, (5, 2, 1, 2))), repeats="richardson_repeats",
+           note=f"scipy.differentiate.derivative, order {RICHARDSON['order']}", derivative=_richardson_1d),
+    Method(AD, lambda f, u, v, ku, kv, eps, info: ad_gradient(f, u, v, ku, kv), _ad_work,
+           "forward-mode AD (JAX)", Style("#00838f", "P", 8, (0, (1, 1))), compiles=True,
+           note="jax.jvp, jit-compiled", sources=("griewank-walther",), derivative=_ad_1d),
+]
+
+
+# --- the measurement over a field -------------------------------------------------------------
 
 @dataclass(frozen=True)
 class MethodResult:
     """One method on one field.
 
-    Times are seconds per frame (all sphere-A pixels, both components);
-    evaluations are per pixel; errors are absolute, in units of h per chart
-    unit, over both components at the reference pixels.
+    Times are seconds per frame (all sphere-A pixels, both components); evaluations are per
+    pixel; errors are absolute, in units of h per chart unit, over both components at the
+    reference pixels.
     """
 
     field: str
-    method: str                 # "exact", "central", "forward", "complex step", ...
+    method: str                 # a `Method.name`
     eps: float | None           # the step, or None
-    valid: bool                 # False: the method's premise fails on this field
     times: tuple                # seconds, one per repeat
-    h_evals: float              # real evaluations of h per pixel (`evaluations`)
+    h_evals: float              # real evaluations of h per pixel (`Method.work`)
     h_complex_evals: float      # complex evaluations of h per pixel
     gradient_evals: float       # evaluations of the generated gradient per pixel
     max_error: float
@@ -711,7 +794,7 @@ class MethodResult:
     note: str = ""
     trig_evals: float = 0.0     # real sines and cosines per pixel
     h_tangent_evals: float = 0.0        # forward-mode passes through h per pixel (AD)
-    compile_seconds: float | None = None    # AD: its first call in the process at the frame's size (trace, compile, run)
+    compile_seconds: float | None = None    # its first call at the frame's size (`Method.compiles`)
 
     @property
     def label(self):
@@ -738,13 +821,11 @@ class MethodResult:
 class Measurement:
     """All results of one `measure` run.
 
-    ``pixels`` is the number of sphere-A pixels timed per frame;
-    ``reference_pixels`` maps each field to the number of pixels whose error
-    was measured, ``excluded_pixels`` to the number of the frame's pixels on
-    the crease band, where no error is measured (0 for sine and rings);
-    ``h_times`` to the times (seconds) of one evaluation of h at all pixels,
-    timed among the methods as a unit of cost; ``seconds`` is the wall time
-    of the run.
+    ``pixels`` is the number of sphere-A pixels timed per frame; ``reference_pixels`` maps
+    each field to the number of pixels whose error was measured, ``excluded_pixels`` to the
+    number of the frame's pixels on the crease band, where no error is measured (0 for a
+    field without creases); ``h_times`` to the times (seconds) of one evaluation of h at all
+    pixels, timed among the methods as a unit of cost; ``seconds`` is the wall time of the run.
     """
 
     config: Config
@@ -770,52 +851,24 @@ class Measurement:
         raise KeyError((field, label))
 
 
-def methods(name, config, ku, kv):
-    """The methods measured on field ``name``: a list of (method, eps, valid, fn, note).
-
-    ``fn(u, v)`` returns (h_u, h_v); ``valid`` is False where the method's
-    premise fails (complex step on a field that is not analytic).
-    """
-    out = [("exact", None, True, lambda u, v: pointwise.exact_gradient(name, u, v, ku, kv), "")]
-    for eps in config.central_steps:
-        out.append(("central", eps, True,
-                    lambda u, v, eps=eps: pointwise.central_gradient(name, u, v, ku, kv, eps), ""))
-    for eps in config.forward_steps:
-        out.append(("forward", eps, True,
-                    lambda u, v, eps=eps: forward_gradient(name, u, v, ku, kv, eps), ""))
-    analytic = ANALYTIC[name]
-    for eps in config.complex_steps:
-        note = "" if analytic else "h is not analytic: Im |f(u + i eps)| = 0"
-        out.append(("complex step", eps, analytic,
-                    lambda u, v, eps=eps: complex_step_gradient(name, u, v, ku, kv, eps), note))
-    if not analytic and F.HEIGHT[name].has(sp.Abs):
-        eps = min(config.complex_steps)
-        out.append(("complex step, |z| continued", eps, True,
-                    lambda u, v, eps=eps: complex_step_gradient(name, u, v, ku, kv, eps, continued=True),
-                    "|f| evaluated as f sign(Re f); one-sided on the crease"))
-    out.append(("richardson", None, True, lambda u, v: richardson_gradient(name, u, v, ku, kv),
-                f"scipy.differentiate.derivative, order {RICHARDSON['order']}"))
-    out.append((AD, None, True, lambda u, v: ad_gradient(name, u, v, ku, kv), "jax.jvp, jit-compiled"))
-    return out
-
-
 def _errors(approx, hi, lo):
     err = np.abs((np.stack(approx) - hi) - lo)
     return float(err.max()), float(np.sqrt(np.mean(err**2)))
 
 
-def measure(config=FAST, *, fields_=FIELDS, uv=None):
-    """Time and check every method on every field, with its work per pixel (see the module docstring).
+def measure(config=FAST, *, fields_=None, uv=None):
+    """Time and check every method on every field where it applies, with its work per pixel
+    (see the module docstring).
 
     Parameters
     ----------
     config : Config
         `FAST` (book build) or `FULL` (release).
-    fields_ : sequence of field names, keyword-only
+    fields_ : sequence of height fields or None, keyword-only
+        As `renderer.formulas.field` takes them; None for every registered field.
     uv : (u, v) pair of (n,) float64 arrays or None, keyword-only
-        Chart points of the sphere-A pixels, shared by all fields (they do
-        not depend on the field); None computes them with `chart_points`
-        for each field.
+        Chart points of the sphere-A pixels, shared by all fields (they do not depend on the
+        field); None computes them with `chart_points`.
 
     Returns
     -------
@@ -823,27 +876,24 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
 
     Notes
     -----
-    Per field, one run of every method at the reference pixels gives the
-    errors; the work per pixel is `evaluations` (for scipy's adaptive
-    iteration, its own count at those pixels, a sample's mean in `FAST`).
-    AD is then called once on all pixels, which compiles its program for
-    that size (`MethodResult.compile_seconds`).  Then ``config.repeats``
-    rounds time every (field, method) pair on all pixels, in an order shuffled each round, so that drifts of the
-    machine's speed fall on all of them alike.
+    Per field, one run of every method at the reference pixels gives the errors and the work
+    per pixel (`Method.work`; for scipy's adaptive iteration its own count at those pixels, a
+    sample's mean in `FAST`).  A method that compiles is then called once on all pixels
+    (`MethodResult.compile_seconds`).  Then rounds time every (field, method) pair on all
+    pixels, in an order shuffled each round, so that drifts of the machine's speed fall on
+    all of them alike.
     """
     t_start = time.perf_counter()
     load_start = os.getloadavg() if hasattr(os, "getloadavg") else None
     rng = np.random.default_rng(config.seed)
-    scene = DRAFT_SCENE
-    ku, kv = float(scene.k_u), float(scene.k_v)
-    results, n_ref, n_excl, h_times = [], {}, {}, {}
-    pixels = None
-    checked, timed = [], []
-    for name in fields_:
-        u, v = chart_points(name, config.size) if uv is None else uv
-        pixels = u.size
-        # The error sample: pixels where the gradient exists (off the ridges' crease band).
-        off = np.flatnonzero(~pointwise.kink_band(name, u, v, ku, kv))
+    ku, kv = float(DRAFT_SCENE.k_u), float(DRAFT_SCENE.k_v)
+    records = [F.field(f) for f in (tuple(F.FIELDS) if fields_ is None else fields_)]
+    u, v = chart_points(size=config.size) if uv is None else uv
+    checked, timed, n_ref, n_excl = [], [], {}, {}
+    for record in records:
+        name = record.name
+        # The error sample: pixels where the gradient exists (off the crease band).
+        off = np.flatnonzero(~pointwise.kink_band(record, u, v, ku, kv))
         n_excl[name] = int(u.size - off.size)
         if config.reference_pixels is not None and config.reference_pixels < off.size:
             pick = np.sort(rng.choice(off, size=config.reference_pixels, replace=False))
@@ -851,54 +901,52 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
             pick = off
         n_ref[name] = int(pick.size)
         ru, rv = u[pick].copy(), v[pick].copy()
-        hi, lo = reference_gradient(name, ru, rv, ku, kv, digits=config.digits)
-
-        # Errors: one run of every method at the reference pixels; the work per pixel.
-        for method, eps, valid, fn, note in methods(name, config, ku, kv):
-            compile_s = None
-            if method == AD:        # the first call at the frame's size traces and compiles: timed apart
-                t0 = time.perf_counter()
-                fn(u, v)
-                compile_s = time.perf_counter() - t0
-            if method == "richardson":
+        hi, lo = reference_gradient(record, ru, rv, ku, kv, digits=config.digits)
+        for m in METHODS:
+            if not m.applies(record):
+                continue
+            for eps in m.steps_in(config):
+                def fn(uu, vv, info=None, m=m, eps=eps, record=record):
+                    return m.gradient(record, uu, vv, ku, kv, eps, {} if info is None else info)
+                compile_s = None
+                if m.compiles:                  # the first call at the frame's size compiles: timed apart
+                    t0 = time.perf_counter()
+                    fn(u, v)
+                    compile_s = time.perf_counter() - t0
                 info = {}
-                approx = richardson_gradient(name, ru, rv, ku, kv, info=info)
-                work = evaluations(name, method, h_per_pixel=info["nfev"] / ru.size)
-                if info["not_converged"]:
+                errors = _errors(fn(ru, rv, info), hi, lo)
+                note = m.note
+                if info.get("not_converged"):
                     note = (note + "; " if note else "") + \
                         f"{info['not_converged']} of {2 * ru.size} components not converged"
-            else:
-                approx = fn(ru, rv)
-                work = evaluations(name, method)
-            checked.append((name, method, eps, valid, note, work, _errors(approx, hi, lo), compile_s))
-            timed.append((fn, u, v, config.richardson_repeats if method == "richardson" else config.repeats))
+                checked.append((name, m.name, eps, note, m.work(record, info), errors, compile_s))
+                timed.append((fn, getattr(config, m.repeats)))
         # One evaluation of h alone, timed with the methods as a unit of cost.
-        timed.append((lambda uu, vv, name=name: pointwise.height(name, uu, vv, ku, kv), u, v, config.repeats))
+        timed.append((lambda uu, vv, record=record: pointwise.height(record, uu, vv, ku, kv), config.repeats))
 
-    # Timing: every (field, method) on all pixels, in an order shuffled
-    # every round, so that changes in the machine's load fall on all of them alike.
+    # Timing: every (field, method) on all pixels, in an order shuffled every round, so that
+    # changes in the machine's load fall on all of them alike.
     times = [[] for _ in timed]
-    for _ in range(max(q for *_, q in timed)):
+    for _ in range(max(q for _, q in timed)):
         for k in rng.permutation(len(timed)):
-            fn, uu, vv, quota = timed[k]
-            if len(times[k]) == quota:
-                continue
-            t0 = time.perf_counter()
-            fn(uu, vv)
-            times[k].append(time.perf_counter() - t0)
-    it = iter(times)            # same order as `timed`: per field, its methods, then h
-    for name in fields_:
-        for entry in [c for c in checked if c[0] == name]:
-            _, method, eps, valid, note, work, (emax, erms), compile_s = entry
-            results.append(MethodResult(name, method, eps, valid, tuple(next(it)), work.h, work.h_complex,
+            fn, quota = timed[k]
+            if len(times[k]) < quota:
+                t0 = time.perf_counter()
+                fn(u, v)
+                times[k].append(time.perf_counter() - t0)
+    it = iter(times)            # the order of `timed`: per field, its methods, then h
+    results, h_times = [], {}
+    for record in records:
+        for name, method_name, eps, note, work, (emax, erms), compile_s in (c for c in checked if c[0] == record.name):
+            results.append(MethodResult(name, method_name, eps, tuple(next(it)), work.h, work.h_complex,
                                         work.gradient, emax, erms, note, work.trig, work.h_tangent, compile_s))
-        h_times[name] = tuple(next(it))
+        h_times[record.name] = tuple(next(it))
     machine = {"python": platform.python_version(), "numpy": np.__version__,
                "scipy": sys.modules["scipy"].__version__,
                "jax": sys.modules["jax"].__version__ if "jax" in sys.modules else None, "cpus": os.cpu_count(),
                "processor": platform.processor() or platform.machine(),
                "load_average_1_5_15_min_at_start": load_start}
-    return Measurement(config, tuple(results), int(pixels), n_ref, n_excl, h_times,
+    return Measurement(config, tuple(results), int(u.size), n_ref, n_excl, h_times,
                        time.perf_counter() - t_start, ku, kv, machine)
 
 
@@ -907,8 +955,8 @@ def measure(config=FAST, *, fields_=FIELDS, uv=None):
 def _non_dominated(times, errors):
     """Indices of the points not dominated in (time, error), both minimised.
 
-    A point is dominated when another is no worse in both coordinates and
-    strictly better in one.  Equal points do not dominate each other.
+    A point is dominated when another is no worse in both coordinates and strictly better in
+    one.  Equal points do not dominate each other.
     """
     t = np.asarray(times, dtype=np.float64)
     e = np.asarray(errors, dtype=np.float64)
@@ -966,3 +1014,165 @@ def to_json(measurement):
             d.update(label=r.label, median=r.median, t_min=r.t_min, t_max=r.t_max, on_front=r in front)
             out["results"].append(d)
     return json.dumps(out, indent=1)
+
+
+# --- a function of one variable ---------------------------------------------------------------
+
+#: The steps of `univariate_errors`: half decades from 1e-1 to 1e-20.
+UNIVARIATE_STEPS = tuple(float(10.0 ** (-k / 2)) for k in range(2, 41))
+
+
+@dataclass(frozen=True)
+class UnivariateRow:
+    """One method at one step: ``eps`` (None for a method without a step), ``value`` its f'(x)
+    (float64), ``error`` = |value - f'(x)| against the mpmath reference, and ``relative_error``
+    = error / |f'(x)| (inf where f'(x) = 0 and the error is not)."""
+
+    method: str
+    eps: float | None
+    value: float
+    error: float
+    relative_error: float
+
+
+@dataclass(frozen=True)
+class UnivariateErrors:
+    """What `univariate_errors` returns: the function (its printed form) and the point x; the
+    derivative f'(x) (mpmath at ``digits`` digits, rounded to float64); ``rows`` (per method
+    that applies, in `METHODS` order, per step); ``curve`` the central difference's U-curve
+    (`renderer.ucurve.UCurve`, ``eps_model`` and ``eps_fitted`` its optimal steps); and
+    ``evaluations``, per method without a step, the values of f it took (Richardson's count)."""
+
+    function: str
+    x: float
+    derivative: float
+    digits: int
+    rows: tuple
+    curve: object
+    evaluations: dict
+
+    def of(self, name):
+        """The rows of the method ``name``, in step order."""
+        return [r for r in self.rows if r.method == name]
+
+    def best(self, name):
+        """The row of the method ``name`` with the least error (the first of equals)."""
+        rows = self.of(name)
+        if not rows:
+            raise KeyError(name)
+        return min(rows, key=lambda r: r.error)
+
+
+def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
+    """Every method of `METHODS` with a one-variable form that applies to ``function``, at x,
+    at each step, against an mpmath reference of the derivative.
+
+    The reference is the function's derivative (`renderer.formulas.Univariate.derivative`,
+    sympy's) evaluated by mpmath at `renderer.ucurve.DIGITS` digits at x as float64 holds it,
+    the derivative `renderer.ucurve.measure_function` measures against; that function also
+    validates the input.  Each error is computed at the reference's precision from the
+    float64 estimate, so no rounding of the reference enters it.  The central difference is the
+    quotient `renderer.ucurve.measure_function` measures (its U-curve is returned as ``curve``).
+
+    Parameters
+    ----------
+    function : sympy expression of one symbol, its text in ``x``, or `renderer.formulas.Univariate`
+        E.g. ``"exp(x) / sqrt(sin(x)**3 + cos(x)**3)"`` (`TEST_FUNCTION`).
+    x : float
+        Any real point where f is defined and differentiable (and f(x +- eps) for each step).
+    steps : sequence of float in [`renderer.pointwise.MIN_STEP`, `renderer.ucurve.MAX_FUNCTION_STEP`], keyword-only
+        The steps of the methods that take one (default `UNIVARIATE_STEPS`).
+
+    Returns
+    -------
+    UnivariateErrors
+
+    Raises
+    ------
+    renderer.validate.InputError
+        One line naming the argument: a function refused by `renderer.formulas.univariate`
+        (an unknown name or operator, more than one variable, a complex constant); a point or
+        a step that is not a finite real number in range; a point where f or f' is not a
+        finite real number, or f has a crease, or float64 f overflows; a step at which
+        f(x +- eps) is not finite; a method whose value there is not finite (Richardson's steps
+        reach where f is not).
+
+    Examples
+    --------
+    >>> e = univariate_errors(TEST_FUNCTION.function, TEST_FUNCTION.x)       # doctest: +SKIP
+    >>> e.best("complex step").relative_error < 1e-15                       # doctest: +SKIP
+    True
+    """
+    record, x = F.univariate(function), validate.real("x", x)
+    with np.errstate(all="ignore"):
+        value = fieldcode.univariate_code(record).value(x)
+    if math.isinf(value):                     # finite at 50 digits (measure_function's test) is not enough
+        raise validate.InvalidValue(f"x = {x!r} is too large for function {record.name}: f(x) overflows float64")
+    curve = ucurve.measure_function(record, x, eps=steps)      # validates x and the steps, f and f' at x
+    steps = tuple(float(e) for e in curve.eps)
+    true_fn = sp.lambdify(F.x_var, record.derivative, modules="mpmath")
+    rows, evaluations = [], {}
+    with mpmath.workdps(ucurve.DIGITS):
+        true = true_fn(mpmath.mpf(x))
+        for m in METHODS:
+            if m.derivative is None or not m.applies(record):
+                continue
+            for eps in ((None,) if m.steps is None else steps):
+                info = {}
+                value = m.derivative(record, x, eps, info)
+                if not math.isfinite(value):
+                    raise validate.InvalidValue(f"function {record.name}: its {m.name} derivative at x = {x!r}"
+                                                + (f" with the step {eps!r}" if eps is not None else "")
+                                                + " is not a finite number (f is not finite where it looks)")
+                if "h_per_pixel" in info:
+                    evaluations[m.name] = info["h_per_pixel"]
+                error = float(abs(mpmath.mpf(value) - true))
+                relative = error / abs(float(true)) if true != 0 else (0.0 if error == 0 else math.inf)
+                rows.append(UnivariateRow(m.name, eps, value, error, relative))
+    return UnivariateErrors(record.name, x, float(true), ucurve.DIGITS, tuple(rows), curve, evaluations)
+
+
+# --- what the papers report ----------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Published:
+    """What a paper reports about a test of the methods, with where it says it: ``source`` (a
+    key of book/references.bib), ``where`` (its section, figure or table), ``method`` (a
+    `Method.name`, or None for the test itself), ``statement`` (what it reports, in our words,
+    not a quotation) and ``value`` (a number it reports, or None where it reports a behaviour)."""
+
+    source: str
+    where: str
+    method: str | None
+    statement: str
+    value: float | None = None
+
+
+@dataclass(frozen=True)
+class Example:
+    """A published test function: ``function`` (text in x for `univariate_errors`) and the point ``x``."""
+
+    function: str
+    x: float
+
+
+#: The classic complex-step test function and point: f(x) = e^x / sqrt(sin^3 x + cos^3 x) at x = 1.5.
+TEST_FUNCTION = Example("exp(x) / sqrt(sin(x)**3 + cos(x)**3)", 1.5)
+
+#: What the two papers report (the text of neither is in this repository; the statements are ours).
+PUBLISHED = (
+    Published("squire-trapp", "§1, eq. (1)", "central",
+              "truncation error O(h²); a small h trades truncation for subtractive cancellation"),
+    Published("squire-trapp", "abstract", "complex step",
+              "avoids the subtractive cancellation of the classical difference quotients"),
+    Published("martins-complex-step", "§2, Fig. 1", None,
+              "the test function e^x/√(sin³x + cos³x) at x = 1.5, relative errors against the analytic "
+              "derivative over steps down to far below machine precision"),
+    Published("martins-complex-step", "§2, Fig. 1", "forward",
+              "the error falls with the step until subtractive cancellation takes over, then grows"),
+    Published("martins-complex-step", "§2, Fig. 1", "central",
+              "falls faster than the forward difference's, and is also ruined by cancellation at small steps"),
+    Published("martins-complex-step", "§2, Fig. 1", "complex step",
+              "falls quadratically with the step, then stays at the precision of f's evaluation however "
+              "small the step"),
+)

@@ -134,7 +134,7 @@ def geometry(scene, width, height):
     _, _, sin_phi = pointwise.chart(*N.T)
     et, ep = pointwise.tangent_frame(*N.T, sin_phi)
     uv, grad = g.uv[on_a], g.grad[on_a]
-    h = pointwise.height(scene.height_field, uv[:, 0], uv[:, 1], scene.k_u, scene.k_v)
+    h = pointwise.height(scene.field, uv[:, 0], uv[:, 1], scene.k_u, scene.k_v)
     return on_a, (*N.T, *et, *ep, grad[:, 0], grad[:, 1], h, np.full(h.shape, scene.radius_a), sin_phi)
 
 

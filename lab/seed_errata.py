@@ -25,6 +25,8 @@ __all__ = ["Erratum", "ERRATA", "measure_all", "reproduced", "ErratumVanished", 
 
 #: Resolution of the measurements (the seed's own 256 x 256 frames).
 SIZE = 256
+#: The draft's strong bump of its Cell 6 (``{**SC9, 'beta': 1.5}``), beside its scene's own β.
+CELL6_BETA = 1.5
 
 
 @dataclass(frozen=True)
@@ -129,7 +131,7 @@ def _terminator_leak(size=SIZE):
     """The seed lets a light reach a bumped pixel whose geometric normal faces away."""
     res = {}
     leaked_by_beta = {}
-    for beta in (0.35, 1.5):
+    for beta in (DRAFT_SCENE.beta, CELL6_BETA):
         scene = DRAFT_SCENE.replace(beta=beta)  # at beta = 0, N' = N and nothing can leak
         count = 0
         worst = 0.0
@@ -140,8 +142,9 @@ def _terminator_leak(size=SIZE):
                 diffuse = scene.kd * max(scene.albedo_a) * max(light.color) * cos_bump[leak]
                 worst = max(worst, float(diffuse.max()))
         leaked_by_beta[beta] = (count, worst)
-    res["leak_pixels_default"], res["leak_diffuse_max_default"] = leaked_by_beta[0.35]
-    res["leak_pixels_beta_1_5"], res["leak_diffuse_max_beta_1_5"] = leaked_by_beta[1.5]
+    res["leak_pixels_default"], res["leak_diffuse_max_default"] = leaked_by_beta[DRAFT_SCENE.beta]
+    res["leak_pixels_beta_1_5"], res["leak_diffuse_max_beta_1_5"] = leaked_by_beta[CELL6_BETA]
+    res["beta_default"] = DRAFT_SCENE.beta
     return res
 
 
@@ -171,19 +174,20 @@ def _specular_ungated(size=SIZE):
 
 
 def _v_border_branch(size=SIZE):
-    """The seed's border test ``vp - vm < 2 eps`` also fires in the interior."""
+    """The seed's border test ``vp - vm < 2 eps`` also fires in the interior: at the draft's step
+    (its keys say "1e-3") and at two smaller ones."""
     scene = DRAFT_SCENE
     g = gbuffer(scene, size, size)
     v = g.uv[..., 1][g.chamber == SPHERE_A]
-    out = {}
-    for eps in (1e-3, 1e-6, 1e-9):
+    out, draft = {}, scene.eps
+    for eps in (draft, 1e-6, 1e-9):
         vp, vm = np.minimum(1.0, v + eps), np.maximum(0.0, v - eps)
         interior = (v + eps <= 1.0) & (v - eps >= 0.0)
         fires = interior & (vp - vm < 2 * eps)
         rel = np.abs((vp - vm)[fires] / (2 * eps) - 1.0)
         out[eps] = (float(np.count_nonzero(fires) / np.count_nonzero(interior)),
                     float(rel.max()) if rel.size else 0.0)
-    return {"fraction_interior_1e-3": out[1e-3][0], "rel_change_1e-3": out[1e-3][1],
+    return {"draft_step": draft, "fraction_interior_1e-3": out[draft][0], "rel_change_1e-3": out[draft][1],
             "fraction_interior_1e-6": out[1e-6][0], "rel_change_1e-6": out[1e-6][1],
             "fraction_interior_1e-9": out[1e-9][0], "rel_change_1e-9": out[1e-9][1]}
 
@@ -261,7 +265,7 @@ ERRATA = (
         seed=r"one-sided quotient whenever $\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border",
         exposed_by="verify/test_theorems.py (central-difference-truncation: interior points take the 2 eps branch)",
         measure=_v_border_branch,
-        criterion="the branch fires at some interior pixels at a step of 1e-3, and at more at 1e-9",
+        criterion=f"the branch fires at some interior pixels at a step of {DRAFT_SCENE.eps:g}, and at more at 1e-9",
         present=lambda m: 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"],
     ),
     Erratum(

@@ -1,5 +1,7 @@
 """The image-wide accuracy measurement (lab/accuracy.py) sees a wrong pipeline."""
 
+import pytest
+
 from lab.accuracy import gradient_accuracy
 
 
@@ -9,3 +11,41 @@ def test_gradient_accuracy_detects_a_wrong_pipeline(monkeypatch):
     monkeypatch.setattr(pointwise, "exact_gradient",
                         lambda *a: tuple(1.000001 * g for g in original(*a)))
     assert gradient_accuracy("sine", count=200)[0].max_ulps > 1e6
+
+
+def test_the_crease_distance_is_the_distance_to_the_nearest_zero_line():
+    """Two routes for the ridges field: `crease_distance` (sign changes of its crease factors, located
+    numerically) against the closed form min(|u - m/k_u|, |v - m/k_v|) at random points; and a reader's
+    field with one crease, at u = 2/5, whose distance is |u - 2/5| wherever its other term has none."""
+    import numpy as np
+
+    from lab.accuracy import crease_distance
+    rng = np.random.default_rng(11)
+    u, v = rng.random(500), rng.random(500)
+    k_u, k_v = 8.0, 4.0
+    closed = np.minimum(np.abs(u * k_u - np.rint(u * k_u)) / k_u, np.abs(v * k_v - np.rint(v * k_v)) / k_v)
+    assert np.allclose(crease_distance(u, v, k_u, k_v, "ridges"), closed, rtol=0, atol=1e-15)
+    near = np.abs(u - 0.4) < 0.2
+    assert np.allclose(crease_distance(u[near], v[near], k_u, k_v, "abs(u - 2/5) + sin(pi*k_v*v)"),
+                       np.abs(u[near] - 0.4), rtol=0, atol=1e-15)
+    assert np.all(np.isinf(crease_distance(u, v, k_u, k_v, "sine")))
+
+
+def test_each_fields_optimum_stays_below_its_crease_distance(monkeypatch):
+    """`optima` takes every registered field from its record, and a field with a crease 0.005 from its
+    optimum point measures only steps below that distance (the rule that was the ridges field's alone)."""
+    import sympy as sp
+
+    from lab import store
+    from lab.accuracy import optima
+    from renderer import formulas as F
+    crease = sp.Abs(sp.sin(sp.pi * (F.u - sp.Rational(61, 200))))             # at u = 0.305
+    creased = F.HeightField("creased", sp.sin(sp.pi * F.k_v * F.v) * crease)
+    monkeypatch.setitem(F.FIELDS, "creased", creased)
+    monkeypatch.setattr(store, "_MEMORY", {})
+    monkeypatch.delenv(store.ENV, raising=False)
+    opt = optima()
+    assert set(opt) == set(F.FIELDS)
+    assert opt["creased"]["crease_distance"] == pytest.approx(0.005, abs=1e-15)
+    assert opt["creased"]["largest_step"] < 0.005 < 0.1 == opt["sine"]["largest_step"]
+    assert (opt["creased"]["u"], opt["creased"]["v"], opt["creased"]["component"]) == creased.optimum_at

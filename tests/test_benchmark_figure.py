@@ -8,19 +8,19 @@ import matplotlib
 matplotlib.use("Agg")
 
 from chapter.benchmark import pareto_figure  # noqa: E402
-from lab import gradient_methods as gm  # noqa: E402
+from renderer import formulas as F  # noqa: E402
 
 
 def _result(field, method, err, ms, eps=None):
     t = ms / 1e3
     return SimpleNamespace(field=field, method=method, eps=eps, max_error=err, rms_error=err,
-                           median=t, t_min=0.8 * t, t_max=1.5 * t, valid=True)
+                           median=t, t_min=0.8 * t, t_max=1.5 * t)
 
 
 def _fake():
     """The exact gradient fastest and most accurate, as on the page: it is the front's lowest point."""
     rows = []
-    for f in gm.FIELDS:
+    for f in F.FIELDS:
         rows += [_result(f, "exact", 1e-14, 1.0), _result(f, "central", 3e-3, 2.0, 1e-3),
                  _result(f, "central", 3e-9, 3.0, 1e-6), _result(f, "richardson", 1e-12, 100.0)]
     return SimpleNamespace(results=tuple(rows), of=lambda f: [r for r in rows if r.field == f])
@@ -35,3 +35,25 @@ def test_the_lowest_marker_stands_clear_of_the_bottom_edge():
         lowest = min(min(ln.get_ydata()) for ln in lines)
         bottom = ax.get_ylim()[0]
         assert lowest / bottom >= 10, (ax.get_title(), lowest, bottom)     # a decade or more of room
+
+
+def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
+    """`univariate_figure`: one line per method in its record's colour and line style, a method without a
+    step drawn across the plot, every text at least 10 pt in a figure at most 5 in wide, nothing overlapping."""
+    from chapter.benchmark import univariate_figure
+    from chapter.figures import _drawn_texts, text_overlaps
+    from lab import gradient_methods as gm
+
+    steps = (1e-2, 1e-6, 1e-10)
+    rows = [gm.UnivariateRow(m, e, 1.0, err, err) for m, errs in (("central", (1e-5, 1e-11, 1e-6)),
+                                                                   ("complex step", (1e-5, 1e-16, 1e-16)))
+            for e, err in zip(steps, errs)] + [gm.UnivariateRow(gm.AD, None, 1.0, 1e-16, 1e-16)]
+    fake = gm.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {})
+    fig = univariate_figure(fake)
+    lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+    for name in ("central", "complex step", gm.AD):
+        m = gm.method(name)
+        assert lines[m.label].get_color() == m.style.colour
+    assert list(lines[gm.method(gm.AD).label].get_xdata()) == [0, 1]           # across the axes
+    assert fig.get_figwidth() <= 5.0 and min(t.get_fontsize() for t in _drawn_texts(fig)) >= 10
+    assert text_overlaps(fig) == []

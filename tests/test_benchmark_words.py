@@ -5,7 +5,7 @@ from types import SimpleNamespace
 import pytest
 
 from chapter.benchmark import fastest_on, share_in_words
-from lab import gradient_methods as gm
+from renderer import formulas as F
 
 
 @pytest.mark.parametrize("count, total, words", [(3, 3, "all three"), (2, 3, "two of the three"),
@@ -23,9 +23,31 @@ def test_share_in_words_refuses_what_it_cannot_say(count, total):
 
 def test_fastest_on_counts_the_fields_where_the_method_is_fastest():
     """A made-up measurement: exact fastest on every field but the last."""
-    slow = {gm.FIELDS[-1]}
-    rows = {f: [SimpleNamespace(method="exact", median=2.0 if f in slow else 1.0),
-                SimpleNamespace(method="central", median=1.5)] for f in gm.FIELDS}
-    fake = SimpleNamespace(of=rows.__getitem__)
-    assert fastest_on(fake, "exact") == share_in_words(len(gm.FIELDS) - 1, len(gm.FIELDS))
-    assert fastest_on(fake, "central") == share_in_words(1, len(gm.FIELDS))
+    fields = list(F.FIELDS)
+    rows = {f: [SimpleNamespace(field=f, method="exact", median=2.0 if f == fields[-1] else 1.0),
+                SimpleNamespace(field=f, method="central", median=1.5)] for f in fields}
+    fake = SimpleNamespace(of=rows.__getitem__, results=[r for f in fields for r in rows[f]])
+    assert fastest_on(fake, "exact") == share_in_words(len(fields) - 1, len(fields))
+    assert fastest_on(fake, "central") == share_in_words(1, len(fields))
+
+
+def test_the_methods_sentence_names_every_record_with_its_steps_and_sources(monkeypatch):
+    """`methods_sentence` reads the records: each label in order, each step of the configuration, each
+    source as a citation, and the fields where a method applies when it does not apply everywhere; a
+    record appended to METHODS is named with no other change."""
+    import re
+
+    from chapter.benchmark import methods_sentence, step_text
+    from lab import gradient_methods as gm
+    toy = gm.Method("backward", None, None, "backward difference", gm.Style("k", "v", 5), steps="forward_steps",
+                    applies=lambda f: f.name == "rings", sources=("higham-accuracy",))
+    monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, toy])
+    text = methods_sentence(gm.FAST)
+    parts = text.split(": ", 1)[1].rstrip(".").split("; ")
+    assert len(parts) == len(gm.METHODS) and text.startswith("Eight methods")
+    for m, part in zip(gm.METHODS, parts):
+        assert part.startswith(m.label)
+        assert re.findall(r"\{cite:p\}`([^`]*)`", part) == ([",".join(m.sources)] if m.sources else [])
+        for eps in (m.steps_in(gm.FAST) if m.steps else ()):
+            assert step_text(eps) in part
+    assert parts[-1].endswith("(on rings)") and "(on" not in parts[0]

@@ -1,6 +1,7 @@
 """The gradient methods of lab/gradient_methods.py: their orders against
 sympy's derivative evaluated by mpmath, the complex step's analyticity
-premise, the work per pixel counted from the formulas, and the Pareto front.
+premise, the work per pixel counted from the formulas, the Pareto front, a method
+added as one record, and a reader's function of one variable through the methods.
 Each check is shown to reject a wrong variant.
 """
 
@@ -18,11 +19,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lab import gradient_methods as gm
+from renderer import DRAFT_SCENE, pointwise, ucurve
 from renderer import formulas as F
 from renderer import generated as G
-from renderer import pointwise
+from renderer.validate import InputError
 
-KU, KV = 8.0, 4.0
+KU, KV = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
 #: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as lab/accuracy.py).
 SPACING = float(np.spacing(np.pi * max(KU, 2 * KV)))
 #: Over many pixels a float64 evaluation of the gradient is off by up to ~40 spacings: the
@@ -31,12 +33,12 @@ SPACING = float(np.spacing(np.pi * max(KU, 2 * KV)))
 FLOAT64_EVAL = 64 * SPACING
 
 
-#: The sine field's (h_u, h_v), `formulas.GRADIENT["sine"]`, as an mpmath function.
-_SINE_GRADIENT_MP = sp.lambdify((F.u, F.v, F.k_u, F.k_v), F.GRADIENT["sine"], "mpmath")
+#: The sine field's (h_u, h_v), its record's gradient, as an mpmath function.
+_SINE_GRADIENT_MP = sp.lambdify((F.u, F.v, F.k_u, F.k_v), F.FIELDS["sine"].gradient, "mpmath")
 
 
 def sine_gradient_mp(u, v, ku=KU, kv=KV):
-    """(h_u, h_v) of the sine field: sympy's derivative (`formulas.GRADIENT`,
+    """(h_u, h_v) of the sine field: sympy's derivative (`HeightField.gradient`,
     checked against seed §3's closed form in tests/test_codegen.py) evaluated
     by mpmath at 40 digits at the float64 point: no float64 rounding of any
     method under test."""
@@ -140,18 +142,21 @@ def test_unknown_field_is_rejected():
     for fn in (lambda: gm.complex_step_gradient("bumps", U0, V0, KU, KV, 1e-20),
                lambda: gm.richardson_gradient("bumps", U0, V0, KU, KV),
                lambda: gm.reference_gradient("bumps", U0, V0, KU, KV)):
-        with pytest.raises(ValueError, match="height_field must be one of"):
+        with pytest.raises(InputError, match="^height_field .*'bumps'"):
             fn()
 
 
 # --- the complex step's premise ------------------------------------------------------------
 
-def test_analyticity_flag_is_read_from_the_expressions():
-    assert gm.ANALYTIC == {"sine": True, "ridges": False, "rings": True}
-    x = sp.Symbol("x", real=True)
-    assert gm.is_analytic(sp.sin(x) * sp.exp(x))
-    assert not gm.is_analytic(sp.Abs(sp.sin(x)))
-    assert not gm.is_analytic(sp.sign(x) * x)
+def applying(field):
+    return [m.name for m in gm.METHODS if m.applies(F.field(field))]
+
+
+def test_the_complex_step_applies_where_the_field_is_analytic_and_its_continuation_where_it_has_an_abs():
+    for name, field in F.FIELDS.items():
+        cs = applying(name)
+        assert ("complex step" in cs) == field.analytic and ("complex step, |z| continued" in cs) != field.analytic
+    assert applying("sin(pi*k_u*u) + Abs(u - 1/2)") == [m.name for m in gm.METHODS if m.name != "complex step"]
 
 
 def test_complex_step_on_ridges_is_wrong_near_a_crease_so_the_flag_matters():
@@ -164,11 +169,8 @@ def test_complex_step_on_ridges_is_wrong_near_a_crease_so_the_flag_matters():
     # Im |f(u + i eps)| = 0: the plain complex step returns 0, wrong by the whole slope.
     assert hu_plain[0] == 0.0
     assert abs(hu_plain[0] - true_hu) > 1.0
-    # Had the flag called ridges analytic, this result would be trusted as exact; it is
-    # flagged instead.
-    def complex_step_valid(field):
-        return {(m, e): ok for m, e, ok, _, _ in gm.methods(field, gm.FAST, KU, KV)}[("complex step", 1e-20)]
-    assert complex_step_valid("ridges") is False and complex_step_valid("sine") is True
+    # Had the record called ridges analytic, this result would be measured as a method's; it is not.
+    assert "complex step" not in applying("ridges") and "complex step" in applying("sine")
     # With |z| continued as z sign(Re z) the complex step is right off the crease.
     hu_cont, _ = gm.complex_step_gradient("ridges", u, v, KU, KV, 1e-20, continued=True)
     assert abs((hu_cont[0] - hi[0, 0]) - lo[0, 0]) <= 4 * SPACING
@@ -176,53 +178,45 @@ def test_complex_step_on_ridges_is_wrong_near_a_crease_so_the_flag_matters():
 
 # --- the work per pixel ------------------------------------------------------------------
 
-def generated_trig_calls(function, field):
-    """math.sin and math.cos calls in the branch of ``field`` of a function of
+def generated_trig_calls(kind, field):
+    """math.sin and math.cos calls in the function ``kind`` (height, exact, central) of ``field`` in
     renderer/generated.py: the code numba compiles, read as text."""
-    source = inspect.getsource(function.py_func)
-    branch = source.split(f"if field == {F.FIELD_CODES[field]}:")[1].split("if field ==")[0]
-    return len(re.findall(r"math\.(?:sin|cos)\(", branch))
+    source = inspect.getsource(G.FIELDS[field][list(F.FIELD_FUNCTIONS).index(kind)])
+    return len(re.findall(r"math\.(?:sin|cos)\(", source))
 
 
-@pytest.mark.parametrize("field", gm.FIELDS)
+@pytest.mark.parametrize("field", F.BUILTIN)
 def test_trig_count_is_the_generated_codes(field):
     # Two routes: sympy's cse over the formulas, and the text numba compiles.
-    assert gm.trig_calls(F.CENTRAL[field]) == generated_trig_calls(G.central_gradient, field)
-    assert gm.trig_calls(F.GRADIENT[field]) == generated_trig_calls(G.exact_gradient, field)
-    assert gm.trig_calls((F.HEIGHT[field],)) == generated_trig_calls(G.height, field)
+    record = F.FIELDS[field]
+    assert gm.evaluations(field, "central").trig == generated_trig_calls("central", field)
+    assert gm.evaluations(field, "exact").trig == generated_trig_calls("exact", field)
+    assert gm.height_work(field).trig == generated_trig_calls("height", field)
+    assert gm.evaluations(field, "forward").trig == 3 * gm.trig_calls((record.expr,))
 
 
 def test_trig_count_rejects_counting_without_the_shared_factors():
     # Counting the stencil's four values of h as written (no cse) gives 8 sines for the
     # sine field; the generated code shares sin(pi k_v v) and sin(pi k_u u) and calls 6.
-    as_written = sum(isinstance(n, sp.sin) for c in F.CENTRAL["sine"] for n in sp.preorder_traversal(c))
-    assert as_written == 8 != generated_trig_calls(G.central_gradient, "sine") == 6
+    as_written = sum(isinstance(n, sp.sin) for c in F.FIELDS["sine"].central for n in sp.preorder_traversal(c))
+    assert as_written == 8 != generated_trig_calls("central", "sine") == 6
 
 
-def test_work_per_pixel_of_each_method():
-    expected = {
-        ("sine", "central"): gm.Evaluations(h=4, trig=6),
-        ("ridges", "central"): gm.Evaluations(h=4, trig=6),
-        ("rings", "central"): gm.Evaluations(h=2, trig=2),      # the u-difference of rings is 0
-        ("sine", "exact"): gm.Evaluations(gradient=1, trig=4),
-        ("rings", "exact"): gm.Evaluations(gradient=1, trig=1),
-        ("sine", "forward"): gm.Evaluations(h=3, trig=6),
-        ("sine", "complex step"): gm.Evaluations(h_complex=2),
-        ("ridges", "h"): gm.Evaluations(h=1, trig=2),
-    }
-    for (field, method), want in expected.items():
-        assert gm.evaluations(field, method) == want, (field, method)
-    assert gm.evaluations("sine", "richardson", h_per_pixel=22.5) == gm.Evaluations(h=22.5, trig=45)
-    with pytest.raises(ValueError, match="pass h_per_pixel"):
+def test_work_per_pixel_of_the_methods_without_a_formula_to_count():
+    assert gm.evaluations("sine", "complex step") == gm.Evaluations(h_complex=2)
+    assert gm.evaluations("sine", "forward").h == 3 and gm.evaluations("sine", "exact").gradient == 1
+    assert gm.evaluations("sine", "richardson", {"h_per_pixel": 22.5}) == gm.Evaluations(h=22.5, trig=45)
+    with pytest.raises(ValueError, match="richardson's evaluations are measured"):
         gm.evaluations("sine", "richardson")
-    with pytest.raises(ValueError, match="unknown method"):
+    with pytest.raises(ValueError, match="^method must be one of .*'backward'"):
         gm.evaluations("sine", "backward")
 
 
 def test_stencil_values_are_the_points_the_stencil_reads():
-    assert [gm.stencil_values(f) for f in gm.FIELDS] == [4, 4, 2]
+    assert [gm.stencil_values(f) for f in ("sine", "ridges", "rings")] == [4, 4, 2]
+    assert gm.evaluations("rings", "central").h == 2                  # the u-difference of rings is 0
     # A stencil that read h only at u +- eps would be counted as 2, not 4.
-    assert sum(p in F.CENTRAL["sine"][0].free_symbols for p, _ in F.STENCIL_POINTS) == 2
+    assert sum(p in F.FIELDS["sine"].central[0].free_symbols for p, _ in F.STENCIL_POINTS) == 2
 
 
 def test_scipy_counts_richardsons_evaluations():
@@ -230,13 +224,13 @@ def test_scipy_counts_richardsons_evaluations():
     u, v = u[:300], v[:300]
     info = {}
     gm.richardson_gradient("ridges", u, v, KU, KV, info=info)
-    assert info["nfev"] > 4 * 2 * u.size     # more than a central difference's four, per component
+    assert info["h_per_pixel"] > 4 * 2       # more than a central difference's four, per component
 
 
 # --- the Pareto front ----------------------------------------------------------------------
 
 def result(label, t, err):
-    return gm.MethodResult("sine", label, None, True, (t,), 0.0, 0.0, 0.0, err, err)
+    return gm.MethodResult("sine", label, None, (t,), 0.0, 0.0, 0.0, err, err)
 
 
 def test_pareto_front_rejects_a_dominated_point():
@@ -270,39 +264,43 @@ def test_chart_points_do_not_depend_on_the_field():
     assert a[0].size > 20000
 
 
-def test_measure_small_run_and_its_presentations():
+def small_chart():
     u, v = gm.chart_points()
     step = max(1, u.size // 2000)
-    m = gm.measure(TINY, uv=(u[::step].copy(), v[::step].copy()))
-    assert m.reference_pixels == {"sine": 30, "ridges": 30, "rings": 30}
+    return u[::step].copy(), v[::step].copy()
+
+
+def test_measure_small_run_and_its_presentations():
+    m = gm.measure(TINY, uv=small_chart())
+    assert m.reference_pixels == dict.fromkeys(F.FIELDS, 30)
     assert m.excluded_pixels["sine"] == 0 and m.excluded_pixels["ridges"] > 0
     exact = m.get("sine", "exact")
     assert exact.max_error <= FLOAT64_EVAL and len(exact.times) == 2
     assert m.get("sine", "central 1e-03").h_evals == 4.0
-    assert m.get("sine", "central 1e-03").trig_evals == 6.0 and m.get("rings", "exact").trig_evals == 1.0
+    assert m.get("sine", "central 1e-03").trig_evals == 6.0
+    assert m.get("rings", "exact").trig_evals == generated_trig_calls("exact", "rings")
     assert m.get("sine", "richardson").h_evals > 4.0
     assert len(m.get("sine", "richardson").times) == 1
-    plain = m.get("ridges", "complex step 1e-20")
-    assert not plain.valid and plain.max_error > 1.0
+    with pytest.raises(KeyError):                                # not measured where it does not apply
+        m.get("ridges", "complex step 1e-20")
     assert m.get("ridges", "complex step, |z| continued 1e-20").max_error <= FLOAT64_EVAL
     assert m.get("sine", "central 1e-06").max_error > 1e4 * FLOAT64_EVAL
-    for f in gm.FIELDS:                   # AD: exact to rounding, compile time kept apart from the runs
+    for f in F.FIELDS:                   # AD: exact to rounding, compile time kept apart from the runs
         ad = m.get(f, gm.AD)
         assert ad.max_error <= FLOAT64_EVAL and len(ad.times) == 2 and ad.compile_seconds > 0
-        assert ad.h_tangent_evals == 2.0 and ad.trig_evals == gm.ad_trig_calls(f)
+        assert ad.h_tangent_evals == 2.0 and ad.trig_evals == gm.ad_trig_calls(F.FIELDS[f])
     from chapter.benchmark import markdown_table, pareto_figure
     table = markdown_table(m, rows="best", include=("central 1e-03",))
     rows = [[c.strip() for c in line.strip("|").split(" | ")] for line in table.splitlines()[2:]]
-    # "best": per field one row per method (6 on sine and rings, 7 on ridges) + central 1e-03.
-    assert [r[0] for r in rows] == ["sine"] * 7 + ["ridges"] * 8 + ["rings"] * 7
+    # "best": per field one row per method that applies + central 1e-03.
+    assert [r[0] for r in rows] == [f for f in F.FIELDS for _ in range(len(applying(f)) + 1)]
     assert all(len(r) == len(rows[0]) == 8 for r in rows)
     assert {"exact", "central 1e-03"} <= {r[1] for r in rows if r[0] == "ridges"}
     shown = {(r[0], r[1]): r for r in rows}
-    for f in gm.FIELDS:                                        # the numbers are the measurement's
+    for f in F.FIELDS:                                         # the numbers are the measurement's
         exact = m.get(f, "exact")
         assert float(shown[f, "exact"][4]) == pytest.approx(exact.max_error, rel=1e-2, abs=1e-300)
         assert float(shown[f, "exact"][5]) == pytest.approx(exact.rms_error, rel=1e-2, abs=1e-300)
-    assert [r[1] for r in rows if r[0] == "ridges" and "not valid" in r[7]] == ["complex step 1e-20"]
     with pytest.raises(ValueError, match="rows must be 'all', 'front' or 'best', got 'some'"):
         markdown_table(m, rows="some")
     fig = pareto_figure(m)
@@ -353,7 +351,7 @@ CHART = st.floats(0.0, 1.0, allow_nan=False)
 
 
 @settings(max_examples=60, deadline=None)
-@given(field=st.sampled_from(gm.FIELDS), u=CHART, v=CHART)
+@given(field=st.sampled_from(F.BUILTIN), u=CHART, v=CHART)
 def test_ad_is_the_exact_gradient_to_rounding_at_random_points(field, u, v):
     # Off the ridges' crease band: on a crease the two take different sides (next test).
     if pointwise.kink_band(field, np.array([u]), np.array([v]), KU, KV)[0]:
@@ -363,9 +361,9 @@ def test_ad_is_the_exact_gradient_to_rounding_at_random_points(field, u, v):
 
 #: Wrong programs AD could be handed: a frequency off by a part in 1e9, and the ridges' |f|
 #: written as sqrt(f^2), the same function, whose program's derivative on the crease is 0/0.
-_f = F.RIDGE_FACTORS[0] * F.RIDGE_FACTORS[1]
+_f = sp.Mul(*F.FIELDS["ridges"].crease_factors)
 WRONG_PROGRAMS = {
-    "sine": F.HEIGHT["sine"].subs(F.k_u, F.k_u * (1 + sp.Rational(1, 10**9))),
+    "sine": F.FIELDS["sine"].expr.subs(F.k_u, F.k_u * (1 + sp.Rational(1, 10**9))),
     "ridges": sp.Pow(_f**2, sp.S.Half, evaluate=False),
 }
 
@@ -410,13 +408,13 @@ def test_jax_slope_of_abs_at_zero_is_measured_and_x64_stays_local():
 def test_crease_values_rejects_a_bad_step():
     with pytest.raises(ValueError, match="eps must be a positive finite number, got -1"):
         gm.crease_values(eps=-1.0)
-    with pytest.raises(ValueError, match="height_field must be one of"):
+    with pytest.raises(InputError, match="^height_field .*'bumps'"):
         gm.ad_gradient("bumps", np.array([0.1]), np.array([0.1]), KU, KV)
 
 
 # --- AD and the exact gradient through one compiler ---------------------------------------------
 
-@pytest.mark.parametrize("field", gm.FIELDS)
+@pytest.mark.parametrize("field", F.BUILTIN)
 def test_the_xla_exact_gradient_is_the_exact_gradient(field):
     """What `same_compiler_times` times as "exact" computes the exact gradient (the numba one)."""
     rng = np.random.default_rng(7)
@@ -447,3 +445,89 @@ def test_same_compiler_times_report_each_side_and_their_ratio(monkeypatch):
 def test_same_compiler_times_refuses_bad_input(kwargs, match):
     with pytest.raises(ValueError, match=match):
         gm.same_compiler_times(np.zeros(4), np.zeros(4), **kwargs)
+
+
+# --- a method added as one record ------------------------------------------------------------
+
+def backward_gradient(field, u, v, ku, kv, eps, info):
+    """A toy method: the backward difference (h(x) - h(x - eps)) / eps in u and v, u wrapped."""
+    h0 = pointwise.height(field, u, v, ku, kv)
+    return ((h0 - pointwise.height(field, np.mod(u - eps, 1.0), v, ku, kv)) / eps,
+            (h0 - pointwise.height(field, u, v - eps, ku, kv)) / eps)
+
+
+BACKWARD = gm.Method("backward", backward_gradient, lambda f, info: gm.Evaluations(h=3.0), "backward difference",
+                     gm.Style("#444444", "v", 6, "--"), steps="forward_steps")
+
+
+def test_a_sixth_method_is_one_record_measured_and_drawn(monkeypatch):
+    """Appending a record to METHODS is the whole change: `measure` runs it on every field, at the
+    steps it names, against the reference; the table shows it and the figure draws it with its style
+    and label.  Its error is first order, as a backward difference's is."""
+    from chapter.benchmark import markdown_table, pareto_figure
+    monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, BACKWARD])
+    m = gm.measure(TINY, uv=small_chart(), fields_=("sine",))
+    back = m.get("sine", "backward 1e-08")
+    assert back.h_evals == 3.0 and 1e-7 < back.max_error < 1e-4 and len(back.times) == TINY.repeats
+    assert "backward 1e-08" in markdown_table(m)
+    fig = pareto_figure(m)
+    drawn = [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_marker() == "v"]
+    assert drawn and drawn[0].get_color() == "#444444"
+    assert "backward difference" in [t.get_text() for ax in fig.axes for lg in [ax.get_legend()] if lg
+                                     for t in lg.get_texts()]
+
+
+# --- a reader's function of one variable -------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def classic():
+    """The classic complex-step test function at its point, through the methods."""
+    return gm.univariate_errors(gm.TEST_FUNCTION.function, gm.TEST_FUNCTION.x)
+
+
+def test_the_reference_of_the_classic_function_is_mpmaths_own_derivative(classic):
+    """An independent route to f'(1.5): mpmath's numerical differentiation of f at 50 digits."""
+    with mpmath.workdps(50):
+        f = lambda x: mpmath.exp(x) / mpmath.sqrt(mpmath.sin(x) ** 3 + mpmath.cos(x) ** 3)  # noqa: E731
+        assert classic.derivative == float(mpmath.diff(f, mpmath.mpf(1.5)))
+    assert classic.derivative == classic.curve.derivative               # measure_function's reference
+
+
+def test_the_classic_function_reproduces_the_papers_behaviour(classic):
+    """What `gm.PUBLISHED` reports, measured: the complex step at the precision of f's evaluation for
+    every step up to 1e-8 (a few units of roundoff), the differences first and second order on the
+    truncation side and ruined by cancellation below their best step, AD at the same precision as the
+    complex step; the central difference's rows are measure_function's U-curve."""
+    u = ucurve.UNIT_ROUNDOFF
+    cs = classic.of("complex step")
+    assert max(r.relative_error for r in cs if r.eps <= 1e-8) <= 8 * u
+    assert classic.best(gm.AD).relative_error <= 8 * u and classic.best("exact").relative_error <= 8 * u
+    for name, order in (("forward", 1.0), ("central", 2.0), ("complex step", 2.0)):
+        rows = [r for r in classic.of(name) if 1e-3 <= r.eps <= 1e-1]
+        slope = np.polyfit(np.log([r.eps for r in rows]), np.log([r.error for r in rows]), 1)[0]
+        assert abs(slope - order) < 0.15, (name, slope)
+        best = classic.best(name)
+        if name != "complex step":
+            assert classic.of(name)[-1].relative_error > 1e3 * best.relative_error   # the cliff below
+    assert [r.error for r in classic.of("central")] == list(classic.curve.error)
+    assert 0.1 < classic.best("central").eps / classic.curve.eps_fitted < 10
+    assert {p.method for p in gm.PUBLISHED} - {None} <= {m.name for m in gm.METHODS}
+
+
+def test_an_abs_function_takes_the_continued_complex_step_and_not_the_plain_one():
+    e = gm.univariate_errors("x*abs(x - 1)", 2.0, steps=(1e-3, 1e-20))
+    names = {r.method for r in e.rows}
+    assert "complex step" not in names and "complex step, |z| continued" in names
+    assert e.best("complex step, |z| continued").relative_error <= 8 * ucurve.UNIT_ROUNDOFF
+
+
+@pytest.mark.parametrize("function, x, match", [
+    ("exp(y)", 1.0, "^function .*'y'"),                     # an unknown symbol
+    ("exp(x)", 1j, "^x must be a real number"),             # not real
+    ("abs(x - 1)", 1.0, "^function .*not differentiable at x = 1.0"),
+    ("sqrt(x)", -1.0, "^function .*x = -1.0"),              # not defined there
+    ("exp(x)", 800.0, "^x = 800.0 is too large"),           # f overflows float64
+])
+def test_a_bad_function_or_point_is_one_input_error(function, x, match):
+    with pytest.raises(InputError, match=match):
+        gm.univariate_errors(function, x)

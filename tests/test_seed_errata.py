@@ -78,3 +78,53 @@ def test_each_erratum_is_worded_once_from_its_own_numbers():
         finding("sphere-b-quadratic", {"pixels": 1})
     with pytest.raises(KeyError, match="erratum_id must be one of"):
         finding("no-such-erratum", {})
+
+
+# ----------------------------------------------------------------- the draft's values, spelled once
+def test_the_draft_is_measured_with_its_own_values_not_the_books_defaults(monkeypatch):
+    """`Scene`'s defaults (the book's) moved away from the draft's step, frequencies and β: the whole
+    register of claims and the errata, measured afresh, render, take G-buffers and central differences
+    only of scenes and at steps that are not the moved defaults (the draft's are read from `DRAFT_SCENE`,
+    or are a value the draft's own cell names), every verdict stays the registered one and every erratum
+    is still reproduced.  (A claim that built its frame from `Scene()` would show here.)"""
+    import inspect
+
+    from lab import accuracy, claims, store
+    from renderer import pointwise
+    from renderer.scene import Scene
+    moved = {"eps": 2.5e-4, "beta": 0.21, "k_u": 3.0, "k_v": 5.0}
+    names = list(inspect.signature(Scene.__init__).parameters)[1:]
+    defaults = list(Scene.__init__.__defaults__)
+    for name, value in moved.items():
+        defaults[names.index(name)] = value
+    monkeypatch.setattr(Scene.__init__, "__defaults__", tuple(defaults))
+    assert Scene().eps == moved["eps"] and DRAFT_SCENE.eps != moved["eps"]
+    scenes, stencils = [], []
+
+    def spy(module, name):
+        real = getattr(module, name)
+        monkeypatch.setattr(module, name, lambda scene, *a, **k: scenes.append(scene) or real(scene, *a, **k))
+    for module in (claims, seed_errata, accuracy):
+        for name in {"render", "gbuffer"} & set(vars(module)):
+            spy(module, name)
+    central = pointwise.central_gradient
+
+    def spied_central(f, u, v, ku, kv, eps, *a):
+        stencils.append((ku, kv, eps))
+        return central(f, u, v, ku, kv, eps, *a)
+    monkeypatch.setattr(pointwise, "central_gradient", spied_central)
+    monkeypatch.setattr(store, "_MEMORY", {})                  # measured afresh, not read from a store
+    monkeypatch.delenv(store.ENV, raising=False)
+    caches = (claims._frames, claims._ucurve, claims._errata)
+    for cache in caches:
+        cache.cache_clear()
+    try:
+        results, errata = claims.evaluate(), seed_errata.reproduced()
+    finally:
+        for cache in caches:
+            cache.cache_clear()
+    assert [(c.id, v, m) for c, m, v in results if v != c.registered] == []
+    assert errata["v-border-branch"]["draft_step"] == DRAFT_SCENE.eps
+    assert len(scenes) > 20 and len(stencils) > 2
+    assert [s for s in scenes if any(getattr(s, k) == x for k, x in moved.items())] == []
+    assert [s for s in stencils if {float(np.max(x)) for x in s} & set(moved.values())] == []

@@ -1,21 +1,22 @@
 """The gradient-methods benchmark as the book and benchmarks/bench_gradients.py show it:
 its run time against error as a figure (`pareto_figure`) and as a Markdown table
-(`markdown_table`), from the numbers `lab.gradient_methods.measure` returns."""
+(`markdown_table`), from the numbers `lab.gradient_methods.measure` returns; the sentence
+naming every method (`methods_sentence`); and a reader's function of one variable through
+the methods (`univariate_figure`, `univariate_table`, `published_table`), from
+`lab.gradient_methods.univariate_errors`.  Every method's label, style and sources are its
+record's (`lab.gradient_methods.METHODS`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from lab import gradient_methods as gm
+from renderer import formulas as F
 
-__all__ = ["pareto_figure", "markdown_table", "fastest_on", "share_in_words"]
+__all__ = ["pareto_figure", "markdown_table", "fastest_on", "share_in_words", "methods_sentence",
+           "univariate_figure", "univariate_table", "published_table", "step_text"]
 
 _NUMBER_WORDS = ("none", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
-
-#: Each method's colour, marker and marker size in `pareto_figure`.
-_STYLE = {"exact": ("#1b5e20", "*", 12), "central": ("#7a1f1f", "o", 5), "forward": ("#b26b00", "s", 5),
-          "complex step": ("#1f4e7a", "D", 6), "complex step, |z| continued": ("#5b7fa6", "d", 7),
-          "richardson": ("#6a1b9a", "^", 8), gm.AD: ("#00838f", "P", 8)}
 
 
 #: The error axis starts this factor below the panel's lowest point.
@@ -35,8 +36,8 @@ def pareto_figure(measurement, *, error="max"):
     fastest to the slowest run; difference sweeps are joined in order of eps
     (unlabelled: neighbouring steps' labels would collide); the Pareto front is the
     grey staircase; each error axis starts `_Y_ROOM` times below its panel's
-    lowest point, so no marker sits on the frame.  Methods whose premise fails on a field are drawn hollow.
-    An error of exactly 0 would be drawn at 1e-18.
+    lowest point, so no marker sits on the frame.  An error of exactly 0 would be drawn at 1e-18.
+    Colours, markers, line styles and legend labels are the methods' records'.
 
     Parameters
     ----------
@@ -59,7 +60,7 @@ def pareto_figure(measurement, *, error="max"):
     names = list(dict.fromkeys(r.field for r in measurement.results))
     # Two columns (a phone's column holds two panels of 2.5 in); the legend fills an empty cell.
     rows = (len(names) + 2) // 2
-    fig = Figure(figsize=(5.0, 2.05 * rows), layout="constrained")
+    fig = Figure(figsize=(5.0, 1.9 * rows), layout="constrained")
     grid = fig.subplots(rows, 2, sharex=True, squeeze=False).ravel()
     axes, spare = grid[:len(names)], grid[len(names):]
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
@@ -75,15 +76,13 @@ def pareto_figure(measurement, *, error="max"):
                                            lw=2.5, zorder=0)
         for method in dict.fromkeys(r.method for r in rs):
             group = [r for r in rs if r.method == method]
-            color, marker, ms = _STYLE.get(method, ("k", "x", 5))
+            style = gm.method(method).style
             t = np.array([1e3 * r.median for r in group])
             e = np.array([_floor(pick(r)) for r in group])
-            ax.hlines(e, [1e3 * r.t_min for r in group], [1e3 * r.t_max for r in group], color=color,
+            ax.hlines(e, [1e3 * r.t_min for r in group], [1e3 * r.t_max for r in group], color=style.colour,
                       lw=0.8)
-            ok = np.array([r.valid for r in group])
-            line, = ax.plot(t, e, color=color, lw=0.8 if len(group) > 1 else 0, alpha=0.7,
-                            marker=marker, ms=ms, markevery=list(np.flatnonzero(ok)))
-            ax.plot(t[~ok], e[~ok], ls="none", marker=marker, ms=ms, color=color, mfc="white")
+            line, = ax.plot(t, e, color=style.colour, ls=style.line, lw=0.8 if len(group) > 1 else 0, alpha=0.7,
+                            marker=style.marker, ms=style.size)
             handles.setdefault(method, line)
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -95,14 +94,14 @@ def pareto_figure(measurement, *, error="max"):
             axis.set_minor_locator(NullLocator())
         ax.set_xlim(t_lo, t_hi)
         ax.set_ylim(min(_floor(pick(r)) for r in rs) / _Y_ROOM, None)
-        ax.set_title(name + ("" if gm.ANALYTIC[name] else " (off the crease band)"), fontsize=10)
+        ax.set_title(name + (" (off the crease band)" if F.field(name).crease_factors else ""), fontsize=10)
         ax.set_ylabel(f"{error} error" if ax in grid[::2] else "", fontsize=10)
         ax.tick_params(labelsize=9)
         ax.grid(alpha=0.3, lw=0.3)
     for ax in axes[-2:]:                # the lowest panel of each column
         ax.set_xlabel("time per frame, ms", fontsize=10)
         ax.xaxis.set_tick_params(labelbottom=True)
-    labels = [{"richardson": "SciPy (Richardson)"}.get(m, m) for m in handles]
+    labels = [m if m == "Pareto front" else gm.method(m).label for m in handles]
     if len(spare):
         for ax in spare:
             ax.axis("off")
@@ -178,9 +177,8 @@ def markdown_table(measurement, *, rows="all", error="max", include=()):
                 chosen.append(r)
         chosen.sort(key=rs.index)
         for r in chosen:
-            note = r.note if r.valid else ("**not valid**: " + r.note)
             cells = (name, r.label, _fmt_evals(r), _fmt_ms(r), f"{r.max_error:.2e}", f"{r.rms_error:.2e}",
-                     "yes" if r in front else "", note)
+                     "yes" if r in front else "", r.note)
             lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
     return "\n".join(lines)
 
@@ -215,5 +213,105 @@ def fastest_on(measurement, method="exact"):
     -------
     str
     """
-    wins = sum(min(measurement.of(f), key=lambda r: r.median).method == method for f in gm.FIELDS)
-    return share_in_words(int(wins), len(gm.FIELDS))
+    fields = list(dict.fromkeys(r.field for r in measurement.results))
+    wins = sum(min(measurement.of(f), key=lambda r: r.median).method == method for f in fields)
+    return share_in_words(int(wins), len(fields))
+
+
+def step_text(eps):
+    """A step as the book writes a power of ten: ``1e-3``, ``3.2e-6`` (``1e-03``'s zero dropped)."""
+    mantissa, exponent = f"{eps:.1e}".split("e")
+    mantissa = mantissa.rstrip("0").rstrip(".")
+    return f"{mantissa}e{int(exponent)}"
+
+
+def _and(items):
+    items = list(items)
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def methods_sentence(config, fields=None):
+    """The sentence (MyST) naming every method of `lab.gradient_methods.METHODS` the benchmark runs:
+    its label, its sources (a citation), its steps in ``config`` and, where it does not apply to
+    every field, the fields it runs on.
+
+    Parameters
+    ----------
+    config : lab.gradient_methods.Config
+    fields : sequence of height fields or None
+        As `renderer.formulas.field` takes them; None for every registered field.
+
+    Returns
+    -------
+    str
+    """
+    records = [F.field(f) for f in (tuple(F.FIELDS) if fields is None else fields)]
+    parts = []
+    for m in gm.METHODS:
+        text = m.label + (f" {{cite:p}}`{','.join(m.sources)}`" if m.sources else "")
+        steps = m.steps_in(config)
+        if steps != (None,):
+            text += " at ε = " + _and([step_text(e) for e in steps])
+        where = [f.name for f in records if m.applies(f)]
+        if len(where) < len(records):
+            text += " (on " + _and(where) + ")"
+        parts.append(text)
+    count = _NUMBER_WORDS[len(parts)] if len(parts) < len(_NUMBER_WORDS) else str(len(parts))
+    return f"{count.capitalize()} methods, each a record of `lab.gradient_methods.METHODS`: " + "; ".join(parts) + "."
+
+
+def univariate_figure(errors):
+    """Relative error of f'(x) against the step, log-log, one line per method of ``errors`` (a
+    `lab.gradient_methods.UnivariateErrors`); a method without a step is a horizontal line across.
+    Drawn for a phone's column: 4.6 in wide, every text 10 pt.  An error of exactly 0 would be drawn at
+    1e-18.  Returns a matplotlib Figure (not shown)."""
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import LogLocator, NullLocator
+    fig = Figure(figsize=(4.6, 3.0), layout="constrained")
+    ax = fig.subplots()
+    steps = [r.eps for r in errors.rows if r.eps is not None]
+    for name in dict.fromkeys(r.method for r in errors.rows):
+        m, rows = gm.method(name), errors.of(name)
+        style = m.style
+        if rows[0].eps is None:
+            ax.axhline(_floor(rows[0].relative_error), color=style.colour, ls=style.line, lw=1.4, label=m.label)
+        else:
+            ax.plot([r.eps for r in rows], [_floor(r.relative_error) for r in rows], color=style.colour,
+                    ls=style.line, lw=1.2, marker=style.marker, ms=min(style.size, 6), label=m.label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlim(max(steps) * 3, min(steps) / 3)          # the step shrinks to the right, as in the papers
+    ax.xaxis.set_major_locator(LogLocator(base=10.0 ** 4, numticks=8))
+    ax.yaxis.set_major_locator(LogLocator(base=10.0 ** 4, numticks=8))
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_minor_locator(NullLocator())
+    ax.set_xlabel("step", fontsize=10)
+    ax.set_ylabel("relative error of f′(x)", fontsize=10)
+    ax.tick_params(labelsize=10)
+    ax.grid(alpha=0.3, lw=0.3)
+    fig.legend(loc="outside lower center", ncols=2, fontsize=10, frameon=False)
+    return fig
+
+
+def univariate_table(errors):
+    """A Markdown table of ``errors`` (`lab.gradient_methods.UnivariateErrors`): per method its best
+    step (the one of least error; "adaptive" or "none" for a method without one) and the relative
+    error there."""
+    lines = ["| method | best step | relative error there |", "|---|---|---|"]
+    for name in dict.fromkeys(r.method for r in errors.rows):
+        best = errors.best(name)
+        where = step_text(best.eps) if best.eps is not None else ("adaptive" if name in errors.evaluations
+                                                                   else "none")
+        lines.append(f"| {gm.method(name).label} | {where} | {best.relative_error:.1e} |")
+    return "\n".join(lines)
+
+
+def published_table(published):
+    """A Markdown table of what papers report (`lab.gradient_methods.PUBLISHED`): the method (its label),
+    the source (a citation) with where it says it, and the statement (with its number where it has one)."""
+    lines = ["| method | source | what it reports |", "|---|---|---|"]
+    for p in published:
+        label = "the test" if p.method is None else gm.method(p.method).label
+        value = "" if p.value is None else f" ({p.value:.3g})"
+        lines.append(f"| {label} | {{cite:t}}`{p.source}`, {p.where} | {p.statement}{value} |")
+    return "\n".join(lines)
