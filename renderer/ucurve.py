@@ -398,6 +398,9 @@ def measure_function(function, x, eps=None):
         raise validate.InvalidValue(f"function {record.name} is not differentiable at x = {x!r}: it has a "
                                     f"crease there (the argument of an abs changes sign)")
     code = fieldcode.univariate_code(record)
+    if not np.isfinite(code.value(x)):
+        raise validate.InvalidValue(f"x must be a point where function {record.name} is a finite float64; "
+                                    f"at x = {x!r} it overflows")
     fd = np.array([code.central(x, float(e)) for e in steps])
     bad = np.flatnonzero(~np.isfinite(fd))
     if bad.size:
