@@ -6,10 +6,37 @@ its report's user property ``ledger``, which pytest-xdist carries from the worke
 the test to the controller, where `pytest_runtest_logreport` files it and
 `pytest_terminal_summary` prints it; without xdist both run in the one process."""
 
+import os
+
 import pytest
 
 #: {theorem id: (status, evidence)} of the verdicts reported to this process.
 LEDGER = {}
+
+
+#: Tests that read one measurement, computed once per process: xdist sends each group to one worker.
+SHARED = {"render-flips": ("test_theorem_holds[no-boundary]", "test_computed_verdict_matches_register[flips-zero]")}
+
+
+def pytest_configure(config):
+    """Under xdist, `SHARED`'s groups each go to one worker (``--dist loadgroup`` for ``load``, the default
+    of ``-n``), and a worker renders on one thread (``NUMBA_NUM_THREADS=1`` unless set, before numba is
+    imported): the workers already fill the cores, and numba's threads on top of them oversubscribe them,
+    as the book's page kernels would (book/_ext/execute_pages.py)."""
+    if getattr(config.option, "dist", "no") == "load":
+        config.option.dist = "loadgroup"
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+
+@pytest.hookimpl(tryfirst=True)          # before xdist's, which reads the groups
+def pytest_collection_modifyitems(config, items):
+    if not config.pluginmanager.hasplugin("xdist"):
+        return
+    for item in items:
+        for group, names in SHARED.items():
+            if item.name in names:
+                item.add_marker(pytest.mark.xdist_group(group))
 
 
 def pytest_runtest_logreport(report):
@@ -20,11 +47,20 @@ def pytest_runtest_logreport(report):
                 LEDGER[theorem_id] = (status, evidence)
 
 
+class _Claims(dict):
+    """{claim id: (measured, verdict)}, each claim measured when it is first read (`lab.claims.Claim.measure`):
+    a worker measures only the claims of its tests."""
+
+    def __missing__(self, claim_id):
+        from lab.claims import CLAIMS
+        self[claim_id] = result = next(c for c in CLAIMS if c.id == claim_id).measure()
+        return result
+
+
 @pytest.fixture(scope="session")
 def claim_results():
-    """{claim id: (measured, verdict)} of the whole register (`lab.claims.evaluate`)."""
-    from lab.claims import evaluate
-    return {c.id: (measured, verdict) for c, measured, verdict in evaluate()}
+    """{claim id: (measured, verdict)} of the register, each measured when a test reads it (`_Claims`)."""
+    return _Claims()
 
 
 @pytest.fixture(scope="session")
