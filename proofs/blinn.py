@@ -33,7 +33,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Dot, Step, Theorem
+from .core import Cross, Dot, Step, Theorem, catalogue
 from .frame import (CHART_RATES, EP_S, ET_S, N, N_S, ON_SPHERE, PHI_OF_V, STANDARD_FRAME, THETA_OF_U, U_OF_THETA,
                     V_OF_PHI, VECTOR_NAMES, e_phi, e_theta, phi, theta)
 
@@ -171,13 +171,4 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
 #: This module's theorem: id -> title.
 TITLES = {"blinn-perturbation": "Blinn's perturbation on the sphere"}
 
-
-def titles():
-    """{id: title} of this module's theorem (proofs/registry.py)."""
-    return TITLES
-
-
-@lru_cache(maxsize=None)
-def build(theorem_id):
-    """The theorem ``theorem_id`` of `TITLES`, built once."""
-    return {"blinn-perturbation": _theorem}[theorem_id]()
+titles, build = catalogue(TITLES, {"blinn-perturbation": _theorem})

@@ -84,7 +84,7 @@ import mpmath
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "spelled", "listed", "Verdict", "Identity", "Step", "calc", "chains", "Theorem", "variant", "check_identities", "written", "Dot",
+__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "spelled", "listed", "Verdict", "Identity", "Step", "calc", "chains", "Theorem", "variant", "check_identities", "written", "catalogue", "Dot",
            "Cross", "Jacobian", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
@@ -496,6 +496,15 @@ class Theorem:
 def placeholder_key(s):
     """The key ``⟦key⟧`` names a named symbol by: its name, or its function's (E for E(x))."""
     return s.func.__name__ if isinstance(s, AppliedUndef) else getattr(s, "__name__", None) or str(s)
+
+
+def catalogue(titles, builders, key=tuple):
+    """``titles()`` and ``build(id)`` of a theorem module, as proofs/registry.py reads them: ``titles``
+    ({id: title}, in the chapter's order) and, for each id, its builder (function () -> Theorem) in
+    ``builders``; ``build`` calls a builder once per value of ``key()`` (the registered fields, for a
+    theorem built from them), then returns the same Theorem."""
+    built = functools.lru_cache(maxsize=None)(lambda theorem_id, _: builders[theorem_id]())
+    return (lambda: titles), (lambda theorem_id: built(theorem_id, key()))
 
 
 def variant(theorem, **changes):

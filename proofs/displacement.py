@@ -35,7 +35,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Step, Theorem, Verdict, calc, listed, spelled, written
+from .core import Cross, Step, Theorem, Verdict, calc, catalogue, listed, spelled, written
 from .frame import PHI_OF_V, THETA_OF_U, U_OF_THETA, V_OF_PHI
 
 theta, phi = sp.symbols("theta phi", real=True)
@@ -292,17 +292,5 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
 #: This module's theorem: id -> title.
 TITLES = {"bump-vs-displacement": "Bump versus displacement"}
 
-
-def titles():
-    """{id: title} of this module's theorem (proofs/registry.py)."""
-    return TITLES
-
-
-def build(theorem_id):
-    """The theorem ``theorem_id`` of `TITLES`, built once per set of registered fields."""
-    return {"bump-vs-displacement": _built}[theorem_id](tuple(F.FIELDS.values()))
-
-
-@lru_cache(maxsize=None)
-def _built(fields):
-    return _theorem()
+#: The statement lists the registered fields: built again when they change.
+titles, build = catalogue(TITLES, {"bump-vs-displacement": _theorem}, key=lambda: tuple(F.FIELDS.values()))

@@ -11,13 +11,13 @@ pbrt-v4's footprint steps.
 """
 
 import random
-from functools import lru_cache, partial
+from functools import partial
 
 import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Step, Theorem, Verdict, calc, written
+from .core import Step, Theorem, Verdict, calc, catalogue, written
 
 x = sp.Symbol("x", real=True)
 eps = sp.Symbol("varepsilon", positive=True)
@@ -304,18 +304,6 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
 TITLES = {"central-difference-truncation": "Truncation error of the central difference",
           "optimal-step": "The optimal central-difference step"}
 
-
-def titles():
-    """{id: title} of this module's theorems, in the chapter's order (proofs/registry.py)."""
-    return TITLES
-
-
-def build(theorem_id):
-    """The theorem ``theorem_id`` of `TITLES`, built once per set of registered fields (the stencil's
-    step has a case per field)."""
-    return _built(theorem_id, tuple(F.FIELDS.values()))
-
-
-@lru_cache(maxsize=None)
-def _built(theorem_id, fields):
-    return {"central-difference-truncation": _truncation, "optimal-step": _optimal}[theorem_id]()
+#: The stencil's step has a case per registered field: built again when they change.
+titles, build = catalogue(TITLES, {"central-difference-truncation": _truncation, "optimal-step": _optimal},
+                          key=lambda: tuple(F.FIELDS.values()))

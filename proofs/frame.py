@@ -8,13 +8,13 @@ dN/dtheta and dN/dphi.  The proofs write the renderer's formulas in its own
 symbols (N_x, N_y, N_z, sin_phi) and check each step at N(theta, phi).
 """
 
-from functools import lru_cache, partial
+from functools import partial
 
 import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Dot, Step, Theorem, Verdict, calc
+from .core import Cross, Dot, Step, Theorem, Verdict, calc, catalogue
 
 theta, phi = sp.symbols("theta phi", real=True)
 #: The unit normal in spherical coordinates (the independent side).
@@ -256,13 +256,5 @@ TITLES = {"chart": "The chart is the spherical angles",
           "frame-orthonormal": "The tangent frame is orthonormal and tangent",
           "frame-orientation": "Orientation of the tangent frame"}
 
-
-def titles():
-    """{id: title} of this module's theorems, in the chapter's order (proofs/registry.py)."""
-    return TITLES
-
-
-@lru_cache(maxsize=None)
-def build(theorem_id):
-    """The theorem ``theorem_id`` of `TITLES`, built once."""
-    return {"chart": _chart, "frame-orthonormal": _orthonormal, "frame-orientation": _orientation}[theorem_id]()
+titles, build = catalogue(TITLES, {"chart": _chart, "frame-orthonormal": _orthonormal,
+                                   "frame-orientation": _orientation})

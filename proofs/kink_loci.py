@@ -20,7 +20,7 @@ import sympy as sp
 from renderer import formulas as F
 from renderer.scene import Scene
 
-from .core import Dot, Step, Theorem, Verdict, written
+from .core import Dot, Step, Theorem, Verdict, catalogue, written
 from .frame import U_OF_THETA
 
 theta, phi = sp.symbols("theta phi", real=True)
@@ -256,13 +256,4 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
 #: This module's theorems: id -> title.
 TITLES = {"kink-loci-rays": "The u-creases are rays", "kink-loci-circles": "The v-creases are circles"}
 
-
-def titles():
-    """{id: title} of this module's theorems, in the chapter's order (proofs/registry.py)."""
-    return TITLES
-
-
-@lru_cache(maxsize=None)
-def build(theorem_id):
-    """The theorem ``theorem_id`` of `TITLES`, built once."""
-    return {"kink-loci-rays": _rays, "kink-loci-circles": _circles}[theorem_id]()
+titles, build = catalogue(TITLES, {"kink-loci-rays": _rays, "kink-loci-circles": _circles})

@@ -22,7 +22,7 @@ import sympy as sp
 from renderer import formulas as F
 from renderer.scene import PointLight, Scene
 
-from .core import Jacobian, Step, Theorem, Verdict
+from .core import Jacobian, Step, Theorem, Verdict, catalogue
 
 x, y, e, R, t, s = sp.symbols("x y e R t s", real=True)
 Cb = sp.Matrix(sp.symbols("C_x C_y C_z", real=True))
@@ -276,13 +276,4 @@ def _no_boundary(attached=None, **evidence):
 #: This module's theorem: id -> title.
 TITLES = {"no-boundary": "The bump moves no boundary"}
 
-
-def titles():
-    """{id: title} of this module's theorem (proofs/registry.py)."""
-    return TITLES
-
-
-@lru_cache(maxsize=None)
-def build(theorem_id):
-    """The theorem ``theorem_id`` of `TITLES`, built once."""
-    return {"no-boundary": _no_boundary}[theorem_id]()
+titles, build = catalogue(TITLES, {"no-boundary": _no_boundary})

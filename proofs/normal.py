@@ -7,7 +7,7 @@ formula N' = M / |M| with M = N + beta g, g = h_u e_theta + h_v e_phi, written
 here.
 """
 
-from functools import lru_cache, partial
+from functools import partial
 
 import numpy as np
 import sympy as sp
@@ -16,7 +16,7 @@ from renderer import formulas as F
 from renderer.scene import BUMPS
 
 from . import frame
-from .core import Dot, Step, Theorem, Verdict, calc, spelled
+from .core import Dot, Step, Theorem, Verdict, calc, catalogue, spelled
 
 Nv = sp.Matrix([F.N_x, F.N_y, F.N_z])
 et, ep = sp.Matrix(F.e_theta), sp.Matrix(F.e_phi)
@@ -204,13 +204,4 @@ def _limit(tilt=None, **evidence):
 TITLES = {"normal-beta-derivative": "The β-derivative of the perturbed normal",
           "beta-zero-regression": "The β → 0 limit"}
 
-
-def titles():
-    """{id: title} of this module's theorems, in the chapter's order (proofs/registry.py)."""
-    return TITLES
-
-
-@lru_cache(maxsize=None)
-def build(theorem_id):
-    """The theorem ``theorem_id`` of `TITLES`, built once."""
-    return {"normal-beta-derivative": _derivative, "beta-zero-regression": _limit}[theorem_id]()
+titles, build = catalogue(TITLES, {"normal-beta-derivative": _derivative, "beta-zero-regression": _limit})
