@@ -1,58 +1,15 @@
-"""Shared measurements of `pytest verify`, each computed once per run (and only when a
-test asks for it: `lab.store`'s measurements once across the xdist workers, the others once
-per worker), and the theorem ledger printed at the end of the run.
+"""Shared measurements of `pytest verify`, each computed once per session (and only
+when a test asks for it), and the theorem ledger printed at the end of the run.
 
 The ledger is collected from the test reports: test_theorem_holds records each verdict as
 its report's user property ``ledger``, which pytest-xdist carries from the worker that ran
 the test to the controller, where `pytest_runtest_logreport` files it and
 `pytest_terminal_summary` prints it; without xdist both run in the one process."""
 
-import os
-import shutil
-import tempfile
-
 import pytest
 
 #: {theorem id: (status, evidence)} of the verdicts reported to this process.
 LEDGER = {}
-
-
-#: The store this run made (`pytest_configure`), removed at its end.
-STORE = pytest.StashKey[str]()
-#: Tests that read one measurement, computed once per process: xdist sends each group to one worker.
-SHARED = {"render-flips": ("test_theorem_holds[no-boundary]", "test_computed_verdict_matches_register[flips-zero]")}
-
-
-def pytest_configure(config):
-    """The run's measurements of `lab.store` go to a store of its own (a new temporary directory, unless
-    ``SYMRENDER_STORE`` names one), which its xdist workers share: a measurement two tests read (a claim's
-    and an accuracy test's) is computed once, by the first worker to ask.  Under xdist, `SHARED`'s groups
-    each go to one worker (``--dist loadgroup`` for ``load``, the default of ``-n``), and a worker renders
-    on one thread (``NUMBA_NUM_THREADS=1`` unless set, before numba is imported): the workers already fill
-    the cores, and numba's threads on top of them oversubscribe them, as the book's page kernels would
-    (book/_ext/execute_pages.py)."""
-    from lab.store import ENV
-    if not os.environ.get(ENV):
-        os.environ[ENV] = config.stash[STORE] = tempfile.mkdtemp(prefix="verify-store-")
-    if getattr(config.option, "dist", "no") == "load":
-        config.option.dist = "loadgroup"
-    if os.environ.get("PYTEST_XDIST_WORKER"):
-        os.environ.setdefault("NUMBA_NUM_THREADS", "1")
-
-
-def pytest_unconfigure(config):
-    if STORE in config.stash:
-        shutil.rmtree(config.stash[STORE], ignore_errors=True)
-
-
-@pytest.hookimpl(tryfirst=True)          # before xdist's, which reads the groups
-def pytest_collection_modifyitems(config, items):
-    if not config.pluginmanager.hasplugin("xdist"):
-        return
-    for item in items:
-        for group, names in SHARED.items():
-            if item.name in names:
-                item.add_marker(pytest.mark.xdist_group(group))
 
 
 def pytest_runtest_logreport(report):
