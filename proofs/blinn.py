@@ -27,11 +27,13 @@ P' = (R + beta h) N and a general bump h(u, v), and finds the renderer's
 surface slopes at every beta.
 """
 
+from functools import lru_cache
+
 import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Dot, Step, Theorem
+from .core import Cross, Dot, Step, Theorem, catalogue
 from .frame import (CHART_RATES, EP_S, ET_S, N, N_S, ON_SPHERE, PHI_OF_V, STANDARD_FRAME, THETA_OF_U, U_OF_THETA,
                     V_OF_PHI, VECTOR_NAMES, e_phi, e_theta, phi, theta)
 
@@ -43,7 +45,13 @@ P_UV = F.R * N.subs({theta: THETA_OF_U, phi: PHI_OF_V}, simultaneous=True)
 _H = sp.Function("H")
 _P_DISPLACED = (F.R + F.beta * _H(F.u, F.v)) * P_UV / F.R
 _SYMBOLS = {sp.Derivative(_H(F.u, F.v), F.u): F.h_u, sp.Derivative(_H(F.u, F.v), F.v): F.h_v, _H(F.u, F.v): F.h}
-EXACT_NORMAL = _P_DISPLACED.diff(F.u).cross(_P_DISPLACED.diff(F.v)).subs(_SYMBOLS).subs(_TO_ANGLES, simultaneous=True)
+
+
+@lru_cache(maxsize=None)
+def exact_normal():
+    """The displaced sphere's normal P'_u x P'_v (a 3 x 1 sympy ImmutableMatrix), as above."""
+    return sp.ImmutableMatrix(_P_DISPLACED.diff(F.u).cross(_P_DISPLACED.diff(F.v)).subs(_SYMBOLS)
+                              .subs(_TO_ANGLES, simultaneous=True))
 
 #: The names the proof uses: N, e_theta, e_phi at N(theta, phi); P_u, P_v; Blinn's N_B = P_u x P_v, its
 #: length and his N'_B; the bump's F_u, F_v; and the slopes t (components along e_theta, e_phi over the
@@ -97,7 +105,7 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
     renderer, scaled = sp.Tuple(T["surface"], T["chart"]), sp.Tuple(SURFACE, CHART)
     draft = sp.ImmutableMatrix(sp.diag(*factors)) * T["blinn"]
     return Theorem(
-        id="blinn-perturbation", title="Blinn's perturbation on the sphere",
+        id="blinn-perturbation", title=TITLES["blinn-perturbation"],
         statement=(
             r"Set Blinn's $N'_B = N_B + \bigl(F_u (N_B\times P_v) - F_v (N_B\times P_u)\bigr)/\lvert N_B\rvert$, "
             r"$N_B = P_u\times P_v$, for sphere A in the renderer's chart, "
@@ -140,7 +148,7 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
                PV_S: sp.ImmutableMatrix(P_UV.diff(F.v).subs(_TO_ANGLES, simultaneous=True)),
                NB_S: Cross(PU_S, PV_S), NORM_NB: 2 * sp.pi**2 * R**2 * s, F_U: f[0], F_V: f[1],
                NBP_S: blinn_normal() if normal is None else normal,
-               T["blinn"]: _slopes(NBP_S), T["displaced"]: _slopes(sp.ImmutableMatrix(EXACT_NORMAL)),
+               T["blinn"]: _slopes(NBP_S), T["displaced"]: _slopes(exact_normal()),
                T["surface"]: _slopes(RENDERER["surface"]), T["chart"]: _slopes(RENDERER["chart"]), **_RENDERER_AT},
         names=NAMES, domain=DOMAIN,
         wrong_variants=(
@@ -160,6 +168,7 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
     )
 
 
-BLINN_PERTURBATION = _theorem()
+#: This module's theorem: id -> title.
+TITLES = {"blinn-perturbation": "Blinn's perturbation on the sphere"}
 
-THEOREMS = (BLINN_PERTURBATION,)
+titles, build = catalogue(TITLES, {"blinn-perturbation": _theorem})

@@ -59,7 +59,7 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
    bound 0.0 included; with at least its `RENDERED` count of renderer outputs.
 8. *Citations.*  A statement or a step's sentence names another theorem only by the marker
    ``⟪id⟫`` (`CITATION`), never by its id in words; the id must be a theorem of the registry
-   (`CITABLE`, which proofs/registry.py fills), or the theorem is refuted.  The book prints the marker as
+   (`CITABLE`, which reads proofs/registry.py's), or the theorem is refuted.  The book prints the marker as
    "Theorem n (title)", plain text (`plain`) as its title.
 9. *Claims* (lab/claims.py).  A claim of the draft reaches its registered verdict from
    finite measurements, by its criterion, whose thresholds are the ones its words state.
@@ -75,6 +75,8 @@ import functools
 import operator
 import random
 import re
+import sys
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -82,7 +84,7 @@ import mpmath
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "Verdict", "Identity", "Step", "calc", "chains", "Theorem", "variant", "check_identities", "written", "Dot",
+__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "spelled", "listed", "Verdict", "Identity", "Step", "calc", "chains", "Theorem", "variant", "check_identities", "written", "catalogue", "Dot",
            "Cross", "Jacobian", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
@@ -97,9 +99,32 @@ TOLERANCE_DIGITS = 20
 CITATION = re.compile(r"⟪([^⟫]*)⟫")
 #: What a statement prints from the theorem's objects (the book fills it in): ``⟦key⟧``.
 PLACEHOLDER = re.compile(r"⟦([^⟧]+)⟧")
-#: id -> title of every theorem that may be cited: filled by proofs/registry.py when it is imported
-#: (this module imports no theorem); a citation while it is empty is refuted, as unknown.
-CITABLE = {}
+
+
+class _Registered(Mapping):
+    """id -> title of every theorem of proofs/registry.py (its ``CITABLE``), read when asked: empty
+    while that module is not imported (this module imports neither a theorem nor the registry)."""
+
+    def _titles(self):
+        registry = sys.modules.get(f"{__package__}.registry")
+        return registry.CITABLE if registry is not None else {}
+
+    def __getitem__(self, theorem_id):
+        return self._titles()[theorem_id]
+
+    def __contains__(self, theorem_id):
+        return theorem_id in self._titles()
+
+    def __iter__(self):
+        return iter(self._titles())
+
+    def __len__(self):
+        return len(self._titles())
+
+
+#: id -> title of every theorem that may be cited: proofs/registry.py's, once it is imported; a
+#: citation while it is not is refuted, as unknown.
+CITABLE = _Registered()
 
 
 def citations(text) -> list:
@@ -113,6 +138,17 @@ def plain(text, titles=None) -> str:
     without a title is left as the marker.  (The book prints "Theorem n (title)".)"""
     titles = CITABLE if titles is None else titles
     return CITATION.sub(lambda m: f"theorem “{titles[m.group(1)]}”" if m.group(1) in titles else m.group(0), text)
+
+
+def spelled(n) -> str:
+    """A count as a statement or an evidence writes it: "three" (fields), 12 from ten on."""
+    return ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine")[n] if n < 10 else str(n)
+
+
+def listed(words) -> str:
+    """Words as a sentence lists them: "sine", "sine and ridges", "sine, ridges and rings"."""
+    words = list(words)
+    return " and ".join([", ".join(words[:-1]), words[-1]] if len(words) > 1 else words)
 
 
 @dataclass(frozen=True)
@@ -462,6 +498,15 @@ def placeholder_key(s):
     return s.func.__name__ if isinstance(s, AppliedUndef) else getattr(s, "__name__", None) or str(s)
 
 
+def catalogue(titles, builders, key=tuple):
+    """``titles()`` and ``build(id)`` of a theorem module, as proofs/registry.py reads them: ``titles``
+    ({id: title}, in the chapter's order) and, for each id, its builder (function () -> Theorem) in
+    ``builders``; ``build`` calls a builder once per value of ``key()`` (the registered fields, for a
+    theorem built from them), then returns the same Theorem."""
+    built = functools.lru_cache(maxsize=None)(lambda theorem_id, _: builders[theorem_id]())
+    return (lambda: titles), (lambda theorem_id: built(theorem_id, key()))
+
+
 def variant(theorem, **changes):
     """A wrong variant's check: ``theorem`` with ``changes`` (fields of `Theorem`), checked when called."""
     from dataclasses import replace
@@ -616,7 +661,7 @@ def _unknown_citation(t):
         unknown = [i for i in citations(text) if i not in CITABLE]
         if unknown:
             return (f"{t.id}: {where} cites ⟪{unknown[0]}⟫, which is no theorem of the registry"
-                    + ("" if CITABLE else " (proofs.registry, which fills proofs.core.CITABLE, is not imported)"))
+                    + ("" if CITABLE else " (proofs.registry, whose theorems proofs.core.CITABLE reads, is not imported)"))
         for m in re.finditer(r"\btheorems?\s+`?([\w-]+)", text):
             if m.group(1) in CITABLE:
                 return f"{t.id}: {where} names theorem {m.group(1)} by its id in words: cite it as ⟪{m.group(1)}⟫"

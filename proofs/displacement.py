@@ -14,9 +14,10 @@ metric factors 1 / (2 pi R sin phi) and 1 / (pi R).
 Is the seed's N' the (first-order) normal of *some* displaced sphere
 P = (R + beta G) N?  Matching tangential parts needs G_theta = -2 pi R sin(phi) h_theta
 and G_phi = -pi R h_phi, which is integrable only if
-2 cos(phi) h_theta + (2 sin(phi) - 1) h_theta_phi = 0 everywhere.  For the rings
-field (h_theta = 0) it holds: the seed's rings bump is the first-order normal
-of the sphere displaced by G = -pi R h.  For sine and ridges it fails, so the
+2 cos(phi) h_theta + (2 sin(phi) - 1) h_theta_phi = 0 everywhere.  Which registered
+fields pass is derived here (`integrable`: the obstruction simplifies to 0), not typed:
+for the rings field (h_theta = 0) it holds, and the seed's rings bump is the first-order
+normal of the sphere displaced by G = -pi R h; for sine and ridges it fails, so the
 seed's bump is the normal of no displaced sphere.
 
 The renderer's bump="surface" is checked twice: its coefficients
@@ -26,7 +27,7 @@ from `renderer.formulas.CHART` (theorem `chart`); and its rendered normals
 equal the displaced surface's, evaluated by mpmath.
 """
 
-from functools import partial
+from functools import lru_cache, partial
 
 import mpmath
 import numpy as np
@@ -34,7 +35,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Step, Theorem, Verdict, calc, written
+from .core import Cross, Step, Theorem, Verdict, calc, catalogue, listed, spelled, written
 from .frame import PHI_OF_V, THETA_OF_U, U_OF_THETA, V_OF_PHI
 
 theta, phi = sp.symbols("theta phi", real=True)
@@ -108,17 +109,18 @@ SEED_DISPLACEMENT = (-2 * sp.pi * R * sp.sin(phi) * H_t, -sp.pi * R * H_p)
 OBSTRUCTION = written(sp.Add(2 * sp.cos(phi) * H_t, sp.Mul(sp.Add(2 * sp.sin(phi), -1, evaluate=False),
                                                           sp.Derivative(H_at, theta, phi), evaluate=False),
                              evaluate=False))
-INTEGRABLE = ("rings",)
 
 
 def _angular(field):
-    """The field's height h(u, v) at the chart's (u, v) of (theta, phi), k_u and k_v symbolic."""
-    return F.HEIGHT[field].subs({F.u: U_OF_THETA, F.v: V_OF_PHI})
+    """The height h(u, v) of ``field`` (a `HeightField`) at the chart's (u, v) of (theta, phi), k_u and
+    k_v symbolic."""
+    return field.expr.subs({F.u: U_OF_THETA, F.v: V_OF_PHI})
 
 
+@lru_cache(maxsize=None)
 def integrability_obstruction(field):
-    """`OBSTRUCTION`, 2 cos(phi) h_theta + (2 sin(phi) - 1) h_theta_phi, for a field of
-    `renderer.formulas.HEIGHT` (sympy expression in theta, phi, k_u, k_v): zero exactly
+    """`OBSTRUCTION`, 2 cos(phi) h_theta + (2 sin(phi) - 1) h_theta_phi, for ``field`` (a
+    `renderer.formulas.HeightField`; a sympy expression in theta, phi, k_u, k_v): zero exactly
     when the seed's bump on that field is the first-order normal of a displaced sphere.
     Returned as 0 when it vanishes identically; else unsimplified, with a point where it is
     not 0 (a nonzero value at one point decides; sympy is asked only when none is found)."""
@@ -131,13 +133,19 @@ def integrability_obstruction(field):
     return sp.simplify(expr)
 
 
-def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
+def integrable():
+    """The names of the registered fields on which the seed's bump is a displaced sphere's first-order
+    normal: those whose `integrability_obstruction` is 0."""
+    return tuple(name for name, field in F.FIELDS.items() if integrability_obstruction(field) == 0)
+
+
+def surface_normal_residual(bump, gradient, fields=None):
     """(worst |N'_renderer - N'_exact|, pixels compared, pixels left out) for the renderer's
     `bump` ('surface' is the one claimed to be the displaced normal) and `gradient`
     ('exact'; 'central' differs by its truncation error).
 
     The pixels are `proofs.pixels.pixels` (seeded: full frame, pole ring at zoom 300 and
-    3e4, crease neighbours) of each field.  N'_exact normalises P_v x P_u of
+    3e4, crease neighbours) of each of ``fields`` (names; every registered field by default).  N'_exact normalises P_v x P_u of
     P(u, v) = (R + beta h(u, v)) N(theta(u), phi(v)) at the pixel's (u, v), in mpmath at
     `pixels.DIGITS` digits (P_v x P_u = (dtheta/du)(dphi/dv) P_phi x P_theta, an outward
     normal); N'_renderer is the G-buffer's Ns.  Pixels with sin phi <= `formulas.POLE_SIN_PHI`,
@@ -145,9 +153,9 @@ def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
     """
     from .pixels import DIGITS, pixels
     worst, compared, left_out = 0.0, 0, 0
-    for field in fields:
+    for field in F.FIELDS if fields is None else fields:
         scene, px = pixels(field, gradient, bump)
-        P = (scene.radius_a + scene.beta * F.HEIGHT[field].subs({F.k_u: scene.k_u, F.k_v: scene.k_v})) \
+        P = (scene.radius_a + scene.beta * F.FIELDS[field].expr.subs({F.k_u: scene.k_u, F.k_v: scene.k_v})) \
             * N.subs({theta: THETA_OF_U, phi: PHI_OF_V}, simultaneous=True)
         fn = sp.lambdify((F.u, F.v), list(sp.diff(P, F.v).cross(sp.diff(P, F.u))), modules="mpmath", cse=True)
         keep = np.sin(np.pi * px["uv"][:, 1]) > float(F.POLE_SIN_PHI)
@@ -160,24 +168,27 @@ def surface_normal_residual(bump, gradient, fields=("sine", "ridges", "rings")):
     return worst, compared, left_out
 
 
-def _evidence(kernel=KERNEL_COEFFS, integrable=INTEGRABLE, bump="surface", gradient="exact"):
+def _evidence(kernel=KERNEL_COEFFS, claimed=None, bump="surface", gradient="exact"):
     """The renderer: its surface-bump coefficients ``kernel`` carry no floor but the pole's; the seed's
-    bump is a displacement's normal for the fields ``integrable`` (the obstruction of each of the
-    renderer's fields); the rendered normals of ``bump`` and ``gradient`` are the displaced surface's."""
+    bump is a displacement's normal for the fields ``claimed`` (default `integrable`) and no other (the
+    obstruction of each of the renderer's fields); the rendered normals of ``bump`` and ``gradient`` are
+    the displaced surface's."""
     if any(c.has(sp.Max) for c in kernel):
         return Verdict("refuted", f"a floor other than max(sin_phi, POLE_SIN_PHI) in the surface bump: {kernel}")
-    obstruction = {f: integrability_obstruction(f) for f in ("sine", "ridges", "rings")}
+    obstruction = {name: integrability_obstruction(f) for name, f in F.FIELDS.items()}
     found = tuple(f for f, o in obstruction.items() if o == 0)
-    if set(found) != set(integrable):
+    claimed = found if claimed is None else claimed
+    if set(found) != set(claimed):
         return Verdict("refuted", f"the draft's bump is a displaced sphere's normal for {found or 'no field'}, "
-                       f"not {integrable}: integrability obstructions {obstruction}")
+                       f"not {claimed}: integrability obstructions {obstruction}")
     worst, compared, left_out = surface_normal_residual(bump, gradient)
     if worst > 1e-12:
         return Verdict("refuted", f"renderer's bump={bump!r}, gradient={gradient!r} normal differs from the displaced "
                        f"surface's by {worst:.2e}", worst, rendered=compared)
     return Verdict("proved", f"the obstruction is 0 for {', '.join(found)} only (the draft's bump is the normal of no "
                    f"displaced sphere for the others); the renderer's surface-bump normals within {worst:.1e} of the "
-                   f"displaced normal (mpmath, {compared} seeded sphere-A pixels of the three fields, pole ring and "
+                   f"displaced normal (mpmath, {compared} seeded sphere-A pixels of the {spelled(len(F.FIELDS))} fields, "
+                   "pole ring and "
                    f"crease neighbours included; {left_out} inside the pole floor sin phi <= "
                    f"{float(F.POLE_SIN_PHI):g} left out)", rendered=compared)
 
@@ -195,10 +206,13 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
     cross = Cross(sp.Derivative(P_S, phi), sp.Derivative(P_S, theta))
     coeffs = sp.Tuple(B_U, B_V)
     curl = written(sp.Add(sp.Derivative(G_T, phi), -sp.Derivative(G_P, theta), evaluate=False))
-    rings = _angular("rings")
+    exact = integrable()
+    others = [name for name in F.FIELDS if name not in exact]
+    fields = {name: f"the {listed(names)} field{'s' if len(names) > 1 else ''}" for name, names in
+              (("exact", exact), ("others", others))}
     potential = sp.Tuple(sp.Derivative(-sp.pi * R * H_at, theta), sp.Derivative(-sp.pi * R * H_at, phi))
     return Theorem(
-        id="bump-vs-displacement", title="Bump versus displacement",
+        id="bump-vs-displacement", title=TITLES["bump-vs-displacement"],
         statement=r"Displace sphere A (radius $R$) along its normal $N(\theta, \varphi)$ by $\beta$ times the "
                   r"height $H(\theta, \varphi)$: the height field $h$ at the chart point of the angles $\theta$, "
                   r"$\varphi$, with partial derivatives $H_\theta = \partial H/\partial\theta$ and "
@@ -208,11 +222,12 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                   r"$H_\varphi = h_v/\pi$) the bracket's tangential coefficients are the renderer's surface bump, "
                   r"the book's " '(`bump="surface"`)' r": $⟦kernel⟧$. The draft's bump $\beta(h_u, h_v)$ has the "
                   r"opposite sign and lacks the chart's metric factors. Nor is the draft's bump, to first order in "
-                  r"$\beta$, the normal of another displaced sphere $(R + \beta G)N$, except on one field: it would "
+                  r"$\beta$, the normal of another displaced sphere $(R + \beta G)N$, "
+                  f"except on {spelled(len(exact))} field{'s' if len(exact) != 1 else ''}: it would "
                   r"need $G$ to have the partial derivatives $⟦G_theta⟧$ and $⟦G_phi⟧$. Partial derivatives of one "
                   r"function have zero curl (its mixed partials commute), and here $⟦curl⟧$. This vanishes "
-                  r"identically for the rings field, with $G = -\pi R h$; it does not for the sine and ridges "
-                  r"fields, where the draft's bump is the normal of no displaced sphere.",
+                  f"identically for {fields['exact']}, with " r"$G = -\pi R h$; it does not for "
+                  f"{fields['others']}, where the draft's bump is the normal of no displaced sphere.",
         steps=(
             *calc(cross,
                   (r"Differentiate $P = (R + \beta H)N$, with $\partial N/\partial\theta = \sin\varphi\, e_\theta$ and "
@@ -234,18 +249,18 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
             Step(r"A function $G$ with these partial derivatives exists only if its mixed partials agree, "
                  r"$\partial G_\theta/\partial\varphi = \partial G_\varphi/\partial\theta$: the curl of a "
                  r"gradient is zero. Here the curl is", curl, -sp.pi * R * obstruction),
-            Step(r"For the sine and ridges fields $H_\theta$ is not zero, nor is the curl (the evidence evaluates "
-                 r"it where it is not), so no $G$ exists. For the rings field $h$ depends on $\varphi$ alone, so "
-                 r"$H_\theta = 0$, the curl vanishes, and $G = -\pi R h$ has the partial derivatives of step 4",
-                 sp.Tuple(G_T, G_P), potential,
-                 cases=(("rings", {H: sp.Lambda((theta, phi), rings)}),)),
+            Step(f"For {fields['others']} " r"$H_\theta$ is not zero, nor is the curl (the evidence evaluates "
+                 f"it where it is not), so no $G$ exists. For {fields['exact']} " r"$h$ depends on $\varphi$ "
+                 r"alone, so $H_\theta = 0$, the curl vanishes, and $G = -\pi R h$ has the partial derivatives of "
+                 "step 4", sp.Tuple(G_T, G_P), potential,
+                 cases=tuple((name, {H: sp.Lambda((theta, phi), _angular(F.FIELDS[name]))}) for name in exact)),
         ),
         claims={"cross": (cross, claim), "kernel": (coeffs, chart), "curl": (curl, -sp.pi * R * obstruction)},
         where={N_S: sp.ImmutableMatrix(N), ET_S: sp.ImmutableMatrix(e_theta), EP_S: sp.ImmutableMatrix(e_phi),
                P_S: sp.MatMul(R + beta * H_at, N_S), B_U: kernel[0], B_V: kernel[1],
                G_T: SEED_DISPLACEMENT[0], G_P: SEED_DISPLACEMENT[1]},
         names={ET_S: r"e_\theta", EP_S: r"e_\varphi", H_at: "H", G_T: r"G_\theta", G_P: r"G_\varphi"},
-        domain={**DOMAIN, sp.Symbol("k_v", real=True): (0.5, 12.0)}, functions=INSTANCE,
+        domain={**DOMAIN, F.k_u: (0.5, 12.0), F.k_v: (0.5, 12.0)}, functions=INSTANCE,
         evidence=partial(_evidence, kernel, **evidence),
         wrong_variants=(("the renderer's chart bump (the seed's) as the displaced normal's coefficients",
                          lambda: _theorem(kernel=F.BUMP["chart"]).check()),
@@ -253,7 +268,7 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                          lambda: _theorem(kernel=away_from_pole(
                              tuple(c.subs(F.POLE_SIN_PHI, sp.Float(1e-3)) for c in F.BUMP["surface"]))).check()),
                         ("the seed's bump the normal of a displaced sphere for every field",
-                         lambda: _theorem(integrable=("sine", "ridges", "rings")).check()),
+                         lambda: _theorem(claimed=tuple(F.FIELDS)).check()),
                         ("the renderer's bump='chart' normals as the displaced surface's",
                          lambda: _theorem(bump="chart").check()),
                         ("the numeric pipeline's bump='surface' normals (central differences) as exactly the "
@@ -274,6 +289,8 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
     )
 
 
-BUMP_VS_DISPLACEMENT = _theorem()
+#: This module's theorem: id -> title.
+TITLES = {"bump-vs-displacement": "Bump versus displacement"}
 
-THEOREMS = (BUMP_VS_DISPLACEMENT,)
+#: The statement lists the registered fields: built again when they change.
+titles, build = catalogue(TITLES, {"bump-vs-displacement": _theorem}, key=lambda: tuple(F.FIELDS.values()))

@@ -2,10 +2,10 @@
 
 The series is proved for any h, by Taylor's theorem.  That it is the renderer's
 quotient is part of the theorem: away from the chart's seam and poles, each
-component of `renderer.formulas.CENTRAL` (the kernel's stencil, with the interior
-branch of `renderer.formulas.STENCIL_POINTS` and of its denominator) equals the
-quotient (h(x + eps) - h(x - eps)) / (2 eps) written here, for every field (a step
-of the proof); the evidence checks that the kernel's formulas take those interior
+component of each registered field's central difference (`HeightField.central`: the
+kernel's stencil, with the interior branch of `renderer.formulas.STENCIL_POINTS` and of
+its denominator) equals the quotient (h(x + eps) - h(x - eps)) / (2 eps) written here,
+for every field (a step of the proof); the evidence checks that the kernel's formulas take those interior
 branches at seeded interior points, wrap and clamp at the borders, and take
 pbrt-v4's footprint steps.
 """
@@ -17,7 +17,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Step, Theorem, Verdict, calc, written
+from .core import Step, Theorem, Verdict, calc, catalogue, written
 
 x = sp.Symbol("x", real=True)
 eps = sp.Symbol("varepsilon", positive=True)
@@ -46,7 +46,7 @@ SERIES_DOMAIN = {x: (-1.0, 1.0), eps: (0.01, 0.3), a: (0.5, 3.0), b: (-1.0, 1.0)
 
 def interior(expr):
     """``expr`` with every Piecewise replaced by its last (default) branch and
-    every Min(1, a) or Max(0, a) by a: the branch that `formulas.CENTRAL` and
+    every Min(1, a) or Max(0, a) by a: the branch that `HeightField.central` and
     `formulas.STENCIL_POINTS` take where u +- eps stays in [0, 1) and v +- eps
     in [0, 1] (no wrap, no clamp)."""
     expr = expr.replace(lambda e: isinstance(e, sp.Piecewise), lambda e: e.args[-1].expr)
@@ -73,9 +73,10 @@ def quotient(h, var, denominator):
     return written(sp.Add(at(1), -at(-1), evaluate=False) / (denominator * e))
 
 
-def kernel_quotient(name, k):
-    """Component ``k`` (0: h_u, 1: h_v) of `formulas.CENTRAL` for field ``name`` at an interior point."""
-    return interior(F.CENTRAL[name][k]).subs(interior_points())
+def kernel_quotient(field, k):
+    """Component ``k`` (0: h_u, 1: h_v) of the central difference of ``field`` (a `HeightField`) at an
+    interior point."""
+    return interior(field.central[k]).subs(interior_points())
 
 
 def interior_branch_mismatches(stencil=F.STENCIL_POINTS, samples=2000, seed=11):
@@ -121,20 +122,22 @@ def border_points(samples=2000, seed=12):
 
 
 def border_mismatches(samples=2000, seed=12, rule=_border_rule, stencil=F.STENCIL_POINTS):
-    """The `border_points` at which ``stencil`` (`formulas.STENCIL_POINTS`), or the v-denominator of
-    `formulas.CENTRAL` (read off its sine field, at ``stencil``), differ from ``rule``; evaluated in float64."""
+    """The `border_points` at which ``stencil`` (`formulas.STENCIL_POINTS`), or the v-quotient of a
+    registered field's central difference (`HeightField.central` at ``stencil``, k_u = 3, k_v = 2),
+    differ from ``rule``; evaluated in float64."""
     args = (F.u, F.v, F.eps_u, F.eps_v)
     points = sp.lambdify(args, [e for _, e in stencil], modules="math")
-    h = F.HEIGHT["sine"].subs({F.k_u: 3, F.k_v: 2})
-    central_v = sp.lambdify(args, F.CENTRAL["sine"][1].subs({F.k_u: 3, F.k_v: 2}).subs(dict(stencil)),
-                            modules="math")
-    h_of = sp.lambdify((F.u, F.v), h, modules="math")
+    ks = {F.k_u: 3, F.k_v: 2}
+    fields = [(sp.lambdify((F.u, F.v), f.expr.subs(ks), modules="math"),
+               sp.lambdify(args, f.central[1].subs(ks).subs(dict(stencil)), modules="math")) for f in F.FIELDS.values()]
     bad = 0
     for u_, v_, step in border_points(samples, seed):
         want = rule(u_, v_, step)
-        got = points(u_, v_, step, step)
-        quotient = (h_of(u_, want[2]) - h_of(u_, want[3])) / want[4]
-        bad += list(got) != list(want[:4]) or abs(central_v(u_, v_, step, step) - quotient) > 1e-9 * (1 + abs(quotient))
+        wrong = list(points(u_, v_, step, step)) != list(want[:4])
+        for h_of, central_v in fields:
+            quotient = (h_of(u_, want[2]) - h_of(u_, want[3])) / want[4]
+            wrong |= abs(central_v(u_, v_, step, step) - quotient) > 1e-9 * (1 + abs(quotient))
+        bad += wrong
     return bad
 
 
@@ -171,10 +174,10 @@ h_uv = sp.Function("h")
 
 
 def _kernel_cases():
-    return tuple((name, {h_uv: sp.Lambda((F.u, F.v), height),
-                         CENTRAL_U: sp.Lambda((F.u, F.v), kernel_quotient(name, 0)),
-                         CENTRAL_V: sp.Lambda((F.u, F.v), kernel_quotient(name, 1))})
-                 for name, height in F.HEIGHT.items())
+    return tuple((name, {h_uv: sp.Lambda((F.u, F.v), field.expr),
+                         CENTRAL_U: sp.Lambda((F.u, F.v), kernel_quotient(field, 0)),
+                         CENTRAL_V: sp.Lambda((F.u, F.v), kernel_quotient(field, 1))})
+                 for name, field in F.FIELDS.items())
 
 
 def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
@@ -185,7 +188,7 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
     quotients = sp.Tuple(*(quotient(h_uv(F.u, F.v), var, denominator) for var in (F.u, F.v)))
     series = written(sp.Add(*claimed, sp.O(eps**order), evaluate=False))
     return Theorem(
-        id="central-difference-truncation", title="Truncation error of the central difference",
+        id="central-difference-truncation", title=TITLES["central-difference-truncation"],
         statement=(r"For a smooth $h$, $$⟦series⟧$$ Away from the seam and the poles this quotient is the renderer's "
                    r"central-difference stencil $D_u$, $D_v$, in $u$ and in $v$, for every height field: $$⟦stencil⟧$$ At "
                    r"the borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
@@ -234,9 +237,6 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
         pages=("s3",),
     )
 
-
-CENTRAL_DIFFERENCE_TRUNCATION = _truncation()
-
 # ----------------------------------------------------------------------------- the optimal step
 H3, H, HX, u_round = sp.symbols("H_3 H H_x u", positive=True)
 E = sp.Function("E")
@@ -260,7 +260,7 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
     slope, curvature = sp.Derivative(E(eps), eps), sp.Derivative(E(eps), (eps, 2))
     stationary, minimum = sp.Subs(slope, eps, eps_star), sp.Subs(curvature, eps, eps_star)
     return Theorem(
-        id="optimal-step", title="The optimal central-difference step",
+        id="optimal-step", title=TITLES["optimal-step"],
         statement=r"The error model $⟦E⟧$ ($u_{\mathrm{round}}$ the unit roundoff, $x$ the point) has one stationary point on "
                   r"$\varepsilon > 0$, $⟦eps_star⟧$, and it is the minimum: $⟦stationary⟧$, $⟦minimum⟧ > 0$.",
         steps=(
@@ -300,6 +300,10 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
     )
 
 
-OPTIMAL_STEP = _optimal()
+#: This module's theorems: id -> title.
+TITLES = {"central-difference-truncation": "Truncation error of the central difference",
+          "optimal-step": "The optimal central-difference step"}
 
-THEOREMS = (CENTRAL_DIFFERENCE_TRUNCATION, OPTIMAL_STEP)
+#: The stencil's step has a case per registered field: built again when they change.
+titles, build = catalogue(TITLES, {"central-difference-truncation": _truncation, "optimal-step": _optimal},
+                          key=lambda: tuple(F.FIELDS.values()))

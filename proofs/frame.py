@@ -14,7 +14,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Dot, Step, Theorem, Verdict, calc
+from .core import Cross, Dot, Step, Theorem, Verdict, calc, catalogue
 
 theta, phi = sp.symbols("theta phi", real=True)
 #: The unit normal in spherical coordinates (the independent side).
@@ -76,7 +76,7 @@ def _chart_evidence(corrupt=None):
     """The renderer's own chart (GBuffer.uv) at its own N against CHART (proofs/pixels.py); ``corrupt``
     alters the renderer's (u, v) first (a wrong variant)."""
     from .pixels import TOLERANCE, chart_error, worst_of
-    worst, count = worst_of(chart_error, [(f, corrupt) for f in ("sine", "ridges", "rings")])
+    worst, count = worst_of(chart_error, [(f, corrupt) for f in F.FIELDS])
     if worst > TOLERANCE["chart"]:
         return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
                        f"{count} sphere-A pixels")
@@ -89,7 +89,7 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
     u_kernel, sin_kernel = F.CHART[0], F.CHART[2]
     rates = sp.Tuple(sp.Derivative(U_OF_THETA, theta), sp.Derivative(V_OF_PHI, phi))
     return Theorem(
-        id="chart", title="The chart is the spherical angles",
+        id="chart", title=TITLES["chart"],
         statement=(r"For $-\pi < \theta < \pi$ and $0 < \varphi < \pi$ the renderer's chart "
                    r"at $N = (N_x, N_y, N_z) = N(\theta, \varphi)$ is "
                    r"$u$: $⟦u⟧$, $v$: $⟦v⟧$ and $⟦sin⟧$; so $⟦rates⟧$, the factors between chart and angular "
@@ -122,8 +122,6 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
     )
 
 
-CHART_INVERSE = _chart()
-
 # ------------------------------------------------------------------------------- the frame
 #: The cut-off below which the frame is the fallback (seed Cell 1, ``tangent_frame``: sin phi > 1e-4).
 SEED_POLE_SIN_PHI = 1e-4
@@ -154,13 +152,13 @@ def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
     if bad is not None:
         return bad
     from .pixels import TOLERANCE, normal_error, worst_of
-    worst, count = worst_of(normal_error, [(f, b, corrupt) for f in ("sine", "ridges", "rings")
+    worst, count = worst_of(normal_error, [(f, b, corrupt) for f in F.FIELDS
                                            for b in ("chart", "surface")])
     if worst > TOLERANCE["normal"]:
         return Verdict("refuted", f"the renderer's N' differs from PERTURBED_NORMAL in this frame by {worst:.1e} "
                        f"at some of {count} sphere-A pixels")
     return Verdict("proved", f"the tangent frame is its regular branch where sin phi > {float(F.POLE_SIN_PHI):g} and its "
-                   f"fallback elsewhere, in each component; the renderer's N' (both bump modes, 3 fields) at {count} seeded sphere-A "
+                   f"fallback elsewhere, in each component; the renderer's N' (both bump modes, {len(F.FIELDS)} fields) at {count} seeded sphere-A "
                    f"pixels (pole ring and fallback included) within {worst:.1e} of the perturbed normal evaluated "
                    "by mpmath in this frame", rendered=count)
 
@@ -170,7 +168,7 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
     d_theta, d_phi = sp.Mul(1 / sp.sin(phi), sp.Derivative(N_S, theta)), sp.Derivative(N_S, phi)
     tangent, unit = sp.Tuple(Dot(ET_S, N_S), Dot(EP_S, N_S)), sp.Tuple(Dot(ET_S, ET_S), Dot(EP_S, EP_S), Dot(ET_S, EP_S))
     return Theorem(
-        id="frame-orthonormal", title="The tangent frame is orthonormal and tangent",
+        id="frame-orthonormal", title=TITLES["frame-orthonormal"],
         statement=(r"For $0 < \varphi < \pi$ the renderer's tangent frame (its "
                    r"branch away from the poles) $e_\theta = ⟦kernel_e_theta⟧$ and "
                    r"$e_\varphi = ⟦kernel_e_phi⟧$, at $N(\theta, \varphi)$, satisfies "
@@ -209,8 +207,6 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
     )
 
 
-FRAME_ORTHONORMAL = _orthonormal()
-
 
 def _orientation_value():
     return sp.simplify(e_theta.cross(e_phi).dot(N))
@@ -228,7 +224,7 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
     triple = Dot(Cross(ET_S, EP_S), N_S)
     poles = Cross(sp.Matrix(fallback[:3]), sp.Matrix(fallback[3:]))
     return Theorem(
-        id="frame-orientation", title="Orientation of the tangent frame",
+        id="frame-orientation", title=TITLES["frame-orientation"],
         statement=r"$⟦orientation⟧$: the pair $(e_\theta, e_\varphi)$ is left-handed about the outward normal, "
                   r"$e_\theta\times e_\varphi = -N$. The pole fallback "
                   r"($\sin\varphi \le ⟦pole⟧$) has $⟦fallback⟧$: right-handed at the "
@@ -255,6 +251,10 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
     )
 
 
-FRAME_ORIENTATION = _orientation()
+#: This module's theorems: id -> title.
+TITLES = {"chart": "The chart is the spherical angles",
+          "frame-orthonormal": "The tangent frame is orthonormal and tangent",
+          "frame-orientation": "Orientation of the tangent frame"}
 
-THEOREMS = (CHART_INVERSE, FRAME_ORTHONORMAL, FRAME_ORIENTATION)
+titles, build = catalogue(TITLES, {"chart": _chart, "frame-orthonormal": _orthonormal,
+                                   "frame-orientation": _orientation})

@@ -17,10 +17,10 @@ from functools import lru_cache, partial
 import numpy as np
 import sympy as sp
 
-from renderer import Scene, gbuffer, render
 from renderer import formulas as F
+from renderer.scene import Scene
 
-from .core import Dot, Step, Theorem, Verdict, written
+from .core import Dot, Step, Theorem, Verdict, catalogue, written
 from .frame import U_OF_THETA
 
 theta, phi = sp.symbols("theta phi", real=True)
@@ -32,16 +32,21 @@ y_img = P[1] * e / (e - P[2])
 RHO = e * R * sp.sin(phi) / (e - R * sp.cos(phi))
 DRHO = e * R * (e * sp.cos(phi) - R) / (e - R * sp.cos(phi)) ** 2
 DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 1.2), R: (0.5, 1.0), e: (2.0, 6.0)}
-#: The crease u = m / k_u solved for theta (the chart of theorem `chart`), which is alpha.
 m_sym = sp.Symbol("m", integer=True)
-ALPHA_M = sp.solve(sp.Eq(U_OF_THETA, m_sym / F.k_u), theta)[0]      # frame's theta is this module's
-_ALPHA_M = sp.lambdify((m_sym, F.k_u), ALPHA_M, modules="numpy")
+
+
+@lru_cache(maxsize=None)
+def ray_angle():
+    """The crease u = m / k_u solved for theta (the chart of theorem `chart`), which is alpha, and
+    it as a numpy function of (m, k_u)."""
+    alpha = sp.solve(sp.Eq(U_OF_THETA, m_sym / F.k_u), theta)[0]      # frame's theta is this module's
+    return alpha, sp.lambdify((m_sym, F.k_u), alpha, modules="numpy")
 
 
 def ray_angles(k_u):
     """Image-plane angles alpha_m (radians, float64 array of ceil(k_u)) of the rays
-    u = m / k_u, m = 0 .. ceil(k_u) - 1, from `ALPHA_M`."""
-    return np.asarray(_ALPHA_M(np.arange(int(np.ceil(k_u))), k_u), dtype=float)
+    u = m / k_u, m = 0 .. ceil(k_u) - 1, from `ray_angle`."""
+    return np.asarray(ray_angle()[1](np.arange(int(np.ceil(k_u))), k_u), dtype=float)
 
 
 def circle_angles(k_v):
@@ -73,7 +78,7 @@ def circle_radii(radius_a, camera_z, k_v):
 
 
 def _half_width(k):
-    """The crease band's half-width about a zero of sin(pi k t) (`formulas.RIDGE_FACTORS`):
+    """The crease band's half-width about a zero of sin(pi k t) (the ridges field's crease factors):
     |sin(pi k (t - m/k))| < KINK_BAND_HALF_WIDTH, i.e. |t - m/k| < asin(w) / (pi k)."""
     return float(np.arcsin(float(F.KINK_BAND_HALF_WIDTH)) / (np.pi * k))
 
@@ -101,6 +106,7 @@ def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO, band_
     """
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    from renderer import gbuffer
     g = gbuffer(scene, width, height)
     X, Y = np.meshgrid(g.x, g.y)
     on_a = g.chamber == 1
@@ -122,17 +128,19 @@ def part_mismatch(kind, scene, size, shift, rho, drho, band_scale):
     there (int array)."""
     mine, on_a = locus_bands(kind, scene, size, size, shift, rho, drho, band_scale)
     other = locus_bands("circles" if kind == "rays" else "rays", scene, size, size)[0].any(axis=0)
+    from renderer import render
     rendered = render(scene, size, size).kink
     where = on_a & ~other
     return (int(np.count_nonzero((rendered != mine.any(axis=0)) & where)),
             np.count_nonzero(mine & (rendered & where)[None], axis=(1, 2)), int(np.count_nonzero(where)))
 
 
-def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=Scene(), all_visible=False, band_scale=1.0):
+def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=None, all_visible=False, band_scale=1.0):
     """Proved if the rendered crease flag is the bands about ``kind``'s loci (`part_mismatch`) and
     exactly the loci claimed visible have crease pixels; else refuted.  ``shift``, ``rho``,
     ``drho``, ``band_scale`` (`locus_bands`) and ``all_visible`` (claim every circle visible):
-    wrong variants."""
+    wrong variants.  ``scene``: the book's, `Scene()`, by default."""
+    scene = Scene() if scene is None else scene
     mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho, band_scale)
     if kind == "rays":
         seen = np.ones(len(per_locus), dtype=bool)             # every ray crosses the visible cap
@@ -181,7 +189,7 @@ def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
     polar = sp.Tuple(rho(phi) * sp.cos(theta), rho(phi) * sp.sin(theta))
     ray = U_OF_THETA.subs(theta, alpha_m)
     return Theorem(
-        id="kink-loci-rays", title="The u-creases are rays",
+        id="kink-loci-rays", title=TITLES["kink-loci-rays"],
         statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the $z$-axis, "
                   r"$⟦polar⟧$ with $⟦rho⟧$: $\alpha = \theta$, so $u = (\alpha + \pi)/2\pi$ depends on the angle "
                   r"alone, and the crease $u = m/k_u$ is the ray $⟦alpha_m⟧$: $⟦ray⟧$.",
@@ -213,7 +221,7 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
     radius, slope, facing = X**2 + Y**2, sp.Derivative(rho(phi), phi), Dot(N_S, E_S - P_S)
     cap = written(sp.Add(e * sp.cos(phi), radius_term, evaluate=False))
     return Theorem(
-        id="kink-loci-circles", title="The v-creases are circles",
+        id="kink-loci-circles", title=TITLES["kink-loci-circles"],
         statement=r"$v = \varphi/\pi$ depends on the image radius alone: $⟦radius⟧$, and "
                   r"$⟦slope⟧ > 0$ on the visible cap, where $⟦facing⟧ > 0$. The crease $v = m/k_v$ is the circle of "
                   r"radius $\rho(\pi m/k_v)$, visible when $\cos(\pi m/k_v) > R/e$.",
@@ -245,7 +253,7 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
     )
 
 
-KINK_LOCI_RAYS = _rays()
-KINK_LOCI_CIRCLES = _circles()
+#: This module's theorems: id -> title.
+TITLES = {"kink-loci-rays": "The u-creases are rays", "kink-loci-circles": "The v-creases are circles"}
 
-THEOREMS = (KINK_LOCI_RAYS, KINK_LOCI_CIRCLES)
+titles, build = catalogue(TITLES, {"kink-loci-rays": _rays, "kink-loci-circles": _circles})

@@ -1,9 +1,14 @@
-"""Where the ridges field is not differentiable, and by how much (seed §3).
+"""Where a field with creases is not differentiable, and by how much (seed §3).
 
-The theorem is about the renderer's ridges field and crease flag,
-`renderer.formulas.HEIGHT["ridges"]`, `RIDGE_FACTORS` and `KINK_BAND`; the
-jumps it states are written here by hand, from seed §3.
+One theorem (``<name>-kinks``) per registered field with creases whose two crease factors
+(`renderer.formulas.HeightField.crease_factors`) vary one with u, the other with v: the
+ridges field of seed §3.  It is about the field's record: its expression, its crease factors
+and its crease flag (`HeightField.kink_band`); the jumps it states are written here by hand,
+from seed §3, for the factors s_1 = sin(pi k_u u), s_2 = sin(pi k_v v) (a field with other
+factors gets the theorem, and its check refutes it).
 """
+
+from functools import lru_cache
 
 import sympy as sp
 
@@ -17,10 +22,7 @@ u, v = F.u, F.v
 k_u, k_v = sp.symbols("k_u k_v", positive=True)
 POSITIVE = {F.k_u: k_u, F.k_v: k_v}
 delta = sp.Symbol("delta", positive=True)
-#: The renderer's ridges field and its two factors.
-h = F.HEIGHT["ridges"].subs(POSITIVE)
-FACTORS = tuple(s.subs(POSITIVE) for s in F.RIDGE_FACTORS)
-BAND = F.KINK_BAND["ridges"].subs(POSITIVE)
+SUFFIX = "-kinks"
 #: Every zero line at once: u = m / k_u and v = m / k_v for a symbolic integer m.
 m = sp.Symbol("m", integer=True)
 #: The other factor's value on the line, nonzero (where it is 0, h vanishes
@@ -37,7 +39,7 @@ MARGIN = sp.Rational(1, 10**6)
 
 #: The one-sided derivatives the proof names: h_u^+, h_u^- on u = m/k_u, h_v^+, h_v^- on v = m/k_v.
 HU_P, HU_M, HV_P, HV_M = sp.symbols("h_u^+ h_u^- h_v^+ h_v^-")
-#: The renderer's crease flag as a function of (u, v): 1 where KINK_BAND holds, else 0.
+#: The renderer's crease flag as a function of (u, v): 1 where the field's band holds, else 0.
 crease = sp.Function("crease")
 #: Points just inside and just outside the crease band about u = 0 and v = 0.
 U_IN, U_OUT, V_IN, V_OUT = sp.symbols("u_in u_out v_in v_out")
@@ -61,10 +63,25 @@ def one_sided(expr, var, at):
                           delta, 0, "+") for sign in (1, -1))
 
 
-def _ridges(jump_u, jump_v, band=BAND):
-    """Theorem ridges-kinks claiming the jumps ``jump_u``, ``jump_v`` (in c), for the crease band ``band``."""
-    on_u = one_sided(h.subs(FACTORS[1], c), u, m / k_u)
-    on_v = one_sided(h.subs(FACTORS[0], c), v, m / k_v)
+def creased():
+    """The names of the registered fields the theorem is about: those with two crease factors
+    (`HeightField.crease_factors`), one varying with u alone, the other with v alone."""
+    return tuple(name for name, f in F.FIELDS.items()
+                 if [x.free_symbols & {u, v} for x in f.crease_factors] == [{u}, {v}])
+
+
+def band_of(field):
+    """The field's crease flag (`HeightField.kink_band`) for positive frequencies."""
+    return field.kink_band.subs(POSITIVE)
+
+
+def _creases(field, jump_u, jump_v, band=None):
+    """Theorem <name>-kinks of ``field`` claiming the jumps ``jump_u``, ``jump_v`` (in c), for the crease band
+    ``band`` (default: the field's, `band_of`)."""
+    name, band = field.name, band_of(field) if band is None else band
+    h, factors = field.expr.subs(POSITIVE), tuple(f.subs(POSITIVE) for f in field.crease_factors)
+    on_u = one_sided(h.subs(factors[1], c), u, m / k_u)
+    on_v = one_sided(h.subs(factors[0], c), v, m / k_v)
     jumps, values = sp.Tuple(HU_P - HU_M, HV_P - HV_M), sp.Tuple(jump_u, jump_v)
     on_lines = sp.Tuple(crease(m / k_u, v), crease(u, m / k_v))
     # Just inside and just outside the seed's half-width: |s| = w (1 -+ eta), where the other factor is 1.
@@ -72,10 +89,10 @@ def _ridges(jump_u, jump_v, band=BAND):
     edges = {"u": sp.Tuple(crease(U_IN, 1 / (2 * k_v)), crease(U_OUT, 1 / (2 * k_v))),
              "v": sp.Tuple(crease(1 / (2 * k_u), V_IN), crease(1 / (2 * k_u), V_OUT))}
     return Theorem(
-        id="ridges-kinks", title="The creases of the ridges field",
-        statement=r"The renderer's ridges field "
+        id=name + SUFFIX, title=_title(name),
+        statement=f"The renderer's {name} field "
                   r"$h = \lvert s_1 s_2\rvert$, the product of its two factors $s_1 = \sin\pi k_u u$ and "
-                  r"$s_2 = \sin\pi k_v v$, is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-ridges⟫. "
+                  r"$s_2 = \sin\pi k_v v$, is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-" + name + "⟫. "
                   r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, its graph "
                   r"has a crease: the one-sided derivatives $h_u^+$ and $h_u^-$ (the slopes just right and just "
                   r"left of the line) differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$."
@@ -114,13 +131,14 @@ def _ridges(jump_u, jump_v, band=BAND):
                U_IN: "u_-", U_OUT: "u_+", V_IN: "v_-", V_OUT: "v_+", ETA: r"\eta"},
         domain=DOMAIN,
         wrong_variants=(
-            ("jump without the factor 2", lambda: _ridges(sp.pi * k_u * sp.Abs(c), JUMP_V).check()),
-            ("jump with the roles of k_u and k_v swapped", lambda: _ridges(2 * sp.pi * k_v * sp.Abs(c), JUMP_V).check()),
+            ("jump without the factor 2", lambda: _creases(field, sp.pi * k_u * sp.Abs(c), JUMP_V).check()),
+            ("jump with the roles of k_u and k_v swapped",
+             lambda: _creases(field, 2 * sp.pi * k_v * sp.Abs(c), JUMP_V).check()),
             ("the crease band ten times wider",
-             lambda: _ridges(JUMP_U, JUMP_V, BAND.xreplace({F.KINK_BAND_HALF_WIDTH: 10 * F.KINK_BAND_HALF_WIDTH})
+             lambda: _creases(field, JUMP_U, JUMP_V, band.xreplace({F.KINK_BAND_HALF_WIDTH: 10 * F.KINK_BAND_HALF_WIDTH})
                              ).check()),
             ("the crease band half as wide",
-             lambda: _ridges(JUMP_U, JUMP_V, BAND.xreplace({F.KINK_BAND_HALF_WIDTH: F.KINK_BAND_HALF_WIDTH / 2})
+             lambda: _creases(field, JUMP_U, JUMP_V, band.xreplace({F.KINK_BAND_HALF_WIDTH: F.KINK_BAND_HALF_WIDTH / 2})
                              ).check())),
         pages=("s3", "s7"),
     )
@@ -130,6 +148,21 @@ def _ridges(jump_u, jump_v, band=BAND):
 JUMP_U = 2 * sp.pi * k_u * sp.Abs(c)
 JUMP_V = 2 * sp.pi * k_v * sp.Abs(c)
 
-RIDGES_KINKS = _ridges(JUMP_U, JUMP_V)
 
-THEOREMS = (RIDGES_KINKS,)
+def _title(name):
+    return f"The creases of the {name} field"
+
+
+def titles():
+    """{id: title} of this module's theorems, one per field of `creased`."""
+    return {name + SUFFIX: _title(name) for name in creased()}
+
+
+def build(theorem_id):
+    """Theorem <name>-kinks of the registered field <name>, built once per field record."""
+    return _built(F.FIELDS[theorem_id.removesuffix(SUFFIX)])
+
+
+@lru_cache(maxsize=None)
+def _built(field):
+    return _creases(field, JUMP_U, JUMP_V)

@@ -4,12 +4,13 @@ A theorem about `renderer.formulas` says what the kernel should compute; this
 module asks what it did.  For seeded random sphere-A pixels of G-buffers of
 the default scene (`renderer.gbuffer`: a full frame, two frames zoomed onto the
 pole, one of them inside the frame's fallback radius, and the pixels next to a
-crease of the ridges field: `SOURCES`), the renderer's chart (u, v), gradient (exact and
-central) and shading normal N' (both bump modes) are compared with the same
-sympy objects evaluated by mpmath at 30 digits, from the renderer's own inputs
-at that pixel (N for the chart; u, v for the gradient; N, its frame and the
-gradient for N').  A wrong formula in the kernel's glue code (arguments
-swapped, a component dropped, a wrong step) refutes the theorem that uses it.
+crease of a field with creases: `SOURCES`), the renderer's chart (u, v), gradient
+(exact and central) and shading normal N' (both bump modes) of any registered
+field (`renderer.formulas.FIELDS`) are compared with the same sympy objects
+evaluated by mpmath at 30 digits, from the renderer's own inputs at that pixel
+(N for the chart; u, v for the gradient; N, its frame and the gradient for N').
+A wrong formula in the kernel's glue code (arguments swapped, a component
+dropped, a wrong step) refutes the theorem that uses it.
 
 Tolerances (absolute): `TOLERANCE`, a few float64 roundings of each output at
 its scale; the central difference also carries the rounding of h divided by
@@ -32,10 +33,12 @@ __all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "footprint
            "PER_FIELD"]
 
 #: Pixels drawn per field, a third from each source (full frame, pole ring at zoom 300 and 3e4; crease
-#: neighbours as well for ridges): >= 200 outside the pole floor, the 3e4 frame being inside it.
+#: neighbours as well for a field with creases): >= 200 outside the pole floor, the 3e4 frame being inside it.
 PER_FIELD = 300
-#: Crease neighbours (ridges): the full frame's sphere-A pixels whose chart point lies within CREASE_BAND / k_u
-#: of a zero line u = m / k_u, or CREASE_BAND / k_v of v = m / k_v: a twentieth of a ridge's width about it.
+#: Crease neighbours (a field with creases): the full frame's sphere-A pixels where a crease factor f
+#: (`HeightField.crease_factors`) has |f| < sin(pi CREASE_BAND): for the ridges field's factors
+#: sin(pi k_u u), sin(pi k_v v), those within CREASE_BAND / k_u of a zero line u = m / k_u, or
+#: CREASE_BAND / k_v of v = m / k_v, a twentieth of a ridge's width about it.
 CREASE_BAND = 0.05
 #: Where each source's pixels lie, by sin(phi) = |(N_x, N_y)| on sphere A: (source, zoom, lowest, highest).
 #: The pole frames are centred on the pole: at zoom 300 every pixel within 5e-3 of it, some inside the
@@ -49,18 +52,22 @@ TOLERANCE = {"chart": 16 * UNIT, "gradient": 64 * UNIT, "normal": 64 * UNIT}
 
 @lru_cache(maxsize=None)
 def _frames(field, gradient, bump):
-    """G-buffers of the default scene (``field``, ``gradient``, ``bump``), one per `SOURCES`: 128², and
-    the pole at zoom 300 and 3e4 (48²)."""
-    scene = Scene(height_field=field, bump=bump, beta=0.35 if bump == "chart" else 0.3)
+    """G-buffers of the default scene (``field``, a `HeightField`; ``gradient``, ``bump``), one per
+    `SOURCES`: 128², and the pole at zoom 300 and 3e4 (48²)."""
+    scene = Scene(height_field=field.name, bump=bump, beta=0.35 if bump == "chart" else 0.3)
     return scene, [gbuffer(scene, 48 if zoom > 1 else 128, 48 if zoom > 1 else 128, gradient=gradient, zoom=zoom)
                    for _, zoom, _, _ in SOURCES]
 
 
-def crease_neighbours(uv, k_u, k_v):
-    """Whether each chart point (``uv``, float64 (..., 2)) is within `CREASE_BAND` / k of a zero line
-    of the ridges field, u = m / k_u or v = m / k_v (bool, ``uv``'s shape less its last axis)."""
-    u, v = uv[..., 0] * k_u, uv[..., 1] * k_v
-    return (np.abs(u - np.rint(u)) < CREASE_BAND) | (np.abs(v - np.rint(v)) < CREASE_BAND)
+def crease_neighbours(field, uv, k_u, k_v):
+    """Whether each chart point (``uv``, float64 (..., 2)) is next to a crease of ``field`` (a
+    `HeightField`): where one of its crease factors f has |f| < sin(pi `CREASE_BAND`) (bool,
+    ``uv``'s shape less its last axis; all False for a field without creases)."""
+    near = np.zeros(uv.shape[:-1], dtype=bool)
+    for f in field.crease_factors:
+        value = sp.lambdify((F.u, F.v), f.xreplace({F.k_u: k_u, F.k_v: k_v}), modules="numpy")(uv[..., 0], uv[..., 1])
+        near |= np.abs(value) < np.sin(np.pi * CREASE_BAND)
+    return near
 
 
 def pixels(field, gradient="exact", bump="chart", seed=0):
@@ -68,9 +75,10 @@ def pixels(field, gradient="exact", bump="chart", seed=0):
     N, Ns, P (k, 3), uv, grad (k, 2), xy (k, 4: the pixel centre x, y and
     the spacings dx, dy), and source (k,: the `SOURCES` name of the G-buffer the
     pixel is from, or "crease" for the crease neighbours), from the full frame,
-    the two pole frames and (ridges) the crease neighbours of the full frame
-    (`crease_neighbours`); and the `Scene`."""
-    scene, frames = _frames(field, gradient, bump)
+    the two pole frames and (a field with creases) the crease neighbours of the full frame
+    (`crease_neighbours`); and the `Scene`.  ``field``: a name of `formulas.FIELDS`."""
+    record = F.FIELDS[field]
+    scene, frames = _frames(record, gradient, bump)
     rng = np.random.default_rng(seed)
     picked = {name: [] for name in ("N", "Ns", "uv", "grad", "P", "xy", "source")}
     for (source, *_), g in zip(SOURCES, frames):
@@ -80,8 +88,8 @@ def pixels(field, gradient="exact", bump="chart", seed=0):
                  xy=np.stack([X, Y, np.full(X.shape, spacing[0]), np.full(X.shape, spacing[1])], axis=-1))
         on_a = g["chamber"] == SPHERE_A
         where = [(source, np.flatnonzero(on_a))]
-        if source == "frame" and field == "ridges":
-            where.append(("crease", np.flatnonzero(on_a & crease_neighbours(g["uv"], scene.k_u, scene.k_v))))
+        if source == "frame" and record.crease_factors:
+            where.append(("crease", np.flatnonzero(on_a & crease_neighbours(record, g["uv"], scene.k_u, scene.k_v))))
         for name, idx in where:
             take = rng.choice(idx, size=min(PER_FIELD // 3, idx.size), replace=False)
             for key in picked:
@@ -125,18 +133,19 @@ def chart_error(field, corrupt=None):
 
 def gradient_error(field, gradient, corrupt=None):
     """Worst |grad - reference| / bound over the sampled pixels: the exact gradient
-    against `formulas.GRADIENT`, central against `formulas.CENTRAL` (stencil
+    against the field's `HeightField.gradient`, central against its `HeightField.central` (stencil
     included) at the scene's eps, both at the renderer's own (u, v); and the count.
     A value <= 1 is within tolerance."""
+    record = F.FIELDS[field]
     scene, px = pixels(field, gradient)
     grad = px["grad"] if corrupt is None else corrupt(px["grad"])
     consts = {F.k_u: scene.k_u, F.k_v: scene.k_v}
     if gradient == "exact":
-        exprs = [e.xreplace(consts) for e in F.GRADIENT[field]]
+        exprs = [e.xreplace(consts) for e in record.gradient]
         ref = _eval(exprs, (F.u, F.v), px["uv"])
         bound = TOLERANCE["gradient"] * np.pi * max(scene.k_u, 2 * scene.k_v)
     elif gradient == "footprint":
-        # The steps from formulas.FOOTPRINT at the pixel (its frame from TANGENT_FRAME), then CENTRAL.
+        # The steps from formulas.FOOTPRINT at the pixel (its frame from TANGENT_FRAME), then the central difference.
         # sin(phi) and the frame enter as arguments, evaluated from CHART and TANGENT_FRAME first:
         # substituted into FOOTPRINT, they would make sympy re-decide each Max it meets (seconds).
         n_sin = np.hstack([px["N"], _eval([F.CHART[2]], (F.N_x, F.N_y, F.N_z), px["N"])])
@@ -144,14 +153,14 @@ def gradient_error(field, gradient, corrupt=None):
         footprint = [e.xreplace({F.R: scene.radius_a, F.camera_z: scene.camera_z}) for e in F.FOOTPRINT]
         steps = _eval(footprint, (F.N_x, F.N_y, F.N_z, F.sin_phi) + F.e_theta + F.e_phi + tuple(F.P)
                       + (F.x, F.y, F.dx, F.dy), np.hstack([n_sin_frame, px["P"], px["xy"]]))
-        exprs = [e.xreplace(dict(F.STENCIL_POINTS)).xreplace(consts) for e in F.CENTRAL[field]]
+        exprs = [e.xreplace(dict(F.STENCIL_POINTS)).xreplace(consts) for e in record.central]
         ref = _eval(exprs, (F.u, F.v, F.eps_u, F.eps_v), np.hstack([px["uv"], steps]))
         scale = np.pi * max(scene.k_u, 2 * scene.k_v)
         bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / float(steps.min())
     else:
         stencil = dict(F.STENCIL_POINTS)
         exprs = [e.xreplace(stencil).xreplace({F.eps_u: scene.eps, F.eps_v: scene.eps, **consts})
-                 for e in F.CENTRAL[field]]
+                 for e in record.central]
         ref = _eval(exprs, (F.u, F.v), px["uv"])
         scale = np.pi * max(scene.k_u, 2 * scene.k_v)
         bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / scene.eps
@@ -169,7 +178,7 @@ def normal_error(field, bump, corrupt=None):
     frame = [c.xreplace({F.sin_phi: sin_phi}) for c in F.TANGENT_FRAME]
     normal = sp.Matrix(F.PERTURBED_NORMAL[bump]).xreplace(
         {**dict(zip(F.e_theta + F.e_phi, frame)), F.sin_phi: sin_phi, F.R: scene.radius_a, F.beta: scene.beta,
-         F.h: F.HEIGHT[field].xreplace({F.k_u: scene.k_u, F.k_v: scene.k_v})})
+         F.h: F.FIELDS[field].expr.xreplace({F.k_u: scene.k_u, F.k_v: scene.k_v})})
     args = (F.N_x, F.N_y, F.N_z, F.h_u, F.h_v, F.u, F.v)
     grad = px["grad"] if corrupt is None else corrupt(px["grad"])
     ref = _eval(list(normal), args, np.hstack([px["N"], grad, px["uv"]]))

@@ -1,43 +1,112 @@
-"""All theorems of the chapter, by id, and the verdict each must reach."""
+"""All theorems of the chapter, by id, and the verdict each must reach.
 
-from . import blinn, core, displacement, finite_difference, frame, gradients, kink_loci, kinks, no_boundary, normal
+Importing this module builds nothing (nor does it import sympy): `THEOREMS` lists the ids of
+each theorem module's ``titles()``, in the chapter's order, and a theorem is built by its
+module's ``build(id)`` when it is first asked for (`get`, ``THEOREMS[id]``), then kept by that
+module.  A module's theorems per height field follow `renderer.formulas.FIELDS` as it stands
+when they are asked for: a field registered later has its theorems too.
+"""
 
-#: id -> Theorem, in the order the chapter uses them.
-THEOREMS = {t.id: t for mod in (frame, gradients, kinks, kink_loci, no_boundary, normal,
-                                        finite_difference, displacement, blinn)
-            for t in mod.THEOREMS}
+import importlib
+from collections.abc import Mapping
 
-#: id -> title of every theorem a statement or a step may cite (``⟪id⟫``, rule 8 of proofs.core):
-#: proofs.core.CITABLE, filled here (the engine imports no theorem).
-CITABLE = core.CITABLE
-CITABLE.update({theorem_id: t.title for theorem_id, t in THEOREMS.items()})
+#: The theorem modules of proofs/, in the chapter's order.  Each has ``titles()`` ({id: title}, in
+#: order, without building a theorem) and ``build(id)`` (the Theorem, built once).
+MODULES = ("frame", "gradients", "kinks", "kink_loci", "no_boundary", "normal", "finite_difference",
+           "displacement", "blinn")
+
+
+def _catalogue():
+    """{id: (module, title)} of every theorem, in the chapter's order."""
+    out = {}
+    for name in MODULES:
+        module = importlib.import_module(f"{__package__}.{name}")
+        out.update((theorem_id, (module, title)) for theorem_id, title in module.titles().items())
+    return out
+
+
+class _Theorems(Mapping):
+    """A read-only mapping over the theorem ids of `_catalogue`, in its order: ``value(module, id,
+    title)`` of each (iterating, ``in`` and ``len`` build nothing)."""
+
+    def __init__(self, value):
+        self._value = value
+
+    def __getitem__(self, theorem_id):
+        module, title = _catalogue()[theorem_id]
+        return self._value(module, theorem_id, title)
+
+    def __contains__(self, theorem_id):
+        return theorem_id in _catalogue()
+
+    def __iter__(self):
+        return iter(_catalogue())
+
+    def __len__(self):
+        return len(_catalogue())
+
+
+#: id -> Theorem, in the order the chapter uses them, each built when first asked for.
+THEOREMS = _Theorems(lambda module, theorem_id, title: module.build(theorem_id))
+
+#: id -> title of every theorem a statement or a step may cite (``⟪id⟫``, rule 8 of proofs.core,
+#: whose CITABLE reads this one: the engine imports no theorem).
+CITABLE = _Theorems(lambda module, theorem_id, title: title)
 
 #: The verdict each theorem must reach: "proved" (sympy decided every step
 #: of its proof, and its evidence holds) or ("verified", bound): sympy left a
 #: step undecided and mpmath found no residual above ``bound`` at the check's
 #: seeded points and digits, or the theorem rests on its renderer evidence
-#: (no-boundary: ``bound`` is then the number of differing outputs).
+#: (no-boundary: ``bound`` is then the number of differing outputs).  A key with
+#: ``{field}`` pins the theorem of each registered height field (gradient-sine, ...).
 #: `pinned_failure` compares a verdict with it; `pytest verify` and the book
 #: build fail on any difference, so a verdict cannot change unnoticed.
 PINNED = {
     "chart": ("verified", 1e-25), "frame-orthonormal": "proved", "frame-orientation": "proved",
-    "gradient-sine": "proved", "gradient-ridges": "proved", "gradient-rings": "proved",
-    "ridges-kinks": "proved", "kink-loci-rays": "proved", "kink-loci-circles": "proved",
-    "no-boundary": ("verified", 0.0), "normal-beta-derivative": "proved", "beta-zero-regression": "proved",
-    "central-difference-truncation": "proved", "optimal-step": "proved", "bump-vs-displacement": "proved",
-    "blinn-perturbation": "proved",
+    "gradient-{field}": "proved", "{field}-kinks": "proved", "kink-loci-rays": "proved",
+    "kink-loci-circles": "proved", "no-boundary": ("verified", 0.0), "normal-beta-derivative": "proved",
+    "beta-zero-regression": "proved", "central-difference-truncation": "proved", "optimal-step": "proved",
+    "bump-vs-displacement": "proved", "blinn-perturbation": "proved",
 }
 
 
 #: Theorems whose check must evaluate the renderer's own outputs, and how many at least:
-#: sphere-A pixels (200 per field, per bump mode where both are compared), or whole
-#: G-buffers and renders.  A check that skips its renderer comparison reports fewer
-#: (`Verdict.rendered`), and `pinned_failure` names it.
+#: sphere-A pixels (200 per field, per bump mode where both are compared, for the theorems
+#: about every field: times the number of registered fields), or whole G-buffers and renders.
+#: A check that skips its renderer comparison reports fewer (`Verdict.rendered`), and
+#: `pinned_failure` names it.  Keys as in `PINNED`.
 RENDERED = {
-    "chart": 3 * 200, "frame-orthonormal": 3 * 2 * 200, "gradient-sine": 200, "gradient-ridges": 200,
-    "gradient-rings": 200, "kink-loci-rays": 200, "kink-loci-circles": 200, "no-boundary": 100,
-    "beta-zero-regression": 12, "central-difference-truncation": 200, "bump-vs-displacement": 3 * 200,
+    "chart": 200, "frame-orthonormal": 2 * 200, "gradient-{field}": 200, "kink-loci-rays": 200,
+    "kink-loci-circles": 200, "no-boundary": 100, "beta-zero-regression": 4, "central-difference-truncation": 200,
+    "bump-vs-displacement": 200,
 }
+#: The entries of `RENDERED` that count per registered field.
+COUNTED_PER_FIELD = ("chart", "frame-orthonormal", "beta-zero-regression", "bump-vs-displacement")
+
+
+def _entry(table, theorem_id):
+    """``table``'s entry for the theorem: its own, or its family's (``gradient-{field}`` for
+    gradient-sine) if it is a theorem of the registry.  KeyError if it has none."""
+    if theorem_id in table:
+        return table[theorem_id]
+    if theorem_id in CITABLE:
+        from renderer.formulas import FIELDS
+        for key, value in table.items():
+            if any(key.replace("{field}", name) == theorem_id for name in FIELDS):
+                return value
+    raise KeyError(theorem_id)
+
+
+def least_rendered(theorem_id):
+    """How many renderer outputs the theorem's check must compare at least (`RENDERED`; 0 if none)."""
+    try:
+        count = _entry(RENDERED, theorem_id)
+    except KeyError:
+        return 0
+    if theorem_id in COUNTED_PER_FIELD:
+        from renderer.formulas import FIELDS
+        count *= len(FIELDS)
+    return count
 
 
 def pin(theorem_id):
@@ -51,7 +120,7 @@ def pin(theorem_id):
     ValueError
         If its pin is neither "proved" nor ("verified", bound) with a finite bound >= 0.
     """
-    p = PINNED[theorem_id]
+    p = _entry(PINNED, theorem_id)
     if p == "proved":
         return "proved", None
     if isinstance(p, tuple) and len(p) == 2 and p[0] == "verified" and isinstance(p[1], (int, float)) \
@@ -65,7 +134,7 @@ def pinned_failure(theorem_id, status, residual, rendered):
     """Why the verdict (``status``, ``residual``, ``rendered``) differs from `PINNED` and
     `RENDERED`, or None if it does not: the status must be the pin's, a verified one's
     residual a number at most the pin's bound (a missing or NaN residual never passes),
-    and at least `RENDERED` renderer outputs compared.
+    and at least `least_rendered` renderer outputs compared.
 
     Raises
     ------
@@ -79,20 +148,20 @@ def pinned_failure(theorem_id, status, residual, rendered):
         return f"{theorem_id} is {status}, pinned {want}"
     if bound is not None and not (residual is not None and residual <= bound):
         return f"{theorem_id} is verified with residual {residual}, pinned at most {bound:g}"
-    if rendered < RENDERED.get(theorem_id, 0):
-        return f"{theorem_id} compared {rendered} renderer outputs, pinned at least {RENDERED[theorem_id]}"
+    least = least_rendered(theorem_id)
+    if rendered < least:
+        return f"{theorem_id} compared {rendered} renderer outputs, pinned at least {least}"
     return None
 
 
 def get(theorem_id):
-    """The theorem with this id.
+    """The theorem with this id, built when first asked for.
 
     Raises
     ------
     KeyError
         Naming the unknown id and the known ones.
     """
-    try:
-        return THEOREMS[theorem_id]
-    except KeyError:
-        raise KeyError(f"no theorem {theorem_id!r}; known: {sorted(THEOREMS)}") from None
+    if theorem_id not in CITABLE:
+        raise KeyError(f"no theorem {theorem_id!r}; known: {sorted(CITABLE)}")
+    return THEOREMS[theorem_id]

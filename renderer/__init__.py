@@ -10,6 +10,7 @@ Public API::
     frame = render(Scene(), 256, 256, gradient="exact")
 """
 
+import functools
 import importlib
 import os
 import stat
@@ -98,8 +99,11 @@ def _private_cache(path):
     return None
 
 
+@functools.cache
 def _numba_cache():
-    """Where numba can cache the compiled kernel.  numba caches beside the package
+    """Where numba can cache the compiled kernel, decided once per process when the kernel is
+    first loaded (`renderer.kernel` calls it before its functions are compiled): importing
+    renderer writes nothing.  numba caches beside the package
     (``renderer/__pycache__``) or in the user's cache directory, and refuses to compile
     at all ("no locator available") where it can write neither: a read-only or
     system-wide install run by a user without a writable home.  There the cache goes
@@ -131,6 +135,3 @@ def _numba_cache():
     numba.config.CACHE_DIR = fallback
     if sys.stderr is not None:           # started with stderr closed: the note is lost, not sent elsewhere
         print(f"symrender: numba cannot cache beside the package nor in {user}: {note}", file=sys.stderr)
-
-
-_numba_cache()

@@ -40,7 +40,10 @@ import numpy as np
 from numba import njit, prange
 from numba.extending import overload
 
-from .generated import chart, footprint, perturbed_normal_chart, perturbed_normal_surface, tangent_frame
+from . import _numba_cache
+
+_numba_cache()          # where numba caches what it compiles, decided before its first function is decorated
+from .generated import chart, footprint, perturbed_normal_chart, perturbed_normal_surface, tangent_frame  # noqa: E402
 
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
 #: Codes of the gradient methods (`renderer.render.GRADIENTS`, in order).

@@ -14,7 +14,8 @@ import sympy as sp
 
 from chapter import latex
 from proofs.core import CITATION, plain
-from proofs.registry import CITABLE, PINNED, RENDERED, THEOREMS, get, pin, pinned_failure
+from renderer.formulas import FIELDS
+from proofs.registry import CITABLE, PINNED, THEOREMS, get, least_rendered, pin, pinned_failure
 from verify.test_theorems import _placed
 
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
@@ -35,9 +36,9 @@ def test_a_check_that_skips_the_renderer_is_named():
 
 def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
     monkeypatch.setitem(PINNED, "chart", pin)
-    assert why in pinned_failure("chart", status, residual, RENDERED["chart"])
+    assert why in pinned_failure("chart", status, residual, least_rendered("chart"))
     assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30)),
-                          RENDERED["chart"]) is None
+                          least_rendered("chart")) is None
 
 
 @pytest.mark.parametrize("residual, passes", [(0.0, True), (1e-30, False), (5e-324, False), (None, False),
@@ -46,7 +47,7 @@ def test_rule_7_a_pin_of_zero_admits_only_a_zero_residual(monkeypatch, residual,
     """("verified", 0.0), as no-boundary's (its residual counts differing renderer outputs): a bound read
     by truthiness (0.0 is false) would never be enforced."""
     monkeypatch.setitem(PINNED, "no-boundary", ("verified", 0.0))
-    why = pinned_failure("no-boundary", "verified", residual, RENDERED["no-boundary"])
+    why = pinned_failure("no-boundary", "verified", residual, least_rendered("no-boundary"))
     assert (why is None) is passes, why
     if not passes:
         assert why == f"no-boundary is verified with residual {residual}, pinned at most 0", why
@@ -75,13 +76,13 @@ def test_rule_7_a_malformed_pin_is_an_error_naming_it(monkeypatch, bad):
 
 
 def test_a_theorem_without_renders_is_pinned_by_its_verdict_alone():
-    assert "optimal-step" not in RENDERED
+    assert least_rendered("optimal-step") == 0
     assert pinned_failure("optimal-step", "proved", None, 0) is None
     assert pinned_failure("optimal-step", "verified", 1e-30, 0) == "optimal-step is verified, pinned proved"
 
 
 def test_every_registered_pin_is_well_formed():
-    assert {pin(t)[0] for t in PINNED} == {"proved", "verified"}
+    assert {pin(t)[0] for t in THEOREMS} == {"proved", "verified"}
     assert pin("no-boundary") == ("verified", 0.0) and pin("optimal-step") == ("proved", None)
 
 
@@ -291,13 +292,13 @@ def test_the_predicted_crease_band_ends_where_the_renderers_flag_does(k):
     assert across_u.tolist() == across_v.tolist() == [True, False]
 
 
-@pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
+@pytest.mark.parametrize("field", list(FIELDS))
 def test_the_generated_gradients_error_is_relative_to_the_gradients_largest_size(field):
     """generated_code_residual measures the kernel's error against pi max(k_u, 2 k_v), the largest |h_u| or
     |h_v| any field reaches (rings' h_v = 2 pi k_v cos(2 pi k_v v)): a kernel whose gradient is half as large
     again is off by at most half of it, and by nearly half at some of the seeded points."""
-    from proofs.gradients import PRINTED, generated_code_residual
-    r = generated_code_residual(field, PRINTED[field], compiled=lambda g: [1.5 * g[0], 1.5 * g[1]])
+    from proofs.gradients import generated_code_residual, printed
+    r = generated_code_residual(FIELDS[field], printed(FIELDS[field]), compiled=lambda g: [1.5 * g[0], 1.5 * g[1]])
     assert 0.4 < r <= 0.5, r
 
 

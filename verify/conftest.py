@@ -20,11 +20,20 @@ def pytest_runtest_logreport(report):
                 LEDGER[theorem_id] = (status, evidence)
 
 
+class _Claims(dict):
+    """{claim id: (measured, verdict)}, each claim measured when it is first read (`lab.claims.Claim.measure`):
+    a worker measures only the claims of its tests."""
+
+    def __missing__(self, claim_id):
+        from lab.claims import CLAIMS
+        self[claim_id] = result = next(c for c in CLAIMS if c.id == claim_id).measure()
+        return result
+
+
 @pytest.fixture(scope="session")
 def claim_results():
-    """{claim id: (measured, verdict)} of the whole register (`lab.claims.evaluate`)."""
-    from lab.claims import evaluate
-    return {c.id: (measured, verdict) for c, measured, verdict in evaluate()}
+    """{claim id: (measured, verdict)} of the register, each measured when a test reads it (`_Claims`)."""
+    return _Claims()
 
 
 @pytest.fixture(scope="session")

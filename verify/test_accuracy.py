@@ -3,9 +3,10 @@
 import pytest
 
 from lab.accuracy import gradient_accuracy, image_beta_order, normal_beta_derivative_residual
+from renderer.formulas import FIELDS
 
 
-@pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
+@pytest.mark.parametrize("field", list(FIELDS))
 def test_exact_gradient_is_float64_accurate_and_central_is_not(field):
     results = gradient_accuracy(field, count=2000)
     exact, central = results[0], {r.method: r for r in results[1:]}
@@ -28,16 +29,20 @@ def test_image_beta_derivative_is_second_order_in_the_median():
 
 def test_each_fields_optimum_at_its_stated_point():
     """`optima`: every field's entry is its curve's (the same `measure` at the same point and
-    steps); the ridges point is farther from every crease than the curve's largest step; rings is
-    measured in v; the fitted optimal step lies below the model-optimal one (measured rounding
-    errors are below their bound) and its measured error within a factor 3 of the fitted model's."""
+    steps), at the point and component its record names (`HeightField.optimum_at`: rings in v); a
+    field with creases is measured farther from every crease than the curve's largest step; the fitted
+    optimal step lies below the model-optimal one (measured rounding errors are below their bound) and
+    its measured error within a factor 3 of the fitted model's."""
     from lab.accuracy import OPTIMUM_POINTS, crease_distance, optima
     from renderer.ucurve import DEFAULT_STEPS, measure
     opt = optima()
-    assert opt["rings"]["component"] == "v" and opt["ridges"]["largest_step"] < opt["ridges"]["crease_distance"]
-    assert opt["ridges"]["crease_distance"] == pytest.approx(float(crease_distance(0.31, 0.47, 8.0, 4.0)))
+    assert set(opt) == set(OPTIMUM_POINTS) == set(FIELDS)
     for field, (u, v, component) in OPTIMUM_POINTS.items():
         o = opt[field]
+        assert (o["u"], o["v"], o["component"]) == (u, v, component) == FIELDS[field].optimum_at, field
+        if FIELDS[field].crease_factors:
+            assert o["largest_step"] < o["crease_distance"], field
+            assert o["crease_distance"] == pytest.approx(float(crease_distance(u, v, o["k_u"], o["k_v"]))), field
         steps = DEFAULT_STEPS[DEFAULT_STEPS <= o["largest_step"]]
         c = measure(field, u, v, component, eps=steps)
         assert (o["steps"], o["eps_model"], o["eps_fitted"]) == (steps.size, c.eps_model, c.eps_fitted), field

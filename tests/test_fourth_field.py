@@ -1,0 +1,68 @@
+"""A fourth height field, registered at run time (`renderer.formulas.register`), gets what the
+fields defined in renderer/formulas.py have, with no edit elsewhere: its theorems (proofs/),
+built, pinned and proved, with wrong variants its check refutes.
+
+The field is sin²(pi k_u u) sin²(pi k_v v), smooth, without creases, and not integrable in the
+sense of theorem bump-vs-displacement (it depends on u).  The `squares` fixture registers it for
+one test and removes it after.
+"""
+
+import pytest
+import sympy as sp
+
+from renderer import formulas as F
+
+
+@pytest.fixture
+def squares():
+    """The field "squares", registered for the test and removed after it."""
+    field = F.register(F.HeightField("squares", sp.sin(sp.pi * F.k_u * F.u) ** 2 * sp.sin(sp.pi * F.k_v * F.v) ** 2))
+    try:
+        yield field
+    finally:
+        F.FIELDS.pop("squares", None)
+
+
+def test_the_fourth_field_has_its_theorems_and_pins(squares):
+    """The registry lists gradient-squares after the other fields' (and no crease theorem: it has no crease),
+    pinned proved with 200 pixels; the theorems about every field cover it: the stencil step has its case,
+    the renderer comparisons count it, and bump-vs-displacement derives that its obstruction is not 0."""
+    from proofs import displacement, registry
+    ids = list(registry.THEOREMS)
+    assert ids[ids.index("gradient-rings") + 1] == "gradient-squares"
+    assert registry.CITABLE["gradient-squares"] == "The gradient of the squares field"
+    assert "squares-kinks" not in registry.CITABLE
+    assert registry.pin("gradient-squares") == ("proved", None) and registry.least_rendered("gradient-squares") == 200
+    assert registry.least_rendered("chart") == 4 * 200
+    stencil = registry.get("central-difference-truncation").steps[-1]
+    assert [label for label, _ in stencil.cases] == ["sine", "ridges", "rings", "squares"]
+    assert displacement.integrable() == ("rings",)
+    assert "it does not for the sine, ridges and squares fields" in registry.get("bump-vs-displacement").statement
+
+
+def test_the_fourth_fields_gradient_is_proved_as_printed(squares):
+    """gradient-squares names its factors s_1, s_2 and reaches h_u = 2 pi k_u s_1 cos(pi k_u u) s_2^2 (derived
+    from the expression, as the other fields' closed forms are), and its check proves it with the renderer's
+    outputs of the new field (the kernel's cfuncs compiled for it)."""
+    from proofs import gradients, registry
+    t = registry.get("gradient-squares")
+    s_1, s_2 = gradients.S1, gradients.S2
+    assert t.shown["h"] == s_1**2 * s_2**2
+    h_u = t.claims["gradient"][1][0].doit()
+    assert sp.simplify(h_u - 2 * sp.pi * F.k_u * s_1 * sp.cos(sp.pi * F.k_u * F.u) * s_2**2) == 0
+    verdict = t.check()
+    assert verdict.status == "proved", verdict.evidence
+    assert registry.pinned_failure(t.id, verdict.status, verdict.residual, verdict.rendered) is None
+
+
+def test_the_fourth_fields_wrong_gradients_are_refuted(squares):
+    """Each wrong closed form of gradient-squares (a factor dropped, k_u and k_v swapped) is refuted at the
+    proof's last step, which the right one passes."""
+    from proofs import registry
+    t = registry.get("gradient-squares")
+    wrong = [(d, check) for d, check in t.wrong_variants if d.startswith("h_u ")]
+    assert len(wrong) >= 4 and any("swapped" in d for d, _ in wrong)
+    for description, check in wrong:
+        verdict = check()
+        assert verdict.status == "refuted", description
+        assert verdict.evidence.startswith(f"gradient-squares, step {len(t.steps)} "), (description, verdict.evidence)
