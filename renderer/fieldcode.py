@@ -34,7 +34,10 @@ from functools import lru_cache
 from numba import cfunc, njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
+from . import _numba_cache
 from . import formulas as F
+
+_numba_cache()          # where numba caches the built-in fields' functions (see renderer.kernel)
 
 __all__ = ["FieldCode", "SIGNATURES", "compiled", "array_code", "univariate_code"]
 
