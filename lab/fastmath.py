@@ -39,9 +39,9 @@ from numba import vectorize
 from renderer import _numba_cache
 from renderer import formulas as F
 from renderer.scene import MAX_FREQUENCY, MAX_SHININESS, MIN_SHININESS
+from renderer.validate import choice, positive_int
 
 _numba_cache()          # where numba caches this module's ufuncs (see renderer.kernel)
-from renderer.validate import choice, positive_int
 
 __all__ = ["FUNCTIONS", "BACKENDS", "DIGITS", "SAMPLES", "SEED", "QUANTILE", "available", "backend",
            "arguments", "reference", "ulps", "flushes", "ulp_table", "floors", "central_differences"]
