@@ -46,7 +46,7 @@ import pytest
 from chapter import figures
 from chapter.theorems import BADGE_STEPS_PROVED
 from renderer import Scene, compare, pointwise, render, to_srgb
-from renderer.scene import HEIGHT_FIELDS
+from renderer.formulas import FIELDS as HEIGHT_FIELDS
 from renderer.ucurve import non_differentiable
 
 from .pages import run_page

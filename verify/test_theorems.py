@@ -39,8 +39,9 @@ def test_every_theorem_has_a_pinned_verdict_and_every_pin_a_theorem():
 
 
 def _placed(text):
-    """The theorem ids a page shows: string constants in the statements of its code cells that call
-    theorem_block, or a function of the page that calls it (as s3's ``theorems(*ids)``)."""
+    """The theorem ids a page shows: string constants, and f-strings with one field placeholder (each
+    registered field), in the statements of its code cells that call theorem_block, or a function of the
+    page that calls it (as s3's ``theorems(*ids)``)."""
     import ast
     cells = [ast.parse(re.sub(r"\A(:\w+:[^\n]*\n)+", "", code))           # less the cell's :tags: lines
              for code in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)\n```", text, re.S) if "theorem_block" in text]
@@ -48,8 +49,13 @@ def _placed(text):
                                     for n in ast.walk(node))
     helpers = {"theorem_block"} | {n.name for tree in cells for n in tree.body
                                    if isinstance(n, ast.FunctionDef) and calls(n, {"theorem_block"})}
-    return {c.value for tree in cells for stmt in tree.body if not isinstance(stmt, ast.FunctionDef)
-            and calls(stmt, helpers) for c in ast.walk(stmt) if isinstance(c, ast.Constant) and isinstance(c.value, str)}
+    def ids(node):                          # a string constant, or an f-string over the registered fields
+        if isinstance(node, ast.JoinedStr):
+            parts = [p.value if isinstance(p, ast.Constant) else "{}" for p in node.values]
+            return {"".join(parts).replace("{}", f) for f in FIELDS} if parts.count("{}") == 1 else set()
+        return {node.value} if isinstance(node, ast.Constant) and isinstance(node.value, str) else set()
+    return {i for tree in cells for stmt in tree.body if not isinstance(stmt, ast.FunctionDef)
+            and calls(stmt, helpers) for c in ast.walk(stmt) for i in ids(c)}
 
 
 def test_every_theorem_is_titled_and_used_on_pages_that_place_it():
