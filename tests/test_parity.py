@@ -63,8 +63,9 @@ SIZES = ((24, 20), (17, 13), (17, 20))
 IMAGE_TOL = 1e-12          # per channel, required by the issue
 LIGHT_2 = PointLight((-6.0, 2.0, 8.0), (0.9, 0.65, 0.25))     # the seed's second light
 U = 2.0**-53               # unit roundoff
-#: How far the two routes' chart points (u, v) may lie apart: a few ulp of 1 (their own
-#: hit points and atan2 sequences; measured within 2^-52).
+#: How far the two routes' chart points (u, v) may lie apart on a well-conditioned hit: a few
+#: ulp of 1 (their own hit points and atan2 sequences; measured within 2^-52).  Near a
+#: silhouette the hit itself moves by the root's condition number times that (`chart_shift`).
 CHART_SHIFT = 2.0**-50
 
 def _monotonic(f):
@@ -111,15 +112,28 @@ def lipschitz(scene):
     return field_bounds(scene.height_field, scene.k_u, scene.k_v)[0]
 
 
-def grad_tolerance(scene, gradient, grad_ref, steps=None, delta=None):
+def chart_shift(scene, width, height, chamber):
+    """How far the two routes' chart points may lie apart, per pixel (H, W, 1): `CHART_SHIFT`
+    times the condition number of sphere A's hit (`hit_condition`, at least 1).  The two routes
+    round the hit's t differently, and a relative error U kappa of t moves the hit point, and so
+    (u, v), by that much more (a random scene's pixel near the silhouette, kappa = 48, had its
+    exact gradient 2.2 CHART_SHIFT-widths of L2 apart)."""
+    shift = np.full((*chamber.shape, 1), CHART_SHIFT)
+    for j, i in np.argwhere(chamber == ref.SPHERE_A):
+        kappa = hit_condition(scene, *ref.pixel_point(scene, i, j, width, height), (0.0, 0.0, 0.0), scene.radius_a)
+        shift[j, i] *= max(1.0, kappa)
+    return shift
+
+
+def grad_tolerance(scene, gradient, grad_ref, steps=None, delta=None, shift=CHART_SHIFT):
     """Allowed |grad_renderer - grad_reference|, per component.
 
     Both routes evaluate the same sympy expressions (the kernel the printed and
     compiled ones, the reference sympy's ``math`` printing), so 1e-12 (1 + |g|)
     covers their roundings (measured worst on these frames: 4.7e-14 relative),
-    and the chart points of the two routes lie up to `CHART_SHIFT` apart, which
-    moves the exact gradient by at most L2 CHART_SHIFT (L2 bounds h's second
-    derivatives, `field_bounds`).
+    and the chart points of the two routes lie up to ``shift`` apart (`CHART_SHIFT`, or
+    per pixel `chart_shift`), which moves the exact gradient by at most L2 shift (L2
+    bounds h's second derivatives, `field_bounds`).
 
     The central pipeline needs an absolute slack on top.  The two routes
     compute the chart (u, v) of a hit point differently (textbook vs
@@ -142,7 +156,7 @@ def grad_tolerance(scene, gradient, grad_ref, steps=None, delta=None):
     lip, second = field_bounds(scene.height_field, scene.k_u, scene.k_v)
     tol = 1e-12 * (1.0 + np.abs(grad_ref))
     if gradient == "exact":
-        tol = tol + second * CHART_SHIFT
+        tol = tol + second * shift
     elif gradient == "central":
         tol = tol + lip * 2.0**-52 / scene.eps
     elif gradient == "footprint":
@@ -338,7 +352,8 @@ def parity_failures(scene, width, height, gradient, *, frame=None, backend="numb
         tol = grad_tolerance(scene, gradient, grad)
         extra = shading_allowance(scene, width, height, chamber, grad, tol)
     else:
-        tol, extra = grad_tolerance(scene, gradient, grad), np.zeros(chamber.shape)
+        tol = grad_tolerance(scene, gradient, grad, shift=chart_shift(scene, width, height, chamber))
+        extra = np.zeros(chamber.shape)
     d_image = np.abs(frame.image - image).max(axis=-1)
     excess = (np.abs(frame.grad - grad) - tol).max(axis=-1)
     second = field_bounds(scene.height_field, scene.k_u, scene.k_v)[1]
