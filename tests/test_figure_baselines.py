@@ -13,7 +13,8 @@ drawn in another colour is 3.2 apart (`test_a_changed_figure_fails_its_baseline`
 figures a page draws in its own cells (panels of renders) are the book build's.
 
 pytest-mpl compares only with ``--mpl``, which pyproject's addopts give every run
-(`test_the_comparison_is_on`).  After a deliberate change of a figure, from the repository:
+(`test_the_comparison_is_on`); a figure that fails leaves its PNG, the baseline's and their
+difference in test-artifacts/figures.  After a deliberate change of a figure, from the repository:
 
     .venv/bin/python -m pytest tests/test_figure_baselines.py --mpl-generate-path=tests/figure_baselines
 """
