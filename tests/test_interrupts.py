@@ -9,7 +9,7 @@ traceback; the output directory as it was (no output file, no ``.part``
 file, no temporary file); and no process left behind, neither in the child's
 session nor anywhere else: every run carries a marker in its environment,
 which all its descendants inherit, and any live process with that marker
-after the run is a leftover (a notebook kernel starts a session of its own).
+after the run is a leftover (wherever it runs, in whatever session).
 
 The moments: during the start-up imports (numpy, then numba's
 llvmlite), found by watching the child's memory maps; and moments a harness
@@ -41,20 +41,18 @@ import pytest
 
 pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
 
-ROOT = Path(__file__).resolve().parent.parent
 SYMRENDER = Path(sys.executable).with_name("symrender")
 MARKER = "SYMRENDER_INTERRUPT_TEST"
 INTERRUPTED = "symrender: interrupted\n"
-#: What each signal must end in: the exit code and stderr's one line (after ``<prog>: ``).
+#: What each signal must end in: the exit code and stderr's one line (after ``symrender: ``).
 OUTCOME = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminated")}
 
-#: Runs ``renderer.cli.main`` (or with ``--tool check_figures``, book/check_figures.py's) with
-#: the moment MOMENT held open: the harness writes the file READY when the moment has come,
-#: and keeps the child there until the signal's exception arrives (or exits 99 after 120 s).
+#: Runs ``renderer.cli.main`` with the moment MOMENT held open: the harness writes the file
+#: READY when the moment has come, and keeps the child there until the signal's exception
+#: arrives (or exits 99 after 120 s).
 #: band: the compiled band of the render or sweep, repeated (the exception comes between two
 #: calls, as in a real render); write: the output's temporary file is written (before its
-#: sync); commit: the report is out, the output not yet renamed into place; any other
-#: moment: nothing is held by the harness (a book page announces it, check_figures).
+#: sync); commit: the report is out, the output not yet renamed into place.
 HARNESS = """
 import os, sys, time
 import renderer.kernel as kernel
@@ -82,13 +80,6 @@ elif moment in ("write", "commit"):
     real = getattr(os, call)
     # fsync: of the output's temporary file; replace: of a staged output (a .part name).
     setattr(os, call, lambda *args: (call == "fsync" or ".part" in str(args[0])) and hold() or real(*args))
-if sys.argv[1] == "--tool":
-    sys.path.insert(0, os.path.join(os.environ["REPO"], "book"))
-    import check_figures
-    from pathlib import Path
-    if os.environ.get("BOOK_ROOT"):
-        check_figures.ROOT = Path(os.environ["BOOK_ROOT"])
-    sys.exit(check_figures.main(sys.argv[3:]))
 from renderer.cli import main
 sys.exit(main(sys.argv[1:]))
 """
@@ -149,7 +140,7 @@ class Run:
         self.token = uuid.uuid4().hex
         self.ready = Path(cwd) / f".ready-{self.token}"
         environ = dict(os.environ, **(env or {}))
-        environ.update({MARKER: self.token, "READY": str(self.ready), "MOMENT": moment or "", "REPO": str(ROOT)})
+        environ.update({MARKER: self.token, "READY": str(self.ready), "MOMENT": moment or ""})
         command = [sys.executable, "-c", HARNESS] if moment else [str(SYMRENDER)]
         self.started = time.monotonic()
         self.proc = subprocess.Popen([*command, *map(str, args)], cwd=cwd, env=environ,
@@ -229,7 +220,7 @@ def leftovers(session, token, grace):
         time.sleep(0.05)
 
 
-def interrupt_problems(rc, err, before, after, left, signum=signal.SIGINT, prog="symrender"):
+def interrupt_problems(rc, err, before, after, left, signum=signal.SIGINT):
     """What is wrong with a run stopped by ``signum``: an exit code other than 130
     (SIGINT) or 143 (SIGTERM), stderr other than the one line, a traceback, a file
     added to the output directory, a process left behind."""
@@ -237,7 +228,7 @@ def interrupt_problems(rc, err, before, after, left, signum=signal.SIGINT, prog=
     code, word = OUTCOME[signum]
     if rc != code:
         problems.append(f"exit code {rc}")
-    if err != f"{prog}: {word}\n":
+    if err != f"symrender: {word}\n":
         problems.append(f"stderr is not the one line: {err[-3000:]!r}")
     if "Traceback" in err:
         problems.append("traceback")
@@ -252,9 +243,9 @@ def listing(directory):
     return sorted(p.name for p in Path(directory).iterdir())
 
 
-def check(run, directory, before, grace=5.0, signum=signal.SIGINT, prog="symrender"):
+def check(run, directory, before, grace=5.0, signum=signal.SIGINT):
     rc, out, err, seconds = run.finish()
-    problems = interrupt_problems(rc, err, before, listing(directory), run.leftovers(grace), signum, prog)
+    problems = interrupt_problems(rc, err, before, listing(directory), run.leftovers(grace), signum)
     assert problems == [], problems
     return seconds
 

@@ -5,9 +5,9 @@ finished by the next one, and two builds in one tree take turns.
 myst-nb (``execute_notebooks: cache``) keys a page's cached outputs on its code cells
 alone, and executes the pages it has to one after another.  This extension:
 
-1. Takes turns.  When the configuration is read, the build takes an exclusive lock on
-   ``.build.lock`` in the book's directory (``fcntl.flock``, held until the build's
-   process ends); a second build in the same tree says in one line that it waits, and waits.
+1. Takes turns.  When the configuration is read, the build takes ``.build.lock`` in the
+   book's directory (`filelock.FileLock`, held until the build's process ends); a second
+   build in the same tree says in one line that it waits, and waits.
 2. Trusts only what a finished build left.  A build that finishes without an error or a
    warning writes the project's one source digest (`lab.store.source_digest`: every file
    of the packages, and the numerical libraries' versions) to ``build-complete`` in the
@@ -54,7 +54,6 @@ numba's threads on top of them oversubscribe the cores (a cold build on 2 cores 
 
 from __future__ import annotations
 
-import fcntl
 import multiprocessing
 import os
 import re
@@ -70,7 +69,7 @@ DIGEST_FILE = "source-digest"
 COMPLETE_FILE = "build-complete"
 #: In the book's directory: the lock a build holds while it runs.
 LOCK_FILE = ".build.lock"
-#: The build's process ("pid") and its lock ("lock", an open file held until the process ends).
+#: The build's process ("pid") and its lock ("lock", a FileLock held until the process ends).
 _build = {}
 
 
@@ -86,14 +85,15 @@ def _read(path):
 
 
 def _lock(path):
-    """``path`` opened and locked (``LOCK_EX``); if another build holds it, after one line on stderr."""
-    lock = open(path, "a")
+    """The `filelock.FileLock` on ``path``, taken; if another build holds it, after one line on stderr."""
+    from filelock import FileLock, Timeout
+    lock = FileLock(path)
     try:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
+        lock.acquire(timeout=0)
+    except Timeout:
         print(f"waiting for the build running in {path.parent} to finish (it holds {path.name})",
               file=sys.stderr, flush=True)
-        fcntl.flock(lock, fcntl.LOCK_EX)
+        lock.acquire()
     return lock
 
 

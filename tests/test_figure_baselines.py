@@ -1,0 +1,182 @@
+"""The book's figures against their PNG baselines in tests/figure_baselines (pytest-mpl).
+
+One test per function of the book's library that draws a figure (`chapter.figures`'s
+diagrams, `ucurve_anatomy` and `displacement_figure`; `chapter.benchmark`'s
+`pareto_figure` and `univariate_figure`), each in the book's style (`chapter.figures.style`)
+and saved at `DPI` dots per inch, so small that the module runs in seconds.  The figures
+that draw a measurement are given fixed numbers made here (a U-curve, timings and errors,
+two renders' masks): their measurements have tests of their own, and measured here they
+would differ between machines (timings; a rounding error's noise, in its last bits).  A
+figure passes when its PNG's RMS difference from its baseline (over 0-255 levels) is at
+most `TOLERANCE`: with numpy's SIMD paths disabled the PNGs are identical, and one line
+drawn in another colour is 3.2 apart (`test_a_changed_figure_fails_its_baseline`).  The
+figures a page draws in its own cells (panels of renders) are the book build's.
+
+pytest-mpl compares only with ``--mpl``, which pyproject's addopts give every run
+(`test_the_comparison_is_on`); a figure that fails leaves its PNG, the baseline's and their
+difference in test-artifacts/figures.  After a deliberate change of a figure, from the repository:
+
+    .venv/bin/python -m pytest tests/test_figure_baselines.py --mpl-generate-path=tests/figure_baselines
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from chapter import figures
+from chapter.benchmark import pareto_figure, univariate_figure
+from lab import gradient_methods as gm
+from renderer import formulas as F
+from renderer.ucurve import UCurve
+
+pytest_plugins = ["pytester"]
+
+BASELINES = Path(__file__).resolve().parent / "figure_baselines"
+#: Dots per inch of the compared PNGs (the book's are drawn at 200).
+DPI = 40
+#: Largest RMS difference from a baseline, in 0-255 levels.
+TOLERANCE = 1.0
+#: style="default": pytest-mpl resets matplotlib to its defaults; each test then sets the book's style.
+FIGURE = pytest.mark.mpl_image_compare(baseline_dir=BASELINES, tolerance=TOLERANCE, style="default",
+                                       savefig_kwargs={"dpi": DPI})
+
+
+@FIGURE
+def test_frame_diagram():
+    figures.style()
+    return figures.frame_diagram()
+
+
+@FIGURE
+def test_normal_diagram():
+    figures.style()
+    return figures.normal_diagram()
+
+
+@FIGURE
+def test_stencil_diagram():
+    figures.style()
+    return figures.stencil_diagram()
+
+
+def _ucurve():
+    """A U-curve as `renderer.ucurve.measure` returns one: truncation A eps^2, rounding noise of
+    size B / eps (a fixed pattern of signs and sizes), the model and the fitted model's steps."""
+    eps = np.geomspace(1e-13, 1e-1, 49)
+    A, B = 0.5, 2e-16
+    truncation = A * eps**2
+    roundoff = B / eps * np.where(np.arange(eps.size) % 3 == 1, -1.0, 1.0) * (0.3 + 0.7 * (np.arange(eps.size) % 5) / 4)
+    error = np.abs(truncation + roundoff)
+    model = A * eps**2 + 1.5 * B / eps
+    eps_model, eps_fitted = (1.5 * B / (2 * A)) ** (1 / 3), (B / (2 * A)) ** (1 / 3)
+    low = int(np.argmin(error))
+    return UCurve(field="sine", u=0.3, v=0.4, component="u", eps=eps, error=error, truncation=truncation,
+                  roundoff=roundoff, model=model, derivative=1.0, third_derivative=6 * A, height=0.5,
+                  model_truncation=A, model_cancellation=B, model_argument=0.5 * B, eps_model=eps_model,
+                  error_model=float(A * eps_model**2 + 1.5 * B / eps_model), eps_measured_min=float(eps[low]),
+                  error_at_measured_min=float(error[low]), fitted_truncation=A, fitted_roundoff=B,
+                  eps_fitted=eps_fitted, error_at_fitted=float(A * eps_fitted**2 + B / eps_fitted))
+
+
+@FIGURE
+def test_ucurve_anatomy():
+    figures.style()
+    return figures.ucurve_anatomy(_ucurve())
+
+
+def _error(method, eps):
+    """A method's error at step ``eps`` (None: a method without one), shaped as the book's measurements are."""
+    if eps is None:
+        return {"exact": 1e-16, "richardson": 3e-13}.get(method, 2e-16)
+    if method.startswith("complex step"):
+        return max(0.1 * eps**2, 1e-16)
+    return (0.1 * eps if method == "forward" else 0.01 * eps**2) + 1e-16 / eps
+
+
+def _measurement():
+    """Every method of `lab.gradient_methods.METHODS` on every field where it applies, at the
+    `FAST` configuration's steps, with fixed times and errors."""
+    rows = []
+    for i, field in enumerate(F.FIELDS):
+        for k, m in enumerate(gm.METHODS):
+            if m.applies(F.field(field)):
+                for j, eps in enumerate(m.steps_in(gm.FAST)):
+                    t, err = 1e-3 * (1 + k) * (1 + 0.3 * j) * (1 + 0.2 * i), _error(m.name, eps)
+                    rows.append(gm.MethodResult(field, m.name, eps, (0.8 * t, t, 1.5 * t), 1.0, 0.0, 0.0, err, err))
+    return gm.Measurement(gm.FAST, tuple(rows), 1000, {}, {}, {}, 1.0, 8.0, 4.0)
+
+
+@FIGURE
+def test_pareto_figure():
+    figures.style()
+    return pareto_figure(_measurement())
+
+
+@FIGURE
+def test_univariate_figure():
+    figures.style()
+    steps = gm.UNIVARIATE_STEPS[::4]
+    rows = [gm.UnivariateRow(m.name, eps, 1.0, _error(m.name, eps), _error(m.name, eps))
+            for m in gm.METHODS if m.derivative is not None and m.name != "complex step, |z| continued"
+            for eps in m.steps_in(SimpleNamespace(central_steps=steps, forward_steps=steps, complex_steps=steps))]
+    return univariate_figure(gm.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {}))
+
+
+def _displaced(n=32):
+    """What `displacement_figure` reads of a `lab.displaced.Displaced`: on an n x n frame, the
+    bumped sphere a disc (chamber 1, the floor 3 elsewhere), the displaced one a disc with a
+    wavy rim; each shaded by one light; their cast shadows two shifted crescents, and the
+    displaced sphere's a patch on itself."""
+    y, x = np.mgrid[-1:1:n * 1j, -1:1:n * 1j]
+    r, angle = np.hypot(x, y), np.arctan2(y, x)
+    bumped_covered, covered = r < 0.6, r < 0.6 + 0.06 * np.sin(8 * angle)
+
+    def shade(disc):
+        z = np.sqrt(np.clip(1 - (r / 0.7) ** 2, 0, 1))
+        lit = np.clip(0.4 * -x + 0.4 * y + 0.8 * z, 0, 1)
+        return np.where(disc[..., None], lit[..., None] * [0.8, 0.5, 0.3], [0.2, 0.2, 0.25])
+
+    shadow = (~covered & (np.hypot(x - 0.25, y + 0.2) < 0.65)) | (bumped_covered & (np.hypot(x - 0.3, y - 0.3) < 0.2))
+    bumped_shadow = ~bumped_covered & (np.hypot(x - 0.2, y + 0.2) < 0.6)
+    bumped = SimpleNamespace(image=shade(bumped_covered), chamber=np.where(bumped_covered, 1, 3).astype(np.uint8))
+    return SimpleNamespace(image=shade(covered), covered=covered, shadow=shadow, bumped=bumped,
+                           bumped_shadow=bumped_shadow)
+
+
+@FIGURE
+def test_displacement_figure():
+    figures.style()
+    return figures.displacement_figure(_displaced())
+
+
+def test_the_comparison_is_on(request):
+    """pytest-mpl compares a figure with its baseline only under ``--mpl`` (or writes the
+    baselines under ``--mpl-generate-path``); without either every test above passes unchecked."""
+    assert request.config.getoption("--mpl") or request.config.getoption("--mpl-generate-path")
+
+
+PLANTED = """
+from chapter import figures
+from tests import test_figure_baselines as t
+
+
+@t.FIGURE
+def test_stencil_diagram(monkeypatch):
+    monkeypatch.setattr(figures, "RED", figures.GREEN)     # the central stencil drawn green
+    return t.test_stencil_diagram()
+"""
+
+
+def test_a_changed_figure_fails_its_baseline(pytester):
+    """The stencil diagram with its stencil drawn in another colour, compared as this module
+    compares it (`FIGURE`), with its baseline: it fails, the two PNGs apart by more than
+    `TOLERANCE`."""
+    pytester.makepyfile(test_planted=PLANTED)
+    result = pytester.runpytest_inprocess("--mpl", "--mpl-results-path", str(pytester.path / "results"),
+                                          "-p", "no:cacheprovider", "-p", "no:xdist")
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines(["*Image files did not match*", "*RMS Value: *", "*Tolerance:*", f"* {TOLERANCE}"])
