@@ -262,7 +262,8 @@ def methods_sentence(config, fields=None):
 
 def univariate_figure(errors):
     """Relative error of f'(x) against the step, log-log, one line per method of ``errors`` (a
-    `lab.gradient_methods.UnivariateErrors`); a method without a step is a horizontal line across.
+    `lab.gradient_methods.UnivariateErrors`), the step growing to the right; a method without a step
+    is a horizontal line across; hollow markers, so that two methods with equal errors both show.
     Drawn for a phone's column: 4.6 in wide, every text 10 pt.  An error of exactly 0 would be drawn at
     1e-18.  Returns a matplotlib Figure (not shown)."""
     from matplotlib.figure import Figure
@@ -277,10 +278,10 @@ def univariate_figure(errors):
             ax.axhline(_floor(rows[0].relative_error), color=style.colour, ls=style.line, lw=1.4, label=m.label)
         else:
             ax.plot([r.eps for r in rows], [_floor(r.relative_error) for r in rows], color=style.colour,
-                    ls=style.line, lw=1.2, marker=style.marker, ms=min(style.size, 6), label=m.label)
+                    ls=style.line, lw=1.2, marker=style.marker, ms=min(style.size, 6), mfc="none", label=m.label)
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlim(max(steps) * 3, min(steps) / 3)          # the step shrinks to the right, as in the papers
+    ax.set_xlim(min(steps) / 3, max(steps) * 3)          # the step grows to the right, as in every U-curve here
     ax.xaxis.set_major_locator(LogLocator(base=10.0 ** 4, numticks=8))
     ax.yaxis.set_major_locator(LogLocator(base=10.0 ** 4, numticks=8))
     for axis in (ax.xaxis, ax.yaxis):
