@@ -268,7 +268,7 @@ def univariate_figure(errors):
     1e-18.  Returns a matplotlib Figure (not shown)."""
     from matplotlib.figure import Figure
     from matplotlib.ticker import LogLocator, NullLocator
-    fig = Figure(figsize=(4.6, 2.8), layout="constrained")
+    fig = Figure(figsize=(4.6, 2.6), layout="constrained")
     ax = fig.subplots()
     steps = [r.eps for r in errors.rows if r.eps is not None]
     for name in dict.fromkeys(r.method for r in errors.rows):
