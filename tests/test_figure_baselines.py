@@ -97,11 +97,16 @@ def _error(method, eps):
     return (0.1 * eps if method == "forward" else 0.01 * eps**2) + 1e-16 / eps
 
 
+#: The fields the Pareto baseline is drawn for: the seed's three, fixed input data as its times and
+#: errors are (a field registered later changes the book's figure, not this test's).
+BASELINE_FIELDS = ("sine", "ridges", "rings")
+
+
 def _measurement():
-    """Every method of `lab.gradient_methods.METHODS` on every field where it applies, at the
-    `FAST` configuration's steps, with fixed times and errors."""
+    """Every method of `lab.gradient_methods.METHODS` on each of `BASELINE_FIELDS` where it applies,
+    at the `FAST` configuration's steps, with fixed times and errors."""
     rows = []
-    for i, field in enumerate(F.FIELDS):
+    for i, field in enumerate(BASELINE_FIELDS):
         for k, m in enumerate(gm.METHODS):
             if m.applies(F.field(field)):
                 for j, eps in enumerate(m.steps_in(gm.FAST)):
