@@ -46,6 +46,7 @@ REFUSED = {
     "real": [
         (lambda: real("x", 2.0, low=0.0, high=1.0), InvalidValue, "x", "must be in [0, 1]"),
         (lambda: real("x", 0.0, low=0.0, low_open=True, high=5.0), InvalidValue, "x", "must be in (0, 5]"),
+        (lambda: real("x", 1.0, low=0.0, high=1.0, high_open=True), InvalidValue, "x", "must be in [0, 1)"),
         (lambda: real("x", -1.0, low=0.0), InvalidValue, "x", "must be >= 0"),
         (lambda: real("x", np.float32("nan")), InvalidValue, "x", "must be finite"),
         (lambda: real("x", -(10**400)), InvalidValue, "x", "integer of 401 digits"),
@@ -60,6 +61,7 @@ REFUSED = {
         (lambda: real_array("a", np.array([True])), InvalidType, "a", "must be real numbers"),
         (lambda: real_array("a", "0.5"), InvalidType, "a", "must be real numbers"),
         (lambda: real_array("a", [1, [2, 3]]), InvalidType, "a", "must be real numbers"),
+        (lambda: real_array("a", np.array([0.5, True], dtype=object)), InvalidType, "a", "must be real numbers"),
     ],
     "vector3": [
         (lambda: vector3("p", (1.0, 2.0)), InvalidValue, "p", "exactly 3 components"),
@@ -86,6 +88,7 @@ REFUSED = {
         (lambda: steps("e", [], low=0.1, high=1.0), InvalidValue, "e", "at least one step"),
         (lambda: steps("e", [0.5] * 3, low=0.1, high=1.0, max_count=2), InvalidValue, "e", "1 to 2 steps"),
         (lambda: steps("e", [0.5, 2.0], low=0.1, high=1.0), InvalidValue, "e", "at flat index 1"),
+        (lambda: steps("e", [1.0], low=0.1, high=1.0, high_open=True), InvalidValue, "e", "must be in [0.1, 1)"),
         (lambda: steps("e", {0.5: 1}, low=0.1, high=1.0), InvalidType, "e", "ordered steps"),
     ],
     "expression": [
@@ -96,8 +99,8 @@ REFUSED = {
         (lambda: expression("f", "u < v", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "'<' is not one of its operators"),
         (lambda: expression("f", "2j*u", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "imaginary"),
         (lambda: expression("f", "I*u", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "'I' is not one of its names"),
-        (lambda: expression("f", "u+" * MAX_EXPRESSION_CHARS + "u", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f",
-         f"1 to {MAX_EXPRESSION_CHARS} characters"),
+        (lambda: expression("f", "u" + " " * MAX_EXPRESSION_CHARS, F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f",
+         f"1 to {MAX_EXPRESSION_CHARS} characters, got {MAX_EXPRESSION_CHARS + 1}"),
         (lambda: expression("f", "u +", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "is not one"),
         (lambda: expression("f", "(u", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "does not parse"),
         (lambda: expression("f", 3, F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidType, "f", "must be a string"),
@@ -108,16 +111,30 @@ ACCEPTED = {
     "real": [(lambda: real("x", np.float32(0.5), low=0.0, high=1.0), 0.5), (lambda: real("x", np.array(3), low=0.0), 3.0),
              (lambda: real("x", Fraction(1, 4)), 0.25), (lambda: real("x", 1.0, low=0.0, high=1.0), 1.0)],
     "real_array": [(lambda: real_array("a", [[1, 2]]).tolist(), [[1.0, 2.0]]),
+                   (lambda: real_array("a", np.array([Fraction(1, 2), 10**20], dtype=object)).tolist(), [0.5, 1e20]),
                    (lambda: str(real_array("a", np.arange(3, dtype=np.int8)).dtype), "float64")],
     "vector3": [(lambda: vector3("p", np.array([1, 2, 3])), (1.0, 2.0, 3.0)), (lambda: vector3("p", [0, 0, 1]), (0.0, 0.0, 1.0))],
     "flag": [(lambda: flag("f", np.array(True)), True), (lambda: flag("f", np.False_), False)],
     "choice": [(lambda: choice("c", "rings", ("sine", "rings")), "rings")],
-    "positive_int": [(lambda: positive_int("n", np.int64(8), high=8), 8)],
-    "steps": [(lambda: steps("e", np.float32(0.5), low=0.1, high=1.0).tolist(), [0.5])],
+    "positive_int": [(lambda: positive_int("n", np.int64(8), high=8), 8), (lambda: positive_int("n", np.array(3)), 3)],
+    "steps": [(lambda: steps("e", np.float32(0.5), low=0.1, high=1.0).tolist(), [0.5]),
+              (lambda: steps("e", [0.5, 1.0], low=0.1, high=1.0, max_count=2).tolist(), [0.5, 1.0])],
     "expression": [(lambda: expression("f", "sin(pi*k_u*u)^2 * sin(pi*k_v*v)**2", F.FIELD_SYMBOLS, F.ELEMENTARY),
                     sp.sin(sp.pi * F.k_u * F.u) ** 2 * sp.sin(sp.pi * F.k_v * F.v) ** 2),
                    (lambda: expression("f", "abs(u - 1/2) + sqrt(E*v)", F.FIELD_SYMBOLS, F.ELEMENTARY),
-                    sp.Abs(F.u - sp.Rational(1, 2)) + sp.sqrt(sp.E * F.v))],
+                    sp.Abs(F.u - sp.Rational(1, 2)) + sp.sqrt(sp.E * F.v)),
+                   (lambda: expression("f", "u" + " " * (MAX_EXPRESSION_CHARS - 1), F.FIELD_SYMBOLS, F.ELEMENTARY), F.u)],
+}
+#: kind: a refusal and how its message ends: the value it got, with its type where the type is the fault.
+SHOWN = {
+    "real": (lambda: real("x", "1"), "got str '1'"),
+    "real_array": (lambda: real_array("a", "0.5"), "got str '0.5'"),
+    "vector3": (lambda: vector3("p", (1.0, 2.0, "3")), "got str '3'"),
+    "flag": (lambda: flag("f", 1), "got int 1"),
+    "choice": (lambda: choice("c", "Sine", ("sine", "rings")), "got 'Sine'"),
+    "positive_int": (lambda: positive_int("n", 2.0), "got float 2.0"),
+    "steps": (lambda: steps("e", {0.5: 1}, low=0.1, high=1.0), "got dict {0.5: 1}"),
+    "expression": (lambda: expression("f", 3, F.FIELD_SYMBOLS, F.ELEMENTARY), "got int 3"),
 }
 
 
@@ -135,6 +152,19 @@ def test_each_kind_accepts_and_returns_plain_values(kind):
     for call, want in ACCEPTED[kind]:
         got = call()
         assert got == want and type(got) is type(want), (got, want)
+
+
+@pytest.mark.parametrize("kind", SHOWN)
+def test_each_kind_names_the_value_it_refused(kind):
+    assert set(SHOWN) == set(REFUSED)
+    call, tail = SHOWN[kind]
+    assert refusal(call)[1].endswith(tail)
+
+
+def test_a_long_value_is_shown_cut_short():
+    """A refused value's text is cut at 80 characters and marked, whatever its size."""
+    message = refusal(lambda: real("x", "a" * 1000))[1]
+    assert message.endswith("got str '" + "a" * 79 + "..."), message          # the repr's first 80 characters
 
 
 def test_the_refusal_check_rejects_another_name_or_phrase():
