@@ -2,7 +2,8 @@
 
 Each kind accepts what its docstring accepts (numpy scalars and 0-d arrays as plain
 values) and refuses the rest, each refusal matched on the parameter's name and the
-essential phrase only (the wording around them is free).  Who calls which kind is
+essential phrase only (the wording around them is free), and once per kind on how it
+shows the value it got (`SHOWN`).  Who calls which kind is
 wiring, tested once per caller: `Scene` and `PointLight` in tests/test_scene_validation.py,
 `renderer.ucurve.measure` in tests/test_ucurve_args.py, `renderer.pointwise` below (each
 function's arguments at their range's ends, and one float past them).
