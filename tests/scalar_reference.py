@@ -209,10 +209,16 @@ def sign(x):
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
 
 
+#: h(s1, s2, v, kv) of seed §2 per field, s1 = sin(pi ku u), s2 = sin(pi kv v): the seed's fields.
+_SEED_HEIGHTS = {"sine": lambda s1, s2, v, kv: s1 * s2, "ridges": lambda s1, s2, v, kv: abs(s1 * s2),
+                 "rings": lambda s1, s2, v, kv: math.sin(TWO_PI * kv * v)}
+#: The fields `seed_height` and `seed_gradient` know.
+SEED_FIELDS = tuple(_SEED_HEIGHTS)
+
+
 def seed_height(field, u, v, ku, kv):
     """h(u, v) of seed §2."""
-    s1, s2 = math.sin(math.pi * ku * u), math.sin(math.pi * kv * v)
-    return {"sine": s1 * s2, "ridges": abs(s1 * s2), "rings": math.sin(TWO_PI * kv * v)}[field]
+    return _SEED_HEIGHTS[field](math.sin(math.pi * ku * u), math.sin(math.pi * kv * v), v, kv)
 
 
 def seed_gradient(field, u, v, ku, kv):
@@ -225,9 +231,6 @@ def seed_gradient(field, u, v, ku, kv):
         return math.pi * ku * c1 * s2 * sigma, math.pi * kv * s1 * c2 * sigma
     return {"rings": (0.0, TWO_PI * kv * math.cos(TWO_PI * kv * v))}[field]
 
-
-#: The fields `seed_height` and `seed_gradient` know.
-SEED_FIELDS = ("sine", "ridges", "rings")
 
 
 def stencil_u(u, eps):

@@ -43,6 +43,7 @@ import numpy as np
 import pytest
 
 from renderer import DRAFT_SCENE, PointLight, Scene, compare, gbuffer, render
+from renderer.formulas import FIELDS
 from renderer.jsgen import SIMULATOR_SCENE
 from renderer.render import check_args
 
@@ -333,11 +334,12 @@ def test_the_curve_marks_its_image_best_step_and_names_its_right_arm_per_field(s
     assert eps == best["eps"] and eps != worst["eps"]
     assert plot.locator("#sim-curve-best-label").text_content() == "image-best step"
     captions = {}
-    for field in ("ridges", "sine", "rings"):
+    for field in FIELDS:
         session.select("height_field", field)
         captions[field] = session.page.text_content("#sim-curve-caption")
-    assert "crease" in captions["ridges"] and "truncation" in captions["sine"]
-    assert "crease" not in captions["sine"] and captions["sine"] == captions["rings"]
+    smooth = {captions[f] for f in FIELDS if not FIELDS[f].crease_factors}
+    assert all(("crease" in captions[f]) == bool(FIELDS[f].crease_factors) for f in FIELDS), captions
+    assert len(smooth) == 1 and "truncation" in smooth.pop(), captions
     session.fill("beta", 0)
     assert plot.locator("#sim-curve-best").count() == 0
     session.fill("beta", SIMULATOR_SCENE.beta)
@@ -739,7 +741,7 @@ def test_the_session_catches_network_use_and_errors(browser, tmp_path):
 LOG_EPS = (-1, -3, -6, -9, -12, -14)
 
 
-@pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
+@pytest.mark.parametrize("field", list(FIELDS))
 def test_the_log_difference_view_shows_the_u_curve(browser, book_html, field):
     """On the log scale the difference canvas is visible on sphere A at every step from
     1e-1 to 1e-14, and its mean level follows the U-curve: lower at the optimum than at

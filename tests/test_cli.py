@@ -28,6 +28,7 @@ from hypothesis import strategies as st
 
 import renderer.cli as cli
 from renderer import PointLight, Scene, compare, render, sweep, to_srgb
+from renderer.formulas import FIELDS
 from renderer.cli import main
 
 
@@ -391,7 +392,7 @@ OPTIONS = {
     "--gradient": ["exact", "central", "footprint", "forward"],
     "-o": ["OUT", "DIR", "DIR/none/o.png"],
     "--format": ["text", "csv", "json", "xml"],
-    "--field": ["sine", "ridges", "rings", "waves"],
+    "--field": [*FIELDS, "waves"],
     "--u": ["0.31", "0", "1", "1.5", "nan", "x"],
     "--component": ["u", "v", "w"],
     "--k-u": ["8", "0", "1e300"],

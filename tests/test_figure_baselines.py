@@ -32,6 +32,7 @@ from chapter.benchmark import pareto_figure, univariate_figure
 from lab import gradient_methods as gm
 from renderer import formulas as F
 from renderer.ucurve import UCurve
+from tests.scalar_reference import SEED_FIELDS
 
 pytest_plugins = ["pytester"]
 
@@ -97,16 +98,13 @@ def _error(method, eps):
     return (0.1 * eps if method == "forward" else 0.01 * eps**2) + 1e-16 / eps
 
 
-#: The fields the Pareto baseline is drawn for: the seed's three, fixed input data as its times and
-#: errors are (a field registered later changes the book's figure, not this test's).
-BASELINE_FIELDS = ("sine", "ridges", "rings")
-
-
 def _measurement():
-    """Every method of `lab.gradient_methods.METHODS` on each of `BASELINE_FIELDS` where it applies,
-    at the `FAST` configuration's steps, with fixed times and errors."""
+    """Every method of `lab.gradient_methods.METHODS` on each of the seed's fields
+    (`scalar_reference.SEED_FIELDS`: fixed input data, as the times and errors are; a field
+    registered later changes the book's figure, not this test's) where it applies, at the `FAST`
+    configuration's steps, with fixed times and errors."""
     rows = []
-    for i, field in enumerate(BASELINE_FIELDS):
+    for i, field in enumerate(SEED_FIELDS):
         for k, m in enumerate(gm.METHODS):
             if m.applies(F.field(field)):
                 for j, eps in enumerate(m.steps_in(gm.FAST)):
