@@ -509,9 +509,11 @@ def _pole_pixels():
 
 
 def _sweep_best():
-    a = {eps: compare(*_frames("sine", eps=eps)).rms for eps in (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10)}
-    best = min(a, key=a.get)
-    return {"best ε": best, **_on(_frames("sine")[1], DRAFT_SCENE.replace(height_field="sine"))}
+    """§4's sweep of the sine field: the image-best step, the one measurement the book shows of it
+    (`lab.accuracy.image_best_step`: the simulator's scene, its half-decade steps)."""
+    from .accuracy import image_best_step
+    best = image_best_step("sine")
+    return {"best ε": best["best"], "scene": best["scene"], "size": best["size"]}
 
 
 def _creases_part():

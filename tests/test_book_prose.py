@@ -363,3 +363,28 @@ def test_a_page_refers_to_a_theorem_by_its_number_and_its_title():
                   "{prf:ref}`thm-bump-vs-displacement` proves",
                   "{prf:ref}`Bump versus displacement <thm-bump-vs-displacement>` (Bump versus displacement)"):
         assert len(theorem_ref_problems(wrong)[1]) == 1, wrong
+
+
+EXERCISES_SENTENCE = re.compile(r"Exercises with folded solutions sit in (.+?);", re.S)
+
+
+def pages_with_exercises(book=BOOK):
+    """The labels (``s3``) of the pages holding an ``{exercise}`` directive."""
+    return {p.stem.split("_")[0] for p in book.glob("s*.md") if re.search(r"^:::+\{exercise\}", p.read_text(), re.M)}
+
+
+def exercises_named_by_the_index(text):
+    """The page labels the index's sentence on exercises refers to, or None without that sentence."""
+    m = EXERCISES_SENTENCE.search(text)
+    return None if m is None else set(re.findall(r"\{ref\}`(s\d)`", m.group(1)))
+
+
+def test_the_index_names_every_page_with_exercises():
+    assert exercises_named_by_the_index((BOOK / "index.md").read_text()) == pages_with_exercises()
+
+
+def test_a_page_with_exercises_left_out_of_the_index_is_found(tmp_path):
+    for p in BOOK.glob("s*.md"):
+        (tmp_path / p.name).write_text(p.read_text())
+    (tmp_path / "s8_history.md").write_text("::::{exercise} New\n:label: ex-new\n::::\n")
+    assert exercises_named_by_the_index((BOOK / "index.md").read_text()) != pages_with_exercises(tmp_path)

@@ -28,7 +28,7 @@ _DI = "$\\lvert\\Delta I\\rvert$"
 SENTENCES = {
     "h3-scale": "$(\\pi k_u)^3 =$ {(π kᵤ)³:,.0f} at $k_u = {k_u:g}$",
     "truncation-until-1e-6": "the model-optimal step ε* is {model optimum ε:.1e}, from $h'''$, $h$, $u h'$ and "
-                             "the unit roundoff (the measured curve's lowest point is {measured_optimum:.1e})",
+                             "the unit roundoff",
     "roundoff-drowns-1e-9": "the quotient's relative error at a step of {step_shown} is "
                             "{relative error at ε = 1e-9:.1e}: {digits} digits still right",
     "cell2-minimum": "the fitted optimal step ε̂ is {fitted optimum ε:.1e}, where the fitted model's error is {error:.1e}",
@@ -84,7 +84,8 @@ SENTENCES = {
                       "picks a side",
     "pole-pixels": "{fallback pixels} pixels use the fallback ({frame}); the draft counts points of a grid of $N_z$ "
                    "values unrelated to the image",
-    "try-sweep": "of the steps tried, the image-best step is {best ε:.0e} ({frame})",
+    "try-sweep": f"of the simulator's half-decade steps, the image-best step (least RMS {_DI} over sphere A) is "
+                 "{best ε:.0e} ({frame})",
     "try-creases": f"{{share in the band:.0%}} of the pixels whose {_DI} exceeds {{threshold_shown}} lie in the "
                    "crease band ({frame})",
     "try-pinch": "with the draft's formula, $N'$ on opposite sides of the pole ($\\sin\\varphi = {sin_phi:g}$, "

@@ -92,7 +92,8 @@ const CONTROLS = [
 export const RIGHT_ARM = {
   smooth: "Right arm: truncation error, which shrinks as ε² when ε shrinks; left arm: rounding, which grows as 1/ε.",
   creased: "Right arm: crease error — at the pixels within ε of a crease the stencil straddles it and the " +
-          "quotient is off by the slope's jump; it shrinks only as fewer pixels lie that near, slower than " +
+          "quotient is off by the slope's jump times the share of the stencil past the crease; it shrinks only " +
+          "as fewer pixels lie that near, slower than " +
           "truncation. Left arm: rounding, which grows as 1/ε.",
 };
 
