@@ -126,6 +126,8 @@ QUANTITIES = {
     "the census's RMS slope": (("census_rms_slope",), lambda: _lib("lab.claims").census()["rms_slope"]),
     "the census's off-band slope": (("census_off_slope",), lambda: _lib("lab.claims").census()["off_slope"]),
     "the census's crease ratio": (("census_ratio",), lambda: _lib("lab.claims").census()["ratio"]),
+    "the census's step for its ratio": (("census_step",), lambda: _lib("lab.claims").census()["step"]),
+    "the step of the draft's crease cell (Cell 7b)": (("s7_crease_step",), lambda: _lib("lab.claims").CELL7B_STEP),
     "the census's frame": (("c3_label",), lambda: _lib("chapter.labels").frame_label(
         _lib("lab.claims").census()["scene"], *_lib("lab.claims").census()["size"])),
     "the closed form's worst error": (("dn_residual",), lambda: _lib("lab.accuracy").normal_beta_derivative_residual()),
@@ -151,7 +153,7 @@ QUANTITIES = {
         ("c4_ad_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "forward-mode AD").trig),
     "JAX's forward-mode slope of |x| at x = 0": (
         ("c4_abs_slope",), lambda: _lib("lab.gradient_methods").abs_slope_at_zero()[0]),
-    "the U-curve's chart v": (("c4_crease_v",), lambda: _lib("renderer.ucurve").SEED_POINT[1]),
+    "the U-curve's chart v": (("c4_crease_v", "s3_torus_v"), lambda: _lib("renderer.ucurve").SEED_POINT[1]),
     "the classic complex-step test function's point": (("c4_classic_x",),
                                                        lambda: _lib("lab.gradient_methods").TEST_FUNCTION.x),
     # The price of fast math (Cell 4): the ulp sample, its quantile, libm's sine.
@@ -159,9 +161,13 @@ QUANTITIES = {
     "the fast-math quantile (%)": (("c4_fm_quantile",), lambda: 100 * _lib("lab.fastmath").QUANTILE),
     "libm's largest sine error (ulp)": (
         ("c4_fm_libm_sin",), lambda: _lib("lab.fastmath").ulp_table()["errors"]["numba"]["sin"]["max"]),
-    "the chapter's amplitude": (("c5_fit_beta",), lambda: _lib("renderer").Scene().beta),
+    "the chapter's amplitude": (("c5_fit_beta", "s3_torus_beta"), lambda: _lib("renderer").Scene().beta),
     "the rings field's image-best step (the simulator's scene and steps, 256 × 256)": (
         ("ex_rings_best",), lambda: _lib("lab.accuracy").image_best_step("rings", 256)["best"]),
+    "the sine field's image-best step (the simulator's scene and steps, 256 × 256)": (
+        ("s4_best",), lambda: _lib("lab.accuracy").image_best_step("sine", 256)["best"]),
+    "the chapter's frequency in u": (("s3_torus_ku",), lambda: _lib("renderer").Scene().k_u),
+    "the chapter's frequency in v": (("s3_torus_kv",), lambda: _lib("renderer").Scene().k_v),
     # Counted on two pages from their own renders.
     "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1", "c4_pixels"), None),
 }
@@ -195,7 +201,12 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s3_rings_h", "s3_rings_xh1", "s3_rings_h3", "s3_rings_C", "s3_k16_ku", "s3_k16_h", "s3_k16_xh1",
                "s3_k16_h3", "s3_k16_eps", "s3_k16_fit", "s3_k16_fit_ratio", "s3_arg_ratio", "s3_ulp_ratio",
                "s3_metric_v", "s3_metric_R", "s3_metric_theta", "s3_metric_phi", "s3_tiny_step", "s3_step_e2",
-               "s3_step_e3", "s3_step_e4", "s3_arg_hi", "s3_arg_lo")
+               "s3_step_e3", "s3_step_e4", "s3_arg_hi", "s3_arg_lo", "ix_mean_off", "census_rms_slope_straddling",
+               "s4_best_label", "s4_best_ratio", "s6_acc_label", "s7_cap_deg", "s7_crease_dip", "s7_parts_chart",
+               "s7_parts_surface", "s7_parts_label", "s7_tilt_chart", "s7_tilt_surface", "s3_torus_a", "s3_torus_r",
+               "s3_torus_point", "s3_torus_dot", "s3_torus_Lu", "s3_torus_Lv", "s3_torus_kappa_u",
+               "s3_torus_kappa_v", "s3_torus_h", "s3_torus_hu", "s3_torus_hv", "s3_torus_exact", "s3_torus_first",
+               "s3_torus_tilt", "s3_torus_agree")
 
 
 def page_glue(notebook: dict) -> dict:

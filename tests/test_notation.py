@@ -21,6 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
+    "displaced-normal": "0e2d782e0c4c7b4f",
     "chart": "a103b721422aac5e",
     "frame-orthonormal": "59d20494cb0bbe94",
     "frame-orientation": "f8fe212f89933948",
