@@ -20,7 +20,12 @@ A record is served only when it is well formed (`_served`): a JSON object of exa
 the fields written, each of its type, whose ``sha256`` is the checksum of the others
 (`_checksum`).  Anything else (not JSON, another shape, a value edited by hand
 while the digest still matches, a record larger than `MAX_RECORD_BYTES`, not a
-regular file) is computed again and replaced, never served and never a traceback.
+regular file: a link, a FIFO) is computed again and replaced, never served and never
+a traceback.  The checksum guards against accidents only (a truncated write, an edit
+by hand): anyone who can write the directory can write a record with a matching
+checksum.  So the store refuses a directory that is not this user's or that other
+users can write (`UntrustedStore`), as the renderer's compile cache does, and never
+follows a link or blocks on a FIFO where its lock or its record should be.
 """
 
 from __future__ import annotations
@@ -37,7 +42,7 @@ from pathlib import Path
 
 from renderer import files
 
-__all__ = ["ENV", "measured", "source_digest"]
+__all__ = ["ENV", "UntrustedStore", "measured", "source_digest"]
 
 #: Environment variable naming the store's directory.
 ENV = "SYMRENDER_STORE"
@@ -51,6 +56,30 @@ MAX_RECORD_BYTES = 16 << 20
 FIELDS = {"name": str, "params": dict, "digest": str, "value": object, "sha256": str}
 _MEMORY = {}
 _DIGEST = []
+
+
+class UntrustedStore(ValueError):
+    """The store's directory (``SYMRENDER_STORE``) could hold another user's records: it is not
+    owned by this user, or others can write it."""
+
+
+def _trusted(directory):
+    """``directory`` as a Path, created (mode 0700) when absent; `UntrustedStore` naming it and why
+    when it is not a directory this user owns and only this user can write."""
+    path = Path(directory)
+    try:
+        path.mkdir(mode=0o700, parents=True, exist_ok=True)
+        st = os.stat(path)
+    except OSError as exc:
+        raise UntrustedStore(f"{ENV}={directory}: cannot be used as the measurement store ({exc.strerror})") from None
+    why = ("is not a directory" if not stat.S_ISDIR(st.st_mode) else
+           f"is owned by uid {st.st_uid}, not by this user (uid {os.getuid()})" if st.st_uid != os.getuid() else
+           f"can be written by other users (mode {stat.S_IMODE(st.st_mode):04o})"
+           if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH) else None)
+    if why:
+        raise UntrustedStore(f"{ENV}={directory} {why}: a record planted there, its checksum recomputed, would be "
+                             "served as a measurement; use a directory only you can write (chmod go-w)")
+    return path
 
 
 def _roots():
@@ -95,6 +124,8 @@ def measured(name, compute, **params):
     ------
     ValueError
         ``name`` is not of that form.
+    UntrustedStore
+        The store's directory is not this user's own (`_trusted`).
     TypeError
         The value or the parameters are not JSON-able (nothing is written).
     """
@@ -105,7 +136,7 @@ def measured(name, compute, **params):
     if (name, key) in _MEMORY:
         return _MEMORY[name, key]
     directory = os.environ.get(ENV)
-    path = Path(directory, f"{name}.json") if directory else None
+    path = _trusted(directory) / f"{name}.json" if directory else None
     with _locked(path):
         record = _served(_read(path), name, json.loads(key))
         if record is not None:
@@ -121,18 +152,34 @@ def measured(name, compute, **params):
 
 @contextmanager
 def _locked(path):
-    """Hold an exclusive lock on ``<path>.lock`` (no lock for the in-memory store): pages
-    executed at once that need the same measurement wait for the first to compute it."""
+    """Hold an exclusive lock on ``.<name>.json.lock`` beside ``path`` (no lock for the in-memory
+    store): pages executed at once that need the same measurement wait for the first to compute
+    it.  The lock file is opened without following a link and without blocking on a FIFO; where
+    it is not a regular file the measurement is computed unlocked (at worst twice: each record is
+    written whole), with a warning naming it."""
     if path is None:
         yield
         return
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path.with_name(f".{path.name}.lock"), "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(lock, fcntl.LOCK_UN)
+    lock_path = path.with_name(f".{path.name}.lock")
+    try:
+        fd = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, 0o600)
+    except OSError as exc:
+        fd, why = None, exc.strerror
+    else:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            fd, why = None, "not a regular file"
+    if fd is None:
+        import warnings
+        warnings.warn(f"{lock_path} cannot be the measurement's lock ({why}); computing {path.name} without it",
+                      stacklevel=4)
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)                                  # releases the lock
 
 
 def _checksum(record):
@@ -171,15 +218,16 @@ def _read(path):
 
 
 def _write(path, record):
-    """Write ``record`` to ``path`` atomically (`renderer.files.write_bytes`); the
-    directory exists (`_locked` made it).
-
-    Raises
-    ------
-    ValueError
-        ``path`` exists and is not a regular file (a symbolic link, a FIFO, a device, a
-        directory): a record replaces only a record, and is never written through to
-        something else."""
-    if os.path.islink(path) or (os.path.lexists(path) and not os.path.isfile(path)):
-        raise ValueError(f"{str(path)!r} is not a regular file (accepted: a record the store wrote, or no file)")
+    """Write ``record`` to ``path`` atomically (`renderer.files.write_bytes`); the directory
+    exists (`_trusted` made it).  Whatever else is at ``path`` (a symbolic link, a FIFO, a
+    device node) is removed first, never written through; where that cannot be done (a
+    directory) the value is kept for this process only, with a warning naming the path."""
+    if os.path.lexists(path) and (os.path.islink(path) or not os.path.isfile(path)):
+        try:
+            os.unlink(path)                        # the link itself, not its target
+        except OSError as exc:
+            import warnings
+            warnings.warn(f"{path} is not a record and cannot be replaced ({exc.strerror}); the measurement "
+                          "is kept for this process only", stacklevel=4)
+            return
     files.write_bytes(path, json.dumps(record).encode("utf-8"))   # key order kept: reads back as written

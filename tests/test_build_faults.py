@@ -310,3 +310,61 @@ def test_two_builds_in_one_tree_take_turns(tmp_path, token):
     second.passes()
     assert second.stderr().count(waiting) == 1 and executions(book) == ["a v1"]
     shows(book, "v1")
+
+
+# ------------------------------------------------------------------ paths the build cannot use
+
+
+def _refusal():
+    sys.path.insert(0, str(ENTRY.parent))
+    try:
+        from execute_pages import refusal
+    finally:
+        sys.path.pop(0)
+    return refusal
+
+
+@pytest.mark.parametrize("where", ["lock", "digest", "complete"])
+@pytest.mark.parametrize("kind", ["fifo", "link", "loop", "directory"])
+def test_a_special_file_where_the_build_writes_is_named_in_one_line(tmp_path, where, kind):
+    """The lock, the cache's digest and the doctrees' mark: a FIFO (a blocking open), a link (followed
+    out of the tree), a link loop or a directory in place of each is refused by name, its kind said;
+    a regular file or none passes (the wrong variant: the check would refuse the build's own files)."""
+    refusal = _refusal()
+    book, doctrees, cache = tmp_path / "book", tmp_path / "book/_build/.doctrees", tmp_path / "book/_build/.jc"
+    for d in (book, doctrees, cache):
+        d.mkdir(parents=True, exist_ok=True)
+    path = {"lock": book / ".build.lock", "digest": cache / "source-digest", "complete": doctrees / "build-complete"}[where]
+    assert refusal(book, doctrees, cache) is None
+    path.write_text("x")
+    assert refusal(book, doctrees, cache) is None
+    path.unlink()
+    {"fifo": lambda: os.mkfifo(path), "link": lambda: path.symlink_to(tmp_path / "outside"),
+     "loop": lambda: path.symlink_to(path), "directory": path.mkdir}[kind]()
+    said = {"fifo": "a special file (a FIFO or a device)", "link": "a symbolic link", "loop": "a symbolic link",
+            "directory": "a directory"}[kind]
+    assert refusal(book, doctrees, cache) == f"{path} is {said}, not the build's file: remove it and build again"
+    assert not (tmp_path / "outside").exists()
+
+
+def test_a_tree_the_build_cannot_write_is_named(tmp_path, monkeypatch):
+    """A read-only book directory (os.access says so: root passes every mode check, so the test
+    asks os.access as a read-only mount would answer) is refused in one line naming it."""
+    refusal = _refusal()
+    book = tmp_path / "book"
+    book.mkdir()
+    real = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode: False if Path(p) == book else real(p, mode))
+    assert refusal(book, book / "_build/.doctrees", book / "_build/.jc") == \
+        f"{book} cannot be written (read-only?): the build writes its output and its lock there"
+
+
+def test_make_book_with_a_fifo_for_its_lock_stops_at_once_with_one_line(tmp_path, token):
+    """End to end: the build neither hangs on the FIFO nor prints a traceback; exit status 2."""
+    book = make_book(tmp_path / "book")
+    os.mkfifo(book / ".build.lock")
+    build = Build(book, token)
+    assert build.wait(timeout=120) == 2
+    err = build.stderr()
+    assert f"make book: {book / '.build.lock'} is a special file (a FIFO or a device)" in err
+    assert "Traceback" not in err and not executions(book)

@@ -171,32 +171,105 @@ def test_the_checksum_rejects_an_edited_value_that_the_digest_alone_would_serve(
 
 
 @pytest.mark.parametrize("kind", ["link", "fifo", "too-big"])
-def test_a_record_that_is_not_a_small_regular_file_is_never_served(fresh, monkeypatch, kind):
+def test_a_record_that_is_not_a_small_regular_file_is_never_served_and_is_replaced(fresh, monkeypatch, kind):
     """A symbolic link (to a valid record, even), a FIFO (which would block a plain read) or a
-    file over `MAX_RECORD_BYTES` is not read: the value is computed again.  A record that is
-    too big is then replaced; a link or a FIFO is refused, naming it (the store writes neither
-    through a link nor into a FIFO, where a write would block)."""
+    file over `MAX_RECORD_BYTES` is not read: the value is computed again and a record the store
+    writes takes its place.  A link is replaced itself, its target left as it was; nothing is
+    written through it or into the FIFO."""
     import os
     directory, calls, compute = fresh
     store.measured("u-curve", compute, size=256)
-    path = directory / "u-curve.json"
+    path, elsewhere = directory / "u-curve.json", directory / "elsewhere.json"
     if kind == "link":
-        path.rename(directory / "elsewhere.json")
-        path.symlink_to(directory / "elsewhere.json")
+        path.rename(elsewhere)
+        path.symlink_to(elsewhere)
     elif kind == "fifo":
         path.unlink()
         os.mkfifo(path)
     else:
         monkeypatch.setattr(store, "MAX_RECORD_BYTES", path.stat().st_size - 1)
+    before = elsewhere.read_bytes() if kind == "link" else None
     _new_process(monkeypatch)
-    if kind == "too-big":
+    store.measured("u-curve", compute, size=256)
+    assert len(calls) == 2 and path.is_file() and not path.is_symlink()
+    assert _stored(directory)["sha256"] == store._checksum(_stored(directory))
+    if kind == "link":
+        assert elsewhere.read_bytes() == before
+
+
+def test_a_directory_in_place_of_a_record_is_kept_and_the_value_is_still_given(fresh, monkeypatch):
+    directory, calls, compute = fresh
+    (directory / "u-curve.json").mkdir()
+    with pytest.warns(UserWarning, match=r"u-curve.json is not a record and cannot be replaced"):
+        assert store.measured("u-curve", compute, size=256)["value"] == 0.1 + 0.2
+    assert (directory / "u-curve.json").is_dir() and len(calls) == 1
+    assert sorted(p.name for p in directory.iterdir() if not p.name.endswith(".lock")) == ["u-curve.json"]
+
+
+@pytest.mark.parametrize("mode", [0o777, 0o770, 0o722])
+def test_a_store_others_can_write_is_refused_and_its_planted_record_never_served(fresh, monkeypatch, mode):
+    """The checksum is not an authentication: a record planted in a directory others can write, its
+    sha256 recomputed, would be served.  Such a directory is refused, naming it and its mode; the
+    same directory private to the user serves the record (the wrong variant: the check off)."""
+    import os
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    planted = {**_stored(directory), "value": 999}
+    (directory / "u-curve.json").write_text(json.dumps({**planted, "sha256": store._checksum(planted)}))
+    _new_process(monkeypatch)
+    os.chmod(directory, mode)
+    with pytest.raises(store.UntrustedStore, match=rf"^{store.ENV}={directory} can be written by other users "
+                                                   rf"\(mode {mode:04o}\): .*chmod go-w\)$"):
         store.measured("u-curve", compute, size=256)
-        assert _stored(directory)["sha256"] == store._checksum(_stored(directory))
-    else:
-        with pytest.raises(ValueError, match=r"u-curve.json' is not a regular file \(accepted: a record the "
-                                              r"store wrote, or no file\)$"):
-            store.measured("u-curve", compute, size=256)
-    assert len(calls) == 2
+    monkeypatch.setattr(store, "_trusted", lambda d: directory)             # the check removed
+    assert store.measured("u-curve", compute, size=256) == 999
+
+
+def test_a_store_of_another_user_or_not_a_directory_is_refused(fresh, monkeypatch, tmp_path):
+    import os
+    directory, calls, compute = fresh
+    uid = os.getuid()
+    monkeypatch.setattr(store.os, "getuid", lambda: uid + 1)
+    with pytest.raises(store.UntrustedStore, match=rf"is owned by uid {uid}, not by this user \(uid {uid + 1}\)"):
+        store.measured("u-curve", compute)
+    monkeypatch.setattr(store.os, "getuid", lambda: uid)
+    monkeypatch.setenv(store.ENV, str(directory / "file"))
+    (directory / "file").write_text("")
+    with pytest.raises(store.UntrustedStore, match=r"/file: cannot be used as the measurement store"):
+        store.measured("u-curve", compute)
+    assert calls == []
+
+
+def test_a_new_store_is_created_private(tmp_path, monkeypatch):
+    import os
+    monkeypatch.setattr(store, "_MEMORY", {})
+    monkeypatch.setenv(store.ENV, str(tmp_path / "new" / "store"))
+    old = os.umask(0o002)                                      # a group-writable umask
+    try:
+        store.measured("x", lambda: 1)
+    finally:
+        os.umask(old)
+    assert (tmp_path / "new" / "store").stat().st_mode & 0o777 == 0o700
+
+
+@pytest.mark.parametrize("kind", ["fifo", "link", "directory"])
+def test_a_lock_that_is_not_a_regular_file_neither_blocks_nor_is_followed(fresh, kind):
+    """A FIFO in place of a measurement's lock would block a plain open, a link would make the store
+    create its target: each is opened without following and without blocking, and the value is
+    computed unlocked, with a warning naming the lock; the link's target is never created."""
+    import os
+    import signal
+    directory, calls, compute = fresh
+    lock, target = directory / ".u-curve.json.lock", directory.parent / f"victim-{kind}"
+    {"fifo": lambda: os.mkfifo(lock), "link": lambda: lock.symlink_to(target), "directory": lock.mkdir}[kind]()
+    signal.signal(signal.SIGALRM, lambda *a: pytest.fail("the store blocked on its lock"))
+    signal.alarm(20)
+    try:
+        with pytest.warns(UserWarning, match=r"\.u-curve\.json\.lock cannot be the measurement's lock"):
+            assert store.measured("u-curve", compute, size=256)["value"] == 0.1 + 0.2
+    finally:
+        signal.alarm(0)
+    assert len(calls) == 1 and not target.exists() and _stored(directory)["value"]["value"] == 0.1 + 0.2
 
 
 def test_an_unreadable_record_is_computed_again(fresh, monkeypatch):
@@ -286,16 +359,6 @@ def test_without_a_store_parameters_in_any_order_are_one_measurement(monkeypatch
     real_dumps = store.json.dumps
     monkeypatch.setattr(store.json, "dumps", lambda obj, **kw: real_dumps(obj))   # ignores sort_keys
     assert ask() == 2
-
-
-def test_a_failed_write_leaves_no_temporary_file(fresh):
-    """The record cannot replace its path (a directory is in the way): the
-    error (the store writes only a regular file) propagates and no temporary file is left."""
-    directory, calls, compute = fresh
-    (directory / "u-curve.json").mkdir()
-    with pytest.raises(ValueError, match="not a regular file"):
-        store.measured("u-curve", compute)
-    assert sorted(p.name for p in directory.iterdir() if not p.name.endswith(".lock")) == ["u-curve.json"]
 
 
 def test_a_record_with_its_fields_in_another_order_is_served(fresh, monkeypatch):

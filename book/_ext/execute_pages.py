@@ -31,6 +31,11 @@ alone, and executes the pages it has to one after another.  This extension:
    ``execute_pages_last``, the others between them.  myst-nb then finds each page in the
    cache; a page that failed is not cached, and myst-nb executes it again and reports its
    error as usual.
+Before any of this, the paths the build writes are checked (`refusal`): the lock, the cache's
+   digest and the doctrees' ``build-complete`` must each be a regular file or absent (a link,
+   a FIFO or a directory in their place would be followed, block the build or stop it with a
+   traceback) and the directories writable; else the build stops with one line naming the
+   path and what to do, exit status 2.
 4. Stops on SIGINT (Ctrl-C) or SIGTERM.  The build's process freezes every process it
    started (the pool's, their kernels, a kernel myst-nb runs), so that none starts another,
    kills them, removes their kernels' connection files, prints one line and exits with
@@ -97,11 +102,36 @@ def _lock(path):
     return lock
 
 
+_KINDS = ((os.path.islink, "a symbolic link"), (os.path.isdir, "a directory"), (os.path.isfile, None))
+
+
+def refusal(book, doctrees, cache):
+    """Why the build cannot use its paths, in one line naming the path, or None.
+
+    ``book``, ``doctrees``, ``cache``: the book's directory, Sphinx's doctree directory and the
+    jupyter-cache directory.  The lock (`LOCK_FILE`), the digest (`DIGEST_FILE`) and the build's
+    mark (`COMPLETE_FILE`) must each be absent or a regular file (not a symbolic link, a FIFO, a
+    device or a directory), and the book's directory and each of the others that exists writable."""
+    for path in (Path(book) / LOCK_FILE, Path(cache) / DIGEST_FILE, Path(doctrees) / COMPLETE_FILE):
+        if os.path.lexists(path):
+            kind = next((k for test, k in _KINDS if test(path)), "a special file (a FIFO or a device)")
+            if kind is not None:
+                return f"{path} is {kind}, not the build's file: remove it and build again"
+    for directory in (Path(book), Path(doctrees), Path(cache)):
+        if directory.exists() and not os.access(directory, os.W_OK | os.X_OK):
+            return f"{directory} cannot be written (read-only?): the build writes its output and its lock there"
+    return None
+
+
 def _begin(app, config):
     """Take the build's lock, then set aside what of the last build's output is not to be trusted (2.)."""
     from lab.store import source_digest
     from renderer import files
     from sphinx.application import ENV_PICKLE_FILENAME
+    why = refusal(app.srcdir, app.doctreedir, _cache_dir(app))
+    if why:
+        print(f"make book: {why}", file=sys.stderr, flush=True)
+        raise SystemExit(2)
     _build["lock"] = _lock(Path(app.srcdir) / LOCK_FILE)
     digest, doctrees, cache = source_digest(), Path(app.doctreedir), _cache_dir(app)
     complete = _read(doctrees / COMPLETE_FILE) == digest
