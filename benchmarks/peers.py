@@ -75,8 +75,8 @@ def _scene(xp, x, y, s, gradient):
     sp = xp.sqrt(nx * nx + ny * ny)
     u = (xp.atan2(ny, nx) + math.pi) / (2 * math.pi)
     v = xp.atan2(sp, nz) / math.pi
-    inv = 1.0 / xp.maximum(sp, 1e-300)
-    pole = sp > 1e-4
+    inv = 1.0 / xp.maximum(sp, 2.0**-1022)
+    pole = sp > 2.0**-1022          # the chart's frame down to float64's smallest normal, as the renderer
     etx, ety = xp.where(pole, -ny * inv, 1.0), xp.where(pole, nx * inv, 0.0)
     epx, epy, epz = xp.where(pole, nz * nx * inv, 0.0), xp.where(pole, nz * ny * inv, 1.0), xp.where(pole, -sp, 0.0)
     au, av = math.pi * s.k_u, math.pi * s.k_v

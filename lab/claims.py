@@ -491,6 +491,9 @@ def _noise_below_1e11():
 
 #: The step of the draft's Cell 7b (its crease: ``{**SCr, 'eps': 1e-4}``).
 CELL7B_STEP = 1e-4
+#: The draft's pole cut-off (Cell 7c; seed Cell 1, ``tangent_frame``): its fixed basis below this
+#: sin(phi).  The renderer keeps the chart's frame down to `formulas.POLE_SIN_PHI` (2^-1022).
+CELL7C_POLE_SIN_PHI = 1e-4
 
 
 def _crease_values():
@@ -504,7 +507,7 @@ def _crease_values():
 
 def _pole_pixels():
     g = gbuffer(DRAFT_SCENE, 256, 256)
-    n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= float(F.POLE_SIN_PHI))))
+    n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= CELL7C_POLE_SIN_PHI)))
     return {"fallback pixels": n, **_on(g, DRAFT_SCENE)}
 
 

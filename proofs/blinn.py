@@ -35,7 +35,7 @@ from renderer import formulas as F
 
 from .core import Cross, Dot, Step, Theorem, catalogue
 from .frame import (CHART_RATES, EP_S, ET_S, N, N_S, ON_SPHERE, PHI_OF_V, STANDARD_FRAME, THETA_OF_U, U_OF_THETA,
-                    V_OF_PHI, VECTOR_NAMES, e_phi, e_theta, phi, theta)
+                    V_OF_PHI, VECTOR_NAMES, e_phi, e_theta, off_pole, phi, theta)
 
 _TO_ANGLES = {F.u: U_OF_THETA, F.v: V_OF_PHI}
 #: Sphere A as a parametric surface P(u, v) of the renderer's chart.
@@ -76,11 +76,9 @@ def blinn_normal(f_u=F_U, f_v=F_V, sign_v=-1):
 
 
 #: The renderer's normals on the sphere: its symbols at N(theta, phi) in its frame's regular branch, and
-#: for bump="surface" its pole floor max(sin phi, POLE_SIN_PHI) read as sin phi (off the cut-off).
+#: for bump="surface" its pole branch read as the regular one (`frame.off_pole`: off the cut-off).
 _RENDERER_AT = {**ON_SPHERE, **dict(zip(F.e_theta, e_theta)), **dict(zip(F.e_phi, e_phi))}
-_FLOOR = sp.Max(F.sin_phi, F.POLE_SIN_PHI)
-RENDERER = {mode: sp.ImmutableMatrix(F.PERTURBED_NORMAL[mode]).xreplace({_FLOOR: F.sin_phi})
-            for mode in ("surface", "chart")}
+RENDERER = {mode: off_pole(sp.ImmutableMatrix(F.PERTURBED_NORMAL[mode])) for mode in ("surface", "chart")}
 
 #: The slopes the theorem states, written by hand: Blinn's, exactly linear in beta; the displaced sphere's
 #: (and the renderer's bump="surface"), R + beta h in place of R; the draft's (bump="chart"), +beta (h_u, h_v).

@@ -21,10 +21,11 @@ normal of the sphere displaced by G = -pi R h; for sine and ridges it fails, so 
 seed's bump is the normal of no displaced sphere.
 
 The renderer's bump="surface" is checked twice: its coefficients
-(`renderer.formulas.BUMP["surface"]`, off the pole cut-off) equal the
-bracket's in chart terms, with the chart's rates du/dtheta and dv/dphi taken
-from `renderer.formulas.CHART` (theorem `chart`); and its rendered normals
-equal the displaced surface's, evaluated by mpmath.
+(`renderer.formulas.BUMP["surface"]`, wherever sin phi > `formulas.POLE_SIN_PHI`,
+float64's smallest normal number) equal the bracket's in chart terms, with the
+chart's rates du/dtheta and dv/dphi taken from `renderer.formulas.CHART`
+(theorem `chart`); and its rendered normals equal the displaced surface's,
+evaluated by mpmath, the pixels inside the seed's pole cut-off sin phi <= 1e-4 included.
 """
 
 from functools import lru_cache, partial
@@ -36,7 +37,7 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Cross, Step, Theorem, Verdict, calc, catalogue, listed, spelled, written
-from .frame import PHI_OF_V, THETA_OF_U, U_OF_THETA, V_OF_PHI
+from .frame import PHI_OF_V, SEED_POLE_SIN_PHI, THETA_OF_U, U_OF_THETA, V_OF_PHI, off_pole
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, beta = sp.symbols("R beta", positive=True)
@@ -60,13 +61,8 @@ SEED_READING = sp.MatMul((R + beta * H_at) ** 2 * sp.sin(phi),
                          sp.MatAdd(N_S, beta * (2 * sp.pi * H_t * ET_S + sp.pi * H_p * EP_S), evaluate=False),
                          evaluate=False)
 
-#: The renderer's coefficients of bump="surface" (`renderer.formulas.BUMP`) away from
-#: the pole cut-off, where its floor max(sin phi, POLE_SIN_PHI) is sin phi.
-_FLOOR = sp.Max(F.sin_phi, F.POLE_SIN_PHI)
-
-
 def away_from_pole(bump):
-    """A bump's coefficients away from the pole cut-off.
+    """A bump's coefficients away from the pole.
 
     Parameters
     ----------
@@ -77,13 +73,13 @@ def away_from_pole(bump):
     Returns
     -------
     tuple of two sympy expressions
-        The same with the kernel's floor max(sin_phi, POLE_SIN_PHI) replaced by
-        sin_phi: equal to the input wherever sin_phi > POLE_SIN_PHI (1e-4), the
-        only region the symbolic identities below compare.  An expression
-        without the floor comes back unchanged.  Source: the renderer's pole
-        guard (seed §3, the 1/sin phi of the chart's v-derivative).
+        The same with the pole branch (Piecewise on sin_phi > POLE_SIN_PHI, 0 at the
+        pole) replaced by its regular branch (`proofs.frame.off_pole`): equal to the
+        input wherever sin_phi > POLE_SIN_PHI (2^-1022), the only region the symbolic
+        identities below compare.  Anything else (a floor max(sin_phi, c), say) comes
+        back unchanged.
     """
-    return tuple(b.subs(_FLOOR, F.sin_phi) for b in bump)
+    return tuple(off_pole(sp.sympify(b)) for b in bump)
 
 
 KERNEL_COEFFS = away_from_pole(F.BUMP["surface"])
@@ -140,7 +136,8 @@ def integrable():
 
 
 def surface_normal_residual(bump, gradient, fields=None):
-    """(worst |N'_renderer - N'_exact|, pixels compared, pixels left out) for the renderer's
+    """(worst |N'_renderer - N'_exact|, pixels compared, pixels left out, pixels compared inside the seed's
+    pole cut-off sin phi <= 1e-4) for the renderer's
     `bump` ('surface' is the one claimed to be the displaced normal) and `gradient`
     ('exact'; 'central' differs by its truncation error).
 
@@ -148,49 +145,52 @@ def surface_normal_residual(bump, gradient, fields=None):
     3e4, crease neighbours) of each of ``fields`` (names; every registered field by default).  N'_exact normalises P_v x P_u of
     P(u, v) = (R + beta h(u, v)) N(theta(u), phi(v)) at the pixel's (u, v), in mpmath at
     `pixels.DIGITS` digits (P_v x P_u = (dtheta/du)(dphi/dv) P_phi x P_theta, an outward
-    normal); N'_renderer is the G-buffer's Ns.  Pixels with sin phi <= `formulas.POLE_SIN_PHI`,
-    where the renderer floors sin phi by design, are left out (and counted).
+    normal); N'_renderer is the G-buffer's Ns.  Pixels with sin phi <= `formulas.POLE_SIN_PHI`
+    (the pole itself, where the displaced surface has no normal) are left out (and counted).
     """
     from .pixels import DIGITS, pixels
-    worst, compared, left_out = 0.0, 0, 0
+    worst, compared, left_out, inside = 0.0, 0, 0, 0
     for field in F.FIELDS if fields is None else fields:
         scene, px = pixels(field, gradient, bump)
         P = (scene.radius_a + scene.beta * F.FIELDS[field].expr.subs({F.k_u: scene.k_u, F.k_v: scene.k_v})) \
             * N.subs({theta: THETA_OF_U, phi: PHI_OF_V}, simultaneous=True)
         fn = sp.lambdify((F.u, F.v), list(sp.diff(P, F.v).cross(sp.diff(P, F.u))), modules="mpmath", cse=True)
-        keep = np.sin(np.pi * px["uv"][:, 1]) > float(F.POLE_SIN_PHI)
+        sin_phi = np.sin(np.pi * px["uv"][:, 1])
+        keep = sin_phi > float(F.POLE_SIN_PHI)
         compared, left_out = compared + int(np.count_nonzero(keep)), left_out + int(np.count_nonzero(~keep))
+        inside += int(np.count_nonzero(keep & (sin_phi <= SEED_POLE_SIN_PHI)))
         for (uu, vv), got in zip(px["uv"][keep], px["Ns"][keep]):
             with mpmath.workdps(DIGITS):
                 c = fn(mpmath.mpf(float(uu)), mpmath.mpf(float(vv)))
                 n = mpmath.sqrt(sum(x * x for x in c))
                 worst = max(worst, max(float(abs(mpmath.mpf(float(gk)) - ck / n)) for gk, ck in zip(got, c)))
-    return worst, compared, left_out
+    return worst, compared, left_out, inside
 
 
 def _evidence(kernel=KERNEL_COEFFS, claimed=None, bump="surface", gradient="exact"):
-    """The renderer: its surface-bump coefficients ``kernel`` carry no floor but the pole's; the seed's
+    """The renderer: its surface-bump coefficients ``kernel`` carry no floor of sin phi; the seed's
     bump is a displacement's normal for the fields ``claimed`` (default `integrable`) and no other (the
     obstruction of each of the renderer's fields); the rendered normals of ``bump`` and ``gradient`` are
     the displaced surface's."""
     if any(c.has(sp.Max) for c in kernel):
-        return Verdict("refuted", f"a floor other than max(sin_phi, POLE_SIN_PHI) in the surface bump: {kernel}")
+        return Verdict("refuted", f"a floor of sin phi in the surface bump, whose 1/sin phi is exact down to "
+                       f"POLE_SIN_PHI: {kernel}")
     obstruction = {name: integrability_obstruction(f) for name, f in F.FIELDS.items()}
     found = tuple(f for f, o in obstruction.items() if o == 0)
     claimed = found if claimed is None else claimed
     if set(found) != set(claimed):
         return Verdict("refuted", f"the draft's bump is a displaced sphere's normal for {found or 'no field'}, "
                        f"not {claimed}: integrability obstructions {obstruction}")
-    worst, compared, left_out = surface_normal_residual(bump, gradient)
+    worst, compared, left_out, inside = surface_normal_residual(bump, gradient)
     if worst > 1e-12:
         return Verdict("refuted", f"renderer's bump={bump!r}, gradient={gradient!r} normal differs from the displaced "
                        f"surface's by {worst:.2e}", worst, rendered=compared)
     return Verdict("proved", f"the obstruction is 0 for {', '.join(found)} only (the draft's bump is the normal of no "
                    f"displaced sphere for the others); the renderer's surface-bump normals within {worst:.1e} of the "
                    f"displaced normal (mpmath, {compared} seeded sphere-A pixels of the {spelled(len(F.FIELDS))} fields, "
-                   "pole ring and "
-                   f"crease neighbours included; {left_out} inside the pole floor sin phi <= "
-                   f"{float(F.POLE_SIN_PHI):g} left out)", rendered=compared)
+                   f"pole ring, crease neighbours and the {inside} inside the draft's pole cut-off sin phi <= "
+                   f"{SEED_POLE_SIN_PHI:g} included"
+                   + (f"; {left_out} at the pole itself left out)" if left_out else ")"), rendered=compared)
 
 
 def _displaced(weight=-beta / (R + beta * H_at)):
@@ -264,9 +264,10 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
         evidence=partial(_evidence, kernel, **evidence),
         wrong_variants=(("the renderer's chart bump (the seed's) as the displaced normal's coefficients",
                          lambda: _theorem(kernel=F.BUMP["chart"]).check()),
-                        ("a surface bump floored at sin phi = 1e-3, not POLE_SIN_PHI",
+                        ("the seed's floor back: the surface bump's sin phi floored at 1e-4",
                          lambda: _theorem(kernel=away_from_pole(
-                             tuple(c.subs(F.POLE_SIN_PHI, sp.Float(1e-3)) for c in F.BUMP["surface"]))).check()),
+                             (_w * F.h_u / (2 * sp.pi * sp.Max(F.sin_phi, SEED_POLE_SIN_PHI)),
+                              F.BUMP["surface"][1]))).check()),
                         ("the seed's bump the normal of a displaced sphere for every field",
                          lambda: _theorem(claimed=tuple(F.FIELDS)).check()),
                         ("the renderer's bump='chart' normals as the displaced surface's",

@@ -47,6 +47,15 @@ def regular_branch(component):
     return component.args[0].expr if isinstance(component, sp.Piecewise) else component
 
 
+def off_pole(expr):
+    """``expr`` (a sympy expression or matrix in the symbols of `renderer.formulas`) with each
+    pole branch, a Piecewise whose first condition is sin_phi > POLE_SIN_PHI (the frame's, and
+    the surface bump's e_theta coefficient), replaced by its regular branch: equal to ``expr``
+    wherever sin phi > POLE_SIN_PHI (2^-1022), the only region the symbolic identities compare."""
+    return expr.replace(lambda e: isinstance(e, sp.Piecewise) and e.args[0].cond == (F.sin_phi > F.POLE_SIN_PHI),
+                        lambda e: e.args[0].expr)
+
+
 #: The renderer's frame where sin(phi) > POLE_SIN_PHI, in terms of N_x, N_y, N_z, sin_phi.
 REGULAR = tuple(regular_branch(c) for c in F.TANGENT_FRAME)
 #: ... and at N(theta, phi).
@@ -80,8 +89,9 @@ def _chart_evidence(corrupt=None):
     if worst > TOLERANCE["chart"]:
         return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
                        f"{count} sphere-A pixels")
-    return Verdict("proved", f"the renderer's (u, v) at {count} seeded sphere-A pixels (pole ring and "
-                   f"fallback included) within {worst:.1e} of the chart, evaluated by mpmath at its N", rendered=count)
+    return Verdict("proved", f"the renderer's (u, v) at {count} seeded sphere-A pixels (pole ring and the "
+                   f"draft's disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} of the chart, "
+                   "evaluated by mpmath at its N", rendered=count)
 
 
 def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
@@ -95,7 +105,8 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
                    r"$u$: $⟦u⟧$, $v$: $⟦v⟧$ and $⟦sin⟧$; so $⟦rates⟧$, the factors between chart and angular "
                    r"derivatives of $h$."),
         steps=(
-            Step(r"At $N(\theta, \varphi)$ the radicand is $\sin^2\varphi\,(\cos^2\theta + \sin^2\theta) = "
+            Step(r"$\operatorname{hypot}(N_x, N_y) = \sqrt{N_x^2 + N_y^2}$ (evaluated without forming the squares); "
+                 r"at $N(\theta, \varphi)$ the radicand is $\sin^2\varphi\,(\cos^2\theta + \sin^2\theta) = "
                  r"\sin^2\varphi$, and $\sin\varphi > 0$ for $0 < \varphi < \pi$", sin_kernel, sp.sin(phi),
                  why_numeric=r"sympy leaves $\sqrt{\sin^2\varphi}$ as $\lvert\sin\varphi\rvert$: its symbol "
                              r"$\varphi$ is real, with no interval to tell it $\sin\varphi > 0$"),
@@ -123,16 +134,21 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
 
 
 # ------------------------------------------------------------------------------- the frame
-#: The cut-off below which the frame is the fallback (seed Cell 1, ``tangent_frame``: sin phi > 1e-4).
+#: The seed's cut-off below which its frame is the fallback (seed Cell 1, ``tangent_frame``: sin phi > 1e-4).
 SEED_POLE_SIN_PHI = 1e-4
+#: The renderer's: float64's smallest normal number.  Above it 1/sin phi is finite and sin phi
+#: has its 53 bits, so the regular branch is evaluated as written; at or below it sin phi is 0
+#: (the pole itself) or subnormal.
+POLE_CLAIMED = 2.0**-1022
 
 
 def _branch_structure(frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
     """Refuted unless every component of ``frame`` (TANGENT_FRAME) is Piecewise((regular,
     sin_phi > POLE_SIN_PHI), (fallback, True)) with FALLBACK_FRAME's values,
-    and ``pole`` (POLE_SIN_PHI) is the seed's cut-off."""
-    if pole != SEED_POLE_SIN_PHI:
-        return Verdict("refuted", f"POLE_SIN_PHI is {pole}, the seed's cut-off is {SEED_POLE_SIN_PHI}")
+    and ``pole`` (POLE_SIN_PHI) is `POLE_CLAIMED`."""
+    if float(pole) != POLE_CLAIMED:
+        return Verdict("refuted", f"POLE_SIN_PHI is {pole}: the regular frame is evaluable in float64 down to "
+                       f"its smallest normal number {POLE_CLAIMED:g} (the draft cut it off at {SEED_POLE_SIN_PHI:g})")
     for k, (c, fallback) in enumerate(zip(frame, F.FALLBACK_FRAME)):
         if not isinstance(c, sp.Piecewise):
             ok = c.is_number and c - fallback == 0         # both branches equal: folded by sympy
@@ -157,10 +173,11 @@ def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
     if worst > TOLERANCE["normal"]:
         return Verdict("refuted", f"the renderer's N' differs from PERTURBED_NORMAL in this frame by {worst:.1e} "
                        f"at some of {count} sphere-A pixels")
-    return Verdict("proved", f"the tangent frame is its regular branch where sin phi > {float(F.POLE_SIN_PHI):g} and its "
-                   f"fallback elsewhere, in each component; the renderer's N' (both bump modes, {len(F.FIELDS)} fields) at {count} seeded sphere-A "
-                   f"pixels (pole ring and fallback included) within {worst:.1e} of the perturbed normal evaluated "
-                   "by mpmath in this frame", rendered=count)
+    return Verdict("proved", f"the tangent frame is its regular branch where sin phi > {float(F.POLE_SIN_PHI):g} "
+                   "(float64's smallest normal number) and its fallback elsewhere, in each component; the "
+                   f"renderer's N' (both bump modes, {len(F.FIELDS)} fields) at {count} seeded sphere-A pixels (pole "
+                   f"ring and the draft's fallback disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} "
+                   "of the perturbed normal evaluated by mpmath in this frame", rendered=count)
 
 
 def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
@@ -194,7 +211,7 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
                         ("e_theta with a flipped sign", lambda: _orthonormal(et=[-c for c in REGULAR[:3]]).check()),
                         ("the kernel's N' built with h_u and h_v swapped",
                          lambda: _orthonormal(corrupt=lambda g: g[:, ::-1]).check()),
-                        ("the pole cut-off moved from 1e-4 to 3e-4", lambda: _orthonormal(pole=3e-4).check()),
+                        ("the seed's pole cut-off 1e-4 back", lambda: _orthonormal(pole=SEED_POLE_SIN_PHI).check()),
                         ("e_theta's z the constant 1 in both branches (the regular branch's 0 and the fallback's "
                          "replaced)", lambda: _orthonormal(frame=F.TANGENT_FRAME[:2] + (sp.Integer(1),)
                                                            + F.TANGENT_FRAME[3:]).check()),
@@ -227,8 +244,8 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
         id="frame-orientation", title=TITLES["frame-orientation"],
         statement=r"$⟦orientation⟧$: the pair $(e_\theta, e_\varphi)$ is left-handed about the outward normal, "
                   r"$e_\theta\times e_\varphi = -N$. The pole fallback "
-                  r"($\sin\varphi \le ⟦pole⟧$) has $⟦fallback⟧$: right-handed at the "
-                  r"north pole, where the outward normal is $+z$.",
+                  r"($\sin\varphi \le ⟦pole⟧$, float64's smallest normal number: the pole itself) has "
+                  r"$⟦fallback⟧$: right-handed at the north pole, where the outward normal is $+z$.",
         steps=(
             Step(r"Cross the frame of ⟪frame-orthonormal⟫: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
                  r"\cos\theta, \cos\varphi\sin\theta, -\sin\varphi) = (-\sin\varphi\cos\theta, -\sin\varphi\sin\theta, "

@@ -71,11 +71,10 @@ def _derivative(claimed=CLAIMED_DERIVATIVE, m=M_CLAIMED):
         seed_says="§3 and §6: 'verified to 1e-12' (Cell 5); Cell 5's Expect: '~1e-9 worst component'.",
     )
 
-#: The renderer's normals, for "surface" with sin phi above the pole cut-off (its floor
-#: max(sin phi, POLE_SIN_PHI) read as sin phi).
+#: The renderer's normals, for "surface" with sin phi above the pole cut-off (its pole branch
+#: read as the regular one, `frame.off_pole`).
 NP_MODE = {mode: sp.MatrixSymbol(f"N'_{mode}", 3, 1) for mode in F.PERTURBED_NORMAL}
-ON_FRAME = {NP_MODE[mode]: sp.ImmutableMatrix(n).xreplace({sp.Max(F.sin_phi, F.POLE_SIN_PHI): F.sin_phi})
-            for mode, n in F.PERTURBED_NORMAL.items()}
+ON_FRAME = {NP_MODE[mode]: frame.off_pole(sp.ImmutableMatrix(n)) for mode, n in F.PERTURBED_NORMAL.items()}
 #: The frame's vectors and the normal as the statement prints them.
 ET_S, EP_S, N_SPHERE = frame.ET_S, frame.EP_S, frame.N_S
 #: The first-order tilt dN'/dbeta at beta = 0, written by hand in e_theta, e_phi: the chart

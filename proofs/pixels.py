@@ -3,7 +3,7 @@
 A theorem about `renderer.formulas` says what the kernel should compute; this
 module asks what it did.  For seeded random sphere-A pixels of G-buffers of
 the default scene (`renderer.gbuffer`: a full frame, two frames zoomed onto the
-pole, one of them inside the frame's fallback radius, and the pixels next to a
+pole, one of them inside the seed's pole cut-off sin phi <= 1e-4, and the pixels next to a
 crease of a field with creases: `SOURCES`), the renderer's chart (u, v), gradient
 (exact and central) and shading normal N' (both bump modes) of any registered
 field (`renderer.formulas.FIELDS`) are compared with the same sympy objects
@@ -33,7 +33,7 @@ __all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "footprint
            "PER_FIELD"]
 
 #: Pixels drawn per field, a third from each source (full frame, pole ring at zoom 300 and 3e4; crease
-#: neighbours as well for a field with creases): >= 200 outside the pole floor, the 3e4 frame being inside it.
+#: neighbours as well for a field with creases): >= 200 outside the seed's pole cut-off, the 3e4 frame being inside it.
 PER_FIELD = 300
 #: Crease neighbours (a field with creases): the full frame's sphere-A pixels where a crease factor f
 #: (`HeightField.crease_factors`) has |f| < sin(pi CREASE_BAND): for the ridges field's factors
@@ -42,7 +42,8 @@ PER_FIELD = 300
 CREASE_BAND = 0.05
 #: Where each source's pixels lie, by sin(phi) = |(N_x, N_y)| on sphere A: (source, zoom, lowest, highest).
 #: The pole frames are centred on the pole: at zoom 300 every pixel within 5e-3 of it, some inside the
-#: fallback radius POLE_SIN_PHI (1e-4); at zoom 3e4 every pixel within 5e-5, all inside it.
+#: seed's fallback radius sin phi = 1e-4 (the renderer keeps the chart's frame there); at zoom 3e4
+#: every pixel within 5e-5, all inside it.
 SOURCES = (("frame", 1.0, 5e-3, 1.0), ("pole-300", 300.0, 0.0, 5e-3), ("pole-3e4", 3e4, 0.0, 5e-5))
 DIGITS = 30
 UNIT = 2.0**-53

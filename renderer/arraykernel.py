@@ -262,7 +262,7 @@ def structure(s):
                   for i, light in enumerate(s.lights)))
 
 
-def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad):
+def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad, normal=False):
     """Render the pixels (xs[i], ys[j]) of a block of rows, row-major.
 
     Parameters
@@ -276,24 +276,28 @@ def render_block(xp, s, xs, ys, *, method, eps, dx, dy, kink, grad):
         The central step (scene units of the chart).
     dx, dy : float
         Pixel spacing (the footprint's ray differentials).
-    kink, grad : bool
-        Whether to return the crease flags and the gradient.
+    kink, grad, normal : bool
+        Whether to return the crease flags, the gradient and the shading normal.
 
     Returns
     -------
     dict of numpy arrays of W * B pixels
         ``image`` (n, 3) float64 in [0, 1], ``chamber`` (n,) uint8, and when
-        asked ``kink`` (n,) bool and ``grad`` (n, 2) float64 (0 off sphere A).
+        asked ``kink`` (n,) bool, ``grad`` (n, 2) float64 (0 off sphere A) and ``normal``
+        (n, 3) float64, the unit shading normal (the bumped one on sphere A, the geometric
+        one elsewhere; garbage on the background), as `renderer.GBuffer.Ns`.
     """
     return xp.run(program, s, structure(s), scene_values(s, eps, dx, dy),
-                  (xs, ys, np.sin(np.pi * xs), np.sin(np.pi * ys)), OUTPUTS, method=method, kink=kink, grad=grad)
+                  (xs, ys, np.sin(np.pi * xs), np.sin(np.pi * ys)), OUTPUTS, method=method, kink=kink, grad=grad,
+                  normal=normal)
 
 
 #: Each output of `program`: (values per pixel, numpy dtype).
-OUTPUTS = {"image": (3, np.float64), "chamber": (1, np.uint8), "kink": (1, np.bool_), "grad": (2, np.float64)}
+OUTPUTS = {"image": (3, np.float64), "chamber": (1, np.uint8), "kink": (1, np.bool_), "grad": (2, np.float64),
+           "normal": (3, np.float64)}
 
 
-def program(xp, s, flat, xs, ys, sin_xs, sin_ys, *, method, kink, grad):
+def program(xp, s, flat, xs, ys, sin_xs, sin_ys, *, method, kink, grad, normal=False):
     """The frame's array program: `render_block`'s outputs as a dict name -> list of
     arrays of the namespace (k arrays for k values per pixel, `OUTPUTS`), unevaluated
     on Dr.Jit.  ``s`` decides the branches (only through `structure`), ``flat`` (its
@@ -341,4 +345,6 @@ def program(xp, s, flat, xs, ys, sin_xs, sin_ys, *, method, kink, grad):
         out["kink"] = [on_a & (code.kink(xp, u, v, q.k_u, q.k_v) if flag is None else flag)]
     if grad:
         out["grad"] = [xp.select(on_a, hu, 0.0), xp.select(on_a, hv, 0.0)]
+    if normal:
+        out["normal"] = list(Ns)
     return out

@@ -97,7 +97,7 @@ class NumpyNamespace:
     """
 
     name = "numpy"
-    sin, cos, atan2, sqrt, abs = np.sin, np.cos, np.arctan2, np.sqrt, np.abs
+    sin, cos, atan2, sqrt, hypot, abs = np.sin, np.cos, np.arctan2, np.sqrt, np.hypot, np.abs
     copysign, minimum, maximum, power = np.copysign, np.minimum, np.maximum, np.power
     select = staticmethod(np.where)
 
@@ -148,6 +148,7 @@ class DrJitNamespace:
         self.vector = {2: llvm.Array2f64, 3: llvm.Array3f64}
         self._frozen = {}
         self.sin, self.cos, self.atan2, self.sqrt, self.abs = dr.sin, dr.cos, dr.atan2, dr.sqrt, dr.abs
+        self.hypot = dr.hypot        # max |a|, |b| times sqrt(1 + ratio^2): no underflow of the squares
         self.copysign, self.minimum, self.maximum, self.power = dr.copysign, dr.minimum, dr.maximum, dr.power
 
     def select(self, cond, a, b):

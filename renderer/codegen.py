@@ -65,7 +65,7 @@ def _py(expr):
 
 class _ArrayPrinter(PythonCodePrinter):
     """sympy's Python printer for array code over a namespace ``xp``: its
-    functions (xp.sin, xp.sqrt, xp.atan2, xp.copysign, xp.abs, xp.minimum,
+    functions (xp.sin, xp.sqrt, xp.hypot, xp.atan2, xp.copysign, xp.abs, xp.minimum,
     xp.maximum) instead of math's and the builtins, a Piecewise as nested
     ``xp.select(cond, a, b)``, logic as ``&``, ``|`` and ``~`` of parenthesized
     operands; constants (math.pi) stay Python floats."""
@@ -131,13 +131,17 @@ def _array(expr):
 class _JavascriptPrinter(JavascriptCodePrinter):
     """sympy's JavaScript printer, but with JavaScript's booleans: sympy 1.14
     prints sympy.true and sympy.false as Python's True and False, which are
-    undefined names in JavaScript (the crease flag of a field without creases)."""
+    undefined names in JavaScript (the crease flag of a field without creases);
+    and `renderer.formulas.hypot` as ``Math.hypot``."""
 
     def _print_BooleanTrue(self, expr):
         return "true"
 
     def _print_BooleanFalse(self, expr):
         return "false"
+
+    def _print_hypot(self, expr):
+        return f"Math.hypot({', '.join(self._print(a) for a in expr.args)})"
 
 
 _JS = _JavascriptPrinter()

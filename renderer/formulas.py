@@ -19,8 +19,8 @@ What lives here (seed §2, §3 and Cell 1, with the project's corrections):
   the seed's crease band about them; `field` also makes a record of a reader's
   own expression in u, v, k_u, k_v;
 * a reader's function of one variable (`Univariate`), for U-curves at any point;
-* the chart (u, v) of a unit normal N of sphere A, and sin(phi);
-* the tangent frame (e_theta, e_phi) with its pole fallback;
+* the chart (u, v) of a unit normal N of sphere A, and sin(phi) (`hypot`);
+* the tangent frame (e_theta, e_phi), a fixed basis only where sin(phi) is 0 or subnormal;
 * the perturbed normal of both bump modes ("chart": the seed's formula;
   "surface": the normal of the displaced sphere P = (R + beta h) N);
 * the central-difference stencil (u wraps, v clamps with a one-sided quotient);
@@ -38,7 +38,7 @@ import sympy as sp
 __all__ = [
     "u", "v", "k_u", "k_v", "FIELD_SYMBOLS", "ELEMENTARY", "KINK_BAND_HALF_WIDTH", "SEED_POINT", "HeightField",
     "FIELDS", "BUILTIN", "register", "field", "Univariate", "univariate", "x_var", "step",
-    "N_x", "N_y", "N_z", "sin_phi", "CHART", "POLE_SIN_PHI",
+    "N_x", "N_y", "N_z", "sin_phi", "hypot", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
     "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FUNCTIONS", "FIELD_FUNCTIONS",
@@ -249,16 +249,50 @@ def field(spec, name="height_field"):
 N_x, N_y, N_z = sp.symbols("N_x N_y N_z", real=True)
 sin_phi = sp.Symbol("sin_phi", nonnegative=True)
 
+
+class hypot(sp.Function):
+    """hypot(x, y) = sqrt(x^2 + y^2), without the underflow of the squares: below about
+    1.5e-154 x^2 + y^2 loses its digits (or is 0), hypot keeps them.  Printed as the libraries'
+    hypot (``math.hypot``, ``xp.hypot`` of `renderer.backends`, ``Math.hypot``); sympy reads it
+    as the square root (`rewrite` with ``sp.sqrt``, ``evalf``, its derivative)."""
+
+    nargs = 2
+
+    def fdiff(self, argindex=1):
+        return self.args[argindex - 1] / self
+
+    def _eval_rewrite_as_sqrt(self, x, y, **hints):
+        return sp.sqrt(x**2 + y**2)
+
+    def _eval_evalf(self, prec):
+        return self.rewrite(sp.sqrt)._eval_evalf(prec)
+
+    def _eval_is_nonnegative(self):
+        if all(a.is_real for a in self.args):
+            return True
+        return None
+
+    def _latex(self, printer):
+        return r"\operatorname{hypot}\left(%s, %s\right)" % tuple(printer._print(a) for a in self.args)
+
+
 #: (u, v, sin phi) of a unit normal (seed Cell 1, ``chartA1``): u = (theta + pi)
 #: / 2 pi with theta = atan2(N_y, N_x), v = phi / pi.  phi = atan2(sin phi, N_z),
-#: not the seed's acos(N_z), which loses half the digits near the poles.
+#: not the seed's acos(N_z), which loses half the digits near the poles; sin phi =
+#: hypot(N_x, N_y), whose relative error is an ulp or so at every sin phi > 0.
 CHART = ((sp.atan2(N_y, N_x) + sp.pi) / (2 * sp.pi),
-         sp.atan2(sp.sqrt(N_x**2 + N_y**2), N_z) / sp.pi,
-         sp.sqrt(N_x**2 + N_y**2))
+         sp.atan2(hypot(N_x, N_y), N_z) / sp.pi,
+         hypot(N_x, N_y))
 
 # ---------------------------------------------------------------- tangent frame
-#: Below this sin(phi) the frame is the fixed basis (seed Cell 1; seed §7 item 4).
-POLE_SIN_PHI = sp.Float(1e-4)
+#: At and below this sin(phi) the frame is the fixed basis: float64's smallest normal number,
+#: 2^-1022.  Above it 1/sin phi is finite (at most 2^1022) and sin phi carries its full 53 bits,
+#: so the chart frame below is evaluated as written; at or below it sin phi is 0 (the pole
+#: itself, where the chart has no theta) or subnormal (1/sin phi overflows from 2^-1024 on).
+#: The seed cut the frame off at sin phi = 1e-4 (its Cell 1, ``tangent_frame``), a disc of
+#: radius 1e-4 R where its fixed basis turned the displaced sphere's normal by up to 175 degrees
+#: (tests/test_pole.py).
+POLE_SIN_PHI = sp.Float(2.0**-1022, 17)
 #: The fixed basis used at the poles: e_theta = (1, 0, 0), e_phi = (0, 1, 0).
 FALLBACK_FRAME = (1, 0, 0, 0, 1, 0)
 _frame = (-N_y / sin_phi, N_x / sin_phi, sp.Float(0),
@@ -275,11 +309,14 @@ e_phi = sp.symbols("ep_x ep_y ep_z", real=True)
 _w = -beta / (R + beta * h)
 #: Coefficients (b_u, b_v) of M = N + b_u e_theta + b_v e_phi, per bump mode.
 #: "chart": the seed's N' formula.  "surface": the normal of P = (R + beta h) N,
-#: with h_theta = h_u / 2 pi and h_phi = h_v / pi (theorem bump-vs-displacement);
-#: sin(phi) is floored at the pole cut-off, where the chart frame is replaced.
+#: with h_theta = h_u / 2 pi and h_phi = h_v / pi (theorem bump-vs-displacement),
+#: 1/sin(phi) as it is wherever the frame is the chart's; at the pole (the fixed frame,
+#: sin phi <= POLE_SIN_PHI), where the chart has no theta and h_u / sin phi no value (its
+#: limit depends on the direction of approach), the e_theta term is 0.
 BUMP = {
     "chart": (beta * h_u, beta * h_v),
-    "surface": (_w * h_u / (2 * sp.pi * sp.Max(sin_phi, POLE_SIN_PHI)), _w * h_v / sp.pi),
+    "surface": (sp.Piecewise((_w * h_u / (2 * sp.pi * sin_phi), sin_phi > POLE_SIN_PHI), (sp.Float(0), True)),
+                _w * h_v / sp.pi),
 }
 #: N' = M / |M| per bump mode, a function of N, the frame, the gradient and
 #: (surface) h, R and sin(phi).

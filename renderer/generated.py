@@ -12,7 +12,7 @@ from numba import njit
 @njit(cache=True, error_model="numpy")
 def chart(N_x, N_y, N_z):
     x0 = 1/math.pi
-    x1 = math.sqrt(N_x**2 + N_y**2)
+    x1 = math.hypot(N_x, N_y)
     return ((1/2)*x0*(math.atan2(N_y, N_x) + math.pi), x0*math.atan2(x1, N_z), x1)
 
 
@@ -29,7 +29,7 @@ def chart_array(N_x, N_y, N_z, out):
 def tangent_frame(N_x, N_y, N_z, sin_phi):
     x0 = 1/sin_phi
     x1 = N_y*x0
-    x2 = (sin_phi > 0.0001)
+    x2 = (sin_phi > 2.2250738585072014e-308)
     x3 = N_x*x0
     return (((-x1) if x2 else (1.0)), ((x3) if x2 else (0.0)), 0.0, ((N_z*x3) if x2 else (0.0)), ((N_z*x1) if x2 else (1.0)), ((-sin_phi) if x2 else (0.0)))
 
@@ -67,10 +67,10 @@ def perturbed_normal_chart_array(N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep
 def perturbed_normal_surface(N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, h_u, h_v, beta, h, R, sin_phi):
     x0 = beta/(math.pi*(R + beta*h))
     x1 = h_v*x0
-    x2 = (1/2)*h_u*x0/max(0.0001, sin_phi)
-    x3 = N_x - ep_x*x1 - et_x*x2
-    x4 = N_y - ep_y*x1 - et_y*x2
-    x5 = N_z - ep_z*x1 - et_z*x2
+    x2 = ((-1/2*h_u*x0/sin_phi) if (sin_phi > 2.2250738585072014e-308) else (0.0))
+    x3 = N_x - ep_x*x1 + et_x*x2
+    x4 = N_y - ep_y*x1 + et_y*x2
+    x5 = N_z - ep_z*x1 + et_z*x2
     x6 = 1/math.sqrt(x3**2 + x4**2 + x5**2)
     return (x3*x6, x4*x6, x5*x6)
 

@@ -10,14 +10,14 @@ import math
 
 def chart(xp, N_x, N_y, N_z):
     x0 = 1/math.pi
-    x1 = xp.sqrt(N_x**2 + N_y**2)
+    x1 = xp.hypot(N_x, N_y)
     return ((1/2)*x0*(xp.atan2(N_y, N_x) + math.pi), x0*xp.atan2(x1, N_z), x1)
 
 
 def tangent_frame(xp, N_x, N_y, N_z, sin_phi):
     x0 = 1/sin_phi
     x1 = N_y*x0
-    x2 = (sin_phi > 0.0001)
+    x2 = (sin_phi > 2.2250738585072014e-308)
     x3 = N_x*x0
     return (xp.select(x2, -x1, 1.0), xp.select(x2, x3, 0.0), 0.0, xp.select(x2, N_z*x3, 0.0), xp.select(x2, N_z*x1, 1.0), xp.select(x2, -sin_phi, 0.0))
 
@@ -35,10 +35,10 @@ def perturbed_normal_chart(xp, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z
 def perturbed_normal_surface(xp, N_x, N_y, N_z, et_x, et_y, et_z, ep_x, ep_y, ep_z, h_u, h_v, beta, h, R, sin_phi):
     x0 = beta/(math.pi*(R + beta*h))
     x1 = h_v*x0
-    x2 = (1/2)*h_u*x0/xp.maximum(0.0001, sin_phi)
-    x3 = N_x - ep_x*x1 - et_x*x2
-    x4 = N_y - ep_y*x1 - et_y*x2
-    x5 = N_z - ep_z*x1 - et_z*x2
+    x2 = xp.select((sin_phi > 2.2250738585072014e-308), -1/2*h_u*x0/sin_phi, 0.0)
+    x3 = N_x - ep_x*x1 + et_x*x2
+    x4 = N_y - ep_y*x1 + et_y*x2
+    x5 = N_z - ep_z*x1 + et_z*x2
     x6 = 1/xp.sqrt(x3**2 + x4**2 + x5**2)
     return (x3*x6, x4*x6, x5*x6)
 

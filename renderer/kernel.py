@@ -98,7 +98,7 @@ def _threading_layer():
 
 _threading_layer()
 
-FORMULAS_DIGEST = "04306c56add9729c1024dd62f815ced199709bd41036093f1ed6a2e668beed04"  # of generated.py, written by renderer/codegen.py
+FORMULAS_DIGEST = "d1fb0c80f4f180448127f3b6abfec6c1df53f175e4bfaebe9eda3c1582c8fed8"  # of generated.py, written by renderer/codegen.py
 if hashlib.sha256(Path(__file__).with_name("generated.py").read_bytes()).hexdigest() != FORMULAS_DIGEST:
     raise ImportError("renderer/generated.py does not match the digest kernel.py holds: it was edited by "
                       "hand or not regenerated; run python -m renderer.codegen")

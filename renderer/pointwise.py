@@ -34,7 +34,7 @@ from .scene import COORDINATE, FREQUENCY, RADIUS, UNIT, Scene
 from .validate import InvalidType, InvalidValue, flag, real_array
 
 __all__ = ["height", "exact_gradient", "central_gradient", "kink_band", "chart", "tangent_frame",
-           "footprint", "reach", "RANGES", "RANGES_CENTRAL", "MIN_STEP"]
+           "footprint", "reach", "RANGES", "RANGES_CENTRAL", "RANGES_FRAME", "MIN_STEP"]
 
 #: Smallest step `central_gradient` accepts: the generated quotient multiplies
 #: by 1 / (2 eps), which overflows for eps below about 2.8e-309.
@@ -46,12 +46,17 @@ MIN_STEP = 1e-300
 #: (`central_gradient`: [0, 1], where its stencil wraps u and clamps v).  Frequencies and
 #: radii: `renderer.Scene`'s.  Steps: [`MIN_STEP`, 1) (below 1 the stencil wraps u once).
 #: Everything else (positions, normals and tangents, sin phi, pixel coordinates and
-#: spacing, camera_z): `Scene`'s coordinates, [-1e6, 1e6], whose squares and quotients
-#: by the tangent frame's smallest sin phi (1e-4) stay far from overflow.
+#: spacing, camera_z): `Scene`'s coordinates, [-1e6, 1e6], whose squares stay far from
+#: overflow (the footprint's quotients by sin phi that overflow take its fallback step).
 RANGES = {"u": dict(low=-1.0, high=2.0), "v": dict(low=-1.0, high=2.0), "k_u": FREQUENCY, "k_v": FREQUENCY,
           "eps": dict(low=MIN_STEP, high=1.0, high_open=True), "radius": RADIUS}
 #: `central_gradient`'s ranges: its chart coordinates in [0, 1].
 RANGES_CENTRAL = {**RANGES, "u": UNIT, "v": UNIT, "eps_v": RANGES["eps"]}
+#: `tangent_frame`'s ranges: N and sin phi are a unit normal's, [-1.5, 1.5] leaving room for
+#: rounding.  The frame divides by sin phi down to `formulas.POLE_SIN_PHI` (2^-1022), so
+#: |N_z N_x| / sin phi stays below 2.25 * 2^1022, under the largest float64 (2^1024).
+UNIT_NORMAL = dict(low=-1.5, high=1.5)
+RANGES_FRAME = {**RANGES, "N_x": UNIT_NORMAL, "N_y": UNIT_NORMAL, "N_z": UNIT_NORMAL, "sin_phi": UNIT_NORMAL}
 
 
 def _field(name):
@@ -189,12 +194,15 @@ def chart(N_x, N_y, N_z):
 
 
 def tangent_frame(N_x, N_y, N_z, sin_phi):
-    """(e_theta, e_phi), each a triple of float64 arrays, with the pole fallback
+    """(e_theta, e_phi), each a triple of float64 arrays: the chart's frame wherever
+    sin phi > `renderer.formulas.POLE_SIN_PHI` (2^-1022), the fixed basis at or below it
     (`renderer.formulas.TANGENT_FRAME`).
 
-    All arguments array_like in [-1e6, 1e6] (broadcast); raises as the module says.
+    All arguments array_like in [-1.5, 1.5] (`RANGES_FRAME`: a unit normal N and its
+    sin phi, broadcast); raises as the module says.
     """
-    c = _evaluate(G.tangent_frame_array, 6, (), ("N_x", "N_y", "N_z", "sin_phi"), (N_x, N_y, N_z, sin_phi))
+    c = _evaluate(G.tangent_frame_array, 6, (), ("N_x", "N_y", "N_z", "sin_phi"), (N_x, N_y, N_z, sin_phi),
+                  RANGES_FRAME)
     return tuple(c[:3]), tuple(c[3:])
 
 

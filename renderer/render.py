@@ -33,7 +33,9 @@ MAX_SIDE = 8192
 #: Most pixels (W * H) of one frame: a frame with kink and grad holds 42 bytes a pixel (0.7 GB at
 #: the most), a G-buffer 138.
 MAX_PIXELS = 4096 * 4096
-#: Largest accepted magnification of the image window (`render`'s ``zoom``).
+#: Largest accepted magnification of the image window (`render`'s ``zoom``).  The pole's shading
+#: normal is right to a few ulps at every zoom: the hit's N_x, N_y = t (x, y) / R keep their relative
+#: precision however near the axis, and so do theta and sin phi (tests/test_pole.py, to 1e6).
 MAX_ZOOM = 1e6
 #: Chamber codes of `Frame.chamber`.
 CHAMBER_NAMES = {BACKGROUND: "background", SPHERE_A: "sphere A", SPHERE_B: "sphere B", FLOOR: "floor"}

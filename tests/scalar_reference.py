@@ -56,7 +56,8 @@ __all__ = [
 
 BACKGROUND, SPHERE_A, SPHERE_B, FLOOR = 0, 1, 2, 3
 TWO_PI = 2.0 * math.pi
-POLE_SIN_PHI = 1e-4      # seed Cell 1, tangent_frame: fallback below this sin(phi)
+POLE_SIN_PHI = 2.0**-1022   # float64's smallest normal: at or below it (sin phi 0 or subnormal) the fixed basis
+#                            (the seed's Cell 1 took it below 1e-4)
 KINK_HALF_WIDTH = 0.03   # seed Cell 1, height1: the crease band
 FOOTPRINT_FALLBACK = 0.0005   # pbrt-v4, BumpMap: the step where the footprint is 0
 FOOTPRINT_LIMIT = 1e8         # pbrt-v4 clamps |du/dx| to this; beyond it, the fallback
@@ -161,7 +162,7 @@ def chart_a(N):
 
 
 def tangent_frame_a(N, sin_phi):
-    """(e_theta, e_phi) of seed §3, with the seed's fixed basis near the poles."""
+    """(e_theta, e_phi) of seed §3, with the seed's fixed basis at the poles (sin phi 0 or subnormal)."""
     if sin_phi > POLE_SIN_PHI:
         e_th = (-N[1] / sin_phi, N[0] / sin_phi, 0.0)
         e_ph = (N[2] * N[0] / sin_phi, N[2] * N[1] / sin_phi, -sin_phi)
@@ -278,14 +279,13 @@ def perturb_surface(N, e_th, e_ph, hu, hv, h, beta, R, sin_phi):
     + rho sin(phi) e_theta and r_phi = rho_phi N + rho e_phi, and e_phi x e_theta = N,
     so r_phi x r_theta is parallel to N - (rho_theta / (rho sin phi)) e_theta
     - (rho_phi / rho) e_phi, with rho_theta = beta h_u / (2 pi), rho_phi = beta h_v / pi.
-    Below the pole cut-off sin(phi) is held at the cut-off, as the frame falls
-    back to the fixed basis there (renderer's documented choice).
+    At the pole cut-off and below (sin phi 0 or subnormal), where the frame falls back to
+    the fixed basis, the e_theta term is dropped (renderer's documented choice).
     """
     if beta == 0.0:
         return N
     rho = R + beta * h
-    s = max(sin_phi, POLE_SIN_PHI)
-    a_th = beta * hu / (TWO_PI * s * rho)
+    a_th = beta * hu / (TWO_PI * sin_phi * rho) if sin_phi > POLE_SIN_PHI else 0.0
     a_ph = beta * hv / (math.pi * rho)
     return normalize(sub(N, add(scale(a_th, e_th), scale(a_ph, e_ph))))
 

@@ -87,7 +87,7 @@ def evaluate(expr, env):
     their magnitudes; a product prod (|a| + b) - prod |a| (its factors' relative
     bounds, and their products, which alone remain where factors vanish) and
     (n - 1) u, a positive integer power likewise;
-    1/x, sqrt, sin, cos, atan2 and pow their derivative times the argument's
+    1/x, sqrt, sin, cos, atan2, hypot and pow their derivative times the argument's
     bound and one rounding (two for the libm functions, which are within an
     ulp); pi and decimal constants one rounding.  A branch (Piecewise, sign,
     a comparison) decided within its bound raises `Ambiguous`.
@@ -146,6 +146,11 @@ def _evaluate(expr, env):
     if isinstance(expr, sp.Abs):
         (x, bx), = args
         return abs(x), bx
+    if isinstance(expr, F.hypot):                  # 1-Lipschitz in each argument; libm's within an ulp
+        (x, bx), (y, by) = args
+        value = mpmath.hypot(x, y)
+        slope = (abs(x) * bx + abs(y) * by) / value if value > 0 else bx + by
+        return value, slope + 2 * U * value
     if isinstance(expr, sp.sign):
         (x, bx), = args
         if x == 0 and bx == 0:
@@ -244,7 +249,7 @@ def _frame(N):
 
 def _normals(rng, n):
     N = rng.normal(size=(n, 3))
-    # A tenth near the poles, with sin(phi) on both sides of the cut-off 1e-4.
+    # A tenth near the poles, sin(phi) from 1e-7 to 1e-2: on both sides of the draft's cut-off 1e-4.
     k = n // 10
     N[:k, :2] *= 10.0 ** rng.uniform(-7, -2, size=(k, 1))
     return N / np.linalg.norm(N, axis=-1, keepdims=True)
@@ -474,8 +479,11 @@ def _two_sided(expr):
 VARIANTS = {
     "h_u of sine with its sign flipped": ("exact", "sine", 1, lambda e: -e),
     "the chart's u from atan2(N_x, N_y)": ("chart", "", 0, lambda e: e.xreplace({F.N_x: F.N_y, F.N_y: F.N_x})),
-    "the pole cut-off at 1e-3": ("tangent_frame", "", 3,
-                                 lambda e: e.xreplace({F.POLE_SIN_PHI: sp.Float(1e-3)})),
+    "the draft's pole cut-off 1e-4": ("tangent_frame", "", 3,
+                                      lambda e: e.xreplace({F.POLE_SIN_PHI: sp.Float(1e-4)})),
+    "the draft's floor of sin phi in the surface normal": (
+        "perturbed_normal_surface", "", 0,
+        lambda e: e.xreplace({F.sin_phi: sp.Max(F.sin_phi, sp.Float(1e-4))})),
     "the surface normal with pi halved": ("perturbed_normal_surface", "", 0,
                                             lambda e: e.xreplace({sp.pi: sp.pi / 2})),
     "the footprint without pbrt's half": ("footprint", "", 1, _doubled_footprint),

@@ -16,11 +16,11 @@ rounds +, -, *, / and sqrt correctly, so whatever uses only those is the same
 bits on both sides: the hits and their chamber (checked exactly), P, N, the
 shadow tests, the footprint's steps given the same sin(phi).  What differs:
 
-(a) the libraries.  numba calls glibc's sin, cos, atan2 and pow; V8 its port
-    of fdlibm's.  Each returns a value within 1 ulp of the exact result, so
-    two results for one argument are at most 1 ulp apart.  (An integral
-    shininess n is raised by repeated squaring on both sides, in numba's
-    order: the same bits for the same base.);
+(a) the libraries.  numba calls glibc's sin, cos, atan2, hypot and pow; V8 its
+    port of fdlibm's (and its own Math.hypot).  Each returns a value within 1
+    ulp of the exact result, so two results for one argument are at most 1 ulp
+    apart.  (An integral shininess n is raised by repeated squaring on both
+    sides, in numba's order: the same bits for the same base.);
 (b) the printers.  formulas.js normalises with Math.pow(s, -1/2) and squares
     with Math.pow(x, 2) where generated.py has 1/math.sqrt(s) and x**2.
 
@@ -32,7 +32,7 @@ worst-case sum, rounded up):
 1. Chart: |du|, |dv| <= CHART_TOL = 6u.  u = (atan2 + pi) / 2 pi: atan2's ulp
    is <= 4u on [-pi, pi], the sum rounds afresh (2u 2 pi over both sides),
    / 2 pi and one more rounding (2u): 4.7u.  v = atan2(sin phi, N_z) / pi:
-   4u, plus 3u if sin phi differs by (b), / pi, plus 2u: 4.3u.
+   4u, plus 3u for sin phi = hypot(N_x, N_y) (a), / pi, plus 2u: 4.3u.
 2. A sine's argument a = (pi k) w, w = u, v or a stencil point (u +- eps
    wrapped, v +- eps clamped: two roundings of values <= 1.25 per side, 5u,
    and 2u for a footprint step that moved by (b)): |da| <= pi k (6u + 7u) +
@@ -55,8 +55,8 @@ worst-case sum, rounded up):
    and nearly so under the pole fallback) and |a/|a| - b/|b|| <= 2|a - b|/|a|,
    so |dNs| <= 4 |dM| + 8u (8u: the normalisation, (b)).  Chart bump:
    |dM| <= beta (|dg_u| + |dg_v|) + 12u (1 + beta (|g_u| + |g_v|)).  Surface
-   bump, M = N - b_u e_theta - b_v e_phi with b_u = q h_u / (2 max(sin phi,
-   POLE_SIN_PHI)), b_v = q h_v, q = beta / (pi (R + beta h)): the same with
+   bump, M = N - b_u e_theta - b_v e_phi with b_u = q h_u / (2 sin phi) (0 at
+   the pole, sin phi <= POLE_SIN_PHI), b_v = q h_v, q = beta / (pi (R + beta h)): the same with
    q / (2 s) and q for beta, plus (|b_u| + |b_v|)(beta DH / (R + beta h) + 12u).
    (The coefficients and their slopes in h_u, h_v and h are formulas.BUMP's,
    evaluated, not retyped.)  At beta = 0, M = N and only the roundings

@@ -149,8 +149,8 @@ def test_the_modules_are_exactly_the_hand_written_files_and_the_generated_ones()
 
 # ---- nothing hand-written retypes a formula --------------------------------------------
 
-#: Calls that only formulas.js may make (the chart's atan2, the seed's acos, the gradients' cos).
-_FORMULA_CALLS = ("Math.atan2", "Math.acos", "Math.cos", "Math.sign")
+#: Calls that only formulas.js may make (the chart's atan2 and hypot, the seed's acos, the gradients' cos).
+_FORMULA_CALLS = ("Math.atan2", "Math.hypot", "Math.acos", "Math.cos", "Math.sign")
 #: The constants of renderer/formulas.py.
 _FORMULA_CONSTANTS = {float(c) for c in (F.POLE_SIN_PHI, F.KINK_BAND_HALF_WIDTH, F.FOOTPRINT_FALLBACK,
                                         F.FOOTPRINT_MAX)}
@@ -170,7 +170,8 @@ def test_the_renderer_core_retypes_no_formula():
     assert retyped_formulas(text) == []
     # The check rejects a hand-written chart, pole cut-off or crease band.
     assert retyped_formulas(text + "\nconst theta = Math.atan2(N[1], N[0]);\n") == ["Math.atan2"]
-    assert retyped_formulas(text + "\nif (sin_phi > 1e-4) {}\n") == ["1e-4"]
+    assert retyped_formulas(text + "\nif (sin_phi > 2.2250738585072014e-308) {}\n") == ["2.2250738585072014e-308"]
+    assert retyped_formulas(text + "\nconst s = Math.hypot(N[0], N[1]);\n") == ["Math.hypot"]
     assert retyped_formulas(text + "\nconst band = Math.abs(f) < 0.03;\n") == ["0.03"]
 
 

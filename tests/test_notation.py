@@ -22,9 +22,9 @@ from proofs.registry import THEOREMS
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
     "displaced-normal": "0e2d782e0c4c7b4f",
-    "chart": "a103b721422aac5e",
+    "chart": "6307786af7272502",
     "frame-orthonormal": "59d20494cb0bbe94",
-    "frame-orientation": "f8fe212f89933948",
+    "frame-orientation": "ef02db2a9bf21f10",
     "gradient-sine": "446824a80459dae6",
     "gradient-ridges": "648c16419819b0d8",
     "gradient-rings": "b1acf10d08155001",

@@ -9,6 +9,7 @@ every comparison it feeds passing on easier points: these tests measure the poin
 import numpy as np
 import pytest
 
+from proofs.frame import SEED_POLE_SIN_PHI
 from proofs.pixels import CREASE_BAND, PER_FIELD, SOURCES, pixels
 from renderer import formulas as F
 
@@ -37,15 +38,16 @@ def test_crease_neighbours_lie_within_the_stated_band_of_a_crease():
 @pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
 def test_each_source_lies_where_documented_the_pole_frames_about_the_pole(field):
     """sin(phi) = |(N_x, N_y)| of each source's pixels within its `SOURCES` bounds; the zoom-3e4 frame all
-    inside the fallback radius, and PER_FIELD's 200 pixels outside it."""
+    inside the draft's fallback radius sin(phi) = 1e-4 (where the renderer keeps the chart's frame), and
+    PER_FIELD's 200 pixels outside it."""
     _, px = pixels(field)
     sin_phi = np.hypot(px["N"][:, 0], px["N"][:, 1])
     for name, _, lo, hi in SOURCES:
         rows = sin_phi[px["source"] == name]
         assert rows.size == PER_FIELD // 3, name
         assert lo <= rows.min() and rows.max() <= hi, (name, rows.min(), rows.max())
-    assert np.all(sin_phi[px["source"] == "pole-3e4"] <= float(F.POLE_SIN_PHI))
-    assert np.count_nonzero(sin_phi > float(F.POLE_SIN_PHI)) >= 200
+    assert np.all(sin_phi[px["source"] == "pole-3e4"] <= SEED_POLE_SIN_PHI)
+    assert np.count_nonzero(sin_phi > SEED_POLE_SIN_PHI) >= 200
     assert set(px["source"]) == {name for name, *_ in SOURCES} | ({"crease"} if field == "ridges" else set())
 
 

@@ -205,8 +205,10 @@ def all_finite(result):
 
 def ranges(function):
     """The ranges ``function``'s arguments are checked with (`pointwise.RANGES_CENTRAL` for the
-    central quotient, else `pointwise.RANGES`, and `COORDINATE` for a name neither lists)."""
-    return pointwise.RANGES_CENTRAL if function == "central_gradient" else pointwise.RANGES
+    central quotient, `pointwise.RANGES_FRAME` for the tangent frame, else `pointwise.RANGES`, and
+    `COORDINATE` for a name neither lists)."""
+    return {"central_gradient": pointwise.RANGES_CENTRAL, "tangent_frame": pointwise.RANGES_FRAME}.get(
+        function, pointwise.RANGES)
 
 
 def ends(name, ranges=pointwise.RANGES):
@@ -234,7 +236,8 @@ def test_each_pointwise_argument_is_wired_to_its_range(function):
 
 def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():
     """All arguments at the ends of their ranges at once (and at the tangent frame's
-    pole cut-off), for every registered field: the ranges are read from the module, so a
+    pole cut-off, float64's smallest normal number, and just above it, where its quotients by
+    sin phi are largest), for every registered field: the ranges are read from the module, so a
     wider one is tried too."""
     central = pointwise.RANGES_CENTRAL
     edge = lambda name, r=pointwise.RANGES: [lim for lim, _ in ends(name, r)]  # noqa: E731
@@ -250,8 +253,11 @@ def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():
     edges = np.array([low, -1.0, 0.0, 1.0, high])
     n = np.array(list(itertools.product(edges, repeat=3))).T
     assert all_finite(pointwise.chart(*n))
-    for s in (low, 0.0, 1e-4, past(1e-4, UP), high):
-        assert all_finite(pointwise.tangent_frame(*n, s))
+    frame = pointwise.RANGES_FRAME
+    unit = np.array(list(itertools.product((*edge("N_x", frame), -1.0, 0.0, 1.0), repeat=3))).T
+    pole = float(F.POLE_SIN_PHI)
+    for s in (*edge("sin_phi", frame), 0.0, 2.0**-1074, pole, past(pole, UP), 1e-4):
+        assert all_finite(pointwise.tangent_frame(*unit, s))
     rng = np.random.default_rng(7)
     pick = lambda: rng.choice(np.concatenate([edges, rng.uniform(low, high, 5)]), 4000)  # noqa: E731
     triple = lambda: (pick(), pick(), pick())  # noqa: E731
