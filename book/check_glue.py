@@ -94,6 +94,7 @@ QUANTITIES = {
     "the window's margin": (("s2_margin",), lambda: _lib("renderer.render").WINDOW_MARGIN),
     "the window's offset": (("s2_offset",), lambda: _lib("renderer.render").WINDOW_OFFSET),
     "the pole threshold of the frame": (("pole_sin_phi",), lambda: float(_lib("renderer.formulas").POLE_SIN_PHI)),
+    "the draft's pole threshold (its Cell 7c)": (("draft_pole_sin_phi",), lambda: _lib("lab.claims").CELL7C_POLE_SIN_PHI),
     "the simulator's linear difference gain": (("s4_gain", "c3_gain"),
                                                lambda: _lib("renderer.ledger").DIFFERENCE_LINEAR_GAIN),
     "the simulator's log-scale black": (("s4_log_floor",),
@@ -206,7 +207,7 @@ ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "s7_parts_surface", "s7_parts_label", "s7_tilt_chart", "s7_tilt_surface", "s3_torus_a", "s3_torus_r",
                "s3_torus_point", "s3_torus_dot", "s3_torus_Lu", "s3_torus_Lv", "s3_torus_kappa_u",
                "s3_torus_kappa_v", "s3_torus_h", "s3_torus_hu", "s3_torus_hv", "s3_torus_exact", "s3_torus_first",
-               "s3_torus_tilt", "s3_torus_agree")
+               "s3_torus_tilt", "s3_torus_agree", "s7_far_zoom", "s7_far_size", "s7_far_inside")
 
 
 def page_glue(notebook: dict) -> dict:

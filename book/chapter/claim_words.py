@@ -82,7 +82,7 @@ SENTENCES = {
     "crease-fd-zero": "the central difference gives {central:+.1e} on the crease, but the exact gradient "
                       "{exact:+.3f}: $\\sin(\\pi k_u u)$ at the float nearest $1/k_u$ is not zero, so the sign "
                       "picks a side",
-    "pole-pixels": "{fallback pixels} pixels use the fallback ({frame}); the draft counts points of a grid of $N_z$ "
+    "pole-pixels": "{fallback pixels} pixels lie inside the draft's fallback disc ({frame}); the draft counts points of a grid of $N_z$ "
                    "values unrelated to the image",
     "try-sweep": f"of the simulator's half-decade steps, the image-best step (least RMS {_DI} over sphere A) is "
                  "{best ε:.0e} ({frame})",
