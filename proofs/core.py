@@ -66,6 +66,11 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
 10. *Placeholders.*  A statement shows mathematics only through ``⟦key⟧`` (`PLACEHOLDER`): a claim,
    a named symbol of ``where`` or an object of ``shown``, which the book prints
    (book/chapter/latex.py); a key that is none of these refutes.
+11. *Thresholds.*  An evidence's threshold (`Verdict.bound`) and a verified pin are at most `TIGHT` times
+   the positive residual measured against them (`loose`), so neither can be loosened unseen.
+12. *Coverage* (proofs/registry.py).  A theorem whose statement is about every height field
+   (`COUNTED_PER_FIELD`) has evidence that compared renderer outputs of each registered field
+   (`Verdict.covers`), not only enough outputs in all.
 """
 
 from __future__ import annotations
@@ -95,6 +100,19 @@ POINTS = 24
 SEED = 0
 #: A residual below 10**(-TOLERANCE_DIGITS) at DIGITS of precision counts as zero.
 TOLERANCE_DIGITS = 20
+#: A threshold (an evidence's ``bound``, a verified pin) may exceed the residual it holds by at most this
+#: factor (rule 11): one loosened by orders of magnitude would pass a defect unseen.
+TIGHT = 1000.0
+
+
+def loose(bound, residual):
+    """Why ``bound`` is too loose for the measured ``residual`` (rule 11), or None: it may be at most
+    `TIGHT` times a positive residual; a residual of exactly 0 leaves it unjudged (a CPU may round
+    that sample exactly)."""
+    if bound is not None and residual is not None and residual > 0 and bound > TIGHT * residual:
+        return (f"its threshold {bound:.2g} is {bound / residual:.2g} times the residual it measured "
+                f"({residual:.2g}), more than {TIGHT:g}: a threshold that loose lets a defect pass; tighten it")
+    return None
 #: A citation of another theorem in a statement or a step's sentence: ``⟪frame-orthonormal⟫``.
 CITATION = re.compile(r"⟪([^⟫]*)⟫")
 #: What a statement prints from the theorem's objects (the book fills it in): ``⟦key⟧``.
@@ -162,6 +180,8 @@ class Verdict:
     points: int | None = None
     rendered: int = 0              # renderer outputs (pixels, or frames) the check compared
     numeric: tuple = ()            # a theorem's steps (numbers) that sympy left and mpmath verified
+    bound: float | None = None     # the threshold evidence held ``residual`` to (rule 11: within TIGHT of it)
+    covers: tuple = ()             # the height fields whose renderer outputs the evidence compared (rule 12)
 
     @property
     def holds(self) -> bool:
@@ -727,10 +747,14 @@ def _prove(t: Theorem) -> Verdict:
         return Verdict("refuted", f"{t.id}: its evidence returned {e!r:.80}, not a Verdict")
     if not e.holds:
         return e if e.status == "refuted" else dataclasses.replace(e, status="refuted")
+    too_loose = loose(e.bound, e.residual)
+    if too_loose:
+        return Verdict("refuted", f"{t.id}: its evidence's {too_loose}", e.residual)
     if e.status == "verified" and not (e.residual is not None and 0 <= e.residual < float("inf") and e.points):
         return Verdict("refuted", f"{t.id}: its evidence is verified but states no finite residual and points "
                        f"(residual {e.residual}, points {e.points}): {e.evidence}")
     if e.status == "verified" and not numeric:
         residual, digits, points = e.residual, e.digits, e.points
     status = "verified" if numeric or e.status == "verified" else "proved"
-    return Verdict(status, f"{summary}; {e.evidence}", residual, digits, points, e.rendered, numeric)
+    return Verdict(status, f"{summary}; {e.evidence}", residual, digits, points, e.rendered, numeric,
+                   covers=e.covers)

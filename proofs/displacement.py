@@ -149,7 +149,7 @@ def surface_normal_residual(bump, gradient, fields=None):
     (the pole itself, where the displaced surface has no normal) are left out (and counted).
     """
     from .pixels import DIGITS, pixels
-    worst, compared, left_out, inside = 0.0, 0, 0, 0
+    worst, compared, left_out, inside, covered = 0.0, 0, 0, 0, []
     for field in F.FIELDS if fields is None else fields:
         scene, px = pixels(field, gradient, bump)
         P = (scene.radius_a + scene.beta * F.FIELDS[field].expr.subs({F.k_u: scene.k_u, F.k_v: scene.k_v})) \
@@ -158,13 +158,14 @@ def surface_normal_residual(bump, gradient, fields=None):
         sin_phi = np.sin(np.pi * px["uv"][:, 1])
         keep = sin_phi > float(F.POLE_SIN_PHI)
         compared, left_out = compared + int(np.count_nonzero(keep)), left_out + int(np.count_nonzero(~keep))
+        covered += [field] if keep.any() and field not in covered else []
         inside += int(np.count_nonzero(keep & (sin_phi <= SEED_POLE_SIN_PHI)))
         for (uu, vv), got in zip(px["uv"][keep], px["Ns"][keep]):
             with mpmath.workdps(DIGITS):
                 c = fn(mpmath.mpf(float(uu)), mpmath.mpf(float(vv)))
                 n = mpmath.sqrt(sum(x * x for x in c))
                 worst = max(worst, max(float(abs(mpmath.mpf(float(gk)) - ck / n)) for gk, ck in zip(got, c)))
-    return worst, compared, left_out, inside
+    return worst, compared, left_out, inside, tuple(covered)
 
 
 def _evidence(kernel=KERNEL_COEFFS, claimed=None, bump="surface", gradient="exact"):
@@ -181,8 +182,8 @@ def _evidence(kernel=KERNEL_COEFFS, claimed=None, bump="surface", gradient="exac
     if set(found) != set(claimed):
         return Verdict("refuted", f"the draft's bump is a displaced sphere's normal for {found or 'no field'}, "
                        f"not {claimed}: integrability obstructions {obstruction}")
-    worst, compared, left_out, inside = surface_normal_residual(bump, gradient)
-    if worst > 1e-12:
+    worst, compared, left_out, inside, covered = surface_normal_residual(bump, gradient)
+    if worst > NORMAL_TOLERANCE:
         return Verdict("refuted", f"renderer's bump={bump!r}, gradient={gradient!r} normal differs from the displaced "
                        f"surface's by {worst:.2e}", worst, rendered=compared)
     return Verdict("proved", f"the obstruction is 0 for {', '.join(found)} only (the draft's bump is the normal of no "
@@ -190,7 +191,14 @@ def _evidence(kernel=KERNEL_COEFFS, claimed=None, bump="surface", gradient="exac
                    f"displaced normal (mpmath, {compared} seeded sphere-A pixels of the {spelled(len(F.FIELDS))} fields, "
                    f"pole ring, crease neighbours and the {inside} inside the draft's pole cut-off sin phi <= "
                    f"{SEED_POLE_SIN_PHI:g} included"
-                   + (f"; {left_out} at the pole itself left out)" if left_out else ")"), rendered=compared)
+                   + (f"; {left_out} at the pole itself left out)" if left_out else ")"), worst,
+                   rendered=compared, bound=NORMAL_TOLERANCE, covers=covered)
+
+
+#: The largest |N'_renderer - N'_exact| the evidence accepts (unit normal components), about 450 float64
+#: roundings: rule 11 of proofs.core holds it within TIGHT of the worst found (5.5e-15 on the machine it
+#: was set on), so it stays above the worst by a margin and far below a defect.
+NORMAL_TOLERANCE = 1e-13
 
 
 def _displaced(weight=-beta / (R + beta * H_at)):

@@ -85,13 +85,13 @@ def _chart_evidence(corrupt=None):
     """The renderer's own chart (GBuffer.uv) at its own N against CHART (proofs/pixels.py); ``corrupt``
     alters the renderer's (u, v) first (a wrong variant)."""
     from .pixels import TOLERANCE, chart_error, worst_of
-    worst, count = worst_of(chart_error, [(f, corrupt) for f in F.FIELDS])
+    worst, count, covered = worst_of(chart_error, [(f, corrupt) for f in F.FIELDS])
     if worst > TOLERANCE["chart"]:
         return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
                        f"{count} sphere-A pixels")
     return Verdict("proved", f"the renderer's (u, v) at {count} seeded sphere-A pixels (pole ring and the "
                    f"draft's disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} of the chart, "
-                   "evaluated by mpmath at its N", rendered=count)
+                   "evaluated by mpmath at its N", rendered=count, covers=covered)
 
 
 def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
@@ -168,7 +168,7 @@ def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
     if bad is not None:
         return bad
     from .pixels import TOLERANCE, normal_error, worst_of
-    worst, count = worst_of(normal_error, [(f, b, corrupt) for f in F.FIELDS
+    worst, count, covered = worst_of(normal_error, [(f, b, corrupt) for f in F.FIELDS
                                            for b in ("chart", "surface")])
     if worst > TOLERANCE["normal"]:
         return Verdict("refuted", f"the renderer's N' differs from PERTURBED_NORMAL in this frame by {worst:.1e} "
@@ -177,7 +177,7 @@ def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
                    "(float64's smallest normal number) and its fallback elsewhere, in each component; the "
                    f"renderer's N' (both bump modes, {len(F.FIELDS)} fields) at {count} seeded sphere-A pixels (pole "
                    f"ring and the draft's fallback disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} "
-                   "of the perturbed normal evaluated by mpmath in this frame", rendered=count)
+                   "of the perturbed normal evaluated by mpmath in this frame", rendered=count, covers=covered)
 
 
 def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):

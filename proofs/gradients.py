@@ -141,7 +141,7 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
                    f"{rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} of their tolerances against "
                    "the exact gradient, the central difference (stencil included) and the central difference with "
                    "the footprint's steps at its (u, v)",
-                   rendered=rendered["exact"][1])
+                   worst, DIGITS, POINTS, rendered=rendered["exact"][1], bound=GENERATED_TOLERANCE)
 
 
 def _argument(field, closed_form):

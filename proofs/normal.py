@@ -116,14 +116,14 @@ def _render_rate(reference_beta=0.0, tiny_beta=TINY_BETA, fields=None):
                     renders += 1
                     if k == 0:
                         bumped.add(image.tobytes())
-    return worst, across_fields, renders, len(bumped)
+    return worst, across_fields, renders, len(bumped), tuple(dict.fromkeys(fields))
 
 
 def _rate_evidence(order=1.0, **sampling):
     """The rendered limit: the images approach the beta = 0 image at rate beta^``order``, every
     configuration reaches the image, and at beta = 0 the field does not (``sampling`` goes to
     `_render_rate`, for the wrong variants)."""
-    worst, across_fields, renders, distinct = _render_rate(**sampling)
+    worst, across_fields, renders, distinct, covered = _render_rate(**sampling)
     configurations = len(BUMPS) * len(PIPELINES) * len(F.FIELDS)
     if across_fields:
         return Verdict("refuted", f"at beta = 0, {across_fields} channel values depend on the height field")
@@ -142,7 +142,7 @@ def _rate_evidence(order=1.0, **sampling):
                    f"{distinct} distinct at beta = {RATE_BETAS[0]:g}: max |I(beta) - I(0)| falls with fitted order "
                    f"{slope:.2f} over beta = 1e-2 ... 1e-8 ({worst[0]:.1e} to {worst[-2]:.1e}), {worst[-1]:.1e} at "
                    f"beta = {TINY_BETA:g} (the linear rate allows {4 * line:.1e}); the beta = 0 renders of the "
-                   f"{spelled(len(F.FIELDS))} fields are equal bit for bit", rendered=renders)
+                   f"{spelled(len(F.FIELDS))} fields are equal bit for bit", rendered=renders, covers=covered)
 
 
 def _limit(tilt=None, **evidence):

@@ -101,9 +101,11 @@ def pixels(field, gradient="exact", bump="chart", seed=0):
 
 
 def worst_of(check, cases):
-    """(largest error, pixels compared) of ``check(*case)`` -> (error, count) over ``cases``."""
+    """(largest error, pixels compared, fields covered) of ``check(*case)`` -> (error, count) over
+    ``cases``, each case's first item a field's name; covered: the fields with pixels compared."""
     results = [check(*case) for case in cases]
-    return max(err for err, _ in results), sum(n for _, n in results)
+    covered = tuple(dict.fromkeys(case[0] for case, (_, n) in zip(cases, results) if n > 0))
+    return max(err for err, _ in results), sum(n for _, n in results), covered
 
 
 @lru_cache(maxsize=None)

@@ -62,7 +62,7 @@ CITABLE = _Theorems(lambda module, theorem_id, title: title)
 #: `pinned_failure` compares a verdict with it; `pytest verify` and the book
 #: build fail on any difference, so a verdict cannot change unnoticed.
 PINNED = {
-    "displaced-normal": "proved", "chart": ("verified", 1e-25), "frame-orthonormal": "proved", "frame-orientation": "proved",
+    "displaced-normal": "proved", "chart": ("verified", 1e-30), "frame-orthonormal": "proved", "frame-orientation": "proved",
     "gradient-{field}": "proved", "{field}-kinks": "proved", "kink-loci-rays": "proved",
     "kink-loci-circles": "proved", "no-boundary": ("verified", 0.0), "normal-beta-derivative": "proved",
     "beta-zero-regression": "proved", "central-difference-truncation": "proved", "optimal-step": "proved",
@@ -130,11 +130,13 @@ def pin(theorem_id):
                      "bound a finite number >= 0")
 
 
-def pinned_failure(theorem_id, status, residual, rendered):
-    """Why the verdict (``status``, ``residual``, ``rendered``) differs from `PINNED` and
+def pinned_failure(theorem_id, status, residual, rendered, covers):
+    """Why the verdict (``status``, ``residual``, ``rendered``, ``covers``) differs from `PINNED` and
     `RENDERED`, or None if it does not: the status must be the pin's, a verified one's
-    residual a number at most the pin's bound (a missing or NaN residual never passes),
-    and at least `least_rendered` renderer outputs compared.
+    residual a number at most the pin's bound (a missing or NaN residual never passes) and
+    the bound within `proofs.core.TIGHT` of it, at least `least_rendered` renderer outputs
+    compared, and for a theorem of `COUNTED_PER_FIELD` outputs of every registered field among
+    them (``covers``: the field names the evidence compared, `proofs.core.Verdict.covers`).
 
     Raises
     ------
@@ -148,9 +150,19 @@ def pinned_failure(theorem_id, status, residual, rendered):
         return f"{theorem_id} is {status}, pinned {want}"
     if bound is not None and not (residual is not None and residual <= bound):
         return f"{theorem_id} is verified with residual {residual}, pinned at most {bound:g}"
+    from .core import loose
+    too_loose = loose(bound, residual)
+    if too_loose:
+        return f"{theorem_id}'s pin: {too_loose}"
     least = least_rendered(theorem_id)
     if rendered < least:
         return f"{theorem_id} compared {rendered} renderer outputs, pinned at least {least}"
+    if theorem_id in COUNTED_PER_FIELD:
+        from renderer.formulas import FIELDS
+        missing = [name for name in FIELDS if name not in set(covers)]
+        if missing:
+            return (f"{theorem_id}'s evidence compared no renderer output of the {', '.join(missing)} "
+                    f"field{'s' if len(missing) > 1 else ''}, which its statement is about")
     return None
 
 

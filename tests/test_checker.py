@@ -18,14 +18,17 @@ from renderer.formulas import FIELDS
 from proofs.registry import CITABLE, PINNED, THEOREMS, get, least_rendered, pin, pinned_failure
 from verify.test_theorems import _placed
 
+#: Every registered field: what a theorem about every field must cover (rule 12).
+ALL = tuple(FIELDS)
+
 VARIANTS = [(t.id, d, fn) for t in THEOREMS.values() for d, fn in t.wrong_variants]
 
 def test_a_check_that_skips_the_renderer_is_named():
     """A verdict reached without its renderer comparison (fewer outputs than pinned) is a change."""
     least = least_rendered("chart")
     assert f"compared {least - 1} renderer outputs, pinned at least {least}" in \
-        pinned_failure("chart", "verified", 1e-30, least - 1)
-    assert pinned_failure("chart", "verified", 1e-30, least) is None
+        pinned_failure("chart", "verified", 1e-30, least - 1, ALL)
+    assert pinned_failure("chart", "verified", 1e-30, least, ALL) is None
 
 
 @pytest.mark.parametrize("pin, status, residual, why", [
@@ -38,9 +41,9 @@ def test_a_check_that_skips_the_renderer_is_named():
 
 def test_a_changed_verdict_is_named(monkeypatch, pin, status, residual, why):
     monkeypatch.setitem(PINNED, "chart", pin)
-    assert why in pinned_failure("chart", status, residual, least_rendered("chart"))
-    assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-30)),
-                          least_rendered("chart")) is None
+    assert why in pinned_failure("chart", status, residual, least_rendered("chart"), ALL)
+    assert pinned_failure("chart", *((pin, None) if isinstance(pin, str) else ("verified", 1e-27)),
+                          least_rendered("chart"), ALL) is None
 
 
 @pytest.mark.parametrize("residual, passes", [(0.0, True), (1e-30, False), (5e-324, False), (None, False),
@@ -49,7 +52,7 @@ def test_rule_7_a_pin_of_zero_admits_only_a_zero_residual(monkeypatch, residual,
     """("verified", 0.0), as no-boundary's (its residual counts differing renderer outputs): a bound read
     by truthiness (0.0 is false) would never be enforced."""
     monkeypatch.setitem(PINNED, "no-boundary", ("verified", 0.0))
-    why = pinned_failure("no-boundary", "verified", residual, least_rendered("no-boundary"))
+    why = pinned_failure("no-boundary", "verified", residual, least_rendered("no-boundary"), ALL)
     assert (why is None) is passes, why
     if not passes:
         assert why == f"no-boundary is verified with residual {residual}, pinned at most 0", why
@@ -59,10 +62,10 @@ def test_rule_7_a_pin_of_zero_admits_only_a_zero_residual(monkeypatch, residual,
 def test_rule_7_a_pin_bounds_the_residual_from_above_inclusively(monkeypatch, bound):
     monkeypatch.setitem(PINNED, "chart", ("verified", bound))
     least = least_rendered("chart")
-    assert pinned_failure("chart", "verified", bound, least) is None
-    assert pinned_failure("chart", "verified", bound * (1 + 1e-9), least) is not None
-    assert pinned_failure("chart", "verified", float("nan"), least) is not None
-    assert "is proved, pinned verified" in pinned_failure("chart", "proved", None, least)
+    assert pinned_failure("chart", "verified", bound, least, ALL) is None
+    assert pinned_failure("chart", "verified", bound * (1 + 1e-9), least, ALL) is not None
+    assert pinned_failure("chart", "verified", float("nan"), least, ALL) is not None
+    assert "is proved, pinned verified" in pinned_failure("chart", "proved", None, least, ALL)
 
 
 @pytest.mark.parametrize("bad", ["verified", ("verified",), ("verified", -1e-30), ("verified", float("inf")),
@@ -75,13 +78,13 @@ def test_rule_7_a_malformed_pin_is_an_error_naming_it(monkeypatch, bad):
     for status, residual in (("proved", None), ("verified", 0.0), ("refuted", None)):
         with pytest.raises(ValueError, match=r"^PINNED\['chart'\] is .*: a pin is \"proved\" or \(\"verified\", bound\), "
                                              r"bound a finite number >= 0$"):
-            pinned_failure("chart", status, residual, least_rendered("chart"))
+            pinned_failure("chart", status, residual, least_rendered("chart"), ALL)
 
 
 def test_a_theorem_without_renders_is_pinned_by_its_verdict_alone():
     assert least_rendered("optimal-step") == 0
-    assert pinned_failure("optimal-step", "proved", None, 0) is None
-    assert pinned_failure("optimal-step", "verified", 1e-30, 0) == "optimal-step is verified, pinned proved"
+    assert pinned_failure("optimal-step", "proved", None, 0, ()) is None
+    assert pinned_failure("optimal-step", "verified", 1e-30, 0, ()) == "optimal-step is verified, pinned proved"
 
 
 def test_every_registered_pin_is_well_formed():
@@ -446,3 +449,50 @@ def test_a_box_refuses_a_numeric_step_without_its_reason_or_a_reason_on_a_proved
     book, show = _chart_box(monkeypatch, dataclasses.replace(t, steps=tuple(steps)))
     with pytest.raises(book.TheoremFailed, match=f"chart: step {k} "):
         show()
+
+
+# ----------------------------------------------------------------- rule 11: thresholds held to residuals
+@pytest.mark.parametrize("module, constant, theorem_id", [
+    ("displacement", "NORMAL_TOLERANCE", "bump-vs-displacement"),
+    ("gradients", "GENERATED_TOLERANCE", "gradient-sine"),
+    ("finite_difference", "FOOTPRINT_TOLERANCE", "central-difference-truncation"),
+])
+def test_an_evidence_threshold_loosened_by_orders_of_magnitude_is_refused(monkeypatch, module, constant, theorem_id):
+    """Each threshold an evidence holds its residual to, raised ten orders of magnitude (a change that
+    lets a defect pass and changes no verdict by itself), refutes the theorem, naming the factor."""
+    import importlib
+
+    from proofs.registry import get
+    mod = importlib.import_module(f"proofs.{module}")
+    monkeypatch.setattr(mod, constant, getattr(mod, constant) * 1e10)
+    v = get(theorem_id).check()
+    assert v.status == "refuted" and "its threshold" in v.evidence and "tighten it" in v.evidence, v.evidence
+
+
+def test_a_verified_pin_loosened_is_refused_and_the_rule_spares_an_exact_zero(monkeypatch):
+    from proofs import core, registry
+    residual = registry.get("chart").check().residual
+    assert registry.pinned_failure("chart", "verified", residual, 10**6, ALL) is None
+    monkeypatch.setitem(registry.PINNED, "chart", ("verified", 1e-20))
+    assert "chart's pin: its threshold 1e-20 is" in registry.pinned_failure("chart", "verified", residual, 10**6, ALL)
+    assert core.loose(1e-20, 0.0) is None and core.loose(1e-20, 1e-23) is None and core.loose(1e-20, 9e-24)
+
+
+def test_rule_12_evidence_that_leaves_out_a_field_is_named(monkeypatch):
+    """A theorem about every field whose evidence compared outputs of only some, enough of them in all,
+    is named (rule 12); each of the four per-field theorems, its evidence narrowed to the first field,
+    is refused."""
+    from proofs import displacement, normal, pixels
+    assert pinned_failure("chart", "verified", 1e-30, 10**6, ALL[:-1]).endswith(
+        f"compared no renderer output of the {ALL[-1]} field, which its statement is about")
+    real = pixels.worst_of
+    monkeypatch.setattr(pixels, "worst_of", lambda check, cases: real(check, [c for c in cases if c[0] == ALL[0]]))
+    real_surface = displacement.surface_normal_residual
+    monkeypatch.setattr(displacement, "surface_normal_residual",
+                        lambda bump, gradient, fields=None: real_surface(bump, gradient, fields=ALL[:1]))
+    real_rate = normal._render_rate
+    monkeypatch.setattr(normal, "_render_rate", lambda **kw: real_rate(**{**kw, "fields": ALL[:1] * len(ALL)}))
+    for theorem_id in ("chart", "frame-orthonormal", "bump-vs-displacement", "beta-zero-regression"):
+        v = get(theorem_id).check()
+        why = pinned_failure(theorem_id, v.status, v.residual, v.rendered, v.covers) if v.holds else v.evidence
+        assert why, theorem_id           # by rule 12, or by the outputs' count where that falls short first

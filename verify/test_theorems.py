@@ -25,7 +25,7 @@ def test_theorem_holds(theorem_id, record_property):
     assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
     assert isinstance(verdict.evidence, str) and verdict.evidence, "the ledger shows the evidence"
     assert not code_words(verdict.evidence), f"§6 shows the evidence to the reader: {code_words(verdict.evidence)}"
-    assert pinned_failure(theorem_id, verdict.status, verdict.residual, verdict.rendered) is None
+    assert pinned_failure(theorem_id, verdict.status, verdict.residual, verdict.rendered, verdict.covers) is None
     if verdict.status == "verified":      # mpmath at >= 30 digits, or >= 100 renders without a difference
         assert (verdict.digits is not None and verdict.digits >= 30 and verdict.points >= 20) or \
             (verdict.digits is None and verdict.points >= 100 and verdict.residual == 0.0)

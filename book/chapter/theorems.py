@@ -196,7 +196,7 @@ def _entry(t):
     return dict(title=t.title, status=v.status, badge=badge(v.status, v.numeric), evidence=v.evidence,
                 seed_says=t.seed_says,
                 pages=list(t.pages), block=block, unexplained=unexplained,
-                changed=pinned_failure(t.id, v.status, v.residual, v.rendered))
+                changed=pinned_failure(t.id, v.status, v.residual, v.rendered, v.covers))
 
 
 def _ledger():
