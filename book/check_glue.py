@@ -366,25 +366,32 @@ def _matches(shown: str, value: float) -> bool:
     return abs(float(shown) - value) <= 0.5 * unit * (1 + 1e-9) + 1e-300
 
 
+def _plain(text):
+    """``text`` as the words rule compares it: lower case, a hyphen or dash between two letters a space
+    (one in a number, ``1.3e-12``, stays), spaces collapsed: "Model‑optimal  step" and "model optimal
+    step" are one phrase."""
+    return " ".join(re.sub(r"(?<=[^\W\d])[-‐‑‒–—](?=[^\W\d])", " ", text.lower()).split())
+
+
 def words_conflicts(html_dir, names: dict, named=None) -> list:
     """One line per place where a quantity's words (`NAMED`) carry a number other than its
     glued value, per quantity whose words are met nowhere (or that is glued nowhere), and
     per pair of quantities whose words contain one another.  ``names`` is `glued`'s."""
     named = NAMED if named is None else named
     bad = [f"the words {a!r} ({n}) contain {b!r} ({m}): a sentence naming one names both"
-           for n, a in named.items() for m, b in named.items() if n != m and b in a]
+           for n, a in named.items() for m, b in named.items() if n != m and _plain(b) in _plain(a)]
     met = {n: 0 for n in named}
     for page in sorted(Path(html_dir).glob("*.html")):
         for sentence in prose_sentences(page.read_text(encoding="utf-8")):
-            low = sentence.lower()
+            low = _plain(sentence)
             for name, words in named.items():
-                at = low.find(words)
+                at = low.find(_plain(words))
                 if at < 0:
                     continue
                 met[name] += 1
-                number = NUMBER.search(sentence, at + len(words))
+                number = NUMBER.search(low, at + len(_plain(words)))
                 values = {_value(v) for v in names.get(name, {}).values()} - {None}
-                if number is None or not values or re.search(r"[<>≤≥]", sentence[at:number.start()]):
+                if number is None or not values or re.search(r"[<>≤≥]", low[at:number.start()]):
                     continue                     # no number, or a threshold of a rule, not a value
                 if not any(_matches(number.group(), v) for v in values):
                     bad.append(f"{page.stem}: {words!r} is followed by {number.group()}, but {name} "

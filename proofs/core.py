@@ -115,6 +115,9 @@ def loose(bound, residual):
     return None
 #: A citation of another theorem in a statement or a step's sentence: ``⟪frame-orthonormal⟫``.
 CITATION = re.compile(r"⟪([^⟫]*)⟫")
+#: A theorem named by its id in words (rule 8 refuses it): "theorem chart", "Theorems `chart`",
+#: "theorem “chart”", any case, any spacing or line break, the id quoted or not.
+WORDS_CITATION = re.compile(r"\btheorems?\s+[`'\"“‘]?([\w-]+)", re.IGNORECASE)
 #: What a statement prints from the theorem's objects (the book fills it in): ``⟦key⟧``.
 PLACEHOLDER = re.compile(r"⟦([^⟧]+)⟧")
 
@@ -682,7 +685,7 @@ def _unknown_citation(t):
         if unknown:
             return (f"{t.id}: {where} cites ⟪{unknown[0]}⟫, which is no theorem of the registry"
                     + ("" if CITABLE else " (proofs.registry, whose theorems proofs.core.CITABLE reads, is not imported)"))
-        for m in re.finditer(r"\btheorems?\s+`?([\w-]+)", text):
+        for m in WORDS_CITATION.finditer(text):
             if m.group(1) in CITABLE:
                 return f"{t.id}: {where} names theorem {m.group(1)} by its id in words: cite it as ⟪{m.group(1)}⟫"
     return None

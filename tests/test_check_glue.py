@@ -156,6 +156,17 @@ def test_the_same_words_with_another_number_fail_wherever_the_number_comes_from(
     assert len(bad) == 1 and "s6_ledger: 'rms slope' is followed by 1.65" in bad[0]
 
 
+@pytest.mark.parametrize("words", ["RMS slope", "rms  slope", "RMS\nslope", "RMS slopes", "rms-slope", "RMS‑slope",
+                                   "Rms Slope"])
+def test_the_words_are_met_in_any_case_spacing_hyphenation_or_plural(tmp_path, words):
+    """The variants of a quantity's words a writer might type carry the rule with them: each, followed
+    by the wrong number, is found (before: only the exact lower-case phrase with single spaces)."""
+    site = _site(tmp_path, s5_lab="<p>The RMS slope is 0.54; the off-band slope is 2.19.</p>",
+                 s6_ledger=f"<p>Measured, the {words} is −1.65e-3.</p>")
+    bad = check_glue.words_conflicts(site, VALUES, NAMED)
+    assert len(bad) == 1 and "is followed by −1.65e-3" in bad[0], bad
+
+
 def test_a_rule_threshold_after_the_words_is_not_a_value(tmp_path):
     site = _site(tmp_path, s6_ledger="<p>Holds if RMS slope &gt; 1.8. The RMS slope is 0.54, the off-band slope 2.19.</p>")
     assert check_glue.words_conflicts(site, VALUES, NAMED) == []

@@ -357,7 +357,9 @@ def test_rule_8_a_citation_of_an_unknown_id_is_refuted(k):
     assert _cite_in(t, k, "by ⟪frame-orthonormal⟫").check().status == "proved"
 
 
-@pytest.mark.parametrize("words", ["theorem frame-orthonormal", "theorems `chart`"])
+@pytest.mark.parametrize("words", ["theorem frame-orthonormal", "theorems `chart`", "Theorem chart", "THEOREMS chart",
+                                   "theorem  chart", "theorem\nchart", "theorem “chart”", "theorem 'chart'",
+                                   "Theorem \"frame-orthonormal\""])
 def test_rule_8_a_theorem_named_by_its_id_in_words_is_refuted(words):
     verdict = _cite_in(get("frame-orientation"), 1, f"(by {words})").check()
     assert verdict.status == "refuted" and "by its id in words" in verdict.evidence, verdict.evidence
