@@ -46,9 +46,8 @@ __all__ = ["ENV", "UntrustedStore", "measured", "source_digest"]
 
 #: Environment variable naming the store's directory.
 ENV = "SYMRENDER_STORE"
-#: The packages whose files a measurement may depend on, and the libraries whose versions it may.
+#: The packages whose files a measurement may depend on (the libraries whose versions it may: `libraries`).
 PACKAGES = ("renderer", "proofs", "lab", "chapter")
-LIBRARIES = ("numpy", "sympy", "mpmath", "numba", "llvmlite")
 _NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,99}")
 #: Largest record read (bytes); the largest the book writes (the theorem ledger) is some tens of KiB.
 MAX_RECORD_BYTES = 16 << 20
@@ -88,10 +87,36 @@ def _roots():
     return {package: Path(find_spec(package).origin).parent for package in PACKAGES}
 
 
+def libraries():
+    """The installed distributions the project's code runs on, sorted: the requirements of the
+    distribution that installs `renderer` (its extras left out) and theirs, transitively (numpy,
+    sympy, matplotlib, jax and jaxlib, drjit, numba and llvmlite, ...).  Derived from the installed
+    metadata, so a dependency added to pyproject.toml is in the digest without a second list."""
+    def name(requirement):
+        return re.match(r"[A-Za-z0-9][A-Za-z0-9._-]*", requirement).group().lower().replace("_", "-")
+    todo = list(metadata.packages_distributions().get("renderer", ()))
+    seen = set()
+    while todo:
+        try:
+            requirements = metadata.requires(todo.pop()) or ()
+        except metadata.PackageNotFoundError:
+            continue
+        for r in requirements:
+            dist = name(r)
+            if "extra ==" not in r and dist not in seen:
+                try:
+                    metadata.version(dist)
+                except metadata.PackageNotFoundError:
+                    continue
+                seen.add(dist)
+                todo.append(dist)
+    return sorted(seen)
+
+
 def source_digest():
     """SHA-256 (hex str) of every file of the project's packages (`PACKAGES`, found where
     Python imports them from: a checkout or an installed wheel; paths and bytes,
-    __pycache__ left out) and the versions of `LIBRARIES`; computed once per process.
+    __pycache__ left out) and the versions of `libraries`; computed once per process.
     The project's one source digest: the store, the book's page cache and the figure
     manifests all use it."""
     if not _DIGEST:
@@ -100,7 +125,7 @@ def source_digest():
             for path in sorted(root.rglob("*")):
                 if path.is_file() and "__pycache__" not in path.parts:
                     h.update(f"{package}/{path.relative_to(root)}".encode() + b"\0" + path.read_bytes() + b"\0")
-        for name in LIBRARIES:
+        for name in libraries():
             h.update(f"{name}=={metadata.version(name)}\0".encode())
         _DIGEST.append(h.hexdigest())
     return _DIGEST[0]

@@ -92,6 +92,42 @@ def test_the_digest_follows_the_source_files(tmp_path, monkeypatch):
     assert store.source_digest() != changed
 
 
+@pytest.mark.parametrize("kind", ["module", "javascript", "data"])
+def test_every_kind_of_file_a_page_reads_through_the_packages_changes_the_digest(tmp_path, monkeypatch, kind):
+    """A page reads the packages' modules, the simulator's JavaScript (renderer/js, printed into §4)
+    and any data file beside them: a changed byte of each kind changes the digest (the wrong
+    variant, a digest of .py files alone, misses the last two)."""
+    name = {"module": "a.py", "javascript": "js/render.js", "data": "tables/points.json"}[kind]
+    for package in store.PACKAGES:
+        (tmp_path / package / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / package / name).write_text("1")
+    monkeypatch.setattr(store, "_roots", lambda: {p: tmp_path / p for p in store.PACKAGES})
+    monkeypatch.setattr(store, "_DIGEST", [])
+    before = store.source_digest()
+    (tmp_path / "lab" / name).write_text("2")
+    monkeypatch.setattr(store, "_DIGEST", [])
+    assert store.source_digest() != before
+
+
+def test_the_digest_follows_every_library_the_project_runs_on(monkeypatch):
+    """The libraries are the installed requirements of the project, transitively: the ones the pages
+    import (matplotlib draws every figure, jax and jaxlib compute §5's AD, scipy its crease roots, drjit
+    the fast backend, pillow the PNGs) are among them, and a new version of any one changes the digest
+    (before: five libraries were typed, and a matplotlib or jax upgrade reused the old pages)."""
+    from importlib import metadata
+    libraries = store.libraries()
+    assert {"numpy", "sympy", "mpmath", "numba", "llvmlite", "matplotlib", "jax", "jaxlib", "scipy", "drjit",
+            "pillow"} <= set(libraries)
+    monkeypatch.setattr(store, "_DIGEST", [])
+    before = store.source_digest()
+    real = metadata.version
+    for library in libraries:
+        monkeypatch.setattr(metadata, "version", lambda d, lib=library: "0.0.0-other" if d == lib else real(d))
+        monkeypatch.setattr(store, "_DIGEST", [])
+        assert store.source_digest() != before, library
+    monkeypatch.setattr(metadata, "version", real)
+
+
 def test_the_same_process_asks_twice_and_computes_once(fresh):
     directory, calls, compute = fresh
     first = store.measured("u-curve", compute, size=256)
