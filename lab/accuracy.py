@@ -308,10 +308,10 @@ def crease_share():
     return measured("crease-share", _crease_share, size=CREASE_SIZE, steps=list(CREASE_STEPS))
 
 
-def _crease_share(size, steps):
-    g = gbuffer(DRAFT_SCENE, size, size)
+def _crease_share(size, steps, scene=DRAFT_SCENE):
+    g = gbuffer(scene, size, size)
     uv = g.uv[g.chamber == SPHERE_A]
-    dist = crease_distance(uv[:, 0], uv[:, 1], DRAFT_SCENE.k_u, DRAFT_SCENE.k_v)
+    dist = crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field)
     return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps], pixels=int(dist.size))
 
 

@@ -531,3 +531,39 @@ def test_the_exercises_compare_with_numbers_cell_4s_table_shows(ran, book_html):
     assert len(rows) == len(ns["fast"].of("sine"))
     for name, row in EXERCISE_ROWS.items():
         assert shows(rows[row], glued[name]), (name, rows[row], glued[name])
+
+
+# ---- what a solution shows, redone from the numbers the page gives ----------------------------
+
+def test_the_torus_solution_is_redone_from_its_givens(ran):
+    """The torus exercise's answers, recomputed by hand from the glued radii, point, field values and
+    β with the solution's own formulas (|p_u| = 2π(a + r cos 2πv), |p_v| = 2πr, κ_u = cos 2πv /
+    (a + r cos 2πv), κ_v = 1/r; the exact and first-order slopes; the tilt atan|t|), are the glued ones."""
+    ns, shown, glued = ran("s3_math")
+    a, r, v, b = glued["s3_torus_a"], glued["s3_torus_r"], glued["s3_torus_v"], glued["s3_torus_beta"]
+    h, hu, hv = glued["s3_torus_h"], glued["s3_torus_hu"], glued["s3_torus_hv"]
+    c = math.cos(2 * math.pi * v)
+    Lu, Lv, ku, kv = 2 * math.pi * (a + r * c), 2 * math.pi * r, c / (a + r * c), 1 / r
+    for key, value in (("Lu", Lu), ("Lv", Lv), ("kappa_u", ku), ("kappa_v", kv)):
+        assert math.isclose(glued[f"s3_torus_{key}"], value, rel_tol=1e-12), key
+    exact = (-b * hu / ((1 + b * h * ku) * Lu), -b * hv / ((1 + b * h * kv) * Lv))
+    first = (-b * hu / Lu, -b * hv / Lv)
+    for key, t in (("exact", exact), ("first", first)):
+        assert numbers(glued[f"s3_torus_{key}"]) == [round(x, 4) for x in t], key
+    assert math.isclose(glued["s3_torus_tilt"], math.degrees(math.atan(math.hypot(*exact))), rel_tol=1e-12)
+    assert glued["s3_torus_agree"] < 1e-15
+
+
+def test_the_pole_and_crease_solutions_of_s7_are_redone_from_their_givens(ran):
+    """§7's pole exercise (the disc R sin φ₀ magnified e/(e − R) onto the image plane; the expected
+    count π radius² / pitch²) and its crease exercise (the half jump |h_R − h_L|/2; the dip, that half
+    jump less the measured floor), recomputed from the glued givens."""
+    ns, shown, glued = ran("s7_pitfalls")
+    e, R = glued["s7_ex_camera"], glued["s7_ex_radius"]
+    assert math.isclose(glued["s7_ex_magnify"], e / (e - R), rel_tol=1e-12)
+    assert math.isclose(glued["s7_ex_disc"], R * glued["draft_pole_sin_phi"] * e / (e - R), rel_tol=1e-12)
+    assert math.isclose(glued["s7_ex_expected"], math.pi * glued["s7_ex_disc"] ** 2 / glued["s7_ex_pitch"] ** 2,
+                        rel_tol=1e-12)
+    half = abs(glued["s7_crease_right"] - glued["s7_crease_left"]) / 2
+    assert math.isclose(glued["s7_crease_half_jump"], half, rel_tol=1e-12)
+    assert math.isclose(glued["s7_crease_dip"], half - glued["s7_crease_err_min"], rel_tol=1e-9)
