@@ -52,7 +52,7 @@ def test_the_fourth_fields_gradient_is_proved_as_printed(squares):
     assert sp.simplify(h_u - 2 * sp.pi * F.k_u * s_1 * sp.cos(sp.pi * F.k_u * F.u) * s_2**2) == 0
     verdict = t.check()
     assert verdict.status == "proved", verdict.evidence
-    assert registry.pinned_failure(t.id, verdict.status, verdict.residual, verdict.rendered) is None
+    assert registry.pinned_failure(t.id, verdict.status, verdict.residual, verdict.rendered, verdict.covers) is None
 
 
 def test_the_fourth_fields_wrong_gradients_are_refuted(squares):
