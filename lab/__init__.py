@@ -7,4 +7,9 @@ each, timed against their error),
 checkable claims, each decided by a stated rule), and `store` (one measurement per
 build, shared by the book's pages); `displaced` (sphere A truly displaced, against the
 bumped render) and `inverse` (β fitted to a normal map).  Imports `proofs` and `renderer`, never the book.
+
+Every public function checks its arguments once, at its entry, as `renderer.validate` checks the
+renderer's (`_checks` holds the lab's own kinds): a bad value raises one
+`renderer.validate.InvalidType` or `renderer.validate.InvalidValue` naming the parameter, the
+value and what is accepted (tests/test_lab_validation.py tries every parameter).
 """

@@ -17,6 +17,10 @@ import sympy as sp
 from renderer import DRAFT_SCENE, Scene, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer.render import SPHERE_A
+from renderer.scene import FREQUENCY, MAX_BETA, UNIT
+from renderer.validate import InvalidValue, positive_int, real, real_array, steps as _steps
+
+from ._checks import MAX_COUNT, MAX_SQUARE, STEP, broadcast, seed as _seed
 
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
@@ -63,13 +67,36 @@ def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=N
     (the sign there depends on the last bit of the float64 factor, and the derivative does not
     exist).
 
+    Parameters
+    ----------
+    field : height field
+    count : int in [1, 2**24], keyword-only
+        Pixels sampled (all of sphere A's where it has fewer).
+    size : int in [1, 4096], keyword-only
+        Frame side in pixels.
+    seed : int in [0, 2**64 - 1], keyword-only
+        Seed of the pixel sample.
+    steps : sequence of float in [1e-300, 1), keyword-only
+        The central difference's steps (chart units), 1 to 64 of them.
+    k_u, k_v : float in (0, 1e3] or None, keyword-only
+
     Returns
     -------
     list of GradientAccuracy: the exact pipeline first, then one per step.
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: not of its kind (a bool, a string where a number is meant) or
+        outside its range.
     """
-    field = F.field(field)
-    k_u = float(DRAFT_SCENE.k_u if k_u is None else k_u)
-    k_v = float(DRAFT_SCENE.k_v if k_v is None else k_v)
+    field = F.field(field, "field")
+    count = positive_int("count", count, high=MAX_COUNT)
+    size = positive_int("size", size, high=MAX_SQUARE)
+    seed = _seed("seed", seed)
+    steps = _steps("steps", steps, **STEP, max_count=64).tolist()
+    k_u = real("k_u", DRAFT_SCENE.k_u if k_u is None else k_u, **FREQUENCY)
+    k_v = real("k_v", DRAFT_SCENE.k_v if k_v is None else k_v, **FREQUENCY)
     scene = Scene(height_field=field, k_u=k_u, k_v=k_v)
     uu, vv = _sample(scene, size, count, seed)
     for factor in field.crease_factors:
@@ -102,9 +129,12 @@ def normal_beta_derivative_residual(trials=2000, seed=5):
     The reference is mpmath's numerical derivative of N'(beta) = M / |M| at 50
     digits (mpmath.diff), independent of the closed form.  One measurement of
     the build (`lab.store`): §5, §6 and the claims register show the same value.
+    ``trials``: an int in [1, 2**24]; ``seed``: an int in [0, 2**64 - 1] (InvalidType or
+    InvalidValue naming the argument otherwise).
     """
     from .store import measured
-    return measured("normal-beta-derivative-residual", _normal_beta_derivative_residual, trials=trials, seed=seed)
+    return measured("normal-beta-derivative-residual", _normal_beta_derivative_residual,
+                    trials=positive_int("trials", trials, high=MAX_COUNT), seed=_seed("seed", seed))
 
 
 def _normal_beta_derivative_residual(trials, seed):
@@ -134,10 +164,25 @@ def _normal_beta_derivative_residual(trials, seed):
 
 def image_beta_order(size=64, beta=None, steps=(1e-1, 5e-2, 2e-2, 1e-2, 5e-3, 2e-3)):
     """`_image_beta_order` (``beta`` None: the draft's), one measurement of the build (`lab.store`;
-    arrays come back as lists)."""
+    arrays come back as lists).
+
+    ``size``: an int in [1, 4096] (pixels); ``beta``: a float in [0, 100] or None; ``steps``:
+    2 to 64 steps db in (0, 100] with beta +- db in [0, 100] (the scenes rendered).
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: not of its kind or outside its range; ``steps`` fewer than two
+        (a slope needs two) or reaching outside [0, 100] from ``beta``.
+    """
     from .store import measured
-    return measured("image-beta-order", _image_beta_order, size=size,
-                    beta=float(DRAFT_SCENE.beta if beta is None else beta), steps=list(steps))
+    size = positive_int("size", size, high=MAX_SQUARE)
+    beta = real("beta", DRAFT_SCENE.beta if beta is None else beta, low=0.0, high=MAX_BETA)
+    steps = _steps("steps", steps, low=MIN_DB, high=MAX_BETA, max_count=64).tolist()
+    if len(steps) < 2 or not (0.0 <= beta - max(steps) and beta + max(steps) <= MAX_BETA):
+        raise InvalidValue(f"steps must be 2 or more steps db with beta +- db in [0, {MAX_BETA:g}] (beta = {beta!r}), "
+                           f"got {steps!r:.80}")
+    return measured("image-beta-order", _image_beta_order, size=size, beta=beta, steps=steps)
 
 
 def _image_beta_order(size, beta, steps):
@@ -174,6 +219,8 @@ def _image_beta_order(size, beta, steps):
             "rms_errors": rms.tolist(), "steps": list(steps), "scene": scene.changes(), "size": size}
 
 
+#: Smallest step db of `image_beta_order` (β units): a render's β must differ from its neighbour's.
+MIN_DB = 1e-12
 #: The steps and frame of `crease_share` (the draft's Cell 3 census: its steps, 256 x 256).
 CREASE_STEPS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 CREASE_SIZE = 256
@@ -202,9 +249,9 @@ def crease_distance(u, v, k_u, k_v, field=None):
 
     Parameters
     ----------
-    u, v : float or array_like, broadcast together
+    u, v : float or array_like in [0, 1], broadcast together
         Chart coordinates.
-    k_u, k_v : float > 0
+    k_u, k_v : float in (0, 1e3]
     field : height field or None
         As `renderer.formulas.field` takes it; None for the draft's (`renderer.DRAFT_SCENE`).
 
@@ -212,9 +259,19 @@ def crease_distance(u, v, k_u, k_v, field=None):
     -------
     float64 array of the broadcast shape (chart units); ``inf`` where no crease lies within
     `CREASE_REACH` (for a field without creases, everywhere).
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: ``u``, ``v`` not real numbers in [0, 1] or not broadcasting
+        together; ``k_u``, ``k_v`` not real numbers in (0, 1e3]; ``field`` refused.
     """
-    record = DRAFT_SCENE.field if field is None else F.field(field)
-    u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
+    record = DRAFT_SCENE.field if field is None else F.field(field, "field")
+    u, v = broadcast(("u", "v"), real_array("u", u, **UNIT), real_array("v", v, **UNIT))
+    return _crease_distance(u, v, real("k_u", k_u, **FREQUENCY), real("k_v", k_v, **FREQUENCY), record)
+
+
+def _crease_distance(u, v, k_u, k_v, record):
     shape, u, v = u.shape, u.ravel(), v.ravel()
     out = np.full(u.shape, np.inf)
     for factor in record.crease_factors:
@@ -280,7 +337,8 @@ def _optima(fields):
     k_u, k_v = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
     out = {}
     for field, (_, (u, v, component)) in fields.items():
-        distance = float(crease_distance(u, v, k_u, k_v, field))
+        distance = float(_crease_distance(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64),
+                                          k_u, k_v, F.field(field)))
         steps = DEFAULT_STEPS[DEFAULT_STEPS < distance]
         if steps.size < 2:
             raise RuntimeError(f"the {field} field's point ({u}, {v}) is {distance:g} from a crease: fewer "
@@ -311,7 +369,7 @@ def crease_share():
 def _crease_share(size, steps, scene=DRAFT_SCENE):
     g = gbuffer(scene, size, size)
     uv = g.uv[g.chamber == SPHERE_A]
-    dist = crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field)
+    dist = _crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field)
     return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps], pixels=int(dist.size))
 
 
@@ -335,18 +393,18 @@ def image_best_step(field, size=256):
 
     Raises
     ------
-    ValueError
-        ``field`` is not a height field of `renderer.Scene`, or ``size`` is below 1.
-    TypeError
-        ``size`` is not an integer.
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``field`` is refused by `renderer.formulas.field` (naming ``field``) or by the scene
+        (naming ``Scene.height_field``: h or its gradient not finite on the chart), or ``size``
+        is not an integer in [1, 4096].
     """
     from renderer.ledger import SIMULATOR_SCENE
-    from renderer.validate import positive_int
 
     from .store import measured
-    SIMULATOR_SCENE.replace(height_field=field)              # the scene's own error for a bad field
-    return measured("image-best-step", _image_best_step, field=field, size=positive_int("size", size),
-                    steps=list(HALF_DECADES))
+    record = F.field(field, "field")
+    SIMULATOR_SCENE.replace(height_field=record)              # the scene's own refusals
+    return measured("image-best-step", _image_best_step, field=record.name,
+                    size=positive_int("size", size, high=MAX_SQUARE), steps=list(HALF_DECADES))
 
 
 def _image_best_step(field, size, steps):

@@ -27,14 +27,18 @@ import numpy as np
 from renderer import DRAFT_SCENE, compare, gbuffer, pointwise, render
 from renderer import formulas as F
 from renderer.render import SPHERE_A
+from renderer.validate import InvalidType, InvalidValue, choice, flag, real
 
+from ._checks import STEP, instance, optional, shown
 from .seed_errata import CELL6_BETA
 
 __all__ = ["Bound", "Criterion", "rule", "about", "ABOUT", "Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED",
            "UNMEASURED", "Unmeasured", "evaluate", "checked", "ClaimChanged", "crease_band_ratio", "census",
-           "relative_error_at", "CELL5_EXPECTED"]
+           "relative_error_at", "CELL5_EXPECTED", "VERDICTS"]
 
 HOLDS, FAILS, CORRECTED = "holds", "does not hold", "holds with a correction"
+#: The verdicts a criterion gives.
+VERDICTS = (HOLDS, FAILS, CORRECTED)
 #: The verdict of a claim whose measurement raised or gave no finite number for a quantity its
 #: criterion reads: registered for no claim, so `checked` and `pytest verify` refuse it.
 UNMEASURED = "not measured"
@@ -55,6 +59,15 @@ class Bound:
     hi: float | None = None
     strict: bool = False
 
+    def __post_init__(self):
+        """InvalidType or InvalidValue naming ``Bound.<field>``: ``quantity`` not a string, ``lo``
+        or ``hi`` not a finite real number (nor None), ``lo > hi``, ``strict`` not True or False."""
+        instance("Bound.quantity", self.quantity, str, "a string")
+        lo, hi = (optional(real, f"Bound.{k}", getattr(self, k)) for k in ("lo", "hi"))
+        if lo is not None and hi is not None and lo > hi:
+            raise InvalidValue(f"Bound.lo must be <= Bound.hi, got lo = {self.lo!r}, hi = {self.hi!r}")
+        flag("Bound.strict", self.strict)
+
     def holds(self, values):
         """Whether ``values[quantity]`` lies within the bound (KeyError if it was not measured)."""
         x = values[self.quantity]
@@ -69,6 +82,17 @@ class Criterion:
 
     cases: tuple
     otherwise: str = FAILS
+
+    def __post_init__(self):
+        """InvalidType or InvalidValue naming ``Criterion.<field>``: ``cases`` not a tuple of
+        (verdict, tuple of `Bound`) pairs, a verdict or ``otherwise`` not one of `VERDICTS`."""
+        instance("Criterion.cases", self.cases, tuple, "a tuple of (verdict, bounds) pairs")
+        for i, case in enumerate(self.cases):
+            if not (isinstance(case, tuple) and len(case) == 2 and isinstance(case[1], tuple)
+                    and all(isinstance(b, Bound) for b in case[1])):
+                raise InvalidType(f"Criterion.cases[{i}] must be a pair (verdict, tuple of Bound), got {shown(case)}")
+            choice(f"Criterion.cases[{i}][0]", case[0], VERDICTS)
+        choice("Criterion.otherwise", self.otherwise, VERDICTS)
 
     def decide(self, values):
         """The verdict for the measured ``values`` (a dict: quantity name -> number).
@@ -98,12 +122,23 @@ ABOUT = 10 ** 0.5
 
 
 def about(quantity, x, lo=True, hi=True):
-    """`Bound`: ``quantity`` about ``x`` (within a factor `ABOUT`), from below (``lo``), above (``hi``) or both."""
+    """`Bound`: ``quantity`` about ``x`` (within a factor `ABOUT`), from below (``lo``), above (``hi``) or both.
+
+    ``x``: a finite real number > 0; ``lo``, ``hi``: True or False (InvalidType or InvalidValue
+    naming the argument otherwise; ``quantity`` as `Bound` checks it)."""
+    x = real("x", x, low=0.0, low_open=True)
+    lo, hi = flag("lo", lo), flag("hi", hi)
     return Bound(quantity, x / ABOUT if lo else None, x * ABOUT if hi else None)
 
 
 def rule(*cases, otherwise=FAILS):
-    """`Criterion` from alternating verdicts and bounds: ``rule(HOLDS, b1, CORRECTED, (b2, b3))``."""
+    """`Criterion` from alternating verdicts and bounds: ``rule(HOLDS, b1, CORRECTED, (b2, b3))``.
+
+    Raises InvalidValue naming ``cases`` for an odd number of them (a verdict without its
+    bounds); a wrong verdict or bound as `Criterion` refuses it."""
+    if len(cases) % 2:
+        raise InvalidValue(f"cases must alternate verdicts and bounds, got {len(cases)} of them (odd): "
+                           f"{cases!r:.80}")
     pairs = [(cases[i], cases[i + 1] if isinstance(cases[i + 1], tuple) else (cases[i + 1],))
              for i in range(0, len(cases), 2)]
     return Criterion(tuple(pairs), otherwise)
@@ -175,7 +210,7 @@ def _err_at(eps):
     c = _ucurve()
     k = np.argmin(np.abs(np.log10(c.eps) - np.log10(eps)))
     if not abs(c.eps[k] / eps - 1) <= 0.01:
-        raise ValueError(f"eps={eps!r}: the U-curve's nearest step is {c.eps[k]:.3g}; a claim at a step is "
+        raise InvalidValue(f"eps={eps!r}: the U-curve's nearest step is {c.eps[k]:.3g}; a claim at a step is "
                          "measured within 1 % of it")
     return float(c.error[k])
 
@@ -187,10 +222,13 @@ def relative_error_at(eps):
 
     Raises
     ------
-    ValueError
-        If no step of the curve lies within 1 % of ``eps``, naming it and the nearest step.
+    renderer.validate.InvalidType
+        ``eps`` is not a real number (a bool, a string).
+    renderer.validate.InvalidValue
+        ``eps`` is not in [1e-300, 1), or no step of the curve lies within 1 % of it, naming
+        it and the nearest step.
     """
-    return _err_at(eps) / abs(_ucurve().derivative)
+    return _err_at(real("eps", eps, **STEP)) / abs(_ucurve().derivative)
 
 
 def _h3_scale():
@@ -674,11 +712,21 @@ def checked(results=None):
     ``results`` the evaluation is one measurement of the build
     (`lab.store`, "claims-register"), shared by the pages that show it.
 
+    ``results``: None, or a list or tuple of (Claim, dict, str) triples as `evaluate` returns.
+
     Raises
     ------
+    renderer.validate.InvalidType
+        ``results`` (or ``results[i]``) is not of that form.
     ClaimChanged
         Naming every claim whose verdict changed, with its measurement.
     """
+    if results is not None:
+        instance("results", results, (list, tuple), "a list of (Claim, dict, verdict) triples or None")
+        for i, r in enumerate(results):
+            if not (isinstance(r, tuple) and len(r) == 3 and isinstance(r[0], Claim) and isinstance(r[1], dict)
+                    and isinstance(r[2], str)):
+                raise InvalidType(f"results[{i}] must be a triple (Claim, dict, verdict), got {shown(r)}")
     if results is None:
         from .store import measured
         by_id = {c.id: c for c in CLAIMS}

@@ -56,7 +56,6 @@ CHUNK = 1 << 20
 _X, _Y, _Z = sp.symbols("X Y Z", real=True)
 
 
-@functools.lru_cache(maxsize=None)
 def surface_function(field):
     """F and grad F of the displaced sphere for one height field, as numpy functions.
 
@@ -75,10 +74,15 @@ def surface_function(field):
 
     Raises
     ------
-    renderer.validate.InputError
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
         ``field`` is refused (`renderer.formulas.field`, naming "field").
     """
-    h = formulas.field(field, "field").expr
+    return _surface_function(formulas.field(field, "field"))
+
+
+@functools.lru_cache(maxsize=None)
+def _surface_function(record):
+    h = record.expr
     r = sp.sqrt(_X**2 + _Y**2 + _Z**2)
     uv = {formulas.N_x: _X / r, formulas.N_y: _Y / r, formulas.N_z: _Z / r}
     chart = {formulas.u: formulas.CHART[0].xreplace(uv), formulas.v: formulas.CHART[1].xreplace(uv)}
@@ -158,7 +162,7 @@ class Displaced:
 
 def _first_root(scene, O, D, samples):
     """Hit t (NaN: miss), point, unit normal and Newton steps of rays O + t D on the displaced sphere."""
-    F, grad = surface_function(scene.height_field)
+    F, grad = _surface_function(scene.field)
     R, beta = scene.radius_a, scene.beta
     const = (R, beta, scene.k_u, scene.k_v)
     t0, t1 = _sphere_span(O, D, R + beta * H_MAX)
@@ -208,7 +212,7 @@ def _first_root(scene, O, D, samples):
 
 def _blocked_by_a(scene, P, L, samples):
     """(n,) bool: does the segment from P (n, 3) to the light L (3,) pass inside the displaced sphere A?"""
-    F, _ = surface_function(scene.height_field)
+    F, _ = _surface_function(scene.field)
     const = (scene.radius_a, scene.beta, scene.k_u, scene.k_v)
     W = L[None, :] - P
     t0, t1 = _sphere_span(P, W, scene.radius_a + scene.beta * H_MAX)
@@ -314,9 +318,9 @@ def render_displaced(scene, width, height, *, samples=64):
 
     Raises
     ------
-    TypeError
-        ``scene`` is not a Scene; a size or ``samples`` not an integer.
-    ValueError
+    renderer.validate.InvalidType
+        ``scene`` is not a Scene; a size or ``samples`` not an integer (a bool, a float).
+    renderer.validate.InvalidValue
         A size out of range; ``samples`` outside [1, 4096]; ``beta * max|h|`` not below
         ``radius_a`` (the displaced radius must stay positive); the camera not outside the
         displaced sphere (``camera_z > radius_a + beta``); a height field whose |h| exceeds
@@ -340,7 +344,7 @@ def render_displaced(scene, width, height, *, samples=64):
     prm, lights = kernel.params(scene, skip=False)
     prm_no_b = kernel.params(scene.replace(sphere_b=False), skip=False)[0]
     _compile(prm, lights)
-    surface_function(scene.height_field)          # sympy's lambdify, once per field, before the clock starts
+    _surface_function(scene.field)                # sympy's lambdify, once per field, before the clock starts
     start = time.perf_counter()
     xs, ys = image_plane(scene.radius_a, scene.camera_z, width, height)
     X, Y = np.meshgrid(xs, ys)

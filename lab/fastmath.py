@@ -38,8 +38,10 @@ from numba import vectorize
 
 from renderer import _numba_cache
 from renderer import formulas as F
-from renderer.scene import MAX_FREQUENCY, MAX_SHININESS, MIN_SHININESS
-from renderer.validate import choice, positive_int
+from renderer.scene import FREQUENCY, MAX_FREQUENCY, MAX_SHININESS, MIN_SHININESS, UNIT
+from renderer.validate import InvalidValue, choice, positive_int, real, real_array
+
+from ._checks import MAX_COUNT, STEP, broadcast, integers, numbers_array, seed as _seed
 
 _numba_cache()          # where numba caches this module's ufuncs (see renderer.kernel)
 
@@ -151,7 +153,9 @@ def backend(name):
 
     Raises
     ------
-    ValueError
+    renderer.validate.InvalidType
+        ``name`` is not a string.
+    renderer.validate.InvalidValue
         ``name`` is not one of `BACKENDS`, or it is ``"drjit"`` and this machine has no
         Dr.Jit LLVM backend (`available`).
     """
@@ -160,8 +164,8 @@ def backend(name):
     if functions is None:
         from renderer.backends import missing
         why = missing("drjit") or "Dr.Jit's LLVM backend did not load"
-        raise ValueError(f"backend 'drjit' is not available on this machine ({why}); "
-                         f"available: {', '.join(available())}")
+        raise InvalidValue(f"backend 'drjit' is not available on this machine ({why}); "
+                           f"available: {', '.join(available())}")
     return functions
 
 
@@ -192,14 +196,15 @@ def arguments(function, count=SAMPLES, seed=SEED):
 
     Raises
     ------
-    ValueError
-        ``function`` is not one of `FUNCTIONS`, or ``count`` is below 1.
-    TypeError
-        ``count`` or ``seed`` is not an integer.
+    renderer.validate.InvalidType
+        ``function`` is not a string, ``count`` or ``seed`` not an integer (a bool, a float).
+    renderer.validate.InvalidValue
+        ``function`` is not one of `FUNCTIONS`, ``count`` not in [1, 2**24], ``seed`` not in
+        [0, 2**64 - 1].
     """
     function = choice("function", function, FUNCTIONS)
-    count = positive_int("count", count)
-    rng = np.random.default_rng(positive_int("seed", seed + 1) - 1)
+    count = positive_int("count", count, high=MAX_COUNT)
+    rng = np.random.default_rng(_seed("seed", seed))
     if function in ("sin", "cos"):
         m = np.arange(1, int(MAX_ANGLE / (math.pi / 2)) + 1) * (math.pi / 2)
         hard = np.concatenate([m, np.nextafter(m, 0.0), np.nextafter(m, np.inf)])
@@ -234,7 +239,7 @@ def flushes(name):
 
     Raises
     ------
-    ValueError
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
         ``name`` as `backend` refuses it.
     """
     return bool(backend(name)["pow"](np.array([0.5]), np.array([1070.0]))[0] == 0.0)
@@ -250,7 +255,8 @@ def reference(function, *args):
     Parameters
     ----------
     function : one of `FUNCTIONS`
-    *args : 1-D float64 arrays of one length (as `backend`'s functions take them)
+    *args : 1-D arrays of finite real numbers, of one length (as `backend`'s functions take
+        them): one for sin, cos and acos, two for atan2 (y, x) and pow (base, exponent)
 
     Returns
     -------
@@ -264,14 +270,24 @@ def reference(function, *args):
 
     Raises
     ------
-    ValueError
-        ``function`` is not one of `FUNCTIONS`, or the arguments are not 1-D of one length.
+    renderer.validate.InvalidType
+        ``function`` is not a string; an argument is not real numbers (a bool, a string).
+    renderer.validate.InvalidValue
+        ``function`` is not one of `FUNCTIONS`; not as many arguments as it takes; an argument
+        not finite (named ``args[i]``); the arguments not 1-D of one length.
     """
-    f = _MP[choice("function", function, FUNCTIONS)]
-    args = [np.asarray(a, dtype=np.float64) for a in args]
+    function = choice("function", function, FUNCTIONS)
+    args = [real_array(f"args[{i}]", a) for i, a in enumerate(args)]
     if any(a.ndim != 1 or a.shape != args[0].shape for a in args):
-        raise ValueError(f"reference: the arguments must be 1-D arrays of one length, got shapes "
-                         f"{[a.shape for a in args]}")
+        raise InvalidValue(f"args must be 1-D arrays of one length, got shapes {[a.shape for a in args]}")
+    arity = 2 if function in ("atan2", "pow") else 1
+    if len(args) != arity:
+        raise InvalidValue(f"args must be {arity} array(s) for {function}, got {len(args)}")
+    return _reference(function, *args)
+
+
+def _reference(function, *args):
+    f = _MP[function]
     n = args[0].size
     hi, rest, exponent = np.empty(n), np.empty(n), np.empty(n, dtype=np.int64)
     with mpmath.workdps(DIGITS):
@@ -292,7 +308,19 @@ def ulps(values, hi, exponent, rest):
     error below 2^-52 ulp for counts below 1); far off it is within a relative 2^-53.
     Returns a float64 array of the common shape (inf where a count exceeds the float64
     range, a value far from a subnormal t; NaN where ``values`` is NaN).
+
+    ``values``: real numbers (inf and NaN allowed: what is judged); ``hi``: finite real numbers;
+    ``exponent``: integers in [-1074, 971]; ``rest``: real numbers in [-0.5, 0.5]; all
+    broadcasting together.  Raises InvalidType (not real numbers, ``exponent`` not integers)
+    or InvalidValue (out of range, not broadcasting) naming the argument.
     """
+    values, hi, exponent, rest = broadcast(("values", "hi", "exponent", "rest"), numbers_array("values", values),
+                                           real_array("hi", hi), integers("exponent", exponent, -1074, 971),
+                                           real_array("rest", rest, low=-0.5, high=0.5))
+    return _ulps(values, hi, exponent, rest)
+
+
+def _ulps(values, hi, exponent, rest):
     values = np.asarray(values, dtype=np.float64)
     with np.errstate(over="ignore", invalid="ignore"):
         d = values - hi
@@ -329,12 +357,12 @@ def ulp_table(count=SAMPLES, seed=SEED):
 
     Raises
     ------
-    ValueError, TypeError
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
         ``count`` or ``seed`` as `arguments` refuses them.
     """
     from .store import measured
-    return measured("fastmath.ulps", _ulp_table, count=positive_int("count", count), seed=seed,
-                    versions=_versions())
+    return measured("fastmath.ulps", _ulp_table, count=positive_int("count", count, high=MAX_COUNT),
+                    seed=_seed("seed", seed), versions=_versions())
 
 
 def _ulp_table(count, seed, versions):
@@ -342,9 +370,9 @@ def _ulp_table(count, seed, versions):
     errors = {name: {} for name in names}
     for function in FUNCTIONS:
         args, hard = arguments(function, count, seed)
-        true = reference(function, *args)
+        true = _reference(function, *args)
         for name in names:
-            errors[name][function] = _summary(ulps(backend(name)[function](*args), *true), hard)
+            errors[name][function] = _summary(_ulps(backend(name)[function](*args), *true), hard)
     return {"backends": names, "missing": [b for b in BACKENDS if b not in names], "quantile": QUANTILE,
             "digits": DIGITS, "errors": errors, "flushes": {name: flushes(name) for name in names}}
 
@@ -374,7 +402,7 @@ def central_differences(name, eps, u, v, k_u, k_v):
     Parameters
     ----------
     name : one of `available`
-    eps : 1-D float64 array, steps in (0, 0.25] (chart units)
+    eps : array_like of float in [1e-300, 1), steps (chart units; u + eps wraps past 1)
     u, v : float in [0, 1]; k_u, k_v : float in (0, 1e3]
 
     Returns
@@ -384,10 +412,14 @@ def central_differences(name, eps, u, v, k_u, k_v):
 
     Raises
     ------
-    ValueError
-        ``name`` as `backend` refuses it.
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``name`` as `backend` refuses it; ``eps`` (any entry), ``u``, ``v``, ``k_u`` or ``k_v``
+        not a real number (a bool, a string) or outside its range (0, NaN, inf), naming it.
     """
-    return _quotient(backend(name)["sin"])(u, v, k_u, k_v, eps)
+    sin = backend(name)["sin"]
+    eps = real_array("eps", eps, **STEP)
+    u, v = real("u", u, **UNIT), real("v", v, **UNIT)
+    return _quotient(sin)(u, v, real("k_u", k_u, **FREQUENCY), real("k_v", k_v, **FREQUENCY), eps)
 
 
 def floors():
@@ -431,11 +463,11 @@ def _floors(versions):
     roundoff = UNIT_ROUNDOFF * (o["h"] + o["x_h1"])
     true = sp.lambdify((F.u, F.v), F.FIELDS["sine"].gradient[0].subs({F.k_u: sp.nsimplify(k_u),
                                                                  F.k_v: sp.nsimplify(k_v)}), modules="mpmath")
-    out, libm = {}, central_differences("numba", DEFAULT_STEPS, u, v, k_u, k_v)
+    out, libm = {}, _quotient(backend("numba")["sin"])(u, v, k_u, k_v, DEFAULT_STEPS)
     with mpmath.workdps(DIGITS):
         t = true(mpmath.mpf(u), mpmath.mpf(v))
         for name in versions:
-            fd = central_differences(name, DEFAULT_STEPS, u, v, k_u, k_v)
+            fd = _quotient(backend(name)["sin"])(u, v, k_u, k_v, DEFAULT_STEPS)
             error = np.array([float(abs(mpmath.mpf(float(y)) - t)) for y in fd])
             best = int(np.argmin(error))
             A, B = fit_model(DEFAULT_STEPS, error, start=(o["h3"] / 6, roundoff))

@@ -84,6 +84,11 @@ from scipy.differentiate import derivative
 from renderer import DRAFT_SCENE, fieldcode, gbuffer, pointwise, ucurve, validate
 from renderer import formulas as F
 from renderer.render import SPHERE_A
+from renderer.scene import FREQUENCY, UNIT
+from renderer.validate import InvalidType, InvalidValue, choice, flag, positive_int, real
+
+from ._checks import MAX_COUNT, MAX_SQUARE, STEP, chart_points as _chart, digits as _digits, instance, optional, seed
+from ._checks import sequence, shown
 
 __all__ = [
     "Style", "Method", "METHODS", "method", "Config", "FAST", "FULL", "Evaluations", "MethodResult",
@@ -177,22 +182,28 @@ class Config:
     Attributes
     ----------
     name : str
-    central_steps, forward_steps, complex_steps : tuple of float
-        The steps eps (chart units) of each sweep (`Method.steps` names them).
-    repeats : int
+    central_steps, forward_steps, complex_steps : tuple of float in [1e-300, 1)
+        The steps eps (chart units) of each sweep (`Method.steps` names them), 1 to 64 each.
+    repeats : int in [1, 1000]
         Timed runs of every method (each run: all pixels of the frame) ...
-    richardson_repeats : int
+    richardson_repeats : int in [1, 1000]
         ... except ``richardson``, ten to twenty times slower than the rest, which is timed
         this many times (`Method.repeats`).
-    reference_pixels : int or None
+    reference_pixels : int in [1, 2**24] or None
         Pixels per field at which errors are measured against mpmath (a seeded sample of the
         pixels where the gradient exists); None for all.
-    digits : int
+    digits : int in [32, 1000]
         mpmath working precision of the reference, in decimal digits.
-    size : int
+    size : int in [1, 4096]
         Frame side in pixels.
-    seed : int
+    seed : int in [0, 2**64 - 1]
         Seed of the pixel sample and of the order in which methods run.
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        A field not of its kind or out of its range (a bool where a number is meant, a
+        string where steps are), naming ``Config.<field>``.
     """
 
     name: str
@@ -205,6 +216,23 @@ class Config:
     digits: int = 34
     size: int = 256
     seed: int = 6
+
+    def __post_init__(self):
+        """Checks each field as its kind (`lab._checks`), once, when the record is made (also by
+        ``dataclasses.replace``): InvalidType or InvalidValue naming ``Config.<field>``; the steps
+        are kept as tuples of floats."""
+        def check(attr, kind, *args, **kwargs):
+            object.__setattr__(self, attr, kind(f"Config.{attr}", getattr(self, attr), *args, **kwargs))
+
+        check("name", instance, str, "a string")
+        for attr in ("central_steps", "forward_steps", "complex_steps"):
+            check(attr, lambda *a: tuple(validate.steps(*a, **STEP, max_count=64).tolist()))
+        check("repeats", positive_int, high=1000)
+        check("richardson_repeats", positive_int, high=1000)
+        check("reference_pixels", lambda n, x: optional(positive_int, n, x, high=MAX_COUNT))
+        check("digits", _digits)
+        check("size", positive_int, high=MAX_SQUARE)
+        check("seed", seed)
 
 
 #: Book build (§5, Cell 4, which reports the time it took): a few hundred reference pixels
@@ -230,14 +258,21 @@ def chart_points(field=None, size=256):
     field : height field or None
         As `renderer.formulas.field` takes it; None for the draft's.  The chart does not depend
         on it (it is computed from the geometry before any gradient).
-    size : int
+    size : int in [1, 4096]
         Frame side in pixels.
 
     Returns
     -------
     (u, v) : two (n,) float64 arrays, contiguous, in row-major pixel order.
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``field`` refused (naming ``field``), ``size`` not an integer in range.
     """
+    field = None if field is None else F.field(field, "field")
     scene = DRAFT_SCENE if field is None else DRAFT_SCENE.replace(height_field=field)
+    size = positive_int("size", size, high=MAX_SQUARE)
     g = gbuffer(scene, size, size)
     uv = g.uv[g.chamber == SPHERE_A]
     return np.ascontiguousarray(uv[:, 0]), np.ascontiguousarray(uv[:, 1])
@@ -245,12 +280,31 @@ def chart_points(field=None, size=256):
 
 # --- the methods over a field --------------------------------------------------------------
 
-def _positive_step(eps):
-    if not (isinstance(eps, (int, float, np.floating)) and np.isfinite(eps) and eps > 0):
-        raise ValueError(f"eps must be a positive finite number, got {eps!r}")
-    return float(eps)
+#: What the methods over a field take and refuse, once in each docstring's words.
+_FIELD_ARGS = """field : height field
+        As `renderer.formulas.field` takes it.
+    uu, vv : array_like of float in [0, 1], broadcast together
+        Chart coordinates ((n,) float64 arrays as a rule).
+    ku, kv : float in (0, 1e3]
+        Frequencies, as `renderer.Scene` takes them."""
+_FIELD_RAISES = """renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: ``field`` refused by `renderer.formulas.field`; ``uu``, ``vv`` not
+        real numbers in [0, 1] (a bool, a NaN, a string) or not broadcasting together; ``ku``,
+        ``kv`` not real numbers in (0, 1e3] (inf, 10**400, a bool)"""
 
 
+def _documented(fn):
+    """``fn`` with `_FIELD_ARGS` and `_FIELD_RAISES` written into its docstring's placeholders."""
+    fn.__doc__ = fn.__doc__.replace("{_FIELD_ARGS}", _FIELD_ARGS).replace("{_FIELD_RAISES}", _FIELD_RAISES)
+    return fn
+
+
+def _field_args(field, uu, vv, ku, kv):
+    """(record, uu, vv, ku, kv) checked as `_FIELD_ARGS` says."""
+    return (F.field(field, "field"), *_chart(uu, vv, ku, kv))
+
+
+@_documented
 def forward_gradient(field, uu, vv, ku, kv, eps):
     """One-sided (forward) difference chart gradient.
 
@@ -263,22 +317,22 @@ def forward_gradient(field, uu, vv, ku, kv, eps):
 
     Parameters
     ----------
-    field : height field
-        As `renderer.formulas.field` takes it.
-    uu, vv : (n,) float64 chart coordinates in [0, 1]
-    ku, kv : float
-    eps : float > 0, the step in chart units
+    {_FIELD_ARGS}
+    eps : float in [1e-300, 1)
+        The step in chart units.
 
     Returns
     -------
-    (h_u, h_v) : two (n,) float64 arrays.
+    (h_u, h_v) : two float64 arrays of the broadcast shape.
 
     Raises
     ------
-    ValueError
-        If ``eps`` is not a positive finite number or ``field`` is refused.
+    {_FIELD_RAISES}; ``eps`` not a real number in [1e-300, 1).
     """
-    eps = _positive_step(eps)
+    return _forward_gradient(*_field_args(field, uu, vv, ku, kv), real("eps", eps, **STEP))
+
+
+def _forward_gradient(field, uu, vv, ku, kv, eps):
     h0 = pointwise.height(field, uu, vv, ku, kv)
     hu = (pointwise.height(field, np.mod(uu + eps, 1.0), vv, ku, kv) - h0) / eps
     step = np.where(vv + eps > 1.0, -eps, eps)
@@ -298,6 +352,7 @@ def _complex_fn(expr, symbols, continued):
     return sp.lambdify(symbols, expr, modules=[{"Abs": _abs_continued}, "numpy"] if continued else "numpy")
 
 
+@_documented
 def complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
     """Complex-step chart gradient, h_u = Im h(u + i eps, v) / eps, h_v likewise.
 
@@ -311,24 +366,25 @@ def complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
 
     Parameters
     ----------
-    field : height field
-        As `renderer.formulas.field` takes it.
-    uu, vv : (n,) float64 chart coordinates
-    ku, kv : float
-    eps : float > 0, the imaginary step in chart units
+    {_FIELD_ARGS}
+    eps : float in [1e-300, 1)
+        The imaginary step in chart units.
     continued : bool, keyword-only
 
     Returns
     -------
-    (h_u, h_v) : two (n,) float64 arrays.
+    (h_u, h_v) : two float64 arrays of the broadcast shape.
 
     Raises
     ------
-    ValueError
-        If ``eps`` is not a positive finite number or ``field`` is refused.
+    {_FIELD_RAISES}; ``eps`` not a real number in [1e-300, 1); ``continued`` not True or False.
     """
-    eps = _positive_step(eps)
-    h = _complex_fn(F.field(field).expr, F.FIELD_SYMBOLS, continued)
+    return _complex_step_gradient(*_field_args(field, uu, vv, ku, kv), real("eps", eps, **STEP),
+                                  continued=flag("continued", continued))
+
+
+def _complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
+    h = _complex_fn(field.expr, F.FIELD_SYMBOLS, continued)
     shape = np.broadcast(uu, vv).shape
     hu = np.imag(h(uu + 1j * eps, vv, ku, kv)) / eps
     hv = np.imag(h(uu, vv + 1j * eps, ku, kv)) / eps
@@ -341,6 +397,7 @@ def complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
 RICHARDSON = dict(initial_step=0.02, order=8, step_factor=2.0, maxiter=10, tolerances=dict(atol=1e-12))
 
 
+@_documented
 def richardson_gradient(field, uu, vv, ku, kv, *, info=None):
     """Chart gradient by `scipy.differentiate.derivative` (settings `RICHARDSON`).
 
@@ -351,10 +408,7 @@ def richardson_gradient(field, uu, vv, ku, kv, *, info=None):
 
     Parameters
     ----------
-    field : height field
-        As `renderer.formulas.field` takes it.
-    uu, vv : (n,) float64 chart coordinates
-    ku, kv : float
+    {_FIELD_ARGS}
     info : dict or None, keyword-only
         If given, receives ``"not_converged"`` (int, elements with status != 0),
         ``"iterations"`` (float, mean iterations per element) and ``"h_per_pixel"`` (float,
@@ -362,14 +416,17 @@ def richardson_gradient(field, uu, vv, ku, kv, *, info=None):
 
     Returns
     -------
-    (h_u, h_v) : two (n,) float64 arrays.
+    (h_u, h_v) : two float64 arrays of the broadcast shape.
 
     Raises
     ------
-    ValueError
-        If ``field`` is refused.
+    {_FIELD_RAISES}; ``info`` not a dict or None.
     """
-    record = F.field(field)
+    return _richardson_gradient(*_field_args(field, uu, vv, ku, kv),
+                                info=optional(instance, "info", info, dict, "a dict or None"))
+
+
+def _richardson_gradient(record, uu, vv, ku, kv, *, info=None):
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     n = uu.size
     x = np.concatenate([uu.ravel(), vv.ravel()])
@@ -406,6 +463,7 @@ def _ad_program(height):
     return jax.jit(gradient)
 
 
+@_documented
 def ad_gradient(field, uu, vv, ku, kv, *, height=None):
     """Chart gradient by forward-mode automatic differentiation (``jax.jvp``).
 
@@ -419,41 +477,52 @@ def ad_gradient(field, uu, vv, ku, kv, *, height=None):
 
     Parameters
     ----------
-    field : height field
-        As `renderer.formulas.field` takes it.
-    uu, vv : (n,) float64 chart coordinates
-    ku, kv : float
+    {_FIELD_ARGS}
     height : sympy expression or None, keyword-only
         The program to differentiate, in u, v, k_u, k_v; None (the default) for the field's
         expression.  A test hands in a wrong one to see it caught.
 
     Returns
     -------
-    (h_u, h_v) : two (n,) float64 numpy arrays.
+    (h_u, h_v) : two float64 numpy arrays of the broadcast shape.
 
     Raises
     ------
-    ValueError
-        If ``field`` is refused.
+    {_FIELD_RAISES}; ``height`` not a sympy expression in u, v, k_u, k_v (nor None).
     """
+    record, uu, vv, ku, kv = _field_args(field, uu, vv, ku, kv)
+    if height is not None:
+        instance("height", height, sp.Expr, "a sympy expression in u, v, k_u, k_v or None")
+        if not height.free_symbols <= set(F.FIELD_SYMBOLS):
+            raise InvalidValue(f"height must be a sympy expression in u, v, k_u, k_v, got {str(height)!r:.80} "
+                               f"(in {', '.join(sorted(map(str, height.free_symbols)))})")
+    return _ad_gradient(record, uu, vv, ku, kv, height=height)
+
+
+def _ad_gradient(record, uu, vv, ku, kv, *, height=None):
     import jax
-    fn = _ad_program(F.field(field).expr if height is None else height)
+    fn = _ad_program(record.expr if height is None else height)
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     with jax.enable_x64(True):
         h_u, h_v = fn(uu, vv, float(ku), float(kv))
         return np.asarray(h_u), np.asarray(h_v)
 
 
-@lru_cache(maxsize=None)
 def ad_trig_calls(field):
-    """Sines and cosines per point in the program XLA compiled for `ad_gradient` of ``field`` (a
-    `renderer.formulas.HeightField`), counted in the optimised HLO text, after XLA's
+    """Sines and cosines per point in the program XLA compiled for `ad_gradient` of ``field`` (as
+    `renderer.formulas.field` takes it), counted in the optimised HLO text, after XLA's
     common-subexpression elimination has merged what it could of the two passes, at a small
-    array size (the program is the same at every size)."""
+    array size (the program is the same at every size).  Raises InvalidType or InvalidValue
+    naming ``field`` if it is refused."""
+    return _ad_trig_calls(F.field(field, "field"))
+
+
+@lru_cache(maxsize=None)
+def _ad_trig_calls(record):
     import jax
     x = np.zeros(4)
     with jax.enable_x64(True):
-        text = _ad_program(F.field(field).expr).lower(x, x, 1.0, 1.0).compile().as_text()
+        text = _ad_program(record.expr).lower(x, x, 1.0, 1.0).compile().as_text()
     return len(re.findall(r"\b(?:sine|cosine)\(", text))
 
 
@@ -467,12 +536,25 @@ def _xla_exact_program(field):
     return jax.jit(lambda uu, vv, ku, kv: tuple(fn(uu, vv, ku, kv)))
 
 
+@_documented
 def xla_exact_gradient(field, uu, vv, ku, kv):
-    """The exact chart gradient compiled by XLA, AD's compiler: (h_u, h_v), two (n,) float64
-    arrays for (n,) float64 ``uu``, ``vv``.  `same_compiler_times` times it beside
-    `ad_gradient`.  Raises ValueError if ``field`` is refused (`renderer.formulas.field`)."""
+    """The exact chart gradient compiled by XLA, AD's compiler: (h_u, h_v), two float64 arrays
+    of the broadcast shape.  `same_compiler_times` times it beside `ad_gradient`.
+
+    Parameters
+    ----------
+    {_FIELD_ARGS}
+
+    Raises
+    ------
+    {_FIELD_RAISES}.
+    """
+    return _xla_exact_gradient(*_field_args(field, uu, vv, ku, kv))
+
+
+def _xla_exact_gradient(record, uu, vv, ku, kv):
     import jax
-    program = _xla_exact_program(F.field(field))
+    program = _xla_exact_program(record)
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     with jax.enable_x64(True):
         h_u, h_v = program(uu, vv, float(ku), float(kv))
@@ -496,17 +578,17 @@ def same_compiler_times(uu, vv, *, ku=None, kv=None, rounds=21, fields_=None):
 
     Raises
     ------
-    ValueError
-        If ``rounds`` is not a positive int or a field is refused.
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: ``uu``, ``vv``, ``ku``, ``kv`` as `ad_gradient` refuses them;
+        ``rounds`` not an integer in [1, 10000]; ``fields_`` not a non-empty list or tuple of
+        height fields (each refused as ``fields_[i]``).
     """
-    if not isinstance(rounds, int) or isinstance(rounds, bool) or rounds < 1:
-        raise ValueError(f"rounds must be a positive int, got {rounds!r}")
-    ku = float(DRAFT_SCENE.k_u if ku is None else ku)
-    kv = float(DRAFT_SCENE.k_v if kv is None else kv)
+    uu, vv, ku, kv = _chart(uu, vv, DRAFT_SCENE.k_u if ku is None else ku, DRAFT_SCENE.k_v if kv is None else kv)
+    rounds = positive_int("rounds", rounds, high=10_000)
     out = {}
-    for record in (F.field(f) for f in (tuple(F.FIELDS) if fields_ is None else fields_)):
-        calls = {"exact": lambda: xla_exact_gradient(record, uu, vv, ku, kv),
-                 "ad": lambda: ad_gradient(record, uu, vv, ku, kv),
+    for record in _fields(fields_):
+        calls = {"exact": lambda: _xla_exact_gradient(record, uu, vv, ku, kv),
+                 "ad": lambda: _ad_gradient(record, uu, vv, ku, kv),
                  "numba": lambda: pointwise.exact_gradient(record, uu, vv, ku, kv)}
         times = {k: [] for k in calls}
         for call in calls.values():                  # the first call compiles
@@ -520,6 +602,13 @@ def same_compiler_times(uu, vv, *, ku=None, kv=None, rounds=21, fields_=None):
         out[record.name] = {"exact": exact, "ad": ad, "numba": numba, "ratio": ad / exact,
                             "compiler": exact / numba}
     return out
+
+
+def _fields(fields_, name="fields_"):
+    """The records of ``fields_`` (None: every registered field), a non-empty list or tuple."""
+    if fields_ is None:
+        return tuple(F.FIELDS.values())
+    return tuple(F.field(f, f"{name}[{i}]") for i, f in enumerate(sequence(name, fields_, "height fields")))
 
 
 def abs_slope_at_zero():
@@ -544,12 +633,12 @@ def crease_values(*, v=None, eps=None, ku=None, kv=None):
 
     Parameters
     ----------
-    v : float or None, keyword-only
+    v : float in [0, 1] or None, keyword-only
         The chart v of both points; None for the U-curve's point (`renderer.ucurve.SEED_POINT`),
         off the creases in v.
-    eps : float > 0 or None, keyword-only
+    eps : float in [1e-300, 1) or None, keyword-only
         The central difference's step in chart units; None for the draft's step.
-    ku, kv : float or None, keyword-only
+    ku, kv : float in (0, 1e3] or None, keyword-only
         The frequencies; None for the U-curve's (`renderer.ucurve.SEED_FREQUENCIES`).
 
     Returns
@@ -561,14 +650,14 @@ def crease_values(*, v=None, eps=None, ku=None, kv=None):
 
     Raises
     ------
-    ValueError
-        If ``eps`` is not a positive finite number.
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: not a real number (a bool, a string) or outside its range.
     """
     record = DRAFT_SCENE.field
-    v = ucurve.SEED_POINT[1] if v is None else float(v)
     ku0, kv0 = ucurve.SEED_FREQUENCIES
-    ku, kv = float(ku0 if ku is None else ku), float(kv0 if kv is None else kv)
-    eps = _positive_step(DRAFT_SCENE.eps if eps is None else eps)
+    v = real("v", ucurve.SEED_POINT[1] if v is None else v, **UNIT)
+    ku, kv = (real(n, k0 if k is None else k, **FREQUENCY) for n, k, k0 in (("ku", ku, ku0), ("kv", kv, kv0)))
+    eps = real("eps", DRAFT_SCENE.eps if eps is None else eps, **STEP)
     f_u = sp.lambdify(F.FIELD_SYMBOLS, sp.diff(sp.Mul(*record.crease_factors), F.u), modules="mpmath")
     out = []
     for u0 in (0.0, 1.0 / ku):
@@ -576,7 +665,7 @@ def crease_values(*, v=None, eps=None, ku=None, kv=None):
         slope = abs(float(f_u(mpmath.mpf(u0), mpmath.mpf(v), mpmath.mpf(ku), mpmath.mpf(kv))))
         out.append(dict(u=u0, factor=float(np.sin(np.pi * ku * u0)),
                         exact=float(pointwise.exact_gradient(record, uu, vv, ku, kv)[0][0]),
-                        ad=float(ad_gradient(record, uu, vv, ku, kv)[0][0]),
+                        ad=float(_ad_gradient(record, uu, vv, ku, kv)[0][0]),
                         central=float(pointwise.central_gradient(record, uu, vv, ku, kv, eps)[0][0]),
                         left=-slope, right=slope))
     return out
@@ -592,6 +681,7 @@ def _reference_fn(field, ku, kv):
     return sp.lambdify((F.u, F.v), [g.subs(ks) for g in field.gradient], modules="mpmath", cse=True)
 
 
+@_documented
 def reference_gradient(field, uu, vv, ku, kv, *, digits=34):
     """The exact gradient at float64 chart points, evaluated by mpmath.
 
@@ -605,17 +695,23 @@ def reference_gradient(field, uu, vv, ku, kv, *, digits=34):
 
     Parameters
     ----------
-    field : height field
-        As `renderer.formulas.field` takes it.
-    uu, vv : (n,) float64
-    ku, kv : float (converted to exact rationals)
-    digits : int, keyword-only
+    {_FIELD_ARGS}  (ku, kv converted to exact rationals)
+    digits : int in [32, 1000], keyword-only
 
     Returns
     -------
-    (hi, lo) : two (2, n) float64 arrays; row 0 is h_u, row 1 is h_v.
+    (hi, lo) : two (2, n) float64 arrays (n points of the broadcast uu, vv, flattened); row 0
+    is h_u, row 1 is h_v.
+
+    Raises
+    ------
+    {_FIELD_RAISES}; ``digits`` not an integer in [32, 1000].
     """
-    fn = _reference_fn(F.field(field), float(ku), float(kv))
+    return _reference_gradient(*_field_args(field, uu, vv, ku, kv), digits=_digits("digits", digits))
+
+
+def _reference_gradient(record, uu, vv, ku, kv, *, digits=34):
+    fn = _reference_fn(record, float(ku), float(kv))
     uu, vv = np.broadcast_arrays(np.ravel(uu), np.ravel(vv))
     hi = np.empty((2, uu.size))
     lo = np.empty((2, uu.size))
@@ -650,7 +746,18 @@ def trig_calls(exprs):
     is computed once per point, so this counts the sin and cos nodes of the replacements and
     the reduced outputs.  The numba kernel calls exactly these (tests/test_gradient_methods.py
     compares the count with the text of renderer/generated.py).
+
+    ``exprs``: a list or tuple of sympy expressions (real numbers among them count 0).  Raises
+    InvalidType naming ``exprs`` (or ``exprs[i]``) for anything else (a string, one expression).
     """
+    for i, e in enumerate(instance("exprs", exprs, (list, tuple), "a list or tuple of sympy expressions")):
+        if isinstance(e, bool) or not isinstance(e, (sp.Basic, int, float)):
+            raise InvalidType(f"exprs[{i}] must be a sympy expression or a real number, got {type(e).__name__} "
+                              f"{e!r:.80}")
+    return _trig_calls(exprs)
+
+
+def _trig_calls(exprs):
     exprs = [e for e in exprs if isinstance(e, sp.Basic)]
     subs, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"))
     return sum(isinstance(node, (sp.sin, sp.cos))
@@ -665,14 +772,20 @@ def _generated(kind, field):
 def stencil_values(field):
     """Values of h per point in the kernel's central difference of ``field``: the stencil points
     (`formulas.STENCIL_POINTS`) that its quotients read.  4 for sine and ridges; 2 for rings,
-    whose u-difference sympy reduced to 0."""
-    used = set().union(*(c.free_symbols for c in F.field(field).central))
+    whose u-difference sympy reduced to 0.  ``field`` as `renderer.formulas.field` takes it (refused:
+    InvalidType or InvalidValue naming ``field``)."""
+    return _stencil_values(F.field(field, "field"))
+
+
+def _stencil_values(field):
+    used = set().union(*(c.free_symbols for c in field.central))
     return sum(p in used for p, _ in F.STENCIL_POINTS)
 
 
 def height_work(field):
-    """One value of h per pixel, with the sines and cosines it costs: the unit of cost."""
-    return Evaluations(h=1.0, trig=float(trig_calls((F.field(field).expr,))))
+    """One value of h per pixel, with the sines and cosines it costs: the unit of cost.  ``field``
+    as `renderer.formulas.field` takes it (refused: InvalidType or InvalidValue naming ``field``)."""
+    return Evaluations(h=1.0, trig=float(_trig_calls((F.field(field, "field").expr,))))
 
 
 def _measured_h(info):
@@ -682,18 +795,20 @@ def _measured_h(info):
 
 
 def method(name):
-    """The record of `METHODS` named ``name``; ValueError naming the names if there is none."""
-    for m in METHODS:
-        if m.name == name:
-            return m
-    raise ValueError(f"method must be one of {[m.name for m in METHODS]}, got {name!r}")
+    """The record of `METHODS` named ``name``.  Raises InvalidValue (InvalidType for a name that is
+    not a string) naming the names."""
+    name = choice("method", name, tuple(m.name for m in METHODS))
+    return next(m for m in METHODS if m.name == name)
 
 
 def evaluations(field, name, info=None):
     """The work per pixel of the method ``name`` on ``field`` (`Method.work`), an `Evaluations`.
-    ``info``: what the method's gradient measured of itself (Richardson's count of values of h).
-    Raises ValueError for an unknown method, or Richardson without ``info``."""
-    return method(name).work(F.field(field), info or {})
+    ``info``: what the method's gradient measured of itself (Richardson's count of values of h), a
+    dict or None.  Raises InvalidType or InvalidValue for a refused field (naming ``field``), an
+    unknown method (``method``) or an ``info`` that is not a dict; ValueError for Richardson
+    without ``info``."""
+    record = F.field(field, "field")
+    return method(name).work(record, optional(instance, "info", info, dict, "a dict or None") or {})
 
 
 # --- the methods over a function of one variable ---------------------------------------------
@@ -737,35 +852,35 @@ def _has_abs(record):
 
 
 def _ad_work(field, info):
-    return Evaluations(h_tangent=2.0, trig=float(ad_trig_calls(field)))
+    return Evaluations(h_tangent=2.0, trig=float(_ad_trig_calls(field)))
 
 
 #: The methods, in the order tables and legends list them.  Adding a method is one record here.
 METHODS = [
     Method("exact", lambda f, u, v, ku, kv, eps, info: pointwise.exact_gradient(f, u, v, ku, kv),
-           lambda f, info: Evaluations(gradient=1.0, trig=float(trig_calls(_generated("exact", f)))),
+           lambda f, info: Evaluations(gradient=1.0, trig=float(_trig_calls(_generated("exact", f)))),
            "exact (sympy)", Style("#1b5e20", "*", 12, "-"), derivative=_exact_1d),
     Method("central", lambda f, u, v, ku, kv, eps, info: pointwise.central_gradient(f, u, v, ku, kv, eps),
-           lambda f, info: Evaluations(h=float(stencil_values(f)), trig=float(trig_calls(_generated("central", f)))),
+           lambda f, info: Evaluations(h=float(_stencil_values(f)), trig=float(_trig_calls(_generated("central", f)))),
            "central difference", Style("#7a1f1f", "o", 5, "-"), steps="central_steps", derivative=_central_1d),
-    Method("forward", lambda f, u, v, ku, kv, eps, info: forward_gradient(f, u, v, ku, kv, eps),
-           lambda f, info: Evaluations(h=3.0, trig=3.0 * trig_calls((f.expr,))),
+    Method("forward", lambda f, u, v, ku, kv, eps, info: _forward_gradient(f, u, v, ku, kv, eps),
+           lambda f, info: Evaluations(h=3.0, trig=3.0 * _trig_calls((f.expr,))),
            "forward difference", Style("#b26b00", "s", 5, "--"), steps="forward_steps", derivative=_forward_1d),
-    Method("complex step", lambda f, u, v, ku, kv, eps, info: complex_step_gradient(f, u, v, ku, kv, eps),
+    Method("complex step", lambda f, u, v, ku, kv, eps, info: _complex_step_gradient(f, u, v, ku, kv, eps),
            lambda f, info: Evaluations(h_complex=2.0), "complex step", Style("#1f4e7a", "D", 6, ":"),
            steps="complex_steps", applies=lambda f: f.analytic, sources=("squire-trapp", "martins-complex-step"),
            derivative=_complex_1d(False)),
     Method("complex step, |z| continued",
-           lambda f, u, v, ku, kv, eps, info: complex_step_gradient(f, u, v, ku, kv, eps, continued=True),
+           lambda f, u, v, ku, kv, eps, info: _complex_step_gradient(f, u, v, ku, kv, eps, continued=True),
            lambda f, info: Evaluations(h_complex=2.0), "complex step, |z| continued",
            Style("#5b7fa6", "d", 7, "-."), steps="complex_steps", applies=_has_abs,
            note="|f| evaluated as f sign(Re f); one-sided on the crease", sources=("martins-complex-step",),
            derivative=_complex_1d(True)),
-    Method("richardson", lambda f, u, v, ku, kv, eps, info: richardson_gradient(f, u, v, ku, kv, info=info),
-           lambda f, info: Evaluations(h=_measured_h(info), trig=_measured_h(info) * trig_calls((f.expr,))),
+    Method("richardson", lambda f, u, v, ku, kv, eps, info: _richardson_gradient(f, u, v, ku, kv, info=info),
+           lambda f, info: Evaluations(h=_measured_h(info), trig=_measured_h(info) * _trig_calls((f.expr,))),
            "SciPy (Richardson)", Style("#6a1b9a", "^", 8, (0, (5, 2, 1, 2))), repeats="richardson_repeats",
            note=f"scipy.differentiate.derivative, order {RICHARDSON['order']}", derivative=_richardson_1d),
-    Method(AD, lambda f, u, v, ku, kv, eps, info: ad_gradient(f, u, v, ku, kv), _ad_work,
+    Method(AD, lambda f, u, v, ku, kv, eps, info: _ad_gradient(f, u, v, ku, kv), _ad_work,
            "forward-mode AD (JAX)", Style("#00838f", "P", 8, (0, (1, 1))), compiles=True,
            note="jax.jvp, jit-compiled", sources=("griewank-walther",), derivative=_ad_1d),
 ]
@@ -856,23 +971,49 @@ def _errors(approx, hi, lo):
     return float(err.max()), float(np.sqrt(np.mean(err**2)))
 
 
+def _config(config):
+    """``config`` as a `Config`: one, or the name of `FAST` or `FULL`."""
+    names = {c.name: c for c in (FAST, FULL)}
+    if isinstance(config, str):
+        return names[choice("config", config, tuple(names))]
+    return instance("config", config, Config, f"a Config or one of {tuple(names)}")
+
+
+def _uv(uv):
+    """``uv`` as two contiguous (n,) float64 arrays of chart coordinates in [0, 1], n >= 1."""
+    if not (isinstance(uv, (tuple, list)) and len(uv) == 2):
+        raise InvalidType(f"uv must be a pair (u, v) of 1-D arrays, got {type(uv).__name__} {uv!r:.80}")
+    u, v = (validate.real_array(n, a, **UNIT) for n, a in zip(("uv[0]", "uv[1]"), uv))
+    if u.ndim != 1 or u.shape != v.shape or u.size == 0:
+        raise InvalidValue(f"uv must be two 1-D arrays of one length n >= 1, got shapes {u.shape} and {v.shape}")
+    return np.ascontiguousarray(u), np.ascontiguousarray(v)
+
+
 def measure(config=FAST, *, fields_=None, uv=None):
     """Time and check every method on every field where it applies, with its work per pixel
     (see the module docstring).
 
     Parameters
     ----------
-    config : Config
-        `FAST` (book build) or `FULL` (release).
-    fields_ : sequence of height fields or None, keyword-only
+    config : Config, or the name of `FAST` or `FULL` ("fast", "full")
+        `FAST` (book build) or `FULL` (release), or another `Config`.  A name stands for its
+        record, as the configuration's name is what a reader (and `Config.name`) calls it.
+    fields_ : list or tuple of height fields, or None, keyword-only
         As `renderer.formulas.field` takes them; None for every registered field.
     uv : (u, v) pair of (n,) float64 arrays or None, keyword-only
-        Chart points of the sphere-A pixels, shared by all fields (they do not depend on the
-        field); None computes them with `chart_points`.
+        Chart points of the sphere-A pixels (in [0, 1], n >= 1), shared by all fields (they do
+        not depend on the field); None computes them with `chart_points`.
 
     Returns
     -------
     Measurement
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: ``config`` neither a `Config` nor "fast" or "full"; ``fields_``
+        not a non-empty list or tuple of height fields (``fields_[i]`` the one refused);
+        ``uv`` not a pair of 1-D arrays of one length of chart coordinates in [0, 1].
 
     Notes
     -----
@@ -883,11 +1024,11 @@ def measure(config=FAST, *, fields_=None, uv=None):
     pixels, in an order shuffled each round, so that drifts of the machine's speed fall on
     all of them alike.
     """
+    config, records, uv = _config(config), _fields(fields_), None if uv is None else _uv(uv)
     t_start = time.perf_counter()
     load_start = os.getloadavg() if hasattr(os, "getloadavg") else None
     rng = np.random.default_rng(config.seed)
     ku, kv = float(DRAFT_SCENE.k_u), float(DRAFT_SCENE.k_v)
-    records = [F.field(f) for f in (tuple(F.FIELDS) if fields_ is None else fields_)]
     u, v = chart_points(size=config.size) if uv is None else uv
     checked, timed, n_ref, n_excl = [], [], {}, {}
     for record in records:
@@ -901,7 +1042,7 @@ def measure(config=FAST, *, fields_=None, uv=None):
             pick = off
         n_ref[name] = int(pick.size)
         ru, rv = u[pick].copy(), v[pick].copy()
-        hi, lo = reference_gradient(record, ru, rv, ku, kv, digits=config.digits)
+        hi, lo = _reference_gradient(record, ru, rv, ku, kv, digits=config.digits)
         for m in METHODS:
             if not m.applies(record):
                 continue
@@ -977,8 +1118,9 @@ def pareto_front(results, *, error="max"):
 
     Parameters
     ----------
-    results : sequence of MethodResult
-        Usually one field's results (`Measurement.of`).
+    results : list or tuple of MethodResult
+        Usually one field's results (`Measurement.of`); any records with ``median``,
+        ``max_error`` and ``rms_error`` do.
     error : {"max", "rms"}, keyword-only
         Which error is minimised with the time.
 
@@ -988,19 +1130,30 @@ def pareto_front(results, *, error="max"):
 
     Raises
     ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``results`` not a list or tuple of `MethodResult` (``results[i]`` the one refused);
+        ``error`` not "max" or "rms".
     ValueError
-        If ``error`` is not "max" or "rms", or a time or error is not finite.
+        A time or error is not finite.
     """
+    if not isinstance(error, str):
+        raise InvalidType(f"error must be 'max' or 'rms', got {shown(error)}")
     if error not in ("max", "rms"):
-        raise ValueError(f"error must be 'max' or 'rms', got {error!r}")
-    results = list(results)
+        raise InvalidValue(f"error must be 'max' or 'rms', got {error!r:.80}")
+    results = list(instance("results", results, (list, tuple), "a list or tuple of MethodResult records"))
+    for i, r in enumerate(results):
+        if not all(hasattr(r, a) for a in ("median", "max_error", "rms_error")):
+            raise InvalidType(f"results[{i}] must be a MethodResult (a record with median, max_error and "
+                              f"rms_error), got {shown(r)}")
     errs = [r.max_error if error == "max" else r.rms_error for r in results]
     keep = _non_dominated([r.median for r in results], errs)
     return sorted((results[i] for i in keep), key=lambda r: r.median)
 
 
 def to_json(measurement):
-    """The measurement as a JSON string (times in seconds, every repeat kept)."""
+    """The measurement (a `Measurement`) as a JSON string (times in seconds, every repeat kept).
+    Raises InvalidType naming ``measurement`` for anything else."""
+    instance("measurement", measurement, Measurement, "a Measurement")
     out = {"config": asdict(measurement.config), "pixels": measurement.pixels,
            "h_alone_seconds": {k: list(v) for k, v in measurement.h_times.items()},
            "reference_pixels": measurement.reference_pixels,
@@ -1091,8 +1244,8 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
     ------
     renderer.validate.InputError
         One line naming the argument: a function refused by `renderer.formulas.univariate`
-        (an unknown name or operator, more than one variable, a complex constant); a point or
-        a step that is not a finite real number in range; a point where f or f' is not a
+        (an unknown name or operator, more than one variable, a complex constant); a point
+        (``x``) or a step (``steps``) that is not a finite real number in range (a bool, NaN); a point where f or f' is not a
         finite real number, or f has a crease, or float64 f overflows; a step at which
         f(x +- eps) is not finite; a method whose value there is not finite (Richardson's steps
         reach where f is not).
@@ -1104,11 +1257,12 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
     True
     """
     record, x = F.univariate(function), validate.real("x", x)
+    steps = validate.steps("steps", steps, low=pointwise.MIN_STEP, high=ucurve.MAX_FUNCTION_STEP)
     with np.errstate(all="ignore"):
         value = fieldcode.univariate_code(record).value(x)
     if math.isinf(value):                     # finite at 50 digits (measure_function's test) is not enough
         raise validate.InvalidValue(f"x = {x!r} is too large for function {record.name}: f(x) overflows float64")
-    curve = ucurve.measure_function(record, x, eps=steps)      # validates x and the steps, f and f' at x
+    curve = ucurve.measure_function(record, x, eps=steps)      # checks f and f' at x, and f at x +- eps
     steps = tuple(float(e) for e in curve.eps)
     true_fn = sp.lambdify(F.x_var, record.derivative, modules="mpmath")
     rows, evaluations = [], {}

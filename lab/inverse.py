@@ -24,11 +24,14 @@ import numpy as np
 import sympy as sp
 
 from renderer import formulas, gbuffer, pointwise
+from renderer.pointwise import UNIT_NORMAL
 from renderer.render import MAX_SIDE, check_args
 from renderer.scene import MAX_BETA
-from renderer.validate import InvalidType, InvalidValue, positive_int, real
+from renderer.validate import InvalidType, InvalidValue, choice, positive_int, real, real_array
 
-__all__ = ["Fit", "fit_beta", "geometry", "jacobian", "normal_and_jacobian", "MAX_STEPS"]
+from ._checks import numbers_array
+
+__all__ = ["Fit", "fit_beta", "geometry", "jacobian", "normal_and_jacobian", "MAX_STEPS", "MODES"]
 
 #: Most Gauss–Newton steps `fit_beta` accepts.
 MAX_STEPS = 100
@@ -37,7 +40,10 @@ _ARGS = ((formulas.N_x, formulas.N_y, formulas.N_z) + formulas.e_theta + formula
          + (formulas.h_u, formulas.h_v, formulas.beta, formulas.h, formulas.R, formulas.sin_phi))
 
 
-@functools.lru_cache(maxsize=None)
+#: The bump modes, as `formulas.PERTURBED_NORMAL` names them.
+MODES = tuple(sorted(formulas.PERTURBED_NORMAL))
+
+
 def jacobian(mode):
     """∂N'/∂β for one bump mode: sympy's derivative of each component of
     `formulas.PERTURBED_NORMAL[mode]`, taken on first use (not at import).
@@ -53,17 +59,20 @@ def jacobian(mode):
 
     Raises
     ------
-    KeyError
-        If ``mode`` is not a bump mode of `formulas.PERTURBED_NORMAL`.
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``mode`` is not a string, or not a bump mode of `formulas.PERTURBED_NORMAL` (`MODES`).
     """
-    if mode not in formulas.PERTURBED_NORMAL:
-        raise KeyError(f"mode must be one of {sorted(formulas.PERTURBED_NORMAL)}, got {mode!r}")
+    return _jacobian(choice("mode", mode, MODES))
+
+
+@functools.lru_cache(maxsize=None)
+def _jacobian(mode):
     return tuple(sp.diff(c, formulas.beta) for c in formulas.PERTURBED_NORMAL[mode])
 
 
 @functools.lru_cache(maxsize=None)
 def _lambdified(mode):
-    return sp.lambdify(_ARGS, [list(formulas.PERTURBED_NORMAL[mode]), list(jacobian(mode))], "numpy", cse=True)
+    return sp.lambdify(_ARGS, [list(formulas.PERTURBED_NORMAL[mode]), list(_jacobian(mode))], "numpy", cse=True)
 
 
 def normal_and_jacobian(mode, geometry, beta):
@@ -73,13 +82,36 @@ def normal_and_jacobian(mode, geometry, beta):
     ----------
     mode : {"chart", "surface"}
     geometry : tuple of 14 float64 arrays of one shape (n,)
-        N (3), e_θ (3), e_φ (3), h_u, h_v, h, R, sin φ, as `formulas._ARGS` orders them without β.
-    beta : float
+        N (3), e_θ (3), e_φ (3), h_u, h_v, h, R, sin φ, as `_ARGS` orders them without β
+        (`geometry` returns them); finite real numbers.
+    beta : float, or (n,) array of floats, in [0, 100]
 
     Returns
     -------
     (normal, jacobian) : two (n, 3) float64 arrays (dimensionless; the Jacobian per unit β).
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: ``mode`` not one of `MODES`; ``geometry`` not a list or tuple of
+        14 arrays, an entry (``geometry[i]``) not finite real numbers or not 1-D of one length;
+        ``beta`` not real numbers in [0, 100], or an array of another shape than (n,).
     """
+    mode = choice("mode", mode, MODES)
+    if not (isinstance(geometry, (tuple, list)) and len(geometry) == len(_ARGS) - 1):
+        raise InvalidType(f"geometry must be a tuple of {len(_ARGS) - 1} arrays (N, e_θ, e_φ, h_u, h_v, h, R, "
+                          f"sin φ), got {type(geometry).__name__} {geometry!r:.80}")
+    geometry = tuple(real_array(f"geometry[{i}]", g) for i, g in enumerate(geometry))
+    if any(g.ndim != 1 or g.shape != geometry[0].shape for g in geometry):
+        raise InvalidValue(f"geometry must be 1-D arrays of one length, got shapes {[g.shape for g in geometry]}")
+    beta = real_array("beta", beta, low=0.0, high=MAX_BETA)
+    if beta.ndim and beta.shape != geometry[0].shape:
+        raise InvalidValue(f"beta must be a number or an array of the geometry's shape {geometry[0].shape}, "
+                           f"got shape {beta.shape}")
+    return _normal_and_jacobian(mode, geometry, beta[()])
+
+
+def _normal_and_jacobian(mode, geometry, beta):
     N, et, ep, hu, hv, h, R, sin_phi = geometry[:3], geometry[3:6], geometry[6:9], *geometry[9:]
     normal, jac = _lambdified(mode)(*N, *et, *ep, hu, hv, beta, h, R, sin_phi)
     n = hu.shape[0]
@@ -145,7 +177,8 @@ def fit_beta(target, scene, *, beta0=0.1, steps=20, tol=1e-12):
     ----------
     target : (H, W, 3) array_like of float
         Perturbed unit normals (``renderer.gbuffer(scene', W, H).Ns``) of a render of
-        ``scene`` with an unknown β; read on sphere A's pixels only, which must be finite.
+        ``scene`` with an unknown β; read on sphere A's pixels only, whose components must be
+        finite and within [-1.5, 1.5] (a unit vector's, with room for rounding).
     scene : renderer.Scene
         The scene (its ``beta`` is ignored; its ``bump`` mode decides the formula).
     beta0 : float in [0, 100], keyword-only
@@ -161,17 +194,14 @@ def fit_beta(target, scene, *, beta0=0.1, steps=20, tol=1e-12):
 
     Raises
     ------
-    TypeError
-        ``scene`` not a Scene; ``target`` not numbers; ``steps`` not an integer; ``beta0`` or
-        ``tol`` not real.
-    ValueError
-        ``target`` not of shape (H, W, 3) with H, W in [1, 8192], or not finite on sphere A;
-        ``beta0``, ``steps`` or ``tol`` out of range.
+    renderer.validate.InvalidType
+        ``scene`` not a Scene; ``target`` not real numbers (bools, strings); ``steps`` not an
+        integer; ``beta0`` or ``tol`` not real.
+    renderer.validate.InvalidValue
+        ``target`` not of shape (H, W, 3) with H, W in [1, 8192], or on sphere A not finite or
+        outside [-1.5, 1.5]; ``beta0``, ``steps`` or ``tol`` out of range.
     """
-    try:
-        target = np.asarray(target, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InvalidType(f"target must be an (H, W, 3) array of floats, got {type(target).__name__}") from None
+    target = numbers_array("target", target)
     if target.ndim != 3 or target.shape[2] != 3 or not 1 <= min(target.shape[:2]) <= max(target.shape[:2]) <= MAX_SIDE:
         raise InvalidValue(f"target must be an (H, W, 3) normal map with H, W in [1, {MAX_SIDE}], "
                            f"got shape {target.shape}")
@@ -182,12 +212,15 @@ def fit_beta(target, scene, *, beta0=0.1, steps=20, tol=1e-12):
     tol = real("tol", tol, low=0.0, low_open=True, high=1.0)
     on_a, inputs = geometry(scene, width, height)
     want = target[on_a]
-    if not np.isfinite(want).all():
-        raise InvalidValue(f"target must be finite on sphere A's {on_a.sum():,} pixels, got "
-                           f"{np.count_nonzero(~np.isfinite(want).all(axis=1)):,} pixels with a NaN or inf")
+    bad = ~((want >= UNIT_NORMAL["low"]) & (want <= UNIT_NORMAL["high"])).all(axis=1)     # NaN too
+    if bad.any():
+        row, col = np.argwhere(on_a)[np.argmax(bad)]
+        raise InvalidValue(f"target must be finite and in [{UNIT_NORMAL['low']}, {UNIT_NORMAL['high']}] on sphere A's "
+                           f"{on_a.sum():,} pixels, got {np.count_nonzero(bad):,} pixels outside, the first "
+                           f"{tuple(want[np.argmax(bad)].tolist())} at (row, column) ({row}, {col})")
     iterates, converged = [], False
     for _ in range(steps + 1):
-        normal, jac = normal_and_jacobian(scene.bump, inputs, beta)
+        normal, jac = _normal_and_jacobian(scene.bump, inputs, beta)
         r = (normal - want).ravel()
         iterates.append((beta, float(np.linalg.norm(r))))
         if converged or len(iterates) > steps:

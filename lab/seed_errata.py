@@ -20,6 +20,9 @@ import numpy as np
 from renderer import DRAFT_SCENE, gbuffer
 from renderer.pointwise import chart, tangent_frame
 from renderer.render import FLOOR, SPHERE_A, SPHERE_B, image_plane
+from renderer.validate import InvalidValue, positive_int
+
+from ._checks import MAX_SQUARE, instance, shown
 
 __all__ = ["Erratum", "ERRATA", "measure_all", "reproduced", "ErratumVanished", "seed_chamber"]
 
@@ -96,7 +99,9 @@ _SEED_CHAMBER = {}
 def seed_chamber(size=SIZE):
     """(size, size) uint8: the chamber map the draft's code computes for its scene, its
     sphere B intersected with the draft's quadratic (erratum sphere-b-quadratic); not
-    this renderer's map of the same scene (`renderer.gbuffer`)."""
+    this renderer's map of the same scene (`renderer.gbuffer`).  ``size``: an int in [1, 4096]
+    (InvalidType or InvalidValue naming ``size`` otherwise)."""
+    size = positive_int("size", size, high=MAX_SQUARE)
     if size not in _SEED_CHAMBER:
         _sphere_b_seed_vs_true(size)
     return _SEED_CHAMBER[size]
@@ -304,11 +309,26 @@ def reproduced(measured=None):
     erratum's defect is still there by its `Erratum.criterion`; the book's
     errata section is built from this, so its build fails on a vanished one.
 
+    ``measured``: None, or a dict {erratum id: dict of its measured numbers} holding every
+    id of `ERRATA`.
+
     Raises
     ------
+    renderer.validate.InvalidType
+        ``measured`` is not a dict, or an erratum's entry is not one (``measured[id]``).
+    renderer.validate.InvalidValue
+        ``measured`` lacks an erratum of `ERRATA` (naming the ids missing).
     ErratumVanished
         Naming every erratum whose measurement fails its criterion.
     """
+    if measured is not None:
+        instance("measured", measured, dict, "a dict {erratum id: measured dict} (measure_all's) or None")
+        missing = [e.id for e in ERRATA if e.id not in measured]
+        if missing:
+            raise InvalidValue(f"measured must hold every erratum of ERRATA, got {shown(measured)}; missing "
+                               f"{', '.join(missing)}")
+        for e in ERRATA:
+            instance(f"measured[{e.id!r}]", measured[e.id], dict, "a dict of measured numbers")
     measured = measure_all() if measured is None else measured
     gone = [f"{e.id}: not ({e.criterion}); measured {measured[e.id]}" for e in ERRATA
             if not e.present(measured[e.id])]

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from renderer import Scene, gbuffer
+from renderer.validate import InvalidValue
 from lab.inverse import fit_beta, geometry, normal_and_jacobian
 
 SIZE, BETA = 40, 0.35
@@ -90,9 +91,9 @@ def test_importing_takes_no_derivative_and_an_unknown_mode_is_named():
     # The Jacobian is sympy's work on first use, not at import (it cost 75 ms of every import).
     import subprocess
     import sys
-    code = "import lab.inverse as m; print(m.jacobian.cache_info().currsize)"
+    code = "import lab.inverse as m; print(m._jacobian.cache_info().currsize)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "0"
     from lab.inverse import jacobian
-    with pytest.raises(KeyError, match=r"mode must be one of \['chart', 'surface'\], got 'bump'"):
+    with pytest.raises(InvalidValue, match=r"^mode must be one of \('chart', 'surface'\), got 'bump'"):
         jacobian("bump")
