@@ -1373,3 +1373,85 @@ def test_the_formula_check_catches_formulas_shrunk_or_running_past_the_column(br
         s.close()
     kind = "over" if "line" in variant else "scale"
     assert found and all((f["over"] > 1) if kind == "over" else (f["scale"] < 0.999) for f in found), (variant, found)
+
+
+# ---- accessibility: axe-core on every page --------------------------------------------------------
+
+#: axe-core's script (book/fetch_mathjax.py fetches the pinned version from the npm registry, sha512-checked);
+#: the test injects it into each page: the site does not serve it.
+AXE = ROOT / "book" / "_vendor" / "axe-core" / "axe.min.js"
+#: axe-core's rules of WCAG 2.0 and 2.1, levels A and AA.
+AXE_TAGS = ["wcag2a", "wcag2aa", "wcag21a", "wcag21aa"]
+#: Run in a page with axe-core in it: every <details> opened (what a reader unfolds is checked too), then
+#: axe.run over the document with AXE_TAGS; its violations as {id, impact, help, nodes, examples}.
+AXE_JS = """async (tags) => {
+  const folded = [...document.querySelectorAll('details:not([open])')];
+  folded.forEach(d => { d.open = true; });
+  await new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
+  // An opened fold fades in (its text passes through every grey on the way): measured once it has.
+  await Promise.all(document.getAnimations().map(a => a.finished.catch(() => null)));
+  const found = await axe.run(document, {runOnly: {type: 'tag', values: tags}, resultTypes: ['violations']});
+  return found.violations.map(v => ({id: v.id, impact: v.impact, help: v.help, nodes: v.nodes.length,
+    examples: v.nodes.slice(0, 4).map(n => n.target.join(' ') + ': ' + (n.failureSummary || '').replace(/\\s+/g, ' ').slice(0, 200))}));
+}"""
+
+
+def axe_violations(browser, url, width, change=None):
+    """axe-core's violations (`AXE_JS`) on the page at ``url`` opened at ``width`` px, offline, once MathJax
+    and fit.js are done; ``change`` as `Formulas`'s (a wrong variant of the site)."""
+    if not AXE.is_file():
+        pytest.fail(f"{AXE} is missing: `make .venv/.installed` (book/fetch_mathjax.py) fetches it")
+    s = Formulas(browser, url, width, change=change)
+    try:
+        s.page.add_script_tag(path=str(AXE))
+        found = s.page.evaluate(AXE_JS, AXE_TAGS)
+        assert s.blocked == [], s.blocked
+        return found
+    finally:
+        s.close()
+
+
+def serious(violations):
+    """The violations axe-core rates serious or critical."""
+    return [v for v in violations if v["impact"] in ("serious", "critical")]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_axe_finds_no_serious_or_critical_violation(browser, book_html, name):
+    """axe-core (WCAG 2.1 A and AA rules) on the page at 390 and at 1280 px, every dropdown open: no
+    violation rated serious or critical (contrast, names of buttons and controls, ARIA structure).
+    Every violation, of any impact, goes to test-artifacts/axe_<page>.json."""
+    report = {}
+    for width in (390, 1280):
+        report[f"{width}px"] = axe_violations(browser, (book_html / f"{name}.html").as_uri(), width)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    (ARTIFACTS / f"axe_{name}.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
+    bad = {w: serious(v) for w, v in report.items() if serious(v)}
+    assert not bad, f"{name}:\n" + json.dumps(bad, indent=1, ensure_ascii=False)
+
+
+#: Wrong variants of the site, each of which axe-core must catch: (page, width, file changed, its text
+#: replaced, its replacement, the rule that must fire).  The theme shows the search field from 960 px.
+WRONG_A11Y = {
+    "the theme's link blue on tinted boxes": (
+        "s3_math", 390, "fit.css", 'html[data-theme="light"] { --pst-color-link: #1259c3; }', "", "color-contrast"),
+    "the search field named short of what it shows": (
+        "index", 1280, "index.html", 'search-button__button pst-js-only" title="Search"',
+        'search-button__button pst-js-only" title="Search" aria-label="Search"', "label-content-name-mismatch"),
+    "the bibliography's deprecated entries": (
+        "s8_history", 390, "s8_history.html", 'role="listitem"', 'role="doc-biblioentry"', "aria-required-children"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_A11Y))
+def test_the_axe_check_catches_a_contrast_failure_a_misnamed_button_and_broken_aria(browser, book_html, variant):
+    name, width, file, old, new, rule = WRONG_A11Y[variant]
+
+    def change(path, text):
+        if path.name != file:
+            return text
+        assert old in text, f"variant {variant!r} no longer applies to {file}"
+        return text.replace(old, new)
+
+    found = serious(axe_violations(browser, (book_html / f"{name}.html").as_uri(), width, change=change))
+    assert rule in {v["id"] for v in found}, (variant, found)
