@@ -415,9 +415,12 @@ class Page:
 
 #: Every image of the article: in a numbered, captioned figure, with alt text, at
 #: ``sharpness`` device pixels per CSS pixel or more.
-#: Run in a page: each table of the article (shown ones) as {"where", "rows": rows shown, "split_rows":
-#: rows whose shown cells do not share a top (a row stacked into a card), "scrolls": whether the box
-#: around it (or the table itself) scrolls sideways, "right": the right edge of that box, "window": the window's width}.
+#: Run in a page: each table of the article (shown ones) as {"where", "head": its first row's text, "rows":
+#: rows shown, "split_rows": rows whose shown cells do not share a top (a row stacked into a card), "scrolls":
+#: whether the box around it (or the table itself) scrolls sideways, "right": the right edge of that box,
+#: "window": the window's width, "hidden_px": how far (px) its columns reach past the box's visible width,
+#: "cue": whether a visible cue stands just above the box (fit.js's p.fit-scroll-cue, the box's previous
+#: sibling: shown, not transparent, text at 12 px or more, within the window)}.
 TABLES = r"""() => [...document.querySelectorAll('article.bd-article table')].filter(t => t.getClientRects().length)
   .map(t => {
     const shown = el => el.getClientRects().length > 0, s = t.closest('section[id]');
@@ -427,10 +430,22 @@ TABLES = r"""() => [...document.querySelectorAll('article.bd-article table')].fi
       return tops.length > 1 && Math.max(...tops) - Math.min(...tops) > 1;
     });
     const box = ['auto', 'scroll'].includes(getComputedStyle(t).overflowX) ? t : t.parentElement;
-    return {where: s ? '#' + s.id : '', rows: rows.length, split_rows: split.length,
+    const cue = box.previousElementSibling, cs = cue && getComputedStyle(cue), r = cue && cue.getBoundingClientRect();
+    const visible = !!cue && cue.matches('.fit-scroll-cue') && shown(cue) && cs.visibility === 'visible'
+      && parseFloat(cs.opacity) > 0.9 && parseFloat(cs.fontSize) >= 12 && cue.textContent.trim().length > 10
+      && r.width > 0 && r.left >= 0 && r.right <= document.documentElement.clientWidth + 0.5;
+    return {where: s ? '#' + s.id : '', head: rows.length ? rows[0].textContent.replace(/\s+/g, ' ').trim().slice(0, 40) : '',
+            rows: rows.length, split_rows: split.length,
             scrolls: ['auto', 'scroll'].includes(getComputedStyle(box).overflowX),
-            right: box.getBoundingClientRect().right, window: document.documentElement.clientWidth};
+            right: box.getBoundingClientRect().right, window: document.documentElement.clientWidth,
+            hidden_px: box.scrollWidth - box.clientWidth, cue: visible};
   })"""
+
+
+def uncued_tables(tables):
+    """The tables of a page (`TABLES`) that hide columns (reach more than a pixel past their box) with no
+    visible cue above them, or carry a cue while hiding nothing."""
+    return [t for t in tables if (t["hidden_px"] > 1) != t["cue"]]
 
 
 def split_tables(tables):
@@ -546,6 +561,49 @@ def test_every_table_keeps_its_rows_as_rows_at_both_widths(site):
         assert not split_tables(found), f"tables not shown as tables at {width} px:\n{_listing(split_tables(found))}"
         wide = [n for n in PAGES for f in site[n, width]["overflow"] if f["kind"] == "page wider than the window"]
         assert not wide, (width, wide)
+
+
+def test_no_table_hides_a_column_without_a_visible_cue(site):
+    """At 390 and 1280 px (every fold open) a table either shows all its columns, or scrolls sideways
+    under a visible line that says so (fit.js); none carries the line while showing everything.  §5's
+    tables reflow on a phone (cells padded less, values broken after a slash); the iterates of the fit
+    still scroll, cued.  The tables that scroll go to test-artifacts/book_pages.json."""
+    bad = [dict(t, page=n, width=w) for w in WIDTHS for n in PAGES for t in uncued_tables(site[n, w]["tables"])]
+    assert not bad, f"tables hiding columns without a cue (or cued for nothing):\n{_listing(bad)}"
+
+
+def test_the_cue_check_catches_a_table_scrolling_without_its_cue(browser, book_html):
+    """Wrong variants at 390 px: the cue hidden (§5's iterates table, which scrolls, is caught), a
+    table too wide for any phone added with fit.js's cue taken off it, and a cue over a table that
+    fits (caught: a cue for nothing)."""
+    p = Page(browser, (book_html / "s5_lab.html").as_uri(), 390)
+    try:
+        p.page.evaluate("document.querySelectorAll('article.bd-article details').forEach(d => d.open = true)")
+        p.page.wait_for_timeout(200)
+        tables = p.page.evaluate(TABLES)
+        assert uncued_tables(tables) == [] and any(t["cue"] for t in tables), tables
+        p.page.add_style_tag(content="article.bd-article p.fit-scroll-cue { display: none; }")
+        assert [t["head"][:6] for t in uncued_tables(p.page.evaluate(TABLES))] == ["k βₖ, "]
+    finally:
+        p.close()
+    p = Page(browser, (book_html / "s9_roadmap.html").as_uri(), 390)
+    try:
+        p.page.evaluate("""() => { const d = document.createElement('div');
+            d.className = 'pst-scrollable-table-container';
+            d.innerHTML = '<table><tr>' + '<td>0.100000000000</td>'.repeat(8) + '</tr><tr>' + '<td>1</td>'.repeat(8) + '</tr></table>';
+            document.querySelector('article.bd-article section').append(d); }""")
+        p.page.wait_for_timeout(200)
+        assert [t["cue"] for t in p.page.evaluate(TABLES)] == [True]           # fit.js cued it
+        # Changed and measured in one task: fit.js, refitting in the next frame, would set the cue right.
+        found = p.page.evaluate(f"() => {{ document.querySelector('p.fit-scroll-cue').remove(); return ({TABLES})(); }}")
+        assert len(uncued_tables(found)) == 1, found
+        found = p.page.evaluate(f"""() => {{ const t = document.querySelector('article.bd-article table');
+            t.innerHTML = '<tr><td>1</td></tr><tr><td>2</td></tr>';
+            const c = document.createElement('p'); c.className = 'fit-scroll-cue'; c.textContent = 'scroll the table sideways';
+            t.parentElement.before(c); return ({TABLES})(); }}""")
+        assert found[0]["hidden_px"] <= 1 and uncued_tables(found) == found, found
+    finally:
+        p.close()
 
 
 def test_the_table_check_catches_rows_stacked_into_cards(browser, book_html):
