@@ -97,7 +97,7 @@
 
   // A table that still scrolls sideways says so just above it, and its box is focusable; one that fits
   // has neither.
-  var CUE = "Wider than the page: scroll the table sideways \u2192";
+  var CUE = "Wider than the page: scroll the table sideways\u00a0\u2192";
   function cue(t) {
     var box = t.closest(".pst-scrollable-table-container") || t;
     var wide = box.scrollWidth > box.clientWidth + 1;
