@@ -34,9 +34,11 @@ book: $(STAMP)
 test: book
 	$(BIN)/python -m pytest -n auto --dist loadscope -m "not audit" verify tests
 
-# The built site's audits: the browser tests (Chromium) and the checks that read book/_build/html.
+# The built site's audits: the browser tests (Chromium) and the checks that read book/_build/html, dealt
+# out one by one but for those sharing a module's page loads (tests/conftest.py's xdist groups): by module,
+# the browser tests went to one worker.
 audit: book
-	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadscope -m audit tests
+	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadgroup -m audit tests
 
 # The checks whose numbers could depend on the CPU's code paths (marked cpu_dependent: the theorems
 # whose checks compare the renderer's outputs with mpmath, and parity with the scalar reference)

@@ -16,8 +16,9 @@ __all__ = ["Ledger", "compare", "to_srgb", "SIMULATOR_SCENE", "DIFFERENCE_LOG_FL
 
 #: The scene the simulator opens on: the default `Scene()` (the draft's scene shaded with the
 #: displaced sphere's normal, ``formulas.PERTURBED_NORMAL["surface"]``, the bump a reader
-#: expects); the draft's chart formula is one control away.
-SIMULATOR_SCENE = Scene()
+#: expects) with the sine field, the smooth field §3 has just derived; the draft's ridges and its
+#: chart formula are one control away.
+SIMULATOR_SCENE = Scene(height_field="sine")
 
 #: The simulator's difference canvas (§4): log10 |difference| is drawn from this floor (black)
 #: to 0 (white), about the rounding level of float64; the linear scale multiplies by the gain.

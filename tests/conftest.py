@@ -16,12 +16,22 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "audit: reads the built site (the book_html fixture); `make audit` runs these")
 
 
+#: Audits that share an expensive module fixture, kept on one worker under ``--dist loadgroup`` (`make
+#: audit`): the pages measured once at both widths (test_book_pages.py's ``site``), the simulator's page
+#: loaded once (test_browser.py's ``session``).  The other audits are dealt out one by one.
+SHARED = ("site", "session")
+
+
 def pytest_collection_modifyitems(items):
     """Every test that reads the built site (it takes `book_html`) is an audit: `make test`
-    leaves it to `make audit`."""
+    leaves it to `make audit`; one that uses a fixture of `SHARED` joins that fixture's xdist group."""
     for item in items:
-        if "book_html" in getattr(item, "fixturenames", ()):
+        names = getattr(item, "fixturenames", ())
+        if "book_html" in names:
             item.add_marker(pytest.mark.audit)
+            for shared in SHARED:
+                if shared in names:
+                    item.add_marker(pytest.mark.xdist_group(f"{item.module.__name__}::{shared}"))
 
 
 @pytest.fixture(scope="session")

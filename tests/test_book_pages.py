@@ -263,7 +263,7 @@ AUDIT = r"""async () => {
 
 #: The least size of a figure's text in CSS px at each width: the sizes a reader holding a phone, or
 #: at a desk, reads without zooming.
-MIN_FIGURE_TEXT_PX = {390: 8.0, 1280: 10.0}
+MIN_FIGURE_TEXT_PX = {390: 10.0, 1280: 10.0}
 
 
 def _image_bytes(url):
@@ -416,9 +416,12 @@ class Page:
 
 #: Every image of the article: in a numbered, captioned figure, with alt text, at
 #: ``sharpness`` device pixels per CSS pixel or more.
-#: Run in a page: each table of the article (shown ones) as {"where", "rows": rows shown, "split_rows":
-#: rows whose shown cells do not share a top (a row stacked into a card), "scrolls": whether the box
-#: around it (or the table itself) scrolls sideways, "right": the right edge of that box, "window": the window's width}.
+#: Run in a page: each table of the article (shown ones) as {"where", "head": its first row's text, "rows":
+#: rows shown, "split_rows": rows whose shown cells do not share a top (a row stacked into a card), "scrolls":
+#: whether the box around it (or the table itself) scrolls sideways, "right": the right edge of that box,
+#: "window": the window's width, "hidden_px": how far (px) its columns reach past the box's visible width,
+#: "cue": whether a visible cue stands just above the box (fit.js's p.fit-scroll-cue, the box's previous
+#: sibling: shown, not transparent, text at 12 px or more, within the window)}.
 TABLES = r"""() => [...document.querySelectorAll('article.bd-article table')].filter(t => t.getClientRects().length)
   .map(t => {
     const shown = el => el.getClientRects().length > 0, s = t.closest('section[id]');
@@ -428,10 +431,22 @@ TABLES = r"""() => [...document.querySelectorAll('article.bd-article table')].fi
       return tops.length > 1 && Math.max(...tops) - Math.min(...tops) > 1;
     });
     const box = ['auto', 'scroll'].includes(getComputedStyle(t).overflowX) ? t : t.parentElement;
-    return {where: s ? '#' + s.id : '', rows: rows.length, split_rows: split.length,
+    const cue = box.previousElementSibling, cs = cue && getComputedStyle(cue), r = cue && cue.getBoundingClientRect();
+    const visible = !!cue && cue.matches('.fit-scroll-cue') && shown(cue) && cs.visibility === 'visible'
+      && parseFloat(cs.opacity) > 0.9 && parseFloat(cs.fontSize) >= 12 && cue.textContent.trim().length > 10
+      && r.width > 0 && r.left >= 0 && r.right <= document.documentElement.clientWidth + 0.5;
+    return {where: s ? '#' + s.id : '', head: rows.length ? rows[0].textContent.replace(/\s+/g, ' ').trim().slice(0, 40) : '',
+            rows: rows.length, split_rows: split.length,
             scrolls: ['auto', 'scroll'].includes(getComputedStyle(box).overflowX),
-            right: box.getBoundingClientRect().right, window: document.documentElement.clientWidth};
+            right: box.getBoundingClientRect().right, window: document.documentElement.clientWidth,
+            hidden_px: box.scrollWidth - box.clientWidth, cue: visible};
   })"""
+
+
+def uncued_tables(tables):
+    """The tables of a page (`TABLES`) that hide columns (reach more than a pixel past their box) with no
+    visible cue above them, or carry a cue while hiding nothing."""
+    return [t for t in tables if (t["hidden_px"] > 1) != t["cue"]]
 
 
 def split_tables(tables):
@@ -449,14 +464,56 @@ FIGURES = """(sharpness) => {
     return {src: img.getAttribute('src').slice(-24), alt: (img.getAttribute('alt') || '').length,
             numbered: !!(number && /Fig\\. \\d+/.test(number.textContent)),
             caption: cap ? cap.textContent.trim().length : 0,
-            sharp: img.naturalWidth >= sharpness * img.clientWidth - 1};
+            sharp: img.naturalWidth >= sharpness * img.clientWidth - 1,
+            ink: cap ? ink(cap.querySelector('.caption-text') || cap) : null};
   });
+  // A text's colour, the colour behind it (the nearest opaque background around it; white) and its weight.
+  function ink(el) {
+    let bg = 'rgb(255, 255, 255)';
+    for (let e = el; e; e = e.parentElement) {
+      const c = getComputedStyle(e).backgroundColor;
+      if (c !== 'transparent' && !/, 0\\)$/.test(c)) { bg = c; break; }
+    }
+    const cs = getComputedStyle(el);
+    return {color: cs.color, background: bg, weight: Number(cs.fontWeight), opacity: Number(cs.opacity)};
+  }
 }"""
 
 
 def bare_figures(figures):
     """The images that are not a numbered, captioned figure with alt text at two device pixels per CSS pixel."""
     return [i for i in figures if not (i["numbered"] and i["caption"] > 40 and i["alt"] > 40 and i["sharp"])]
+
+
+def contrast(color, background):
+    """WCAG 2's contrast ratio of two CSS colours given as ``rgb(r, g, b)`` (a computed style)."""
+    import re
+
+    def luminance(css):
+        channels = [int(x) / 255 for x in re.findall(r"\d+", css)[:3]]
+        lin = [c / 12.92 if c <= 0.03928 else ((c + 0.055) / 1.055) ** 2.4 for c in channels]
+        return 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2]
+    hi, lo = sorted((luminance(color), luminance(background)), reverse=True)
+    return (hi + 0.05) / (lo + 0.05)
+
+
+#: A caption reads as text, not as a footnote: 7:1 against what is behind it (WCAG's enhanced contrast)
+#: in a regular weight or bolder, opaque.
+MIN_CAPTION_CONTRAST, MIN_CAPTION_WEIGHT = 7.0, 400
+
+
+def pale_captions(figures):
+    """The figures of a page (`FIGURES`) whose caption is under `MIN_CAPTION_CONTRAST`, lighter than
+    `MIN_CAPTION_WEIGHT` or translucent; each with its contrast."""
+    out = []
+    for f in figures:
+        ink = f["ink"]
+        if ink is None:
+            continue
+        ratio = round(contrast(ink["color"], ink["background"]), 2)
+        if ratio < MIN_CAPTION_CONTRAST or ink["weight"] < MIN_CAPTION_WEIGHT or ink["opacity"] < 1:
+            out.append(dict(f, contrast=ratio))
+    return out
 
 
 @pytest.fixture(scope="module")
@@ -549,6 +606,49 @@ def test_every_table_keeps_its_rows_as_rows_at_both_widths(site):
         assert not wide, (width, wide)
 
 
+def test_no_table_hides_a_column_without_a_visible_cue(site):
+    """At 390 and 1280 px (every fold open) a table either shows all its columns, or scrolls sideways
+    under a visible line that says so (fit.js); none carries the line while showing everything.  §5's
+    tables reflow on a phone (cells padded less, values broken after a slash); the iterates of the fit
+    still scroll, cued.  The tables that scroll go to test-artifacts/book_pages.json."""
+    bad = [dict(t, page=n, width=w) for w in WIDTHS for n in PAGES for t in uncued_tables(site[n, w]["tables"])]
+    assert not bad, f"tables hiding columns without a cue (or cued for nothing):\n{_listing(bad)}"
+
+
+def test_the_cue_check_catches_a_table_scrolling_without_its_cue(browser, book_html):
+    """Wrong variants at 390 px: the cue hidden (§5's iterates table, which scrolls, is caught), a
+    table too wide for any phone added with fit.js's cue taken off it, and a cue over a table that
+    fits (caught: a cue for nothing)."""
+    p = Page(browser, (book_html / "s5_lab.html").as_uri(), 390)
+    try:
+        p.page.evaluate("document.querySelectorAll('article.bd-article details').forEach(d => d.open = true)")
+        p.page.wait_for_timeout(200)
+        tables = p.page.evaluate(TABLES)
+        assert uncued_tables(tables) == [] and any(t["cue"] for t in tables), tables
+        p.page.add_style_tag(content="article.bd-article p.fit-scroll-cue { display: none; }")
+        assert [t["head"][:6] for t in uncued_tables(p.page.evaluate(TABLES))] == ["k βₖ, "]
+    finally:
+        p.close()
+    p = Page(browser, (book_html / "s9_roadmap.html").as_uri(), 390)
+    try:
+        p.page.evaluate("""() => { const d = document.createElement('div');
+            d.className = 'pst-scrollable-table-container';
+            d.innerHTML = '<table><tr>' + '<td>0.100000000000</td>'.repeat(8) + '</tr><tr>' + '<td>1</td>'.repeat(8) + '</tr></table>';
+            document.querySelector('article.bd-article section').append(d); }""")
+        p.page.wait_for_timeout(200)
+        assert [t["cue"] for t in p.page.evaluate(TABLES)] == [True]           # fit.js cued it
+        # Changed and measured in one task: fit.js, refitting in the next frame, would set the cue right.
+        found = p.page.evaluate(f"() => {{ document.querySelector('p.fit-scroll-cue').remove(); return ({TABLES})(); }}")
+        assert len(uncued_tables(found)) == 1, found
+        found = p.page.evaluate(f"""() => {{ const t = document.querySelector('article.bd-article table');
+            t.innerHTML = '<tr><td>1</td></tr><tr><td>2</td></tr>';
+            const c = document.createElement('p'); c.className = 'fit-scroll-cue'; c.textContent = 'scroll the table sideways';
+            t.parentElement.before(c); return ({TABLES})(); }}""")
+        assert found[0]["hidden_px"] <= 1 and uncued_tables(found) == found, found
+    finally:
+        p.close()
+
+
 def test_the_table_check_catches_rows_stacked_into_cards(browser, book_html):
     """Wrong variant: the old phone rule that set each cell of a row as a block of its own (a card per
     row); §3's optima table and §5's tables are then caught at 390 px, and pass without it."""
@@ -571,6 +671,32 @@ def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_s
     images = [dict(i, page=name) for (name, width), a in site.items() if width == 1280 for i in a["figures"]]
     assert len(images) >= 12
     assert bare_figures(images) == []
+
+
+def test_every_caption_reads_at_the_texts_contrast(site):
+    """Every figure's caption, at both widths: at least 7:1 against its background, in a regular weight
+    (the theme's muted grey in its light 300 weight read pale)."""
+    found = [dict(f, page=n, width=w) for (n, w), a in site.items() for f in pale_captions(a["figures"])]
+    assert sum(1 for a in site.values() for f in a["figures"] if f["ink"]) >= 2 * 12
+    assert not found, f"pale captions:\n{_listing(found)}"
+
+
+def test_the_caption_check_catches_the_themes_pale_caption_and_a_grey_one(browser, book_html):
+    """Wrong variants on §5 at 390 px: the theme's caption (muted grey, weight 300) and a caption in
+    #777 (4.5:1) are caught; the site's passes."""
+    p = Page(browser, (book_html / "s5_lab.html").as_uri(), 390)
+    try:
+        assert pale_captions(p.page.evaluate(FIGURES, 2)) == []
+        sheet = p.page.add_style_tag(content="article.bd-article figcaption { color: var(--pst-color-text-muted);"
+                                             " font-weight: 300; }")
+        found = pale_captions(p.page.evaluate(FIGURES, 2))
+        assert found and len(found) == len(p.page.evaluate(FIGURES, 2)), found
+        sheet.evaluate("s => s.remove()")
+        p.page.add_style_tag(content="article.bd-article figcaption { color: #777; }")
+        found = pale_captions(p.page.evaluate(FIGURES, 2))
+        assert found and all(4.4 < f["contrast"] < 4.6 for f in found), found
+    finally:
+        p.close()
 
 
 def test_the_figure_check_catches_a_bare_image_and_a_blurred_one(browser, book_html, tmp_path):
@@ -606,7 +732,7 @@ def test_every_figure_records_the_size_of_its_smallest_text(site):
 
 
 def test_the_text_in_every_figure_is_large_enough_at_both_widths(site):
-    """No figure's smallest text under `MIN_FIGURE_TEXT_PX` CSS px: 8 at 390 px, 10 at 1280 px."""
+    """No figure's smallest text under `MIN_FIGURE_TEXT_PX` CSS px: 10 at 390 px and at 1280 px."""
     bad = [dict(f, page=n, width=w) for w in WIDTHS for n in PAGES
            for f in small_figure_text(site[n, w], MIN_FIGURE_TEXT_PX[w])]
     assert not bad, f"figures with text under {MIN_FIGURE_TEXT_PX} CSS px:\n{_listing(bad)}"
@@ -754,10 +880,10 @@ def test_the_width_check_catches_an_overwide_block_in_details(browser, book_html
 
 def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record(browser, book_html, tmp_path):
     """Wrong variants: a figure with 5-pt text shown at its size (5 pt at 100 dpi: 5 x 100/72 = 6.9 CSS
-    px, under 8), a figure whose only small text is the superscript of a 7.2-pt ``10^{-6}`` (the label at
-    10 CSS px, its exponent drawn at 0.7 x 7.2 = 5 pt: 7 px), a figure with 10-pt text twice as wide as the 300-px column (shown at half its size:
-    6.9 px), and a PNG without the record; the 10-pt figure that fits passes, one without text is not
-    measured."""
+    px, under 10), one with a 6.5-pt title (9.0 px), a figure whose only small text is the superscript of
+    a 7.2-pt ``10^{-6}`` (the label at 10 CSS px, its exponent drawn at 0.7 x 7.2 = 5 pt: 7 px), a figure
+    with 10-pt text twice as wide as the 300-px column (shown at half its size: 6.9 px), and a PNG without
+    the record; the 10-pt figure that fits passes, one without text is not measured."""
     import base64
 
     import matplotlib
@@ -777,12 +903,13 @@ def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record
         return (f'<img src="data:image/png;base64,{base64.b64encode(png).decode()}" '
                 f'width="{size_css["width"]}" height="{size_css["height"]}">')
     page = _synthetic(tmp_path, shown(5) + shown(10) + shown() + f'<img src="{_png(300, 150)}">' + shown(10, 6.4)
-                      + shown(7.2, title="$10^{-6}$"), book_html)
+                      + shown(7.2, title="$10^{-6}$") + shown(6.5), book_html)
     audit = _audit(browser, page)
     found = audit["figure_text"]
-    assert [f["recorded"] for f in found] == [True, True, True, False, True, True]
-    assert [f["png_px"] is None for f in found] == [False, False, True, True, False, False]
-    assert [found.index(f) for f in small_figure_text(audit, MIN_FIGURE_TEXT_PX[390])] == [0, 4, 5], found
+    assert [f["recorded"] for f in found] == [True, True, True, False, True, True, True]
+    assert [f["png_px"] is None for f in found] == [False, False, True, True, False, False, False]
+    assert [found.index(f) for f in small_figure_text(audit, MIN_FIGURE_TEXT_PX[390])] == [0, 4, 5, 6], found
+    assert found[6]["css_px"] == pytest.approx(6.5 * 100 / 72, rel=0.01)           # 9.0 px
     assert found[0]["css_px"] == pytest.approx(5 * 100 / 72, rel=0.01)
     assert found[1]["css_px"] == pytest.approx(10 * 100 / 72, rel=0.01)
     wide = audit["images"][4]
@@ -908,6 +1035,7 @@ def test_text_overlaps_catches_neighbouring_axes_running_together(figure):
         fig, axes = figure(1, 3, figsize=(10, 2.8), **layout)
         for a in axes:
             im = a.imshow(np.zeros((20, 40)), extent=(0, 1, 0, 1), aspect=0.5)
+            a.set_xticks(np.linspace(0, 1, 5)); a.xaxis.set_major_formatter("{x:.2f}")    # as matplotlib chose at 10 pt
             a.set_title("a field"); a.set_xlabel("$u$"); a.set_ylabel("$v$")
         fig.colorbar(im, ax=axes, shrink=0.8)
         return text_overlaps(fig)

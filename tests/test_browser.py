@@ -18,10 +18,14 @@ for that scene at the extremes of the controls; every control reachable and
 movable from the keyboard; the layout at 1280 x 900 (canvases, U-curve and
 readout in view together) and at 390 px (canvases stacked, at least 300 px
 wide, and a tap on a phone reading out the pixel tapped), and at both widths, scrolled through
-the simulator, no control, readout, plot or caption covering another; and on every page of the
-book each formula, inline and displayed, at the text's size or larger and within the column at 390
-and 1280 px, every dropdown open (MathJax 4 breaks the lines), its fonts from the site.  Screenshots go
-to test-artifacts/.  Each check is shown rejecting a wrong variant.
+the simulator, no control, readout, plot or caption covering another; every control a target of 24 x 24
+CSS px or more at both widths, the ε slider landing on each decade by pointer (tick marks) and keyboard
+(Page Up / Page Down), and the simulator used from the keyboard alone with its canvases' text alternatives
+and live readout kept current; and on every page of the book each formula, inline and displayed, at the
+text's size or larger and within the column at 390 and 1280 px, every dropdown open (MathJax 4 breaks
+the lines), its fonts from the site, and axe-core (WCAG 2.1 A and AA) finding no serious or critical
+violation at either width.  Screenshots go to test-artifacts/.  Each check is shown rejecting a wrong
+variant.
 
 The book is built into a temporary directory for the test unless
 SYMRENDER_BOOK_HTML names a freshly built site (.ci/run builds the book first
@@ -245,20 +249,24 @@ def _within(got, python):
     return abs(got[0] - rms) <= rms_bound and abs(got[1] - top) <= max_bound
 
 
-def test_the_simulator_opens_on_the_displaced_sphere_normal(session):
-    """The opening scene is the default `Scene()`, the draft's with bump="surface"
-    (renderer.jsgen.SIMULATOR_SCENE), and its ledger is Python's for that scene; Python's ledger of the draft's chart formula (the wrong
-    variant: a simulator that ignored the bump control) lies outside the bounds."""
+def test_the_simulator_opens_on_the_sine_field_with_the_displaced_sphere_normal(session):
+    """The opening scene is the default `Scene()` with the sine field (the field §3 derives), shaded
+    with the displaced sphere's normal (renderer.jsgen.SIMULATOR_SCENE), and its ledger is Python's for
+    that scene; Python's ledger of the draft's chart formula (the wrong variant: a simulator that ignored
+    the bump control) lies outside the bounds, and so does the default field's (ridges)."""
     session.set_eps(-3)
+    assert session.page.input_value("#sim-height_field") == "sine"
     assert session.page.input_value("#sim-bump") == "surface"
     assert session.page.input_value("#sim-scale") == "linear"        # as the book's figures show it
     opened = session.sim("sim.frames.scene")
     want = json.loads(json.dumps(dataclasses.asdict(SIMULATOR_SCENE)))
     assert opened == want
-    assert SIMULATOR_SCENE == Scene() and SIMULATOR_SCENE.replace(bump="chart") == DRAFT_SCENE   # the rest is the draft's
+    assert SIMULATOR_SCENE == Scene(height_field="sine")
+    assert SIMULATOR_SCENE.replace(height_field="ridges", bump="chart") == DRAFT_SCENE   # the rest is the draft's
     got = (session.ledger("rms"), session.ledger("max"))
     assert _within(got, _python_ledger(SIMULATOR_SCENE, 1e-3))
-    assert not _within(got, _python_ledger(DRAFT_SCENE, 1e-3))
+    assert not _within(got, _python_ledger(SIMULATOR_SCENE.replace(bump="chart"), 1e-3))
+    assert not _within(got, _python_ledger(Scene(), 1e-3))
 
 
 def test_eps_slider_moves_the_ledger_as_python_predicts(session):
@@ -303,8 +311,9 @@ def test_the_u_curve_is_the_ledger_of_its_sample_and_follows_the_controls(sessio
     for near in (-3.0, -2.5):
         point = min(curve["points"], key=lambda p: abs(np.log10(p["eps"]) - near))
         eps, got = point["eps"], (point["rms"], point["max_abs"])
-        assert _within(got, _python_ledger(SIMULATOR_SCENE, eps, stride)), eps
-        assert not _within(got, _python_ledger(SIMULATOR_SCENE, eps, stride + 1)), eps
+        ridges = SIMULATOR_SCENE.replace(height_field="ridges")
+        assert _within(got, _python_ledger(ridges, eps, stride)), eps
+        assert not _within(got, _python_ledger(ridges, eps, stride + 1)), eps
     plot = session.page.locator("#sim-curve")
     rms_line = plot.locator("#sim-curve-rms").get_attribute("points")
     assert len(rms_line.split()) == 27
@@ -428,7 +437,7 @@ def _readout_pixel(session, i, j):
 #: each position of an "every" the page is recorded: every input's value, every range's printed
 #: value, the scene object the renderer was handed, the renderer's other arguments (width, height,
 #: numeric gradient, zoom: `render.check_args`'s order, read off its frame and G-buffer), and
-#: every text that prints ε (the numeric canvas's caption, the U-curve's label and marker, the
+#: every text that prints ε (the numeric canvas's caption and text alternative, the U-curve's label and marker, the
 #: readout's step at the centre pixel).  A move the page does not update after within 5 s (its
 #: renderer threw) is recorded as such and ends the run.  Returns the records.
 MOVES_JS = """async (moves) => {
@@ -460,6 +469,7 @@ MOVES_JS = """async (moves) => {
              printed: Object.fromEntries(inputs.filter((e) => e.type === 'range').map((e) =>
                                          [e.id.slice(4), document.getElementById(e.id + '-value').textContent])),
              eps_texts: [document.getElementById('sim-caption-numeric').textContent, plot.getAttribute('aria-label'),
+                         document.getElementById('sim-canvas-numeric').getAttribute('aria-label'),
                          'ε = ' + plot.dataset.eps, step ? step.nextElementSibling.textContent : ''] };
   };
   const out = [];
@@ -713,12 +723,292 @@ def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_
             n = s.updates()
             page.keyboard.press("Enter")
             s.wait_update(n)
-        assert page.input_value("#sim-height_field") == "ridges"     # reset was last
+        assert page.input_value("#sim-height_field") == "sine"       # reset was last
         # The probe moves with the arrow keys on a focused canvas.
         page.focus("#sim-canvas-symbolic")
         page.keyboard.press("ArrowRight")
         assert page.get_attribute("#sim-readout", "data-i") is not None
         assert s.errors == [] and s.blocked == []
+    finally:
+        s.close()
+
+
+# ---- the simulator for every hand, keyboard and screen reader --------------------------------------
+
+#: Run in the page: each control of the simulator (input, select, button) as [id, width, height] in CSS px.
+CONTROL_BOXES_JS = """() => [...document.querySelectorAll('[data-symrender-sim] :is(input, select, button)')].map(e => {
+  const r = e.getBoundingClientRect(); return [e.id, +r.width.toFixed(1), +r.height.toFixed(1)]; })"""
+#: The least target, CSS px a side (WCAG 2.2, 2.5.8, AA).
+MIN_TARGET_PX = 24
+
+
+def _simulator_at(browser, book_html, width, bundle=None):
+    """The §4 page at ``width`` px, 844 px tall with touch at 390 px (a phone), 900 at 1280."""
+    phone = width < 720
+    options = dict(viewport={"width": width, "height": 844 if phone else 900})
+    if phone:
+        options.update(has_touch=True, is_mobile=True, device_scale_factor=2)
+    return Session(browser, _url(book_html), bundle=bundle, **options)
+
+
+def small_targets(s):
+    """The simulator's controls smaller than `MIN_TARGET_PX` either way, and the count of all."""
+    boxes = s.page.evaluate(CONTROL_BOXES_JS)
+    return [b for b in boxes if min(b[1], b[2]) < MIN_TARGET_PX], len(boxes)
+
+
+@pytest.mark.parametrize("width", [390, 1280])
+def test_every_control_is_a_target_of_at_least_24_px(browser, book_html, width):
+    """Every slider, menu, checkbox and button of the simulator at least 24 x 24 CSS px (the browser's
+    own: sliders 16 px tall, menus 20, the checkbox 13); the boxes go to test-artifacts/s4_targets_<width>.json."""
+    s = _simulator_at(browser, book_html, width)
+    try:
+        small, count = small_targets(s)
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        (ARTIFACTS / f"s4_targets_{width}.json").write_text(json.dumps(s.page.evaluate(CONTROL_BOXES_JS), indent=1))
+        assert count == len(CONTROLS) + len(BUTTONS)
+        assert not small, small
+    finally:
+        s.close()
+
+
+def test_the_target_check_catches_the_browsers_20_px_menus(browser, book_html):
+    """Wrong variant: the menus at the browser's height (20 px) are caught, every one of them."""
+    old = ".symrender-sim select { min-height: 1.75rem; }"
+
+    def bundle(text):
+        assert text.count(old) == 1
+        return text.replace(old, "")
+
+    s = _simulator_at(browser, book_html, 390, bundle=bundle)
+    try:
+        small, _ = small_targets(s)
+        menus = s.page.evaluate("document.querySelectorAll('[data-symrender-sim] select').length")
+        assert len(small) == menus and all(b[2] == 20 for b in small), small
+    finally:
+        s.close()
+
+
+#: The decades of the ε slider (log10 ε).
+DECADES = range(-14, 0)
+#: Chromium's range thumb, CSS px wide: the slider's value v sits at left + THUMB/2 + (v - min)/(max - min)
+#: (width - THUMB).
+THUMB = 16
+
+
+def eps_pointer_landings(s, offsets, tap):
+    """{decade: [value of the ε slider after a click (``tap``: a tap) at the decade's position + offset
+    px, for each of ``offsets``]}; before each, the slider is moved to the end of its range away from
+    the decade (a click on the thumb itself would not move it)."""
+    slider = s.page.locator("#sim-log_eps")
+    slider.evaluate("e => e.scrollIntoView({block: 'center'})")
+    box = slider.bounding_box()
+    lo, hi = (float(slider.get_attribute(a)) for a in ("min", "max"))
+    out = {}
+    for k in DECADES:
+        out[k] = []
+        for dx in offsets:
+            slider.evaluate("(e, v) => { e.value = v; e.dispatchEvent(new Event('input')); }",
+                            str(lo if k > (lo + hi) / 2 else hi))
+            x = box["x"] + THUMB / 2 + (k - lo) / (hi - lo) * (box["width"] - THUMB) + dx
+            y = box["y"] + box["height"] / 2
+            if tap:
+                s.page.touchscreen.tap(x, y)
+            else:
+                s.page.mouse.click(x, y)
+            out[k].append(slider.input_value())
+    return out
+
+
+#: Keys pressed on the focused ε slider from the opening step, 1e-3, and the value after each.
+EPS_KEYS = [("PageDown", "-4"), ("PageDown", "-5"), ("PageDown", "-6"), ("ArrowLeft", "-6.1"), ("PageUp", "-6"),
+            *[("ArrowLeft", None)] * 9, ("ArrowLeft", "-7"), ("PageDown", "-8"), ("ArrowRight", "-7.9"),
+            ("PageDown", "-8"), ("Home", "-14"), ("PageDown", "-14"), ("End", "-1"), ("PageUp", "-1")]
+
+
+def eps_key_landings(s):
+    """[(key, value of the ε slider after it)] for `EPS_KEYS`, from the opening step, the slider focused."""
+    s.page.focus("#sim-log_eps")
+    out = []
+    for key, _ in EPS_KEYS:
+        s.page.keyboard.press(key)
+        out.append((key, s.page.input_value("#sim-log_eps")))
+    return out
+
+
+@pytest.mark.parametrize("width", [390, 1280])
+def test_the_eps_slider_lands_on_every_decade_by_pointer_and_by_keyboard(browser, book_html, width):
+    """The ε slider moves by tenths of a decade; each decade is a tick mark to which the pointer snaps:
+    a click (a tap on the phone) 3 px either side of a decade's place lands on that decade exactly (a
+    tenth of a decade is 1.6 px at 1280, 2.6 px at 390), and the page prints 1.0e-k.  From the keyboard,
+    the arrow keys move a tenth, Page Up and Page Down to the next decade, Home and End to the ends."""
+    s = _simulator_at(browser, book_html, width)
+    try:
+        landed = eps_pointer_landings(s, (-3, 3), tap=width < 720)
+        missed = {k: v for k, v in landed.items() if v != [str(k)] * 2}
+        assert not missed, missed
+        s.page.locator("#sim-log_eps").evaluate("(e) => { e.value = '-6'; e.dispatchEvent(new Event('input')); }")
+        # (an update the clicks scheduled may come first: wait for the frame of this step)
+        s.page.wait_for_function(f"{SIM}.frames.scene.eps === 1e-6", timeout=30_000)
+        assert s.page.text_content("#sim-log_eps-value") == "1.0e-6"
+        assert s.page.get_attribute("#sim-log_eps", "aria-valuetext") == "1.0e-6"
+        s.page.evaluate(f"(sim => sim.apply_preset({{set: {{}}}}))({SIM})")           # back to the opening 1e-3
+        got = eps_key_landings(s)
+        want = [(k, v) for k, v in EPS_KEYS]
+        assert [g for g, w in zip(got, want) if w[1] is not None] == [w for w in want if w[1] is not None], got
+        assert s.errors == []
+    finally:
+        s.close()
+
+
+#: Wrong variants of the ε slider: (old text of the bundle, new text, which landing must fail).
+WRONG_EPS = {
+    "no tick marks (the pointer lands a tenth or two off)": (
+        'input.setAttribute("list", ticks[0].id);', "", "pointer"),
+    "Page Up and Page Down left to the browser (a tenth of the range: 1.3 decades)": (
+        'input.addEventListener("keydown", (ev) => this.tick_key(c, input, ev));', "", "keys"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_EPS))
+def test_the_decade_check_catches_a_slider_without_ticks_or_decade_keys(browser, book_html, variant):
+    old, new, which = WRONG_EPS[variant]
+
+    def bundle(text):
+        assert text.count(old) == 1, variant
+        return text.replace(old, new)
+
+    s = _simulator_at(browser, book_html, 390, bundle=bundle)
+    try:
+        if which == "pointer":
+            landed = eps_pointer_landings(s, (-3, 3), tap=True)
+            assert sum(v != [str(k)] * 2 for k, v in landed.items()) >= len(DECADES) // 2, landed
+        else:
+            got = dict(enumerate(eps_key_landings(s)))
+            assert got[0] != ("PageDown", "-4"), got
+    finally:
+        s.close()
+
+
+#: Run in the page: what a screen reader is given for the simulator: each canvas's role and label, the
+#: readout's and the hint's live region, the U-curve's role and label, the ε slider's value text.
+SPOKEN_JS = """() => {
+  const attr = (sel, a) => document.querySelector(sel).getAttribute(a);
+  return {canvases: Object.fromEntries(['numeric', 'symbolic', 'difference'].map(n =>
+            [n, [attr('#sim-canvas-' + n, 'role'), attr('#sim-canvas-' + n, 'aria-label')]])),
+          readout: [attr('#sim-readout', 'aria-live'), document.getElementById('sim-readout').textContent],
+          hint: attr('#sim-hint', 'aria-live'), curve: [attr('#sim-curve', 'role'), attr('#sim-curve', 'aria-label')],
+          eps: attr('#sim-log_eps', 'aria-valuetext')};
+}"""
+
+
+def spoken_problems(s):
+    """Where what a screen reader is given departs from what the simulator shows (`SPOKEN_JS`): a canvas
+    that is not an image with a label naming the field, β, the view and the normal, the numeric canvas's ε
+    and the difference's largest |ΔI| and RMS as the ledger prints them; a readout or hint that is no
+    polite live region; the U-curve not an image labelled with the current ε; the ε slider's value text
+    not what it prints."""
+    said, st = s.page.evaluate(SPOKEN_JS), s.sim("sim.state")
+    found = []
+    eps = s.page.text_content("#sim-log_eps-value")
+    for name, (role, label) in said["canvases"].items():
+        label = label or ""
+        if role != "img":
+            found.append(f"{name} canvas: role {role!r}")
+        if name != "difference":
+            for part in (f"the {st['height_field']} field", f"β = {st['beta']:.2f}", {"shaded": "shaded", "bump": "size of ∇h",
+                         "kink": "crease band"}[st["view"]], s.page.evaluate(
+                         "document.querySelector('#sim-bump').selectedOptions[0].textContent")):
+                if part not in label:
+                    found.append(f"{name} canvas: {part!r} not in {label!r}")
+    if st["numeric"] == "central" and f"ε = {eps}" not in said["canvases"]["numeric"][1]:
+        found.append(f"numeric canvas: ε = {eps} not in {said['canvases']['numeric'][1]!r}")
+    difference = said["canvases"]["difference"][1] or ""
+    for cell in ("max", "rms"):
+        value = re.sub(r"e([+-])0*(\d)", r"e\1\2", f"{s.ledger(cell):.1e}")       # as JavaScript's toExponential(1)
+        if value not in difference:
+            found.append(f"difference canvas: the ledger's {cell} {value} not in {difference!r}")
+    if said["readout"][0] != "polite":
+        found.append(f"readout: aria-live {said['readout'][0]!r}")
+    if said["hint"] != "polite":
+        found.append(f"hint: aria-live {said['hint']!r}")
+    if said["curve"][0] != "img" or f"ε = {eps}" not in (said["curve"][1] or ""):
+        found.append(f"U-curve: {said['curve']}")
+    if said["eps"] != eps:
+        found.append(f"ε slider: aria-valuetext {said['eps']!r}, printed {eps!r}")
+    return found
+
+
+def _keyboard_walk(s):
+    """Use the simulator from the keyboard alone, checking `spoken_problems` after each move: Tab to the
+    field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
+    and move the probe with the arrow keys (the readout reads the pixel), then on to the view menu and
+    change it.  Returns {move: problems} and the readout's texts."""
+    page, found, readouts = s.page, {}, []
+
+    def move(name, key):
+        n = s.updates()
+        page.keyboard.press(key)
+        s.wait_update(n)
+        found[name] = spoken_problems(s)
+
+    def tab_to(target):
+        for _ in range(60):
+            if page.evaluate("document.activeElement.id") == target:
+                return
+            page.keyboard.press("Tab")
+        raise AssertionError(f"Tab never reached #{target}")
+
+    page.focus("#sim-preset-try1")
+    found["opening"] = spoken_problems(s)
+    tab_to("sim-height_field"); move("field", "ArrowDown")
+    tab_to("sim-log_eps"); move("ε", "PageDown")
+    tab_to("sim-beta"); move("β", "ArrowRight")
+    tab_to("sim-canvas-symbolic")
+    for key in ("ArrowRight", "ArrowDown"):
+        page.keyboard.press(key)
+        readouts.append(page.text_content("#sim-readout"))
+    tab_to("sim-view"); move("view", "ArrowDown")
+    return found, readouts
+
+
+def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser, book_html):
+    """From the keyboard alone (Tab, arrow keys, Page Down): the field, ε, β and the view change, and
+    the probe walks over the symbolic canvas, the readout (a polite live region) reading each pixel;
+    after every move each canvas is an image whose label says what it draws (field, β, normal, view;
+    the numeric canvas's ε; the difference's largest |ΔI| and RMS as the ledger prints them), the
+    U-curve's label the current ε, the ε slider's value text the ε printed (`spoken_problems`)."""
+    s = _simulator_at(browser, book_html, 1280)
+    try:
+        found, readouts = _keyboard_walk(s)
+        assert found == dict.fromkeys(found, []), found
+        assert len(set(readouts)) == 2 and all(r.startswith("pixel") for r in readouts), readouts
+        assert s.errors == []
+    finally:
+        s.close()
+
+
+#: Wrong variants of what a screen reader is given: (old text of the bundle, new text, a problem it must cause).
+WRONG_SPOKEN = {
+    "the canvases' labels written once, not kept current": ("    this.describe(ledger);\n", "", "not in"),
+    "a readout that is not announced": ('"aria-live": "polite" });\n    root.append(el("div", { class: "sim-stage" }',
+                                        '"aria-live": "off" });\n    root.append(el("div", { class: "sim-stage" }',
+                                        "readout: aria-live 'off'"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_SPOKEN))
+def test_the_spoken_check_catches_stale_labels_and_a_silent_readout(browser, book_html, variant):
+    old, new, message = WRONG_SPOKEN[variant]
+
+    def bundle(text):
+        assert text.count(old) == 1, variant
+        return text.replace(old, new)
+
+    s = _simulator_at(browser, book_html, 1280, bundle=bundle)
+    try:
+        found, _ = _keyboard_walk(s)
+        assert any(message in p for problems in found.values() for p in problems), found
     finally:
         s.close()
 
@@ -1373,3 +1663,85 @@ def test_the_formula_check_catches_formulas_shrunk_or_running_past_the_column(br
         s.close()
     kind = "over" if "line" in variant else "scale"
     assert found and all((f["over"] > 1) if kind == "over" else (f["scale"] < 0.999) for f in found), (variant, found)
+
+
+# ---- accessibility: axe-core on every page --------------------------------------------------------
+
+#: axe-core's script (book/fetch_mathjax.py fetches the pinned version from the npm registry, sha512-checked);
+#: the test injects it into each page: the site does not serve it.
+AXE = ROOT / "book" / "_vendor" / "axe-core" / "axe.min.js"
+#: axe-core's rules of WCAG 2.0 and 2.1, levels A and AA.
+AXE_TAGS = ["wcag2a", "wcag2aa", "wcag21a", "wcag21aa"]
+#: Run in a page with axe-core in it: every <details> opened (what a reader unfolds is checked too), then
+#: axe.run over the document with AXE_TAGS; its violations as {id, impact, help, nodes, examples}.
+AXE_JS = """async (tags) => {
+  const folded = [...document.querySelectorAll('details:not([open])')];
+  folded.forEach(d => { d.open = true; });
+  await new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
+  // An opened fold fades in (its text passes through every grey on the way): measured once it has.
+  await Promise.all(document.getAnimations().map(a => a.finished.catch(() => null)));
+  const found = await axe.run(document, {runOnly: {type: 'tag', values: tags}, resultTypes: ['violations']});
+  return found.violations.map(v => ({id: v.id, impact: v.impact, help: v.help, nodes: v.nodes.length,
+    examples: v.nodes.slice(0, 4).map(n => n.target.join(' ') + ': ' + (n.failureSummary || '').replace(/\\s+/g, ' ').slice(0, 200))}));
+}"""
+
+
+def axe_violations(browser, url, width, change=None):
+    """axe-core's violations (`AXE_JS`) on the page at ``url`` opened at ``width`` px, offline, once MathJax
+    and fit.js are done; ``change`` as `Formulas`'s (a wrong variant of the site)."""
+    if not AXE.is_file():
+        pytest.fail(f"{AXE} is missing: `make .venv/.installed` (book/fetch_mathjax.py) fetches it")
+    s = Formulas(browser, url, width, change=change)
+    try:
+        s.page.add_script_tag(path=str(AXE))
+        found = s.page.evaluate(AXE_JS, AXE_TAGS)
+        assert s.blocked == [], s.blocked
+        return found
+    finally:
+        s.close()
+
+
+def serious(violations):
+    """The violations axe-core rates serious or critical."""
+    return [v for v in violations if v["impact"] in ("serious", "critical")]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_axe_finds_no_serious_or_critical_violation(browser, book_html, name):
+    """axe-core (WCAG 2.1 A and AA rules) on the page at 390 and at 1280 px, every dropdown open: no
+    violation rated serious or critical (contrast, names of buttons and controls, ARIA structure).
+    Every violation, of any impact, goes to test-artifacts/axe_<page>.json."""
+    report = {}
+    for width in (390, 1280):
+        report[f"{width}px"] = axe_violations(browser, (book_html / f"{name}.html").as_uri(), width)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    (ARTIFACTS / f"axe_{name}.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
+    bad = {w: serious(v) for w, v in report.items() if serious(v)}
+    assert not bad, f"{name}:\n" + json.dumps(bad, indent=1, ensure_ascii=False)
+
+
+#: Wrong variants of the site, each of which axe-core must catch: (page, width, file changed, its text
+#: replaced, its replacement, the rule that must fire).  The theme shows the search field from 960 px.
+WRONG_A11Y = {
+    "the theme's link blue on tinted boxes": (
+        "s3_math", 390, "fit.css", 'html[data-theme="light"] { --pst-color-link: #1259c3; }', "", "color-contrast"),
+    "the search field named short of what it shows": (
+        "index", 1280, "index.html", 'search-button__button pst-js-only" title="Search"',
+        'search-button__button pst-js-only" title="Search" aria-label="Search"', "label-content-name-mismatch"),
+    "the bibliography's deprecated entries": (
+        "s8_history", 390, "s8_history.html", 'role="listitem"', 'role="doc-biblioentry"', "aria-required-children"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_A11Y))
+def test_the_axe_check_catches_a_contrast_failure_a_misnamed_button_and_broken_aria(browser, book_html, variant):
+    name, width, file, old, new, rule = WRONG_A11Y[variant]
+
+    def change(path, text):
+        if path.name != file:
+            return text
+        assert old in text, f"variant {variant!r} no longer applies to {file}"
+        return text.replace(old, new)
+
+    found = serious(axe_violations(browser, (book_html / f"{name}.html").as_uri(), width, change=change))
+    assert rule in {v["id"] for v in found}, (variant, found)

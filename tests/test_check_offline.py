@@ -45,7 +45,7 @@ def test_a_site_that_would_fetch_or_miss_a_script_fails(tmp_path, head, found):
 AIDS = ('<aside class="sidebar margin"><p>Goldberg [<a class="reference internal" href="s8_history.html#id11">'
         '1991</a>]</p></aside><div class="exercise admonition" id="ex-a"><p class="admonition-title">Exercise 1'
         '</p></div><div class="solution dropdown admonition"><p>6.9e-07</p></div>'
-        '<div class="citation" role="doc-biblioentry"><p>D. Goldberg. <a class="reference external" '
+        '<div class="citation" role="listitem"><p>D. Goldberg. <a class="reference external" '
         'href="https://doi.org/10.1145/103162.103163">doi:10.1145/103162.103163</a>.</p></div>')
 
 

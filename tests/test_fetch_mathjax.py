@@ -31,7 +31,7 @@ def test_fetch_unpacks_the_pinned_paths_once_and_refuses_another_tarball(tmp_pat
     url, integrity = _tarball(tmp_path / "mathjax.tgz", {"tex-chtml.js": b"mj", "node-main.js": b"node",
                                                          "input/tex/extensions/ams.js": b"ams",
                                                          "input/tex/extensions/../../../escape.js": b"x"})
-    monkeypatch.setattr(fetch_mathjax, "PINS", ((url, integrity, ("tex-chtml.js", "input/tex/extensions/"), ""),))
+    monkeypatch.setattr(fetch_mathjax, "PINS", ((url, integrity, ("tex-chtml.js", "input/tex/extensions/"), fetch_mathjax.MATHJAX),))
     where = tmp_path / "vendor"
     assert fetch_mathjax.fetch(where) == 5
     mathjax = where / "html" / "_static" / "mathjax"
@@ -41,7 +41,7 @@ def test_fetch_unpacks_the_pinned_paths_once_and_refuses_another_tarball(tmp_pat
     assert fetch_mathjax.fetch(where) == 5                        # in place: nothing fetched
 
     url, _ = _tarball(tmp_path / "other.tgz", {"tex-chtml.js": b"another"})
-    monkeypatch.setattr(fetch_mathjax, "PINS", ((url, integrity, ("tex-chtml.js",), ""),))
+    monkeypatch.setattr(fetch_mathjax, "PINS", ((url, integrity, ("tex-chtml.js",), fetch_mathjax.MATHJAX),))
     with pytest.raises(SystemExit, match=r"other\.tgz has sha512 .*, pinned sha512-.*; nothing written"):
         fetch_mathjax.fetch(where)
     assert (mathjax / "tex-chtml.js").read_bytes() == b"mj"

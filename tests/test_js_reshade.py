@@ -39,7 +39,7 @@ from renderer import jsgen
 from .jsnode import DRIVERS, node_command, read_frame, scene_json, write_modules
 
 WIDTH, HEIGHT = 48, 40                      # non-square: a transposed image shows
-SIM = jsgen.SIMULATOR_SCENE
+SIM = jsgen.SIMULATOR_SCENE.replace(height_field="ridges")     # the draft's field: the steps below leave it
 #: The U-curve's steps here: both slopes and the bottom of the U.
 CURVE = [1e-1, 1e-4, 1e-7, 1e-11]
 SAMPLE_STRIDE = 3

@@ -341,7 +341,7 @@ def test_each_exercise_of_the_site_is_in_its_notebook_numbered_with_its_solution
 def test_the_bibliography_lists_every_work_on_the_site_and_in_the_notebook(book_html):
     keys = _bib()
     html = (book_html / "s8_history.html").read_text(encoding="utf-8")
-    listed = re.findall(r'<div class="citation" id="[^"]+" role="doc-biblioentry">', html)
+    listed = re.findall(r'<div class="citation" id="[^"]+" role="listitem">', html)
     assert len(listed) == len(keys)
     text = "".join("".join(c["source"]) for c in _notebook(book_html, "s8_history")["cells"])
     dois = re.findall(r"^- .*?\(https://doi\.org/([^)\s]+)\)", text, re.M | re.S)

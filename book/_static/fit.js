@@ -2,8 +2,12 @@
 // - a number with a hyphen in it (1e-16, 2-3) is kept on one line: Chromium breaks after that hyphen;
 // - a long identifier or code line gets <wbr> break points between its parts (after . _ / ( [ , = and
 //   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word;
-// - tables wider than their column are scaled down to fit, to no less than MIN_TABLE; a wider table
-//   scrolls sideways inside the theme's box around it (fit.css);
+// - in a table cell, values joined by slashes ("0.51/0.5/0.5") may break after a slash (a zero-width
+//   space, which fit.css's nowrap turns off from 721 px; Chromium would break at a <wbr> even there), so
+//   that a phone's narrow column wraps them; tables wider than their column are then scaled down to
+//   fit, to no less than MIN_TABLE; a wider table scrolls sideways inside the theme's box around it
+//   (fit.css), with a visible cue above it (p.fit-scroll-cue) that says so, and the box takes the
+//   keyboard's focus (its arrow keys scroll it);
 // - a display formula is broken again when its column's width changes: MathJax 4 breaks a display for
 //   the width its column has when it is typeset (none inside a closed <details>, which has no width).
 // This is redone whenever the article changes size (window, sidebars, an opened <details>).
@@ -71,6 +75,41 @@
     });
   }
 
+  // Table cells: values joined by slashes ("0.51/0.5/0.5", "1.2e+03/7.8e+02") in a span.fit-slashes, with a
+  // break point (a zero-width space) after each slash, which fit.css turns off from 721 px.
+  var SLASHED = /[^\s\/]*\d(?:\/\d[^\s\/]*)+/g;
+  function breakTableCells(root) {
+    root.querySelectorAll("td, th").forEach(function (cell) {
+      textNodes(cell, SKIP).forEach(function (n) {
+        var frag = document.createDocumentFragment(), last = 0, m;
+        SLASHED.lastIndex = 0;
+        while ((m = SLASHED.exec(n.data))) {
+          frag.append(n.data.slice(last, m.index));
+          var s = document.createElement("span");
+          s.className = "fit-slashes"; s.textContent = m[0].replace(/\//g, "/\u200b");
+          frag.append(s);
+          last = m.index + m[0].length;
+        }
+        if (last) { frag.append(n.data.slice(last)); n.parentNode.replaceChild(frag, n); }
+      });
+    });
+  }
+
+  // A table that still scrolls sideways says so just above it, and its box is focusable; one that fits
+  // has neither.
+  var CUE = "Wider than the page: scroll the table sideways\u00a0\u2192";
+  function cue(t) {
+    var box = t.closest(".pst-scrollable-table-container") || t;
+    var wide = box.scrollWidth > box.clientWidth + 1;
+    var prev = box.previousElementSibling, has = !!(prev && prev.classList.contains("fit-scroll-cue"));
+    if (wide && !has) {
+      var p = document.createElement("p");
+      p.className = "fit-scroll-cue"; p.textContent = CUE; p.setAttribute("aria-hidden", "true");
+      box.parentNode.insertBefore(p, box);
+    } else if (!wide && has) prev.remove();
+    if (wide) box.setAttribute("tabindex", "0"); else if (box.getAttribute("tabindex") === "0") box.removeAttribute("tabindex");
+  }
+
   // Each display formula typeset for its column's present width: those whose column (the element
   // around the formula) has another width than when they were last broken are typeset again, at that
   // width.  `broken` maps each of MathJax's math items to that width (0: it had none).
@@ -104,6 +143,7 @@
         t.style.fontSize = 100 * scale + "%";
         need = t.getBoundingClientRect().width;
       }
+      cue(t);
     });
     if (typeset) document.documentElement.setAttribute("data-fit", "done");     // for the browser tests
   }
@@ -113,7 +153,7 @@
   function whenTypeset() {
     var mj = window.MathJax, root = article();
     function done() {
-      if (root) { keepNumbersWhole(root); breakLongWords(root); rebreak(root, true); }
+      if (root) { keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
       typeset = true;
       fit();
     }

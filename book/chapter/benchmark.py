@@ -30,7 +30,7 @@ def _floor(e):
 
 def pareto_figure(measurement, *, error="max"):
     """Log-log plot of time per frame against error, one panel per field, stacked for a
-    phone's column (5 in wide, every text at least 9 pt, a shared time axis).
+    phone's column (5 in wide, every text at the book's size, `chapter.figures.TEXT_PT`, a shared time axis).
 
     Each point is a method at its median time, with a horizontal bar from the
     fastest to the slowest run; difference sweeps are joined in order of eps
@@ -94,20 +94,19 @@ def pareto_figure(measurement, *, error="max"):
             axis.set_minor_locator(NullLocator())
         ax.set_xlim(t_lo, t_hi)
         ax.set_ylim(min(_floor(pick(r)) for r in rs) / _Y_ROOM, None)
-        ax.set_title(name + (" (off the crease band)" if F.field(name).crease_factors else ""), fontsize=10)
-        ax.set_ylabel(f"{error} error" if ax in grid[::2] else "", fontsize=10)
-        ax.tick_params(labelsize=9)
+        ax.set_title(name + ("\n(off the crease band)" if F.field(name).crease_factors else ""))   # a panel's width
+        ax.set_ylabel(f"{error} error" if ax in grid[::2] else "")
         ax.grid(alpha=0.3, lw=0.3)
     for ax in axes[-2:]:                # the lowest panel of each column
-        ax.set_xlabel("time per frame, ms", fontsize=10)
+        ax.set_xlabel("time per frame, ms")
         ax.xaxis.set_tick_params(labelbottom=True)
     labels = [m if m == "Pareto front" else gm.method(m).label for m in handles]
     if len(spare):
         for ax in spare:
             ax.axis("off")
-        spare[0].legend(list(handles.values()), labels, loc="center", fontsize=9, frameon=False)
+        spare[0].legend(list(handles.values()), labels, loc="center", frameon=False)
     else:
-        fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, fontsize=9, frameon=False)
+        fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, frameon=False)
     return fig
 
 
@@ -264,7 +263,7 @@ def univariate_figure(errors):
     """Relative error of f'(x) against the step, log-log, one line per method of ``errors`` (a
     `lab.gradient_methods.UnivariateErrors`), the step growing to the right; a method without a step
     is a horizontal line across; hollow markers, so that two methods with equal errors both show.
-    Drawn for a phone's column: 4.6 in wide, every text 10 pt.  An error of exactly 0 would be drawn at
+    Drawn for a phone's column: 4.6 in wide, every text at `chapter.figures.TEXT_PT`.  An error of exactly 0 would be drawn at
     1e-18.  Returns a matplotlib Figure (not shown)."""
     from matplotlib.figure import Figure
     from matplotlib.ticker import LogLocator, NullLocator
@@ -286,11 +285,10 @@ def univariate_figure(errors):
     ax.yaxis.set_major_locator(LogLocator(base=10.0 ** 4, numticks=8))
     for axis in (ax.xaxis, ax.yaxis):
         axis.set_minor_locator(NullLocator())
-    ax.set_xlabel("step", fontsize=10)
-    ax.set_ylabel("relative error of f′(x)", fontsize=10)
-    ax.tick_params(labelsize=10)
+    ax.set_xlabel("step")
+    ax.set_ylabel("relative error of f′(x)")
     ax.grid(alpha=0.3, lw=0.3)
-    fig.legend(loc="outside lower center", ncols=2, fontsize=10, frameon=False)
+    fig.legend(loc="outside lower center", ncols=2, frameon=False)
     return fig
 
 

@@ -49,6 +49,14 @@ RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
 #: turns it into CSS pixels at the width each image is shown.
 SMALLEST_TEXT_KEY = "symrender:smallest-text-px"
 
+#: The size of every text in the book's figures, in points (`style`).  A figure shown in a phone's column
+#: (342 CSS px at 390 px, 323 in a dropdown) is scaled to it, and its text with it: text of ``pt`` points
+#: on a figure ``w`` inches wide is then ``pt * 342 / (72 * w)`` CSS px, at least 10 (tests/test_book_pages.py)
+#: when ``pt / w`` is at least 2.1: 11 pt on the book's figures, at most 5.2 in wide with what sticks out
+#: (4.9 in a dropdown).  A sub- or superscript is drawn at 70 %: none in the figures' text but the frame
+#: diagram's labels, drawn larger.
+TEXT_PT = 11.0
+
 #: How far above the fitted model's arm `ucurve_anatomy` draws each slope guide (a factor in error).
 GUIDE_OFFSET = 30.0
 
@@ -59,7 +67,9 @@ def style():
     a Figure displayed in IPython becomes `figure_png`'s PNG."""
     import matplotlib as mpl
     from matplotlib.scale import register_scale
-    mpl.rcParams.update({"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8,
+    mpl.rcParams.update({**{key: TEXT_PT for key in ("font.size", "axes.titlesize", "axes.labelsize", "xtick.labelsize",
+                                                     "ytick.labelsize", "legend.fontsize", "legend.title_fontsize",
+                                                     "figure.titlesize")},
                          "savefig.bbox": "tight", "svg.hashsalt": "symrender", "image.interpolation": "nearest"})
     register_scale(_PlainLogScale)
     try:
@@ -233,7 +243,7 @@ def frame_diagram(theta=-0.35, phi=0.8):
         tip = project(N + 0.45 * vec)
         ax.annotate("", tip, base, arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.8))
         ax.text(*(tip + 0.04 * (tip - base) / max(np.linalg.norm(tip - base), 1e-9)), label, color=colour,
-                fontsize=11)                                     # its subscript drawn at 0.7 x 11 = 7.7 pt
+                fontsize=12.5)                                   # its subscript drawn at 0.7 x 12.5 = 8.75 pt
     ax.plot(*project(_sphere_point(0.0, 0.0)), "o", color="k", ms=3)
     ax.text(*(project(_sphere_point(0.0, 0.0)) + [0.03, 0.03]), r"pole $\varphi = 0$")
     ax.set_aspect("equal"); ax.axis("off")
@@ -274,7 +284,7 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
         hh = float(pointwise.height(field, u, phi / np.pi, scene.k_u, scene.k_v))
         return in_plane @ np.array(normal[mode](*N3, *e_t, *e_p, hu, hv, beta, hh, r0, sin_phi), float).ravel()
 
-    fig, ax = plt.subplots(figsize=(4.2, 5.4))          # for a phone's column: at most 5 in wide, text >= 9 pt
+    fig, ax = plt.subplots(figsize=(4.2, 5.4))          # for a phone's column: text at TEXT_PT, 2.1 pt per inch or more
     ax.plot(*base.T, color=GREY, lw=1.5)
     ax.plot(*bumped.T, color=GREY, lw=1.0, ls="--")
     length = 0.22
@@ -299,7 +309,7 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
     ax.legend(handles, ["sphere A: the geometry, unchanged", r"the sphere displaced by $\beta h$",
                         "shading normal: the displaced sphere's", "the displaced curve's own normal",
                         "the draft's formula", r"$N$, no bump"],
-              loc="upper center", bbox_to_anchor=(0.5, -0.01), ncols=1, frameon=False, fontsize=9.5)
+              loc="upper center", bbox_to_anchor=(0.5, -0.01), ncols=1, frameon=False)
     ax.set_aspect("equal"); ax.axis("off")
     ax.set_title(rf"one meridian, {field} field, $\beta = {beta:g}$")
     return fig
@@ -327,14 +337,14 @@ def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
     ax.plot(u0 + du, h_0 + exact * du, color=BLUE, lw=1.5, label=rf"exact slope at the centre: {exact:+.2f}")
     ax.plot([u0], [h_0], "o", color=BLUE)
     ax.set_xlabel(r"$u$"); ax.set_ylabel(r"$h$")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False, fontsize=9)   # below: clear of the data
-    ax.set_title("a central stencil straddles the crease")           # no sub- or superscripts: 9 pt and up
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)   # below: clear of the data
+    ax.set_title("a central stencil straddles the crease")           # no sub- or superscripts: all at TEXT_PT
     return fig
 
 
 def ucurve_anatomy(curve):
     """The measured U-curve of a `renderer.ucurve.UCurve`, drawn for the narrow column (5 in wide,
-    text at 9 pt or more).
+    text at `TEXT_PT`).
 
     Lines: the float64 quotient's error (label ``|error| ...``), its exact split into exact
     arithmetic at the rounded u +- eps (dashed) and the rounding of the float64 evaluation
@@ -368,15 +378,15 @@ def ucurve_anatomy(curve):
         ax.loglog(steps, GUIDE_OFFSET * arm(steps), color="k", lw=1.2, label=f"_guide slope {slope}")
         mid = np.sqrt(steps[0] * steps[-1])                      # the guide's middle on log axes
         ax.annotate(f"slope {slope}\n{words}", (mid, GUIDE_OFFSET * arm(mid)), (mid, 60 * GUIDE_OFFSET * arm(mid)),
-                    ha="center", va="bottom", fontsize=9, arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
-    ax.annotate(r"fitted $\hat\varepsilon$", (fitted / 1.6, 1e-17), ha="right", fontsize=9)
-    ax.annotate("model-optimal \u03b5*", (model * 1.6, 1e-17), ha="left", fontsize=9)
+                    ha="center", va="bottom", arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
+    ax.annotate(r"fitted $\hat\varepsilon$", (fitted / 1.6, 1e-17), ha="right")
+    ax.annotate("model-optimal \u03b5*", (model * 1.6, 1e-17), ha="left")
     ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $\partial h/\partial u$"); ax.set_ylim(1e-18, 1e5)
     ax.xaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=6))
     ax.yaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=7))
     handles, labels = ax.get_legend_handles_labels()                 # the measured curves first, the model last
     ax.legend(handles[1:] + handles[:1], labels[1:] + labels[:1], loc="upper center", bbox_to_anchor=(0.5, -0.2),
-              frameon=False, fontsize=9)                             # below the axes
+              frameon=False)                                         # below the axes
     ax.grid(alpha=0.3)
     return fig
 
@@ -472,7 +482,7 @@ def displacement_figure(result):
     (sRGB), each with the other's silhouette outlined.  Bottom: coverage of sphere A (grey in
     both, red only displaced, blue only bumped) and cast shadows (red only displaced, blue only
     bumped, green where the bumps shadow each other and the bumped render is lit).  5 in wide,
-    text at least 9 pt.  Returns a matplotlib Figure.
+    text at `TEXT_PT`.  Returns a matplotlib Figure.
     """
     import matplotlib.pyplot as plt
     from matplotlib.colors import to_rgb
@@ -485,7 +495,7 @@ def displacement_figure(result):
         ax.imshow(rgb)
         if outline is not None:
             ax.contour(outline.astype(float), levels=[0.5], colors="white", linewidths=0.8)
-        ax.set_title(title, fontsize=10)
+        ax.set_title(title)
         ax.set_xticks([])
         ax.set_yticks([])
 
@@ -505,6 +515,6 @@ def displacement_figure(result):
                                          (~result.shadow & result.bumped_shadow, BLUE), (self_shadow, GREEN)]),
           "cast shadow")
     fig.legend(handles=[Patch(color=RED, label="displaced only"), Patch(color=BLUE, label="bumped only"),
-                        Patch(color=GREEN, label="self-shadow")], loc="outside lower center", ncols=3, fontsize=9,
-               frameon=False)
+                        Patch(color=GREEN, label="self-shadow")], loc="outside lower center", ncols=3,
+               frameon=False, handlelength=1.2, handletextpad=0.5, columnspacing=1.0)   # within the figure's width
     return fig

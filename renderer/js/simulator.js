@@ -18,8 +18,12 @@ const NUMERIC = GRADIENTS.filter((g) => g !== "exact");
 
 // The slider of log10 eps, and the steps of the U-curve: the slider's range in
 // half decades (27 steps), fine enough to show the bottom of the U and its two
-// slopes, coarse enough to stay cheap (see CURVE_SAMPLE).
-const LOG_EPS = { min: -14, max: -1, step: 0.1 };
+// slopes, coarse enough to stay cheap (see CURVE_SAMPLE).  The slider moves by a
+// tenth of a decade (an arrow key), so that it lands exactly on each decade; each
+// decade is a tick mark (a <datalist>), to which Chromium snaps a pointer within a
+// few pixels (a tenth of a decade is under 3 px on a phone), and Page Up / Page Down
+// jump to the next decade.
+const LOG_EPS = { min: -14, max: -1, step: 0.1, ticks: 1 };
 export const CURVE_LOG_EPS = Array.from({ length: 2 * (LOG_EPS.max - LOG_EPS.min) + 1 }, (_, i) => LOG_EPS.min + i / 2);
 // The U-curve is the ledger over a grid of at most CURVE_SAMPLE x CURVE_SAMPLE
 // of the frame's pixels (every 6th column and row at 256 x 256: a 36th of
@@ -116,7 +120,8 @@ export const PRESETS = [
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
 ];
 
-const HINT = "Hover over a canvas, or tap it, to read that pixel in the readout.";
+const HINT = "Hover over a canvas, tap it, or focus it and use the arrow keys, to read that pixel in the readout; " +
+  "on the ε slider, Page Up and Page Down move a whole decade.";
 // The controls shown above the canvases.
 const MAIN = ["height_field", "log_eps", "beta"];
 
@@ -145,6 +150,11 @@ const STYLE = `
 .symrender-sim .sim-controls { display: grid; grid-template-columns: repeat(auto-fill, minmax(13rem, 1fr)); gap: 0.4rem 1rem; margin: 0.8rem 0; }
 .symrender-sim .sim-controls label { display: flex; flex-direction: column; }
 .symrender-sim .sim-controls label.sim-check { flex-direction: row; align-items: center; gap: 0.4rem; }
+/* Every control a target of at least 24 x 24 CSS px (WCAG 2.2, 2.5.8): the browser's are 13-20 px tall. */
+.symrender-sim input[type="range"] { height: 1.75rem; margin: 0; }
+.symrender-sim select { min-height: 1.75rem; }
+.symrender-sim input[type="checkbox"] { width: 1.5rem; height: 1.5rem; margin: 0; }
+.symrender-sim button { min-height: 1.75rem; min-width: 1.75rem; }
 .symrender-sim output { font-variant-numeric: tabular-nums; }
 .symrender-sim .sim-presets { display: flex; flex-wrap: wrap; gap: 0.4rem; margin: 0.4rem 0; align-items: center; }
 .symrender-sim .sim-presets button, .symrender-sim .sim-reset { padding: 0.2rem 0.6rem; }
@@ -264,7 +274,7 @@ class Simulator {
     this.inputs = {};
     this.outputs = {};
     const controls = CONTROLS.map((c) => {
-      let input;
+      let input, ticks = [];
       if (c.kind === "select") {
         input = el("select", { id: `sim-${c.name}` },
                    c.options.map((o) => el("option", { value: String(o), text: c.labels?.[o] ?? String(o) })));
@@ -273,6 +283,12 @@ class Simulator {
       } else if (c.kind === "range") {
         input = el("input", { id: `sim-${c.name}`, type: "range", min: c.min, max: c.max, step: c.step });
         input.addEventListener("input", () => this.set_from_input(c, input));
+        if (c.ticks) {
+          ticks = [el("datalist", { id: `sim-${c.name}-ticks` }, Array.from(
+            { length: Math.floor((c.max - c.min) / c.ticks) + 1 }, (_, k) => el("option", { value: String(c.min + k * c.ticks) })))];
+          input.setAttribute("list", ticks[0].id);
+          input.addEventListener("keydown", (ev) => this.tick_key(c, input, ev));
+        }
       } else {
         input = el("input", { id: `sim-${c.name}`, type: "checkbox" });
         input.addEventListener("change", () => this.set_from_input(c, input));
@@ -284,12 +300,30 @@ class Simulator {
       if (c.kind === "select") return el("label", {}, [el("span", { text: c.label }), input]);
       const out = el("output", { id: `sim-${c.name}-value`, for: `sim-${c.name}` });
       this.outputs[c.name] = out;
-      return el("label", {}, [el("span", {}, [c.label + " ", out]), input]);
+      return el("label", {}, [el("span", {}, [c.label + " ", out]), input, ...ticks]);
     });
     const main = CONTROLS.map((c, i) => MAIN.includes(c.name) ? controls[i] : null).filter(Boolean);
     this.main_controls.append(...main);
     root.append(el("div", { class: "sim-controls" }, controls.filter((c) => !main.includes(c))));
     this.sync_inputs();
+  }
+
+  // Page Up / Page Down on a slider with tick marks: to the next tick above or below (the ε slider: the
+  // next decade), as a reader's drag would (an input event).
+  tick_key(c, input, ev) {
+    if (ev.key !== "PageUp" && ev.key !== "PageDown") return;
+    ev.preventDefault();
+    const x = Number(input.value) / c.ticks, up = ev.key === "PageUp";
+    const k = up ? Math.floor(x + 1e-9) + 1 : Math.ceil(x - 1e-9) - 1;
+    input.value = String(Math.min(c.max, Math.max(c.min, k * c.ticks)));
+    input.dispatchEvent(new Event("input"));
+  }
+
+  // What a slider's value reads as (its aria-valuetext), and the value printed beside it.
+  show_value(c, value) {
+    const text = c.show ? c.show(value) : String(value);
+    if (this.outputs[c.name]) this.outputs[c.name].textContent = text;
+    if (c.kind === "range") this.inputs[c.name].setAttribute("aria-valuetext", text);
   }
 
   // The β slider's range follows the shading normal; β is clamped into it.
@@ -305,7 +339,7 @@ class Simulator {
       const input = this.inputs[c.name];
       const value = this.state[c.name];
       if (c.kind === "checkbox") input.checked = value; else input.value = String(value);
-      if (this.outputs[c.name]) this.outputs[c.name].textContent = c.show ? c.show(value) : String(value);
+      this.show_value(c, value);
     }
   }
 
@@ -316,7 +350,7 @@ class Simulator {
     else value = input.value;
     this.state[c.name] = value;
     if (c.name === "bump") this.sync_inputs();
-    if (this.outputs[c.name]) this.outputs[c.name].textContent = c.show ? c.show(value) : String(value);
+    this.show_value(c, value);
     this.schedule();
   }
 
@@ -355,6 +389,7 @@ class Simulator {
     this.timings.push({ resolution: s.resolution, ms, shade_ms: t_shade - t0, draw_ms: t1 - t_shade,
                         curve_ms: performance.now() - t1, full: res.full, shaded: res.shaded });
     this.frames = { scene, numeric: res.numeric, symbolic: res.symbolic, ledger, ms };
+    this.describe(ledger);
     const put = (id, text, value) => {
       const td = this.root.querySelector(`#${id}`);
       td.textContent = text;
@@ -441,8 +476,26 @@ class Simulator {
                          `difference |ΔI|, ${diff}; the band in blue`] }[view];
     ["numeric", "symbolic", "difference"].forEach((name, i) => {
       this.root.querySelector(`#sim-caption-${name}`).textContent = cap[i];
-      this.canvases[name].setAttribute("aria-label", `${cap[i]} (arrow keys move the probe)`);
     });
+  }
+
+  // Each canvas's text alternative (its aria-label, the canvases being role="img"): what it draws, in
+  // words, and the ledger's numbers for the difference; rewritten on every update.
+  describe(ledger) {
+    const s = this.state, bump = CONTROLS.find((c) => c.name === "bump").labels[s.bump];
+    const view = { shaded: "shaded", bump: "the size of ∇h in grey", kink: "the crease band in white" }[s.view];
+    const what = `sphere A with the ${s.height_field} field, β = ${s.beta.toFixed(2)}, kᵤ = ${s.k_u}, kᵥ = ${s.k_v}, ` +
+      `the shading normal ${bump}, ${s.resolution} × ${s.resolution} pixels` + (s.zoom > 1 ? `, the pole magnified ×${s.zoom}` : "");
+    const pipe = s.numeric === "central" ? `central differences at ε = ${eps_of(s.log_eps).toExponential(1)}`
+      : "central differences, each pixel's footprint its step";
+    const scale = s.scale === "log" ? `log scale, ${power_of_ten(LOG_FLOOR)} black to 1 white` : `linear scale, × ${LINEAR_GAIN}`;
+    const text = {
+      numeric: `Render by ${pipe}: ${what}; ${view}.`,
+      symbolic: `Render by the exact gradient: ${what}; ${view}.`,
+      difference: `Difference |ΔI| of the two renders (${s.view === "bump" ? "of the sizes of ∇h" : "shaded"}), ${scale}: ` +
+        `on sphere A at most ${fmt(ledger.max_abs, 1)}, RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips.`,
+    };
+    for (const [name, t] of Object.entries(text)) this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe.`);
   }
 
   // The U-curve: RMS and max |ΔI| on sphere A against ε, log-log, the current ε marked.
