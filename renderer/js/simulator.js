@@ -44,7 +44,7 @@ const DEFAULT_STATE = {
   numeric: "central", height_field: SIMULATOR_SCENE.height_field, k_u: SIMULATOR_SCENE.k_u,
   k_v: SIMULATOR_SCENE.k_v, beta: SIMULATOR_SCENE.beta, bump: SIMULATOR_SCENE.bump,
   log_eps: Math.log10(SIMULATOR_SCENE.eps), model: SIMULATOR_SCENE.model, resolution: 256, view: "shaded",
-  scale: "linear", zoom: 1, sphere_b: SIMULATOR_SCENE.sphere_b,
+  scale: "log", zoom: 1, sphere_b: SIMULATOR_SCENE.sphere_b,
 };
 
 // Grey level in [0, 1] of a difference d >= 0 on the chosen scale: on the log scale log10 d from
