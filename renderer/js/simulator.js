@@ -38,9 +38,9 @@ export function curve_stride(resolution) {
 // The β slider: up to 2 for the chart formula; below R for the displaced sphere
 // (scene.py: R + β h must stay positive), on the slider's grid of 0.01.
 const BETA = { min: 0, max: 2, step: 0.01 };
-const beta_max = (bump) => bump === "surface" ? Math.round(100 * (SIMULATOR_SCENE.radius_a - BETA.step)) / 100 : BETA.max;
+export const beta_max = (bump) => bump === "surface" ? Math.round(100 * (SIMULATOR_SCENE.radius_a - BETA.step)) / 100 : BETA.max;
 
-const DEFAULT_STATE = {
+export const DEFAULT_STATE = {
   numeric: "central", height_field: SIMULATOR_SCENE.height_field, k_u: SIMULATOR_SCENE.k_u,
   k_v: SIMULATOR_SCENE.k_v, beta: SIMULATOR_SCENE.beta, bump: SIMULATOR_SCENE.bump,
   log_eps: Math.log10(SIMULATOR_SCENE.eps), model: SIMULATOR_SCENE.model, resolution: 256, view: "shaded",
@@ -67,7 +67,7 @@ const LOG_SCALE = `log: ${power_of_ten(LOG_FLOOR)} black, 1 white`;
 const LINEAR_SCALE = `linear: |ΔI| × ${LINEAR_GAIN}`;
 
 // The controls, in tab order.  kind: select | range | checkbox; `labels` names a select's options.
-const CONTROLS = [
+export const CONTROLS = [
   { name: "height_field", label: "height field", kind: "select", options: HEIGHT_FIELDS },
   { name: "log_eps", label: "ε, the finite-difference step", kind: "range", ...LOG_EPS,
     show: (x) => eps_of(x).toExponential(1) },

@@ -1,0 +1,106 @@
+"""The simulator's controls against the Python scene, under node (no browser, no built book).
+
+`tests/js/controls_driver.mjs` imports the generated simulator module and returns, for every
+position of every control (each option of a menu, each end, default and decade tick of a slider,
+both states of the checkbox, each applied alone to the opening state) and for each preset, the
+scene `scene_of` hands the renderer.  Each must be a `renderer.Scene` Python accepts; a control
+named like a Scene field moves that field and nothing else (the ε slider moves ``eps``, to the
+printed value); a control of the view (scale, resolution, zoom, numeric pipeline) moves none; the
+menus offer exactly Python's choices; the opening scene is `SIMULATOR_SCENE`.  Wrong variants: a
+`scene_of` that swaps the two frequencies, and one that ignores the bump control.
+"""
+
+import dataclasses
+import json
+import subprocess
+
+import pytest
+
+from renderer import Scene
+from renderer.formulas import FIELDS
+from renderer.ledger import SIMULATOR_SCENE
+from renderer.render import GRADIENTS
+from renderer.scene import BUMPS, MODELS, PointLight as Light
+
+from .jsnode import DRIVERS, node_command, write_modules
+
+#: The simulator's controls that set a Scene field (the ε slider sets eps from log10 eps) ...
+SCENE_CONTROLS = {"height_field": "height_field", "beta": "beta", "bump": "bump", "k_u": "k_u", "k_v": "k_v",
+                  "model": "model", "sphere_b": "sphere_b", "log_eps": "eps"}
+#: ... and those that change only how the frames are drawn or sampled.
+VIEW_CONTROLS = {"view", "scale", "numeric", "resolution", "zoom"}
+
+
+def _positions(tmp_path, transform=None):
+    modules = write_modules(tmp_path / "modules", transform)
+    out = subprocess.run([*node_command("the controls test runs the simulator's module under node"),
+                          str(DRIVERS / "controls_driver.mjs"), str(modules)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
+
+
+def _scene(fields):
+    """A Scene from the JSON of one (lists back to tuples, lights to Light records): raises as Scene does."""
+    def value(name, x):
+        if name == "lights":
+            return tuple(Light(tuple(l["position"]), tuple(l["color"])) for l in x)
+        return tuple(x) if isinstance(x, list) else x
+    return Scene(**{name: value(name, x) for name, x in fields.items()})
+
+
+def _problems(data):
+    """What is wrong with the controls' scenes (an empty list when nothing is)."""
+    bad = []
+    default = _scene(data["default"])
+    if default != SIMULATOR_SCENE:
+        bad.append(f"opening scene {default} is not SIMULATOR_SCENE")
+    seen = {}
+    for p in data["positions"]:
+        try:
+            scene = _scene(p["scene"])
+        except (TypeError, ValueError) as exc:
+            bad.append(f"{p['control']}={p['value']!r} is a scene Python refuses: {exc}")
+            continue
+        moved = {f.name for f in dataclasses.fields(Scene) if getattr(scene, f.name) != getattr(default, f.name)}
+        control, value = p["control"], p["value"]
+        seen.setdefault(control, []).append(value)
+        if control in VIEW_CONTROLS:
+            if moved:
+                bad.append(f"{control}={value!r} moves the scene's {sorted(moved)}")
+            continue
+        field = SCENE_CONTROLS[control]
+        want = 10.0 ** value if control == "log_eps" else value
+        if moved - {field}:
+            bad.append(f"{control}={value!r} moves {sorted(moved - {field})} besides {field}")
+        if control == "log_eps" and float(value).is_integer() and scene.eps != 10.0 ** value:
+            bad.append(f"the ε slider at the decade {value} renders eps {scene.eps!r}, not 1e{int(value)}")
+        got = getattr(scene, field)
+        if not (got == pytest.approx(want, rel=0.05) if isinstance(want, float) else got == want):
+            bad.append(f"{control}={value!r} renders {field}={got!r}")
+    for control, choices in (("height_field", tuple(FIELDS)), ("bump", BUMPS), ("model", MODELS),
+                             ("numeric", tuple(g for g in GRADIENTS if g != "exact"))):
+        if sorted(map(str, seen.get(control, ()))) != sorted(choices):
+            bad.append(f"the {control} menu offers {seen.get(control)}, Python {choices}")
+    if set(seen) != set(SCENE_CONTROLS) | VIEW_CONTROLS:
+        bad.append(f"controls {sorted(set(seen) ^ (set(SCENE_CONTROLS) | VIEW_CONTROLS))} unaccounted for")
+    for preset in data["presets"]:
+        try:
+            _scene(preset["scene"])
+        except (TypeError, ValueError) as exc:                   # renderer.validate's errors are these
+            bad.append(f"preset {preset['id']} is a scene Python refuses: {exc}")
+    return bad
+
+
+def test_every_control_position_is_a_python_scene_moving_its_own_field(tmp_path):
+    assert _problems(_positions(tmp_path)) == []
+
+
+@pytest.mark.parametrize("variant, transform", [
+    ("k_u and k_v swapped", lambda name, text: text.replace("k_u: state.k_u, k_v: state.k_v",
+                                                            "k_u: state.k_v, k_v: state.k_u")),
+    ("the bump control ignored", lambda name, text: text.replace("bump: state.bump,", "")),
+])
+def test_the_controls_check_catches_a_wrong_scene_of(tmp_path, variant, transform):
+    data = _positions(tmp_path, lambda name, text: transform(name, text) if name == "simulator" else text)
+    assert _problems(data), variant
