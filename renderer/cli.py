@@ -15,8 +15,10 @@ stderr); ``-o -`` on a terminal; option abbreviations, and negative values after
 (``--eps=-1e-3`` works); digits of other scripts; huge values repeated in messages; TOML
 nested thousands deep (a RecursionError, exit 1); integers beyond a float (the library
 names them); scene files that are FIFOs, devices or huge; unwritable directories (found
-at the write); file names stdout cannot encode; a bad ``NUMBA_NUM_THREADS``; matplotlib's
-warnings about an unwritable home. There are no progress bars.
+at the write); file names stdout cannot encode; matplotlib's warnings about an unwritable
+home. There are no progress bars.  ``NUMBA_NUM_THREADS`` other than an integer in [1,
+`renderer.validate.MAX_THREADS`] is refused before numba reads it (numba's pool segfaulted
+at 100000).
 """
 
 from __future__ import annotations
@@ -422,6 +424,9 @@ def _emit(stream, data, name):
 
 def _run(argv):
     args = build_parser().parse_args(argv)
+    if "NUMBA_NUM_THREADS" in os.environ:          # before numba reads it (0 fails its import)
+        from renderer.validate import thread_count
+        thread_count("NUMBA_NUM_THREADS", os.environ["NUMBA_NUM_THREADS"])
     report, outputs = _COMMANDS[args.command](args)
     _stop_if_signalled()
     on_stdout = any(path == "-" for path, _ in outputs)      # then the report goes to stderr

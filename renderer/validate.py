@@ -12,7 +12,8 @@ command line (``symrender``) check their arguments with these functions:
 * a flag (`flag`): ``True`` or ``False`` (Python's or numpy's);
 * a choice (`choice`): one of a tuple of strings;
 * a positive integer (`positive_int`): an ``int`` or numpy integer >= 1;
-* steps (`steps`): a non-empty array of step sizes within a range.
+* steps (`steps`): a non-empty array of step sizes within a range;
+* a thread count (`thread_count`): numba's ``NUMBA_NUM_THREADS``, in [1, `MAX_THREADS`].
 
 Refused everywhere: a bool where a number is asked (``True`` is not 1.0), complex
 numbers, strings (numpy would parse ``"0.5"``), containers without an order (a set,
@@ -27,12 +28,13 @@ and what is accepted.
 from __future__ import annotations
 
 import numbers
+import os
 import sys
 
 import numpy as np
 
 __all__ = ["InputError", "InvalidValue", "InvalidType", "real", "real_array", "vector3", "flag",
-           "choice", "positive_int", "steps"]
+           "choice", "positive_int", "steps", "thread_count", "MAX_THREADS"]
 
 
 class InputError(Exception):
@@ -277,6 +279,32 @@ def steps(name, value, *, low, high, high_open=False, max_count=None):
         count = "at least one step" if max_count is None else f"1 to {max_count} steps"
         raise InvalidValue(f"{name} must hold {count}, got {a.size}")
     return a
+
+
+#: Most threads `thread_count` accepts: 64, or the machine's CPUs where it has more (numba's
+#: default is one per CPU).  NUMBA_NUM_THREADS=100000 made numba's thread pool segfault.
+MAX_THREADS = max(64, os.cpu_count() or 1)
+
+
+def thread_count(name, value):
+    """``value``, a count of threads (an int, or the text of an environment variable such as
+    numba's ``NUMBA_NUM_THREADS``), as an int in [1, `MAX_THREADS`].
+
+    Raises
+    ------
+    InvalidValue
+        Not the digits of an integer, or outside [1, `MAX_THREADS`] (the message names
+        ``name``, the value and the range).
+    """
+    try:
+        n = int(value) if isinstance(value, (int, str)) and not isinstance(value, bool) else None
+    except ValueError:
+        n = None
+    if n is None or not 1 <= n <= MAX_THREADS:
+        shown = repr(value[:40]) + ("..." if len(value) > 40 else "") if isinstance(value, str) else _shown(value)
+        raise InvalidValue(f"{name} must be an integer in [1, {MAX_THREADS}] (a count of threads: at most 64, "
+                           f"or this machine's CPUs where more), got {shown}")
+    return n
 
 
 #: Longest expression text accepted (characters): a height field or a function is a formula, not a program.

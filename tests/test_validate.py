@@ -23,8 +23,8 @@ import sympy as sp
 from renderer import formulas as F
 from renderer import pointwise
 from renderer.scene import COORDINATE
-from renderer.validate import (MAX_EXPRESSION_CHARS, InputError, InvalidType, InvalidValue, choice, expression,
-                               flag, positive_int, real, real_array, steps, vector3)
+from renderer.validate import (MAX_EXPRESSION_CHARS, MAX_THREADS, InputError, InvalidType, InvalidValue, choice,
+                               expression, flag, positive_int, real, real_array, steps, thread_count, vector3)
 
 UP, DOWN = math.inf, -math.inf
 
@@ -92,6 +92,13 @@ REFUSED = {
         (lambda: steps("e", [1.0], low=0.1, high=1.0, high_open=True), InvalidValue, "e", "must be in [0.1, 1)"),
         (lambda: steps("e", {0.5: 1}, low=0.1, high=1.0), InvalidType, "e", "ordered steps"),
     ],
+    "thread_count": [
+        (lambda: thread_count("T", "100000"), InvalidValue, "T", f"integer in [1, {MAX_THREADS}]"),   # segfaulted
+        (lambda: thread_count("T", "0"), InvalidValue, "T", "integer in [1, "),
+        (lambda: thread_count("T", "abc"), InvalidValue, "T", "integer in [1, "),
+        (lambda: thread_count("T", True), InvalidValue, "T", "integer in [1, "),
+        (lambda: thread_count("T", 10**5000), InvalidValue, "T", "integer of 16,610 bits"),
+    ],
     "expression": [
         (lambda: expression("f", "u + w", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "'w' is not one of its names"),
         (lambda: expression("f", "u.__class__", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "'.' is not one of its operators"),
@@ -118,6 +125,7 @@ ACCEPTED = {
     "flag": [(lambda: flag("f", np.array(True)), True), (lambda: flag("f", np.False_), False)],
     "choice": [(lambda: choice("c", "rings", ("sine", "rings")), "rings")],
     "positive_int": [(lambda: positive_int("n", np.int64(8), high=8), 8), (lambda: positive_int("n", np.array(3)), 3)],
+    "thread_count": [(lambda: thread_count("T", " 4"), 4), (lambda: thread_count("T", MAX_THREADS), MAX_THREADS)],
     "steps": [(lambda: steps("e", np.float32(0.5), low=0.1, high=1.0).tolist(), [0.5]),
               (lambda: steps("e", [0.5, 1.0], low=0.1, high=1.0, max_count=2).tolist(), [0.5, 1.0])],
     "expression": [(lambda: expression("f", "sin(pi*k_u*u)^2 * sin(pi*k_v*v)**2", F.FIELD_SYMBOLS, F.ELEMENTARY),
@@ -136,12 +144,14 @@ SHOWN = {
     "positive_int": (lambda: positive_int("n", 2.0), "got float 2.0"),
     "steps": (lambda: steps("e", {0.5: 1}, low=0.1, high=1.0), "got dict {0.5: 1}"),
     "expression": (lambda: expression("f", 3, F.FIELD_SYMBOLS, F.ELEMENTARY), "got int 3"),
+    "thread_count": (lambda: thread_count("T", "100000"), "got '100000'"),
 }
 
 
 @pytest.mark.parametrize("kind", REFUSED)
 def test_each_kind_refuses_naming_the_parameter(kind):
-    assert {fn.__name__ for fn in (real, real_array, vector3, flag, choice, positive_int, steps, expression)} \
+    assert {fn.__name__ for fn in (real, real_array, vector3, flag, choice, positive_int, steps, expression,
+                                   thread_count)} \
         == set(REFUSED) == set(ACCEPTED)
     for call, error, name, phrase in REFUSED[kind]:
         got, message = refusal(call)
