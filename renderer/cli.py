@@ -18,7 +18,8 @@ names them); scene files that are FIFOs, devices or huge; unwritable directories
 at the write); file names stdout cannot encode; matplotlib's warnings about an unwritable
 home. There are no progress bars.  ``NUMBA_NUM_THREADS`` other than an integer in [1,
 `renderer.validate.MAX_THREADS`] is refused before numba reads it (numba's pool segfaulted
-at 100000).
+at 100000), and a ``--set`` value spanning lines (TOML would read the second as a key of
+its own, dropped) is refused.
 """
 
 from __future__ import annotations
@@ -227,8 +228,8 @@ def load_scene(path=None, sets=()):
     overrides = {}
     for item in sets:
         key, eq, text = item.partition("=")
-        if not eq:
-            raise UsageError(f"--set expects key=value, got {item!r}")
+        if not eq or "\n" in item or "\r" in item:
+            raise UsageError(f"--set expects key=value on one line, got {item!r:.200}")
         overrides[key.strip()] = _toml_value(text)
     return _replace(scene, overrides, "--set")
 

@@ -15,9 +15,10 @@ command line (``symrender``) check their arguments with these functions:
 * steps (`steps`): a non-empty array of step sizes within a range;
 * a thread count (`thread_count`): numba's ``NUMBA_NUM_THREADS``, in [1, `MAX_THREADS`].
 
-Refused everywhere: a bool where a number is asked (``True`` is not 1.0), complex
-numbers, strings (numpy would parse ``"0.5"``), containers without an order (a set,
-a dict), non-finite numbers, and an integer too large for a float (``10**400``).
+Refused everywhere: a bool where a number is asked (``True`` is not 1.0, in an array
+either), complex numbers, strings (numpy would parse ``"0.5"``), containers without an
+order (a set, a dict), masked arrays (numpy would drop the mask), non-finite numbers, and
+an integer too large for a float (``10**400``).
 
 Each refusal is an `InvalidValue` (a ValueError) or an `InvalidType` (a
 TypeError); both are `InputError`, which the command line reports as an input
@@ -55,7 +56,10 @@ def _shown(value, limit=80):
     long for repr is described by its size)."""
     if isinstance(value, int) and value.bit_length() > 3 * sys.get_int_max_str_digits():
         return f"an integer of {value.bit_length():,} bits"
-    text = " ".join(repr(value).split())         # an array's repr spans lines
+    try:
+        text = " ".join(repr(value).split())     # an array's repr spans lines
+    except ValueError:                           # it holds an int too long for repr
+        return f"a {type(value).__name__} holding an integer of more than {sys.get_int_max_str_digits()} digits"
     text = text if len(text) <= limit else text[:limit] + "..."
     return f"{type(value).__name__} {text}"
 
@@ -156,10 +160,15 @@ def real_array(name, value, *, low=None, high=None, low_open=False, high_open=Fa
         return InvalidType(f"{name} must be real numbers (a scalar or an array), got {_shown(value, 60)}")
 
     accepted = _accepted(low, high, low_open, high_open)
+    if isinstance(value, np.ma.MaskedArray):     # np.asarray would drop the mask
+        raise InvalidType(f"{name} must be real numbers (a scalar or an array), got a masked array: "
+                          f"fill it (numpy.ma.filled) or select its unmasked values (.compressed())")
     try:
         raw = np.asarray(value)
     except (TypeError, ValueError):              # a ragged list
         raise wrong_type() from None
+    if not isinstance(value, np.ndarray) and raw.dtype.kind in "iuf" and _holds_bool(value):
+        raise InvalidType(f"{name} must be real numbers, not bools (True is not 1.0), got {_shown(value, 60)}")
     if raw.dtype.kind == "O" and all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
                                      for x in raw.flat):
         try:
@@ -174,6 +183,15 @@ def real_array(name, value, *, low=None, high=None, low_open=False, high_open=Fa
         raise InvalidValue(f"{name} must be {accepted}, got {float(a.reshape(-1)[bad[0]])!r} "
                            f"at flat index {bad[0]}")
     return a
+
+
+def _holds_bool(value):
+    """Whether a nested list or tuple holds a bool (numpy reads ``[True, 0.5]`` as [1.0, 0.5])."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind == "b" or (value.dtype.kind == "O" and any(map(_holds_bool, value.flat)))
+    return isinstance(value, (list, tuple)) and any(map(_holds_bool, value))
 
 
 def vector3(name, value, *, low=None, high=None):
@@ -193,7 +211,7 @@ def vector3(name, value, *, low=None, high=None):
         raise InvalidType(f"{name} must be a sequence of 3 real numbers (a tuple, list or 1-D array), "
                           f"got {_shown(value)}")
     if len(value) != 3:
-        raise InvalidValue(f"{name} must have exactly 3 components, got {len(value)}: {value!r:.80}")
+        raise InvalidValue(f"{name} must have exactly 3 components, got {len(value)}: {_shown(value)}")
     return tuple(real(f"{name}[{i}]", c, low=low, high=high) for i, c in enumerate(value))
 
 

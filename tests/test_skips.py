@@ -269,6 +269,8 @@ def test_the_sweep_check_rejects_a_frame_of_another_step_and_a_wrong_census():
 @pytest.mark.parametrize("bad, match", [
     ((), "1 to 64"), ([1e-3, 0.0], r"eps_values\[1\]"), ([float("nan")], r"eps_values\[0\]"),
     ("1e-3", "sequence"), ([True], r"eps_values\[0\]"), ([1e-3] * 65, "1 to 64"),
+    (np.array(1e-3), "^eps_values must be a sequence"),          # a 0-d array: numpy's "iteration over a 0-d array"
+    pytest.param(10**5000, "^eps_values must be a sequence.* integer of", id="5001 digits"),  # its repr raised
 ])
 def test_sweep_rejects_bad_steps(bad, match):
     with pytest.raises((TypeError, ValueError), match=match):

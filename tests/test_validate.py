@@ -63,6 +63,10 @@ REFUSED = {
         (lambda: real_array("a", "0.5"), InvalidType, "a", "must be real numbers"),
         (lambda: real_array("a", [1, [2, 3]]), InvalidType, "a", "must be real numbers"),
         (lambda: real_array("a", np.array([0.5, True], dtype=object)), InvalidType, "a", "must be real numbers"),
+        (lambda: real_array("a", [True, 0.5]), InvalidType, "a", "not bools"),       # numpy reads [1.0, 0.5]
+        (lambda: real_array("a", [np.array([True]), np.array([0.5])]), InvalidType, "a", "not bools"),
+        (lambda: real_array("a", np.ma.masked_array([0.2, 0.5], mask=[True, False])), InvalidType, "a",
+         "masked array"),                                                            # numpy drops the mask
     ],
     "vector3": [
         (lambda: vector3("p", (1.0, 2.0)), InvalidValue, "p", "exactly 3 components"),
@@ -70,6 +74,7 @@ REFUSED = {
         (lambda: vector3("p", (0.0, 2.0, 0.0), low=0.0, high=1.0), InvalidValue, "p[1]", "must be in [0, 1]"),
         (lambda: vector3("p", np.array(0.5)), InvalidType, "p", "sequence of 3 real numbers"),
         (lambda: vector3("p", {0.5, 1.3, 2.0}), InvalidType, "p", "sequence of 3 real numbers"),
+        (lambda: vector3("p", [10**5000, 0.0]), InvalidValue, "p", "integer of more than"),   # repr would raise
     ],
     "flag": [
         (lambda: flag("f", 1), InvalidType, "f", "must be True or False"),
@@ -242,6 +247,17 @@ def test_each_pointwise_argument_is_wired_to_its_range(function):
             assert all_finite(call(function, **{argument: limit})), (argument, limit)
             _, message = refusal(lambda: call(function, **{argument: beyond}))
             assert message.startswith(f"{argument} must be in ") and "flat index 0" in message, message
+
+
+@pytest.mark.parametrize("point, error", [(b"abc", InvalidType), ({0.1, 0.2, 0.3}, InvalidType),
+                                          ((c for c in (0.1, 0.2, 0.3)), InvalidType), (0.5, InvalidType),
+                                          ((0.1, 0.2), InvalidValue), ([10**5000, 0.0], InvalidValue)])
+def test_a_footprint_point_is_a_tuple_list_or_array_of_three(point, error):
+    """Bytes, a set (no order) and a generator were read as three components; a huge integer's
+    repr raised a ValueError that named nothing."""
+    got, message = refusal(lambda: call("footprint", P=point))
+    assert got is error and message.startswith("P must ") and "three components" in message, message
+    assert all_finite(call("footprint", P=np.array([[0.1, 0.2], [0.1, 0.2], [0.99, 0.97]])))
 
 
 def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():
