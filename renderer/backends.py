@@ -9,7 +9,12 @@ environment variable ``DRJIT_LIBLLVM_PATH`` when it is set (set it to a path
 that does not exist to switch the backend off), else the newest
 ``libLLVM-*.so*`` of at least that version in the system's library
 directories.  Without one, `drjit_llvm` returns None and the numba kernel
-renders.
+renders.  A library that cannot serve may kill the process that loads it (a
+truncated file: SIGBUS), so Dr.Jit loads it first in a child process (`probe`,
+once per process): a refusal is one sentence naming the path and Dr.Jit's own
+words, which it would otherwise print on stderr.  Dr.Jit's traces, frozen
+functions and kernel launches are not safe from several threads at once (the
+process aborts): the renderer runs them under one lock, `DRJIT_LOCK`.
 
 The array namespaces (`NumpyNamespace`, `DrJitNamespace`) are what the
 branch-free array kernel (`renderer.arraykernel`) and the generated array
@@ -19,10 +24,15 @@ functions, ``select`` and the conversion of a frame's outputs to numpy.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import glob
 import os
 import re
+import signal
+import subprocess
+import sys
+import threading
 
 import numpy as np
 
@@ -59,21 +69,71 @@ def llvm_library():
     return max(found, key=lambda p: (library_version(p), p), default=None)
 
 
+#: Held by every use of Dr.Jit by the renderer (`DrJitNamespace.scope`, loading it): Dr.Jit's
+#: frozen functions and traces are not thread-safe (four threads rendering at once aborted the
+#: process: "jit_var(...): unknown variable!").  Reentrant: a render loads Dr.Jit under it.
+DRJIT_LOCK = threading.RLock()
+
+#: What the child process of `probe` runs: the LLVM version Dr.Jit loaded, or nothing.
+_PROBE = ("import drjit\n"
+          "if drjit.has_backend(drjit.JitBackend.LLVM):\n"
+          "    print(drjit.detail.llvm_version()[0])\n")
+#: Longest the child of `probe` may take (seconds): it imports Dr.Jit and loads LLVM (0.2 s here).
+PROBE_TIMEOUT = 60
+
+
 @functools.cache
+def probe(path):
+    """(LLVM major version, None) when Dr.Jit's LLVM backend initialises with the library
+    ``path``, else (None, why): tried in a child process (``DRJIT_LIBLLVM_PATH=path``), since
+    loading a broken library can kill the process (a truncated file: SIGBUS), and Dr.Jit's
+    own lines on stderr are returned in ``why`` rather than printed.  Cached per path."""
+    try:
+        child = subprocess.run([sys.executable, "-P", "-c", _PROBE], stdin=subprocess.DEVNULL, capture_output=True,
+                               text=True, env={**os.environ, "DRJIT_LIBLLVM_PATH": path}, timeout=PROBE_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        return None, f"loading it took more than {PROBE_TIMEOUT} s"
+    except OSError as exc:
+        return None, f"no process could be started to load it ({exc.strerror})"
+    said = "; ".join(" ".join(line.split()) for line in child.stderr.splitlines() if line.strip())[-400:]
+    if child.returncode < 0:
+        try:
+            name = signal.Signals(-child.returncode).name
+        except ValueError:
+            name = f"signal {-child.returncode}"
+        return None, f"loading it killed the child process that tried ({name})" + (f": {said}" if said else "")
+    if child.returncode or not child.stdout.strip().isdigit():
+        return None, f"Dr.Jit could not load it: {said or 'no reason given'}"
+    return int(child.stdout), None
+
+
 def drjit_llvm():
     """The ``drjit.llvm`` module when Dr.Jit's LLVM backend works on this machine, else None.
 
-    Sets ``DRJIT_LIBLLVM_PATH`` to `llvm_library` (if unset) before Dr.Jit
-    is first imported, then asks Dr.Jit whether the backend initialised.
-    Never raises: a missing wheel or library, or an LLVM older than
+    Checks `llvm_library` with `probe` (in a child process) before Dr.Jit is
+    first imported here, sets ``DRJIT_LIBLLVM_PATH`` to it (if unset), then asks
+    Dr.Jit whether the backend initialised; its warnings are silenced (its
+    errors raise).  Decided once per process.  Never raises: a missing wheel or
+    library, a library that cannot be loaded, or an LLVM older than
     `MIN_LLVM_VERSION` (which would abort the process on the first frame), is None.
     """
+    with DRJIT_LOCK:
+        return _drjit_llvm()
+
+
+@functools.cache
+def _drjit_llvm():
+    import importlib.util
     path = llvm_library()
-    if path is None or not os.path.isfile(path):    # Dr.Jit would print its own failure on stderr
+    if path is None or not os.path.isfile(path) or importlib.util.find_spec("drjit") is None:
+        return None
+    version, _ = probe(path)
+    if version is None or version < MIN_LLVM_VERSION:
         return None
     os.environ.setdefault("DRJIT_LIBLLVM_PATH", path)
     try:
         import drjit
+        drjit.set_log_level(drjit.LogLevel.Error)
         if not drjit.has_backend(drjit.JitBackend.LLVM) or drjit.detail.llvm_version()[0] < MIN_LLVM_VERSION:
             return None
         import drjit.llvm
@@ -158,10 +218,13 @@ class DrJitNamespace:
             a = self.Float64(a)
         return self.dr.select(cond, a, b)
 
+    @contextlib.contextmanager
     def scope(self):
-        """Context of a render: Dr.Jit's FastMath off while the frame is traced (it
-        would fold a * 0 to 0 also where a is inf or NaN; IEEE arithmetic, as numba's)."""
-        return self.dr.scoped_set_flag(self.dr.JitFlag.FastMath, False)
+        """Context of a render: `DRJIT_LOCK` held (one thread at a time traces, freezes and
+        launches), and Dr.Jit's FastMath off while the frame is traced (it would fold
+        a * 0 to 0 also where a is inf or NaN; IEEE arithmetic, as numba's)."""
+        with DRJIT_LOCK, self.dr.scoped_set_flag(self.dr.JitFlag.FastMath, False):
+            yield
 
     def grid(self, cols, rows):
         """As `NumpyNamespace.grid`, gathered inside the kernel from the two short arrays."""
@@ -229,24 +292,47 @@ def missing(name):
     """Why backend ``name`` cannot run here and how to get it (a sentence), or None when it can."""
     if name != "drjit" or drjit_llvm() is not None:
         return None
+    return f"Dr.Jit's LLVM backend is unavailable: {_why_not()}; {_REMEDY}"
+
+
+_REMEDY = (f"install the system's LLVM (Debian: apt-get install libllvm19) or set DRJIT_LIBLLVM_PATH to a "
+           f"libLLVM-*.so of LLVM {MIN_LLVM_VERSION} or newer, or use backend 'numba' or 'auto'")
+
+
+def _why_not():
+    """What keeps Dr.Jit's LLVM backend off (`drjit_llvm` is None), naming the library's path."""
+    import importlib.util
     path = llvm_library()
     if path is None:
-        found = (f"no libLLVM shared library of LLVM {MIN_LLVM_VERSION} or newer was found ("
-                 + ", ".join(LIBRARY_PATTERNS) + ")")
-    elif not os.path.isfile(path):
-        found = f"DRJIT_LIBLLVM_PATH is {path!r}, not a file"
-    elif (library_version(path) or MIN_LLVM_VERSION) < MIN_LLVM_VERSION:
-        found = f"the LLVM library {path!r} is older than LLVM {MIN_LLVM_VERSION}"
-    else:
-        found = f"Dr.Jit could not load the LLVM library {path!r}"
-    return (f"Dr.Jit's LLVM backend is unavailable: {found}; install the system's LLVM (Debian: "
-            f"apt-get install libllvm19) or set DRJIT_LIBLLVM_PATH to a libLLVM-*.so of LLVM "
-            f"{MIN_LLVM_VERSION} or newer, or use backend 'numba' or 'auto'")
+        return (f"no libLLVM shared library of LLVM {MIN_LLVM_VERSION} or newer was found ("
+                + ", ".join(LIBRARY_PATTERNS) + ")")
+    if not os.path.isfile(path):
+        return f"DRJIT_LIBLLVM_PATH is {path!r}, not a file"
+    if importlib.util.find_spec("drjit") is None:
+        return "the drjit package is not installed"
+    named = f"DRJIT_LIBLLVM_PATH={path!r}" if "DRJIT_LIBLLVM_PATH" in os.environ else f"the LLVM library {path!r}"
+    version, why = probe(path)
+    if version is None:
+        return f"{named} cannot serve: {why}"
+    if version < MIN_LLVM_VERSION:
+        return f"{named} is older than LLVM {MIN_LLVM_VERSION} (it is LLVM {version})"
+    return f"Dr.Jit could not load the LLVM library {path!r}"
+
+
+@functools.cache
+def _note_fallback():
+    """One line on stderr, once per process, when "auto" renders with numba although a
+    libLLVM file is named or found (it cannot serve): silent where there is none, or where
+    ``DRJIT_LIBLLVM_PATH`` names no file (how the backend is switched off)."""
+    path = llvm_library()
+    if path is not None and os.path.isfile(path) and sys.stderr is not None:
+        print(f"symrender: backend 'auto' renders with numba: {_why_not()}", file=sys.stderr)
 
 
 def resolve(name):
     """The backend that renders for an accepted ``name`` of `BACKENDS`: "auto" is
-    "drjit" where Dr.Jit's LLVM backend works, else "numba".
+    "drjit" where Dr.Jit's LLVM backend works, else "numba" (with one line on stderr,
+    once per process, when a libLLVM file exists but cannot serve: `_note_fallback`).
 
     Raises
     ------
@@ -255,7 +341,10 @@ def resolve(name):
         message says what is missing and how to get it).
     """
     if name == "auto":
-        return "drjit" if drjit_llvm() is not None else "numba"
+        if drjit_llvm() is not None:
+            return "drjit"
+        _note_fallback()
+        return "numba"
     why = missing(name)
     if why is not None:
         raise InvalidValue(f"backend must be one of {', '.join(map(repr, BACKENDS))} available on this "

@@ -15,8 +15,11 @@ stderr); ``-o -`` on a terminal; option abbreviations, and negative values after
 (``--eps=-1e-3`` works); digits of other scripts; huge values repeated in messages; TOML
 nested thousands deep (a RecursionError, exit 1); integers beyond a float (the library
 names them); scene files that are FIFOs, devices or huge; unwritable directories (found
-at the write); file names stdout cannot encode; a bad ``NUMBA_NUM_THREADS``; matplotlib's
-warnings about an unwritable home. There are no progress bars.
+at the write); file names stdout cannot encode; matplotlib's warnings about an unwritable
+home. There are no progress bars.  ``NUMBA_NUM_THREADS`` other than an integer in [1,
+`renderer.validate.MAX_THREADS`] is refused before numba reads it (numba's pool segfaulted
+at 100000), and a ``--set`` value spanning lines (TOML would read the second as a key of
+its own, dropped) is refused.
 """
 
 from __future__ import annotations
@@ -225,8 +228,8 @@ def load_scene(path=None, sets=()):
     overrides = {}
     for item in sets:
         key, eq, text = item.partition("=")
-        if not eq:
-            raise UsageError(f"--set expects key=value, got {item!r}")
+        if not eq or "\n" in item or "\r" in item:
+            raise UsageError(f"--set expects key=value on one line, got {item!r:.200}")
         overrides[key.strip()] = _toml_value(text)
     return _replace(scene, overrides, "--set")
 
@@ -422,6 +425,9 @@ def _emit(stream, data, name):
 
 def _run(argv):
     args = build_parser().parse_args(argv)
+    if "NUMBA_NUM_THREADS" in os.environ:          # before numba reads it (0 fails its import)
+        from renderer.validate import thread_count
+        thread_count("NUMBA_NUM_THREADS", os.environ["NUMBA_NUM_THREADS"])
     report, outputs = _COMMANDS[args.command](args)
     _stop_if_signalled()
     on_stdout = any(path == "-" for path, _ in outputs)      # then the report goes to stderr

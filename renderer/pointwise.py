@@ -31,7 +31,7 @@ from . import formulas as F
 from . import generated as G
 from .render import GBuffer
 from .scene import COORDINATE, FREQUENCY, RADIUS, UNIT, Scene
-from .validate import InvalidType, InvalidValue, flag, real_array
+from .validate import InvalidType, InvalidValue, _shown, flag, real_array
 
 __all__ = ["height", "exact_gradient", "central_gradient", "kink_band", "chart", "tangent_frame",
            "footprint", "reach", "RANGES", "RANGES_CENTRAL", "RANGES_FRAME", "MIN_STEP"]
@@ -102,14 +102,15 @@ def _evaluate(loop, k, lead, names, args, ranges=RANGES):
 
 
 def _triple(name, value):
-    """``value`` as three components (x, y, z), or ValueError naming ``name``."""
-    try:
-        parts = tuple(value)
-    except TypeError:
-        parts = ()
-    if len(parts) != 3:
-        raise InvalidValue(f"{name} must have three components (x, y, z), got {value!r:.60}")
-    return parts
+    """``value`` as three components (x, y, z): a tuple, a list or an array whose first axis has
+    length 3; TypeError for another kind (a set, bytes, a generator), ValueError for another
+    length, each naming ``name``."""
+    if not isinstance(value, (tuple, list, np.ndarray)) or np.ndim(value) == 0:
+        raise InvalidType(f"{name} must be three components (x, y, z): a tuple, list or array, "
+                          f"got {_shown(value, 60)}")
+    if len(value) != 3:
+        raise InvalidValue(f"{name} must have three components (x, y, z), got {len(value)}: {_shown(value, 60)}")
+    return tuple(value)
 
 
 _UV = ("u", "v", "k_u", "k_v")
@@ -231,8 +232,9 @@ def footprint(x, y, dx, dy, camera_z, P, N, e_theta, e_phi, radius, sin_phi):
     Raises
     ------
     TypeError, ValueError
-        As the module says; ValueError also for a P, N, e_theta or e_phi that
-        is not three components.
+        As the module says; TypeError also for a P, N, e_theta or e_phi that is
+        not a tuple, list or array (a set, bytes, a generator), ValueError for
+        one that is not three components.
     """
     P, N, e_theta, e_phi = (_triple(n, t) for n, t in (("P", P), ("N", N), ("e_theta", e_theta),
                                                         ("e_phi", e_phi)))

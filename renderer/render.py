@@ -155,10 +155,14 @@ def bands(height, width):
 def threads(workers):
     """Run the kernel inside the block, alone (`_KERNEL_LOCK`), its rows on
     ``workers`` threads (None: numba's count, the machine's cores; at most
-    that many), and restore numba's thread count after."""
+    that many), and restore numba's thread count after.  Numba's count
+    (``NUMBA_NUM_THREADS``) must be in [1, `renderer.validate.MAX_THREADS`]:
+    numba would launch that many threads (100000 segfaulted), so a larger one
+    is refused (InvalidValue) before any is launched."""
+    most = validate.thread_count("NUMBA_NUM_THREADS", numba.config.NUMBA_NUM_THREADS)
     with _KERNEL_LOCK:
         before = numba.get_num_threads()
-        numba.set_num_threads(min(int(workers or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
+        numba.set_num_threads(min(int(workers or most), most))
         try:
             yield
         finally:
@@ -234,9 +238,11 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
         True: only the work the outputs need (see `renderer.kernel`).  False:
         the reference path that skips nothing; both give the same bits.
     workers : int in [1, 64] or None, keyword-only
-        Threads rendering rows side by side (None: numba's default, the
-        machine's cores).  The image is the same bits for any number.
-        The numba backend's; Dr.Jit runs on its own thread pool.
+        Threads rendering rows side by side (None: numba's count,
+        ``NUMBA_NUM_THREADS`` or the machine's cores; never more than that
+        count).  The image is the same bits for any number.  The numba
+        backend's; Dr.Jit runs on its own thread pool, and one render at a
+        time uses it (`renderer.backends.DRJIT_LOCK`: other threads wait).
     backend : {"numba", "drjit", "auto", "numpy"}, keyword-only
         "numba": the per-pixel kernel (`renderer.kernel`), the book's.
         "drjit": the branch-free array kernel (`renderer.arraykernel`, the
@@ -267,8 +273,9 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     ValueError
         A size outside [1, 8192], an unknown ``gradient`` or ``backend``,
         ``zoom`` outside [1, 1e6], ``workers`` outside [1, 64];
-        ``backend="drjit"`` where Dr.Jit's LLVM backend is unavailable (the
-        message says what is missing and how to install it).
+        ``NUMBA_NUM_THREADS`` outside [1, `renderer.validate.MAX_THREADS`]
+        (numba backend); ``backend="drjit"`` where Dr.Jit's LLVM backend is
+        unavailable (the message says what is missing and how to install it).
 
     Notes
     -----

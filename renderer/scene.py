@@ -11,7 +11,7 @@ from dataclasses import dataclass, field, fields
 from functools import lru_cache
 
 from . import formulas
-from .validate import InvalidType, InvalidValue, choice, flag, real, vector3
+from .validate import InvalidType, InvalidValue, _shown, choice, flag, real, vector3
 
 __all__ = ["PointLight", "Scene", "DRAFT_SCENE", "MODELS", "BUMPS"]
 
@@ -199,12 +199,12 @@ class Scene:
         if isinstance(lights, PointLight):
             raise InvalidType("Scene.lights must be a sequence of PointLight, got a single PointLight")
         if not isinstance(lights, (tuple, list)):
-            raise InvalidType(f"Scene.lights must be a tuple of PointLight, got {lights!r:.80}")
+            raise InvalidType(f"Scene.lights must be a tuple of PointLight, got {_shown(lights)}")
         if len(lights) > MAX_LIGHTS:     # each light costs a shadow ray per pixel
             raise InvalidValue(f"Scene.lights holds at most {MAX_LIGHTS} lights, got {len(lights):,}")
         for i, light in enumerate(lights):
             if not isinstance(light, PointLight):
-                raise InvalidType(f"Scene.lights[{i}] must be a PointLight, got {light!r:.80}")
+                raise InvalidType(f"Scene.lights[{i}] must be a PointLight, got {_shown(light)}")
         set_("lights", tuple(lights))
         set_("ambient", vector3("Scene.ambient", self.ambient, **INTENSITY))
         set_("albedo_a", vector3("Scene.albedo_a", self.albedo_a, **UNIT))

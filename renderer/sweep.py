@@ -60,8 +60,10 @@ def _check_steps(eps_values):
     (a set or a mapping: the census is reported in the order of the steps);
     ValueError for no steps, more than `MAX_STEPS`, or a step outside
     [`MIN_EPS`, `MAX_EPS`] (naming its index)."""
-    if isinstance(eps_values, (str, bytes)) or not hasattr(eps_values, "__iter__"):
-        raise validate.InvalidType(f"eps_values must be a sequence of positive numbers, got {eps_values!r:.80}")
+    if (isinstance(eps_values, (str, bytes)) or not hasattr(eps_values, "__iter__")
+            or np.ndim(eps_values) == 0 and isinstance(eps_values, np.ndarray)):    # 0-d: not iterable
+        raise validate.InvalidType(f"eps_values must be a sequence of positive numbers, got "
+                                   f"{validate._shown(eps_values)}")
     if isinstance(eps_values, (collections.abc.Set, collections.abc.Mapping,
                                collections.abc.KeysView, collections.abc.ValuesView)):
         raise validate.InvalidType(f"eps_values must be ordered (a list, tuple, array or iterator), got a "

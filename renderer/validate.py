@@ -12,11 +12,13 @@ command line (``symrender``) check their arguments with these functions:
 * a flag (`flag`): ``True`` or ``False`` (Python's or numpy's);
 * a choice (`choice`): one of a tuple of strings;
 * a positive integer (`positive_int`): an ``int`` or numpy integer >= 1;
-* steps (`steps`): a non-empty array of step sizes within a range.
+* steps (`steps`): a non-empty array of step sizes within a range;
+* a thread count (`thread_count`): numba's ``NUMBA_NUM_THREADS``, in [1, `MAX_THREADS`].
 
-Refused everywhere: a bool where a number is asked (``True`` is not 1.0), complex
-numbers, strings (numpy would parse ``"0.5"``), containers without an order (a set,
-a dict), non-finite numbers, and an integer too large for a float (``10**400``).
+Refused everywhere: a bool where a number is asked (``True`` is not 1.0, in an array
+either), complex numbers, strings (numpy would parse ``"0.5"``), containers without an
+order (a set, a dict), masked arrays (numpy would drop the mask), non-finite numbers, and
+an integer too large for a float (``10**400``).
 
 Each refusal is an `InvalidValue` (a ValueError) or an `InvalidType` (a
 TypeError); both are `InputError`, which the command line reports as an input
@@ -27,12 +29,13 @@ and what is accepted.
 from __future__ import annotations
 
 import numbers
+import os
 import sys
 
 import numpy as np
 
 __all__ = ["InputError", "InvalidValue", "InvalidType", "real", "real_array", "vector3", "flag",
-           "choice", "positive_int", "steps"]
+           "choice", "positive_int", "steps", "thread_count", "MAX_THREADS"]
 
 
 class InputError(Exception):
@@ -53,7 +56,10 @@ def _shown(value, limit=80):
     long for repr is described by its size)."""
     if isinstance(value, int) and value.bit_length() > 3 * sys.get_int_max_str_digits():
         return f"an integer of {value.bit_length():,} bits"
-    text = " ".join(repr(value).split())         # an array's repr spans lines
+    try:
+        text = " ".join(repr(value).split())     # an array's repr spans lines
+    except ValueError:                           # it holds an int too long for repr
+        return f"a {type(value).__name__} holding an integer of more than {sys.get_int_max_str_digits()} digits"
     text = text if len(text) <= limit else text[:limit] + "..."
     return f"{type(value).__name__} {text}"
 
@@ -154,10 +160,15 @@ def real_array(name, value, *, low=None, high=None, low_open=False, high_open=Fa
         return InvalidType(f"{name} must be real numbers (a scalar or an array), got {_shown(value, 60)}")
 
     accepted = _accepted(low, high, low_open, high_open)
+    if isinstance(value, np.ma.MaskedArray):     # np.asarray would drop the mask
+        raise InvalidType(f"{name} must be real numbers (a scalar or an array), got a masked array: "
+                          f"fill it (numpy.ma.filled) or select its unmasked values (.compressed())")
     try:
         raw = np.asarray(value)
     except (TypeError, ValueError):              # a ragged list
         raise wrong_type() from None
+    if not isinstance(value, np.ndarray) and raw.dtype.kind in "iuf" and _holds_bool(value):
+        raise InvalidType(f"{name} must be real numbers, not bools (True is not 1.0), got {_shown(value, 60)}")
     if raw.dtype.kind == "O" and all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_))
                                      for x in raw.flat):
         try:
@@ -172,6 +183,15 @@ def real_array(name, value, *, low=None, high=None, low_open=False, high_open=Fa
         raise InvalidValue(f"{name} must be {accepted}, got {float(a.reshape(-1)[bad[0]])!r} "
                            f"at flat index {bad[0]}")
     return a
+
+
+def _holds_bool(value):
+    """Whether a nested list or tuple holds a bool (numpy reads ``[True, 0.5]`` as [1.0, 0.5])."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind == "b" or (value.dtype.kind == "O" and any(map(_holds_bool, value.flat)))
+    return isinstance(value, (list, tuple)) and any(map(_holds_bool, value))
 
 
 def vector3(name, value, *, low=None, high=None):
@@ -191,7 +211,7 @@ def vector3(name, value, *, low=None, high=None):
         raise InvalidType(f"{name} must be a sequence of 3 real numbers (a tuple, list or 1-D array), "
                           f"got {_shown(value)}")
     if len(value) != 3:
-        raise InvalidValue(f"{name} must have exactly 3 components, got {len(value)}: {value!r:.80}")
+        raise InvalidValue(f"{name} must have exactly 3 components, got {len(value)}: {_shown(value)}")
     return tuple(real(f"{name}[{i}]", c, low=low, high=high) for i, c in enumerate(value))
 
 
@@ -277,6 +297,32 @@ def steps(name, value, *, low, high, high_open=False, max_count=None):
         count = "at least one step" if max_count is None else f"1 to {max_count} steps"
         raise InvalidValue(f"{name} must hold {count}, got {a.size}")
     return a
+
+
+#: Most threads `thread_count` accepts: 64, or the machine's CPUs where it has more (numba's
+#: default is one per CPU).  NUMBA_NUM_THREADS=100000 made numba's thread pool segfault.
+MAX_THREADS = max(64, os.cpu_count() or 1)
+
+
+def thread_count(name, value):
+    """``value``, a count of threads (an int, or the text of an environment variable such as
+    numba's ``NUMBA_NUM_THREADS``), as an int in [1, `MAX_THREADS`].
+
+    Raises
+    ------
+    InvalidValue
+        Not the digits of an integer, or outside [1, `MAX_THREADS`] (the message names
+        ``name``, the value and the range).
+    """
+    try:
+        n = int(value) if isinstance(value, (int, str)) and not isinstance(value, bool) else None
+    except ValueError:
+        n = None
+    if n is None or not 1 <= n <= MAX_THREADS:
+        shown = repr(value[:40]) + ("..." if len(value) > 40 else "") if isinstance(value, str) else _shown(value)
+        raise InvalidValue(f"{name} must be an integer in [1, {MAX_THREADS}] (a count of threads: at most 64, "
+                           f"or this machine's CPUs where more), got {shown}")
+    return n
 
 
 #: Longest expression text accepted (characters): a height field or a function is a formula, not a program.

@@ -128,26 +128,101 @@ def test_discovery_takes_the_newest_llvm_that_is_new_enough(tmp_path, monkeypatc
     assert backends.llvm_library() == str(tmp_path / "d" / f"libLLVM-{backends.MIN_LLVM_VERSION + 2}.so.1")
 
 
-def test_a_loaded_llvm_older_than_the_minimum_is_refused(tmp_path):
-    """DRJIT_LIBLLVM_PATH may name any library: the version Dr.Jit loaded decides (here
-    Dr.Jit is told it loaded one version below and then the minimum), and the refusal
-    names the library and the minimum.  In a fresh process: Dr.Jit loads LLVM once."""
-    path = tmp_path / "libLLVM-15.so"
+def test_a_loaded_llvm_older_than_the_minimum_is_refused(tmp_path, monkeypatch):
+    """DRJIT_LIBLLVM_PATH may name any library: the version Dr.Jit loaded (in `backends.probe`'s
+    child process, here a stand-in) decides, and the refusal names the variable, the library
+    and the minimum."""
+    path = tmp_path / "libLLVM-99.so"
     path.write_bytes(b"")
-    code = ("import drjit\n"
-            "from renderer import backends\n"
-            "drjit.has_backend = lambda backend: True\n"
-            "for version in (backends.MIN_LLVM_VERSION - 1, backends.MIN_LLVM_VERSION):\n"
-            "    drjit.detail.llvm_version = lambda: (version, 0, 6)\n"
-            "    print(backends.drjit_llvm.__wrapped__() is not None)\n"
-            "backends.drjit_llvm = lambda: None\n"
-            "print(backends.missing('drjit'))\n")
+    monkeypatch.setenv("DRJIT_LIBLLVM_PATH", str(path))
+    monkeypatch.setattr(backends, "probe", lambda p: (backends.MIN_LLVM_VERSION - 1, None))
+    assert backends._drjit_llvm.__wrapped__() is None
+    monkeypatch.setattr(backends, "drjit_llvm", lambda: None)
+    assert (f"DRJIT_LIBLLVM_PATH={str(path)!r} is older than LLVM {backends.MIN_LLVM_VERSION} (it is LLVM "
+            f"{backends.MIN_LLVM_VERSION - 1})") in backends.missing("drjit")
+
+
+#: A libLLVM cut short (its first 100,000 bytes): loading it kills the process with SIGBUS.
+TRUNCATED = 100_000
+
+
+@pytest.mark.parametrize("how", ["truncated", "not a library"])
+def test_a_library_that_cannot_load_is_refused_in_one_line_and_auto_renders_with_numba(tmp_path, how):
+    """DRJIT_LIBLLVM_PATH naming a truncated libLLVM (before: the process died of SIGBUS, no
+    message, under ``auto`` too) or a file that is no library (before: Dr.Jit's two lines on
+    stderr): ``--backend drjit`` is one line naming the variable and the path, exit 2;
+    ``--backend auto`` renders the numba frame after one line saying why."""
+    library = backends.llvm_library() if how == "truncated" else None
+    if how == "truncated" and (library is None or not os.path.isfile(library)):
+        require_backend("drjit")
+    path = tmp_path / "libLLVM-20.so"
+    path.write_bytes(open(library, "rb").read(TRUNCATED) if library else b"not an ELF file\n" * 100)
     env = {**os.environ, "DRJIT_LIBLLVM_PATH": str(path)}
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
-    assert result.returncode == 0, result.stderr
-    usable_below, usable_at, refusal = result.stdout.splitlines()
-    assert (usable_below, usable_at) == ("False", "True")
-    assert f"{str(path)!r} is older than LLVM {backends.MIN_LLVM_VERSION}" in refusal
+    argv = [sys.executable, "-m", "renderer.cli", "render", "--size", "8x8", "-o"]
+    refused = subprocess.run(argv + [str(tmp_path / "a.png"), "--backend", "drjit"], capture_output=True,
+                             text=True, env=env, timeout=300)
+    assert (refused.returncode, len(refused.stderr.splitlines())) == (2, 1), refused
+    assert f"DRJIT_LIBLLVM_PATH={str(path)!r}" in refused.stderr and not (tmp_path / "a.png").exists()
+    if how == "truncated":
+        assert "SIGBUS" in refused.stderr
+    auto = subprocess.run(argv + [str(tmp_path / "b.png"), "--backend", "auto"], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert auto.returncode == 0, auto
+    assert auto.stderr.splitlines() == [auto.stderr.strip()] and "renders with numba" in auto.stderr, auto.stderr
+    numba = subprocess.run(argv + [str(tmp_path / "c.png")], capture_output=True, text=True, env=env, timeout=300)
+    assert (tmp_path / "b.png").read_bytes() == (tmp_path / "c.png").read_bytes()
+
+
+def test_the_probe_reads_the_childs_death_and_words(monkeypatch):
+    """`backends.probe` in its three outcomes, from a stand-in child: a version, Dr.Jit's words
+    (one line, not printed), a death by signal (named)."""
+    said = "import sys; print('jit_find_library(): Unable to load', file=sys.stderr); print('x', file=sys.stderr)"
+    for code, want in [("print(19)", (19, None)),
+                       (said, (None, "Dr.Jit could not load it: jit_find_library(): Unable to load; x")),
+                       ("import os, signal; os.kill(os.getpid(), signal.SIGBUS)",
+                        (None, "loading it killed the child process that tried (SIGBUS)"))]:
+        monkeypatch.setattr(backends, "_PROBE", code)
+        assert backends.probe.__wrapped__("/any/libLLVM.so") == want
+
+
+THREADED = """
+import sys, threading
+import numpy as np
+from renderer import Scene, render
+jobs = [(Scene(), 32, 24), (Scene(height_field="ridges"), 40, 16), (Scene(beta=0.8), 16, 32)]
+threads, repeats = int(sys.argv[1]), int(sys.argv[2])
+frames, start = {}, threading.Barrier(threads)
+def work(i):
+    start.wait()
+    for r in range(repeats):
+        k = (i + r) % len(jobs)
+        frames[i, r] = k, render(*jobs[k], backend="drjit").image
+workers = [threading.Thread(target=work, args=(i,)) for i in range(threads)]
+for t in workers:
+    t.start()
+for t in workers:
+    t.join()
+alone = [render(*job, backend="drjit").image for job in jobs]
+print(len(frames), sum(not np.array_equal(image, alone[k]) for k, image in frames.values()))
+"""
+
+
+@pytest.mark.parametrize("threads", [4])
+def test_drjit_renders_from_several_threads_at_once_as_from_one(threads):
+    """Four threads rendering on Dr.Jit at once, 30 frames each: every frame is the one rendered
+    alone, nothing on stderr, within 120 s (3 s here).  Before `backends.DRJIT_LOCK` the
+    process aborted ("jit_var(...): unknown variable!"), a replay raised ("Kernel input
+    variable ... not allocated"), Dr.Jit printed "The frozen function has been recorded 11
+    times", or the threads spun for minutes.  In a child process: the failure can kill it."""
+    require_backend("drjit")
+    repeats = 30
+    try:
+        child = subprocess.run([sys.executable, "-c", THREADED, str(threads), str(repeats)], capture_output=True,
+                               text=True, timeout=120)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"{threads} threads rendering on Dr.Jit did not finish in 120 s")
+    assert (child.returncode, child.stderr) == (0, ""), child.stderr[-2000:]
+    assert child.stdout.split() == [str(threads * repeats), "0"]
 
 
 def test_auto_is_drjit_where_it_is_available():

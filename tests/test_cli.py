@@ -233,6 +233,7 @@ def test_scene_file_errors_name_the_file_and_the_key(tmp_path, capsys, text, pat
     (["render", "--view", "sideways", "-o", "OUT"], "--view"),                     # argparse
     (["render", "--size", "64", "-o", "OUT"], "--size"),                           # the command's parser
     (["render", "--set", "beta", "-o", "OUT"], "--set"),
+    (["render", "--set", "beta=0.5\nradius_a=2", "-o", "OUT"], "--set"),        # TOML dropped the second line
     (["render", "--set", "beta=-1", "-o", "OUT"], "beta"),                         # the library: Scene
     (["render", "--size", "0x8", "-o", "OUT"], "width"),                           # render
     (["sweep", "--eps", "1e-3,0.5", "--size", "8x8"], "--eps"),                    # sweep's steps

@@ -33,15 +33,35 @@ def test_a_page_that_fails_is_named_with_its_exception_on_the_console(tmp_path, 
     monkeypatch.setenv("NUMBA_NUM_THREADS", "1")
     (tmp_path / "page.md").write_text(PAGE, encoding="utf-8")
     (tmp_path / "plain.md").write_text("# No code\n", encoding="utf-8")
-    env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60),
-                          doc2path=lambda d: str(tmp_path / f"{d}.md"))
-    app = SimpleNamespace(env=env, outdir=str(tmp_path / "html"),
-                          config=SimpleNamespace(execute_pages_first=[], execute_pages_last=[],
-                                                 nb_execution_cache_path=str(tmp_path / "cache")))
+    app = _app(tmp_path)
     with caplog.at_level(logging.WARNING):
-        execute_pages._execute(app, env, ["page", "plain"])
+        execute_pages._execute(app, app.env, ["page", "plain"])
     assert [r.getMessage() for r in caplog.records if "failed to execute" in r.getMessage()] == [
         "page failed to execute: ClaimChanged: h3-scale: registered 'holds', computed 'does not hold' (ratio 2.1)"]
+
+
+def _app(tmp_path):
+    """A stand-in for Sphinx's application: the pages are ``tmp_path/<name>.md``, the cache beside them."""
+    env = SimpleNamespace(mystnb_config=SimpleNamespace(execution_mode="cache", execution_timeout=60),
+                          doc2path=lambda d: str(tmp_path / f"{d}.md"))
+    return SimpleNamespace(env=env, outdir=str(tmp_path / "html"),
+                           config=SimpleNamespace(execute_pages_first=[], execute_pages_last=[],
+                                                  nb_execution_cache_path=str(tmp_path / "cache")))
+
+
+def test_the_page_kernels_start_without_ipykernels_tcp_warning(tmp_path, capfd, monkeypatch):
+    """ipykernel logs "Kernel is running over TCP without encryption" at every start, on the
+    build's stderr (nine lines a `make book`): the pool's kernels log errors only, and still run
+    the page (it is cached)."""
+    from jupyter_cache import get_cache
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "1")        # as in the test above
+    (tmp_path / "page.md").write_text(NOTEBOOK_FRONT_MATTER + "\n# A page\n\n```{code-cell}\nx = 1\n```\n",
+                                      encoding="utf-8")
+    app = _app(tmp_path)
+    execute_pages._execute(app, app.env, ["page"])
+    err = capfd.readouterr().err
+    assert "without encryption" not in err, err
+    assert len(get_cache(str(tmp_path / "cache")).list_cache_records()) == 1
 
 
 def test_the_cause_is_the_exception_line_without_colours():

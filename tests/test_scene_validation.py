@@ -162,6 +162,15 @@ def test_huge_finite_values_are_refused_not_overflowed():
         assert message.startswith(f"Scene.{field}"), message
 
 
+def test_an_integer_too_long_to_print_is_described_by_name():
+    """Python refuses to print an int of more than 4300 digits: the message describes it, naming
+    the field (the repr once raised a ValueError that named nothing)."""
+    for kwargs, field in ((dict(lights=10**5000), "lights"), (dict(lights=[10**5000]), "lights[0]"),
+                          (dict(center_b=[10**5000, 0.0]), "center_b")):
+        _, message = refusal(lambda: Scene(**kwargs))
+        assert message.startswith(f"Scene.{field} ") and "integer of" in message, message
+
+
 # --- each argument of the entry points ----------------------------------------------------
 
 _SCENE = Scene()

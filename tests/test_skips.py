@@ -269,6 +269,8 @@ def test_the_sweep_check_rejects_a_frame_of_another_step_and_a_wrong_census():
 @pytest.mark.parametrize("bad, match", [
     ((), "1 to 64"), ([1e-3, 0.0], r"eps_values\[1\]"), ([float("nan")], r"eps_values\[0\]"),
     ("1e-3", "sequence"), ([True], r"eps_values\[0\]"), ([1e-3] * 65, "1 to 64"),
+    (np.array(1e-3), "^eps_values must be a sequence"),          # a 0-d array: numpy's "iteration over a 0-d array"
+    pytest.param(10**5000, "^eps_values must be a sequence.* integer of", id="5001 digits"),  # its repr raised
 ])
 def test_sweep_rejects_bad_steps(bad, match):
     with pytest.raises((TypeError, ValueError), match=match):
@@ -297,6 +299,26 @@ def test_bad_workers_are_refused(bad, error):
         render(Scene(), 8, 8, workers=bad)
     with pytest.raises(error, match="workers"):
         sweep(Scene(), (1e-3,), 8, 8, workers=bad)
+
+
+@pytest.mark.parametrize("value", ["100000", "0", "abc"])
+def test_a_thread_count_numba_cannot_launch_is_refused_in_one_line(tmp_path, value):
+    """NUMBA_NUM_THREADS=100000 segfaulted numba's thread pool, 0 failed numba's import (exit 1,
+    "internal error") and "abc" printed numba's warning with a traceback: the command line says
+    in one line the variable, the value and the range, exit 2, nothing written; the library's
+    render refuses the count numba read before any thread is launched.  In child processes."""
+    from renderer.validate import MAX_THREADS
+    env, out = {**os.environ, "NUMBA_NUM_THREADS": value}, tmp_path / "x.png"
+    cli = subprocess.run([sys.executable, "-m", "renderer.cli", "render", "--size", "4x4", "-o", str(out)],
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert (cli.returncode, len(cli.stderr.splitlines())) == (2, 1), cli
+    assert f"NUMBA_NUM_THREADS must be an integer in [1, {MAX_THREADS}]" in cli.stderr and repr(value) in cli.stderr
+    assert not out.exists()
+    if value == "100000":
+        code = "from renderer import Scene, render\nrender(Scene(), 4, 4)"
+        library = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+        assert library.returncode == 1 and library.stderr.splitlines()[-1].startswith(
+            "renderer.validate.InvalidValue: NUMBA_NUM_THREADS must be an integer in [1, "), library
 
 
 def test_renders_from_several_threads_at_once_give_the_serial_bits():

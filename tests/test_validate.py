@@ -23,8 +23,8 @@ import sympy as sp
 from renderer import formulas as F
 from renderer import pointwise
 from renderer.scene import COORDINATE
-from renderer.validate import (MAX_EXPRESSION_CHARS, InputError, InvalidType, InvalidValue, choice, expression,
-                               flag, positive_int, real, real_array, steps, vector3)
+from renderer.validate import (MAX_EXPRESSION_CHARS, MAX_THREADS, InputError, InvalidType, InvalidValue, choice,
+                               expression, flag, positive_int, real, real_array, steps, thread_count, vector3)
 
 UP, DOWN = math.inf, -math.inf
 
@@ -63,6 +63,10 @@ REFUSED = {
         (lambda: real_array("a", "0.5"), InvalidType, "a", "must be real numbers"),
         (lambda: real_array("a", [1, [2, 3]]), InvalidType, "a", "must be real numbers"),
         (lambda: real_array("a", np.array([0.5, True], dtype=object)), InvalidType, "a", "must be real numbers"),
+        (lambda: real_array("a", [True, 0.5]), InvalidType, "a", "not bools"),       # numpy reads [1.0, 0.5]
+        (lambda: real_array("a", [np.array([True]), np.array([0.5])]), InvalidType, "a", "not bools"),
+        (lambda: real_array("a", np.ma.masked_array([0.2, 0.5], mask=[True, False])), InvalidType, "a",
+         "masked array"),                                                            # numpy drops the mask
     ],
     "vector3": [
         (lambda: vector3("p", (1.0, 2.0)), InvalidValue, "p", "exactly 3 components"),
@@ -70,6 +74,7 @@ REFUSED = {
         (lambda: vector3("p", (0.0, 2.0, 0.0), low=0.0, high=1.0), InvalidValue, "p[1]", "must be in [0, 1]"),
         (lambda: vector3("p", np.array(0.5)), InvalidType, "p", "sequence of 3 real numbers"),
         (lambda: vector3("p", {0.5, 1.3, 2.0}), InvalidType, "p", "sequence of 3 real numbers"),
+        (lambda: vector3("p", [10**5000, 0.0]), InvalidValue, "p", "integer of more than"),   # repr would raise
     ],
     "flag": [
         (lambda: flag("f", 1), InvalidType, "f", "must be True or False"),
@@ -91,6 +96,13 @@ REFUSED = {
         (lambda: steps("e", [0.5, 2.0], low=0.1, high=1.0), InvalidValue, "e", "at flat index 1"),
         (lambda: steps("e", [1.0], low=0.1, high=1.0, high_open=True), InvalidValue, "e", "must be in [0.1, 1)"),
         (lambda: steps("e", {0.5: 1}, low=0.1, high=1.0), InvalidType, "e", "ordered steps"),
+    ],
+    "thread_count": [
+        (lambda: thread_count("T", "100000"), InvalidValue, "T", f"integer in [1, {MAX_THREADS}]"),   # segfaulted
+        (lambda: thread_count("T", "0"), InvalidValue, "T", "integer in [1, "),
+        (lambda: thread_count("T", "abc"), InvalidValue, "T", "integer in [1, "),
+        (lambda: thread_count("T", True), InvalidValue, "T", "integer in [1, "),
+        (lambda: thread_count("T", 10**5000), InvalidValue, "T", "integer of 16,610 bits"),
     ],
     "expression": [
         (lambda: expression("f", "u + w", F.FIELD_SYMBOLS, F.ELEMENTARY), InvalidValue, "f", "'w' is not one of its names"),
@@ -118,6 +130,7 @@ ACCEPTED = {
     "flag": [(lambda: flag("f", np.array(True)), True), (lambda: flag("f", np.False_), False)],
     "choice": [(lambda: choice("c", "rings", ("sine", "rings")), "rings")],
     "positive_int": [(lambda: positive_int("n", np.int64(8), high=8), 8), (lambda: positive_int("n", np.array(3)), 3)],
+    "thread_count": [(lambda: thread_count("T", " 4"), 4), (lambda: thread_count("T", MAX_THREADS), MAX_THREADS)],
     "steps": [(lambda: steps("e", np.float32(0.5), low=0.1, high=1.0).tolist(), [0.5]),
               (lambda: steps("e", [0.5, 1.0], low=0.1, high=1.0, max_count=2).tolist(), [0.5, 1.0])],
     "expression": [(lambda: expression("f", "sin(pi*k_u*u)^2 * sin(pi*k_v*v)**2", F.FIELD_SYMBOLS, F.ELEMENTARY),
@@ -136,12 +149,14 @@ SHOWN = {
     "positive_int": (lambda: positive_int("n", 2.0), "got float 2.0"),
     "steps": (lambda: steps("e", {0.5: 1}, low=0.1, high=1.0), "got dict {0.5: 1}"),
     "expression": (lambda: expression("f", 3, F.FIELD_SYMBOLS, F.ELEMENTARY), "got int 3"),
+    "thread_count": (lambda: thread_count("T", "100000"), "got '100000'"),
 }
 
 
 @pytest.mark.parametrize("kind", REFUSED)
 def test_each_kind_refuses_naming_the_parameter(kind):
-    assert {fn.__name__ for fn in (real, real_array, vector3, flag, choice, positive_int, steps, expression)} \
+    assert {fn.__name__ for fn in (real, real_array, vector3, flag, choice, positive_int, steps, expression,
+                                   thread_count)} \
         == set(REFUSED) == set(ACCEPTED)
     for call, error, name, phrase in REFUSED[kind]:
         got, message = refusal(call)
@@ -232,6 +247,17 @@ def test_each_pointwise_argument_is_wired_to_its_range(function):
             assert all_finite(call(function, **{argument: limit})), (argument, limit)
             _, message = refusal(lambda: call(function, **{argument: beyond}))
             assert message.startswith(f"{argument} must be in ") and "flat index 0" in message, message
+
+
+@pytest.mark.parametrize("point, error", [(b"abc", InvalidType), ({0.1, 0.2, 0.3}, InvalidType),
+                                          ((c for c in (0.1, 0.2, 0.3)), InvalidType), (0.5, InvalidType),
+                                          ((0.1, 0.2), InvalidValue), ([10**5000, 0.0], InvalidValue)])
+def test_a_footprint_point_is_a_tuple_list_or_array_of_three(point, error):
+    """Bytes, a set (no order) and a generator were read as three components; a huge integer's
+    repr raised a ValueError that named nothing."""
+    got, message = refusal(lambda: call("footprint", P=point))
+    assert got is error and message.startswith("P must ") and "three components" in message, message
+    assert all_finite(call("footprint", P=np.array([[0.1, 0.2], [0.1, 0.2], [0.99, 0.97]])))
 
 
 def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():

@@ -194,16 +194,32 @@ def _execute(app, env, docnames):
             logging.getLogger(__name__).warning(f"{Path(uri).stem} failed to execute: {cause(record.traceback)}")
 
 
+#: Arguments of each page's kernel (nbclient's ``extra_arguments``): its log at ERROR, so that
+#: ipykernel's warning at every start, "Kernel is running over TCP without encryption" (nine
+#: lines a build), is not printed; the kernel listens on the loopback interface only and checks
+#: each message's signature (the key is in its connection file, readable by this user only).
+KERNEL_ARGUMENTS = ("--IPKernelApp.log_level=ERROR",)
+
+
+def _quiet_kernels():
+    """In each of the pool's processes: the notebooks jupyter-cache runs start their kernels
+    with `KERNEL_ARGUMENTS`."""
+    from functools import partial
+    from jupyter_cache.executors import basic
+    basic.single_nb_execution = partial(basic.single_nb_execution, extra_arguments=KERNEL_ARGUMENTS)
+
+
 def _run(cache, pks, timeout):
     """Execute the project notebooks ``pks`` of ``cache`` in this order, in a pool of processes
-    forked from this one (so `_stop` is theirs too), one per CPU, caching each that succeeds.
+    forked from this one (so `_stop` is theirs too), one per CPU, caching each that succeeds;
+    their kernels log errors only (`_quiet_kernels`).
     Returns [(status, uri)] in the same order: status 0 if it succeeded, 1 if a cell raised,
     2 if it could not be executed or cached."""
     from jupyter_cache.cache.db import NbProjectRecord
     from jupyter_cache.executors.basic import ExecutionWorkerLocalMProc, ProcessData
     NbProjectRecord.remove_tracebacks(pks, cache.db)
     jobs = [ProcessData(pk, cache.get_project_record(pk).uri, cache, timeout, False) for pk in pks]
-    with multiprocessing.get_context("fork").Pool() as pool:
+    with multiprocessing.get_context("fork").Pool(initializer=_quiet_kernels) as pool:
         return pool.map(ExecutionWorkerLocalMProc(), jobs)
 
 
