@@ -1104,12 +1104,12 @@ def test_the_books_diagrams_have_no_colliding_text():
 
 
 def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_html, tmp_path):
-    """Wrong variants: a page MAX_HEIGHT px tall, a reading path of 12,001 words, asides of 8,001 words
-    (folded, in a margin, on the ledger page).  Folded and margin words are asides, not reading; the
+    """Wrong variants: a page MAX_HEIGHT px tall, a reading path one word over MAX_READING_WORDS, asides one over
+    MAX_ASIDE_WORDS (folded, in a margin, on the ledger page).  Folded and margin words are asides, not reading; the
     ledger page is all aside; a folded block's height does not count; code counts nowhere."""
     tall = _synthetic(tmp_path, f'<div style="height: {MAX_HEIGHT}px"></div><details><summary>s</summary>'
                       '<div style="height: 20000px"></div></details>')
-    wordy = _synthetic(tmp_path, "<p>" + "word " * 12_001 + "</p><details><summary>fold </summary><p>"
+    wordy = _synthetic(tmp_path, "<p>" + "word " * (MAX_READING_WORDS + 1) + "</p><details><summary>fold </summary><p>"
                        + "word " * 3000 + "</p><aside class='margin'>" + "word " * 500 + "</aside></details>"
                        + "<aside class='sidebar margin'><p>" + "word " * 1000 + "</p></aside><pre>"
                        + "code " * 5000 + "</pre>")
@@ -1121,14 +1121,15 @@ def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_htm
         finally:
             p.close()
     assert MAX_HEIGHT <= lengths["tall"]["height"] < 20_000         # the folded 20,000 px do not count
-    assert 12_001 <= lengths["wordy"]["words"] < 12_100          # the folded and margin words do not count,
+    assert MAX_READING_WORDS + 1 <= lengths["wordy"]["words"] < MAX_READING_WORDS + 100   # folded, margin words not,
     assert lengths["wordy"]["aside"] == 4_501                    # they are asides (once each); code is neither
     bad = too_long(lengths)
     assert any(b.startswith("tall:") for b in bad) and any("on the reading path" in b for b in bad), bad
     page = lambda words, aside=0: {"height": 100, "words": words, "aside": aside}  # noqa: E731
-    assert too_long({"a": page(12_000), "b": page(0, 8_000)}) == []
-    assert too_long({"a": page(12_000), "s6_ledger": page(7_000), "b": page(0, 1_000)}) == []  # the ledger is aside
-    assert too_long({"a": page(11_000), "glossary": page(1_500)}) == []                      # so is the glossary
-    assert too_long({"a": page(11_000), "b": page(1_500)}) != []
-    assert too_long({"s6_ledger": page(7_000), "b": page(0, 1_001)}) == [
-        "8001 words in folds, margins and the ledger (at most 8000)"]
+    R, A = MAX_READING_WORDS, MAX_ASIDE_WORDS
+    assert too_long({"a": page(R), "b": page(0, A)}) == []
+    assert too_long({"a": page(R), "s6_ledger": page(A - 1_000), "b": page(0, 1_000)}) == []  # the ledger is aside
+    assert too_long({"a": page(R - 1_000), "glossary": page(1_500)}) == []                     # so is the glossary
+    assert too_long({"a": page(R - 1_000), "b": page(1_500)}) != []
+    assert too_long({"s6_ledger": page(A - 1_000), "b": page(0, 1_001)}) == [
+        f"{A + 1} words in folds, margins and the ledger (at most {A})"]
