@@ -84,13 +84,18 @@ def sequence(name, value, what):
     return tuple(value)
 
 
+def _array(value):
+    """``np.asarray(value)``, or an object array where numpy cannot make one (a ragged list)."""
+    try:
+        return np.asarray(value)
+    except (TypeError, ValueError):
+        return np.asarray(None)
+
+
 def numbers_array(name, value):
     """``value`` as a float64 array of real numbers, inf and NaN allowed (a value judged, not an input
     of a formula): any integer or floating dtype; not bool, complex, strings, objects or ragged lists."""
-    try:
-        a = np.asarray(value)
-    except (TypeError, ValueError):
-        a = np.asarray(None)
+    a = _array(value)
     if a.dtype.kind not in "iuf":
         raise InvalidType(f"{name} must be real numbers (a scalar or an array), got {shown(value, 60)}")
     return a.astype(np.float64, copy=False)
@@ -98,10 +103,7 @@ def numbers_array(name, value):
 
 def integers(name, value, low, high):
     """``value`` as an int64 array of integers in [low, high]: any integer dtype; not bool or float."""
-    try:
-        a = np.asarray(value)
-    except (TypeError, ValueError):
-        a = np.asarray(None)
+    a = _array(value)
     if a.dtype.kind not in "iu":
         raise InvalidType(f"{name} must be integers in [{low}, {high}], got {shown(value, 60)}")
     bad = np.flatnonzero((a < low) | (a > high))

@@ -311,8 +311,8 @@ def _census(size, scene=DRAFT_SCENE):
                            ("straddling", int(np.count_nonzero(dist < eps)))):
             out[key].append(value)
     logs = np.log(CENSUS_STEPS)
-    default = CENSUS_STEPS.index(scene.eps) if scene.eps in CENSUS_STEPS else 0
-    return dict(out, steps=list(CENSUS_STEPS), step=CENSUS_STEPS[default],
+    default = CENSUS_STEPS.index(scene.eps)
+    return dict(out, steps=list(CENSUS_STEPS), step=scene.eps,
                 rms_slope=float(np.polyfit(logs, np.log(out["rms"]), 1)[0]),
                 off_slope=float(np.polyfit(logs, np.log(out["off_band"]), 1)[0]),
                 ratio=out["on_band"][default] / out["off_band"][default], scene=scene.changes(), size=[size, size])

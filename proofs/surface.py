@@ -33,7 +33,7 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Cross, Dot, Step, Theorem, catalogue
-from .displacement import away_from_pole
+from .displacement import KERNEL_COEFFS
 
 u, v, beta, h, h_u, h_v = F.u, F.v, F.beta, F.h, F.h_u, F.h_v
 
@@ -69,7 +69,7 @@ PRINCIPAL = sp.ImmutableMatrix([-beta * h_u / ((1 + beta * h * K_U) * L_U),
 #: Sphere A: kappa = 1/R, |p_u| = 2 pi R sin(phi), |p_v| = pi R (the chart's rates, theorem `chart`).
 SPHERE = {K_U: 1 / F.R, K_V: 1 / F.R, L_U: 2 * sp.pi * F.R * F.sin_phi, L_V: sp.pi * F.R}
 #: The renderer's bump="surface" coefficients of e_theta and e_phi, off its pole floor.
-RENDERER = sp.ImmutableMatrix(away_from_pole(F.BUMP["surface"]))
+RENDERER = sp.ImmutableMatrix(KERNEL_COEFFS)
 
 
 def _vector(name):

@@ -870,15 +870,18 @@ WRONG_EPS = {
 }
 
 
+def _replaced_once(old, new, variant):
+    """A bundle transform for a wrong variant: ``old`` (which must occur once) replaced by ``new``."""
+    def bundle(text):
+        assert text.count(old) == 1, f"variant {variant!r} no longer applies to the bundle"
+        return text.replace(old, new)
+    return bundle
+
+
 @pytest.mark.parametrize("variant", sorted(WRONG_EPS))
 def test_the_decade_check_catches_a_slider_without_ticks_or_decade_keys(browser, book_html, variant):
     old, new, which = WRONG_EPS[variant]
-
-    def bundle(text):
-        assert text.count(old) == 1, variant
-        return text.replace(old, new)
-
-    s = _simulator_at(browser, book_html, 390, bundle=bundle)
+    s = _simulator_at(browser, book_html, 390, bundle=_replaced_once(old, new, variant))
     try:
         if which == "pointer":
             landed = eps_pointer_landings(s, (-3, 3), tap=True)
@@ -1000,12 +1003,7 @@ WRONG_SPOKEN = {
 @pytest.mark.parametrize("variant", sorted(WRONG_SPOKEN))
 def test_the_spoken_check_catches_stale_labels_and_a_silent_readout(browser, book_html, variant):
     old, new, message = WRONG_SPOKEN[variant]
-
-    def bundle(text):
-        assert text.count(old) == 1, variant
-        return text.replace(old, new)
-
-    s = _simulator_at(browser, book_html, 1280, bundle=bundle)
+    s = _simulator_at(browser, book_html, 1280, bundle=_replaced_once(old, new, variant))
     try:
         found, _ = _keyboard_walk(s)
         assert any(message in p for problems in found.values() for p in problems), found

@@ -35,7 +35,7 @@ def test_crease_neighbours_lie_within_the_stated_band_of_a_crease():
     assert CREASE_BAND <= 0.1                          # next to a crease: within a tenth of a period of it
 
 
-@pytest.mark.parametrize("field", ["sine", "ridges", "rings"])
+@pytest.mark.parametrize("field", list(F.FIELDS))
 def test_each_source_lies_where_documented_the_pole_frames_about_the_pole(field):
     """sin(phi) = |(N_x, N_y)| of each source's pixels within its `SOURCES` bounds; the zoom-3e4 frame all
     inside the draft's fallback radius sin(phi) = 1e-4 (where the renderer keeps the chart's frame), and
