@@ -10,29 +10,42 @@ and is held against a route of its own:
   against the crossings of an integer by k_u (u -+ eps) or k_v (v -+ eps), the ridges field's zero lines
   counted with integers, not located by root finding;
 * the census's ledger (RMS, largest difference, means on and off the crease band): against the same
-  sums taken by numpy over the two frames' pixels, not by `renderer.compare`.
+  sums taken by numpy over the two frames' pixels, not by `renderer.compare`;
+* `lab.accuracy.gradient_accuracy` (every field): its pixels against sphere A's in the G-buffer, its errors
+  against mpmath differentiating h itself (``mpmath.diff``, not the sympy gradient the renderer compiles)
+  and a central quotient written here (u wrapped, v clamped);
+* the image-best step (`lab.accuracy._image_best_step`, every field): against the least RMS |dI| of
+  frames rendered one step at a time (`renderer.render`, not the sweep);
+* the central difference's optima (`lab.accuracy._optima`) at random points, directions and
+  frequencies: the crease distance against integers, h, h' and h''' against mpmath, the model-optimal
+  step against its formula.
 """
 
+import mpmath
 import numpy as np
 import pytest
+import sympy as sp
 
-from lab.accuracy import _crease_share
+import lab.accuracy as accuracy
+from lab.accuracy import _crease_share, _image_best_step, _optima, gradient_accuracy
 from lab.claims import CENSUS_STEPS, _census
-from renderer import DRAFT_SCENE, gbuffer, render
+from renderer import DRAFT_SCENE, Scene, gbuffer, pointwise, render
+from renderer import formulas as F
 from renderer.render import SPHERE_A
+from renderer.ucurve import DEFAULT_STEPS, UNIT_ROUNDOFF
 
 SIZE = 40
 
 
-def _scenes(count=3, seed=2026):
-    """Random ridges scenes: k_u and k_v at least 1.5 apart, and beta, the camera and sphere B moved."""
+def _scenes(count=3, seed=2026, field="ridges"):
+    """Random scenes of ``field``: k_u and k_v at least 1.5 apart, and beta, the camera and sphere B moved."""
     rng = np.random.default_rng(seed)
     out = []
     while len(out) < count:
         k_u, k_v = rng.uniform(2.0, 12.0, 2)
         if abs(k_u - k_v) < 1.5:
             continue
-        out.append(DRAFT_SCENE.replace(k_u=float(k_u), k_v=float(k_v), beta=float(rng.uniform(0.1, 0.6)),
+        out.append(DRAFT_SCENE.replace(height_field=field, k_u=float(k_u), k_v=float(k_v), beta=float(rng.uniform(0.1, 0.6)),
                                        camera_z=float(rng.uniform(3.5, 6.0)), radius_b=float(rng.uniform(0.2, 0.4)),
                                        center_b=tuple(float(x) for x in rng.uniform([0.3, 0.3, 1.1], [0.7, 0.7, 1.5]))))
     return out
@@ -82,3 +95,146 @@ def test_a_census_that_reads_one_frequency_twice_is_caught(monkeypatch):
     scene = _scenes(1, seed=7)[0]
     c = _census(SIZE, scene)
     assert c["straddling"] != [int(np.count_nonzero(_straddles(scene, SIZE, e))) for e in CENSUS_STEPS]
+
+
+def _h(field, k_u, k_v, modules):
+    """h(u, v) of ``field`` at these frequencies, lambdified for ``modules``."""
+    expr = F.FIELDS[field].expr.subs({F.k_u: sp.nsimplify(k_u), F.k_v: sp.nsimplify(k_v)})
+    return sp.lambdify((F.u, F.v), expr, modules=modules)
+
+
+def _partial(h, u, v, component, order=1):
+    """The order-th partial derivative of h along ``component`` at (u, v), by mpmath.diff, 30 digits."""
+    with mpmath.workdps(30):
+        u, v = mpmath.mpf(float(u)), mpmath.mpf(float(v))
+        if component == "u":
+            return mpmath.diff(lambda x: h(x, v), u, order)
+        return mpmath.diff(lambda y: h(u, y), v, order)
+
+
+def _accuracy_route(field, k_u, k_v, steps, monkeypatch):
+    """(gradient_accuracy's records, the same records computed here), SIZE squared, 40 pixels."""
+    seen = []
+    real = pointwise.exact_gradient
+    monkeypatch.setattr(pointwise, "exact_gradient",
+                        lambda f, u, v, ku, kv: seen.append((u.copy(), v.copy())) or real(f, u, v, ku, kv))
+    got = gradient_accuracy(field, count=40, size=SIZE, seed=3, steps=steps, k_u=k_u, k_v=k_v)
+    (u, v), = seen
+    g = gbuffer(Scene(height_field=field, k_u=k_u, k_v=k_v), SIZE, SIZE)
+    pixels = {(float(a), float(b)) for a, b in g.uv[g.chamber == SPHERE_A]}
+    assert len(u) >= 30 and all((float(a), float(b)) in pixels for a, b in zip(u, v))
+    assert len(set(zip(u.tolist(), v.tolist()))) == len(u)
+    h_mp, h = _h(field, k_u, k_v, "mpmath"), _h(field, k_u, k_v, "numpy")
+    ref = [[_partial(h_mp, a, b, c) for c in "uv"] for a, b in zip(u, v)]
+    pairs = [real(F.FIELDS[field], u, v, k_u, k_v)]
+    for eps in steps:
+        lo, hi = np.maximum(v - eps, 0.0), np.minimum(v + eps, 1.0)
+        pairs.append(((h((u + eps) % 1.0, v) - h((u - eps) % 1.0, v)) / (2 * eps), (h(u, hi) - h(u, lo)) / (hi - lo)))
+    scale = np.spacing(np.pi * max(k_u, 2 * k_v))
+    mine = []
+    for hu, hv in pairs:
+        with mpmath.workdps(30):          # the exact gradient's errors are ulps: subtract at 30 digits
+            err = np.array([[float(abs(mpmath.mpf(float(x)) - r)) for x, r in zip(pair, refs)]
+                            for pair, refs in zip(zip(hu, hv), ref)])
+        mine.append((len(u), float(err.max()), float(np.sqrt(np.mean(err**2))), float(err.max() / scale)))
+    return [(r.pixels, r.max_abs, r.rms_abs, r.max_ulps) for r in got], mine
+
+
+@pytest.mark.parametrize("field", sorted(F.FIELDS))
+def test_gradient_accuracy_is_mpmath_differentiating_h_at_sphere_a_pixels(field, monkeypatch):
+    """Random frequencies k_u != k_v; steps large enough that truncation, not rounding, sets the
+    central errors (so a quotient evaluated another way agrees to many digits)."""
+    scene = _scenes(1, seed=11, field=field)[0]
+    got, mine = _accuracy_route(field, scene.k_u, scene.k_v, [3e-2, 3e-3], monkeypatch)
+    for g, m in zip(got, mine):
+        assert g == pytest.approx(m, rel=1e-6)
+
+
+def test_a_reference_with_its_frequencies_swapped_is_caught(monkeypatch):
+    """The wrong variant: gradient_accuracy's mpmath reference built with k_u and k_v exchanged."""
+    real = accuracy._reference.__wrapped__
+    monkeypatch.setattr(accuracy, "_reference", lambda field, ku, kv: real(field, kv, ku))
+    scene = _scenes(1, seed=11, field="sine")[0]
+    got, mine = _accuracy_route("sine", scene.k_u, scene.k_v, [3e-3], monkeypatch)
+    assert got[0] != pytest.approx(mine[0], rel=1e-6)
+
+
+def _frame_rms(scene, steps):
+    """RMS |ΔI| over the pixels both frames see on sphere A, each step's central frame rendered alone
+    against the exact frame."""
+    exact = render(scene, SIZE, SIZE)
+    rms = []
+    for eps in steps:
+        central = render(scene.replace(eps=eps), SIZE, SIZE, gradient="central")
+        both = (exact.chamber == SPHERE_A) & (central.chamber == SPHERE_A)
+        rms.append(float(np.sqrt(np.mean((central.image - exact.image)[both] ** 2))))
+    return rms
+
+
+BEST_STEPS = [1e-1, 3e-2, 1e-2, 1e-3, 1e-5, 1e-7]
+
+
+@pytest.mark.parametrize("field", sorted(F.FIELDS))
+def test_the_image_best_step_is_the_least_rms_of_frames_rendered_one_by_one(field, monkeypatch):
+    """On a random scene of the field (either bump mode) put in the simulator scene's place."""
+    import renderer.ledger as ledger
+    scene = _scenes(1, seed=23, field=field)[0].replace(bump=("surface", "chart")[len(field) % 2])
+    monkeypatch.setattr(ledger, "SIMULATOR_SCENE", scene)
+    got = _image_best_step(field, SIZE, BEST_STEPS)
+    rms = _frame_rms(scene, BEST_STEPS)
+    assert got["rms"] == pytest.approx(rms, rel=1e-9)
+    assert got["best"] == BEST_STEPS[int(np.argmin(rms))]
+    assert got["steps"] == BEST_STEPS and got["size"] == [SIZE, SIZE] and got["scene"] == scene.changes()
+
+
+def test_an_image_best_step_with_its_frequencies_swapped_is_caught(monkeypatch):
+    """The wrong variant: the measurement run on the scene with k_u and k_v exchanged."""
+    import renderer.ledger as ledger
+    scene = _scenes(1, seed=23, field="ridges")[0]
+    monkeypatch.setattr(ledger, "SIMULATOR_SCENE", scene.replace(k_u=scene.k_v, k_v=scene.k_u))
+    assert _image_best_step("ridges", SIZE, BEST_STEPS)["rms"] != pytest.approx(_frame_rms(scene, BEST_STEPS), rel=1e-9)
+
+
+def _optima_route(seed, monkeypatch):
+    """(`_optima` at random frequencies and a random point and direction per field, what it should say)."""
+    rng = np.random.default_rng(seed)
+    k_u, k_v = _scenes(1, seed=seed)[0].k_u, _scenes(1, seed=seed)[0].k_v
+    monkeypatch.setattr(accuracy, "DRAFT_SCENE", DRAFT_SCENE.replace(k_u=k_u, k_v=k_v))
+    points = {}
+    for name in F.FIELDS:
+        while True:
+            u, v = (float(x) for x in rng.uniform(0.05, 0.95, 2))
+            distance = min(abs(u * k_u - round(u * k_u)) / k_u, abs(v * k_v - round(v * k_v)) / k_v) \
+                if F.FIELDS[name].crease_factors else np.inf
+            if distance > 1e-3:
+                break
+        points[name] = (u, v, str(rng.choice(["u", "v"])), distance)
+    got = _optima({name: [str(F.FIELDS[name].expr), list(p[:3])] for name, p in points.items()})
+    want = {}
+    for name, (u, v, component, distance) in points.items():
+        h = _h(name, k_u, k_v, "mpmath")
+        with mpmath.workdps(30):
+            height = abs(float(h(mpmath.mpf(u), mpmath.mpf(v))))
+        h1, h3 = (abs(float(_partial(h, u, v, component, n))) for n in (1, 3))
+        x = u if component == "u" else v
+        below = DEFAULT_STEPS[DEFAULT_STEPS < distance]
+        want[name] = dict(k_u=k_u, k_v=k_v, crease_distance=distance, steps=int(below.size),
+                          largest_step=float(below.max()), h=height, h1=h1, x_h1=abs(x) * h1, h3=h3,
+                          eps_model=(3 * UNIT_ROUNDOFF * (height + abs(x) * h1) / h3) ** (1 / 3))
+    return got, want
+
+
+@pytest.mark.parametrize("seed", [31, 32])
+def test_the_optima_at_random_points_and_frequencies_are_mpmaths(seed, monkeypatch):
+    got, want = _optima_route(seed, monkeypatch)
+    for name, fields in want.items():
+        assert {key: got[name][key] for key in fields} == pytest.approx(fields, rel=1e-7), name
+
+
+def test_optima_measured_with_the_frequencies_exchanged_are_caught(monkeypatch):
+    """The wrong variant: the optimum's curve measured with k_u and k_v exchanged."""
+    import renderer.ucurve as ucurve
+    real = ucurve.measure
+    monkeypatch.setattr(ucurve, "measure", lambda *a, k_u, k_v, **kw: real(*a, k_u=k_v, k_v=k_u, **kw))
+    got, want = _optima_route(31, monkeypatch)
+    assert any(got[name]["h1"] != pytest.approx(want[name]["h1"], rel=1e-7) for name in want)
