@@ -955,15 +955,19 @@ class Measurement:
     machine: dict = dc_field(default_factory=dict)
 
     def of(self, field):
-        """The results for one field, in the order they were defined."""
-        return [r for r in self.results if r.field == field]
+        """The results for one field, in the order they were defined; KeyError naming the fields
+        measured if ``field`` is not one of them."""
+        found = [r for r in self.results if r.field == field]
+        if not found:
+            raise KeyError(f"field {field!r} was not measured; measured: {sorted({r.field for r in self.results})}")
+        return found
 
     def get(self, field, label):
-        """The result with this field and label; KeyError if absent."""
-        for r in self.results:
-            if r.field == field and r.label == label:
+        """The result with this field and label; KeyError naming the labels of the field if absent."""
+        for r in self.of(field):
+            if r.label == label:
                 return r
-        raise KeyError((field, label))
+        raise KeyError(f"no result labelled {label!r} for {field!r}; its labels: {[r.label for r in self.of(field)]}")
 
 
 def _errors(approx, hi, lo):
@@ -1209,10 +1213,11 @@ class UnivariateErrors:
         return [r for r in self.rows if r.method == name]
 
     def best(self, name):
-        """The row of the method ``name`` with the least error (the first of equals)."""
+        """The row of the method ``name`` with the least error (the first of equals); KeyError naming
+        the methods measured if ``name`` is not one of them."""
         rows = self.of(name)
         if not rows:
-            raise KeyError(name)
+            raise KeyError(f"method {name!r} was not measured; measured: {sorted({r.method for r in self.rows})}")
         return min(rows, key=lambda r: r.error)
 
 

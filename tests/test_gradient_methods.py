@@ -267,8 +267,10 @@ def test_measure_small_run_and_its_presentations():
     assert m.get("rings", "exact").trig_evals == generated_trig_calls("exact", "rings")
     assert m.get("sine", "richardson").h_evals > 4.0
     assert len(m.get("sine", "richardson").times) == 1
-    with pytest.raises(KeyError):                                # not measured where it does not apply
-        m.get("ridges", "complex step 1e-20")
+    with pytest.raises(KeyError, match=r"'complex step 1e-20' for 'ridges'; its labels: \[.*'exact'"):
+        m.get("ridges", "complex step 1e-20")                   # not measured where it does not apply
+    with pytest.raises(KeyError, match=r"field 'Sine' was not measured; measured: \['ridges', 'rings', 'sine'\]"):
+        m.of("Sine")                                            # a typo is not an empty list
     assert m.get("ridges", "complex step, |z| continued 1e-20").max_error <= FLOAT64_EVAL
     assert m.get("sine", "central 1e-06").max_error > 1e4 * FLOAT64_EVAL
     for f in F.FIELDS:                   # AD: exact to rounding, compile time kept apart from the runs
@@ -482,6 +484,8 @@ def test_the_classic_function_reproduces_the_papers_behaviour(classic):
         if name != "complex step":
             assert classic.of(name)[-1].relative_error > 1e3 * best.relative_error   # the cliff below
     assert [r.error for r in classic.of("central")] == list(classic.curve.error)
+    with pytest.raises(KeyError, match=r"method 'centrall' was not measured; measured: \[.*'central'"):
+        classic.best("centrall")
     assert 0.1 < classic.best("central").eps / classic.curve.eps_fitted < 10
     assert {p.method for p in gm.PUBLISHED} - {None} <= {m.name for m in gm.METHODS}
 
