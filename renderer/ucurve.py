@@ -404,7 +404,7 @@ def measure_function(function, x, eps=None):
     fd = np.array([code.central(x, float(e)) for e in steps])
     bad = np.flatnonzero(~np.isfinite(fd))
     if bad.size:
-        raise validate.InvalidValue(f"eps must keep f finite at x +- eps; f({x!r} +- {steps[bad[0]]!r}) is not "
+        raise validate.InvalidValue(f"eps must keep f finite at x +- eps; f({x!r} +- {float(steps[bad[0]])!r}) is not "
                                     f"(step {bad[0]})")
 
     def quotient(e):

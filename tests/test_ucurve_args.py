@@ -1,8 +1,10 @@
-"""`renderer.ucurve.measure`'s arguments: each is wired to its validator (`renderer.validate`,
-whose kinds tests/test_validate.py tests once each), and refused by name.
+"""The arguments of `renderer.ucurve.measure` and `renderer.ucurve.measure_function`: each is wired
+to its validator (`renderer.validate`, whose kinds tests/test_validate.py tests once each), and
+refused by name.
 
-One refusal per parameter, matched on the parameter's name and the essential phrase only;
-the accepted values at each limit are measured (a step each).
+One refusal per parameter, matched on the parameter's name and the essential phrase only (the
+reader's function: each of its own refusals whole); the accepted values at each limit are measured
+(a step each).
 """
 
 from fractions import Fraction
@@ -11,7 +13,7 @@ import numpy as np
 import pytest
 
 from renderer.pointwise import MIN_STEP
-from renderer.ucurve import measure
+from renderer.ucurve import DEFAULT_STEPS, MAX_FUNCTION_STEP, measure, measure_function
 from renderer.validate import InputError
 
 
@@ -41,3 +43,25 @@ def test_values_at_the_limits_and_numpy_scalars_are_measured():
         for name in ("u", "v"):
             if name in kwargs:
                 assert getattr(uc, name) == float(kwargs[name]) and type(getattr(uc, name)) is float
+
+
+@pytest.mark.parametrize("args, kwargs, error, message", [
+    (("x + y", 0.5), {}, ValueError, "function must be an expression in x (with pi"),
+    (("sin(x)", True), {}, TypeError, "x must be a real number"),
+    (("sin(x)", float("inf")), {}, ValueError, "x must be finite, got inf"),
+    (("sin(x)", 0.5), dict(eps=[1e-3, 2e3]), ValueError, "eps must be in [1e-300, 1000]"),
+    (("sin(x)", 0.5), dict(eps=[1e-301]), ValueError, "eps must be in [1e-300, 1000]"),
+    (("sqrt(x)", -1.0), {}, ValueError, "function sqrt(x) must be defined and differentiable at x = -1.0"),
+    (("abs(x)", 0.0), {}, ValueError, "function Abs(x) is not differentiable at x = 0.0: it has a crease"),
+    (("exp(x)", 800.0), {}, ValueError, "x must be a point where function exp(x) is a finite float64"),
+    (("log(x)", 0.5), dict(eps=[1e-3, 0.6]), ValueError, "eps must keep f finite at x +- eps; f(0.5 +- 0.6) is not (step 1)"),
+])
+def test_measure_functions_arguments_are_refused_by_name(args, kwargs, error, message):
+    with pytest.raises(InputError) as info:
+        measure_function(*args, **kwargs)
+    assert isinstance(info.value, error) and str(info.value).startswith(message), str(info.value)
+
+
+def test_measure_function_takes_its_steps_or_the_default_ones():
+    assert measure_function("sin(x)", 0.5, eps=[MAX_FUNCTION_STEP, 1e-3]).eps.tolist() == [MAX_FUNCTION_STEP, 1e-3]
+    assert np.array_equal(measure_function("sin(x)", 0.5).eps, DEFAULT_STEPS)
