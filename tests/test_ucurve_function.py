@@ -1,0 +1,72 @@
+"""`renderer.ucurve.measure_function` (a reader's function of one variable) against mpmath, at random
+functions, points and steps.
+
+The route here is written without the module's helpers: f as an mpmath lambda of its own, the abscissae
+fl(x + eps) and fl(x - eps) rounded by Python, f', f''' by ``mpmath.diff``.  The truncation is the
+exact-arithmetic quotient at those abscissae less f'(x); the error is |truncation + roundoff|; the
+roundoff is the float64 quotient (Python's math library here, the numba-compiled f there) less the exact
+one, so the two agree to the rounding of f's few evaluations over eps.
+"""
+
+import math
+
+import mpmath
+import numpy as np
+import pytest
+
+from renderer.ucurve import UNIT_ROUNDOFF, measure_function
+
+#: (text the reader types, the same function for mpmath, for float64 Python) with parameters a, b.
+FAMILIES = [
+    ("{a}*sin({b}*x)", lambda a, b: lambda x: a * mpmath.sin(b * x), lambda a, b: lambda x: a * math.sin(b * x)),
+    ("exp({a}*x)/({b} + x**2)", lambda a, b: lambda x: mpmath.exp(a * x) / (b + x**2),
+     lambda a, b: lambda x: math.exp(a * x) / (b + x**2)),
+    ("log({b} + x**2)*cos({a}*x)", lambda a, b: lambda x: mpmath.log(b + x**2) * mpmath.cos(a * x),
+     lambda a, b: lambda x: math.log(b + x**2) * math.cos(a * x)),
+]
+
+
+def _cases(count=6, seed=2027):
+    rng = np.random.default_rng(seed)
+    for i in range(count):
+        text, mp, py = FAMILIES[i % len(FAMILIES)]
+        a, b = (round(float(y), 3) for y in rng.uniform([0.5, 0.5], [3.0, 2.0]))
+        # The text's decimals are the reader's numbers: mpmath reads them as decimals, Python as floats.
+        with mpmath.workdps(50):
+            a_mp, b_mp = mpmath.mpf(repr(a)), mpmath.mpf(repr(b))
+        yield text.format(a=a, b=b), mp(a_mp, b_mp), py(a, b), \
+            round(float(rng.uniform(-2.0, 2.0)), 4)
+
+
+@pytest.mark.parametrize("text, f_mp, f_py, x", list(_cases()), ids=lambda c: c if isinstance(c, str) else "")
+def test_the_u_curve_of_a_readers_function_is_mpmaths(text, f_mp, f_py, x):
+    steps = [1e-1, 1e-3, 1e-5, 1e-8, 1e-11]
+    uc = measure_function(text, x, eps=steps)
+    with mpmath.workdps(40):
+        X = mpmath.mpf(x)
+        true = mpmath.diff(f_mp, X)
+        assert uc.derivative == pytest.approx(float(true), rel=1e-14)
+        assert uc.height == pytest.approx(float(f_mp(X)), rel=1e-14)
+        assert uc.third_derivative == pytest.approx(float(mpmath.diff(f_mp, X, 3)), rel=1e-12)
+        for i, e in enumerate(steps):
+            plus, minus = x + e, x - e
+            exact = (f_mp(mpmath.mpf(plus)) - f_mp(mpmath.mpf(minus))) / (2 * mpmath.mpf(e))
+            # The module's mpmath reads f's constants as sympy prints them (17 digits), 1e-17 from both
+            # the decimal and the float: the truncation agrees to 1e-9 or to 1e-15 of f'.
+            assert uc.truncation[i] == pytest.approx(float(exact - true), rel=1e-9, abs=1e-15 * abs(float(true)))
+            assert uc.error[i] == pytest.approx(abs(uc.truncation[i] + uc.roundoff[i]), rel=1e-9, abs=1e-300)
+            python = (f_py(plus) - f_py(minus)) / (2 * e)
+            slack = 8 * UNIT_ROUNDOFF * max(abs(f_py(plus)), abs(f_py(minus))) / e
+            assert abs(uc.roundoff[i] - float(mpmath.mpf(python) - exact)) <= slack, (text, e)
+    assert uc.u == x and uc.component == "x" and np.isnan(uc.v)
+
+
+def test_abscissae_taken_on_one_side_are_caught(monkeypatch):
+    """The wrong variant: the exact quotient taken at fl(x + eps) twice (it is 0, and the truncation
+    -f'(x))."""
+    import renderer.ucurve as ucurve
+    real = ucurve._curve
+    monkeypatch.setattr(ucurve, "_curve", lambda label, x, steps, quotient, *rest: real(
+        label, x, steps, lambda e: (lambda fd, p, m, d: (fd, p, p, d))(*quotient(e)), *rest))
+    with pytest.raises(AssertionError):
+        test_the_u_curve_of_a_readers_function_is_mpmaths(*next(_cases()))
