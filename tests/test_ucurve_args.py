@@ -52,6 +52,7 @@ def test_values_at_the_limits_and_numpy_scalars_are_measured():
     (("sin(x)", 0.5), dict(eps=[1e-3, 2e3]), ValueError, "eps must be in [1e-300, 1000]"),
     (("sin(x)", 0.5), dict(eps=[1e-301]), ValueError, "eps must be in [1e-300, 1000]"),
     (("sqrt(x)", -1.0), {}, ValueError, "function sqrt(x) must be defined and differentiable at x = -1.0"),
+    (("1/x", 0.0), {}, ValueError, "function 1/x must be defined and differentiable at x = 0.0"),   # mpmath raises
     (("abs(x)", 0.0), {}, ValueError, "function Abs(x) is not differentiable at x = 0.0: it has a crease"),
     (("exp(x)", 800.0), {}, ValueError, "x must be a point where function exp(x) is a finite float64"),
     (("log(x)", 0.5), dict(eps=[1e-3, 0.6]), ValueError, "eps must keep f finite at x +- eps; f(0.5 +- 0.6) is not (step 1)"),

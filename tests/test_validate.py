@@ -249,15 +249,28 @@ def test_each_pointwise_argument_is_wired_to_its_range(function):
             assert message.startswith(f"{argument} must be in ") and "flat index 0" in message, message
 
 
+@pytest.mark.parametrize("argument", ["P", "N", "e_theta", "e_phi"])
 @pytest.mark.parametrize("point, error", [(b"abc", InvalidType), ({0.1, 0.2, 0.3}, InvalidType),
                                           ((c for c in (0.1, 0.2, 0.3)), InvalidType), (0.5, InvalidType),
-                                          ((0.1, 0.2), InvalidValue), ([10**5000, 0.0], InvalidValue)])
-def test_a_footprint_point_is_a_tuple_list_or_array_of_three(point, error):
-    """Bytes, a set (no order) and a generator were read as three components; a huge integer's
-    repr raised a ValueError that named nothing."""
-    got, message = refusal(lambda: call("footprint", P=point))
-    assert got is error and message.startswith("P must ") and "three components" in message, message
-    assert all_finite(call("footprint", P=np.array([[0.1, 0.2], [0.1, 0.2], [0.99, 0.97]])))
+                                          (np.array(0.5), InvalidType), ((0.1, 0.2), InvalidValue),
+                                          ([10**5000, 0.0], InvalidValue)])
+def test_a_footprint_vector_is_a_tuple_list_or_array_of_three(argument, point, error):
+    """Each of the four vectors: bytes, a set (no order) and a generator were read as three components;
+    a huge integer's repr raised a ValueError that named nothing."""
+    got, message = refusal(lambda: call("footprint", **{argument: point}))
+    assert got is error and message.startswith(f"{argument} must ") and "three components" in message, message
+    assert all_finite(call("footprint", **{argument: np.array([[0.1, 0.2], [0.1, 0.2], [0.99, 0.97]])}))
+
+
+def test_a_footprint_vectors_refusal_shows_the_value_cut_at_60_characters():
+    assert refusal(lambda: call("footprint", e_phi=(0.1, 0.2)))[1] == \
+        "e_phi must have three components (x, y, z), got 2: tuple (0.1, 0.2)"
+    assert refusal(lambda: call("footprint", e_theta=b"abc"))[1] == \
+        "e_theta must be three components (x, y, z): a tuple, list or array, got bytes b'abc'"
+    assert refusal(lambda: call("footprint", N=[0.0] * 40))[1] == \
+        "N must have three components (x, y, z), got 40: list " + "[" + "0.0, " * 11 + "0.0,..."
+    assert refusal(lambda: call("footprint", P={0.5}))[1] == \
+        "P must be three components (x, y, z): a tuple, list or array, got set {0.5}"
 
 
 def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():
