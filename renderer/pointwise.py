@@ -105,7 +105,7 @@ def _triple(name, value):
     """``value`` as three components (x, y, z): a tuple, a list or an array whose first axis has
     length 3; TypeError for another kind (a set, bytes, a generator), ValueError for another
     length, each naming ``name``."""
-    if not isinstance(value, (tuple, list, np.ndarray)) or np.ndim(value) == 0:
+    if not isinstance(value, (tuple, list, np.ndarray)) or (isinstance(value, np.ndarray) and value.ndim == 0):
         raise InvalidType(f"{name} must be three components (x, y, z): a tuple, list or array, "
                           f"got {_shown(value, 60)}")
     if len(value) != 3:
@@ -238,8 +238,8 @@ def footprint(x, y, dx, dy, camera_z, P, N, e_theta, e_phi, radius, sin_phi):
     """
     P, N, e_theta, e_phi = (_triple(n, t) for n, t in (("P", P), ("N", N), ("e_theta", e_theta),
                                                         ("e_phi", e_phi)))
-    names = ("x", "y", "dx", "dy", "camera_z", "P_x", "P_y", "P_z", "N_x", "N_y", "N_z", "et_x", "et_y", "et_z",
-             "ep_x", "ep_y", "ep_z", "radius", "sin_phi")
+    names = ("x", "y", "dx", "dy", "camera_z", *(f"{n}[{i}]" for n in ("P", "N", "e_theta", "e_phi") for i in range(3)),
+             "radius", "sin_phi")
     return tuple(_evaluate(G.footprint_array, 2, (), names, (x, y, dx, dy, camera_z, *P, *N, *e_theta, *e_phi,
                                                              radius, sin_phi)))
 

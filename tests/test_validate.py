@@ -262,6 +262,15 @@ def test_a_footprint_vector_is_a_tuple_list_or_array_of_three(argument, point, e
     assert all_finite(call("footprint", **{argument: np.array([[0.1, 0.2], [0.1, 0.2], [0.99, 0.97]])}))
 
 
+@pytest.mark.parametrize("argument", ["P", "N", "e_theta", "e_phi"])
+def test_each_component_of_a_footprint_vector_is_refused_by_its_name_and_index(argument):
+    for i in range(3):
+        vector = list(CALLS["footprint"][1][argument])
+        vector[i] = np.array([0.5, np.inf])
+        _, message = refusal(lambda: call("footprint", **{argument: vector}))
+        assert message.startswith(f"{argument}[{i}] must be in [") and message.endswith("got inf at flat index 1")
+
+
 def test_a_footprint_vectors_refusal_shows_the_value_cut_at_60_characters():
     assert refusal(lambda: call("footprint", e_phi=(0.1, 0.2)))[1] == \
         "e_phi must have three components (x, y, z), got 2: tuple (0.1, 0.2)"
