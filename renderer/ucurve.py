@@ -184,22 +184,32 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
 
     Parameters
     ----------
-    eps, error : 1-D float64 arrays of one length, eps > 0
-    start : (float, float) > 0
+    eps, error : 1-D arrays of real numbers of one length, eps > 0, error >= 0
+    start : two real numbers > 0
         First guess, e.g. (|third derivative| / 6, u |h|).
 
     Raises
     ------
+    renderer.validate.InputError
+        Naming the argument: not real numbers, eps not positive, an error negative, shapes that
+        differ, a start that is not two positive numbers.
     ValueError
         Fewer than 2 steps with nonzero error; or no fit: no convergence in 100
         steps, or an optimum (B / 2A)^(1/3) outside the steps (they see one side of it).
     """
-    eps, error = np.asarray(eps, dtype=np.float64), np.asarray(error, dtype=np.float64)
+    eps = validate.real_array("eps", eps, low=0.0, low_open=True)
+    error = validate.real_array("error", error, low=0.0)
+    if eps.ndim != 1 or error.shape != eps.shape:
+        raise validate.InvalidValue(f"eps and error must be 1-D arrays of one length, got shapes {eps.shape} "
+                                    f"and {error.shape}")
+    start = validate.real_array("start", start, low=0.0, low_open=True)
+    if start.shape != (2,):
+        raise validate.InvalidValue(f"start must be two numbers (A, B), got shape {start.shape}")
     keep = error > 0
     if np.count_nonzero(keep) < 2:
         raise ValueError("error must have at least 2 nonzero entries to fit a two-term model")
     e, err = eps[keep], error[keep]
-    p = np.log(np.asarray(start, dtype=np.float64))
+    p = np.log(start)
     with np.errstate(all="ignore"):
         for _ in range(100):
             trunc, rnd = np.exp(p[0]) * e**2, np.exp(p[1]) / e
