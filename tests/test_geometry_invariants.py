@@ -542,12 +542,24 @@ def test_reach_gate_adds_the_shading_normal_and_bad_arguments_are_named():
     g = gbuffer(scene, 64, 48)
     plain, gated = pointwise.reach(scene, g), pointwise.reach(scene, g, gate=True)
     assert np.all(gated <= plain) and np.count_nonzero(plain & ~gated) > 0
-    with pytest.raises(TypeError, match="scene must be"):
+    with pytest.raises(TypeError, match="^scene must be a renderer.Scene, got object$"):
         pointwise.reach(object(), g)
-    with pytest.raises(TypeError, match="gbuffer must be"):
+    with pytest.raises(TypeError, match="^gbuffer must be a renderer.GBuffer, got Frame$"):
         pointwise.reach(scene, render(scene, 8, 8))
-    with pytest.raises(TypeError, match="gate"):
+    with pytest.raises(TypeError, match="^gate must be True or False, got int 1$"):
         pointwise.reach(scene, g, gate=1)
+
+
+def test_reach_keeps_a_light_of_zero_colour_in_its_place():
+    """One mask per light of the scene, in order, those of zero colour included (the kernel leaves
+    them out of shading, where they add exactly 0): the dark light's mask is the one it would have
+    with a colour."""
+    dark, lit = PointLight((3.0, 2.0, 5.0), (0.0, 0.0, 0.0)), PointLight((3.0, 2.0, 5.0))
+    scene = Scene(beta=0.0)
+    g = gbuffer(scene, 32, 24)
+    masks = pointwise.reach(scene.replace(lights=(*scene.lights[:1], dark, *scene.lights[1:])), g)
+    assert masks.shape == (len(scene.lights) + 1, 24, 32)
+    assert np.array_equal(masks[1], pointwise.reach(scene.replace(lights=(lit,)), g)[0]) and masks[1].any()
 
 
 @pytest.mark.parametrize("width, height", [(64, 64), (96, 48), (40, 120)])
@@ -570,7 +582,8 @@ def test_reach_refuses_a_gbuffer_whose_arrays_are_of_another_frame(field):
     scene = Scene()
     small, big = gbuffer(scene, 8, 8), gbuffer(scene, 16, 12)
     mixed = dataclasses.replace(big, **{field: getattr(small, field)})
-    with pytest.raises(ValueError, match=r"^gbuffer\.\w+ has shape \(8, 8, 3\), gbuffer\.chamber \(12, 16\)"
+    with pytest.raises(ValueError, match=r"^gbuffer\.\w+ has shape \(8, 8, 3\), gbuffer\.chamber \(12, 16\): "
+                                         r"the arrays must be one frame's, \(12, 16, 3\)$"
                                          if field != "chamber" else r"^gbuffer\.P has shape \(12, 16, 3\), "
                                                                      r"gbuffer\.chamber \(8, 8\)"):
         pointwise.reach(scene, mixed)
