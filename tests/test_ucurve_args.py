@@ -32,6 +32,8 @@ def test_each_argument_is_refused_by_name(kwargs, error, name, phrase):
         measure(**{"eps": [1e-3], **kwargs})
     assert isinstance(info.value, error)
     assert str(info.value).startswith(f"{name} ") and phrase in str(info.value)
+    if name in ("u", "v", "k_u", "k_v"):           # refused by measure itself, as a scalar, not by a callee
+        assert "flat index" not in str(info.value), str(info.value)
 
 
 def test_values_at_the_limits_and_numpy_scalars_are_measured():
@@ -43,6 +45,8 @@ def test_values_at_the_limits_and_numpy_scalars_are_measured():
         for name in ("u", "v"):
             if name in kwargs:
                 assert getattr(uc, name) == float(kwargs[name]) and type(getattr(uc, name)) is float
+    uc = measure("rings", 0.2, 0.3, "v", eps=[1e-3])
+    assert (uc.field, uc.u, uc.v, uc.component) == ("rings", 0.2, 0.3, "v")
 
 
 @pytest.mark.parametrize("args, kwargs, error, message", [

@@ -1,5 +1,9 @@
-"""`renderer.ucurve.measure_function` (a reader's function of one variable) against mpmath, at random
-functions, points and steps.
+"""`renderer.ucurve`'s U-curves against routes of their own.
+
+A reader's function (`renderer.ucurve.measure_function`) against mpmath at random functions, points and
+steps; and where a field has a crease (`renderer.ucurve.measure` with a ``reason``), the reference the
+split is measured against: the derivative at the float64 point itself by ``mpmath.diff`` (the crease in
+exact arithmetic lies an ulp or so to one side), at frequencies that do not divide a power of ten.
 
 The route here is written without the module's helpers: f as an mpmath lambda of its own, the abscissae
 fl(x + eps) and fl(x - eps) rounded by Python, f', f''' by ``mpmath.diff``.  The truncation is the
@@ -14,7 +18,11 @@ import mpmath
 import numpy as np
 import pytest
 
-from renderer.ucurve import UNIT_ROUNDOFF, measure_function
+import sympy as sp
+
+from renderer import formulas as F
+from renderer import pointwise
+from renderer.ucurve import UNIT_ROUNDOFF, measure, measure_function
 
 #: (text the reader types, the same function for mpmath, for float64 Python) with parameters a, b.
 FAMILIES = [
@@ -70,3 +78,25 @@ def test_abscissae_taken_on_one_side_are_caught(monkeypatch):
         label, x, steps, lambda e: (lambda fd, p, m, d: (fd, p, p, d))(*quotient(e)), *rest))
     with pytest.raises(AssertionError):
         test_the_u_curve_of_a_readers_function_is_mpmaths(*next(_cases()))
+
+
+@pytest.mark.parametrize("k, x, component", [(1 / 0.3, 0.3, "u"), (2.6, 1 / 2.6, "u"), (10 / 3, 0.6, "u"),
+                                             (2.6, 1 / 2.6, "v"), (8.0, 0.125, "u"), (4.0, 0.25, "v")])
+def test_at_a_crease_the_reference_is_the_derivative_at_the_float_point(k, x, component):
+    at = dict(u=x, v=0.47, k_u=k) if component == "u" else dict(u=0.31, v=x, k_v=k)
+    c = measure("ridges", component=component, eps=[1e-3], **at)
+    assert c.reason is not None and "crease" in c.reason
+    assert (c.field, c.component, c.u, c.v) == ("ridges", component, at["u"], at["v"])
+    k_u, k_v = at.get("k_u", 8.0), at.get("k_v", 4.0)
+    h = sp.lambdify((F.u, F.v), F.FIELDS["ridges"].expr.subs({F.k_u: sp.Rational(k_u), F.k_v: sp.Rational(k_v)}),
+                    modules="mpmath")
+    with mpmath.workdps(60):
+        U, V = mpmath.mpf(at["u"]), mpmath.mpf(at["v"])
+        # On the crease exactly (8 * 0.125 = 1), the slope from above, as the class says.
+        side = mpmath.mpf(10) ** -45 if k * x == 1.0 and float(mpmath.mpf(k) * mpmath.mpf(x)) == 1.0 else 0
+        if component == "u":
+            slope = mpmath.diff(lambda t: h(t, V), U + side)
+        else:
+            slope = mpmath.diff(lambda t: h(U, t), V + side)
+    fd = float(pointwise.central_gradient("ridges", at["u"], at["v"], k_u, k_v, 1e-3)[component == "v"])
+    assert fd - c.roundoff[0] - c.truncation[0] == pytest.approx(float(slope), rel=1e-9)
