@@ -20,10 +20,14 @@ rates: verify's, and the tests' of all mutants and of those verify missed.  With
 ``--baseline`` the unmutated copy runs first, and the audit stops if it does not pass
 (a failing baseline would count every mutant as killed).
 
-mutmut's own run covers the pure-Python modules the fast tests exercise (its
-configuration is ``[tool.mutmut]`` in pyproject.toml): ``pip install mutmut``, then
-``mutmut run`` and ``mutmut results``, as mutmut documents.  It cannot mutate the
-numba kernel or module-level sympy, which is what the mutants here cover.
+mutmut's own run covers lab/, proofs/ and the renderer's pure-Python references against
+the tests `make test` runs in its own process (its configuration, and what it leaves out
+and why, is ``[tool.mutmut]`` in pyproject.toml): ``pip install mutmut``, then ``mutmut run``
+(or ``mutmut run "renderer.ucurve*"`` for one module) and ``mutmut results``, as mutmut
+documents.  A mutant costs seconds (a survivor runs every test that reached its function):
+on 2 cores one module takes minutes to an hour, all of them a day.  It cannot mutate the
+numba kernel, module-level sympy, the JavaScript, the pages or the build, which is what
+the mutants here cover.
 
 Usage: python benchmarks/mutation_audit.py [--list first|second|all] [--baseline] [ID ...]
        (default: every mutant of both lists; IDs choose among the list's)
