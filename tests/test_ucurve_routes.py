@@ -87,6 +87,11 @@ def test_at_a_crease_the_reference_is_the_derivative_at_the_float_point(k, x, co
     c = measure("ridges", component=component, eps=[1e-3], **at)
     assert c.reason is not None and "crease" in c.reason
     assert (c.field, c.component, c.u, c.v) == ("ridges", component, at["u"], at["v"])
+    # No true derivative, no model and no optimum: every one of them NaN (a float), the model a NaN per step.
+    nan = ("derivative", "third_derivative", "model_truncation", "model_cancellation", "model_argument",
+           "eps_model", "error_model", "eps_measured_min", "error_at_measured_min")
+    assert all(type(getattr(c, name)) is float and np.isnan(getattr(c, name)) for name in nan)
+    assert c.model.shape == c.eps.shape and np.isnan(c.model).all()
     k_u, k_v = at.get("k_u", 8.0), at.get("k_v", 4.0)
     h = sp.lambdify((F.u, F.v), F.FIELDS["ridges"].expr.subs({F.k_u: sp.Rational(k_u), F.k_v: sp.Rational(k_v)}),
                     modules="mpmath")
