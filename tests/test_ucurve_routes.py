@@ -67,6 +67,12 @@ def test_the_u_curve_of_a_readers_function_is_mpmaths(text, f_mp, f_py, x):
             slack = 8 * UNIT_ROUNDOFF * max(abs(f_py(plus)), abs(f_py(minus))) / e
             assert abs(uc.roundoff[i] - float(mpmath.mpf(python) - exact)) <= slack, (text, e)
     assert uc.u == x and uc.component == "x" and np.isnan(uc.v)
+    # The error model E(eps) = T eps^2 + (C + G) / eps, its minimiser and least value, from mpmath's values.
+    T, C, G = abs(uc.third_derivative) / 6, UNIT_ROUNDOFF * abs(uc.height), UNIT_ROUNDOFF * abs(x * uc.derivative)
+    star = ((C + G) / (2 * T)) ** (1 / 3)
+    assert uc.eps_model == pytest.approx(star, rel=1e-12)
+    assert uc.error_model == pytest.approx(T * star**2 + (C + G) / star, rel=1e-12)
+    assert uc.model == pytest.approx(T * uc.eps**2 + (C + G) / uc.eps, rel=1e-12)
 
 
 def test_abscissae_taken_on_one_side_are_caught(monkeypatch):
