@@ -73,6 +73,18 @@ def test_the_u_curve_of_a_readers_function_is_mpmaths(text, f_mp, f_py, x):
     assert uc.eps_model == pytest.approx(star, rel=1e-12)
     assert uc.error_model == pytest.approx(T * star**2 + (C + G) / star, rel=1e-12)
     assert uc.model == pytest.approx(T * uc.eps**2 + (C + G) / uc.eps, rel=1e-12)
+    assert (uc.model_truncation, uc.model_cancellation, uc.model_argument) == pytest.approx((T, C, G), rel=1e-12)
+    best = int(np.argmin(uc.error))
+    assert (uc.eps_measured_min, uc.error_at_measured_min) == (steps[best], uc.error[best])
+
+
+def test_the_model_without_truncation_or_without_rounding_has_its_optimum_at_an_end():
+    """h_u of rings is 0 (no truncation: E falls as eps grows, eps* infinite, least E 0); sin at 0 has
+    h = x h' = 0 (no rounding: eps* = 0, least E 0)."""
+    flat = measure("rings", component="u", eps=[1e-3, 1e-6])
+    assert flat.reason is None and (flat.model_truncation, flat.eps_model, flat.error_model) == (0.0, np.inf, 0.0)
+    exact = measure_function("sin(x)", 0.0, eps=[1e-3, 1e-6])
+    assert (exact.model_cancellation + exact.model_argument, exact.eps_model, exact.error_model) == (0.0, 0.0, 0.0)
 
 
 def test_abscissae_taken_on_one_side_are_caught(monkeypatch):
