@@ -22,7 +22,7 @@ import sympy as sp
 
 from renderer import formulas as F
 from renderer import pointwise
-from renderer.ucurve import UNIT_ROUNDOFF, measure, measure_function
+from renderer.ucurve import UNIT_ROUNDOFF, measure, measure_function, non_differentiable
 
 #: (text the reader types, the same function for mpmath, for float64 Python) with parameters a, b.
 FAMILIES = [
@@ -76,6 +76,9 @@ def test_the_u_curve_of_a_readers_function_is_mpmaths(text, f_mp, f_py, x):
     assert (uc.model_truncation, uc.model_cancellation, uc.model_argument) == pytest.approx((T, C, G), rel=1e-12)
     best = int(np.argmin(uc.error))
     assert (uc.eps_measured_min, uc.error_at_measured_min) == (steps[best], uc.error[best])
+    A, B, fitted = uc.fitted_truncation, uc.fitted_roundoff, uc.eps_fitted
+    assert fitted == pytest.approx((B / (2 * A)) ** (1 / 3), rel=1e-12, nan_ok=True)     # NaN: no U to fit
+    assert uc.error_at_fitted == pytest.approx(A * fitted**2 + B / fitted, rel=1e-12, nan_ok=True)
 
 
 def test_the_model_without_truncation_or_without_rounding_has_its_optimum_at_an_end():
@@ -123,3 +126,17 @@ def test_at_a_crease_the_reference_is_the_derivative_at_the_float_point(k, x, co
             slope = mpmath.diff(lambda t: h(U, t), V + side)
     fd = float(pointwise.central_gradient("ridges", at["u"], at["v"], k_u, k_v, 1e-3)[component == "v"])
     assert fd - c.roundoff[0] - c.truncation[0] == pytest.approx(float(slope), rel=1e-9)
+
+
+def test_a_crease_is_a_sign_change_within_one_ulp_of_any_abs_of_the_field():
+    """One ulp from the crease counts as on it, two do not; a field with two Abs is read at either
+    one's crease; a crease of tiny slope is still a crease."""
+    at = dict(v=0.47, k_u=8.0, k_v=4.0)
+    assert non_differentiable("ridges", 0.125 + 2**-55, component="u", **at) is not None
+    assert non_differentiable("ridges", 0.125 + 2**-54, component="u", **at) is None
+    two = sp.Abs(sp.sin(sp.pi * F.k_u * F.u)) + sp.Abs(sp.sin(sp.pi * F.k_v * F.v))
+    assert "where sin(pi*k_u*u) changes sign" in non_differentiable(two, 0.125, 0.3, "u", 8.0, 4.0)
+    assert "where sin(pi*k_v*v) changes sign" in non_differentiable(two, 0.3, 0.25, "v", 8.0, 4.0)
+    assert non_differentiable(two, 0.3, 0.3, "v", 8.0, 4.0) is None
+    tiny = sp.Abs((F.u - sp.Rational(1, 2)) / 10**20, evaluate=False) + F.v
+    assert "changes sign" in non_differentiable(tiny, 0.5, 0.3, "u", 8.0, 4.0)
