@@ -312,3 +312,8 @@ def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():
     got = pointwise.footprint(pick(), pick(), pick(), pick(), pick(), triple(), triple(), triple(), triple(),
                               rng.choice([*edge("radius"), 1.0], 4000), pick())
     assert all_finite(got)
+
+
+def test_arguments_that_do_not_broadcast_are_refused_with_every_shape():
+    _, message = refusal(lambda: pointwise.height("sine", [0.1, 0.2], [0.1, 0.2, 0.3], 8.0, 4.0))
+    assert message == "the arguments must broadcast to one shape, got u (2,), v (3,), k_u (), k_v ()"
