@@ -278,8 +278,9 @@ def test_a_footprint_vectors_refusal_shows_the_value_cut_at_60_characters():
         "e_theta must be three components (x, y, z): a tuple, list or array, got bytes b'abc'"
     assert refusal(lambda: call("footprint", N=[0.0] * 40))[1] == \
         "N must have three components (x, y, z), got 40: list " + "[" + "0.0, " * 11 + "0.0,..."
-    assert refusal(lambda: call("footprint", P={0.5}))[1] == \
-        "P must be three components (x, y, z): a tuple, list or array, got set {0.5}"
+    assert refusal(lambda: call("footprint", P=set(range(40))))[1] == \
+        "P must be three components (x, y, z): a tuple, list or array, got set " + \
+        "{" + ", ".join(map(str, range(16))) + ", 1..."
 
 
 def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():
