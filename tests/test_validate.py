@@ -280,7 +280,7 @@ def test_a_footprint_vectors_refusal_shows_the_value_cut_at_60_characters():
         "N must have three components (x, y, z), got 40: list " + "[" + "0.0, " * 11 + "0.0,..."
     assert refusal(lambda: call("footprint", P=set(range(40))))[1] == \
         "P must be three components (x, y, z): a tuple, list or array, got set " + \
-        "{" + ", ".join(map(str, range(16))) + ", 1..."
+        "{" + ", ".join(map(str, range(17))) + ", 1..."
 
 
 def test_pointwise_outputs_are_finite_at_every_corner_of_the_ranges():
