@@ -22,9 +22,12 @@ def pytest_configure(config):
 SHARED = ("site", "session")
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items):
     """Every test that reads the built site (it takes `book_html`) is an audit: `make test`
-    leaves it to `make audit`; one that uses a fixture of `SHARED` joins that fixture's xdist group."""
+    leaves it to `make audit`; one that uses a fixture of `SHARED` joins that fixture's xdist group.
+    First among the hooks: xdist's worker reads the groups in its own hook, which would otherwise run
+    before this one and see none (each worker then built the shared fixture for itself)."""
     for item in items:
         names = getattr(item, "fixturenames", ())
         if "book_html" in names:
