@@ -12,18 +12,21 @@ Each page (index, §1-§9, glossary) is opened offline from the built site, its 
     client rects, then the character where the line changes);
 (d) width: nothing wider than the article's column, nothing cut off by a box that hides its
     overflow (a box that scrolls may hold wider content), the page no wider than the window;
-(e) formulas: tests/test_browser.py measures each, inline and displayed (full size, within the column);
+(e) formulas: each, inline and displayed, at the size of the text around it or larger and within the
+    column, every dropdown open (MathJax 4 breaks the lines), its fonts from the site;
 (f) text in figures: each figure's PNG records the smallest font size it draws, in its own pixels
     (`chapter.figures.figure_png`); shown at a rendered over natural width, that is
-    ``png px * rendered / natural`` CSS px, at least `MIN_FIGURE_TEXT_PX` at each width.
+    ``png px * rendered / natural`` CSS px, at least `MIN_FIGURE_TEXT_PX` at each width;
+(g) accessibility: axe-core (WCAG 2.1 A and AA rules) finds no serious or critical violation.
 
 Every check is shown catching a planted defect (the ``test_the_*_check_*`` tests), and
 `chapter.figures.text_overlaps`, which `chapter.page.show` runs on every figure a page publishes, is
 tested on planted overlaps and on the book's diagrams.  The measurements go to
 test-artifacts/book_pages.json; with ``SYMRENDER_SHOTS=1`` a screenshot of every page at both widths
 goes to test-artifacts/pages/ (full-page captures take about a second each).  Each page is opened
-once, at 1280 px, and then resized to 390 px (fit.js refits on the article's resize; a fresh load at
-390 px measures the same on every page).
+twice (`site`): at 1280 px, then narrowed to 390 px (fit.js refits on the article's resize), for
+(a)-(g) at both widths; and at 390 px, as a phone opens it, for (e) and (g) (on every page (a)-(d)
+measured the same there as after the narrowing).
 
 A finding in a page's text (class b, or a break or overflow caused by what the text says) is the
 page author's or the theorem printer's to fix: these tests fail on it and name page, class and text.
@@ -365,20 +368,39 @@ def browser():
         b.close()
 
 
-class Page:
-    """A page opened offline at ``width`` px (only file: and data: addresses load), once MathJax has
-    typeset it and fit.js (if the page has it) is done."""
+#: True in a page once fit.js (if the page has it: the book's pages do) has fitted it.
+FITTED = "!document.querySelector('script[src*=\"fit.js\"]') || document.documentElement.dataset.fit === 'done'"
 
-    def __init__(self, browser, url, width, height=900):
+
+class Page:
+    """A page opened offline at ``width`` px, once MathJax has typeset it and fit.js is done.  Only file:
+    addresses load; any other request is blocked and recorded in ``blocked``, and console errors and
+    uncaught exceptions in ``errors``.  ``change(path, text)``, if given, rewrites each HTML and CSS file
+    the page loads from the site (a wrong variant)."""
+
+    def __init__(self, browser, url, width, height=900, change=None):
         self.context = browser.new_context(viewport={"width": width, "height": height})
-        self.context.route("**/*", lambda r: r.continue_() if r.request.url.startswith(("file:", "data:"))
-                           else r.abort())
+        self.blocked, self.errors = [], []
+
+        def route(r):
+            if not r.request.url.startswith("file://"):
+                self.blocked.append(r.request.url)
+                return r.abort()
+            if change is None or not r.request.url.split("?")[0].endswith((".html", ".css")):
+                return r.continue_()
+            from urllib.parse import unquote, urlparse
+            path = Path(unquote(urlparse(r.request.url).path))
+            r.fulfill(body=change(path, path.read_text(encoding="utf-8")),
+                      content_type="text/css" if path.suffix == ".css" else "text/html")
+
+        self.context.route("**/*", route)
         self.page = self.context.new_page()
+        self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
+        self.page.on("pageerror", lambda e: self.errors.append(str(e)))
         self.page.goto(url)
         self.page.wait_for_load_state("load")
         self.page.evaluate("() => window.MathJax && MathJax.startup ? MathJax.startup.promise : null")
-        self.page.wait_for_function("!document.querySelector('script[src*=\"fit.js\"]')"
-                                    " || document.documentElement.dataset.fit === 'done'", timeout=30_000)
+        self.page.wait_for_function(FITTED, timeout=30_000)
         self.page.evaluate("() => document.querySelectorAll('article.bd-article details[open]')"
                            ".forEach(d => d.setAttribute('data-open-at-load', ''))")
 
@@ -389,13 +411,27 @@ class Page:
 
     def resize(self, width, height=900):
         """The same page at another width, as a reader who turns a phone would see it: the folds
-        the audit opened closed again, the viewport resized, and fit.js's refit (on the
+        opened since the load closed again, the viewport resized, and fit.js's refit (on the
         article's resize) done.  Saves a second load and MathJax typesetting."""
         self.page.evaluate("() => document.querySelectorAll('article.bd-article details')"
                            ".forEach(d => { d.open = d.hasAttribute('data-open-at-load'); })")
+        self.page.evaluate("() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
+        self.page.evaluate("document.documentElement.removeAttribute('data-fit')")
         self.page.set_viewport_size({"width": width, "height": height})
+        self.page.wait_for_function(FITTED, timeout=30_000)
         self.page.evaluate("() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => "
                            "setTimeout(r, 100))))")
+
+    def formulas(self):
+        """`FORMULAS_JS`'s list: every typeset formula of the article, every dropdown open."""
+        return self.page.evaluate(FORMULAS_JS)
+
+    def axe(self):
+        """axe-core's violations (`AXE_JS`), every dropdown open."""
+        if not AXE.is_file():
+            pytest.fail(f"{AXE} is missing: `make .venv/.installed` (book/fetch_mathjax.py) fetches it")
+        self.page.add_script_tag(path=str(AXE))
+        return self.page.evaluate(AXE_JS, AXE_TAGS)
 
     def length(self):
         """{"height": px, "words": n} of the page as it opens (folded material closed): the page's
@@ -516,15 +552,31 @@ def pale_captions(figures):
     return out
 
 
+#: `site`'s key of the measurements of a page opened at 390 px (its (page, 390) ones are of the page
+#: opened at 1280 px, then narrowed).
+PHONE = "390 px at load"
+
+
 @pytest.fixture(scope="module")
 def site(browser, book_html):
-    """{(page, width): audit} for every page of the built site at both widths; saves the report and
-    a screenshot of each."""
+    """Every page of the built site, each opened twice: {(page, width): the audit classes (a)-(d), its
+    length, figures, tables and formulas} at 1280 px and then narrowed to 390 px, with axe-core's
+    violations at 1280 px (the window widened again); {(page, PHONE): formulas and axe-core's violations}
+    of the page opened at 390 px; {(page, "loads"): [{"blocked", "errors"}] of each load, up to axe-core}.  Saves the report, and with
+    SYMRENDER_SHOTS=1 a screenshot of each page at each width."""
     shots = ARTIFACTS / "pages"
     shots.mkdir(parents=True, exist_ok=True)
     found = {}
     for name in PAGES:
-        p = Page(browser, (book_html / f"{name}.html").as_uri(), WIDTHS[0])
+        url, loads = (book_html / f"{name}.html").as_uri(), []
+        phone = Page(browser, url, 390)
+        try:
+            found[name, PHONE] = {"formulas": phone.formulas()}
+            loads.append({"blocked": list(phone.blocked), "errors": list(phone.errors)})
+            found[name, PHONE]["axe"] = phone.axe()
+        finally:
+            phone.close()
+        p = Page(browser, url, WIDTHS[0])
         try:
             for width in WIDTHS:
                 if width != WIDTHS[0]:
@@ -534,10 +586,16 @@ def site(browser, book_html):
                 found[name, width]["length"] = lengths
                 found[name, width]["figures"] = p.page.evaluate(FIGURES, 2)
                 found[name, width]["tables"] = p.page.evaluate(TABLES)
+                found[name, width]["formulas"] = p.formulas()
                 if os.environ.get("SYMRENDER_SHOTS") == "1":
                     p.screenshot(shots / f"{name}_{width}.png")
+            loads.append({"blocked": list(p.blocked), "errors": list(p.errors)})
+            # Last: axe-core's reading of the stylesheets fails in the console (file: has no CORS).
+            p.resize(WIDTHS[0])
+            found[name, WIDTHS[0]]["axe"] = p.axe()
         finally:
             p.close()
+        found[name, "loads"] = loads
     summary = {f"{w}px": {"images": sum(len(found[n, w]["images"]) for n in PAGES),
                           "images_off_ratio": sum(len(_stretched(found[n, w])) for n in PAGES),
                           "text_nodes": sum(found[n, w]["text_nodes"] for n in PAGES),
@@ -668,7 +726,7 @@ def test_the_table_check_catches_rows_stacked_into_cards(browser, book_html):
 def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_size(site):
     """No bare plot: each image of each page sits in a figure numbered "Fig. n" with a caption and
     alt text, and has at least two device pixels per CSS pixel (for high-density screens)."""
-    images = [dict(i, page=name) for (name, width), a in site.items() if width == 1280 for i in a["figures"]]
+    images = [dict(i, page=name) for name in PAGES for i in site[name, 1280]["figures"]]
     assert len(images) >= 12
     assert bare_figures(images) == []
 
@@ -676,8 +734,8 @@ def test_every_image_is_a_numbered_captioned_figure_with_alt_text_at_twice_its_s
 def test_every_caption_reads_at_the_texts_contrast(site):
     """Every figure's caption, at both widths: at least 7:1 against its background, in a regular weight
     (the theme's muted grey in its light 300 weight read pale)."""
-    found = [dict(f, page=n, width=w) for (n, w), a in site.items() for f in pale_captions(a["figures"])]
-    assert sum(1 for a in site.values() for f in a["figures"] if f["ink"]) >= 2 * 12
+    found = [dict(f, page=n, width=w) for n in PAGES for w in WIDTHS for f in pale_captions(site[n, w]["figures"])]
+    assert sum(1 for n in PAGES for w in WIDTHS for f in site[n, w]["figures"] if f["ink"]) >= 2 * 12
     assert not found, f"pale captions:\n{_listing(found)}"
 
 
@@ -725,7 +783,7 @@ def test_the_book_is_short_enough(site):
 def test_every_figure_records_the_size_of_its_smallest_text(site):
     """Every image of the book is a matplotlib figure displayed through `chapter.figures.figure_png`,
     whose PNG records its smallest text; one without the record would go unmeasured, so it fails here."""
-    figures = [dict(f, page=n, width=w) for (n, w), a in site.items() for f in a["figure_text"]]
+    figures = [dict(f, page=n, width=w) for n in PAGES for w in WIDTHS for f in site[n, w]["figure_text"]]
     assert len(figures) >= 2 * 12
     missing = [f for f in figures if not f["recorded"]]
     assert not missing, f"figures whose PNG records no text size:\n{_listing(missing)}"
@@ -1133,3 +1191,177 @@ def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_htm
     assert too_long({"a": page(R - 1_000), "b": page(1_500)}) != []
     assert too_long({"s6_ledger": page(A - 1_000), "b": page(0, 1_001)}) == [
         f"{A + 1} words in folds, margins and the ledger (at most {A})"]
+
+
+# ---- every formula of the book: at full size, within the column ---------------------------------
+
+#: Run in a page once MathJax and fit.js are done: every dropdown opened (fit.js then breaks their
+#: displays again, if their width has changed), each typeset formula of the article, inline or displayed, as {"display", "scale": its
+#: font size over the font size of the text around it (the element around its span.math or div.math),
+#: times any CSS transform of it or of an element around it within the article, "px": its font size as
+#: drawn, "over": how far (px) its typeset box
+#: reaches past the article's column, 0 if it ends within, "error": whether MathJax set a TeX error,
+#: "text", "where"}.
+FORMULAS_JS = r"""async () => {
+  const root = document.querySelector('article.bd-article');
+  const folded = [...root.querySelectorAll('details:not([open])')];
+  if (folded.length) {
+    // fit.js refits on each toggle event, in its own listener (on the document, capturing): the last
+    // dropdown's own listener runs after all of them.
+    const last = new Promise(r => folded[folded.length - 1].addEventListener('toggle', r, {once: true}));
+    folded.forEach(d => { d.open = true; });
+    await last;
+  }
+  const cs = getComputedStyle(root), box = root.getBoundingClientRect();
+  const left = box.left + parseFloat(cs.paddingLeft), right = box.right - parseFloat(cs.paddingRight);
+  const px = el => parseFloat(getComputedStyle(el).fontSize);
+  return [...root.querySelectorAll('mjx-container')].filter(m => m.getClientRects().length).map(m => {
+    const around = (m.closest('.math') || m).parentElement;        // the text the formula stands in
+    let scale = px(m) / px(around);
+    for (let e = m; e !== root; e = e.parentElement) {
+      const t = getComputedStyle(e).transform;
+      if (t !== 'none') { const d = new DOMMatrix(t); scale *= Math.hypot(d.a, d.b); }
+    }
+    const rects = [m, ...m.querySelectorAll('mjx-math')].flatMap(e => [...e.getClientRects()]).filter(r => r.width);
+    const over = Math.max(0, ...rects.map(r => Math.max(r.right - right, left - r.left)));
+    const section = m.closest('section[id]');
+    return {display: m.getAttribute('display') === 'true', scale: +scale.toFixed(3),
+            px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror'),
+            text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
+            where: section ? '#' + section.id : ''};
+  });
+}"""
+
+
+def formula_findings(found):
+    """The formulas of a FORMULAS_JS list that a reader cannot read whole: set below the text's size
+    (scale under 1), reaching past the column by more than a pixel, or a TeX error."""
+    return [f for f in found if f["scale"] < 0.999 or f["over"] > 1 or f["error"]]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_every_formula_is_at_full_size_within_the_column(site, name):
+    """Every formula of every page, inline and displayed, every dropdown open, is typeset at the size of
+    the text around it or larger, and ends within the article's column: the page opened at 390 px, and
+    opened at 1280 px, then the window narrowed to 390 (fit.js breaks the displays typeset for 1280
+    again); MathJax breaks the lines, nothing scales a formula down.  Nothing is fetched from off the
+    site and no script fails.  The measurements go to test-artifacts/formulas_<page>.json."""
+    report = []
+    for key, at in ((PHONE, "390 px"), (1280, "1280 px"), (390, "1280 px then 390 px")):
+        found = site[name, key]["formulas"]
+        report.append({"at": at, "formulas": len(found), "displays": sum(f["display"] for f in found),
+                       "smallest_scale": min((f["scale"] for f in found), default=None),
+                       "widest_overflow_px": max((f["over"] for f in found), default=None),
+                       "findings": formula_findings(found)})
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    (ARTIFACTS / f"formulas_{name}.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
+    bad = [r for r in report if r["findings"]]
+    assert not bad, f"{name}:\n" + json.dumps(bad, indent=1, ensure_ascii=False)
+    assert site[name, "loads"] == [{"blocked": [], "errors": []}] * 2, site[name, "loads"]
+
+
+#: Wrong variants of the site (the file changed, its text replaced, its replacement), each of which the
+#: formula check must catch on §3 at 390 px: MathJax left to let formulas run past the column (its
+#: default), and formulas set at 62 % of the text (as fit.js once shrank them to fit).
+WRONG_FORMULAS = {
+    "MathJax breaking no line": ("s3_math.html", '"displayOverflow": "linebreak", "linebreaks": {"inline": true',
+                                 '"displayOverflow": "overflow", "linebreaks": {"inline": false'),
+    "formulas shrunk to 62 %": ("fit.css", "article.bd-article span.math { display: inline; }",
+                                "article.bd-article span.math { display: inline; font-size: 62%; }"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_FORMULAS))
+def test_the_formula_check_catches_formulas_shrunk_or_running_past_the_column(browser, book_html, variant):
+    file, old, new = WRONG_FORMULAS[variant]
+
+    def change(path, text):
+        if path.name != file:
+            return text
+        assert text.count(old) == 1, f"variant {variant!r} no longer applies to {file}"
+        return text.replace(old, new)
+
+    s = Page(browser, (book_html / "s3_math.html").as_uri(), 390, change=change)
+    try:
+        found = formula_findings(s.formulas())
+    finally:
+        s.close()
+    kind = "over" if "line" in variant else "scale"
+    assert found and all((f["over"] > 1) if kind == "over" else (f["scale"] < 0.999) for f in found), (variant, found)
+
+
+# ---- accessibility: axe-core on every page --------------------------------------------------------
+
+#: axe-core's script (book/fetch_mathjax.py fetches the pinned version from the npm registry, sha512-checked);
+#: the test injects it into each page: the site does not serve it.
+AXE = Path(__file__).parents[1] / "book" / "_vendor" / "axe-core" / "axe.min.js"
+#: axe-core's rules of WCAG 2.0 and 2.1, levels A and AA.
+AXE_TAGS = ["wcag2a", "wcag2aa", "wcag21a", "wcag21aa"]
+#: Run in a page with axe-core in it: every <details> opened (what a reader unfolds is checked too), then
+#: axe.run over the document with AXE_TAGS; its violations as {id, impact, help, nodes, examples}.
+AXE_JS = """async (tags) => {
+  const folded = [...document.querySelectorAll('details:not([open])')];
+  folded.forEach(d => { d.open = true; });
+  await new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
+  // An opened fold fades in (its text passes through every grey on the way): measured once it has.
+  await Promise.all(document.getAnimations().map(a => a.finished.catch(() => null)));
+  const found = await axe.run(document, {runOnly: {type: 'tag', values: tags}, resultTypes: ['violations']});
+  return found.violations.map(v => ({id: v.id, impact: v.impact, help: v.help, nodes: v.nodes.length,
+    examples: v.nodes.slice(0, 4).map(n => n.target.join(' ') + ': ' + (n.failureSummary || '').replace(/\\s+/g, ' ').slice(0, 200))}));
+}"""
+
+
+def axe_violations(browser, url, width, change=None):
+    """axe-core's violations (`Page.axe`) on the page at ``url`` opened at ``width`` px, offline, once
+    MathJax and fit.js are done; ``change`` as `Page`'s (a wrong variant of the site)."""
+    s = Page(browser, url, width, change=change)
+    try:
+        found = s.axe()
+        assert s.blocked == [], s.blocked
+        return found
+    finally:
+        s.close()
+
+
+def serious(violations):
+    """The violations axe-core rates serious or critical."""
+    return [v for v in violations if v["impact"] in ("serious", "critical")]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_axe_finds_no_serious_or_critical_violation(site, name):
+    """axe-core (WCAG 2.1 A and AA rules) on the page opened at 390 and at 1280 px, every dropdown open: no
+    violation rated serious or critical (contrast, names of buttons and controls, ARIA structure).
+    Every violation, of any impact, goes to test-artifacts/axe_<page>.json."""
+    report = {"390px": site[name, PHONE]["axe"], "1280px": site[name, 1280]["axe"]}
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    (ARTIFACTS / f"axe_{name}.json").write_text(json.dumps(report, indent=1, ensure_ascii=False))
+    bad = {w: serious(v) for w, v in report.items() if serious(v)}
+    assert not bad, f"{name}:\n" + json.dumps(bad, indent=1, ensure_ascii=False)
+
+
+#: Wrong variants of the site, each of which axe-core must catch: (page, width, file changed, its text
+#: replaced, its replacement, the rule that must fire).  The theme shows the search field from 960 px.
+WRONG_A11Y = {
+    "the theme's link blue on tinted boxes": (
+        "s3_math", 390, "fit.css", 'html[data-theme="light"] { --pst-color-link: #1259c3; }', "", "color-contrast"),
+    "the search field named short of what it shows": (
+        "index", 1280, "index.html", 'search-button__button pst-js-only" title="Search"',
+        'search-button__button pst-js-only" title="Search" aria-label="Search"', "label-content-name-mismatch"),
+    "the bibliography's deprecated entries": (
+        "s8_history", 390, "s8_history.html", 'role="listitem"', 'role="doc-biblioentry"', "aria-required-children"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_A11Y))
+def test_the_axe_check_catches_a_contrast_failure_a_misnamed_button_and_broken_aria(browser, book_html, variant):
+    name, width, file, old, new, rule = WRONG_A11Y[variant]
+
+    def change(path, text):
+        if path.name != file:
+            return text
+        assert old in text, f"variant {variant!r} no longer applies to {file}"
+        return text.replace(old, new)
+
+    found = serious(axe_violations(browser, (book_html / f"{name}.html").as_uri(), width, change=change))
+    assert rule in {v["id"] for v in found}, (variant, found)
