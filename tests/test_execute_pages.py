@@ -64,6 +64,12 @@ def test_the_page_kernels_start_without_ipykernels_tcp_warning(tmp_path, capfd, 
     assert len(get_cache(str(tmp_path / "cache")).list_cache_records()) == 1
 
 
+def test_pages_start_in_the_configured_order():
+    order = execute_pages.execution_order(["a", "s3", "b", "s5", "ledger", "c", "index"],
+                                          first=["s5", "s3"], last=["index", "ledger"])
+    assert order == ["s5", "s3", "a", "b", "c", "index", "ledger"]
+
+
 def test_the_cause_is_the_exception_line_without_colours():
     tb = ("An error occurred while executing the following cell:\n------------------\nx = 1\n"
           "\x1b[0;31mKeyError\x1b[0m: 'inner'\n\nDuring handling...\n"

@@ -27,8 +27,9 @@ alone, and executes the pages it has to one after another.  This extension:
    the cache's project (jupyter-cache's ``jupytext`` reader gives the same notebook, and
    so the same key, as myst-nb's) and the ones the cache does not hold run in a pool of
    processes forked from the build's, one per CPU, each with jupyter-cache's
-   ``local-parallel`` worker: first the pages of ``execute_pages_first``, last those of
-   ``execute_pages_last``, the others between them.  myst-nb then finds each page in the
+   ``local-parallel`` worker, one page at a time to the first free process: first the pages of
+   ``execute_pages_first``, last those of ``execute_pages_last`` (each in its order), the others
+   between them (`execution_order`).  myst-nb then finds each page in the
    cache; a page that failed is not cached, and myst-nb executes it again and reports its
    error as usual.
 Before any of this, the paths the build writes are checked (`refusal`): the lock, the cache's
@@ -178,8 +179,7 @@ def _execute(app, env, docnames):
     from jupyter_cache import get_cache
     from myst_nb.core.read import is_myst_markdown_notebook
     from sphinx.util import logging
-    first, last = app.config.execute_pages_first, app.config.execute_pages_last
-    order = sorted(docnames, key=lambda d: (d in last) - (d in first))
+    order = execution_order(docnames, app.config.execute_pages_first, app.config.execute_pages_last)
     paths = [env.doc2path(d) for d in order if env.doc2path(d).endswith(".md")]
     cache = get_cache(str(_cache_dir(app)))
     pks = [cache.add_nb_to_project(path, read_data={"name": "jupytext", "type": "plugin"}).pk
@@ -192,6 +192,14 @@ def _execute(app, env, docnames):
         if status:                                      # the console names the cause, not only the log file
             record = cache.get_project_record(uri)
             logging.getLogger(__name__).warning(f"{Path(uri).stem} failed to execute: {cause(record.traceback)}")
+
+
+def execution_order(docnames, first, last):
+    """``docnames`` in the order their notebooks start: those in ``first`` in its order, the others
+    in theirs, those in ``last`` in its order.  The pool gives the next page to the first free
+    process, so a long page listed first runs beside the others, not after them."""
+    return sorted(docnames, key=lambda d: (first.index(d) - len(first) if d in first else
+                                           len(last) + last.index(d) if d in last else 0))
 
 
 #: Arguments of each page's kernel (nbclient's ``extra_arguments``): its log at ERROR, so that
@@ -220,7 +228,9 @@ def _run(cache, pks, timeout):
     NbProjectRecord.remove_tracebacks(pks, cache.db)
     jobs = [ProcessData(pk, cache.get_project_record(pk).uri, cache, timeout, False) for pk in pks]
     with multiprocessing.get_context("fork").Pool(initializer=_quiet_kernels) as pool:
-        return pool.map(ExecutionWorkerLocalMProc(), jobs)
+        # One page at a time to whichever process is free, in this order (map's default hands out
+        # pages in pairs: a long page and the one after it then run one after the other).
+        return list(pool.imap(ExecutionWorkerLocalMProc(), jobs, chunksize=1))
 
 
 def _stop(signum, frame):
