@@ -17,8 +17,9 @@ def pytest_configure(config):
 
 
 #: Audits that share an expensive module fixture, kept on one worker under ``--dist loadgroup`` (`make
-#: audit`): the pages measured once at both widths (test_book_pages.py's ``site``), the simulator's page
-#: loaded once (test_browser.py's ``session``).  The other audits are dealt out one by one.
+#: audit`): every page opened twice and measured (test_book_pages.py's ``site``: its layout, formulas
+#: and axe-core's audit, about a minute), the simulator's page loaded once (test_browser.py's
+#: ``session``).  The other audits are dealt out one by one.
 SHARED = ("site", "session")
 
 
