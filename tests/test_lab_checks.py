@@ -1,0 +1,57 @@
+"""lab/_checks.py, the lab's argument checks, at the edges of what they accept and of what their
+messages show: values of every length about the cut of `shown`, integers about the size Python
+refuses to print, integer arrays reaching each end of their interval."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+
+from lab import _checks
+from renderer.validate import InvalidType, InvalidValue
+
+RNG = np.random.default_rng(20261125)
+
+
+@pytest.mark.parametrize("limit", [60, 80, int(RNG.integers(5, 200))])
+def test_a_value_is_shown_whole_up_to_the_limit_and_cut_there_beyond(limit):
+    for length in (limit - 1, limit, limit + 1, limit + 2, int(RNG.integers(limit + 3, 4 * limit))):
+        value = "".join(RNG.choice(list("abcdefghij"), length - 2))       # repr adds two quotes
+        expect = repr(value)
+        assert len(expect) == length
+        got = _checks.shown(value, limit)
+        if len(expect) <= limit:
+            assert got == f"str {expect}", (limit, length, got)
+        else:
+            assert got == f"str {expect[:limit]}...", (limit, length, got)
+    assert _checks.shown("x" * 200).endswith("x" * 78 + "...")                 # the default cut: 80
+
+
+def test_an_integer_too_long_to_print_is_shown_by_its_size():
+    """Python refuses str() of an int over `sys.get_int_max_str_digits()` digits (about 3.32 bits a
+    digit): such an int, and any of more than 3 bits a digit, is shown by its bit count."""
+    limit = sys.get_int_max_str_digits()
+    for bits in (int(3.5 * limit), 4 * limit, 10 * limit, 3 * limit + 1):
+        assert _checks.shown(1 << (bits - 1)) == f"an integer of {bits:,} bits"
+    assert _checks.shown(12345) == "int 12345"
+    assert _checks.shown((1 << (3 * limit - 1)) + 1) == f"int {(1 << (3 * limit - 1)) + 1}"[:84] + "..."
+
+
+def test_integer_arrays_take_both_ends_and_refuse_one_past_either():
+    for _ in range(20):
+        low, high = sorted(int(x) for x in RNG.integers(-10**6, 10**6, size=2))
+        inside = np.array([low, high, (low + high) // 2], dtype=RNG.choice([np.int32, np.int64]))
+        np.testing.assert_array_equal(_checks.integers("n", inside, low, high), inside)
+        for wrong in (low - 1, high + 1):
+            with pytest.raises(InvalidValue, match=rf"got {wrong} at flat index 1"):
+                _checks.integers("n", np.array([low, wrong]), low, high)
+
+
+def test_a_wrong_kind_of_array_is_shown_cut_at_60_characters():
+    value = [0.5] * 100
+    with pytest.raises(InvalidType) as info:
+        _checks.integers("n", value, 0, 9)
+    shown = str(info.value).split("got ", 1)[1]
+    assert shown.startswith("list [0.5, 0.5") and shown.endswith("...") and len(shown) == len("list ") + 60 + 3
