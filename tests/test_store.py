@@ -128,6 +128,32 @@ def test_the_digest_follows_every_library_the_project_runs_on(monkeypatch):
     monkeypatch.setattr(metadata, "version", real)
 
 
+def test_the_library_walk_follows_installed_requirements_past_absent_ones(monkeypatch):
+    """`store.libraries` on a made-up installation: names normalised (``Typing_Extensions`` is the
+    distribution typing-extensions), requirements of an extra left out, a requirement not installed
+    (its marker false here) skipped without ending the walk, a distribution that vanished skipped; and
+    a checkout that is not installed (no distribution holds `renderer`) runs on no known library."""
+    from importlib import metadata
+    from types import SimpleNamespace
+    requires = {"sym-render": ["Typing_Extensions>=4", "absent-lib; python_version < '3'", "NumPy>=1.26",
+                               'pytest>=8; extra == "test"'],
+                "numpy": ["absent-two", "mpmath"], "typing-extensions": None, "mpmath": [], "pytest": []}
+
+    def installed(table):
+        def look(dist):
+            if dist not in requires:
+                raise metadata.PackageNotFoundError(dist)
+            return table[dist]
+        return look
+    fake = SimpleNamespace(PackageNotFoundError=metadata.PackageNotFoundError,
+                           packages_distributions=lambda: {"renderer": ["sym-render", "gone-dist"]},
+                           requires=installed(requires), version=installed(dict.fromkeys(requires, "1.0")))
+    monkeypatch.setattr(store, "metadata", fake)
+    assert store.libraries() == ["mpmath", "numpy", "typing-extensions"]
+    fake.packages_distributions = lambda: {"lab": ["sym-render"]}
+    assert store.libraries() == []
+
+
 def test_the_same_process_asks_twice_and_computes_once(fresh):
     directory, calls, compute = fresh
     first = store.measured("u-curve", compute, size=256)
