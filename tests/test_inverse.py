@@ -97,3 +97,15 @@ def test_importing_takes_no_derivative_and_an_unknown_mode_is_named():
     from lab.inverse import jacobian
     with pytest.raises(InvalidValue, match=r"^mode must be one of \('chart', 'surface'\), got 'bump'"):
         jacobian("bump")
+
+
+def test_a_geometry_of_another_length_is_refused_with_the_length_geometry_returns():
+    """The refusal names the count of arrays `geometry` hands over (14: N, e_θ, e_φ by components,
+    h_u, h_v, h, R, sin φ), whether one is missing or one too many."""
+    from renderer.validate import InvalidType
+    _, inputs = geometry(Scene(), 8, 8)
+    for wrong in (inputs[:-1], (*inputs, inputs[0]), list(inputs[:3])):
+        with pytest.raises(InvalidType, match=rf"^geometry must be a tuple of {len(inputs)} arrays \(N, e_θ"):
+            normal_and_jacobian("chart", wrong, 0.1)
+    normal, _ = normal_and_jacobian("chart", list(inputs), 0.1)
+    assert normal.shape == (inputs[0].shape[0], 3)
