@@ -109,3 +109,14 @@ def test_a_geometry_of_another_length_is_refused_with_the_length_geometry_return
             normal_and_jacobian("chart", wrong, 0.1)
     normal, _ = normal_and_jacobian("chart", list(inputs), 0.1)
     assert normal.shape == (inputs[0].shape[0], 3)
+
+
+def test_beta_is_taken_on_its_whole_interval_and_refused_past_either_end():
+    from lab.inverse import MAX_BETA
+    _, inputs = geometry(Scene(), 8, 8)
+    n = inputs[0].shape[0]
+    for beta in (0.0, MAX_BETA, np.linspace(0.0, MAX_BETA, n)):
+        assert np.isfinite(normal_and_jacobian("surface", inputs, beta)[1]).all()
+    for beta in (-1e-300, -0.5, np.nextafter(MAX_BETA, np.inf), 2 * MAX_BETA, np.full(n, -0.1)):
+        with pytest.raises(InvalidValue, match=r"^beta must be .*\[0(\.0)?, "):
+            normal_and_jacobian("surface", inputs, beta)
