@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -120,3 +122,16 @@ def test_beta_is_taken_on_its_whole_interval_and_refused_past_either_end():
     for beta in (-1e-300, -0.5, np.nextafter(MAX_BETA, np.inf), 2 * MAX_BETA, np.full(n, -0.1)):
         with pytest.raises(InvalidValue, match=r"^beta must be .*\[0(\.0)?, "):
             normal_and_jacobian("surface", inputs, beta)
+
+
+def test_a_normal_map_one_pixel_thin_or_at_the_largest_side_is_fitted():
+    """Every (H, W) with H, W in [1, MAX_SIDE] is a normal map: one row, one column and a row
+    MAX_SIDE pixels long are each fitted; a side of 0 or MAX_SIDE + 1 is refused."""
+    from lab.inverse import MAX_SIDE
+    scene = Scene(beta=BETA)
+    for height, width in ((1, 64), (64, 1), (1, MAX_SIDE), (MAX_SIDE, 1)):
+        fit = fit_beta(gbuffer(scene, width, height).Ns, scene.replace(beta=0.05))
+        assert fit.converged and abs(fit.beta - BETA) <= 1e-9 and fit.pixels > 0, (height, width)
+    for shape in ((0, 8, 3), (1, MAX_SIDE + 1, 3), (MAX_SIDE + 1, 1, 3)):
+        with pytest.raises(InvalidValue, match=r"^target must be an \(H, W, 3\) normal map .*got shape " + re.escape(str(shape))):
+            fit_beta(np.zeros(shape), scene)
