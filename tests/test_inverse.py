@@ -12,6 +12,7 @@ from renderer.validate import InvalidValue
 from lab.inverse import fit_beta, geometry, normal_and_jacobian
 
 SIZE, BETA = 40, 0.35
+RNG = np.random.default_rng(20261125)
 
 
 @pytest.mark.parametrize("mode", ["chart", "surface"])
@@ -135,3 +136,35 @@ def test_a_normal_map_one_pixel_thin_or_at_the_largest_side_is_fitted():
     for shape in ((0, 8, 3), (1, MAX_SIDE + 1, 3), (MAX_SIDE + 1, 1, 3)):
         with pytest.raises(InvalidValue, match=r"^target must be an \(H, W, 3\) normal map .*got shape " + re.escape(str(shape))):
             fit_beta(np.zeros(shape), scene)
+
+
+def test_the_start_and_the_tolerance_are_taken_on_their_whole_intervals():
+    """beta0 in [0, MAX_BETA] for bump="chart" (a chart-mode β may exceed R: it moves no surface),
+    in [0, R) for "surface"; tol in (0, 1]."""
+    from lab.inverse import MAX_BETA
+    target = gbuffer(Scene(beta=BETA), 24, 24).Ns
+    radius = Scene().radius_a
+    start = float(RNG.uniform(2 * radius, MAX_BETA))
+    assert fit_beta(target, Scene(bump="chart"), beta0=start).iterates[0][0] == start
+    assert fit_beta(target, Scene(bump="chart"), beta0=MAX_BETA).iterates[0][0] == MAX_BETA
+    with pytest.raises(InvalidValue, match=r"^beta0 must be"):
+        fit_beta(target, Scene(bump="surface"), beta0=radius)
+    assert fit_beta(target, Scene(), tol=1.0).iterates[0][0] == 0.1
+    for tol in (np.nextafter(1.0, 2.0), 1.5, 2.0, 10.0):
+        with pytest.raises(InvalidValue, match=r"^tol must be"):
+            fit_beta(target, Scene(), tol=tol)
+
+
+def test_a_bad_normal_is_named_at_its_own_pixel():
+    """A normal outside [-1.5, 1.5] (or NaN) at a random pixel of sphere A: the refusal names that
+    pixel's (row, column) and components, and how many pixels are bad."""
+    scene = Scene(beta=BETA)
+    on_a, _ = geometry(scene, 32, 32)
+    pixels = np.argwhere(on_a)
+    for _ in range(5):
+        target = gbuffer(scene, 32, 32).Ns.copy()
+        row, col = pixels[RNG.integers(1, len(pixels))]
+        target[row, col] = (0.0, float(RNG.choice([2.0, -7.5, np.nan])), 0.0)
+        with pytest.raises(InvalidValue, match=rf"got 1 pixels outside, the first \(0\.0, .*\) at \(row, column\) "
+                                               rf"\({row}, {col}\)$"):
+            fit_beta(target, scene)
