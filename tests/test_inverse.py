@@ -168,3 +168,14 @@ def test_a_bad_normal_is_named_at_its_own_pixel():
         with pytest.raises(InvalidValue, match=rf"got 1 pixels outside, the first \(0\.0, .*\) at \(row, column\) "
                                                rf"\({row}, {col}\)$"):
             fit_beta(target, scene)
+
+
+def test_normals_at_the_ends_of_the_accepted_range_are_read():
+    """Components of exactly -1.5 and 1.5 on sphere A are within the accepted range (a fit is made)."""
+    scene = Scene(beta=BETA)
+    on_a, _ = geometry(scene, 32, 32)
+    target = gbuffer(scene, 32, 32).Ns.copy()
+    rows, cols = np.nonzero(on_a)
+    target[rows[0], cols[0]] = (1.5, -1.5, 0.0)
+    target[rows[-1], cols[-1]] = (-1.5, 1.5, 1.5)
+    assert np.isfinite(fit_beta(target, scene).beta)
