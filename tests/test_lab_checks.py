@@ -49,9 +49,10 @@ def test_integer_arrays_take_both_ends_and_refuse_one_past_either():
                 _checks.integers("n", np.array([low, wrong]), low, high)
 
 
-def test_a_wrong_kind_of_array_is_shown_cut_at_60_characters():
-    value = [0.5] * 100
+@pytest.mark.parametrize("check, value", [(lambda v: _checks.integers("n", v, 0, 9), [0.5] * 100),
+                                          (lambda v: _checks.numbers_array("n", v), ["x"] * 100)])
+def test_a_wrong_kind_of_array_is_shown_cut_at_60_characters(check, value):
     with pytest.raises(InvalidType) as info:
-        _checks.integers("n", value, 0, 9)
+        check(value)
     shown = str(info.value).split("got ", 1)[1]
-    assert shown.startswith("list [0.5, 0.5") and shown.endswith("...") and len(shown) == len("list ") + 60 + 3
+    assert shown.startswith(f"list [{value[0]!r}, ") and shown.endswith("...") and len(shown) == len("list ") + 60 + 3
