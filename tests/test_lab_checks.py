@@ -56,3 +56,14 @@ def test_a_wrong_kind_of_array_is_shown_cut_at_60_characters(check, value):
         check(value)
     shown = str(info.value).split("got ", 1)[1]
     assert shown.startswith(f"list [{value[0]!r}, ") and shown.endswith("...") and len(shown) == len("list ") + 60 + 3
+
+
+def test_chart_points_refuse_either_coordinate_off_the_chart_and_name_only_the_two_that_broadcast():
+    for _ in range(10):
+        inside = RNG.uniform(0.0, 1.0, size=4)
+        outside = float(RNG.choice([-1e-9, 1 + 1e-9, RNG.uniform(1.0, 5.0), -RNG.uniform(0.0, 5.0)]))
+        for name, args in (("uu", (np.append(inside, outside), inside[:1])), ("vv", (inside[:1], np.append(inside, outside)))):
+            with pytest.raises(InvalidValue, match=rf"^{name} must be"):
+                _checks.chart_points(*args, 1.0, 2.0)
+    with pytest.raises(InvalidValue, match=r"^uu, vv must broadcast to one shape, got uu \(2,\), vv \(3,\)$"):
+        _checks.chart_points(np.zeros(2), np.zeros(3), 1.0, 2.0)
