@@ -253,6 +253,6 @@ def _write(path, record):
         except OSError as exc:
             import warnings
             warnings.warn(f"{path} is not a record and cannot be replaced ({exc.strerror}); the measurement "
-                          "is kept for this process only", stacklevel=4)
+                          "is kept for this process only", stacklevel=3)   # the line calling measured()
             return
     files.write_bytes(path, json.dumps(record).encode("utf-8"))   # key order kept: reads back as written

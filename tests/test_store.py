@@ -262,8 +262,14 @@ def test_a_record_that_is_not_a_small_regular_file_is_never_served_and_is_replac
 def test_a_directory_in_place_of_a_record_is_kept_and_the_value_is_still_given(fresh, monkeypatch):
     directory, calls, compute = fresh
     (directory / "u-curve.json").mkdir()
-    with pytest.warns(UserWarning, match=r"u-curve.json is not a record and cannot be replaced"):
-        assert store.measured("u-curve", compute, size=256)["value"] == 0.1 + 0.2
+
+    def ask():
+        return store.measured("u-curve", compute, size=256)
+    with pytest.warns(UserWarning, match=r"u-curve.json is not a record and cannot be replaced \(.*\); the "
+                      r"measurement is kept for this process only$") as caught:
+        assert ask()["value"] == 0.1 + 0.2
+    # The warning points at the line that asked for the measurement.
+    assert [(w.filename, w.lineno) for w in caught] == [(__file__, ask.__code__.co_firstlineno + 1)]
     assert (directory / "u-curve.json").is_dir() and len(calls) == 1
     assert sorted(p.name for p in directory.iterdir() if not p.name.endswith(".lock")) == ["u-curve.json"]
 
@@ -327,8 +333,12 @@ def test_a_lock_that_is_not_a_regular_file_neither_blocks_nor_is_followed(fresh,
     signal.signal(signal.SIGALRM, lambda *a: pytest.fail("the store blocked on its lock"))
     signal.alarm(20)
     try:
-        with pytest.warns(UserWarning, match=r"\.u-curve\.json\.lock cannot be the measurement's lock"):
-            assert store.measured("u-curve", compute, size=256)["value"] == 0.1 + 0.2
+        def ask():
+            return store.measured("u-curve", compute, size=256)
+        with pytest.warns(UserWarning, match=r"\.u-curve\.json\.lock cannot be the measurement's lock") as caught:
+            assert ask()["value"] == 0.1 + 0.2
+        # The warning points at the line that asked for the measurement.
+        assert [(w.filename, w.lineno) for w in caught] == [(__file__, ask.__code__.co_firstlineno + 1)]
     finally:
         signal.alarm(0)
     assert len(calls) == 1 and not target.exists() and _stored(directory)["value"]["value"] == 0.1 + 0.2
