@@ -71,8 +71,8 @@ def _trusted(directory):
         st = os.stat(path)
     except OSError as exc:
         raise UntrustedStore(f"{ENV}={directory}: cannot be used as the measurement store ({exc.strerror})") from None
-    why = ("is not a directory" if not stat.S_ISDIR(st.st_mode) else
-           f"is owned by uid {st.st_uid}, not by this user (uid {os.getuid()})" if st.st_uid != os.getuid() else
+    # (A path that is not a directory failed mkdir above.)
+    why = (f"is owned by uid {st.st_uid}, not by this user (uid {os.getuid()})" if st.st_uid != os.getuid() else
            f"can be written by other users (mode {stat.S_IMODE(st.st_mode):04o})"
            if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH) else None)
     if why:

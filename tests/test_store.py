@@ -232,6 +232,14 @@ def test_the_checksum_rejects_an_edited_value_that_the_digest_alone_would_serve(
     assert store.measured("u-curve", compute, size=256) == "edited" and len(calls) == 1
 
 
+def test_a_record_of_exactly_the_largest_size_is_served(fresh, monkeypatch):
+    directory, calls, compute = fresh
+    first = store.measured("u-curve", compute, size=256)
+    monkeypatch.setattr(store, "MAX_RECORD_BYTES", (directory / "u-curve.json").stat().st_size)
+    _new_process(monkeypatch)
+    assert store.measured("u-curve", compute, size=256) == first and len(calls) == 1
+
+
 @pytest.mark.parametrize("kind", ["link", "fifo", "too-big"])
 def test_a_record_that_is_not_a_small_regular_file_is_never_served_and_is_replaced(fresh, monkeypatch, kind):
     """A symbolic link (to a valid record, even), a FIFO (which would block a plain read) or a
