@@ -67,3 +67,15 @@ def test_chart_points_refuse_either_coordinate_off_the_chart_and_name_only_the_t
                 _checks.chart_points(*args, 1.0, 2.0)
     with pytest.raises(InvalidValue, match=r"^uu, vv must broadcast to one shape, got uu \(2,\), vv \(3,\)$"):
         _checks.chart_points(np.zeros(2), np.zeros(3), 1.0, 2.0)
+
+
+def test_an_integer_is_taken_as_python_numpy_or_0_d_array_and_a_seed_from_0():
+    for value in (7, np.int16(7), np.uint64(7), np.array(7), np.array(7, dtype=np.int8)):
+        assert _checks.integer("n", value, 0, 9) == 7 and type(_checks.integer("n", value, 0, 9)) is int
+    assert _checks.seed("seed", 0) == 0 and _checks.seed("seed", _checks.MAX_SEED) == _checks.MAX_SEED
+    for value in (np.array([7]), True, 7.0, "7"):
+        with pytest.raises(InvalidType, match=r"^n must be an integer in \[0, 9\]"):
+            _checks.integer("n", value, 0, 9)
+    for value in (-1, _checks.MAX_SEED + 1):
+        with pytest.raises(InvalidValue, match=r"^seed must be an integer in \[0, 2\*\*64 - 1\]"):
+            _checks.seed("seed", value)
