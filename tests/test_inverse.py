@@ -179,3 +179,22 @@ def test_normals_at_the_ends_of_the_accepted_range_are_read():
     target[rows[0], cols[0]] = (1.5, -1.5, 0.0)
     target[rows[-1], cols[-1]] = (-1.5, 1.5, 1.5)
     assert np.isfinite(fit_beta(target, scene).beta)
+
+
+@pytest.mark.parametrize("mode, beta, push, start", [("surface", 0.99, 2.0, 0.9), ("chart", 100.0, 200.0, 99.0)])
+def test_a_step_past_the_range_stops_at_its_edge(mode, beta, push, start):
+    """A target whose best β lies past the range (the normal map at β pushed along ∂N'/∂β): the
+    fit's step is cut at the edge: just below R under the displaced surface's normal (R + β h must
+    stay positive), at MAX_BETA on the chart."""
+    from lab.inverse import MAX_BETA
+    scene = Scene(bump=mode)
+    on_a, inputs = geometry(scene, 24, 24)
+    normal, jac = normal_and_jacobian(mode, inputs, beta)
+    target = np.zeros((24, 24, 3))
+    target[on_a] = np.clip(normal + push * jac, -1.5, 1.5)
+    fit = fit_beta(target, scene, beta0=start)
+    edge = np.nextafter(scene.radius_a, 0.0) if mode == "surface" else MAX_BETA
+    assert max(b for b, _ in fit.iterates) == edge == fit.beta, fit.iterates
+    assert all(np.isfinite(r) for _, r in fit.iterates)
+    if mode == "chart":             # from 99 to the edge is a step of exactly 1: within tol = 1, done
+        assert [b for b, _ in fit_beta(target, scene, beta0=start, tol=1.0).iterates] == [start, MAX_BETA]
