@@ -44,7 +44,9 @@ def integer(name, value, low, high):
     """``value`` as an int in [low, high]: a Python or numpy integer, not a bool or a float."""
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
-    accepted = f"an integer in [{low}, {high if high < 2**32 else f'2**{high.bit_length()} - 1'}]"
+    # A bound of 2**k - 1 past 32 bits reads as such (MAX_SEED: 2**64 - 1); any other, as digits.
+    mersenne = high.bit_length() > 32 and high & (high + 1) == 0
+    accepted = f"an integer in [{low}, {f'2**{high.bit_length()} - 1' if mersenne else high}]"
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise InvalidType(f"{name} must be {accepted}, got {shown(value)}")
     n = int(value)

@@ -4,6 +4,7 @@ refuses to print, integer arrays reaching each end of their interval."""
 
 from __future__ import annotations
 
+import re
 import sys
 
 import numpy as np
@@ -79,3 +80,18 @@ def test_an_integer_is_taken_as_python_numpy_or_0_d_array_and_a_seed_from_0():
     for value in (-1, _checks.MAX_SEED + 1):
         with pytest.raises(InvalidValue, match=r"^seed must be an integer in \[0, 2\*\*64 - 1\]"):
             _checks.seed("seed", value)
+
+
+@pytest.mark.parametrize("high, reads", [(9, "9"), (2**24, "16777216"), (2**32 - 1, "4294967295"),
+                                         (2**32, "4294967296"), (2**40, "1099511627776"), (2**40 - 1, "2**40 - 1"), (2**33 - 1, "2**33 - 1"),
+                                         (2**64 - 1, "2**64 - 1"), (2**64, "18446744073709551616")])
+def test_the_accepted_interval_reads_as_written(high, reads):
+    with pytest.raises(InvalidValue, match=rf"^n must be an integer in \[0, {re.escape(reads)}\], got -1$"):
+        _checks.integer("n", -1, 0, high)
+
+
+def test_an_out_of_range_integer_is_printed_whole_up_to_64_bits():
+    for value, reads in ((2**63, "9223372036854775808"), (2**64 - 1, "18446744073709551615"),
+                         (2**64, "int 18446744073709551616"), (-(2**64), "int -18446744073709551616")):
+        with pytest.raises(InvalidValue, match=rf", got {reads}$"):
+            _checks.integer("n", value, 0, 9)
