@@ -58,7 +58,8 @@ def test_steps_on_one_side_of_the_optimum_are_refused_without_a_warning(case):
     eps, error, start = ONE_SIDED[case]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        with pytest.raises(ValueError, match=r"^the U-curve model did not fit \(steps on one side"):
+        with pytest.raises(ValueError, match=r"^the U-curve model did not fit \(steps on one side of the optimum "
+                                             r"only, or no convergence in 100 Gauss-Newton steps\)$"):
             fit_model(eps, error, start=start)
 
 
