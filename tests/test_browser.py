@@ -50,7 +50,6 @@ from renderer.jsgen import SIMULATOR_SCENE
 from renderer.render import check_args
 
 from .jsnode import ARTIFACTS, in_ci, require_tool
-from .test_book_pages import PAGES
 from .test_check_glue import check_glue
 from .test_js_parity import CHART_TOL, image_bound
 
