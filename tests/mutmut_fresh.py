@@ -34,7 +34,7 @@ def _caches():
     """The lru_cache wrappers defined in `MUTATED` modules, found again only when modules were imported."""
     if len(sys.modules) != _seen["modules"]:
         _seen["modules"] = len(sys.modules)
-        _seen["caches"] = [f for f in gc.get_objects() if isinstance(f, functools._lru_cache_wrapper)
+        _seen["caches"] = [f for f in gc.get_objects() if type(f) is functools._lru_cache_wrapper   # not a weak proxy
                            and _mutated(str(getattr(f, "__module__", "")))]
     return _seen["caches"]
 
