@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.util
 import logging
+import sys
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -13,6 +14,7 @@ from .pages import NOTEBOOK_FRONT_MATTER
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("execute_pages", ROOT / "book" / "_ext" / "execute_pages.py")
 execute_pages = importlib.util.module_from_spec(_spec)
+sys.modules["execute_pages"] = execute_pages        # as Sphinx loads it: its pool pickles its functions by name
 _spec.loader.exec_module(execute_pages)
 
 PAGE = NOTEBOOK_FRONT_MATTER + """
