@@ -707,10 +707,10 @@ def test_the_cue_check_catches_a_table_scrolling_without_its_cue(browser, book_h
 
 def test_the_table_check_catches_rows_stacked_into_cards(browser, book_html):
     """Wrong variant: the old phone rule that set each cell of a row as a block of its own (a card per
-    row); §3's optima table and §5's tables are then caught at 390 px, and pass without it."""
+    row); §5's tables are then caught at 390 px, and pass without it."""
     cards = ("article.bd-article table, article.bd-article tbody, article.bd-article tr, article.bd-article th,"
              " article.bd-article td { display: block; width: auto !important; }")
-    for name in ("s3_math", "s5_lab"):
+    for name in ("s5_lab",):
         p = Page(browser, (book_html / f"{name}.html").as_uri(), 390)
         try:
             assert p.page.evaluate(TABLES) and not split_tables(p.page.evaluate(TABLES))
@@ -1258,20 +1258,22 @@ def test_every_formula_is_at_full_size_within_the_column(site, name):
     assert site[name, "loads"] == [{"blocked": [], "errors": []}] * 2, site[name, "loads"]
 
 
-#: Wrong variants of the site (the file changed, its text replaced, its replacement), each of which the
-#: formula check must catch on §3 at 390 px: MathJax left to let formulas run past the column (its
-#: default), and formulas set at 62 % of the text (as fit.js once shrank them to fit).
+#: Wrong variants of the site (the page opened, the file changed, its text replaced, its replacement), each
+#: of which the formula check must catch at 390 px: MathJax left to let formulas run past the column (its
+#: default; §3 has the formulas too long for a phone's column), and formulas set at 62 % of the text (as
+#: fit.js once shrank them to fit; any page with formulas shows it, §1 quickly).
 WRONG_FORMULAS = {
-    "MathJax breaking no line": ("s3_math.html", '"displayOverflow": "linebreak", "linebreaks": {"inline": true',
+    "MathJax breaking no line": ("s3_math", "s3_math.html",
+                                 '"displayOverflow": "linebreak", "linebreaks": {"inline": true',
                                  '"displayOverflow": "overflow", "linebreaks": {"inline": false'),
-    "formulas shrunk to 62 %": ("fit.css", "article.bd-article span.math { display: inline; }",
+    "formulas shrunk to 62 %": ("s1_what_changes", "fit.css", "article.bd-article span.math { display: inline; }",
                                 "article.bd-article span.math { display: inline; font-size: 62%; }"),
 }
 
 
 @pytest.mark.parametrize("variant", sorted(WRONG_FORMULAS))
 def test_the_formula_check_catches_formulas_shrunk_or_running_past_the_column(browser, book_html, variant):
-    file, old, new = WRONG_FORMULAS[variant]
+    name, file, old, new = WRONG_FORMULAS[variant]
 
     def change(path, text):
         if path.name != file:
@@ -1279,7 +1281,7 @@ def test_the_formula_check_catches_formulas_shrunk_or_running_past_the_column(br
         assert text.count(old) == 1, f"variant {variant!r} no longer applies to {file}"
         return text.replace(old, new)
 
-    s = Page(browser, (book_html / "s3_math.html").as_uri(), 390, change=change)
+    s = Page(browser, (book_html / f"{name}.html").as_uri(), 390, change=change)
     try:
         found = formula_findings(s.formulas())
     finally:
@@ -1342,10 +1344,11 @@ def test_axe_finds_no_serious_or_critical_violation(site, name):
 
 
 #: Wrong variants of the site, each of which axe-core must catch: (page, width, file changed, its text
-#: replaced, its replacement, the rule that must fire).  The theme shows the search field from 960 px.
+#: replaced, its replacement, the rule that must fire), each on a page that shows the fault and is quick to
+#: audit (axe-core takes about 1 s on the index, 10 on §3).  The theme shows the search field from 960 px.
 WRONG_A11Y = {
     "the theme's link blue on tinted boxes": (
-        "s3_math", 390, "fit.css", 'html[data-theme="light"] { --pst-color-link: #1259c3; }', "", "color-contrast"),
+        "index", 390, "fit.css", 'html[data-theme="light"] { --pst-color-link: #1259c3; }', "", "color-contrast"),
     "the search field named short of what it shows": (
         "index", 1280, "index.html", 'search-button__button pst-js-only" title="Search"',
         'search-button__button pst-js-only" title="Search" aria-label="Search"', "label-content-name-mismatch"),

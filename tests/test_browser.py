@@ -661,7 +661,7 @@ WRONG_CONTROLS = {
         "but computed with"),
     "β up to R under the displaced sphere's normal": (
         "Math.round(100 * (SIMULATOR_SCENE.radius_a - BETA.step)) / 100", "SIMULATOR_SCENE.radius_a",
-        [("sim-bump", "surface"), ("sim-beta", "every")], "did not update"),
+        [("sim-bump", "surface"), ("sim-beta", "max")], "did not update"),
     "kᵤ from 0": ('name: "k_u", label: "kᵤ, frequency in u", kind: "range", min: 1',
                  'name: "k_u", label: "kᵤ, frequency in u", kind: "range", min: 0', [("sim-k_u", "every")], "refuses"),
     "the renderer handed a β of its own": (
