@@ -76,7 +76,7 @@ def test_no_text_of_the_figure_collides_whatever_the_machine_times():
 
     figures.style()
     base, rng = _measurement(), np.random.default_rng(20261125)
-    for _ in range(16):
+    for _ in range(6):
         rows = tuple(dataclasses.replace(r, times=(0.8 * t, t, 1.5 * t), max_error=e, rms_error=e)
                      for r in base.results for t, e in [10 ** rng.uniform((-3.3, -16), (-0.3, 0.3))])
         fig = pareto_figure(dataclasses.replace(base, results=rows))
