@@ -1198,7 +1198,8 @@ def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_htm
 #: font size over the font size of the text around it (the element around its span.math or div.math),
 #: times any CSS transform of it or of an element around it within the article, "px": its font size as
 #: drawn, "over": how far (px) its typeset box
-#: reaches past the article's column, 0 if it ends within, "error": whether MathJax set a TeX error,
+#: reaches past the article's column, 0 if it ends within, "error": whether MathJax set a TeX error or a command
+#: it does not know (its noundefined extension shows it as red text, the backslash included),
 #: "text", "where"}.
 FORMULAS_JS = r"""async () => {
   const root = document.querySelector('article.bd-article');
@@ -1224,7 +1225,7 @@ FORMULAS_JS = r"""async () => {
     const over = Math.max(0, ...rects.map(r => Math.max(r.right - right, left - r.left)));
     const section = m.closest('section[id]');
     return {display: m.getAttribute('display') === 'true', scale: +scale.toFixed(3),
-            px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror'),
+            px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror') || [...m.querySelectorAll('mjx-mtext')].some((t) => t.textContent.startsWith('\\')),
             text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
             where: section ? '#' + section.id : ''};
   });
@@ -1261,14 +1262,21 @@ def test_every_formula_is_at_full_size_within_the_column(site, name):
 #: Wrong variants of the site (the page opened, the file changed, its text replaced, its replacement), each
 #: of which the formula check must catch at 390 px: MathJax left to let formulas run past the column (its
 #: default; §3 has the formulas too long for a phone's column), and formulas set at 62 % of the text (as
-#: fit.js once shrank them to fit; any page with formulas shows it, §1 quickly).
+#: fit.js once shrank them to fit; any page with formulas shows it, §1 quickly), and a formula whose TeX
+#: MathJax cannot read (a statement's text mistyped: MathJax shows an error box in its place).
 WRONG_FORMULAS = {
     "MathJax breaking no line": ("s3_math", "s3_math.html",
                                  '"displayOverflow": "linebreak", "linebreaks": {"inline": true',
                                  '"displayOverflow": "overflow", "linebreaks": {"inline": false'),
     "formulas shrunk to 62 %": ("s1_what_changes", "fit.css", "article.bd-article span.math { display: inline; }",
                                 "article.bd-article span.math { display: inline; font-size: 62%; }"),
+    "a TeX command MathJax does not know": ("s1_what_changes", "s1_what_changes.html", r"\(\varepsilon =\)",
+                                           r"\(\vAREPSILON =\)"),
 }
+#: What each variant must show in every formula the check finds: a reach past the column, a scale, an error.
+FORMULA_FAULT = {"MathJax breaking no line": lambda f: f["over"] > 1,
+                 "formulas shrunk to 62 %": lambda f: f["scale"] < 0.999,
+                 "a TeX command MathJax does not know": lambda f: f["error"]}
 
 
 @pytest.mark.parametrize("variant", sorted(WRONG_FORMULAS))
@@ -1286,8 +1294,7 @@ def test_the_formula_check_catches_formulas_shrunk_or_running_past_the_column(br
         found = formula_findings(s.formulas())
     finally:
         s.close()
-    kind = "over" if "line" in variant else "scale"
-    assert found and all((f["over"] > 1) if kind == "over" else (f["scale"] < 0.999) for f in found), (variant, found)
+    assert found and all(FORMULA_FAULT[variant](f) for f in found), (variant, found)
 
 
 # ---- accessibility: axe-core on every page --------------------------------------------------------
