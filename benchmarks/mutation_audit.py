@@ -26,8 +26,11 @@ and why, is ``[tool.mutmut]`` in pyproject.toml): ``pip install mutmut``, then `
 (or ``mutmut run "renderer.ucurve*"`` for one module) and ``mutmut results``, as mutmut
 documents.  A mutant costs seconds (a survivor runs every test that reached its function):
 on 2 cores one module takes minutes to an hour, all of them a day.  It cannot mutate the
-numba kernel, module-level sympy, the JavaScript, the pages or the build, which is what
-the mutants here cover.
+numba kernel, the JavaScript, the pages or the build, which is what the mutants here cover.
+A mutant of a function that runs at import (a theorem's cases, the registry's mapping) is
+never active in its run (its workers fork after the tests were collected), and is reported
+as surviving: run it in a new process, where the import runs it mutated:
+``cd mutants && MUTANT_UNDER_TEST=<name> python -m pytest -x -p tests.mutmut_fresh <its tests>``.
 
 Usage: python benchmarks/mutation_audit.py [--list first|second|all] [--baseline] [ID ...]
        (default: every mutant of both lists; IDs choose among the list's)
