@@ -498,3 +498,17 @@ def test_rule_12_evidence_that_leaves_out_a_field_is_named(monkeypatch):
         v = get(theorem_id).check()
         why = pinned_failure(theorem_id, v.status, v.residual, v.rendered, v.covers) if v.holds else v.evidence
         assert why, theorem_id           # by rule 12, or by the outputs' count where that falls short first
+
+
+def test_a_theorem_about_every_field_names_each_field_its_evidence_left_out():
+    """Rule 12's refusal, read whole: the fields left out, in the registry's order, with the noun's number
+    following their count; and a theorem the registry does not know is named in the KeyError."""
+    least = least_rendered("chart")
+    for covers in (ALL[1:], ALL[2:], ()):
+        missing = [f for f in ALL if f not in covers]
+        noun = "field" if len(missing) == 1 else "fields"
+        assert pinned_failure("chart", "verified", 1e-30, least, covers) == (
+            f"chart's evidence compared no renderer output of the {', '.join(missing)} {noun}, "
+            "which its statement is about")
+    with pytest.raises(KeyError, match="no-such-theorem"):
+        pin("no-such-theorem")
