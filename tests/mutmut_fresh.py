@@ -17,11 +17,15 @@ Not run by ``make test``: only ``pytest -p tests.mutmut_fresh``.
 import functools
 import gc
 import sys
+import tomllib
+from pathlib import Path
 
 import pytest
 
-#: The modules whose caches are emptied: the mutated ones (pyproject.toml's ``source_paths``).
-MUTATED = ("lab", "proofs", "renderer.ucurve", "renderer.pointwise")
+#: The modules whose caches are emptied: the mutated ones, pyproject.toml's ``[tool.mutmut]`` ``source_paths``
+#: as module names ("renderer/ucurve.py" -> "renderer.ucurve").
+MUTATED = tuple(path.removesuffix(".py").replace("/", ".") for path in tomllib.loads(
+    (Path(__file__).parents[1] / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["mutmut"]["source_paths"])
 
 _seen = {"modules": -1, "caches": []}
 
@@ -39,11 +43,16 @@ def _caches():
     return _seen["caches"]
 
 
-@pytest.fixture(autouse=True)
-def _forget_memoised_values():
+def forget():
+    """Empty every lru_cache of the `MUTATED` modules, ``proofs.core._DECIDED`` and ``lab.store._MEMORY``."""
     for f in _caches():
         f.cache_clear()
     for module, name in (("proofs.core", "_DECIDED"), ("lab.store", "_MEMORY")):
         if module in sys.modules:
             getattr(sys.modules[module], name).clear()
+
+
+@pytest.fixture(autouse=True)
+def _forget_memoised_values():
+    forget()
     yield
