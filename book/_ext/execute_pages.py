@@ -231,7 +231,9 @@ def _run(cache, pks, timeout):
     with multiprocessing.get_context("fork").Pool(initializer=_quiet_kernels) as pool:
         # One job at a time to whichever process is free, in this order (map's default hands out
         # pages in pairs: a long page and the one after it then run one after the other).
-        done = list(pool.imap(_work, [None, *jobs], chunksize=1))[1:]
+        # The kernels compiled first when two or more pages run (`_work`).
+        ahead = [None] if len(jobs) > 1 else []
+        done = list(pool.imap(_work, [*ahead, *jobs], chunksize=1))[len(ahead):]
         pool.close()        # each process ends at its queue's end (leaving the block terminates them:
         pool.join()         # SIGTERM, which `_stop` leaves to the build's own process)
     return done
@@ -242,7 +244,8 @@ def _work(job):
     the renderer's kernels compiled into numba's cache by a new interpreter (`COMPILE`; this process
     is forked from one that may run numba's threads).  That job goes first: without it the first
     pages to render each compiled the same kernels at once (cold builds on 2 CPUs, alternated: medians
-    48.9 s without, 47.2 s with).  Its failure is the pages' to report, each with its cause."""
+    48.9 s without, 47.2 s with); a page that runs alone compiles what it renders, without it.  Its
+    failure is the pages' to report, each with its cause."""
     if job is not None:
         from jupyter_cache.executors.basic import ExecutionWorkerLocalMProc
         return ExecutionWorkerLocalMProc()(job)
