@@ -41,11 +41,8 @@ from pathlib import Path
 
 import pytest
 
-from .jsnode import ARTIFACTS, in_ci, require_tool
+from .jsnode import ARTIFACTS, chromium
 
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 PAGES = ("index", "s1_what_changes", "s2_scene", "s3_math", "s4_simulator", "s5_lab", "s6_ledger",
          "s7_pitfalls", "s8_history", "s9_roadmap", "glossary")
 WIDTHS = (1280, 390)
@@ -355,17 +352,7 @@ def too_long(lengths):
 
 @pytest.fixture(scope="module")
 def browser():
-    require_tool(CHROMIUM, "the page tests drive Debian's Chromium (apt-get install chromium)")
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        if in_ci():
-            pytest.fail("playwright is not installed (CI=true: this test may not skip)")
-        pytest.skip("playwright is not installed")
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
-        yield b
-        b.close()
+    yield from chromium("the page tests drive Debian's Chromium")
 
 
 #: True in a page once fit.js (if the page has it: the book's pages do) has fitted it.

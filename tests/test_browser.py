@@ -49,17 +49,12 @@ from renderer.formulas import FIELDS
 from renderer.jsgen import SIMULATOR_SCENE
 from renderer.render import check_args
 
-from .jsnode import ARTIFACTS, in_ci, require_tool
+from .jsnode import ARTIFACTS, chromium
 from .test_check_glue import check_glue
 from .test_js_parity import CHART_TOL, image_bound
 
-CHROMIUM = "/usr/bin/chromium"
 ROOT = Path(__file__).parents[1]
 SIZE = 256
-# Flags for a machine with no network (see the environment notes): without the
-# background-networking ones Chromium keeps trying to reach Google's hosts.
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 CONTROLS = ["sim-height_field", "sim-log_eps", "sim-beta", "sim-bump", "sim-view", "sim-scale", "sim-numeric",
             "sim-k_u", "sim-k_v", "sim-model", "sim-resolution", "sim-zoom", "sim-sphere_b"]
 BUTTONS = ["sim-preset-try1", "sim-preset-try2", "sim-preset-try3", "sim-preset-try4", "sim-reset"]
@@ -72,17 +67,7 @@ TYPED = {"Uint8Array": np.uint8, "Uint8ClampedArray": np.uint8, "Int8Array": np.
 
 @pytest.fixture(scope="module")
 def browser():
-    require_tool(CHROMIUM, "the browser test drives Debian's Chromium (apt-get install chromium)")
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        if in_ci():
-            pytest.fail("playwright is not installed (CI=true: this test may not skip)")
-        pytest.skip("playwright is not installed")
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
-        yield b
-        b.close()
+    yield from chromium("the browser test drives Debian's Chromium")
 
 
 class Session:

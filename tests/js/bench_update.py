@@ -27,7 +27,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).parents[2]
 sys.path.insert(0, str(ROOT))
-from tests.test_browser import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
+from tests.jsnode import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
 
 MOVES = {"eps": ("log_eps", [-3.1, -3]), "beta": ("beta", [0.3, 0.4])}
 PAGE = ('<!doctype html><html><head><meta charset="utf-8"></head><body style="max-width:900px">'
@@ -87,7 +87,7 @@ def main(argv=None):
         times = {(name, kind): [] for name in urls for kind in MOVES}
         load = [os.getloadavg()[0]]
         with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
+            browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=list(CHROMIUM_ARGS))
             for _ in range(args.rounds):
                 for name, url in urls.items():
                     for kind, (control, values) in MOVES.items():
