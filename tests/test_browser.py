@@ -420,18 +420,21 @@ def _readout_pixel(session, i, j):
 #: value, the scene object the renderer was handed, the renderer's other arguments (width, height,
 #: numeric gradient, zoom: `render.check_args`'s order, read off its frame and G-buffer), and
 #: every text that prints ε (the numeric canvas's caption and text alternative, the U-curve's label and marker, the
-#: readout's step at the centre pixel).  A move the page does not update after within 5 s (its
-#: renderer threw) is recorded as such and ends the run.  Returns the records.
+#: readout's step at the centre pixel).  A move the page does not update after (an uncaught error
+#: came first, or 5 s passed) is recorded as such and ends the run.  Returns the records.
 MOVES_JS = """async (moves) => {
   const root = document.querySelector('[data-symrender-sim]'), sim = root.symrender;
   window.requestAnimationFrame = (cb) => setTimeout(() => cb(performance.now()), 0);
+  let threw = false;
+  window.addEventListener('error', () => { threw = true; });
+  window.addEventListener('unhandledrejection', () => { threw = true; });
   const inputs = [...root.querySelectorAll('input, select')];
-  // Make a change and wait for the update it schedules; false if none comes within 5 s (it threw).
+  // Make a change and wait for the update it schedules; false if the page threw first or none came in 5 s.
   const act = async (change) => {
     const n = Number(root.dataset.updates), t0 = performance.now();
     change();
     while (Number(root.dataset.updates) <= n) {
-      if (performance.now() - t0 > 5000) return false;
+      if (threw || performance.now() - t0 > 5000) return false;
       await new Promise((r) => setTimeout(r, 0));
     }
     return true;
