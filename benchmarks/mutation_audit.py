@@ -27,9 +27,10 @@ and why, is ``[tool.mutmut]`` in pyproject.toml): ``pip install mutmut``, then `
 documents.  A mutant costs seconds (a survivor runs every test that reached its function):
 on 2 cores one module takes minutes to an hour, all of them a day.  It cannot mutate the
 numba kernel, the JavaScript, the pages or the build, which is what the mutants here cover.
-A mutant of a function that runs at import (a theorem's cases, the registry's mapping) is
-never active in its run (its workers fork after the tests were collected), and is reported
-as surviving: run it in a new process, where the import runs it mutated:
+A mutant of a function that runs at import or collection (a theorem's cases, the registry's
+mapping, a theorem's wrong variants, which tests/test_checker.py's parameters hold) is never
+active in its run (its workers fork after the tests were collected), and is reported as
+surviving: run it in a new process, where the import runs it mutated:
 ``cd mutants && MUTANT_UNDER_TEST=<name> python -m pytest -x -p tests.mutmut_fresh <its tests>``.
 
 Usage: python benchmarks/mutation_audit.py [--list first|second|all] [--baseline] [ID ...]
