@@ -35,7 +35,8 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
 
 1. *Citing.*  ``using`` names earlier steps only, ``1 <= j < k`` for step k (an int):
    never the step itself, a later one or step 0; each cited left side is a name (or a
-   tuple of names), replaced by that step's right side.
+   tuple of names), replaced by that step's right side, and the step contains that name (one
+   of them at least: its sides, or the definitions of ``where`` they reach).
 2. *Chains.*  A ``link`` continues the step before it, never step 1; its left side is
    that step's right side, or is decided equal to it with the link's rewrites and cases.
    A claim is reached by a run of one chain: its left side a step's, its right side the
@@ -675,6 +676,16 @@ def _rewrites(t, k, step):
             if not isinstance(name, (sp.Symbol, sp.MatrixSymbol, AppliedUndef)):
                 return f"uses step {j}, whose left side is not a name"
             out[name] = value
+    # A citation the step never reaches (its sides, through the theorem's other definitions) is refused:
+    # it would tell the reader the step rests on a step it does not use.
+    if not step.using:
+        return out
+    others = {n: v for n, v in t.where.items() if n not in out}
+    sides = [_substitute(x, others) for x in (step.lhs, step.rhs, *([t.steps[k - 2].rhs] if step.link else []))]
+    for j in step.using:
+        lhs = t.steps[j - 1].lhs
+        if not any(x.has(name) for name in (lhs if isinstance(lhs, sp.Tuple) else [lhs]) for x in sides):
+            return f"uses step {j}, whose left side {lhs} it does not contain"
     return out
 
 

@@ -257,6 +257,12 @@ def test_using_rewrites_with_an_earlier_step_and_only_an_earlier_named_one():
     assert later.check().evidence == "square, step 1 (use a later step) uses step 2, which does not come before it"
     unnamed = square_theorem(*CHAIN, Step("use an unnamed side", a_, a_, using=(1,)), claims={})
     assert unnamed.check().evidence == "square, step 3 (use an unnamed side) uses step 1, whose left side is not a name"
+    # A citation the step never reaches is refused (it holds without it: b = b), named or through where.
+    idle = square_theorem(lemma, Step("cite an idle step", b_, b_, using=(1,)), claims={}, where={e: SQUARE})
+    assert idle.check().evidence == "square, step 2 (cite an idle step) uses step 1, whose left side e it does not contain"
+    pair = square_theorem(Step("name both", sp.Tuple(e, f), sp.Tuple(SQUARE, a_)),
+                          Step("use one of them", f + 1, a_ + 1, using=(1,)), claims={}, where={e: SQUARE, f: a_})
+    assert pair.check().status == "proved"
 
 
 def test_cases_must_each_hold_and_the_failing_one_is_named():
