@@ -161,8 +161,6 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
             ("Blinn's e_phi slope over 2 pi R, not pi R",
              lambda: _theorem(blinn=sp.Matrix([BLINN[0], -beta * h_v / (2 * sp.pi * R)])).check()),
         ),
-        pages=("s8",),
-        seed_says="§8: Blinn computed his perturbation exactly; finite differences are the folklore shortcut.",
     )
 
 

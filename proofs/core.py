@@ -488,8 +488,6 @@ class Theorem:
     evidence : callable () -> Verdict, or None: the renderer's outputs (or code) against the
                         statement; its status is "verified" where the theorem rests on it,
                         "proved" where it is a gate that passed
-    pages : tuple       book pages that use the theorem
-    seed_says : str     what the seed claims, where it makes a claim about this
     """
 
     id: str
@@ -504,8 +502,6 @@ class Theorem:
     domain: dict = field(default_factory=dict)
     functions: dict = field(default_factory=dict)
     evidence: Callable[[], Verdict] | None = None
-    pages: tuple = ()
-    seed_says: str = ""
 
     def check(self) -> Verdict:
         """Every link, every step on its own, every claim reached, then the evidence: the

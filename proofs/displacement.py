@@ -293,8 +293,6 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                         ("the obstruction's last term with 2 sin(phi) + 1, not 2 sin(phi) - 1",
                          lambda: _theorem(obstruction=2 * sp.cos(phi) * H_t
                                           + (2 * sp.sin(phi) + 1) * sp.Derivative(H_at, theta, phi)).check())),
-        pages=("s3", "s7"),
-        seed_says="§3 and Cell 8 present the bump as the shading-side stand-in for displacement.",
     )
 
 

@@ -239,7 +239,6 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
                         *((f"{p} without its {'wrap' if p.name[0] == 'u' else 'clamp'} (its interior branch "
                            "everywhere)", lambda p=p: _truncation(stencil=_stencil_with(p, interior)).check())
                           for p in (F.u_p, F.u_m, F.v_p, F.v_m))),
-        pages=("s3",),
     )
 
 # ----------------------------------------------------------------------------- the optimal step
@@ -300,8 +299,6 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
                          lambda: _optimal(eps**2 * H3 / 3 + u_round * (H + HX) / eps).check()),
                         ("the model's truncation term at eps^3, not eps^2",
                          lambda: _optimal(eps**3 * H3 / 6 + u_round * (H + HX) / eps).check())),
-        pages=("s3", "s5", "s7"),
-        seed_says="§3: truncation dominates until eps ~ 1e-6; Cell 2 expects the minimum near 1e-6.",
     )
 
 

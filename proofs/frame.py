@@ -128,8 +128,6 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
                         ("v with the arguments of atan2 swapped",
                          lambda: _chart(v_kernel=sp.atan2(F.N_z, sp.sqrt(F.N_x**2 + F.N_y**2)) / sp.pi).check()),
                         ("the kernel's u and v swapped", lambda: _chart(corrupt=lambda a: a[:, ::-1]).check())),
-        pages=("s3",),
-        seed_says="Cell 1 (chartA1): u = (theta + pi) / 2 pi, v = acos(N_z) / pi.",
     )
 
 
@@ -220,7 +218,6 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
                              sp.Piecewise((c.args[0].expr, c.args[0].cond), (sp.Integer(k == 1), True))
                              if k < 3 and isinstance(c, sp.Piecewise) else c
                              for k, c in enumerate(F.TANGENT_FRAME))).check())),
-        pages=("s3",),
     )
 
 
@@ -263,8 +260,6 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
                          lambda: _orientation(et=REGULAR[3:], ep=REGULAR[:3]).check()),
                         ("the pole fallback with e_theta and e_phi swapped",
                          lambda: _orientation(fallback=F.FALLBACK_FRAME[3:] + F.FALLBACK_FRAME[:3]).check())),
-        pages=("s3", "s5"),
-        seed_says="Cell 2 prints (e_theta x e_phi) . N and labels the frame 'unit, aligned with N'.",
     )
 
 

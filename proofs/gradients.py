@@ -209,7 +209,6 @@ def _theorem(field, closed_form=None, **evidence):
                          lambda: _theorem(field, corrupt=lambda g: g[:, ::-1]).check()),
                         ("the kernel's gradient evaluated in float32",
                          lambda: _theorem(field, compiled=lambda g: [np.float32(x) for x in g]).check())),
-        pages=("s3", "s5"),
     )
 
 

@@ -210,8 +210,6 @@ def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
                          lambda: _rays(shift=np.pi / Scene().k_u).check()),
                         ("the ray's angle with + pi (its last term), not - pi",
                          lambda: _rays(alpha=written(sp.Add(2 * sp.pi * m_sym / F.k_u, sp.pi, evaluate=False))).check())),
-        pages=("s3", "s4"),
-        seed_says="§3: the zero lines u = m/k_u are rays 'by Chapter 5's longitude theorem'.",
     )
 
 
@@ -248,8 +246,6 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
                          lambda: _circles(all_visible=True).check()),
                         ("the radii with e + R cos(phi) in the projection's denominator",
                          lambda: _circles(rho=e * R * sp.sin(phi) / (e + R * sp.cos(phi))).check())),
-        pages=("s3", "s4"),
-        seed_says="§3: the zero lines v = m/k_v are circles 'by its corollary'.",
     )
 
 

@@ -140,7 +140,6 @@ def _creases(field, jump_u, jump_v, band=None):
             ("the crease band half as wide",
              lambda: _creases(field, JUMP_U, JUMP_V, band.xreplace({F.KINK_BAND_HALF_WIDTH: F.KINK_BAND_HALF_WIDTH / 2})
                              ).check())),
-        pages=("s3", "s7"),
     )
 
 

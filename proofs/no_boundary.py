@@ -267,9 +267,6 @@ def _no_boundary(attached=None, **evidence):
                          lambda: _no_boundary(root=1).check()),
                         ("a reach predicate in which sphere B shadows nothing",
                          lambda: _no_boundary(reach=_without_sphere_b).check())),
-        pages=("s1", "s3", "s4"),
-        seed_says="§3: the chamber masks are functions of geometry alone; the seed's shading code "
-                  "nonetheless lets lights past the geometric terminator (errata E2).",
     )
 
 

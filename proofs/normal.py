@@ -67,8 +67,6 @@ def _derivative(claimed=CLAIMED_DERIVATIVE, m=M_CLAIMED):
         wrong_variants=(("sign of the projection flipped",
                          lambda: _derivative((sp.Identity(3) + NP_S * NP_S.T) * G_S / NORM_M_S).check()),
                         ("the 1/|M| factor dropped", lambda: _derivative((sp.Identity(3) - NP_S * NP_S.T) * G_S).check())),
-        pages=("s3", "s5"),
-        seed_says="§3 and §6: 'verified to 1e-12' (Cell 5); Cell 5's Expect: '~1e-9 worst component'.",
     )
 
 #: The renderer's normals, for "surface" with sin phi above the pole cut-off (its pole branch
@@ -194,8 +192,6 @@ def _limit(tilt=None, **evidence):
                          lambda: _limit(tiny_beta=1e-10).check()),
                         ("one height field rendered in place of every field",
                          lambda: _limit(fields=(next(iter(F.FIELDS)),) * len(F.FIELDS)).check())),
-        pages=("s3", "s5"),
-        seed_says="Cell 6 expects beta = 0 agreement at ~1e-16.",
     )
 
 

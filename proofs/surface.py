@@ -177,8 +177,6 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
             ("the renderer's chart bump (the draft's) as the sphere's slopes",
              lambda: _theorem(renderer=sp.ImmutableMatrix(F.BUMP["chart"])).check()),
         ),
-        pages=("s3",),
-        seed_says="§3 gives the bumped normal for sphere A only, as N + beta (h_u e_theta + h_v e_phi).",
     )
 
 

@@ -58,15 +58,12 @@ def _placed(text):
             and calls(stmt, helpers) for c in ast.walk(stmt) for i in ids(c)}
 
 
-def test_every_theorem_is_titled_and_used_on_pages_that_place_it():
-    """The ledger's "used on" list names book pages, among them the page whose theorem block shows
-    the theorem (`_placed`); the title is the block's heading."""
+def test_every_theorem_is_titled_and_placed_on_a_page():
+    """Some book page's theorem block shows the theorem (`_placed`); the title is the block's heading."""
     pages = {p.name.split("_")[0]: p.read_text(encoding="utf-8") for p in BOOK.glob("s[0-9]_*.md")}
     for t in THEOREMS.values():
         assert isinstance(t.title, str) and t.title.strip() == t.title and len(t.title) > 3, t.id
-        assert isinstance(t.pages, tuple) and set(t.pages) <= set(pages), (t.id, t.pages)
-        placed = {name for name, text in pages.items() if t.id in _placed(text)}
-        assert placed and placed <= set(t.pages), (t.id, placed, t.pages)
+        assert any(t.id in _placed(text) for text in pages.values()), f"{t.id} is placed on no page"
 
 
 def test_every_claim_is_stated_and_every_statement_prints():

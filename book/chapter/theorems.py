@@ -194,8 +194,7 @@ def _entry(t):
              f"**{badge(v.status, v.numeric)}** · evidence: {{ref}}`§6 <ledger-{t.id}>`\n:::\n\n"
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, badge=badge(v.status, v.numeric), evidence=v.evidence,
-                seed_says=t.seed_says,
-                pages=list(t.pages), block=block, unexplained=unexplained,
+                block=block, unexplained=unexplained,
                 changed=pinned_failure(t.id, v.status, v.residual, v.rendered, v.covers))
 
 
