@@ -9,9 +9,15 @@ import sys
 from pathlib import Path
 from types import SimpleNamespace
 
+import pytest
+
 from .pages import NOTEBOOK_FRONT_MATTER
 
 ROOT = Path(__file__).resolve().parents[1]
+#: The build forks its page pool, as it should; JAX warns at any fork of a test worker that imported it
+#: (another test did), though the pool's processes run no JAX.
+pytestmark = pytest.mark.filterwarnings(r"ignore:os\.fork\(\) was called:RuntimeWarning")
+
 _spec = importlib.util.spec_from_file_location("execute_pages", ROOT / "book" / "_ext" / "execute_pages.py")
 execute_pages = importlib.util.module_from_spec(_spec)
 sys.modules["execute_pages"] = execute_pages        # as Sphinx loads it: its pool pickles its functions by name

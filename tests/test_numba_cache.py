@@ -91,6 +91,8 @@ def _as_user(uid, gid, cwd, work):
     assert os.waitstatus_to_exitcode(status) == 0, "the other user's process failed"
 
 
+# JAX warns at any fork of a test worker that imported it (another test did); `_as_user`'s child runs no JAX.
+@pytest.mark.filterwarnings(r"ignore:os\.fork\(\) was called:RuntimeWarning")
 def test_a_cache_planted_by_another_user_is_refused_and_nothing_runs(tmp_path):
     """The attack: another user creates the victim's fallback directory first (world-writable),
     filled with the index files a real render writes, each replaced by a pickle that runs a
