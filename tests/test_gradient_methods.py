@@ -230,6 +230,17 @@ def test_pareto_front_rejects_a_dominated_point():
     assert slow_coarse not in front and tie_time not in front
 
 
+def test_pareto_front_minimises_the_error_it_is_asked_for():
+    """max and rms rank a spiky method and a uniformly coarse one oppositely: each front keeps its own."""
+    def both(label, t, max_error, rms_error):
+        return gm.MethodResult("sine", label, None, (t,), 0.0, 0.0, 0.0, max_error, rms_error)
+    fast = both("fast", 1.0, 1e-6, 1e-8)                  # a few bad pixels: large max, small rms
+    slow = both("slow", 2.0, 1e-7, 1e-7)                  # uniform: smaller max, larger rms
+    assert [r.method for r in gm.pareto_front([fast, slow], error="max")] == ["fast", "slow"]
+    assert [r.method for r in gm.pareto_front([fast, slow], error="rms")] == ["fast"]
+    assert [r.method for r in gm.pareto_front([fast, slow])] == ["fast", "slow"]      # "max" by default
+
+
 def test_pareto_front_validates_its_input():
     with pytest.raises(ValueError, match="error must be 'max' or 'rms'"):
         gm.pareto_front([result("a", 1.0, 1.0)], error="mean")
