@@ -58,6 +58,15 @@ def test_the_reference_rounds_sin_pi_correctly():
     assert e[0] == math.frexp(hi[0])[1] - 1 - 52
 
 
+def test_the_reference_counts_in_the_subnormal_ulp_below_the_normal_range():
+    """ulp(t) is 2^-1074 for every t below 2^-1021 (subnormals and the smallest binade of normals alike),
+    2^(floor(log2 |t|) - 52) above; sin x rounds to x there (sin x = x - x^3/6 ...)."""
+    tiny = np.array([5e-324, 1e-310, 2.0**-1022, 2.0**-1021, -1e-310])
+    hi, e, rest = fm.reference("sin", tiny)
+    np.testing.assert_array_equal(hi, tiny)
+    assert e.tolist() == [-1074, -1074, -1074, -1073, -1074] and np.all(np.abs(rest) < 1e-300)
+
+
 @pytest.mark.parametrize("function", fm.FUNCTIONS)
 @pytest.mark.parametrize("wrong", ["+1 ulp", "+2 ulps", "1e-10 relative"])
 def test_planted_wrong_functions_are_counted_as_mpmath_counts_them(function, wrong):
@@ -160,6 +169,10 @@ def test_the_floor_follows_the_sine(monkeypatch):
     assert bad["error"] > 1e3 * good["error"] and bad["fitted_roundoff"] > 1e3 * good["fitted_roundoff"]
     assert bad["fitted_step"] > good["fitted_step"]
     assert good["step"] in DEFAULT_STEPS and bad["step"] in DEFAULT_STEPS
+    # The fitted step minimises the fitted model E = A eps^2 + B/eps: there 2 A eps^3 = B, so E eps = 3B/2.
+    for f in (good, bad):
+        assert f["fitted_error"] * f["fitted_step"] == pytest.approx(1.5 * f["fitted_roundoff"], rel=1e-9)
+    assert 0.5 < good["fitted_step"] / out["model"]["step"] < 2          # near the error model's optimum
 
 
 @pytest.mark.parametrize("call, match", [

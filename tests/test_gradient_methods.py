@@ -501,6 +501,17 @@ def test_the_classic_function_reproduces_the_papers_behaviour(classic):
     assert {p.method for p in gm.PUBLISHED} - {None} <= {m.name for m in gm.METHODS}
 
 
+def test_each_method_has_a_row_per_step_or_one_without(classic):
+    """A method that takes a step is measured at every step of the curve; one that takes none (AD,
+    Richardson, exact) once, its step None; every method with a one-variable form that applies is there."""
+    steps = [float(e) for e in classic.curve.eps]
+    measured = {r.method for r in classic.rows}
+    for m in gm.METHODS:
+        if m.name in measured:
+            assert [r.eps for r in classic.of(m.name)] == ([None] if m.steps is None else steps), m.name
+    assert {m.name for m in gm.METHODS if m.steps is None} & measured and len(measured) >= 5, measured
+
+
 def test_an_abs_function_takes_the_continued_complex_step_and_not_the_plain_one():
     e = gm.univariate_errors("x*abs(x - 1)", 2.0, steps=(1e-3, 1e-20))
     names = {r.method for r in e.rows}
