@@ -58,6 +58,33 @@ def test_the_reference_rounds_sin_pi_correctly():
     assert e[0] == math.frexp(hi[0])[1] - 1 - 52
 
 
+@pytest.mark.parametrize("seed, count", [(fm.SEED, 2000), (12345, 501)])
+def test_the_arguments_are_the_sets_their_docstring_names(seed, count):
+    """`fm.arguments`, read against its docstring: the random part in each function's range and the
+    hard points exactly the sets it lists (at the book's seed and at another)."""
+    (x,), hard = fm.arguments("sin", count, seed)
+    quarter = math.pi / 2
+    assert 0 <= x[:count].min() and x[:count].max() <= fm.MAX_ANGLE and x.size == count + hard
+    m = np.round(x[count:] / quarter)
+    assert np.all(np.abs(x[count:] - m * quarter) <= np.spacing(x[count:]))      # m pi/2 and its neighbours
+    assert np.unique(m, return_counts=True)[1].tolist() == [3] * int(fm.MAX_ANGLE / quarter)
+    (y, x), hard = fm.arguments("atan2", count, seed)
+    half = count // 2
+    assert np.all(np.hypot(y[:half], x[:half]) <= 1 + 1e-15)                     # (N_y, N_x) of unit N
+    assert np.all(y[half:count] >= 0) and np.allclose(np.hypot(y[half:count], x[half:count]), 1, atol=1e-15)
+    tiny = [2.0**-j for j in range(1, 61)]
+    assert set(zip(y[count:], x[count:])) == ({(t, -1.0) for t in tiny} | {(-t, -1.0) for t in tiny}
+                                              | {(t, 1.0) for t in tiny})
+    (x,), hard = fm.arguments("acos", count, seed)
+    assert np.all(np.abs(x[:count]) <= 1)
+    assert set(x[count:]) == {s * (1 - j * 2.0**-53) for j in range(1000) for s in (1, -1)}
+    (base, exponent), hard = fm.arguments("pow", count, seed)
+    assert np.all((exponent >= 1) & (exponent <= 1e4) & (base >= 0) & (base <= 1))
+    assert np.all(exponent * np.log2(base) > fm.MIN_POWER_LOG2)                  # a normal power
+    assert set(base[count:]) == {1 - 2.0**-j for j in range(1, 54)} | {0.999}
+    assert np.allclose(np.unique(exponent[count:]), np.geomspace(1, 1e4, 41), rtol=1e-12)
+
+
 def test_the_reference_counts_in_the_subnormal_ulp_below_the_normal_range():
     """ulp(t) is 2^-1074 for every t below 2^-1021 (subnormals and the smallest binade of normals alike),
     2^(floor(log2 |t|) - 52) above; sin x rounds to x there (sin x = x - x^3/6 ...)."""
