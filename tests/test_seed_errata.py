@@ -30,6 +30,23 @@ def test_a_pair_in_a_cast_shadow_does_not_leak(monkeypatch):
     assert (m["leak_pixels_default"], m["leak_pixels_beta_1_5"]) == (2, 2)
 
 
+@pytest.mark.parametrize("position", [(0.3, 0.3, 1.6), (0.45, 0.45, 1.05), (0.4, 0.45, 0.95), (0.2, 0.2, 1.2)],
+                         ids=["B between", "B between, close", "B beyond the light", "B beyond, lower"])
+def test_the_drafts_cast_shadow_is_sphere_b_cutting_the_segment(position):
+    """The draft's quadratic for sphere B's cast shadow on A against a march of 2,000 points along each
+    segment from the hit point to the light: lights with B between them and A, and lights between A and
+    B, where the line meets B beyond the light (a root past 1, which casts no shadow)."""
+    from renderer import gbuffer
+    from renderer.scene import PointLight
+    scene = DRAFT_SCENE.replace(lights=(PointLight(position, (1.0, 1.0, 1.0)),))
+    [(_, _, _, cast)] = seed_errata._light_terms(scene, size=48)
+    g = gbuffer(scene, 48, 48)
+    P = g.P[g.chamber == SPHERE_A]
+    s = np.linspace(0.0, 1.0, 2001)[1:-1, None, None]
+    inside = np.linalg.norm(P + s * (np.asarray(position) - P) - np.asarray(scene.center_b), axis=-1) < scene.radius_b
+    assert P.shape[0] > 1000 and np.count_nonzero(cast != inside.any(axis=0)) <= 2
+
+
 def _facing_away(scene, P):
     """A shading normal at P that faces away from the first light while its half vector with the eye leans
     towards it: the draft adds a lobe there."""
@@ -51,7 +68,13 @@ def test_the_ungated_lobe_is_counted_on_both_spheres(monkeypatch, codes, pairs):
     g = SimpleNamespace(chamber=np.array([codes], dtype=np.uint8), P=np.array([[P, P]]), Ns=np.array([[Ns, Ns]]))
     monkeypatch.setattr(seed_errata, "DRAFT_SCENE", scene)
     monkeypatch.setattr(seed_errata, "gbuffer", lambda scene, w, h: g)
-    assert seed_errata._specular_ungated(size=2)["pixels"] == pairs
+    found = seed_errata._specular_ungated(size=2)
+    assert found["pixels"] == pairs
+    # The lobe it adds, by hand: k_s max(0, Ns . h)^n times the light's brightest channel; none, none added.
+    L, E = np.asarray(scene.lights[0].position), np.array([0.0, 0.0, scene.camera_z])
+    w, v = (L - P) / np.linalg.norm(L - P), (E - P) / np.linalg.norm(E - P)
+    lobe = scene.ks * max(Ns @ ((w + v) / np.linalg.norm(w + v)), 0.0) ** scene.shininess * max(scene.lights[0].color)
+    assert lobe > 0 and found["max_specular_added"] == (pytest.approx(lobe, rel=1e-12) if pairs else 0.0)
 
 
 # ----------------------------------------------------------------------- the book's words for them
