@@ -951,13 +951,13 @@ def test_the_figure_text_check_catches_5_pt_text_and_a_figure_without_its_record
     assert [f["recorded"] for f in found] == [True, True, True, False, True, True, True]
     assert [f["png_px"] is None for f in found] == [False, False, True, True, False, False, False]
     assert [found.index(f) for f in small_figure_text(audit, MIN_FIGURE_TEXT_PX[390])] == [0, 4, 5, 6], found
-    assert found[6]["css_px"] == pytest.approx(6.5 * 100 / 72, rel=0.01)           # 9.0 px
-    assert found[0]["css_px"] == pytest.approx(5 * 100 / 72, rel=0.01)
-    assert found[1]["css_px"] == pytest.approx(10 * 100 / 72, rel=0.01)
+    assert found[6]["css_px"] == pytest.approx(6.5 * 100 / 72, rel=0.01, abs=0)           # 9.0 px
+    assert found[0]["css_px"] == pytest.approx(5 * 100 / 72, rel=0.01, abs=0)
+    assert found[1]["css_px"] == pytest.approx(10 * 100 / 72, rel=0.01, abs=0)
     wide = audit["images"][4]
     assert wide["shown"][0] == 300 and found[4]["css_px"] == pytest.approx(
-        10 * 100 / 72 * 300 / (wide["natural"][0] / 2), rel=0.01)
-    assert found[5]["css_px"] == pytest.approx(0.7 * 7.2 * 100 / 72, rel=0.01)
+        10 * 100 / 72 * 300 / (wide["natural"][0] / 2), rel=0.01, abs=0)
+    assert found[5]["css_px"] == pytest.approx(0.7 * 7.2 * 100 / 72, rel=0.01, abs=0)
 
 
 def test_figure_png_records_the_smallest_text_drawn(figure):

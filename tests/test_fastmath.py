@@ -198,7 +198,7 @@ def test_the_floor_follows_the_sine(monkeypatch):
     assert good["step"] in DEFAULT_STEPS and bad["step"] in DEFAULT_STEPS
     # The fitted step minimises the fitted model E = A eps^2 + B/eps: there 2 A eps^3 = B, so E eps = 3B/2.
     for f in (good, bad):
-        assert f["fitted_error"] * f["fitted_step"] == pytest.approx(1.5 * f["fitted_roundoff"], rel=1e-9)
+        assert f["fitted_error"] * f["fitted_step"] == pytest.approx(1.5 * f["fitted_roundoff"], rel=1e-9, abs=0)
     assert 0.5 < good["fitted_step"] / out["model"]["step"] < 2          # near the error model's optimum
 
 

@@ -29,16 +29,16 @@ def _curves(count=20, seed=11):
 @pytest.mark.parametrize("A, B, eps", list(_curves()), ids=lambda x: f"{x:.1e}" if isinstance(x, float) else "")
 def test_a_synthetic_curve_is_recovered(A, B, eps):
     got = fit_model(eps, A * eps**2 + B / eps, start=(1.0, 1e-16))
-    assert got == pytest.approx((A, B), rel=1e-9)
+    assert got == pytest.approx((A, B), rel=1e-9, abs=0)
 
 
 def test_two_nonzero_errors_fit_and_zero_errors_are_left_out():
     eps = np.array([1e-3, 1e-6])
-    assert fit_model(eps, 3.0 * eps**2 + 2e-16 / eps) == pytest.approx((3.0, 2e-16), rel=1e-12)
+    assert fit_model(eps, 3.0 * eps**2 + 2e-16 / eps) == pytest.approx((3.0, 2e-16), rel=1e-12, abs=0)
     with_zeros = np.array([1e-2, 1e-3, 1e-5, 1e-6])
     error = 3.0 * with_zeros**2 + 2e-16 / with_zeros
     error[[0, 2]] = 0.0                                    # an exact quotient at two of the steps
-    assert fit_model(with_zeros, error) == pytest.approx((3.0, 2e-16), rel=1e-12)
+    assert fit_model(with_zeros, error) == pytest.approx((3.0, 2e-16), rel=1e-12, abs=0)
     with pytest.raises(ValueError, match="^error must have at least 2 nonzero entries to fit a two-term model$"):
         fit_model(with_zeros, np.where(with_zeros == 1e-3, 1e-9, 0.0))
 

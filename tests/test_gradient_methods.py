@@ -386,11 +386,11 @@ def test_ad_on_the_crease_beside_the_exact_gradient_and_the_central_difference()
     # f = -0.0 (f = 0 times a negative factor here) times f_u, which is one of the one-sided slopes.
     assert at_zero["exact"] == 0.0
     f_u = -slope if np.sin(np.pi * KV * 0.47) < 0 else slope
-    assert at_zero["ad"] == pytest.approx(gm.abs_slope_at_zero()[1] * f_u, rel=1e-12)
-    assert at_zero["ad"] in (pytest.approx(-slope, rel=1e-12), pytest.approx(slope, rel=1e-12))
+    assert at_zero["ad"] == pytest.approx(gm.abs_slope_at_zero()[1] * f_u, rel=1e-12, abs=0)
+    assert at_zero["ad"] in (pytest.approx(-slope, rel=1e-12, abs=0), pytest.approx(slope, rel=1e-12, abs=0))
     # Where the factor is a rounding residue, both take the side its sign picks: the same one.
-    assert at_residue["exact"] == pytest.approx(at_residue["ad"], rel=1e-12)
-    assert abs(at_residue["exact"]) == pytest.approx(slope, rel=1e-12)
+    assert at_residue["exact"] == pytest.approx(at_residue["ad"], rel=1e-12, abs=0)
+    assert abs(at_residue["exact"]) == pytest.approx(slope, rel=1e-12, abs=0)
     # The central difference averages the two sides: ~0.
     for c in (at_zero, at_residue):
         assert abs(c["central"]) < 1e-9 * slope

@@ -76,7 +76,7 @@ def _problems(data):
         if control == "log_eps" and float(value).is_integer() and scene.eps != 10.0 ** value:
             bad.append(f"the ε slider at the decade {value} renders eps {scene.eps!r}, not 1e{int(value)}")
         got = getattr(scene, field)
-        if not (got == pytest.approx(want, rel=0.05) if isinstance(want, float) else got == want):
+        if not (got == pytest.approx(want, rel=0.05, abs=0) if isinstance(want, float) else got == want):
             bad.append(f"{control}={value!r} renders {field}={got!r}")
     for control, choices in (("height_field", tuple(FIELDS)), ("bump", BUMPS), ("model", MODELS),
                              ("numeric", tuple(g for g in GRADIENTS if g != "exact"))):

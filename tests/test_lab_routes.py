@@ -78,11 +78,11 @@ def test_the_census_is_its_frames_sums_and_its_straddling_count(scene):
         both = on_a & (numeric.chamber == SPHERE_A)
         d = np.abs(numeric.image - symbolic.image)[both]                  # (pixels, 3)
         band = symbolic.kink[both]
-        assert c["rms"][k] == pytest.approx(float(np.sqrt(np.mean(d**2))), rel=1e-12)
+        assert c["rms"][k] == pytest.approx(float(np.sqrt(np.mean(d**2))), rel=1e-12, abs=0)
         assert c["max"][k] == float(d.max())
         if band.any():
-            assert c["on_band"][k] == pytest.approx(float(d[band].mean()), rel=1e-12)
-        assert c["off_band"][k] == pytest.approx(float(d[~band].mean()), rel=1e-12)
+            assert c["on_band"][k] == pytest.approx(float(d[band].mean()), rel=1e-12, abs=0)
+        assert c["off_band"][k] == pytest.approx(float(d[~band].mean()), rel=1e-12, abs=0)
         assert c["flips"][k] == int(np.count_nonzero(numeric.chamber != symbolic.chamber))
         assert c["straddling"][k] == int(np.count_nonzero(_straddles(scene, SIZE, eps)))
 
@@ -147,7 +147,7 @@ def test_gradient_accuracy_is_mpmath_differentiating_h_at_sphere_a_pixels(field,
     scene = _scenes(1, seed=11, field=field)[0]
     got, mine = _accuracy_route(field, scene.k_u, scene.k_v, [3e-2, 3e-3], monkeypatch)
     for g, m in zip(got, mine):
-        assert g == pytest.approx(m, rel=1e-6)
+        assert g == pytest.approx(m, rel=1e-6, abs=0)
 
 
 def test_a_reference_with_its_frequencies_swapped_is_caught(monkeypatch):
@@ -156,7 +156,7 @@ def test_a_reference_with_its_frequencies_swapped_is_caught(monkeypatch):
     monkeypatch.setattr(accuracy, "_reference", lambda field, ku, kv: real(field, kv, ku))
     scene = _scenes(1, seed=11, field="sine")[0]
     got, mine = _accuracy_route("sine", scene.k_u, scene.k_v, [3e-3], monkeypatch)
-    assert got[0] != pytest.approx(mine[0], rel=1e-6)
+    assert got[0] != pytest.approx(mine[0], rel=1e-6, abs=0)
 
 
 def _frame_rms(scene, steps):
@@ -182,7 +182,7 @@ def test_the_image_best_step_is_the_least_rms_of_frames_rendered_one_by_one(fiel
     monkeypatch.setattr(ledger, "SIMULATOR_SCENE", scene)
     got = _image_best_step(field, SIZE, BEST_STEPS)
     rms = _frame_rms(scene, BEST_STEPS)
-    assert got["rms"] == pytest.approx(rms, rel=1e-9)
+    assert got["rms"] == pytest.approx(rms, rel=1e-9, abs=0)
     assert got["best"] == BEST_STEPS[int(np.argmin(rms))]
     assert got["steps"] == BEST_STEPS and got["size"] == [SIZE, SIZE] and got["scene"] == scene.changes()
 
@@ -192,7 +192,7 @@ def test_an_image_best_step_with_its_frequencies_swapped_is_caught(monkeypatch):
     import renderer.ledger as ledger
     scene = _scenes(1, seed=23, field="ridges")[0]
     monkeypatch.setattr(ledger, "SIMULATOR_SCENE", scene.replace(k_u=scene.k_v, k_v=scene.k_u))
-    assert _image_best_step("ridges", SIZE, BEST_STEPS)["rms"] != pytest.approx(_frame_rms(scene, BEST_STEPS), rel=1e-9)
+    assert _image_best_step("ridges", SIZE, BEST_STEPS)["rms"] != pytest.approx(_frame_rms(scene, BEST_STEPS), rel=1e-9, abs=0)
 
 
 def _optima_route(seed, monkeypatch):
@@ -228,7 +228,7 @@ def _optima_route(seed, monkeypatch):
 def test_the_optima_at_random_points_and_frequencies_are_mpmaths(seed, monkeypatch):
     got, want = _optima_route(seed, monkeypatch)
     for name, fields in want.items():
-        assert {key: got[name][key] for key in fields} == pytest.approx(fields, rel=1e-7), name
+        assert {key: got[name][key] for key in fields} == pytest.approx(fields, rel=1e-7, abs=0), name
 
 
 def test_optima_measured_with_the_frequencies_exchanged_are_caught(monkeypatch):
@@ -237,4 +237,4 @@ def test_optima_measured_with_the_frequencies_exchanged_are_caught(monkeypatch):
     real = ucurve.measure
     monkeypatch.setattr(ucurve, "measure", lambda *a, k_u, k_v, **kw: real(*a, k_u=k_v, k_v=k_u, **kw))
     got, want = _optima_route(31, monkeypatch)
-    assert any(got[name]["h1"] != pytest.approx(want[name]["h1"], rel=1e-7) for name in want)
+    assert any(got[name]["h1"] != pytest.approx(want[name]["h1"], rel=1e-7, abs=0) for name in want)

@@ -102,5 +102,5 @@ def test_the_stacking_claim_compares_only_blocks_whose_samples_are_all_on_sphere
         return SimpleNamespace(image=image, chamber=chamber, scene=scene)
     monkeypatch.setattr(claims, "render", render)
     values = claims._stacking()
-    assert values["one-sample error, with / without the bump"] == pytest.approx(2.0, rel=1e-12)
-    assert (values["bumped"], values["flat"]) == (pytest.approx(0.02, rel=1e-12), pytest.approx(0.01, rel=1e-12))
+    assert values["one-sample error, with / without the bump"] == pytest.approx(2.0, rel=1e-12, abs=0)
+    assert (values["bumped"], values["flat"]) == (pytest.approx(0.02, rel=1e-12, abs=0), pytest.approx(0.01, rel=1e-12, abs=0))

@@ -53,9 +53,9 @@ def test_the_u_curve_of_a_readers_function_is_mpmaths(text, f_mp, f_py, x):
     with mpmath.workdps(40):
         X = mpmath.mpf(x)
         true = mpmath.diff(f_mp, X)
-        assert uc.derivative == pytest.approx(float(true), rel=1e-14)
-        assert uc.height == pytest.approx(float(f_mp(X)), rel=1e-14)
-        assert uc.third_derivative == pytest.approx(float(mpmath.diff(f_mp, X, 3)), rel=1e-12)
+        assert uc.derivative == pytest.approx(float(true), rel=1e-14, abs=0)
+        assert uc.height == pytest.approx(float(f_mp(X)), rel=1e-14, abs=0)
+        assert uc.third_derivative == pytest.approx(float(mpmath.diff(f_mp, X, 3)), rel=1e-12, abs=0)
         for i, e in enumerate(steps):
             plus, minus = x + e, x - e
             exact = (f_mp(mpmath.mpf(plus)) - f_mp(mpmath.mpf(minus))) / (2 * mpmath.mpf(e))
@@ -70,15 +70,15 @@ def test_the_u_curve_of_a_readers_function_is_mpmaths(text, f_mp, f_py, x):
     # The error model E(eps) = T eps^2 + (C + G) / eps, its minimiser and least value, from mpmath's values.
     T, C, G = abs(uc.third_derivative) / 6, UNIT_ROUNDOFF * abs(uc.height), UNIT_ROUNDOFF * abs(x * uc.derivative)
     star = ((C + G) / (2 * T)) ** (1 / 3)
-    assert uc.eps_model == pytest.approx(star, rel=1e-12)
-    assert uc.error_model == pytest.approx(T * star**2 + (C + G) / star, rel=1e-12)
-    assert uc.model == pytest.approx(T * uc.eps**2 + (C + G) / uc.eps, rel=1e-12)
-    assert (uc.model_truncation, uc.model_cancellation, uc.model_argument) == pytest.approx((T, C, G), rel=1e-12)
+    assert uc.eps_model == pytest.approx(star, rel=1e-12, abs=0)
+    assert uc.error_model == pytest.approx(T * star**2 + (C + G) / star, rel=1e-12, abs=0)
+    assert uc.model == pytest.approx(T * uc.eps**2 + (C + G) / uc.eps, rel=1e-12, abs=0)
+    assert (uc.model_truncation, uc.model_cancellation, uc.model_argument) == pytest.approx((T, C, G), rel=1e-12, abs=0)
     best = int(np.argmin(uc.error))
     assert (uc.eps_measured_min, uc.error_at_measured_min) == (steps[best], uc.error[best])
     A, B, fitted = uc.fitted_truncation, uc.fitted_roundoff, uc.eps_fitted
-    assert fitted == pytest.approx((B / (2 * A)) ** (1 / 3), rel=1e-12, nan_ok=True)     # NaN: no U to fit
-    assert uc.error_at_fitted == pytest.approx(A * fitted**2 + B / fitted, rel=1e-12, nan_ok=True)
+    assert fitted == pytest.approx((B / (2 * A)) ** (1 / 3), rel=1e-12, abs=0, nan_ok=True)     # NaN: no U to fit
+    assert uc.error_at_fitted == pytest.approx(A * fitted**2 + B / fitted, rel=1e-12, abs=0, nan_ok=True)
 
 
 def test_the_model_without_truncation_or_without_rounding_has_its_optimum_at_an_end():
@@ -125,7 +125,7 @@ def test_at_a_crease_the_reference_is_the_derivative_at_the_float_point(k, x, co
         else:
             slope = mpmath.diff(lambda t: h(U, t), V + side)
     fd = float(pointwise.central_gradient("ridges", at["u"], at["v"], k_u, k_v, 1e-3)[component == "v"])
-    assert fd - c.roundoff[0] - c.truncation[0] == pytest.approx(float(slope), rel=1e-9)
+    assert fd - c.roundoff[0] - c.truncation[0] == pytest.approx(float(slope), rel=1e-9, abs=0)
 
 
 def test_a_crease_is_a_sign_change_within_one_ulp_of_any_abs_of_the_field():

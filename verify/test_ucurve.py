@@ -87,7 +87,7 @@ def test_at_the_charts_edge_1_the_reference_is_the_slope_from_inside(component):
     inside = (float(pointwise.height("ridges", c.u, c.v, 8.0, 4.0))
               - float(pointwise.height("ridges", below["u"], below["v"], 8.0, 4.0))) / d
     assert c.reason is not None and abs(inside) > 1.0
-    assert reference == pytest.approx(inside, rel=1e-5)
+    assert reference == pytest.approx(inside, rel=1e-5, abs=0)
 
 
 @pytest.mark.parametrize("kwargs", [
@@ -104,10 +104,10 @@ def test_the_fitted_model_recovers_a_synthetic_curve_and_the_truncation_coeffici
     from renderer.ucurve import fit_model
     eps = np.logspace(-1, -15, 200)
     A, B = fit_model(eps, 61.0 * eps**2 + 1e-17 / eps)
-    assert A == pytest.approx(61.0, rel=1e-9) and B == pytest.approx(1e-17, rel=1e-9)
+    assert A == pytest.approx(61.0, rel=1e-9, abs=0) and B == pytest.approx(1e-17, rel=1e-9, abs=0)
     # On the measured curve, A is |h'''| / 6 (the truncation term), not twice or half of it.
-    assert curve.fitted_truncation == pytest.approx(abs(curve.third_derivative) / 6, rel=0.1)
-    assert curve.fitted_truncation != pytest.approx(abs(curve.third_derivative) / 3, rel=0.1)
+    assert curve.fitted_truncation == pytest.approx(abs(curve.third_derivative) / 6, rel=0.1, abs=0)
+    assert curve.fitted_truncation != pytest.approx(abs(curve.third_derivative) / 3, rel=0.1, abs=0)
 
 
 def test_the_fitted_optimum_does_not_depend_on_the_grid(curve):
@@ -158,7 +158,7 @@ def test_the_model_optimal_step_from_an_independent_derivative(curve):
         x = mpmath.mpf(0.31)
         h0, h1, h3 = (float(abs(mpmath.diff(h, x, n))) for n in (0, 1, 3))
     star = (3 * UNIT_ROUNDOFF * (h0 + 0.31 * h1) / h3) ** (1 / 3)
-    assert curve.eps_model == pytest.approx(star, rel=1e-9)
-    assert curve.error_model == pytest.approx(h3 / 6 * star**2 + UNIT_ROUNDOFF * (h0 + 0.31 * h1) / star, rel=1e-9)
+    assert curve.eps_model == pytest.approx(star, rel=1e-9, abs=0)
+    assert curve.error_model == pytest.approx(h3 / 6 * star**2 + UNIT_ROUNDOFF * (h0 + 0.31 * h1) / star, rel=1e-9, abs=0)
     assert curve.model == pytest.approx(h3 / 6 * curve.eps**2 + UNIT_ROUNDOFF * (h0 + 0.31 * h1) / curve.eps,
-                                        rel=1e-9)
+                                        rel=1e-9, abs=0)
