@@ -50,6 +50,17 @@ def test_the_largest_ungated_lobe_is_found_pixel_by_pixel(monkeypatch):
     assert found["pixels"] == 2 and found["max_specular_added"] == pytest.approx(max(lobes), rel=1e-12, abs=0)
 
 
+def test_the_drafts_sphere_b_hits_lie_off_it_by_the_closed_form():
+    """The draft's quadratic for sphere B keeps a t^2 + 2 b t and replaces c = |E - C|^2 - r^2 with |C|^2 - r^2, so
+    at each of its roots |P - C|^2 - r^2 = |E - C|^2 - |C|^2 = e^2 - 2 e C_z: every hit lies the same distance
+    sqrt(r^2 + e^2 - 2 e C_z) - r off the sphere (a number the errata show, here without the draft's code)."""
+    e, (_, _, c_z), r = DRAFT_SCENE.camera_z, DRAFT_SCENE.center_b, DRAFT_SCENE.radius_b
+    off = abs(np.sqrt(r * r + e * e - 2 * e * c_z) - r)
+    m = seed_errata._sphere_b_seed_vs_true()
+    assert m["off_surface_max"] == pytest.approx(off, rel=1e-12, abs=0)
+    assert m["off_surface_relative"] == pytest.approx(off / r, rel=1e-12, abs=0)
+
+
 @pytest.mark.parametrize("position", [(0.3, 0.3, 1.6), (0.45, 0.45, 1.05), (0.4, 0.45, 0.95), (0.2, 0.2, 1.2)],
                          ids=["B between", "B between, close", "B beyond the light", "B beyond, lower"])
 def test_the_drafts_cast_shadow_is_sphere_b_cutting_the_segment(position):
