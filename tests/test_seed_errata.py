@@ -40,13 +40,8 @@ def test_the_largest_ungated_lobe_is_found_pixel_by_pixel(monkeypatch):
                         Ns=np.array([normals]))
     monkeypatch.setattr(seed_errata, "DRAFT_SCENE", scene)
     monkeypatch.setattr(seed_errata, "gbuffer", lambda scene, w, h: g)
-    L, E = np.asarray(scene.lights[0].position), np.array([0.0, 0.0, scene.camera_z])
-    lobes = []
-    for P, Ns in zip(points, normals):
-        w, v = (L - P) / np.linalg.norm(L - P), (E - P) / np.linalg.norm(E - P)
-        lobes.append(scene.ks * max(Ns @ ((w + v) / np.linalg.norm(w + v)), 0.0) ** scene.shininess
-                     * max(scene.lights[0].color))
     found = seed_errata._specular_ungated(size=2)
+    lobes = [_lobe(scene, P, Ns) for P, Ns in zip(points, normals)]
     assert found["pixels"] == 2 and found["max_specular_added"] == pytest.approx(max(lobes), rel=1e-12, abs=0)
 
 
@@ -78,6 +73,14 @@ def test_the_drafts_cast_shadow_is_sphere_b_cutting_the_segment(position):
     assert P.shape[0] > 1000 and np.count_nonzero(cast != inside.any(axis=0)) <= 2
 
 
+def _lobe(scene, P, Ns):
+    """The Blinn lobe the draft adds at P with shading normal Ns, by hand: k_s max(0, Ns . h)^n times the first
+    light's brightest channel, h the half vector of the directions to that light and to the eye."""
+    L, E = np.asarray(scene.lights[0].position), np.array([0.0, 0.0, scene.camera_z])
+    w, v = (L - P) / np.linalg.norm(L - P), (E - P) / np.linalg.norm(E - P)
+    return scene.ks * max(Ns @ ((w + v) / np.linalg.norm(w + v)), 0.0) ** scene.shininess * max(scene.lights[0].color)
+
+
 def _facing_away(scene, P):
     """A shading normal at P that faces away from the first light while its half vector with the eye leans
     towards it: the draft adds a lobe there."""
@@ -101,10 +104,7 @@ def test_the_ungated_lobe_is_counted_on_both_spheres(monkeypatch, codes, pairs):
     monkeypatch.setattr(seed_errata, "gbuffer", lambda scene, w, h: g)
     found = seed_errata._specular_ungated(size=2)
     assert found["pixels"] == pairs
-    # The lobe it adds, by hand: k_s max(0, Ns . h)^n times the light's brightest channel; none, none added.
-    L, E = np.asarray(scene.lights[0].position), np.array([0.0, 0.0, scene.camera_z])
-    w, v = (L - P) / np.linalg.norm(L - P), (E - P) / np.linalg.norm(E - P)
-    lobe = scene.ks * max(Ns @ ((w + v) / np.linalg.norm(w + v)), 0.0) ** scene.shininess * max(scene.lights[0].color)
+    lobe = _lobe(scene, P, Ns)                            # none counted, none added
     assert lobe > 0 and found["max_specular_added"] == (pytest.approx(lobe, rel=1e-12, abs=0) if pairs else 0.0)
 
 
