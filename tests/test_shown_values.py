@@ -153,7 +153,7 @@ def test_the_u_curve_of_s3_draws_slope_guides_parallel_to_its_arms_with_the_slop
     for line in guides:
         x, y = (np.log10(np.asarray(d, float)) for d in line.get_data())
         slope, _ = np.polyfit(x, y, 1)
-        (note,) = [t for t in ax.texts if np.isclose(np.log10(t.xy[0]), (x[0] + x[-1]) / 2)]
+        (note,) = [t for t in ax.texts if np.isclose(np.log10(t.xy[0]), (x[0] + x[-1]) / 2, rtol=0, atol=1e-9)]
         (named,) = numbers(note.get_text().split("\n")[0])
         assert math.isclose(slope, named, abs_tol=1e-9), (slope, note.get_text())
         arm = (eps >= 10 ** x[0]) & (eps <= 10 ** x[-1]) & (error > 0)
@@ -266,7 +266,7 @@ def test_the_normal_diagram_draws_the_displacement_its_title_names_and_the_norma
     h = pointwise.height(p["field"], np.full_like(x, (p["theta"] + np.pi) / (2 * np.pi)), np.arctan2(x, z) / np.pi,
                          scene.k_u, scene.k_v)
     big = np.abs(h) > 0.1
-    assert np.allclose((np.hypot(x, z) - scene.radius_a)[big] / h[big], beta, rtol=1e-9)
+    assert np.allclose((np.hypot(x, z) - scene.radius_a)[big] / h[big], beta, rtol=1e-9, atol=0)
     if kwargs:
         return
     arrows = {}

@@ -15,9 +15,9 @@ def test_split_is_exact(curve):
 def test_truncation_follows_eps_squared_h3_over_6_at_large_steps(curve):
     big = (curve.eps > 1e-4) & (curve.eps < 1e-2)
     predicted = curve.eps[big] ** 2 * curve.third_derivative / 6
-    assert np.allclose(curve.truncation[big], predicted, rtol=2e-2)
+    assert np.allclose(curve.truncation[big], predicted, rtol=2e-2, atol=0)
     # A wrong coefficient (1/3) is rejected by the same comparison.
-    assert not np.allclose(curve.truncation[big], 2 * predicted, rtol=2e-2)
+    assert not np.allclose(curve.truncation[big], 2 * predicted, rtol=2e-2, atol=0)
 
 
 def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the_model_optimal_step(curve):
@@ -25,7 +25,7 @@ def test_the_plotted_model_is_the_truncation_where_it_dominates_and_least_at_the
     measured truncation at large steps (a wrong 1/6 fails), and its minimum lies at the model-optimal step
     (a wrong roundoff coefficient moves it by the cube root of the error)."""
     big = (curve.eps > 1e-4) & (curve.eps < 1e-2)
-    assert np.allclose(curve.model[big], np.abs(curve.truncation[big]), rtol=2e-2)
+    assert np.allclose(curve.model[big], np.abs(curve.truncation[big]), rtol=2e-2, atol=0)
     around = measure(eps=curve.eps_model * np.array([0.75, 0.9, 1.0, 1.1, 1.3]))
     assert np.argmin(around.model) == 2, around.model
 
