@@ -105,16 +105,15 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
     return Theorem(
         id="blinn-perturbation", title=TITLES["blinn-perturbation"],
         statement=(
-            r"Set Blinn's $N'_B = N_B + \bigl(F_u (N_B\times P_v) - F_v (N_B\times P_u)\bigr)/\lvert N_B\rvert$, "
-            r"$N_B = P_u\times P_v$, for sphere A in the renderer's chart, "
-            rf"$P(u, v) = R\,N(\theta, \varphi)$ with $\theta = {sp.latex(THETA_OF_U)}$, "
-            rf"$\varphi = {sp.latex(PHI_OF_V)}$. Then $⟦inward⟧$ points inward, so the displacement "
-            r"$P \to (R + \beta h)N$ is $F = -\beta h$. Measured as slopes $t$ (the components along $e_\theta$, "
+            r"Set Blinn's $⟦N'_B⟧$, $⟦N_B⟧$, for sphere A in the renderer's chart, "
+            r"$⟦P⟧$ with $⟦theta⟧$, $⟦phi⟧$. Then $⟦inward⟧$ points inward, so the displacement "
+            r"$⟦displacement⟧$ is Blinn's $F$ with $⟦F_u⟧$ and $⟦F_v⟧$. Measured as slopes $t$ (the components "
+            r"along $e_\theta$, "
             r"$e_\varphi$ over the one along $N$), Blinn's normal has $⟦blinn⟧$, the displaced sphere's "
             r"$⟦displaced⟧$, and the renderer's bump modes surface and chart (the draft's) "
             r"$⟦renderer⟧$. Blinn's slopes equal the displaced sphere's to first order in $\beta$, not beyond "
             r"($R + \beta h$ in place of $R$: he drops the terms in $F$ itself); the draft's are Blinn's times "
-            r"$(-2\pi R\sin\varphi, -\pi R)$, $⟦factors⟧$: the opposite sign, and the chart's metric factors "
+            r"$⟦scale⟧$, $⟦factors⟧$: the opposite sign, and the chart's metric factors "
             r"missing."),
         steps=(
             Step(r"By the chain rule with $\theta = 2\pi u - \pi$ and $\varphi = \pi v$ of ⟪chart⟫, "
@@ -141,6 +140,11 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
         ),
         claims={"inward": (NB_S, inward), "blinn": (T["blinn"], blinn), "displaced": (T["displaced"], SURFACE),
                 "renderer": (renderer, scaled), "factors": (T["chart"], draft)},
+        shown={"P": sp.Eq(sp.Function("P")(F.u, F.v), R * sp.Function("N")(theta, phi), evaluate=False),
+               "theta": sp.Eq(theta, THETA_OF_U, evaluate=False), "phi": sp.Eq(phi, PHI_OF_V, evaluate=False),
+               "displacement": sp.Eq(sp.MatrixSymbol("P'", 3, 1), sp.MatMul(R + beta * h, N_S, evaluate=False),
+                                     evaluate=False),
+               "scale": sp.Tuple(*factors)},
         where={N_S: sp.ImmutableMatrix(N), ET_S: sp.ImmutableMatrix(e_theta), EP_S: sp.ImmutableMatrix(e_phi),
                PU_S: sp.ImmutableMatrix(P_UV.diff(F.u).subs(_TO_ANGLES, simultaneous=True)),
                PV_S: sp.ImmutableMatrix(P_UV.diff(F.v).subs(_TO_ANGLES, simultaneous=True)),

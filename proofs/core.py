@@ -66,7 +66,9 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
    finite measurements, by its criterion, whose thresholds are the ones its words state.
 10. *Placeholders.*  A statement shows mathematics only through ``⟦key⟧`` (`PLACEHOLDER`): a claim,
    a named symbol of ``where`` or an object of ``shown``, which the book prints
-   (book/chapter/latex.py); a key that is none of these refutes.
+   (book/chapter/latex.py); a key that is none of these refutes, and so does a relation typed in
+   its mathematics (`TYPED_RELATION`: =, <, >, ``\\le``, ``\\ne``, ``\\to``, ``\\in`` and the like), whose sides no
+   object holds: the typed math may name symbols and write operations, never assert.
 11. *Thresholds.*  An evidence's threshold (`Verdict.bound`) and a verified pin are at most `TIGHT` times
    the positive residual measured against them (`loose`), so neither can be loosened unseen.
 12. *Coverage* (proofs/registry.py).  A theorem whose statement is about every height field
@@ -90,7 +92,7 @@ import mpmath
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-__all__ = ["CITATION", "PLACEHOLDER", "placeholder_key", "citations", "plain", "spelled", "listed", "Verdict", "Identity", "Step", "calc", "chains", "Theorem", "variant", "check_identities", "written", "catalogue", "Dot",
+__all__ = ["CITATION", "PLACEHOLDER", "TYPED_RELATION", "placeholder_key", "citations", "plain", "spelled", "listed", "Verdict", "Identity", "Step", "calc", "chains", "Theorem", "variant", "check_identities", "written", "catalogue", "Dot",
            "Cross", "Jacobian", "DIGITS", "POINTS"]
 
 #: Working precision of numerical verification, in significant decimal digits.
@@ -121,6 +123,12 @@ CITATION = re.compile(r"⟪([^⟫]*)⟫")
 WORDS_CITATION = re.compile(r"\btheorems?\s+[`'\"“‘]?([\w-]+)", re.IGNORECASE)
 #: What a statement prints from the theorem's objects (the book fills it in): ``⟦key⟧``.
 PLACEHOLDER = re.compile(r"⟦([^⟧]+)⟧")
+#: A relation typed by hand in a statement's mathematics (rule 10 refuses it): =, <, >, the Unicode
+#: ones and LaTeX's (``\le``, ``\leqslant``, ``\ne``, ``\to``, ``\in``, ...).
+TYPED_RELATION = re.compile(r"[=<>≤≥≠→∈≈≡]|\\(?:[lg]eq?(?:slant)?|[lg]t|neq?|to|in|ni|approx|equiv|sim|simeq|propto|"
+                            r"mapsto|[rl]ightarrow|[LR]ightarrow|subset|subseteq)(?![a-zA-Z])")
+#: A statement's mathematics: ``$...$`` or ``$$...$$``.
+MATH = re.compile(r"\$\$(.+?)\$\$|\$(.+?)\$", re.DOTALL)
 
 
 class _Registered(Mapping):
@@ -703,9 +711,15 @@ def _unknown_placeholder(t):
     shown object), or None."""
     known = set(t.claims) | {placeholder_key(s) for s in t.where} | set(t.shown)
     unknown = [k for k in t.placeholders() if k not in known]
-    return (f"{t.id}: its statement shows ⟦{unknown[0]}⟧, which is neither a claim {sorted(t.claims)}, a named "
-            f"symbol {sorted(placeholder_key(s) for s in t.where)} nor a shown object {sorted(t.shown)}"
-            if unknown else None)
+    if unknown:
+        return (f"{t.id}: its statement shows ⟦{unknown[0]}⟧, which is neither a claim {sorted(t.claims)}, a named "
+                f"symbol {sorted(placeholder_key(s) for s in t.where)} nor a shown object {sorted(t.shown)}")
+    for m in MATH.finditer(t.statement):
+        typed = TYPED_RELATION.search(PLACEHOLDER.sub("", m.group(1) or m.group(2)))
+        if typed:
+            return (f"{t.id}: its statement types the relation {typed.group(0)!r} by hand in {m.group(0)!r}: show it "
+                    "through ⟦key⟧, from a claim, a named symbol of where or an object of shown")
+    return None
 
 
 def _prove(t: Theorem) -> Verdict:

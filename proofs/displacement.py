@@ -37,7 +37,7 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Cross, Step, Theorem, Verdict, calc, catalogue, listed, spelled, written
-from .frame import PHI_OF_V, SEED_POLE_SIN_PHI, THETA_OF_U, U_OF_THETA, V_OF_PHI, off_pole
+from .frame import CHART_RATES, PHI_OF_V, SEED_POLE_SIN_PHI, THETA_OF_U, U_OF_THETA, V_OF_PHI, off_pole
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, beta = sp.symbols("R beta", positive=True)
@@ -100,6 +100,8 @@ DOMAIN = {theta: (-3.0, 3.0), phi: (0.1, 3.0), R: (0.5, 2.0), beta: (0.0, 0.3), 
 #: -beta (G_theta / (R sin phi) e_theta + G_phi / R e_phi), with the seed's beta (h_u e_theta + h_v e_phi)
 #: = beta (2 pi H_theta e_theta + pi H_phi e_phi) (h_u = H_theta / (du/dtheta), theorem `chart`).
 G_T, G_P = sp.symbols("G_theta G_phi")
+#: The G of the fields where it exists (H depends on phi alone): -pi R H.
+POTENTIAL = -sp.pi * R * H_at
 SEED_DISPLACEMENT = (-2 * sp.pi * R * sp.sin(phi) * H_t, -sp.pi * R * H_p)
 #: The obstruction: G exists only where d/dphi G_theta - d/dtheta G_phi = -pi R OBSTRUCTION vanishes.
 OBSTRUCTION = written(sp.Add(2 * sp.cos(phi) * H_t, sp.Mul(sp.Add(2 * sp.sin(phi), -1, evaluate=False),
@@ -218,23 +220,23 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
     others = [name for name in F.FIELDS if name not in exact]
     fields = {name: f"the {listed(names)} field{'s' if len(names) > 1 else ''}" for name, names in
               (("exact", exact), ("others", others))}
-    potential = sp.Tuple(sp.Derivative(-sp.pi * R * H_at, theta), sp.Derivative(-sp.pi * R * H_at, phi))
+    potential = sp.Tuple(sp.Derivative(POTENTIAL, theta), sp.Derivative(POTENTIAL, phi))
     return Theorem(
         id="bump-vs-displacement", title=TITLES["bump-vs-displacement"],
         statement=r"Displace sphere A (radius $R$) along its normal $N(\theta, \varphi)$ by $\beta$ times the "
                   r"height $H(\theta, \varphi)$: the height field $h$ at the chart point of the angles $\theta$, "
-                  r"$\varphi$, with partial derivatives $H_\theta = \partial H/\partial\theta$ and "
-                  r"$H_\varphi = \partial H/\partial\varphi$. The displaced surface $⟦P⟧$ has"
+                  r"$\varphi$, with partial derivatives $H_\theta$ and $H_\varphi$ in $\theta$ and in $\varphi$. "
+                  r"The displaced surface $⟦P⟧$ has"
                   "$$⟦cross⟧$$"
-                  r"and its unit normal is the bracket normalised. In chart terms ($H_\theta = h_u/2\pi$, "
-                  r"$H_\varphi = h_v/\pi$) the bracket's tangential coefficients are the renderer's surface bump, "
+                  r"and its unit normal is the bracket normalised. In chart terms ($⟦H_theta⟧$, "
+                  r"$⟦H_phi⟧$) the bracket's tangential coefficients are the renderer's surface bump, "
                   r"the book's " '(`bump="surface"`)' r": $⟦kernel⟧$. The draft's bump $\beta(h_u, h_v)$ has the "
                   r"opposite sign and lacks the chart's metric factors. Nor is the draft's bump, to first order in "
                   r"$\beta$, the normal of another displaced sphere $(R + \beta G)N$, "
                   f"except on {spelled(len(exact))} field{'s' if len(exact) != 1 else ''}: it would "
                   r"need $G$ to have the partial derivatives $⟦G_theta⟧$ and $⟦G_phi⟧$. Partial derivatives of one "
                   r"function have zero curl (its mixed partials commute), and here $⟦curl⟧$. This vanishes "
-                  f"identically for {fields['exact']}, with " r"$G = -\pi R h$; it does not for "
+                  f"identically for {fields['exact']}, with " r"$⟦G⟧$; it does not for "
                   f"{fields['others']}, where the draft's bump is the normal of no displaced sphere.",
         steps=(
             *calc(cross,
@@ -264,6 +266,9 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                  cases=tuple((name, {H: sp.Lambda((theta, phi), _angular(F.FIELDS[name]))}) for name in exact)),
         ),
         claims={"cross": (cross, claim), "kernel": (coeffs, chart), "curl": (curl, -sp.pi * R * obstruction)},
+        shown={"H_theta": sp.Eq(H_t, F.h_u * CHART_RATES[0], evaluate=False),
+               "H_phi": sp.Eq(H_p, F.h_v * CHART_RATES[1], evaluate=False),
+               "G": sp.Eq(sp.Symbol("G"), POTENTIAL, evaluate=False)},
         where={N_S: sp.ImmutableMatrix(N), ET_S: sp.ImmutableMatrix(e_theta), EP_S: sp.ImmutableMatrix(e_phi),
                P_S: sp.MatMul(R + beta * H_at, N_S), B_U: kernel[0], B_V: kernel[1],
                G_T: SEED_DISPLACEMENT[0], G_P: SEED_DISPLACEMENT[1]},

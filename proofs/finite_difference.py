@@ -185,6 +185,13 @@ def _kernel_cases():
                  for name, field in F.FIELDS.items())
 
 
+#: The renderer's footprint rule (`formulas.FOOTPRINT_RULE`) at the differentials of u, named as the statement
+#: shows them (an inline fraction within a fraction is set at half size).
+DU_DX, DU_DY = sp.symbols("du/dx du/dy", real=True)
+with sp.evaluate(False):
+    FOOTPRINT_SHOWN = F.FOOTPRINT_RULE.expr.xreplace(dict(zip(F.FOOTPRINT_RULE.variables, (DU_DX, DU_DY))))
+
+
 def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
     """Theorem central-difference-truncation with the series of the terms ``claimed`` + O(eps^``order``)
     (written as they stand: a term the O-term contains is refused, not absorbed), the stencil's quotients
@@ -200,7 +207,7 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
                    r"clamped distance.  Here $\varepsilon_u$ and $\varepsilon_v$ are the steps in $u$ and in $v$: "
                    r"both the one fixed step $\varepsilon$ by default, or, if the renderer is asked for footprint "
                    r"steps, each pixel's own, half the change of $u$ (of $v$) from the pixel to its neighbours, "
-                   r"$\varepsilon_u = \tfrac12(\lvert\partial u/\partial x\rvert + \lvert\partial u/\partial y\rvert)$ "
+                   r"$⟦footprint⟧$ "
                    r"with $x$, $y$ in pixels (pbrt-v4's rule; likewise $\varepsilon_v$)."),
         steps=(
             Step(r"Taylor's theorem: $h$ is smooth, so $h(x + \varepsilon)$ is its Taylor polynomial of degree 5 "
@@ -214,7 +221,8 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
                  quotients, cases=_kernel_cases()),
         ),
         claims={"series": (QUOTIENT, series), "stencil": (kernel, quotients)},
-        names={CENTRAL_U: "D_u", CENTRAL_V: "D_v"},
+        shown={"footprint": sp.Eq(F.eps_u, FOOTPRINT_SHOWN, evaluate=False)},
+        names={CENTRAL_U: "D_u", CENTRAL_V: "D_v", DU_DX: r"\partial u/\partial x", DU_DY: r"\partial u/\partial y"},
         domain={**SERIES_DOMAIN, **KERNEL_DOMAIN}, functions=INSTANCE,
         evidence=partial(_stencil_evidence, **stencil),
         wrong_variants=(("coefficient 1/3 instead of 1/6",
@@ -265,8 +273,8 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
     stationary, minimum = sp.Subs(slope, eps, eps_star), sp.Subs(curvature, eps, eps_star)
     return Theorem(
         id="optimal-step", title=TITLES["optimal-step"],
-        statement=r"The error model $⟦E⟧$ ($u_{\mathrm{round}}$ the unit roundoff, $x$ the point) has one stationary point on "
-                  r"$\varepsilon > 0$, $⟦eps_star⟧$, and it is the minimum: $⟦stationary⟧$, $⟦minimum⟧ > 0$.",
+        statement=r"Where $⟦curved⟧$, the error model $⟦E⟧$ ($u_{\mathrm{round}}$ the unit roundoff, $x$ the point) has "
+                  r"one stationary point on $⟦steps⟧$, $⟦eps_star⟧$, and it is the minimum: $⟦stationary⟧$ and $⟦minimum⟧$.",
         steps=(
             *calc(slope,
                   ("Differentiate the model term by term",
@@ -284,6 +292,7 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
                  r"minimum", minimum, H3),
         ),
         claims={"stationary": (stationary, sp.Integer(0)), "minimum": (minimum, H3)},
+        shown={"steps": sp.Gt(eps, 0, evaluate=False), "curved": sp.Gt(H3, 0, evaluate=False)},
         where={E(eps): model, eps_star: star}, names=NAMES, domain=STEP_DOMAIN,
         wrong_variants=(("exponent 1/2 instead of 1/3",
                          lambda: _optimal(star=(3 * u_round * (H + HX) / H3) ** sp.Rational(1, 2)).check()),

@@ -22,7 +22,10 @@ N = sp.Matrix([sp.sin(phi) * sp.cos(theta), sp.sin(phi) * sp.sin(theta), sp.cos(
 #: The renderer's symbols at N(theta, phi).  sin_phi is the kernel's sqrt(N_x^2 + N_y^2)
 #: (`formulas.CHART`), which is sin(phi) for 0 < phi < pi (theorem `chart`).
 ON_SPHERE = {F.N_x: N[0], F.N_y: N[1], F.N_z: N[2], F.sin_phi: sp.sin(phi)}
-#: Sampling domain: away from the poles, where sin(phi) > 0, and off the seam theta = +-pi.
+#: The theorems' hypotheses, as their statements show them: off the seam theta = +-pi, away from the poles.
+THETA_OFF_SEAM = sp.Contains(theta, sp.Interval.open(-sp.pi, sp.pi), evaluate=False)
+PHI_OFF_POLES = sp.Contains(phi, sp.Interval.open(0, sp.pi), evaluate=False)
+#: Sampling domain: inside the hypotheses, where sin(phi) > 0.
 DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 3.13)}
 
 #: The vectors the proofs name: N, e_theta and e_phi, defined (``where``) as the renderer's.
@@ -100,8 +103,8 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
     rates = sp.Tuple(sp.Derivative(U_OF_THETA, theta), sp.Derivative(V_OF_PHI, phi))
     return Theorem(
         id="chart", title=TITLES["chart"],
-        statement=(r"For $-\pi < \theta < \pi$ and $0 < \varphi < \pi$ the renderer's chart "
-                   r"at $N = (N_x, N_y, N_z) = N(\theta, \varphi)$ is "
+        statement=(r"For $⟦theta⟧$ and $⟦phi⟧$ the renderer's chart "
+                   r"at the unit normal $N(\theta, \varphi)$, $⟦N_x⟧$, $⟦N_y⟧$, $⟦N_z⟧$, is "
                    r"$u$: $⟦u⟧$, $v$: $⟦v⟧$ and $⟦sin⟧$; so $⟦rates⟧$, the factors between chart and angular "
                    r"derivatives of $h$."),
         steps=(
@@ -122,6 +125,7 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
         ),
         claims={"u": (u_kernel, u_claim), "v": (v_kernel, V_OF_PHI), "sin": (sin_kernel, sp.sin(phi)),
                 "rates": (rates, sp.Tuple(*RATES_CLAIMED))},
+        shown={"theta": THETA_OFF_SEAM, "phi": PHI_OFF_POLES},
         where={F.N_x: N[0], F.N_y: N[1], F.N_z: N[2]}, domain=DOMAIN,
         evidence=partial(_chart_evidence, corrupt),
         wrong_variants=(("u without the offset pi: theta / 2 pi", lambda: _chart(u_claim=theta / (2 * sp.pi)).check()),
@@ -184,9 +188,9 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
     tangent, unit = sp.Tuple(Dot(ET_S, N_S), Dot(EP_S, N_S)), sp.Tuple(Dot(ET_S, ET_S), Dot(EP_S, EP_S), Dot(ET_S, EP_S))
     return Theorem(
         id="frame-orthonormal", title=TITLES["frame-orthonormal"],
-        statement=(r"For $0 < \varphi < \pi$ the renderer's tangent frame (its "
-                   r"branch away from the poles) $e_\theta = ⟦kernel_e_theta⟧$ and "
-                   r"$e_\varphi = ⟦kernel_e_phi⟧$, at $N(\theta, \varphi)$, satisfies "
+        statement=(r"For $⟦phi⟧$ the renderer's tangent frame (its "
+                   r"branch away from the poles) $⟦kernel_e_theta⟧$ and "
+                   r"$⟦kernel_e_phi⟧$, at $N(\theta, \varphi)$, satisfies "
                    r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
         steps=(
             *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ by ⟪chart⟫, "
@@ -203,7 +207,8 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
         ),
         claims={"e_theta": (ET_S, d_theta), "e_phi": (EP_S, d_phi), "tangent": (tangent, sp.Tuple(0, 0)),
                 "unit": (unit, sp.Tuple(1, 1, 0))},
-        shown={"kernel_e_theta": sp.Matrix(REGULAR[:3]).T, "kernel_e_phi": sp.Matrix(REGULAR[3:]).T},
+        shown={"phi": PHI_OFF_POLES, "kernel_e_theta": sp.Eq(ET_S, sp.Matrix(REGULAR[:3]).T, evaluate=False),
+               "kernel_e_phi": sp.Eq(EP_S, sp.Matrix(REGULAR[3:]).T, evaluate=False)},
         where=_where(et, ep), names=VECTOR_NAMES, domain=DOMAIN, evidence=partial(_frame_evidence, **evidence),
         wrong_variants=(("e_phi multiplied by sin(phi)", lambda: _orthonormal(ep=[c * F.sin_phi for c in REGULAR[3:]]).check()),
                         ("e_theta with a flipped sign", lambda: _orthonormal(et=[-c for c in REGULAR[:3]]).check()),
@@ -240,8 +245,8 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
     return Theorem(
         id="frame-orientation", title=TITLES["frame-orientation"],
         statement=r"$⟦orientation⟧$: the pair $(e_\theta, e_\varphi)$ is left-handed about the outward normal, "
-                  r"$e_\theta\times e_\varphi = -N$. The pole fallback "
-                  r"($\sin\varphi \le ⟦pole⟧$, float64's smallest normal number: the pole itself) has "
+                  r"$⟦cross⟧$. The pole fallback "
+                  r"($⟦pole⟧$, float64's smallest normal number: the pole itself) has "
                   r"$⟦fallback⟧$: right-handed at the north pole, where the outward normal is $+z$.",
         steps=(
             Step(r"Cross the frame of ⟪frame-orthonormal⟫: $(-\sin\theta, \cos\theta, 0) \times (\cos\varphi"
@@ -252,8 +257,9 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
             Step(r"At the poles the kernel takes the fixed pair $e_\theta = (1, 0, 0)$, $e_\varphi = (0, 1, 0)$, "
                  r"whose cross product is $+z$, the outward normal at the north pole", poles, CLAIMED_FALLBACK_CROSS),
         ),
-        claims={"orientation": (triple, sp.Integer(claimed)), "fallback": (poles, CLAIMED_FALLBACK_CROSS)},
-        shown={"pole": sp.Float(F.POLE_SIN_PHI, 2)},
+        claims={"orientation": (triple, sp.Integer(claimed)), "fallback": (poles, CLAIMED_FALLBACK_CROSS),
+                "cross": (Cross(ET_S, EP_S), -N_S)},
+        shown={"pole": sp.LessThan(F.sin_phi, sp.Float(F.POLE_SIN_PHI, 2))},
         where=_where(et, ep), names=VECTOR_NAMES, domain=DOMAIN,
         wrong_variants=(("the seed's reading: aligned with N (+1)", lambda: _orientation(1).check()),
                         ("the frame with e_theta and e_phi swapped",

@@ -194,13 +194,13 @@ def _theorem(field, closed_form=None, **evidence):
     gradient = sp.Tuple(F.h_u, F.h_v)
     return Theorem(
         id=PREFIX + name, title=_title(name),
-        statement=(r"For $h = ⟦h⟧$" + (", $⟦s_1⟧$, $⟦s_2⟧$" if names else "")
+        statement=(r"For $⟦h⟧$" + (", $⟦s_1⟧$, $⟦s_2⟧$" if names else "")
                    + f" (the renderer's {name} field): $⟦gradient⟧$."),
         steps=calc(gradient,
                    (f"The renderer's gradient of the {name} field (the formula compiled into its kernel) is "
                     "sympy's derivative of its $h$", sp.Tuple(sp.Derivative(h, u), sp.Derivative(h, v))),
                    *_argument(field, closed_form)),
-        claims={"gradient": (gradient, sp.Tuple(*closed_form))}, shown={"h": h},
+        claims={"gradient": (gradient, sp.Tuple(*closed_form))}, shown={"h": sp.Eq(sp.Symbol("h"), h, evaluate=False)},
         where={F.h_u: field.gradient[0], F.h_v: field.gradient[1], **names}, domain=DOMAIN,
         evidence=partial(_gradient_evidence, field, closed_form, **evidence),
         wrong_variants=(*((description, lambda wrong=wrong: _theorem(field, wrong).check())

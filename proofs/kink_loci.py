@@ -21,7 +21,7 @@ from renderer import formulas as F
 from renderer.scene import Scene
 
 from .core import Dot, Step, Theorem, Verdict, catalogue, written
-from .frame import U_OF_THETA
+from .frame import PHI_OF_V, U_OF_THETA, V_OF_PHI
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, e = sp.symbols("R e", positive=True)
@@ -33,6 +33,9 @@ RHO = e * R * sp.sin(phi) / (e - R * sp.cos(phi))
 DRHO = e * R * (e * sp.cos(phi) - R) / (e - R * sp.cos(phi)) ** 2
 DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 1.2), R: (0.5, 1.0), e: (2.0, 6.0)}
 m_sym = sp.Symbol("m", integer=True)
+#: The zero lines u = m / k_u and v = m / k_v, and the circle's polar angle phi_m (v = m / k_v by the chart).
+LINE_U, LINE_V = m_sym / F.k_u, m_sym / F.k_v
+PHI_M = PHI_OF_V.subs(F.v, LINE_V)
 
 
 @lru_cache(maxsize=None)
@@ -166,6 +169,7 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=None, all_visible=False, ba
 #: The quantities the proofs name: the image point (x, y), its radius rho(phi), the ray's angle alpha_m,
 #: the eye E and the normal N.
 X, Y = sp.symbols("x y", real=True)
+ALPHA = sp.Symbol("alpha", real=True)
 rho = sp.Function("rho")
 alpha_m = sp.Symbol("alpha_m")
 E_S, N_S, P_S = (sp.MatrixSymbol(name, 3, 1) for name in "ENP")
@@ -191,17 +195,18 @@ def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
     return Theorem(
         id="kink-loci-rays", title=TITLES["kink-loci-rays"],
         statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the $z$-axis, "
-                  r"$⟦polar⟧$ with $⟦rho⟧$: $\alpha = \theta$, so $u = (\alpha + \pi)/2\pi$ depends on the angle "
-                  r"alone, and the crease $u = m/k_u$ is the ray $⟦alpha_m⟧$: $⟦ray⟧$.",
+                  r"$⟦polar⟧$ with $⟦rho⟧$: $⟦alpha⟧$, so $⟦u⟧$ depends on the angle "
+                  r"alone, and the crease $⟦line_u⟧$ is the ray $⟦alpha_m⟧$: $⟦ray⟧$.",
         steps=(
             Step(r"Project $P = R\,N(\theta, \varphi)$ from the eye $(0, 0, e)$ onto the image plane $z = 0$: its "
                  r"$x$ and $y$ scale by $e/(e - P_z)$, and $P_z = R\cos\varphi$", sp.Tuple(X, Y), polar,
                  defines=(rho(phi),)),
             Step(r"So the image point's polar angle $\alpha$ is $\theta$, and $u = (\theta + \pi)/2\pi$, by ⟪chart⟫, "
-                 r"is a function of $\alpha$ alone; $u = m/k_u$ on the ray", ray, m_sym / F.k_u,
+                 r"is a function of $\alpha$ alone; $u = m/k_u$ on the ray", ray, LINE_U,
                  defines=(alpha_m,)),
         ),
-        claims={"polar": (sp.Tuple(X, Y), polar), "ray": (ray, m_sym / F.k_u)},
+        claims={"polar": (sp.Tuple(X, Y), polar), "ray": (ray, LINE_U)},
+        shown={"alpha": sp.Eq(ALPHA, theta), "u": sp.Eq(F.u, U_OF_THETA.subs(theta, ALPHA)), "line_u": sp.Eq(F.u, LINE_U)},
         where=_where(rho_, alpha), names=NAMES, domain={**DOMAIN, m_sym: (0.0, 8.0), F.k_u: (0.5, 12.0)},
         evidence=partial(_loci, "rays", **evidence),
         wrong_variants=(("projection with a flipped sign: e + R cos(phi) in the denominator",
@@ -220,9 +225,9 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
     cap = written(sp.Add(e * sp.cos(phi), radius_term, evaluate=False))
     return Theorem(
         id="kink-loci-circles", title=TITLES["kink-loci-circles"],
-        statement=r"$v = \varphi/\pi$ depends on the image radius alone: $⟦radius⟧$, and "
-                  r"$⟦slope⟧ > 0$ on the visible cap, where $⟦facing⟧ > 0$. The crease $v = m/k_v$ is the circle of "
-                  r"radius $\rho(\pi m/k_v)$, visible when $\cos(\pi m/k_v) > R/e$.",
+        statement=r"$⟦v⟧$ depends on the image radius alone: $⟦radius⟧$, and $⟦slope⟧$, so "
+                  r"$⟦rising⟧$ on the visible cap, where $⟦facing⟧$ is positive. The crease $⟦line_v⟧$ is the circle of "
+                  r"radius $⟦rho_m⟧$, visible when $⟦visible⟧$.",
         steps=(
             Step(r"By ⟪kink-loci-rays⟫, $x^2 + y^2 = \rho(\varphi)^2 (\cos^2\theta + \sin^2\theta)$", radius,
                  rho(phi)**2),
@@ -233,6 +238,8 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
                  r"$\varphi = \pi m/k_v$ has one radius", facing, cap),
         ),
         claims={"radius": (radius, rho(phi)**2), "slope": (slope, drho), "facing": (facing, cap)},
+        shown={"v": sp.Eq(F.v, V_OF_PHI), "rising": sp.Gt(slope, 0), "line_v": sp.Eq(F.v, LINE_V),
+               "rho_m": rho(PHI_M), "visible": sp.Gt(sp.cos(PHI_M), R / e)},
         where=_where(RHO_SHOWN), names=NAMES, domain=DOMAIN, evidence=partial(_loci, "circles", **evidence),
         wrong_variants=(("derivative with the factor e cos(phi) - R replaced by e - R cos(phi)",
                          lambda: _circles(e * R / (e - R * sp.cos(phi))).check()),

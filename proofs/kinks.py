@@ -14,6 +14,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
+from . import gradients as G
 from .core import Step, Theorem, calc, written
 
 u, v = F.u, F.v
@@ -25,6 +26,7 @@ delta = sp.Symbol("delta", positive=True)
 SUFFIX = "-kinks"
 #: Every zero line at once: u = m / k_u and v = m / k_v for a symbolic integer m.
 m = sp.Symbol("m", integer=True)
+LINE_U, LINE_V = m / k_u, m / k_v
 #: The other factor's value on the line, nonzero (where it is 0, h vanishes
 #: along the whole line and there is no crease).
 c = sp.Symbol("c", real=True, nonzero=True)
@@ -80,10 +82,11 @@ def _creases(field, jump_u, jump_v, band=None):
     ``band`` (default: the field's, `band_of`)."""
     name, band = field.name, band_of(field) if band is None else band
     h, factors = field.expr.subs(POSITIVE), tuple(f.subs(POSITIVE) for f in field.crease_factors)
-    on_u = one_sided(h.subs(factors[1], c), u, m / k_u)
-    on_v = one_sided(h.subs(factors[0], c), v, m / k_v)
+    on_u = one_sided(h.subs(factors[1], c), u, LINE_U)
+    on_v = one_sided(h.subs(factors[0], c), v, LINE_V)
+    names = {e.subs(POSITIVE): s for s, e in G.named_factors(field).items()}
     jumps, values = sp.Tuple(HU_P - HU_M, HV_P - HV_M), sp.Tuple(jump_u, jump_v)
-    on_lines = sp.Tuple(crease(m / k_u, v), crease(u, m / k_v))
+    on_lines = sp.Tuple(crease(LINE_U, v), crease(u, LINE_V))
     # Just inside and just outside the seed's half-width: |s| = w (1 -+ eta), where the other factor is 1.
     w_in, w_out = (sp.asin(W * (1 + s * ETA), evaluate=False) for s in (-1, 1))
     edges = {"u": sp.Tuple(crease(U_IN, 1 / (2 * k_v)), crease(U_OUT, 1 / (2 * k_v))),
@@ -91,17 +94,16 @@ def _creases(field, jump_u, jump_v, band=None):
     return Theorem(
         id=name + SUFFIX, title=_title(name),
         statement=f"The renderer's {name} field "
-                  r"$h = \lvert s_1 s_2\rvert$, the product of its two factors $s_1 = \sin\pi k_u u$ and "
-                  r"$s_2 = \sin\pi k_v v$, is differentiable wherever $s_1 s_2 \ne 0$, by ⟪gradient-" + name + "⟫. "
-                  r"On every zero line $u = m/k_u$ ($m$ any integer), where the other factor is $c \ne 0$, its graph "
+                  r"$⟦h⟧$, the product of its two factors $⟦s_1⟧$ and $⟦s_2⟧$, is differentiable wherever "
+                  r"$⟦smooth⟧$, by ⟪gradient-" + name + "⟫. "
+                  r"On every zero line $⟦line_u⟧$ ($m$ any integer), where the other factor is $⟦c⟧$, its graph "
                   r"has a crease: the one-sided derivatives $h_u^+$ and $h_u^-$ (the slopes just right and just "
-                  r"left of the line) differ, and so do $h_v^\pm$ on $v = m/k_v$: $⟦jumps⟧$."
+                  r"left of the line) differ, and so do $h_v^\pm$ on $⟦line_v⟧$: $⟦jumps⟧$."
                   "\n\n"
                   r"*Corollary (the renderer's crease band).* A central difference whose two points straddle a "
                   r"crease returns neither one-sided slope, so the renderer flags the pixels near a crease, and "
                   r"the book reports their error apart. Its crease flag is 1 on every zero line, $⟦lines⟧$, and "
-                  rf"exactly where $\lvert s_1\rvert < {float(SEED_HALF_WIDTH):g}$ or "
-                  rf"$\lvert s_2\rvert < {float(SEED_HALF_WIDTH):g}$: a band about "
+                  r"exactly where $⟦band⟧$: a band about "
                   rf"${float(SEED_HALF_WIDTH):g}/\pi k_u$ wide in $u$ on each side of a line (likewise in $v$), "
                   r"the half-width the draft chose.",
         steps=(
@@ -123,6 +125,10 @@ def _creases(field, jump_u, jump_v, band=None):
             Step(r"Likewise across $v$, where $s_1 = 1$", edges["v"], sp.Tuple(1, 0), defines=(V_IN, V_OUT)),
         ),
         claims={"jumps": (jumps, values), "lines": (on_lines, sp.Tuple(1, 1))},
+        shown={"h": sp.Eq(sp.Symbol("h"), h.xreplace(names), evaluate=False),
+               **{str(s): sp.Eq(s, e, evaluate=False) for e, s in names.items()},
+               "smooth": sp.Ne(sp.Mul(*names.values()), 0), "c": sp.Ne(c, 0, evaluate=False),
+               "line_u": sp.Eq(u, LINE_U), "line_v": sp.Eq(v, LINE_V), "band": band.xreplace(names)},
         where={HU_P: on_u[0], HU_M: on_u[1], HV_P: on_v[0], HV_M: on_v[1],
                crease: sp.Lambda((u, v), sp.Piecewise((1, band), (0, True))),
                U_IN: w_in / (sp.pi * k_u), U_OUT: w_out / (sp.pi * k_u), V_IN: w_in / (sp.pi * k_v),

@@ -22,7 +22,7 @@ import sympy as sp
 from renderer import formulas as F
 from renderer.scene import PointLight, Scene
 
-from .core import Jacobian, Step, Theorem, Verdict, catalogue
+from .core import Dot, Jacobian, Step, Theorem, Verdict, catalogue
 
 x, y, e, R, t, s = sp.symbols("x y e R t s", real=True)
 Cb = sp.Matrix(sp.symbols("C_x C_y C_z", real=True))
@@ -54,6 +54,8 @@ PREDICATES = {
     CAST: (SEGMENT - Cb).dot(SEGMENT - Cb) - r_b**2,
     FLOOR: P_A[2] * L[2],
 }
+#: The vectors the statement's attached predicate names: the normal, the light and the hit point.
+N_S, L_S, P_S = (sp.MatrixSymbol(x, 3, 1) for x in "NLP")
 NAMES = {T_FLOOR: r"t_{\mathrm{floor}}", ATTACHED: r"a", CAST: r"q", FLOOR: r"f"}
 
 
@@ -239,7 +241,7 @@ def _no_boundary(attached=None, **evidence):
     return Theorem(
         id="no-boundary", title=TITLES["no-boundary"],
         statement=r"The chamber of every pixel and every shadow predicate (attached: "
-                  r"$N\cdot(L - P) > 0$; cast: a root of the segment quadratic in $(0, 1)$; the floor "
+                  r"$⟦attached⟧$; cast: a root of the segment quadratic in $(0, 1)$; the floor "
                   r"plane between $P$ and $L$) are functions of the geometry alone, of none of the bump's parameters: "
                   r"its strength $\beta$, its frequencies $k_u$, $k_v$ and the central difference's steps "
                   r"$\varepsilon_u$, $\varepsilon_v$ in $u$ and in $v$ (both the one fixed step $\varepsilon$ by "
@@ -256,6 +258,7 @@ def _no_boundary(attached=None, **evidence):
                  r"$f = P_z L_z$: built from the same geometry", shadow, sp.ZeroMatrix(3, len(BUMP))),
         ),
         claims={"chamber": (chamber, sp.ZeroMatrix(3, len(BUMP))), "shadow": (shadow, sp.ZeroMatrix(3, len(BUMP)))},
+        shown={"attached": sp.Gt(Dot(N_S, L_S - P_S), 0)},
         where=where, names=NAMES, domain=DOMAIN, evidence=partial(_evidence, **evidence),
         wrong_variants=(("the seed's attached-shadow rule, with the bumped normal",
                          lambda: _no_boundary(_seed_attached_predicate()).check()),

@@ -16,7 +16,7 @@ from renderer import formulas as F
 from renderer.scene import BUMPS
 
 from . import frame
-from .core import Dot, Step, Theorem, Verdict, calc, catalogue, spelled
+from .core import Dot, Step, Theorem, Verdict, calc, catalogue, spelled, written
 
 Nv = sp.Matrix([F.N_x, F.N_y, F.N_z])
 et, ep = sp.Matrix(F.e_theta), sp.Matrix(F.e_phi)
@@ -143,6 +143,14 @@ def _rate_evidence(order=1.0, **sampling):
                    f"{spelled(len(F.FIELDS))} fields are equal bit for bit", rendered=renders, covers=covered)
 
 
+#: Taylor's theorem about beta = 0, as the statement shows it for either normal N'(beta) (its derivative there
+#: a name: `TAYLOR_NAMES`).
+_NP, _N, _SLOPE = sp.Function("N'"), sp.Symbol("N"), sp.Symbol("slope")
+TAYLOR = sp.Eq(_NP(F.beta), written(sp.Add(_N, sp.Mul(F.beta, _SLOPE, evaluate=False), sp.Order(F.beta**2), evaluate=False)),
+               evaluate=False)
+TAYLOR_NAMES = {_SLOPE: r"\left.\partial N'/\partial\beta\right|_{\beta=0}"}
+
+
 def _limit(tilt=None, **evidence):
     """Theorem beta-zero-regression claiming the tilts ``tilt`` ({mode: T}, default `TILT_SHOWN`), with the
     evidence's options (wrong variants)."""
@@ -154,10 +162,10 @@ def _limit(tilt=None, **evidence):
         statement=r"Both of the renderer's perturbed normals (bump modes "
                   r"chart and surface), on sphere A in the renderer's frame, orthonormal by ⟪frame-orthonormal⟫ "
                   r"and left-handed by ⟪frame-orientation⟫, satisfy $⟦limit⟧$ and "
-                  r"$N'(\beta) = N + \beta\,\partial N'/\partial\beta|_{\beta=0} + O(\beta^2)$ with $⟦chart⟧$ and "
-                  r"$⟦surface⟧$: at $\beta = 0$ neither normal depends on the height field, and each returns "
+                  r"$⟦taylor⟧$ with $⟦chart⟧$ and "
+                  r"$⟦surface⟧$: at $⟦zero⟧$ neither normal depends on the height field, and each returns "
                   r"to $N$ at rate $\beta$.  (This is about the normals; that the rendered images approach the "
-                  r"$\beta = 0$ image at that rate is measured, in the ledger's evidence, not proved.)",
+                  r"$⟦zero⟧$ image at that rate is measured, in the ledger's evidence, not proved.)",
         steps=(
             Step(r"Both normals are built from $N$, $e_\theta$, $e_\varphi$ by dot products, the same in every "
                  r"orthonormal frame, so take $e_\theta = x$, $e_\varphi = y$, $N = -z$; at $\beta = 0$ both bump "
@@ -172,8 +180,9 @@ def _limit(tilt=None, **evidence):
         ),
         claims={"limit": (at_zero, sp.Tuple(N_SPHERE, N_SPHERE)), "chart": (slope["chart"], tilt["chart"]),
                 "surface": (slope["surface"], tilt["surface"])},
+        shown={"zero": sp.Eq(F.beta, 0), "taylor": TAYLOR},
         where={**ON_FRAME, **frame.STANDARD_FRAME, F.sin_phi: sp.sin(frame.phi)},
-        names={**frame.VECTOR_NAMES, NP_MODE["chart"]: r"N'_{\mathrm{chart}}",
+        names={**frame.VECTOR_NAMES, **TAYLOR_NAMES, NP_MODE["chart"]: r"N'_{\mathrm{chart}}",
                NP_MODE["surface"]: r"N'_{\mathrm{surface}}"},
         domain=SPHERE_DOMAIN, evidence=partial(_rate_evidence, **evidence),
         wrong_variants=(("the chart tilt with h_u and h_v swapped",

@@ -56,6 +56,8 @@ def _sum(*terms):
     return sp.MatAdd(*terms, evaluate=False)
 
 
+#: The displaced surface p + beta h n, as the statement writes it.
+DISPLACED = _sum(P_S, sp.MatMul(beta * h, N_S, evaluate=False))
 #: p_u + beta h n_u and p_v + beta h n_v, as the statement writes them.
 A = _sum(PU_S, sp.MatMul(beta * h, NU_S, evaluate=False))
 B = _sum(PV_S, sp.MatMul(beta * h, NV_S, evaluate=False))
@@ -127,15 +129,15 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
     return Theorem(
         id="displaced-normal", title=TITLES["displaced-normal"],
         statement=r"Let $p(u, v)$ be a surface with unit normal $n$, displaced along it by $\beta$ times a "
-                  r"height $h(u, v)$: $p' = p + \beta h\, n$. Then exactly $$⟦cross⟧$$ and the first product "
-                  r"lies along $n$. Measure a normal by its slopes $t = (t_u, t_v)$: its components along "
-                  r"$e_u = p_u/\lvert p_u\rvert$ and $e_v = p_v/\lvert p_v\rvert$ over its component along $n$. "
+                  r"height $h(u, v)$: $⟦displaced⟧$. Then exactly $$⟦cross⟧$$ and the first product "
+                  r"lies along $n$. Measure a normal by its slopes $⟦t⟧$: its components along "
+                  r"$⟦e_u⟧$ and $⟦e_v⟧$ over its component along $n$. "
                   r"On an orthogonal chart, right- or left-handed, the displaced normal's slopes are, to first "
                   r"order in $\beta$, $⟦first_u⟧$ and $⟦first_v⟧$: the slope of $h$ divided by the chart's "
                   r"arc lengths, tilting away from rising $h$. Where the chart follows the principal directions, "
-                  r"$n_u = \kappa_u p_u$ and $n_v = \kappa_v p_v$ (a sphere, a torus, a plane), exactly "
-                  r"$$⟦principal⟧$$ On sphere A ($\kappa_u = \kappa_v = 1/R$, $\lvert p_u\rvert = 2\pi R\sin\varphi$, "
-                  r"$\lvert p_v\rvert = \pi R$) these are the renderer's surface bump: $$⟦sphere⟧$$",
+                  r"$⟦n_u⟧$ and $⟦n_v⟧$ (a sphere, a torus, a plane), exactly "
+                  r"$$⟦principal⟧$$ On sphere A ($⟦kappa_u⟧$, $⟦kappa_v⟧$, $⟦L_u⟧$, "
+                  r"$⟦L_v⟧$) these are the renderer's surface bump: $$⟦sphere⟧$$",
         steps=(
             Step(r"Differentiate $p' = p + \beta h\, n$ by the product rule", sp.Tuple(DU_S, DV_S), derivatives,
                  cases=(("any surface", ANY_SURFACE),)),
@@ -157,6 +159,13 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
         ),
         claims={"cross": (product, cross), "first_u": (T_U, first[0]), "first_v": (T_V, first[1]),
                 "principal": (slopes, principal), "sphere": (at_sphere, renderer)},
+        shown={"displaced": sp.Eq(sp.MatrixSymbol("p'", 3, 1), DISPLACED, evaluate=False),
+               "t": sp.Eq(sp.Symbol("t"), sp.Tuple(T_U, T_V), evaluate=False),
+               **{str(e): sp.Eq(e, sp.MatMul(1 / length, p, evaluate=False), evaluate=False)
+                  for e, p, length in ((EU_S, PU_S, L_U), (EV_S, PV_S, L_V))},
+               **{str(n): sp.Eq(n, sp.MatMul(k, p, evaluate=False), evaluate=False)
+                  for n, k, p in ((NU_S, K_U, PU_S), (NV_S, K_V, PV_S))},
+               **{str(k): sp.Eq(k, value, evaluate=False) for k, value in sphere.items()}},
         where={C_S: cross, T_U: Dot(C_S, EU_S) / Dot(C_S, N_S), T_V: Dot(C_S, EV_S) / Dot(C_S, N_S)},
         names=NAMES, domain=DOMAIN, functions=INSTANCES,
         wrong_variants=(

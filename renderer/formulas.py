@@ -41,7 +41,7 @@ __all__ = [
     "N_x", "N_y", "N_z", "sin_phi", "hypot", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
-    "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FUNCTIONS", "FIELD_FUNCTIONS",
+    "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FOOTPRINT_RULE", "FUNCTIONS", "FIELD_FUNCTIONS",
     "UNIVARIATE_FUNCTIONS",
 ]
 
@@ -336,6 +336,9 @@ FOOTPRINT_FALLBACK, FOOTPRINT_MAX = sp.Float(0.0005), sp.Float(0.25)
 #: sin phi = 0, or a ray grazing the tangent plane); here a footprint that is
 #: not below 1e8 (or is NaN) takes the fallback step.
 FOOTPRINT_LIMIT = sp.Float(1e8)
+#: pbrt-v4's rule for a step from a pixel's two chart differentials (du/dx, du/dy): half the sum of their sizes.
+_a, _b = sp.symbols("a b", real=True)
+FOOTPRINT_RULE = sp.Lambda((_a, _b), sp.Mul(sp.S.Half, sp.Abs(_a) + sp.Abs(_b), evaluate=False))
 
 
 def _ray_differential(sx, sy):
@@ -355,7 +358,7 @@ def _footprint():
     for axis, scale in ((e_theta, 2 * sp.pi * R * sin_phi), (e_phi, sp.pi * R)):
         d = [sum(a * c for a, c in zip(axis, _ray_differential(*s))) / scale
              for s in ((dx, 0), (0, dy))]
-        half = (sp.Abs(d[0]) + sp.Abs(d[1])) / 2
+        half = FOOTPRINT_RULE(*d)
         # Min left unevaluated: sympy would try to order its arguments (0.2 s at every import), and
         # the printed code is the same.
         steps.append(sp.Piecewise((sp.Min(half, FOOTPRINT_MAX, evaluate=False),

@@ -246,6 +246,24 @@ def test_named_symbols_are_printed_and_substituted_when_checked():
     assert shown.check().status == "proved" and statement(shown) == "$a^{3}$"
 
 
+@pytest.mark.parametrize("typed", [
+    "$a = b$", "$a=b$", "$⟦square⟧ > 0$", "$$a < b$$", "$a\\le b$", "$a \\leq b$", "$a \\geqslant b$",
+    "$a \\ne 0$", "$a\\neq0$", "$\\beta \\to 0$", "$x \\in (0, 1)$", "$a ≤ b$", "$a ≠ b$", "$a \\approx b$",
+    "$a \\lt b$", "$\\varphi \\rightarrow 0$", "$a\n= b$"])
+def test_a_relation_typed_in_a_statement_is_refused(typed):
+    """Rule 10: a statement asserts only through ⟦key⟧; a relation typed by hand, in any spelling, refutes."""
+    t = dataclasses.replace(square_theorem(*CHAIN), statement=f"Here $⟦square⟧$, and {typed}.")
+    verdict = t.check()
+    assert verdict.status == "refuted" and "types the relation" in verdict.evidence, verdict
+
+
+def test_typed_mathematics_that_asserts_nothing_passes():
+    """Names and operations are not relations: \\left, \\infty, \\int, \\top, \\lvert, \\pm, a < outside math."""
+    text = (r"For $⟦square⟧$, $\left(a + b\right)^2$, $\infty$, $\int f$, $x^\top$, $\lvert a\rvert$, "
+            r"$h_v^\pm$, $\inf$, $\tone$, and in words a < b = c.")
+    assert dataclasses.replace(square_theorem(*CHAIN), statement=text).check().status == "proved"
+
+
 def test_using_rewrites_with_an_earlier_step_and_only_an_earlier_named_one():
     e, f = sp.symbols("e f")
     lemma = Step("name the square", e, a_**2 + 2 * a_ * b_ + b_**2)

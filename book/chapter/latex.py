@@ -110,6 +110,20 @@ class _Printer(LatexPrinter):
             out.append(("- " if i == 0 else " - ") + shown if negative(t) else (" + " if i else "") + shown)
         return "".join(out)
 
+    def _print_Contains(self, expr):
+        """x in an interval with finite ends as the chain ``a < x < b`` (``\\le`` at a closed end)."""
+        x, where = expr.args
+        if not isinstance(where, sp.Interval) or not (where.start.is_finite and where.end.is_finite):
+            return super()._print_Contains(expr)
+        left, right = (r"\le" if closed else "<" for closed in (not where.left_open, not where.right_open))
+        return f"{self._print(where.start)} {left} {self._print(x)} {right} {self._print(where.end)}"
+
+    def _print_Or(self, expr):
+        return r"\ \text{or}\ ".join(self._print(a) for a in expr.args)
+
+    def _print_And(self, expr):
+        return r"\ \text{and}\ ".join(self._print(a) for a in expr.args)
+
     def _print_Identity(self, expr):
         return "I"
 
