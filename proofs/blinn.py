@@ -105,13 +105,13 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
     return Theorem(
         id="blinn-perturbation", title=TITLES["blinn-perturbation"],
         statement=(
-            r"Set Blinn's $⟦N'_B⟧$, $⟦N_B⟧$, for sphere A in the renderer's chart, "
+            r"Set Blinn's $$⟦N'_B⟧$$ with $⟦N_B⟧$, for sphere A in the renderer's chart, "
             r"$⟦P⟧$ with $⟦theta⟧$, $⟦phi⟧$. Then $⟦inward⟧$ points inward, so the displacement "
             r"$⟦displacement⟧$ is Blinn's $F$ with $⟦F_u⟧$ and $⟦F_v⟧$. Measured as slopes $t$ (the components "
             r"along $e_\theta$, "
-            r"$e_\varphi$ over the one along $N$), Blinn's normal has $⟦blinn⟧$, the displaced sphere's "
-            r"$⟦displaced⟧$, and the renderer's bump modes surface and chart (the draft's) "
-            r"$⟦renderer⟧$. Blinn's slopes equal the displaced sphere's to first order in $\beta$, not beyond "
+            r"$e_\varphi$ over the one along $N$), Blinn's normal has $$⟦blinn⟧$$ the displaced sphere's "
+            r"$$⟦displaced⟧$$ and the renderer's bump modes surface and chart (the draft's) "
+            r"$$⟦renderer⟧$$ Blinn's slopes equal the displaced sphere's to first order in $\beta$, not beyond "
             r"($R + \beta h$ in place of $R$: he drops the terms in $F$ itself); the draft's are Blinn's times "
             r"$⟦scale⟧$, $⟦factors⟧$: the opposite sign, and the chart's metric factors "
             r"missing."),

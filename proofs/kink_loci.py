@@ -225,7 +225,7 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
     cap = written(sp.Add(e * sp.cos(phi), radius_term, evaluate=False))
     return Theorem(
         id="kink-loci-circles", title=TITLES["kink-loci-circles"],
-        statement=r"$⟦v⟧$ depends on the image radius alone: $⟦radius⟧$, and $⟦slope⟧$, so "
+        statement=r"$⟦v⟧$ depends on the image radius alone: $⟦radius⟧$, and $$⟦slope⟧$$ so "
                   r"$⟦rising⟧$ on the visible cap, where $⟦facing⟧$ is positive. The crease $⟦line_v⟧$ is the circle of "
                   r"radius $⟦rho_m⟧$, visible when $⟦visible⟧$.",
         steps=(

@@ -21,23 +21,23 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "displaced-normal": "43ae7620a8f975e7",
-    "chart": "c6a1b9e16c1a8587",
-    "frame-orthonormal": "59d20494cb0bbe94",
+    "displaced-normal": "e77bd6d0933eddf5",
+    "chart": "89a71c9788f0def5",
+    "frame-orthonormal": "1d4c2d47fdf1d014",
     "frame-orientation": "dd3828e6dc0022c6",
     "gradient-sine": "446824a80459dae6",
     "gradient-ridges": "648c16419819b0d8",
     "gradient-rings": "b1acf10d08155001",
-    "ridges-kinks": "a50a1804d26cc3e0",
-    "kink-loci-rays": "91350f8058cb6706",
-    "kink-loci-circles": "4bad79e982474361",
+    "ridges-kinks": "e85caab753b3c15e",
+    "kink-loci-rays": "f3b495515ac86235",
+    "kink-loci-circles": "18d16a7d7f27d6f5",
     "no-boundary": "dd93398a150ef50a",
     "normal-beta-derivative": "981715b4a04fc96b",
     "beta-zero-regression": "526cde311129c8d0",
-    "central-difference-truncation": "3d06527d0bd718df",
-    "optimal-step": "6d84f8f938e62b43",
-    "bump-vs-displacement": "46b825fa52ed129a",
-    "blinn-perturbation": "c2c9bbae01eb0269",
+    "central-difference-truncation": "325fb9f5c39808e4",
+    "optimal-step": "ca82e478bc3eb386",
+    "bump-vs-displacement": "756daa99ad4187a8",
+    "blinn-perturbation": "62445efc1132568a",
 }
 
 

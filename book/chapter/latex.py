@@ -33,8 +33,9 @@ class _Printer(LatexPrinter):
     dot product, ``(a)^{1/3}`` for a cube root, ``h'''(x)`` and ``H_\\theta`` for
     derivatives of a function, ``\\frac{dE}{d\\varepsilon}`` for the derivative of a name."""
 
-    def __init__(self, names):
-        super().__init__({"fold_func_brackets": True, "mat_delim": "(", "fold_frac_powers": True})
+    def __init__(self, names, inline=False):
+        super().__init__({"fold_func_brackets": True, "mat_delim": "(", "fold_frac_powers": True,
+                          "fold_short_frac": inline})
         self.names = names
 
     # --- the proofs' own notation: dot and cross products, Jacobians
@@ -100,12 +101,14 @@ class _Printer(LatexPrinter):
         return super()._print_Mul(expr)
 
     def _print_MatAdd(self, expr):
-        """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), then by their vectors' names."""
+        """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), then by their vectors' names; a
+        `written` sum in the order written."""
         def negative(t):
             return isinstance(t, sp.MatMul) and t.as_coeff_matrices()[0].could_extract_minus_sign()
         out = []
-        for i, t in enumerate(sorted(expr.args, key=lambda t: (negative(t), self._print(sp.MatMul(
-                *t.as_coeff_matrices()[1])) if isinstance(t, sp.MatMul) else self._print(t)))):
+        terms = expr.args if self._settings["order"] == "none" else sorted(expr.args, key=lambda t: (
+            negative(t), self._print(sp.MatMul(*t.as_coeff_matrices()[1])) if isinstance(t, sp.MatMul) else self._print(t)))
+        for i, t in enumerate(terms):
             shown = self.parenthesize(-t if negative(t) else t, PRECEDENCE["Add"])
             out.append(("- " if i == 0 else " - ") + shown if negative(t) else (" + " if i else "") + shown)
         return "".join(out)
@@ -135,6 +138,8 @@ class _Printer(LatexPrinter):
         numer, denom = sp.fraction(coeff)
         mats = " ".join(self.parenthesize(m, PRECEDENCE["Mul"], strict=False) if not isinstance(m, sp.MatAdd)
                         else rf"\left({self._print(m)}\right)" for m in matrices)
+        if denom != 1 and abs(numer) == 1 and len(matrices) == 1:       # a fraction bar groups a sum already
+            mats = self._print(matrices[0])
         if numer == -1:
             top = f"- {mats}"
         elif numer == 1:
@@ -179,7 +184,7 @@ class _Printer(LatexPrinter):
         return rf"\frac{{{top}}}{{{below}}} \left({self._print(f)}\right)"         # d/du (expression)
 
 
-def tex(expr, names=None) -> str:
+def tex(expr, names=None, inline=False) -> str:
     """LaTeX of a sympy object as the book prints it (see `_Printer`); a str is LaTeX already.
 
     Parameters
@@ -188,6 +193,8 @@ def tex(expr, names=None) -> str:
     names : dict, optional
         {symbol, MatrixSymbol or function: LaTeX}, for the symbols whose name is not their
         notation (``H_3`` printed ``\\lvert h'''\\rvert``): a theorem's ``names``.
+    inline : bool
+        In running text: a short fraction written ``a / b`` (a stacked one is set at 70 %, small on a phone).
 
     Returns
     -------
@@ -195,16 +202,16 @@ def tex(expr, names=None) -> str:
     """
     if isinstance(expr, str):
         return expr
-    return _Printer(names or {}).doprint(sp.sympify(expr))
+    return _Printer(names or {}, inline).doprint(sp.sympify(expr))
 
 
-def definition(t, symbol) -> str:
+def definition(t, symbol, inline=False) -> str:
     """``name = definition`` of a named symbol of theorem ``t``'s ``where`` (``E(x) = ...`` for a
-    function), in LaTeX.  Raises KeyError for a symbol ``t.where`` does not define."""
+    function), in LaTeX (``inline`` as `tex`'s).  Raises KeyError for a symbol ``t.where`` does not define."""
     d = t.where[symbol]
     if isinstance(d, sp.Lambda):
-        return f"{tex(symbol(*d.variables), t.names)} = {tex(d.expr, t.names)}"
-    return f"{tex(symbol, t.names)} = {tex(d, t.names)}"
+        return f"{tex(symbol(*d.variables), t.names, inline)} = {tex(d.expr, t.names, inline)}"
+    return f"{tex(symbol, t.names, inline)} = {tex(d, t.names, inline)}"
 
 
 class _Relation:
@@ -227,22 +234,23 @@ def statement(t) -> str:
     named = {placeholder_key(s): s for s in t.where}
 
     def display(m):
-        """A claim set apart, ``$$⟦key⟧$$``: laid out as `chain` lays out a proof's display, each
-        fraction at full size (``\\dfrac``: one within another is otherwise set at 70 %)."""
-        if m.group(1) not in t.claims:
-            return m.group(0)
-        lhs, rhs = t.claims[m.group(1)]
-        shown = chain(t, [_Relation(lhs, rhs)]).replace(r"\frac{", r"\dfrac{")
-        return f"\n\n$$\n{shown}\n$$\n\n"
+        """A placeholder set apart, ``$$⟦key⟧$$``: a claim laid out as `chain` lays out a proof's display,
+        anything else as `fill` prints it; each fraction at full size (``\\dfrac``: one within another is
+        otherwise set at 70 %)."""
+        if m.group(1) in t.claims:
+            shown = chain(t, [_Relation(*t.claims[m.group(1)])])
+        else:
+            shown = PLACEHOLDER.sub(fill, m.group(1).join("⟦⟧"))
+        return "\n\n$$\n{}\n$$\n\n".format(shown.replace(r"\frac{", r"\dfrac{"))
 
     def fill(m):
         key = m.group(1)
         if key in t.claims:
-            return " = ".join(tex(x, t.names) for x in t.claims[key])
+            return " = ".join(tex(x, t.names, inline=True) for x in t.claims[key])
         if key in named:
-            return definition(t, named[key])
+            return definition(t, named[key], inline=True)
         if key in t.shown:
-            return tex(t.shown[key], t.names)
+            return tex(t.shown[key], t.names, inline=True)
         raise KeyError(f"theorem {t.id!r}: the statement names ⟦{key}⟧, neither a claim {sorted(t.claims)}, "
                        f"a named symbol {sorted(named)} nor a shown object {sorted(t.shown)}")
     return PLACEHOLDER.sub(fill, re.sub(rf"\$\$\s*{PLACEHOLDER.pattern}\s*\$\$", display, t.statement))
