@@ -382,6 +382,7 @@ def test_a_citation_prints_as_the_theorems_number_and_title_in_the_book_and_its_
     with pytest.raises(KeyError, match="no-such"):
         _cited("by ⟪no-such⟫")
     assert "⟪" not in plain("⟪chart⟫ and ⟪frame-orientation⟫")
+    assert plain("by ⟪no-such⟫ and ⟪chart⟫") == f"by ⟪no-such⟫ and theorem “{CITABLE['chart']}”"   # no title: left as written
     from chapter.page import plain_markdown       # a box outside the book (a notebook run by a reader)
     assert plain_markdown(_cited("by ⟪chart⟫, so")) == f"by Theorem ({CITABLE['chart']}), so"
 

@@ -779,3 +779,8 @@ def test_a_residual_at_the_tolerance_is_not_below_it():
         m.setattr(core, "_numeric_residual", lambda ident, seed, points, digits: (
             10.0 ** -core.TOLERANCE_DIGITS if points > 3 else 0.0, {x: 1}))
         assert check_identities([Identity("full", x, x, {x: (1, 2)})]).status == "refuted"
+
+
+def test_a_count_is_spelled_in_words_below_ten_in_digits_from_ten():
+    from proofs.core import spelled
+    assert [spelled(n) for n in (0, 1, 3, 9, 10, 12)] == ["no", "one", "three", "nine", "10", "12"]
