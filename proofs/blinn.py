@@ -34,7 +34,7 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Cross, Dot, Step, Theorem, catalogue
-from .frame import (CHART_RATES, EP_S, ET_S, N, N_S, ON_SPHERE, PHI_OF_V, STANDARD_FRAME, THETA_OF_U, U_OF_THETA,
+from .frame import (CHART_RATES, EP_S, ET_S, N, N_S, ON_SPHERE, PHI_OF_V, PHI_OFF_POLES, STANDARD_FRAME, THETA_OF_U, U_OF_THETA,
                     V_OF_PHI, VECTOR_NAMES, e_phi, e_theta, off_pole, phi, theta)
 
 _TO_ANGLES = {F.u: U_OF_THETA, F.v: V_OF_PHI}
@@ -105,18 +105,17 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
     return Theorem(
         id="blinn-perturbation", title=TITLES["blinn-perturbation"],
         statement=(
-            r"Set Blinn's $$⟦N'_B⟧$$ with $⟦N_B⟧$, for sphere A in the renderer's chart, "
-            r"$⟦P⟧$ with $⟦theta⟧$, $⟦phi⟧$. Then $⟦inward⟧$ points inward, so the displacement "
-            r"$⟦displacement⟧$ is Blinn's $F$ with $⟦F_u⟧$ and $⟦F_v⟧$. Measured as slopes $t$ (the components "
-            r"along $e_\theta$, "
-            r"$e_\varphi$ over the one along $N$), Blinn's normal has $$⟦blinn⟧$$ the displaced sphere's "
+            r"Set Blinn's $$⟦N'_B⟧$$ with $⟦N_B⟧$, for sphere A in the renderer's chart, away from the poles ($⟦phi_range⟧$), "
+            r"$⟦P⟧$ with $⟦theta⟧$, $⟦phi⟧$. Then $⟦inward⟧$ points inward, so the outward displacement "
+            r"$⟦displacement⟧$ is, in Blinn's terms (along $N_B$), $⟦F_u⟧$ and $⟦F_v⟧$. As slopes $t$ (components along "
+            r"$e_\theta$, $e_\varphi$ over the one along $N$), Blinn's normal has $$⟦blinn⟧$$ the displaced sphere's "
             r"$$⟦displaced⟧$$ and the renderer's bump modes surface and chart (the draft's) "
             r"$$⟦renderer⟧$$ Blinn's slopes equal the displaced sphere's to first order in $\beta$, not beyond "
             r"($R + \beta h$ in place of $R$: he drops the terms in $F$ itself); the draft's are Blinn's times "
             r"$⟦scale⟧$, $⟦factors⟧$: the opposite sign, and the chart's metric factors "
             r"missing."),
         steps=(
-            Step(r"By the chain rule with $\theta = 2\pi u - \pi$ and $\varphi = \pi v$ of ⟪chart⟫, "
+            Step(r"By the chain rule with $\theta = \pi(2u - 1)$ and $\varphi = \pi v$ of ⟪chart⟫, "
                  r"$P_u = 2\pi\,\partial P/\partial\theta$ and $P_v = \pi\,\partial P/\partial\varphi$, with "
                  r"$\partial N/\partial\theta = \sin\varphi\, e_\theta$, $\partial N/\partial\varphi = e_\varphi$ "
                  r"by ⟪frame-orthonormal⟫", frame, sp.Tuple(2 * sp.pi * R * s * ET_S, sp.pi * R * EP_S)),
@@ -142,6 +141,7 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
                 "renderer": (renderer, scaled), "factors": (T["chart"], draft)},
         shown={"P": sp.Eq(sp.Function("P")(F.u, F.v), R * sp.Function("N")(theta, phi), evaluate=False),
                "theta": sp.Eq(theta, THETA_OF_U, evaluate=False), "phi": sp.Eq(phi, PHI_OF_V, evaluate=False),
+               "phi_range": PHI_OFF_POLES,
                "displacement": sp.Eq(sp.MatrixSymbol("P'", 3, 1), sp.MatMul(R + beta * h, N_S, evaluate=False),
                                      evaluate=False),
                "scale": sp.Tuple(*factors)},

@@ -37,7 +37,7 @@ import sympy as sp
 from renderer import formulas as F
 
 from .core import Cross, Step, Theorem, Verdict, calc, catalogue, listed, spelled, written
-from .frame import CHART_RATES, PHI_OF_V, SEED_POLE_SIN_PHI, THETA_OF_U, U_OF_THETA, V_OF_PHI, off_pole
+from .frame import CHART_RATES, PHI_OF_V, PHI_OFF_POLES, SEED_POLE_SIN_PHI, THETA_OF_U, U_OF_THETA, V_OF_PHI, off_pole
 
 theta, phi = sp.symbols("theta phi", real=True)
 R, beta = sp.symbols("R beta", positive=True)
@@ -223,14 +223,14 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
     potential = sp.Tuple(sp.Derivative(POTENTIAL, theta), sp.Derivative(POTENTIAL, phi))
     return Theorem(
         id="bump-vs-displacement", title=TITLES["bump-vs-displacement"],
-        statement=r"Displace sphere A (radius $R$) along its normal $N(\theta, \varphi)$ by $\beta$ times the "
-                  r"height $H(\theta, \varphi)$: the height field $h$ at the chart point of the angles $\theta$, "
-                  r"$\varphi$, with partial derivatives $H_\theta$ and $H_\varphi$ in $\theta$ and in $\varphi$. "
+        statement=r"Away from the poles, $⟦phi⟧$, displace sphere A (radius $R$) along its normal $N(\theta, \varphi)$ by $\beta$ times the "
+                  r"height $H(\theta, \varphi)$ ($h$ at the chart point of $\theta$, $\varphi$), with partial "
+                  r"derivatives $H_\theta$, $H_\varphi$. "
                   r"The displaced surface $⟦P⟧$ has"
                   "$$⟦cross⟧$$"
                   r"and its unit normal is the bracket normalised. In chart terms ($⟦H_theta⟧$, "
                   r"$⟦H_phi⟧$) the bracket's tangential coefficients are the renderer's surface bump, "
-                  r"the book's " '(`bump="surface"`)' r": $⟦kernel⟧$. The draft's bump $\beta(h_u, h_v)$ has the "
+                  r"the book's " '(`bump="surface"`)' r": $$⟦kernel⟧$$ The draft's bump $\beta(h_u, h_v)$ has the "
                   r"opposite sign and lacks the chart's metric factors. Nor is the draft's bump, to first order in "
                   r"$\beta$, the normal of another displaced sphere $(R + \beta G)N$, "
                   f"except on {spelled(len(exact))} field{'s' if len(exact) != 1 else ''}: it would "
@@ -261,14 +261,14 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                  r"gradient is zero. Here the curl is", curl, -sp.pi * R * obstruction),
             Step(f"For {fields['others']} " r"$H_\theta$ is not zero, nor is the curl (the evidence evaluates "
                  f"it where it is not), so no $G$ exists. For {fields['exact']} " r"$h$ depends on $\varphi$ "
-                 r"alone, so $H_\theta = 0$, the curl vanishes, and $G = -\pi R h$ has the partial derivatives of "
+                 r"alone, so $H_\theta = 0$, the curl vanishes, and $G = -\pi R H$ has the partial derivatives of "
                  "step 4", sp.Tuple(G_T, G_P), potential,
                  cases=tuple((name, {H: sp.Lambda((theta, phi), _angular(F.FIELDS[name]))}) for name in exact)),
         ),
         claims={"cross": (cross, claim), "kernel": (coeffs, chart), "curl": (curl, -sp.pi * R * obstruction)},
         shown={"H_theta": sp.Eq(H_t, F.h_u * CHART_RATES[0], evaluate=False),
                "H_phi": sp.Eq(H_p, F.h_v * CHART_RATES[1], evaluate=False),
-               "G": sp.Eq(sp.Symbol("G"), POTENTIAL, evaluate=False)},
+               "G": sp.Eq(sp.Symbol("G"), POTENTIAL, evaluate=False), "phi": PHI_OFF_POLES},
         where={N_S: sp.ImmutableMatrix(N), ET_S: sp.ImmutableMatrix(e_theta), EP_S: sp.ImmutableMatrix(e_phi),
                P_S: sp.MatMul(R + beta * H_at, N_S), B_U: kernel[0], B_V: kernel[1],
                G_T: SEED_DISPLACEMENT[0], G_P: SEED_DISPLACEMENT[1]},

@@ -204,11 +204,9 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
         statement=(r"For a smooth $h$, $$⟦series⟧$$ Away from the seam and the poles this quotient is the renderer's "
                    r"central-difference stencil $D_u$, $D_v$, in $u$ and in $v$, for every height field: $$⟦stencil⟧$$ At "
                    r"the borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
-                   r"clamped distance.  Here $\varepsilon_u$ and $\varepsilon_v$ are the steps in $u$ and in $v$: "
-                   r"both the one fixed step $\varepsilon$ by default, or, if the renderer is asked for footprint "
-                   r"steps, each pixel's own, half the change of $u$ (of $v$) from the pixel to its neighbours, "
-                   r"$⟦footprint⟧$ "
-                   r"with $x$, $y$ in pixels (pbrt-v4's rule; likewise $\varepsilon_v$)."),
+                   r"clamped distance.  Here $\varepsilon_u$, $\varepsilon_v$ are the steps in $u$ and $v$: one fixed "
+                   r"step $\varepsilon$ by default, or each pixel's footprint, the mean size of $u$'s change to the "
+                   r"next pixel in $x$ and in $y$, $⟦footprint⟧$ (pbrt-v4's rule; likewise $\varepsilon_v$)."),
         steps=(
             Step(r"Taylor's theorem: $h$ is smooth, so $h(x + \varepsilon)$ is its Taylor polynomial of degree 5 "
                  r"about $x$, up to a remainder of order $\varepsilon^6$", written(f(sp.Add(x, eps, evaluate=False))),

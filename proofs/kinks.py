@@ -104,7 +104,7 @@ def _creases(field, jump_u, jump_v, band=None):
                   r"crease returns neither one-sided slope, so the renderer flags the pixels near a crease, and "
                   r"the book reports their error apart. Its crease flag is 1 on every zero line, $⟦lines⟧$, and "
                   r"exactly where $⟦band⟧$: a band about "
-                  rf"${float(SEED_HALF_WIDTH):g}/\pi k_u$ wide in $u$ on each side of a line (likewise in $v$), "
+                  rf"${float(SEED_HALF_WIDTH):g}/(\pi k_u)$ wide in $u$ on each side of a line (likewise in $v$), "
                   r"the half-width the draft chose.",
         steps=(
             *calc(sp.Tuple(HU_P, HU_M),

@@ -240,12 +240,11 @@ def _no_boundary(attached=None, **evidence):
     where = {**PREDICATES, **({ATTACHED: attached} if attached is not None else {})}
     return Theorem(
         id="no-boundary", title=TITLES["no-boundary"],
-        statement=r"The chamber of every pixel and every shadow predicate (attached: "
-                  r"$⟦attached⟧$; cast: a root of the segment quadratic in $(0, 1)$; the floor "
-                  r"plane between $P$ and $L$) are functions of the geometry alone, of none of the bump's parameters: "
+        statement=r"The chamber of every pixel (the nearest of the hits $t_A$, $t_B$, $t_{\mathrm{floor}}$) and "
+                  r"every shadow predicate (attached, $a$: $⟦attached⟧$; cast, $q$: a root of the segment quadratic "
+                  r"in $(0, 1)$; floor, $f$: the floor plane between $P$ and $L$) are functions of the geometry alone, of none of the bump's parameters: "
                   r"its strength $\beta$, its frequencies $k_u$, $k_v$ and the central difference's steps "
-                  r"$\varepsilon_u$, $\varepsilon_v$ in $u$ and in $v$ (both the one fixed step $\varepsilon$ by "
-                  r"default, or each pixel's footprint steps): $⟦chamber⟧$ and $⟦shadow⟧$. "
+                  r"$\varepsilon_u$, $\varepsilon_v$ (fixed or footprint): $$⟦chamber⟧$$ and $$⟦shadow⟧$$ "
                   r"Hence no pixel changes chamber, and no shadow boundary moves, when the bump's parameters "
                   r"change: the renderer's per-pixel hits and shadow tests come out bit for bit the same.",
         steps=(

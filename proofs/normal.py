@@ -160,7 +160,7 @@ def _limit(tilt=None, **evidence):
     return Theorem(
         id="beta-zero-regression", title=TITLES["beta-zero-regression"],
         statement=r"Both of the renderer's perturbed normals (bump modes "
-                  r"chart and surface), on sphere A in the renderer's frame, orthonormal by ⟪frame-orthonormal⟫ "
+                  r"chart and surface), on sphere A for $⟦phi⟧$ in the renderer's frame, orthonormal by ⟪frame-orthonormal⟫ "
                   r"and left-handed by ⟪frame-orientation⟫, satisfy $⟦limit⟧$ and "
                   r"$⟦taylor⟧$ with $⟦chart⟧$ and "
                   r"$⟦surface⟧$: at $⟦zero⟧$ neither normal depends on the height field, and each returns "
@@ -180,7 +180,7 @@ def _limit(tilt=None, **evidence):
         ),
         claims={"limit": (at_zero, sp.Tuple(N_SPHERE, N_SPHERE)), "chart": (slope["chart"], tilt["chart"]),
                 "surface": (slope["surface"], tilt["surface"])},
-        shown={"zero": sp.Eq(F.beta, 0), "taylor": TAYLOR},
+        shown={"zero": sp.Eq(F.beta, 0), "taylor": TAYLOR, "phi": frame.PHI_OFF_POLES},
         where={**ON_FRAME, **frame.STANDARD_FRAME, F.sin_phi: sp.sin(frame.phi)},
         names={**frame.VECTOR_NAMES, **TAYLOR_NAMES, NP_MODE["chart"]: r"N'_{\mathrm{chart}}",
                NP_MODE["surface"]: r"N'_{\mathrm{surface}}"},

@@ -34,6 +34,7 @@ from renderer import formulas as F
 
 from .core import Cross, Dot, Step, Theorem, catalogue, written
 from .displacement import KERNEL_COEFFS
+from .frame import PHI_OFF_POLES
 
 u, v, beta, h, h_u, h_v = F.u, F.v, F.beta, F.h, F.h_u, F.h_v
 
@@ -136,7 +137,7 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
                   r"order in $\beta$, $⟦first_u⟧$ and $⟦first_v⟧$: the slope of $h$ divided by the chart's "
                   r"arc lengths, tilting away from rising $h$. Where the chart follows the principal directions, "
                   r"$⟦n_u⟧$ and $⟦n_v⟧$ (a sphere, a torus, a plane), exactly "
-                  r"$$⟦principal⟧$$ On sphere A ($⟦kappa_u⟧$, $⟦kappa_v⟧$, $⟦L_u⟧$, "
+                  r"$$⟦principal⟧$$ On sphere A, for $⟦phi⟧$ ($⟦kappa_u⟧$, $⟦kappa_v⟧$, $⟦L_u⟧$, "
                   r"$⟦L_v⟧$) these are the renderer's surface bump: $$⟦sphere⟧$$",
         steps=(
             Step(r"Differentiate $p' = p + \beta h\, n$ by the product rule", sp.Tuple(DU_S, DV_S), derivatives,
@@ -165,7 +166,7 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
                   for e, p, length in ((EU_S, PU_S, L_U), (EV_S, PV_S, L_V))},
                **{str(n): sp.Eq(n, sp.MatMul(k, p, evaluate=False), evaluate=False)
                   for n, k, p in ((NU_S, K_U, PU_S), (NV_S, K_V, PV_S))},
-               **{str(k): sp.Eq(k, value, evaluate=False) for k, value in sphere.items()}},
+               **{str(k): sp.Eq(k, value, evaluate=False) for k, value in sphere.items()}, "phi": PHI_OFF_POLES},
         where={C_S: cross, T_U: Dot(C_S, EU_S) / Dot(C_S, N_S), T_V: Dot(C_S, EV_S) / Dot(C_S, N_S)},
         names=NAMES, domain=DOMAIN, functions=INSTANCES,
         wrong_variants=(

@@ -21,23 +21,23 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "displaced-normal": "e77bd6d0933eddf5",
-    "chart": "89a71c9788f0def5",
-    "frame-orthonormal": "1d4c2d47fdf1d014",
+    "displaced-normal": "b6151ad238afc77b",
+    "chart": "a8c819435a24b376",
+    "frame-orthonormal": "141c6af31a23ddcf",
     "frame-orientation": "dd3828e6dc0022c6",
     "gradient-sine": "446824a80459dae6",
     "gradient-ridges": "648c16419819b0d8",
     "gradient-rings": "b1acf10d08155001",
-    "ridges-kinks": "e85caab753b3c15e",
-    "kink-loci-rays": "f3b495515ac86235",
+    "ridges-kinks": "f04df1931f933884",
+    "kink-loci-rays": "625f2a4e3de291f9",
     "kink-loci-circles": "18d16a7d7f27d6f5",
-    "no-boundary": "dd93398a150ef50a",
+    "no-boundary": "99ef972915e7dec4",
     "normal-beta-derivative": "981715b4a04fc96b",
-    "beta-zero-regression": "526cde311129c8d0",
-    "central-difference-truncation": "325fb9f5c39808e4",
+    "beta-zero-regression": "3bf643c3991f84b8",
+    "central-difference-truncation": "14efabe2eebdca85",
     "optimal-step": "ca82e478bc3eb386",
-    "bump-vs-displacement": "756daa99ad4187a8",
-    "blinn-perturbation": "62445efc1132568a",
+    "bump-vs-displacement": "297fcf6f15272694",
+    "blinn-perturbation": "41778b11d7d85bc7",
 }
 
 

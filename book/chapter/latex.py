@@ -34,9 +34,8 @@ class _Printer(LatexPrinter):
     derivatives of a function, ``\\frac{dE}{d\\varepsilon}`` for the derivative of a name."""
 
     def __init__(self, names, inline=False):
-        super().__init__({"fold_func_brackets": True, "mat_delim": "(", "fold_frac_powers": True,
-                          "fold_short_frac": inline})
-        self.names = names
+        super().__init__({"fold_func_brackets": True, "mat_delim": "(", "fold_frac_powers": True})
+        self.names, self.inline = names, inline
 
     # --- the proofs' own notation: dot and cross products, Jacobians
     def _print_Dot(self, expr):
@@ -92,13 +91,20 @@ class _Printer(LatexPrinter):
             self._settings["order"] = order
 
     def _print_Mul(self, expr):
-        """A coefficient times the derivative of a name: ``\\frac{1}{\\sin\\varphi} \\frac{\\partial N}{\\partial\\theta}``."""
+        """A coefficient times the derivative of a name: ``\\frac{1}{\\sin\\varphi} \\frac{\\partial N}{\\partial\\theta}``.
+        In running text (``inline``) a fraction over one symbol or number is written ``a / b`` (``m / k_u``), any
+        other stacked: ``a / 2 \\pi`` could be read as ``(a / 2) \\pi``."""
         named = [a for a in expr.args if isinstance(a, sp.Derivative) and isinstance(a.expr, (sp.Symbol, sp.MatrixSymbol))]
         if len(named) == 1 and len(expr.args) > 1:
             rest = sp.Mul(*[a for a in expr.args if a is not named[0]])
             coefficient = "-" if rest == -1 else self.parenthesize(rest, PRECEDENCE["Mul"])
             return f"{coefficient} {self._print(named[0])}"
-        return super()._print_Mul(expr)
+        fold = self._settings["fold_short_frac"]
+        self._settings["fold_short_frac"] = self.inline and sp.fraction(expr)[1].is_Atom
+        try:
+            return super()._print_Mul(expr)
+        finally:
+            self._settings["fold_short_frac"] = fold
 
     def _print_MatAdd(self, expr):
         """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), then by their vectors' names; a
@@ -194,7 +200,8 @@ def tex(expr, names=None, inline=False) -> str:
         {symbol, MatrixSymbol or function: LaTeX}, for the symbols whose name is not their
         notation (``H_3`` printed ``\\lvert h'''\\rvert``): a theorem's ``names``.
     inline : bool
-        In running text: a short fraction written ``a / b`` (a stacked one is set at 70 %, small on a phone).
+        In running text: a fraction over one symbol or number written ``a / b`` (a stacked one is set at 70 %,
+        small on a phone).
 
     Returns
     -------
