@@ -32,7 +32,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import Cross, Dot, Step, Theorem, catalogue, written
+from .core import Cross, Dot, Step, Theorem, catalogue
 from .displacement import KERNEL_COEFFS
 from .frame import PHI_OFF_POLES
 
@@ -160,7 +160,7 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
         ),
         claims={"cross": (product, cross), "first_u": (T_U, first[0]), "first_v": (T_V, first[1]),
                 "principal": (slopes, principal), "sphere": (at_sphere, renderer)},
-        shown={"displaced": sp.Eq(sp.MatrixSymbol("p'", 3, 1), written(DISPLACED), evaluate=False),
+        shown={"displaced": sp.Eq(sp.MatrixSymbol("p'", 3, 1), DISPLACED, evaluate=False),
                "t": sp.Eq(sp.Symbol("t"), sp.Tuple(T_U, T_V), evaluate=False),
                **{str(e): sp.Eq(e, sp.MatMul(1 / length, p, evaluate=False), evaluate=False)
                   for e, p, length in ((EU_S, PU_S, L_U), (EV_S, PV_S, L_V))},

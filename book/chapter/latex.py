@@ -107,13 +107,13 @@ class _Printer(LatexPrinter):
             self._settings["fold_short_frac"] = fold
 
     def _print_MatAdd(self, expr):
-        """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), then by their vectors' names; a
-        `written` sum in the order written."""
+        """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), a vector before a scaled one
+        (p_u + beta h n_u), then by their vectors' names."""
         def negative(t):
             return isinstance(t, sp.MatMul) and t.as_coeff_matrices()[0].could_extract_minus_sign()
         out = []
-        terms = expr.args if self._settings["order"] == "none" else sorted(expr.args, key=lambda t: (
-            negative(t), self._print(sp.MatMul(*t.as_coeff_matrices()[1])) if isinstance(t, sp.MatMul) else self._print(t)))
+        terms = sorted(expr.args, key=lambda t: (negative(t), isinstance(t, sp.MatMul), self._print(
+            sp.MatMul(*t.as_coeff_matrices()[1])) if isinstance(t, sp.MatMul) else self._print(t)))
         for i, t in enumerate(terms):
             shown = self.parenthesize(-t if negative(t) else t, PRECEDENCE["Add"])
             out.append(("- " if i == 0 else " - ") + shown if negative(t) else (" + " if i else "") + shown)
