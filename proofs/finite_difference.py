@@ -260,7 +260,7 @@ ERROR_MODEL = written(sp.Add(sp.Mul(sp.Rational(1, 6), eps**2, H3, evaluate=Fals
                              sp.Mul(u_round, ROUNDOFF, 1 / eps, evaluate=False), evaluate=False))
 #: The optimal step, as written: (3 u (|h| + |x h'|) / |h'''|)^(1/3).
 EPS_STAR = written(sp.Pow(sp.Mul(3, u_round, ROUNDOFF, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
-NAMES = {H: r"\lvert h\rvert", HX: r"\lvert x h'\rvert", H3: r"\lvert h'''\rvert", u_round: r"u_{\mathrm{round}}",
+NAMES = {H: r"\lvert h\rvert", HX: r"\lvert u\,h'\rvert", H3: r"\lvert h'''\rvert", u_round: r"u_{\mathrm{round}}",
          eps_star: r"\varepsilon^\ast"}
 STEP_DOMAIN = {eps: (0.05, 2.0), H: (0.1, 10.0), HX: (0.1, 10.0), H3: (0.1, 10.0), u_round: (1e-3, 0.1)}
 
@@ -271,7 +271,7 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
     stationary, minimum = sp.Subs(slope, eps, eps_star), sp.Subs(curvature, eps, eps_star)
     return Theorem(
         id="optimal-step", title=TITLES["optimal-step"],
-        statement=r"Where $⟦curved⟧$, the error model $⟦E⟧$ ($u_{\mathrm{round}}$ the unit roundoff, $x$ the point) has "
+        statement=r"Where $⟦curved⟧$, the error model $⟦E⟧$ ($u_{\mathrm{round}}$ the unit roundoff, $u$ the point) has "
                   r"one stationary point on $⟦steps⟧$, $⟦eps_star⟧$, and it is the minimum: $⟦stationary⟧$ and $⟦minimum⟧$.",
         steps=(
             *calc(slope,
@@ -279,12 +279,12 @@ def _optimal(model=ERROR_MODEL, star=EPS_STAR):
                    written(sp.Add(sp.Mul(sp.Rational(1, 3), eps, H3, evaluate=False),
                                   sp.Mul(-1, u_round, ROUNDOFF, eps**-2, evaluate=False), evaluate=False))),
                   (r"Put it over the common denominator $3\varepsilon^2$ and write $3u_{\mathrm{round}}(\lvert h\rvert + "
-                   r"\lvert x h'\rvert)/\lvert h'''\rvert$ as $\varepsilon^{\ast 3}$",
+                   r"\lvert u\,h'\rvert)/\lvert h'''\rvert$ as $\varepsilon^{\ast 3}$",
                    written(sp.Mul(sp.Rational(1, 3), H3, sp.Add(eps**3, -eps_star**3, evaluate=False), eps**-2,
                                   evaluate=False)))),
             Step(r"For $\varepsilon > 0$ the factor $\varepsilon^3 - \varepsilon^{\ast 3}$ vanishes only at "
                  r"$\varepsilon = \varepsilon^\ast$, negative below it and positive above", stationary, sp.Integer(0)),
-            Step(r"Differentiate again: $E'' = \lvert h'''\rvert/3 + 2u_{\mathrm{round}}(\lvert h\rvert + \lvert x h'\rvert)/"
+            Step(r"Differentiate again: $E'' = \lvert h'''\rvert/3 + 2u_{\mathrm{round}}(\lvert h\rvert + \lvert u\,h'\rvert)/"
                  r"\varepsilon^3$, which at "
                  r"$\varepsilon^\ast$ is $\lvert h'''\rvert/3 + 2\lvert h'''\rvert/3 > 0$: $\varepsilon^\ast$ is the "
                  r"minimum", minimum, H3),

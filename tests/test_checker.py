@@ -210,7 +210,7 @@ def test_the_box_shows_statement_badge_and_steps_and_links_its_ledger_row(monkey
     places = [block.index(latex.statement(t)), block.index("**PROVED** · evidence: {ref}`§6 <ledger-optimal-step>`"),
               block.index(":::{prf:proof}")] + [block.index(f"**Step {k}.** ") for k in range(1, len(t.steps) + 1)]
     assert places == sorted(places)
-    assert (r"\varepsilon^\ast = \left(3 u_{\mathrm{round}} \left(\lvert h\rvert + \lvert x h'\rvert\right) / "
+    assert (r"\varepsilon^\ast = \left(3 u_{\mathrm{round}} \left(\lvert h\rvert + \lvert u\,h'\rvert\right) / "
             r"\lvert h'''\rvert\right)^{1/3}") in block
     assert "reduced to 0" not in block and "reduced to 0 by sympy" in row
     assert row.startswith("* (ledger-optimal-step)=\n  {prf:ref}`The optimal central-difference step <thm-optimal-step>`")

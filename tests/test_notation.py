@@ -35,7 +35,7 @@ PRINTED = {
     "normal-beta-derivative": "981715b4a04fc96b",
     "beta-zero-regression": "3bf643c3991f84b8",
     "central-difference-truncation": "14efabe2eebdca85",
-    "optimal-step": "ca82e478bc3eb386",
+    "optimal-step": "dadac2c110509a2c",
     "bump-vs-displacement": "297fcf6f15272694",
     "blinn-perturbation": "41778b11d7d85bc7",
 }
