@@ -133,6 +133,9 @@ class Displaced:
     self_shadowed : int
         Pixels on sphere A in both frames where a light is blocked by the displaced sphere
         A itself and lights the pixel in the bumped frame (reaches it with Ns . w > 0).
+    blocked : (n_lights, H, W) bool
+        The displaced sphere A cuts the segment from the hit point to light k (asked where the
+        surface faces the light and is not the background; False elsewhere).
     samples : int
         Points per ray and per shadow segment of the bracketing march.
     newton_max, newton_mean : int, float
@@ -153,6 +156,7 @@ class Displaced:
     silhouette_changed: int
     shadow_changed: int
     self_shadowed: int
+    blocked: np.ndarray
     samples: int
     newton_max: int
     newton_mean: float
@@ -383,5 +387,5 @@ def render_displaced(scene, width, height, *, samples=64):
     on_a = steps.reshape(shape)[covered]
     return Displaced(image, chamber, covered, shadow, P, N, bumped, bumped_shadow,
                      int((covered != covered_bumped).sum()), int((shadow != bumped_shadow).sum()), self_shadowed,
-                     samples, int(on_a.max(initial=0)), float(on_a.mean()) if on_a.size else 0.0,
+                     blocked, samples, int(on_a.max(initial=0)), float(on_a.mean()) if on_a.size else 0.0,
                      seconds, render_seconds)

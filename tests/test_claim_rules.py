@@ -10,11 +10,13 @@ mutant of lab/claims.py (its measurements are checked by pytest verify).
 import math
 import re
 
+import mpmath
+import numpy as np
 import pytest
 import sympy as sp
 
-from lab.claims import (CLAIMS, CORRECTED, FAILS, HOLDS, UNMEASURED, Bound, Claim, ClaimChanged, Criterion,
-                        Unmeasured, checked, rule)
+from lab.claims import (CLAIMS, CORRECTED, DRAFT_SCENE, FAILS, HOLDS, UNMEASURED, Bound, Claim, ClaimChanged,
+                        Criterion, Unmeasured, checked, rule)
 
 
 @pytest.mark.parametrize("bound, x, inside", [
@@ -318,3 +320,22 @@ def test_the_cell5_measurement_compares_the_worst_error_with_the_drafts_expectat
     measured, verdict = claim.measure()
     assert verdict == FAILS and measured["expected"] == _numbers(claim.quote)[0]
     assert measured["ratio"] == measured["worst component"] / measured["expected"] > 1e3
+
+
+def test_the_cell5_worst_error_is_the_drafts_trials_against_mpmaths_derivative():
+    """The draft's Cell 5 check, redone from its description (seed 5, 2000 unit normals N, g = 4 x a standard
+    normal, forward step 1e-7 at the draft's beta) with the exact derivative taken by mpmath's numerical
+    differentiation at 30 digits, not by the closed form the lab uses: the same worst component."""
+    claim = next(c for c in CLAIMS if c.id == "cell5-fd-1e-9")
+    rng, beta, step, worst = np.random.default_rng(5), DRAFT_SCENE.beta, 1e-7, 0.0
+    with mpmath.workdps(30):
+        for _ in range(2000):
+            N = rng.normal(size=3)
+            N /= np.linalg.norm(N)
+            g = rng.normal(size=3) * 4.0
+            unit = [lambda b, k=k: (N[k] + b * g[k]) / mpmath.sqrt(sum((N[i] + b * g[i]) ** 2 for i in range(3)))
+                    for k in range(3)]
+            exact = np.array([float(mpmath.diff(f, mpmath.mpf(beta))) for f in unit])
+            M, M2 = N + beta * g, N + (beta + step) * g
+            worst = max(worst, float(np.abs(exact - (M2 / np.linalg.norm(M2) - M / np.linalg.norm(M)) / step).max()))
+    assert claim.measure()[0]["worst component"] == pytest.approx(worst, rel=1e-8, abs=0)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from renderer import Scene, generated, kernel, pointwise
+from renderer import Scene, gbuffer, generated, kernel, pointwise
 from renderer.render import image_plane
 from lab.displaced import H_MAX, render_displaced
 
@@ -13,10 +13,13 @@ SIZE = 48
 SINE = Scene(height_field="sine", bump="surface", beta=0.2)
 
 
+#: The displaced frames' scenes, by field.
+SCENES = {"sine": SINE, "ridges": Scene(bump="surface")}
+
+
 @pytest.fixture(scope="module")
 def displaced():
-    return {name: render_displaced(scene, SIZE, SIZE) for name, scene in
-            (("sine", SINE), ("ridges", Scene(bump="surface")))}
+    return {name: render_displaced(scene, SIZE, SIZE) for name, scene in SCENES.items()}
 
 
 def test_beta_zero_reproduces_the_undisplaced_render():
@@ -70,6 +73,21 @@ def test_normals_agree_with_the_surface_mode_normal(displaced):
     assert np.abs(d.normal[interior][keep] - out.T).max() <= 1e-9
     # The bumps tilt the normal: the comparison is not of two radial directions.
     assert np.abs(out.T - N).max() > 0.1
+
+
+def test_the_self_shadowed_pixels_are_those_the_bumped_frame_lights_and_the_displaced_sphere_blocks(displaced):
+    """self_shadowed counts the pixels on A in both frames where some light is blocked by the displaced A and
+    lights the bumped frame: reached by the kernel's predicate and facing the bumped normal, Ns . w > 0, the
+    gate here taken by hand."""
+    for name, d in displaced.items():
+        scene = SCENES[name]
+        geo = gbuffer(scene, *d.covered.shape[::-1], gradient="exact")
+        w = np.stack([np.asarray(light.position) for light in scene.lights])[:, None, None, :] - geo.P
+        facing = np.einsum("hwc,khwc->khw", geo.Ns, w) > 0
+        lit = pointwise.reach(scene, geo) & facing
+        both = d.covered & (d.bumped.chamber == 1)
+        assert d.self_shadowed == int(((d.blocked & lit).any(axis=0) & both).sum()) > 0
+        assert d.blocked.shape == lit.shape and not d.blocked[:, ~d.covered & (d.chamber == 0)].any()
 
 
 def test_displacement_moves_silhouette_and_shadows(displaced):
