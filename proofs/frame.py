@@ -104,8 +104,8 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
     return Theorem(
         id="chart", title=TITLES["chart"],
         statement=(r"For $⟦theta⟧$ and $⟦phi⟧$ the renderer's chart "
-                   r"at the unit normal $N(\theta, \varphi)$, $⟦N_x⟧$, $⟦N_y⟧$, $⟦N_z⟧$, is "
-                   r"$u$: $⟦u⟧$, $v$: $⟦v⟧$ and $⟦sin⟧$; so $⟦rates⟧$, the factors between chart and angular "
+                   r"at the unit normal $N(\theta, \varphi)$, $⟦N_x⟧$, $⟦N_y⟧$, $⟦N_z⟧$, computes "
+                   r"$u$ as $⟦u⟧$ and $v$ as $⟦v⟧$, with $⟦sin⟧$; so $⟦rates⟧$, the factors between chart and angular "
                    r"derivatives of $h$."),
         steps=(
             Step(r"$\operatorname{hypot}(N_x, N_y) = \sqrt{N_x^2 + N_y^2}$ (evaluated without forming the squares); "

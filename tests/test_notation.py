@@ -22,7 +22,7 @@ from proofs.registry import THEOREMS
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
     "displaced-normal": "d274d74c95884aac",
-    "chart": "a8c819435a24b376",
+    "chart": "09b8685f622439b8",
     "frame-orthonormal": "141c6af31a23ddcf",
     "frame-orientation": "dd3828e6dc0022c6",
     "gradient-sine": "446824a80459dae6",
