@@ -229,9 +229,9 @@ class _Relation:
 
 
 def statement(t) -> str:
-    """Theorem ``t``'s statement with each ``⟦key⟧`` printed: a claim as ``lhs = rhs`` (one set
-    apart, ``$$⟦key⟧$$``, as a display laid out by `chain`), a named
-    symbol of ``where`` as ``name = definition``, an object of ``shown`` as itself.
+    """Theorem ``t``'s statement with each ``⟦key⟧`` printed: a claim as ``lhs = rhs`` (laid out by
+    `chain` when set apart, ``$$⟦key⟧$$``), a named symbol of ``where`` as ``name = definition``, an
+    object of ``shown`` as itself; in running text as `tex` prints ``inline``, set apart at full size.
 
     Raises
     ------
