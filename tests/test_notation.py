@@ -1,6 +1,6 @@
-"""The theorems print as the book shows them: each theorem's statement, the display of each of its calc
-chains and the definitions its steps introduce, in LaTeX from book/chapter/latex.py, are the text the chapter was
-reviewed in.  A printer that drops a prime, a sign or a bracket states a theorem other than the one
+"""The theorems print as the book shows them: each theorem's statement, its steps' sentences, the display of
+each of its calc chains and the definitions its steps introduce, in LaTeX from book/chapter/latex.py, are the
+text the chapter was reviewed in.  A printer that drops a prime, a sign or a bracket states a theorem other than the one
 checked; this fails, naming the theorem and printing its new text.
 
 After an intended change of notation, review the new text (it is printed) and record its digest here:
@@ -21,30 +21,31 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "displaced-normal": "d274d74c95884aac",
-    "chart": "09b8685f622439b8",
-    "frame-orthonormal": "141c6af31a23ddcf",
-    "frame-orientation": "dd3828e6dc0022c6",
-    "gradient-sine": "446824a80459dae6",
-    "gradient-ridges": "648c16419819b0d8",
-    "gradient-rings": "b1acf10d08155001",
-    "ridges-kinks": "f04df1931f933884",
-    "kink-loci-rays": "625f2a4e3de291f9",
-    "kink-loci-circles": "18d16a7d7f27d6f5",
-    "no-boundary": "99ef972915e7dec4",
-    "normal-beta-derivative": "981715b4a04fc96b",
-    "beta-zero-regression": "3bf643c3991f84b8",
-    "central-difference-truncation": "14efabe2eebdca85",
-    "optimal-step": "dadac2c110509a2c",
-    "bump-vs-displacement": "297fcf6f15272694",
-    "blinn-perturbation": "41778b11d7d85bc7",
+    "displaced-normal": "ba9128c0f1141247",
+    "chart": "806ac8c86dd7e8dc",
+    "frame-orthonormal": "ca796763e8a38dd6",
+    "frame-orientation": "e1293a724b51b121",
+    "gradient-sine": "25fc2c5ba570a217",
+    "gradient-ridges": "b02fc36b87d6eb4f",
+    "gradient-rings": "ae03be6cd6d67f6e",
+    "ridges-kinks": "2e2b04724b57b029",
+    "kink-loci-rays": "95b076ae790e8aaa",
+    "kink-loci-circles": "6022d9a53d3dc1f9",
+    "no-boundary": "5993c461f22a0875",
+    "normal-beta-derivative": "dba4385ca0e80bf9",
+    "beta-zero-regression": "ddf30c60292784fd",
+    "central-difference-truncation": "bae73524f9a92e17",
+    "optimal-step": "8ff24d3b64fdf31c",
+    "bump-vs-displacement": "ffe5c390b8e702ae",
+    "blinn-perturbation": "aca835b10f5124cb",
 }
 
 
 def printed(t):
-    """The theorem's text as the book prints it: statement, each calc chain's display, each defined symbol."""
-    return "\n".join([latex.statement(t)] + [latex.chain(t, [s for _, s in run], [k for k, _ in run])
-                                               for run in _chains(t.steps)]
+    """The theorem's text as the book prints it: statement, each step's sentence, each calc chain's display,
+    each defined symbol."""
+    return "\n".join([latex.statement(t)] + [s.why for s in t.steps]
+                     + [latex.chain(t, [s for _, s in run], [k for k, _ in run]) for run in _chains(t.steps)]
                      + [latex.definition(t, d) for s in t.steps for d in s.defines])
 
 
