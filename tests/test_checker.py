@@ -513,3 +513,19 @@ def test_a_theorem_about_every_field_names_each_field_its_evidence_left_out():
             "which its statement is about")
     with pytest.raises(KeyError, match="no-such-theorem"):
         pin("no-such-theorem")
+
+
+def test_the_shadow_predicates_leave_a_root_at_the_light_undecided():
+    """no-boundary's predicates (`predicate_masks`) compare the kernel's reach only where float64 decides:
+    with the light on sphere B's near side, B's segment quadratic has the root s = 1 at every point of A,
+    so no point of A that the other predicates light is decided (a root within the margin of 1, not only
+    of 0, is undecided)."""
+    from proofs.no_boundary import predicate_masks
+    from renderer import Scene, gbuffer
+    from renderer.scene import PointLight
+    centre, radius = np.asarray(Scene().center_b, float), Scene().radius_b
+    scene = Scene(lights=(PointLight(tuple(centre - radius * centre / np.linalg.norm(centre))),))
+    g = gbuffer(scene, 48, 48)
+    masks, decided = predicate_masks(scene, g)
+    lit_on_a = masks[0] & (g.chamber == 1)
+    assert lit_on_a.sum() > 50 and not (lit_on_a & decided[0]).any()
