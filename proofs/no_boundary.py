@@ -138,6 +138,10 @@ REACH_SCENES = (Scene(), Scene(lights=(PointLight((0.5, -1.0, -6.0)), PointLight
                 Scene(sphere_b=False, lights=(PointLight((0.0, -1.02, 0.1)), PointLight((1.0, -0.4, 0.15)))))
 
 
+#: The side of the square frames of `REACH_SCENES` that `reach_mismatches` compares, in pixels.
+REACH_SIZE = 128
+
+
 def predicate_masks(scene, g, margin=1e-9):
     """(masks (n_lights, H, W) bool, decided (n_lights, H, W) bool): the statement's predicates
     evaluated at the G-buffer's hit points in float64, written here from their definitions:
@@ -174,7 +178,7 @@ def predicate_masks(scene, g, margin=1e-9):
     return np.array(masks), np.array(decided)
 
 
-def reach_mismatches(size=128, reach=None):
+def reach_mismatches(size=REACH_SIZE, reach=None):
     """(differing, decided, all): (pixel, light) pairs over `REACH_SCENES` where
     `renderer.pointwise.reach` (or ``reach``, for wrong variants) and `predicate_masks` differ
     (decided pairs only), the decided pairs, and all pairs."""
@@ -212,7 +216,7 @@ def _evidence(gate=False, reach=None, root=0):
                    "bit for bit, and the kernel's reach predicate gives each light the same mask "
                    f"({distinct} distinct shading normals: every parameter reaches them); that predicate equals "
                    f"the predicates, evaluated at the hit points, at all {compared} decided (pixel, light) pairs (of "
-                   f"{pairs}) of {len(REACH_SCENES)} scenes (128x128; a light inside sphere B, lights behind A, below "
+                   f"{pairs}) of {len(REACH_SCENES)} scenes ({REACH_SIZE}x{REACH_SIZE}; a light inside sphere B, lights behind A, below "
                    "the floor, and beside A just above it)",
                    residual=float(values + masks + differing), points=frames, rendered=frames)
 

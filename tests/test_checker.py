@@ -529,3 +529,22 @@ def test_the_shadow_predicates_leave_a_root_at_the_light_undecided():
     masks, decided = predicate_masks(scene, g)
     lit_on_a = masks[0] & (g.chamber == 1)
     assert lit_on_a.sum() > 50 and not (lit_on_a & decided[0]).any()
+
+
+@pytest.mark.parametrize("miss", [0.5, 10.0])
+def test_the_shadow_predicates_leave_a_grazing_segment_undecided(miss):
+    """A segment that misses sphere B by a hair (its quadratic's discriminant -8 a r delta, within the margin
+    of b^2, though far above the margin itself) is neither lit nor shadowed in float64: undecided.  A point
+    and a light in B's tangent plane, moved off it by delta."""
+    from types import SimpleNamespace
+    from proofs.no_boundary import predicate_masks
+    from renderer import Scene
+    from renderer.scene import PointLight
+    scene = Scene()
+    centre, radius = np.asarray(scene.center_b, float), scene.radius_b
+    out, along = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    delta = miss * 1e-9 * 400 / (8 * 25 * radius)                 # |disc| = miss * 1e-9 * b^2, b^2 = 400, a = 25
+    P, L = (centre + (radius + delta) * out + t * along for t in (-2.0, 3.0))
+    g = SimpleNamespace(P=P[None, None], N=along[None, None], chamber=np.ones((1, 1), np.uint8))
+    masks, decided = predicate_masks(scene.replace(lights=(PointLight(tuple(L)),)), g)
+    assert masks[0, 0, 0] and decided[0, 0, 0] == (miss > 1.0)
