@@ -31,11 +31,12 @@ def test_theorem_text_names_no_code(theorem_id):
 @pytest.mark.parametrize("text, found", [
     ("the crease flag (`KINK_BAND`)", ["KINK_BAND"]),
     ("the interior branches of STENCIL_POINTS", ["STENCIL_POINTS"]),
-    ("the renderer's bump (renderer.formulas.BUMP['surface'])", ["renderer.formulas"]),
+    ("the renderer's bump (renderer.formulas.BUMP['surface'])", ["renderer.formulas", "BUMP"]),
     ("kernel.reach gives each light the same mask", ["kernel.reach"]),
     ("against `GRADIENT`", ["`GRADIENT`"]),
     ("$(\\mathrm{CENTRAL}_u, \\mathrm{crease}, t_{\\mathrm{floor}})$", ["\\mathrm{CENTRAL}"]),
     ("the seed's half-width", ["seed"]),
+    ("CIRCLES phi=0.1 and the RMS error, CPU time", ["CIRCLES"]),
     ("at 24 seeded points, $s_1 = \\sin\\pi k_u u$, $N_x$, width 0.03, the draft's `bump=\"surface\"`", []),
 ])
 def test_code_words_finds_code_and_spares_mathematics(text, found):

@@ -46,7 +46,8 @@ def badge(status, numeric=()):
 #: What reader-facing text must not contain (`code_words`): a name from the code, constant-shaped
 #: (KINK_BAND, STENCIL_POINTS) or a dotted path (renderer.formulas, kernel.reach), a constant
 #: set as code (`GRADIENT`), or "seed" (the book calls the source document "the draft").
-_CODE_WORD = re.compile(r"\b[A-Z][A-Z0-9]*_[A-Z0-9_]*\b|\b[A-Za-z_]\w+\.[A-Za-z_]\w+|`[^`]*\b[A-Z]{2,}\b[^`]*`")
+_CODE_WORD = re.compile(r"\b[A-Z][A-Z0-9]*_[A-Z0-9_]*\b|\b[A-Za-z_]\w+\.[A-Za-z_]\w+|`[^`]*\b[A-Z]{2,}\b[^`]*`|"
+                        r"\b(?!(?:RMS|LLVM|SIMD|CPU)\b)[A-Z]{3,}\b")
 _SEED = re.compile(r"\bseed\b", re.IGNORECASE)
 #: ... and, in mathematics too, a constant's name set upright (\mathrm{CENTRAL}).
 _UPRIGHT_CONSTANT = re.compile(r"\\mathrm\{[A-Z][A-Z0-9_]+\}")
@@ -56,7 +57,8 @@ _MATH = re.compile(r"\$\$.*?\$\$|\$[^$]*\$", re.S)
 def code_words(text):
     """The tokens of ``text`` (a theorem's title, statement, step sentence or evidence) that
     read as code or audit vocabulary: outside its ``$...$`` mathematics, constant-shaped
-    names (``KINK_BAND``), dotted paths (``renderer.formulas``), code spans holding a
+    names (``KINK_BAND``; ``CIRCLES``, three capitals or more that are not an acronym the book uses:
+    RMS, LLVM, SIMD, CPU), dotted paths (``renderer.formulas``), code spans holding a
     constant (```GRADIENT```) and the word "seed"; anywhere, a constant's name set upright
     (``\\mathrm{CENTRAL}``).  An empty list is text a reader can read.
 
