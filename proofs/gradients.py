@@ -200,7 +200,7 @@ def _theorem(field, closed_form=None, **evidence):
                    (f"The renderer's gradient of the {name} field (the formula compiled into its kernel) is "
                     "sympy's derivative of its $h$", sp.Tuple(sp.Derivative(h, u), sp.Derivative(h, v))),
                    *_argument(field, closed_form)),
-        claims={"gradient": (gradient, sp.Tuple(*closed_form))}, shown={"h": sp.Eq(sp.Symbol("h"), h, evaluate=False)},
+        claims={"gradient": (gradient, sp.Tuple(*closed_form))}, shown={"h": sp.Eq(F.h, h, evaluate=False)},
         where={F.h_u: field.gradient[0], F.h_v: field.gradient[1], **names}, domain=DOMAIN,
         evidence=partial(_gradient_evidence, field, closed_form, **evidence),
         wrong_variants=(*((description, lambda wrong=wrong: _theorem(field, wrong).check())

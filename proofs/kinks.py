@@ -84,7 +84,7 @@ def _creases(field, jump_u, jump_v, band=None):
     h, factors = field.expr.subs(POSITIVE), tuple(f.subs(POSITIVE) for f in field.crease_factors)
     on_u = one_sided(h.subs(factors[1], c), u, LINE_U)
     on_v = one_sided(h.subs(factors[0], c), v, LINE_V)
-    names = {e.subs(POSITIVE): s for s, e in G.named_factors(field).items()}
+    named = G.named_factors(field)
     jumps, values = sp.Tuple(HU_P - HU_M, HV_P - HV_M), sp.Tuple(jump_u, jump_v)
     on_lines = sp.Tuple(crease(LINE_U, v), crease(u, LINE_V))
     # Just inside and just outside the seed's half-width: |s| = w (1 -+ eta), where the other factor is 1.
@@ -125,14 +125,13 @@ def _creases(field, jump_u, jump_v, band=None):
             Step(r"Likewise across $v$, where $s_1 = 1$", edges["v"], sp.Tuple(1, 0), defines=(V_IN, V_OUT)),
         ),
         claims={"jumps": (jumps, values), "lines": (on_lines, sp.Tuple(1, 1))},
-        shown={"h": sp.Eq(sp.Symbol("h"), h.xreplace(names), evaluate=False),
-               **{str(s): sp.Eq(s, e, evaluate=False) for e, s in names.items()},
-               "smooth": sp.Ne(sp.Mul(*names.values()), 0), "c": sp.Ne(c, 0, evaluate=False),
-               "line_u": sp.Eq(u, LINE_U), "line_v": sp.Eq(v, LINE_V), "band": band.xreplace(names)},
+        shown={"h": sp.Eq(F.h, G.shown(field), evaluate=False), "smooth": sp.Ne(sp.Mul(*named), 0),
+               "c": sp.Ne(c, 0, evaluate=False), "line_u": sp.Eq(u, LINE_U), "line_v": sp.Eq(v, LINE_V),
+               "band": band.xreplace({e.subs(POSITIVE): s for s, e in named.items()})},
         where={HU_P: on_u[0], HU_M: on_u[1], HV_P: on_v[0], HV_M: on_v[1],
                crease: sp.Lambda((u, v), sp.Piecewise((1, band), (0, True))),
                U_IN: w_in / (sp.pi * k_u), U_OUT: w_out / (sp.pi * k_u), V_IN: w_in / (sp.pi * k_v),
-               V_OUT: w_out / (sp.pi * k_v), W: SEED_HALF_WIDTH, ETA: MARGIN},
+               V_OUT: w_out / (sp.pi * k_v), W: SEED_HALF_WIDTH, ETA: MARGIN, **named},
         names={HU_P: r"h_u^+", HU_M: r"h_u^-", HV_P: r"h_v^+", HV_M: r"h_v^-", crease: r"\mathrm{crease}",
                U_IN: "u_-", U_OUT: "u_+", V_IN: "v_-", V_OUT: "v_+", ETA: r"\eta"},
         domain=DOMAIN,

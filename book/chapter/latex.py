@@ -244,10 +244,7 @@ def statement(t) -> str:
         """A placeholder set apart, ``$$⟦key⟧$$``: a claim laid out as `chain` lays out a proof's display,
         anything else as `fill` prints it; each fraction at full size (``\\dfrac``: one within another is
         otherwise set at 70 %)."""
-        if m.group(1) in t.claims:
-            shown = chain(t, [_Relation(*t.claims[m.group(1)])])
-        else:
-            shown = PLACEHOLDER.sub(fill, m.group(1).join("⟦⟧"))
+        shown = chain(t, [_Relation(*t.claims[m.group(1)])]) if m.group(1) in t.claims else fill(m)
         return "\n\n$$\n{}\n$$\n\n".format(shown.replace(r"\frac{", r"\dfrac{"))
 
     def fill(m):

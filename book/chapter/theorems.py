@@ -17,6 +17,7 @@ import re
 from collections import Counter
 
 from lab import store
+from proofs.core import MATH
 
 from . import latex
 
@@ -51,7 +52,6 @@ _CODE_WORD = re.compile(r"\b[A-Z][A-Z0-9]*_[A-Z0-9_]*\b|\b[A-Za-z_]\w+\.[A-Za-z_
 _SEED = re.compile(r"\bseed\b", re.IGNORECASE)
 #: ... and, in mathematics too, a constant's name set upright (\mathrm{CENTRAL}).
 _UPRIGHT_CONSTANT = re.compile(r"\\mathrm\{[A-Z][A-Z0-9_]+\}")
-_MATH = re.compile(r"\$\$.*?\$\$|\$[^$]*\$", re.S)
 
 
 def code_words(text):
@@ -71,7 +71,7 @@ def code_words(text):
     list of str
         The offending tokens, in order.
     """
-    prose = _MATH.sub(" ", text)
+    prose = MATH.sub(" ", text)
     return ([m.group(0) for m in _CODE_WORD.finditer(prose)] + [m.group(0) for m in _SEED.finditer(prose)]
             + _UPRIGHT_CONSTANT.findall(text))
 
