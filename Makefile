@@ -44,9 +44,12 @@ test: book
 
 # The built site's audits: the browser tests (Chromium) and the checks that read book/_build/html, dealt
 # out one by one but for those sharing a module's page loads (tests/conftest.py's xdist groups): by module,
-# the browser tests went to one worker.
+# the browser tests went to one worker.  One worker more than the CPUs: a worker waiting on its browser
+# (a load, a timer, an animation) leaves a CPU to the others (2 CPUs, 4 runs each, alternated: medians
+# 116 s with 3 workers, 124 s with 2; make test's workers wait on nothing, and 3 made it slower).
+AUDIT_WORKERS := $(shell echo $$(( $$(nproc) + 1 )))
 audit: book
-	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n auto --dist loadgroup -m audit tests
+	SYMRENDER_BOOK_HTML=$(CURDIR)/book/_build/html $(BIN)/python -m pytest -n $(AUDIT_WORKERS) --dist loadgroup -m audit tests
 
 # The checks whose numbers could depend on the CPU's code paths (marked cpu_dependent: the theorems
 # whose checks compare the renderer's outputs with mpmath, and parity with the scalar reference)
