@@ -1,6 +1,7 @@
 # Two commands: `make book` and `make test`.  Both bootstrap .venv from a bare
 # python3 (venv + pip), installing the pinned versions in constraints.txt: pip installs
-# uv (pinned there too), and uv the project (39 s against pip's 96 s on a fresh machine).
+# uv (pinned there too), and uv the project (39 s against pip's 96 s on a fresh machine, when both compiled
+# the whole venv's bytecode; see below for why it no longer does).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
