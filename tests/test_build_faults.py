@@ -238,6 +238,29 @@ def test_the_pools_processes_leave_a_ctrl_c_to_the_build_and_die_with_it(tmp_pat
     assert alive == []
 
 
+def test_a_pool_process_killed_from_outside_is_named_and_its_pages_still_executed(tmp_path, token):
+    """The pool's processes SIGKILLed while a page executes (as the OOM killer would): the build
+    neither waits for the dead process's page nor starts another process in the pool; it warns in one
+    line and myst-nb executes the page (status 1: the warning is an error).  The wrong variant,
+    `multiprocessing.Pool`, forked a replacement within 0.1 s and waited forever."""
+    book = make_book(tmp_path / "book")
+    build = Build(book, token, hold="execute:a")
+    held(book, build)
+    me = psutil.Process(build.proc.pid)
+    pool = [p for p in me.children() if p.cmdline() == me.cmdline()]
+    assert pool
+    for p in pool:
+        p.kill()
+    psutil.wait_procs(pool, timeout=10)
+    time.sleep(0.5)
+    assert [p for p in me.children() if p.cmdline() == me.cmdline()] == []
+    (book / "release").touch()
+    assert build.wait(timeout=120) == 1, build.stderr()[-3000:]
+    assert "a process executing the pages died (killed from outside the build?)" in build.stderr()
+    assert executions(book) == ["a v1", "a v1"]
+    shows(book, "v1")
+
+
 # ------------------------------------------------------------------ SIGKILL, then a build
 
 

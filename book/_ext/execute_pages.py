@@ -26,13 +26,14 @@ alone, and executes the pages it has to one after another.  This extension:
 3. Executes the pages before Sphinx reads them.  The pages about to be read are added to
    the cache's project (jupyter-cache's ``jupytext`` reader gives the same notebook, and
    so the same key, as myst-nb's) and the ones the cache does not hold run in a pool of
-   processes forked from the build's, one per CPU, each with jupyter-cache's
+   processes forked from the build's (`concurrent.futures.ProcessPoolExecutor`), one per CPU, each with jupyter-cache's
    ``local-parallel`` worker, one page at a time to the first free process: first the pages of
    ``execute_pages_first``, last those of ``execute_pages_last`` (each in its order), the others
    between them (`execution_order`), after one job that compiles the renderer's kernels
    (`_work`: otherwise the first pages compile the same ones at once).  myst-nb then finds each page in the
    cache; a page that failed is not cached, and myst-nb executes it again and reports its
-   error as usual.
+   error as usual.  A process of the pool that dies (the OOM killer, a signal) is not replaced:
+   the build warns once, and myst-nb executes the pages not yet cached.
 Before any of this, the paths the build writes are checked (`refusal`): the lock, the cache's
    digest and the doctrees' ``build-complete`` must each be a regular file or absent (a link,
    a FIFO or a directory in their place would be followed, block the build or stop it with a
@@ -45,8 +46,9 @@ Before any of this, the paths the build writes are checked (`refusal`): the lock
    so that a terminal's Ctrl-C reaches the build's process only (nbclient in a pool process
    would otherwise shut its kernel down at once, and the kernel log its broken reply on
    stderr before the build freezes it); they die with the build's process (Linux's
-   ``PR_SET_PDEATHSIG``), as they would with its process group, and one the pool forks
-   meanwhile (to replace one it lost) ends at once.  It leaves what
+   ``PR_SET_PDEATHSIG``), as they would with its process group.  The pool forks them all at its
+   first page, from the build's main thread (the thread `_stop` runs in), and replaces none:
+   no process starts while the build stops.  It leaves what
    a killed build leaves, which 2. does not trust.  ``make book`` runs this file
    (jupyter-book's command line) so that this holds from the first instant of the build,
    not only once Sphinx has loaded its extensions.  A signal the build was started with
@@ -177,6 +179,7 @@ def _finish(app, exception):
 def _execute(app, env, docnames):
     if env.mystnb_config.execution_mode != "cache" or not docnames:
         return
+    from concurrent.futures.process import BrokenProcessPool
     from jupyter_cache import get_cache
     from myst_nb.core.read import is_myst_markdown_notebook
     from sphinx.util import logging
@@ -189,10 +192,16 @@ def _execute(app, env, docnames):
     if not todo:
         return
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")          # the kernels inherit it
-    for status, uri in _run(cache, todo, env.mystnb_config.execution_timeout):
+    log = logging.getLogger(__name__)
+    try:
+        done = _run(cache, todo, env.mystnb_config.execution_timeout)
+    except BrokenProcessPool:
+        log.warning("a process executing the pages died (killed from outside the build?); "
+                    "the pages it left are executed one by one")
+        return
+    for status, uri in done:
         if status:                                      # the console names the cause, not only the log file
-            record = cache.get_project_record(uri)
-            logging.getLogger(__name__).warning(f"{Path(uri).stem} failed to execute: {cause(record.traceback)}")
+            log.warning(f"{Path(uri).stem} failed to execute: {cause(cache.get_project_record(uri).traceback)}")
 
 
 def execution_order(docnames, first, last):
@@ -223,20 +232,21 @@ def _run(cache, pks, timeout):
     forked from this one (so `_stop` is theirs too), one per CPU, caching each that succeeds;
     their kernels log errors only (`_quiet_kernels`).
     Returns [(status, uri)] in the same order: status 0 if it succeeded, 1 if a cell raised,
-    2 if it could not be executed or cached."""
+    2 if it could not be executed or cached.  Raises `BrokenProcessPool` if a process of the pool died.
+
+    `ProcessPoolExecutor` with fork forks every process at the first job, in this thread, and
+    replaces none that dies (`multiprocessing.Pool`'s own thread forks replacements at any moment,
+    even while `_stop` kills the pool, and waits forever for a job its dead process held)."""
+    from concurrent.futures import ProcessPoolExecutor
     from jupyter_cache.cache.db import NbProjectRecord
     from jupyter_cache.executors.basic import ProcessData
     NbProjectRecord.remove_tracebacks(pks, cache.db)
     jobs = [ProcessData(pk, cache.get_project_record(pk).uri, cache, timeout, False) for pk in pks]
-    with multiprocessing.get_context("fork").Pool(initializer=_quiet_kernels) as pool:
-        # One job at a time to whichever process is free, in this order (map's default hands out
-        # pages in pairs: a long page and the one after it then run one after the other).
-        # The kernels compiled first when two or more pages run (`_work`).
+    with ProcessPoolExecutor(mp_context=multiprocessing.get_context("fork"), initializer=_quiet_kernels) as pool:
+        # One job at a time to whichever process is free, in this order; the kernels compiled
+        # first when two or more pages run (`_work`).
         ahead = [None] if len(jobs) > 1 else []
-        done = list(pool.imap(_work, [*ahead, *jobs], chunksize=1))[len(ahead):]
-        pool.close()        # each process ends at its queue's end (leaving the block terminates them:
-        pool.join()         # SIGTERM, which `_stop` leaves to the build's own process)
-    return done
+        return list(pool.map(_work, [*ahead, *jobs]))[len(ahead):]
 
 
 def _work(job):
@@ -275,8 +285,7 @@ def _stop(signum, frame):
     for other in (signal.SIGINT, signal.SIGTERM):     # a second Ctrl-C changes nothing
         signal.signal(other, signal.SIG_IGN)
     import psutil
-    _build["stopping"] = True                 # a process forked from now on (the pool replacing
-    me, frozen = psutil.Process(), {}         # one it lost) ends at once: `_forked`
+    me, frozen = psutil.Process(), {}
     while new := [p for p in me.children(recursive=True) if p.pid not in frozen]:
         for p in new:
             frozen[p.pid] = p
@@ -300,13 +309,11 @@ def _stop(signum, frame):
 
 
 def _forked():
-    """In a process forked from the build's (the pool's): ends at once if the build is
-    stopping; else leaves the build's process group and dies when the build's process does.
-    A process its children fork is left alone."""
-    if os.getppid() != _build.get("pid"):
+    """In a process forked from the build's (the pool's): leaves the build's process group and
+    dies when the build's process does.  A process its children fork is left alone (which
+    process forked is noted before the fork: the parent may have died since)."""
+    if _build.get("forker") != _build.get("pid"):
         return
-    if _build.get("stopping"):
-        os._exit(128 + signal.SIGKILL)
     os.setpgid(0, 0)
     if sys.platform.startswith("linux"):
         import ctypes
@@ -319,7 +326,7 @@ def _forked():
 def _handle_signals():
     """`_stop` on SIGINT and SIGTERM in this process, the build's (a signal it ignores stays ignored)."""
     if "pid" not in _build:
-        os.register_at_fork(after_in_child=_forked)
+        os.register_at_fork(before=lambda: _build.update(forker=os.getpid()), after_in_child=_forked)
     _build["pid"] = os.getpid()
     for signum in (signal.SIGINT, signal.SIGTERM):
         if signal.getsignal(signum) is not signal.SIG_IGN:
