@@ -163,6 +163,12 @@ def left_behind(token):
     return found
 
 
+def pool_processes(build):
+    """The processes forked from the build's (its page pool's: the same command line), and the build's."""
+    me = psutil.Process(build.proc.pid)
+    return [p for p in me.children() if p.cmdline() == me.cmdline()], me
+
+
 @pytest.fixture
 def token():
     """The marker of the test's builds; whatever carries it is killed after the test."""
@@ -229,8 +235,7 @@ def test_the_pools_processes_leave_a_ctrl_c_to_the_build_and_die_with_it(tmp_pat
     book = make_book(tmp_path / "book")
     build = Build(book, token, hold="execute:a")
     held(book, build)
-    me = psutil.Process(build.proc.pid)
-    pool = [p for p in me.children() if p.cmdline() == me.cmdline()]      # forked from the build's process
+    pool, me = pool_processes(build)
     assert pool and all(os.getpgid(p.pid) == p.pid != os.getpgid(me.pid) for p in pool)
     os.kill(me.pid, signal.SIGKILL)
     build.wait()
@@ -246,14 +251,13 @@ def test_a_pool_process_killed_from_outside_is_named_and_its_pages_still_execute
     book = make_book(tmp_path / "book")
     build = Build(book, token, hold="execute:a")
     held(book, build)
-    me = psutil.Process(build.proc.pid)
-    pool = [p for p in me.children() if p.cmdline() == me.cmdline()]
+    pool, _ = pool_processes(build)
     assert pool
     for p in pool:
         p.kill()
     psutil.wait_procs(pool, timeout=10)
     time.sleep(0.5)
-    assert [p for p in me.children() if p.cmdline() == me.cmdline()] == []
+    assert pool_processes(build)[0] == []
     (book / "release").touch()
     assert build.wait(timeout=120) == 1, build.stderr()[-3000:]
     assert "a process executing the pages died (killed from outside the build?)" in build.stderr()
