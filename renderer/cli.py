@@ -4,7 +4,7 @@ An input error (a bad option, a malformed scene file, an output directory that d
 exist, a value the library refuses with `renderer.validate.InputError`) prints ONE line
 ``symrender: error: ...`` and returns 2; anything else is a bug: one line ``symrender:
 internal error: ...`` and 1, never a traceback.  Ctrl-C prints ``symrender: interrupted``
-and returns 130, SIGTERM ``symrender: terminated`` and 143.  The report is printed first,
+and returns 130, SIGTERM ``symrender: terminated`` and 143 (whatever exception then ends the command).  The report is printed first,
 then the output is put in place by `renderer.files.write_bytes`: an error or a signal at
 any moment leaves no output and no temporary file.  ``-o -`` (``--plot -``) writes the
 PNG to stdout and the report to stderr.  PNGs carry no varying metadata.
@@ -454,7 +454,9 @@ def main(argv=None) -> int:
         return _run(sys.argv[1:] if argv is None else list(argv))
     except SystemExit as exc:           # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
-    except KeyboardInterrupt:
+    # After a signal, whatever ends the command is the signal's: code it interrupts may turn the
+    # KeyboardInterrupt into another exception (numba, typing a band's arguments, raised a TypeError).
+    except (KeyboardInterrupt, Exception) if _signal else KeyboardInterrupt:
         signum = _signal[0] if _signal else signal.SIGINT
         say("terminated" if signum == signal.SIGTERM else "interrupted")
         return 128 + signum

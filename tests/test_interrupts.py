@@ -53,8 +53,8 @@ OUTCOME = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminate
 #: arrives (or exits 99 after 120 s).
 #: band: the compiled band of the render or sweep, run once (numba compiles or loads it), then
 #: repeated until the signal comes (its exception comes between two calls, as in a real render;
-#: or C code drops it, seen inside numba's dispatch of a band in 1 to 3 runs of 40 here, and the
-#: loop ends as the render's bands would, before the check before writing);
+#: or, inside numba's typing of a band's arguments, it is dropped (the loop then ends as the render's
+#: bands would, before the check before writing) or turned into a TypeError, both seen here);
 #: write: the output's temporary file is written (before its
 #: sync); commit: the report is out, the output not yet renamed into place.
 HARNESS = """
@@ -419,6 +419,32 @@ def test_main_in_process_restores_the_handlers_and_ignores_a_second_signal(capsy
     assert {sig: signal.getsignal(sig) for sig in SIGNALS} == before
     capsys.readouterr()
 
+
+
+@pytest.mark.parametrize("signum", SIGNALS, ids=["SIGINT", "SIGTERM"])
+def test_an_exception_the_interrupted_code_raises_instead_is_the_signals(capsys, monkeypatch, signum):
+    """Code that a signal interrupts may turn its KeyboardInterrupt into another exception (numba's
+    typing of a band's arguments raised ``TypeError: _get_wrapper_address() missing 1 required
+    positional argument``): the command still ends with the signal's code and one line.  Without a
+    signal the same exception is an internal error (exit 1).  The wrong variant, `main` catching
+    only KeyboardInterrupt for the signal, exits 1 with ``internal error`` (checked by hand)."""
+    import renderer.cli as cli
+
+    def command(args):
+        try:
+            os.kill(os.getpid(), signum)
+            time.sleep(1.0)                       # the exception comes here
+        except KeyboardInterrupt:
+            pass
+        raise TypeError("what the interrupted code raised")
+
+    monkeypatch.setitem(cli._COMMANDS, "render", command)
+    code, word = OUTCOME[signum]
+    assert cli.main(["render", "-o", "x.png"]) == code
+    assert capsys.readouterr().err == f"symrender: {word}\n"
+    monkeypatch.setitem(cli._COMMANDS, "render", lambda args: (_ for _ in ()).throw(TypeError("a bug")))
+    assert cli.main(["render", "-o", "x.png"]) == 1
+    assert "internal error: TypeError: a bug" in capsys.readouterr().err
 
 
 def _render_with_a_dropped_ctrl_c(monkeypatch, how):
