@@ -62,9 +62,12 @@ import os, sys, time
 import renderer.kernel as kernel
 ready, moment = os.environ["READY"], os.environ["MOMENT"]
 
+arrived = []
+
 def arrive():
-    if not os.path.exists(ready):
-        open(ready, "w").close()
+    # Once: the test deletes the file when it has seen it, and a later band must not write it again.
+    if not arrived:
+        arrived.append(open(ready, "w").close())
 
 def hold():
     arrive()
