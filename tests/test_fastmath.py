@@ -20,13 +20,15 @@ from renderer.ucurve import DEFAULT_STEPS, SEED_FREQUENCIES, SEED_POINT
 from tests.jsnode import in_ci
 
 RNG = np.random.default_rng(12)
+#: The functions as mpmath defines them (the library's references call mpmath.libmp's directly).
+MP = {"sin": mpmath.sin, "cos": mpmath.cos, "atan2": mpmath.atan2, "acos": mpmath.acos, "pow": mpmath.power}
 ARGUMENTS = fm.arguments        # the real one, for `few` while a test plants another
 
 
 def mp_ulps(y, function, *args):
     """|y - t| / ulp(t) computed in mpmath at 60 digits, the definition written out."""
     with mpmath.workdps(60):
-        t = fm._MP[function](*(mpmath.mpf(float(a)) for a in args))
+        t = MP[function](*(mpmath.mpf(float(a)) for a in args))
         e = -1074 if t == 0 else max(int(mpmath.floor(mpmath.log(abs(t), 2))), -1022) - 52
         return float(abs(mpmath.mpf(float(y)) - t) / mpmath.mpf(2) ** e)
 
@@ -99,7 +101,7 @@ def test_the_reference_counts_in_the_subnormal_ulp_below_the_normal_range():
 def test_planted_wrong_functions_are_counted_as_mpmath_counts_them(function, wrong):
     args = few(function, 30, 30)
     with mpmath.workdps(60):
-        true = [fm._MP[function](*(mpmath.mpf(float(a)) for a in p)) for p in zip(*args)]
+        true = [MP[function](*(mpmath.mpf(float(a)) for a in p)) for p in zip(*args)]
         rounded = np.array([float(t) for t in true])
     if wrong == "1e-10 relative":
         y = rounded * (1 + 1e-10)
@@ -144,7 +146,7 @@ def rounded(function):
     """``function`` correctly rounded, from mpmath (a backend with every count <= 0.5)."""
     def run(*args):
         with mpmath.workdps(60):
-            return np.array([float(fm._MP[function](*(mpmath.mpf(float(a)) for a in p))) for p in zip(*args)])
+            return np.array([float(MP[function](*(mpmath.mpf(float(a)) for a in p))) for p in zip(*args)])
     return run
 
 
