@@ -32,9 +32,9 @@ import os
 from functools import lru_cache
 
 import mpmath
-from mpmath import libmp
 import numpy as np
 import sympy as sp
+from mpmath import libmp
 from numba import vectorize
 
 from renderer import _numba_cache
@@ -301,8 +301,8 @@ def _reference(function, *args):
         hi[i] = libmp.to_float(t, rnd=libmp.round_nearest)
         # t = man 2^exp with a man of bc bits: 2^(exp + bc - 1) <= |t| < 2^(exp + bc).
         e = exponent[i] = -1074 if t == libmp.fzero else max(t[2] + t[3] - 1, -1022) - 52
-        rest[i] = libmp.to_float(libmp.mpf_shift(libmp.mpf_sub(t, libmp.from_float(hi[i]), prec, libmp.round_nearest), -e),
-                                 rnd=libmp.round_nearest)
+        below = libmp.mpf_sub(t, libmp.from_float(hi[i]), prec, libmp.round_nearest)     # t - hi
+        rest[i] = libmp.to_float(libmp.mpf_shift(below, -e), rnd=libmp.round_nearest)
     return hi, exponent, rest
 
 
