@@ -418,9 +418,15 @@ def main(argv=None) -> int:
         print("check_glue: the same name shows different values on different pages:\n  " + "\n  ".join(bad),
               file=sys.stderr)
         return 1
-    # The library's stored measurements are the build's (computed again where the code has changed).
+    # The library's stored measurements are the build's (computed again where the code has changed), for
+    # this check only: a process that calls main() keeps its own store, or none.
+    own = "SYMRENDER_STORE" in os.environ
     os.environ.setdefault("SYMRENDER_STORE", str(cache_dir.parent / ".measurements"))
-    sourced = quantity_conflicts(names)
+    try:
+        sourced = quantity_conflicts(names)
+    finally:
+        if not own:
+            del os.environ["SYMRENDER_STORE"]
     if sourced:
         print("check_glue: a glued quantity is unregistered, or shows two values, or not the library's:\n  "
               + "\n  ".join(sourced), file=sys.stderr)

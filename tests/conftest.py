@@ -38,6 +38,24 @@ def pytest_collection_modifyitems(items):
                     item.add_marker(pytest.mark.xdist_group(f"{item.module.__name__}::{shared}"))
 
 
+@pytest.fixture(autouse=True)
+def _project_environment_kept():
+    """Fails the test that leaves one of the project's environment variables (``SYMRENDER_*``: the
+    store, the site, ...) set, changed or removed: its worker goes on to other tests, which would read
+    another store or site than theirs and fail or pass by the order the tests were dealt.  A fixture
+    of a wider scope (test_shown_values' module-scoped store) is set up before this looks and undone
+    after it has."""
+    def own():
+        return {k: v for k, v in os.environ.items() if k.startswith("SYMRENDER_")}
+    before = own()
+    yield
+    after = own()
+    if after != before:
+        pytest.fail("the test left the environment changed: " + ", ".join(
+            f"{k}={after.get(k)!r} (was {before.get(k)!r})" for k in sorted(before.keys() | after.keys())
+            if before.get(k) != after.get(k)), pytrace=False)
+
+
 @pytest.fixture(scope="session")
 def book_html():
     """The built site: SYMRENDER_BOOK_HTML if set (``make test`` builds the book first and

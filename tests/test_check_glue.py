@@ -8,6 +8,7 @@ them; each check is shown failing on a wrong variant.  The registry of quantitie
 from __future__ import annotations
 
 import importlib.util
+import os
 import time
 from pathlib import Path
 
@@ -15,6 +16,7 @@ import nbformat
 import pytest
 from jupyter_cache import get_cache
 from jupyter_cache.base import CacheBundleIn
+from lab.store import ENV
 
 _SPEC = importlib.util.spec_from_file_location("check_glue", Path(__file__).parents[1] / "book" / "check_glue.py")
 check_glue = importlib.util.module_from_spec(_SPEC)
@@ -57,6 +59,24 @@ def test_one_value_per_shared_name_passes(tmp_path, capsys):
     assert check_glue.glued(cache)["eps_fitted_sine"] == {"s5_lab": "4.3e-07", "s7_pitfalls": "4.3e-07"}
     assert check_glue.main([str(cache)]) == 0
     assert "1 shown on several pages" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("caller", [None, "callers-store"])
+def test_the_library_is_read_from_the_builds_store_and_the_callers_environment_is_left_as_it_was(
+        tmp_path, monkeypatch, caller):
+    """The library's values are evaluated against the build's store (beside the cache) unless the caller
+    names one, and ``SYMRENDER_STORE`` is as the caller had it afterwards: left set, it sent every later
+    measurement of the calling process (a test worker) to the store of a build it never asked for."""
+    seen = []
+    monkeypatch.setattr(check_glue, "quantity_conflicts", lambda names: seen.append(os.environ.get(ENV)) or [])
+    if caller:
+        monkeypatch.setenv(ENV, str(tmp_path / caller))
+    else:
+        monkeypatch.delenv(ENV, raising=False)
+    cache = _cache(tmp_path, [("/b/s5_lab.md", _page(eps_fitted_sine=4.3e-7))])
+    assert check_glue.main([str(cache)]) == 0
+    assert seen == [str(tmp_path / caller) if caller else str(cache.parent / ".measurements")]
+    assert os.environ.get(ENV) == (str(tmp_path / caller) if caller else None)
 
 
 def test_two_values_under_one_name_fail_naming_pages_and_values(tmp_path, capsys):

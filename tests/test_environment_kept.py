@@ -1,0 +1,53 @@
+"""tests/conftest.py fails a test that leaves a ``SYMRENDER_*`` variable changed.
+
+Such a leak fails or passes the later tests of the same worker by the order the tests
+were dealt (book/check_glue.py's ``main`` once left the build's store set in the worker that
+called it, and a later test of the in-memory store then read a stored value).  The scratch
+modules below run under the project's conftest, in a process of their own (a leak planted here
+would otherwise be this worker's).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).parents[1]
+
+#: Module -> its source: a test per way of leaving the environment changed, and three that undo their patch
+#: (a module-scoped one lasts across the module's tests).
+MODULES = {
+    "test_sets": "import os\ndef test_it():\n    os.environ['SYMRENDER_PLANTED'] = '1'\n",
+    "test_changes": "import os\ndef test_it():\n    os.environ['SYMRENDER_STORE'] = '/elsewhere'\n",
+    "test_removes": "import os\ndef test_it():\n    del os.environ['SYMRENDER_SHOTS']\n",
+    "test_monkeypatched": "def test_it(monkeypatch):\n    monkeypatch.setenv('SYMRENDER_STORE', '/elsewhere')\n",
+    "test_module_patch": (
+        "import os, pytest\n"
+        "@pytest.fixture(scope='module')\n"
+        "def store():\n"
+        "    with pytest.MonkeyPatch.context() as patch:\n"
+        "        patch.setenv('SYMRENDER_STORE', '/module')\n"
+        "        yield\n"
+        "def test_one(store):\n    assert os.environ['SYMRENDER_STORE'] == '/module'\n"
+        "def test_two(store):\n    assert os.environ['SYMRENDER_STORE'] == '/module'\n"),
+}
+
+
+def test_a_test_that_sets_changes_or_removes_a_project_variable_fails_and_a_patch_undone_passes(tmp_path):
+    for name, source in MODULES.items():
+        (tmp_path / f"{name}.py").write_text(source)
+    (tmp_path / "conftest.py").write_text("from tests.conftest import _project_environment_kept\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1",
+           "SYMRENDER_STORE": "/given", "SYMRENDER_SHOTS": "0"}
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-o", "addopts=",
+                           "--rootdir", str(tmp_path), "-rE", str(tmp_path)],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    errors = {line.split("::")[0].removeprefix("ERROR ").removesuffix(".py"): line
+              for line in done.stdout.splitlines() if line.startswith("ERROR ")}
+    assert set(errors) == {"test_sets", "test_changes", "test_removes"}, done.stdout + done.stderr
+    for message in ("SYMRENDER_PLANTED='1' (was None)", "SYMRENDER_STORE='/elsewhere' (was '/given')",
+                    "SYMRENDER_SHOTS=None (was '0')"):
+        assert message in done.stdout, done.stdout
+    assert "6 passed, 3 errors" in done.stdout, done.stdout
