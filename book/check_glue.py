@@ -420,13 +420,14 @@ def main(argv=None) -> int:
         return 1
     # The library's stored measurements are the build's (computed again where the code has changed), for
     # this check only: a process that calls main() keeps its own store, or none.
-    own = "SYMRENDER_STORE" in os.environ
-    os.environ.setdefault("SYMRENDER_STORE", str(cache_dir.parent / ".measurements"))
+    from lab.store import ENV
+    own = ENV in os.environ
+    os.environ.setdefault(ENV, str(cache_dir.parent / ".measurements"))
     try:
         sourced = quantity_conflicts(names)
     finally:
         if not own:
-            del os.environ["SYMRENDER_STORE"]
+            del os.environ[ENV]
     if sourced:
         print("check_glue: a glued quantity is unregistered, or shows two values, or not the library's:\n  "
               + "\n  ".join(sourced), file=sys.stderr)
