@@ -57,14 +57,17 @@ def _app(tmp_path):
                                                   nb_execution_cache_path=str(tmp_path / "cache")))
 
 
+def _page(code):
+    return NOTEBOOK_FRONT_MATTER + f"\n# A page\n\n```{{code-cell}}\n{code}\n```\n"
+
+
 def test_the_page_kernels_start_without_ipykernels_tcp_warning(tmp_path, capfd, monkeypatch):
     """ipykernel logs "Kernel is running over TCP without encryption" at every start, on the
     build's stderr (nine lines a `make book`): the pool's kernels log errors only, and still run
     the page (it is cached)."""
     from jupyter_cache import get_cache
     monkeypatch.setenv("NUMBA_NUM_THREADS", "1")        # as in the test above
-    (tmp_path / "page.md").write_text(NOTEBOOK_FRONT_MATTER + "\n# A page\n\n```{code-cell}\nx = 1\n```\n",
-                                      encoding="utf-8")
+    (tmp_path / "page.md").write_text(_page("x = 1"), encoding="utf-8")
     app = _app(tmp_path)
     execute_pages._execute(app, app.env, ["page"])
     err = capfd.readouterr().err
@@ -123,9 +126,33 @@ def test_a_pool_process_leaves_the_signal_to_the_build():
     assert _forked() == ("carried on 0\n", "")
 
 
-def test_the_kernel_compiling_job_runs():
-    """`_work`'s job for None runs `COMPILE` with its output discarded and its failure left to the pages:
-    that it still runs (a renamed import would only make every cold build slower) is checked here."""
-    import subprocess
-    done = subprocess.run([sys.executable, "-c", execute_pages.COMPILE], capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0 and not done.stderr, done.stderr[-2000:]
+def test_a_pool_process_runs_its_pages_in_one_kernel_each_a_stranger_to_the_last(tmp_path):
+    """One process of the pool, four pages in turn (`_work`): the first defines a name; the second,
+    in the same kernel, does not know it (NameError, as alone) and runs in its own directory; the
+    third kills its kernel; the fourth runs in a new one.  The kernel ends with the process.  The
+    wrong variants: no reset between pages (the second passes), a kernel per page (one process id
+    per page), a dead kernel kept (the fourth fails too), no change of directory."""
+    import psutil
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+
+    from jupyter_cache import get_cache
+    from jupyter_cache.executors.basic import ProcessData
+    log = tmp_path / "kernels.log"
+    logged = f'import os\nopen({str(log)!r}, "a").write(f"{{os.getpid()}} {{os.getcwd()}}\\n")\n'
+    (tmp_path / "sub").mkdir()
+    pages = {"a.md": "shared = 1", "sub/b.md": "shared", "c.md": "os._exit(9)", "d.md": "print('d ran')"}
+    cache = get_cache(str(tmp_path / "cache"))
+    jobs = []
+    for name, code in pages.items():
+        (tmp_path / name).write_text(_page(logged + code), encoding="utf-8")
+        pk = cache.add_nb_to_project(str(tmp_path / name), read_data={"name": "jupytext", "type": "plugin"}).pk
+        jobs.append(ProcessData(pk, cache.get_project_record(pk).uri, cache, 60, False))
+    with ProcessPoolExecutor(1, mp_context=get_context("fork")) as pool:
+        done = [status for status, _ in pool.map(execute_pages._work, jobs)]
+    assert done == [0, 1, 2, 0], done
+    assert "NameError: name 'shared' is not defined" in execute_pages.cause(cache.get_project_record(jobs[1].uri).traceback)
+    pids, cwds = zip(*(line.split(" ", 1) for line in log.read_text().splitlines()))
+    assert pids[0] == pids[1] == pids[2] != pids[3], pids
+    assert cwds == (str(tmp_path), str(tmp_path / "sub"), str(tmp_path), str(tmp_path)), cwds
+    assert not any(psutil.pid_exists(int(pid)) for pid in set(pids))

@@ -29,9 +29,10 @@ alone, and executes the pages it has to one after another.  This extension:
    processes forked from the build's (`concurrent.futures.ProcessPoolExecutor`), one per CPU, each with jupyter-cache's
    ``local-parallel`` worker, one page at a time to the first free process: first the pages of
    ``execute_pages_first``, last those of ``execute_pages_last`` (each in its order), the others
-   between them (`execution_order`), after one job that compiles the renderer's kernels
-   (`_work`: otherwise the first pages compile the same ones at once).  myst-nb then finds each page in the
-   cache; a page that failed is not cached, and myst-nb executes it again and reports its
+   between them (`execution_order`).  Each process runs its pages in one kernel (`_kernel`), emptied
+   between pages: a page sees no name an earlier one defined, but the modules they imported and the
+   functions numba compiled stay loaded.  myst-nb then finds each page in the
+   cache; a page that failed is not cached, and myst-nb executes it again, in a new kernel, and reports its
    error as usual.  A process of the pool that dies (the OOM killer, a signal) is not replaced:
    the build warns once, and myst-nb executes the pages not yet cached.
 Before any of this, the paths the build writes are checked (`refusal`): the lock, the cache's
@@ -212,25 +213,32 @@ def execution_order(docnames, first, last):
                                            len(last) + last.index(d) if d in last else 0))
 
 
-#: Arguments of each page's kernel (nbclient's ``extra_arguments``): its log at ERROR, so that
-#: ipykernel's warning at every start, "Kernel is running over TCP without encryption" (nine
-#: lines a build), is not printed; the kernel listens on the loopback interface only and checks
-#: each message's signature (the key is in its connection file, readable by this user only).
+#: Arguments of each page's kernel (`KernelManager.start_kernel`'s ``extra_arguments``): its log at
+#: ERROR, so that ipykernel's warning at every start, "Kernel is running over TCP without encryption",
+#: is not printed; the kernel listens on the loopback interface only and checks each message's
+#: signature (the key is in its connection file, readable by this user only).
 KERNEL_ARGUMENTS = ("--IPKernelApp.log_level=ERROR",)
 
-
-def _quiet_kernels():
-    """In each of the pool's processes: the notebooks jupyter-cache runs start their kernels
-    with `KERNEL_ARGUMENTS`."""
-    from functools import partial
-    from jupyter_cache.executors import basic
-    basic.single_nb_execution = partial(basic.single_nb_execution, extra_arguments=KERNEL_ARGUMENTS)
+#: Run in a process's kernel before each of its pages but the first: in the page's directory, without
+#: the names and figures of the pages before it, the execution count at 1, as in a new kernel.
+RESET = """
+import os, sys
+os.chdir({cwd!r})
+if "matplotlib.pyplot" in sys.modules:
+    sys.modules["matplotlib.pyplot"].close("all")
+get_ipython().reset(new_session=True)
+"""
+#: The client class of `_kernel`'s manager, whose ``client()`` nbclient calls: nbclient waits for
+#: messages in an event loop, where a blocking client's wait blocks the loop (a kernel that dies
+#: mid-page is then never noticed).
+ASYNC_CLIENT = "jupyter_client.asynchronous.AsyncKernelClient"
+#: Seconds `RESET` may take before the kernel is replaced (it takes a few milliseconds).
+RESET_TIMEOUT = 10
 
 
 def _run(cache, pks, timeout):
     """Execute the project notebooks ``pks`` of ``cache`` in this order, in a pool of processes
-    forked from this one (so `_stop` is theirs too), one per CPU, caching each that succeeds;
-    their kernels log errors only (`_quiet_kernels`).
+    forked from this one (so `_stop` is theirs too), one per CPU, caching each that succeeds.
     Returns [(status, uri)] in the same order: status 0 if it succeeded, 1 if a cell raised,
     2 if it could not be executed or cached.  Raises `BrokenProcessPool` if a process of the pool died.
 
@@ -242,38 +250,61 @@ def _run(cache, pks, timeout):
     from jupyter_cache.executors.basic import ProcessData
     NbProjectRecord.remove_tracebacks(pks, cache.db)
     jobs = [ProcessData(pk, cache.get_project_record(pk).uri, cache, timeout, False) for pk in pks]
-    with ProcessPoolExecutor(mp_context=multiprocessing.get_context("fork"), initializer=_quiet_kernels) as pool:
-        # One job at a time to whichever process is free, in this order; the kernels compiled
-        # first when two or more pages run (`_work`).
-        ahead = [None] if len(jobs) > 1 else []
-        return list(pool.map(_work, [*ahead, *jobs]))[len(ahead):]
+    with ProcessPoolExecutor(mp_context=multiprocessing.get_context("fork")) as pool:
+        return list(pool.map(_work, jobs))         # one page at a time to whichever process is free
 
 
 def _work(job):
-    """A page's notebook ``job`` executed (jupyter-cache's ``local-parallel`` worker), or, for None,
-    the renderer's kernels compiled into numba's cache by a new interpreter (`COMPILE`; this process
-    is forked from one that may run numba's threads).  That job goes first: without it the first
-    pages to render each compiled the same kernels at once (cold builds on 2 CPUs, alternated: medians
-    48.9 s without, 47.2 s with); a page that runs alone compiles what it renders, without it.  Its
-    failure is the pages' to report, each with its cause."""
-    if job is not None:
-        from jupyter_cache.executors.basic import ExecutionWorkerLocalMProc
-        return ExecutionWorkerLocalMProc()(job)
-    import subprocess
-    subprocess.run([sys.executable, "-c", COMPILE], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL, check=False)
+    """A page's notebook ``job`` executed by jupyter-cache's ``local-parallel`` worker, in this
+    process's kernel (`_kernel`)."""
+    from jupyter_cache.executors.basic import ExecutionWorkerLocalMProc
+    from jupyter_cache.executors.utils import single_nb_execution
+
+    class InOneKernel(ExecutionWorkerLocalMProc):
+        @staticmethod
+        def execute(project_nb, data):
+            cwd = str(Path(project_nb.uri).parent)
+            return single_nb_execution(project_nb.nb, cwd=cwd, timeout=data.timeout,
+                                       allow_errors=data.allow_errors, km=_kernel(cwd))
+    return InOneKernel()(job)
 
 
-#: A scene of each field under each bump, rendered at 8 x 8 px: numba compiles and caches the kernels.
-COMPILE = """
-from dataclasses import replace
-from renderer import DRAFT_SCENE, render
-from renderer.formulas import FIELDS
-from renderer.scene import BUMPS
-for field in FIELDS:
-    for bump in BUMPS:
-        render(replace(DRAFT_SCENE, height_field=field, bump=bump), 8, 8)
-"""
+def _kernel(cwd):
+    """This process's kernel (a `jupyter_client.KernelManager`), ready for a page in the directory
+    ``cwd``: the one its last page ran in, emptied by `RESET`, or a new one (at the first page, or
+    when the last one died or did not reply), which this process shuts down when it exits.
+
+    A page's kernel and its imports cost about 2 s of CPU.  One kernel per process instead of one per
+    page: cold builds on 2 CPUs, alternated, three each, medians 52.6 s against 58.6 s (70 against 85
+    core-seconds).  The job that compiled the renderer's kernels ahead of the pages then gained nothing
+    (53.1 s without it, 52.6 s with) and was dropped.  The pages stay each other's strangers as far as
+    names go: a page that uses a name an earlier one defined fails, as it would alone."""
+    if "kernel" in _build:
+        km, shut_down = _build["kernel"]
+        if _emptied(km, cwd):
+            return km
+        shut_down()
+    from multiprocessing.util import Finalize
+    from jupyter_client.manager import KernelManager
+    km = KernelManager(kernel_name="python3", client_class=ASYNC_CLIENT)
+    km.start_kernel(cwd=cwd, extra_arguments=list(KERNEL_ARGUMENTS))
+    _build["kernel"] = km, Finalize(km, km.shutdown_kernel, kwargs={"now": True}, exitpriority=0)
+    return km
+
+
+def _emptied(km, cwd):
+    """Whether the kernel of ``km`` replied to `RESET` in the directory ``cwd`` without an error
+    (a kernel that died, or is still busy with a cell that timed out, does not reply)."""
+    client = km.blocking_client()
+    client.start_channels()
+    try:
+        client.wait_for_ready(timeout=RESET_TIMEOUT)
+        reply = client.execute_interactive(RESET.format(cwd=cwd), store_history=False, timeout=RESET_TIMEOUT)
+        return reply["content"]["status"] == "ok"
+    except (RuntimeError, TimeoutError):
+        return False
+    finally:
+        client.stop_channels()
 
 
 def _stop(signum, frame):
