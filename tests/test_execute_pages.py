@@ -126,6 +126,27 @@ def test_a_pool_process_leaves_the_signal_to_the_build():
     assert _forked() == ("carried on 0\n", "")
 
 
+def _jobs(tmp_path, pages):
+    """``pages`` (path under ``tmp_path`` -> text) written and added to a cache's project there:
+    the cache and the pages' jobs, in that order."""
+    from jupyter_cache import get_cache
+    from jupyter_cache.executors.basic import ProcessData
+    cache, jobs = get_cache(str(tmp_path / "cache")), []
+    for name, text in pages.items():
+        (tmp_path / name).write_text(text, encoding="utf-8")
+        pk = cache.add_nb_to_project(str(tmp_path / name), read_data={"name": "jupytext", "type": "plugin"}).pk
+        jobs.append(ProcessData(pk, cache.get_project_record(pk).uri, cache, 60, False))
+    return cache, jobs
+
+
+def _in_one_process(jobs):
+    """Each job's status, the jobs executed in turn by `_work` in one process of a pool like the build's."""
+    from concurrent.futures import ProcessPoolExecutor
+    from multiprocessing import get_context
+    with ProcessPoolExecutor(1, mp_context=get_context("fork")) as pool:
+        return [status for status, _ in pool.map(execute_pages._work, jobs)]
+
+
 def test_a_pool_process_runs_its_pages_in_one_kernel_each_a_stranger_to_the_last(tmp_path):
     """One process of the pool, four pages in turn (`_work`): the first defines a name; the second,
     in the same kernel, does not know it (NameError, as alone) and runs in its own directory; the
@@ -133,26 +154,35 @@ def test_a_pool_process_runs_its_pages_in_one_kernel_each_a_stranger_to_the_last
     wrong variants: no reset between pages (the second passes), a kernel per page (one process id
     per page), a dead kernel kept (the fourth fails too), no change of directory."""
     import psutil
-    from concurrent.futures import ProcessPoolExecutor
-    from multiprocessing import get_context
-
-    from jupyter_cache import get_cache
-    from jupyter_cache.executors.basic import ProcessData
     log = tmp_path / "kernels.log"
     logged = f'import os\nopen({str(log)!r}, "a").write(f"{{os.getpid()}} {{os.getcwd()}}\\n")\n'
     (tmp_path / "sub").mkdir()
     pages = {"a.md": "shared = 1", "sub/b.md": "shared", "c.md": "os._exit(9)", "d.md": "print('d ran')"}
-    cache = get_cache(str(tmp_path / "cache"))
-    jobs = []
-    for name, code in pages.items():
-        (tmp_path / name).write_text(_page(logged + code), encoding="utf-8")
-        pk = cache.add_nb_to_project(str(tmp_path / name), read_data={"name": "jupytext", "type": "plugin"}).pk
-        jobs.append(ProcessData(pk, cache.get_project_record(pk).uri, cache, 60, False))
-    with ProcessPoolExecutor(1, mp_context=get_context("fork")) as pool:
-        done = [status for status, _ in pool.map(execute_pages._work, jobs)]
+    cache, jobs = _jobs(tmp_path, {name: _page(logged + code) for name, code in pages.items()})
+    done = _in_one_process(jobs)
     assert done == [0, 1, 2, 0], done
     assert "NameError: name 'shared' is not defined" in execute_pages.cause(cache.get_project_record(jobs[1].uri).traceback)
     pids, cwds = zip(*(line.split(" ", 1) for line in log.read_text().splitlines()))
     assert pids[0] == pids[1] == pids[2] != pids[3], pids
     assert cwds == (str(tmp_path), str(tmp_path / "sub"), str(tmp_path), str(tmp_path)), cwds
     assert not any(psutil.pid_exists(int(pid)) for pid in set(pids))
+
+
+def test_a_page_of_another_kernel_spec_gets_a_kernel_of_its_own(tmp_path, monkeypatch):
+    """The process's kernel serves the pages of its spec only: a page whose notebook names another
+    spec runs in a kernel of that spec, and the next page of the first spec in a new kernel of its
+    own.  The wrong variant (the spec not compared) runs all three in one kernel."""
+    import json
+    spec = tmp_path / "jupyter" / "kernels" / "other"
+    spec.mkdir(parents=True)
+    (spec / "kernel.json").write_text(json.dumps({
+        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+        "display_name": "Another Python", "language": "python"}))
+    monkeypatch.setenv("JUPYTER_PATH", str(tmp_path / "jupyter"))
+    report = "import os\nprint(os.getpid())  # page {}"       # pages of one code share one cache record
+    other = _page(report.format("b")).replace("name: python3", "name: other")
+    cache, jobs = _jobs(tmp_path, {"a.md": _page(report.format("a")), "b.md": other, "c.md": _page(report.format("c"))})
+    assert _in_one_process(jobs) == [0, 0, 0]
+    pids = [cache.get_cache_bundle(cache.get_cached_project_nb(job.pk).pk).nb.cells[-1].outputs[0]["text"]
+            for job in jobs]
+    assert len(set(pids)) == 3, pids

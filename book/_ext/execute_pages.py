@@ -79,7 +79,8 @@ DIGEST_FILE = "source-digest"
 COMPLETE_FILE = "build-complete"
 #: In the book's directory: the lock a build holds while it runs.
 LOCK_FILE = ".build.lock"
-#: The build's process ("pid") and its lock ("lock", a FileLock held until the process ends).
+#: The build's process ("pid") and its lock ("lock", a FileLock held until the process ends); in a
+#: process of the page pool, its kernel and the kernel's shutdown ("kernel", `_kernel`).
 _build = {}
 
 
@@ -263,16 +264,17 @@ def _work(job):
     class InOneKernel(ExecutionWorkerLocalMProc):
         @staticmethod
         def execute(project_nb, data):
-            cwd = str(Path(project_nb.uri).parent)
+            cwd, name = str(Path(project_nb.uri).parent), project_nb.nb.metadata.kernelspec.name
             return single_nb_execution(project_nb.nb, cwd=cwd, timeout=data.timeout,
-                                       allow_errors=data.allow_errors, km=_kernel(cwd))
+                                       allow_errors=data.allow_errors, km=_kernel(name, cwd))
     return InOneKernel()(job)
 
 
-def _kernel(cwd):
-    """This process's kernel (a `jupyter_client.KernelManager`), ready for a page in the directory
-    ``cwd``: the one its last page ran in, emptied by `RESET`, or a new one (at the first page, or
-    when the last one died or did not reply), which this process shuts down when it exits.
+def _kernel(name, cwd):
+    """This process's kernel (a `jupyter_client.KernelManager` of the kernel spec ``name``), ready
+    for a page in the directory ``cwd``: the one its last page ran in, emptied by `RESET`, or a new
+    one (at the first page, or when the last one was of another spec, died or did not reply), which
+    this process shuts down when it exits.
 
     A page's kernel and its imports cost about 2 s of CPU.  One kernel per process instead of one per
     page: cold builds on 2 CPUs, alternated, three each, medians 52.6 s against 58.6 s (70 against 85
@@ -281,12 +283,12 @@ def _kernel(cwd):
     names go: a page that uses a name an earlier one defined fails, as it would alone."""
     if "kernel" in _build:
         km, shut_down = _build["kernel"]
-        if _emptied(km, cwd):
+        if km.kernel_name == name and _emptied(km, cwd):
             return km
         shut_down()
     from multiprocessing.util import Finalize
     from jupyter_client.manager import KernelManager
-    km = KernelManager(kernel_name="python3", client_class=ASYNC_CLIENT)
+    km = KernelManager(kernel_name=name, client_class=ASYNC_CLIENT)
     km.start_kernel(cwd=cwd, extra_arguments=list(KERNEL_ARGUMENTS))
     _build["kernel"] = km, Finalize(km, km.shutdown_kernel, kwargs={"now": True}, exitpriority=0)
     return km
