@@ -126,16 +126,16 @@ def test_a_pool_process_leaves_the_signal_to_the_build():
     assert _forked() == ("carried on 0\n", "")
 
 
-def _jobs(tmp_path, pages):
-    """``pages`` (path under ``tmp_path`` -> text) written and added to a cache's project there:
-    the cache and the pages' jobs, in that order."""
+def _jobs(tmp_path, pages, timeout=60):
+    """``pages`` (path under ``tmp_path`` -> text) written and added to a cache's project there, each
+    cell given ``timeout`` seconds: the cache and the pages' jobs, in that order."""
     from jupyter_cache import get_cache
     from jupyter_cache.executors.basic import ProcessData
     cache, jobs = get_cache(str(tmp_path / "cache")), []
     for name, text in pages.items():
         (tmp_path / name).write_text(text, encoding="utf-8")
         pk = cache.add_nb_to_project(str(tmp_path / name), read_data={"name": "jupytext", "type": "plugin"}).pk
-        jobs.append(ProcessData(pk, cache.get_project_record(pk).uri, cache, 60, False))
+        jobs.append(ProcessData(pk, cache.get_project_record(pk).uri, cache, timeout, False))
     return cache, jobs
 
 
@@ -147,42 +147,90 @@ def _in_one_process(jobs):
         return [status for status, _ in pool.map(execute_pages._work, jobs)]
 
 
-def test_a_pool_process_runs_its_pages_in_one_kernel_each_a_stranger_to_the_last(tmp_path):
-    """One process of the pool, four pages in turn (`_work`): the first defines a name; the second,
-    in the same kernel, does not know it (NameError, as alone) and runs in its own directory; the
-    third kills its kernel; the fourth runs in a new one.  The kernel ends with the process.  The
-    wrong variants: no reset between pages (the second passes), a kernel per page (one process id
-    per page), a dead kernel kept (the fourth fails too), no change of directory."""
+def _outputs(cache, job):
+    """The outputs of the last cell of ``job``'s page as cached."""
+    return cache.get_cache_bundle(cache.get_cached_project_nb(job.pk).pk).nb.cells[-1].outputs
+
+
+#: A page's first lines: its kernel's process id and directory appended to ``log``, and the ids
+#: of the kernels logged before it that are still alive in ``others``.
+LOGGED = """import os
+def alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+others = sorted({{int(line.split()[0]) for line in open({log!r})}} - {{os.getpid()}}) if os.path.exists({log!r}) else []
+others = [pid for pid in others if alive(pid)]
+open({log!r}, "a").write(f"{{os.getpid()}} {{os.getcwd()}} {{others}}\\n")
+"""
+
+
+def test_a_pool_process_runs_its_pages_in_one_kernel_each_a_stranger_to_the_last(tmp_path, monkeypatch):
+    """One process of the pool, pages in turn (`_work`): the first defines a name; the second, in
+    the same kernel, does not know it (NameError, as alone) and runs in its own directory; the third
+    counts its execution from 1; the fourth times out; the fifth runs in a new kernel, the last one
+    gone; the sixth kills its kernel; the seventh runs in a new one.  The kernels end with the
+    process.  The wrong variants: no reset between pages (the second passes), a kernel per page, a
+    kernel kept after its cell timed out or after it died, no change of directory, the execution
+    count not reset."""
     import psutil
+    monkeypatch.setattr(execute_pages, "RESET_TIMEOUT", 120)      # a busy kernel kept would be waited for
     log = tmp_path / "kernels.log"
-    logged = f'import os\nopen({str(log)!r}, "a").write(f"{{os.getpid()}} {{os.getcwd()}}\\n")\n'
     (tmp_path / "sub").mkdir()
-    pages = {"a.md": "shared = 1", "sub/b.md": "shared", "c.md": "os._exit(9)", "d.md": "print('d ran')"}
-    cache, jobs = _jobs(tmp_path, {name: _page(logged + code) for name, code in pages.items()})
+    pages = {"a.md": "shared = 1", "sub/b.md": "shared", "c.md": "1 + 1", "d.md": "import time\ntime.sleep(30)",
+             "e.md": "print('e ran')", "f.md": "os._exit(9)", "g.md": "print('g ran')"}
+    cache, jobs = _jobs(tmp_path, {name: _page(LOGGED.format(log=str(log)) + code) for name, code in pages.items()},
+                        timeout=8)
     done = _in_one_process(jobs)
-    assert done == [0, 1, 2, 0], done
+    assert done == [0, 1, 0, 1, 0, 2, 0], done
     assert "NameError: name 'shared' is not defined" in execute_pages.cause(cache.get_project_record(jobs[1].uri).traceback)
-    pids, cwds = zip(*(line.split(" ", 1) for line in log.read_text().splitlines()))
-    assert pids[0] == pids[1] == pids[2] != pids[3], pids
-    assert cwds == (str(tmp_path), str(tmp_path / "sub"), str(tmp_path), str(tmp_path)), cwds
+    assert "CellTimeoutError" in execute_pages.cause(cache.get_project_record(jobs[3].uri).traceback)
+    [result] = _outputs(cache, jobs[2])
+    assert (result["output_type"], result["execution_count"]) == ("execute_result", 1)
+    pids, cwds, others = zip(*(line.split(" ", 2) for line in log.read_text().splitlines()))
+    assert pids[0] == pids[1] == pids[2] == pids[3] != pids[4] == pids[5] != pids[6], pids
+    assert cwds == (str(tmp_path), str(tmp_path / "sub")) + (str(tmp_path),) * 5, cwds
+    assert set(others) == {"[]"}, others                # each page's kernel the only one alive
     assert not any(psutil.pid_exists(int(pid)) for pid in set(pids))
 
 
 def test_a_page_of_another_kernel_spec_gets_a_kernel_of_its_own(tmp_path, monkeypatch):
     """The process's kernel serves the pages of its spec only: a page whose notebook names another
     spec runs in a kernel of that spec, and the next page of the first spec in a new kernel of its
-    own.  The wrong variant (the spec not compared) runs all three in one kernel."""
+    own, each the only kernel alive.  The wrong variants: the spec not compared (all three in one
+    kernel), the kernel replaced but not shut down."""
     import json
     spec = tmp_path / "jupyter" / "kernels" / "other"
     spec.mkdir(parents=True)
     (spec / "kernel.json").write_text(json.dumps({
         "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
-        "display_name": "Another Python", "language": "python"}))
+        "display_name": "Another Python", "language": "python", "env": {"KERNEL_SPEC": "other"}}))
     monkeypatch.setenv("JUPYTER_PATH", str(tmp_path / "jupyter"))
-    report = "import os\nprint(os.getpid())  # page {}"       # pages of one code share one cache record
-    other = _page(report.format("b")).replace("name: python3", "name: other")
-    cache, jobs = _jobs(tmp_path, {"a.md": _page(report.format("a")), "b.md": other, "c.md": _page(report.format("c"))})
+    log = tmp_path / "kernels.log"
+    report = LOGGED.format(log=str(log)) + "print(os.environ.get('KERNEL_SPEC'))  # page "   # one code, one record
+    other = _page(report + "b").replace("name: python3", "name: other")
+    cache, jobs = _jobs(tmp_path, {"a.md": _page(report + "a"), "b.md": other, "c.md": _page(report + "c")})
     assert _in_one_process(jobs) == [0, 0, 0]
-    pids = [cache.get_cache_bundle(cache.get_cached_project_nb(job.pk).pk).nb.cells[-1].outputs[0]["text"]
-            for job in jobs]
-    assert len(set(pids)) == 3, pids
+    assert [_outputs(cache, job)[0]["text"] for job in jobs] == ["None\n", "other\n", "None\n"]
+    pids, _, others = zip(*(line.split(" ", 2) for line in log.read_text().splitlines()))
+    assert len(set(pids)) == 3 and set(others) == {"[]"}, (pids, others)
+
+
+def test_no_kernel_client_outlives_its_page(tmp_path):
+    """nbclient, given a kernel it does not own, leaves the client it made running (a heartbeat
+    thread and its sockets); `_work` stops it after the page: pages in turn in one process leave
+    no client and no thread behind.  The wrong variants: the clients not stopped, or dropped
+    without being stopped (one thread more per page)."""
+    import threading
+    cache, jobs = _jobs(tmp_path, {f"{name}.md": _page(f"{name} = 1") for name in "abc"})
+    threads = []
+    try:
+        for job in jobs:
+            assert execute_pages._work(job)[0] == 0
+            threads.append(threading.active_count())
+        assert execute_pages._build["kernel"][0].clients == []
+    finally:
+        execute_pages._build.pop("kernel")[1]()
+    assert threads[0] == threads[1] == threads[2], threads

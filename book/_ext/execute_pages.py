@@ -30,8 +30,10 @@ alone, and executes the pages it has to one after another.  This extension:
    ``local-parallel`` worker, one page at a time to the first free process: first the pages of
    ``execute_pages_first``, last those of ``execute_pages_last`` (each in its order), the others
    between them (`execution_order`).  Each process runs its pages in one kernel (`_kernel`), emptied
-   between pages: a page sees no name an earlier one defined, but the modules they imported and the
-   functions numba compiled stay loaded.  myst-nb then finds each page in the
+   between pages (`RESET`): a page sees no name or figure an earlier one left, but the modules they
+   imported stay loaded with what they hold: the functions numba and JAX compiled, `lab.store`'s
+   values in memory, matplotlib's settings (each page that draws sets its style), the warnings
+   already shown once.  myst-nb then finds each page in the
    cache; a page that failed is not cached, and myst-nb executes it again, in a new kernel, and reports its
    error as usual.  A process of the pool that dies (the OOM killer, a signal) is not replaced:
    the build warns once, and myst-nb executes the pages not yet cached.
@@ -214,14 +216,17 @@ def execution_order(docnames, first, last):
                                            len(last) + last.index(d) if d in last else 0))
 
 
-#: Arguments of each page's kernel (`KernelManager.start_kernel`'s ``extra_arguments``): its log at
-#: ERROR, so that ipykernel's warning at every start, "Kernel is running over TCP without encryption",
-#: is not printed; the kernel listens on the loopback interface only and checks each message's
-#: signature (the key is in its connection file, readable by this user only).
-KERNEL_ARGUMENTS = ("--IPKernelApp.log_level=ERROR",)
+#: Arguments of each page's kernel (`KernelManager.start_kernel`'s ``extra_arguments``): its history
+#: in memory, not in the user's IPython history file (as nbclient starts its kernels: kernels side by
+#: side writing one file lock it); its log at ERROR, so that ipykernel's warning at every start,
+#: "Kernel is running over TCP without encryption", is not printed (the kernel listens on the loopback
+#: interface only and checks each message's signature; the key is in its connection file, readable by
+#: this user only).
+KERNEL_ARGUMENTS = ("--HistoryManager.hist_file=:memory:", "--IPKernelApp.log_level=ERROR")
 
-#: Run in a process's kernel before each of its pages but the first: in the page's directory, without
-#: the names and figures of the pages before it, the execution count at 1, as in a new kernel.
+#: Run in a process's kernel before each of its pages but the first: the page starts in its directory,
+#: without the names and figures of the pages before it, its execution count at 1, as in a new kernel.
+#: What the modules imported hold stays (see the module's docstring, 3.).
 RESET = """
 import os, sys
 os.chdir({cwd!r})
@@ -261,20 +266,33 @@ def _work(job):
     from jupyter_cache.executors.basic import ExecutionWorkerLocalMProc
     from jupyter_cache.executors.utils import single_nb_execution
 
+    from nbclient.exceptions import CellTimeoutError
+
     class InOneKernel(ExecutionWorkerLocalMProc):
         @staticmethod
         def execute(project_nb, data):
             cwd, name = str(Path(project_nb.uri).parent), project_nb.nb.metadata.kernelspec.name
-            return single_nb_execution(project_nb.nb, cwd=cwd, timeout=data.timeout,
-                                       allow_errors=data.allow_errors, km=_kernel(name, cwd))
+            km = _kernel(name, cwd)
+            try:
+                result = single_nb_execution(project_nb.nb, cwd=cwd, timeout=data.timeout,
+                                             allow_errors=data.allow_errors, km=km)
+            finally:                        # nbclient, not owning the kernel, leaves its client running
+                while km.clients:
+                    km.clients.pop().stop_channels()
+            if isinstance(result.err, CellTimeoutError):       # the kernel still runs the cell
+                _build.pop("kernel")[1]()
+            return result
     return InOneKernel()(job)
 
 
 def _kernel(name, cwd):
     """This process's kernel (a `jupyter_client.KernelManager` of the kernel spec ``name``), ready
     for a page in the directory ``cwd``: the one its last page ran in, emptied by `RESET`, or a new
-    one (at the first page, or when the last one was of another spec, died or did not reply), which
-    this process shuts down when it exits.
+    one (at the first page, or when the last one was of another spec, died, did not reply or timed
+    out), which this process shuts down when it exits (`multiprocessing.util.Finalize`; a process
+    killed, or terminated by the pool when another died, leaves its kernel to end itself when it
+    finds its parent gone, and the kernel's connection file behind).  The clients nbclient makes
+    of it are kept in ``km.clients``, to be stopped after the page.
 
     A page's kernel and its imports cost about 2 s of CPU.  One kernel per process instead of one per
     page: cold builds on 2 CPUs, alternated, three each, medians 52.6 s against 58.6 s (70 against 85
@@ -288,7 +306,14 @@ def _kernel(name, cwd):
         shut_down()
     from multiprocessing.util import Finalize
     from jupyter_client.manager import KernelManager
-    km = KernelManager(kernel_name=name, client_class=ASYNC_CLIENT)
+
+    class PageKernel(KernelManager):
+        def client(self, **kwargs):
+            made = super().client(**kwargs)
+            self.clients.append(made)
+            return made
+    km = PageKernel(kernel_name=name, client_class=ASYNC_CLIENT)
+    km.clients = []
     km.start_kernel(cwd=cwd, extra_arguments=list(KERNEL_ARGUMENTS))
     _build["kernel"] = km, Finalize(km, km.shutdown_kernel, kwargs={"now": True}, exitpriority=0)
     return km
