@@ -265,7 +265,6 @@ def _work(job):
     process's kernel (`_kernel`)."""
     from jupyter_cache.executors.basic import ExecutionWorkerLocalMProc
     from jupyter_cache.executors.utils import single_nb_execution
-
     from nbclient.exceptions import CellTimeoutError
 
     class InOneKernel(ExecutionWorkerLocalMProc):
@@ -321,7 +320,8 @@ def _kernel(name, cwd):
 
 def _emptied(km, cwd):
     """Whether the kernel of ``km`` replied to `RESET` in the directory ``cwd`` without an error
-    (a kernel that died, or is still busy with a cell that timed out, does not reply)."""
+    within `RESET_TIMEOUT` (a kernel that died or hangs does not; one whose cell timed out was
+    already shut down by `_work`)."""
     client = km.blocking_client()
     client.start_channels()
     try:
