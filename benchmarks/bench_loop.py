@@ -1,24 +1,28 @@
-"""The author's loop, timed side by side: a base revision against this working tree.
+"""The author's loop, timed side by side from fresh clones: a base revision against a head revision.
 
-For each tree (REV checked out with ``git worktree`` into a temporary directory, and a
-copy of this working tree) the same commands run with this ``.venv`` and ``PYTHONPATH``
-set to the tree, so that the tree's packages are the ones imported (checked before
-timing).  The trees alternate, ``--repeats`` times; the table gives each command's
-median in seconds and the ratio base / head.
+For each revision, and alternating base and head ``--repeats`` times, a new ``git clone`` of
+this repository is checked out at the revision and the revision's own ``bash .ci/run`` runs in
+it, as CI runs it: the venv installed from the package registries, the book built cold (no
+bytecode, numba cache or jupyter cache yet), the tests, the audits where the revision has them.
+Each step's seconds are read from the lines ``.ci/run`` prints; then, in the same clone,
 
-* ``verify``: ``pytest verify`` (the proof checker; numba's cache warm);
-* ``book cold``: ``make book`` with no book/_build;
+* ``pytest verify``: the proof checker alone (numba's cache warm from the book);
 * ``book no change``: ``make book`` again;
-* ``book ledger.py edited``: a comment appended to renderer/ledger.py, ``make book``;
-* ``test``: ``make test`` after ``make book`` (``--test``: slow, the base's takes minutes).
+* ``book ledger.py edited``: a comment appended to renderer/ledger.py, ``make book``.
 
-Usage: python benchmarks/bench_loop.py --base REV [--repeats N] [--test]
+The table gives each row's median in seconds and head / base in per cent.  A revision's steps
+are its own (a base without ``make audit`` runs its audits inside ``make test``), so compare the
+totals, and steps only where both have them.  Commit what you measure: a clone sees commits only.
+Run it on a machine doing nothing else; a repeat takes about 12 minutes on 2 cores.
+
+Usage: python benchmarks/bench_loop.py --base REV [--head REV] [--repeats N]
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import shutil
 import statistics
 import subprocess
@@ -27,83 +31,70 @@ import tempfile
 import time
 from pathlib import Path
 
-from mutation_audit import scratch_copy      # benchmarks/: this working tree, copied
-
 ROOT = Path(__file__).resolve().parents[1]
-BIN = Path(sys.executable).parent
+#: What .ci/run prints after each step.
+STEP = re.compile(r"^\.ci/run: '(.+)' took (\d+) s$", re.M)
 
 
-def env_for(tree: Path) -> dict:
-    return {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{tree / 'book'}", "CI": "true"}
-
-
-def timed(tree: Path, cmd: list[str], must_pass=True) -> float:
-    """Seconds ``cmd`` takes in ``tree``; a failure stops the benchmark unless ``must_pass`` is
-    false (then it is reported, with the end of its output, and the time still counts)."""
+def timed(tree: Path, cmd: list[str]) -> tuple[float, str]:
+    """Seconds ``cmd`` takes in ``tree`` (as CI's environment: CI=true, bytecode written), and its
+    stderr; a failure stops the benchmark with the end of its output."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "VIRTUAL_ENV")}
     start = time.monotonic()
-    run = subprocess.run(cmd, cwd=tree, env=env_for(tree), capture_output=True, text=True)
+    run = subprocess.run(cmd, cwd=tree, env={**env, "CI": "true"}, capture_output=True, text=True)
     seconds = time.monotonic() - start
     if run.returncode != 0:
-        if must_pass:
-            raise SystemExit(f"{' '.join(cmd)} failed in {tree}:\n{(run.stdout + run.stderr)[-3000:]}")
-        print(f"{' '.join(cmd)} failed in {tree} ({seconds:.0f} s): {run.stdout.strip().splitlines()[-1:]}",
-              file=sys.stderr, flush=True)
-    return seconds
+        raise SystemExit(f"{' '.join(cmd)} failed in {tree}:\n{(run.stdout + run.stderr)[-3000:]}")
+    return seconds, run.stderr
 
 
-def make(target):
-    return ["make", "-o", ".venv/.installed", f"BIN={BIN}", target]
-
-
-def rounds(tree: Path, with_test: bool) -> dict[str, float]:
-    """One timing of each command in ``tree``."""
-    out = {"verify": timed(tree, [str(BIN / "python"), "-m", "pytest", "verify", "-q", "-p", "no:cacheprovider"])}
-    shutil.rmtree(tree / "book" / "_build", ignore_errors=True)
-    out["book cold"] = timed(tree, make("book"))
-    out["book no change"] = timed(tree, make("book"))
+def one_round(rev: str, tree: Path) -> dict[str, float]:
+    """One fresh clone of ``rev`` at ``tree``, timed: each step of its .ci/run, the total, then the rest."""
+    shutil.rmtree(tree, ignore_errors=True)
+    subprocess.run(["git", "clone", "--quiet", str(ROOT), str(tree)], check=True)
+    subprocess.run(["git", "checkout", "--quiet", "--detach", rev], cwd=tree, check=True)
+    total, stderr = timed(tree, ["bash", ".ci/run"])
+    out = {step.replace(" -o book", ""): float(s) for step, s in STEP.findall(stderr)}
+    out[".ci/run in all"] = total
+    out["pytest verify"] = timed(tree, [str(tree / ".venv" / "bin" / "python"), "-m", "pytest", "verify",
+                                        "-q", "-p", "no:cacheprovider"])[0]
+    out["book no change"] = timed(tree, ["make", "book"])[0]
     ledger = tree / "renderer" / "ledger.py"
-    text = ledger.read_text(encoding="utf-8")
-    ledger.write_text(text + "# edited\n", encoding="utf-8")
-    try:
-        out["book ledger.py edited"] = timed(tree, make("book"))
-    finally:
-        ledger.write_text(text, encoding="utf-8")
-    if with_test:     # a base whose tests need what this checkout no longer installs may fail some
-        timed(tree, make("book"))           # the edit reverted: make test then finds the book current
-        out["test"] = timed(tree, make("test"), must_pass=False)
-    print(f"{tree.name}: " + ", ".join(f"{k} {v:.1f} s" for k, v in out.items()), file=sys.stderr, flush=True)
+    ledger.write_text(ledger.read_text(encoding="utf-8") + "# edited\n", encoding="utf-8")
+    out["book ledger.py edited"] = timed(tree, ["make", "book"])[0]
+    print(f"{rev}: " + ", ".join(f"{k} {v:.0f} s" for k, v in out.items()), file=sys.stderr, flush=True)
     return out
 
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--base", required=True, help="the revision to compare against")
+    p.add_argument("--head", default="HEAD", help="the revision measured (default HEAD)")
     p.add_argument("--repeats", type=int, default=1)
-    p.add_argument("--test", action="store_true", help="time make test too")
     args = p.parse_args(argv)
+    if args.repeats < 1:
+        raise SystemExit(f"--repeats: {args.repeats} is not a positive number of rounds")
+    revs = {}
+    for name in ("base", "head"):
+        rev = getattr(args, name)
+        found = subprocess.run(["git", "rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"], cwd=ROOT,
+                               capture_output=True, text=True)
+        if found.returncode != 0:
+            raise SystemExit(f"--{name}: {rev!r} is not a commit of {ROOT}")
+        revs[name] = found.stdout.strip()[:12]
+    times = {"base": [], "head": []}
     with tempfile.TemporaryDirectory(prefix="symrender-loop-") as tmp:
-        base, head = Path(tmp, "base"), Path(tmp, "head")
-        subprocess.run(["git", "worktree", "add", "--detach", str(base), args.base], cwd=ROOT, check=True,
-                       capture_output=True)
-        try:
-            head.mkdir()
-            scratch_copy(head)
-            for tree in (base, head):
-                where = subprocess.run([str(BIN / "python"), "-c", "import renderer; print(renderer.__file__)"],
-                                       cwd=tree, env=env_for(tree), capture_output=True, text=True).stdout
-                assert where.startswith(str(tree)), (tree, where)
-                timed(tree, [str(BIN / "python"), "-c", "import renderer; renderer.render(renderer.Scene(), 8, 8)"])
-            times = {"base": [], "head": []}
-            for _ in range(args.repeats):
-                for name, tree in (("base", base), ("head", head)):
-                    times[name].append(rounds(tree, args.test))
-        finally:
-            subprocess.run(["git", "worktree", "remove", "--force", str(base)], cwd=ROOT, capture_output=True)
-    print(f"| what | base {args.base} (s) | head (s) | base / head |\n|---|---:|---:|---:|")
-    for key in times["head"][0]:
-        b = statistics.median(t[key] for t in times["base"])
-        h = statistics.median(t[key] for t in times["head"])
-        print(f"| {key} | {b:.1f} | {h:.1f} | {b / h:.1f}x |")
+        for _ in range(args.repeats):
+            for name in ("base", "head"):
+                times[name].append(one_round(revs[name], Path(tmp, name)))
+    rows = list(dict.fromkeys([*times["base"][0], *times["head"][0]]))
+    print(f"| what | base {revs['base']} (s) | head {revs['head']} (s) | head / base |\n|---|---:|---:|---:|")
+    for key in rows:
+        b = [t[key] for t in times["base"] if key in t]
+        h = [t[key] for t in times["head"] if key in t]
+        cell = lambda xs: f"{statistics.median(xs):.1f}" if xs else "—"      # noqa: E731
+        ratio = f"{100 * statistics.median(h) / statistics.median(b):.0f} %" if b and h else "—"
+        print(f"| {key} | {cell(b)} | {cell(h)} | {ratio} |")
 
 
 if __name__ == "__main__":
