@@ -87,7 +87,7 @@ def main(argv=None):
         for _ in range(args.repeats):
             for name in ("base", "head"):
                 times[name].append(one_round(revs[name], Path(tmp, name)))
-    rows = list(dict.fromkeys([*times["base"][0], *times["head"][0]]))
+    rows = list(dict.fromkeys([*times["head"][0], *times["base"][0]]))      # head's steps in its order
     print(f"| what | base {revs['base']} (s) | head {revs['head']} (s) | head / base |\n|---|---:|---:|---:|")
     for key in rows:
         b = [t[key] for t in times["base"] if key in t]
