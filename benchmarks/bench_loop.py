@@ -55,6 +55,8 @@ def one_round(rev: str, tree: Path) -> dict[str, float]:
     subprocess.run(["git", "checkout", "--quiet", "--detach", rev], cwd=tree, check=True)
     total, stderr = timed(tree, ["bash", ".ci/run"])
     out = {step.replace(" -o book", ""): float(s) for step, s in STEP.findall(stderr)}
+    if not out:
+        raise SystemExit(f"{rev}'s .ci/run printed no line like \".ci/run: 'make book' took 46 s\": no step to time")
     out[".ci/run in all"] = total
     out["pytest verify"] = timed(tree, [str(tree / ".venv" / "bin" / "python"), "-m", "pytest", "verify",
                                         "-q", "-p", "no:cacheprovider"])[0]
