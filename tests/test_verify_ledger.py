@@ -26,3 +26,20 @@ def test_the_ledger_is_printed_with_each_verdict(workers):
     steps = len(THEOREMS["frame-orientation"].steps)
     assert (theorem_id, status) == ("frame-orientation", "proved"), rows
     assert re.match(rf"{steps} steps\b", evidence), rows      # the verdict's evidence, which counts the steps
+
+
+def test_the_ledger_is_in_the_chapters_order_whatever_order_the_verdicts_arrive_in(monkeypatch):
+    """The controller sorts the rows by the place each report carries (it imports no theorem to sort
+    them): verdicts arriving last to first are printed first to last.  The wrong variant, rows in the
+    order of arrival, prints them reversed."""
+    from types import SimpleNamespace
+
+    from verify import conftest
+    monkeypatch.setattr(conftest, "LEDGER", {})
+    ids = list(THEOREMS)
+    for place, theorem_id in reversed(list(enumerate(ids))):
+        conftest.pytest_runtest_logreport(SimpleNamespace(
+            when="call", user_properties=[("ledger", (place, theorem_id, "proved", "evidence"))]))
+    lines = []
+    conftest.pytest_terminal_summary(SimpleNamespace(section=lambda title: None, write_line=lines.append))
+    assert [line.split()[0] for line in lines] == ids, lines

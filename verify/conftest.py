@@ -4,11 +4,13 @@ when a test asks for it), and the theorem ledger printed at the end of the run.
 The ledger is collected from the test reports: test_theorem_holds records each verdict as
 its report's user property ``ledger``, which pytest-xdist carries from the worker that ran
 the test to the controller, where `pytest_runtest_logreport` files it and
-`pytest_terminal_summary` prints it; without xdist both run in the one process."""
+`pytest_terminal_summary` prints it, in the chapter's order (the theorem's place, which the report
+carries: the controller does not import the theorems to sort them); without xdist both run in the one
+process."""
 
 import pytest
 
-#: {theorem id: (status, evidence)} of the verdicts reported to this process.
+#: {theorem id: (place in the chapter, status, evidence)} of the verdicts reported to this process.
 LEDGER = {}
 
 
@@ -16,8 +18,8 @@ def pytest_runtest_logreport(report):
     if report.when == "call":
         for name, value in report.user_properties:
             if name == "ledger":
-                theorem_id, status, evidence = value
-                LEDGER[theorem_id] = (status, evidence)
+                place, theorem_id, status, evidence = value
+                LEDGER[theorem_id] = (place, status, evidence)
 
 
 class _Claims(dict):
@@ -54,9 +56,7 @@ def pytest_terminal_summary(terminalreporter):
     if not LEDGER:
         return
     tr = terminalreporter
-    from proofs.registry import THEOREMS
     tr.section("theorem ledger")
     width = max(len(k) for k in LEDGER)
-    for theorem_id in sorted(LEDGER, key=list(THEOREMS).index):      # in the chapter's order
-        status, evidence = LEDGER[theorem_id]
+    for theorem_id, (_, status, evidence) in sorted(LEDGER.items(), key=lambda item: item[1][0]):
         tr.write_line(f"{theorem_id:<{width}}  {status:<8}  {evidence}")

@@ -21,7 +21,8 @@ BOOK = Path(__file__).resolve().parents[1] / "book"
                                         for t in THEOREMS])
 def test_theorem_holds(theorem_id, record_property):
     verdict = THEOREMS[theorem_id].check()
-    record_property("ledger", (theorem_id, verdict.status, verdict.evidence))      # printed by conftest.py
+    # printed by conftest.py, in the chapter's order: the place, not the registry, travels with the report
+    record_property("ledger", (list(THEOREMS).index(theorem_id), theorem_id, verdict.status, verdict.evidence))
     assert verdict.holds, f"{theorem_id} {verdict.status}: {verdict.evidence}"
     assert isinstance(verdict.evidence, str) and verdict.evidence, "the ledger shows the evidence"
     assert not code_words(verdict.evidence), f"§6 shows the evidence to the reader: {code_words(verdict.evidence)}"
