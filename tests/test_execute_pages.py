@@ -182,7 +182,7 @@ def test_a_pool_process_runs_its_pages_in_one_kernel_each_a_stranger_to_the_last
     pages = {"a.md": "shared = 1", "sub/b.md": "shared", "c.md": "1 + 1", "d.md": "import time\ntime.sleep(30)",
              "e.md": "print('e ran')", "f.md": "os._exit(9)", "g.md": "print('g ran')"}
     cache, jobs = _jobs(tmp_path, {name: _page(LOGGED.format(log=str(log)) + code) for name, code in pages.items()},
-                        timeout=8)
+                        timeout=3)
     done = _in_one_process(jobs)
     assert done == [0, 1, 0, 1, 0, 2, 0], done
     assert "NameError: name 'shared' is not defined" in execute_pages.cause(cache.get_project_record(jobs[1].uri).traceback)
