@@ -7,6 +7,7 @@ file that reach a function once per mutant of it in proofs/core.py.
 """
 
 import dataclasses
+import itertools
 import re
 
 import pytest
@@ -346,6 +347,43 @@ def test_square_roots_are_reduced_whatever_way_their_radicand_is_written():
     assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T)) == 0
     assert core._radicals_reduced(sp.sqrt(S) ** 3 - T * sp.sqrt(T + 1)) != 0
     assert core._radicals_reduced((x + 1) ** 2 - x**2 - 2 * x - 1) == 0          # no root: plain expansion
+
+
+#: Angles spelt as `_circle_reduced` meets them: z, 2z three ways (the last one -2z) and y.
+_z = sp.Symbol("z", real=True)
+SPELLINGS = (_z, 2 * _z, (_z + 1) ** 2 - _z**2 - 1, _z**2 - (_z + 1) ** 2 + 1, y)
+#: sin and cos of each two spellings: equal (2z spelt two ways; cos of 2z and -2z) or not.
+SPELLING_PAIRS = [(f, a, b) for f in (sp.sin, sp.cos) for a, b in itertools.combinations(SPELLINGS, 2)]
+
+
+@pytest.mark.parametrize("seed", range(2 * len(SPELLING_PAIRS)))
+def test_the_circle_reduction_is_zero_exactly_when_the_expression_vanishes(seed):
+    """`_circle_reduced` against an independent reference, mpmath at 50 digits at five random points.  The
+    expression: a random polynomial in sin and cos of `SPELLINGS` times sin(a)**2 + cos(b)**2 - 1, a and b
+    spellings of one angle (an identity), plus for odd seeds a random term times f(a) - f(b) for the next
+    pair of `SPELLING_PAIRS` (an identity only where the two are equal), over a denominator that does not
+    vanish.  The reduction is 0 when, and only when, the expression vanishes.  Wrong variants it catches:
+    an angle's spellings kept apart, different angles taken for one, sin(-a) taken for sin(a), the circle's
+    relation with a wrong sign, the numerator left unreduced."""
+    import random
+
+    import mpmath
+    rng = random.Random(seed)
+    terms = [f(a) for a in SPELLINGS for f in (sp.sin, sp.cos)]
+
+    def poly(n):
+        return sum(rng.randint(-3, 3) * sp.Mul(*rng.sample(terms, rng.randint(0, 3))) for _ in range(n))
+    angle = rng.choice(((SPELLINGS[0],), SPELLINGS[1:4], (y,)))
+    expr = poly(3) * (sp.sin(rng.choice(angle)) ** 2 + sp.cos(rng.choice(angle)) ** 2 - 1)
+    if seed % 2:
+        f, a, b = SPELLING_PAIRS[seed // 2]
+        expr += rng.choice(terms) * (f(a) - f(b))
+    expr /= 3 + rng.choice(terms)
+    fn = sp.lambdify((_z, y), expr, modules="mpmath")
+    with mpmath.workdps(50):
+        vanishes = all(abs(fn(mpmath.mpf(rng.uniform(-3, 3)), mpmath.mpf(rng.uniform(-3, 3)))) < mpmath.mpf(10) ** -40
+                       for _ in range(5))
+    assert (core._circle_reduced(expr) == 0) == vanishes, (expr, core._circle_reduced(expr))
 
 
 # ------------------------------------------------------------------------- the soundness rules
