@@ -386,6 +386,17 @@ def test_the_circle_reduction_is_zero_exactly_when_the_expression_vanishes(seed)
     assert (core._circle_reduced(expr) == 0) == vanishes, (expr, core._circle_reduced(expr))
 
 
+def test_a_sine_inside_a_root_or_an_abs_is_left_to_the_other_simplifiers():
+    """sin and cos under a square root or an Abs are not a polynomial in s and c: the circle reduction
+    refuses them (PolynomialError), and `_exactly_zero` goes on to the others, which prove the identity and
+    leave the non-identity undecided.  The wrong variant, the refusal not caught, raises here."""
+    root_identity, not_identity = sp.sqrt(sp.sin(_z) ** 2 + sp.cos(_z) ** 2) - 1, sp.Abs(sp.sin(_z)) - sp.sin(_z)
+    for expr in (root_identity, not_identity):
+        with pytest.raises(sp.PolynomialError):
+            core._circle_reduced(expr)
+    assert core._exactly_zero(root_identity) and not core._exactly_zero(not_identity)
+
+
 # ------------------------------------------------------------------------- the soundness rules
 # Each test plants a violation of one rule of proofs/core.py's docstring and requires a refusal: no
 # correct theorem breaks a rule, so only a planted violation shows that the checker enforces it.
