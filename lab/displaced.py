@@ -264,7 +264,7 @@ def _shade(prm, prm_no_b, lights, chamber, P, N, albedo, blocked, image):
     normal faces the light, the floor plane, sphere B).  Called as for a point of sphere A, so
     that the kernel does not test its undisplaced sphere A; on sphere B with sphere B off."""
     s, s_no_b = prm[0], prm_no_b[0]
-    masked = lights.copy()
+    masked, geo = lights.copy(), np.empty((lights.shape[0], kernel.LIGHT_COLUMNS))
     for j in range(chamber.shape[0]):
         for i in range(chamber.shape[1]):
             if chamber[j, i] == kernel.BACKGROUND:
@@ -274,7 +274,7 @@ def _shade(prm, prm_no_b, lights, chamber, P, N, albedo, blocked, image):
                     masked[k].color[c] = 0.0 if blocked[k, j, i] else lights[k].color[c]
             p, n = (P[j, i, 0], P[j, i, 1], P[j, i, 2]), (N[j, i, 0], N[j, i, 1], N[j, i, 2])
             a = (albedo[j, i, 0], albedo[j, i, 1], albedo[j, i, 2])
-            rgb = kernel.shade(s_no_b if chamber[j, i] == kernel.SPHERE_B else s, masked, p, n, n, a,
+            rgb = kernel.shade(s_no_b if chamber[j, i] == kernel.SPHERE_B else s, masked, geo, p, n, n, a,
                                kernel.SPHERE_A, True)
             image[j, i, 0], image[j, i, 1], image[j, i, 2] = rgb
 

@@ -3,15 +3,15 @@
 One pixel at a time, in the order of the data flow (seed Cell 1,
 ``render_numeric_bump``; the §4 simulator's renderer/js/render.js and the
 scalar reference of tests/ take the same steps): camera ray -> `nearest_hit`
-(chamber) -> `surface` (hit point, normal, albedo) -> on sphere A: `chart`,
-`tangent_frame`, `gradient`, `shading_normal` -> `shade`: ambient + per
-light, `reach` (the normal faces the light, the floor plane does not
-separate them, no blocker sphere on the segment) then Lambert and
-Blinn/Phong with the shading normal.
+(chamber) -> `surface` (hit point, normal, albedo) -> per light `facing`
+(the normal faces the light, the floor plane does not separate them) -> on
+sphere A: `chart`, `tangent_frame`, `gradient`, `shading_normal` ->
+`shade_lit`: ambient + per light not `shadowed` (no blocker sphere on the
+segment) Lambert and Blinn/Phong with the shading normal.
 
 Everything up to the gradient depends on geometry alone (theorem "bump moves
-no boundary"), which licenses `sweep_rows`: geometry and shadow rays once per
-pixel, sphere A re-shaded per step.  Sphere A's formulas come from
+no boundary"), which licenses the frames of `render_rows`: geometry and shadow
+rays once per pixel, sphere A shaded per frame (an eps sweep's steps).  Sphere A's formulas come from
 renderer/generated.py (`renderer.codegen` prints `renderer.formulas`).
 Compiled on first use, cached in ``__pycache__`` (or numba's user cache);
 as that cache checks only the file of the function it compiled, this file
@@ -38,7 +38,6 @@ from pathlib import Path
 import numba
 import numpy as np
 from numba import njit, prange
-from numba.extending import overload
 
 from . import _numba_cache
 
@@ -70,11 +69,15 @@ DERIVED = {"phong": lambda scene: scene.model == "phong",
            "surface": lambda scene: scene.bump == "surface"}
 #: A point light: position and colour (linear RGB intensities).
 LIGHT = np.dtype([("position", "f8", (3,)), ("color", "f8", (3,))], align=True)
-#: Per light, `sweep_row`'s geometry of one pixel: the unit vector ``w`` to the light, its
-#: `specular_axis` (``axis``, ``wv``), and whether the light reaches the pixel (``lit``).
-LIGHT_GEOMETRY = np.dtype([("w", "f8", (3,)), ("axis", "f8", (3,)), ("wv", "f8"), ("lit", "?")], align=True)
+#: What `render_row` keeps of each light at one pixel, a row of an (n, `LIGHT_COLUMNS`) float64
+#: array: the unit vector to the light (columns `W` to W + 2), its `specular_axis` (`AXIS` to
+#: AXIS + 2, and `WV`) and its `STATE`: `UNTRACED` (the normal faces it, its shadow ray not yet
+#: traced), `LIT` (it reaches the pixel) or `DARK` (it does not).  A plain array: with a record
+#: array's nested fields instead, renders measured about 10 % slower.
+W, AXIS, WV, STATE, LIGHT_COLUMNS = 0, 3, 6, 7, 8
+UNTRACED, LIT, DARK = 0.0, 1.0, 2.0
 #: What `render_rows` computes, and how (see its docstring).
-Job = namedtuple("Job", "method eps skip want_kink want_grad want_geo dx dy")
+Job = namedtuple("Job", "methods steps skip want_kink want_grad want_geo dx dy")
 #: The arrays `render_rows` writes (see its docstring).
 Outputs = namedtuple("Outputs", "image chamber kink grad t P N Ns uv")
 
@@ -239,30 +242,41 @@ def chart_of(N):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def reach(s, L, P, N, code, skip, gate, Ns):
-    """Unit vector w from P to the light L and whether the light reaches P:
-    the geometric normal faces it (attached shadow), the floor plane does not
-    separate them (floor on, P off the floor), and no blocker sphere (B for A,
-    A for B, both for the floor) cuts the segment (cast shadow).  Geometry
-    only.  With ``gate`` the shadow ray is not traced where Ns . w <= 0, where
-    `light_term` adds nothing (then False is returned); with ``skip`` sphere B
-    is tested only if it is on."""
+def facing(s, L, P, N, code):
+    """Unit vector w from P to the light L, and whether the light can reach P on
+    the cheap tests: the geometric normal faces it (attached shadow) and the floor
+    plane does not separate them (floor on, P off the floor); else (0, 0, 0), False."""
     wx, wy, wz = L[0] - P[0], L[1] - P[1], L[2] - P[2]
     if not N[0] * wx + N[1] * wy + N[2] * wz > 0.0:
         return (0.0, 0.0, 0.0), False
     if s.floor and code != FLOOR and ((L[2] < 0.0 and P[2] > 0.0) or (L[2] > 0.0 and P[2] < 0.0)):
         return (0.0, 0.0, 0.0), False
+    return unit_vector(wx, wy, wz, wx * wx + wy * wy + wz * wz), True
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def shadowed(s, L, P, code, skip):
+    """Does a blocker sphere (B for A, A for B, both for the floor) cut the segment from
+    P to the light L (cast shadow)?  With ``skip`` sphere B is tested only if it is on."""
+    wx, wy, wz = L[0] - P[0], L[1] - P[1], L[2] - P[2]
     w2 = wx * wx + wy * wy + wz * wz
-    w = unit_vector(wx, wy, wz, w2)
-    if gate and not Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0:
-        return w, False
     if code != SPHERE_A and segment_blocked(wx, wy, wz, w2, L, 0.0, 0.0, 0.0, s.radius_a):
-        return w, False
+        return True
     if code != SPHERE_B and (s.sphere_b or not skip):
         c = s.center_b
-        if segment_blocked(wx, wy, wz, w2, L, c[0], c[1], c[2], s.radius_b) and s.sphere_b:
-            return w, False
-    return w, True
+        return segment_blocked(wx, wy, wz, w2, L, c[0], c[1], c[2], s.radius_b) and s.sphere_b
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def reach(s, L, P, N, code, skip, gate, Ns):
+    """(w, whether the light L reaches P): `facing` and not `shadowed`; geometry
+    only.  With ``gate`` the shadow ray is not traced where Ns . w <= 0, where
+    `light_term` adds nothing (then False is returned)."""
+    w, ok = facing(s, L, P, N, code)
+    if not ok or (gate and not Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0):
+        return w, False
+    return w, not shadowed(s, L, P, code, skip)
 
 
 @njit(cache=True, error_model="numpy")
@@ -322,21 +336,50 @@ def light_term(s, color, w, axis, wv, Ns, albedo):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def shade(s, lights, P, N, Ns, albedo, code, skip):
-    """Ambient plus every light that reaches P (seed Cell 1, ``shade1``): (r, g, b) clipped to [0, 1]."""
-    r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
-    view = (0.0, 0.0, 0.0)
+def face(s, lights, P, N, code, geo):
+    """Fill ``geo`` ((n, `LIGHT_COLUMNS`) float64) with each light's `facing` at P: its unit
+    vector w, and its state `UNTRACED` (its shadow ray traced when a frame first needs it) or `DARK`."""
     for k in range(lights.shape[0]):
-        light = lights[k]
-        w, lit = reach(s, light.position, P, N, code, skip, skip, Ns)
-        if lit:
-            if view[2] == 0.0:          # > 0 once computed: P is below the eye
-                view = view_vector(s, P)
+        w, ok = facing(s, lights[k].position, P, N, code)
+        geo[k, W], geo[k, W + 1], geo[k, W + 2] = w
+        geo[k, STATE] = UNTRACED if ok else DARK
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def shade_lit(s, lights, geo, P, view, Ns, albedo, code, skip):
+    """Ambient plus every light that reaches P (seed Cell 1, ``shade1``), with shading normal
+    Ns and ``view`` the `view_vector`, for the lights `face` described in ``geo``: (r, g, b)
+    clipped to [0, 1].  A light's
+    shadow ray is traced the first time a frame needs it (with ``skip``, not where Ns . w <=
+    0, where `light_term` adds nothing), and its verdict and `specular_axis` kept in ``geo``
+    for the pixel's other frames."""
+    r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
+    for k in range(lights.shape[0]):
+        state = geo[k, STATE]
+        if state == DARK:
+            continue
+        w = (geo[k, W], geo[k, W + 1], geo[k, W + 2])
+        if skip and not Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2] > 0.0:
+            continue
+        if state == UNTRACED:
+            if shadowed(s, lights[k].position, P, code, skip):
+                geo[k, STATE] = DARK
+                continue
             axis, wv = specular_axis(s, w, view)
-            dr, dg, db = light_term(s, light.color, w, axis, wv, Ns, albedo)
-            r, g, b = r + dr, g + dg, b + db
+            geo[k, AXIS], geo[k, AXIS + 1], geo[k, AXIS + 2] = axis
+            geo[k, WV], geo[k, STATE] = wv, LIT
+        axis = (geo[k, AXIS], geo[k, AXIS + 1], geo[k, AXIS + 2])
+        dr, dg, db = light_term(s, lights[k].color, w, axis, geo[k, WV], Ns, albedo)
+        r, g, b = r + dr, g + dg, b + db
     # + 0.0: a -0.0 (a -0.0 albedo times a light) leaves as 0.0, not as a negative zero pixel.
     return min(max(r, 0.0), 1.0) + 0.0, min(max(g, 0.0), 1.0) + 0.0, min(max(b, 0.0), 1.0) + 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def shade(s, lights, geo, P, N, Ns, albedo, code, skip):
+    """One frame's (r, g, b) at P: `face` then `shade_lit` (``geo`` scratch, as `face`'s)."""
+    face(s, lights, P, N, code, geo)
+    return shade_lit(s, lights, geo, P, view_vector(s, P), Ns, albedo, code, skip)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -366,7 +409,13 @@ def shading_normal(s, N, frame, h, hu, hv, sin_phi):
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def render_rows(scene, lights, xs, ys, first, last, job, out, field):
-    """Render the pixels of rows ``first`` to ``last - 1`` (in parallel) into the preallocated outputs.
+    """Render the pixels of rows ``first`` to ``last - 1`` (in parallel) into the preallocated
+    outputs: F frames of one geometry, which differ only in sphere A's gradient method and step.
+
+    Per pixel the geometry (hit, normal, chart, tangent frame) is computed once, and each
+    light's shadow ray at most once (theorem "bump moves no boundary": none depends on the
+    gradient); sphere A is shaded per frame.  A render is one frame; an eps sweep
+    (`renderer.sweep`) is the exact frame and one central frame per step.
 
     Parameters
     ----------
@@ -379,15 +428,16 @@ def render_rows(scene, lights, xs, ys, first, last, job, out, field):
     first, last : int
         The rows to render, 0 <= first <= last <= H.
     job : Job
-        ``method`` (int: `EXACT`, `CENTRAL` or `FOOTPRINT`), ``eps`` (float, the central
-        step), ``skip`` (bool, see the module), ``want_kink``, ``want_grad``, ``want_geo``
-        (bool: which optional outputs to write), ``dx``, ``dy`` (float, the pixel spacing).
+        ``methods`` ((F,) int64: `EXACT`, `CENTRAL` or `FOOTPRINT` per frame), ``steps`` ((F,)
+        float64, the central step per frame), ``skip`` (bool, see the module), ``want_kink``,
+        ``want_grad``, ``want_geo`` (bool: which optional outputs to write), ``dx``, ``dy``
+        (float, the pixel spacing).
     field : FieldCode
         The height field's compiled functions (`renderer.fieldcode.compiled`).
     out : Outputs
-        image (H, W, 3) float64, chamber (H, W) uint8; kink (H, W) bool and grad (H, W, 2)
-        float64 when wanted; t (H, W), P, N, Ns (H, W, 3), uv (H, W, 2) float64 when
-        ``want_geo`` (the GBuffer).  Written in place.
+        image (F, H, W, 3) float64, chamber (H, W) uint8; kink (H, W) bool (frame 0's crease
+        flag) and grad (F, H, W, 2) float64 when wanted; t (H, W), P, N, Ns (H, W, 3), uv
+        (H, W, 2) float64 of frame 0 when ``want_geo`` (the GBuffer).  Written in place.
 
     Notes
     -----
@@ -405,9 +455,10 @@ def render_rows(scene, lights, xs, ys, first, last, job, out, field):
 def render_row(j, scene, lights, xs, ys, sin_x, job, out, field):
     """Row j of `render_rows`."""
     s, y, sin_y = scene[0], ys[j], math.sin(math.pi * ys[j])
-    method, eps, skip, dx, dy = job.method, job.eps, job.skip, job.dx, job.dy
+    methods, steps, skip, dx, dy = job.methods, job.steps, job.skip, job.dx, job.dy
     want_kink, want_grad, want_geo = job.want_kink, job.want_grad, job.want_geo
     image, chamber, kink, grad = out.image, out.chamber, out.kink, out.grad
+    geo = np.empty((lights.shape[0], LIGHT_COLUMNS))
     for i in range(xs.shape[0]):
         x = xs[i]
         t, code = nearest_hit(s, x, y, skip)
@@ -417,96 +468,35 @@ def render_row(j, scene, lights, xs, ys, sin_x, job, out, field):
         if code == BACKGROUND:
             continue
         P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
-        Ns = N
-        if code == SPHERE_A:
+        face(s, lights, P, N, code, geo)
+        view, Ns = view_vector(s, P), N
+        if code != SPHERE_A:
+            rgb = shade_lit(s, lights, geo, P, view, N, albedo, code, skip)
+            for f in range(image.shape[0]):
+                image[f, j, i, 0], image[f, j, i, 1], image[f, j, i, 2] = rgb
+        else:
             u, v, sin_phi = chart_of(N)
             frame = tangent_frame(N[0], N[1], N[2], sin_phi)
-            h, hu, hv, flag = 0.0, 0.0, 0.0, False
-            if want_grad or want_geo or s.beta != 0.0 or not skip:
-                h, hu, hv, flag = gradient(s, field, method, eps, u, v, x, y, dx, dy, P, N, frame, sin_phi)
-            elif want_kink:
-                flag = field.kink(u, v, s.k_u, s.k_v)
-            Ns = shading_normal(s, N, frame, h, hu, hv, sin_phi)
-            if want_grad:
-                grad[j, i, 0], grad[j, i, 1] = hu, hv
-            if want_kink:
-                kink[j, i] = flag
+            for f in range(image.shape[0]):
+                h, hu, hv, flag = 0.0, 0.0, 0.0, False
+                if want_grad or want_geo or s.beta != 0.0 or not skip:
+                    h, hu, hv, flag = gradient(s, field, methods[f], steps[f], u, v, x, y, dx, dy, P, N, frame,
+                                               sin_phi)
+                elif want_kink and f == 0:
+                    flag = field.kink(u, v, s.k_u, s.k_v)
+                ns = shading_normal(s, N, frame, h, hu, hv, sin_phi)
+                image[f, j, i, 0], image[f, j, i, 1], image[f, j, i, 2] = shade_lit(s, lights, geo, P, view, ns,
+                                                                                    albedo, code, skip)
+                if want_grad:
+                    grad[f, j, i, 0], grad[f, j, i, 1] = hu, hv
+                if f == 0:
+                    Ns = ns
+                    if want_kink:
+                        kink[j, i] = flag
             if want_geo:
                 out.uv[j, i, 0], out.uv[j, i, 1] = u, v
-        image[j, i, 0], image[j, i, 1], image[j, i, 2] = shade(s, lights, P, N, Ns, albedo, code, skip)
         for c in range(3 if want_geo else 0):
             out.P[j, i, c], out.N[j, i, c], out.Ns[j, i, c] = P[c], N[c], Ns[c]
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def sweep_rows(scene, lights, xs, ys, first, last, steps, images, chamber, kink, grads, field):
-    """Rows ``first`` to ``last - 1`` of the exact frame (index 0) and of one central frame per
-    step (1, 2, ...).
-    Per pixel the geometry and the shadow rays are computed once (they do not
-    depend on the gradient); sphere A is re-shaded per step, crease flag kept.
-    scene, lights, xs, ys as `render_rows`; steps (S,) float64; images (S+1, H, W, 3),
-    grads (S+1, H, W, 2) float64; chamber (H, W) uint8, kink (H, W) bool; field as `render_rows`.
-    The caller allocates the outputs with these shapes (nothing is checked here).
-    """
-    sin_x = np.sin(np.pi * xs)
-    for j in prange(first, last):
-        sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads, field)
-
-
-@njit(cache=True, error_model="numpy")
-def sweep_row(j, scene, lights, xs, ys, sin_x, steps, images, chamber, kink, grads, field):
-    """Row j of `sweep_rows`."""
-    s, y, sin_y, n = scene[0], ys[j], math.sin(math.pi * ys[j]), lights.shape[0]
-    geo = light_geometry(n)
-    for i in range(xs.shape[0]):
-        x = xs[i]
-        t, code = nearest_hit(s, x, y, True)
-        chamber[j, i] = code
-        if code == BACKGROUND:
-            continue
-        P, N, albedo = surface(s, x, y, t, code, sin_x[i] * sin_y)
-        if code != SPHERE_A:
-            rgb = shade(s, lights, P, N, N, albedo, code, True)
-            for f in range(images.shape[0]):
-                images[f, j, i, 0], images[f, j, i, 1], images[f, j, i, 2] = rgb
-            continue
-        u, v, sin_phi = chart_of(N)
-        frame = tangent_frame(N[0], N[1], N[2], sin_phi)
-        view = view_vector(s, P)
-        for k in range(n):
-            # Every shadow ray of an attached light, once (Ns varies with the step).
-            g = geo[k]
-            w, g.lit = reach(s, lights[k].position, P, N, code, True, False, N)
-            axis, g.wv = specular_axis(s, w, view)
-            g.w[0], g.w[1], g.w[2] = w
-            g.axis[0], g.axis[1], g.axis[2] = axis
-        for f in range(images.shape[0]):
-            method, eps = (EXACT, 0.0) if f == 0 else (CENTRAL, steps[f - 1])
-            h, hu, hv, flag = gradient(s, field, method, eps, u, v, x, y, 0.0, 0.0, P, N, frame, sin_phi)
-            if f == 0:
-                kink[j, i] = flag
-            Ns = shading_normal(s, N, frame, h, hu, hv, sin_phi)
-            r, g, b = s.ka * s.ambient[0], s.ka * s.ambient[1], s.ka * s.ambient[2]
-            for k in range(n):
-                light = geo[k]
-                if light.lit:
-                    dr, dg, db = light_term(s, lights[k].color, light.w, light.axis, light.wv, Ns, albedo)
-                    r, g, b = r + dr, g + dg, b + db
-            images[f, j, i, 0], images[f, j, i, 1] = min(max(r, 0.0), 1.0) + 0.0, min(max(g, 0.0), 1.0) + 0.0
-            images[f, j, i, 2] = min(max(b, 0.0), 1.0) + 0.0
-            grads[f, j, i, 0], grads[f, j, i, 1] = hu, hv
-
-
-def light_geometry(n):
-    """An (n,) `LIGHT_GEOMETRY` record array of zeros, fields read by name (compiled: the
-    array; interpreted, NUMBA_DISABLE_JIT=1: its ``np.recarray`` view, as numpy's plain
-    structured array has no attribute access)."""
-    return np.zeros(n, LIGHT_GEOMETRY).view(np.recarray)
-
-
-@overload(light_geometry, jit_options=dict(cache=True))
-def _light_geometry(n):
-    return lambda n: np.zeros(n, LIGHT_GEOMETRY)
 
 
 def params(scene, skip=True):

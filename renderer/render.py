@@ -171,9 +171,9 @@ def threads(workers):
 
 def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_geo, workers):
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
-    out = dict(image=np.zeros((height, width, 3)), chamber=np.zeros((height, width), np.uint8),
+    out = dict(image=np.zeros((1, height, width, 3)), chamber=np.zeros((height, width), np.uint8),
                kink=np.zeros((height, width) if want_kink else (1, 1), bool),
-               grad=np.zeros((height, width, 2) if want_grad else (1, 1, 2)))
+               grad=np.zeros((1, height, width, 2) if want_grad else (1, 1, 1, 2)))
     geo_shape = (height, width) if want_geo else (1, 1)
     geo = dict(t=np.full(geo_shape, np.inf), P=np.zeros(geo_shape + (3,)), N=np.zeros(geo_shape + (3,)),
                Ns=np.zeros(geo_shape + (3,)), uv=np.zeros(geo_shape + (2,)))
@@ -183,13 +183,15 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     dx = float(x[1] - x[0]) if width > 1 else window
     dy = float(y[0] - y[1]) if height > 1 else window
     prm, lights = kernel.params(scene, skip)
-    job = kernel.Job(method=GRADIENTS.index(gradient), eps=float(scene.eps), skip=skip, want_kink=want_kink,
+    job = kernel.Job(methods=np.array([GRADIENTS.index(gradient)]), steps=np.array([float(scene.eps)]), skip=skip,
+                     want_kink=want_kink,
                      want_grad=want_grad, want_geo=want_geo, dx=dx, dy=dy)
     outputs = kernel.Outputs(**out, **geo)
     code = fieldcode.compiled(scene.field)
     with threads(workers):
         for first, last in bands(height, width):
             kernel.render_rows(prm, lights, x, y, first, last, job, outputs, code)
+    out["image"], out["grad"] = out["image"][0], out["grad"][0]          # the one frame
     return x, y, out, geo
 
 

@@ -3,7 +3,7 @@
 Everything above the gradient depends on geometry alone (the theorem "bump
 moves no boundary", proved in proofs/no_boundary.py and checked by verify/
 with independent full renders).  So for a sweep over the step eps of the
-numeric pipeline the kernel (`renderer.kernel.sweep_rows`) computes, per
+numeric pipeline the kernel (`renderer.kernel.render_rows`, one frame per step) computes, per
 pixel, the ray, the chamber, the hit point, the shadow rays and the colour of
 every object but sphere A once, and re-shades sphere A per step; the exact
 frame is rendered in the same pass.  tests/test_skips.py shows every frame
@@ -123,9 +123,13 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
     x, y = image_plane(scene.radius_a, scene.camera_z, width, height, zoom)
     prm, lights = kernel.params(scene)
     code = fieldcode.compiled(scene.field)
+    job = kernel.Job(methods=np.array([kernel.EXACT] + [kernel.CENTRAL] * len(steps)), steps=np.array((0.0,) + steps),
+                     skip=True, want_kink=True, want_grad=True, want_geo=False, dx=0.0, dy=0.0)
+    none = np.zeros((1, 1, 3))
+    outputs = kernel.Outputs(images, chamber, kink, grads, np.zeros((1, 1)), none, none, none, np.zeros((1, 1, 2)))
     with threads(workers):
         for first, last in bands(height, width):       # a Ctrl-C stops the sweep between two bands
-            kernel.sweep_rows(prm, lights, x, y, first, last, np.array(steps), images, chamber, kink, grads, code)
+            kernel.render_rows(prm, lights, x, y, first, last, job, outputs, code)
     frames = [Frame(images[f], chamber.copy(), kink.copy(), grads[f], scene.replace(eps=e) if f else scene,
                     "central" if f else "exact") for f, e in enumerate((scene.eps,) + steps)]
     census = tuple(compare(frame, frames[0]) for frame in frames[1:])

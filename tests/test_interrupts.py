@@ -78,14 +78,13 @@ def hold():
     os._exit(99)
 
 if moment == "band":
-    for name in ("render_rows", "sweep_rows"):
-        def band(*args, real=getattr(kernel, name)):
-            from renderer.cli import _signal
+    def band(*args, real=kernel.render_rows):
+        from renderer.cli import _signal
+        real(*args)
+        arrive()
+        while not _signal:
             real(*args)
-            arrive()
-            while not _signal:
-                real(*args)
-        setattr(kernel, name, band)
+    kernel.render_rows = band
 elif moment in ("write", "commit"):
     call = {"write": "fsync", "commit": "replace"}[moment]
     real = getattr(os, call)

@@ -90,7 +90,7 @@ def test_a_frame_of_max_pixels_is_allocated(call, allocations):
     for width in (MAX_PIXELS // MAX_SIDE, 4096, MAX_SIDE):
         height = MAX_PIXELS // width
         assert width * height == MAX_PIXELS
-        frames = (2,) if call == "sweep" else ()
+        frames = (2,) if call == "sweep" else (1,)          # the image: (frames, H, W, 3)
         with pytest.raises(Allocated) as asked:
             CALLS[call](width, height)
         assert asked.value.args[0][:-1] == frames + (height, width)

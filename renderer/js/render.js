@@ -399,7 +399,7 @@ export function render(scene, width, height, gradient = "exact", zoom = 1.0) {
 // Theorem "bump moves no boundary": what a pixel sees, its hit point, normal,
 // chart and tangent frame, and which lights reach it on geometry alone do not
 // depend on the bump.  A G-buffer keeps them for a frame; `shade_a` shades
-// sphere A on it for any values of the bump's fields (kernel.py `sweep_row`
+// sphere A on it for any values of the bump's fields (kernel.py `render_row`
 // does the same for an eps sweep), bit for bit what `render` gives
 // (tests/test_js_reshade.py).
 
