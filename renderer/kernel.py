@@ -499,6 +499,22 @@ def render_row(j, scene, lights, xs, ys, sin_x, job, out, field):
             out.P[j, i, c], out.N[j, i, c], out.Ns[j, i, c] = P[c], N[c], Ns[c]
 
 
+@njit(cache=True, error_model="numpy")
+def reach_rows(scene, lights, chamber, P, N, Ns, gate, out):
+    """`reach` at every pixel of a G-buffer (`renderer.pointwise.reach`): out[k, j, i] for light
+    k, (H, W) uint8 chamber, (H, W, 3) float64 P, N, Ns; ``out`` (n, H, W) bool, written in place."""
+    s = scene[0]
+    for j in range(chamber.shape[0]):
+        for i in range(chamber.shape[1]):
+            code = chamber[j, i]
+            if code == BACKGROUND:
+                continue
+            p, n, ns = (P[j, i, 0], P[j, i, 1], P[j, i, 2]), (N[j, i, 0], N[j, i, 1], N[j, i, 2]), \
+                (Ns[j, i, 0], Ns[j, i, 1], Ns[j, i, 2])
+            for k in range(lights.shape[0]):
+                out[k, j, i] = reach(s, lights[k].position, p, n, code, True, gate, ns)[1]
+
+
 def params(scene, skip=True):
     """The kernel's scene and lights, by name, for a validated `renderer.Scene`.
 

@@ -288,21 +288,5 @@ def reach(scene, gbuffer, *, gate=False):
                                f"the arrays must be one frame's, {chamber.shape + (3,)}")
     prm, lights = kernel.params(scene, skip=False)
     out = np.zeros((lights.shape[0],) + gbuffer.chamber.shape, dtype=bool)
-    _reach_rows(prm, lights, gbuffer.chamber, gbuffer.P, gbuffer.N, gbuffer.Ns, flag("gate", gate), out)
+    kernel.reach_rows(prm, lights, gbuffer.chamber, gbuffer.P, gbuffer.N, gbuffer.Ns, flag("gate", gate), out)
     return out
-
-
-# Not cached: numba's cache would key this on pointwise.py alone, and keep the
-# kernel's reach inlined as it was when first compiled after kernel.py changes.
-@njit(error_model="numpy")
-def _reach_rows(prm, lights, chamber, P, N, Ns, gate, out):
-    s = prm[0]
-    for j in range(chamber.shape[0]):
-        for i in range(chamber.shape[1]):
-            code = chamber[j, i]
-            if code == kernel.BACKGROUND:
-                continue
-            p, n, ns = (P[j, i, 0], P[j, i, 1], P[j, i, 2]), (N[j, i, 0], N[j, i, 1], N[j, i, 2]), \
-                (Ns[j, i, 0], Ns[j, i, 1], Ns[j, i, 2])
-            for k in range(lights.shape[0]):
-                out[k, j, i] = kernel.reach(s, lights[k].position, p, n, code, True, gate, ns)[1]
