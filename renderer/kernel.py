@@ -16,7 +16,8 @@ renderer/generated.py (`renderer.codegen` prints `renderer.formulas`).
 Compiled on first use, cached in ``__pycache__`` (or numba's user cache);
 as that cache checks only the file of the function it compiled, this file
 holds generated.py's SHA-256 (`FORMULAS_DIGEST`) and refuses any other.
-Threads: see `_threading_layer`; `renderer.render` runs one call at a time.
+No numba threading layer: `render_rows` releases the GIL (``nogil``), and
+`renderer.render.run_bands` runs its bands on Python threads.
 
 ``skip``: True does only the work the outputs need (an object that is off is
 not intersected; a shadow ray only where the light could add light; at
@@ -27,17 +28,13 @@ of tests/test_skips.py, which shows both give the same bits.
 
 from __future__ import annotations
 
-import ctypes
 import hashlib
-import importlib
 import math
-import sys
 from collections import namedtuple
 from pathlib import Path
 
-import numba
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from . import _numba_cache
 
@@ -81,25 +78,6 @@ Job = namedtuple("Job", "methods steps skip want_kink want_grad want_geo dx dy")
 #: The arrays `render_rows` writes (see its docstring).
 Outputs = namedtuple("Outputs", "image chamber kink grad t P N Ns uv")
 
-
-def _threading_layer():
-    """numba's threading layer, unless NUMBA_THREADING_LAYER chose one: TBB (pip
-    puts its library in <prefix>/lib, off the loader's path) survives a fork
-    and several threads; numba's default, GNU OpenMP, kills a child forked
-    after a render.  Without TBB the ``workqueue`` layer, fork-safe, slower."""
-    if numba.config.THREADING_LAYER != "default":
-        return
-    library = Path(sys.prefix, "lib", "libtbb.so.12")
-    try:
-        if library.exists():
-            ctypes.CDLL(str(library), mode=ctypes.RTLD_GLOBAL)
-        importlib.import_module("numba.np.ufunc.tbbpool")      # loads only beside a usable TBB
-        numba.config.THREADING_LAYER = "tbb"
-    except (ImportError, OSError):
-        numba.config.THREADING_LAYER = "workqueue"
-
-
-_threading_layer()
 
 FORMULAS_DIGEST = "d1fb0c80f4f180448127f3b6abfec6c1df53f175e4bfaebe9eda3c1582c8fed8"  # of generated.py, written by renderer/codegen.py
 if hashlib.sha256(Path(__file__).with_name("generated.py").read_bytes()).hexdigest() != FORMULAS_DIGEST:
@@ -407,9 +385,9 @@ def shading_normal(s, N, frame, h, hu, hv, sin_phi):
     return perturbed_normal_chart(N[0], N[1], N[2], et0, et1, et2, ep0, ep1, ep2, hu, hv, s.beta)
 
 
-@njit(cache=True, error_model="numpy", parallel=True)
-def render_rows(scene, lights, xs, ys, first, last, job, out, field):
-    """Render the pixels of rows ``first`` to ``last - 1`` (in parallel) into the preallocated
+@njit(cache=True, error_model="numpy", nogil=True)
+def render_rows(scene, lights, xs, ys, first, last, stride, job, out, field):
+    """Render the pixels of rows ``first``, ``first + stride``, ... below ``last`` into the preallocated
     outputs: F frames of one geometry, which differ only in sphere A's gradient method and step.
 
     Per pixel the geometry (hit, normal, chart, tangent frame) is computed once, and each
@@ -420,13 +398,13 @@ def render_rows(scene, lights, xs, ys, first, last, job, out, field):
     Parameters
     ----------
     scene : (1,) `SCENE` record array
-        From `params` (one record: numba's parallel loop takes arrays, not records).
+        From `params`.
     lights : (n,) `LIGHT` record array
         From `params`.
     xs, ys : (W,), (H,) float64
         Pixel centres on the image plane (scene units).
-    first, last : int
-        The rows to render, 0 <= first <= last <= H.
+    first, last, stride : int
+        The rows to render, ``range(first, last, stride)``: 0 <= first, last <= H, stride >= 1.
     job : Job
         ``methods`` ((F,) int64: `EXACT`, `CENTRAL` or `FOOTPRINT` per frame), ``steps`` ((F,)
         float64, the central step per frame), ``skip`` (bool, see the module), ``want_kink``,
@@ -445,20 +423,18 @@ def render_rows(scene, lights, xs, ys, first, last, job, out, field):
     (a wrong one is read or written out of bounds, or compiles another specialization).
     """
     sin_x = np.sin(np.pi * xs)
-    for j in prange(first, last):
-        render_row(j, scene, lights, xs, ys, sin_x, job, out, field)
+    geo = np.empty((lights.shape[0], LIGHT_COLUMNS))
+    for j in range(first, last, stride):
+        render_row(j, scene, lights, xs, ys, sin_x, geo, job, out, field)
 
 
-# A row is a function of its own: numba's parallel loop cannot take the
-# steps inlined (inline="always", 1.3x: LLVM leaves them as calls).
 @njit(cache=True, error_model="numpy")
-def render_row(j, scene, lights, xs, ys, sin_x, job, out, field):
-    """Row j of `render_rows`."""
+def render_row(j, scene, lights, xs, ys, sin_x, geo, job, out, field):
+    """Row j of `render_rows` (``geo``: scratch for `face`)."""
     s, y, sin_y = scene[0], ys[j], math.sin(math.pi * ys[j])
     methods, steps, skip, dx, dy = job.methods, job.steps, job.skip, job.dx, job.dy
     want_kink, want_grad, want_geo = job.want_kink, job.want_grad, job.want_geo
     image, chamber, kink, grad = out.image, out.chamber, out.kink, out.grad
-    geo = np.empty((lights.shape[0], LIGHT_COLUMNS))
     for i in range(xs.shape[0]):
         x = xs[i]
         t, code = nearest_hit(s, x, y, skip)

@@ -9,9 +9,9 @@ differences whose step is the pixel's footprint in the chart, pbrt-v4's rule).
 
 from __future__ import annotations
 
+import concurrent.futures
 import math
 import threading
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numba
@@ -130,11 +130,6 @@ def check_args(scene, width, height, gradient, zoom):
     return scene, width, height, gradient, zoom
 
 
-#: One kernel call at a time: numba's fallback threading layer, workqueue, may
-#: not be entered from two threads at once (`renderer.kernel._threading_layer`).
-_KERNEL_LOCK = threading.Lock()
-
-
 def check_workers(workers):
     """``workers``: None or an integer in [1, 64] (`renderer.validate.positive_int`)."""
     return None if workers is None else validate.positive_int("workers", workers, high=64)
@@ -151,22 +146,35 @@ def bands(height, width):
     return [(j, min(j + rows, height)) for j in range(0, height, rows)]
 
 
-@contextmanager
-def threads(workers):
-    """Run the kernel inside the block, alone (`_KERNEL_LOCK`), its rows on
-    ``workers`` threads (None: numba's count, the machine's cores; at most
-    that many), and restore numba's thread count after.  Numba's count
-    (``NUMBA_NUM_THREADS``) must be in [1, `renderer.validate.MAX_THREADS`]:
-    numba would launch that many threads (100000 segfaulted), so a larger one
-    is refused (InvalidValue) before any is launched."""
+def run_bands(rows, height, width, workers):
+    """Call ``rows(first, last, stride)`` on every band of `bands`, on ``workers`` threads
+    (None: ``NUMBA_NUM_THREADS``, numba's count, by default the machine's cores; at most
+    that count): thread t of n computes rows first + t, first + t + n, ... of each band (the
+    kernel releases the GIL), a new pool per call (none survives into a forked child).  A
+    KeyboardInterrupt stops every thread after its band.  The count must be in [1,
+    `renderer.validate.MAX_THREADS`] (InvalidValue: numba's own pool, 100000 threads,
+    segfaulted at that count)."""
     most = validate.thread_count("NUMBA_NUM_THREADS", numba.config.NUMBA_NUM_THREADS)
-    with _KERNEL_LOCK:
-        before = numba.get_num_threads()
-        numba.set_num_threads(min(int(workers or most), most))
+    n, work = min(int(workers or most), most), bands(height, width)
+    if n == 1:
+        for first, last in work:
+            rows(first, last, 1)
+        return
+    stop = threading.Event()
+
+    def thread(t):
+        for first, last in work:
+            if stop.is_set():
+                return
+            rows(first + t, last, n)
+    with concurrent.futures.ThreadPoolExecutor(n) as pool:
+        done = [pool.submit(thread, t) for t in range(n)]
         try:
-            yield
-        finally:
-            numba.set_num_threads(before)
+            for d in done:
+                d.result()
+        except BaseException:
+            stop.set()
+            raise
 
 
 def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_geo, workers):
@@ -188,9 +196,8 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
                      want_grad=want_grad, want_geo=want_geo, dx=dx, dy=dy)
     outputs = kernel.Outputs(**out, **geo)
     code = fieldcode.compiled(scene.field)
-    with threads(workers):
-        for first, last in bands(height, width):
-            kernel.render_rows(prm, lights, x, y, first, last, job, outputs, code)
+    run_bands(lambda first, last, stride: kernel.render_rows(prm, lights, x, y, first, last, stride, job, outputs,
+                                                             code), height, width, workers)
     out["image"], out["grad"] = out["image"][0], out["grad"][0]          # the one frame
     return x, y, out, geo
 

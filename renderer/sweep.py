@@ -20,7 +20,7 @@ import numpy as np
 
 from . import fieldcode, kernel, validate
 from .ledger import compare
-from .render import Frame, bands, check_args, check_workers, image_plane, threads
+from .render import Frame, check_args, check_workers, image_plane, run_bands
 from .scene import MAX_EPS, MIN_EPS
 
 __all__ = ["Sweep", "sweep", "MAX_STEPS", "MAX_SWEEP_PIXELS"]
@@ -127,9 +127,8 @@ def sweep(scene, eps_values, width, height, *, zoom=1.0, workers=None):
                      skip=True, want_kink=True, want_grad=True, want_geo=False, dx=0.0, dy=0.0)
     none = np.zeros((1, 1, 3))
     outputs = kernel.Outputs(images, chamber, kink, grads, np.zeros((1, 1)), none, none, none, np.zeros((1, 1, 2)))
-    with threads(workers):
-        for first, last in bands(height, width):       # a Ctrl-C stops the sweep between two bands
-            kernel.render_rows(prm, lights, x, y, first, last, job, outputs, code)
+    run_bands(lambda first, last, stride: kernel.render_rows(prm, lights, x, y, first, last, stride, job, outputs,
+                                                             code), height, width, workers)
     frames = [Frame(images[f], chamber.copy(), kink.copy(), grads[f], scene.replace(eps=e) if f else scene,
                     "central" if f else "exact") for f, e in enumerate((scene.eps,) + steps)]
     census = tuple(compare(frame, frames[0]) for frame in frames[1:])
