@@ -79,7 +79,6 @@ from typing import Callable
 import mpmath
 import numpy as np
 import sympy as sp
-from scipy.differentiate import derivative
 
 from renderer import DRAFT_SCENE, fieldcode, gbuffer, pointwise, ucurve, validate
 from renderer import formulas as F
@@ -436,6 +435,7 @@ def _richardson_gradient(record, uu, vv, ku, kv, *, info=None):
     def h(x, other, moves_v):
         return pointwise.height(record, np.where(moves_v, other, x), np.where(moves_v, x, other), ku, kv)
 
+    from scipy.differentiate import derivative        # here: scipy's import is 0.8 s from a fresh clone
     res = derivative(h, x, args=(other, moves_v), **RICHARDSON)
     if info is not None:
         info.update(not_converged=int(np.count_nonzero(res.status != 0)), iterations=float(np.mean(res.nit)),
@@ -832,6 +832,7 @@ def _complex_1d(continued):
 
 
 def _richardson_1d(function, x, eps, info):
+    from scipy.differentiate import derivative
     res = derivative(_complex_fn(function.expr, (F.x_var,), False), np.float64(x))
     info["h_per_pixel"] = float(res.nfev)
     return float(res.df)
