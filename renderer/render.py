@@ -192,8 +192,7 @@ def _run(scene, width, height, gradient, zoom, skip, want_kink, want_grad, want_
     dy = float(y[0] - y[1]) if height > 1 else window
     prm, lights = kernel.params(scene, skip)
     job = kernel.Job(methods=np.array([GRADIENTS.index(gradient)]), steps=np.array([float(scene.eps)]), skip=skip,
-                     want_kink=want_kink,
-                     want_grad=want_grad, want_geo=want_geo, dx=dx, dy=dy)
+                     want_kink=want_kink, want_grad=want_grad, want_geo=want_geo, dx=dx, dy=dy)
     outputs = kernel.Outputs(**out, **geo)
     code = fieldcode.compiled(scene.field)
     run_bands(lambda first, last, stride: kernel.render_rows(prm, lights, x, y, first, last, stride, job, outputs,
