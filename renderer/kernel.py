@@ -11,8 +11,8 @@ segment) Lambert and Blinn/Phong with the shading normal.
 
 Everything up to the gradient depends on geometry alone (theorem "bump moves
 no boundary"), which licenses the frames of `render_rows`: geometry and shadow
-rays once per pixel, sphere A shaded per frame (an eps sweep's steps).  Sphere A's formulas come from
-renderer/generated.py (`renderer.codegen` prints `renderer.formulas`).
+rays once per pixel, sphere A shaded per frame (an eps sweep's steps).  Sphere
+A's formulas come from renderer/generated.py (`renderer.codegen` prints `renderer.formulas`).
 Compiled on first use, cached in ``__pycache__`` (or numba's user cache);
 as that cache checks only the file of the function it compiled, this file
 holds generated.py's SHA-256 (`FORMULAS_DIGEST`) and refuses any other.

@@ -180,6 +180,18 @@ def test_shadow_rays_are_traced_only_where_the_light_can_add_light(interpreted, 
     assert 0 < fast["shadow_rays"] < full["shadow_rays"]
 
 
+@pytest.mark.parametrize("name", ["strong bump", "surface bump, phong"])
+def test_a_sweep_traces_each_shadow_ray_at_most_once_per_pixel(interpreted, name):
+    """A sweep's frames share each pixel's shadow rays: six frames trace no more of them than
+    one ungated render (which traces every light the normal faces, once), and more than none."""
+    scene = SCENES[name]
+    full, _ = run(interpreted, scene, skip=False)
+    interpreted.clear()
+    sweep(scene, (1e-1, 1e-2, 1e-3, 1e-5, 1e-8), 16, 12)
+    swept = _work(interpreted, scene)
+    assert 0 < swept["shadow_rays"] <= full["shadow_rays"]
+
+
 def test_zero_colour_lights_are_dropped_from_the_kernels_lights():
     scene = SCENES["zero-colour light"]
 
