@@ -293,7 +293,8 @@ def test_sweep_rejects_bad_steps(bad, match):
 
 @pytest.mark.parametrize("gradient", GRADIENTS)
 def test_the_number_of_threads_changes_no_bit(gradient):
-    scene, size = Scene(beta=1.2, bump="chart"), (96, 80)
+    from renderer.render import THREAD_PIXELS
+    scene, size = Scene(beta=1.2, bump="chart"), (96, 3 * THREAD_PIXELS // 96 + 1)     # room for 3 threads
     one = render(scene, *size, gradient=gradient, workers=1)
     for workers in (None, 2, 3):
         assert differences(one, render(scene, *size, gradient=gradient, workers=workers)) == [], workers
@@ -345,19 +346,21 @@ def test_renders_from_several_threads_at_once_give_the_serial_bits():
 _FORK = r"""
 import os, sys
 from renderer import Scene, render
-parent = render(Scene(), 24, 20).image.tobytes()
+from renderer.render import THREAD_PIXELS
+assert 128 * 128 >= 2 * THREAD_PIXELS   # two threads render it
+parent = render(Scene(), 128, 128, workers=2).image.tobytes()
 pid = os.fork()
 if pid == 0:                            # the child renders too, after the parent's threads ran
-    os._exit(0 if render(Scene(), 24, 20).image.tobytes() == parent else 3)
+    os._exit(0 if render(Scene(), 128, 128, workers=2).image.tobytes() == parent else 3)
 _, status = os.waitpid(pid, 0)
 sys.exit(os.waitstatus_to_exitcode(status))
 """
 
 
 def test_a_forked_child_renders_after_its_parent():
-    """A child forked after a render renders too: no thread pool outlives a call (a pool kept
-    for the process would leave the child waiting on threads it does not have, and numba's
-    GNU OpenMP layer, used by an earlier kernel, killed such a child)."""
+    """A child forked after a render renders too: it makes its own rendering threads (the
+    parent's pool would leave it waiting on threads it does not have; numba's GNU OpenMP
+    layer, used by an earlier kernel, killed such a child)."""
     run = subprocess.run([sys.executable, "-c", _FORK], capture_output=True, text=True, timeout=60)
     assert run.returncode == 0, run.stderr[-2000:]
 
