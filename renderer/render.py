@@ -147,9 +147,9 @@ def bands(height, width):
     return [(j, min(j + rows, height)) for j in range(0, height, rows)]
 
 
-#: Pixels per thread at least: handing work to a thread costs some 0.3 ms (the GIL, the
-#: kernel's dispatch), about what 4096 pixels take (2 threads, 64 x 64: 0.80 ms against 0.71
-#: on one; 128 x 128: 1.96 against 2.39).
+#: Pixels per thread at least: handing rows to a second thread costs some 0.3 ms (the GIL, the
+#: kernel's dispatch), so it gains from about 128 x 128 (measured, 2 threads against one:
+#: 64 x 64 0.80 ms against 0.71, 128 x 128 1.96 against 2.39; medians of 300 renders).
 THREAD_PIXELS = 1 << 13
 #: The process's rendering threads, made on first use (`_pool`); a forked child, which has none of
 #: its parent's threads, makes its own (`_forget_pool`).
@@ -178,10 +178,10 @@ def run_bands(rows, height, width, workers):
     that count, and at most one per `THREAD_PIXELS` pixels): thread t of n computes rows
     first + t, first + t + n, ... of each band (the kernel releases the GIL); thread 0 is
     the caller, the others come from a pool kept for the process (a pool made per call cost
-    about 1 ms, more than a 64 x 64 render).  A
-    KeyboardInterrupt stops every thread after its band, and returns when they have.  The
-    count must be in [1, `renderer.validate.MAX_THREADS`] (InvalidValue: numba's own pool,
-    100000 threads, segfaulted at that count)."""
+    about 1 ms, more than a 64 x 64 render).  A KeyboardInterrupt stops every thread after
+    its band, and returns when they have.  The count must be in [1,
+    `renderer.validate.MAX_THREADS`] (InvalidValue: numba's own pool, 100000 threads,
+    segfaulted at that count)."""
     most = validate.thread_count("NUMBA_NUM_THREADS", numba.config.NUMBA_NUM_THREADS)
     n = min(int(workers or most), most, max(1, height * width // THREAD_PIXELS))
     work, stop = bands(height, width), threading.Event()
@@ -273,7 +273,7 @@ def render(scene, width, height, *, gradient="exact", zoom=1.0, kink=True, grad=
     workers : int in [1, 64] or None, keyword-only
         Threads rendering rows side by side (None: numba's count,
         ``NUMBA_NUM_THREADS`` or the machine's cores; never more than that
-        count).  The image is the same bits for any number.  The numba
+        count, nor more than one per `THREAD_PIXELS` pixels).  The image is the same bits for any number.  The numba
         backend's; Dr.Jit runs on its own thread pool, and one render at a
         time uses it (`renderer.backends.DRJIT_LOCK`: other threads wait).
     backend : {"numba", "drjit", "auto", "numpy"}, keyword-only
