@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import hypothesis  # noqa: F401  (imported at collection: this module's run keeps hypothesis's plugin)
 import pytest
 
 from proofs.registry import THEOREMS
@@ -43,3 +44,21 @@ def test_the_ledger_is_in_the_chapters_order_whatever_order_the_verdicts_arrive_
     lines = []
     conftest.pytest_terminal_summary(SimpleNamespace(section=lambda title: None, write_line=lines.append))
     assert [line.split()[0] for line in lines] == ids, lines
+
+
+def test_a_run_that_imported_no_hypothesis_drops_its_plugin(monkeypatch, pytestconfig):
+    """verify/conftest.py unregisters hypothesis's pytest plugin, by the name it is registered under,
+    when the run's collection imported no hypothesis, and leaves it otherwise.  The wrong variants: the
+    hook gone, a wrong name (nothing found to drop), the condition turned round."""
+    from types import SimpleNamespace
+
+    from verify import conftest
+    assert pytestconfig.pluginmanager.get_plugin(conftest.HYPOTHESIS_PLUGIN) is not None
+    dropped = []
+    session = SimpleNamespace(config=SimpleNamespace(pluginmanager=SimpleNamespace(
+        unregister=lambda name: dropped.append(name))))
+    conftest.pytest_collection_finish(session)
+    assert dropped == []
+    monkeypatch.delitem(sys.modules, "hypothesis")
+    conftest.pytest_collection_finish(session)
+    assert dropped == [conftest.HYPOTHESIS_PLUGIN]
