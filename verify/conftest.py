@@ -6,7 +6,7 @@ its report's user property ``ledger``, which pytest-xdist carries from the worke
 the test to the controller, where `pytest_runtest_logreport` files it and
 `pytest_terminal_summary` prints it, in the chapter's order (the theorem's place, which the report
 carries: the controller does not import the theorems to sort them); without xdist both run in the one
-process."""
+process.  A run of the checker alone leaves out hypothesis's pytest plugin (`pytest_collection_finish`)."""
 
 import sys
 
