@@ -89,9 +89,19 @@ def _check_expression(name, expr, symbols):
     if unknown:
         raise ValueError(f"{name} may call only {', '.join(f.__name__ for f in ELEMENTARY)}; it calls "
                          f"{', '.join(sorted(unknown))}")
-    if expr.has(sp.I, sp.zoo, sp.oo, sp.nan) or any(not a.is_real for a in expr.atoms(sp.Number)):
+    if expr.has(sp.I, sp.zoo, sp.oo, sp.nan, sp.AccumBounds) or any(not a.is_real for a in expr.atoms(sp.Number)):
         raise ValueError(f"{name} must be real: it holds {expr.atoms(sp.Number, sp.NumberSymbol) - {sp.pi, sp.E}}"
                          f" or an imaginary unit or infinity")
+    for var in sorted(expr.free_symbols - {k_u, k_v}, key=str):      # the variables, not the frequencies
+        # |g| of a g sympy cannot tell is real (g = u**u) differentiates into re, im and arg of g; a
+        # negative base, c**u, into log(c) = log|c| + i pi.
+        d = sp.diff(expr, var)
+        held = {type(f).__name__ for f in d.atoms(sp.re, sp.im, sp.arg, sp.Derivative)} | \
+            ({"the imaginary unit"} if d.has(sp.I) else set())
+        if held:
+            raise ValueError(f"{name} must have a real derivative in {var} in closed form; sympy's holds "
+                             f"{', '.join(sorted(held))} (an abs of what sympy cannot tell is real, or a "
+                             f"negative base to a power in {var}, say)")
     return expr
 
 

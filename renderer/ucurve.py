@@ -30,6 +30,7 @@ far below the float64 quantities measured (>= 1e-17).
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import lru_cache
@@ -73,10 +74,12 @@ def _crease(expr, var, at, x0):
         df = sp.lambdify(var, sp.diff(inner, var).subs(at), modules="mpmath")
         with mpmath.workdps(DIGITS):
             X = mpmath.mpf(x0)
-            slope = abs(df(X))
+            value, slope = _real(f, X), _real(df, X)
+            if value is None or slope is None:          # no value there: no sign change to find
+                continue
             # |F / F'| is the distance to the zero to first order; 1 + 1e-9 covers the second.
-            if slope > mpmath.mpf(10) ** (-DIGITS // 2) and \
-                    abs(f(X)) <= slope * abs(float(np.spacing(x0))) * (1 + mpmath.mpf(10) ** -9):
+            if abs(slope) > mpmath.mpf(10) ** (-DIGITS // 2) and \
+                    abs(value) <= abs(slope) * abs(float(np.spacing(x0))) * (1 + mpmath.mpf(10) ** -9):
                 return next((f for f in sp.Mul.make_args(inner) if var in f.free_symbols), inner)
     return None
 
@@ -230,11 +233,15 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
                      "convergence in 100 Gauss-Newton steps)")
 
 
-def _line(expr, var, at):
-    """h, h' and h''' as mpmath functions of ``var`` alone (the others at ``at``), the derivative
-    of |f| as sign(f) f' (its DiracDelta, which vanishes off the crease, dropped)."""
-    g = expr.subs(at)
-    smooth = lambda e: e.replace(lambda x: isinstance(x, sp.DiracDelta), lambda x: 0)  # noqa: E731
+def _line(g, var):
+    """h, h' and h''' as mpmath functions of ``g``, an expression in ``var`` alone, the derivative
+    of |f| as sign(f) f' (the derivatives of sign, which vanish off the crease, dropped: sympy's
+    DiracDelta, and the derivative it leaves unevaluated where it cannot tell f is real)."""
+    def kink(x):
+        return isinstance(x, sp.DiracDelta) or isinstance(x, sp.Derivative) and isinstance(x.expr, sp.sign)
+
+    def smooth(e):
+        return e.replace(kink, lambda x: 0)
     return tuple(sp.lambdify(var, smooth(sp.diff(g, var, n)), modules="mpmath") for n in (0, 1, 3))
 
 
@@ -249,25 +256,53 @@ def _stencil():
     return sp.lambdify(args, [points[p] for p in (F.u_p, F.u_m, F.v_p, F.v_m)] + dens, modules="math")
 
 
+def _real(fn, X):
+    """``fn(X)`` (an mpmath function at an mpf, at the current precision) where it is a real number
+    float64 can hold, else None: a pole (ZeroDivisionError), an overflow, a complex value, or one
+    beyond float64's range (which the U-curve would report as inf)."""
+    try:
+        y = mpmath.mpmathify(fn(X))             # a constant derivative is a Python number
+    except (ArithmeticError, ValueError, TypeError):
+        return None
+    return y if isinstance(y, mpmath.mpf) and abs(y) <= np.finfo(float).max else None
+
+
+def _undefined(label, point):
+    """The refusal of a point where the function, or a derivative the measurement needs, has no value."""
+    what, where = (("function", f"x = {point['u']!r}") if point["component"] == "x" else
+                   ("field", f"(u, v) = ({point['u']!r}, {point['v']!r})"))
+    return validate.InvalidValue(f"{what} {label} must be defined and differentiable at {where}, where it or a "
+                                 f"derivative the measurement needs is not a real number float64 can hold")
+
+
 def _curve(label, x, steps, quotient, line, reason, point):
     """The U-curve of the float64 quotients ``quotient(eps) -> (value, x_plus, x_minus, den)`` of the
     function ``line`` = (h, h', h''') of one variable at x: `UCurve`'s fields (``label`` and
-    ``point`` fill its field, u, v, component)."""
+    ``point`` fill its field, u, v, component).  Raises `renderer.validate.InvalidValue` where h or
+    h' (or h''', which the model needs where there is a derivative) is not a real number float64
+    can hold at x, or, naming ``eps``, where a quotient, or h at one of its abscissae, is not."""
     h_mp, dh_mp, d3h_mp = line
     with mpmath.workdps(DIGITS):
         X = mpmath.mpf(x)
         if reason is None:
-            true = dh_mp(X)
+            true = _real(dh_mp, X)
         else:
             # The one-sided derivative: the derivative 1e-40 inside (smaller x at the chart's
             # edge 1), where the field is smooth and within ~1e-39 of the one-sided limit.
-            true = dh_mp(X + mpmath.mpf(10) ** -(DIGITS - 10) * (-1 if x == 1.0 else 1))
-        h0, h3 = h_mp(X), d3h_mp(X)
+            true = _real(dh_mp, X + mpmath.mpf(10) ** -(DIGITS - 10) * (-1 if x == 1.0 else 1))
+        h0, h3 = _real(h_mp, X), (_real(d3h_mp, X) if reason is None else mpmath.nan)
+        if true is None or h0 is None or h3 is None:
+            raise _undefined(label, point)
         error, trunc, roundoff = [], [], []
-        for e in steps:
+        for i, e in enumerate(steps):
             fd, plus, minus, den = quotient(float(e))
             # The abscissae and the denominator, exactly as float64 made them.
-            exact_fd = (h_mp(mpmath.mpf(plus)) - h_mp(mpmath.mpf(minus))) / mpmath.mpf(den)
+            ends = _real(h_mp, mpmath.mpf(plus)), _real(h_mp, mpmath.mpf(minus))
+            if None in ends or not np.isfinite(fd):
+                raise validate.InvalidValue(
+                    f"eps must keep {label} finite and real at the abscissae of its quotient; at the step "
+                    f"{float(e)!r} (step {i}) it is not, at {minus!r} or {plus!r}")
+            exact_fd = (ends[0] - ends[1]) / mpmath.mpf(den)
             trunc.append(float(exact_fd - true))
             roundoff.append(float(mpmath.mpf(fd) - exact_fd))
             error.append(float(abs(mpmath.mpf(fd) - true)))
@@ -330,7 +365,11 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     ValueError
         Naming the argument, for an unknown field or component, a chart
         point outside [0, 1], a frequency outside (0, 1e3], no steps or a
-        step outside [`renderer.pointwise.MIN_STEP`, 1).
+        step outside [`renderer.pointwise.MIN_STEP`, 1); naming ``field``, a
+        point where h, h' or h''' (the model's, where h' exists) is not a real
+        number float64 can hold (a pole of a reader's field, a line where it
+        has no value) or whose exact value has too many digits to print;
+        naming ``eps``, a step at whose abscissae h or the quotient is not.
     TypeError
         Naming the argument, for one of the wrong type (a bool, a string
         for a number).  Both are `renderer.validate.InputError`.
@@ -352,6 +391,14 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     k = 0 if component == "u" else 1
     var, x = (F.u, u) if k == 0 else (F.v, v)
     at = {F.k_u: _rational(k_u), F.k_v: _rational(k_v), (F.v if k == 0 else F.u): _rational(v if k == 0 else u)}
+    point, g = dict(u=u, v=v, component=component), record.expr.subs(at)
+    if g.has(sp.zoo, sp.nan, sp.oo, -sp.oo):                # no value on the line (tan(pi u), u = 1/2)
+        raise _undefined(record.name, point)
+    if sys.get_int_max_str_digits() and any(max(abs(r.p), r.q) >= 10 ** sys.get_int_max_str_digits()
+                                            for r in g.atoms(sp.Rational)):     # which lambdify cannot print
+        raise validate.InvalidValue(f"field {record.name} is too large to measure at (u, v) = ({u!r}, {v!r}): "
+                                    f"its exact value there has more digits than Python prints")
+    line = _line(g, var)
     stencil = _stencil()
 
     def quotient(e):
@@ -359,8 +406,8 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
         fd = float(pointwise.central_gradient(record, u, v, k_u, k_v, e)[k])
         return fd, points[2 * k], points[2 * k + 1], points[4 + k]
 
-    return _curve(record.name, x, steps, quotient, _line(record.expr, var, at),
-                  non_differentiable(record, u, v, component, k_u, k_v), dict(u=u, v=v, component=component))
+    return _curve(record.name, x, steps, quotient, line, non_differentiable(record, u, v, component, k_u, k_v),
+                  point)
 
 
 #: The largest step `measure_function` accepts (its smallest is `renderer.pointwise.MIN_STEP`).
@@ -392,18 +439,18 @@ def measure_function(function, x, eps=None):
     ------
     renderer.validate.InputError
         Naming the argument: an expression refused by `renderer.formulas.univariate`, a point
-        or a step that is not a finite float in range, a point where f or f' is not a finite
-        real number or f has a crease (|g| where g changes sign), a step at which f(x +- eps)
-        is not finite.
+        or a step that is not a finite float in range, a point where f, f' or f''' is not a real
+        number float64 can hold or f has a crease (|g| where g changes sign), a step at which
+        f(x +- eps) is not.
     """
     record = F.univariate(function, "function")
     x = validate.real("x", x)
     steps = DEFAULT_STEPS if eps is None else validate.steps("eps", eps, low=pointwise.MIN_STEP,
                                                               high=MAX_FUNCTION_STEP)
-    line = _line(record.expr, F.x_var, {})
-    if not all(_finite_real(fn, x) for fn in line[:2]):
-        raise validate.InvalidValue(f"function {record.name} must be defined and differentiable at x = {x!r}, "
-                                    f"where it or its derivative is not a finite real number")
+    line, point = _line(record.expr, F.x_var), dict(u=x, v=float("nan"), component="x")
+    with mpmath.workdps(DIGITS):
+        if any(_real(fn, mpmath.mpf(x)) is None for fn in line[:2]):     # before the crease and float64 checks
+            raise _undefined(record.name, point)
     if _crease(record.expr, F.x_var, {}, x) is not None:
         raise validate.InvalidValue(f"function {record.name} is not differentiable at x = {x!r}: it has a "
                                     f"crease there (the argument of an abs changes sign)")
@@ -411,23 +458,8 @@ def measure_function(function, x, eps=None):
     if not np.isfinite(code.value(x)):
         raise validate.InvalidValue(f"x must be a point where function {record.name} is a finite float64; "
                                     f"at x = {x!r} it overflows")
-    fd = np.array([code.central(x, float(e)) for e in steps])
-    bad = np.flatnonzero(~np.isfinite(fd))
-    if bad.size:
-        raise validate.InvalidValue(f"eps must keep f finite at x +- eps; f({x!r} +- {float(steps[bad[0]])!r}) is not "
-                                    f"(step {bad[0]})")
 
     def quotient(e):
         return code.central(x, e), x + e, x - e, 2 * e
 
-    return _curve(record.name, x, steps, quotient, line, None, dict(u=x, v=float("nan"), component="x"))
-
-
-def _finite_real(fn, x):
-    """Whether the mpmath function ``fn`` is a finite real number at x (at `DIGITS` digits)."""
-    with mpmath.workdps(DIGITS):
-        try:
-            y = fn(mpmath.mpf(x))
-        except (ValueError, ZeroDivisionError, TypeError):
-            return False
-        return isinstance(y, mpmath.mpf) and mpmath.isfinite(y)
+    return _curve(record.name, x, steps, quotient, line, None, point)

@@ -134,6 +134,17 @@ def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
         assert message.startswith("Scene.height_field ") and "not finite" in message, message
 
 
+@pytest.mark.parametrize("text, held", [("abs(u**u)", "arg, im, re"), ("cos(3)**v", "the imaginary unit")])
+def test_a_field_whose_derivative_sympy_cannot_write_real_is_refused(text, held):
+    """|g| of a g sympy cannot tell is real, and a negative base to a power in v: their derivatives
+    hold complex parts, which no printer of the kernels has.  A real abs is a field like any other."""
+    _, message = refusal(lambda: Scene(height_field=text))
+    assert message.startswith("Scene.height_field: ") and f"sympy's holds {held}" in message, message
+    assert Scene(height_field="abs(sin(pi*k_u*u))*v").field.crease_factors
+    _, message = refusal(lambda: Scene(height_field="u*atan(tan(pi/2))"))    # sympy: an interval, not a number
+    assert message.startswith("Scene.height_field: ") and "must be real" in message, message
+
+
 @pytest.mark.parametrize("kwargs, field, phrase", [
     (dict(radius_b=3.0), "radius_b", "sphere B"),                        # the camera inside sphere B
     (dict(camera_z=1.0), "camera_z", "radius_a"),                        # the camera on sphere A

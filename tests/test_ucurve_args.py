@@ -7,14 +7,18 @@ reader's function: each of its own refusals whole); the accepted values at each 
 (a step each).
 """
 
+import re
 from fractions import Fraction
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
 
 from renderer.pointwise import MIN_STEP
 from renderer.ucurve import DEFAULT_STEPS, MAX_FUNCTION_STEP, measure, measure_function
 from renderer.validate import InputError
+
+from .expressions import fields_at_points, functions_at_points
 
 
 @pytest.mark.parametrize("kwargs, error, name, phrase", [
@@ -58,8 +62,11 @@ def test_values_at_the_limits_and_numpy_scalars_are_measured():
     (("sqrt(x)", -1.0), {}, ValueError, "function sqrt(x) must be defined and differentiable at x = -1.0"),
     (("1/x", 0.0), {}, ValueError, "function 1/x must be defined and differentiable at x = 0.0"),   # mpmath raises
     (("abs(x)", 0.0), {}, ValueError, "function Abs(x) is not differentiable at x = 0.0: it has a crease"),
-    (("exp(x)", 800.0), {}, ValueError, "x must be a point where function exp(x) is a finite float64"),
-    (("log(x)", 0.5), dict(eps=[1e-3, 0.6]), ValueError, "eps must keep f finite at x +- eps; f(0.5 +- 0.6) is not (step 1)"),
+    (("exp(x)", 800.0), {}, ValueError, "function exp(x) must be defined and differentiable at x = 800.0"),
+    (("exp(x)/exp(x - 1)", 710.0), {}, ValueError, "x must be a point where function exp(x)*exp(1 - x) is a finite float64"),
+    (("log(x)", 0.5), dict(eps=[1e-3, 0.6]), ValueError,
+     "eps must keep log(x) finite and real at the abscissae of its quotient; at the step 0.6 (step 1) it is not, "
+     "at -0.09999999999999998 or 1.1"),
 ])
 def test_measure_functions_arguments_are_refused_by_name(args, kwargs, error, message):
     with pytest.raises(InputError) as info:
@@ -70,3 +77,63 @@ def test_measure_functions_arguments_are_refused_by_name(args, kwargs, error, me
 def test_measure_function_takes_its_steps_or_the_default_ones():
     assert measure_function("sin(x)", 0.5, eps=[MAX_FUNCTION_STEP, 1e-3]).eps.tolist() == [MAX_FUNCTION_STEP, 1e-3]
     assert np.array_equal(measure_function("sin(x)", 0.5).eps, DEFAULT_STEPS)
+
+
+#: Steps from wide (past a nearby singularity) to below the rounding of x.
+STEPS = (0.5, 1e-4, 1e-9, 1e-14)
+
+
+def _u_curve_or_refusal(call, names):
+    """``call()``'s U-curve, of finite numbers, or one `InputError` whose message starts with one of
+    ``names`` (the parameter it refuses)."""
+    try:
+        uc = call()
+    except InputError as exc:
+        assert re.match(rf"^({'|'.join(names)})\b", str(exc)) and "\n" not in str(exc), str(exc)
+        return None
+    assert all(np.isfinite(a).all() for a in (uc.error, uc.truncation, uc.roundoff)) and np.isfinite(uc.height)
+    assert uc.reason is not None or np.isfinite(uc.derivative), uc
+    return uc
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=functions_at_points())
+def test_any_function_at_any_point_is_a_u_curve_or_one_input_error(case):
+    """Whatever f a reader types and wherever: a U-curve of finite numbers, or one refusal naming
+    ``function``, ``x`` or ``eps``; never an exception from inside mpmath or sympy (a pole, an
+    overflow, a complex value, a derivative sympy leaves unevaluated)."""
+    text, x = case
+    _u_curve_or_refusal(lambda: measure_function(text, x, eps=STEPS), ("function", "x", "eps"))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=fields_at_points())
+def test_any_field_at_any_chart_point_is_a_u_curve_or_one_input_error(case):
+    """The same for a reader's height field at a chart point, refusals naming ``field`` or ``eps``:
+    at a pole of the field, on a line where it has no value (tan(pi u) at u = 1/2), past a branch
+    point."""
+    text, u, v, component = case
+    _u_curve_or_refusal(lambda: measure(text, u, v, component, eps=STEPS), ("field", "eps"))
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: measure_function("exp(exp(x))", 1e300), "function"),      # mpmath overflows
+    (lambda: measure_function("tanh(x)", 1.0, eps=[1e-3, 100.0]), None),  # measured
+    (lambda: measure_function("x**2.5", 0.0), "function"),              # f, f' are 0; the model's f''' infinite
+    (lambda: measure("1/(u - 0.31)"), "field"),                          # a pole at the seed's point
+    (lambda: measure("abs(log(u + 1))"), None),          # measured: sympy's h''' holds d/du sign(log(u + 1))
+    (lambda: measure("tan(pi*u)", 0.5, component="v"), "field"),         # no value on the line u = 1/2
+    (lambda: measure("log(v)", 0.5, 0.0, component="v"), "field"),      # log 0 at the pole
+    (lambda: measure("sqrt(u - 0.3)", 0.31, eps=[1e-3, 0.02]), "eps"),  # u - eps past the branch point
+    (lambda: measure("u*(3*k_u + 1/k_u)**(3**k_u)"), "field"),          # 9,077 digits at k_u = 8
+    (lambda: measure("abs(log(u - 0.31))"), "field"),                   # the crease check meets the pole
+    # float64 rounds u_m**2 up to the constant (h(u_m) = 0); exactly it is below it (h imaginary).
+    (lambda: measure("sqrt(u**2 - 0.1417678433433451)", 0.3774972702218265, eps=[2.0**-10]), "eps"),
+])
+def test_a_singular_point_is_one_input_error_naming_what_is_wrong(call, name):
+    """One case of each kind the random tests above draw, fixed: the refusal names the argument."""
+    if name is None:
+        assert _u_curve_or_refusal(call, ()) is not None
+    else:
+        with pytest.raises(InputError, match=rf"^{name}\b"):
+            call()
