@@ -701,7 +701,9 @@ def reference_gradient(field, uu, vv, ku, kv, *, digits=34):
     Returns
     -------
     (hi, lo) : two (2, n) float64 arrays (n points of the broadcast uu, vv, flattened); row 0
-    is h_u, row 1 is h_v.
+    is h_u, row 1 is h_v; NaN (hi and lo) where a component is not a finite real number: a
+    reader's field past a branch point, or at a pole (both components, mpmath raising), where
+    the float64 methods give NaN or inf.
 
     Raises
     ------
@@ -717,9 +719,15 @@ def _reference_gradient(record, uu, vv, ku, kv, *, digits=34):
     lo = np.empty((2, uu.size))
     with mpmath.workdps(digits):
         for j, (a, b) in enumerate(zip(uu.tolist(), vv.tolist())):
-            for c, val in enumerate(fn(mpmath.mpf(a), mpmath.mpf(b))):
+            try:
+                values = [mpmath.mpmathify(g) for g in fn(mpmath.mpf(a), mpmath.mpf(b))]
+            except (ArithmeticError, ValueError, TypeError):        # a pole of the field's gradient
+                values = [mpmath.nan, mpmath.nan]
+            for c, val in enumerate(values):
+                if not (isinstance(val, mpmath.mpf) and mpmath.isfinite(val)):   # complex, or infinite
+                    val = mpmath.nan
                 hi[c, j] = float(val)
-                lo[c, j] = float(val - hi[c, j])
+                lo[c, j] = float(val - hi[c, j]) if mpmath.isfinite(val) else math.nan
     return hi, lo
 
 
@@ -814,7 +822,10 @@ def evaluations(field, name, info=None):
 # --- the methods over a function of one variable ---------------------------------------------
 
 def _exact_1d(function, x, eps, info):
-    return float(sp.lambdify(F.x_var, function.derivative, modules="math")(x))
+    try:
+        return float(sp.lambdify(F.x_var, function.derivative, modules="math")(x))
+    except (ArithmeticError, ValueError):   # math's overflow, pole or domain error: no float64 value
+        return math.nan
 
 
 def _central_1d(function, x, eps, info):
@@ -1268,7 +1279,11 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
         value = fieldcode.univariate_code(record).value(x)
     if math.isinf(value):                     # finite at 50 digits (measure_function's test) is not enough
         raise validate.InvalidValue(f"x = {x!r} is too large for function {record.name}: f(x) overflows float64")
-    curve = ucurve.measure_function(record, x, eps=steps)      # checks f and f' at x, and f at x +- eps
+    try:
+        curve = ucurve.measure_function(record, x, eps=steps)      # checks f and f' at x, and f at x +- eps
+    except validate.InvalidValue as exc:                           # its eps is this function's steps
+        text = str(exc)
+        raise validate.InvalidValue(f"steps{text[3:]}" if text.startswith("eps ") else text) from None
     steps = tuple(float(e) for e in curve.eps)
     true_fn = sp.lambdify(F.x_var, record.derivative, modules="mpmath")
     rows, evaluations = [], {}
@@ -1287,7 +1302,8 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
                 if "h_per_pixel" in info:
                     evaluations[m.name] = info["h_per_pixel"]
                 error = float(abs(mpmath.mpf(value) - true))
-                relative = error / abs(float(true)) if true != 0 else (0.0 if error == 0 else math.inf)
+                # In mpmath: a derivative below float64's range (exp(x) at x = -780) is not 0 there.
+                relative = float(error / abs(true)) if true != 0 else (0.0 if error == 0 else math.inf)
                 rows.append(UnivariateRow(m.name, eps, value, error, relative))
     return UnivariateErrors(record.name, x, float(true), ucurve.DIGITS, tuple(rows), curve, evaluations)
 

@@ -8,6 +8,7 @@ Each check is shown to reject a wrong variant.
 from __future__ import annotations
 
 import inspect
+import math
 import re
 import time
 
@@ -15,7 +16,7 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-from hypothesis import given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from lab import gradient_methods as gm
@@ -23,6 +24,8 @@ from renderer import DRAFT_SCENE, pointwise, ucurve
 from renderer import formulas as F
 from renderer import generated as G
 from renderer.validate import InputError
+
+from .expressions import functions_at_points
 
 KU, KV = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
 #: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as lab/accuracy.py).
@@ -525,7 +528,52 @@ def test_an_abs_function_takes_the_continued_complex_step_and_not_the_plain_one(
     ("abs(x - 1)", 1.0, "^function .*not differentiable at x = 1.0"),
     ("sqrt(x)", -1.0, "^function .*x = -1.0"),              # not defined there
     ("exp(x)", 800.0, "^x = 800.0 is too large"),           # f overflows float64
+    ("abs(atan(x)**atan(x))", 1.0, "^function: .* derivative in x in closed form; sympy's holds arg, im, re"),
+    ("cos(3)**x", 1.0, "^function: .* derivative in x in closed form; sympy's holds the imaginary unit"),
 ])
 def test_a_bad_function_or_point_is_one_input_error(function, x, match):
     with pytest.raises(InputError, match=match):
         gm.univariate_errors(function, x)
+
+
+def test_a_derivative_below_float64s_range_is_measured_and_one_whose_program_overflows_refused():
+    """exp at -778.8: f' = 1e-338 is 0 in float64, the relative errors finite all the same (taken in
+    mpmath).  tanh(sinh(x)) at -951.8: the float64 program of sympy's derivative overflows (cosh x),
+    so the exact method has no value there: one refusal naming the function."""
+    found = gm.univariate_errors("exp(x)", -778.8, steps=(1e-2, 1e-6))
+    assert found.derivative == 0.0 and all(math.isfinite(r.relative_error) for r in found.rows)
+    with pytest.raises(InputError, match=r"^function tanh\(sinh\(x\)\): its exact derivative at x = -951.8"):
+        gm.univariate_errors("tanh(sinh(x))", -951.8, steps=(1e-2,))
+
+
+def test_a_step_past_where_f_is_defined_is_refused_by_this_functions_name_for_it():
+    with pytest.raises(InputError, match=r"^steps must keep log\(x\) finite and real .* at the step 0.6 \(step 1\)"):
+        gm.univariate_errors("log(x)", 0.5, steps=(1e-3, 0.6))
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=functions_at_points())
+def test_any_function_at_any_point_is_measured_or_one_input_error(case):
+    """Whatever f a reader types and wherever: every method's row a finite value and error, or one
+    refusal naming ``function``, ``x`` or ``steps`` (never an exception from inside mpmath, math,
+    SciPy or JAX: a pole, an overflow of a derivative, a derivative below float64's range)."""
+    text, x = case
+    try:
+        found = gm.univariate_errors(text, x, steps=(1e-2, 1e-6, 1e-20))
+    except InputError as exc:
+        assert re.match(r"^(function|x|steps)\b", str(exc)) and "\n" not in str(exc), str(exc)
+        return
+    assert found.rows and all(math.isfinite(r.value) and math.isfinite(r.error) and not math.isnan(r.relative_error)
+                              for r in found.rows), found.rows
+
+
+def test_the_reference_is_nan_where_the_gradient_has_no_value_and_mpmaths_elsewhere():
+    """A pole in u at the first point (both components NaN: mpmath raises), a square root past its
+    branch point in v at the last (h_v complex: NaN), the values elsewhere mpmath's own."""
+    uu, vv = np.array([0.31, 0.5, 0.2]), np.array([0.47, 0.47, 0.3])
+    hi, lo = gm.reference_gradient("1/(u - 0.31) + sqrt(v - 0.4)", uu, vv, 8.0, 4.0)
+    with mpmath.workdps(50):
+        h_u = [float(-1 / (mpmath.mpf(a) - mpmath.mpf("0.31")) ** 2) for a in uu[1:]]
+        h_v = float(1 / (2 * mpmath.sqrt(mpmath.mpf(0.47) - mpmath.mpf("0.4"))))
+    assert np.isnan(hi[:, 0]).all() and np.isnan(lo[:, 0]).all() and np.isnan(hi[1, 2]) and np.isnan(lo[1, 2])
+    assert np.allclose(hi[0, 1:], h_u, rtol=1e-15, atol=0) and np.isclose(hi[1, 1], h_v, rtol=1e-15, atol=0)
