@@ -157,7 +157,10 @@ class NumpyNamespace:
     """
 
     name = "numpy"
-    sin, cos, atan2, sqrt, hypot, abs = np.sin, np.cos, np.arctan2, np.sqrt, np.hypot, np.abs
+    # Every function of `renderer.formulas.ELEMENTARY`, by math's name (a test checks each namespace).
+    sin, cos, tan, asin, acos, atan = np.sin, np.cos, np.tan, np.asin, np.acos, np.atan
+    sinh, cosh, tanh, exp, log, abs = np.sinh, np.cosh, np.tanh, np.exp, np.log, np.abs
+    atan2, sqrt, hypot = np.arctan2, np.sqrt, np.hypot
     copysign, minimum, maximum, power = np.copysign, np.minimum, np.maximum, np.power
     select = staticmethod(np.where)
 
@@ -207,7 +210,10 @@ class DrJitNamespace:
         self.dr, self.Float64, self.UInt32, self.UInt8 = dr, llvm.Float64, llvm.UInt32, llvm.UInt8
         self.vector = {2: llvm.Array2f64, 3: llvm.Array3f64}
         self._frozen = {}
-        self.sin, self.cos, self.atan2, self.sqrt, self.abs = dr.sin, dr.cos, dr.atan2, dr.sqrt, dr.abs
+        # Every function of `renderer.formulas.ELEMENTARY`, by math's name, as NumpyNamespace's.
+        self.sin, self.cos, self.tan, self.asin, self.acos = dr.sin, dr.cos, dr.tan, dr.asin, dr.acos
+        self.atan, self.sinh, self.cosh, self.tanh = dr.atan, dr.sinh, dr.cosh, dr.tanh
+        self.exp, self.log, self.abs, self.atan2, self.sqrt = dr.exp, dr.log, dr.abs, dr.atan2, dr.sqrt
         self.hypot = dr.hypot        # max |a|, |b| times sqrt(1 + ratio^2): no underflow of the squares
         self.copysign, self.minimum, self.maximum, self.power = dr.copysign, dr.minimum, dr.maximum, dr.power
 

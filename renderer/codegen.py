@@ -68,12 +68,12 @@ class _ArrayPrinter(PythonCodePrinter):
     functions (xp.sin, xp.sqrt, xp.hypot, xp.atan2, xp.copysign, xp.abs, xp.minimum,
     xp.maximum) instead of math's and the builtins, a Piecewise as nested
     ``xp.select(cond, a, b)``, logic as ``&``, ``|`` and ``~`` of parenthesized
-    operands; constants (math.pi) stay Python floats."""
+    operands; constants (math.pi, math.e) stay Python floats."""
 
     _operators = {"and": "&", "or": "|", "not": "~"}
 
     def _module_format(self, fqn, register=True):
-        if fqn.startswith("math.") and fqn != "math.pi":
+        if fqn.startswith("math.") and fqn not in ("math.pi", "math.e"):
             return "xp." + fqn[len("math."):]
         return super()._module_format(fqn, register)
 

@@ -275,7 +275,9 @@ def _on_chart(field, k_u, k_v):
     t = np.linspace(0.0, 1.0, CHART_CHECK_POINTS)
     uu, vv = np.meshgrid(t, t)
     with np.errstate(all="ignore"):
-        values = [np.broadcast_to(np.asarray(a, dtype=np.float64), uu.shape) for a in fn(uu, vv, k_u, k_v)]
+        # numpy's frequencies: a term of them alone overflows to inf, where Python's floats raise.
+        values = [np.broadcast_to(np.asarray(a, dtype=np.float64), uu.shape)
+                  for a in fn(uu, vv, np.float64(k_u), np.float64(k_v))]
     return float(np.min(values[0])), all(np.all(np.isfinite(a)) for a in values)
 
 

@@ -20,7 +20,10 @@ import sys
 import numpy as np
 import pytest
 
-from renderer import PointLight, Scene, arraykernel, backends, kernel, render, validate
+import sympy as sp
+
+from renderer import PointLight, Scene, arraykernel, backends, codegen, kernel, render, validate
+from renderer import formulas as F
 from tests.test_parity import IMAGE_TOL, LIGHT_2, grad_tolerance, require_backend
 
 ARRAY_BACKENDS = ("numpy", "drjit")
@@ -67,6 +70,20 @@ def test_array_backends_return_the_frames_types_and_shapes(backend):
     bare = render(Scene(), 7, 5, backend=backend, kink=False, grad=False)
     assert bare.kink is None and bare.grad is None
     assert np.array_equal(bare.image, frame.image)
+
+
+@pytest.mark.parametrize("backend", ARRAY_BACKENDS)
+def test_each_namespace_has_every_function_a_field_may_call(backend):
+    """The array code calls ``xp.<name>`` for each of `formulas.ELEMENTARY` (a reader's field may use any):
+    each name the printer writes is the namespace's function of that name."""
+    require_backend(backend)
+    xp, x = backends.namespace(backend), sp.Symbol("x")
+    for f in F.ELEMENTARY:
+        name = codegen._array(f(x)).removeprefix("xp.").removesuffix("(x)")
+        assert getattr(xp, name, None) is not None, (backend, f, name)
+    with pytest.raises(AssertionError):                      # the check sees a missing one
+        assert getattr(xp, codegen._array(sp.erf(x)).removeprefix("xp.").removesuffix("(x)"), None) is not None
+    assert [codegen._array(c) for c in (sp.pi, sp.E)] == ["math.pi", "math.e"]    # constants: math's floats
 
 
 @pytest.mark.parametrize("backend", ARRAY_BACKENDS)

@@ -44,6 +44,9 @@ SQUARES = F.register(F.HeightField("squares", sp.sin(sp.pi * F.k_u * F.u) ** 2 *
 '''
 #: A reader's own field, as text (`renderer.formulas.field` parses it).
 READERS = "cos(pi*k_u*u) * sin(pi*k_v*v)^3 + u/2"
+#: A reader's field calling every function a field may (`formulas.ELEMENTARY`), each where it is real,
+#: and both constants.
+EVERY_FUNCTION = " + ".join(f"{f.__name__}((0.3*u + 0.2*v)*k_u/8 + 0.1)/8" for f in F.ELEMENTARY) + " + E*pi/64"
 
 
 @pytest.fixture(scope="module")
@@ -123,9 +126,12 @@ def test_its_u_curve_is_the_references(squares):
         assert np.all(np.abs(quotient - reference) <= 4 * (lip + 1) * 2 * U / steps + 4 * U * abs(want))
 
 
-@pytest.mark.parametrize("gradient, backend", [("exact", "numba"), ("central", "numpy"), ("footprint", "numba")])
-def test_a_readers_expression_renders_as_the_reference(gradient, backend):
-    scene = Scene(height_field=READERS, beta=0.5, bump="chart")
+@pytest.mark.parametrize("text, gradient, backend", [
+    (READERS, "exact", "numba"), (READERS, "central", "numpy"), (READERS, "footprint", "numba"),
+    (EVERY_FUNCTION, "exact", "numba"), (EVERY_FUNCTION, "central", "numpy"), (EVERY_FUNCTION, "footprint", "drjit")],
+    ids=lambda p: {READERS: "readers", EVERY_FUNCTION: "every-function"}.get(p))
+def test_a_readers_expression_renders_as_the_reference(text, gradient, backend):
+    scene = Scene(height_field=text, beta=0.5, bump="chart")
     assert scene.height_field not in F.FIELDS and scene.field.expr.has(F.u, F.v, F.k_u, F.k_v)
     assert_parity(scene, gradient, backend, ((17, 20),))
 

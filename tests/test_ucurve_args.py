@@ -63,7 +63,8 @@ def test_values_at_the_limits_and_numpy_scalars_are_measured():
     (("1/x", 0.0), {}, ValueError, "function 1/x must be defined and differentiable at x = 0.0"),   # mpmath raises
     (("abs(x)", 0.0), {}, ValueError, "function Abs(x) is not differentiable at x = 0.0: it has a crease"),
     (("exp(x)", 800.0), {}, ValueError, "function exp(x) must be defined and differentiable at x = 800.0"),
-    (("exp(x)/exp(x - 1)", 710.0), {}, ValueError, "x must be a point where function exp(x)*exp(1 - x) is a finite float64"),
+    (("exp(x)/exp(x - 1)", 710.0), {}, ValueError,
+     "x must be a point where function exp(x)*exp(1 - x) is a finite float64"),
     (("log(x)", 0.5), dict(eps=[1e-3, 0.6]), ValueError,
      "eps must keep log(x) finite and real at the abscissae of its quotient; at the step 0.6 (step 1) it is not, "
      "at -0.09999999999999998 or 1.1"),
