@@ -505,7 +505,8 @@ def _ad_gradient(record, uu, vv, ku, kv, *, height=None):
     uu, vv = np.broadcast_arrays(np.asarray(uu, dtype=np.float64), np.asarray(vv, dtype=np.float64))
     with jax.enable_x64(True):
         h_u, h_v = fn(uu, vv, float(ku), float(kv))
-        return np.asarray(h_u), np.asarray(h_v)
+        # A height that does not vary with u or v (2 k_u) gives JAX's scalar tangent: one per point.
+        return tuple(np.array(np.broadcast_to(np.asarray(g), uu.shape)) for g in (h_u, h_v))
 
 
 def ad_trig_calls(field):

@@ -567,6 +567,17 @@ def test_any_function_at_any_point_is_measured_or_one_input_error(case):
                               for r in found.rows), found.rows
 
 
+@pytest.mark.parametrize("text", ["2*k_u", "u", "sin(pi*k_v*v)"])
+def test_every_method_gives_one_value_per_point_of_any_field(text):
+    """A field constant in u and v (2 k_u), or in one of them: every method's gradient is two
+    float64 arrays of the points' shape (AD's once were JAX's scalar tangent for the constant)."""
+    record, uu, vv = F.field(text), np.array([0.31, 0.5, 0.9]), np.array([0.47, 0.2, 0.6])
+    for m in gm.METHODS:
+        if m.applies(record):
+            grad = m.gradient(record, uu, vv, 8.0, 4.0, None if m.steps is None else 1e-6, {})
+            assert [np.asarray(g).shape for g in grad] == [(3,), (3,)], (m.name, text)
+
+
 def test_the_reference_is_nan_where_the_gradient_has_no_value_and_mpmaths_elsewhere():
     """A pole in u at the first point (both components NaN: mpmath raises), a square root past its
     branch point in v at the last (h_v complex: NaN), the values elsewhere mpmath's own."""
