@@ -100,7 +100,7 @@ def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=N
     scene = Scene(height_field=field, k_u=k_u, k_v=k_v)
     uu, vv = _sample(scene, size, count, seed)
     for factor in field.crease_factors:
-        keep = np.abs(sp.lambdify(F.FIELD_SYMBOLS, factor, modules="numpy")(uu, vv, k_u, k_v)) > 1e-9
+        keep = np.abs(sp.lambdify(F.FIELD_SYMBOLS, factor, modules="numpy")(uu, vv, *np.float64([k_u, k_v]))) > 1e-9
         uu, vv = uu[keep], vv[keep]
     ref_fn = _reference(field, k_u, k_v)
     with mpmath.workdps(DIGITS):
@@ -274,6 +274,7 @@ def crease_distance(u, v, k_u, k_v, field=None):
 def _crease_distance(u, v, k_u, k_v, record):
     shape, u, v = u.shape, u.ravel(), v.ravel()
     out = np.full(u.shape, np.inf)
+    k_u, k_v = np.float64(k_u), np.float64(k_v)     # numpy's overflow to inf, not Python's OverflowError
     for factor in record.crease_factors:
         g = sp.lambdify((F.u, F.v, F.k_u, F.k_v), factor, modules="numpy")
         for along_u in (True, False):

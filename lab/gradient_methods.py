@@ -385,6 +385,7 @@ def complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
 def _complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
     h = _complex_fn(field.expr, F.FIELD_SYMBOLS, continued)
     shape = np.broadcast(uu, vv).shape
+    ku, kv = np.float64(ku), np.float64(kv)     # k_u**k_u overflows to inf, as in the kernel, not raising
     hu = np.imag(h(uu + 1j * eps, vv, ku, kv)) / eps
     hv = np.imag(h(uu, vv + 1j * eps, ku, kv)) / eps
     return np.broadcast_to(hu, shape), np.broadcast_to(hv, shape)
@@ -455,10 +456,13 @@ def _ad_program(height):
     import jax.numpy as jnp
     h = sp.lambdify(F.FIELD_SYMBOLS, height, modules="jax")
 
+    def height_at(uu, vv, ku, kv):      # a float: a constant field (0) prints as an int, whose tangent is float0
+        return jnp.asarray(h(uu, vv, ku, kv), dtype=jnp.float64)
+
     def gradient(uu, vv, ku, kv):
         one = jnp.ones_like(uu)
-        h_u = jax.jvp(lambda x: h(x, vv, ku, kv), (uu,), (one,))[1]
-        h_v = jax.jvp(lambda y: h(uu, y, ku, kv), (vv,), (one,))[1]
+        h_u = jax.jvp(lambda x: height_at(x, vv, ku, kv), (uu,), (one,))[1]
+        h_v = jax.jvp(lambda y: height_at(uu, y, ku, kv), (vv,), (one,))[1]
         return h_u, h_v
     return jax.jit(gradient)
 
@@ -479,8 +483,8 @@ def ad_gradient(field, uu, vv, ku, kv, *, height=None):
     ----------
     {_FIELD_ARGS}
     height : sympy expression or None, keyword-only
-        The program to differentiate, in u, v, k_u, k_v; None (the default) for the field's
-        expression.  A test hands in a wrong one to see it caught.
+        The program to differentiate, in u, v, k_u, k_v, checked as a reader's field is; None
+        (the default) for the field's expression.  A test hands in a wrong one to see it caught.
 
     Returns
     -------
@@ -488,14 +492,14 @@ def ad_gradient(field, uu, vv, ku, kv, *, height=None):
 
     Raises
     ------
-    {_FIELD_RAISES}; ``height`` not a sympy expression in u, v, k_u, k_v (nor None).
+    {_FIELD_RAISES}; ``height`` not a sympy expression (nor None), or one a field could not be
+        (`renderer.formulas.field`, naming ``height``: not real, a symbol other than u, v, k_u, k_v).
     """
     record, uu, vv, ku, kv = _field_args(field, uu, vv, ku, kv)
     if height is not None:
-        instance("height", height, sp.Expr, "a sympy expression in u, v, k_u, k_v or None")
-        if not height.free_symbols <= set(F.FIELD_SYMBOLS):
-            raise InvalidValue(f"height must be a sympy expression in u, v, k_u, k_v, got {str(height)!r:.80} "
-                               f"(in {', '.join(sorted(map(str, height.free_symbols)))})")
+        # A program a field could be: real, in u, v, k_u, k_v, of the functions the printers know.
+        height = F.field(instance("height", height, sp.Expr, "a sympy expression in u, v, k_u, k_v or None"),
+                         "height").expr
     return _ad_gradient(record, uu, vv, ku, kv, height=height)
 
 
@@ -799,7 +803,8 @@ def height_work(field):
 
 def _measured_h(info):
     if "h_per_pixel" not in info:
-        raise ValueError("richardson's evaluations are measured: pass the info its gradient filled")
+        raise InvalidValue(f"info must hold 'h_per_pixel' for richardson, whose evaluations are measured: "
+                           f"pass the dict its gradient filled; got {sorted(info)!r}")
     return info["h_per_pixel"]
 
 
@@ -814,8 +819,8 @@ def evaluations(field, name, info=None):
     """The work per pixel of the method ``name`` on ``field`` (`Method.work`), an `Evaluations`.
     ``info``: what the method's gradient measured of itself (Richardson's count of values of h), a
     dict or None.  Raises InvalidType or InvalidValue for a refused field (naming ``field``), an
-    unknown method (``method``) or an ``info`` that is not a dict; ValueError for Richardson
-    without ``info``."""
+    unknown method (``method``), an ``info`` that is not a dict, or Richardson's without
+    ``"h_per_pixel"`` in ``info`` (naming ``info``)."""
     record = F.field(field, "field")
     return method(name).work(record, optional(instance, "info", info, dict, "a dict or None") or {})
 

@@ -83,15 +83,17 @@ def _check_expression(name, expr, symbols):
         raise TypeError(f"{name} must be a sympy expression, got {type(expr).__name__}")
     extra = expr.free_symbols - set(symbols)
     if extra:
-        raise ValueError(f"{name} may use only {', '.join(map(str, symbols))}; it uses "
+        raise ValueError(f"{name} must use only {', '.join(map(str, symbols))}; it uses "
                          f"{', '.join(sorted(map(str, extra)))}")
     unknown = {type(f).__name__ for f in expr.atoms(sp.Function) if not isinstance(f, ELEMENTARY)}
     if unknown:
-        raise ValueError(f"{name} may call only {', '.join(f.__name__ for f in ELEMENTARY)}; it calls "
+        raise ValueError(f"{name} must call only {', '.join(f.__name__ for f in ELEMENTARY)}; it calls "
                          f"{', '.join(sorted(unknown))}")
-    if expr.has(sp.I, sp.zoo, sp.oo, sp.nan, sp.AccumBounds) or any(not a.is_real for a in expr.atoms(sp.Number)):
-        raise ValueError(f"{name} must be real: it holds {expr.atoms(sp.Number, sp.NumberSymbol) - {sp.pi, sp.E}}"
-                         f" or an imaginary unit or infinity")
+    held = [str(a) for a in (sp.I, sp.zoo, sp.oo, -sp.oo, sp.nan) if expr.has(a)] + \
+        sorted({str(a) for a in expr.atoms(sp.Number) if not a.is_real}) + \
+        (["an interval, AccumBounds"] if expr.has(sp.AccumBounds) else [])
+    if held:
+        raise ValueError(f"{name} must be real and finite: it holds {', '.join(dict.fromkeys(held))}")
     for var in sorted(expr.free_symbols - {k_u, k_v}, key=str):      # the variables, not the frequencies
         # |g| of a g sympy cannot tell is real (g = u**u) differentiates into re, im and arg of g; a
         # negative base, c**u, into log(c) = log|c| + i pi.
@@ -225,8 +227,9 @@ _EXPRESSIONS = {}
 
 
 def field(spec, name="height_field"):
-    """The `HeightField` ``spec`` names: a registered name, a `HeightField`, or a reader's
-    sympy expression (or its text, parsed by `renderer.validate.expression`) in u, v, k_u, k_v.
+    """The `HeightField` ``spec`` names: a registered name, a `HeightField`, a reader's
+    sympy expression (or its text, parsed by `renderer.validate.expression`) in u, v, k_u, k_v,
+    or a real number (a constant field, flat: no β moves its normal).
 
     Raises
     ------
@@ -243,9 +246,11 @@ def field(spec, name="height_field"):
         return FIELDS[spec]
     if isinstance(spec, str) and spec in _EXPRESSIONS:
         return _EXPRESSIONS[spec]
+    if isinstance(spec, (int, float)) and not isinstance(spec, bool):     # a constant (TOML's height_field = 0)
+        spec = sp.sympify(spec)
     if not isinstance(spec, (str, sp.Expr)):
-        raise InvalidType(f"{name} must be one of {tuple(FIELDS)}, a HeightField or a sympy expression in "
-                          f"u, v, k_u, k_v, got {type(spec).__name__}")
+        raise InvalidType(f"{name} must be one of {tuple(FIELDS)}, a HeightField, a sympy expression in "
+                          f"u, v, k_u, k_v or a real number, got {type(spec).__name__}")
     expr = expression(name, spec, FIELD_SYMBOLS, ELEMENTARY, fields=tuple(FIELDS)) if isinstance(spec, str) else spec
     try:
         record = HeightField(str(expr), expr)

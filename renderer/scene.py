@@ -268,7 +268,7 @@ CHART_CHECK_POINTS = 65
 
 @lru_cache(maxsize=64)
 def _on_chart(field, k_u, k_v):
-    """(least h, whether h and its gradient are finite) on a grid of the chart, numpy float64."""
+    """(least h, whether h and its gradient are finite and real) on a grid of the chart, numpy float64."""
     import numpy as np
     import sympy as sp
     fn = sp.lambdify(formulas.FIELD_SYMBOLS, [field.expr, *field.gradient], modules="numpy")
@@ -276,8 +276,10 @@ def _on_chart(field, k_u, k_v):
     uu, vv = np.meshgrid(t, t)
     with np.errstate(all="ignore"):
         # numpy's frequencies: a term of them alone overflows to inf, where Python's floats raise.
-        values = [np.broadcast_to(np.asarray(a, dtype=np.float64), uu.shape)
-                  for a in fn(uu, vv, np.float64(k_u), np.float64(k_v))]
+        # A constant sympy cannot tell is complex, (0.5 - pi)**pi, comes out a Python complex.
+        values = [np.broadcast_to(a, uu.shape) for a in fn(uu, vv, np.float64(k_u), np.float64(k_v))]
+    if any(np.iscomplexobj(a) for a in values):
+        return float("nan"), False
     return float(np.min(values[0])), all(np.all(np.isfinite(a)) for a in values)
 
 
@@ -287,8 +289,8 @@ def _check_on_chart(scene):
     radius radius_a + beta h positive there."""
     low, finite = _on_chart(scene.field, scene.k_u, scene.k_v)
     if not finite:
-        raise InvalidValue(f"Scene.height_field {scene.height_field!r} or its gradient is not finite at every "
-                           f"point of the chart [0, 1]^2 (k_u = {scene.k_u:g}, k_v = {scene.k_v:g})")
+        raise InvalidValue(f"Scene.height_field {scene.height_field!r} or its gradient is not finite and real at "
+                           f"every point of the chart [0, 1]^2 (k_u = {scene.k_u:g}, k_v = {scene.k_v:g})")
     if scene.bump == "surface" and not scene.radius_a + scene.beta * low > 0.0:
         raise InvalidValue(f"Scene.beta = {scene.beta!r} with height_field {scene.height_field!r} (least value "
                            f"{low:.3g}) puts the displaced radius radius_a + beta h at or below 0; bump='surface' "

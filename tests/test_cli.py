@@ -178,7 +178,7 @@ def test_a_scene_file_with_set_overrides(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("text, value", [
-    ("height_field=sine", "sine"), ('model="phong"', "phong"), ("floor=false", False), ("k_v=3", 3.0),
+    ("height_field=sine", "sine"), ("height_field=0", "0"), ('model="phong"', "phong"), ("floor=false", False), ("k_v=3", 3.0),
     ("center_b=[0.5, 0.5, 1.4]", (0.5, 0.5, 1.4)),
     ("lights=[{position=[1, 2, 3], color=[0.5, 0.5, 0.5]}]", (PointLight((1, 2, 3), (0.5, 0.5, 0.5)),)),
 ])

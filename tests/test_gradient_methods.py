@@ -16,16 +16,16 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from lab import gradient_methods as gm
 from renderer import DRAFT_SCENE, pointwise, ucurve
 from renderer import formulas as F
 from renderer import generated as G
-from renderer.validate import InputError
+from renderer.validate import InputError, InvalidValue
 
-from .expressions import functions_at_points
+from .expressions import expressions, fields_at_points, functions_at_points
 
 KU, KV = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
 #: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as lab/accuracy.py).
@@ -193,8 +193,9 @@ def test_work_per_pixel_of_the_methods_without_a_formula_to_count():
     assert gm.evaluations("sine", "complex step") == gm.Evaluations(h_complex=2)
     assert gm.evaluations("sine", "forward").h == 3 and gm.evaluations("sine", "exact").gradient == 1
     assert gm.evaluations("sine", "richardson", {"h_per_pixel": 22.5}) == gm.Evaluations(h=22.5, trig=45)
-    with pytest.raises(ValueError, match="richardson's evaluations are measured"):
-        gm.evaluations("sine", "richardson")
+    for info in (None, {}, {"iterations": 3.0}):
+        with pytest.raises(InvalidValue, match="^info must hold 'h_per_pixel' for richardson"):
+            gm.evaluations("sine", "richardson", info)
     with pytest.raises(ValueError, match="^method must be one of .*'backward'"):
         gm.evaluations("sine", "backward")
 
@@ -567,15 +568,51 @@ def test_any_function_at_any_point_is_measured_or_one_input_error(case):
                               for r in found.rows), found.rows
 
 
-@pytest.mark.parametrize("text", ["2*k_u", "u", "sin(pi*k_v*v)"])
+@pytest.mark.parametrize("text", ["0", "2*k_u", "u", "sin(pi*k_v*v)"])
 def test_every_method_gives_one_value_per_point_of_any_field(text):
-    """A field constant in u and v (2 k_u), or in one of them: every method's gradient is two
-    float64 arrays of the points' shape (AD's once were JAX's scalar tangent for the constant)."""
+    """A field constant in u and v (0, 2 k_u), or in one of them: every method's gradient is two
+    float64 arrays of the points' shape (AD's once were JAX's scalar tangent for 2 k_u, and JAX's
+    float0 tangent of an integer for 0)."""
     record, uu, vv = F.field(text), np.array([0.31, 0.5, 0.9]), np.array([0.47, 0.2, 0.6])
     for m in gm.METHODS:
         if m.applies(record):
             grad = m.gradient(record, uu, vv, 8.0, 4.0, None if m.steps is None else 1e-6, {})
-            assert [np.asarray(g).shape for g in grad] == [(3,), (3,)], (m.name, text)
+            assert [(np.asarray(g).dtype, np.shape(g)) for g in grad] == [(np.float64, (3,))] * 2, (m.name, text)
+
+
+#: Frequencies at the ends of what a scene accepts, and the draft's.
+FREQUENCIES = st.sampled_from([1e-3, 0.5, KV, KU, 1e3])
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")     # numpy's, where it gives NaN or inf
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=fields_at_points(), ku=FREQUENCIES, kv=FREQUENCIES, program=expressions(["u", "v", "k_u", "k_v"]))
+@example(case=("cos(k_u**k_u)", 0.31, 0.47, "u"), ku=1e3, kv=1e3, program="log(log(1))")
+def test_any_field_at_any_point_gives_every_method_one_float_per_point_or_one_input_error(case, ku, kv, program):
+    """Whatever field a reader types, at any chart point and frequencies: every method that applies,
+    the reference and AD of any program give float64 arrays of the points' shape (NaN or inf where
+    the field has no value, as numpy gives), or the field or program is refused by name when parsed;
+    never an exception from inside numpy, sympy's printers or JAX (k_u**k_u at k_u = 1e3 raised
+    Python's OverflowError in the complex step; a program sympy reads as complex infinity, a KeyError)."""
+    text, u, v, _ = case
+    uu, vv = np.array([u, 0.31]), np.array([v, 0.47])
+    try:
+        record = F.field(text)
+    except InputError as exc:
+        assert str(exc).startswith("height_field") and "\n" not in str(exc), str(exc)
+    else:
+        for m in gm.METHODS:
+            if m.applies(record):
+                grad = m.gradient(record, uu, vv, ku, kv, None if m.steps is None else 1e-6, {})
+                assert [(np.asarray(g).dtype, np.shape(g)) for g in grad] == [(np.float64, (2,))] * 2, m.name
+        assert all(a.shape == (2, 2) for a in gm.reference_gradient(record, uu, vv, ku, kv, digits=32))
+    height = sp.parse_expr(program, local_dict={s.name: s for s in F.FIELD_SYMBOLS})
+    try:
+        grad = gm.ad_gradient("sine", uu, vv, ku, kv, height=height)
+    except InputError as exc:
+        assert str(exc).startswith("height") and "\n" not in str(exc), str(exc)
+    else:
+        assert [(g.dtype, g.shape) for g in grad] == [(np.float64, (2,))] * 2
 
 
 def test_the_reference_is_nan_where_the_gradient_has_no_value_and_mpmaths_elsewhere():

@@ -21,6 +21,7 @@ import re
 
 import numpy as np
 import pytest
+import sympy as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -129,9 +130,14 @@ def test_the_field_check_rejects_a_refusal_that_names_another_field():
 def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
     scene = Scene(height_field="sin(pi*k_u*u)^2 * sin(pi*k_v*v)^2", beta=0.5)
     assert scene.field.expr == (F.FIELDS["sine"].expr ** 2) and scene.height_field not in F.FIELDS
-    for text in ("1/u", "log(v)", "1e400*u", "u*(k_u + k_v)**(k_u**k_v)"):     # the last: 12**4096 overflows
+    # A number is a constant field (TOML reads height_field = 0 as one); a bool is not a number here.
+    assert [Scene(height_field=c).field.gradient for c in (0, 0.5)] == [(0, 0)] * 2
+    _, message = refusal(lambda: Scene(height_field=True))
+    assert message.startswith("Scene.height_field must be") and message.endswith("got bool"), message
+    # 12**4096 overflows; (0.5 - pi)**pi is a complex number sympy does not evaluate.
+    for text in ("1/u", "log(v)", "1e400*u", "u*(k_u + k_v)**(k_u**k_v)", "u*(0.5 - pi)**pi", "(0.5 - pi)**pi"):
         _, message = refusal(lambda: Scene(height_field=text))
-        assert message.startswith("Scene.height_field ") and "not finite" in message, message
+        assert message.startswith("Scene.height_field ") and "not finite and real" in message, message
 
 
 @pytest.mark.parametrize("text, held", [("abs(u**u)", "arg, im, re"), ("cos(3)**v", "the imaginary unit")])
@@ -143,6 +149,15 @@ def test_a_field_whose_derivative_sympy_cannot_write_real_is_refused(text, held)
     assert Scene(height_field="abs(sin(pi*k_u*u))*v").field.crease_factors
     _, message = refusal(lambda: Scene(height_field="u*atan(tan(pi/2))"))    # sympy: an interval, not a number
     assert message.startswith("Scene.height_field: ") and "must be real" in message, message
+
+
+@pytest.mark.parametrize("expr, held", [(sp.I * F.u, "I"), (sp.zoo * F.u, "zoo"), (F.u + sp.oo, "oo"),
+                                        (F.u - sp.oo, "-oo"), (sp.nan * F.u, "nan"),
+                                        (F.u * sp.AccumBounds(0, 1), "an interval")])
+def test_a_sympy_field_holding_a_constant_that_is_not_a_real_number_is_refused_naming_it(expr, held):
+    _, message = refusal(lambda: Scene(height_field=expr))
+    assert message.startswith("Scene.height_field: ") and f"must be real and finite: it holds {held}" in message, \
+        message
 
 
 @pytest.mark.parametrize("kwargs, field, phrase", [
