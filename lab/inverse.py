@@ -199,7 +199,9 @@ def fit_beta(target, scene, *, beta0=0.1, steps=20, tol=1e-12):
         integer; ``beta0`` or ``tol`` not real.
     renderer.validate.InvalidValue
         ``target`` not of shape (H, W, 3) with H, W in [1, 8192], or on sphere A not finite or
-        outside [-1.5, 1.5]; ``beta0``, ``steps`` or ``tol`` out of range.
+        outside [-1.5, 1.5]; ``beta0``, ``steps`` or ``tol`` out of range; ``scene`` whose normals
+        on sphere A do not move with β (dN'/dβ = 0 on every pixel: a field of gradient 0, such as
+        a constant, or no pixel on sphere A), where β cannot be recovered.
     """
     target = numbers_array("target", target)
     if target.ndim != 3 or target.shape[2] != 3 or not 1 <= min(target.shape[:2]) <= max(target.shape[:2]) <= MAX_SIDE:
@@ -226,6 +228,10 @@ def fit_beta(target, scene, *, beta0=0.1, steps=20, tol=1e-12):
         if converged or len(iterates) > steps:
             break
         J = jac.ravel()
+        if not J @ J > 0.0:
+            raise InvalidValue(f"scene must show normals that move with beta on sphere A to fit beta; at beta = "
+                               f"{beta:g} dN'/dbeta is 0 on all {on_a.sum():,} of its pixels (height_field "
+                               f"{scene.height_field!r}: a gradient 0 everywhere, or no pixel on sphere A)")
         step = -float(J @ r) / float(J @ J)
         # Keep β in the scene's range (surface: R + β h > 0).
         new = min(max(beta + step, 0.0), np.nextafter(high, 0.0) if scene.bump == "surface" else high)

@@ -198,3 +198,14 @@ def test_a_step_past_the_range_stops_at_its_edge(mode, beta, push, start):
     assert all(np.isfinite(r) for _, r in fit.iterates)
     if mode == "chart":             # from 99 to the edge is a step of exactly 1: within tol = 1, done
         assert [b for b, _ in fit_beta(target, scene, beta0=start, tol=1.0).iterates] == [start, MAX_BETA]
+
+
+@pytest.mark.parametrize("mode", ["surface", "chart"])
+@pytest.mark.parametrize("field", ["1", "0", "2*k_u"])
+def test_a_field_whose_normals_do_not_move_with_beta_is_refused_not_divided_by_zero(mode, field):
+    """A constant field has gradient 0: no β moves a normal, so none can be recovered.  The fit
+    says so, naming the scene, where its Gauss-Newton step divided by |dN'/dβ|² = 0."""
+    scene = Scene(height_field=field, bump=mode, beta=0.2)
+    with pytest.raises(InvalidValue, match=r"^scene must show normals that move with beta .* on all [\d,]+ of its "
+                                           rf"pixels \(height_field '{re.escape(field)}'"):
+        fit_beta(gbuffer(scene, 8, 8).Ns, scene)
