@@ -1,6 +1,6 @@
 """Run time against error of the gradient methods, release configuration.
 
-Runs `lab.gradient_methods.measure` with the FULL configuration (all sphere-A
+Runs `lab.gradient_benchmark.measure` with the FULL configuration (all sphere-A
 pixels of a 256^2 frame in the mpmath reference, twelve steps per difference
 sweep, fifteen interleaved repeats; forward-mode AD with its compile time apart), prints the Pareto front of each height
 field, the best step of every method and the full table (medians with the
@@ -22,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "book")]          # book/ for the book's `chapter` (its table)
 
 from chapter.benchmark import markdown_table, step_text  # noqa: E402
+from lab import gradient_benchmark as gb  # noqa: E402
 from lab import gradient_methods as gm  # noqa: E402
 from renderer import DRAFT_SCENE  # noqa: E402
 
@@ -30,17 +31,17 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results",
                     help="directory for gradients.md and gradients.json (default benchmarks/results)")
-    ap.add_argument("--repeats", type=int, default=gm.FULL.repeats,
-                    help=f"timed runs per method (default {gm.FULL.repeats})")
+    ap.add_argument("--repeats", type=int, default=gb.FULL.repeats,
+                    help=f"timed runs per method (default {gb.FULL.repeats})")
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error(f"--repeats must be >= 1, got {args.repeats}")
-    config = dataclasses.replace(gm.FULL, repeats=args.repeats, richardson_repeats=args.repeats)
+    config = dataclasses.replace(gb.FULL, repeats=args.repeats, richardson_repeats=args.repeats)
 
-    m = gm.measure(config)
+    m = gb.measure(config)
     h_ms = {f: 1e3 * statistics.median(t) for f, t in m.h_times.items()}
     excluded = ", ".join(f"{f} {n:,}" for f, n in m.excluded_pixels.items() if n)
-    draft = gm.MethodResult("", "central", DRAFT_SCENE.eps, (0.0,), 0, 0, 0, 0, 0).label    # its row's label
+    draft = gb.MethodResult("", "central", DRAFT_SCENE.eps, (0.0,), 0, 0, 0, 0, 0).label    # its row's label
     head = [
         "# Gradient methods: run time against error (FULL configuration)",
         "",
@@ -66,7 +67,7 @@ def main(argv=None):
     print(full)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "gradients.md").write_text(front + "\n" + best + "\n" + full)
-    (args.out / "gradients.json").write_text(gm.to_json(m) + "\n")
+    (args.out / "gradients.json").write_text(gb.to_json(m) + "\n")
     print(f"wrote {args.out / 'gradients.md'} and {args.out / 'gradients.json'}")
 
 

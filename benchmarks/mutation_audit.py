@@ -182,7 +182,7 @@ SECOND = [
     ("store-digest-without-chapter", "lab/store.py",
      'PACKAGES = ("renderer", "proofs", "lab", "chapter")', 'PACKAGES = ("renderer", "proofs", "lab")',
      "the source digest misses book/chapter (a stored theorem block outlives its code)"),
-    ("pareto-strictly-better-in-both", "lab/gradient_methods.py",
+    ("pareto-strictly-better-in-both", "lab/gradient_benchmark.py",
      "((t < t[i]) | (e < e[i]))", "((t < t[i]) & (e < e[i]))",
      "a method dominated only if strictly better in time and error (ties in one kept on the front)"),
     ("beta-order-intercept", "lab/accuracy.py",

@@ -149,14 +149,14 @@ QUANTITIES = {
         ("c4_central_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "central").trig),
     "sines and cosines per pixel of the sine field's exact gradient": (
         ("c4_exact_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "exact").trig),
-    "the benchmark's complex step": (("c4_cs_step",), lambda: _lib("lab.gradient_methods").FAST.complex_steps[0]),
+    "the benchmark's complex step": (("c4_cs_step",), lambda: _lib("lab.gradient_benchmark").FAST.complex_steps[0]),
     "sines and cosines per pixel in XLA's program for the sine field's AD gradient": (
         ("c4_ad_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "forward-mode AD").trig),
     "JAX's forward-mode slope of |x| at x = 0": (
         ("c4_abs_slope",), lambda: _lib("lab.gradient_methods").abs_slope_at_zero()[0]),
     "the U-curve's chart v": (("c4_crease_v", "s3_torus_v"), lambda: _lib("renderer.ucurve").SEED_POINT[1]),
     "the classic complex-step test function's point": (("c4_classic_x",),
-                                                       lambda: _lib("lab.gradient_methods").TEST_FUNCTION.x),
+                                                       lambda: _lib("lab.gradient_benchmark").TEST_FUNCTION.x),
     # The price of fast math (Cell 4): the ulp sample, its quantile, libm's sine.
     "the fast-math sample per function": (("c4_fm_points",), lambda: _lib("lab.fastmath").SAMPLES),
     "the fast-math quantile (%)": (("c4_fm_quantile",), lambda: 100 * _lib("lab.fastmath").QUANTILE),

@@ -2,7 +2,7 @@
 
 `accuracy` (the gradients and the β-derivative against mpmath, the U-curve's optimum),
 `gradient_methods` (the ways of differentiating a height field or a reader's f(x), one record
-each, timed against their error),
+each) and `gradient_benchmark` (their run time against their error, and what the papers report),
 `seed_errata` (the defects of the draft's code, re-measured), `claims` (the draft's
 checkable claims, each decided by a stated rule), and `store` (one measurement per
 build, shared by the book's pages); `displaced` (sphere A truly displaced, against the

@@ -129,3 +129,12 @@ def chart_points(uu, vv, ku, kv, names=("uu", "vv", "ku", "kv")):
     (0, 1e3] (floats), as `renderer.Scene` accepts them."""
     uu, vv = broadcast(names[:2], real_array(names[0], uu, **UNIT), real_array(names[1], vv, **UNIT))
     return uu, vv, real(names[2], ku, **FREQUENCY), real(names[3], kv, **FREQUENCY)
+
+
+def height_fields(name, fields_):
+    """The height-field records of ``fields_`` (None: every registered field), a non-empty list or
+    tuple of what `renderer.formulas.field` takes, each refused as ``name[i]``."""
+    from renderer import formulas as F
+    if fields_ is None:
+        return tuple(F.FIELDS.values())
+    return tuple(F.field(f, f"{name}[{i}]") for i, f in enumerate(sequence(name, fields_, "height fields")))

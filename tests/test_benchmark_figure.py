@@ -42,13 +42,14 @@ def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
     step drawn across the plot, every text at least 10 pt in a figure at most 5 in wide, nothing overlapping."""
     from chapter.benchmark import univariate_figure
     from chapter.figures import _drawn_texts, text_overlaps
+    from lab import gradient_benchmark as gb
     from lab import gradient_methods as gm
 
     steps = (1e-2, 1e-6, 1e-10)
-    rows = [gm.UnivariateRow(m, e, 1.0, err, err) for m, errs in (("central", (1e-5, 1e-11, 1e-6)),
+    rows = [gb.UnivariateRow(m, e, 1.0, err, err) for m, errs in (("central", (1e-5, 1e-11, 1e-6)),
                                                                    ("complex step", (1e-5, 1e-16, 1e-16)))
-            for e, err in zip(steps, errs)] + [gm.UnivariateRow(gm.AD, None, 1.0, 1e-16, 1e-16)]
-    fake = gm.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {})
+            for e, err in zip(steps, errs)] + [gb.UnivariateRow(gm.AD, None, 1.0, 1e-16, 1e-16)]
+    fake = gb.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {})
     fig = univariate_figure(fake)
     lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
     for name in ("central", "complex step", gm.AD):

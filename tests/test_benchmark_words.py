@@ -38,16 +38,17 @@ def test_the_methods_sentence_names_every_record_with_its_steps_and_sources(monk
     import re
 
     from chapter.benchmark import methods_sentence, step_text
+    from lab import gradient_benchmark as gb
     from lab import gradient_methods as gm
     toy = gm.Method("backward", None, None, "backward difference", gm.Style("k", "v", 5), steps="forward_steps",
                     applies=lambda f: f.name == "rings", sources=("higham-accuracy",))
     monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, toy])
-    text = methods_sentence(gm.FAST)
+    text = methods_sentence(gb.FAST)
     parts = text.split(": ", 1)[1].rstrip(".").split("; ")
     assert len(parts) == len(gm.METHODS) and text.startswith("Eight methods")
     for m, part in zip(gm.METHODS, parts):
         assert part.startswith(m.label)
         assert re.findall(r"\{cite:p\}`([^`]*)`", part) == ([",".join(m.sources)] if m.sources else [])
-        for eps in (m.steps_in(gm.FAST) if m.steps else ()):
+        for eps in (m.steps_in(gb.FAST) if m.steps else ()):
             assert step_text(eps) in part
     assert parts[-1].endswith("(on rings)") and "(on" not in parts[0]

@@ -145,7 +145,7 @@ def rendering_functions():
     """Names that render, as a page cell calls them: `renderer.render`, `renderer.gbuffer`,
     and every function of proofs/ and lab/ whose body names one of them (calls it, or hands it to
     `lab.store.measured`), to a fixed point, less `NOT_A_FRAME`.  Matched by name, so a
-    homonym (ucurve.measure and gradient_methods.measure) asks for one label too many."""
+    homonym (ucurve.measure and gradient_benchmark.measure) asks for one label too many."""
     names = {}
     for path in sorted([*(ROOT / "proofs").glob("*.py"), *(ROOT / "lab").glob("*.py")]):
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):

@@ -29,6 +29,7 @@ import pytest
 
 from chapter import figures
 from chapter.benchmark import pareto_figure, univariate_figure
+from lab import gradient_benchmark as gb
 from lab import gradient_methods as gm
 from renderer import formulas as F
 from renderer.ucurve import UCurve
@@ -107,10 +108,10 @@ def _measurement():
     for i, field in enumerate(SEED_FIELDS):
         for k, m in enumerate(gm.METHODS):
             if m.applies(F.field(field)):
-                for j, eps in enumerate(m.steps_in(gm.FAST)):
+                for j, eps in enumerate(m.steps_in(gb.FAST)):
                     t, err = 1e-3 * (1 + k) * (1 + 0.3 * j) * (1 + 0.2 * i), _error(m.name, eps)
-                    rows.append(gm.MethodResult(field, m.name, eps, (0.8 * t, t, 1.5 * t), 1.0, 0.0, 0.0, err, err))
-    return gm.Measurement(gm.FAST, tuple(rows), 1000, {}, {}, {}, 1.0, 8.0, 4.0)
+                    rows.append(gb.MethodResult(field, m.name, eps, (0.8 * t, t, 1.5 * t), 1.0, 0.0, 0.0, err, err))
+    return gb.Measurement(gb.FAST, tuple(rows), 1000, {}, {}, {}, 1.0, 8.0, 4.0)
 
 
 @FIGURE
@@ -122,11 +123,11 @@ def test_pareto_figure():
 @FIGURE
 def test_univariate_figure():
     figures.style()
-    steps = gm.UNIVARIATE_STEPS[::4]
-    rows = [gm.UnivariateRow(m.name, eps, 1.0, _error(m.name, eps), _error(m.name, eps))
+    steps = gb.UNIVARIATE_STEPS[::4]
+    rows = [gb.UnivariateRow(m.name, eps, 1.0, _error(m.name, eps), _error(m.name, eps))
             for m in gm.METHODS if m.derivative is not None and m.name != "complex step, |z| continued"
             for eps in m.steps_in(SimpleNamespace(central_steps=steps, forward_steps=steps, complex_steps=steps))]
-    return univariate_figure(gm.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {}))
+    return univariate_figure(gb.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {}))
 
 
 def _displaced(n=32):

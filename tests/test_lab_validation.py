@@ -18,6 +18,7 @@ import pytest
 import sympy as sp
 
 from lab import accuracy, claims, displaced, fastmath, inverse, seed_errata
+from lab import gradient_benchmark as gb
 from lab import gradient_methods as gm
 from renderer import Scene
 from renderer import formulas as F
@@ -55,7 +56,7 @@ CHART_KINDS = dict(field=p("field", named="field"), uu=p("array", ([1.5], V, "1.
                    vv=p("array", ([0.5, 0.5, 0.5], V, "broadcast")), ku=p("real", (0.0, V, "got 0.0")),
                    kv=p("real", (1e4, V, "got 10000.0")))
 EPS = p("real", (0.0, V, "got 0.0"), (1.0, V, "got 1.0"))
-RESULT = gm.MethodResult("sine", "exact", None, (1.0,), 0.0, 0.0, 1.0, 1e-15, 1e-16)
+RESULT = gb.MethodResult("sine", "exact", None, (1.0,), 0.0, 0.0, 1.0, 1e-15, 1e-16)
 CONFIG = dict(name="tiny", central_steps=(1e-3,), forward_steps=(1e-8,), complex_steps=(1e-20,), repeats=1,
               richardson_repeats=1, reference_pixels=5, digits=34, size=16, seed=6)
 #: A measurement of the errata in which every defect is there (`seed_errata.reproduced` checks that).
@@ -88,7 +89,7 @@ FUNCTIONS = {
     "accuracy.image_best_step": (accuracy.image_best_step, dict(field="sine", size=4),
                                  dict(field=p("field"), size=p("int", (0, V, "got 0")))),
     # lab.gradient_methods
-    "gradient_methods.Config": (gm.Config, CONFIG, {
+    "gradient_benchmark.Config": (gb.Config, CONFIG, {
         **{k: p("steps", ([1.0], V, "1.0 at flat index 0"), named=f"Config.{k}")
            for k in ("central_steps", "forward_steps", "complex_steps")},
         **{k: p("int", (1001, V, "1001"), named=f"Config.{k}") for k in ("repeats", "richardson_repeats")},
@@ -96,7 +97,7 @@ FUNCTIONS = {
         "reference_pixels": p("int", named="Config.reference_pixels"),
         "digits": p("int", (31, V, "got 31"), named="Config.digits"),
         "size": p("int", (4097, V, "4097"), named="Config.size"), "seed": p("seed", named="Config.seed")}),
-    "gradient_methods.chart_points": (gm.chart_points, dict(field="sine", size=16),
+    "gradient_benchmark.chart_points": (gb.chart_points, dict(field="sine", size=16),
                                       dict(field=p("field"), size=p("int"))),
     "gradient_methods.forward_gradient": (gm.forward_gradient, dict(CHART, eps=1e-3), dict(CHART_KINDS, eps=EPS)),
     "gradient_methods.complex_step_gradient": (gm.complex_step_gradient, dict(CHART, eps=1e-20, continued=False),
@@ -105,7 +106,8 @@ FUNCTIONS = {
                                              dict(CHART_KINDS, info=p("own", ([], T, "list []")))),
     "gradient_methods.ad_gradient": (gm.ad_gradient, dict(CHART, height=F.FIELDS["sine"].expr),
                                      dict(CHART_KINDS, height=p("own", ("u", T, "str 'u'"),
-                                                                (sp.Symbol("w"), V, "it uses w"), (sp.zoo * F.u, V, "must be real")))),
+                                                                (sp.Symbol("w"), V, "it uses w"),
+                                                                (sp.zoo * F.u, V, "must be real")))),
     "gradient_methods.xla_exact_gradient": (gm.xla_exact_gradient, CHART, CHART_KINDS),
     "gradient_methods.reference_gradient": (gm.reference_gradient, dict(CHART, digits=34),
                                             dict(CHART_KINDS, digits=p("int", (31, V, "got 31"), (1001, V, "1001")))),
@@ -120,15 +122,15 @@ FUNCTIONS = {
     "gradient_methods.evaluations": (gm.evaluations, dict(field="sine", name="exact", info=None),
                                      dict(field=p("field"), name=p("name", named="method"),
                                           info=p("own", ("h", T, "str 'h'")))),
-    "gradient_methods.measure": (gm.measure, dict(config="fast", fields_=("rings",), uv=(U8, V8)),
+    "gradient_benchmark.measure": (gb.measure, dict(config="fast", fields_=("rings",), uv=(U8, V8)),
                                  dict(config=p("name", ((), T, "tuple ()")), fields_=p("fields"),
                                       uv=p("own", ("uv", T, "str 'uv'"), ((U8,), T, "tuple"),
                                            ((U8, [True] * 8), T, "list [True"), ((U8, V8[:4]), V, "(8,) and (4,)"),
                                            ((U8 + 1, V8), V, "1.1 at flat index 0")))),
-    "gradient_methods.pareto_front": (gm.pareto_front, dict(results=[RESULT], error="max"),
+    "gradient_benchmark.pareto_front": (gb.pareto_front, dict(results=[RESULT], error="max"),
                                       dict(results=p("own", ("r", T, "str 'r'"), ([RESULT, 1], T, "int 1")),
                                            error=p("name"))),
-    "gradient_methods.to_json": (gm.to_json, dict(measurement=gm.Measurement(gm.FAST, (RESULT,), 1, {}, {}, {},
+    "gradient_benchmark.to_json": (gb.to_json, dict(measurement=gb.Measurement(gb.FAST, (RESULT,), 1, {}, {}, {},
                                                                            1.0, 8.0, 4.0)),
                                  dict(measurement=p("own", ("m", T, "str 'm'"), (RESULT, T, "MethodResult")))),
     "gradient_methods.crease_values": (gm.crease_values, dict(v=0.47, eps=1e-3, ku=8.0, kv=4.0),
@@ -137,7 +139,7 @@ FUNCTIONS = {
                                                                           fields_=("rings",)),
                                              dict(uu=p("array"), vv=p("array"), ku=p("real"), kv=p("real"),
                                                   rounds=p("int", (10**4 + 1, V, "10001")), fields_=p("fields"))),
-    "gradient_methods.univariate_errors": (gm.univariate_errors, dict(function="exp(x)", x=0.5, steps=(1e-3,)),
+    "gradient_benchmark.univariate_errors": (gb.univariate_errors, dict(function="exp(x)", x=0.5, steps=(1e-3,)),
                                            dict(function=p("field"), x=p("real"), steps=p("steps"))),
     # lab.fastmath
     "fastmath.backend": (fastmath.backend, dict(name="numpy"), dict(name=p("name", named="backend"))),
@@ -235,7 +237,7 @@ def test_the_table_covers_every_public_function_and_parameter():
     """Every function of the modules' ``__all__`` with parameters, and every parameter, is in the table."""
     import inspect
     listed = {}
-    for module in (accuracy, gm, fastmath, inverse, displaced, seed_errata, claims):
+    for module in (accuracy, gm, gb, fastmath, inverse, displaced, seed_errata, claims):
         for name in module.__all__:
             obj = getattr(module, name)
             if (inspect.isfunction(obj) or inspect.isclass(obj) and name in ("Config", "Bound", "Criterion")) \

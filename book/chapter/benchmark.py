@@ -1,15 +1,16 @@
 """The gradient-methods benchmark as the book and benchmarks/bench_gradients.py show it:
 its run time against error as a figure (`pareto_figure`) and as a Markdown table
-(`markdown_table`), from the numbers `lab.gradient_methods.measure` returns; the sentence
+(`markdown_table`), from the numbers `lab.gradient_benchmark.measure` returns; the sentence
 naming every method (`methods_sentence`); and a reader's function of one variable through
 the methods (`univariate_figure`, `univariate_table`, `published_table`), from
-`lab.gradient_methods.univariate_errors`.  Every method's label, style and sources are its
+`lab.gradient_benchmark.univariate_errors`.  Every method's label, style and sources are its
 record's (`lab.gradient_methods.METHODS`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from lab import gradient_benchmark as gb
 from lab import gradient_methods as gm
 from renderer import formulas as F
 
@@ -41,7 +42,7 @@ def pareto_figure(measurement, *, error="max"):
 
     Parameters
     ----------
-    measurement : lab.gradient_methods.Measurement
+    measurement : lab.gradient_benchmark.Measurement
     error : {"max", "rms"}, keyword-only
 
     Returns
@@ -69,7 +70,7 @@ def pareto_figure(measurement, *, error="max"):
     handles = {}
     for ax, name in zip(axes, names):
         rs = measurement.of(name)
-        front = gm.pareto_front(rs, error=error)
+        front = gb.pareto_front(rs, error=error)
         ft = [1e3 * r.median for r in front]
         fe = [_floor(pick(r)) for r in front]
         handles["Pareto front"], = ax.step(ft + [t_hi], fe + [fe[-1]], where="post", color="0.75",
@@ -134,7 +135,7 @@ def markdown_table(measurement, *, rows="all", error="max", include=()):
 
     Parameters
     ----------
-    measurement : lab.gradient_methods.Measurement
+    measurement : lab.gradient_benchmark.Measurement
     rows : {"all", "front", "best"}, keyword-only
         "all": every result; "front": the Pareto front of each field;
         "best": per field, the exact gradient and, of every other method, the
@@ -142,7 +143,7 @@ def markdown_table(measurement, *, rows="all", error="max", include=()):
     error : {"max", "rms"}, keyword-only
         The error that defines the front and "best".
     include : sequence of str, keyword-only
-        Labels (`lab.gradient_methods.MethodResult.label`, e.g. ``"central 1e-03"``) shown in
+        Labels (`lab.gradient_benchmark.MethodResult.label`, e.g. ``"central 1e-03"``) shown in
         every field even when ``rows`` would leave them out.
 
     Returns
@@ -162,7 +163,7 @@ def markdown_table(measurement, *, rows="all", error="max", include=()):
     key = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
     for name in dict.fromkeys(r.field for r in measurement.results):
         rs = measurement.of(name)
-        front = gm.pareto_front(rs, error=error)
+        front = gb.pareto_front(rs, error=error)
         if rows == "front":
             chosen = list(front)
         elif rows == "best":
@@ -205,7 +206,7 @@ def fastest_on(measurement, method="exact"):
 
     Parameters
     ----------
-    measurement : lab.gradient_methods.Measurement
+    measurement : lab.gradient_benchmark.Measurement
     method : str
         A method's name as the measurement's rows carry it.
 
@@ -237,7 +238,7 @@ def methods_sentence(config, fields=None):
 
     Parameters
     ----------
-    config : lab.gradient_methods.Config
+    config : lab.gradient_benchmark.Config
     fields : sequence of height fields or None
         As `renderer.formulas.field` takes them; None for every registered field.
 
@@ -262,7 +263,7 @@ def methods_sentence(config, fields=None):
 
 def univariate_figure(errors):
     """Relative error of f'(x) against the step, log-log, one line per method of ``errors`` (a
-    `lab.gradient_methods.UnivariateErrors`), the step growing to the right; a method without a step
+    `lab.gradient_benchmark.UnivariateErrors`), the step growing to the right; a method without a step
     is a horizontal line across; hollow markers, so that two methods with equal errors both show.
     Drawn for a phone's column: 4.6 in wide, every text at `chapter.figures.TEXT_PT`.  An error of exactly 0 would be drawn at
     1e-18.  Returns a matplotlib Figure (not shown)."""
@@ -294,7 +295,7 @@ def univariate_figure(errors):
 
 
 def univariate_table(errors):
-    """A Markdown table of ``errors`` (`lab.gradient_methods.UnivariateErrors`): per method its best
+    """A Markdown table of ``errors`` (`lab.gradient_benchmark.UnivariateErrors`): per method its best
     step (the one of least error; "adaptive" or "none" for a method without one) and the relative
     error there."""
     lines = ["| method | best step | relative error there |", "|---|---|---|"]
@@ -307,7 +308,7 @@ def univariate_table(errors):
 
 
 def published_table(published):
-    """A Markdown table of what papers report (`lab.gradient_methods.PUBLISHED`): the method (its label),
+    """A Markdown table of what papers report (`lab.gradient_benchmark.PUBLISHED`): the method (its label),
     the source (a citation) with where it says it, and the statement (with its number where it has one)."""
     lines = ["| method | source | what it reports |", "|---|---|---|"]
     for p in published:
