@@ -149,6 +149,7 @@ VISIBLE = 1e-6        # ... and the second-order gap a correction names is visib
 NONZERO = 1e-2        # bump-nonzero, "demonstrably nonzero": a hundredth of full scale (2.5 8-bit levels)
 FD_ZERO = 1e-6        # crease-fd-zero, "FD ≈ 0": six digits below the one-sided slopes (pi k_u ~ 25)
 MOST = 0.95           # try-creases, "exactly where": all but one large difference in twenty
+CLIFF = 10.0          # cell2-minimum, "cliff beyond" a step: a decade of rise over the two decades of step below it
 
 
 def _numbers(text):
@@ -191,8 +192,10 @@ def _readings(claim):
     if q in ("roundoff-drowns-1e-9", "noise-below-1e-11"):            # "drowns" / "noise" at that step: error ~1
         return _edges("relative error at ε = " + re.sub(r"e-0*", "e-", f"{n[0]:g}"), lo=1 / ABOUT)
     if q == "cell2-minimum":                                            # "near ε ≈ 1e-6, cliff beyond 1e-8"
-        return (_edges("fitted optimum ε", n[0] / ABOUT, n[0] * ABOUT, HOLDS, CORRECTED)
-                + _edges("fitted optimum ε", n[1], n[0] * DECADE, CORRECTED, FAILS))
+        growth = f"error growth from ε = {n[1]:.0e} to {n[1] / 100:.0e}".replace("e-0", "e-")
+        return (_edges("fitted optimum ε", n[0] / ABOUT, n[0] * ABOUT, HOLDS, CORRECTED, **{growth: 100.0})
+                + _edges("fitted optimum ε", n[1], n[0] * DECADE, CORRECTED, FAILS, **{growth: 100.0})
+                + _edges(growth, CLIFF, None, HOLDS, FAILS, **{"fitted optimum ε": n[0]}))
     if q == "frame-aligned":                                            # "aligned with N": +1
         return [({"(eθ × eφ)·N": 1}, HOLDS), ({"(eθ × eφ)·N": -1}, FAILS), ({"(eθ × eφ)·N": 1 + JUST}, FAILS)]
     if q == "flips-zero":                                               # "zero"
