@@ -190,7 +190,7 @@ def _evidence(kernel=KERNEL_COEFFS, claimed=None, bump="surface", gradient="exac
                        f"surface's by {worst:.2e}", worst, rendered=compared)
     return Verdict("proved", f"the obstruction is 0 for {', '.join(found)} only (the draft's bump is the normal of no "
                    f"displaced sphere for the others); the renderer's surface-bump normals within {worst:.1e} of the "
-                   f"displaced normal (mpmath, {compared} seeded sphere-A pixels of the {spelled(len(F.FIELDS))} fields, "
+                   f"displaced normal (mpmath, {compared:,} seeded sphere-A pixels of the {spelled(len(F.FIELDS))} fields, "
                    f"pole ring, crease neighbours and the {inside} inside the draft's pole cut-off sin phi <= "
                    f"{SEED_POLE_SIN_PHI:g} included"
                    + (f"; {left_out} at the pole itself left out)" if left_out else ")"), worst,

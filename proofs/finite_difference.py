@@ -170,7 +170,7 @@ def _stencil_evidence(rule=_border_rule, half=0.5, stencil=F.STENCIL_POINTS):
     return Verdict("proved", "the stencil takes its interior branch at 2,000 seeded interior points, and at "
                    "2,000 points near the borders wraps u, clamps v and divides by the clamped distance; the "
                    f"footprint steps, compiled, equal pbrt-v4's least-squares rule within {fp:.1e} "
-                   f"(relative) at {pixels} sphere-A pixels", fp, rendered=pixels, bound=FOOTPRINT_TOLERANCE)
+                   f"(relative) at {pixels:,} sphere-A pixels", fp, rendered=pixels, bound=FOOTPRINT_TOLERANCE)
 
 
 #: The renderer's stencil as functions of (u, v), one pair per height field (the steps' cases).

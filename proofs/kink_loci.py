@@ -155,13 +155,13 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=None, all_visible=False, ba
                                       for p, r, s in zip(phis, rhos, seen))
     family = "u-creases (rays)" if kind == "rays" else "v-creases (circles)"
     if mismatched > 0:
-        return Verdict("refuted", f"{mismatched} of {compared} sphere-A pixels: the rendered crease flag differs "
+        return Verdict("refuted", f"{mismatched:,} of {compared:,} sphere-A pixels: the rendered crease flag differs "
                        f"from the {family} predicted from the loci")
     if not np.array_equal(per_locus > 0, seen):
         return Verdict("refuted", f"rendered crease pixels per locus {per_locus.tolist()}, but the loci "
                        f"claimed visible are {seen.tolist()}")
     return Verdict("proved", f"{what}; the bands about these loci (closed form alone) equal the rendered crease "
-                   f"flag on all {compared} sphere-A pixels off the other family, and exactly the visible loci have "
+                   f"flag on all {compared:,} sphere-A pixels off the other family, and exactly the visible loci have "
                    f"crease pixels ({', '.join(map(str, per_locus))}) ({SIZE} × {SIZE})",
                    rendered=compared)
 

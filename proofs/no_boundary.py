@@ -209,14 +209,14 @@ def _evidence(gate=False, reach=None, root=0):
     differing, compared, pairs = reach_mismatches(reach=reach)
     if differing or compared < pairs * 0.99:
         return Verdict("refuted", f"kernel.reach differs from the shadow predicates at {differing} of {compared} "
-                       f"decided (pixel, light) pairs (of {pairs}; 99% must be decided)")
-    return Verdict("verified", f"the near roots t_A, t_B are the renderer's t (to 1e-9) at its {on_spheres} sphere "
+                       f"decided (pixel, light) pairs (of {pairs:,}; 99% must be decided)")
+    return Verdict("verified", f"the near roots t_A, t_B are the renderer's t (to 1e-9) at its {on_spheres:,} sphere "
                    f"pixels; {frames} independent G-buffers ({len(F.FIELDS)} fields x eps 1e-1..1e-8 x 2 pipelines x beta {BETAS} "
                    f"(chart) or {SURFACE_BETAS} (surface), 64x64) have the chamber, t, P and N of the beta = 0 frame "
                    "bit for bit, and the kernel's reach predicate gives each light the same mask "
                    f"({distinct} distinct shading normals: every parameter reaches them); that predicate equals "
-                   f"the predicates, evaluated at the hit points, at all {compared} decided (pixel, light) pairs (of "
-                   f"{pairs}) of {len(REACH_SCENES)} scenes ({REACH_SIZE}x{REACH_SIZE}; a light inside sphere B, lights behind A, below "
+                   f"the predicates, evaluated at the hit points, at all {compared:,} decided (pixel, light) pairs (of "
+                   f"{pairs:,}) of {len(REACH_SCENES)} scenes ({REACH_SIZE}x{REACH_SIZE}; a light inside sphere B, lights behind A, below "
                    "the floor, and beside A just above it)",
                    residual=float(values + masks + differing), points=frames, rendered=frames)
 
