@@ -238,3 +238,21 @@ def test_the_frame_is_the_fixed_pair_only_at_sin_phi_zero_or_subnormal():
     assert np.allclose(ep.T[:, :2], [[0.6, 0.8]] * 4, rtol=0, atol=8 * U)
     fixed = [np.array(e).ravel() for e in pointwise.tangent_frame(0.0, 0.0, 1.0, np.array([0.0, tiny, 2.0**-1074]))]
     assert np.array_equal(np.concatenate(fixed), np.repeat(np.array(F.FALLBACK_FRAME, float), 3))
+
+
+def test_the_sine_fields_slope_per_unit_length_has_a_different_limit_on_each_meridian():
+    """§7's "The pole": h_u / (2 pi R sin phi), phi = pi v, tends to k_u k_v cos(pi k_u u) / 2R as v -> 0
+    along the meridian u, so the sine field's bumped normal has no limit at the pole.  A field whose
+    slope vanishes there to first order in phi (rings: no u at all) has one."""
+    import sympy as sp
+
+    from renderer import formulas as F
+    R = sp.Symbol("R", positive=True)
+    ku, kv = sp.Symbol("k_u", positive=True), sp.Symbol("k_v", positive=True)
+
+    def limit(name):
+        h_u = F.FIELDS[name].gradient[0].subs({F.k_u: ku, F.k_v: kv})
+        return sp.limit(h_u / (2 * sp.pi * R * sp.sin(sp.pi * F.v)), F.v, 0, "+")
+    assert sp.simplify(limit("sine") - ku * kv * sp.cos(sp.pi * ku * F.u) / (2 * R)) == 0
+    assert limit("sine").subs({F.u: 0}) != limit("sine").subs({F.u: sp.Rational(1, 2) / ku})
+    assert limit("rings") == 0

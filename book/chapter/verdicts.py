@@ -81,7 +81,7 @@ def _results(ids=None):
 
 
 def _note(claim, verdict):
-    return (f"```{{margin}}\n**The draft** ({claim.where}): “{claim.quote}” — {{term}}`{WORDS[verdict]}` "
+    return (f"```{{margin}}\n**Draft {claim.where}:** “{claim.quote}” — {{term}}`{WORDS[verdict]}` "
             f"({{ref}}`why <claim-{claim.id}>`)\n```")
 
 
