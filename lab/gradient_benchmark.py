@@ -610,7 +610,7 @@ TEST_FUNCTION = Example("exp(x) / sqrt(sin(x)**3 + cos(x)**3)", 1.5)
 #: What the two papers report (the text of neither is in this repository; the statements are ours).
 PUBLISHED = (
     Published("squire-trapp", "§1, eq. (1)", "central",
-              "truncation error O(h²); a small h trades truncation for subtractive cancellation"),
+              "truncation error O(ε²); a small ε trades truncation for subtractive cancellation"),
     Published("squire-trapp", "abstract", "complex step",
               "avoids the subtractive cancellation of the classical difference quotients"),
     Published("martins-complex-step", "§2, Fig. 1", None,
