@@ -284,7 +284,7 @@ ERRATA = (
     ),
     Erratum(
         id="fallback-orientation",
-        where="Cell 1, `tangent_frame`, and §7 item 4",
+        where="Cell 1, `tangent_frame`, and the draft's §7, item 4",
         seed=r"fallback $e_\theta = (1,0,0)$, $e_\varphi = (0,1,0)$",
         exposed_by="verify/test_errata.py",
         measure=_fallback_orientation,
