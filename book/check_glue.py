@@ -24,6 +24,9 @@ carry two numbers, whether the number was glued, or written into a measurement's
 text, or typed.  Each quantity's words must be met at least once, and no
 quantity's words may contain another's.
 
+A count the prose shows is written as the book writes numbers: 29,919, not 29919
+(`bare_counts`; a four-digit number from 1900 to 2099 is read as a year).
+
 Usage: python book/check_glue.py [CACHE_DIR [HTML_DIR]]
        (defaults: book/_build/.jupyter_cache, and html/ beside it)
 Exit status 0 if every check passes, 1 if not, 2 if there is no cache or no site.
@@ -401,6 +404,23 @@ def words_conflicts(html_dir, names: dict, named=None) -> list:
     return bad
 
 
+#: An integer of four digits or more written without thousands separators, not part of a word, a
+#: decimal, an exponent, a range or an identifier (a DOI's digits follow a letter or a point).
+BARE_COUNT = re.compile(r"(?<![\w.,−\-/^#])\d{4,}(?![\w.,]?\d|[\w])")
+
+
+def bare_counts(html_dir) -> list:
+    """One line per count of 1,000 or more that a page's prose (outside maths and code) writes
+    without thousands separators: "13686 pixels" where the book writes "13,686"."""
+    bad = []
+    for page in sorted(Path(html_dir).glob("*.html")):
+        for sentence in prose_sentences(page.read_text(encoding="utf-8")):
+            for m in BARE_COUNT.finditer(sentence):
+                if not (len(m.group()) == 4 and 1900 <= int(m.group()) <= 2099):
+                    bad.append(f"{page.stem}: {m.group()} in “{sentence[:160]}”")
+    return bad
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     cache_dir = Path(argv[0] if argv else "book/_build/.jupyter_cache")
@@ -436,10 +456,16 @@ def main(argv=None) -> int:
     if worded:
         print("check_glue: the same words carry different numbers:\n  " + "\n  ".join(worded), file=sys.stderr)
         return 1
+    bare = bare_counts(html_dir)
+    if bare:
+        print("check_glue: a count without thousands separators (write 13,686, or format the glue with ','):\n  "
+              + "\n  ".join(bare), file=sys.stderr)
+        return 1
     print(f"check_glue: {len(names)} glued names; {shared} shown on several pages, each with one value; "
           f"{len(QUANTITIES)} quantities with one value under all their names, "
           f"{sum(s is not None for _, s in QUANTITIES.values())} of them the library's; "
-          f"{len(NAMED)} quantities named in prose, each with one value under its words")
+          f"{len(NAMED)} quantities named in prose, each with one value under its words; every count with its "
+          f"thousands separators")
     return 0
 
 

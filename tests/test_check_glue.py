@@ -267,3 +267,22 @@ def test_the_books_glue_is_the_registrys_and_its_fitted_optimum_not_the_argmin(b
     assert quantity_conflicts(names) == []
     argmin = {**names, "eps_fitted_sine": {"s5_lab": repr(check_glue._ucurve().eps_measured_min)}}
     assert [line.split(":")[0] for line in quantity_conflicts(argmin)] == ["the fitted optimal step"]
+
+
+def test_a_count_without_thousands_separators_is_found_and_years_dois_decimals_and_maths_are_not(tmp_path):
+    """"on 13686 pixels" (a glue shown without ',', or a count typed into a measurement's text) fails;
+    the book's 13,686, a year, a DOI, a decimal, an exponent and a number inside maths or code pass."""
+    ok = ("<p>On 13,686 pixels (Blinn, 1978; doi:10.1137/S003614459631241X), 0.12345 and 1e-1000, "
+          "2^-1022; <span class='math'>\\frac{1}{1000000}</span> <code>N = 4096</code>.</p>")
+    assert check_glue.bare_counts(_site(tmp_path, s7_pitfalls=ok)) == []
+    bad = check_glue.bare_counts(_site(tmp_path, s7_pitfalls=ok + "<li>It covers 13686 pixels.</li><td>2899</td>"))
+    assert [b.split(" in ")[0] for b in bad] == ["s7_pitfalls: 13686", "s7_pitfalls: 2899"], bad
+
+
+def test_main_fails_on_a_bare_count(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(check_glue, "words_conflicts", lambda *a: [])
+    monkeypatch.setattr(check_glue, "quantity_conflicts", lambda names: [])
+    monkeypatch.setattr(check_glue, "glued", lambda cache: {})
+    site = _site(tmp_path, s7_pitfalls="<p>It covers 13686 pixels.</p>")
+    assert check_glue.main([str(tmp_path / "cache"), str(site)]) == 1
+    assert "s7_pitfalls: 13686" in capsys.readouterr().err
