@@ -89,7 +89,8 @@ def _check_expression(name, expr, symbols):
     if unknown:
         raise ValueError(f"{name} must call only {', '.join(f.__name__ for f in ELEMENTARY)}; it calls "
                          f"{', '.join(sorted(unknown))}")
-    held = [str(a) for a in (sp.I, sp.zoo, sp.oo, -sp.oo, sp.nan) if expr.has(a)] + \
+    # sympy's numbers oo, -oo and nan are not real; I and zoo are not numbers to it, nor an interval.
+    held = [str(a) for a in (sp.I, sp.zoo) if expr.has(a)] + \
         sorted({str(a) for a in expr.atoms(sp.Number) if not a.is_real}) + \
         (["an interval, AccumBounds"] if expr.has(sp.AccumBounds) else [])
     if held:
