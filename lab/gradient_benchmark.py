@@ -20,18 +20,13 @@ are available here, not as each could best be compiled.
 `univariate_errors` runs the methods on a reader's f(x) (`renderer.formulas.univariate`) at
 any real x where it is differentiable, at each step of a grid, against the mpmath value of
 its derivative; the central difference's row is `renderer.ucurve.measure_function`'s
-U-curve.  `PUBLISHED` holds what the complex-step papers report about their test function.
+U-curve.  `PUBLISHED` holds what the complex-step papers report about their test function
+(Squire and Trapp 1998, Martins et al. 2003: `lab.gradient_methods`'s references [1] and [2],
+book/references.bib's ``squire-trapp`` and ``martins-complex-step``).
 
 `FAST` is the configuration the book runs when it is built; `FULL` the one the benchmark
 runs for a release.  `pareto_front` picks a `Measurement`'s non-dominated methods; the book
 draws and tabulates it (book/chapter/benchmark.py).
-
-References
-----------
-.. [1] W. Squire and G. Trapp, "Using complex variables to estimate derivatives of real
-   functions", SIAM Review 40(1), 110-112, 1998.
-.. [2] J. R. R. A. Martins, P. Sturdza and J. J. Alonso, "The complex-step derivative
-   approximation", ACM Trans. Math. Softw. 29(3), 245-262, 2003.
 """
 
 from __future__ import annotations

@@ -192,7 +192,7 @@ def _readings(claim):
     if q in ("roundoff-drowns-1e-9", "noise-below-1e-11"):            # "drowns" / "noise" at that step: error ~1
         return _edges("relative error at ε = " + re.sub(r"e-0*", "e-", f"{n[0]:g}"), lo=1 / ABOUT)
     if q == "cell2-minimum":                                            # "near ε ≈ 1e-6, cliff beyond 1e-8"
-        growth = f"error growth from ε = {n[1]:.0e} to {n[1] / 100:.0e}".replace("e-0", "e-")
+        growth = "error growth over the two decades"                   # below the cliff's step, n[1]
         return (_edges("fitted optimum ε", n[0] / ABOUT, n[0] * ABOUT, HOLDS, CORRECTED, **{growth: 100.0})
                 + _edges("fitted optimum ε", n[1], n[0] * DECADE, CORRECTED, FAILS, **{growth: 100.0})
                 + _edges(growth, CLIFF, None, HOLDS, FAILS, **{"fitted optimum ε": n[0]}))

@@ -33,7 +33,7 @@ SENTENCES = {
                             "{relative error at ε = 1e-9:.1e}: {digits} digits still right",
     "cell2-minimum": "the fitted optimal step ε̂ is {fitted optimum ε:.1e}, where the fitted model's error is {error:.1e}; "
                      "from a step of {top step:.0e} to {bottom step:.0e} the relative error grows "
-                     "{error growth from ε = 1e-8 to 1e-10:.0f}-fold",
+                     "{error growth over the two decades:.0f}-fold",
     "frame-aligned": "$(e_\\theta \\times e_\\varphi)\\cdot N = {(eθ × eφ)·N}$: the frame is left-handed about "
                      "the outward normal",
     "flips-zero": "over {gbuffers} independent G-buffers, {geometry values differing} geometry values (chamber, $t$, "
