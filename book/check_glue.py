@@ -25,7 +25,9 @@ text, or typed.  Each quantity's words must be met at least once, and no
 quantity's words may contain another's.
 
 A count the prose shows is written as the book writes numbers: 29,919, not 29919
-(`bare_counts`; a four-digit number from 1900 to 2099 is read as a year).
+(`bare_counts`; a four-digit number from 1900 to 2099 is read as a year), and
+a number glued into prose is formatted with ',' (`unseparated_formats`) so that
+a measurement that comes out larger on another machine is written so too.
 
 Usage: python book/check_glue.py [CACHE_DIR [HTML_DIR]]
        (defaults: book/_build/.jupyter_cache, and html/ beside it)
@@ -404,9 +406,11 @@ def words_conflicts(html_dir, names: dict, named=None) -> list:
     return bad
 
 
-#: An integer of four digits or more written without thousands separators, not part of a word, a
-#: decimal, an exponent, a range or an identifier (a DOI's digits follow a letter or a point).
-BARE_COUNT = re.compile(r"(?<![\w.,−\-/^#])\d{4,}(?![\w.,]?\d|[\w])")
+#: Four digits or more before any decimal point, written without thousands separators, and not in a
+#: word, a decimal's fraction, an exponent, a range or an identifier (a DOI's digits follow a point).
+BARE_COUNT = re.compile(r"(?<![\w.,−\-/^#])\d{4,}(?![\w,]?\d|[\w])")
+#: A number glued into prose: {glue:text}`name` or {glue:text}`name:spec`.
+GLUE_TEXT = re.compile(r"\{glue:text\}`([\w-]+)(?::([^`]*))?`")
 
 
 def bare_counts(html_dir) -> list:
@@ -418,6 +422,22 @@ def bare_counts(html_dir) -> list:
             for m in BARE_COUNT.finditer(sentence):
                 if not (len(m.group()) == 4 and 1900 <= int(m.group()) <= 2099):
                     bad.append(f"{page.stem}: {m.group()} in “{sentence[:160]}”")
+    return bad
+
+
+def unseparated_formats(names: dict, book_dir=Path(__file__).parent) -> list:
+    """One line per number glued into a page's prose (``book_dir/*.md``) by a format without ','
+    that could write it as four digits or more (any but an e-format): a time that shows 986 ms on
+    this machine shows 2286 on a slower one, so `bare_counts` on one build cannot vouch for it.
+    ``names`` is `glued`'s."""
+    bad = []
+    for page in sorted(Path(book_dir).glob("*.md")):
+        for m in GLUE_TEXT.finditer(page.read_text(encoding="utf-8")):
+            name, spec = m.group(1), m.group(2) or ""
+            value = _parsed(next(iter(names.get(name, {}).values()), None))
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if number and "," not in spec and not spec.lower().endswith("e"):
+                bad.append(f"{page.stem}: {m.group()} (write {{glue:text}}`{name}:,{spec}`)")
     return bad
 
 
@@ -456,7 +476,7 @@ def main(argv=None) -> int:
     if worded:
         print("check_glue: the same words carry different numbers:\n  " + "\n  ".join(worded), file=sys.stderr)
         return 1
-    bare = bare_counts(html_dir)
+    bare = unseparated_formats(names) + bare_counts(html_dir)
     if bare:
         print("check_glue: a count without thousands separators (write 13,686, or format the glue with ','):\n  "
               + "\n  ".join(bare), file=sys.stderr)

@@ -275,8 +275,24 @@ def test_a_count_without_thousands_separators_is_found_and_years_dois_decimals_a
     ok = ("<p>On 13,686 pixels (Blinn, 1978; doi:10.1137/S003614459631241X), 0.12345 and 1e-1000, "
           "2^-1022; <span class='math'>\\frac{1}{1000000}</span> <code>N = 4096</code>.</p>")
     assert check_glue.bare_counts(_site(tmp_path, s7_pitfalls=ok)) == []
-    bad = check_glue.bare_counts(_site(tmp_path, s7_pitfalls=ok + "<li>It covers 13686 pixels.</li><td>2899</td>"))
-    assert [b.split(" in ")[0] for b in bad] == ["s7_pitfalls: 13686", "s7_pitfalls: 2899"], bad
+    bad = check_glue.bare_counts(_site(tmp_path, s7_pitfalls=ok + "<li>It covers 13686 pixels.</li><td>2899</td>"
+                                                                  "<td>84532.1336</td>"))
+    assert [b.split(" in ")[0] for b in bad] == ["s7_pitfalls: 13686", "s7_pitfalls: 2899", "s7_pitfalls: 84532"], bad
+
+
+def test_a_number_glued_without_a_separating_format_is_found_whatever_its_value_on_this_build(tmp_path):
+    """A time glued as `ms:.0f` shows 986 here and 2286 on a slower machine: every number glued into
+    prose by a format that can write four digits carries ','; e-formats, strings and flags need none."""
+    names = {"ms": {"s5_lab": "986.25"}, "n": {"s5_lab": "12"}, "x": {"s5_lab": "1.5e-07"},
+             "label": {"s5_lab": "'128 × 128'"}, "flag": {"s5_lab": "True"}}
+    (tmp_path / "s5_lab.md").write_text("{glue:text}`ms:,.0f` {glue:text}`x:.1e` {glue:text}`label` "
+                                        "{glue:text}`flag` {glue:text}`n:,` {glue:text}`x:,g`", encoding="utf-8")
+    assert check_glue.unseparated_formats(names, tmp_path) == []
+    (tmp_path / "s5_lab.md").write_text("{glue:text}`ms:.0f` {glue:text}`n` {glue:text}`x:g` {glue:text}`ms:.1%`",
+                                        encoding="utf-8")
+    bad = check_glue.unseparated_formats(names, tmp_path)
+    assert [b.split(" (")[0] for b in bad] == ["s5_lab: {glue:text}`ms:.0f`", "s5_lab: {glue:text}`n`",
+                                              "s5_lab: {glue:text}`x:g`", "s5_lab: {glue:text}`ms:.1%`"], bad
 
 
 def test_main_fails_on_a_bare_count(tmp_path, monkeypatch, capsys):
