@@ -12,8 +12,8 @@ from collections.abc import Mapping
 
 #: The theorem modules of proofs/, in the chapter's order.  Each has ``titles()`` ({id: title}, in
 #: order, without building a theorem) and ``build(id)`` (the Theorem, built once).
-MODULES = ("surface", "frame", "gradients", "kinks", "kink_loci", "no_boundary", "normal", "finite_difference",
-           "displacement", "blinn")
+MODULES = ("surface", "frame", "displacement", "gradients", "kinks", "kink_loci", "no_boundary", "finite_difference",
+           "normal", "blinn")
 
 
 def _catalogue():

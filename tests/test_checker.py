@@ -213,7 +213,8 @@ def test_the_box_shows_statement_badge_and_steps_and_links_its_ledger_row(monkey
     assert (r"\varepsilon^\ast = \left(3 u_{\mathrm{round}} \left(\lvert h\rvert + \lvert u\,h'\rvert\right) / "
             r"\lvert h'''\rvert\right)^{1/3}") in block
     assert "reduced to 0" not in block and "reduced to 0 by sympy" in row
-    assert row.startswith("* (ledger-optimal-step)=\n  {prf:ref}`The optimal central-difference step <thm-optimal-step>`")
+    assert row.startswith("* (ledger-optimal-step)=\n  {prf:ref}`thm-optimal-step` (The optimal central-difference "
+                          "step), `optimal-step`: **PROVED**")
 
 
 def test_undecided_identity_is_verified_numerically(monkeypatch):

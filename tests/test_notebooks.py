@@ -272,6 +272,22 @@ def test_a_citation_reads_as_the_theorems_number_and_title_on_the_page(book_html
         assert heading and heading[2] == CITABLE[theorem_id] and {n for _, n, _ in links} == {heading[1]}, theorem_id
 
 
+def test_the_ledger_lists_every_theorem_once_as_theorem_n_in_the_books_order(book_html):
+    """§6's theorem ledger names each theorem as its box's heading does ("Theorem n (title)", linked
+    to the box) and lists them in the order the book numbers them, 1, 2, 3, ...: a reader who meets
+    Theorem 5 in §3 finds it fifth (the registry's order is the chapter's)."""
+    from proofs.registry import CITABLE, THEOREMS
+    pages = {p.name: unescape(p.read_text(encoding="utf-8")) for p in book_html.glob("s[0-9]_*.html")}
+    number = {i: int(n) for html in pages.values()
+              for i, n in re.findall(r'id="thm-([\w-]+)">\s*<p[^>]*><span[^>]*>Theorem (\d+) </span>', html)}
+    ledger = re.findall(r'id="ledger-([\w-]+)">(?:</span>)?<a[^>]*href="[\w.]*#thm-([\w-]+)">Theorem (\d+)</a> \(([^)]*)\)',
+                        pages["s6_ledger.html"])
+    assert [i for i, *_ in ledger] == list(THEOREMS) == sorted(number, key=number.get), (ledger, number)
+    shown = [(target, int(n), title.replace("’", "'")) for _, target, n, title in ledger]     # the site's quotes curl
+    assert shown == [(i, number[i], CITABLE[i]) for i in THEOREMS]
+    assert sorted(number.values()) == list(range(1, len(THEOREMS) + 1))
+
+
 # --- the learning aids: exercises, margin notes, citations, the bibliography ----------------------
 
 def _bib():

@@ -258,7 +258,7 @@ def _folded(label, text):
 
 def ledger_table():
     """MyST markdown, one list item per theorem, labelled ``ledger-<id>`` (the theorem's box
-    links here with ``{ref}`§6 <ledger-<id>>```): its title (linked to the box), id,
+    links here with ``{ref}`§6 <ledger-<id>>```): "Theorem n" (linked to the box), its title, id,
     verdict; then its evidence (what its steps took, and the
     renderer's outputs compared), the first clause shown and the rest folded.  (What the
     draft says about a theorem is in the claims register, `chapter.verdicts.register`.)  (A list, not a table: the evidence is a
@@ -272,7 +272,7 @@ def ledger_table():
     items = []
     for theorem_id, e in ledger().items():
         _refuse(theorem_id, e)
-        items.append(f"* (ledger-{theorem_id})=\n  {{prf:ref}}`{e['title']} <thm-{theorem_id}>` (`{theorem_id}`): "
+        items.append(f"* (ledger-{theorem_id})=\n  {{prf:ref}}`thm-{theorem_id}` ({e['title']}), `{theorem_id}`: "
                      f"**{e['badge']}**.\n\n"
                      f"  {_folded('Evidence', e['evidence'])}")
     return "\n".join(items)
