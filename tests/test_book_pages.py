@@ -1100,6 +1100,36 @@ def test_text_overlaps_catches_legend_entries_on_each_other_not_inside_their_box
     assert "'a note' / legend" in text_overlaps(fig)
 
 
+def test_text_overlaps_catches_the_data_drawn_through_a_legend_entry(figure):
+    """§5's footprint histogram as first drawn: its two vertical lines ran through the legend's entries.
+    A line, bars and a marker on an entry are caught, each once, by its label; a line of markers whose
+    markers all miss the entry is not (its path is not drawn)."""
+    import numpy as np
+    from chapter.figures import text_overlaps
+
+    def entries_at(x, draw):
+        fig, ax = figure(figsize=(5, 3.5))
+        ax.plot([0, 1], [0, 1], label="a line", lw=0)
+        draw(ax, x)
+        ax.set_xlim(0, 1); ax.set_ylim(0, 1)
+        ax.legend(loc="upper left", frameon=False)
+        fig.canvas.draw()
+        box = ax.get_legend().get_texts()[0].get_window_extent()
+        return text_overlaps(fig), ax.transData.inverted().transform(box.get_points()).mean(axis=0)
+
+    _, (x, y) = entries_at(0.9, lambda ax, x: None)          # the first entry's centre, in data units
+    cases = {"vertical": lambda ax, at: ax.axvline(at, label="vertical"),
+             "_bars": lambda ax, at: ax.bar([at, at + 0.01], [1.0, 1.0], width=0.01),     # reported once
+             "markers": lambda ax, at: ax.plot([at, 0.95], [y, 0.05], "o", ms=3, label="markers")}
+    for kind, draw in cases.items():
+        found, _ = entries_at(x, draw)
+        what = "patch" if kind.startswith("_") else f"line {kind!r}"
+        assert [f for f in found if f.startswith("'a line'")] == [f"'a line' / the data's {what}"], (kind, found)
+        assert entries_at(0.9, draw)[0] == [], kind
+    found, _ = entries_at(x, lambda ax, at: ax.plot([0.0, 0.6], [y, y], "o", ms=3, label="markers"))
+    assert found == [], found          # the segment between the two markers would cross the entry: not drawn
+
+
 def test_text_overlaps_catches_an_annotation_across_the_frame_and_ignores_ticks_out_of_view(figure):
     from chapter.figures import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))

@@ -411,6 +411,9 @@ def text_overlaps(fig, gap=0.5):
       boxes overlap (twins, insets) are not each other's "other" axes;
     * a text or annotation placed in an axes with a frame that straddles the
       frame: ``'a' / the frame of its axes``.
+    * a legend entry crossed by a line of its axes' data or covered by one of its
+      patches (a bar, a span): ``'a' / the data's line 'b'`` (its label, if it has one;
+      a line drawn as markers only counts where a marker falls).
 
     Parameters
     ----------
@@ -458,6 +461,11 @@ def text_overlaps(fig, gap=0.5):
         own = {id(t) for t in lg.findobj(Text)}
         frame = lg.get_window_extent(renderer)
         out += [f"{name(t)} / legend" for t, bt in zip(drawn, boxes) if id(t) not in own and frame.overlaps(bt)]
+    for lg in (lg for lg in fig.findobj(Legend) if lg.get_visible() and lg.axes in axes):
+        data = [a for a in lg.axes.lines + lg.axes.patches if a.get_visible()]
+        for t in lg.get_texts():
+            bt = t.get_window_extent(renderer)
+            out += list(dict.fromkeys(f"{name(t)} / the data's {_kind(a)}" for a in data if _crosses(a, bt, renderer)))
     for t, bt in zip(drawn, boxes):
         home = owner.get(id(t))
         if home is not None and home.axison and t in home.texts:
@@ -473,6 +481,25 @@ def text_overlaps(fig, gap=0.5):
                 label = ax.get_title() or f"{fig.axes.index(ax) + 1} of {len(fig.axes)}"
                 out.append(f"{name(t)} / axes {label!r}")
     return out
+
+
+def _kind(artist):
+    """'line' or 'patch', and the artist's label if it has one: "line 'fitted'"."""
+    from matplotlib.lines import Line2D
+    label = artist.get_label()
+    return ("line" if isinstance(artist, Line2D) else "patch") + ("" if label.startswith("_") or not label
+                                                                   else f" {label!r}")
+
+
+def _crosses(artist, box, renderer):
+    """Whether a Line2D's drawn path (its markers, if it draws no line) or a patch meets ``box`` (display units)."""
+    from matplotlib.lines import Line2D
+    if not isinstance(artist, Line2D):
+        return artist.get_window_extent(renderer).overlaps(box)
+    path = artist.get_transform().transform_path(artist.get_path())
+    if artist.get_linestyle() in ("None", "", " ", "none"):
+        return any(box.contains(x, y) for x, y in path.vertices)
+    return path.intersects_bbox(box, filled=False)
 
 
 def displacement_figure(result):
