@@ -1130,6 +1130,27 @@ def test_text_overlaps_catches_the_data_drawn_through_a_legend_entry(figure):
     assert found == [], found          # the segment between the two markers would cross the entry: not drawn
 
 
+def test_text_overlaps_catches_a_line_through_a_label_unless_a_mask_hides_it(figure):
+    """§3's U-curve and frame diagram as first drawn: a slope guide ran through its own label, the
+    sphere's grid lines through the arrows' labels.  A label on a line fails; the same label on an
+    opaque box drawn above the line (`figures.MASK`) passes; an annotation's arrow may touch its line."""
+    from chapter.figures import MASK, text_overlaps
+    fig, ax = figure(figsize=(5, 3.5))
+    ax.plot([0, 1], [0.5, 0.5], color="grey", label="grid")
+    ax.set_xlim(0, 1); ax.set_ylim(0, 1)
+    label = ax.text(0.4, 0.5, "a label", va="center")
+    assert text_overlaps(fig) == ["'a label' / the data's line 'grid'"]
+    label.set_bbox(dict(MASK, facecolor="none"))              # a box that hides nothing
+    assert text_overlaps(fig) == ["'a label' / the data's line 'grid'"]
+    label.set_bbox(MASK)
+    assert text_overlaps(fig) == []
+    label.set_zorder(1)                                       # the box under the line: the line shows through
+    assert text_overlaps(fig) == ["'a label' / the data's line 'grid'"]
+    label.remove()
+    ax.annotate("slope", (0.5, 0.4), (0.5, 0.7), ha="center", arrowprops=dict(arrowstyle="-"))   # across the line
+    assert text_overlaps(fig) == []
+
+
 def test_text_overlaps_catches_an_annotation_across_the_frame_and_ignores_ticks_out_of_view(figure):
     from chapter.figures import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))

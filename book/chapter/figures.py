@@ -57,6 +57,10 @@ SMALLEST_TEXT_KEY = "symrender:smallest-text-px"
 #: diagram's labels, drawn larger.
 TEXT_PT = 11.0
 
+#: The box behind a label written over a diagram's lines (``ax.text(..., bbox=MASK)``): the page's white,
+#: so that no line runs through the letters (`text_overlaps` lets such a label lie on the lines it hides).
+MASK = dict(boxstyle="square,pad=0.1", facecolor="white", edgecolor="none")
+
 #: How far above the fitted model's arm `ucurve_anatomy` draws each slope guide (a factor in error).
 GUIDE_OFFSET = 30.0
 
@@ -242,10 +246,12 @@ def frame_diagram(theta=-0.35, phi=0.8):
                                (e_p, GREEN, r"$e_\varphi$ (along $v$)")):
         tip = project(N + 0.45 * vec)
         ax.annotate("", tip, base, arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.8))
-        ax.text(*(tip + 0.04 * (tip - base) / max(np.linalg.norm(tip - base), 1e-9)), label, color=colour,
-                fontsize=12.5)                                   # its subscript drawn at 0.7 x 12.5 = 8.75 pt
+        way = (tip - base) / max(np.linalg.norm(tip - base), 1e-9)
+        side = lambda d, names: names[0] if d < -0.3 else names[2] if d > 0.3 else names[1]    # noqa: E731
+        ax.text(*(tip + 0.04 * way), label, color=colour, fontsize=12.5, bbox=MASK,   # subscript: 0.7 x 12.5 = 8.75 pt
+                ha=side(way[0], ("right", "center", "left")), va=side(way[1], ("top", "center", "bottom")))  # past the tip
     ax.plot(*project(_sphere_point(0.0, 0.0)), "o", color="k", ms=3)
-    ax.text(*(project(_sphere_point(0.0, 0.0)) + [0.03, 0.03]), r"pole $\varphi = 0$")
+    ax.text(*(project(_sphere_point(0.0, 0.0)) + [0.03, 0.03]), r"pole $\varphi = 0$", bbox=MASK)
     ax.set_aspect("equal"); ax.axis("off")
     ax.set_title(r"chart $u = (\theta + \pi)/2\pi$ (meridians), $v = \varphi/\pi$ (parallels)")
     return fig
@@ -378,7 +384,8 @@ def ucurve_anatomy(curve):
         ax.loglog(steps, GUIDE_OFFSET * arm(steps), color="k", lw=1.2, label=f"_guide slope {slope}")
         mid = np.sqrt(steps[0] * steps[-1])                      # the guide's middle on log axes
         ax.annotate(f"slope {slope}\n{words}", (mid, GUIDE_OFFSET * arm(mid)), (mid, 60 * GUIDE_OFFSET * arm(mid)),
-                    ha="center", va="bottom", arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
+                    ha="right" if slope == "+2" else "center", va="bottom",     # off the rising guide's way
+                    arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
     ax.annotate(r"fitted $\hat\varepsilon$", (fitted / 1.6, 1e-17), ha="right")
     ax.annotate("model-optimal \u03b5*", (model * 1.6, 1e-17), ha="left")
     ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $\partial h/\partial u$"); ax.set_ylim(1e-18, 1e5)
@@ -411,8 +418,9 @@ def text_overlaps(fig, gap=0.5):
       boxes overlap (twins, insets) are not each other's "other" axes;
     * a text or annotation placed in an axes with a frame that straddles the
       frame: ``'a' / the frame of its axes``.
-    * a legend entry crossed by a line of its axes' data or covered by one of its
-      patches (a bar, a span): ``'a' / the data's line 'b'`` (its label, if it has one;
+    * a text or legend entry in an axes crossed by a line of that axes' data or
+      covered by one of its patches (a bar, a span), unless an opaque box drawn above
+      it hides it (`MASK`): ``'a' / the data's line 'b'`` (its label, if it has one;
       a line drawn as markers only counts where a marker falls).
 
     Parameters
@@ -461,11 +469,16 @@ def text_overlaps(fig, gap=0.5):
         own = {id(t) for t in lg.findobj(Text)}
         frame = lg.get_window_extent(renderer)
         out += [f"{name(t)} / legend" for t, bt in zip(drawn, boxes) if id(t) not in own and frame.overlaps(bt)]
-    for lg in (lg for lg in fig.findobj(Legend) if lg.get_visible() and lg.axes in axes):
-        data = [a for a in lg.axes.lines + lg.axes.patches if a.get_visible()]
-        for t in lg.get_texts():
-            bt = t.get_window_extent(renderer)
-            out += list(dict.fromkeys(f"{name(t)} / the data's {_kind(a)}" for a in data if _crosses(a, bt, renderer)))
+    for ax in axes:
+        legend = ax.get_legend()
+        written = [t for t in ax.texts if t.get_visible() and t.get_text()] + (
+            legend.get_texts() if legend is not None and legend.get_visible() else [])
+        data = [a for a in ax.lines + ax.patches if a.get_visible()]
+        for t in written:
+            bt, box = Text.get_window_extent(t, renderer), t.get_bbox_patch()     # an annotation's text, not its arrow
+            masked = box is not None and box.get_visible() and box.get_facecolor()[3] == 1
+            out += list(dict.fromkeys(f"{name(t)} / the data's {_kind(a)}" for a in data if _crosses(a, bt, renderer)
+                                      and not (masked and t.get_zorder() > a.get_zorder())))
     for t, bt in zip(drawn, boxes):
         home = owner.get(id(t))
         if home is not None and home.axison and t in home.texts:
