@@ -253,7 +253,7 @@ def frame_diagram(theta=-0.35, phi=0.8):
     ax.plot(*project(_sphere_point(0.0, 0.0)), "o", color="k", ms=3)
     ax.text(*(project(_sphere_point(0.0, 0.0)) + [0.03, 0.03]), r"pole $\varphi = 0$", bbox=MASK)
     ax.set_aspect("equal"); ax.axis("off")
-    ax.set_title(r"chart $u = (\theta + \pi)/2\pi$ (meridians), $v = \varphi/\pi$ (parallels)")
+    ax.set_title(r"lines of constant $u = (\theta + \pi)/2\pi$ and $v = \varphi/\pi$")
     return fig
 
 
