@@ -41,7 +41,7 @@ def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
     """`univariate_figure`: one line per method in its record's colour and line style, a method without a
     step drawn across the plot, every text at least 10 pt in a figure at most 5 in wide, nothing overlapping."""
     from chapter.benchmark import univariate_figure
-    from chapter.figures import _drawn_texts, text_overlaps
+    from chapter.layout import drawn_texts, text_overlaps
     from lab import gradient_benchmark as gb
     from lab import gradient_methods as gm
 
@@ -56,7 +56,7 @@ def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
         m = gm.method(name)
         assert lines[m.label].get_color() == m.style.colour
     assert list(lines[gm.method(gm.AD).label].get_xdata()) == [0, 1]           # across the axes
-    assert fig.get_figwidth() <= 5.0 and min(t.get_fontsize() for t in _drawn_texts(fig)) >= 10
+    assert fig.get_figwidth() <= 5.0 and min(t.get_fontsize() for t in drawn_texts(fig)) >= 10
     assert text_overlaps(fig) == []
 
 
@@ -71,7 +71,7 @@ def test_no_text_of_the_figure_collides_whatever_the_machine_times():
     import numpy as np
 
     from chapter import figures
-    from chapter.figures import text_overlaps
+    from chapter.layout import text_overlaps
 
     from .test_figure_baselines import _measurement
 

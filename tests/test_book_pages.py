@@ -20,7 +20,7 @@ Each page (index, §1-§9, glossary) is opened offline from the built site, its 
 (g) accessibility: axe-core (WCAG 2.1 A and AA rules) finds no serious or critical violation.
 
 Every check is shown catching a planted defect (the ``test_the_*_check_*`` tests), and
-`chapter.figures.text_overlaps`, which `chapter.page.show` runs on every figure a page publishes, is
+`chapter.layout.text_overlaps`, which `chapter.page.show` runs on every figure a page publishes, is
 tested on planted overlaps and on the book's diagrams.  The measurements go to
 test-artifacts/book_pages.json; with ``SYMRENDER_SHOTS=1`` a screenshot of every page at both widths
 goes to test-artifacts/pages/ (full-page captures take about a second each).  Each page is opened
@@ -984,7 +984,7 @@ def test_figure_png_records_the_smallest_text_drawn(figure):
 def test_drawn_size_is_the_smallest_glyph_mathtext_draws(figure):
     """Plain text: its font size; mathtext: its smallest glyph (a script 0.7, a script's script 0.49 of
     the size, a fraction's parts a level down); only the lines that are mathtext count."""
-    from chapter.figures import drawn_size
+    from chapter.layout import drawn_size
     fig, ax = figure()
     size = lambda s, parse_math=True: drawn_size(ax.text(0, 0, s, fontsize=10, parse_math=parse_math))  # noqa: E731
     assert size("1e-6") == 10
@@ -1001,7 +1001,8 @@ def test_drawn_size_is_the_smallest_glyph_mathtext_draws(figure):
 def test_the_books_log_axes_label_their_ticks_in_plain_numbers(figure):
     """After `chapter.figures.style`, a log axis's labels are plain text ("1e-6", "0.01", "1", "100":
     every glyph at the label's size), minor ticks included where matplotlib labels them."""
-    from chapter.figures import drawn_size, style
+    from chapter.figures import style
+    from chapter.layout import drawn_size
     style()
     fig, ax = figure()
     ax.loglog([1e-8, 1e3], [0.2, 0.9])
@@ -1013,7 +1014,7 @@ def test_the_books_log_axes_label_their_ticks_in_plain_numbers(figure):
     assert min(drawn_size(t) for t in ax.get_xticklabels() + ax.get_yticklabels(minor=True)) == ax.xaxis.get_ticklabels()[0].get_fontsize()
 
 
-# --- figures: chapter.figures.text_overlaps, which chapter.page.show runs before publishing ---------
+# --- figures: chapter.layout.text_overlaps, which chapter.page.show runs before publishing ---------
 
 @pytest.fixture
 def figure():
@@ -1042,7 +1043,7 @@ def _clean(ax):
 
 
 def test_text_overlaps_passes_a_clean_figure_and_catches_two_labels_on_top_of_each_other(figure):
-    from chapter.figures import text_overlaps
+    from chapter.layout import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
     _clean(ax)
     assert text_overlaps(fig) == []
@@ -1053,7 +1054,8 @@ def test_text_overlaps_passes_a_clean_figure_and_catches_two_labels_on_top_of_ea
 def test_text_overlaps_catches_a_title_on_a_label(figure):
     """The diagram of the central stencil as it was: the crease's label just above the axes, under the title."""
     import matplotlib.pyplot as plt
-    from chapter.figures import stencil_diagram, style, text_overlaps
+    from chapter.figures import stencil_diagram, style
+    from chapter.layout import text_overlaps
     style()
     fig = stencil_diagram()
     try:
@@ -1071,7 +1073,8 @@ def test_text_overlaps_catches_neighbouring_axes_running_together(figure):
     """§2's three fields in a row, as first drawn: the last tick label of one image and the first of
     the next read as one number, and a y label sits on the neighbouring image."""
     import numpy as np
-    from chapter.figures import style, text_overlaps
+    from chapter.figures import style
+    from chapter.layout import text_overlaps
     style()
     def fields(**layout):
         fig, axes = figure(1, 3, figsize=(10, 2.8), **layout)
@@ -1087,7 +1090,7 @@ def test_text_overlaps_catches_neighbouring_axes_running_together(figure):
 
 
 def test_text_overlaps_catches_legend_entries_on_each_other_not_inside_their_box(figure):
-    from chapter.figures import text_overlaps
+    from chapter.layout import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
     _clean(ax)
     ax.get_legend().remove()
@@ -1104,8 +1107,7 @@ def test_text_overlaps_catches_the_data_drawn_through_a_legend_entry(figure):
     """§5's footprint histogram as first drawn: its two vertical lines ran through the legend's entries.
     A line, bars and a marker on an entry are caught, each once, by its label; a line of markers whose
     markers all miss the entry is not (its path is not drawn)."""
-    import numpy as np
-    from chapter.figures import text_overlaps
+    from chapter.layout import text_overlaps
 
     def entries_at(x, draw):
         fig, ax = figure(figsize=(5, 3.5))
@@ -1134,7 +1136,8 @@ def test_text_overlaps_catches_a_line_through_a_label_unless_a_mask_hides_it(fig
     """§3's U-curve and frame diagram as first drawn: a slope guide ran through its own label, the
     sphere's grid lines through the arrows' labels.  A label on a line fails; the same label on an
     opaque box drawn above the line (`figures.MASK`) passes; an annotation's arrow may touch its line."""
-    from chapter.figures import MASK, text_overlaps
+    from chapter.figures import MASK
+    from chapter.layout import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
     ax.plot([0, 1], [0.5, 0.5], color="grey", label="grid")
     ax.set_xlim(0, 1); ax.set_ylim(0, 1)
@@ -1152,7 +1155,7 @@ def test_text_overlaps_catches_a_line_through_a_label_unless_a_mask_hides_it(fig
 
 
 def test_text_overlaps_catches_an_annotation_across_the_frame_and_ignores_ticks_out_of_view(figure):
-    from chapter.figures import text_overlaps
+    from chapter.layout import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
     _clean(ax)
     ax.set_xticks([0, 0.5, 1, 1.02])                          # a tick out of view: not drawn, not counted
@@ -1164,7 +1167,7 @@ def test_text_overlaps_catches_an_annotation_across_the_frame_and_ignores_ticks_
 
 def test_text_overlaps_works_on_a_closed_figure_and_rejects_bad_arguments(figure):
     import matplotlib.pyplot as plt
-    from chapter.figures import text_overlaps
+    from chapter.layout import text_overlaps
     fig, ax = figure()
     ax.text(0.5, 0.5, "x"); ax.text(0.5, 0.5, "y")
     plt.close(fig)
@@ -1179,7 +1182,7 @@ def test_the_books_diagrams_have_no_colliding_text():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from chapter import figures
+    from chapter import figures, layout
     from renderer.ucurve import measure
     figures.style()
     found = {}
@@ -1188,7 +1191,7 @@ def test_the_books_diagrams_have_no_colliding_text():
                        ("ucurve_anatomy", lambda: figures.ucurve_anatomy(measure("sine")))):
         fig = make()
         try:
-            found[name] = figures.text_overlaps(fig)
+            found[name] = layout.text_overlaps(fig)
         finally:
             plt.close(fig)
     ARTIFACTS.mkdir(parents=True, exist_ok=True)

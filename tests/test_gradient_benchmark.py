@@ -123,14 +123,14 @@ def test_measure_small_run_and_its_presentations():
 
 def assert_drawn_for_a_phone(fig, panels):
     """One panel per field, in at most two columns read row by row, at most 5 in wide, every drawn
-    text at least 9 pt, and no two texts overlapping (`chapter.figures.text_overlaps`)."""
-    from chapter.figures import _drawn_texts, text_overlaps
+    text at least 9 pt, and no two texts overlapping (`chapter.layout.text_overlaps`)."""
+    from chapter.layout import drawn_texts, text_overlaps
     axes = [ax for ax in fig.axes if ax.get_title()]
     assert len(axes) == panels and fig.get_figwidth() <= 5.0, (len(axes), fig.get_figwidth())
     boxes = [ax.get_position() for ax in axes]
     columns = len({round(b.x0, 6) for b in boxes})
     assert columns <= 2 and all(a.y0 > b.y1 for a, b in zip(boxes, boxes[columns:])), boxes
-    assert min(t.get_fontsize() for t in _drawn_texts(fig)) >= 9.0
+    assert min(t.get_fontsize() for t in drawn_texts(fig)) >= 9.0
     assert text_overlaps(fig) == []
 
 

@@ -13,7 +13,7 @@ renders (`plain_markdown`: a cross-reference becomes its title, a directive
 its body).  book/_ext/notebooks.py writes the downloaded notebooks' prose with
 the same `plain_markdown`.
 
-`show` refuses a figure whose text overlaps (`chapter.figures.text_overlaps`),
+`show` refuses a figure whose text overlaps (`chapter.layout.text_overlaps`),
 so the build fails on one instead of publishing it.
 """
 
@@ -112,7 +112,7 @@ def show(name, fig):
         raise TypeError(f"fig must be a matplotlib.figure.Figure, got {type(fig).__name__}")
     import matplotlib.pyplot as plt
 
-    from .figures import text_overlaps
+    from .layout import text_overlaps
     try:
         clashes = text_overlaps(fig)
         if clashes:
