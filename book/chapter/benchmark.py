@@ -113,7 +113,7 @@ def pareto_figure(measurement, *, error="max"):
 
 
 def _fmt_ms(r):
-    return f"{1e3 * r.median:.2f} ({1e3 * r.t_min:.2f}–{1e3 * r.t_max:.2f})"
+    return f"{1e3 * r.median:,.2f} ({1e3 * r.t_min:,.2f}–{1e3 * r.t_max:,.2f})"       # separated: a slower machine's times run longer
 
 
 def _fmt_evals(r):

@@ -81,7 +81,7 @@ SENTENCES = {
                         "at {fine_step_shown}, {max |ΔI| ratio:.0f} times, as a second-order error should ({frame})",
     "noise-below-1e-11": "the quotient's relative error at a step of {step_shown} is "
                          "{relative error at ε = 1e-11:.1e}: digits lost, not noise",
-    "crease-fd-zero": "the central difference gives {central:+.1e} on the crease, but the exact gradient "
+    "crease-fd-zero": "the central difference at a step of {step_shown} gives {central:+.1e} on the crease, but the exact gradient "
                       "{exact:+.3f}: $\\sin(\\pi k_u u)$ at the float nearest $1/k_u$ is not zero, so the sign "
                       "picks a side",
     "pole-pixels": "{fallback pixels} pixels lie inside the draft's fallback disc ({frame}); the draft counts points of a grid of $N_z$ "
