@@ -192,7 +192,7 @@ def _evidence(kernel=KERNEL_COEFFS, claimed=None, bump="surface", gradient="exac
                    f"displaced sphere for the others); the renderer's surface-bump normals within {worst:.1e} of the "
                    f"displaced normal (mpmath, {compared:,} seeded sphere-A pixels of the {spelled(len(F.FIELDS))} fields, "
                    f"pole ring, crease neighbours and the {inside} inside the draft's pole cut-off sin phi <= "
-                   f"{SEED_POLE_SIN_PHI:g} included"
+                   f"{SEED_POLE_SIN_PHI:g}, of frames zoomed onto the pole, included"
                    + (f"; {left_out} at the pole itself left out)" if left_out else ")"), worst,
                    rendered=compared, bound=NORMAL_TOLERANCE, covers=covered)
 

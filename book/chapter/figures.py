@@ -330,9 +330,9 @@ def ucurve_anatomy(curve):
         ax.annotate(f"slope {slope}\n{words}", (mid, GUIDE_OFFSET * arm(mid)), (mid, 60 * GUIDE_OFFSET * arm(mid)),
                     ha="right" if slope == "+2" else "center", va="bottom",     # off the rising guide's way
                     arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
-    ax.annotate(r"fitted $\hat\varepsilon$", (fitted / 1.6, 1e-17), ha="right")
-    ax.annotate("model-optimal \u03b5*", (model * 1.6, 1e-17), ha="left")
-    ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $\partial h/\partial u$"); ax.set_ylim(1e-18, 1e5)
+    ax.annotate(r"fitted $\hat\varepsilon$", (fitted / 1.6, 1e-20), ha="right")      # below the curves' floor
+    ax.annotate(r"model-optimal $\varepsilon^*$", (model * 1.6, 1e-20), ha="left")
+    ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $\partial h/\partial u$"); ax.set_ylim(1e-21, 1e5)
     ax.xaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=6))
     ax.yaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=7))
     handles, labels = ax.get_legend_handles_labels()                 # the measured curves first, the model last

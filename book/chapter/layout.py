@@ -13,6 +13,9 @@ from __future__ import annotations
 
 __all__ = ["drawn_size", "drawn_texts", "text_overlaps"]
 
+#: The least clear space between a label and a line of the data, in points, beyond the line's half width.
+CLEARANCE = 1.0
+
 
 def drawn_size(text):
     """The smallest font size, in points, at which ``text`` draws a glyph: its font size, or, for a
@@ -177,11 +180,14 @@ def _kind(artist):
 
 
 def _crosses(artist, box, renderer):
-    """Whether a Line2D's drawn path (its markers, if it draws no line) or a patch meets ``box`` (display units)."""
+    """Whether a Line2D as drawn (its path's stroke, or its markers if it draws no line) comes within
+    `CLEARANCE` of ``box`` (display units), or a patch meets it."""
     from matplotlib.lines import Line2D
     if not isinstance(artist, Line2D):
         return artist.get_window_extent(renderer).overlaps(box)
     path = artist.get_transform().transform_path(artist.get_path())
     if artist.get_linestyle() in ("None", "", " ", "none"):
+        box = box.padded(renderer.points_to_pixels(artist.get_markersize() / 2 + CLEARANCE))
         return any(box.contains(x, y) for x, y in path.vertices)
-    return path.intersects_bbox(box, filled=False)
+    return path.intersects_bbox(box.padded(renderer.points_to_pixels(artist.get_linewidth() / 2 + CLEARANCE)),
+                                filled=False)
