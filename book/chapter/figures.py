@@ -331,7 +331,7 @@ def ucurve_anatomy(curve):
                     ha="right" if slope == "+2" else "center", va="bottom",     # off the rising guide's way
                     arrowprops=dict(arrowstyle="-", color="k", lw=0.6))
     ax.annotate(r"fitted $\hat\varepsilon$", (fitted / 1.6, 1e-20), ha="right")      # below the curves' floor
-    ax.annotate(r"model-optimal $\varepsilon^*$", (model * 1.6, 1e-20), ha="left")
+    ax.annotate("model-optimal \u03b5*", (model * 1.6, 1e-20), ha="left")            # no superscript: 70 % size
     ax.set_xlabel(r"step $\varepsilon$"); ax.set_ylabel(r"error in $\partial h/\partial u$"); ax.set_ylim(1e-21, 1e5)
     ax.xaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=6))
     ax.yaxis.set_major_locator(plt.matplotlib.ticker.LogLocator(numticks=7))
