@@ -28,13 +28,10 @@ $(STAMP): pyproject.toml constraints.txt book/fetch_mathjax.py
 # book/_ext/execute_pages.py runs jupyter-book's command line (`jupyter-book build`) with the
 # build's own handling of Ctrl-C and SIGTERM from its first instant: one line, exit 130 or 143,
 # no process of the build left.  The build takes book/.build.lock: a second one in the tree waits.
-# myst-nb logs a page that failed to execute in html/reports and never deletes the log: a build
-# starts without the last one's, so that the site holds only the failures of its own build.
 # The checks after it only read, and each prints a line naming itself; they run with SIGINT
 # ignored, so that a Ctrl-C meanwhile stops make when the check ends, without a traceback.
 UNINTERRUPTED := $(BIN)/python -c 'import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_IGN); os.execv(sys.executable, [sys.executable, *sys.argv[1:]])'
 book: $(STAMP)
-	rm -rf book/_build/html/reports
 	$(BIN)/python book/_ext/execute_pages.py build book --warningiserror --keep-going --quiet
 	@$(UNINTERRUPTED) book/check_offline.py book/_build/html
 	@$(UNINTERRUPTED) book/check_glue.py book/_build/.jupyter_cache book/_build/html

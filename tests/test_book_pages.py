@@ -1139,10 +1139,17 @@ def test_text_overlaps_catches_a_line_through_a_label_unless_a_mask_hides_it(fig
     from chapter.figures import MASK
     from chapter.layout import text_overlaps
     fig, ax = figure(figsize=(5, 3.5))
-    ax.plot([0, 1], [0.5, 0.5], color="grey", label="grid")
+    ax.plot([0, 1], [0.5, 0.5], color="grey", lw=1.5, label="grid")
     ax.set_xlim(0, 1); ax.set_ylim(0, 1)
     label = ax.text(0.4, 0.5, "a label", va="center")
     assert text_overlaps(fig) == ["'a label' / the data's line 'grid'"]
+    fig.canvas.draw()
+    top = label.get_window_extent().y1                        # display px; 100 dpi: a point is 100/72 px
+    for gap_pt, found in ((1.25, ["'a label' / the data's line 'grid'"]), (2.5, [])):   # half width 0.75 pt + 1 pt
+        y = ax.transData.inverted().transform((0, top + gap_pt * fig.dpi / 72))[1]
+        ax.lines[0].set_ydata([y, y])
+        assert text_overlaps(fig) == found, gap_pt           # a line just clear of the letters still touches them
+    ax.lines[0].set_ydata([0.5, 0.5])
     label.set_bbox(dict(MASK, facecolor="none"))              # a box that hides nothing
     assert text_overlaps(fig) == ["'a label' / the data's line 'grid'"]
     label.set_bbox(MASK)

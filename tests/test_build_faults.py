@@ -309,13 +309,17 @@ def test_a_build_after_a_killed_one_redoes_what_is_stale(tmp_path, token, hold, 
 
 def test_a_build_that_failed_is_not_trusted_by_the_next(tmp_path, token):
     """A page whose cell raises fails the build (status 1, the page and the exception named);
-    the next build, nothing changed, fails the same way instead of finding the page current."""
+    the next build, nothing changed, fails the same way instead of finding the page current.  The
+    site's reports/ holds the logs of its own build's failures only (myst-nb never deletes one)."""
     book = make_book(tmp_path / "book")
     (book / "a.md").write_text(PAGE.format(page="a") + '\n```{code-cell}\nraise ValueError("page a refuses")\n```\n')
+    reports = book / "_build" / "html" / "reports"
     for name in ("first", "again"):
         build = Build(book, token, name=name)
         assert build.wait() == 1, build.stderr()[-3000:]
         assert "a failed to execute: ValueError: page a refuses" in build.stderr()
+        assert sorted(p.name for p in reports.iterdir()) == ["a.err.log"]
+        (reports / "gone.err.log").write_text("a page of an earlier build that failed")
 
 
 # ------------------------------------------------------------------ two builds at once

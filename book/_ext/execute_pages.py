@@ -20,7 +20,8 @@ alone, and executes the pages it has to one after another.  This extension:
    the environment saved but the pages not all written, a page's HTML half written) is
    redone by the next one, which executes again only the pages the cache lacks; a build
    that failed is not trusted either (the next reads every page again, and a page that
-   failed fails again).  After a build that did not finish, a cached notebook whose file
+   failed fails again; the logs myst-nb wrote of its failed pages, in the site's reports/,
+   are deleted, since myst-nb never deletes them).  After a build that did not finish, a cached notebook whose file
    does not read as a notebook (jupyter-cache records a notebook, then writes its file) is
    dropped from the cache.
 3. Executes the pages before Sphinx reads them.  The pages about to be read are added to
@@ -141,6 +142,7 @@ def _begin(app, config):
         print(f"make book: {why}", file=sys.stderr, flush=True)
         raise SystemExit(2)
     _build["lock"] = _lock(Path(app.srcdir) / LOCK_FILE)
+    shutil.rmtree(Path(app.outdir) / "reports", ignore_errors=True)     # myst-nb's logs of the last build's failed pages
     digest, doctrees, cache = source_digest(), Path(app.doctreedir), _cache_dir(app)
     complete = _read(doctrees / COMPLETE_FILE) == digest
     (doctrees / COMPLETE_FILE).unlink(missing_ok=True)        # first: this build may be killed

@@ -92,11 +92,12 @@ def text_overlaps(fig, gap=0.5):
       y label on the neighbouring image): ``'a' / axes 'title'``.  Axes whose
       boxes overlap (twins, insets) are not each other's "other" axes;
     * a text or annotation placed in an axes with a frame that straddles the
-      frame: ``'a' / the frame of its axes``.
-    * a text or legend entry in an axes crossed by a line of that axes' data or
-      covered by one of its patches (a bar, a span), unless an opaque box drawn above
-      it hides it (`MASK`): ``'a' / the data's line 'b'`` (its label, if it has one;
-      a line drawn as markers only counts where a marker falls).
+      frame: ``'a' / the frame of its axes``;
+    * a text or legend entry in an axes that a line of that axes' data comes
+      within `CLEARANCE` of, or that one of its patches (a bar, a span) covers,
+      unless an opaque box drawn above the line hides it (`chapter.figures.MASK`):
+      ``'a' / the data's line 'b'`` (its label, if it has one; a line drawn as
+      markers only counts where a marker falls).
 
     Parameters
     ----------
@@ -146,10 +147,9 @@ def text_overlaps(fig, gap=0.5):
         out += [f"{name(t)} / legend" for t, bt in zip(drawn, boxes) if id(t) not in own and frame.overlaps(bt)]
     for ax in axes:
         legend = ax.get_legend()
-        written = [t for t in ax.texts if t.get_visible() and t.get_text()] + (
-            legend.get_texts() if legend is not None and legend.get_visible() else [])
+        own = {id(t) for t in ax.texts + (legend.get_texts() if legend is not None else [])}
         data = [a for a in ax.lines + ax.patches if a.get_visible()]
-        for t in written:
+        for t in (t for t in drawn if id(t) in own):                # its labels and legend entries, as drawn
             bt, box = Text.get_window_extent(t, renderer), t.get_bbox_patch()     # an annotation's text, not its arrow
             masked = box is not None and box.get_visible() and box.get_facecolor()[3] == 1
             out += list(dict.fromkeys(f"{name(t)} / the data's {_kind(a)}" for a in data if _crosses(a, bt, renderer)
