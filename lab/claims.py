@@ -24,7 +24,8 @@ from typing import Callable
 
 import numpy as np
 
-from renderer import DRAFT_SCENE, compare, gbuffer, pointwise, render
+from renderer import BUMPS, DRAFT_SCENE, compare, gbuffer, pointwise, render
+from renderer import generated as G
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 from renderer.validate import InvalidType, InvalidValue, choice, flag, real
@@ -580,18 +581,24 @@ LARGE_DIFFERENCE = 1e-3
 
 
 def _rings_pinch():
-    """rings: h_v = 2 pi k_v cos(2 pi k_v v) is nonzero at the pole while e_phi turns
-    with theta, so N' points in opposite directions on opposite sides of the pole."""
+    """rings: h = sin(2 pi k_v v) has h_v = 2 pi k_v at the pole, where e_phi turns with theta,
+    so the displaced sphere comes to a cone's point there and N' turns over across the pole
+    with either bump: the kernel's own N' (`renderer.generated`), either side of the pole."""
     phi, d = PINCH_PHI, DRAFT_SCENE
-    out = []
-    for theta in (0.0, np.pi):
-        N = np.array([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)])
-        _, hv = pointwise.exact_gradient("rings", (theta + np.pi) / (2 * np.pi), phi / np.pi, d.k_u, d.k_v)
-        _, e_phi = pointwise.tangent_frame(*N, np.sin(phi))
-        M = N + d.beta * float(hv) * np.array([float(c) for c in e_phi])
-        out.append(M / np.linalg.norm(M))
-    angle = float(np.degrees(np.arccos(np.clip(out[0] @ out[1], -1, 1))))
-    return {"angle (degrees)": angle, "sin_phi": float(np.sin(phi)), "field": "rings", "beta": d.beta}
+    turn = {}
+    for bump in BUMPS:
+        out = []
+        for theta in (0.0, np.pi):
+            N = (np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi))
+            u, v, sin_phi = (float(c) for c in pointwise.chart(*N))
+            h = float(pointwise.height("rings", u, v, d.k_u, d.k_v))
+            hu, hv = (float(c) for c in pointwise.exact_gradient("rings", u, v, d.k_u, d.k_v))
+            frame = [float(c) for e in pointwise.tangent_frame(*N, sin_phi) for c in e]
+            extra = (h, d.radius_a, sin_phi) if bump == "surface" else ()
+            out.append(np.array(getattr(G, f"perturbed_normal_{bump}")(*N, *frame, hu, hv, d.beta, *extra)))
+        turn[bump] = float(np.degrees(np.arccos(np.clip(out[0] @ out[1], -1, 1))))
+    return {"angle (degrees)": turn["chart"], "displaced sphere's angle (degrees)": turn["surface"],
+            "sin_phi": float(np.sin(phi)), "field": "rings", "beta": d.beta}
 
 
 def _beta_zero_slider():

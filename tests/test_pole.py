@@ -242,8 +242,9 @@ def test_the_frame_is_the_fixed_pair_only_at_sin_phi_zero_or_subnormal():
 
 def test_the_sine_fields_slope_per_unit_length_has_a_different_limit_on_each_meridian():
     """§7's "The pole": h_u / (2 pi R sin phi), phi = pi v, tends to k_u k_v cos(pi k_u u) / 2R as v -> 0
-    along the meridian u, so the sine field's bumped normal has no limit at the pole.  A field whose
-    slope vanishes there to first order in phi (rings: no u at all) has one."""
+    along the meridian u, so the sine field's bumped normal has no limit at the pole.  The rings
+    field has no u: its slope along e_theta tends to 0 (its slope along e_phi, which turns with the
+    meridian, does not: `test_the_pinch_claim_measures_the_rings_cone_point`)."""
     import sympy as sp
 
     from renderer import formulas as F
@@ -256,3 +257,25 @@ def test_the_sine_fields_slope_per_unit_length_has_a_different_limit_on_each_mer
     assert sp.simplify(limit("sine") - ku * kv * sp.cos(sp.pi * ku * F.u) / (2 * R)) == 0
     assert limit("sine").subs({F.u: 0}) != limit("sine").subs({F.u: sp.Rational(1, 2) / ku})
     assert limit("rings") == 0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_pinch_claim_measures_the_rings_cone_point(seed, monkeypatch):
+    """`lab.claims._rings_pinch` against the closed form, at random beta, k_v and colatitude phi: on
+    the meridians theta = 0 and pi the rings field's h_v = 2 pi k_v cos(2 pi k_v v), v = phi / pi, tilts
+    the draft's N + beta h_v e_phi away from the pole by atan(beta h_v) and the displaced sphere's
+    N - beta h_v / (pi (R + beta h)) e_phi towards it by atan(beta h_v / (pi (R + beta h))), N itself
+    being phi off the pole: the two sides' normals differ by 2 (tilt + phi) and 2 (tilt - phi)."""
+    from lab import claims
+    rng = np.random.default_rng(seed)
+    beta, k_v, phi = rng.uniform(0.05, 0.9), rng.uniform(1.0, 12.0), 10.0 ** rng.uniform(-6, -2)
+    scene = claims.DRAFT_SCENE.replace(beta=float(beta), k_v=float(k_v))
+    monkeypatch.setattr(claims, "DRAFT_SCENE", scene)
+    monkeypatch.setattr(claims, "PINCH_PHI", float(phi))
+    v = phi / math.pi
+    h, h_v = math.sin(2 * math.pi * k_v * v), 2 * math.pi * k_v * math.cos(2 * math.pi * k_v * v)
+    chart = 2 * (math.atan(beta * h_v) + phi)
+    surface = 2 * (math.atan(beta * h_v / (math.pi * (scene.radius_a + beta * h))) - phi)
+    m = claims._rings_pinch()
+    assert m["angle (degrees)"] == pytest.approx(math.degrees(chart), rel=1e-9)
+    assert m["displaced sphere's angle (degrees)"] == pytest.approx(math.degrees(surface), rel=1e-9)

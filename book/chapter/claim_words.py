@@ -36,7 +36,7 @@ SENTENCES = {
                      "{error growth over the two decades:.0f}-fold",
     "frame-aligned": "$(e_\\theta \\times e_\\varphi)\\cdot N = {(eθ × eφ)·N}$: the frame is left-handed about "
                      "the outward normal",
-    "flips-zero": "over {gbuffers} independent G-buffers, {geometry values differing} geometry values (chamber, $t$, "
+    "flips-zero": "over {gbuffers} independent {{term}}`G-buffers <G-buffer>`, {geometry values differing} geometry values (chamber, $t$, "
                   "$P$, $N$) and {reach-mask pixels differing} reach-mask pixels differ",
     "shadow-curves-unchanged": "true of the renderer, not of the draft's code: its shading lights "
                                "{pairs lit past the terminator:,} (pixel, light) pairs past the terminator",
@@ -91,7 +91,8 @@ SENTENCES = {
     "try-creases": f"{{share in the band:.0%}} of the pixels whose {_DI} exceeds {{threshold_shown}} lie in the "
                    "crease band ({frame})",
     "try-pinch": "with the draft's formula, $N'$ on opposite sides of the pole ($\\sin\\varphi = {sin_phi:g}$, "
-                 "{field}, $\\beta = {beta:g}$) differ by {angle (degrees):.0f}°",
+                 "{field}, $\\beta = {beta:g}$) differ by {angle (degrees):.0f}°; the displaced "
+                 "sphere's, by {displaced sphere's angle (degrees):.0f}°",
     "try-beta0": "at $\\beta = 0$, renders of two fields by the two pipelines differ in {values differing} values "
                  "({frame})",
 }
