@@ -157,6 +157,55 @@ def test_displacement_figure():
     return figures.displacement_figure(_displaced())
 
 
+@FIGURE
+def test_difference_bar():
+    """Both scales of `figures.difference_bar`: the log one beside a panel, the linear one under two."""
+    import matplotlib.pyplot as plt
+    figures.style()
+    ramp = np.repeat(np.linspace(0.0, 1.0, 32)[None, :, None], 3, axis=2).repeat(8, axis=0)
+    fig, ax = plt.subplot_mosaic([["log", "log"], ["a", "b"]], figsize=(4.8, 4.0), layout="constrained")
+    for a in ax.values():
+        a.imshow(ramp)
+        a.axis("off")
+    figures.difference_bar(fig, ax["log"], log_floor=1e-16)
+    figures.difference_bar(fig, [ax["a"], ax["b"]], gain=100.0, location="bottom")
+    return fig
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_difference_bar_maps_each_difference_to_its_grey_in_the_image(seed):
+    """The bar's grey for |ΔI| = d is the image's: min(gain d, 1) on the linear scale, and
+    1 - log10 d / log10 floor on the log one (renderer/js/simulator.js's), at random d, gain, floor;
+    its tick labels are plain numbers (no mathtext)."""
+    import matplotlib.pyplot as plt
+    rng = np.random.default_rng(seed)
+    gain, floor = 10.0 ** rng.uniform(0, 4), 10.0 ** -rng.integers(4, 20)
+    d = 10.0 ** rng.uniform(np.log10(floor), 0, 50)
+    fig, ax = plt.subplots()
+    try:
+        linear = figures.difference_bar(fig, ax, gain=gain)
+        log = figures.difference_bar(fig, ax, log_floor=floor)
+        assert np.allclose(np.clip(linear.norm(d), 0, 1), np.minimum(gain * d, 1.0), rtol=1e-12, atol=0)
+        assert np.allclose(log.norm(d), 1.0 - np.log10(d) / np.log10(floor), rtol=1e-9, atol=1e-12)
+        fig.canvas.draw()
+        labels = [t.get_text() for bar in (linear, log) for t in bar.ax.get_yticklabels()]
+        assert labels and not any("$" in t for t in labels), labels
+    finally:
+        plt.close(fig)
+
+
+@pytest.mark.parametrize("kwargs", [{}, {"gain": 1.0, "log_floor": 0.1}, {"gain": 0.0}, {"gain": float("nan")},
+                                    {"log_floor": 1.0}, {"log_floor": -1e-3}])
+def test_the_difference_bar_refuses_a_scale_it_cannot_draw(kwargs):
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots()
+    try:
+        with pytest.raises(ValueError, match="gain|log_floor"):
+            figures.difference_bar(fig, ax, **kwargs)
+    finally:
+        plt.close(fig)
+
+
 def test_the_comparison_is_on(request):
     """pytest-mpl compares a figure with its baseline only under ``--mpl`` (or writes the
     baselines under ``--mpl-generate-path``); without either every test above passes unchecked."""

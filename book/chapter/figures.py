@@ -28,6 +28,7 @@ What of a figure collides, and how small its text is drawn, is `chapter.layout`'
 from __future__ import annotations
 
 import io
+import math
 
 import numpy as np
 from matplotlib.scale import LogScale
@@ -38,7 +39,7 @@ from renderer import Scene, pointwise
 from .layout import drawn_size, drawn_texts
 
 __all__ = ["style", "figure_png", "PlainLogFormatter", "SMALLEST_TEXT_KEY", "MASK", "frame_diagram", "normal_diagram",
-           "stencil_diagram", "ucurve_anatomy", "displacement_figure"]
+           "stencil_diagram", "ucurve_anatomy", "displacement_figure", "difference_bar"]
 
 #: The book's colours: measured (dark red), exact (dark blue), third quantity (green), guides (grey).
 RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
@@ -85,6 +86,38 @@ def style():
             InteractiveShell.instance().display_formatter.formatters["image/png"].for_type(Figure, figure_png)
     except (ImportError, AttributeError, NameError):
         pass                                            # outside IPython: nothing to configure
+
+
+def difference_bar(fig, ax, *, gain=None, log_floor=None, location="right"):
+    """A grey colour bar for difference images drawn on ``ax`` (one axes or a list of them) of ``fig``:
+    each channel's |ΔI| (linear colour units) from black to white, linearly from 0 to 1 / ``gain``
+    (an image of ``gain`` |ΔI| clipped at 1: the bar's triangle marks the clipping) or, with
+    ``log_floor``, logarithmically from ``log_floor`` to 1 (an image of 1 - log10 |ΔI| / log10
+    ``log_floor``, as the simulator draws it).  Pass exactly one of them.  ``location``: matplotlib's
+    (beside the axes, "right", or under them, "bottom").  Returns the Colorbar.
+
+    Raises ValueError naming ``gain`` / ``log_floor`` when not exactly one is a positive number
+    (``log_floor`` < 1)."""
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import LogNorm, Normalize
+    if (gain is None) == (log_floor is None):
+        raise ValueError(f"pass exactly one of gain and log_floor, got gain={gain!r}, log_floor={log_floor!r}")
+    if gain is not None and not gain > 0:
+        raise ValueError(f"gain must be a positive number, got {gain!r}")
+    if log_floor is not None and not 0 < log_floor < 1:
+        raise ValueError(f"log_floor must be a number in (0, 1), got {log_floor!r}")
+    norm = Normalize(0.0, 1.0 / gain) if gain else LogNorm(log_floor, 1.0)
+    bar = fig.colorbar(ScalarMappable(norm=norm, cmap="gray"), ax=ax, shrink=0.8, aspect=16 if location == "right" else 24,
+                       extend="max" if gain else "neither", location=location)
+    if gain:                      # 0, half way and the clipping value, in the book's plain numbers
+        bar.set_ticks([0.0, 0.5 / gain, 1.0 / gain], labels=[f"{x:g}" for x in (0.0, 0.5 / gain, 1.0 / gain)])
+    if log_floor:                 # every fourth decade, written plainly (colorbar's default is mathtext's 10^-16)
+        bar.set_ticks([10.0**k for k in range(0, math.floor(math.log10(log_floor)) - 1, -4)])
+        bar.ax.xaxis.set_major_formatter(PlainLogFormatter())
+        bar.ax.yaxis.set_major_formatter(PlainLogFormatter())
+        bar.ax.minorticks_off()
+    bar.set_label("|ΔI| per channel")
+    return bar
 
 
 class PlainLogFormatter(LogFormatter):
