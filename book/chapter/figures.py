@@ -121,12 +121,13 @@ def difference_bar(fig, ax, *, gain=None, log_floor=None, location="right"):
 
 
 class PlainLogFormatter(LogFormatter):
-    """Log-axis tick labels as plain numbers, every character at the label's size: ``0.01`` to
-    ``1000`` as decimals, others as ``1e-6``, ``2e5`` (matplotlib's default, mathtext's
+    """Log-axis tick labels as plain numbers, every character at the label's size, one notation per
+    axis: decimals (``0.01`` to ``1000``) on an axis whose view lies within [0.01, 1e4], else
+    ``1e-6``, ``1e-2``, ``2e5`` throughout but for ``1`` (matplotlib's default, mathtext's
     ``10^{-6}``, draws the exponent at 70 % of the label's size: 6-7 CSS px on a phone)."""
 
     def _num_to_string(self, x, vmin, vmax):
-        if 1e-2 <= x < 1e4:
+        if x == 1 or 1e-2 <= min(vmin, vmax) and max(vmin, vmax) <= 1e4:
             return f"{x:g}"
         mantissa, exponent = f"{x:.0e}".split("e")
         return f"{mantissa}e{int(exponent)}"
@@ -379,7 +380,7 @@ def displacement_figure(result):
     """The displaced sphere beside the bumped one, and where their silhouettes and shadows differ.
 
     ``result`` is a `lab.displaced.Displaced`.  Top: the bumped render and the displaced one
-    (sRGB), each with the other's silhouette outlined.  Bottom: coverage of sphere A (grey in
+    (sRGB), each with the other's silhouette outlined (white on black).  Bottom: coverage of sphere A (grey in
     both, red only displaced, blue only bumped) and cast shadows (red only displaced, blue only
     bumped, green where the bumps shadow each other and the bumped render is lit).  5 in wide,
     text at `TEXT_PT`.  Returns a matplotlib Figure.
@@ -393,8 +394,9 @@ def displacement_figure(result):
 
     def panel(ax, rgb, title, outline=None):
         ax.imshow(rgb)
-        if outline is not None:
-            ax.contour(outline.astype(float), levels=[0.5], colors="white", linewidths=0.8)
+        if outline is not None:           # white on black: seen over the dark sphere and the light floor
+            for colour, width in (("black", 2.0), ("white", 0.8)):
+                ax.contour(outline.astype(float), levels=[0.5], colors=colour, linewidths=width)
         ax.set_title(title)
         ax.set_xticks([])
         ax.set_yticks([])
