@@ -124,8 +124,6 @@ QUANTITIES = {
     "the straddling share at a step of 1e-4": (("s3_share_e4",), lambda: _crease_share(1e-4)),
     "the straddling census's sphere-A pixels": (("s3_share_pixels",),
                                                 lambda: _lib("lab.accuracy").crease_share()["pixels"]),
-    "the chart spacing of the census's pixels": (("s3_share_spacing",),
-                                                 lambda: _lib("lab.accuracy").crease_share()["spacing"]),
     "the straddling pixels at a step of 1e-4": (("s3_share_n4",), lambda: _lib("lab.claims").census()["straddling"][
         _lib("lab.claims").census()["steps"].index(1e-4)]),
     "the third derivative at the U-curve's point": (("s3_ex_h3",), lambda: abs(_ucurve().third_derivative)),

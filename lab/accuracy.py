@@ -362,23 +362,16 @@ def crease_share():
     the draft's scene at `CREASE_SIZE` squared, the share of sphere-A pixels whose stencil
     straddles a crease (chart distance to one below the step, `crease_distance`) at each step
     of `CREASE_STEPS`.  Returns a dict: ``steps``, ``share`` (list of floats in [0, 1], step
-    order), ``pixels`` (sphere-A pixels of the frame) and ``spacing`` (chart units: the median
-    chart distance between neighbouring sphere-A pixels, u along rows, v along columns; no row
-    crosses the seam u = 0, which the camera on the z axis sees along the row y = 0)."""
+    order) and ``pixels`` (sphere-A pixels of the frame)."""
     from .store import measured
     return measured("crease-share", _crease_share, size=CREASE_SIZE, steps=list(CREASE_STEPS))
 
 
 def _crease_share(size, steps, scene=DRAFT_SCENE):
     g = gbuffer(scene, size, size)
-    on_a = g.chamber == SPHERE_A
-    uv = g.uv[on_a]
+    uv = g.uv[g.chamber == SPHERE_A]
     dist = _crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field)
-    du = np.abs(np.diff(g.uv[..., 0], axis=1))[on_a[:, 1:] & on_a[:, :-1]]
-    dv = np.abs(np.diff(g.uv[..., 1], axis=0))[on_a[1:] & on_a[:-1]]
-    spacing = float(np.median(np.concatenate([du, dv])))
-    return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps], pixels=int(dist.size),
-                spacing=spacing)
+    return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps], pixels=int(dist.size))
 
 
 #: The steps of the simulator's U-curve (``CURVE_LOG_EPS`` in renderer/js/simulator.js): half decades

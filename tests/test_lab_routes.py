@@ -66,24 +66,6 @@ def test_the_crease_share_counts_the_stencils_that_cross_a_zero_line(scene):
     share = _crease_share(SIZE, steps, scene)
     assert share["share"] == [pytest.approx(float(np.mean(_straddles(scene, SIZE, e))), abs=1e-12) for e in steps]
     assert share["pixels"] == _straddles(scene, SIZE, 1e-3).size
-    assert share["spacing"] == pytest.approx(_spacing(scene, SIZE), rel=1e-9, abs=0)
-
-
-def _spacing(scene, size):
-    """The median chart distance between neighbouring sphere-A pixels, from the G-buffer's normals
-    by numpy's spherical coordinates (not the chart it stores), pixel pair by pixel pair."""
-    g = gbuffer(scene, size, size)
-    u = (np.arctan2(g.N[..., 1], g.N[..., 0]) + np.pi) / (2 * np.pi)
-    v = np.arccos(np.clip(g.N[..., 2], -1, 1)) / np.pi
-    on_a, gaps = g.chamber == SPHERE_A, []
-    for i in range(size):
-        for j in range(size):
-            if j + 1 < size and on_a[i, j] and on_a[i, j + 1]:
-                gap = abs(u[i, j + 1] - u[i, j])
-                gaps.append(min(gap, 1 - gap))
-            if i + 1 < size and on_a[i, j] and on_a[i + 1, j]:
-                gaps.append(abs(v[i + 1, j] - v[i, j]))
-    return float(np.median(gaps))
 
 
 @pytest.mark.parametrize("scene", _scenes(2, seed=7) + _scenes(1, seed=8, field="sine"),

@@ -125,6 +125,6 @@ def register():
         entries.append(
             f"(claim-{c.id})=\n"
             f"**{n}. {claim.where}:** “{claim.quote}”{noted}. "
-            f"**{{term}}`{WORDS[verdict]}`**: {measured_text(c.id, measured)}; by the rule: "
+            f"**{{term}}`{WORDS[verdict]}`**: {measured_text(c.id, measured)}; rule: "
             f"{rule_text(claim.criterion)}.\n")
     return "\n".join(entries)

@@ -113,8 +113,8 @@ export const PRESETS = [
     hint: "Kink view, linear difference scale: the crease band is white on the renders and blue on the " +
           "difference, where the large differences sit: central differences straddle the crease." },
   { id: "try3", label: "3 · rings: magnify the pole", set: { height_field: "rings", zoom: 4, view: "shaded", bump: "chart" },
-    hint: "The draft's formula at the pole, magnified: the rings converge on it, and the shading flips from " +
-          "one side of the pole to the other, where the draft's normal turns over." },
+    hint: "The pole, magnified: the rings circle it, and the shading flips from one side of it to the other " +
+          "with either normal (the shading-normal control swaps them): the bumped sphere comes to a cone's point." },
   { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta",
     hint: "With β = 0 both renders are the un-bumped sphere: the difference is black, the ledger reads " +
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
