@@ -78,10 +78,10 @@ def _ucurve():
     return _lib("renderer.ucurve").measure()
 
 
-def _crease_share(step):
-    """`lab.accuracy.crease_share`'s share of straddling stencils at ``step``."""
+def _crease_share(step, key="share"):
+    """`lab.accuracy.crease_share`'s share of straddling stencils at ``step`` (``key``: "share_u", along u only)."""
     share = _lib("lab.accuracy").crease_share()
-    return dict(zip(share["steps"], share["share"]))[step]
+    return dict(zip(share["steps"], share[key]))[step]
 
 
 #: The glued quantities with a value in the library or more than one name: quantity -> (its glue
@@ -124,6 +124,8 @@ QUANTITIES = {
     "the straddling share at a step of 1e-4": (("s3_share_e4",), lambda: _crease_share(1e-4)),
     "the straddling census's sphere-A pixels": (("s3_share_pixels",),
                                                 lambda: _lib("lab.accuracy").crease_share()["pixels"]),
+    "the straddling pixels along u at a step of 1e-4": (("s3_share_rays_e4",), lambda: round(
+        _crease_share(1e-4, "share_u") * _lib("lab.accuracy").crease_share()["pixels"])),
     "the straddling pixels at a step of 1e-4": (("s3_share_n4",), lambda: _lib("lab.claims").census()["straddling"][
         _lib("lab.claims").census()["steps"].index(1e-4)]),
     "the third derivative at the U-curve's point": (("s3_ex_h3",), lambda: abs(_ucurve().third_derivative)),

@@ -271,13 +271,14 @@ def crease_distance(u, v, k_u, k_v, field=None):
     return _crease_distance(u, v, real("k_u", k_u, **FREQUENCY), real("k_v", k_v, **FREQUENCY), record)
 
 
-def _crease_distance(u, v, k_u, k_v, record):
+def _crease_distance(u, v, k_u, k_v, record, along=(True, False)):
+    """`crease_distance` on validated arrays; ``along``: the directions searched (True: u, False: v)."""
     shape, u, v = u.shape, u.ravel(), v.ravel()
     out = np.full(u.shape, np.inf)
     k_u, k_v = np.float64(k_u), np.float64(k_v)     # numpy's overflow to inf, not Python's OverflowError
     for factor in record.crease_factors:
         g = sp.lambdify((F.u, F.v, F.k_u, F.k_v), factor, modules="numpy")
-        for along_u in (True, False):
+        for along_u in along:
             if (F.u if along_u else F.v) in factor.free_symbols:
                 def g_at(s, at=slice(None), along_u=along_u, g=g):   # s: offsets (n,) or (n, m) at u[at], v[at]
                     uu, vv = (u[at, None], v[at, None]) if np.ndim(s) == 2 else (u[at], v[at])
@@ -362,7 +363,8 @@ def crease_share():
     the draft's scene at `CREASE_SIZE` squared, the share of sphere-A pixels whose stencil
     straddles a crease (chart distance to one below the step, `crease_distance`) at each step
     of `CREASE_STEPS`.  Returns a dict: ``steps``, ``share`` (list of floats in [0, 1], step
-    order) and ``pixels`` (sphere-A pixels of the frame)."""
+    order), ``share_u`` (the same for a crease reached along u alone: on the draft's frame the
+    rays u = m/k_u from the pole) and ``pixels`` (sphere-A pixels of the frame)."""
     from .store import measured
     return measured("crease-share", _crease_share, size=CREASE_SIZE, steps=list(CREASE_STEPS))
 
@@ -371,7 +373,9 @@ def _crease_share(size, steps, scene=DRAFT_SCENE):
     g = gbuffer(scene, size, size)
     uv = g.uv[g.chamber == SPHERE_A]
     dist = _crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field)
-    return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps], pixels=int(dist.size))
+    along_u = _crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field, along=(True,))
+    return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps],
+                share_u=[float(np.mean(along_u < eps)) for eps in steps], pixels=int(dist.size))
 
 
 #: The steps of the simulator's U-curve (``CURVE_LOG_EPS`` in renderer/js/simulator.js): half decades

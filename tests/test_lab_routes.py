@@ -51,13 +51,13 @@ def _scenes(count=3, seed=2026, field="ridges"):
     return out
 
 
-def _straddles(scene, size, eps):
+def _straddles(scene, size, eps, along_v=True):
     """Sphere-A pixels whose stencil u -+ eps or v -+ eps crosses a zero line m/k_u or m/k_v, counted
-    by the integer parts of k (u -+ eps) and k (v -+ eps)."""
+    by the integer parts of k (u -+ eps) and k (v -+ eps); with ``along_v`` False, the lines m/k_u only."""
     g = gbuffer(scene, size, size)
     u, v = g.uv[g.chamber == SPHERE_A].T
     crosses = lambda x, k: np.floor(k * (x - eps)) != np.floor(k * (x + eps))   # noqa: E731
-    return crosses(u, scene.k_u) | crosses(v, scene.k_v)
+    return crosses(u, scene.k_u) | (crosses(v, scene.k_v) & along_v)
 
 
 @pytest.mark.parametrize("scene", _scenes(), ids=lambda s: f"ku{s.k_u:.2f}-kv{s.k_v:.2f}")
@@ -66,6 +66,8 @@ def test_the_crease_share_counts_the_stencils_that_cross_a_zero_line(scene):
     share = _crease_share(SIZE, steps, scene)
     assert share["share"] == [pytest.approx(float(np.mean(_straddles(scene, SIZE, e))), abs=1e-12) for e in steps]
     assert share["pixels"] == _straddles(scene, SIZE, 1e-3).size
+    assert share["share_u"] == [pytest.approx(float(np.mean(_straddles(scene, SIZE, e, along_v=False))), abs=1e-12)
+                                for e in steps]
 
 
 @pytest.mark.parametrize("scene", _scenes(2, seed=7) + _scenes(1, seed=8, field="sine"),
