@@ -307,6 +307,28 @@ def test_a_build_after_a_killed_one_redoes_what_is_stale(tmp_path, token, hold, 
         assert "second edition" in page_html(book)
 
 
+def test_an_edited_static_file_reaches_a_site_whose_pages_are_current(tmp_path, token):
+    """Sphinx copies html_static_path only when it writes a page: the build makes every page out
+    of date when a static file is newer than its copy, so the edit reaches the site (and a file
+    the site lost is copied again), the page executed once; with nothing newer, no page is written."""
+    book = make_book(tmp_path / "book")
+    (book / "_config.yml").write_text(CONFIG + "  config:\n    html_static_path: [_static]\n")
+    (book / "_static").mkdir()
+    style, copy = book / "_static" / "fit.css", book / "_build" / "html" / "_static" / "fit.css"
+    style.write_text("p { color: black; }\n")
+    Build(book, token, name="first").passes()
+    assert copy.read_text() == style.read_text()
+    for name, edit in (("edited", lambda: style.write_text("p { color: navy; }\n")), ("lost", copy.unlink)):
+        time.sleep(0.05)                                  # a later mtime on coarse clocks
+        edit()
+        Build(book, token, name=name).passes()
+        assert copy.read_text() == style.read_text(), name
+    written = (book / "_build" / "html" / "a.html").stat().st_mtime_ns
+    Build(book, token, name="unchanged").passes()              # nothing newer: no page written again
+    assert (book / "_build" / "html" / "a.html").stat().st_mtime_ns == written
+    assert executions(book) == ["a v1"]
+
+
 def test_a_build_that_failed_is_not_trusted_by_the_next(tmp_path, token):
     """A page whose cell raises fails the build (status 1, the page and the exception named);
     the next build, nothing changed, fails the same way instead of finding the page current.  The

@@ -182,6 +182,23 @@ def _finish(app, exception):
         files.write_bytes(Path(app.doctreedir) / COMPLETE_FILE, source_digest().encode())
 
 
+def _static_changed(app, env, added, changed, removed):
+    """Every page, when a file of the book's own ``html_static_path`` (the directories in the book,
+    not those extensions add, whose ``*_t`` templates are copied under other names) is newer than
+    its copy in the site or has none: Sphinx copies those files only when it writes a page, so an
+    edited stylesheet would not reach a site whose pages are all current."""
+    site, book = Path(app.outdir) / "_static", Path(app.confdir).resolve()
+    for base in app.config.html_static_path:
+        root = (book / base).resolve()
+        if not root.is_relative_to(book):
+            continue
+        for source in (p for p in root.rglob("*") if p.is_file()):
+            copy = site / source.relative_to(root)
+            if not copy.is_file() or copy.stat().st_mtime < source.stat().st_mtime:
+                return sorted(env.found_docs)
+    return []
+
+
 def _execute(app, env, docnames):
     if env.mystnb_config.execution_mode != "cache" or not docnames:
         return
@@ -411,6 +428,7 @@ def setup(app):
     app.add_config_value("execute_pages_first", [], "env", types=[list])
     app.add_config_value("execute_pages_last", [], "env", types=[list])
     app.connect("config-inited", _begin, priority=100)          # before the extensions that write
+    app.connect("env-get-outdated", _static_changed)
     app.connect("env-before-read-docs", _execute, priority=900)
     app.connect("build-finished", _finish, priority=900)        # after the extensions that write
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
