@@ -126,8 +126,8 @@ QUANTITIES = {
                                                 lambda: _lib("lab.accuracy").crease_share()["pixels"]),
     "the straddling pixels along u at a step of 1e-4": (("s3_share_rays_e4",), lambda: round(
         _crease_share(1e-4, "share_u") * _lib("lab.accuracy").crease_share()["pixels"])),
-    "the straddling pixels at a step of 1e-4": (("s3_share_n4",), lambda: _lib("lab.claims").census()["straddling"][
-        _lib("lab.claims").census()["steps"].index(1e-4)]),
+    "the straddling pixels at a step of 1e-4": (("s3_share_n4",), lambda: dict(zip(
+        *(_lib("lab.claims").census()[key] for key in ("steps", "straddling"))))[1e-4]),
     "the third derivative at the U-curve's point": (("s3_ex_h3",), lambda: abs(_ucurve().third_derivative)),
     "the relative error at a step of 1e-9": (("ucurve_rel_1e9",), lambda: _lib("lab.claims").relative_error_at(1e-9)),
     "the relative error at a step of 1e-11": (("ucurve_rel_1e11",),

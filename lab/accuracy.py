@@ -372,8 +372,9 @@ def crease_share():
 def _crease_share(size, steps, scene=DRAFT_SCENE):
     g = gbuffer(scene, size, size)
     uv = g.uv[g.chamber == SPHERE_A]
-    dist = _crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field)
-    along_u = _crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field, along=(True,))
+    along_u, along_v = (_crease_distance(uv[:, 0], uv[:, 1], scene.k_u, scene.k_v, scene.field, along=(a,))
+                        for a in (True, False))
+    dist = np.minimum(along_u, along_v)
     return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps],
                 share_u=[float(np.mean(along_u < eps)) for eps in steps], pixels=int(dist.size))
 

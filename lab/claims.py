@@ -25,7 +25,7 @@ from typing import Callable
 import numpy as np
 
 from renderer import BUMPS, DRAFT_SCENE, compare, gbuffer, pointwise, render
-from renderer import generated as G
+from renderer import kernel
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 from renderer.validate import InvalidType, InvalidValue, choice, flag, real
@@ -583,19 +583,19 @@ LARGE_DIFFERENCE = 1e-3
 def _rings_pinch():
     """rings: h = sin(2 pi k_v v) has h_v = 2 pi k_v at the pole, where e_phi turns with theta,
     so the displaced sphere comes to a cone's point there and N' turns over across the pole
-    with either bump: the kernel's own N' (`renderer.generated`), either side of the pole."""
+    with either bump: the kernel's own N' (`renderer.kernel.shading_normal`), either side of it."""
     phi, d = PINCH_PHI, DRAFT_SCENE
     turn = {}
     for bump in BUMPS:
+        record = kernel.params(d.replace(bump=bump), skip=False)[0][0]
         out = []
         for theta in (0.0, np.pi):
-            N = (np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi))
+            N = np.array([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)])
             u, v, sin_phi = (float(c) for c in pointwise.chart(*N))
             h = float(pointwise.height("rings", u, v, d.k_u, d.k_v))
             hu, hv = (float(c) for c in pointwise.exact_gradient("rings", u, v, d.k_u, d.k_v))
-            frame = [float(c) for e in pointwise.tangent_frame(*N, sin_phi) for c in e]
-            extra = (h, d.radius_a, sin_phi) if bump == "surface" else ()
-            out.append(np.array(getattr(G, f"perturbed_normal_{bump}")(*N, *frame, hu, hv, d.beta, *extra)))
+            frame = tuple(float(c) for e in pointwise.tangent_frame(*N, sin_phi) for c in e)
+            out.append(np.array(kernel.shading_normal(record, N, frame, h, hu, hv, sin_phi)))
         turn[bump] = float(np.degrees(np.arccos(np.clip(out[0] @ out[1], -1, 1))))
     return {"angle (degrees)": turn["chart"], "displaced sphere's angle (degrees)": turn["surface"],
             "sin_phi": float(np.sin(phi)), "field": "rings", "beta": d.beta}
