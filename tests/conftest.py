@@ -58,7 +58,7 @@ def _project_environment_kept():
 
 @pytest.fixture(scope="session")
 def book_html():
-    """The built site: SYMRENDER_BOOK_HTML if set (``make test`` builds the book first and
+    """The built site: SYMRENDER_BOOK_HTML if set (``make audit`` builds the book first and
     passes it), else book/_build/html, built here as ``make book`` builds it (the test
     processes of one run take turns, as any two builds in one tree do: the build holds
     book/.build.lock, book/_ext/execute_pages.py; the first builds, the others find it current)."""

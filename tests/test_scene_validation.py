@@ -140,6 +140,28 @@ def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
         assert message.startswith("Scene.height_field ") and "not finite and real" in message, message
 
 
+def _off_contract(fields, k_u, k_v):
+    """The fields of ``fields`` a built-in may not be (`Scene` skips the chart check for them and
+    checks only beta < radius_a): not finite and real with its gradient on the chart, or with
+    h < -1 there, where R + beta h would reach 0 under beta < R."""
+    from renderer.scene import _on_chart
+    off = []
+    for field in fields:
+        low, finite = _on_chart(field, k_u, k_v)
+        if not (finite and low >= -1.0):
+            off.append(field.name)
+    return off
+
+
+@settings(max_examples=25, deadline=None)
+@given(k_u=st.floats(1e-3, 1e3), k_v=st.floats(1e-3, 1e3))
+def test_every_builtin_field_is_finite_and_at_least_minus_one_on_the_chart(k_u, k_v):
+    """What lets `Scene` trust a field of `formulas.BUILTIN` without the chart check, held for
+    whatever field is registered there, at random frequencies; a field twice the sine is refused."""
+    assert _off_contract([F.FIELDS[name] for name in F.BUILTIN], k_u, k_v) == []
+    twice = F.HeightField("twice", 2 * F.FIELDS["sine"].expr)
+    assert _off_contract([twice], 1.5, 1.5) == ["twice"]
+
 @pytest.mark.parametrize("text, held", [("abs(u**u)", "arg, im, re"), ("cos(3)**v", "the imaginary unit")])
 def test_a_field_whose_derivative_sympy_cannot_write_real_is_refused(text, held):
     """|g| of a g sympy cannot tell is real, and a negative base to a power in v: their derivatives

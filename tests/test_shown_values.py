@@ -573,3 +573,10 @@ def test_the_pole_and_crease_solutions_of_s7_are_redone_from_their_givens(ran):
     half = abs(glued["s7_crease_right"] - glued["s7_crease_left"]) / 2
     assert math.isclose(glued["s7_crease_half_jump"], half, rel_tol=1e-12)
     assert math.isclose(glued["s7_crease_dip"], half - glued["s7_crease_err_min"], rel_tol=1e-9)
+    # Against the left-hand slope: the float64 quotients from the curve's signed parts (the right-hand
+    # slope, its reference, plus truncation and roundoff), not from the page's central differences.
+    crease = ns["crease"]
+    q = glued["s7_crease_right"] + crease.truncation + crease.roundoff
+    assert math.isclose(glued["s7_crease_err_min_left"], float(np.abs(q - glued["s7_crease_left"]).min()),
+                        rel_tol=1e-12)
+    assert glued["s7_crease_err_min_left"] < glued["s7_crease_err_min"]     # "either way": each slope's dip
