@@ -25,9 +25,9 @@ and live readout kept current.  (Every page's formulas and axe-core's audit are 
 on the pages it opens once.)  Screenshots go to test-artifacts/.  Each check is shown rejecting a wrong
 variant.
 
-The book is built into a temporary directory for the test unless
-SYMRENDER_BOOK_HTML names a freshly built site (.ci/run builds the book first
-and passes it).  With CI=true a missing Chromium or Playwright fails the test.
+The tests read SYMRENDER_BOOK_HTML's site (``make audit`` builds the book first and
+passes it); without it, the book is built into book/_build as ``make book`` builds it
+(tests/conftest.py's ``book_html``).  With CI=true a missing Chromium or Playwright fails the test.
 """
 
 from __future__ import annotations

@@ -160,6 +160,17 @@ CASES = [
 ]
 
 
+def field_cases(cases, fields):
+    """Cases for each of ``fields`` that no case of ``cases`` renders (a field newly registered in
+    renderer/formulas.py): central and exact, at the book's other defaults."""
+    named = {c[1].height_field for c in cases}
+    return [(f"{name}-{g}", Scene(height_field=name), 64, 48, g, 1.0)
+            for name in fields if name not in named for g in ("central", "exact")]
+
+
+CASES += field_cases(CASES, F.BUILTIN)
+
+
 # ---- the error model -----------------------------------------------------------------
 
 def slope(scene):
@@ -453,6 +464,9 @@ def test_parity_cover_the_acceptance_grid():
     assert min(central_eps) <= 1e-10 and max(central_eps) >= 1e-1
     assert any(c[5] > 1.0 for c in CASES if c[4] == "footprint")
     assert {s.shininess == int(s.shininess) for s in scenes} == {True, False}
+    assert {s.height_field for s in scenes} == set(F.BUILTIN)
+    new = "sin(pi*k_u*u)**2"                               # a field no case renders
+    assert [c[0] for c in field_cases(CASES, [*F.BUILTIN, new])] == [f"{new}-central", f"{new}-exact"]
 
 
 def test_js_renderer_matches_python_within_the_error_model(rows):
