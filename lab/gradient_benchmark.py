@@ -43,7 +43,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from renderer import DRAFT_SCENE, fieldcode, gbuffer, pointwise, ucurve, validate
+from renderer import DRAFT_SCENE, gbuffer, pointwise, ucurve, validate
 from renderer import formulas as F
 from renderer.render import SPHERE_A
 from renderer.scene import UNIT
@@ -542,12 +542,10 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
     """
     record, x = F.univariate(function), validate.real("x", x)
     steps = validate.steps("steps", steps, low=pointwise.MIN_STEP, high=ucurve.MAX_FUNCTION_STEP)
-    with np.errstate(all="ignore"):
-        value = fieldcode.univariate_code(record).value(x)
-    if math.isinf(value):                     # finite at 50 digits (measure_function's test) is not enough
-        raise validate.InvalidValue(f"x = {x!r} is too large for function {record.name}: f(x) overflows float64")
     try:
-        curve = ucurve.measure_function(record, x, eps=steps)      # checks f and f' at x, and f at x +- eps
+        # Refuses a point where f or f' is not a real number float64 holds, a crease, a float64 f(x) that
+        # overflows, and a step at which f(x +- eps) is not finite.
+        curve = ucurve.measure_function(record, x, eps=steps)
     except validate.InvalidValue as exc:                           # its eps is this function's steps
         text = str(exc)
         raise validate.InvalidValue(f"steps{text[3:]}" if text.startswith("eps ") else text) from None
@@ -561,7 +559,8 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
                 continue
             for eps in ((None,) if m.steps is None else steps):
                 info = {}
-                value = m.derivative(record, x, eps, info)
+                with np.errstate(all="ignore"):           # a value that is not finite is refused below
+                    value = m.derivative(record, x, eps, info)
                 if not math.isfinite(value):
                     raise validate.InvalidValue(f"function {record.name}: its {m.name} derivative at x = {x!r}"
                                                 + (f" with the step {eps!r}" if eps is not None else "")

@@ -240,13 +240,22 @@ def test_an_abs_function_takes_the_continued_complex_step_and_not_the_plain_one(
     ("exp(x)", 1j, "^x must be a real number"),             # not real
     ("abs(x - 1)", 1.0, "^function .*not differentiable at x = 1.0"),
     ("sqrt(x)", -1.0, "^function .*x = -1.0"),              # not defined there
-    ("exp(x)", 800.0, "^x = 800.0 is too large"),           # f overflows float64
+    ("exp(x)", 800.0, r"^function exp\(x\) must be defined .* not a real number float64 can hold"),
+    ("sinh(x)**2/cosh(x)", 400.0, "^x must be a point where .* at x = 400.0 it overflows"),  # f finite, f64 not
+    ("log(x**2)", 0.0, r"^function log\(x\*\*2\) must be defined"),  # f is infinite: not "too large"
+    ("1/x", 0.0, "^function 1/x must be defined"),
     ("abs(atan(x)**atan(x))", 1.0, "^function: .* derivative in x in closed form; sympy's holds arg, im, re"),
     ("cos(3)**x", 1.0, "^function: .* derivative in x in closed form; sympy's holds the imaginary unit"),
 ])
 def test_a_bad_function_or_point_is_one_input_error(function, x, match):
     with pytest.raises(InputError, match=match):
         gb.univariate_errors(function, x)
+
+
+@pytest.mark.filterwarnings("error::RuntimeWarning")
+def test_a_method_reaching_past_the_domain_is_refused_without_a_numpy_warning():
+    with pytest.raises(InputError, match=r"^function log\(x\): its richardson derivative at x = 0.02"):
+        gb.univariate_errors("log(x)", 0.02, steps=(1e-2,))
 
 
 def test_a_derivative_below_float64s_range_is_measured_and_one_whose_program_overflows_refused():
@@ -264,12 +273,14 @@ def test_a_step_past_where_f_is_defined_is_refused_by_this_functions_name_for_it
         gb.univariate_errors("log(x)", 0.5, steps=(1e-3, 0.6))
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(case=functions_at_points())
 def test_any_function_at_any_point_is_measured_or_one_input_error(case):
     """Whatever f a reader types and wherever: every method's row a finite value and error, or one
     refusal naming ``function``, ``x`` or ``steps`` (never an exception from inside mpmath, math,
-    SciPy or JAX: a pole, an overflow of a derivative, a derivative below float64's range)."""
+    SciPy or JAX: a pole, an overflow of a derivative, a derivative below float64's range), and no
+    numpy warning on the way (Richardson's steps reaching past log's domain, log(x) at 0.02)."""
     text, x = case
     try:
         found = gb.univariate_errors(text, x, steps=(1e-2, 1e-6, 1e-20))
