@@ -579,4 +579,5 @@ def test_the_pole_and_crease_solutions_of_s7_are_redone_from_their_givens(ran):
     q = glued["s7_crease_right"] + crease.truncation + crease.roundoff
     assert math.isclose(glued["s7_crease_err_min_left"], float(np.abs(q - glued["s7_crease_left"]).min()),
                         rel_tol=1e-12)
-    assert glued["s7_crease_err_min_left"] < glued["s7_crease_err_min"]     # "either way": each slope's dip
+    # "Either way": the quotient came nearer each slope than half the jump at some step.
+    assert max(glued["s7_crease_err_min"], glued["s7_crease_err_min_left"]) < half

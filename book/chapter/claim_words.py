@@ -82,7 +82,7 @@ SENTENCES = {
     "noise-below-1e-11": "the quotient's relative error at a step of {step_shown} is "
                          "{relative error at ε = 1e-11:.1e}: digits lost, not noise",
     "crease-fd-zero": "the central difference at a step of {step_shown} gives {central:+.1e} on the crease, but the exact gradient "
-                      "{exact:+.3f}: $\\sin(\\pi k_u u)$ at the float nearest $1/k_u$ is not zero, so the sign "
+                      "{exact:+.3f}: float64's $\\sin(\\pi k_u u)$ at $u = 1/k_u$ is the sine of $\\pi$ rounded, not zero, so the sign "
                       "picks a side",
     "pole-pixels": "{fallback pixels} pixels lie inside the draft's fallback disc ({frame}); the draft counts points of a grid of $N_z$ "
                    "values unrelated to the image",
