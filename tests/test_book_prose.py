@@ -257,7 +257,7 @@ def test_an_unlabelled_rendered_number_is_found():
     """Wrong variants: a label dropped from a caption, from a table's intro, and a new cell
     that renders through a proofs/ function with a paragraph that does not say at what size."""
     renders = rendering_functions()
-    assert {"render", "gbuffer", "image_beta_order", "crease_band_ratio", "gradient_accuracy"} <= renders
+    assert {"render", "gbuffer", "image_beta_order", "census", "gradient_accuracy"} <= renders
     assert "tex_number" not in renders
     s4 = (BOOK / "s4_simulator.md").read_text(encoding="utf-8")
     assert unlabelled(s4.replace("The opening frame ({glue:text}`s4_label`):", "The opening frame:"), renders)

@@ -203,9 +203,8 @@ def _readings(claim):
         return [p for a, b in (both, both[::-1]) for p in _counts(a, 0, **{b: 0})]
     if q == "shadow-curves-unchanged":                                  # "unchanged": no pair lit past it
         return _counts("pairs lit past the terminator", 0, HOLDS, CORRECTED)
-    if q == "cell1-ripples":                                            # sphere A must show: B not the whole frame
-        return _edges("share of the frame on the draft's sphere B", hi=1.0, inside=HOLDS, outside=FAILS)[:1] + \
-            [({"share of the frame on the draft's sphere B": 1.0}, FAILS)]
+    if q == "cell1-ripples":                                            # sphere A must show: a pixel at least
+        return _counts("draft's sphere-A pixels", 0, inside=FAILS, outside=HOLDS)
     if q == "census-slope":                                             # "descending the truncation slope"
         p = _series_power() * (1 - SLOPE)
         return (_edges("RMS slope", lo=p, inside=HOLDS, outside=CORRECTED, **{"off-band slope": 2.0})

@@ -40,7 +40,8 @@ SENTENCES = {
                   "$P$, $N$) and {reach-mask pixels differing} reach-mask pixels differ",
     "shadow-curves-unchanged": "true of the renderer, not of the draft's code: its shading lights "
                                "{pairs lit past the terminator:,} (pixel, light) pairs past the terminator",
-    "cell1-ripples": "the draft's sphere B covers {pixels_b:,} of the {pixels:,} pixels, so sphere A never appears",
+    "cell1-ripples": "the draft's sphere B covers {pixels_b:,} of the {pixels:,} pixels and its sphere A "
+                     "{draft's sphere-A pixels:,}: sphere A never appears",
     "census-slope": "the RMS slope is {RMS slope:.2f}, the off-band slope {off-band slope:.2f} (fitted over the "
                     "{steps} steps, {frame}): only the pixels off the crease band descend at second order",
     "census-flips": "{flips} flips over the {steps} steps ({frame})",
