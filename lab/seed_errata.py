@@ -17,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-from renderer import DRAFT_SCENE, gbuffer
+from renderer import DRAFT_SCENE, gbuffer, pointwise
 from renderer.pointwise import chart, tangent_frame
 from renderer.render import FLOOR, SPHERE_A, SPHERE_B, image_plane
 from renderer.validate import InvalidValue, positive_int
@@ -149,7 +149,7 @@ def _terminator_leak(size=SIZE):
         leaked_by_beta[beta] = (count, worst)
     res["leak_pixels_default"], res["leak_diffuse_max_default"] = leaked_by_beta[DRAFT_SCENE.beta]
     res["leak_pixels_beta_1_5"], res["leak_diffuse_max_beta_1_5"] = leaked_by_beta[CELL6_BETA]
-    res["beta_default"] = DRAFT_SCENE.beta
+    res["beta_default"], res["beta_large"] = DRAFT_SCENE.beta, CELL6_BETA
     return res
 
 
@@ -180,20 +180,28 @@ def _specular_ungated(size=SIZE):
 
 def _v_border_branch(size=SIZE):
     """The seed's border test ``vp - vm < 2 eps`` also fires in the interior: at the draft's step
-    (its keys say "1e-3") and at two smaller ones."""
+    (its keys say "1e-3") and at two smaller ones.  Where it fires, the seed divides by the rounded
+    span vp - vm instead of 2 eps; ``nearer_1e-6`` is the share of those pixels at 1e-6 where that
+    quotient is the nearer to the exact h_v (`pointwise.exact_gradient`): the span takes the
+    rounding of the arguments out."""
     scene = DRAFT_SCENE
     g = gbuffer(scene, size, size)
-    v = g.uv[..., 1][g.chamber == SPHERE_A]
+    u, v = (g.uv[..., i][g.chamber == SPHERE_A] for i in (0, 1))
     out, draft = {}, scene.eps
     for eps in (draft, 1e-6, 1e-9):
         vp, vm = np.minimum(1.0, v + eps), np.maximum(0.0, v - eps)
         interior = (v + eps <= 1.0) & (v - eps >= 0.0)
         fires = interior & (vp - vm < 2 * eps)
-        rel = np.abs((vp - vm)[fires] / (2 * eps) - 1.0)
+        span = (vp - vm)[fires]
+        rel = np.abs(span / (2 * eps) - 1.0)
+        h_at = lambda w: pointwise.height(scene.field, u[fires], w[fires], scene.k_u, scene.k_v)  # noqa: E731
+        dh = h_at(vp) - h_at(vm)
+        exact = pointwise.exact_gradient(scene.field, u[fires], v[fires], scene.k_u, scene.k_v)[1]
+        nearer = np.abs(dh / span - exact) < np.abs(dh / (2 * eps) - exact)
         out[eps] = (float(np.count_nonzero(fires) / np.count_nonzero(interior)),
-                    float(rel.max()) if rel.size else 0.0)
+                    float(rel.max()) if rel.size else 0.0, float(nearer.mean()) if nearer.size else 0.0)
     return {"draft_step": draft, "fraction_interior_1e-3": out[draft][0], "rel_change_1e-3": out[draft][1],
-            "fraction_interior_1e-6": out[1e-6][0], "rel_change_1e-6": out[1e-6][1],
+            "fraction_interior_1e-6": out[1e-6][0], "rel_change_1e-6": out[1e-6][1], "nearer_1e-6": out[1e-6][2],
             "fraction_interior_1e-9": out[1e-9][0], "rel_change_1e-9": out[1e-9][1]}
 
 
@@ -221,19 +229,20 @@ def _acos_pole(size=SIZE):
 
 
 def _fallback_orientation():
-    """(e_theta x e_phi) . N is -1 on the chart frame but +1 on the pole fallback."""
+    """(e_theta x e_phi) . N is -1 on the chart frame but +1 on the fallback at the north pole (the
+    fallback's fixed pair gives -1 at the south pole, where N is reversed)."""
     rng = np.random.default_rng(3)
     theta = rng.uniform(-np.pi, np.pi, 1000)
     phi = rng.uniform(0.05, np.pi - 0.05, 1000)
     N = np.stack([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)])
     et, ep = tangent_frame(*N, np.hypot(N[0], N[1]))
     regular = np.einsum("ij,ij->j", np.cross(np.stack(et), np.stack(ep), axis=0), N)
-    pole = np.array([0.0, 0.0, 1.0])[:, None]
-    et0, ep0 = tangent_frame(*pole, np.zeros(1))
-    fallback = np.einsum("ij,ij->j", np.cross(np.stack(et0), np.stack(ep0), axis=0), pole)
+    poles = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, -1.0]])              # north, south
+    et0, ep0 = tangent_frame(*poles, np.zeros(2))
+    fallback = np.einsum("ij,ij->j", np.cross(np.stack(et0), np.stack(ep0), axis=0), poles)
     return {"orientation_regular_min": float(regular.min()),
             "orientation_regular_max": float(regular.max()),
-            "orientation_fallback": float(fallback[0])}
+            "orientation_fallback": float(fallback[0]), "orientation_fallback_south": float(fallback[1])}
 
 
 ERRATA = (
@@ -267,7 +276,7 @@ ERRATA = (
     Erratum(
         id="v-border-branch",
         where="Cell 1, `grad_numeric`",
-        seed=r"one-sided quotient whenever $\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border",
+        seed=r"the border branch, dividing by $v_+ - v_-$ instead of $2\varepsilon$, whenever $\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border",
         exposed_by="verify/test_theorems.py (central-difference-truncation: interior points take the 2 eps branch)",
         measure=_v_border_branch,
         criterion=f"the branch fires at some interior pixels at a step of {DRAFT_SCENE.eps:g}, and at more at 1e-9",

@@ -53,7 +53,7 @@ def test_acos_pole_loses_digits_atan2_does_not(errata):
 
 def test_fallback_orientation_is_reflected(errata):
     m = errata["fallback-orientation"]
-    assert m["orientation_fallback"] == 1.0
+    assert m["orientation_fallback"] == 1.0 and m["orientation_fallback_south"] == -1.0
     assert m["orientation_regular_max"] == pytest.approx(-1.0, abs=1e-12)
 
 
@@ -62,6 +62,8 @@ def test_v_border_branch_fires_in_interior(errata):
     assert 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"]
     # The change is the rounding of v +- eps over the step: each smaller step changes the quotient more.
     assert 0 < m["rel_change_1e-3"] < m["rel_change_1e-6"] < m["rel_change_1e-9"]
+    # Where it fires, the rounded span is the better divisor (what §6 says): nearer at most pixels.
+    assert 0.5 < m["nearer_1e-6"] <= 1.0
 
 
 def test_every_erratum_is_present_by_its_criterion(errata):

@@ -59,7 +59,7 @@ SENTENCES = {
                      "unwrapped $h$, so the wrapper never runs (wired into the central gradient it counts {wired})",
     "stacking": "no new integral, but a harder integrand: one sample per pixel misses the 4 × 4 box filter by RMS "
                 "{bumped:.1e} with the bump, {flat:.1e} without ({frame})",
-    "blinn-exact": "derived from the surface, but exact only to first order in $\\beta$: at $\\beta = {point[beta]:g}$ "
+    "blinn-exact": "read as exact in $\\beta$ (how he evaluated $F_u$, $F_v$ is not measured here): derived from the surface, but exact only to first order in $\\beta$: at $\\beta = {point[beta]:g}$ "
                    "($h = {point[h]:g}$, $h_u = {point[h_u]:g}$, $h_v = {point[h_v]:g}$, $\\varphi = {point[phi]:g}$) "
                    "his slopes differ from the displaced sphere's by {slope gap:.2e}, while their first-order terms "
                    "agree exactly",
@@ -148,6 +148,8 @@ def bound_text(bound) -> str:
 
 def rule_text(criterion) -> str:
     """A `lab.claims.Criterion` as §6's register shows it: its cases in order, each a verdict
-    and its bounds joined by "and", then the verdict otherwise."""
+    and its bounds joined by "and", then the verdict otherwise, unless that is "does not hold"
+    (`lab.claims.FAILS`), which the register states once for every rule."""
+    default = [] if criterion.otherwise == FAILS else [f"otherwise {WORDS[criterion.otherwise].lower()}"]
     return "; ".join([f"{WORDS[verdict].lower()} if {' and '.join(map(bound_text, bounds))}"
-                      for verdict, bounds in criterion.cases] + [f"otherwise {WORDS[criterion.otherwise].lower()}"])
+                      for verdict, bounds in criterion.cases] + default)

@@ -26,9 +26,10 @@ WORDS = {
         title="Lights leak past the terminator of the bumped sphere",
         correction=r"a light reaches $P$ only if $N\cdot w > 0$ (geometric) and no blocker cuts the segment; $N'$ then only weights Lambert and the lobe",
         finding=(
-            "At the default $\\beta$ the draft's rule lights {leak_pixels_default:,} (pixel, light) "
+            "At the default $\\beta$ the draft's rule and normal, on this renderer's geometry (E1 hides "
+            "sphere A), light {leak_pixels_default:,} (pixel, light) "
             "pairs on sphere A whose geometric normal faces away from the light (Lambert term up "
-            "to {leak_diffuse_max_default:.2f}); at $\\beta = 1.5$, {leak_pixels_beta_1_5:,}; at "
+            "to {leak_diffuse_max_default:.2f}); at $\\beta = {beta_large:g}$, {leak_pixels_beta_1_5:,}; at "
             "$\\beta = 0$, none. The lit region's boundary moves with $\\beta$, against the "
             "draft's own theorem."
         ),
@@ -43,13 +44,15 @@ WORDS = {
         ),
     ),
     "v-border-branch": dict(
-        title="The one-sided v-difference fires in the interior",
-        correction=r"one-sided only where $v \pm \varepsilon$ leaves $[0, 1]$; elsewhere divide by $2\varepsilon$",
+        title="The border test of the v-difference fires in the interior",
+        correction=r"the clamped span only at the border; elsewhere $2\varepsilon$, the quotient of §3's error model",
         finding=(
             "At a step of 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
             "sphere-A pixels (relative change of the quotient up to {rel_change_1e-3:.1e}); at "
             "1e-6 at {fraction_interior_1e-6:.0%} ({rel_change_1e-6:.1e}); at 1e-9 at "
-            "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e})."
+            "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e}). Where it fires its divisor is the better one: the "
+            "rounded span takes the arguments' rounding out, and at 1e-6 its quotient is nearer the exact $h_v$ "
+            "at {nearer_1e-6:.0%} of those pixels."
         ),
     ),
     "acos-pole": dict(
@@ -66,8 +69,9 @@ WORDS = {
         correction="kept as the draft has it (the convention is the draft's); measured and disclosed",
         finding=(
             "$(e_\\theta \\times e_\\varphi)\\cdot N$ is {orientation_regular_min:.0f} on the "
-            "regular frame (to rounding) and {orientation_fallback:+.0f} on the fallback: the "
-            "fallback pair is a reflection of the frame it replaces, not a rotation."
+            "regular frame (to rounding) and {orientation_fallback:+.0f} on the fallback at the north "
+            "pole, which this camera faces ({orientation_fallback_south:+.0f} at the south): there the "
+            "fallback pair is a reflection of the frame it replaces."
         ),
     ),
 }
