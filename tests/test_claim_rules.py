@@ -186,8 +186,12 @@ def _readings(claim):
     n, q = _numbers(claim.quote), claim.id
     if q == "h3-scale":                                                 # "≈ 2,000"
         return _edges("(π kᵤ)³", n[0] / ABOUT, n[0] * ABOUT)
-    if q in ("truncation-until-1e-6", "try-sweep", "cell5-fd-1e-9"):     # "~ 10⁻⁶", "near 1e-6", "~1e-9"
-        quantity = {"truncation-until-1e-6": "model optimum ε", "try-sweep": "best ε", "cell5-fd-1e-9": "worst component"}
+    if q == "try-sweep":                                                # "near 1e-6", "brightens again past 1e-8"
+        growth = "RMS growth past 1e-8"
+        return (_edges("best ε", n[0] / ABOUT, n[0] * ABOUT, **{growth: 100.0})
+                + _edges(growth, lo=ABOUT, **{"best ε": n[0]}))
+    if q in ("truncation-until-1e-6", "cell5-fd-1e-9"):                 # "~ 10⁻⁶", "~1e-9"
+        quantity = {"truncation-until-1e-6": "model optimum ε", "cell5-fd-1e-9": "worst component"}
         return _edges(quantity[q], n[0] / ABOUT, n[0] * ABOUT)
     if q in ("roundoff-drowns-1e-9", "noise-below-1e-11"):            # "drowns" / "noise" at that step: error ~1
         return _edges("relative error at ε = " + re.sub(r"e-0*", "e-", f"{n[0]:g}"), lo=1 / ABOUT)

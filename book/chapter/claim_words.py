@@ -88,7 +88,7 @@ SENTENCES = {
     "pole-pixels": "{fallback pixels} pixels lie inside the draft's fallback disc ({frame}); the draft counts points of a grid of $N_z$ "
                    "values unrelated to the image",
     "try-sweep": f"of the simulator's half-decade steps, the image-best step (least RMS {_DI} over sphere A) is "
-                 "{best ε:.0e} ({frame})",
+                 "{best ε:.0e}, and from {from:.0e} down to {to:.0e} the RMS grows {RMS growth past 1e-8:.1e} times ({frame})",
     "try-creases": f"{{share in the band:.0%}} of the pixels whose {_DI} exceeds {{threshold_shown}} lie in the "
                    "crease band ({frame})",
     "try-pinch": "with the draft's formula, $N'$ on opposite sides of the pole ($\\sin\\varphi = {sin_phi:g}$, "
