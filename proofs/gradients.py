@@ -135,8 +135,8 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
     if max(r for r, _ in rendered.values()) > 1:
         return Verdict("refuted", "the renderer's gradient leaves its tolerance by "
                        + ", ".join(f"{m} {r:.2g}x" for m, (r, _) in rendered.items()))
-    return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath ({DIGITS} digits, {POINTS} "
-                   f"points); the renderer's exact, central and footprint gradients at "
+    return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath, relative to "
+                   f"pi max(k_u, 2 k_v) ({DIGITS} digits, {POINTS} points); the renderer's exact, central and footprint gradients at "
                    f"{rendered['exact'][1]:,} seeded sphere-A pixels within {rendered['exact'][0]:.2f}, "
                    f"{rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} of their tolerances against "
                    "the exact gradient, the central difference (stencil included) and the central difference with "

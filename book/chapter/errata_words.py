@@ -50,8 +50,8 @@ WORDS = {
             "At a step of 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
             "sphere-A pixels (relative change of the quotient up to {rel_change_1e-3:.1e}); at "
             "1e-6 at {fraction_interior_1e-6:.0%} ({rel_change_1e-6:.1e}); at 1e-9 at "
-            "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e}). Where it fires its divisor is the better one: the "
-            "rounded span takes the arguments' rounding out, and at 1e-6 its quotient is nearer the exact $h_v$ "
+            "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e}). Where it fires its divisor, the rounded span, is "
+            "the better one (it takes the arguments' rounding out): at 1e-6 its quotient is nearer the exact $h_v$ "
             "at {nearer_1e-6:.0%} of those pixels."
         ),
     ),
