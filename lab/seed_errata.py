@@ -194,8 +194,8 @@ def _v_border_branch(size=SIZE):
         fires = interior & (vp - vm < 2 * eps)
         span = (vp - vm)[fires]
         rel = np.abs(span / (2 * eps) - 1.0)
-        h_at = lambda w: pointwise.height(scene.field, u[fires], w[fires], scene.k_u, scene.k_v)  # noqa: E731
-        dh = h_at(vp) - h_at(vm)
+        dh = (pointwise.height(scene.field, u[fires], vp[fires], scene.k_u, scene.k_v)
+              - pointwise.height(scene.field, u[fires], vm[fires], scene.k_u, scene.k_v))
         exact = pointwise.exact_gradient(scene.field, u[fires], v[fires], scene.k_u, scene.k_v)[1]
         nearer = np.abs(dh / span - exact) < np.abs(dh / (2 * eps) - exact)
         out[eps] = (float(np.count_nonzero(fires) / np.count_nonzero(interior)),
