@@ -92,7 +92,7 @@ def _chart_evidence(corrupt=None):
     if worst > TOLERANCE["chart"]:
         return Verdict("refuted", f"the renderer's (u, v) differs from CHART(N) by {worst:.1e} at some of "
                        f"{count:,} sphere-A pixels")
-    return Verdict("proved", f"the renderer's (u, v) at {count:,} seeded sphere-A pixels (pole ring and the "
+    return Verdict("proved", f"the renderer's (u, v) at {count:,} seeded sphere-A pixels (zoomed pole ring and the "
                    f"draft's disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} of the chart, "
                    "evaluated by mpmath at its N", rendered=count, covers=covered)
 
@@ -177,7 +177,7 @@ def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
                        f"at some of {count:,} sphere-A pixels")
     return Verdict("proved", f"the tangent frame is its regular branch where sin phi > {float(F.POLE_SIN_PHI):g} "
                    "(float64's smallest normal number) and its fallback elsewhere, in each component; the "
-                   f"renderer's N' (both bump modes, {len(F.FIELDS)} fields) at {count:,} seeded sphere-A pixels (pole "
+                   f"renderer's N' (both bump modes, {len(F.FIELDS)} fields) at {count:,} seeded sphere-A pixels (zoomed pole "
                    f"ring and the draft's fallback disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} "
                    "of the perturbed normal evaluated by mpmath in this frame", rendered=count, covers=covered)
 
