@@ -247,7 +247,7 @@ def _drowns_below_1e9():
 #: "cliff beyond 1e-8" (Cell 2's Expect): the error is measured there and two decades of step further
 #: down; a cliff is a rise of at least a decade over those two (roundoff's 1/ε gives two).
 CLIFF_STEPS = (1e-8, 1e-10)
-CLIFF = "error growth over the two decades"
+CLIFF_GROWTH = "error growth over the two decades"
 
 
 def _cell2_minimum():
@@ -255,7 +255,7 @@ def _cell2_minimum():
     opt = optima()["sine"]
     top, bottom = (relative_error_at(e) for e in CLIFF_STEPS)
     return {"fitted optimum ε": opt["eps_fitted"], "error": opt["error_at_fitted"],
-            CLIFF: bottom / top, "error at the top": top, "error at the bottom": bottom,
+            CLIFF_GROWTH: bottom / top, "error at the top": top, "error at the bottom": bottom,
             "top step": CLIFF_STEPS[0], "bottom step": CLIFF_STEPS[1]}
 
 
@@ -612,8 +612,8 @@ CLAIMS = (
     Claim("cell2-minimum", "Cell 2, Expect", "minimum near ε ≈ 1e-6, cliff beyond 1e-8",
           "optimum of the two-term model fitted to the measured U-curve, and the measured error's growth "
           f"from ε = {CLIFF_STEPS[0]:g} to {CLIFF_STEPS[1]:g} (renderer/ucurve.py)", HOLDS, _cell2_minimum,
-          rule(HOLDS, (about("fitted optimum ε", 1e-6), Bound(CLIFF, lo=10.0)),
-               CORRECTED, (Bound("fitted optimum ε", 1e-8, 10 * 1e-6), Bound(CLIFF, lo=10.0)))),
+          rule(HOLDS, (about("fitted optimum ε", 1e-6), Bound(CLIFF_GROWTH, lo=10.0)),
+               CORRECTED, (Bound("fitted optimum ε", 1e-8, 10 * 1e-6), Bound(CLIFF_GROWTH, lo=10.0)))),
     Claim("frame-aligned", "Cell 2", "`e_th × e_ph` … (unit, aligned with N)",
           "sympy: (eθ × eφ)·N", FAILS, _orientation,
           rule(HOLDS, Bound("(eθ × eφ)·N", 1, 1))),

@@ -41,7 +41,7 @@ class Erratum:
     id: str
     where: str
     seed: str          # what the seed's code does, as the draft writes it (LaTeX allowed)
-    exposed_by: str    # the test that fails on the seed's variant
+    exposed_by: str    # the test (tests/ or verify/) that fails on the seed's variant
     measure: Callable[[], dict] = field(repr=False)
     #: When the defect counts as still there, as `reproduced`'s error message states it, and
     #: as a test of the measured dict (`reproduced` applies it).
@@ -205,7 +205,7 @@ def _v_border_branch(size=SIZE):
             "fraction_interior_1e-9": out[1e-9][0], "rel_change_1e-9": out[1e-9][1]}
 
 
-def _acos_pole(size=SIZE):
+def _acos_pole():
     """v = acos(N_z)/pi loses digits near the pole; atan2(sin phi, N_z) does not."""
     rng = np.random.default_rng(9)
     # Normals at sin(phi) = 1e-8 ... 1e-2 around the north pole, rounded to float64.
