@@ -7,8 +7,9 @@ files git tracks, plus untracked ones it does not ignore); an edit of
 renderer/formulas.py is followed by ``python -m renderer.codegen``, so that it reaches
 the kernel as a real change would.  Then ``pytest verify -x`` runs in the copy, and if
 it passes, ``pytest tests -x -m "not audit"`` (without the audits of the built book,
-which need one, and without tests/test_mutation_list.py, which fails on any mutant's edit).  Nothing is written into the repository.  About a minute per
-mutant verify kills, several per mutant that reaches the tests.
+which need one, and without tests/test_mutation_list.py, which fails on any mutant's
+edit).  Nothing is written into the repository.  About a minute per mutant verify
+kills, several per mutant that reaches the tests.
 
 Two lists: `MUTANTS`, the first audit's, and `SECOND`, the second audit's (new kinds
 of bug, across proofs/, lab/, renderer/ and its JavaScript, and book/).  Every old

@@ -276,7 +276,8 @@ ERRATA = (
     Erratum(
         id="v-border-branch",
         where="Cell 1, `grad_numeric`",
-        seed=r"the border branch, dividing by $v_+ - v_-$ instead of $2\varepsilon$, whenever $\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border",
+        seed=(r"the border branch, dividing by $v_+ - v_-$ instead of $2\varepsilon$, whenever "
+              r"$\mathrm{fl}(v_+ - v_-) < 2\varepsilon$, which rounding makes true away from the border"),
         exposed_by="verify/test_theorems.py (central-difference-truncation: interior points take the 2 eps branch)",
         measure=_v_border_branch,
         criterion=f"the branch fires at some interior pixels at a step of {DRAFT_SCENE.eps:g}, and at more at 1e-9",

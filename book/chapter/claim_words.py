@@ -59,7 +59,8 @@ SENTENCES = {
                      "unwrapped $h$, so the wrapper never runs (wired into the central gradient it counts {wired})",
     "stacking": "no new integral, but a harder integrand: one sample per pixel misses the 4 × 4 box filter by RMS "
                 "{bumped:.1e} with the bump, {flat:.1e} without ({frame})",
-    "blinn-exact": "read as exact in $\\beta$ (how he evaluated $F_u$, $F_v$ is not measured here): derived from the surface, but exact only to first order in $\\beta$: at $\\beta = {point[beta]:g}$ "
+    "blinn-exact": "read as exact in $\\beta$ (how he evaluated $F_u$, $F_v$ is not measured here): derived from the "
+                   "surface, but exact only to first order in $\\beta$: at $\\beta = {point[beta]:g}$ "
                    "($h = {point[h]:g}$, $h_u = {point[h_u]:g}$, $h_v = {point[h_v]:g}$, $\\varphi = {point[phi]:g}$) "
                    "his slopes differ from the displaced sphere's by {slope gap:.2e}, while their first-order terms "
                    "agree exactly",
@@ -83,12 +84,14 @@ SENTENCES = {
     "noise-below-1e-11": "the quotient's relative error at a step of {step_shown} is "
                          "{relative error at ε = 1e-11:.1e}: digits lost, not noise",
     "crease-fd-zero": "the central difference at a step of {step_shown} gives {central:+.1e} on the crease, but the exact gradient "
-                      "{exact:+.3f}: float64's $\\sin(\\pi k_u u)$ at $u = 1/k_u$ is the sine of $\\pi$ rounded, not zero, so the sign "
+                      "{exact:+.3f}: float64's $\\sin(\\pi k_u u)$ at $u = 1/k_u$ is the sine of $\\pi$ rounded, not zero, "
+                      "so the sign "
                       "picks a side",
     "pole-pixels": "{fallback pixels} pixels lie inside the draft's fallback disc ({frame}); the draft counts points of a grid of $N_z$ "
                    "values unrelated to the image",
     "try-sweep": f"of the simulator's half-decade steps, the image-best step (least RMS {_DI} over sphere A) is "
-                 "{best ε:.0e}, and from {from:.0e} down to {to:.0e} the RMS grows {RMS growth past 1e-8:.1e} times ({frame})",
+                 "{best ε:.0e}, and from {from:.0e} down to {to:.0e} the RMS grows {RMS growth past 1e-8:.1e} times "
+                 "({frame})",
     "try-creases": f"{{share in the band:.0%}} of the pixels whose {_DI} exceeds {{threshold_shown}} lie in the "
                    "crease band ({frame})",
     "try-pinch": "with the draft's formula, $N'$ on opposite sides of the pole ($\\sin\\varphi = {sin_phi:g}$, "
