@@ -144,6 +144,7 @@ SLOPE = 0.1           # an exponent "at" p (a quadratic, the truncation slope): 
 DECADE = 10.0         # a correction "within a decade" of the claimed value
 JUST = 1e-3           # just inside / outside a threshold t: t (1 -+ JUST); a count: t -+ 1
 HARDER = 2.0          # stacking, "no new integral": the bump may not double one sample's error
+CONVERGE = 1.0        # ... and "composes under the filter": a 2 x 2 box misses the 4 x 4 box by less than one sample
 FLOAT_EXACT = 1e-12   # blinn-exact, "exactly": a gap of O(1) slopes evaluated in float64 is rounding below this
 VISIBLE = 1e-6        # ... and the second-order gap a correction names is visible above this
 NONZERO = 1e-2        # bump-nonzero, "demonstrably nonzero": a hundredth of full scale (2.5 8-bit levels)
@@ -206,7 +207,9 @@ def _readings(claim):
         both = ("geometry values differing", "reach-mask pixels differing")
         return [p for a, b in (both, both[::-1]) for p in _counts(a, 0, **{b: 0})]
     if q == "shadow-curves-unchanged":                                  # "unchanged": no pair lit past it
-        return _counts("pairs lit past the terminator", 0, HOLDS, CORRECTED)
+        moved, lit = "boundary values moved", "pairs lit past the terminator"
+        return (_counts(lit, 0, HOLDS, CORRECTED, **{moved: 0}) + _counts(moved, 0, HOLDS, FAILS, **{lit: 0})
+                + _counts(moved, 0, CORRECTED, FAILS, **{lit: 5}))
     if q == "cell1-ripples":                                            # sphere A must show: a pixel at least
         return _counts("draft's sphere-A pixels", 0, inside=FAILS, outside=HOLDS)
     if q == "census-slope":                                             # "descending the truncation slope"
@@ -229,7 +232,10 @@ def _readings(claim):
         numeric, exact = "count printed, numeric", "count printed, exact"
         return _counts(numeric, n[0], **{exact: n[1]}) + _counts(exact, n[1], **{numeric: n[0]})
     if q == "stacking":
-        return _edges("one-sample error, with / without the bump", hi=HARDER, inside=HOLDS, outside=CORRECTED)
+        harder, converges = "one-sample error, with / without the bump", "bumped error, 2 × 2 box / one sample"
+        return (_edges(harder, hi=HARDER, inside=HOLDS, outside=CORRECTED, **{converges: 0.5})
+                + _edges(converges, hi=CONVERGE, inside=HOLDS, outside=FAILS, **{harder: 1.0})
+                + _edges(converges, hi=CONVERGE, inside=CORRECTED, outside=FAILS, **{harder: 3.0}))
     if q == "blinn-exact":
         return (_edges("slope gap", hi=FLOAT_EXACT, inside=HOLDS, outside=FAILS, **{"first-order gap": 0.0})
                 + _edges("slope gap", lo=VISIBLE, inside=CORRECTED, outside=FAILS, **{"first-order gap": 0.0})
@@ -237,7 +243,10 @@ def _readings(claim):
     if q == "symbolic-not-slower":                                      # "at or under"
         return [({"sin/cos calls, exact minus central": d}, HOLDS if d <= 0 else FAILS) for d in (-1, 0, 1)]
     if q == "dn-verified-1e-12":                                        # "verified to 10⁻¹²"
-        return _edges("closed form's residual", hi=n[0], inside=CORRECTED, outside=FAILS)
+        closed, draft = "closed form's residual", "draft's check's worst error"     # ... by its own check
+        return (_edges(closed, hi=n[0], inside=CORRECTED, outside=FAILS, **{draft: 1.0})
+                + _edges(closed, hi=n[0], inside=HOLDS, outside=FAILS, **{draft: 0.0})
+                + _edges(draft, hi=n[0], inside=HOLDS, outside=CORRECTED, **{closed: 0.0}))
     if q == "beta-quadratic":                                           # "quadratic — 100× per decade"
         p = math.log10(n[0])
         return (_edges("median order", p * (1 - SLOPE), p * (1 + SLOPE), CORRECTED, FAILS, **{"RMS order": 1.0})
@@ -271,6 +280,14 @@ def test_each_criterion_turns_where_the_claims_words_put_its_threshold(claim):
     assert len(probes) >= 2
     for values, verdict in probes:
         assert claim.criterion.decide(values) == verdict, (values, verdict)
+
+
+@pytest.mark.parametrize("claim", CLAIMS, ids=[c.id for c in CLAIMS])
+def test_every_claim_can_hold_and_can_fail(claim):
+    """The probes of its words reach both verdicts: no rule decides its claim before it is measured
+    (one that cannot fail is a check of nothing; one that cannot hold, a verdict typed in)."""
+    reached = {claim.criterion.decide(values) for values, _ in _readings(claim)}
+    assert {HOLDS, FAILS} <= reached, reached
 
 
 def test_the_numbers_are_read_from_the_words():
@@ -345,3 +362,23 @@ def test_the_cell5_worst_error_is_the_drafts_trials_against_mpmaths_derivative()
             M, M2 = N + beta * g, N + (beta + step) * g
             worst = max(worst, float(np.abs(exact - (M2 / np.linalg.norm(M2) - M / np.linalg.norm(M)) / step).max()))
     assert claim.measure()[0]["worst component"] == pytest.approx(worst, rel=1e-8, abs=0)
+
+
+def test_the_boundary_and_derivative_claims_read_the_measurements_their_rules_name(monkeypatch):
+    """Claim shadow-curves-unchanged adds the G-buffers' moved values and reach-mask pixels (claim flips-zero's
+    renders): one moved boundary fails it.  Claim dn-verified-1e-12 holds only if the draft's own check shows
+    10⁻¹² too: planted measurements, each turning its verdict."""
+    import lab.accuracy
+    import lab.claims
+    import proofs.no_boundary
+    by_id = {c.id: c for c in CLAIMS}
+    monkeypatch.setattr(proofs.no_boundary, "render_flips", lambda: (4, 2, 1, 3))
+    monkeypatch.setattr(lab.claims, "_errata", lambda: {"terminator-leak": {"leak_pixels_default": 0}})
+    values, verdict = by_id["shadow-curves-unchanged"].measure()
+    assert (values["boundary values moved"], verdict) == (3, FAILS)
+    monkeypatch.setattr(proofs.no_boundary, "render_flips", lambda: (4, 0, 0, 3))
+    assert by_id["shadow-curves-unchanged"].measure()[1] == HOLDS
+    monkeypatch.setattr(lab.accuracy, "normal_beta_derivative_residual", lambda: 1e-16)
+    monkeypatch.setattr(lab.claims, "_cell5_fd", lambda: {"worst component": 1e-13})
+    values, verdict = by_id["dn-verified-1e-12"].measure()
+    assert (values["draft's check's worst error"], verdict) == (1e-13, HOLDS)

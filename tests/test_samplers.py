@@ -83,10 +83,11 @@ def test_a_claim_at_a_step_is_measured_at_that_step(monkeypatch):
 
 
 def test_the_stacking_claim_compares_only_blocks_whose_samples_are_all_on_sphere_a(monkeypatch):
-    """Claim stacking measures the 4 x 4 box filter against one sample per pixel where all 16 samples of the
-    pixel lie on sphere A: a block with a sample off A averages another object in.  Planted frames: the one
-    sample misses the box by 0.02 with the bump and 0.01 without it on every block, and every block of the first
-    row has one sample off A (0 there), which would add its 1/32 to the miss were it compared."""
+    """Claim stacking measures the 4 x 4 box filter against one sample per pixel, and against a 2 x 2 box,
+    where all 16 samples of the pixel lie on sphere A: a block with a sample off A averages another object in.
+    Planted frames: the one sample misses the box by 0.02 with the bump and 0.01 without it on every block, the
+    2 x 2 box by 0.01 and 0.007, and every block of the first row has one sample off A (0 there), which would
+    add its 1/32 to the miss were it compared."""
     from types import SimpleNamespace
 
     from lab import claims
@@ -97,10 +98,16 @@ def test_the_stacking_claim_compares_only_blocks_whose_samples_are_all_on_sphere
         if width == 512:
             chamber[0, ::4] = 0
             image[0, ::4] = 0.0
+        elif width == 256:                   # a checkerboard of +-0.03 inside each 2 x 2 block: averaged away
+            image += 0.01 if scene.beta else 0.007
+            image[::2, ::2] += 0.03
+            image[1::2, 1::2] -= 0.03
         else:
             image += 0.02 if scene.beta else 0.01
         return SimpleNamespace(image=image, chamber=chamber, scene=scene)
     monkeypatch.setattr(claims, "render", render)
     values = claims._stacking()
     assert values["one-sample error, with / without the bump"] == pytest.approx(2.0, rel=1e-12, abs=0)
+    assert (values[claims.CONVERGES], values["flat_2x2"]) == (pytest.approx(0.5, rel=1e-12, abs=0),
+                                                              pytest.approx(0.7, rel=1e-12, abs=0))
     assert (values["bumped"], values["flat"]) == (pytest.approx(0.02, rel=1e-12, abs=0), pytest.approx(0.01, rel=1e-12, abs=0))

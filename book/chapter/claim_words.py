@@ -38,7 +38,8 @@ SENTENCES = {
                      "the outward normal",
     "flips-zero": "over {gbuffers} independent {{term}}`G-buffers <G-buffer>`, {geometry values differing} geometry values (chamber, $t$, "
                   "$P$, $N$) and {reach-mask pixels differing} reach-mask pixels differ",
-    "shadow-curves-unchanged": "true of the renderer, not of the draft's code: its shading lights "
+    "shadow-curves-unchanged": "true of the renderer ({boundary values moved} boundary values move), not of the "
+                               "draft's code: its shading lights "
                                "{pairs lit past the terminator:,} (pixel, light) pairs past the terminator",
     "cell1-ripples": "the draft's sphere B covers {pixels_b:,} of the {pixels:,} pixels and its sphere A "
                      "{draft's sphere-A pixels:,}: sphere A never appears",
@@ -58,7 +59,8 @@ SENTENCES = {
     "cell4-counter": "the counter prints {count printed, numeric} and {count printed, exact}: the gradients call the "
                      "unwrapped $h$, so the wrapper never runs (wired into the central gradient it counts {wired})",
     "stacking": "no new integral, but a harder integrand: one sample per pixel misses the 4 × 4 box filter by RMS "
-                "{bumped:.1e} with the bump, {flat:.1e} without ({frame})",
+                "{bumped:.1e} with the bump, {flat:.1e} without, and a 2 × 2 box leaves "
+                "{bumped error, 2 × 2 box / one sample:.0%} of it ({flat_2x2:.0%} without; {frame})",
     "blinn-exact": "read as exact in $\\beta$ (how he evaluated $F_u$, $F_v$ is not measured here): derived from the "
                    "surface, but exact only to first order in $\\beta$: at $\\beta = {point[beta]:g}$ "
                    "($h = {point[h]:g}$, $h_u = {point[h_u]:g}$, $h_v = {point[h_v]:g}$, $\\varphi = {point[phi]:g}$) "
@@ -72,7 +74,8 @@ SENTENCES = {
                      "has a worst component error of {worst component:.1e}, about {ratio_shown:,.0f} times the "
                      "draft's expected {expected_shown}",
     "dn-verified-1e-12": "the closed form's worst error is {closed form's residual:.1e} against a 50-digit mpmath "
-                         "derivative, which the draft's forward difference cannot show",
+                         "derivative, which the draft's forward difference (worst error "
+                         "{draft's check's worst error:.1e}) cannot show",
     "beta-quadratic": "the median order of the image's β-derivative is {median order:.2f}, but its RMS order "
                       "{RMS order:.2f}: second order at most pixels, not where a clip or a max(0, ·) switches "
                       "({frame})",
