@@ -63,7 +63,7 @@ CONFIG = dict(name="tiny", central_steps=(1e-3,), forward_steps=(1e-8,), complex
 ERRATA = {"sphere-b-quadratic": dict(off_surface_relative=2.0, seed_pixels_b=6, true_pixels_b=1),
           "terminator-leak": dict(leak_pixels_default=1, leak_diffuse_max_default=1.0),
           "specular-ungated": dict(pixels=1, max_specular_added=1.0),
-          "v-border-branch": {"fraction_interior_1e-3": 0.1, "fraction_interior_1e-9": 0.2},
+          "v-border-branch": {"fraction_interior": [0.1, 0.2]},
           "acos-pole": dict(max_rel_error_acos=1.0, max_rel_error_atan2=0.0),
           "fallback-orientation": dict(orientation_fallback=1.0, orientation_regular_min=-1.0,
                                        orientation_regular_max=-1.0)}

@@ -178,7 +178,7 @@ def test_the_draft_is_measured_with_its_own_values_not_the_books_defaults(monkey
         for cache in caches:
             cache.cache_clear()
     assert [(c.id, v, m) for c, m, v in results if v != c.registered] == []
-    assert errata["v-border-branch"]["draft_step"] == DRAFT_SCENE.eps
+    assert errata["v-border-branch"]["steps"][0] == DRAFT_SCENE.eps
     assert len(scenes) > 20 and len(stencils) > 2
     assert [s for s in scenes if any(getattr(s, k) == x for k, x in moved.items())] == []
     assert [s for s in stencils if {float(np.max(x)) for x in s} & set(moved.values())] == []

@@ -59,11 +59,13 @@ def test_fallback_orientation_is_reflected(errata):
 
 def test_v_border_branch_fires_in_interior(errata):
     m = errata["v-border-branch"]
-    assert 0 < m["fraction_interior_1e-3"] < m["fraction_interior_1e-9"]
+    assert m["steps"] == sorted(m["steps"], reverse=True) and len(m["steps"]) == 3
+    assert 0 < m["fraction_interior"][0] < m["fraction_interior"][-1]
     # The change is the rounding of v +- eps over the step: each smaller step changes the quotient more.
-    assert 0 < m["rel_change_1e-3"] < m["rel_change_1e-6"] < m["rel_change_1e-9"]
-    # Where it fires, the rounded span is the better divisor (what §6 says): nearer at most pixels.
-    assert 0.5 < m["nearer_1e-6"] <= 1.0
+    assert 0 < m["rel_change"][0] < m["rel_change"][1] < m["rel_change"][2]
+    # Where it fires, the rounded span is the better divisor (what §6 says, at the middle step): nearer at
+    # most pixels.
+    assert 0.5 < m["nearer"][1] <= 1.0
 
 
 def test_every_erratum_is_present_by_its_criterion(errata):
@@ -75,7 +77,8 @@ def test_every_erratum_is_present_by_its_criterion(errata):
     ("sphere-b-quadratic", "off_surface_relative", 0.0),
     ("terminator-leak", "leak_pixels_default", 0),
     ("specular-ungated", "pixels", 0),
-    ("v-border-branch", "fraction_interior_1e-3", 0.0),
+    ("v-border-branch", "fraction_interior", [0.0, 0.1, 0.2]),
+    ("v-border-branch", "fraction_interior", [0.2, 0.2, 0.2]),
     ("acos-pole", "max_rel_error_acos", 1e-16),
     ("fallback-orientation", "orientation_fallback", -1.0),
 ])

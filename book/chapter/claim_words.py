@@ -17,7 +17,7 @@ from lab.claims import CORRECTED, FAILS, HOLDS
 
 from .labels import frame_label
 
-__all__ = ["SENTENCES", "WORDS", "measured_text", "rule_text", "bound_text"]
+__all__ = ["SENTENCES", "WORDS", "measured_text", "rule_text", "bound_text", "power"]
 
 #: How a verdict reads (each is a term of the glossary).
 WORDS = {HOLDS: "Holds", CORRECTED: "Holds with a correction", FAILS: "Does not hold"}
@@ -105,8 +105,8 @@ SENTENCES = {
 }
 
 
-def _power(x):
-    """A power of ten as the draft writes it: 1e-9."""
+def power(x):
+    """A power of ten as the draft writes it: 1e-9 (``x``: a float; its leading digit is rounded away)."""
     return re.sub(r"e([-+])0*", lambda m: "e" + m.group(1).replace("+", ""), f"{x:.0e}")
 
 
@@ -126,7 +126,7 @@ def measured_text(claim_id, values) -> str:
     if "scene" in v:
         v["frame"] = frame_label(v["scene"], *v["size"])
     for key in [k for k in v if k.endswith("step") or k in ("expected", "threshold")]:
-        v[f"{key}_shown"] = _power(v[key])                      # a power of ten as the draft writes it
+        v[f"{key}_shown"] = power(v[key])                       # a power of ten as the draft writes it
     if "ratio" in v:
         v["ratio_shown"] = float(f"{v['ratio']:.2g}")           # "about 16,000 times": two digits
     template = SENTENCES[claim_id + "/ran"] if v.get("rows computed") == 1 else SENTENCES[claim_id]

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from lab.seed_errata import ERRATA
 
+from .claim_words import power
+
 __all__ = ["WORDS", "finding", "errata"]
 
 #: Erratum id -> {"title", "correction" (this renderer's way), "finding" (str.format over the measured dict)}.
@@ -47,12 +49,12 @@ WORDS = {
         title="The border test of the v-difference fires in the interior",
         correction=r"the clamped span only at the border; elsewhere $2\varepsilon$, the quotient of §3's error model",
         finding=(
-            "At a step of 1e-3 the branch fires at {fraction_interior_1e-3:.2%} of interior "
-            "sphere-A pixels (relative change of the quotient up to {rel_change_1e-3:.1e}); at "
-            "1e-6 at {fraction_interior_1e-6:.0%} ({rel_change_1e-6:.1e}); at 1e-9 at "
-            "{fraction_interior_1e-9:.0%} ({rel_change_1e-9:.1e}). Where it fires its divisor, the rounded span, is "
-            "the better one (it takes the arguments' rounding out): at 1e-6 its quotient is nearer the exact $h_v$ "
-            "at {nearer_1e-6:.0%} of those pixels."
+            "At a step of {steps_shown[0]} the branch fires at {fraction_interior[0]:.2%} of interior "
+            "sphere-A pixels (relative change of the quotient up to {rel_change[0]:.1e}); at "
+            "{steps_shown[1]} at {fraction_interior[1]:.0%} ({rel_change[1]:.1e}); at {steps_shown[2]} at "
+            "{fraction_interior[2]:.0%} ({rel_change[2]:.1e}). Where it fires its divisor, the rounded span, is "
+            "the better one (it takes the arguments' rounding out): at {steps_shown[1]} its quotient is nearer the "
+            "exact $h_v$ at {nearer[1]:.0%} of those pixels."
         ),
     ),
     "acos-pole": dict(
@@ -87,7 +89,8 @@ def finding(erratum_id, measured) -> str:
     """
     if erratum_id not in WORDS:
         raise KeyError(f"erratum_id must be one of {sorted(WORDS)}, got {erratum_id!r}")
-    return WORDS[erratum_id]["finding"].format(**measured)
+    shown = {"steps_shown": [power(x) for x in measured["steps"]]} if "steps" in measured else {}
+    return WORDS[erratum_id]["finding"].format(**measured, **shown)
 
 
 def errata(measured) -> str:
