@@ -126,10 +126,12 @@ WORDS_CITATION = re.compile(r"\btheorems?\s+[`'\"“‘]?([\w-]+)", re.IGNORECAS
 PLACEHOLDER = re.compile(r"⟦([^⟧]+)⟧")
 #: A relation typed by hand in a statement's mathematics (rule 10 refuses it): =, <, >, the Unicode
 #: ones and LaTeX's (``\le``, ``\leqslant``, ``\ne``, ``\to``, ``\in``, ...).
-TYPED_RELATION = re.compile(r"[=<>≤≥≠→∈≈≡]|\\(?:[lg]eq?(?:slant)?|[lg]t|neq?|to|in|ni|approx|equiv|sim|simeq|propto|"
-                            r"mapsto|[rl]ightarrow|[LR]ightarrow|subset|subseteq)(?![a-zA-Z])")
-#: A statement's mathematics: ``$...$`` or ``$$...$$``.
-MATH = re.compile(r"\$\$(.+?)\$\$|\$(.+?)\$", re.DOTALL)
+TYPED_RELATION = re.compile(r"[=<>≤≥≠→←⇒⇔∈∉≈≡∼≃≅∝↦⊂⊆⊃⊇≪≫]|\\(?:[lg]eq?(?:slant)?|[lg]t|neq?|to|in|notin|ni|approx|"
+                            r"equiv|sim|simeq|cong|propto|mapsto|su[bp]set(?:eq)?|ll|gg|gets|iff|implies|"
+                            r"(?:long)?(?:[lL]eft|[rR]ight|[lL]eftright)arrow)(?![a-zA-Z])")
+#: A statement's mathematics, in each delimiter MyST takes: ``$...$``, ``$$...$$``, ``\\(...\\)``,
+#: ``\\[...\\]`` and the ``{math}`` role; its one non-empty group is the TeX.
+MATH = re.compile(r"\$\$(.+?)\$\$|\$(.+?)\$|\\\((.+?)\\\)|\\\[(.+?)\\\]|\{math\}`([^`]+)`", re.DOTALL)
 
 
 class _Registered(Mapping):
@@ -741,7 +743,7 @@ def _unknown_placeholder(t):
         return (f"{t.id}: its statement shows ⟦{unknown[0]}⟧, which is neither a claim {sorted(t.claims)}, a named "
                 f"symbol {sorted(placeholder_key(s) for s in t.where)} nor a shown object {sorted(t.shown)}")
     for m in MATH.finditer(t.statement):
-        typed = TYPED_RELATION.search(PLACEHOLDER.sub("", m.group(1) or m.group(2)))
+        typed = TYPED_RELATION.search(PLACEHOLDER.sub("", next(g for g in m.groups() if g is not None)))
         if typed:
             return (f"{t.id}: its statement types the relation {typed.group(0)!r} by hand in {m.group(0)!r}: show it "
                     "through ⟦key⟧, from a claim, a named symbol of where or an object of shown")

@@ -250,9 +250,16 @@ def test_named_symbols_are_printed_and_substituted_when_checked():
 @pytest.mark.parametrize("typed", [
     "$a = b$", "$a=b$", "$⟦square⟧ > 0$", "$$a < b$$", "$a\\le b$", "$a \\leq b$", "$a \\geqslant b$",
     "$a \\ne 0$", "$a\\neq0$", "$\\beta \\to 0$", "$x \\in (0, 1)$", "$a ≤ b$", "$a ≠ b$", "$a \\approx b$",
-    "$a \\lt b$", "$\\varphi \\rightarrow 0$", "$a\n= b$"])
+    "$a \\lt b$", "$\\varphi \\rightarrow 0$", "$a\n= b$",
+    *(f"$a {r} b$" for r in ("≥", "→", "∈", "≈", "≡", "\\ge", "\\geq", "\\gt", "\\leqslant", "\\sim", "\\simeq",
+                           "\\equiv", "\\propto", "\\mapsto", "\\subset", "\\subseteq", "\\ni", "\\Rightarrow",
+                           "\\leftarrow", "\\Leftarrow", "\\longrightarrow", "\\Leftrightarrow", "\\iff",
+                           "\\implies", "\\gets", "\\notin", "\\cong", "\\supseteq", "\\ll", "\\gg", "⇒", "∉",
+                           "≃", "⊆")),
+    "\\(a = b\\)", "\\[a \\le b\\]", "{math}`a = b`"])
 def test_a_relation_typed_in_a_statement_is_refused(typed):
-    """Rule 10: a statement asserts only through ⟦key⟧; a relation typed by hand, in any spelling, refutes."""
+    """Rule 10: a statement asserts only through ⟦key⟧; a relation typed by hand, in any spelling and any of
+    MyST's math delimiters, refutes."""
     t = dataclasses.replace(square_theorem(*CHAIN), statement=f"Here $⟦square⟧$, and {typed}.")
     verdict = t.check()
     assert verdict.status == "refuted" and "types the relation" in verdict.evidence, verdict
@@ -261,7 +268,8 @@ def test_a_relation_typed_in_a_statement_is_refused(typed):
 def test_typed_mathematics_that_asserts_nothing_passes():
     """Names and operations are not relations: \\left, \\infty, \\int, \\top, \\lvert, \\pm, a < outside math."""
     text = (r"For $⟦square⟧$, $\left(a + b\right)^2$, $\infty$, $\int f$, $x^\top$, $\lvert a\rvert$, "
-            r"$h_v^\pm$, $\inf$, $\tone$, and in words a < b = c.")
+            r"$h_v^\pm$, $\inf$, $\tone$, $\sin\gamma$, $\nabla\lambda$, $\neg\ell$, $\lim$, $\simple$, "
+            r"\(\partial\), {math}`\theta`, and in words a < b = c.")
     assert dataclasses.replace(square_theorem(*CHAIN), statement=text).check().status == "proved"
 
 

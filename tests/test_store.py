@@ -69,17 +69,23 @@ def test_the_digest_reads_every_package_whose_code_stores_a_measurement():
 
 
 def test_the_digest_follows_the_source_files(tmp_path, monkeypatch):
-    """A changed byte in any file of the project's packages changes the digest."""
+    """A changed byte in any file of any of the project's packages changes the digest."""
     for package in store.PACKAGES:
         (tmp_path / package).mkdir()
         (tmp_path / package / "a.py").write_text("x = 1\n")
     monkeypatch.setattr(store, "_roots", lambda: {p: tmp_path / p for p in store.PACKAGES})
     monkeypatch.setattr(store, "_DIGEST", [])
     before = store.source_digest()
+    for package in store.PACKAGES:                      # each package alone, then put back
+        (tmp_path / package / "a.py").write_text("x = 2\n")
+        monkeypatch.setattr(store, "_DIGEST", [])
+        assert store.source_digest() != before, package
+        (tmp_path / package / "a.py").write_text("x = 1\n")
+    monkeypatch.setattr(store, "_DIGEST", [])
+    assert store.source_digest() == before
     (tmp_path / "renderer" / "a.py").write_text("x = 2\n")
     monkeypatch.setattr(store, "_DIGEST", [])
     changed = store.source_digest()
-    assert changed != before
     # Bytecode and numba's cache (in __pycache__) and directories are not sources: the digest stays.
     (tmp_path / "renderer" / "__pycache__").mkdir()
     (tmp_path / "renderer" / "__pycache__" / "a.cpython-311.pyc").write_bytes(b"\0compiled")
