@@ -5,12 +5,15 @@ import pytest
 from lab.accuracy import gradient_accuracy
 
 
-def test_gradient_accuracy_detects_a_wrong_pipeline(monkeypatch):
+@pytest.mark.parametrize("factor, ulps", [(1.000001, 1e6), (1 + 2.0**-45, 64)])
+def test_gradient_accuracy_detects_a_wrong_pipeline(monkeypatch, factor, ulps):
+    """A gradient a millionth off, and one 2^-45 off (a few hundred ulps of its scale, just past
+    verify/test_accuracy.py's limit of 64): the measurement sees each past its bound."""
     from renderer import pointwise
     original = pointwise.exact_gradient
     monkeypatch.setattr(pointwise, "exact_gradient",
-                        lambda *a: tuple(1.000001 * g for g in original(*a)))
-    assert gradient_accuracy("sine", count=200)[0].max_ulps > 1e6
+                        lambda *a: tuple(factor * g for g in original(*a)))
+    assert gradient_accuracy("sine", count=200)[0].max_ulps > ulps
 
 
 def test_the_crease_distance_is_the_distance_to_the_nearest_zero_line():
