@@ -44,7 +44,8 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
    same or a later step's, every step between them a link.
 3. *The cache.*  `_DECIDED` reuses a verdict only under the same key: both sides after
    every substitution (``where``, the rewrites, the case), the domain, the sampled
-   functions, and the seed, points and digits of the numbers (`SEED`, `POINTS`, `DIGITS`).
+   functions, the seed, points and digits of the numbers (`SEED`, `POINTS`, `DIGITS`) and the
+   tolerance that counts a residual as zero (`TOLERANCE_DIGITS`).
 4. *Series.*  Only a right side may carry an O-term: one, a term of its sum, in one
    variable about a finite point, ``O((x - x0)**n)``.  The step holds when the series of
    lhs - rhs (less the O-term) vanishes through (x - x0)**(n - 1).  A written term that
@@ -662,7 +663,7 @@ def _decide(theorem, step, lhs, rhs, rewrites=None):
     for label, case in step.cases or (("", {}),):
         where = {**theorem.where, **(rewrites or {}), **case}
         a, b = _substitute(lhs, where), _substitute(rhs, where)
-        key = (a, b, frozenset(domain.items()), frozenset(functions.items()), tuple(numbers.items()))
+        key = (a, b, frozenset(domain.items()), frozenset(functions.items()), tuple(numbers.items()), TOLERANCE_DIGITS)
         if key not in _DECIDED:
             a, b = _value(a), _value(b)
             series = _below_order(a, b)

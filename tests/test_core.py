@@ -452,6 +452,11 @@ def _maximum(cut):
     return Theorem("max", "Maximum", "", (step,), {}, domain={x: (0, 1)})
 
 
+def _tiny_gap():
+    """A one-step theorem, x = x + 10^-25: numerically zero at the default tolerance, not at 10^-26."""
+    return Theorem("gap", "Gap", "", (Step("a tiny gap", x, x + sp.Rational(1, 10**25)),), {}, domain={x: (0, 1)})
+
+
 def _with(name, value, theorem):
     """``theorem.check`` with core's ``name`` set to ``value`` for the check."""
     def check():
@@ -476,6 +481,8 @@ CACHE_PAIRS = {
     "seed": (_with("SEED", 6, _maximum(sp.Rational(96, 100))), _with("SEED", 0, _maximum(sp.Rational(96, 100)))),
     "points": (_with("POINTS", 1, _maximum(sp.Rational(9, 10))), _with("POINTS", 24, _maximum(sp.Rational(9, 10)))),
     "digits": (_with("DIGITS", 30, _arctangents({x: (0.1, 10)})), _with("DIGITS", 15, _arctangents({x: (0.1, 10)}))),
+    # x = x + 1e-25: a residual that counts as zero below 1e-20 and not below 1e-26.
+    "tolerance": (_with("TOLERANCE_DIGITS", 20, _tiny_gap()), _with("TOLERANCE_DIGITS", 26, _tiny_gap())),
 }
 
 
