@@ -165,6 +165,40 @@ def test_a_new_wheel_name_makes_every_notebook_page_written_again():
     assert env.notebook_wheel == app.notebook_wheel and notebooks._outdated(app, env, set(), set(), set()) == []
 
 
+def test_the_wheel_is_built_again_when_what_it_packages_changed(tmp_path, monkeypatch):
+    """The site's wheel is reused only under the same key (the source digest, pyproject.toml and the README)
+    and as the one wheel there: a change of any part, or a second wheel, builds it again."""
+    root, site = tmp_path / "root", tmp_path / "build" / "html"
+    root.mkdir()
+    for name in ("pyproject.toml", "README.md", "constraints.txt"):
+        (root / name).write_text(name)
+    built, digest = [], ["d0"]
+
+    def build_wheel(_, folder):
+        folder.mkdir(parents=True, exist_ok=True)
+        for old in folder.glob("*.whl"):
+            old.unlink()
+        built.append(folder / f"p-{len(built)}-py3-none-any.whl")
+        built[-1].write_bytes(b"wheel")
+        return built[-1]
+    monkeypatch.setattr(notebooks, "ROOT", root)
+    monkeypatch.setattr(notebooks, "build_wheel", build_wheel)
+    monkeypatch.setattr(notebooks, "write_readme", lambda *a: None)
+    monkeypatch.setattr(notebooks, "source_digest", lambda: digest[0])
+    app = SimpleNamespace(builder=SimpleNamespace(format="html"), outdir=str(site))
+
+    def builds(change):
+        before = len(built)
+        change()
+        notebooks._project_files(app)
+        assert app.notebook_wheel == built[-1].name
+        return len(built) - before
+    assert builds(lambda: None) == 1 and builds(lambda: None) == 0
+    for change in (lambda: (root / "pyproject.toml").write_text("version 2"), lambda: (root / "README.md").write_text("new"),
+                   lambda: digest.__setitem__(0, "d1"), lambda: (site / notebooks.DOWNLOADS / "other.whl").write_bytes(b"")):
+        assert builds(change) == 1 and builds(lambda: None) == 0
+
+
 def test_a_failed_wheel_build_names_what_failed(tmp_path):
     # The project as it is, but with a version no packaging tool accepts.
     root = tmp_path / "project"
