@@ -94,7 +94,7 @@ def _chart_evidence(corrupt=None):
                        f"{count:,} sphere-A pixels")
     return Verdict("proved", f"the renderer's (u, v) at {count:,} seeded sphere-A pixels (zoomed pole ring and the "
                    f"draft's disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} of the chart, "
-                   "evaluated by mpmath at its N", rendered=count, covers=covered)
+                   "evaluated by mpmath at its N", residual=worst, rendered=count, bound=TOLERANCE["chart"], covers=covered)
 
 
 def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
@@ -179,7 +179,8 @@ def _frame_evidence(corrupt=None, frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
                    "(float64's smallest normal number) and its fallback elsewhere, in each component; the "
                    f"renderer's N' (both bump modes, {len(F.FIELDS)} fields) at {count:,} seeded sphere-A pixels (zoomed pole "
                    f"ring and the draft's fallback disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} "
-                   "of the perturbed normal evaluated by mpmath in this frame", rendered=count, covers=covered)
+                   "of the perturbed normal evaluated by mpmath in this frame", residual=worst, rendered=count,
+                   bound=TOLERANCE["normal"], covers=covered)
 
 
 def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):

@@ -18,7 +18,7 @@ import sympy as sp
 
 from renderer import formulas as F
 
-from .core import DIGITS, POINTS, Theorem, Verdict, calc, written
+from .core import DIGITS, POINTS, Theorem, Verdict, calc, loose, written
 
 u, v, k_u, k_v = F.u, F.v, F.k_u, F.k_v
 #: The factors as the proofs name them: s_1 a field's factor in u, s_2 its factor in v (seed §3's
@@ -135,6 +135,9 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
     if max(r for r, _ in rendered.values()) > 1:
         return Verdict("refuted", "the renderer's gradient leaves its tolerance by "
                        + ", ".join(f"{m} {r:.2g}x" for m, (r, _) in rendered.items()))
+    for method, (r, _) in rendered.items():                    # rule 11 on each tolerance, in its own units
+        if loose(1.0, r):
+            return Verdict("refuted", f"the renderer's {method} gradient's tolerance: {loose(1.0, r)}")
     return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath, relative to "
                    f"pi max(k_u, 2 k_v) ({DIGITS} digits, {POINTS} points); the renderer's exact, central and footprint gradients at "
                    f"{rendered['exact'][1]:,} seeded sphere-A pixels within {rendered['exact'][0]:.2f}, "

@@ -137,8 +137,9 @@ def chart_error(field, corrupt=None):
 def gradient_error(field, gradient, corrupt=None):
     """Worst |grad - reference| / bound over the sampled pixels: the exact gradient
     against the field's `HeightField.gradient`, central against its `HeightField.central` (stencil
-    included) at the scene's eps, both at the renderer's own (u, v); and the count.
-    A value <= 1 is within tolerance."""
+    included) at the scene's eps, and footprint against the central difference at each pixel's own steps
+    (each pixel held to the bound its own smaller step gives), all at the renderer's own (u, v); and the
+    count.  A value <= 1 is within tolerance."""
     record = F.FIELDS[field]
     scene, px = pixels(field, gradient)
     grad = px["grad"] if corrupt is None else corrupt(px["grad"])
@@ -159,7 +160,7 @@ def gradient_error(field, gradient, corrupt=None):
         exprs = [e.xreplace(dict(F.STENCIL_POINTS)).xreplace(consts) for e in record.central]
         ref = _eval(exprs, (F.u, F.v, F.eps_u, F.eps_v), np.hstack([px["uv"], steps]))
         scale = np.pi * max(scene.k_u, 2 * scene.k_v)
-        bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / float(steps.min())
+        bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / steps.min(axis=1, keepdims=True)
     else:
         stencil = dict(F.STENCIL_POINTS)
         exprs = [e.xreplace(stencil).xreplace({F.eps_u: scene.eps, F.eps_v: scene.eps, **consts})
@@ -167,7 +168,7 @@ def gradient_error(field, gradient, corrupt=None):
         ref = _eval(exprs, (F.u, F.v), px["uv"])
         scale = np.pi * max(scene.k_u, 2 * scene.k_v)
         bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / scene.eps
-    return float(np.max(np.abs(grad - ref)) / bound), grad.shape[0]
+    return float(np.max(np.abs(grad - ref) / bound)), grad.shape[0]
 
 
 def normal_error(field, bump, corrupt=None):

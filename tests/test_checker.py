@@ -473,6 +473,17 @@ def test_an_evidence_threshold_loosened_by_orders_of_magnitude_is_refused(monkey
     assert v.status == "refuted" and "its threshold" in v.evidence and "tighten it" in v.evidence, v.evidence
 
 
+@pytest.mark.parametrize("output, theorem_id", [("chart", "chart"), ("normal", "frame-orthonormal"),
+                                                ("gradient", "gradient-ridges")])
+def test_a_pixel_tolerance_loosened_by_orders_of_magnitude_is_refused(monkeypatch, output, theorem_id):
+    """The same for the tolerances the renderer's pixels are held to (proofs/pixels.py's TOLERANCE)."""
+    from proofs import pixels
+    from proofs.registry import get
+    monkeypatch.setitem(pixels.TOLERANCE, output, pixels.TOLERANCE[output] * 1e10)
+    v = get(theorem_id).check()
+    assert v.status == "refuted" and "its threshold" in v.evidence and "tighten it" in v.evidence, v.evidence
+
+
 def test_a_verified_pin_loosened_is_refused_and_the_rule_spares_an_exact_zero(monkeypatch):
     from proofs import core, registry
     residual = registry.get("chart").check().residual
