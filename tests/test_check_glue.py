@@ -247,6 +247,9 @@ def test_a_registered_book_whose_names_agree_with_each_other_and_the_library_pas
     ({"s4_log_floor": {"s4_simulator": "$10^{-15}$"}}, "the library's value is 1e-16"),
     ({"s7_eps_opt": {"s7_pitfalls": "3.73e-07"}}, "s7_eps_opt: glued on s7_pitfalls, but registered nowhere"),
     ({"s1_size": {}}, "s1_size: registered, but no page glues it"),
+    # A figure's name is exempt only where every page glues a figure under it: a number beside one is not.
+    ({"fig-x": {"s5_lab": "<Figure size 640x380 with 1 Axes>", "s6_ledger": "3.73e-07"}},
+     "fig-x: glued on s5_lab, s6_ledger, but registered nowhere"),
 ])
 def test_two_values_of_one_quantity_an_unregistered_name_or_a_value_off_the_library_fail(change, message):
     shown = {k: v for k, v in {**SHOWN, **change}.items() if v}
