@@ -558,6 +558,15 @@ def test_check_catches_a_tampered_file_and_the_generator_restores_it(copies, cap
     assert codegen.main(["--check"]) == 0
 
 
+@pytest.mark.parametrize("target", ["GENERATED", "GENERATED_ARRAY"])
+def test_check_catches_a_missing_generated_file_and_the_generator_writes_it(copies, capsys, target):
+    path = copies[target]
+    fresh = path.read_text(encoding="utf-8")
+    path.unlink()
+    assert codegen.main(["--check"]) == 1 and f"{path} is stale" in capsys.readouterr().err
+    assert codegen.main([]) == 0 and path.read_text(encoding="utf-8") == fresh
+
+
 @pytest.mark.parametrize("lines", [0, 2])
 def test_a_kernel_without_exactly_one_digest_line_is_refused(lines):
     text = "x = 1\n" + 'FORMULAS_DIGEST = "abc"  # of generated.py\n' * lines
