@@ -94,7 +94,8 @@ def _chart_evidence(corrupt=None):
                        f"{count:,} sphere-A pixels")
     return Verdict("proved", f"the renderer's (u, v) at {count:,} seeded sphere-A pixels (zoomed pole ring and the "
                    f"draft's disc sin phi <= {SEED_POLE_SIN_PHI:g} included) within {worst:.1e} of the chart, "
-                   "evaluated by mpmath at its N", residual=worst, rendered=count, bound=TOLERANCE["chart"], covers=covered)
+                   "evaluated by mpmath at its N", residual=worst, rendered=count, bound=TOLERANCE["chart"],
+                   covers=covered)
 
 
 def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):

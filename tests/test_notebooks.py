@@ -194,8 +194,9 @@ def test_the_wheel_is_built_again_when_what_it_packages_changed(tmp_path, monkey
         assert app.notebook_wheel == built[-1].name
         return len(built) - before
     assert builds(lambda: None) == 1 and builds(lambda: None) == 0
-    for change in (lambda: (root / "pyproject.toml").write_text("version 2"), lambda: (root / "README.md").write_text("new"),
-                   lambda: digest.__setitem__(0, "d1"), lambda: (site / notebooks.DOWNLOADS / "other.whl").write_bytes(b"")):
+    for change in (lambda: (root / "pyproject.toml").write_text("version 2"),
+                   lambda: (root / "README.md").write_text("new"), lambda: digest.__setitem__(0, "d1"),
+                   lambda: (site / notebooks.DOWNLOADS / "other.whl").write_bytes(b"")):
         assert builds(change) == 1 and builds(lambda: None) == 0
 
 
