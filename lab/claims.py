@@ -31,6 +31,7 @@ from renderer.render import SPHERE_A
 from renderer.validate import InvalidType, InvalidValue, choice, flag, real
 
 from ._checks import STEP, instance, optional, shown
+from .accuracy import DIGITS
 from .seed_errata import CELL6_BETA
 
 __all__ = ["Bound", "Criterion", "rule", "about", "ABOUT", "Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED",
@@ -339,9 +340,9 @@ def _cell3_runs():
     sphere A; with its sphere B (erratum sphere-b-quadratic) no pixel of the draft's code's
     map is on A, against this renderer's count on its frame of the same scene."""
     from .seed_errata import seed_chamber
-    code = seed_chamber(256)
+    code = seed_chamber(CENSUS_SIZE)
     on_a = (code & 3) == SPHERE_A
-    num, sym = _frames(size=256)
+    num, sym = _frames(size=CENSUS_SIZE)
     same = np.ones(code.shape, bool)          # its code_e == code_sym: two maps of one scene
     try:
         np.abs(num.image - sym.image)[same & on_a].max()
@@ -402,22 +403,24 @@ def _cell4_counter():
     return {"count printed, numeric": numeric, "count printed, exact": exact, "wired": wired, "step": d.eps}
 
 
-#: The quantity that decides whether the box filter still converges on the bumped image (claim stacking).
+#: The quantity that decides whether the box filter still converges on the bumped image (claim stacking),
+#: and the side of the frame that claim filters to (its 4 x 4 box's renders are four times as wide).
 CONVERGES = "bumped error, 2 × 2 box / one sample"
+STACKING_SIZE = 128
 
 
 def _stacking():
     """Bump under a pixel filter: a 4 x 4 box filter (a 512² render averaged to
-    128²) against one sample per pixel and against a 2 x 2 box (a 256² render), on
+    `STACKING_SIZE`², 128²) against one sample per pixel and against a 2 x 2 box (a 256² render), on
     sphere-A pixels whose 16 samples are all on A, with the bump and without it."""
-    err, two, bumped = {}, {}, DRAFT_SCENE.beta
+    err, two, bumped, n = {}, {}, DRAFT_SCENE.beta, STACKING_SIZE
     for beta in (bumped, 0.0):
         scene = DRAFT_SCENE.replace(beta=beta)
-        fine, mid, one = render(scene, 512, 512), render(scene, 256, 256), render(scene, 128, 128)
-        box = fine.image.reshape(128, 4, 128, 4, 3).mean(axis=(1, 3))
-        all_a = (fine.chamber == SPHERE_A).reshape(128, 4, 128, 4).all(axis=(1, 3)) & (one.chamber == SPHERE_A)
-        rms = {n: float(np.sqrt(np.mean((box - image)[all_a] ** 2)))
-               for n, image in ((1, one.image), (2, mid.image.reshape(128, 2, 128, 2, 3).mean(axis=(1, 3))))}
+        fine, mid, one = (render(scene, k * n, k * n) for k in (4, 2, 1))
+        box = fine.image.reshape(n, 4, n, 4, 3).mean(axis=(1, 3))
+        all_a = (fine.chamber == SPHERE_A).reshape(n, 4, n, 4).all(axis=(1, 3)) & (one.chamber == SPHERE_A)
+        rms = {k: float(np.sqrt(np.mean((box - image)[all_a] ** 2)))
+               for k, image in ((1, one.image), (2, mid.image.reshape(n, 2, n, 2, 3).mean(axis=(1, 3))))}
         err[beta], two[beta] = rms[1], rms[2] / rms[1]
     return {"one-sample error, with / without the bump": err[bumped] / err[0.0], CONVERGES: two[bumped],
             "flat_2x2": two[0.0], "bumped": err[bumped], "flat": err[0.0], **_on(one, DRAFT_SCENE)}
@@ -468,12 +471,13 @@ def _timing():
 
 
 #: The draft's expected worst component error of its Cell 5 check ("~1e-9"): its criterion's centre,
-#: and what the measured worst is compared with.
+#: and what the measured worst is compared with; and the random cases the check draws.
 CELL5_EXPECTED = 1e-9
+CELL5_TRIALS = 2000
 
 
 def _cell5_fd():
-    rng, trials, step = np.random.default_rng(5), 2000, 1e-7      # the draft's check, as its cell runs it
+    rng, trials, step = np.random.default_rng(5), CELL5_TRIALS, 1e-7    # the draft's check, as its cell runs it
     beta, worst = DRAFT_SCENE.beta, 0.0
     for _ in range(trials):
         N = rng.normal(size=3)
@@ -639,13 +643,13 @@ CLAIMS = (
           "the seed's sphere-B quadratic on the default frame (errata E1)", FAILS, _cell1_ripples,
           rule(FAILS, Bound("draft's sphere-A pixels", 0, 0), otherwise=HOLDS)),
     Claim("census-slope", "Cell 3, Expect", "the ε-sweep table descending the truncation slope",
-          "fitted slope of the census over ε = 1e-1 … 1e-6 (ridges, 256²)", CORRECTED, _census_slope,
+          f"fitted slope of the census over ε = {CENSUS_STEPS[0]:.0e} … {CENSUS_STEPS[-1]:.0e} (ridges, {CENSUS_SIZE}²)", CORRECTED, _census_slope,
           rule(HOLDS, Bound("RMS slope", lo=1.8, strict=True), CORRECTED, Bound("off-band slope", lo=1.8, strict=True))),
-    Claim("census-flips", "Cell 3, Expect", "flips = 0 everywhere", "the census of Cell 3 (ridges, 256²)", HOLDS,
+    Claim("census-flips", "Cell 3, Expect", "flips = 0 everywhere", f"the census of Cell 3 (ridges, {CENSUS_SIZE}²)", HOLDS,
           _census_flips,
           rule(HOLDS, Bound("flips", 0, 0))),
     Claim("cell3-runs", "Cell 3", "the census as an epsilon sweep … print the table",
-          "the draft's reduction over its own chamber map (its sphere B), 256²", FAILS, _cell3_runs,
+          f"the draft's reduction over its own chamber map (its sphere B), {CENSUS_SIZE}²", FAILS, _cell3_runs,
           rule(HOLDS, Bound("rows computed", lo=1))),
     Claim("kink-order-of-magnitude", "Cell 3, Expect",
           "the kink-loci error an order of magnitude above the smooth interior",
@@ -660,7 +664,7 @@ CLAIMS = (
           "the draft's counting scheme, run: a counter around h, gradients calling h", FAILS, _cell4_counter,
           rule(HOLDS, (Bound("count printed, numeric", 4, 4), Bound("count printed, exact", 1, 1)))),
     Claim("stacking", "§6, Stacking", "bump composes under Ch. 6's filter … no new integral, ever",
-          "4 × 4 box filter against one sample and a 2 × 2 box per pixel, with and without the bump (128²)", CORRECTED,
+          f"4 × 4 box filter against one sample and a 2 × 2 box per pixel, with and without the bump ({STACKING_SIZE}²)", CORRECTED,
           _stacking,
           rule(FAILS, Bound(CONVERGES, lo=1),
                CORRECTED, Bound("one-sample error, with / without the bump", lo=2, strict=True), otherwise=HOLDS)),
@@ -671,10 +675,10 @@ CLAIMS = (
           "transcendental calls in the generated gradients; timings beside", HOLDS, _timing,
           rule(HOLDS, Bound("sin/cos calls, exact minus central", hi=0))),
     Claim("cell5-fd-1e-9", "Cell 5, Expect", "~1e-9 worst component on the normal derivative",
-          "the seed's forward-difference check over 2,000 trials", FAILS, _cell5_fd,
+          f"the seed's forward-difference check over {CELL5_TRIALS:,} trials", FAILS, _cell5_fd,
           rule(HOLDS, about("worst component", CELL5_EXPECTED))),
     Claim("dn-verified-1e-12", "§3, §6", "∂N′/∂β … verified to 10⁻¹²",
-          "float64 closed form against mpmath at 50 digits", CORRECTED, _dn_1e12,
+          f"float64 closed form against mpmath at {DIGITS} digits", CORRECTED, _dn_1e12,
           rule(HOLDS, (Bound("closed form's residual", hi=1e-12, strict=True),
                        Bound("draft's check's worst error", hi=1e-12, strict=True)),
                CORRECTED, Bound("closed form's residual", hi=1e-12, strict=True))),
@@ -685,7 +689,7 @@ CLAIMS = (
           "numeric vs symbolic at β = 0", HOLDS, _beta0,
           rule(HOLDS, about("max |ΔI|", 1e-16, lo=False))),
     Claim("bump-nonzero", "Cell 6, Expect", "the β=1.5 bump demonstrably nonzero",
-          "mean |ΔI| between β = 1.5 and β = 0", HOLDS, _bump_nonzero,
+          f"mean |ΔI| between β = {CELL6_BETA:g} and β = 0", HOLDS, _bump_nonzero,
           rule(HOLDS, Bound("mean |ΔI|", lo=1e-2, strict=True))),
     Claim("cell6-truncation", "Cell 6, Expect", "the FD error sitting at its truncation-slope value",
           f"max |ΔI| at ε = {DRAFT_SCENE.eps:g} and {DRAFT_SCENE.eps / 10:g} (sine, β = {CELL6_BETA:g})", HOLDS,
