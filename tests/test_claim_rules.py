@@ -207,7 +207,7 @@ def _readings(claim):
         both = ("geometry values differing", "reach-mask pixels differing")
         return [p for a, b in (both, both[::-1]) for p in _counts(a, 0, **{b: 0})]
     if q == "shadow-curves-unchanged":                                  # "unchanged": no pair lit past it
-        moved, lit = "boundary values moved", "pairs lit past the terminator"
+        moved, lit = "G-buffer values moved", "pairs lit past the terminator"
         return (_counts(lit, 0, HOLDS, CORRECTED, **{moved: 0}) + _counts(moved, 0, HOLDS, FAILS, **{lit: 0})
                 + _counts(moved, 0, CORRECTED, FAILS, **{lit: 5}))
     if q == "cell1-ripples":                                            # sphere A must show: a pixel at least
@@ -243,7 +243,7 @@ def _readings(claim):
     if q == "symbolic-not-slower":                                      # "at or under"
         return [({"sin/cos calls, exact minus central": d}, HOLDS if d <= 0 else FAILS) for d in (-1, 0, 1)]
     if q == "dn-verified-1e-12":                                        # "verified to 10⁻¹²"
-        closed, draft = "closed form's residual", "draft's check's worst error"     # ... by its own check
+        closed, draft = "closed form's worst error", "draft's check's worst error"     # ... by its own check
         return (_edges(closed, hi=n[0], inside=CORRECTED, outside=FAILS, **{draft: 1.0})
                 + _edges(closed, hi=n[0], inside=HOLDS, outside=FAILS, **{draft: 0.0})
                 + _edges(draft, hi=n[0], inside=HOLDS, outside=CORRECTED, **{closed: 0.0}))
@@ -375,7 +375,7 @@ def test_the_boundary_and_derivative_claims_read_the_measurements_their_rules_na
     monkeypatch.setattr(proofs.no_boundary, "render_flips", lambda: (4, 2, 1, 3))
     monkeypatch.setattr(lab.claims, "_errata", lambda: {"terminator-leak": {"leak_pixels_default": 0}})
     values, verdict = by_id["shadow-curves-unchanged"].measure()
-    assert (values["boundary values moved"], verdict) == (3, FAILS)
+    assert (values["G-buffer values moved"], verdict) == (3, FAILS)
     monkeypatch.setattr(proofs.no_boundary, "render_flips", lambda: (4, 0, 0, 3))
     assert by_id["shadow-curves-unchanged"].measure()[1] == HOLDS
     monkeypatch.setattr(lab.accuracy, "normal_beta_derivative_residual", lambda: 1e-16)

@@ -38,9 +38,9 @@ SENTENCES = {
                      "the outward normal",
     "flips-zero": "over {gbuffers} independent {{term}}`G-buffers <G-buffer>`, {geometry values differing} geometry values (chamber, $t$, "
                   "$P$, $N$) and {reach-mask pixels differing} reach-mask pixels differ",
-    "shadow-curves-unchanged": "true of the renderer ({boundary values moved} boundary values move), not of the "
-                               "draft's code: its shading lights "
-                               "{pairs lit past the terminator:,} (pixel, light) pairs past the terminator",
+    "shadow-curves-unchanged": "true of the renderer ({G-buffer values moved} G-buffer values move), not of the "
+                               "draft's shading rule: on this renderer's geometry it lights "
+                               "{pairs lit past the terminator:,} (pixel, light) pairs past the geometric terminator",
     "cell1-ripples": "the draft's sphere B covers {pixels_b:,} of the {pixels:,} pixels and its sphere A "
                      "{draft's sphere-A pixels:,}: sphere A never appears",
     "census-slope": "the RMS slope is {RMS slope:.2f}, the off-band slope {off-band slope:.2f} (fitted over the "
@@ -58,9 +58,9 @@ SENTENCES = {
                          "{values of h, exact:g} times, and its generated code calls {trig_exact:g} sines and cosines",
     "cell4-counter": "the counter prints {count printed, numeric} and {count printed, exact}: the gradients call the "
                      "unwrapped $h$, so the wrapper never runs (wired into the central gradient it counts {wired})",
-    "stacking": "no new integral, but a harder integrand: one sample per pixel misses the 4 × 4 box filter by RMS "
-                "{bumped:.1e} with the bump, {flat:.1e} without, and a 2 × 2 box leaves "
-                "{bumped error, 2 × 2 box / one sample:.0%} of it ({flat_2x2:.0%} without; {frame})",
+    "stacking": "no new integral, but a harder integrand: one sample per pixel misses a 4 × 4 box filter (Ch. 6's) "
+                "by RMS {bumped:.1e} with the bump, {flat:.1e} without, and a 2 × 2 box leaves "
+                "{bumped error, 2 × 2 box / one sample:.0%} of that miss ({flat_2x2:.0%} without; {frame})",
     "blinn-exact": "read as exact in $\\beta$ (how he evaluated $F_u$, $F_v$ is not measured here): derived from the "
                    "surface, but exact only to first order in $\\beta$: at $\\beta = {point[beta]:g}$ "
                    "($h = {point[h]:g}$, $h_u = {point[h_u]:g}$, $h_v = {point[h_v]:g}$, $\\varphi = {point[phi]:g}$) "
@@ -73,9 +73,9 @@ SENTENCES = {
     "cell5-fd-1e-9": "the draft's own check, a forward difference with step {step_shown} over {trials:,} random cases, "
                      "has a worst component error of {worst component:.1e}, about {ratio_shown:,.0f} times the "
                      "draft's expected {expected_shown}",
-    "dn-verified-1e-12": "the closed form's worst error is {closed form's residual:.1e} against a 50-digit mpmath "
-                         "derivative, which the draft's forward difference (worst error "
-                         "{draft's check's worst error:.1e}) cannot show",
+    "dn-verified-1e-12": "the closed form's worst error is {closed form's worst error:.1e} against a 50-digit mpmath "
+                         "derivative; the draft's forward-difference check errs by up to "
+                         "{draft's check's worst error:.1e}",
     "beta-quadratic": "the median order of the image's β-derivative is {median order:.2f}, but its RMS order "
                       "{RMS order:.2f}: second order at most pixels, not where a clip or a max(0, ·) switches "
                       "({frame})",

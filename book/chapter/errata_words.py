@@ -52,8 +52,8 @@ WORDS = {
             "At a step of {steps_shown[0]} the branch fires at {fraction_interior[0]:.2%} of interior "
             "sphere-A pixels (relative change of the quotient up to {rel_change[0]:.1e}); at "
             "{steps_shown[1]} at {fraction_interior[1]:.0%} ({rel_change[1]:.1e}); at {steps_shown[2]} at "
-            "{fraction_interior[2]:.0%} ({rel_change[2]:.1e}). Where it fires its divisor, the rounded span, is "
-            "the better one (it takes the arguments' rounding out): at {steps_shown[1]} its quotient is nearer the "
+            "{fraction_interior[2]:.0%} ({rel_change[2]:.1e}). Where it fires, the rounded span is "
+            "the better divisor (it takes the arguments' rounding out): at {steps_shown[1]} its quotient is nearer the "
             "exact $h_v$ at {nearer[1]:.0%} of those pixels."
         ),
     ),
