@@ -152,6 +152,7 @@ def test_gradient_accuracy_is_mpmath_differentiating_h_at_sphere_a_pixels(field,
     central errors (so a quotient evaluated another way agrees to many digits)."""
     scene = _scenes(1, seed=11, field=field)[0]
     got, mine = _accuracy_route(field, scene.k_u, scene.k_v, [3e-2, 3e-3], monkeypatch)
+    assert len(got) == len(mine) == 3                  # the exact gradient and the two steps
     for g, m in zip(got, mine):
         assert g == pytest.approx(m, rel=1e-6, abs=0)
 

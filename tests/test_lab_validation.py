@@ -6,7 +6,7 @@ inf, an integer too large for a float, a negative count, ...) with the error and
 message shows the value; a parameter adds values outside its own range.  The cases are
 generated from the table: each is one call with one argument replaced, which must raise the
 error named, with a message whose subject (before "must", where it says what is accepted) is
-the parameter's name, and which shows the value.  `test_a_valid_call_works` makes each function's valid call.
+the parameter's name, and which shows the value.  `test_a_valid_call_is_not_refused` makes each function's valid call.
 """
 
 from __future__ import annotations
@@ -249,6 +249,8 @@ def test_the_table_covers_every_public_function_and_parameter():
 
 
 @pytest.mark.parametrize("function", FUNCTIONS)
-def test_a_valid_call_works(function):
+def test_a_valid_call_is_not_refused(function):
+    """The baseline of the refusal tests here: the call they break, with every argument valid, is
+    answered (what it answers is each function's own tests')."""
     call, valid, _ = FUNCTIONS[function]
     assert call(**valid) is not None
