@@ -490,7 +490,8 @@ def test_chamber_is_the_nearest_positive_hit_for_a_distant_camera(camera_z):
 
 
 @pytest.mark.parametrize("kwargs", [
-    dict(beta=S.MAX_BETA, bump="chart"), dict(beta=0.999, bump="surface"), dict(k_u=S.MAX_FREQUENCY, height_field="sine"),
+    dict(beta=S.MAX_BETA, bump="chart"), dict(beta=0.999, bump="surface"),
+    dict(k_u=S.MAX_FREQUENCY, height_field="sine"),
     dict(beta=S.MAX_BETA, bump="chart", k_u=S.MAX_FREQUENCY, k_v=S.MAX_FREQUENCY, height_field="sine"),
 ], ids=["largest beta", "surface beta near R", "largest k_u", "both"])
 def test_perturbed_normal_is_unit_for_the_largest_inputs_scene_accepts(kwargs):
