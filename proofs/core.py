@@ -663,7 +663,8 @@ def _decide(theorem, step, lhs, rhs, rewrites=None):
     for label, case in step.cases or (("", {}),):
         where = {**theorem.where, **(rewrites or {}), **case}
         a, b = _substitute(lhs, where), _substitute(rhs, where)
-        key = (a, b, frozenset(domain.items()), frozenset(functions.items()), tuple(numbers.items()), TOLERANCE_DIGITS)
+        key = (a, b, frozenset(domain.items()), frozenset(functions.items()), tuple(numbers.items()),
+               TOLERANCE_DIGITS)
         if key not in _DECIDED:
             a, b = _value(a), _value(b)
             series = _below_order(a, b)

@@ -140,9 +140,9 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
             return Verdict("refuted", f"the renderer's {method} gradient's tolerance: {loose(1.0, r)}")
     return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath, relative to "
                    f"pi max(k_u, 2 k_v) ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
-                   f"footprint gradients at {rendered['exact'][1]:,} seeded sphere-A pixels at {rendered['exact'][0]:.2f}, "
-                   f"{rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} times their rounding tolerances "
-                   "against "
+                   f"footprint gradients at {rendered['exact'][1]:,} seeded sphere-A pixels at "
+                   f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
+                   "times their rounding tolerances against "
                    "the exact gradient, the central difference (stencil included) and the central difference with "
                    "the footprint's steps at its (u, v)",
                    worst, DIGITS, POINTS, rendered=rendered["exact"][1], bound=GENERATED_TOLERANCE)

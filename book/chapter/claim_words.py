@@ -106,7 +106,7 @@ SENTENCES = {
 
 
 def power(x):
-    """A power of ten as the draft writes it: 1e-9 (``x``: a float; its leading digit is rounded away)."""
+    """``x`` (a float) to one significant digit as the draft writes a power of ten: 1e-9, 3e-6."""
     return re.sub(r"e([-+])0*", lambda m: "e" + m.group(1).replace("+", ""), f"{x:.0e}")
 
 
