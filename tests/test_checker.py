@@ -484,6 +484,19 @@ def test_a_pixel_tolerance_loosened_by_orders_of_magnitude_is_refused(monkeypatc
     assert v.status == "refuted" and "its threshold" in v.evidence and "tighten it" in v.evidence, v.evidence
 
 
+def test_the_rendered_rate_is_held_to_its_claimed_order_within_a_tenth(monkeypatch):
+    """Theorem beta-zero-regression's evidence fits the order at which renders approach the beta = 0 render
+    (1.00): claimed at 1 it holds; claimed 0.15 or more away, and at 2, it is refuted (accepting within 1
+    instead of 0.1 let the mutation audit's loosened fit through)."""
+    from proofs import normal
+    measured = normal._render_rate()
+    monkeypatch.setattr(normal, "_render_rate", lambda **kw: measured)
+    assert normal._rate_evidence().status == "proved"
+    for order in (0.85, 1.15, 2.0):
+        v = normal._rate_evidence(order=order)
+        assert v.status == "refuted" and "fitted order" in v.evidence, (order, v.evidence)
+
+
 def test_a_verified_pin_loosened_is_refused_and_the_rule_spares_an_exact_zero(monkeypatch):
     from proofs import core, registry
     residual = registry.get("chart").check().residual
