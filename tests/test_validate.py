@@ -249,6 +249,25 @@ def test_each_pointwise_argument_is_wired_to_its_range(function):
             assert message.startswith(f"{argument} must be in ") and "flat index 0" in message, message
 
 
+#: Values each kind of argument must refuse, written from the docstrings rather than read from the module's
+#: ranges (which the test above reads): a step is in (0, 1), a frequency and a radius are positive, and the
+#: central quotient's chart point lies in [0, 1].
+REFUSED = {"eps": (0.0, -1e-3, 1.0), "eps_v": (0.0, -1e-3, 1.0), "k_u": (0.0, -1.0), "k_v": (0.0, -1.0),
+           "radius": (0.0, -1.0)}
+REFUSED_CENTRAL = {**REFUSED, "u": (-0.1, 1.1), "v": (-0.1, 1.1)}
+
+
+@pytest.mark.parametrize("function", CALLS)
+def test_each_pointwise_argument_refuses_what_its_kind_cannot_be(function):
+    refused = REFUSED_CENTRAL if function == "central_gradient" else REFUSED
+    names = [a for a in inspect.signature(CALLS[function][0]).parameters if a in refused]
+    assert names or function in ("chart", "tangent_frame")
+    for argument in names:
+        for value in refused[argument]:
+            _, message = refusal(lambda: call(function, **{argument: value}))
+            assert message.startswith(f"{argument} must be in "), (argument, value, message)
+
+
 @pytest.mark.parametrize("argument", ["P", "N", "e_theta", "e_phi"])
 @pytest.mark.parametrize("point, error", [(b"abc", InvalidType), ({0.1, 0.2, 0.3}, InvalidType),
                                           ((c for c in (0.1, 0.2, 0.3)), InvalidType), (0.5, InvalidType),
