@@ -246,3 +246,16 @@ def test_the_check_rejects_a_wrong_reshade(variant, tmp_path):
 
     found = problems(write_modules(tmp_path / "js", transform), tmp_path / "out")
     assert found, f"wrong variant {variant!r} passed"
+
+
+def test_the_simulators_curve_steps_are_the_half_decades_python_measures(modules, tmp_path):
+    """The simulator's U-curve steps (``CURVE_LOG_EPS`` as the slider prints them, `eps_of`) are
+    `lab.accuracy.HALF_DECADES`, the steps the book's image-best step is measured over: the whole
+    slider, both ends included."""
+    from lab.accuracy import HALF_DECADES
+    node = node_command("the simulator's curve steps are read under node")
+    script = tmp_path / "steps.mjs"
+    script.write_text(f'import {{ CURVE_LOG_EPS, eps_of }} from "{(modules / "simulator.js").as_uri()}";\n'
+                      "console.log(JSON.stringify(CURVE_LOG_EPS.map(eps_of)));\n", encoding="utf-8")
+    out = subprocess.run([*node, str(script)], check=True, capture_output=True, text=True, timeout=120).stdout
+    assert json.loads(out) == [float(f"{x:.2g}") for x in HALF_DECADES]
