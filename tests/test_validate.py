@@ -252,14 +252,14 @@ def test_each_pointwise_argument_is_wired_to_its_range(function):
 #: Values each kind of argument must refuse, written from the docstrings rather than read from the module's
 #: ranges (which the test above reads): a step is in (0, 1), a frequency and a radius are positive, and the
 #: central quotient's chart point lies in [0, 1].
-REFUSED = {"eps": (0.0, -1e-3, 1.0), "eps_v": (0.0, -1e-3, 1.0), "k_u": (0.0, -1.0), "k_v": (0.0, -1.0),
+KIND_REFUSALS = {"eps": (0.0, -1e-3, 1.0), "eps_v": (0.0, -1e-3, 1.0), "k_u": (0.0, -1.0), "k_v": (0.0, -1.0),
            "radius": (0.0, -1.0)}
-REFUSED_CENTRAL = {**REFUSED, "u": (-0.1, 1.1), "v": (-0.1, 1.1)}
+KIND_REFUSALS_CENTRAL = {**KIND_REFUSALS, "u": (-0.1, 1.1), "v": (-0.1, 1.1)}
 
 
 @pytest.mark.parametrize("function", CALLS)
 def test_each_pointwise_argument_refuses_what_its_kind_cannot_be(function):
-    refused = REFUSED_CENTRAL if function == "central_gradient" else REFUSED
+    refused = KIND_REFUSALS_CENTRAL if function == "central_gradient" else KIND_REFUSALS
     names = [a for a in inspect.signature(CALLS[function][0]).parameters if a in refused]
     assert names or function in ("chart", "tangent_frame")
     for argument in names:
