@@ -136,8 +136,9 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
         return Verdict("refuted", "the renderer's gradient leaves its tolerance by "
                        + ", ".join(f"{m} {r:.2g}x" for m, (r, _) in rendered.items()))
     for method, (r, _) in rendered.items():                    # rule 11 on each tolerance, in its own units
-        if loose(1.0, r):
-            return Verdict("refuted", f"the renderer's {method} gradient's tolerance: {loose(1.0, r)}")
+        why = loose(1.0, r)
+        if why:
+            return Verdict("refuted", f"the renderer's {method} gradient's tolerance: {why}")
     return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath, relative to "
                    f"pi max(k_u, 2 k_v) ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
                    f"footprint gradients at {rendered['exact'][1]:,} seeded sphere-A pixels at "
