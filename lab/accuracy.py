@@ -16,6 +16,7 @@ import sympy as sp
 
 from renderer import DRAFT_SCENE, Scene, gbuffer, pointwise, render
 from renderer import formulas as F
+from renderer.ledger import CURVE_LOG_EPS
 from renderer.render import SPHERE_A
 from renderer.scene import FREQUENCY, MAX_BETA, UNIT
 from renderer.validate import InvalidValue, positive_int, real, real_array, steps as _steps
@@ -379,9 +380,8 @@ def _crease_share(size, steps, scene=DRAFT_SCENE):
                 share_u=[float(np.mean(along_u < eps)) for eps in steps], pixels=int(dist.size))
 
 
-#: The steps of the simulator's U-curve (``CURVE_LOG_EPS`` in renderer/js/simulator.js): half decades
-#: from 1e-14 to 1e-1, chart units.
-HALF_DECADES = tuple(float(x) for x in 10.0 ** (np.arange(-28, -1) / 2))
+#: The steps of the simulator's U-curve (`renderer.ledger.CURVE_LOG_EPS`), chart units.
+HALF_DECADES = tuple(10.0 ** e for e in CURVE_LOG_EPS)
 
 
 def image_best_step(field, size=256):

@@ -32,7 +32,7 @@ from pathlib import Path
 
 from . import codegen, formulas, kernel, scene
 from .files import write_bytes
-from .ledger import DIFFERENCE_LINEAR_GAIN, DIFFERENCE_LOG_FLOOR, SIMULATOR_SCENE
+from .ledger import CURVE_LOG_EPS, DIFFERENCE_LINEAR_GAIN, DIFFERENCE_LOG_FLOOR, SIMULATOR_SCENE, SLIDER_LOG_EPS
 from .render import CHAMBER_NAMES, GRADIENTS, MAX_SIDE, MAX_ZOOM, WINDOW_MARGIN, WINDOW_OFFSET
 
 __all__ = ["JS_DIR", "MODULE_ORDER", "GENERATED", "SIMULATOR_SCENE", "formulas_js", "constants_js", "sources",
@@ -82,6 +82,8 @@ def constants_js():
         "TINY": kernel.TINY,
         "LOG_FLOOR": DIFFERENCE_LOG_FLOOR,
         "LINEAR_GAIN": DIFFERENCE_LINEAR_GAIN,
+        "SLIDER_LOG_EPS": list(SLIDER_LOG_EPS),
+        "CURVE_LOG_EPS": list(CURVE_LOG_EPS),
     }
     out = [_HEADER.format(src="renderer/scene.py, render.py and kernel.py")]
     for name, value in consts.items():

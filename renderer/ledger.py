@@ -12,7 +12,8 @@ from numba import njit
 from .render import SPHERE_A, Frame
 from .scene import Scene
 
-__all__ = ["Ledger", "compare", "to_srgb", "SIMULATOR_SCENE", "DIFFERENCE_LOG_FLOOR", "DIFFERENCE_LINEAR_GAIN"]
+__all__ = ["Ledger", "compare", "to_srgb", "SIMULATOR_SCENE", "DIFFERENCE_LOG_FLOOR", "DIFFERENCE_LINEAR_GAIN",
+           "SLIDER_LOG_EPS", "CURVE_LOG_EPS"]
 
 #: The scene the simulator opens on: the default `Scene()` (the draft's scene shaded with the
 #: displaced sphere's normal, ``formulas.PERTURBED_NORMAL["surface"]``, the bump a reader
@@ -24,6 +25,12 @@ SIMULATOR_SCENE = Scene(height_field="sine")
 #: to 0 (white), about the rounding level of float64; the linear scale multiplies by the gain.
 DIFFERENCE_LOG_FLOOR = -16
 DIFFERENCE_LINEAR_GAIN = 100
+
+#: The simulator's ε slider: log10 of its smallest and largest step (chart units), whole decades.
+SLIDER_LOG_EPS = (-14, -1)
+#: The steps of the simulator's U-curve, as log10 ε: every half decade of the slider, both ends
+#: included (27 steps).  `lab.accuracy.HALF_DECADES` measures the book's image-best step over them.
+CURVE_LOG_EPS = tuple(SLIDER_LOG_EPS[0] + i / 2 for i in range(2 * (SLIDER_LOG_EPS[1] - SLIDER_LOG_EPS[0]) + 1))
 
 
 @dataclass(frozen=True)

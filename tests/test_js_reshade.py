@@ -250,12 +250,43 @@ def test_the_check_rejects_a_wrong_reshade(variant, tmp_path):
 
 def test_the_simulators_curve_steps_are_the_half_decades_python_measures(modules, tmp_path):
     """The simulator's U-curve steps (``CURVE_LOG_EPS`` as the slider prints them, `eps_of`) are
-    `lab.accuracy.HALF_DECADES`, the steps the book's image-best step is measured over: the whole
-    slider, both ends included."""
+    `lab.accuracy.HALF_DECADES`, the steps the book's image-best step is measured over; and they are
+    every half decade of the slider, both ends included."""
     from lab.accuracy import HALF_DECADES
+    from renderer.ledger import CURVE_LOG_EPS, SLIDER_LOG_EPS
+    assert (CURVE_LOG_EPS[0], CURVE_LOG_EPS[-1]) == SLIDER_LOG_EPS
+    assert np.diff(CURVE_LOG_EPS).tolist() == [0.5] * (len(CURVE_LOG_EPS) - 1)
     node = node_command("the simulator's curve steps are read under node")
     script = tmp_path / "steps.mjs"
-    script.write_text(f'import {{ CURVE_LOG_EPS, eps_of }} from "{(modules / "simulator.js").as_uri()}";\n'
-                      "console.log(JSON.stringify(CURVE_LOG_EPS.map(eps_of)));\n", encoding="utf-8")
+    script.write_text(f'import {{ CURVE_LOG_EPS }} from "{(modules / "constants.js").as_uri()}";\n'
+                      f'import {{ eps_of, CONTROLS }} from "{(modules / "simulator.js").as_uri()}";\n'
+                      "const slider = CONTROLS.find((c) => c.name === 'log_eps');\n"
+                      "console.log(JSON.stringify([CURVE_LOG_EPS.map(eps_of), [slider.min, slider.max]]));\n",
+                      encoding="utf-8")
     out = subprocess.run([*node, str(script)], check=True, capture_output=True, text=True, timeout=120).stdout
-    assert json.loads(out) == [float(f"{x:.2g}") for x in HALF_DECADES]
+    steps, slider = json.loads(out)
+    assert steps == [float(f"{x:.2g}") for x in HALF_DECADES]
+    assert tuple(slider) == SLIDER_LOG_EPS
+
+
+def test_the_simulators_curve_samples_at_most_curve_sample_pixels_a_side_and_no_fewer_than_it_must(
+        modules, tmp_path):
+    """``curve_stride(resolution)``: the U-curve reads every stride-th column and row, so at most
+    ``CURVE_SAMPLE`` of them a side at every resolution the control offers and every side up to
+    `renderer.render.MAX_SIDE`, and the least such stride (one less would read more than
+    ``CURVE_SAMPLE``)."""
+    from renderer.render import MAX_SIDE
+    node = node_command("the simulator's curve stride is read under node")
+    script = tmp_path / "stride.mjs"
+    script.write_text(f'import {{ curve_stride, CURVE_SAMPLE, CONTROLS }} from "{(modules / "simulator.js").as_uri()}";\n'
+                      f"const sides = Array.from({{ length: {MAX_SIDE} }}, (_, i) => i + 1);\n"
+                      "const offered = CONTROLS.find((c) => c.name === 'resolution').options;\n"
+                      "console.log(JSON.stringify([CURVE_SAMPLE, offered, sides.map(curve_stride)]));\n",
+                      encoding="utf-8")
+    out = subprocess.run([*node, str(script)], check=True, capture_output=True, text=True, timeout=120).stdout
+    sample, offered, strides = json.loads(out)
+    assert set(offered) <= set(range(1, MAX_SIDE + 1)), offered
+    read = lambda side, stride: -(-side // stride)            # columns 0, stride, 2 stride, ... below side
+    bad = [(side, stride) for side, stride in enumerate(strides, 1)
+           if read(side, stride) > sample or (stride > 1 and read(side, stride - 1) <= sample)]
+    assert not bad, bad[:5]

@@ -3,7 +3,7 @@
 // Only this module touches the DOM; the renderer core runs the same under node
 // (tests/test_js_parity.py, tests/test_js_reshade.py).
 import { SIMULATOR_SCENE, HEIGHT_FIELDS, FIELD_CREASES, MODELS, GRADIENTS, BUMPS, SPHERE_A, CHAMBER_NAMES,
-         LOG_FLOOR, LINEAR_GAIN } from "./constants.js";
+         LOG_FLOOR, LINEAR_GAIN, SLIDER_LOG_EPS, CURVE_LOG_EPS } from "./constants.js";
 import { PairRenderer, probe_pixel } from "./render.js";
 import { compare, to_srgb } from "./ledger.js";
 
@@ -16,15 +16,14 @@ export function eps_of(log_eps) {
 // The numeric pipelines the left canvas can show: every gradient method but the exact one.
 const NUMERIC = GRADIENTS.filter((g) => g !== "exact");
 
-// The slider of log10 eps, and the steps of the U-curve: the slider's range in
-// half decades (27 steps), fine enough to show the bottom of the U and its two
+// The slider of log10 eps, and the steps of the U-curve (CURVE_LOG_EPS, from
+// renderer/ledger.py): the slider's range in half decades, fine enough to show the bottom of the U and its two
 // slopes, coarse enough to stay cheap (see CURVE_SAMPLE).  The slider moves by a
 // tenth of a decade (an arrow key), so that it lands exactly on each decade; each
 // decade is a tick mark (a <datalist>), to which Chromium snaps a pointer within a
 // few pixels (a tenth of a decade is under 3 px on a phone), and Page Up / Page Down
 // jump to the next decade.
-const LOG_EPS = { min: -14, max: -1, step: 0.1, ticks: 1 };
-export const CURVE_LOG_EPS = Array.from({ length: 2 * (LOG_EPS.max - LOG_EPS.min) + 1 }, (_, i) => LOG_EPS.min + i / 2);
+const LOG_EPS = { min: SLIDER_LOG_EPS[0], max: SLIDER_LOG_EPS[1], step: 0.1, ticks: 1 };
 // The U-curve is the ledger over a grid of at most CURVE_SAMPLE x CURVE_SAMPLE
 // of the frame's pixels (every 6th column and row at 256 x 256: a 36th of
 // sphere A's pixels): its 27 steps then cost less than re-shading sphere A once
