@@ -29,7 +29,7 @@ DIFFERENCE_LINEAR_GAIN = 100
 #: The simulator's ε slider: log10 of its smallest and largest step (chart units), whole decades.
 SLIDER_LOG_EPS = (-14, -1)
 #: The steps of the simulator's U-curve, as log10 ε: every half decade of the slider, both ends
-#: included (27 steps).  `lab.accuracy.HALF_DECADES` measures the book's image-best step over them.
+#: included.  `lab.accuracy.HALF_DECADES` measures the book's image-best step over them.
 CURVE_LOG_EPS = tuple(SLIDER_LOG_EPS[0] + i / 2 for i in range(2 * (SLIDER_LOG_EPS[1] - SLIDER_LOG_EPS[0]) + 1))
 
 

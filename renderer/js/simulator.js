@@ -26,7 +26,7 @@ const NUMERIC = GRADIENTS.filter((g) => g !== "exact");
 const LOG_EPS = { min: SLIDER_LOG_EPS[0], max: SLIDER_LOG_EPS[1], step: 0.1, ticks: 1 };
 // The U-curve is the ledger over a grid of at most CURVE_SAMPLE x CURVE_SAMPLE
 // of the frame's pixels (every 6th column and row at 256 x 256: a 36th of
-// sphere A's pixels): its 27 steps then cost less than re-shading sphere A once
+// sphere A's pixels): its steps then cost less than re-shading sphere A once
 // for the whole frame, so a change of beta, bump or field, which recomputes the
 // curve, stays within one update.
 export const CURVE_SAMPLE = 48;
