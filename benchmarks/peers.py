@@ -6,9 +6,9 @@ Blinn-Phong, two lights, sphere B, checker floor), a textbook ray-sphere
 quadratic, central differences or the exact gradient of the ridges field, and
 a frame per call returned as a NumPy (H, W, 3) float64 array.  The same
 function runs on Dr.Jit's LLVM backend and on JAX (``jax.jit``, XLA CPU)
-through a six-entry namespace.  `benchmarks/bench_render.py` times it beside
+through a six-entry namespace.  `benchmarks/bench_peers.py` times it beside
 `renderer.render`; it checks first that each peer draws the project's image
-(`agreement`), so the two are timed on the same per-pixel work.
+(within its ``AGREEMENT``), so the two are timed on the same per-pixel work.
 """
 
 from __future__ import annotations
@@ -151,8 +151,3 @@ def renderer_for(xp, scene, width, height, gradient):
         return np.stack([np.asarray(c) for c in rgb], axis=-1).reshape(height, width, 3)
     return frame
 
-
-def agreement(peer_image, project_image):
-    """(max |dI|, fraction of pixels with any |dI| > 1e-9) of a peer's frame against the project's."""
-    d = np.abs(peer_image - project_image).max(axis=-1)
-    return float(d.max()), float(np.mean(d > 1e-9))
