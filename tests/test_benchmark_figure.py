@@ -4,6 +4,7 @@ gradient's star) stands a decade or more above its panel's bottom edge."""
 from types import SimpleNamespace
 
 import matplotlib
+import pytest
 
 matplotlib.use("Agg")
 
@@ -60,25 +61,42 @@ def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
     assert text_overlaps(fig) == []
 
 
-def test_no_text_of_the_figure_collides_whatever_the_machine_times():
+@pytest.mark.parametrize("added", [0, 1, 4])
+def test_no_text_of_the_figure_collides_whatever_the_machine_times(monkeypatch, added):
     """The times are the machine's, so the panels' widths move with the tick labels the time axis
     needs; a panel's title (two lines for a field with creases) must not reach the neighbouring tick
     labels at any of them, nor at any errors.  Seeded draws of every run's time from 0.5 ms to 0.5 s
     (the page's methods span about that, the fastest to the slowest) and its error from 1e-16 to 2,
-    in the book's style."""
+    in the book's style.  With ``added`` methods appended to `METHODS` (a legend taller than a row),
+    the panels keep the height they have without them, and the legend lists the records' order."""
     import dataclasses
 
     import numpy as np
 
     from chapter import figures
     from chapter.layout import text_overlaps
+    from lab import gradient_methods as gm
 
     from .test_figure_baselines import _measurement
 
     figures.style()
-    base, rng = _measurement(), np.random.default_rng(20261125)
+
+    def panels(fig):                                          # each panel's height in inches, laid out
+        fig.draw_without_rendering()
+        return [a.get_position().height * fig.get_figheight() for a in fig.axes if a.get_title()]
+
+    alone = panels(pareto_figure(_measurement()))
+    central = gm.method("central")
+    monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, *(dataclasses.replace(
+        central, name=f"toy {i}", label=f"toy difference {i}", style=dataclasses.replace(central.style, marker="v"))
+        for i in range(added))])
+    base, rng = _measurement([m.name for m in gm.METHODS]), np.random.default_rng(20261125)
     for _ in range(6):
         rows = tuple(dataclasses.replace(r, times=(0.8 * t, t, 1.5 * t), max_error=e, rms_error=e)
                      for r in base.results for t, e in [10 ** rng.uniform((-3.3, -16), (-0.3, 0.3))])
         fig = pareto_figure(dataclasses.replace(base, results=rows))
         assert text_overlaps(fig) == [], [(r.field, r.method, r.times, r.max_error) for r in rows]
+    grown = panels(pareto_figure(base))
+    assert len(grown) == len(alone) and min(h / a for h, a in zip(grown, alone)) > 0.97, (grown, alone)
+    legend = [t.get_text() for a in fig.axes if a.get_legend() for t in a.get_legend().get_texts()]
+    assert legend == ["Pareto front", *(m.label for m in gm.METHODS if m.name in {r.method for r in rows})]

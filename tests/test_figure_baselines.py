@@ -99,14 +99,21 @@ def _error(method, eps):
     return (0.1 * eps if method == "forward" else 0.01 * eps**2) + 1e-16 / eps
 
 
-def _measurement():
-    """Every method of `lab.gradient_methods.METHODS` on each of the seed's fields
+#: The methods the baselines draw: fixed input data, as `SEED_FIELDS` are (a method appended to
+#: `lab.gradient_methods.METHODS` changes the book's figures, not these baselines;
+#: tests/test_benchmark_figure.py draws the figure with more).
+BASELINE_METHODS = ("exact", "central", "forward", "complex step", "complex step, |z| continued", "richardson",
+                    gm.AD)
+
+
+def _measurement(methods=BASELINE_METHODS):
+    """Each of ``methods`` (names of `lab.gradient_methods.METHODS`) on each of the seed's fields
     (`scalar_reference.SEED_FIELDS`: fixed input data, as the times and errors are; a field
     registered later changes the book's figure, not this test's) where it applies, at the `FAST`
     configuration's steps, with fixed times and errors."""
     rows = []
     for i, field in enumerate(SEED_FIELDS):
-        for k, m in enumerate(gm.METHODS):
+        for k, m in enumerate(map(gm.method, methods)):
             if m.applies(F.field(field)):
                 for j, eps in enumerate(m.steps_in(gb.FAST)):
                     t, err = 1e-3 * (1 + k) * (1 + 0.3 * j) * (1 + 0.2 * i), _error(m.name, eps)
@@ -125,7 +132,8 @@ def test_univariate_figure():
     figures.style()
     steps = gb.UNIVARIATE_STEPS[::4]
     rows = [gb.UnivariateRow(m.name, eps, 1.0, _error(m.name, eps), _error(m.name, eps))
-            for m in gm.METHODS if m.derivative is not None and m.name != "complex step, |z| continued"
+            for m in map(gm.method, BASELINE_METHODS) if m.derivative is not None
+            and m.name != "complex step, |z| continued"
             for eps in m.steps_in(SimpleNamespace(central_steps=steps, forward_steps=steps, complex_steps=steps))]
     return univariate_figure(gb.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {}))
 

@@ -161,7 +161,7 @@ BACKWARD = gm.Method("backward", backward_gradient, lambda f, info: gm.Evaluatio
                      gm.Style("#444444", "v", 6, "--"), steps="forward_steps")
 
 
-def test_a_sixth_method_is_one_record_measured_and_drawn(monkeypatch):
+def test_a_new_method_is_one_record_measured_and_drawn(monkeypatch):
     """Appending a record to METHODS is the whole change: `measure` runs it on every field, at the
     steps it names, against the reference; the table shows it and the figure draws it with its style
     and label.  Its error is first order, as a backward difference's is."""

@@ -22,6 +22,8 @@ _NUMBER_WORDS = ("none", "one", "two", "three", "four", "five", "six", "seven", 
 
 #: The error axis starts this factor below the panel's lowest point.
 _Y_ROOM = 30.0
+#: The height of a row of panels, inches (more if the legend, in a row's spare cell, is taller).
+_ROW_IN = 1.9
 
 
 def _floor(e):
@@ -38,7 +40,8 @@ def pareto_figure(measurement, *, error="max"):
     (unlabelled: neighbouring steps' labels would collide); the Pareto front is the
     grey staircase; each error axis starts `_Y_ROOM` times below its panel's
     lowest point, so no marker sits on the frame.  An error of exactly 0 would be drawn at 1e-18.
-    Colours, markers, line styles and legend labels are the methods' records'.
+    Colours, markers, line styles and legend labels are the methods' records', and the legend lists
+    them in `lab.gradient_methods.METHODS`' order.
 
     Parameters
     ----------
@@ -54,6 +57,7 @@ def pareto_figure(measurement, *, error="max"):
     ValueError
         If ``error`` is not "max" or "rms".
     """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.ticker import LogLocator, NullLocator
     if error not in ("max", "rms"):
@@ -61,7 +65,7 @@ def pareto_figure(measurement, *, error="max"):
     names = list(dict.fromkeys(r.field for r in measurement.results))
     # Two columns (a phone's column holds two panels of 2.5 in); the legend fills an empty cell.
     rows = (len(names) + 2) // 2
-    fig = Figure(figsize=(5.0, 1.9 * rows), layout="constrained")
+    fig = Figure(figsize=(5.0, _ROW_IN * rows), layout="constrained")
     grid = fig.subplots(rows, 2, sharex=True, squeeze=False).ravel()
     axes, spare = grid[:len(names)], grid[len(names):]
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
@@ -102,11 +106,16 @@ def pareto_figure(measurement, *, error="max"):
     for ax in axes[-2:]:                # the lowest panel of each column
         ax.set_xlabel("time per frame, ms")
         ax.xaxis.set_tick_params(labelbottom=True)
+    handles = {m: handles[m] for m in ("Pareto front", *(m.name for m in gm.METHODS)) if m in handles}
     labels = [m if m == "Pareto front" else gm.method(m).label for m in handles]
     if len(spare):
         for ax in spare:
             ax.axis("off")
-        spare[0].legend(list(handles.values()), labels, loc="center", frameon=False)
+        legend = spare[0].legend(list(handles.values()), labels, loc="center", frameon=False)
+        # A legend taller than a row (more methods than it holds) would squeeze the panels: the rows,
+        # of equal height in the constrained layout, grow to the legend's height.
+        tall = legend.get_window_extent(FigureCanvasAgg(fig).get_renderer()).height / fig.dpi
+        fig.set_figheight(rows * max(_ROW_IN, tall))
     else:
         fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, frameon=False)
     return fig
