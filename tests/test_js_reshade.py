@@ -248,6 +248,17 @@ def test_the_check_rejects_a_wrong_reshade(variant, tmp_path):
     assert found, f"wrong variant {variant!r} passed"
 
 
+def _node_json(modules, tmp_path, why, imports, expression):
+    """The JSON value of the JavaScript ``expression`` under node, with ``imports`` ({module: names}) of
+    the simulator's modules in ``modules``; ``why`` names the test (`node_command`)."""
+    script = tmp_path / "probe.mjs"
+    script.write_text("".join(f'import {{ {", ".join(names)} }} from "{(modules / f"{m}.js").as_uri()}";\n'
+                              for m, names in imports.items()) + f"console.log(JSON.stringify({expression}));\n",
+                      encoding="utf-8")
+    out = subprocess.run([*node_command(why), str(script)], check=True, capture_output=True, text=True, timeout=120)
+    return json.loads(out.stdout)
+
+
 def test_the_simulators_curve_steps_are_the_half_decades_python_measures(modules, tmp_path):
     """The simulator's U-curve steps (``CURVE_LOG_EPS`` as the slider prints them, `eps_of`) are
     `lab.accuracy.HALF_DECADES`, the steps the book's image-best step is measured over; and they are
@@ -256,15 +267,10 @@ def test_the_simulators_curve_steps_are_the_half_decades_python_measures(modules
     from renderer.ledger import CURVE_LOG_EPS, SLIDER_LOG_EPS
     assert (CURVE_LOG_EPS[0], CURVE_LOG_EPS[-1]) == SLIDER_LOG_EPS
     assert np.diff(CURVE_LOG_EPS).tolist() == [0.5] * (len(CURVE_LOG_EPS) - 1)
-    node = node_command("the simulator's curve steps are read under node")
-    script = tmp_path / "steps.mjs"
-    script.write_text(f'import {{ CURVE_LOG_EPS }} from "{(modules / "constants.js").as_uri()}";\n'
-                      f'import {{ eps_of, CONTROLS }} from "{(modules / "simulator.js").as_uri()}";\n'
-                      "const slider = CONTROLS.find((c) => c.name === 'log_eps');\n"
-                      "console.log(JSON.stringify([CURVE_LOG_EPS.map(eps_of), [slider.min, slider.max]]));\n",
-                      encoding="utf-8")
-    out = subprocess.run([*node, str(script)], check=True, capture_output=True, text=True, timeout=120).stdout
-    steps, slider = json.loads(out)
+    steps, slider = _node_json(modules, tmp_path, "the simulator's curve steps are read under node",
+                               {"constants": ["CURVE_LOG_EPS"], "simulator": ["eps_of", "CONTROLS"]},
+                               "[CURVE_LOG_EPS.map(eps_of), ['min', 'max'].map((k) => "
+                               "CONTROLS.find((c) => c.name === 'log_eps')[k])]")
     assert steps == [float(f"{x:.2g}") for x in HALF_DECADES]
     assert tuple(slider) == SLIDER_LOG_EPS
 
@@ -276,15 +282,11 @@ def test_the_simulators_curve_samples_at_most_curve_sample_pixels_a_side_and_no_
     `renderer.render.MAX_SIDE`, and the least such stride (one less would read more than
     ``CURVE_SAMPLE``)."""
     from renderer.render import MAX_SIDE
-    node = node_command("the simulator's curve stride is read under node")
-    script = tmp_path / "stride.mjs"
-    script.write_text(f'import {{ curve_stride, CURVE_SAMPLE, CONTROLS }} from "{(modules / "simulator.js").as_uri()}";\n'
-                      f"const sides = Array.from({{ length: {MAX_SIDE} }}, (_, i) => i + 1);\n"
-                      "const offered = CONTROLS.find((c) => c.name === 'resolution').options;\n"
-                      "console.log(JSON.stringify([CURVE_SAMPLE, offered, sides.map(curve_stride)]));\n",
-                      encoding="utf-8")
-    out = subprocess.run([*node, str(script)], check=True, capture_output=True, text=True, timeout=120).stdout
-    sample, offered, strides = json.loads(out)
+    sample, offered, strides = _node_json(
+        modules, tmp_path, "the simulator's curve stride is read under node",
+        {"simulator": ["curve_stride", "CURVE_SAMPLE", "CONTROLS"]},
+        f"[CURVE_SAMPLE, CONTROLS.find((c) => c.name === 'resolution').options, "
+        f"Array.from({{ length: {MAX_SIDE} }}, (_, i) => curve_stride(i + 1))]")
     assert set(offered) <= set(range(1, MAX_SIDE + 1)), offered
     read = lambda side, stride: -(-side // stride)            # columns 0, stride, 2 stride, ... below side
     bad = [(side, stride) for side, stride in enumerate(strides, 1)
