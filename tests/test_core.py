@@ -847,4 +847,11 @@ def test_a_residual_at_the_tolerance_is_not_below_it():
 
 def test_a_count_is_spelled_in_words_below_ten_in_digits_from_ten():
     from proofs.core import spelled
-    assert [spelled(n) for n in (0, 1, 3, 9, 10, 12)] == ["no", "one", "three", "nine", "10", "12"]
+    assert [spelled(n) for n in range(13)] == ["no", "one", "two", "three", "four", "five", "six", "seven", "eight",
+                                               "nine", "10", "11", "12"]
+
+
+def test_words_are_listed_as_a_sentence_lists_them():
+    from proofs.core import listed
+    assert [listed(w) for w in ([], ["sine"], ("sine", "ridges"), iter(["sine", "ridges", "rings"]), "abcd")] == [
+        "", "sine", "sine and ridges", "sine, ridges and rings", "a, b, c and d"]
