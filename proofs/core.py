@@ -118,6 +118,8 @@ def loose(bound, residual):
         return (f"its threshold {bound:.2g} is {bound / residual:.2g} times the residual it measured "
                 f"({residual:.2g}), more than {TIGHT:g}: a threshold that loose lets a defect pass; tighten it")
     return None
+
+
 #: A citation of another theorem in a statement or a step's sentence: ``⟪frame-orthonormal⟫``.
 CITATION = re.compile(r"⟪([^⟫]*)⟫")
 #: A theorem named by its id in words (rule 8 refuses it): "theorem chart", "Theorems `chart`",

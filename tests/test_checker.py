@@ -7,6 +7,7 @@ the checker (proofs/core.py, proofs/registry.py, chapter.theorems), run by ``mak
 
 import dataclasses
 import re
+import sys
 
 import numpy as np
 import pytest
@@ -376,6 +377,15 @@ def test_no_text_names_a_theorem_by_its_id_and_every_citation_is_known():
     assert set(CITABLE) == set(THEOREMS)
 
 
+def test_the_checkers_citable_titles_are_the_registrys_once_it_is_imported_and_none_before(monkeypatch):
+    """`proofs.core.CITABLE` reads proofs/registry.py's titles when asked: every one while the registry
+    is imported; none (a citation is then unknown) while it is not."""
+    from proofs import core
+    assert dict(core.CITABLE) == CITABLE and len(core.CITABLE) == len(CITABLE) and "chart" in core.CITABLE
+    monkeypatch.delitem(sys.modules, "proofs.registry")
+    assert dict(core.CITABLE) == {} and len(core.CITABLE) == 0 and "chart" not in core.CITABLE
+
+
 def test_a_citation_prints_as_the_theorems_number_and_title_in_the_book_and_its_title_in_plain_text():
     from chapter.theorems import _cited
     assert _cited("by ⟪chart⟫, so") == f"by {{prf:ref}}`thm-chart` ({CITABLE['chart']}), so"
@@ -503,7 +513,8 @@ def test_a_verified_pin_loosened_is_refused_and_the_rule_spares_an_exact_zero(mo
     assert registry.pinned_failure("chart", "verified", residual, 10**6, ALL) is None
     monkeypatch.setitem(registry.PINNED, "chart", ("verified", 1e-20))
     assert "chart's pin: its threshold 1e-20 is" in registry.pinned_failure("chart", "verified", residual, 10**6, ALL)
-    assert core.loose(1e-20, 0.0) is None and core.loose(1e-20, 1e-23) is None and core.loose(1e-20, 9e-24)
+    assert core.loose(1e-20, 0.0) is None and core.loose(1e-20, 1e-23) is None
+    assert "threshold 1e-20 is 4e+03 times the residual it measured (2.5e-24)" in core.loose(1e-20, 2.5e-24)
 
 
 def test_rule_12_evidence_that_leaves_out_a_field_is_named(monkeypatch):
