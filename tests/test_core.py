@@ -243,6 +243,8 @@ def test_named_symbols_are_printed_and_substituted_when_checked():
     with pytest.raises(KeyError, match=r"⟦cube⟧, neither a claim \['square'\], a named symbol"):
         statement(unknown)
     assert unknown.check().status == "refuted" and "⟦cube⟧" in unknown.check().evidence
+    named = dataclasses.replace(t, statement="⟦cube⟧").check().evidence
+    assert "shows ⟦cube⟧, which is neither a claim ['square'], a named symbol ['e'] nor a shown object []" in named
     shown = dataclasses.replace(square_theorem(*CHAIN), statement="$⟦cube⟧$", shown={"cube": a_**3})
     assert shown.check().status == "proved" and statement(shown) == "$a^{3}$"
 
@@ -263,6 +265,7 @@ def test_a_relation_typed_in_a_statement_is_refused(typed):
     t = dataclasses.replace(square_theorem(*CHAIN), statement=f"Here $⟦square⟧$, and {typed}.")
     verdict = t.check()
     assert verdict.status == "refuted" and "types the relation" in verdict.evidence, verdict
+    assert f"by hand in {typed!r}: show it through ⟦key⟧" in verdict.evidence, verdict
 
 
 def test_typed_mathematics_that_asserts_nothing_passes():
