@@ -23,6 +23,22 @@ def squares():
         F.FIELDS.pop("squares", None)
 
 
+@pytest.fixture
+def built_before():
+    """bump-vs-displacement's statement, built before the `squares` fixture registers its field."""
+    from proofs import registry
+    return registry.get("bump-vs-displacement").statement
+
+
+def test_a_theorem_built_from_the_fields_is_built_again_when_they_change(built_before, squares):
+    """`proofs.core.catalogue`'s key: bump-vs-displacement, built before the field was registered, is built
+    again for it, and states the built-in fields alone again once it is removed."""
+    from proofs import registry
+    assert "squares" not in built_before and "squares" in registry.get("bump-vs-displacement").statement
+    F.FIELDS.pop("squares")
+    assert registry.get("bump-vs-displacement").statement == built_before
+
+
 def test_the_fourth_field_has_its_theorems_and_pins(squares):
     """The registry lists gradient-squares after the other fields' (and no crease theorem: it has no crease),
     pinned proved with 200 pixels; the theorems about every field cover it: the stencil step has its case,
