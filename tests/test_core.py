@@ -856,5 +856,5 @@ def test_a_count_is_spelled_in_words_below_ten_in_digits_from_ten():
 
 def test_words_are_listed_as_a_sentence_lists_them():
     from proofs.core import listed
-    assert [listed(w) for w in ([], ["sine"], ("sine", "ridges"), iter(["sine", "ridges", "rings"]), "abcd")] == [
-        "", "sine", "sine and ridges", "sine, ridges and rings", "a, b, c and d"]
+    assert [listed(w) for w in ([], ["red"], ("red", "green"), iter(["red", "green", "blue"]), "abcd")] == [
+        "", "red", "red and green", "red, green and blue", "a, b, c and d"]
