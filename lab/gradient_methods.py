@@ -58,7 +58,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from renderer import DRAFT_SCENE, fieldcode, pointwise, ucurve
+from renderer import DRAFT_SCENE, fieldcode, pointwise, ucurve, validate
 from renderer import formulas as F
 from renderer.scene import FREQUENCY, UNIT
 from renderer.validate import InvalidType, InvalidValue, choice, flag, positive_int, real
@@ -112,8 +112,11 @@ class Method:
     label : str
         Its name in a legend or a sentence.
     style : Style
-    steps : str or None
-        The `Config` attribute listing its steps; None for a method without a step.
+    steps : str, tuple of float or None
+        The `Config` attribute listing its steps (``"central_steps"``, ``"forward_steps"`` or
+        ``"complex_steps"``: it runs at the steps a configuration gives that sweep); or its own steps,
+        1 to 64 floats in [1e-300, 1) (chart units), the same in every configuration; None for a
+        method without a step.
     repeats : str
         The `Config` attribute saying how many times it is timed.
     applies : callable
@@ -135,7 +138,7 @@ class Method:
     work: Callable
     label: str
     style: Style
-    steps: str | None = None
+    steps: str | tuple | None = None
     repeats: str = "repeats"
     applies: Callable = _always
     compiles: bool = False
@@ -143,9 +146,22 @@ class Method:
     sources: tuple = ()
     derivative: Callable | None = None
 
+    def __post_init__(self):
+        """Its own steps, if given, are checked once, when the record is made: InvalidType or
+        InvalidValue naming ``Method.steps``."""
+        if self.steps is not None and not isinstance(self.steps, str):
+            object.__setattr__(self, "steps", tuple(validate.steps("Method.steps", self.steps, **STEP,
+                                                                   max_count=64).tolist()))
+
     def steps_in(self, config):
-        """Its steps in ``config`` (a tuple of floats), or (None,) for a method without a step."""
-        return (None,) if self.steps is None else tuple(getattr(config, self.steps))
+        """Its steps in ``config`` (a `lab.gradient_benchmark.Config`; a tuple of floats), or (None,)
+        for a method without a step.  InvalidValue if ``steps`` names no step list of ``config``."""
+        if self.steps is None:
+            return (None,)
+        if isinstance(self.steps, tuple):
+            return self.steps
+        lists = tuple(name for name in vars(config) if name.endswith("_steps"))
+        return tuple(getattr(config, choice("Method.steps", self.steps, lists)))
 
 
 # --- the methods over a field --------------------------------------------------------------

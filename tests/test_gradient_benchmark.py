@@ -6,6 +6,7 @@ is shown to reject a wrong variant.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 
@@ -18,7 +19,7 @@ from lab import gradient_benchmark as gb
 from lab import gradient_methods as gm
 from renderer import DRAFT_SCENE, pointwise, ucurve
 from renderer import formulas as F
-from renderer.validate import InputError
+from renderer.validate import InputError, InvalidType, InvalidValue
 
 from .expressions import functions_at_points
 from .test_gradient_methods import FLOAT64_EVAL, applying, generated_trig_calls
@@ -159,6 +160,24 @@ def backward_gradient(field, u, v, ku, kv, eps, info):
 
 BACKWARD = gm.Method("backward", backward_gradient, lambda f, info: gm.Evaluations(h=3.0), "backward difference",
                      gm.Style("#444444", "v", 6, "--"), steps="forward_steps")
+
+
+def test_a_method_with_steps_of_its_own_runs_at_them_in_every_configuration(monkeypatch):
+    """A record may give its own steps instead of naming a `Config` list: `measure` runs it at exactly
+    those, whatever the configuration.  Steps out of range and a name that is no step list are refused,
+    naming ``Method.steps``."""
+    own = dataclasses.replace(BACKWARD, name="backward, own", steps=[3e-5, 1e-4])
+    assert own.steps == (3e-5, 1e-4)
+    monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, own])
+    for config in (TINY, dataclasses.replace(TINY, forward_steps=(1e-2,))):
+        m = gb.measure(config, uv=small_chart(), fields_=("sine",))
+        assert sorted(r.eps for r in m.results if r.method == own.name) == [3e-5, 1e-4]
+    for bad, error in ((0.0, InvalidValue), ((1e-3, 2.0), InvalidValue), ((1e-3, "x"), InvalidType), ([1e-3] * 65, InvalidValue)):
+        with pytest.raises(error, match=r"^Method\.steps"):
+            dataclasses.replace(BACKWARD, steps=bad)
+    with pytest.raises(InvalidValue, match=r"^Method\.steps must be one of \('central_steps', 'forward_steps', "
+                                           r"'complex_steps'\), got 'backward_steps'"):
+        dataclasses.replace(BACKWARD, steps="backward_steps").steps_in(TINY)
 
 
 def test_a_new_method_is_one_record_measured_and_drawn(monkeypatch):
