@@ -53,9 +53,13 @@ def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
     fake = gb.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {})
     fig = univariate_figure(fake)
     lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+    from matplotlib.lines import Line2D
     for name in ("central", "complex step", gm.AD):
-        m = gm.method(name)
-        assert lines[m.label].get_color() == m.style.colour
+        m, drawn = gm.method(name), lines[gm.method(name).label]
+        assert drawn.get_color() == m.style.colour
+        assert drawn.get_linestyle() == Line2D([], [], linestyle=m.style.line).get_linestyle()
+        assert drawn.get_marker() == (m.style.marker if m.steps else "None")
+    assert len({lines[gm.method(n).label].get_linestyle() for n in ("central", "complex step", gm.AD)}) == 3
     assert list(lines[gm.method(gm.AD).label].get_xdata()) == [0, 1]           # across the axes
     assert fig.get_figwidth() <= 5.0 and min(t.get_fontsize() for t in drawn_texts(fig)) >= 10
     assert text_overlaps(fig) == []

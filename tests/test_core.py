@@ -812,7 +812,6 @@ def test_a_step_reports_a_verified_case_over_a_proved_one_and_the_larger_residua
 def test_another_seed_draws_other_points_for_each_component():
     import random
     undecided = Identity("a", sp.atan(x) + sp.atan(1 / x), sp.pi / 2, {x: (0, 1)})
-    sampled = Identity("b", x + sp.Max(0, x - sp.Rational(9, 10)), x, {x: (0, 1)})
     sampled = Identity("b", x + sp.Max(0, x - sp.Rational(8, 10)), x, {x: (0, 1)})
     rng = random.Random(5 + 1)                                  # seed 5, the second undecided component
     point = max(rng.uniform(0, 1) for _ in range(core.POINTS))

@@ -373,15 +373,6 @@ def test_an_unreadable_record_is_computed_again(fresh, monkeypatch):
     assert len(calls) == 1 and json.loads((directory / "u-curve.json").read_text())["value"]
 
 
-def test_without_a_store_values_live_in_the_process(monkeypatch):
-    monkeypatch.delenv(store.ENV, raising=False)
-    monkeypatch.setattr(store, "_MEMORY", {})
-    calls = []
-    for _ in range(2):
-        store.measured("count", lambda: calls.append(1) or len(calls))
-    assert calls == [1]
-
-
 @pytest.mark.parametrize("name", ["", "Upper", "../escape", "a/b", "x" * 101, 7])
 def test_bad_names_are_refused(name, fresh):
     _, calls, compute = fresh

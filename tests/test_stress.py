@@ -5,12 +5,15 @@ wrong renderer would break.
 """
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from renderer import GRADIENTS, Scene, gbuffer, kernel, pointwise, render
 from renderer.formulas import POLE_SIN_PHI
@@ -141,34 +144,40 @@ def test_grazing_rays_at_the_silhouette_stay_on_the_surface():
     assert np.abs(np.linalg.norm(P, axis=-1) - R).max() < 1e-12
 
 
-@pytest.mark.parametrize("m", range(0, 9))
-def test_points_exactly_on_the_u_creases(m):
-    """u = m / k_u as float64 represents it, v off the v-creases: what each
-    pipeline returns and what the kink flag says."""
-    ku, kv = 8.0, 4.0
-    u, v = np.array([m / ku]), np.array([0.47])
-    # |h_u| on either side: ridges is |sine|, so its one-sided h_u are +- sine's there
+@settings(max_examples=80, deadline=None)
+@given(k=st.one_of(st.integers(1, 16).map(float), st.floats(1.0, 16.0)), k_other=st.floats(1.0, 16.0),
+       component=st.sampled_from((0, 1)), which=st.floats(0.0, 1.0), other=st.floats(0.02, 0.98))
+def test_points_exactly_on_a_crease(k, k_other, component, which, other):
+    """A point on a crease of ridges (u = m / k_u, or v = m / k_v, as float64 represents them; the
+    other coordinate off its own creases), at any frequencies: the kink flag is set, the exact
+    gradient's component across the crease is 0 or one side's slope, and the central quotient,
+    straddling the kink, averages the two sides to about 0.  The creases inside the chart, and u = 0
+    and 1 where k_u is a whole number (u wraps; at another k_u the seam is a jump, not a crease;
+    v = 0 and 1 are the poles, where the quotient is one-sided)."""
+    ku, kv = (k, k_other) if component == 0 else (k_other, k)
+    wraps = component == 0 and k.is_integer()
+    m = round(which * k) if wraps else 1 + round(which * (math.ceil(k) - 2))
+    crease = m / k
+    assume(wraps or 1e-3 < crease < 1 - 1e-3)
+    u, v = (np.array([crease]), np.array([other])) if component == 0 else (np.array([other]), np.array([crease]))
+    assume(abs(math.sin(math.pi * (kv, ku)[component] * other)) > 0.3)
+    # |h| on either side: ridges is |sine|, so its one-sided slopes are +- sine's there
     # (tests/scalar_reference.py's closed form of seed §3).
-    one_sided = abs(ref.grad_exact("sine", u[0], v[0], ku, kv)[0])
-    exact = pointwise.exact_gradient("ridges", u, v, ku, kv)[0][0]
-    fd = pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4)[0][0]
-    assert pointwise.kink_band("ridges", u, v, ku, kv)[0]             # flagged
+    one_sided = abs(ref.grad_exact("sine", u[0], v[0], ku, kv)[component])
+    exact = pointwise.exact_gradient("ridges", u, v, ku, kv)[component][0]
+    fd = pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4)[component][0]
+    assert pointwise.kink_band("ridges", u, v, ku, kv)[0]
     # The exact form returns 0 where the float sine is exactly 0, else one side.
     assert exact == 0.0 or abs(abs(exact) - one_sided) < 1e-9 * one_sided
-    # The central quotient straddles the kink and averages the two sides: ~0.
     assert abs(fd) < 1e-6 * one_sided
-
-
-@pytest.mark.parametrize("m", range(1, 4))
-def test_points_exactly_on_the_v_creases(m):
-    ku, kv = 8.0, 4.0
-    u, v = np.array([0.31]), np.array([m / kv])
-    one_sided = abs(ref.grad_exact("sine", u[0], v[0], ku, kv)[1])   # as for u above
-    exact = pointwise.exact_gradient("ridges", u, v, ku, kv)[1][0]
-    fd = pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4)[1][0]
-    assert pointwise.kink_band("ridges", u, v, ku, kv)[0]
-    assert exact == 0.0 or abs(abs(exact) - one_sided) < 1e-9 * one_sided
-    assert abs(fd) < 1e-6 * one_sided
+    # A twentieth of a crease's spacing off it, both give that side's slope (|sine|'s, within the
+    # quotient's truncation error).
+    off = crease + (0.05 if crease < 0.5 else -0.05) / k
+    u, v = (np.array([off]), v) if component == 0 else (u, np.array([off]))
+    slope = abs(ref.grad_exact("sine", u[0], v[0], ku, kv)[component])
+    for got, rtol in ((pointwise.exact_gradient("ridges", u, v, ku, kv), 1e-12),
+                      (pointwise.central_gradient("ridges", u, v, ku, kv, 1e-4), 1e-5)):
+        assert abs(abs(got[component][0]) - slope) < rtol * slope
 
 
 def test_shading_goes_continuously_to_zero_at_the_terminator():
