@@ -461,12 +461,15 @@ def test_surface_check_rejects_a_point_one_part_in_1e11_off():
 
 
 def test_finite_and_range_checks_reject_bad_values():
+    """Each helper on its own (``all_finite`` is the only check on the buffers without a range), and
+    ``all_finite`` on every array it is given, not only the first."""
     image = np.full((4, 4, 3), 0.5)
     assert all_finite(image) and in_unit_interval(image)
-    for bad in (np.nan, np.inf, 1.0 + 2**-52, -1e-300):
+    for bad in (np.nan, np.inf, -np.inf, 1.0 + 2**-52, -1e-300):
         wrong = image.copy()
         wrong[2, 1, 0] = bad
-        assert not (all_finite(wrong) and in_unit_interval(wrong))
+        assert all_finite(wrong) == all_finite(image, wrong) == math.isfinite(bad)
+        assert not in_unit_interval(wrong)
 
 
 # --- valid scenes outside the seed's range -------------------------------------------------

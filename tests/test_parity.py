@@ -40,6 +40,7 @@ shown to reject a wrong variant at the end of the file.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import itertools
 import math
@@ -50,12 +51,15 @@ import numpy as np
 import pytest
 import sympy as sp
 from allpairspy import AllPairs
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
 from mpmath import iv
 
 from renderer import GRADIENTS, MODELS, PointLight, Scene, backends, render
 from renderer import formulas as F
 from renderer.validate import InputError
 from tests import scalar_reference as ref
+from tests.test_any_scene import accepted_scenes
 from tests.jsnode import in_ci
 
 pytestmark = pytest.mark.cpu_dependent     # make test-baseline-simd runs the file again
@@ -588,6 +592,43 @@ def test_parity_rejects_a_scene_that_differs_in_one_field(change, gradient, kind
     wrong = render(scene.replace(**change), 24, 20, gradient=gradient)
     failures = parity_failures(scene, 24, 20, gradient, frame=wrong)
     assert any(kind in f for f in failures), failures
+
+
+def _nudged(value, by):
+    """``value`` (a Scene field's) with its first number scaled by 1 + ``by`` (or set to ``by`` where 0);
+    None for a value without a number (a name, a flag)."""
+    if isinstance(value, bool) or isinstance(value, str):
+        return None
+    if isinstance(value, float):
+        return value * (1 + by) if value else by
+    if isinstance(value, PointLight):
+        return PointLight(_nudged(value.position, by), value.color)
+    first = _nudged(value[0], by) if value else None
+    return None if first is None else (first, *value[1:])
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(other=accepted_scenes(), name=st.sampled_from([f.name for f in dataclasses.fields(Scene)]),
+       by=st.one_of(st.none(), st.floats(-10.0, -3.0).map(lambda e: 10.0**e)))
+def test_parity_rejects_a_frame_of_any_one_field_changed(other, name, by):
+    """The default scene's frame replaced by the frame of the scene with any one field changed (set to
+    its value in any accepted scene, or its first number nudged by 1e-10 to 1e-3 relative): wherever
+    the two frames differ (a chamber or a kink flag, a channel by more than 1e-9, a gradient component
+    by more than 1e-9 relative) at more pixels than the grazing exemption may excuse, parity fails.
+    Its allowances hide no change of the scene, however small."""
+    scene = Scene()
+    value = getattr(other, name) if by is None else _nudged(getattr(scene, name), by)
+    assume(value is not None)
+    try:
+        changed = scene.replace(**{name: value})
+    except ValueError:
+        assume(False)
+    right, wrong = render(scene, 24, 20), render(changed, 24, 20)
+    differs = ((right.chamber != wrong.chamber) | (right.kink != wrong.kink)
+               | (np.abs(right.image - wrong.image).max(axis=-1) > 1e-9)
+               | (np.abs(right.grad - wrong.grad) > 1e-9 * (1 + np.abs(right.grad))).any(axis=-1))
+    assume(np.count_nonzero(differs) > MAX_GRAZING)
+    assert parity_failures(scene, 24, 20, "exact", frame=wrong), (name, value)
 
 
 def _seed_sphere_b_t(x, y, scene):
