@@ -111,8 +111,8 @@ MUTANTS = [
      "return np.where(c <= 0.04045, 12.92 * c,", "the sRGB breakpoint of the decoding side"),
     ("camera-offset", "renderer/render.py", "WINDOW_MARGIN, WINDOW_OFFSET = 1.25, 0.15",
      "WINDOW_MARGIN, WINDOW_OFFSET = 1.25, -0.15", "the window shifted up, not down"),
-    ("model-coefficient", "renderer/ucurve.py", "T, C, G = abs(h3f) / 6,", "T, C, G = abs(h3f) / 2,",
-     "the plotted U-curve model's truncation term over 2, not 6"),
+    ("model-coefficient", "renderer/formulas.py", "ERROR_MODEL = sp.Add(sp.Mul(sp.Rational(1, 6),",
+     "ERROR_MODEL = sp.Add(sp.Mul(sp.Rational(1, 2),", "the plotted U-curve model's truncation term over 2, not 6"),
 ]
 
 #: The second audit: new kinds of bug, none of `MUTANTS`' kinds.  At least eight in proofs/ (the

@@ -20,7 +20,7 @@ from renderer import formulas as F
 from .core import Step, Theorem, Verdict, calc, catalogue, written
 
 x = sp.Symbol("x", real=True)
-eps = sp.Symbol("varepsilon", positive=True)
+eps = F.eps
 f = sp.Function("h")
 ORDER = 6
 
@@ -248,18 +248,13 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
     )
 
 # ----------------------------------------------------------------------------- the optimal step
-H3, H, HX, u_round = sp.symbols("H_3 H H_x u", positive=True)
+H3, H, HX, u_round = F.H3, F.H, F.HX, F.u_round
 E = sp.Function("E")
 eps_star = sp.Symbol("eps_star", positive=True)
-#: The error model, truncation plus roundoff, as written: eps^2 |h'''| / 6 + u (|h| + |x h'|) / eps.
-#: Roundoff has two sources: the rounded values h(x +- eps) (each off by at most about u |h|, so
-#: u |h| / eps in the quotient) and the rounded abscissae fl(x +- eps) (each off by at most u |x|,
-#: which moves h by |h'| u |x|, so u |x h'| / eps in the quotient).
+#: The renderer's error model and optimal step (`renderer.formulas.ERROR_MODEL` and `EPS_STAR`, what
+#: the U-curves draw), kept as written.
 ROUNDOFF = sp.Add(H, HX, evaluate=False)
-ERROR_MODEL = written(sp.Add(sp.Mul(sp.Rational(1, 6), eps**2, H3, evaluate=False),
-                             sp.Mul(u_round, ROUNDOFF, 1 / eps, evaluate=False), evaluate=False))
-#: The optimal step, as written: (3 u (|h| + |x h'|) / |h'''|)^(1/3).
-EPS_STAR = written(sp.Pow(sp.Mul(3, u_round, ROUNDOFF, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
+ERROR_MODEL, EPS_STAR = written(F.ERROR_MODEL), written(F.EPS_STAR)
 NAMES = {H: r"\lvert h\rvert", HX: r"\lvert u\,h'\rvert", H3: r"\lvert h'''\rvert", u_round: r"u_{\mathrm{round}}",
          eps_star: r"\varepsilon^\ast"}
 STEP_DOMAIN = {eps: (0.05, 2.0), H: (0.1, 10.0), HX: (0.1, 10.0), H3: (0.1, 10.0), u_round: (1e-3, 0.1)}

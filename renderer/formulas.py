@@ -25,7 +25,8 @@ What lives here (seed §2, §3 and Cell 1, with the project's corrections):
   "surface": the normal of the displaced sphere P = (R + beta h) N);
 * the central-difference stencil (u wraps, v clamps with a one-sided quotient);
 * the pixel footprint in (u, v), the step of ``gradient="footprint"``
-  (pbrt-v4's bump-mapping rule).
+  (pbrt-v4's bump-mapping rule);
+* the central difference's error model and its optimal step (`ERROR_MODEL`, `EPS_STAR`).
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ __all__ = [
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
     "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FOOTPRINT_RULE", "FUNCTIONS", "FIELD_FUNCTIONS",
-    "UNIVARIATE_FUNCTIONS",
+    "UNIVARIATE_FUNCTIONS", "eps", "H3", "H", "HX", "u_round", "ERROR_MODEL", "EPS_STAR",
 ]
 
 # ---------------------------------------------------------------- height fields
@@ -429,6 +430,23 @@ FIELD_FUNCTIONS = {
 }
 #: Assignments printed before a function's outputs (the stencil's points).
 PRELUDE = {"central": STENCIL_POINTS}
+
+
+# ------------------------------------------- the central difference's error model
+#: The step, |h'''|, |h| and |x h'| at the point, and the unit roundoff u_round (named as the
+#: optimal-step theorem prints them).
+eps, H3, H, HX, u_round = sp.Symbol("varepsilon", positive=True), *sp.symbols("H_3 H H_x u", positive=True)
+#: The error model of the central quotient at x, truncation plus roundoff, as written:
+#: eps^2 |h'''| / 6 + u_round (|h| + |x h'|) / eps.  Roundoff has two sources: the rounded values
+#: h(x +- eps) (each off by at most about u_round |h|, so u_round |h| / eps in the quotient) and the
+#: rounded abscissae fl(x +- eps) (each off by at most u_round |x|, which moves h by |h'| u_round |x|,
+#: so u_round |x h'| / eps); the trade-off as in Higham, *Accuracy and Stability of Numerical Algorithms*.
+#: `renderer.ucurve` draws it and proofs/finite_difference.py proves where it is least.
+ERROR_MODEL = sp.Add(sp.Mul(sp.Rational(1, 6), eps**2, H3, evaluate=False),
+                     sp.Mul(u_round, sp.Add(H, HX, evaluate=False), 1 / eps, evaluate=False), evaluate=False)
+#: Its minimiser over eps > 0 where |h'''| > 0, as written: (3 u_round (|h| + |x h'|) / |h'''|)^(1/3).
+EPS_STAR = sp.Pow(sp.Mul(3, u_round, sp.Add(H, HX, evaluate=False), 1 / H3, evaluate=False), sp.Rational(1, 3),
+                  evaluate=False)
 
 
 # ------------------------------------------------------- a function of one variable

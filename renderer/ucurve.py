@@ -275,6 +275,18 @@ def _undefined(label, point):
                                  f"derivative the measurement needs is not a real number float64 can hold")
 
 
+@lru_cache(maxsize=None)
+def _error_model():
+    """`renderer.formulas.ERROR_MODEL` and `EPS_STAR` as numpy functions of (eps, |h'''|, |h|,
+    |x h'|, u_round): the model's coefficient of eps^2 (truncation) and of 1/eps from |h| (the
+    rounded values) and from |x h'| (the rounded abscissae), the model, and its minimiser."""
+    args = (F.eps, F.H3, F.H, F.HX, F.u_round)
+    expanded = sp.expand(F.ERROR_MODEL)
+    roundoff = expanded.coeff(F.eps, -1)
+    parts = (expanded.coeff(F.eps, 2), roundoff.subs(F.HX, 0), roundoff.subs(F.H, 0), F.ERROR_MODEL, F.EPS_STAR)
+    return tuple(sp.lambdify(args, p, "numpy") for p in parts)
+
+
 def _curve(label, x, steps, quotient, line, reason, point):
     """The U-curve of the float64 quotients ``quotient(eps) -> (value, x_plus, x_minus, den)`` of the
     function ``line`` = (h, h', h''') of one variable at x: `UCurve`'s fields (``label`` and
@@ -316,12 +328,14 @@ def _curve(label, x, steps, quotient, line, reason, point):
         return UCurve(**measured, model=np.full(steps.shape, nan), derivative=nan, third_derivative=nan,
                       model_truncation=nan, model_cancellation=nan, model_argument=nan, eps_model=nan,
                       error_model=nan, eps_measured_min=nan, error_at_measured_min=nan, reason=reason)
-    T, C, G = abs(h3f) / 6, UNIT_ROUNDOFF * abs(h0f), UNIT_ROUNDOFF * abs(x * float(true))
-    model = T * steps**2 + (C + G) / steps
-    # E'(eps) = 2 T eps - (C + G) / eps^2 = 0.  No truncation (T = 0): E falls towards 0 as eps grows
-    # (eps* infinite); no rounding (C + G = 0, h = 0 at x = 0): E is least, 0, at eps* = 0.
-    star = ((C + G) / (2 * T)) ** (1 / 3) if T > 0 else float("inf")
-    least = T * star**2 + (C + G) / star if 0 < star < float("inf") else 0.0
+    trunc, cancel, argument, model_at, star_at = _error_model()
+    given = (abs(h3f), abs(h0f), abs(x * float(true)), UNIT_ROUNDOFF)
+    T, C, G = (float(f(1.0, *given)) for f in (trunc, cancel, argument))
+    model = model_at(steps, *given)
+    # No truncation (T = 0): E falls towards 0 as eps grows (eps* infinite); no rounding (C + G = 0,
+    # h = 0 at x = 0): E is least, 0, at eps* = 0.
+    star = float(star_at(1.0, *given)) if T > 0 else float("inf")
+    least = float(model_at(star, *given)) if 0 < star < float("inf") else 0.0
     try:
         A, B = fit_model(steps, error, start=(max(T, 1e-300), max(C + G, 1e-300)))
     except ValueError:              # an exact quotient (h_u of rings: zero error) has no U to fit

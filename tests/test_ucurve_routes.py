@@ -140,3 +140,35 @@ def test_a_crease_is_a_sign_change_within_one_ulp_of_any_abs_of_the_field():
     assert non_differentiable(two, 0.3, 0.3, "v", 8.0, 4.0) is None
     tiny = sp.Abs((F.u - sp.Rational(1, 2)) / 10**20, evaluate=False) + F.v
     assert "changes sign" in non_differentiable(tiny, 0.5, 0.3, "u", 8.0, 4.0)
+
+
+
+def test_the_curves_draw_the_model_the_optimal_step_theorem_proves(monkeypatch):
+    """One error model: the optimal-step theorem is about `renderer.formulas.ERROR_MODEL` and `EPS_STAR`
+    (the same objects), and a U-curve's model, its coefficients and its optimum are read from them.
+    Planted in the records one at a time: the truncation over 2, not 6, plus a term eps (the curve's
+    truncation coefficient triples, its model follows term for term, its optimum stays EPS_STAR's), and
+    the optimum's 3 dropped (the optimum shrinks by 3^(1/3), nothing else moves).  The same plants in
+    renderer/formulas.py leave the theorem refuted (the mutation audit's model-coefficient)."""
+    import renderer.ucurve as ucurve
+    from proofs import finite_difference as fd
+    assert fd.ERROR_MODEL.args[0] is F.ERROR_MODEL and fd.EPS_STAR.args[0] is F.EPS_STAR
+
+    def curve(**planted):
+        with monkeypatch.context() as m:
+            for name, value in planted.items():
+                m.setattr(F, name, value)
+            ucurve._error_model.cache_clear()
+            try:
+                return measure_function("exp(x)*sin(3*x)", 0.4, eps=[1e-3, 1e-6])
+            finally:
+                ucurve._error_model.cache_clear()
+    right = curve()
+    model = curve(ERROR_MODEL=F.ERROR_MODEL.xreplace({sp.Rational(1, 6): sp.Rational(1, 2)}) + F.eps)
+    assert model.model_truncation == pytest.approx(3 * right.model_truncation, rel=1e-15)
+    assert (model.model_cancellation, model.model_argument, model.eps_model) == \
+        (right.model_cancellation, right.model_argument, right.eps_model)
+    assert model.model == pytest.approx(right.model + 2 * right.model_truncation * right.eps**2 + right.eps, rel=1e-14)
+    star = curve(EPS_STAR=F.EPS_STAR.xreplace({3: 1}))
+    assert star.eps_model == pytest.approx(right.eps_model / 3 ** (1 / 3), rel=1e-14)
+    assert (star.model_truncation, star.model.tolist()) == (right.model_truncation, right.model.tolist())
