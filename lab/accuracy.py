@@ -125,9 +125,10 @@ def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=N
 
 
 def normal_beta_derivative_residual(trials=2000, seed=5):
-    """Worst |float64 (I - N'N'^T) g / |M| - dN'/dbeta| over random (N, g, beta), a float.
+    """Worst |float64 (I - N'N'^T) g / |M| - dN'/dbeta| over random (N, frame, gradient, beta), a float:
+    the closed form the theorem normal-beta-derivative proves, evaluated in float64 (numpy).
 
-    The reference is mpmath's numerical derivative of N'(beta) = M / |M| at 50
+    The reference is mpmath's numerical derivative of the renderer's N'(beta) = M / |M| at 50
     digits (mpmath.diff), independent of the closed form.  One measurement of
     the build (`lab.store`): §5, §6 and the claims register show the same value.
     ``trials``: an int in [1, 2**24]; ``seed``: an int in [0, 2**64 - 1] (InvalidType or
@@ -138,28 +139,33 @@ def normal_beta_derivative_residual(trials=2000, seed=5):
                     trials=positive_int("trials", trials, high=MAX_COUNT), seed=_seed("seed", seed))
 
 
+@lru_cache(maxsize=None)
+def _normal_and_derivative():
+    """The renderer's chart-mode normal N' (`renderer.formulas.PERTURBED_NORMAL`) as an mpmath function,
+    and the closed form the theorem normal-beta-derivative proves of it, (I - N'N'^T) g / |M|, as a
+    numpy one: each of (N, e_theta, e_phi, h_u, h_v, beta) to a list of three components."""
+    from proofs import normal, registry
+    theorem = registry.get("normal-beta-derivative")
+    args = (F.N_x, F.N_y, F.N_z, *F.e_theta, *F.e_phi, F.h_u, F.h_v, F.beta)
+    return (sp.lambdify(args, list(normal.N_PRIME), "mpmath"),
+            sp.lambdify(args, list(theorem.explicit(normal.CLAIMED_DERIVATIVE)), "numpy"))
+
+
 def _normal_beta_derivative_residual(trials, seed):
+    normal, closed = _normal_and_derivative()
     rng = np.random.default_rng(seed)
     worst = 0.0
     with mpmath.workdps(DIGITS):
         for _ in range(trials):
             N = rng.normal(size=3)
             N /= np.linalg.norm(N)
-            g = rng.normal(size=3) * 4.0
+            frame, gradient = rng.normal(size=6), rng.normal(size=2) * 2.0
             b = float(rng.uniform(0.0, 2.0))
-            M = N + b * g
-            Np = M / np.linalg.norm(M)
-            closed = (g - Np * (Np @ g)) / np.linalg.norm(M)        # float64
-            Nm = [mpmath.mpf(float(x)) for x in N]
-            gm = [mpmath.mpf(float(x)) for x in g]
-
-            def comp(k, beta):
-                m = [Nm[i] + beta * gm[i] for i in range(3)]
-                return m[k] / mpmath.sqrt(sum(x * x for x in m))
-
+            given = [float(x) for x in (*N, *frame, *gradient)]
+            derivative = closed(*given, b)                                  # float64
             for k in range(3):
-                ref = mpmath.diff(lambda beta: comp(k, beta), mpmath.mpf(b))
-                worst = max(worst, float(abs(mpmath.mpf(float(closed[k])) - ref)))
+                ref = mpmath.diff(lambda beta: normal(*given, beta)[k], mpmath.mpf(b))
+                worst = max(worst, float(abs(mpmath.mpf(float(derivative[k])) - ref)))
     return worst
 
 

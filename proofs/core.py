@@ -547,6 +547,11 @@ class Theorem:
         first failure refutes, naming the theorem and the step (number and sentence) or claim."""
         return _prove(self)
 
+    def explicit(self, x):
+        """``x`` (an expression in the theorem's names) with its ``where`` substituted to the
+        renderer's symbols and evaluated: written forms unwrapped, matrices explicit."""
+        return _explicit(_substitute(x, self.where))
+
     def placeholders(self) -> list:
         """The keys of the statement's ``⟦key⟧`` placeholders, in order."""
         return PLACEHOLDER.findall(self.statement)

@@ -52,3 +52,31 @@ def test_each_fields_optimum_stays_below_its_crease_distance(monkeypatch):
     assert opt["creased"]["crease_distance"] == pytest.approx(0.005, abs=1e-15)
     assert opt["creased"]["largest_step"] < 0.005 < 0.1 == opt["sine"]["largest_step"]
     assert (opt["creased"]["u"], opt["creased"]["v"], opt["creased"]["component"]) == creased.optimum_at
+
+
+@pytest.mark.parametrize("variant", ["the projection onto N, not N'", "the sign of the projection flipped",
+                                     "the renderer's normal without its beta"])
+def test_the_normal_derivative_measurement_is_of_the_proved_form_and_the_renderers_normal(monkeypatch, variant):
+    """The float64 side is the closed form the theorem normal-beta-derivative proves (its object,
+    evaluated through the theorem's names), the reference the renderer's chart-mode normal: a wrong
+    closed form planted in the theorem, or a wrong normal in the renderer's record, is measured far
+    past verify's 1e-13."""
+    import sympy as sp
+
+    from lab import accuracy
+    from proofs import normal
+    from renderer import formulas as F
+    with monkeypatch.context() as m:
+        if variant == "the renderer's normal without its beta":
+            m.setattr(normal, "N_PRIME", normal.N_PRIME.subs(F.beta, 0))
+        else:
+            projection = normal.N_S if variant.startswith("the projection onto N") else normal.NP_S
+            sign = -1 if variant.startswith("the projection") else 1
+            m.setattr(normal, "CLAIMED_DERIVATIVE", (sp.Identity(3) + sign * projection * projection.T)
+                      * normal.G_S / normal.NORM_M_S)
+        accuracy._normal_and_derivative.cache_clear()
+        try:
+            assert accuracy._normal_beta_derivative_residual(20, 5) > 1e-3
+        finally:
+            accuracy._normal_and_derivative.cache_clear()
+    assert accuracy._normal_beta_derivative_residual(20, 5) < 1e-13
