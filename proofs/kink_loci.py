@@ -29,8 +29,13 @@ P = R * sp.Matrix([sp.sin(phi) * sp.cos(theta), sp.sin(phi) * sp.sin(theta), sp.
 #: Projection from the eye (0, 0, e) onto the image plane z = 0.
 x_img = P[0] * e / (e - P[2])
 y_img = P[1] * e / (e - P[2])
-RHO = e * R * sp.sin(phi) / (e - R * sp.cos(phi))
-DRHO = e * R * (e * sp.cos(phi) - R) / (e - R * sp.cos(phi)) ** 2
+#: rho(phi), the image radius of sphere A's circle of polar angle phi, and rho'(phi), as written (the
+#: theorems print them so): e R sin(phi) / (e - R cos(phi)) and e R (e cos phi - R) / (e - R cos phi)^2;
+#: `RHO` and `DRHO` are the same objects unwrapped, which the evidence evaluates.
+RHO_SHOWN = written(sp.Mul(e, R, sp.sin(phi), sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -1), evaluate=False))
+DRHO_SHOWN = written(sp.Mul(e, R, sp.Add(e * sp.cos(phi), -R, evaluate=False),
+                            sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -2), evaluate=False))
+RHO, DRHO = RHO_SHOWN.args[0], DRHO_SHOWN.args[0]
 DOMAIN = {theta: (-3.1, 3.1), phi: (0.01, 1.2), R: (0.5, 1.0), e: (2.0, 6.0)}
 m_sym = sp.Symbol("m", integer=True)
 #: The zero lines u = m / k_u and v = m / k_v, and the circle's polar angle phi_m (v = m / k_v by the chart).
@@ -52,10 +57,16 @@ def ray_angles(k_u):
     return np.asarray(ray_angle()[1](np.arange(int(np.ceil(k_u))), k_u), dtype=float)
 
 
+@lru_cache(maxsize=None)
+def _circle_angle():
+    """`PHI_M` (the chart's phi at v = m / k_v) as a numpy function of (m, k_v)."""
+    return sp.lambdify((m_sym, F.k_v), PHI_M, modules="numpy")
+
+
 def circle_angles(k_v):
-    """Polar angles phi_m = pi m / k_v (radians, float64 array) of the circles v = m / k_v,
-    m = 0 .. floor(k_v); m = 0 is the north pole, the circle of radius 0."""
-    return np.pi * np.arange(int(np.floor(k_v)) + 1) / k_v
+    """Polar angles phi_m (radians, float64 array) of the circles v = m / k_v, m = 0 .. floor(k_v),
+    from `PHI_M`: pi m / k_v; m = 0 is the north pole, the circle of radius 0."""
+    return np.asarray(_circle_angle()(np.arange(int(np.floor(k_v)) + 1), k_v), dtype=float)
 
 
 @lru_cache(maxsize=None)
@@ -110,9 +121,10 @@ def locus_bands(kind, scene, width, height, shift=0.0, rho=RHO, drho=DRHO, band_
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     from renderer import gbuffer
+    from renderer.render import SPHERE_A
     g = gbuffer(scene, width, height)
     X, Y = np.meshgrid(g.x, g.y)
-    on_a = g.chamber == 1
+    on_a = g.chamber == SPHERE_A
     if kind == "rays":
         off = np.angle(np.exp(1j * (np.arctan2(Y, X)[None] - ray_angles(scene.k_u)[:, None, None] - shift)))
         return (np.abs(off) < 2 * np.pi * band_scale * _half_width(scene.k_u)) & on_a, on_a
@@ -174,12 +186,8 @@ rho = sp.Function("rho")
 alpha_m = sp.Symbol("alpha_m")
 E_S, N_S, P_S = (sp.MatrixSymbol(name, 3, 1) for name in "ENP")
 NAMES = {alpha_m: r"\alpha_m"}
-#: rho(phi) and the ray's angle as written: e R sin(phi) / (e - R cos(phi)), 2 pi m / k_u - pi.
-RHO_SHOWN = written(sp.Mul(e, R, sp.sin(phi), sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -1), evaluate=False))
+#: The ray's angle as written: 2 pi m / k_u - pi.
 ALPHA_SHOWN = written(sp.Add(2 * sp.pi * m_sym / F.k_u, -sp.pi, evaluate=False))
-#: rho'(phi) as written: e R (e cos phi - R) / (e - R cos phi)^2.
-DRHO_SHOWN = written(sp.Mul(e, R, sp.Add(e * sp.cos(phi), -R, evaluate=False),
-                            sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -2), evaluate=False))
 
 
 def _where(rho_, alpha=ALPHA_SHOWN):

@@ -119,14 +119,15 @@ def root_mismatches(root, size=64):
     of `_sphere_roots` (0, the near one; 1 for a wrong variant), written here and
     evaluated in float64, differs from the renderer's ray parameter t by more than 1e-9."""
     from renderer import gbuffer
+    from renderer.render import SPHERE_A, SPHERE_B
     scene = Scene()
     g = gbuffer(scene, size, size)
     at = (*np.meshgrid(g.x, g.y), scene.camera_z, scene.radius_a, scene.radius_b, *scene.center_b)
     with np.errstate(invalid="ignore"):                 # sqrt of a negative off the sphere
         near = [sp.lambdify((x, y, e, R, r_b, *Cb), _sphere_roots(C, r)[root])(*at)
                 for C, r in ((sp.zeros(3, 1), R), (Cb, r_b))]
-    on = (g.chamber == 1) | (g.chamber == 2)
-    want = np.where(g.chamber == 1, *near)
+    on = (g.chamber == SPHERE_A) | (g.chamber == SPHERE_B)
+    want = np.where(g.chamber == SPHERE_A, *near)
     return int(np.count_nonzero(on & ~(np.abs(want - g.t) <= 1e-9))), int(np.count_nonzero(on))
 
 
