@@ -83,9 +83,23 @@ def away_from_pole(bump):
 
 
 KERNEL_COEFFS = away_from_pole(F.BUMP["surface"])
-#: ... and as the statement writes them: the displaced normal's tangential coefficients in chart terms.
-_w = -F.beta / (F.R + F.beta * F.h)
-CHART_COEFFS = sp.Tuple(_w * F.h_u / (2 * sp.pi * F.sin_phi), _w * F.h_v / sp.pi)
+
+
+def chart_terms(claim):
+    """The tangential coefficients (of e_theta, e_phi) of the displaced normal ``claim`` (a 3-vector
+    expression in N, e_theta, e_phi, like `CLAIM`), each over its coefficient of N, in chart terms:
+    H_theta = h_u du/dtheta and H_phi = h_v dv/dphi (`proofs.frame.CHART_RATES`), H = h, in the
+    renderer's symbols (`renderer.formulas`).  A sympy Tuple of two expressions."""
+    basis = {N_S: sp.ImmutableMatrix([1, 0, 0]), ET_S: sp.ImmutableMatrix([0, 1, 0]),
+             EP_S: sp.ImmutableMatrix([0, 0, 1])}
+    weights = sp.Matrix(claim.xreplace(basis).doit())
+    chart = {H_t: F.h_u * CHART_RATES[0], H_p: F.h_v * CHART_RATES[1]}
+    return sp.Tuple(*(sp.factor(weights[k] / weights[0]).subs(chart).subs(H_at, F.h).xreplace(
+        {sp.sin(phi): F.sin_phi, R: F.R, beta: F.beta}) for k in (1, 2)))
+
+
+#: ... and as the statement derives them: the displaced normal's tangential coefficients in chart terms.
+CHART_COEFFS = chart_terms(CLAIM)
 B_U, B_V = sp.symbols("b_u b_v")
 KERNEL_DOMAIN = {F.beta: (0.0, 2.0), F.R: (0.5, 2.0), F.h: (-1.0, 1.0), F.h_u: (-30.0, 30.0),
                  F.h_v: (-30.0, 30.0), F.sin_phi: (0.001, 1.0)}
@@ -278,9 +292,8 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
         wrong_variants=(("the renderer's chart bump (the seed's) as the displaced normal's coefficients",
                          lambda: _theorem(kernel=F.BUMP["chart"]).check()),
                         ("the seed's floor back: the surface bump's sin phi floored at 1e-4",
-                         lambda: _theorem(kernel=away_from_pole(
-                             (_w * F.h_u / (2 * sp.pi * sp.Max(F.sin_phi, SEED_POLE_SIN_PHI)),
-                              F.BUMP["surface"][1]))).check()),
+                         lambda: _theorem(kernel=(KERNEL_COEFFS[0].xreplace(
+                             {F.sin_phi: sp.Max(F.sin_phi, SEED_POLE_SIN_PHI)}), KERNEL_COEFFS[1])).check()),
                         ("the seed's bump the normal of a displaced sphere for every field",
                          lambda: _theorem(claimed=tuple(F.FIELDS)).check()),
                         ("the renderer's bump='chart' normals as the displaced surface's",
@@ -294,7 +307,7 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                         ("the tangential term at beta^2, not beta",
                          lambda: _theorem(_displaced(-beta**2 / (R + beta * H_at))).check()),
                         ("the chart coefficient of e_phi (the last) h_v / 2 pi, not h_v / pi",
-                         lambda: _theorem(chart=sp.Tuple(CHART_COEFFS[0], _w * F.h_v / (2 * sp.pi))).check()),
+                         lambda: _theorem(chart=sp.Tuple(CHART_COEFFS[0], CHART_COEFFS[1] / 2)).check()),
                         ("the obstruction's last term with 2 sin(phi) + 1, not 2 sin(phi) - 1",
                          lambda: _theorem(obstruction=2 * sp.cos(phi) * H_t
                                           + (2 * sp.sin(phi) + 1) * sp.Derivative(H_at, theta, phi)).check())),
