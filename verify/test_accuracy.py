@@ -4,6 +4,7 @@ import pytest
 
 from lab.accuracy import gradient_accuracy, image_beta_order, normal_beta_derivative_residual
 from renderer.formulas import FIELDS
+from renderer.ucurve import UNIT_ROUNDOFF
 
 
 @pytest.mark.parametrize("field", list(FIELDS))
@@ -52,7 +53,7 @@ def test_each_fields_optimum_at_its_stated_point():
             f"{field}: at its fitted step the measured error is {ratio:.3g} times the model's (accepted: within "
             f"a factor 3) at optimum=({u}, {v}, {component!r}); register the field with another optimum= point "
             f"(lab.accuracy.optima()[{field!r}] gives both errors)")
-        assert o["h"] + o["x_h1"] == pytest.approx(c.model_argument / o["argument_share"] / 2.0**-53), field
+        assert o["h"] + o["x_h1"] == pytest.approx(c.model_argument / o["argument_share"] / UNIT_ROUNDOFF), field
 
 
 def test_the_crease_share_is_the_census_straddling_count():

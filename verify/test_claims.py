@@ -7,7 +7,7 @@ in tests/test_claim_rules.py.
 
 import pytest
 
-from lab.claims import CLAIMS, CORRECTED, FAILS, HOLDS
+from lab.claims import CENSUS_SIZE, CLAIMS, CORRECTED, FAILS, HOLDS
 
 
 @pytest.mark.parametrize("claim", CLAIMS, ids=[c.id for c in CLAIMS])
@@ -27,5 +27,5 @@ def test_cell3_runs_tells_the_drafts_code_from_this_renderers_frame(claim_result
 
     measured, _ = claim_results["cell3-runs"]
     code, pixels, ours = measured["code_pixels_a"], measured["pixels"], measured["pixels_a"]
-    chamber = gbuffer(DRAFT_SCENE, 256, 256).chamber
+    chamber = gbuffer(DRAFT_SCENE, CENSUS_SIZE, CENSUS_SIZE).chamber
     assert (code, pixels, ours) == (0, chamber.size, int(np.count_nonzero(chamber == SPHERE_A)))

@@ -7,6 +7,7 @@ import pytest
 
 from lab.seed_errata import ERRATA, ErratumVanished, reproduced
 from renderer import DRAFT_SCENE, gbuffer
+from renderer.render import SPHERE_A, SPHERE_B
 
 def test_every_erratum_is_measured_and_reported(errata):
     assert [e.id for e in ERRATA] == list(errata)
@@ -23,7 +24,7 @@ def test_sphere_b_seed_variant_is_off_the_surface(errata):
     # The renderer's own sphere-B hit points are on the surface.
     scene = DRAFT_SCENE
     g = gbuffer(scene, 128, 128)
-    b = g.chamber == 2
+    b = g.chamber == SPHERE_B
     dist = np.linalg.norm(g.P[b] - np.asarray(scene.center_b), axis=-1)
     assert np.max(np.abs(dist - scene.radius_b)) <= 1e-12 * scene.radius_b
 
@@ -38,7 +39,7 @@ def test_terminator_leak_exists_in_seed_rule_only(errata):
     scene = DRAFT_SCENE.replace(lights=(light,), ka=0.0, beta=1.5)
     g = gbuffer(scene, 128, 128)
     image = render(scene, 128, 128).image
-    a = g.chamber == 1
+    a = g.chamber == SPHERE_A
     away = a & (np.einsum("hwc,hwc->hw", g.N, np.asarray(light.position) - g.P) <= 0)
     bumped_toward = away & (np.einsum("hwc,hwc->hw", g.Ns, np.asarray(light.position) - g.P) > 0)
     assert bumped_toward.sum() > 0          # pixels the seed's rule would light
@@ -124,7 +125,7 @@ def test_specular_lobe_is_gated_by_the_shading_normal():
     v /= np.linalg.norm(v, axis=-1, keepdims=True)
     h = w_hat + v
     h /= np.linalg.norm(h, axis=-1, keepdims=True)
-    a = g.chamber == 1
+    a = g.chamber == SPHERE_A
     lit = np.einsum("hwc,hwc->hw", g.N, w) > 0
     away = np.einsum("hwc,hwc->hw", g.Ns, w_hat) <= 0
     seed_lobe = np.maximum(np.einsum("hwc,hwc->hw", g.Ns, h), 0) ** scene.shininess

@@ -2,9 +2,15 @@
 behaves as its theory says, and the checks reject wrong variants."""
 
 import numpy as np
+import sympy as sp
 import pytest
 
-from renderer.ucurve import UNIT_ROUNDOFF, measure
+from proofs.finite_difference import CLAIMED, eps, f, x
+from renderer.ucurve import SEED_FREQUENCIES, UNIT_ROUNDOFF, measure
+
+#: The central quotient's truncation coefficient (h''' eps^2 times it), as the theorem
+#: central-difference-truncation proves it: 1/6.
+TRUNCATION = float(CLAIMED[1] / (eps**2 * sp.diff(f(x), x, 3)))
 
 def test_split_is_exact(curve):
     # error = |truncation + roundoff| up to the float64 rounding of each part.
@@ -14,7 +20,7 @@ def test_split_is_exact(curve):
 
 def test_truncation_follows_eps_squared_h3_over_6_at_large_steps(curve):
     big = (curve.eps > 1e-4) & (curve.eps < 1e-2)
-    predicted = curve.eps[big] ** 2 * curve.third_derivative / 6
+    predicted = curve.eps[big] ** 2 * curve.third_derivative * TRUNCATION
     assert np.allclose(curve.truncation[big], predicted, rtol=2e-2, atol=0)
     # A wrong coefficient (1/3) is rejected by the same comparison.
     assert not np.allclose(curve.truncation[big], 2 * predicted, rtol=2e-2, atol=0)
@@ -80,12 +86,12 @@ def test_at_the_charts_edge_1_the_reference_is_the_slope_from_inside(component):
     at = dict(u=1.0) if component == "u" else dict(v=1.0)
     c = measure("ridges", component=component, eps=[1e-3], **at)
     k = 0 if component == "u" else 1
-    fd = float(pointwise.central_gradient("ridges", c.u, c.v, 8.0, 4.0, 1e-3)[k])
+    fd = float(pointwise.central_gradient("ridges", c.u, c.v, *SEED_FREQUENCIES, 1e-3)[k])
     reference = fd - c.roundoff[0] - c.truncation[0]
     d = 1e-7
     below = dict(u=c.u - d * (k == 0), v=c.v - d * (k == 1))
-    inside = (float(pointwise.height("ridges", c.u, c.v, 8.0, 4.0))
-              - float(pointwise.height("ridges", below["u"], below["v"], 8.0, 4.0))) / d
+    inside = (float(pointwise.height("ridges", c.u, c.v, *SEED_FREQUENCIES))
+              - float(pointwise.height("ridges", below["u"], below["v"], *SEED_FREQUENCIES))) / d
     assert c.reason is not None and abs(inside) > 1.0
     assert reference == pytest.approx(inside, rel=1e-5, abs=0)
 
@@ -106,8 +112,8 @@ def test_the_fitted_model_recovers_a_synthetic_curve_and_the_truncation_coeffici
     A, B = fit_model(eps, 61.0 * eps**2 + 1e-17 / eps)
     assert A == pytest.approx(61.0, rel=1e-9, abs=0) and B == pytest.approx(1e-17, rel=1e-9, abs=0)
     # On the measured curve, A is |h'''| / 6 (the truncation term), not twice or half of it.
-    assert curve.fitted_truncation == pytest.approx(abs(curve.third_derivative) / 6, rel=0.1, abs=0)
-    assert curve.fitted_truncation != pytest.approx(abs(curve.third_derivative) / 3, rel=0.1, abs=0)
+    assert curve.fitted_truncation == pytest.approx(abs(curve.third_derivative) * TRUNCATION, rel=0.1, abs=0)
+    assert curve.fitted_truncation != pytest.approx(abs(curve.third_derivative) * 2 * TRUNCATION, rel=0.1, abs=0)
 
 
 def test_the_fitted_optimum_does_not_depend_on_the_grid(curve):
