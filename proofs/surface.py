@@ -34,7 +34,7 @@ from renderer import formulas as F
 
 from .core import Cross, Dot, Step, Theorem, catalogue
 from .displacement import KERNEL_COEFFS
-from .frame import PHI_OFF_POLES
+from .frame import CHART_RATES, PHI_OFF_POLES
 
 u, v, beta, h, h_u, h_v = F.u, F.v, F.beta, F.h, F.h_u, F.h_v
 
@@ -69,8 +69,9 @@ CROSS = _sum(Cross(A, B), sp.MatMul(beta * h_u, Cross(N_S, B), evaluate=False),
 FIRST = (-beta * h_u / L_U + sp.O(beta**2), -beta * h_v / L_V + sp.O(beta**2))
 PRINCIPAL = sp.ImmutableMatrix([-beta * h_u / ((1 + beta * h * K_U) * L_U),
                                 -beta * h_v / ((1 + beta * h * K_V) * L_V)])
-#: Sphere A: kappa = 1/R, |p_u| = 2 pi R sin(phi), |p_v| = pi R (the chart's rates, theorem `chart`).
-SPHERE = {K_U: 1 / F.R, K_V: 1 / F.R, L_U: 2 * sp.pi * F.R * F.sin_phi, L_V: sp.pi * F.R}
+#: Sphere A: kappa = 1/R, |p_u| = R sin(phi) dtheta/du = 2 pi R sin(phi) and |p_v| = R dphi/dv = pi R
+#: (the chart's rates, theorem `chart`).
+SPHERE = {K_U: 1 / F.R, K_V: 1 / F.R, L_U: F.R * F.sin_phi / CHART_RATES[0], L_V: F.R / CHART_RATES[1]}
 #: The renderer's bump="surface" coefficients of e_theta and e_phi, off its pole floor.
 RENDERER = sp.ImmutableMatrix(KERNEL_COEFFS)
 
