@@ -24,6 +24,7 @@ from typing import Callable
 
 import numpy as np
 
+from proofs.frame import SEED_POLE_SIN_PHI
 from renderer import BUMPS, DRAFT_SCENE, compare, gbuffer, pointwise, render
 from renderer import kernel
 from renderer import formulas as F
@@ -537,8 +538,9 @@ def _noise_below_1e11():
 #: The step of the draft's Cell 7b (its crease: ``{**SCr, 'eps': 1e-4}``).
 CELL7B_STEP = 1e-4
 #: The draft's pole cut-off (Cell 7c; seed Cell 1, ``tangent_frame``): its fixed basis below this
-#: sin(phi).  The renderer keeps the chart's frame down to `formulas.POLE_SIN_PHI` (2^-1022).
-CELL7C_POLE_SIN_PHI = 1e-4
+#: sin(phi), as the frame's theorems name it (`proofs.frame.SEED_POLE_SIN_PHI`).  The renderer keeps
+#: the chart's frame down to `formulas.POLE_SIN_PHI` (2^-1022).
+CELL7C_POLE_SIN_PHI = SEED_POLE_SIN_PHI
 
 
 def _crease_values():
