@@ -13,6 +13,7 @@ pbrt-v4's footprint steps.
 import random
 from functools import partial
 
+import numpy as np
 import sympy as sp
 
 from renderer import formulas as F
@@ -122,23 +123,33 @@ def border_points(samples=2000, seed=12):
 
 
 def border_mismatches(samples=2000, seed=12, rule=_border_rule, stencil=F.STENCIL_POINTS):
-    """The `border_points` at which ``stencil`` (`formulas.STENCIL_POINTS`), or the v-quotient of a
-    registered field's central difference (`HeightField.central` at ``stencil``, k_u = 3, k_v = 2),
-    differ from ``rule``; evaluated in float64."""
+    """The `border_points` at which ``stencil`` (`formulas.STENCIL_POINTS`), the v-quotient of a
+    registered field's central difference (`HeightField.central` at ``stencil``, k_u = 3, k_v = 2), or
+    the compiled kernel's central differences (`renderer.pointwise.central_gradient`, both components)
+    differ from ``rule``; evaluated in float64 (the quotients within 1e-9 relative)."""
     args = (F.u, F.v, F.eps_u, F.eps_v)
     points = sp.lambdify(args, [e for _, e in stencil], modules="math")
     ks = {F.k_u: 3, F.k_v: 2}
     fields = [(sp.lambdify((F.u, F.v), f.expr.subs(ks), modules="math"),
                sp.lambdify(args, f.central[1].subs(ks).subs(dict(stencil)), modules="math")) for f in F.FIELDS.values()]
-    bad = 0
-    for u_, v_, step in border_points(samples, seed):
-        want = rule(u_, v_, step)
-        wrong = list(points(u_, v_, step, step)) != list(want[:4])
+    at = list(border_points(samples, seed))
+    wrong = np.zeros(len(at), dtype=bool)
+    rules = [rule(u_, v_, step) for u_, v_, step in at]
+    for i, ((u_, v_, step), want) in enumerate(zip(at, rules)):
+        wrong[i] = list(points(u_, v_, step, step)) != list(want[:4])
         for h_of, central_v in fields:
             quotient = (h_of(u_, want[2]) - h_of(u_, want[3])) / want[4]
-            wrong |= abs(central_v(u_, v_, step, step) - quotient) > 1e-9 * (1 + abs(quotient))
-        bad += wrong
-    return bad
+            wrong[i] |= abs(central_v(u_, v_, step, step) - quotient) > 1e-9 * (1 + abs(quotient))
+    # The compiled kernel's central differences (`renderer.pointwise.central_gradient`) by the rule, too.
+    from renderer import pointwise
+    u_, v_, step = (np.array(c) for c in zip(*at))
+    for (h_of, _), name in zip(fields, F.FIELDS):
+        rule_u = np.array([(h_of(w[0], v) - h_of(w[1], v)) / (2 * s) for w, v, s in zip(rules, v_, step)])
+        rule_v = np.array([(h_of(u, w[2]) - h_of(u, w[3])) / w[4] for w, u in zip(rules, u_)])
+        for compiled, quotient in zip(pointwise.central_gradient(name, u_, v_, ks[F.k_u], ks[F.k_v], step),
+                                      (rule_u, rule_v)):
+            wrong |= ~(np.abs(compiled - quotient) <= 1e-9 * (1 + np.abs(quotient)))
+    return int(np.count_nonzero(wrong))
 
 
 def _stencil_with(point, change):

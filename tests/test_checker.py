@@ -584,3 +584,26 @@ def test_the_shadow_predicates_leave_a_grazing_segment_undecided(miss):
     g = SimpleNamespace(P=P[None, None], N=along[None, None], chamber=np.ones((1, 1), np.uint8))
     masks, decided = predicate_masks(scene.replace(lights=(PointLight(tuple(L)),)), g)
     assert masks[0, 0, 0] and decided[0, 0, 0] == (miss > 1.0)
+
+
+@pytest.mark.parametrize("wrong", ["a millionth off", "v's one-sided quotient over 2 eps at the poles"])
+def test_the_stencils_evidence_reads_the_compiled_kernel(monkeypatch, wrong):
+    """central-difference-truncation's evidence holds the compiled kernel's central differences
+    (`renderer.pointwise.central_gradient`) to the border rule as well as the formulas: a kernel a
+    millionth off, or one whose v-quotient at the poles divides by 2 eps, is refuted; the formulas
+    unchanged."""
+    from proofs import finite_difference as fd
+    from renderer import pointwise
+    real = pointwise.central_gradient
+    if wrong == "a millionth off":
+        planted = lambda *a: tuple(g * (1 + 1e-6) for g in real(*a))            # noqa: E731
+    else:
+        def planted(name, u, v, k_u, k_v, eps):
+            hu, hv = real(name, u, v, k_u, k_v, eps)
+            clamped = (v + eps > 1) | (v - eps < 0)
+            width = np.minimum(1.0, v + eps) - np.maximum(0.0, v - eps)
+            return hu, np.where(clamped, hv * width / (2 * eps), hv)
+    assert fd.border_mismatches() == 0
+    monkeypatch.setattr(pointwise, "central_gradient", planted)
+    assert fd.border_mismatches() > 100
+    assert fd._stencil_evidence().status == "refuted"
