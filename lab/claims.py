@@ -554,7 +554,7 @@ def _crease_values():
 
 def _pole_pixels():
     g = gbuffer(DRAFT_SCENE, 256, 256)
-    n = int(np.count_nonzero((g.chamber == SPHERE_A) & (np.hypot(g.N[..., 0], g.N[..., 1]) <= CELL7C_POLE_SIN_PHI)))
+    n = int(np.count_nonzero((g.chamber == SPHERE_A) & (pointwise.chart(*np.moveaxis(g.N, -1, 0))[2] <= CELL7C_POLE_SIN_PHI)))
     return {"fallback pixels": n, **_on(g, DRAFT_SCENE)}
 
 

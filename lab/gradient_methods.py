@@ -544,11 +544,12 @@ def crease_values(*, v=None, eps=None, ku=None, kv=None):
     ku, kv = (real(n, k0 if k is None else k, **FREQUENCY) for n, k, k0 in (("ku", ku, ku0), ("kv", kv, kv0)))
     eps = real("eps", DRAFT_SCENE.eps if eps is None else eps, **STEP)
     f_u = sp.lambdify(F.FIELD_SYMBOLS, sp.diff(sp.Mul(*record.crease_factors), F.u), modules="mpmath")
+    factor_u = sp.lambdify(F.FIELD_SYMBOLS, next(c for c in record.crease_factors if F.u in c.free_symbols))
     out = []
     for u0 in (0.0, 1.0 / ku):
         uu, vv = np.array([u0]), np.array([v])
         slope = abs(float(f_u(mpmath.mpf(u0), mpmath.mpf(v), mpmath.mpf(ku), mpmath.mpf(kv))))
-        out.append(dict(u=u0, factor=float(np.sin(np.pi * ku * u0)),
+        out.append(dict(u=u0, factor=float(factor_u(u0, v, ku, kv)),
                         exact=float(pointwise.exact_gradient(record, uu, vv, ku, kv)[0][0]),
                         ad=float(_ad_gradient(record, uu, vv, ku, kv)[0][0]),
                         central=float(pointwise.central_gradient(record, uu, vv, ku, kv, eps)[0][0]),

@@ -25,7 +25,7 @@ import sympy as sp
 
 from renderer import formulas, gbuffer, pointwise
 from renderer.pointwise import UNIT_NORMAL
-from renderer.render import MAX_SIDE, check_args
+from renderer.render import MAX_SIDE, SPHERE_A, check_args
 from renderer.scene import MAX_BETA
 from renderer.validate import InvalidType, InvalidValue, choice, positive_int, real, real_array
 
@@ -161,7 +161,7 @@ def geometry(scene, width, height):
         As `renderer.gbuffer` for a bad scene or size.
     """
     g = gbuffer(scene, width, height, gradient="exact")
-    on_a = g.chamber == 1
+    on_a = g.chamber == SPHERE_A
     N = g.N[on_a]
     _, _, sin_phi = pointwise.chart(*N.T)
     et, ep = pointwise.tangent_frame(*N.T, sin_phi)

@@ -28,6 +28,7 @@ import sympy as sp
 from renderer import Scene, gbuffer
 from renderer import formulas as F
 from renderer.render import SPHERE_A
+from renderer.ucurve import UNIT_ROUNDOFF
 
 __all__ = ["pixels", "chart_error", "gradient_error", "normal_error", "footprint_error", "worst_of", "TOLERANCE",
            "PER_FIELD"]
@@ -46,7 +47,7 @@ CREASE_BAND = 0.05
 #: every pixel within 5e-5, all inside it.
 SOURCES = (("frame", 1.0, 5e-3, 1.0), ("pole-300", 300.0, 0.0, 5e-3), ("pole-3e4", 3e4, 0.0, 5e-5))
 DIGITS = 30
-UNIT = 2.0**-53
+UNIT = UNIT_ROUNDOFF
 #: Absolute tolerances of the outputs at their scale (chart units; gradient per k; unit normal).
 TOLERANCE = {"chart": 16 * UNIT, "gradient": 64 * UNIT, "normal": 64 * UNIT}
 

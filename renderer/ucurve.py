@@ -40,6 +40,7 @@ import numpy as np
 import sympy as sp
 
 from renderer import fieldcode, pointwise, validate
+from renderer.scene import DRAFT_SCENE
 from renderer import formulas as F
 
 __all__ = ["UCurve", "measure", "measure_function", "fit_model", "non_differentiable", "UNIT_ROUNDOFF",
@@ -50,9 +51,9 @@ UNIT_ROUNDOFF = 2.0**-53
 #: mpmath working precision of the references, in decimal digits.
 DIGITS = 50
 #: The seed's chart point (u, v) of Cell 2's U-curve (sine field), and its
-#: frequencies (k_u, k_v), the default scene's.
+#: frequencies (k_u, k_v), the draft's scene's.
 SEED_POINT = F.SEED_POINT
-SEED_FREQUENCIES = (8.0, 4.0)
+SEED_FREQUENCIES = (DRAFT_SCENE.k_u, DRAFT_SCENE.k_v)
 #: The default steps: 14 per decade from 1e-1 to 1e-15, so that every power of ten is one of them.
 DEFAULT_STEPS = np.logspace(-1, -15, 14 * 14 + 1)
 

@@ -35,6 +35,7 @@ from matplotlib.scale import LogScale
 from matplotlib.ticker import LogFormatter
 
 from renderer import Scene, pointwise
+from renderer.render import SPHERE_A
 
 from .layout import drawn_size, drawn_texts
 
@@ -217,7 +218,7 @@ def frame_diagram(theta=-0.35, phi=0.8):
         xy = pts @ view.T
         ax.plot(np.where(front, xy[:, 0], np.nan), np.where(front, xy[:, 1], np.nan), color=GREEN, lw=0.6, alpha=0.6)
     N = _sphere_point(theta, phi)
-    sin_phi = np.hypot(N[0], N[1])
+    sin_phi = pointwise.chart(*N)[2]
     e_t, e_p = (np.array(v, float).ravel() for v in pointwise.tangent_frame(N[0], N[1], N[2], sin_phi))
     base = project(N)
     for vec, colour, label in ((N, RED, r"$N$"), (e_t, BLUE, r"$e_\theta$ (along $u$)"),
@@ -250,8 +251,8 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
     scene = Scene(height_field=field, beta=beta)
     r0 = scene.radius_a
     phis = np.linspace(phi0 - span, phi0 + span, 400)
-    u = (theta + np.pi) / (2 * np.pi)
-    h = pointwise.height(field, np.full_like(phis, u), phis / np.pi, scene.k_u, scene.k_v)
+    u, v, _ = pointwise.chart(*np.array([_sphere_point(theta, p) for p in phis]).T)      # the chart's (u, v)
+    h = pointwise.height(field, u, v, scene.k_u, scene.k_v)
     base = np.stack([r0 * np.sin(phis), r0 * np.cos(phis)], axis=-1)       # x along the meridian's plane, z up
     bumped = np.stack([(r0 + beta * h) * np.sin(phis), (r0 + beta * h) * np.cos(phis)], axis=-1)
     in_plane = np.array([[np.cos(theta), np.sin(theta), 0.0], [0.0, 0.0, 1.0]])
@@ -261,11 +262,10 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
 
     def shading(mode, phi):
         N3 = _sphere_point(theta, phi)
-        sin_phi = np.hypot(N3[0], N3[1])
+        u_at, v_at, sin_phi = (float(np.ravel(c)[0]) for c in pointwise.chart(*N3))
         e_t, e_p = (np.array(x, float).ravel() for x in pointwise.tangent_frame(N3[0], N3[1], N3[2], sin_phi))
-        hu, hv = (float(np.asarray(g).ravel()[0]) for g in
-                  pointwise.exact_gradient(field, u, phi / np.pi, scene.k_u, scene.k_v))
-        hh = float(pointwise.height(field, u, phi / np.pi, scene.k_u, scene.k_v))
+        hu, hv = (float(np.asarray(g).ravel()[0]) for g in pointwise.exact_gradient(field, u_at, v_at, scene.k_u, scene.k_v))
+        hh = float(pointwise.height(field, u_at, v_at, scene.k_u, scene.k_v))
         return in_plane @ np.array(normal[mode](*N3, *e_t, *e_p, hu, hv, beta, hh, r0, sin_phi), float).ravel()
 
     fig, ax = plt.subplots(figsize=(4.2, 5.4))          # for a phone's column: text at TEXT_PT, 2.1 pt per inch or more
@@ -389,7 +389,7 @@ def displacement_figure(result):
     from matplotlib.colors import to_rgb
     from matplotlib.patches import Patch
     from renderer import to_srgb
-    covered, bumped_covered = result.covered, result.bumped.chamber == 1
+    covered, bumped_covered = result.covered, result.bumped.chamber == SPHERE_A
     fig, axes = plt.subplots(2, 2, figsize=(5.0, 5.6), layout="constrained")
 
     def panel(ax, rgb, title, outline=None):
