@@ -16,8 +16,10 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+import sympy as sp
 
 from renderer import DRAFT_SCENE, gbuffer, pointwise
+from renderer import formulas as F
 from renderer.pointwise import chart, tangent_frame
 from renderer.render import FLOOR, SPHERE_A, SPHERE_B, image_plane
 from renderer.validate import InvalidValue, positive_int
@@ -220,8 +222,9 @@ def _acos_pole():
     N = np.stack([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), np.cos(phi)])
     N /= np.linalg.norm(N, axis=0)
     v_acos = np.arccos(np.clip(N[2], -1, 1))
+    from proofs.frame import PHI_OF_V                    # phi of the chart's v
     _, v_atan, _ = chart(*N)
-    v_atan = v_atan * np.pi
+    v_atan = sp.lambdify(F.v, PHI_OF_V)(v_atan)
     # Reference: phi of the float64 vector, from its exact components (mpmath, 40 digits).
     import mpmath
     with mpmath.workdps(40):

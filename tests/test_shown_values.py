@@ -223,7 +223,10 @@ def test_the_stencil_legend_names_the_slopes_the_library_computes_at_the_stencil
     the red points) and the slope of the secant drawn; its exact slope is `pointwise.exact_gradient`
     there and the slope of the blue line; the dotted line and its annotation sit on a crease
     (`renderer.ucurve.non_differentiable`), between the stencil's points."""
-    p = {**{k: v.default for k, v in inspect.signature(figures.stencil_diagram).parameters.items()}, **kwargs}
+    from renderer import DRAFT_SCENE
+    from renderer.formulas import SEED_POINT
+    p = {**{k: v.default for k, v in inspect.signature(figures.stencil_diagram).parameters.items()},
+         "k_u": DRAFT_SCENE.k_u, "k_v": DRAFT_SCENE.k_v, "v": SEED_POINT[1], **kwargs}     # None: the draft's
     ax = figures.stencil_diagram(**kwargs).axes[0]
     (a, b), (h_a, h_b) = curve(ax, "central stencil")
     u0, eps = (a + b) / 2, (b - a) / 2

@@ -299,17 +299,23 @@ def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span
     return fig
 
 
-def stencil_diagram(k_u=8.0, v=0.47, k_v=4.0, eps=0.02, offset=0.006):
+def stencil_diagram(k_u=None, v=None, k_v=None, eps=0.02, offset=0.006):
     """h along u across the crease u = 1/k_u of the ridges field, the central stencil
     u0 +- eps with its centre u0 just beside the crease, its secant (the central difference),
-    and the exact one-sided slope at u0 (`pointwise.height`, `pointwise.exact_gradient`)."""
+    and the exact one-sided slope at u0 (`pointwise.height`, `pointwise.central_gradient`,
+    `pointwise.exact_gradient`).  ``k_u``, ``k_v`` None: the draft's; ``v`` None: the seed's point's."""
     import matplotlib.pyplot as plt
+
+    from renderer import DRAFT_SCENE
+    from renderer.formulas import SEED_POINT
+    k_u, k_v = (DRAFT_SCENE.k_u if k_u is None else k_u), (DRAFT_SCENE.k_v if k_v is None else k_v)
+    v = SEED_POINT[1] if v is None else v
     crease = 1.0 / k_u
     u = np.linspace(crease - 3 * eps, crease + 3 * eps, 400)
     h = pointwise.height("ridges", u, np.full_like(u, v), k_u, k_v)
     u0 = crease + offset
     (h_m, h_0, h_p) = pointwise.height("ridges", np.array([u0 - eps, u0, u0 + eps]), np.full(3, v), k_u, k_v)
-    secant = (h_p - h_m) / (2 * eps)
+    secant = float(np.asarray(pointwise.central_gradient("ridges", u0, v, k_u, k_v, eps)[0]).ravel()[0])
     exact = float(np.asarray(pointwise.exact_gradient("ridges", u0, v, k_u, k_v)[0]).ravel()[0])
     fig, ax = plt.subplots(figsize=(5.0, 3.2), layout="constrained")
     ax.plot(u, h, color=GREY, lw=1.5, label=r"$h(u, v)$, ridges field")
