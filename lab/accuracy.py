@@ -325,6 +325,8 @@ def optima():
     ``v``, ``component``, ``k_u``, ``k_v``, ``steps`` (how many), ``largest_step``,
     ``smallest_step``, ``crease_distance`` (inf for a field without creases); ``h`` = |h|,
     ``h1`` = |h'|, ``x_h1`` = |x h'| (x the component's coordinate), ``h3`` = |h'''|;
+    ``model_truncation`` and ``model_roundoff``, the error model's coefficients of eps^2 and 1/eps
+    (`renderer.formulas.ERROR_MODEL`: |h'''| / 6 and u_round (|h| + |x h'|));
     ``eps_model`` the model-optimal step eps* and ``error_model`` the model's error E(eps*);
     ``eps_fitted`` the fitted optimal step eps^, ``error_at_fitted`` the fitted model's error there
     and ``measured_at_fitted`` the float64 quotient's measured error at eps^;
@@ -358,6 +360,7 @@ def _optima(fields):
                           largest_step=float(steps.max()), smallest_step=float(steps.min()),
                           crease_distance=distance, h=abs(c.height), h1=abs(c.derivative),
                           x_h1=c.model_argument / UNIT_ROUNDOFF, h3=abs(c.third_derivative),
+                          model_truncation=c.model_truncation, model_roundoff=c.model_cancellation + c.model_argument,
                           eps_model=c.eps_model, error_model=c.error_model, eps_fitted=c.eps_fitted,
                           error_at_fitted=c.error_at_fitted, measured_at_fitted=at_fitted,
                           fitted_over_model=c.eps_fitted / c.eps_model,

@@ -459,14 +459,14 @@ def floors():
 
 
 def _floors(versions):
-    from renderer.ucurve import DEFAULT_STEPS, UNIT_ROUNDOFF, fit_model
+    from renderer.ucurve import DEFAULT_STEPS, fit_model
 
     from .accuracy import optima
     o = optima()["sine"]                   # the book's U-curve: its point and the error model's optimum
     u, v, k_u, k_v = o["u"], o["v"], o["k_u"], o["k_v"]
     if o["component"] != "u" or o["steps"] != DEFAULT_STEPS.size:
         raise RuntimeError(f"the sine field's U-curve is no longer h_u over the default steps: {o}")
-    roundoff = UNIT_ROUNDOFF * (o["h"] + o["x_h1"])
+    roundoff = o["model_roundoff"]                     # the error model's B (renderer.formulas.ERROR_MODEL)
     true = sp.lambdify((F.u, F.v), F.FIELDS["sine"].gradient[0].subs({F.k_u: sp.nsimplify(k_u),
                                                                  F.k_v: sp.nsimplify(k_v)}), modules="mpmath")
     out, libm = {}, _quotient(backend("numba")["sin"])(u, v, k_u, k_v, DEFAULT_STEPS)
@@ -476,7 +476,7 @@ def _floors(versions):
             fd = _quotient(backend(name)["sin"])(u, v, k_u, k_v, DEFAULT_STEPS)
             error = np.array([float(abs(mpmath.mpf(float(y)) - t)) for y in fd])
             best = int(np.argmin(error))
-            A, B = fit_model(DEFAULT_STEPS, error, start=(o["h3"] / 6, roundoff))
+            A, B = fit_model(DEFAULT_STEPS, error, start=(o["model_truncation"], roundoff))
             fitted = (B / (2 * A)) ** (1 / 3)
             out[name] = {"error": float(error[best]), "step": float(DEFAULT_STEPS[best]), "fitted_step": fitted,
                          "fitted_error": A * fitted**2 + B / fitted, "fitted_roundoff": B,
