@@ -257,3 +257,15 @@ def test_every_function_that_draws_a_figure_has_a_baseline():
              for name, f in vars(importlib.import_module(info.name)).items()
              if inspect.isfunction(f) and f.__module__ == info.name and any(d in inspect.getsource(f) for d in drawing)]
     assert len(found) >= 7 and [f for f in found if f"{f.rsplit('.', 1)[1]}(" not in here] == []
+
+
+def test_the_chamber_colours_cover_every_chamber_code_in_order():
+    """`figures.chamber_colours`: one colour per code of `renderer.render.CHAMBER_NAMES`, the colour map
+    indexed by code (0 to the last), each colour distinct."""
+    from matplotlib.colors import to_rgb
+
+    from renderer.render import CHAMBER_NAMES
+    cmap, colours = figures.chamber_colours()
+    assert sorted(colours) == sorted(CHAMBER_NAMES) == list(range(cmap.N))
+    assert [to_rgb(cmap(code)) for code in sorted(colours)] == [to_rgb(colours[code]) for code in sorted(colours)]
+    assert len(set(colours.values())) == len(colours)

@@ -40,10 +40,20 @@ from renderer.render import SPHERE_A
 from .layout import drawn_size, drawn_texts
 
 __all__ = ["style", "figure_png", "PlainLogFormatter", "SMALLEST_TEXT_KEY", "MASK", "frame_diagram", "normal_diagram",
-           "stencil_diagram", "ucurve_anatomy", "displacement_figure", "difference_bar"]
+           "stencil_diagram", "ucurve_anatomy", "displacement_figure", "difference_bar", "chamber_colours"]
 
 #: The book's colours: measured (dark red), exact (dark blue), third quantity (green), guides (grey).
 RED, BLUE, GREEN, GREY = "#7a1f1f", "#1f4e7a", "#2a7a1f", "#777777"
+
+
+def chamber_colours():
+    """A chamber map's colours: (ListedColormap indexed by chamber code, {code: colour}); draw the map
+    with ``vmin=0, vmax=len(colours) - 1``.  The codes are `renderer.render.CHAMBER_NAMES`'."""
+    from matplotlib.colors import ListedColormap
+
+    from renderer.render import BACKGROUND, FLOOR, SPHERE_B
+    colours = {BACKGROUND: "black", SPHERE_A: "#a33", SPHERE_B: "#58c", FLOOR: "#ccb"}
+    return ListedColormap([colours[c] for c in sorted(colours)]), colours
 
 
 #: The PNG text chunk (tEXt) in which `figure_png` records the smallest size of a figure's drawn
