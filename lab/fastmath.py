@@ -47,7 +47,7 @@ from ._checks import MAX_COUNT, STEP, broadcast, integers, numbers_array, seed a
 _numba_cache()          # where numba caches this module's ufuncs (see renderer.kernel)
 
 __all__ = ["FUNCTIONS", "BACKENDS", "DIGITS", "SAMPLES", "SEED", "QUANTILE", "available", "backend",
-           "arguments", "reference", "ulps", "flushes", "ulp_table", "floors", "central_differences"]
+           "arguments", "reference", "ulps", "flushes", "ulp_table", "floors", "central_differences", "max_angle"]
 
 #: The transcendental functions of the render kernel, in the order of the tables.
 FUNCTIONS = ("sin", "cos", "atan2", "acos", "pow")
@@ -60,8 +60,16 @@ SAMPLES = 2**16
 SEED = 9
 #: The high quantile of the ulp error reported beside the maximum.
 QUANTILE = 0.999
-#: Largest argument of a sine or cosine in the kernel: 2 pi k v (the rings field) at the largest k.
-MAX_ANGLE = 2 * math.pi * MAX_FREQUENCY
+
+
+def max_angle():
+    """The largest argument of a sine or cosine in the registered height fields and their gradients
+    (`renderer.formulas.FIELDS`), at u = v = 1 and the largest k (`MAX_FREQUENCY`): 2 pi k v of the
+    rings field among the built-in ones.  A float (radians); each argument is read as growing with
+    u, v and k, as every linear phase does."""
+    at = {F.u: 1, F.v: 1, F.k_u: MAX_FREQUENCY, F.k_v: MAX_FREQUENCY}
+    return max(float(abs(a.args[0].subs(at))) for f in F.FIELDS.values() for e in (f.expr, *f.gradient)
+               for a in e.atoms(sp.sin, sp.cos))
 #: log2 of the smallest power pow's sample reaches: just above the smallest normal float64, 2^-1022.
 MIN_POWER_LOG2 = -1021.0
 
@@ -178,9 +186,9 @@ def arguments(function, count=SAMPLES, seed=SEED):
     hard points:
 
     * sin, cos: x = pi k u (u, v in [0, 1], k in (0, 1e3]; 2 pi k v for rings), uniform on
-      [0, `MAX_ANGLE`]; hard points: the float64 multiples m pi / 2 (m = 1 .. 4000) and
-      their neighbours either side, where one of the two is near 0 and the range
-      reduction must keep the digits.
+      [0, `max_angle`]; hard points: the float64 multiples m pi / 2 up to it and their
+      neighbours either side, where one of the two is near 0 and the range reduction must
+      keep the digits.
     * atan2 (y, x): the chart's two calls atan2(N_y, N_x) and atan2(sin phi, N_z), N a
       unit vector uniform on the sphere (half the sample each); hard points: the seam
       atan2(+-2^-j, -1) near +-pi and the pole atan2(2^-j, +-1), j = 1 .. 60.
@@ -207,9 +215,10 @@ def arguments(function, count=SAMPLES, seed=SEED):
     count = positive_int("count", count, high=MAX_COUNT)
     rng = np.random.default_rng(_seed("seed", seed))
     if function in ("sin", "cos"):
-        m = np.arange(1, int(MAX_ANGLE / (math.pi / 2)) + 1) * (math.pi / 2)
+        top = max_angle()
+        m = np.arange(1, int(top / (math.pi / 2)) + 1) * (math.pi / 2)
         hard = np.concatenate([m, np.nextafter(m, 0.0), np.nextafter(m, np.inf)])
-        return (np.concatenate([rng.uniform(0.0, MAX_ANGLE, count), hard]),), hard.size
+        return (np.concatenate([rng.uniform(0.0, top, count), hard]),), hard.size
     if function == "atan2":
         N = rng.normal(size=(count, 3))
         N /= np.linalg.norm(N, axis=1, keepdims=True)

@@ -66,10 +66,10 @@ def test_the_arguments_are_the_sets_their_docstring_names(seed, count):
     hard points exactly the sets it lists (at the book's seed and at another)."""
     (x,), hard = fm.arguments("sin", count, seed)
     quarter = math.pi / 2
-    assert 0 <= x[:count].min() and x[:count].max() <= fm.MAX_ANGLE and x.size == count + hard
+    assert 0 <= x[:count].min() and x[:count].max() <= fm.max_angle() and x.size == count + hard
     m = np.round(x[count:] / quarter)
     assert np.all(np.abs(x[count:] - m * quarter) <= np.spacing(x[count:]))      # m pi/2 and its neighbours
-    assert np.unique(m, return_counts=True)[1].tolist() == [3] * int(fm.MAX_ANGLE / quarter)
+    assert np.unique(m, return_counts=True)[1].tolist() == [3] * int(fm.max_angle() / quarter)
     (y, x), hard = fm.arguments("atan2", count, seed)
     half = count // 2
     assert np.all(np.hypot(y[:half], x[:half]) <= 1 + 1e-15)                     # (N_y, N_x) of unit N
@@ -242,3 +242,20 @@ def test_drjit_computes_float64_and_its_quotient_is_near_libms(drjit_backend):
     steps = DEFAULT_STEPS[DEFAULT_STEPS > 1e-6]
     np.testing.assert_allclose(fm.central_differences("drjit", steps, u, v, k_u, k_v),
                                fm.central_differences("numba", steps, u, v, k_u, k_v), rtol=1e-8)
+
+
+def test_the_sampled_angles_follow_the_registered_fields():
+    """`max_angle` is the largest phase of the fields' sines and cosines: the built-in fields' 2 pi k
+    (rings), and 3 pi k for a field sin(3 pi k_u u) registered for this test; the sample reaches it."""
+    import sympy as sp
+
+    from renderer import formulas as F
+    from renderer.scene import MAX_FREQUENCY
+    assert fm.max_angle() == pytest.approx(2 * math.pi * MAX_FREQUENCY, rel=1e-15)
+    F.register(F.HeightField("triple", sp.sin(3 * sp.pi * F.k_u * F.u)))
+    try:
+        assert fm.max_angle() == pytest.approx(3 * math.pi * MAX_FREQUENCY, rel=1e-15)
+        (x,), hard = fm.arguments("sin", count=1000, seed=1)
+        assert 2 * math.pi * MAX_FREQUENCY < x.max() <= fm.max_angle() * (1 + 1e-15)
+    finally:
+        F.FIELDS.pop("triple", None)
