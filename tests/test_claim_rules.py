@@ -393,7 +393,7 @@ def test_the_registers_own_measurements_against_routes_of_their_own():
     from renderer import formulas as F
     k = DRAFT_SCENE.k_u
     third = sp.diff(sp.sin(sp.pi * F.k_u * F.u), F.u, 3).subs({F.k_u: k, F.u: 0})
-    assert _h3_scale()["(π kᵤ)³"] == pytest.approx(float(abs(third)), rel=1e-15)
+    assert _h3_scale()["(π kᵤ)³"] == pytest.approx(float(abs(third)), rel=1e-15, abs=0)
     counts = _cell4_counter()
     assert (counts["count printed, numeric"], counts["count printed, exact"]) == (0, 0)
     assert counts["wired"] == len(F.STENCIL_POINTS)
@@ -411,4 +411,4 @@ def test_about_refuses_zero_and_takes_any_positive_size():
     from renderer.validate import InvalidValue
     with pytest.raises(InvalidValue, match="^x must be"):
         about("q", 0.0)
-    assert about("q", 5e-324).lo == pytest.approx(5e-324 / ABOUT, rel=1e-15)
+    assert about("q", 5e-324).lo == pytest.approx(5e-324 / ABOUT, rel=1e-15, abs=0)

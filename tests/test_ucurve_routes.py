@@ -165,10 +165,10 @@ def test_the_curves_draw_the_model_the_optimal_step_theorem_proves(monkeypatch):
                 ucurve._error_model.cache_clear()
     right = curve()
     model = curve(ERROR_MODEL=F.ERROR_MODEL.xreplace({sp.Rational(1, 6): sp.Rational(1, 2)}) + F.eps)
-    assert model.model_truncation == pytest.approx(3 * right.model_truncation, rel=1e-15)
+    assert model.model_truncation == pytest.approx(3 * right.model_truncation, rel=1e-15, abs=0)
     assert (model.model_cancellation, model.model_argument, model.eps_model) == \
         (right.model_cancellation, right.model_argument, right.eps_model)
-    assert model.model == pytest.approx(right.model + 2 * right.model_truncation * right.eps**2 + right.eps, rel=1e-14)
+    assert model.model == pytest.approx(right.model + 2 * right.model_truncation * right.eps**2 + right.eps, rel=1e-14, abs=0)
     star = curve(EPS_STAR=F.EPS_STAR.xreplace({3: 1}))
-    assert star.eps_model == pytest.approx(right.eps_model / 3 ** (1 / 3), rel=1e-14)
+    assert star.eps_model == pytest.approx(right.eps_model / 3 ** (1 / 3), rel=1e-14, abs=0)
     assert (star.model_truncation, star.model.tolist()) == (right.model_truncation, right.model.tolist())
