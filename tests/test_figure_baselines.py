@@ -232,7 +232,18 @@ def test_stencil_diagram(monkeypatch):
 """
 
 
-def test_a_changed_figure_fails_its_baseline(pytester):
+@pytest.fixture
+def drawn_once():
+    """The stencil diagram drawn before `pytester` is set up.  pytester forgets, at its teardown, every
+    module imported since its setup; a module the planted test imported first (pyplot's, numba's
+    registries, loaded with the first kernel) would be imported again by a later test of this worker,
+    beside classes and registrations that outlived the first copy ("duplicate registration for
+    PolynomialType"; "Single argument to subplot must be a three-digit integer, not GridSpec")."""
+    import matplotlib.pyplot as plt
+    plt.close(figures.stencil_diagram())
+
+
+def test_a_changed_figure_fails_its_baseline(drawn_once, pytester):
     """The stencil diagram with its stencil drawn a shade redder (#a02d2d for #7a1f1f), compared as this
     module compares it (`FIGURE`), with its baseline: it fails, the two PNGs 1.13 apart, just past
     `TOLERANCE` (a tolerance raised by a fifth would pass it; the stencil drawn green is 3.2 apart)."""
