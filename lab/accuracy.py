@@ -141,13 +141,14 @@ def normal_beta_derivative_residual(trials=2000, seed=5):
 
 @lru_cache(maxsize=None)
 def _normal_and_derivative():
-    """The renderer's chart-mode normal N' (`renderer.formulas.PERTURBED_NORMAL`) as an mpmath function,
-    and the closed form the theorem normal-beta-derivative proves of it, (I - N'N'^T) g / |M|, as a
-    numpy one: each of (N, e_theta, e_phi, h_u, h_v, beta) to a list of three components."""
+    """The renderer's chart-mode normal N' (`renderer.formulas.PERTURBED_NORMAL`) as three mpmath functions,
+    one per component, and the closed form the theorem normal-beta-derivative proves of it,
+    (I - N'N'^T) g / |M|, as a numpy one to a list of three components: each of (N, e_theta, e_phi,
+    h_u, h_v, beta)."""
     from proofs import normal, registry
     theorem = registry.get("normal-beta-derivative")
     args = (F.N_x, F.N_y, F.N_z, *F.e_theta, *F.e_phi, F.h_u, F.h_v, F.beta)
-    return (sp.lambdify(args, list(normal.N_PRIME), "mpmath"),
+    return (tuple(sp.lambdify(args, c, "mpmath") for c in normal.N_PRIME),
             sp.lambdify(args, list(theorem.explicit(normal.CLAIMED_DERIVATIVE)), "numpy"))
 
 
@@ -164,7 +165,7 @@ def _normal_beta_derivative_residual(trials, seed):
             given = [float(x) for x in (*N, *frame, *gradient)]
             derivative = closed(*given, b)                                  # float64
             for k in range(3):
-                ref = mpmath.diff(lambda beta: normal(*given, beta)[k], mpmath.mpf(b))
+                ref = mpmath.diff(lambda beta: normal[k](*given, beta), mpmath.mpf(b))
                 worst = max(worst, float(abs(mpmath.mpf(float(derivative[k])) - ref)))
     return worst
 
