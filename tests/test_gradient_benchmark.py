@@ -175,8 +175,8 @@ def test_a_method_with_steps_of_its_own_runs_at_them_in_every_configuration(monk
     for bad, error in ((0.0, InvalidValue), ((1e-3, 2.0), InvalidValue), ((1e-3, "x"), InvalidType), ([1e-3] * 65, InvalidValue)):
         with pytest.raises(error, match=r"^Method\.steps"):
             dataclasses.replace(BACKWARD, steps=bad)
-    with pytest.raises(InvalidValue, match=r"^Method\.steps must be one of \('central_steps', 'forward_steps', "
-                                           r"'complex_steps'\), got 'backward_steps'"):
+    lists = tuple(f.name for f in dataclasses.fields(gb.Config) if f.name.endswith("_steps"))
+    with pytest.raises(InvalidValue, match=re.escape(f"Method.steps must be one of {lists}, got 'backward_steps'")):
         dataclasses.replace(BACKWARD, steps="backward_steps").steps_in(TINY)
 
 
