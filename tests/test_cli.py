@@ -425,3 +425,39 @@ def test_any_input_succeeds_or_is_one_input_error(command, toml, pairs):
         added = set(os.listdir(d)) - set(before)
         ok = rc == 0 and added <= {"o.png", "p.png"} or one_line(rc, err.getvalue()) and not added
         assert ok, (argv, err.getvalue())
+
+
+def ucurve_drift(parser, measure):
+    """Where ``symrender ucurve``'s parser departs from the library it calls: each option that passes a
+    parameter of ``measure`` whose default differs from that parameter's default in the signature, or
+    whose help does not print the default the command runs with."""
+    import inspect
+    parsers = parser._subparsers._group_actions[0].choices
+    actions = {a.dest: a for a in parsers["ucurve"]._actions}
+    out = []
+    for name, p in inspect.signature(measure).parameters.items():
+        if name not in actions or p.default is None:
+            continue
+        a = actions[name]
+        shown = f"{a.default:g}" if isinstance(a.default, float) else str(a.default)
+        if a.default != p.default or f"(default {shown})" not in a.help:
+            out.append(f"--{name.replace('_', '-')}: default {a.default!r}, help {a.help!r}; the library's {p.default!r}")
+    return out
+
+
+def test_the_ucurve_commands_defaults_are_the_librarys(monkeypatch):
+    """The parser types its defaults (importing sympy for ``--help`` would cost half a second), so they are
+    held to `renderer.ucurve.measure`'s: the seed's point and frequencies, the field and the component, each
+    also as its help prints it.  A library default moved (the seed's point nudged) and a help printing
+    another default are caught."""
+    import renderer.ucurve
+    assert ucurve_drift(cli.build_parser(), renderer.ucurve.measure) == []
+    real = renderer.ucurve.measure
+
+    def moved(field="sine", u=0.32, v=real.__defaults__[2], component="v", eps=None, k_u=8.0, k_v=5.0):
+        raise AssertionError("not called")
+    assert [line.split(":")[0] for line in ucurve_drift(cli.build_parser(), moved)] == ["--u", "--component", "--k-v"]
+    parser = cli.build_parser()
+    v = next(a for a in parser._subparsers._group_actions[0].choices["ucurve"]._actions if a.dest == "v")
+    v.help = v.help.replace(f"(default {v.default:g})", f"(default {v.default / 2:g})")
+    assert [line.split(":")[0] for line in ucurve_drift(parser, real)] == ["--v"]
