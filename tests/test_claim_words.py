@@ -2,6 +2,8 @@
 formatted from its own values, and each rule is shown with its cases in order.  Checked by the
 numbers and the structure they show, not by their wording."""
 
+import dataclasses
+import math
 import re
 
 import pytest
@@ -89,3 +91,50 @@ def test_the_cell5_sentence_shows_the_ratio_to_two_digits_and_the_drafts_powers(
     text = measured_text("cell5-fd-1e-9", {"worst component": 1.63e-5, "expected": 1e-9, "ratio": 16300.0,
                                            "step": 1e-7, "trials": 2000})
     assert "16,000" in text and "1e-9" in text and "1e-7" in text and "2,000" in text
+
+
+#: A number written in a claim's words: not inside a field (braces), maths ($...$) or parentheses' first
+#: place ("max(0, ·)"), and not a section's, cell's or chapter's number, a fraction's numerator ("1/kᵤ") or
+#: a frame's side ("256²": its label is checked above).
+TYPED = re.compile(r"(?<![\w.(])[-+]?\d[\d,]*(?:\.\d+)?(?:e[-+]?\d+)?(?![\w/])")
+
+
+def typed_numbers(text):
+    text = re.sub(r"\{[^{}]*\}|\$[^$]*\$|\b(?:Cell|Ch\.|§)\s?\d+[a-z]?", " ", text)
+    return [float(n.replace(",", "")) for n in TYPED.findall(text)]
+
+
+def unrun_numbers(claim, values, sentences=SENTENCES):
+    """The numbers typed in ``claim``'s measurement and in its book sentences that are none of the
+    numbers it was measured with (``values``, nested lists and dicts included): a step, a size or a
+    digit count written beside the run rather than read from it."""
+    def flat(v):
+        if isinstance(v, dict):
+            return [x for w in v.values() for x in flat(w)]
+        if isinstance(v, (list, tuple)):
+            return [x for w in v for x in flat(w)]
+        return [float(v)] if isinstance(v, (int, float)) and not isinstance(v, bool) else []
+    ran = flat(values)
+    texts = [claim.measurement] + [t for k, t in sentences.items() if k.split("/")[0] == claim.id]
+    return [(text[:40], n) for text in texts for n in typed_numbers(text)
+            if not any(math.isclose(n, x, rel_tol=1e-12, abs_tol=0) for x in ran)]
+
+
+@pytest.mark.parametrize("claim", CLAIMS, ids=[c.id for c in CLAIMS])
+def test_every_number_a_claims_words_type_is_one_it_was_measured_with(claim, register):
+    """The register's "measurement" column and the book's sentence name steps, β, trial counts, filter
+    sizes and digits: each is a number the claim's run recorded, so that a parameter changed in the code
+    cannot leave the words behind."""
+    _, values, _ = register[claim.id]
+    assert unrun_numbers(claim, values) == []
+
+
+def test_a_claims_words_naming_a_step_or_a_digit_count_it_did_not_run_are_caught(register):
+    by_id = {c.id: c for c in CLAIMS}
+    _, values, _ = register["cell6-truncation"]
+    drifted = dataclasses.replace(by_id["cell6-truncation"],
+                                  measurement=by_id["cell6-truncation"].measurement.replace("0.0001", "0.0002"))
+    assert unrun_numbers(drifted, values) == [(drifted.measurement[:40], 0.0002)]
+    _, values, _ = register["dn-verified-1e-12"]
+    sentences = {"dn-verified-1e-12": SENTENCES["dn-verified-1e-12"].replace("{digits}-digit", "40-digit")}
+    assert [n for _, n in unrun_numbers(by_id["dn-verified-1e-12"], values, sentences)] == [40.0]

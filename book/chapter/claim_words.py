@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 
-from lab.claims import CORRECTED, FAILS, HOLDS
+from lab.claims import CONVERGES, CORRECTED, FAILS, HOLDS
 
 from .labels import frame_label
 
@@ -58,9 +58,9 @@ SENTENCES = {
                          "{values of h, exact:g} times, and its generated code calls {trig_exact:g} sines and cosines",
     "cell4-counter": "the counter prints {count printed, numeric} and {count printed, exact}: the gradients call the "
                      "unwrapped $h$, so the wrapper never runs (wired into the central gradient it counts {wired})",
-    "stacking": "no new integral, but a harder integrand: one sample per pixel misses a 4 × 4 box filter (Ch. 6's) "
-                "by RMS {bumped:.1e} with the bump, {flat:.1e} without, and a 2 × 2 box leaves "
-                "{bumped error, 2 × 2 box / one sample:.0%} of that miss ({flat_2x2:.0%} without; {frame})",
+    "stacking": "no new integral, but a harder integrand: one sample per pixel misses a {box sides[0]} × {box sides[0]} "
+                "box filter (Ch. 6's) by RMS {bumped:.1e} with the bump, {flat:.1e} without, and a {box sides[1]} × "
+                f"{{box sides[1]}} box leaves {{{CONVERGES}:.0%}} of that miss ({{flat_2x2:.0%}} without; {{frame}})",
     "blinn-exact": "read as exact in $\\beta$ (how he evaluated $F_u$, $F_v$ is not measured here): derived from the "
                    "surface, but exact only to first order in $\\beta$: at $\\beta = {point[beta]:g}$ "
                    "($h = {point[h]:g}$, $h_u = {point[h_u]:g}$, $h_v = {point[h_v]:g}$, $\\varphi = {point[phi]:g}$) "
@@ -73,7 +73,7 @@ SENTENCES = {
     "cell5-fd-1e-9": "the draft's own check, a forward difference with step {step_shown} over {trials:,} random cases, "
                      "has a worst component error of {worst component:.1e}, about {ratio_shown:,.0f} times the "
                      "draft's expected {expected_shown}",
-    "dn-verified-1e-12": "the closed form's worst error is {closed form's worst error:.1e} against a 50-digit mpmath "
+    "dn-verified-1e-12": "the closed form's worst error is {closed form's worst error:.1e} against a {digits}-digit mpmath "
                          "derivative; the draft's forward-difference check errs by up to "
                          "{draft's check's worst error:.1e}",
     "beta-quadratic": "the median order of the image's β-derivative is {median order:.2f}, but its RMS order "
