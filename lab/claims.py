@@ -33,7 +33,7 @@ from renderer.validate import InvalidType, InvalidValue, choice, flag, real
 
 from ._checks import STEP, instance, optional, shown
 from .accuracy import DIGITS
-from .seed_errata import CELL6_BETA
+from .seed_errata import CELL6_BETA, CELL6_FIELD
 
 __all__ = ["Bound", "Criterion", "rule", "about", "ABOUT", "Claim", "CLAIMS", "HOLDS", "FAILS", "CORRECTED",
            "UNMEASURED", "Unmeasured", "evaluate", "checked", "ClaimChanged", "census",
@@ -523,19 +523,19 @@ def _beta0():
 
 
 def _bump_nonzero():
-    s, flat = DRAFT_SCENE.replace(height_field="sine", beta=CELL6_BETA), 0.0
+    s, flat = DRAFT_SCENE.replace(height_field=CELL6_FIELD, beta=CELL6_BETA), 0.0
     bumped = render(s, 128, 128)
     d = float(np.abs(bumped.image - render(s.replace(beta=flat), 128, 128).image).mean())
     return {"mean |ΔI|": d, "flat β": flat, **_on(bumped)}
 
 
 def _cell6_truncation():
-    """The draft's Cell 6 at its step and at a tenth of it (the sine field, its strong bump)."""
+    """The draft's Cell 6 at its step and at a tenth of it (its field, `CELL6_FIELD`, and its strong bump)."""
     coarse, fine = DRAFT_SCENE.eps, DRAFT_SCENE.eps / 10
-    a = compare(*_frames("sine", CELL6_BETA, coarse)).max_abs
-    b = compare(*_frames("sine", CELL6_BETA, fine)).max_abs
+    a = compare(*_frames(CELL6_FIELD, CELL6_BETA, coarse)).max_abs
+    b = compare(*_frames(CELL6_FIELD, CELL6_BETA, fine)).max_abs
     return {"max |ΔI| ratio": a / b, "coarse": a, "fine": b, "coarse_step": coarse, "fine_step": fine,
-            **_on(_frames("sine", CELL6_BETA, coarse)[1])}
+            **_on(_frames(CELL6_FIELD, CELL6_BETA, coarse)[1])}
 
 
 def _noise_below_1e11():
@@ -655,10 +655,10 @@ CLAIMS = (
           rule(FAILS, Bound("draft's sphere-A pixels", 0, 0), otherwise=HOLDS)),
     Claim("census-slope", "Cell 3, Expect", "the ε-sweep table descending the truncation slope",
           f"fitted slope of the census over ε = {CENSUS_STEPS[0]:.0e} … {CENSUS_STEPS[-1]:.0e} "
-          f"(ridges, {CENSUS_SIZE}²)",
+          f"({DRAFT_SCENE.height_field}, {CENSUS_SIZE}²)",
           CORRECTED, _census_slope,
           rule(HOLDS, Bound("RMS slope", lo=1.8, strict=True), CORRECTED, Bound("off-band slope", lo=1.8, strict=True))),
-    Claim("census-flips", "Cell 3, Expect", "flips = 0 everywhere", f"the census of Cell 3 (ridges, {CENSUS_SIZE}²)",
+    Claim("census-flips", "Cell 3, Expect", "flips = 0 everywhere", f"the census of Cell 3 ({DRAFT_SCENE.height_field}, {CENSUS_SIZE}²)",
           HOLDS,
           _census_flips,
           rule(HOLDS, Bound("flips", 0, 0))),
@@ -708,7 +708,7 @@ CLAIMS = (
           f"mean |ΔI| between β = {CELL6_BETA:g} and β = 0", HOLDS, _bump_nonzero,
           rule(HOLDS, Bound("mean |ΔI|", lo=1e-2, strict=True))),
     Claim("cell6-truncation", "Cell 6, Expect", "the FD error sitting at its truncation-slope value",
-          f"max |ΔI| at ε = {DRAFT_SCENE.eps:g} and {DRAFT_SCENE.eps / 10:g} (sine, β = {CELL6_BETA:g})", HOLDS,
+          f"max |ΔI| at ε = {DRAFT_SCENE.eps:g} and {DRAFT_SCENE.eps / 10:g} ({CELL6_FIELD}, β = {CELL6_BETA:g})", HOLDS,
           _cell6_truncation,
           rule(HOLDS, about("max |ΔI| ratio", 10 ** 2))),
     Claim("noise-below-1e-11", "Cell 7a", "below eps ~ 1e-11 the difference quotient is noise",

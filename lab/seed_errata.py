@@ -30,8 +30,9 @@ __all__ = ["Erratum", "ERRATA", "measure_all", "reproduced", "ErratumVanished", 
 
 #: Resolution of the measurements (the seed's own 256 x 256 frames).
 SIZE = 256
-#: The draft's strong bump of its Cell 6 (``{**SC9, 'beta': 1.5}``), beside its scene's own β.
-CELL6_BETA = 1.5
+#: The draft's strong bump of its Cell 6 (``{**SC9, 'beta': 1.5, 'hf': 'sine'}``), beside its scene's own β,
+#: and the field it bumps.
+CELL6_BETA, CELL6_FIELD = 1.5, "sine"
 
 
 @dataclass(frozen=True)
