@@ -644,7 +644,7 @@ def _series_refusal(lhs, rhs):
         return f"its right side must end in one O-term, a term of its sum: it has {sorted(map(str, found))}"
     var, point = order.variables[0], order.point[0]
     n = sp.degree(order.expr, var) if len(order.variables) == 1 and order.expr.is_polynomial(var) else None
-    if n is None or not point.is_finite or n < 1 or order.expr != (var - point) ** n:
+    if n is None or n < 1 or order.expr != (var - point) ** n:         # x0 infinite: (x - oo)**n is no power of x
         return f"its O-term {order} is not O((x - x0)**n) in one variable x about a finite point x0, n >= 1"
     inside = [t for t in terms if t != order and order.contains(t) is True]
     if inside:

@@ -536,7 +536,8 @@ def test_rule_4_an_order_term_anywhere_but_ending_the_right_side_is_refused():
     cases = {"its left side carries an O-term": (sp.O(x_**2), sp.O(x_**3)),
              "must end in one O-term, a term of its sum": (sp.exp(x_), 1 + x_ * (1 + sp.O(x_))),
              "is not O((x - x0)**n) in one variable": (sp.exp(x_ * y_), 1 + sp.O(x_ * y_)),
-             "about a finite point": (sp.exp(1 / x_), 1 + sp.O(1 / x_, (x_, sp.oo)))}
+             "about a finite point": (sp.exp(1 / x_), 1 + sp.O(1 / x_, (x_, sp.oo))),
+             "x0, n >= 1": (x_**3, x_**3 + sp.O(x_**2, (x_, sp.oo)))}         # a power, about infinity
     for why, (lhs, rhs) in cases.items():
         t = Theorem("o", "o", "", (Step("series", lhs, rhs),), {}, domain={x_: (0.1, 1), y_: (0.1, 1)})
         v = t.check()
@@ -857,3 +858,48 @@ def test_words_are_listed_as_a_sentence_lists_them():
     from proofs.core import listed
     assert [listed(w) for w in ([], ["red"], ("red", "green"), iter(["red", "green", "blue"]), "abcd")] == [
         "", "red", "red and green", "red, green and blue", "a, b, c and d"]
+
+
+# ----------------------------------------------------------- rules a review found no planted violation of
+def test_a_nan_that_only_the_full_sampling_meets_refutes():
+    """Sides NaN only above x = 9/10 (a formula that breaks near one end of its interval): the 3-point
+    probe misses it (checked here), so the verdict rests on the full sampling keeping a NaN as the worst
+    residual, after finite ones, and refuting with it."""
+    nan_above = sp.Lambda(x, sp.Piecewise((sp.nan, x > sp.Rational(9, 10)), (0, True)))
+    edge = Identity("nan edge", x + h(x), x, {x: (0, 1)}, {h: nan_above})
+    probe, _ = core._numeric_residual(edge, 1000, 3, core.DIGITS)          # the probe's seed and size
+    assert probe == 0.0
+    v = check_identities([edge])
+    assert v.status == "refuted" and "residual nan" in v.evidence, v
+    r, at = core._numeric_residual(Identity("n", h(x), 0, {x: (0, 1)}, {h: nan_above}), 0, core.POINTS, 30)
+    assert r != r and at[x] > 0.9                                            # NaN, where it was met
+
+
+def test_rule_4_an_order_term_of_order_zero_is_refused():
+    """O(1) as the whole series of exp x: it claims nothing about any power of x, so a check through
+    power n - 1 = -1 would pass anything."""
+    v = Theorem("o", "o", "", (Step("series", sp.exp(x), sp.O(1, x)),), {}, domain={x: (0.1, 1)}).check()
+    assert v.status == "refuted" and "n >= 1" in v.evidence, v
+
+
+@pytest.mark.parametrize("bound, status", [(1e-19, "refuted"), (1e-22, "proved")])
+def test_rule_11_a_theorems_own_evidence_held_to_a_loose_threshold_is_refused(bound, status):
+    """Evidence that measured 1e-24 and held it to 1e-19 (10^5 times: loose enough to pass a defect) refutes
+    the theorem whose steps all hold; held to 1e-22 (100 times) it does not."""
+    v = square_theorem(*CHAIN, evidence=lambda: Verdict("verified", "e", 1e-24, 30, 24, bound=bound)).check()
+    assert v.status == ("refuted" if status == "refuted" else "verified"), v
+    assert ("tighten it" in v.evidence) == (status == "refuted")
+
+
+def test_the_evidence_is_not_asked_for_a_theorem_its_steps_or_statement_already_refute():
+    """Evidence renders frames (seconds): a theorem whose claim no chain reaches, or whose statement shows
+    an unknown placeholder, is refuted without it."""
+    asked = []
+
+    def evidence():
+        asked.append(1)
+        return Verdict("proved", "asked")
+    unreached = square_theorem(CHAIN[0], evidence=evidence).check()
+    unknown = dataclasses.replace(square_theorem(*CHAIN, evidence=evidence), statement="⟦cube⟧").check()
+    assert (unreached.status, unknown.status, asked) == ("refuted", "refuted", [])
+    assert square_theorem(*CHAIN, evidence=evidence).check().status == "proved" and asked == [1]
