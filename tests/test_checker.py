@@ -520,7 +520,7 @@ def test_a_verified_pin_loosened_is_refused_and_the_rule_spares_an_exact_zero(mo
 def test_rule_12_evidence_that_leaves_out_a_field_is_named(monkeypatch):
     """A theorem about every field whose evidence compared outputs of only some, enough of them in all,
     is named (rule 12); each of the four per-field theorems, its evidence narrowed to the first field,
-    is refused."""
+    is refused: three by rule 12 alone (their outputs counted enough), β → 0's by its own evidence."""
     from proofs import displacement, normal, pixels
     assert pinned_failure("chart", "verified", 1e-30, 10**6, ALL[:-1]).endswith(
         f"compared no renderer output of the {ALL[-1]} field, which its statement is about")
@@ -531,10 +531,14 @@ def test_rule_12_evidence_that_leaves_out_a_field_is_named(monkeypatch):
                         lambda bump, gradient, fields=None: real_surface(bump, gradient, fields=ALL[:1]))
     real_rate = normal._render_rate
     monkeypatch.setattr(normal, "_render_rate", lambda **kw: real_rate(**{**kw, "fields": ALL[:1] * len(ALL)}))
-    for theorem_id in ("chart", "frame-orthonormal", "bump-vs-displacement", "beta-zero-regression"):
+    for theorem_id in ("chart", "frame-orthonormal", "bump-vs-displacement"):
         v = get(theorem_id).check()
-        why = pinned_failure(theorem_id, v.status, v.residual, v.rendered, v.covers) if v.holds else v.evidence
-        assert why, theorem_id           # by rule 12, or by the outputs' count where that falls short first
+        assert v.holds and v.covers == ALL[:1], (theorem_id, v)
+        # Outputs enough in number (10^9): only rule 12 is left to refuse it.
+        assert f"compared no renderer output of the {', '.join(ALL[1:])} field" in pinned_failure(
+            theorem_id, v.status, v.residual, 10**9, v.covers), theorem_id
+    v = get("beta-zero-regression").check()          # its own evidence counts the configurations it rendered
+    assert v.status == "refuted" and "not every configuration was rendered" in v.evidence, v.evidence
 
 
 def test_a_theorem_about_every_field_names_each_field_its_evidence_left_out():
