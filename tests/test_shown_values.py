@@ -312,7 +312,7 @@ def test_a_difference_panel_is_the_difference_amplified_by_the_gain_its_title_na
 
 
 @pytest.mark.parametrize("page, name, frames", [
-    ("s5_lab", "fig-c6-beta", lambda ns: [ns["flat"], ns["sine"]]),
+    ("s5_lab", "fig-c6-beta", lambda ns: [ns["flat"], ns["strong"]]),
     ("s1_what_changes", "fig-s1-bump", lambda ns: [ns["frames"]["surface"]["flat"]]),   # beta = 0: one for both
 ])
 def test_a_render_titled_with_its_beta_is_the_render_at_that_beta(ran, page, name, frames):
