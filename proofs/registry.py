@@ -80,8 +80,12 @@ RENDERED = {
     "kink-loci-circles": 200, "no-boundary": 100, "beta-zero-regression": 4, "central-difference-truncation": 200,
     "bump-vs-displacement": 200,
 }
-#: The entries of `RENDERED` that count per registered field.
+#: The entries of `RENDERED` that count per registered field: the theorems about every field, whose
+#: evidence names the fields it compared (`proofs.core.Verdict.covers`; `pinned_failure` holds the two together).
 COUNTED_PER_FIELD = ("chart", "frame-orthonormal", "beta-zero-regression", "bump-vs-displacement")
+#: A verified verdict rests on mpmath at `LEAST_DIGITS` digits and `LEAST_POINTS` seeded points at least, or,
+#: when renderer evidence alone verifies it (no digits), on `LEAST_RENDERS` outputs without a difference.
+LEAST_DIGITS, LEAST_POINTS, LEAST_RENDERS = 30, 20, 100
 
 
 def _entry(table, theorem_id):
@@ -136,7 +140,8 @@ def pinned_failure(theorem_id, status, residual, rendered, covers):
     residual a number at most the pin's bound (a missing or NaN residual never passes) and
     the bound within `proofs.core.TIGHT` of it, at least `least_rendered` renderer outputs
     compared, and for a theorem of `COUNTED_PER_FIELD` outputs of every registered field among
-    them (``covers``: the field names the evidence compared, `proofs.core.Verdict.covers`).
+    them (``covers``: the field names the evidence compared, `proofs.core.Verdict.covers`); evidence
+    that names the fields it compared belongs to a theorem of `COUNTED_PER_FIELD`.
 
     Raises
     ------
@@ -163,7 +168,45 @@ def pinned_failure(theorem_id, status, residual, rendered, covers):
         if missing:
             return (f"{theorem_id}'s evidence compared no renderer output of the {', '.join(missing)} "
                     f"field{'s' if len(missing) > 1 else ''}, which its statement is about")
+    elif covers:
+        return (f"{theorem_id}'s evidence compared outputs field by field ({', '.join(covers)}), but its "
+                "least count is not per field (COUNTED_PER_FIELD)")
     return None
+
+
+def verdict_failure(theorem_id, verdict):
+    """Why ``verdict`` (a `proofs.core.Verdict` of the theorem) does not stand, or None: it does not
+    hold; it is not its pin (`pinned_failure`); or it is verified on fewer than `LEAST_DIGITS` digits
+    at `LEAST_POINTS` points, or, without digits, on fewer than `LEAST_RENDERS` outputs or a residual
+    other than 0.  `pytest verify` and the book's theorem blocks refuse what this names.
+
+    Raises
+    ------
+    KeyError, ValueError
+        As `pin`.
+    """
+    v = verdict
+    if not v.holds:
+        return f"{theorem_id} is {v.status}: {v.evidence}"
+    why = pinned_failure(theorem_id, v.status, v.residual, v.rendered, v.covers)
+    if why or v.status != "verified":
+        return why
+    if v.digits is not None and v.digits >= LEAST_DIGITS and (v.points or 0) >= LEAST_POINTS:
+        return None
+    if v.digits is None and (v.points or 0) >= LEAST_RENDERS and v.residual == 0.0:
+        return None
+    return (f"{theorem_id} is verified at {v.digits} digits and {v.points} points (residual {v.residual}): "
+            f"at least {LEAST_DIGITS} digits at {LEAST_POINTS} points, or {LEAST_RENDERS} outputs without a difference")
+
+
+def unknown_keys():
+    """The keys of `PINNED`, `RENDERED` and `COUNTED_PER_FIELD` that name no theorem (a ``{field}`` key: the
+    theorem of no registered field), and the entries of `COUNTED_PER_FIELD` that `RENDERED` lacks."""
+    from renderer.formulas import FIELDS
+    known = set(CITABLE)
+    out = [key for key in [*PINNED, *RENDERED, *COUNTED_PER_FIELD]
+           if not any(key.replace("{field}", f) in known for f in FIELDS)]
+    return out + [f"{key} (not in RENDERED)" for key in COUNTED_PER_FIELD if key not in RENDERED]
 
 
 def get(theorem_id):

@@ -14,7 +14,7 @@ import pytest
 import sympy as sp
 
 from chapter import latex
-from proofs.core import CITATION, plain
+from proofs.core import CITATION, Verdict, plain
 from renderer.formulas import FIELDS
 from proofs.registry import CITABLE, PINNED, THEOREMS, get, least_rendered, pin, pinned_failure
 from verify.test_theorems import _placed
@@ -53,7 +53,7 @@ def test_rule_7_a_pin_of_zero_admits_only_a_zero_residual(monkeypatch, residual,
     """("verified", 0.0), as no-boundary's (its residual counts differing renderer outputs): a bound read
     by truthiness (0.0 is false) would never be enforced."""
     monkeypatch.setitem(PINNED, "no-boundary", ("verified", 0.0))
-    why = pinned_failure("no-boundary", "verified", residual, least_rendered("no-boundary"), ALL)
+    why = pinned_failure("no-boundary", "verified", residual, least_rendered("no-boundary"), ())
     assert (why is None) is passes, why
     if not passes:
         assert why == f"no-boundary is verified with residual {residual}, pinned at most 0", why
@@ -69,7 +69,8 @@ def test_rule_7_a_pin_bounds_the_residual_from_above_inclusively(monkeypatch, bo
     assert "is proved, pinned verified" in pinned_failure("chart", "proved", None, least, ALL)
 
 
-@pytest.mark.parametrize("bad", ["verified", ("verified",), ("verified", -1e-30), ("verified", float("inf")),
+@pytest.mark.parametrize("bad", ["verified", ("verified",), ["verified", 1e-30], ("verified", 1e-30, "x"),
+                                 ("verified", -1e-30), ("verified", float("inf")),
                                  ("verified", float("nan")), ("verified", None), ("verified", True), ("proved", 0.0),
                                  ("refuted", 0.0), "refuted", "Proved", None])
 def test_rule_7_a_malformed_pin_is_an_error_naming_it(monkeypatch, bad):
@@ -161,8 +162,79 @@ def test_no_sentence_is_shared_between_theorems():
 
 
 def test_registry_names_unknown_ids():
-    with pytest.raises(KeyError, match="no theorem 'no-such'"):
+    with pytest.raises(KeyError, match=r"no theorem 'no-such'; known: \[.*'chart'"):
         get("no-such")
+
+
+def test_the_registry_builds_nothing_until_a_theorem_is_asked_for(monkeypatch):
+    """Importing the registry loads none of numpy, sympy, matplotlib or numba (each test worker and page
+    kernel imports it); listing, counting, testing and titling the theorems build none; asking for one
+    builds that one."""
+    import importlib
+
+    from proofs import registry
+
+    from .test_interrupts import heavy_modules_after
+    assert heavy_modules_after("import proofs.registry") == "[]"
+    assert "'sympy'" in heavy_modules_after("import proofs.registry as r; r.get('chart')")
+    built = []
+    for name in registry.MODULES:
+        module = importlib.import_module(f"proofs.{name}")
+        monkeypatch.setattr(module, "build", lambda theorem_id, real=module.build: built.append(theorem_id) or real(theorem_id))
+    ids, n, known, title = list(registry.THEOREMS), len(registry.CITABLE), "chart" in registry.THEOREMS, \
+        registry.CITABLE["chart"]
+    assert (len(ids), n, known, isinstance(title, str), built) == (n, len(ids), True, True, [])
+    registry.get("chart")
+    assert built == ["chart"]
+
+
+def test_a_family_pin_serves_only_a_theorem_of_the_registry_and_yields_to_its_own(monkeypatch):
+    """``{field}-kinks`` pins the kinks theorem of each field that has creases: sine has none, so
+    "sine-kinks" is no theorem and has no pin; a theorem's own entry comes before its family's."""
+    assert "sine-kinks" not in CITABLE and "ridges-kinks" in CITABLE
+    with pytest.raises(KeyError, match="sine-kinks"):
+        pin("sine-kinks")
+    assert pin("ridges-kinks") == ("proved", None)
+    monkeypatch.setitem(PINNED, "gradient-sine", ("verified", 1e-20))
+    assert (pin("gradient-sine"), pin("gradient-rings")) == (("verified", 1e-20), ("proved", None))
+
+
+def test_a_key_of_the_pins_that_names_no_theorem_is_named(monkeypatch):
+    """A misspelt key would pin nothing and leave its theorem to the family's pin, or to none."""
+    from proofs import registry
+    assert registry.unknown_keys() == []
+    monkeypatch.setitem(PINNED, "no-such", "proved")
+    monkeypatch.setitem(registry.RENDERED, "kink-loci-ray", 200)
+    monkeypatch.setattr(registry, "COUNTED_PER_FIELD", (*registry.COUNTED_PER_FIELD, "optimal-step"))
+    assert registry.unknown_keys() == ["no-such", "kink-loci-ray", "optimal-step (not in RENDERED)"]
+
+
+def test_evidence_compared_field_by_field_belongs_to_a_theorem_counted_per_field(monkeypatch):
+    """A theorem whose evidence names the fields it compared is one about every field: its least count
+    grows with the fields and every field must be among them.  Left out of COUNTED_PER_FIELD, it is
+    named; so is a per-field theorem whose evidence reports fields."""
+    from proofs import registry
+    assert pinned_failure("beta-zero-regression", "proved", None, 10**9, ALL) is None
+    monkeypatch.setattr(registry, "COUNTED_PER_FIELD", tuple(t for t in registry.COUNTED_PER_FIELD
+                                                             if t != "beta-zero-regression"))
+    assert "least count is not per field" in pinned_failure("beta-zero-regression", "proved", None, 10**9, ALL)
+    assert "(sine)" in pinned_failure("gradient-sine", "proved", None, 10**9, ("sine",))
+
+
+@pytest.mark.parametrize("theorem_id, verdict, why", [
+    ("chart", Verdict("verified", "e", 1e-31, 20, 24, 10**9, covers=ALL), "at 20 digits and 24 points"),
+    ("chart", Verdict("verified", "e", 1e-31, 30, 19, 10**9, covers=ALL), "at 30 digits and 19 points"),
+    ("chart", Verdict("verified", "e", 1e-31, 30, 24, 10**9, covers=ALL), None),
+    ("no-boundary", Verdict("verified", "e", 0.0, None, 99, 10**9), "at None digits and 99 points"),
+    ("no-boundary", Verdict("verified", "e", 0.0, None, 100, 10**9), None),
+    ("chart", Verdict("refuted", "forced"), "chart is refuted: forced"),
+])
+def test_a_verified_verdict_rests_on_enough_digits_and_points_or_renders(theorem_id, verdict, why):
+    """`pytest verify` and the book refuse what `verdict_failure` names: besides the pin, a verified verdict
+    rests on mpmath at 30 digits and 20 points, or on 100 renders without a difference."""
+    from proofs.registry import verdict_failure
+    found = verdict_failure(theorem_id, verdict)
+    assert found == why if why is None else why in found, found
 
 
 def test_book_block_refuses_a_failing_theorem(monkeypatch):

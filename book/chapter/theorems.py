@@ -188,7 +188,7 @@ def _numeric_note(t, v):
 
 
 def _entry(t):
-    from proofs.registry import pinned_failure
+    from proofs.registry import verdict_failure
     v = t.check()
     note, unexplained = _numeric_note(t, v)
     steps = _proof(t, v.numeric if v.status == "verified" else (), note)
@@ -197,7 +197,7 @@ def _entry(t):
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, badge=badge(v.status, v.numeric), evidence=v.evidence,
                 block=block, unexplained=unexplained,
-                changed=pinned_failure(t.id, v.status, v.residual, v.rendered, v.covers))
+                changed=v.holds and verdict_failure(t.id, v))
 
 
 def _ledger():
