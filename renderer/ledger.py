@@ -107,7 +107,7 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
                 raise ValueError(f"{name}.{field} must be a {np.dtype(dtype)} array of shape {dims}, got {got}")
     arrays = [np.ascontiguousarray(a) for a in (numeric.image, symbolic.image, numeric.chamber,
                                                    symbolic.chamber, symbolic.kink)]
-    top, sq, pixels, on, n_on, off, n_off, flips = ledger_sums(*arrays)
+    top, sq, pixels, on, n_on, off, n_off, flips = ledger_sums(*arrays, SPHERE_A)
     entries = n_on + n_off
     return Ledger(
         max_abs=float(top),
@@ -120,18 +120,20 @@ def compare(numeric: Frame, symbolic: Frame) -> Ledger:
 
 
 @njit(cache=True, error_model="numpy")
-def ledger_sums(num_image, sym_image, num_chamber, sym_chamber, band):
+def ledger_sums(num_image, sym_image, num_chamber, sym_chamber, band, sphere_a):
     """One pass over two frames for `renderer.compare`: over the pixels on
-    sphere A in both, max |dI|, the sum of |dI|^2, the pixel count, the sum
-    and count of |dI| on and off the crease ``band`` (channel values); and the
-    number of pixels whose chamber differs.  Images (H, W, C) float64,
-    chambers (H, W) uint8, band (H, W) bool."""
+    sphere A (chamber code ``sphere_a``) in both, max |dI|, the sum of |dI|^2,
+    the pixel count, the sum and count of |dI| on and off the crease ``band``
+    (channel values); and the number of pixels whose chamber differs.  Images
+    (H, W, C) float64, chambers (H, W) uint8, band (H, W) bool.  The code is an
+    argument, not a global: numba's cache, invalidated by this file alone, would
+    keep another file's constant as it was compiled."""
     top, sq, pixels, on, n_on, off, n_off, flips = 0.0, 0.0, 0, 0.0, 0, 0.0, 0, 0
     for j in range(num_chamber.shape[0]):
         for i in range(num_chamber.shape[1]):
             a, b = num_chamber[j, i], sym_chamber[j, i]
             flips += a != b
-            if a != SPHERE_A or b != SPHERE_A:
+            if a != sphere_a or b != sphere_a:
                 continue
             pixels += 1
             for c in range(num_image.shape[2]):

@@ -176,3 +176,59 @@ def test_a_read_only_install_without_a_writable_home_compiles_in_the_fallback(tm
     assert done.returncode == 0 and done.stdout == "ok\n", done.stderr[-2000:]
     assert done.stderr.count("\n") == 1 and "compiled functions are cached in" in done.stderr, done.stderr
     assert list((shared / f"symrender-numba-{os.getuid()}").rglob("*.nbi"))
+
+
+def cross_file_globals(module):
+    """[(function, name)]: the globals each function ``module`` compiles with numba's on-disk cache reads
+    from another file.  numba compiles a global in as a constant and invalidates a cached function only
+    when its own file changes, so an edit to that other file would leave the cached code stale (a
+    constant moved in renderer.kernel, say, and renderer.ledger's cached sums still reading the old one).
+    Modules, builtins and the module's own top-level names are not counted."""
+    import ast
+    import builtins
+    import dis
+    import inspect
+    import types
+
+    from numba.core.caching import NullCache
+    from numba.core.registry import CPUDispatcher
+    tree = ast.parse(inspect.getsource(module))
+    own = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))} | {
+        t.id for n in tree.body if isinstance(n, (ast.Assign, ast.AnnAssign))
+        for target in (n.targets if isinstance(n, ast.Assign) else [n.target]) for t in ast.walk(target)
+        if isinstance(t, ast.Name)}
+    out = []
+    for name, f in vars(module).items():
+        if not (isinstance(f, CPUDispatcher) and f.py_func.__module__ == module.__name__
+                and not isinstance(f._cache, NullCache)):
+            continue
+        for ins in dis.get_instructions(f.py_func):
+            g = ins.argval
+            if ins.opname == "LOAD_GLOBAL" and g not in own and not hasattr(builtins, g) \
+                    and not isinstance(f.py_func.__globals__.get(g), types.ModuleType):
+                out.append((name, g))
+    return sorted(set(out))
+
+
+def test_no_cached_kernel_reads_a_constant_or_function_of_another_file(tmp_path, monkeypatch):
+    """Every cached numba function of renderer/ and lab/ reads only its own file's globals, except the
+    kernel's calls into generated.py, which kernel.py's FORMULAS_DIGEST ties to kernel.py's own text (an
+    edited generated.py fails the import until the digest, and so kernel.py and its cache, change too).
+    A planted module whose cached function compares with another file's constant is named."""
+    import ast
+    import importlib
+    import pkgutil
+
+    import lab
+    kernel = ROOT / "renderer" / "kernel.py"
+    guarded = {("renderer.kernel", a.asname or a.name) for n in ast.walk(ast.parse(kernel.read_text(encoding="utf-8")))
+               if isinstance(n, ast.ImportFrom) and n.module == "generated" for a in n.names}
+    assert len(guarded) >= 5
+    found = [(m.name, f, g) for package in (renderer, lab) for m in pkgutil.iter_modules(package.__path__, package.__name__ + ".")
+             for f, g in cross_file_globals(importlib.import_module(m.name)) if (m.name, g) not in guarded]
+    assert found == []
+    (tmp_path / "planted_sums.py").write_text(
+        "from numba import njit\nfrom renderer.render import SPHERE_A\n\n\n@njit(cache=True)\ndef on_a(code):\n"
+        "    return code == SPHERE_A\n\n\n@njit\ndef uncached(code):\n    return code == SPHERE_A\n", encoding="utf-8")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert cross_file_globals(importlib.import_module("planted_sums")) == [("on_a", "SPHERE_A")]
