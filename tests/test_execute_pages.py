@@ -234,3 +234,53 @@ def test_no_kernel_client_outlives_its_page(tmp_path):
     finally:
         execute_pages._build.pop("kernel")[1]()
     assert threads[0] == threads[1] == threads[2], threads
+
+
+def _last_build(tmp_path, monkeypatch, complete, cached):
+    """A book tree as a build left it: the doctrees' ``build-complete`` reading ``complete``, the cache's
+    digest ``cached``, Sphinx's saved environment and an executed page; the project's digest is "now"."""
+    from lab import store
+    monkeypatch.setattr(store, "_DIGEST", ["now"])
+    monkeypatch.setattr(execute_pages, "_drop_unreadable", lambda cache: None)
+    book = tmp_path / "book"
+    doctrees, cache, out = book / "_build" / ".doctrees", book / "_build" / ".jupyter_cache", book / "_build" / "html"
+    for d in (doctrees, cache, out):
+        d.mkdir(parents=True)
+    (cache / execute_pages.DIGEST_FILE).write_text(cached)
+    (doctrees / execute_pages.COMPLETE_FILE).write_text(complete)
+    (doctrees / "environment.pickle").write_text("env")
+    (cache / "executed-page").write_text("old output")
+    app = SimpleNamespace(srcdir=book, doctreedir=doctrees, outdir=out, _warncount=0,
+                          config=SimpleNamespace(nb_execution_cache_path=str(cache)))
+    return app, doctrees, cache
+
+
+@pytest.mark.parametrize("complete, cached, environment_kept, cache_kept", [
+    ("now", "now", True, True), ("before", "now", False, True), ("now", "before", False, False)])
+def test_a_build_trusts_only_what_both_digests_vouch_for(tmp_path, monkeypatch, complete, cached, environment_kept,
+                                                         cache_kept):
+    """Sphinx's saved environment is kept only when the last build finished under the current digest and
+    the cache was executed under it; the cache only when it was; build-complete is gone either way (this
+    build may be killed).  A build-complete that merely exists, stale, is not trusted."""
+    app, doctrees, cache = _last_build(tmp_path, monkeypatch, complete, cached)
+    try:
+        execute_pages._begin(app, None)
+    finally:
+        execute_pages._build.pop("lock").release()
+    assert (doctrees / "environment.pickle").exists() == environment_kept
+    assert (cache / "executed-page").exists() == cache_kept
+    assert (cache / execute_pages.DIGEST_FILE).read_text() == "now"
+    assert not (doctrees / execute_pages.COMPLETE_FILE).exists()
+
+
+def test_only_a_build_without_an_error_or_a_warning_is_marked_complete(tmp_path, monkeypatch):
+    app, doctrees, _ = _last_build(tmp_path, monkeypatch, "x", "x")
+    (doctrees / execute_pages.COMPLETE_FILE).unlink()
+    execute_pages._finish(app, RuntimeError("sphinx failed"))
+    assert not (doctrees / execute_pages.COMPLETE_FILE).exists()
+    app._warncount = 1
+    execute_pages._finish(app, None)
+    assert not (doctrees / execute_pages.COMPLETE_FILE).exists()
+    app._warncount = 0
+    execute_pages._finish(app, None)
+    assert (doctrees / execute_pages.COMPLETE_FILE).read_text() == "now"

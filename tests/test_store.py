@@ -469,3 +469,37 @@ def test_the_digest_reads_the_packages_where_python_imports_them_from():
     assert sorted(roots) == sorted(store.PACKAGES)
     for package, root in roots.items():
         assert root == Path(importlib.import_module(package).__file__).parent
+
+
+def test_a_fifo_fed_a_sealed_record_is_never_read(fresh, monkeypatch):
+    """A FIFO in a record's place, a writer holding it open with a well-formed record in the pipe (value 999,
+    its checksum matching): the store does not read it (only a regular file is), and computes the value."""
+    import os
+    import signal
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    path = directory / "u-curve.json"
+    planted = _sealed({**{k: v for k, v in _stored(directory).items() if k != "sha256"}, "value": 999})
+    path.unlink()
+    os.mkfifo(path)
+    writer = os.open(path, os.O_RDWR | os.O_NONBLOCK)
+    os.write(writer, json.dumps(planted).encode())
+    old = signal.signal(signal.SIGALRM, lambda *a: pytest.fail("the store blocked on the FIFO"))
+    signal.alarm(20)
+    try:
+        _new_process(monkeypatch)
+        assert store.measured("u-curve", compute, size=256) != 999 and len(calls) == 2
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+        os.close(writer)
+
+
+def test_a_sealed_record_with_a_field_more_is_computed_again(fresh, monkeypatch):
+    """A record whose checksum matches its fields, with one field the store never writes: not served."""
+    directory, calls, compute = fresh
+    store.measured("u-curve", compute, size=256)
+    record = {k: v for k, v in _stored(directory).items() if k != "sha256"}
+    (directory / "u-curve.json").write_text(json.dumps(_sealed({**record, "value": 999, "extra": 1})))
+    _new_process(monkeypatch)
+    assert store.measured("u-curve", compute, size=256) != 999 and len(calls) == 2
