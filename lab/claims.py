@@ -192,12 +192,16 @@ def _errata():
     return measure_all()
 
 
-@lru_cache(maxsize=None)
 def _frames(field=None, beta=None, eps=None, size=128):
     """(central, exact) frames of the draft's scene, ``size`` squared, with its field, β and step
-    replaced where given."""
+    replaced where given; rendered once per scene (`_frames_of`: the scene is the key, so a test that
+    patches `DRAFT_SCENE` gets its own frames)."""
     changes = {"height_field": field, "beta": beta, "eps": eps}
-    scene = DRAFT_SCENE.replace(**{k: x for k, x in changes.items() if x is not None})
+    return _frames_of(DRAFT_SCENE.replace(**{k: x for k, x in changes.items() if x is not None}), size)
+
+
+@lru_cache(maxsize=None)
+def _frames_of(scene, size):
     return render(scene, size, size, gradient="central"), render(scene, size, size)
 
 

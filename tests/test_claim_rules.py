@@ -412,3 +412,12 @@ def test_about_refuses_zero_and_takes_any_positive_size():
     with pytest.raises(InvalidValue, match="^x must be"):
         about("q", 0.0)
     assert about("q", 5e-324).lo == pytest.approx(5e-324 / ABOUT, rel=1e-15, abs=0)
+
+
+def test_the_claims_frames_are_those_of_the_draft_scene_as_it_stands(monkeypatch):
+    """The frames the claims share are cached by scene: a test that patches the draft's scene (as the
+    pinch and sampler tests do) is measured on its scene, not on frames cached before the patch."""
+    from lab import claims
+    before = claims._frames(size=8)[1].scene.beta
+    monkeypatch.setattr(claims, "DRAFT_SCENE", claims.DRAFT_SCENE.replace(beta=0.0))
+    assert (before, claims._frames(size=8)[1].scene.beta) == (DRAFT_SCENE.beta, 0.0)
