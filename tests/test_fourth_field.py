@@ -39,6 +39,24 @@ def test_a_theorem_built_from_the_fields_is_built_again_when_they_change(built_b
     assert registry.get("bump-vs-displacement").statement == built_before
 
 
+@pytest.fixture
+def listed_before():
+    """The registry's ids, listed before the `squares` fixture registers its field."""
+    from proofs import registry
+    return list(registry.THEOREMS)
+
+
+def test_the_registry_lists_a_field_registered_after_it_was_listed(listed_before, squares):
+    """The catalogue is read again at each call, so a field registered after a first listing (in one test
+    worker, any earlier test) has its theorem, and loses it when removed."""
+    from proofs import registry
+    assert "gradient-squares" not in listed_before and "gradient-squares" in registry.THEOREMS
+    F.FIELDS.pop("squares")
+    assert list(registry.THEOREMS) == listed_before
+    with pytest.raises(KeyError, match="gradient-squares"):
+        registry.pin("gradient-squares")
+
+
 def test_the_fourth_field_has_its_theorems_and_pins(squares):
     """The registry lists gradient-squares after the other fields' (and no crease theorem: it has no crease),
     pinned proved with 200 pixels; the theorems about every field cover it: the stencil step has its case,
