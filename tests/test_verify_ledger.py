@@ -1,6 +1,7 @@
 """`pytest verify` prints the theorem ledger (README), also when xdist runs the theorems in a worker
 processes, as `make test` does: each verdict travels in its test report to the process that prints."""
 
+import os
 import re
 import subprocess
 import sys
@@ -62,3 +63,18 @@ def test_a_run_that_imported_no_hypothesis_drops_its_plugin(monkeypatch, pytestc
     monkeypatch.delitem(sys.modules, "hypothesis")
     conftest.pytest_collection_finish(session)
     assert dropped == [conftest.HYPOTHESIS_PLUGIN]
+
+
+def test_verify_fails_a_theorem_that_holds_but_not_with_its_pin(tmp_path):
+    """`pytest verify` applies the pins: frame-orientation, proved, pinned ("verified", 1e-25) by a plugin
+    loaded into the run, fails naming the difference (a verify that only asked whether the verdict holds
+    would pass it)."""
+    (tmp_path / "planted_pin.py").write_text(
+        "def pytest_configure(config):\n    from proofs import registry\n"
+        "    registry.PINNED['frame-orientation'] = ('verified', 1e-25)\n", encoding="utf-8")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    run = subprocess.run([sys.executable, "-m", "pytest", "verify/test_theorems.py", "-k", "frame-orientation",
+                          "-p", "no:cacheprovider", "-p", "no:xdist", "-p", "planted_pin"], cwd=ROOT, env=env,
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 1, run.stdout[-2000:] + run.stderr[-2000:]
+    assert "frame-orientation is proved, pinned verified" in run.stdout, run.stdout[-2000:]
