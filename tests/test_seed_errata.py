@@ -169,7 +169,7 @@ def test_the_draft_is_measured_with_its_own_values_not_the_books_defaults(monkey
     monkeypatch.setattr(pointwise, "central_gradient", spied_central)
     monkeypatch.setattr(store, "_MEMORY", {})                  # measured afresh, not read from a store
     monkeypatch.delenv(store.ENV, raising=False)
-    caches = (claims._frames, claims._ucurve, claims._errata)
+    caches = (claims._frames_of, claims._ucurve, claims._errata)
     for cache in caches:
         cache.cache_clear()
     try:
