@@ -403,16 +403,19 @@ def test_a_special_file_where_the_build_writes_is_named_in_one_line(tmp_path, wh
     assert not (tmp_path / "outside").exists()
 
 
-def test_a_tree_the_build_cannot_write_is_named(tmp_path, monkeypatch):
-    """A read-only book directory (os.access says so: root passes every mode check, so the test
-    asks os.access as a read-only mount would answer) is refused in one line naming it."""
+@pytest.mark.parametrize("which", ["book", "doctrees", "cache"])
+def test_a_tree_the_build_cannot_write_is_named(tmp_path, monkeypatch, which):
+    """A read-only book, doctree or cache directory (os.access says so: root passes every mode check, so
+    the test asks os.access as a read-only mount would answer) is refused in one line naming it."""
     refusal = _refusal()
     book = tmp_path / "book"
-    book.mkdir()
+    paths = {"book": book, "doctrees": book / "_build/.doctrees", "cache": book / "_build/.jc"}
+    for path in paths.values():
+        path.mkdir(parents=True, exist_ok=True)
     real = os.access
-    monkeypatch.setattr(os, "access", lambda p, mode: False if Path(p) == book else real(p, mode))
-    assert refusal(book, book / "_build/.doctrees", book / "_build/.jc") == \
-        f"{book} cannot be written (read-only?): the build writes its output and its lock there"
+    monkeypatch.setattr(os, "access", lambda p, mode: False if Path(p) == paths[which] else real(p, mode))
+    assert refusal(*paths.values()) == \
+        f"{paths[which]} cannot be written (read-only?): the build writes its output and its lock there"
 
 
 def test_make_book_with_a_fifo_for_its_lock_stops_at_once_with_one_line(tmp_path, token):
