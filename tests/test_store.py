@@ -8,6 +8,7 @@ shown failing on a wrong variant of the store.
 from __future__ import annotations
 
 import json
+from contextlib import contextmanager
 
 import pytest
 
@@ -195,6 +196,19 @@ def _sealed(record):
     return {**record, "sha256": store._checksum(record)}
 
 
+@contextmanager
+def _unblocked(seconds=20):
+    """Fails the test, instead of hanging it, if the block takes ``seconds`` (a read of a FIFO blocks)."""
+    import signal
+    old = signal.signal(signal.SIGALRM, lambda *a: pytest.fail("the store blocked (on a FIFO?)"))
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
 def _stored(directory, name="u-curve"):
     return json.loads((directory / f"{name}.json").read_text())
 
@@ -269,7 +283,8 @@ def test_a_record_that_is_not_a_small_regular_file_is_never_served_and_is_replac
         monkeypatch.setattr(store, "MAX_RECORD_BYTES", path.stat().st_size - 1)
     before = elsewhere.read_bytes() if kind == "link" else None
     _new_process(monkeypatch)
-    store.measured("u-curve", compute, size=256)
+    with _unblocked():
+        store.measured("u-curve", compute, size=256)
     assert len(calls) == 2 and path.is_file() and not path.is_symlink()
     assert _stored(directory)["sha256"] == store._checksum(_stored(directory))
     if kind == "link":
@@ -475,7 +490,6 @@ def test_a_fifo_fed_a_sealed_record_is_never_read(fresh, monkeypatch):
     """A FIFO in a record's place, a writer holding it open with a well-formed record in the pipe (value 999,
     its checksum matching): the store does not read it (only a regular file is), and computes the value."""
     import os
-    import signal
     directory, calls, compute = fresh
     store.measured("u-curve", compute, size=256)
     path = directory / "u-curve.json"
@@ -484,14 +498,11 @@ def test_a_fifo_fed_a_sealed_record_is_never_read(fresh, monkeypatch):
     os.mkfifo(path)
     writer = os.open(path, os.O_RDWR | os.O_NONBLOCK)
     os.write(writer, json.dumps(planted).encode())
-    old = signal.signal(signal.SIGALRM, lambda *a: pytest.fail("the store blocked on the FIFO"))
-    signal.alarm(20)
     try:
         _new_process(monkeypatch)
-        assert store.measured("u-curve", compute, size=256) != 999 and len(calls) == 2
+        with _unblocked():
+            assert store.measured("u-curve", compute, size=256) != 999 and len(calls) == 2
     finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
         os.close(writer)
 
 
