@@ -197,7 +197,7 @@ def _entry(t):
              f"::::{{dropdown}} Proof\n:::{{prf:proof}}\n{steps}\n:::\n::::\n")   # folded: the statement reads first
     return dict(title=t.title, status=v.status, badge=badge(v.status, v.numeric), evidence=v.evidence,
                 block=block, unexplained=unexplained,
-                changed=v.holds and verdict_failure(t.id, v))
+                changed=verdict_failure(t.id, v))
 
 
 def _ledger():
