@@ -155,6 +155,14 @@ def _js(expr):
 def _body(prelude, outputs, printer, indent):
     """Lines computing ``outputs`` after the assignments ``prelude``, with cse; and the printed outputs."""
     subs, reduced = sp.cse(list(outputs), symbols=sp.numbered_symbols("x"))
+    # Only the prelude's names something reads (rings' central quotient reads no u stencil point).
+    read = set().union(*(sp.sympify(e).free_symbols for e in [e for _, e in subs] + list(reduced)))
+    kept = []
+    for s, e in reversed(list(prelude)):
+        if s in read:
+            kept.insert(0, (s, e))
+            read |= e.free_symbols
+    prelude = kept
     # An output that is an integer (0 for rings' h_u) is printed as a float,
     # so that every function returns the same types for every field.
     reduced = [sp.Float(e) if e.is_Integer else e for e in reduced]

@@ -196,8 +196,6 @@ def rings_exact(u, v, k_u, k_v):
 
 
 def rings_central(u, v, k_u, k_v, eps_u, eps_v):
-    u_p = ((eps_u + u - 1) if (eps_u + u >= 1) else (eps_u + u))
-    u_m = ((-eps_u + u + 1) if (eps_u - u > 0) else (-eps_u + u))
     v_p = min(1, eps_v + v)
     v_m = max(0, -eps_v + v)
     x0 = 2*math.pi*k_v

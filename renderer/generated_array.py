@@ -145,8 +145,6 @@ def rings_exact(xp, u, v, k_u, k_v):
 
 
 def rings_central(xp, u, v, k_u, k_v, eps_u, eps_v):
-    u_p = xp.select((eps_u + u >= 1), eps_u + u - 1, eps_u + u)
-    u_m = xp.select((eps_u - u > 0), -eps_u + u + 1, -eps_u + u)
     v_p = xp.minimum(1, eps_v + v)
     v_m = xp.maximum(0, -eps_v + v)
     x0 = 2*math.pi*k_v

@@ -79,7 +79,7 @@ Job = namedtuple("Job", "methods steps skip want_kink want_grad want_geo dx dy")
 Outputs = namedtuple("Outputs", "image chamber kink grad t P N Ns uv")
 
 
-FORMULAS_DIGEST = "d1fb0c80f4f180448127f3b6abfec6c1df53f175e4bfaebe9eda3c1582c8fed8"  # of generated.py, written by renderer/codegen.py
+FORMULAS_DIGEST = "9c6e1e198171ab8cb9ea0ff1480cb81b72b3f5b021ec671fb6123e0cece6b7b6"  # of generated.py, written by renderer/codegen.py
 if hashlib.sha256(Path(__file__).with_name("generated.py").read_bytes()).hexdigest() != FORMULAS_DIGEST:
     raise ImportError("renderer/generated.py does not match the digest kernel.py holds: it was edited by "
                       "hand or not regenerated; run python -m renderer.codegen")

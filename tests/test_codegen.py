@@ -674,6 +674,39 @@ def test_javascript_signatures_are_the_python_ones():
     assert codegen.js_source() == source                   # regenerated, the same text
 
 
+def unread_names(source):
+    """{function: names it assigns and never reads} of generated Python (ast) or JavaScript
+    (``const NAME = ...;``, read where the name occurs again in its function)."""
+    if "export function" in source:
+        functions = {m.group(1): m.group(0) for m in re.finditer(r"export function (\w+)\(.*?\n}", source, re.S)}
+        found = {f: {n for n in re.findall(r"const (\w+) =", body) if len(re.findall(rf"\b{n}\b", body)) == 1}
+                 for f, body in functions.items()}
+    else:
+        import ast
+        found = {}
+        for fn in (n for n in ast.walk(ast.parse(source)) if isinstance(n, ast.FunctionDef)):
+            names = [n for n in ast.walk(fn) if isinstance(n, ast.Name)]
+            found[fn.name] = ({n.id for n in names if isinstance(n.ctx, ast.Store)}
+                              - {n.id for n in names if isinstance(n.ctx, ast.Load)})
+    return {f: names for f, names in found.items() if names}
+
+
+def test_no_generated_function_assigns_a_name_it_never_reads():
+    """The prelude (the central quotient's stencil points) is written only where read: rings' h does
+    not depend on u, and its central functions once assigned u_p and u_m for nothing, in every
+    backend's text.  Over the built-in fields, a reader's field, and a function of one variable;
+    the check is shown finding such a line planted into each language."""
+    sources = {"python": codegen.python_source(), "array": codegen.array_source(), "js": codegen.js_source(),
+               "own field": codegen.field_source(F.field("sin(pi*k_v*v)**3")),
+               "univariate": codegen.univariate_source(F.univariate("exp(x)/sqrt(sin(x)**3 + cos(x)**3)"))}
+    assert {k: unread_names(s) for k, s in sources.items()} == {k: {} for k in sources}
+    assert unread_names(sources["python"].replace("    return (math.sin(v*x0)", "    w_p = u + 1\n    return (math.sin(v*x0)", 1)) \
+        == {"rings_central": {"w_p"}}
+    js = sources["js"].replace("  if (field === ", "  if (field === 99) { const w_p = u + 1; return w_p; }\n"
+                               "  const u_q = u;\n  if (field === ", 1)
+    assert list(unread_names(js).values()) == [{"u_q"}]
+
+
 # ---- (c) pointwise gives the renderer's bits ----------------------------------------------
 
 def each(fn, *arrays):
