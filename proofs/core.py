@@ -566,9 +566,13 @@ def catalogue(titles, builders, key=tuple):
     """``titles()`` and ``build(id)`` of a theorem module, as proofs/registry.py reads them: ``titles``
     ({id: title}, in the chapter's order) and, for each id, its builder (function () -> Theorem) in
     ``builders``; ``build`` calls a builder once per value of ``key()`` (the registered fields, for a
-    theorem built from them), then returns the same Theorem."""
+    theorem built from them), then returns the same Theorem, until ``build.cache_clear()``."""
     built = functools.lru_cache(maxsize=None)(lambda theorem_id, _: builders[theorem_id]())
-    return (lambda: titles), (lambda theorem_id: built(theorem_id, key()))
+
+    def build(theorem_id):
+        return built(theorem_id, key())
+    build.cache_clear = built.cache_clear
+    return (lambda: titles), build
 
 
 def variant(theorem, **changes):

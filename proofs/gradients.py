@@ -234,3 +234,6 @@ def build(theorem_id):
 @lru_cache(maxsize=None)
 def _built(field):
     return _theorem(field)
+
+
+build.cache_clear = _built.cache_clear

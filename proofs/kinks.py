@@ -170,3 +170,6 @@ def build(theorem_id):
 @lru_cache(maxsize=None)
 def _built(field):
     return _creases(field, JUMP_U, JUMP_V)
+
+
+build.cache_clear = _built.cache_clear

@@ -11,7 +11,8 @@ import importlib
 from collections.abc import Mapping
 
 #: The theorem modules of proofs/, in the chapter's order.  Each has ``titles()`` ({id: title}, in
-#: order, without building a theorem) and ``build(id)`` (the Theorem, built once).
+#: order, without building a theorem) and ``build(id)`` (the Theorem, built once, until
+#: ``build.cache_clear()``).
 MODULES = ("surface", "frame", "displacement", "gradients", "kinks", "kink_loci", "no_boundary", "finite_difference",
            "normal", "blinn")
 

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from proofs import registry
+
 ROOT = Path(__file__).parents[1]
 
 
@@ -54,6 +56,20 @@ def _project_environment_kept():
         pytest.fail("the test left the environment changed: " + ", ".join(
             f"{k}={after.get(k)!r} (was {before.get(k)!r})" for k in sorted(before.keys() | after.keys())
             if before.get(k) != after.get(k)), pytrace=False)
+
+
+@pytest.fixture(autouse=True)
+def _no_theorem_outlives_its_test():
+    """Each theorem module's built theorems are dropped after each test (rebuilding one takes
+    milliseconds): a theorem is built from its module's objects when first asked for and then kept,
+    so one first built while a test had planted a wrong object (a monkeypatched normal, a loosened
+    tolerance) would otherwise be every later test's in that worker, and pass or fail them by the
+    order the tests were dealt."""
+    yield
+    for name in registry.MODULES:
+        module = sys.modules.get(f"proofs.{name}")
+        if module is not None:
+            module.build.cache_clear()
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,5 @@
-"""tests/conftest.py fails a test that leaves a ``SYMRENDER_*`` variable changed.
+"""tests/conftest.py fails a test that leaves a ``SYMRENDER_*`` variable changed, and drops the
+theorems a test built.
 
 Such a leak fails or passes the later tests of the same worker by the order the tests
 were dealt (book/check_glue.py's ``main`` once left the build's store set in the worker that
@@ -13,6 +14,8 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).parents[1]
 
@@ -51,3 +54,30 @@ def test_a_test_that_sets_changes_or_removes_a_project_variable_fails_and_a_patc
                     "SYMRENDER_SHOTS=None (was '0')"):
         assert message in done.stdout, done.stdout
     assert "6 passed, 3 errors" in done.stdout, done.stdout
+
+
+#: Two tests dealt in this order: the first plants a normal without its β in proofs.normal and builds
+#: the theorem that reads it; the second asks for that theorem again.
+PLANTED = (
+    "from proofs import normal, registry\n"
+    "from renderer import formulas as F\n"
+    "BUILT = []\n"
+    "def test_planted(monkeypatch):\n"
+    "    monkeypatch.setattr(normal, 'N_PRIME', normal.N_PRIME.subs(F.beta, 0))\n"
+    "    BUILT.append(registry.get('normal-beta-derivative'))\n"
+    "def test_next():\n"
+    "    assert registry.get('normal-beta-derivative') is not BUILT[0]\n")
+
+
+@pytest.mark.parametrize("kept", [True, False], ids=["conftest", "without it"])
+def test_a_theorem_built_while_a_test_planted_is_not_the_next_tests(tmp_path, kept):
+    """A theorem is built when first asked for and then kept by its module: without the conftest's
+    fixture, one built under a test's plant was the next test's (run alone, a test of the ∂N′/∂β
+    measurement failed so; in a worker, the later tests would have read the planted theorem)."""
+    (tmp_path / "test_plant.py").write_text(PLANTED)
+    (tmp_path / "conftest.py").write_text("from tests.conftest import _no_theorem_outlives_its_test\n" if kept else "")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1"}
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-o", "addopts=",
+                           "--rootdir", str(tmp_path), str(tmp_path)],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert ("2 passed" if kept else "1 failed, 1 passed") in done.stdout, done.stdout + done.stderr
