@@ -187,6 +187,7 @@ def test_a_library_that_cannot_load_is_refused_in_one_line_and_auto_renders_with
     assert auto.returncode == 0, auto
     assert auto.stderr.splitlines() == [auto.stderr.strip()] and "renders with numba" in auto.stderr, auto.stderr
     numba = subprocess.run(argv + [str(tmp_path / "c.png")], capture_output=True, text=True, env=env, timeout=300)
+    assert numba.returncode == 0, numba.stderr
     assert (tmp_path / "b.png").read_bytes() == (tmp_path / "c.png").read_bytes()
 
 
