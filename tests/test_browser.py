@@ -323,7 +323,10 @@ def test_the_curve_marks_its_image_best_step_and_names_its_right_arm_per_field(s
     plot = session.page.locator("#sim-curve")
     eps = float(plot.locator("#sim-curve-best").get_attribute("data-eps"))
     assert eps == best["eps"] and eps != worst["eps"]
-    assert plot.locator("#sim-curve-best-label").text_content() == "image-best step"
+    # Its step printed beside it and spoken in the plot's label, as the ε slider prints a step.
+    printed = f"{eps:.1e}".replace("e-0", "e-")
+    assert plot.locator("#sim-curve-best-label").text_content() == f"best ε = {printed}"
+    assert plot.get_attribute("aria-label").endswith(f"; the image-best step: {printed}")
     captions = {}
     for field in FIELDS:
         session.select("height_field", field)
@@ -332,7 +335,7 @@ def test_the_curve_marks_its_image_best_step_and_names_its_right_arm_per_field(s
     assert all(("crease" in captions[f]) == bool(FIELDS[f].crease_factors) for f in FIELDS), captions
     assert len(smooth) == 1 and "truncation" in smooth.pop(), captions
     session.fill("beta", 0)
-    assert plot.locator("#sim-curve-best").count() == 0
+    assert plot.locator("#sim-curve-best").count() == 0 and "image-best" not in plot.get_attribute("aria-label")
     session.fill("beta", SIMULATOR_SCENE.beta)
     assert session.errors == []
 
@@ -886,7 +889,9 @@ SPOKEN_JS = """() => {
             [n, [attr('#sim-canvas-' + n, 'role'), attr('#sim-canvas-' + n, 'aria-label')]])),
           readout: [attr('#sim-readout', 'aria-live'), document.getElementById('sim-readout').textContent],
           hint: attr('#sim-hint', 'aria-live'), curve: [attr('#sim-curve', 'role'), attr('#sim-curve', 'aria-label')],
-          eps: attr('#sim-log_eps', 'aria-valuetext')};
+          eps: attr('#sim-log_eps', 'aria-valuetext'),
+          labels: [...document.querySelectorAll('.symrender-sim :is(select, input)')].map(
+            e => e.closest('label').querySelector('span').firstChild.textContent.trim())};
 }"""
 
 
@@ -895,7 +900,7 @@ def spoken_problems(s):
     that is not an image with a label naming the field, β, the view and the normal, the numeric canvas's ε
     and the difference's largest |ΔI| and RMS as the ledger prints them; a readout or hint that is no
     polite live region; the U-curve not an image labelled with the current ε; the ε slider's value text
-    not what it prints."""
+    not what it prints; a control whose accessible name does not begin with its label."""
     said, st = s.page.evaluate(SPOKEN_JS), s.sim("sim.state")
     found = []
     eps = s.page.text_content("#sim-log_eps-value")
@@ -924,6 +929,12 @@ def spoken_problems(s):
         found.append(f"U-curve: {said['curve']}")
     if said["eps"] != eps:
         found.append(f"ε slider: aria-valuetext {said['eps']!r}, printed {eps!r}")
+    # Each control's name in Chromium's accessibility tree (axe passes a control inside a <label> whose
+    # first labelable element, an <output>, takes the label instead: the sliders were once nameless).
+    named = re.findall(r'- (?:slider|combobox|checkbox)(?: "([^"]*)")?', s.page.locator(".symrender-sim").aria_snapshot())
+    for label, name in zip(said["labels"], named, strict=True):
+        if not name.startswith(label):
+            found.append(f"control {label!r}: accessible name {name!r}")
     return found
 
 
@@ -979,6 +990,8 @@ def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser,
 #: Wrong variants of what a screen reader is given: (old text of the bundle, new text, a problem it must cause).
 WRONG_SPOKEN = {
     "the canvases' labels written once, not kept current": ("    this.describe(ledger);\n", "", "not in"),
+    "sliders named by the value beside them": ('return el("label", { for: input.id }, [el("span"',
+                                              'return el("label", {}, [el("span"', "accessible name"),
     "a readout that is not announced": ('"aria-live": "polite" });\n    root.append(el("div", { class: "sim-stage" }',
                                         '"aria-live": "off" });\n    root.append(el("div", { class: "sim-stage" }',
                                         "readout: aria-live 'off'"),
@@ -1109,6 +1122,11 @@ def test_preset_two_shows_the_pipelines_parting_on_the_crease_band(browser, book
             assert (_rgb(s.canvas(name))[kink] == 255).all(), name
         bright, share = _share_in_band(s)
         assert bright > 100 and share > 0.9, (bright, share)
+        # The band the hint names stands out from the black of no difference: 3:1 at least (WCAG's
+        # contrast for graphics; a blue of at most 90 was 1.1:1).
+        band = _rgb(s.canvas("difference"))[kink & (s.frame("chamber") == 1)] / 255.0
+        linear = np.where(band <= 0.04045, band / 12.92, ((band + 0.055) / 1.055) ** 2.4)
+        assert ((linear @ [0.2126, 0.7152, 0.0722] + 0.05) / 0.05).min() >= 3
         s.select("scale", "log")
         bright_log, share_log = _share_in_band(s)
         assert bright_log > 10 * bright and share_log < 0.5, (bright_log, share_log)

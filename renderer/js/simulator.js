@@ -198,8 +198,9 @@ function fmt(x, digits = 3) {
 // The U-curve plot's axes: log10 eps over the slider's range, log10 |ΔI| from
 // CURVE_FLOOR (where an exact zero is drawn) to 0.
 const CURVE_FLOOR = LOG_FLOOR - 1;
-// The crease band on the difference canvas of the kink view: at least this much blue.
-const BAND_BLUE = 90;
+// The crease band on the difference canvas of the kink view: a sky blue at least (green, blue), its red
+// channel left to the difference; against the black of no difference, 6.8:1 (a darker blue was near-invisible).
+const BAND_GREEN = 150, BAND_BLUE = 255;
 const CURVE_COLOURS = { rms: "#2f7ed8", max: "#e8590c" };
 
 class Simulator {
@@ -299,7 +300,8 @@ class Simulator {
       if (c.kind === "select") return el("label", {}, [el("span", { text: c.label }), input]);
       const out = el("output", { id: `sim-${c.name}-value`, for: `sim-${c.name}` });
       this.outputs[c.name] = out;
-      return el("label", {}, [el("span", {}, [c.label + " ", out]), input, ...ticks]);
+      // `for`: the label's first labelable descendant is the <output>, which it would name instead.
+      return el("label", { for: input.id }, [el("span", {}, [c.label + " ", out]), input, ...ticks]);
     });
     const main = CONTROLS.map((c, i) => MAIN.includes(c.name) ? controls[i] : null).filter(Boolean);
     this.main_controls.append(...main);
@@ -453,12 +455,12 @@ class Simulator {
             r = g = b = level(Math.max(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]),
                                        Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]),
                                        Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2])));
-            if (view === "kink" && symbolic.kink[k]) { r = Math.round(0.6 * r); g = r; b = Math.max(b, BAND_BLUE); }
+            if (view === "kink" && symbolic.kink[k]) { r = Math.round(0.6 * r); g = Math.max(r, BAND_GREEN); b = BAND_BLUE; }
           } else {
             r = level(Math.abs(numeric.image[3 * k] - symbolic.image[3 * k]));
             g = level(Math.abs(numeric.image[3 * k + 1] - symbolic.image[3 * k + 1]));
             b = level(Math.abs(numeric.image[3 * k + 2] - symbolic.image[3 * k + 2]));
-            if (view === "kink" && symbolic.kink[k]) b = Math.max(b, BAND_BLUE);
+            if (view === "kink" && symbolic.kink[k]) { g = Math.max(g, BAND_GREEN); b = BAND_BLUE; }
           }
         }
         px[4 * k] = r; px[4 * k + 1] = g; px[4 * k + 2] = b; px[4 * k + 3] = 255;
@@ -534,11 +536,13 @@ class Simulator {
     // The image-best step: of the curve's steps, the one of least RMS |ΔI| over sphere A in this
     // frame (none when every RMS is 0, as at β = 0).
     const best = points.reduce((b, p, i) => (p.rms < points[b].rms ? i : b), 0);
-    if (points[best].rms < Math.max(...points.map((p) => p.rms))) {
+    const marked = points[best].rms < Math.max(...points.map((p) => p.rms));
+    const best_eps = eps_of(CURVE_LOG_EPS[best]).toExponential(1);
+    if (marked) {
       const xb = X(CURVE_LOG_EPS[best]), yb = Math.min(Y(points[best].rms) + 6, H - m.bottom - 22);
       nodes.push(svg("path", { id: "sim-curve-best", d: `M ${xb.toFixed(1)} ${yb.toFixed(1)} l -5 9 l 10 0 z`,
                                fill: CURVE_COLOURS.rms, stroke: "currentColor", "data-eps": String(eps_of(CURVE_LOG_EPS[best])) }));
-      nodes.push(svg("text", { id: "sim-curve-best-label", x: xb, y: yb + 21, "text-anchor": "middle" }, "image-best step"));
+      nodes.push(svg("text", { id: "sim-curve-best-label", x: xb, y: yb + 21, "text-anchor": "middle" }, `best ε = ${best_eps}`));
     }
     const here = this.curve.here, x = X(Math.log10(here.eps));
     nodes.push(svg("line", { id: "sim-curve-marker", x1: x, x2: x, y1: m.top, y2: H - m.bottom, stroke: "currentColor",
@@ -557,7 +561,8 @@ class Simulator {
     const stride = this.curve.stride, s = this.state.resolution;
     const sample = stride === 1 ? `all ${s} × ${s} pixels` : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame`;
     plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; at ε = ` +
-                      `${here.eps.toExponential(1)} RMS ${fmt(here.rms, 1)}, max ${fmt(here.max_abs, 1)}`);
+                      `${here.eps.toExponential(1)} RMS ${fmt(here.rms, 1)}, max ${fmt(here.max_abs, 1)}` +
+                      (marked ? `; the image-best step: ${best_eps}` : ""));
     plot.dataset.eps = String(here.eps);
     this.root.querySelector("#sim-curve-caption").textContent =
       `The U-curve of central differences, on ${sample}, at half-decade steps of ε; the dashed line and ` +
