@@ -16,7 +16,7 @@ order in beta and for either handedness,
     t = -beta (h_u / |p_u|, h_v / |p_v|) + O(beta^2):
 
 the slope of h divided by the chart's arc lengths, tilting away from rising h.  Where the chart
-follows the principal directions (n_u = kappa_u p_u, n_v = kappa_v p_v: a sphere, a torus, a
+follows lines of curvature (n_u = kappa_u p_u, n_v = kappa_v p_v: a sphere, a torus, a
 plane) the slopes are exactly -beta (h_u / ((1 + beta h kappa_u) |p_u|), h_v / ((1 + beta h
 kappa_v) |p_v|)).  For sphere A (kappa = 1/R, |p_u| = 2 pi R sin phi, |p_v| = pi R) these are the
 coefficients of the renderer's bump="surface" (`renderer.formulas.BUMP`), the theorem
@@ -136,7 +136,7 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
                   r"$⟦e_u⟧$ and $⟦e_v⟧$ over its component along $n$. "
                   r"On an orthogonal chart, right- or left-handed, the displaced normal's slopes are, to first "
                   r"order in $\beta$, $⟦first_u⟧$ and $⟦first_v⟧$: the slope of $h$ divided by the chart's "
-                  r"arc lengths, tilting away from rising $h$. Where the chart follows the principal directions, "
+                  r"arc lengths, tilting away from rising $h$. Where the chart follows lines of curvature, "
                   r"$⟦n_u⟧$ and $⟦n_v⟧$ (a sphere, a torus, a plane), exactly "
                   r"$$⟦principal⟧$$ On sphere A, for $⟦phi⟧$ ($⟦kappa_u⟧$, $⟦kappa_v⟧$, $⟦L_u⟧$, "
                   r"$⟦L_v⟧$) these are the renderer's surface bump: $$⟦sphere⟧$$",

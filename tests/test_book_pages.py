@@ -313,8 +313,10 @@ def smallest(values):
 #: glossary, are the asides, with a budget of their own.
 #: An exercise's statement stays open (a learner scans them), only its solution folds.  The budgets grew
 #: once, by about 500 words each, for §3's derivation of the displaced normal on any surface, its torus
-#: exercise and its theorem (its statement in a fold, as every theorem of §3 now is).
-MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_500, 8_500, 13_500
+#: exercise and its theorem (its statement in a fold, as every theorem of §3 now is); the reading path's
+#: once more, by 100 words, for Richardson's extrapolation and its exercise (§3), the lesson on
+#: numerical differentiation a learner's review found missing.
+MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_600, 8_500, 13_500
 #: The pages outside the reading path: looked up, not read through.
 LOOKUP_PAGES = ("s6_ledger", "glossary")
 LENGTH = r"""() => {
@@ -1274,7 +1276,7 @@ FORMULAS_JS = r"""async () => {
     const section = m.closest('section[id]');
     return {display: m.getAttribute('display') === 'true', scale: +scale.toFixed(3),
             px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror') || [...m.querySelectorAll('mjx-mtext')].some((t) => t.textContent.startsWith('\\')),
-            text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
+            tab: m.tabIndex >= 0, text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
             where: section ? '#' + section.id : ''};
   });
 }"""
@@ -1282,8 +1284,9 @@ FORMULAS_JS = r"""async () => {
 
 def formula_findings(found):
     """The formulas of a FORMULAS_JS list that a reader cannot read whole: set below the text's size
-    (scale under 1), reaching past the column by more than a pixel, or a TeX error."""
-    return [f for f in found if f["scale"] < 0.999 or f["over"] > 1 or f["error"]]
+    (scale under 1), reaching past the column by more than a pixel, or a TeX error; or that a keyboard
+    reader must Tab through (in the Tab order: MathJax's default)."""
+    return [f for f in found if f["scale"] < 0.999 or f["over"] > 1 or f["error"] or f["tab"]]
 
 
 @pytest.mark.parametrize("name", PAGES)
@@ -1311,7 +1314,7 @@ def test_every_formula_is_at_full_size_within_the_column(site, name):
 #: every formula the check finds must show), each of which the formula check must catch at 390 px: MathJax
 #: left to let formulas run past the column (its default; §3 has the formulas too long for a phone's
 #: column), formulas set at 62 % of the text (as fit.js once shrank them to fit; any page with formulas
-#: shows it, §1 quickly), and a TeX command MathJax does not know (a statement's text mistyped: MathJax
+#: shows it, §1 quickly), formulas left in the Tab order, and a TeX command MathJax does not know (a statement's text mistyped: MathJax
 #: sets it as red text, backslash and all).
 WRONG_FORMULAS = {
     "MathJax breaking no line": ("s3_math", "s3_math.html",
@@ -1321,6 +1324,8 @@ WRONG_FORMULAS = {
     "formulas shrunk to 62 %": ("s1_what_changes", "fit.css", "article.bd-article span.math { display: inline; }",
                                 "article.bd-article span.math { display: inline; font-size: 62%; }",
                                 lambda f: f["scale"] < 0.999),
+    "formulas in the Tab order": ("s1_what_changes", "s1_what_changes.html", '"inTabOrder": false',
+                                  '"inTabOrder": true', lambda f: f["tab"]),
     "a TeX command MathJax does not know": ("s1_what_changes", "s1_what_changes.html", r"\(\varepsilon =\)",
                                            r"\(\vAREPSILON =\)", lambda f: f["error"]),
 }

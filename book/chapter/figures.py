@@ -338,7 +338,7 @@ def stencil_diagram(k_u=None, v=None, k_v=None, eps=0.02, offset=0.006):
     ax.plot([u0], [h_0], "o", color=BLUE)
     ax.set_xlabel(r"$u$"); ax.set_ylabel(r"$h$")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)   # below: clear of the data
-    ax.set_title(f"stencil centre u = {u0:.3f}, step ε = {eps:g}")     # all at TEXT_PT
+    ax.set_title(f"stencil centre u = {u0:.3f} at v = {v:g}, step ε = {eps:g}")     # all at TEXT_PT
     return fig
 
 
