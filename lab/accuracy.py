@@ -41,7 +41,7 @@ class GradientAccuracy:
     pixels: int
     max_abs: float
     rms_abs: float
-    max_ulps: float        # |error| / spacing(pi max(k_u, 2 k_v)), the gradient's scale
+    max_ulps: float        # |error| / spacing(formulas.gradient_scale(k_u, k_v)), the gradient's scale
     rms_ulps: float
 
 
@@ -111,9 +111,9 @@ def gradient_accuracy(field, *, count=2000, size=256, seed=4, steps=STEPS, k_u=N
         with mpmath.workdps(DIGITS):
             err = np.array([[float(abs(mpmath.mpf(float(a)) - r[0])), float(abs(mpmath.mpf(float(b)) - r[1]))]
                             for a, b, r in zip(hu, hv, ref)])
-        # In units of the float64 spacing at the gradient's natural scale pi max(k_u, 2 k_v):
+        # In units of the float64 spacing at the gradient's natural scale (`formulas.gradient_scale`):
         # the spacing of each reference value would inflate wherever it passes near 0.
-        ulps = err / np.spacing(np.pi * max(k_u, 2 * k_v))
+        ulps = err / np.spacing(F.gradient_scale(k_u, k_v, field))
         return GradientAccuracy(field.name, method, len(uu), float(err.max()), float(np.sqrt((err**2).mean())),
                                 float(ulps.max()), float(np.sqrt((ulps**2).mean())))
 

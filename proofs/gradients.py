@@ -111,7 +111,7 @@ def generated_code_residual(field, closed_form, *, seed=0, points=POINTS, compil
             got = pointwise.exact_gradient(field, uu, vv, ku, kv)        # 0-d arrays
             got = compiled(got) if compiled else got
             ref = fn(*at)
-            scale = mpmath.pi * max(ku, 2 * kv)
+            scale = F.gradient_scale(ku, kv, field)
             for g, r in zip(got, ref):
                 worst = max(worst, float(abs(mpmath.mpf(float(g)) - r) / scale))
             taken += 1
@@ -129,7 +129,7 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
     worst = generated_code_residual(field, closed_form, compiled=compiled)
     if worst > GENERATED_TOLERANCE:
         return Verdict("refuted", f"generated (compiled) gradient differs from the closed form by "
-                       f"{worst:.2e} (relative to pi max(k_u, 2 k_v))", worst, DIGITS, POINTS)
+                       f"{worst:.2e} (relative to {F.gradient_scale_text(field)})", worst, DIGITS, POINTS)
     from .pixels import gradient_error
     rendered = {method: gradient_error(field.name, method, corrupt) for method in ("exact", "central", "footprint")}
     if max(r for r, _ in rendered.values()) > 1:
@@ -140,7 +140,7 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
         if why:
             return Verdict("refuted", f"the renderer's {method} gradient's tolerance: {why}")
     return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath, relative to "
-                   f"pi max(k_u, 2 k_v) ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
+                   f"{F.gradient_scale_text(field)} ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
                    f"footprint gradients at {rendered['exact'][1]:,} seeded sphere-A pixels at "
                    f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
                    "times their rounding tolerances against "

@@ -148,7 +148,7 @@ def gradient_error(field, gradient, corrupt=None):
     if gradient == "exact":
         exprs = [e.xreplace(consts) for e in record.gradient]
         ref = _eval(exprs, (F.u, F.v), px["uv"])
-        bound = TOLERANCE["gradient"] * np.pi * max(scene.k_u, 2 * scene.k_v)
+        bound = TOLERANCE["gradient"] * F.gradient_scale(scene.k_u, scene.k_v, record)
     elif gradient == "footprint":
         # The steps from formulas.FOOTPRINT at the pixel (its frame from TANGENT_FRAME), then the central difference.
         # sin(phi) and the frame enter as arguments, evaluated from CHART and TANGENT_FRAME first:
@@ -160,14 +160,14 @@ def gradient_error(field, gradient, corrupt=None):
                       + (F.x, F.y, F.dx, F.dy), np.hstack([n_sin_frame, px["P"], px["xy"]]))
         exprs = [e.xreplace(dict(F.STENCIL_POINTS)).xreplace(consts) for e in record.central]
         ref = _eval(exprs, (F.u, F.v, F.eps_u, F.eps_v), np.hstack([px["uv"], steps]))
-        scale = np.pi * max(scene.k_u, 2 * scene.k_v)
+        scale = F.gradient_scale(scene.k_u, scene.k_v, record)
         bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / steps.min(axis=1, keepdims=True)
     else:
         stencil = dict(F.STENCIL_POINTS)
         exprs = [e.xreplace(stencil).xreplace({F.eps_u: scene.eps, F.eps_v: scene.eps, **consts})
                  for e in record.central]
         ref = _eval(exprs, (F.u, F.v), px["uv"])
-        scale = np.pi * max(scene.k_u, 2 * scene.k_v)
+        scale = F.gradient_scale(scene.k_u, scene.k_v, record)
         bound = TOLERANCE["gradient"] * scale + 4 * UNIT * (1 + scale) / scene.eps
     return float(np.max(np.abs(grad - ref) / bound)), grad.shape[0]
 

@@ -150,8 +150,8 @@ def build_parser():
                                    "(--function, --x).")
     what = u.add_mutually_exclusive_group()
     what.add_argument("--field", default="sine",
-                      help="the height field: a name (sine, ridges, rings) or an expression in u, v, k_u, k_v "
-                           "such as 'sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2' (default sine)")
+                      help="the height field: a registered name (an unknown one is refused with the list) or an "
+                           "expression in u, v, k_u, k_v such as 'sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2' (default sine)")
     what.add_argument("--function", metavar="EXPR",
                       help="instead of a field, a function of x, e.g. 'exp(x)/sqrt(sin(x)**3 + cos(x)**3)' "
                            "(pi, E, + - * / ** and sin cos tan asin acos atan sinh cosh tanh exp log sqrt abs)")

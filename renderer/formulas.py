@@ -32,13 +32,13 @@ What lives here (seed §2, §3 and Cell 1, with the project's corrections):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import sympy as sp
 
 __all__ = [
     "u", "v", "k_u", "k_v", "FIELD_SYMBOLS", "ELEMENTARY", "KINK_BAND_HALF_WIDTH", "SEED_POINT", "HeightField",
-    "FIELDS", "BUILTIN", "register", "field", "Univariate", "univariate", "x_var", "step",
+    "FIELDS", "BUILTIN", "register", "field", "gradient_scale", "gradient_scale_text", "Univariate", "univariate", "x_var", "step",
     "N_x", "N_y", "N_z", "sin_phi", "hypot", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
@@ -220,6 +220,48 @@ _s1, _s2 = sp.sin(sp.pi * k_u * u), sp.sin(sp.pi * k_v * v)
 register(HeightField("sine", _s1 * _s2))
 register(HeightField("ridges", sp.Abs(_s1 * _s2)))
 register(HeightField("rings", sp.sin(2 * sp.pi * k_v * v)))
+
+
+def _argument_rates(expr):
+    """|d a/du| and |d a/dv| of each argument a of a sine or cosine in ``expr``, with k_u, k_v positive:
+    the nonzero ones, as sympy expressions in k_u, k_v."""
+    positive = {k_u: sp.Symbol("k_u", positive=True), k_v: sp.Symbol("k_v", positive=True)}
+    rates = {sp.Abs(sp.diff(f.args[0], x)).xreplace(positive) for f in expr.atoms(sp.sin, sp.cos) for x in (u, v)}
+    return {r.xreplace({p: k for k, p in positive.items()}) for r in rates if r != 0}
+
+
+@lru_cache(maxsize=None)
+def _scale(records):
+    """(the largest rate of `_argument_rates` over ``records``, as a sympy expression in positive k_u, k_v (1
+    if none turns), and it as a float64 function of (k_u, k_v))."""
+    positive = {k_u: sp.Symbol("k_u", positive=True), k_v: sp.Symbol("k_v", positive=True)}
+    rates = set().union(*(_argument_rates(r.expr) for r in records))
+    largest = sp.Max(*(r.xreplace(positive) for r in rates)) if rates else sp.Integer(1)
+    return largest, sp.lambdify(tuple(positive.values()), largest, "math")
+
+
+def gradient_scale(ku, kv, field=None):
+    """The gradient's natural scale at frequencies ``ku``, ``kv`` (floats): the largest rate, per unit of
+    u or v, at which the argument of a sine or cosine turns in any registered field (and in ``field``, a
+    `HeightField`, if given): pi max(k_u, 2 k_v) for the built-in fields (rings' 2 pi k_v v), 1 where
+    no argument turns.  The gradient checks' tolerances (proofs/pixels.py, proofs/gradients.py) and
+    `lab.accuracy`'s ulps are in its units, so a field that turns faster widens them for every field.
+    Returns a float."""
+    return float(_scale(_scale_records(field))[1](ku, kv))
+
+
+def gradient_scale_text(field=None):
+    """`gradient_scale` as evidence prints it: ``"pi max(k_u, 2 k_v)"`` for the built-in fields."""
+    largest = _scale(_scale_records(field))[0]
+    terms = largest.args if isinstance(largest, sp.Max) else (largest,)
+    printed = [str(t / sp.pi).replace("*", " ") for t in terms]
+    return "pi " + (f"max({', '.join(printed)})" if len(printed) > 1 else printed[0])
+
+
+def _scale_records(field):
+    return tuple(FIELDS.values()) + ((field,) if field is not None and field not in FIELDS.values() else ())
+
+
 #: The fields defined here, which renderer/generated.py holds compiled; others (registered later,
 #: or a reader's expression) are printed and compiled when first used (`renderer.fieldcode`).
 BUILTIN = tuple(FIELDS)

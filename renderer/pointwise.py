@@ -117,7 +117,7 @@ _UV = ("u", "v", "k_u", "k_v")
 
 
 def height(name, u, v, k_u, k_v):
-    """h(u, v) of field ``name`` (`renderer.formulas.HEIGHT`).
+    """h(u, v) of field ``name`` (its `renderer.formulas.HeightField.expr`).
 
     Parameters
     ----------
@@ -130,7 +130,7 @@ def height(name, u, v, k_u, k_v):
 
     Returns
     -------
-    ndarray of float64, the broadcast shape, in [-1, 1].
+    ndarray of float64, the broadcast shape (in [-1, 1] for the built-in fields).
 
     Raises
     ------
@@ -141,7 +141,7 @@ def height(name, u, v, k_u, k_v):
 
 
 def exact_gradient(name, u, v, k_u, k_v):
-    """(h_u, h_v), sympy's derivative (`renderer.formulas.GRADIENT`).
+    """(h_u, h_v), sympy's derivative (its `renderer.formulas.HeightField.gradient`).
 
     For ridges sign(f) f' (one of the one-sided derivatives on a crease, 0
     where the float64 factor is exactly 0).  Arguments as `height`; returns

@@ -100,3 +100,28 @@ def test_the_fourth_fields_wrong_gradients_are_refuted(squares):
         verdict = check()
         assert verdict.status == "refuted", description
         assert verdict.evidence.startswith(f"gradient-squares, step {len(t.steps)} "), (description, verdict.evidence)
+
+
+def test_a_field_that_turns_faster_widens_the_gradient_scale_and_its_gradient_is_proved(monkeypatch):
+    """The scale the gradient checks hold errors to (`formulas.gradient_scale`) is derived from the registered
+    fields' sines: pi max(k_u, 2 k_v) for the built-in ones at any frequencies; a field of sin(2 pi k_u u)
+    sin(2 pi k_v v) widens it to pi max(2 k_u, 2 k_v), and its gradient theorem is proved.  With the scale
+    typed as pi max(k_u, 2 k_v), as it was in six places, the renderer's exact gradient of that field left its
+    tolerance and the theorem was refuted: shown here."""
+    import math
+
+    import numpy as np
+
+    from proofs import registry
+    for ku, kv in np.random.default_rng(7).uniform(0.5, 24.0, (20, 2)):
+        assert F.gradient_scale(ku, kv) == pytest.approx(math.pi * max(ku, 2 * kv), rel=1e-15)
+    assert F.gradient_scale_text() == "pi max(k_u, 2 k_v)"
+    F.register(F.HeightField("checker", sp.sin(2 * sp.pi * F.k_u * F.u) * sp.sin(2 * sp.pi * F.k_v * F.v)))
+    try:
+        assert F.gradient_scale_text() == "pi max(2 k_u, 2 k_v)"
+        verdict = registry.get("gradient-checker").check()
+        assert verdict.status == "proved" and "relative to pi max(2 k_u, 2 k_v)" in verdict.evidence, verdict.evidence
+        monkeypatch.setattr(F, "gradient_scale", lambda ku, kv, field=None: math.pi * max(ku, 2 * kv))
+        assert registry.get("gradient-checker").check().status == "refuted"
+    finally:
+        F.FIELDS.pop("checker", None)

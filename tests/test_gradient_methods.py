@@ -28,8 +28,8 @@ from renderer.validate import InputError, InvalidValue
 from .expressions import expressions, fields_at_points
 
 KU, KV = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
-#: float64 spacing at the gradient's scale pi max(k_u, 2 k_v) = 8 pi (as lab/accuracy.py).
-SPACING = float(np.spacing(np.pi * max(KU, 2 * KV)))
+#: float64 spacing at the gradient's scale (`formulas.gradient_scale`: 8 pi here, as in lab/accuracy.py).
+SPACING = float(np.spacing(F.gradient_scale(KU, KV)))
 #: Over many pixels a float64 evaluation of the gradient is off by up to ~40 spacings: the
 #: phase pi k u (up to 8 pi) is rounded, and the rounding is multiplied by the slope, up to
 #: 8 pi.  verify/test_accuracy.py allows 64 spacings for the exact gradient; so do we.

@@ -24,7 +24,7 @@ shadow tests, the footprint's steps given the same sin(phi).  What differs:
 (b) the printers.  formulas.js normalises with Math.pow(s, -1/2) and squares
     with Math.pow(x, 2) where generated.py has 1/math.sqrt(s) and x**2.
 
-With u = 2^-53 the unit roundoff and L = pi max(k_u, 2 k_v), which bounds
+With u = 2^-53 the unit roundoff and L = formulas.gradient_scale (pi max(k_u, 2 k_v)), which bounds
 the slope pi k of every sine argument and |h_u|, |h_v| (L^2 bounds h's
 second derivatives), the differences propagate as follows (each step a
 worst-case sum, rounded up):
@@ -174,8 +174,9 @@ CASES += field_cases(CASES, F.BUILTIN)
 # ---- the error model -----------------------------------------------------------------
 
 def slope(scene):
-    """L = pi max(k_u, 2 k_v): the largest pi k of a sine argument, and a bound of |grad h|."""
-    return math.pi * max(scene.k_u, 2.0 * scene.k_v)
+    """L = `formulas.gradient_scale` (pi max(k_u, 2 k_v) for the built-in fields): the largest rate of a sine's
+    argument, and a bound of |grad h|."""
+    return F.gradient_scale(scene.k_u, scene.k_v)
 
 
 def arg_tol(scene):

@@ -136,7 +136,7 @@ def _accuracy_route(field, k_u, k_v, steps, monkeypatch):
     for eps in steps:
         lo, hi = np.maximum(v - eps, 0.0), np.minimum(v + eps, 1.0)
         pairs.append(((h((u + eps) % 1.0, v) - h((u - eps) % 1.0, v)) / (2 * eps), (h(u, hi) - h(u, lo)) / (hi - lo)))
-    scale = np.spacing(np.pi * max(k_u, 2 * k_v))
+    scale = np.spacing(F.gradient_scale(k_u, k_v))
     mine = []
     for hu, hv in pairs:
         with mpmath.workdps(30):          # the exact gradient's errors are ulps: subtract at 30 digits
