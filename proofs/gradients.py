@@ -140,7 +140,8 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
         if why:
             return Verdict("refuted", f"the renderer's {method} gradient's tolerance: {why}")
     return Verdict("proved", f"the kernel's generated code within {worst:.1e} of mpmath, relative to "
-                   f"{F.gradient_scale_text(field)} ({DIGITS} digits, {POINTS} points); the renderer's exact, central and "
+                   f"{F.gradient_scale_text(field)} ({DIGITS} digits, {POINTS} points); the renderer's exact, "
+                   "central and "
                    f"footprint gradients at {rendered['exact'][1]:,} seeded sphere-A pixels at "
                    f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
                    "times their rounding tolerances against "

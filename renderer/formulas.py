@@ -38,7 +38,8 @@ import sympy as sp
 
 __all__ = [
     "u", "v", "k_u", "k_v", "FIELD_SYMBOLS", "ELEMENTARY", "KINK_BAND_HALF_WIDTH", "SEED_POINT", "HeightField",
-    "FIELDS", "BUILTIN", "register", "field", "gradient_scale", "gradient_scale_text", "Univariate", "univariate", "x_var", "step",
+    "FIELDS", "BUILTIN", "register", "field", "gradient_scale", "gradient_scale_text", "Univariate", "univariate",
+    "x_var", "step",
     "N_x", "N_y", "N_z", "sin_phi", "hypot", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
@@ -222,22 +223,24 @@ register(HeightField("ridges", sp.Abs(_s1 * _s2)))
 register(HeightField("rings", sp.sin(2 * sp.pi * k_v * v)))
 
 
+#: The frequencies as positive symbols, so that |d a/du| and a Max of rates simplify.
+_POSITIVE = {k_u: sp.Symbol("k_u", positive=True), k_v: sp.Symbol("k_v", positive=True)}
+
+
 def _argument_rates(expr):
-    """|d a/du| and |d a/dv| of each argument a of a sine or cosine in ``expr``, with k_u, k_v positive:
-    the nonzero ones, as sympy expressions in k_u, k_v."""
-    positive = {k_u: sp.Symbol("k_u", positive=True), k_v: sp.Symbol("k_v", positive=True)}
-    rates = {sp.Abs(sp.diff(f.args[0], x)).xreplace(positive) for f in expr.atoms(sp.sin, sp.cos) for x in (u, v)}
-    return {r.xreplace({p: k for k, p in positive.items()}) for r in rates if r != 0}
+    """|d a/du| and |d a/dv| of each argument a of a sine or cosine in ``expr``: the nonzero ones, as
+    sympy expressions in the positive frequencies `_POSITIVE`."""
+    rates = {sp.Abs(sp.diff(f.args[0], x)).xreplace(_POSITIVE) for f in expr.atoms(sp.sin, sp.cos) for x in (u, v)}
+    return rates - {0}
 
 
 @lru_cache(maxsize=None)
 def _scale(records):
-    """(the largest rate of `_argument_rates` over ``records``, as a sympy expression in positive k_u, k_v (1
-    if none turns), and it as a float64 function of (k_u, k_v))."""
-    positive = {k_u: sp.Symbol("k_u", positive=True), k_v: sp.Symbol("k_v", positive=True)}
+    """(the largest rate of `_argument_rates` over ``records`` (1 if none turns), and it as a float64
+    function of (k_u, k_v))."""
     rates = set().union(*(_argument_rates(r.expr) for r in records))
-    largest = sp.Max(*(r.xreplace(positive) for r in rates)) if rates else sp.Integer(1)
-    return largest, sp.lambdify(tuple(positive.values()), largest, "math")
+    largest = sp.Max(*rates) if rates else sp.Integer(1)
+    return largest, sp.lambdify(tuple(_POSITIVE.values()), largest, "math")
 
 
 def gradient_scale(ku, kv, field=None):
