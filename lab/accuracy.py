@@ -25,7 +25,7 @@ from ._checks import MAX_COUNT, MAX_SQUARE, STEP, broadcast, seed as _seed
 
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
-           "image_beta_order", "optima", "crease_distance", "crease_share", "image_best_step", "OPTIMUM_POINTS",
+           "image_beta_order", "optima", "measure_optimum", "crease_distance", "crease_share", "image_best_step", "OPTIMUM_POINTS",
            "DIGITS", "HALF_DECADES"]
 
 DIGITS = 50
@@ -345,28 +345,43 @@ def optima():
 
 
 def _optima(fields):
+    return {field: measure_optimum(field, u, v, component) for field, (_, (u, v, component)) in fields.items()}
+
+
+def measure_optimum(field, u, v, component):
+    """What `optima` measures of a field, at any chart point: the dict of one field of `optima` (its keys
+    there), measured now, not stored, with the draft's frequencies.  ``field``: a name, a `HeightField`
+    or an expression (`renderer.formulas.field`); ``u``, ``v`` in [0, 1]; ``component`` "u" or "v".
+    Before registering a field with ``optimum=``, try points here: `pytest verify` holds
+    ``measured_at_fitted / error_at_fitted`` within a factor 3.
+
+    Raises
+    ------
+    RuntimeError
+        The point lies so close to a crease that fewer than two default steps are below it.
+    renderer.validate.InputError
+        As `renderer.ucurve.measure`, for a bad field, point or component.
+    """
     from renderer.ucurve import DEFAULT_STEPS, UNIT_ROUNDOFF, measure
     k_u, k_v = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
-    out = {}
-    for field, (_, (u, v, component)) in fields.items():
-        distance = float(_crease_distance(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64),
-                                          k_u, k_v, F.field(field)))
-        steps = DEFAULT_STEPS[DEFAULT_STEPS < distance]
-        if steps.size < 2:
-            raise RuntimeError(f"the {field} field's point ({u}, {v}) is {distance:g} from a crease: fewer "
-                               "than two of the default steps lie below that")
-        c = measure(field, u, v, component, eps=steps, k_u=k_u, k_v=k_v)
-        at_fitted = float(measure(field, u, v, component, eps=[c.eps_fitted], k_u=k_u, k_v=k_v).error[0])
-        out[field] = dict(u=u, v=v, component=component, k_u=k_u, k_v=k_v, steps=int(steps.size),
-                          largest_step=float(steps.max()), smallest_step=float(steps.min()),
-                          crease_distance=distance, h=abs(c.height), h1=abs(c.derivative),
-                          x_h1=c.model_argument / UNIT_ROUNDOFF, h3=abs(c.third_derivative),
-                          model_truncation=c.model_truncation, model_roundoff=c.model_cancellation + c.model_argument,
-                          eps_model=c.eps_model, error_model=c.error_model, eps_fitted=c.eps_fitted,
-                          error_at_fitted=c.error_at_fitted, measured_at_fitted=at_fitted,
-                          fitted_over_model=c.eps_fitted / c.eps_model,
-                          argument_share=c.model_argument / (c.model_cancellation + c.model_argument))
-    return out
+    record = F.field(field)
+    distance = float(_crease_distance(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64),
+                                      k_u, k_v, record))
+    steps = DEFAULT_STEPS[DEFAULT_STEPS < distance]
+    if steps.size < 2:
+        raise RuntimeError(f"the {record.name} field's point ({u}, {v}) is {distance:g} from a crease: fewer "
+                           "than two of the default steps lie below that")
+    c = measure(record, u, v, component, eps=steps, k_u=k_u, k_v=k_v)
+    at_fitted = float(measure(record, u, v, component, eps=[c.eps_fitted], k_u=k_u, k_v=k_v).error[0])
+    return dict(u=u, v=v, component=component, k_u=k_u, k_v=k_v, steps=int(steps.size),
+                largest_step=float(steps.max()), smallest_step=float(steps.min()),
+                crease_distance=distance, h=abs(c.height), h1=abs(c.derivative),
+                x_h1=c.model_argument / UNIT_ROUNDOFF, h3=abs(c.third_derivative),
+                model_truncation=c.model_truncation, model_roundoff=c.model_cancellation + c.model_argument,
+                eps_model=c.eps_model, error_model=c.error_model, eps_fitted=c.eps_fitted,
+                error_at_fitted=c.error_at_fitted, measured_at_fitted=at_fitted,
+                fitted_over_model=c.eps_fitted / c.eps_model,
+                argument_share=c.model_argument / (c.model_cancellation + c.model_argument))
 
 
 def crease_share():

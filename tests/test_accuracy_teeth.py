@@ -83,3 +83,15 @@ def test_the_normal_derivative_measurement_is_of_the_proved_form_and_the_rendere
         finally:
             accuracy._normal_and_derivative.cache_clear()
     assert accuracy._normal_beta_derivative_residual(20, 5) < 1e-13
+
+
+def test_a_candidate_point_is_measured_as_optima_measures_a_registered_one():
+    """`measure_optimum` is `optima`'s measurement at any point: at each registered field's point it gives
+    what `optima` stores, and it measures a field not registered (a newcomer trying an ``optimum=`` for
+    sin(2 pi k_u u) sin(2 pi k_v v) before registering it)."""
+    from lab.accuracy import measure_optimum, optima
+    for name, o in optima().items():
+        assert measure_optimum(name, o["u"], o["v"], o["component"]) == o, name
+    tried = measure_optimum("sin(2*pi*k_u*u) * sin(2*pi*k_v*v)", 0.37, 0.47, "u")
+    assert (tried["u"], tried["v"], tried["component"]) == (0.37, 0.47, "u")
+    assert 1 / 3 < tried["measured_at_fitted"] / tried["error_at_fitted"] < 3

@@ -52,7 +52,7 @@ def test_each_fields_optimum_at_its_stated_point():
         assert 1 / 3 < ratio < 3, (
             f"{field}: at its fitted step the measured error is {ratio:.3g} times the model's (accepted: within "
             f"a factor 3) at optimum=({u}, {v}, {component!r}); register the field with another optimum= point "
-            f"(lab.accuracy.optima()[{field!r}] gives both errors)")
+            f"(lab.accuracy.measure_optimum({field!r}, u, v, component) measures any point first)")
         assert o["h"] + o["x_h1"] == pytest.approx(c.model_argument / o["argument_share"] / UNIT_ROUNDOFF), field
 
 
