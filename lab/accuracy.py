@@ -19,7 +19,7 @@ from renderer import formulas as F
 from renderer.ledger import CURVE_LOG_EPS
 from renderer.render import SPHERE_A
 from renderer.scene import FREQUENCY, MAX_BETA, UNIT
-from renderer.validate import InvalidValue, positive_int, real, real_array, steps as _steps
+from renderer.validate import InvalidValue, choice, positive_int, real, real_array, steps as _steps
 
 from ._checks import MAX_COUNT, MAX_SQUARE, STEP, broadcast, seed as _seed
 
@@ -357,14 +357,17 @@ def measure_optimum(field, u, v, component):
 
     Raises
     ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        Naming the argument: ``field`` refused, ``u`` or ``v`` not a real number in [0, 1],
+        ``component`` not "u" or "v".
     RuntimeError
         The point lies so close to a crease that fewer than two default steps are below it.
-    renderer.validate.InputError
-        As `renderer.ucurve.measure`, for a bad field, point or component.
     """
     from renderer.ucurve import DEFAULT_STEPS, UNIT_ROUNDOFF, measure
+    record = F.field(field, "field")
+    u, v = (real(name, x, low=0.0, high=1.0) for name, x in (("u", u), ("v", v)))
+    component = choice("component", component, ("u", "v"))
     k_u, k_v = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
-    record = F.field(field)
     distance = float(_crease_distance(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64),
                                       k_u, k_v, record))
     steps = DEFAULT_STEPS[DEFAULT_STEPS < distance]

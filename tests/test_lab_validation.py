@@ -86,6 +86,9 @@ FUNCTIONS = {
     "accuracy.crease_distance": (accuracy.crease_distance, dict(u=0.3, v=[0.4, 0.6], k_u=8.0, k_v=4.0, field="ridges"),
                                  dict(u=p("array", ([0.3, 0.4, 0.5], V, "broadcast")), v=p("array"), k_u=p("real"),
                                       k_v=p("real"), field=p("field"))),
+    "accuracy.measure_optimum": (accuracy.measure_optimum, dict(field="rings", u=0.31, v=0.47, component="v"),
+                                 dict(field=p("field"), u=p("real", (1.5, V, "got 1.5")), v=p("real", (-0.1, V, "got -0.1")),
+                                      component=p("own", ("w", V, "'w'"), (1, T, "int 1")))),
     "accuracy.image_best_step": (accuracy.image_best_step, dict(field="sine", size=4),
                                  dict(field=p("field"), size=p("int", (0, V, "got 0")))),
     # lab.gradient_methods
