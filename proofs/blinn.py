@@ -130,8 +130,8 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
             Step(r"The displaced sphere $P' = (R + \beta h)N$ has the normal $P'_u \times P'_v$, whose slopes carry "
                  r"$R + \beta h$ where Blinn's carry $R$: equal to first order in $\beta$, different at the second",
                  T["displaced"], SURFACE),
-            Step(r"The renderer's normals are $M/\lVert M\rVert$ with $M = N + b_u e_\theta + b_v e_\varphi$, whose "
-                 r"slopes in an orthonormal frame are $(b_u, b_v)$: the displaced sphere's for `bump='surface'`, "
+            Step(r"The renderer's normals are $M/\lVert M\rVert$ with $M = N + t_u e_\theta + t_v e_\varphi$, whose "
+                 r"slopes in an orthonormal frame are $(t_u, t_v)$: the displaced sphere's for `bump='surface'`, "
                  r"the draft's $+\beta(h_u, h_v)$ for `bump='chart'`", renderer, scaled,
                  cases=(("a left-handed orthonormal basis", {**STANDARD_FRAME, F.sin_phi: s}),)),
             Step(r"Comparing steps 3 and 5, the draft's slopes are Blinn's scaled by $-2\pi R\sin\varphi$ and "

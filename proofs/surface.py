@@ -157,7 +157,7 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
             Step(r"On sphere A, $n = p/R$ gives $\kappa_u = \kappa_v = 1/R$, and by ⟪chart⟫ a step in $u$ "
                  r"covers $\lvert p_u\rvert = 2\pi R\sin\varphi$, one in $v$ covers $\lvert p_v\rvert = \pi R$; "
                  r"in the renderer's left-handed chart (⟪frame-orientation⟫) step 5 gives its surface bump's "
-                 r"coefficients $(b_u, b_v)$", at_sphere, renderer),
+                 r"coefficients $(t_u, t_v)$", at_sphere, renderer),
         ),
         claims={"cross": (product, cross), "first_u": (T_U, first[0]), "first_v": (T_V, first[1]),
                 "principal": (slopes, principal), "sphere": (at_sphere, renderer)},

@@ -369,7 +369,7 @@ beta, R, h, h_u, h_v = sp.symbols("beta R h h_u h_v", real=True)
 e_theta = sp.symbols("et_x et_y et_z", real=True)
 e_phi = sp.symbols("ep_x ep_y ep_z", real=True)
 _w = -beta / (R + beta * h)
-#: Coefficients (b_u, b_v) of M = N + b_u e_theta + b_v e_phi, per bump mode.
+#: Coefficients (t_u, t_v) of M = N + t_u e_theta + t_v e_phi, per bump mode.
 #: "chart": the seed's N' formula.  "surface": the normal of P = (R + beta h) N,
 #: with h_theta = h_u / 2 pi and h_phi = h_v / pi (theorem bump-vs-displacement),
 #: 1/sin(phi) as it is wherever the frame is the chart's; at the pole (the fixed frame,

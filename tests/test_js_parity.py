@@ -55,9 +55,9 @@ worst-case sum, rounded up):
    and nearly so under the pole fallback) and |a/|a| - b/|b|| <= 2|a - b|/|a|,
    so |dNs| <= 4 |dM| + 8u (8u: the normalisation, (b)).  Chart bump:
    |dM| <= beta (|dg_u| + |dg_v|) + 12u (1 + beta (|g_u| + |g_v|)).  Surface
-   bump, M = N - b_u e_theta - b_v e_phi with b_u = q h_u / (2 sin phi) (0 at
-   the pole, sin phi <= POLE_SIN_PHI), b_v = q h_v, q = beta / (pi (R + beta h)): the same with
-   q / (2 s) and q for beta, plus (|b_u| + |b_v|)(beta DH / (R + beta h) + 12u).
+   bump, M = N - t_u e_theta - t_v e_phi with t_u = q h_u / (2 sin phi) (0 at
+   the pole, sin phi <= POLE_SIN_PHI), t_v = q h_v, q = beta / (pi (R + beta h)): the same with
+   q / (2 s) and q for beta, plus (|t_u| + |t_v|)(beta DH / (R + beta h) + 12u).
    (The coefficients and their slopes in h_u, h_v and h are formulas.BUMP's,
    evaluated, not retyped.)  At beta = 0, M = N and only the roundings
    remain: both sides normalise N, by different printers (b).
@@ -115,7 +115,7 @@ KINK_BAND_HALF_WIDTH = float(F.KINK_BAND_HALF_WIDTH)
 
 def _bump_functions():
     """Per bump mode, numpy functions of (beta, R, h, h_u, h_v, sin phi) giving
-    the coefficients (b_u, b_v) of M = N + b_u e_theta + b_v e_phi
+    the coefficients (t_u, t_v) of M = N + t_u e_theta + t_v e_phi
     (`formulas.BUMP`) and their derivatives in h_u, h_v and h (sympy's), for
     the error model of step 7."""
     args = (F.beta, F.R, F.h, F.h_u, F.h_v, F.sin_phi)
@@ -205,7 +205,7 @@ def grad_tolerance(scene, gradient, g, uv, steps):
 
 def normal_tolerance(scene, g, dg, h, sin_phi):
     """Step 7: allowed |dNs| given Python's gradient ``g``, its bound ``dg``,
-    h and sin(phi) per pixel.  The coefficients (b_u, b_v) of M and their
+    h and sin(phi) per pixel.  The coefficients (t_u, t_v) of M and their
     slopes in h_u, h_v and h are `formulas.BUMP` of the scene's mode, evaluated."""
     f = BUMP[scene.bump]
     at = (scene.beta, scene.radius_a, h, g[..., 0], g[..., 1], sin_phi)

@@ -21,7 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "displaced-normal": "d6686abc9b3cedd5",
+    "displaced-normal": "0e810649159f81d2",
     "chart": "806ac8c86dd7e8dc",
     "frame-orthonormal": "ca796763e8a38dd6",
     "frame-orientation": "e1293a724b51b121",
@@ -36,8 +36,8 @@ PRINTED = {
     "beta-zero-regression": "ddf30c60292784fd",
     "central-difference-truncation": "bae73524f9a92e17",
     "optimal-step": "8ff24d3b64fdf31c",
-    "bump-vs-displacement": "ffe5c390b8e702ae",
-    "blinn-perturbation": "aca835b10f5124cb",
+    "bump-vs-displacement": "8908f50dedeb2cc0",
+    "blinn-perturbation": "9955779fe68ebcfa",
 }
 
 
