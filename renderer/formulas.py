@@ -244,12 +244,16 @@ def _scale(records):
 
 
 def gradient_scale(ku, kv, field=None):
-    """The gradient's natural scale at frequencies ``ku``, ``kv`` (floats): the largest rate, per unit of
-    u or v, at which the argument of a sine or cosine turns in any registered field (and in ``field``, a
-    `HeightField`, if given): pi max(k_u, 2 k_v) for the built-in fields (rings' 2 pi k_v v), 1 where
-    no argument turns.  The gradient checks' tolerances (proofs/pixels.py, proofs/gradients.py) and
-    `lab.accuracy`'s ulps are in its units, so a field that turns faster widens them for every field.
-    Returns a float."""
+    """The gradient's natural scale: the largest rate at which the argument of a sine or cosine turns in
+    any registered field (and in ``field``, a `HeightField`, if given), pi max(k_u, 2 k_v) for the
+    built-in fields (rings' 2 pi k_v v; seed §2's fields), 1 where no argument turns.  It bounds |h_u|
+    and |h_v| of a product of sines of unit amplitude.  The gradient checks' tolerances
+    (proofs/pixels.py, proofs/gradients.py) and `lab.accuracy`'s ulps are in its units, so a field
+    that turns faster widens them for every field.
+
+    ``ku``, ``kv``: positive floats, the frequencies (periods over the chart; not validated, the
+    callers' scenes are).  Returns a float, in radians per chart unit; it raises nothing of its own
+    (a non-number fails in `math`)."""
     return float(_scale(_scale_records(field))[1](ku, kv))
 
 
