@@ -36,7 +36,7 @@ def pytest_collection_modifyitems(items):
         if "book_html" in names:
             item.add_marker(pytest.mark.audit)
             for shared in SHARED:
-                if shared in names:
+                if shared in names and item.config.pluginmanager.hasplugin("xdist"):   # not under -p no:xdist
                     item.add_marker(pytest.mark.xdist_group(f"{item.module.__name__}::{shared}"))
 
 

@@ -42,14 +42,15 @@ def test_alone(book_html, k):
 '''
 
 
-def run_audit(tmp_path, hook_order=None):
-    """Two workers, ``--dist loadgroup`` and ``-m audit`` as `make audit` runs them, over a scratch
-    module whose module fixture ``site`` (one of `SHARED`) appends its process id to a file per build;
-    the project's hooks as tests/conftest.py declares them, or (``hook_order``: pytest.hookimpl's
-    arguments, as text) the grouping hook called from a hook of that order.
+def run_audit(tmp_path, hook_order=None, xdist=True, conftest=None):
+    """Two workers, ``--dist loadgroup`` and ``-m audit`` as `make audit` runs them (or, ``xdist``
+    false, one process with xdist not loaded), over a scratch module whose module fixture ``site``
+    (one of `SHARED`) appends its process id to a file per build; the project's hooks as
+    tests/conftest.py declares them, or (``hook_order``: pytest.hookimpl's arguments, as text) the
+    grouping hook called from a hook of that order, or ``conftest``'s text.
     Returns (pytest's return code, builds)."""
     (tmp_path / "test_scratch.py").write_text(SCRATCH)
-    (tmp_path / "conftest.py").write_text(
+    (tmp_path / "conftest.py").write_text(conftest or (
         "from tests.conftest import pytest_configure, pytest_collection_modifyitems\n" if hook_order is None
         else textwrap.dedent(f"""
             import pytest
@@ -59,12 +60,13 @@ def run_audit(tmp_path, hook_order=None):
             @pytest.hookimpl({hook_order})
             def pytest_collection_modifyitems(items):
                 project.pytest_collection_modifyitems(items)
-            """))
+            """)))
     builds = tmp_path / "builds"
     # Only xdist among the plugins (the others cost each process a second of imports).
     env = dict(os.environ, BUILDS=str(builds), PYTHONPATH=str(ROOT), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
-    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "xdist", "-p", "no:cacheprovider", "-n", "2",
-                           "--dist", "loadgroup", "-m", "audit", "-o", "addopts=", "--rootdir", str(tmp_path),
+    workers = ["-p", "xdist", "-n", "2", "--dist", "loadgroup"] if xdist else ["-p", "no:xdist"]
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", *workers, "-p", "no:cacheprovider",
+                           "-m", "audit", "-o", "addopts=", "--strict-markers", "--rootdir", str(tmp_path),
                            str(tmp_path)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
     return done, builds.read_text().split() if builds.exists() else []
 
@@ -82,3 +84,24 @@ def test_the_check_catches_groups_assigned_after_xdist_read_them(tmp_path):
     done, builds = run_audit(tmp_path, hook_order="")
     assert done.returncode == 0, done.stdout + done.stderr
     assert len(builds) == 2, builds
+
+
+#: The grouping hook as it was: the xdist_group mark added whether or not xdist is loaded.
+UNGUARDED = """
+from tests import conftest as project
+pytest_configure = project.pytest_configure
+
+def pytest_collection_modifyitems(config, items):
+    config.pluginmanager.hasplugin = lambda name: True
+    project.pytest_collection_modifyitems(items)
+"""
+
+
+def test_the_audits_run_in_one_process_without_xdist(tmp_path):
+    """``-p no:xdist`` (one process, as a debugger wants it): the audits run, the shared fixture built
+    once, and no mark of a plugin not loaded (under --strict-markers, pytest's internal error)."""
+    done, builds = run_audit(tmp_path, xdist=False)
+    assert done.returncode == 0 and "24 passed" in done.stdout, done.stdout + done.stderr
+    assert len(builds) == 1, builds
+    done, _ = run_audit(tmp_path, xdist=False, conftest=UNGUARDED)
+    assert done.returncode != 0 and "'xdist_group' not found in `markers`" in done.stdout + done.stderr, done.stdout
