@@ -1359,6 +1359,10 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
         s.close()
 
 
+#: The share of a phone's screen (390 x 844 px) that what sticks at the top (the theme's header and the
+#: simulator's main controls) may cover while the canvases scroll by beneath it.
+MAX_STUCK = 0.25
+
 #: Run in the page with the name of a reading position: scrolls there and returns [target,
 #: what covers it] for each point of a target that something else covers (document.elementFromPoint
 #: at a 5 x 5 grid of points inside the target's box, within the viewport).  The positions: "top"
@@ -1367,7 +1371,8 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
 #: "ucurve_middle" (the U-curve's plot with its caption at the bottom of the screen, as it comes into
 #: view, and in the middle) and "ledger" (the ledger in the middle).  The targets: the main controls
 #: (the field, ε and β: at every position where they stick to the screen, else at "top"), the readout
-#: (its part below what sticks at the top: a box scrolled under a bar is not covered by it), and at
+#: (its part below what sticks at the top: a box scrolled under a bar is not covered by it; on a phone
+#: at "canvases", what sticks at the top at most `MAX_STUCK` of the screen), and at
 #: both "ucurve" positions the plot and its caption, which must also lie wholly on the screen,
 #: and on a phone (under 720 px) the ε slider, wholly on the screen with them; on a phone at
 #: "difference", the ε slider and the difference canvas wholly on the screen, uncovered (dragging ε
@@ -1406,6 +1411,9 @@ COVERED_JS = """async (where) => {
       if (hit !== el && !el.contains(hit)) found.push(label + ' covered by ' + name(hit));
     }
   };
+  // On a phone what sticks at the top (the theme's header and the main controls) leaves the page most of the screen.
+  if (where === 'canvases' && innerWidth < 720 && bar() > MAX_STUCK * innerHeight)
+    found.push(`what sticks at the top covers ${Math.round(100 * bar() / innerHeight)} % of the screen (over ${100 * MAX_STUCK} %)`);
   if (where === 'top' || sticky(main))
     for (const id of ['sim-height_field', 'sim-log_eps', 'sim-beta']) check(document.getElementById(id), '#' + id);
   check(readout, '#sim-readout', bar());
@@ -1432,7 +1440,7 @@ COVERED_JS = """async (where) => {
       if (th.getBoundingClientRect().right > box.left + ledger.clientWidth + 1) found.push(`ledger column "${th.textContent}" cut off`);
   }
   return [...new Set(found)];
-}"""
+}""".replace("MAX_STUCK", str(MAX_STUCK))
 READING_POSITIONS = ("top", "canvases", "difference", "ucurve_bottom", "ucurve_middle", "ledger")
 
 
@@ -1499,6 +1507,11 @@ WRONG_LAYOUTS = {
         "#sim-log_eps beside the difference canvas covered by nothing (off the screen)"),
     "the readout scrolled over the sticky controls": ("bundle",
         "z-index: 3; /* above the readout */", "z-index: 1;", "covered by dl#sim-readout"),
+    "the field's menu under its name, the panel a quarter of the screen": ("bundle",
+        "padding: 0.2rem 0;\n    gap: 0 1rem; font-size: 0.9rem; }\n  /* The field's menu beside its name: with the theme's header, the panel covers under a quarter of a phone's screen. */\n"
+        "  .symrender-sim .sim-main label:has(select) { flex-direction: row;",
+        "padding: 0.3rem 0; }\n  .symrender-sim .sim-main label:has(select) { flex-direction: column;",
+        "what sticks at the top covers"),
     "the plot's labels drawn small": ("bundle",
         ".sim-curve text { fill: currentColor; font-size: 11px; }", ".sim-curve text { fill: currentColor; font-size: 8px; }",
         "#sim-curve's text at 8.0 px (under 10)"),

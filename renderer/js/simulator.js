@@ -167,7 +167,11 @@ const STYLE = `
    it, so the canvases and never the plot or its caption; it scrolls on under the controls. */
 @media (max-width: 720px) {
   .symrender-sim .sim-main { grid-template-columns: minmax(0, 1fr); position: sticky; top: 3.5rem;
-    z-index: 3; /* above the readout */ background: var(--pst-color-background, #fff); padding: 0.3rem 0; }
+    z-index: 3; /* above the readout */ background: var(--pst-color-background, #fff); padding: 0.2rem 0;
+    gap: 0 1rem; font-size: 0.9rem; }
+  /* The field's menu beside its name: with the theme's header, the panel covers under a quarter of a phone's screen. */
+  .symrender-sim .sim-main label:has(select) { flex-direction: row; align-items: center; gap: 0.5rem; }
+  .symrender-sim .sim-main label:has(select) select { flex: 1; min-width: 0; }
   .symrender-sim .sim-stage { grid-template-columns: minmax(0, 1fr); }
   .symrender-sim .sim-curve, .symrender-sim .sim-readout { grid-column: 1; }
   .symrender-sim .sim-curve { order: 1; }
