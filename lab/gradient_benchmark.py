@@ -17,7 +17,7 @@ AD runs JAX's jit-compiled (XLA) program, whose first call at a frame's size com
 is timed apart (`MethodResult.compile_seconds`).  So the times compare the methods as they
 are available here, not as each could best be compiled.
 
-`univariate_errors` runs the methods on a reader's f(x) (`renderer.formulas.univariate`) at
+`univariate_errors` runs the methods on a reader's f(x) (`renderer.univariate.univariate`) at
 any real x where it is differentiable, at each step of a grid, against the mpmath value of
 its derivative; the central difference's row is `renderer.ucurve.measure_function`'s
 U-curve.  `PUBLISHED` holds what the complex-step papers report about their test function
@@ -45,6 +45,7 @@ import sympy as sp
 
 from renderer import DRAFT_SCENE, gbuffer, pointwise, ucurve, validate
 from renderer import formulas as F
+from renderer import univariate as U
 from renderer.render import SPHERE_A
 from renderer.scene import UNIT
 from renderer.validate import InvalidType, InvalidValue, choice, positive_int
@@ -504,7 +505,7 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
     """Every method of `lab.gradient_methods.METHODS` with a one-variable form that applies to
     ``function``, at x, at each step, against an mpmath reference of the derivative.
 
-    The reference is the function's derivative (`renderer.formulas.Univariate.derivative`,
+    The reference is the function's derivative (`renderer.univariate.Univariate.derivative`,
     sympy's) evaluated by mpmath at `renderer.ucurve.DIGITS` digits at x as float64 holds it,
     the derivative `renderer.ucurve.measure_function` measures against; that function also
     validates the input.  Each error is computed at the reference's precision from the
@@ -513,7 +514,7 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
 
     Parameters
     ----------
-    function : sympy expression of one symbol, its text in ``x``, or `renderer.formulas.Univariate`
+    function : sympy expression of one symbol, its text in ``x``, or `renderer.univariate.Univariate`
         E.g. ``"exp(x) / sqrt(sin(x)**3 + cos(x)**3)"`` (`TEST_FUNCTION`).
     x : float
         Any real point where f is defined and differentiable (and f(x +- eps) for each step).
@@ -527,7 +528,7 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
     Raises
     ------
     renderer.validate.InputError
-        One line naming the argument: a function refused by `renderer.formulas.univariate`
+        One line naming the argument: a function refused by `renderer.univariate.univariate`
         (an unknown name or operator, more than one variable, a complex constant); a point
         (``x``) or a step (``steps``) that is not a finite real number in range (a bool, NaN); a point where f or f' is not a
         finite real number, or f has a crease, or float64 f overflows; a step at which
@@ -540,7 +541,7 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
     >>> e.best("complex step").relative_error < 1e-15                       # doctest: +SKIP
     True
     """
-    record, x = F.univariate(function), validate.real("x", x)
+    record, x = U.univariate(function), validate.real("x", x)
     steps = validate.steps("steps", steps, low=pointwise.MIN_STEP, high=ucurve.MAX_FUNCTION_STEP)
     try:
         # Refuses a point where f or f' is not a real number float64 holds, a crease, a float64 f(x) that
@@ -550,7 +551,7 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
         text = str(exc)
         raise validate.InvalidValue(f"steps{text[3:]}" if text.startswith("eps ") else text) from None
     steps = tuple(float(e) for e in curve.eps)
-    true_fn = sp.lambdify(F.x_var, record.derivative, modules="mpmath")
+    true_fn = sp.lambdify(U.x_var, record.derivative, modules="mpmath")
     rows, evaluations = [], {}
     with mpmath.workdps(ucurve.DIGITS):
         true = true_fn(mpmath.mpf(x))

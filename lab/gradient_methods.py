@@ -60,6 +60,7 @@ import sympy as sp
 
 from renderer import DRAFT_SCENE, fieldcode, pointwise, ucurve, validate
 from renderer import formulas as F
+from renderer import univariate as U
 from renderer.scene import FREQUENCY, UNIT
 from renderer.validate import InvalidType, InvalidValue, choice, flag, positive_int, real
 
@@ -120,7 +121,7 @@ class Method:
     repeats : str
         The `Config` attribute saying how many times it is timed.
     applies : callable
-        ``applies(record) -> bool`` for a `HeightField` or a `renderer.formulas.Univariate`:
+        ``applies(record) -> bool`` for a `HeightField` or a `renderer.univariate.Univariate`:
         whether its premise holds there; it is measured only where it does.
     compiles : bool
         Its first call at a new array size compiles: that call is timed apart.
@@ -710,7 +711,7 @@ def evaluations(field, name, info=None):
 
 def _exact_1d(function, x, eps, info):
     try:
-        return float(sp.lambdify(F.x_var, function.derivative, modules="math")(x))
+        return float(sp.lambdify(U.x_var, function.derivative, modules="math")(x))
     except (ArithmeticError, ValueError):   # math's overflow, pole or domain error: no float64 value
         return math.nan
 
@@ -725,13 +726,13 @@ def _forward_1d(function, x, eps, info):
 
 def _complex_1d(continued):
     def derivative_(function, x, eps, info):
-        return float(np.imag(_complex_fn(function.expr, (F.x_var,), continued)(complex(x, eps))) / eps)
+        return float(np.imag(_complex_fn(function.expr, (U.x_var,), continued)(complex(x, eps))) / eps)
     return derivative_
 
 
 def _richardson_1d(function, x, eps, info):
     from scipy.differentiate import derivative
-    res = derivative(_complex_fn(function.expr, (F.x_var,), False), np.float64(x))
+    res = derivative(_complex_fn(function.expr, (U.x_var,), False), np.float64(x))
     info["h_per_pixel"] = float(res.nfev)
     return float(res.df)
 
@@ -739,7 +740,7 @@ def _richardson_1d(function, x, eps, info):
 def _ad_1d(function, x, eps, info):
     import jax
     import jax.numpy as jnp
-    f = sp.lambdify(F.x_var, function.expr, modules="jax")
+    f = sp.lambdify(U.x_var, function.expr, modules="jax")
     with jax.enable_x64(True):
         return float(jax.jvp(f, (jnp.float64(x),), (jnp.float64(1.0),))[1])
 

@@ -40,6 +40,7 @@ from sympy.printing.jscode import JavascriptCodePrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from . import formulas as F
+from . import univariate as U
 
 __all__ = ["python_source", "array_source", "js_source", "field_source", "univariate_source", "digest", "kernel_text",
            "targets", "GENERATED", "GENERATED_ARRAY", "KERNEL", "JS_FIELD_FUNCTIONS"]
@@ -187,9 +188,9 @@ def field_source(field, prefix="", array=False):
 
 
 def univariate_source(function):
-    """Text of the scalar functions of a `renderer.formulas.Univariate` (`formulas.UNIVARIATE_FUNCTIONS`)."""
-    return "\n\n".join(_function(name, args, outputs(function), F.UNIVARIATE_PRELUDE.get(name, ()), _py)
-                         for name, (args, outputs) in F.UNIVARIATE_FUNCTIONS.items())
+    """Text of the scalar functions of a `renderer.univariate.Univariate` (`univariate.FUNCTIONS`)."""
+    return "\n\n".join(_function(name, args, outputs(function), U.PRELUDE.get(name, ()), _py)
+                         for name, (args, outputs) in U.FUNCTIONS.items())
 
 
 def _fields_table(prefix=""):

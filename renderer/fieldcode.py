@@ -15,7 +15,7 @@ field:
   its text, `formulas.field`).
 * `array_code`: the branch-free array functions of the array kernel
   (`renderer.arraykernel`), renderer/generated_array.py's for a built-in field.
-* `univariate_code`: f, and its central and forward differences, of a `formulas.Univariate`,
+* `univariate_code`: f, and its central and forward differences, of a `univariate.Univariate`,
   as numba ``njit`` functions.
 
 Calling a field's code through a pointer keeps it out of the kernel's inlining; the
@@ -36,6 +36,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from . import _numba_cache
 from . import formulas as F
+from . import univariate as U
 
 _numba_cache()          # where numba caches the built-in fields' functions (see renderer.kernel)
 
@@ -102,15 +103,15 @@ def array_code(field):
     return FieldCode(*(ns[name] for name in F.FIELD_FUNCTIONS))
 
 
-#: A function of one variable's compiled functions (`formulas.UNIVARIATE_FUNCTIONS`).
-UnivariateCode = namedtuple("UnivariateCode", tuple(F.UNIVARIATE_FUNCTIONS))
+#: A function of one variable's compiled functions (`univariate.FUNCTIONS`).
+UnivariateCode = namedtuple("UnivariateCode", tuple(U.FUNCTIONS))
 
 
 @lru_cache(maxsize=None)
 def univariate_code(function):
-    """``value(x)``, ``central(x, step)``, ``forward(x, step)`` of a `formulas.Univariate`, numba
+    """``value(x)``, ``central(x, step)``, ``forward(x, step)`` of a `univariate.Univariate`, numba
     ``njit`` functions of float64 scalars (the abscissae x +- step rounded in float64, as a
     program computes them)."""
     from .codegen import univariate_source
     ns = _execute(univariate_source(function), f"function {function.name}")
-    return UnivariateCode(*(njit(error_model="numpy")(ns[name]) for name in F.UNIVARIATE_FUNCTIONS))
+    return UnivariateCode(*(njit(error_model="numpy")(ns[name]) for name in U.FUNCTIONS))

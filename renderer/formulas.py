@@ -18,7 +18,7 @@ What lives here (seed §2, §3 and Cell 1, with the project's corrections):
   derived from it the exact gradient, the central difference, the creases and
   the seed's crease band about them; `field` also makes a record of a reader's
   own expression in u, v, k_u, k_v;
-* a reader's function of one variable (`Univariate`), for U-curves at any point;
+* (a reader's function of one variable is `renderer.univariate`'s);
 * the chart (u, v) of a unit normal N of sphere A, and sin(phi) (`hypot`);
 * the tangent frame (e_theta, e_phi), a fixed basis only where sin(phi) is 0 or subnormal;
 * the perturbed normal of both bump modes ("chart": the seed's formula;
@@ -38,13 +38,12 @@ import sympy as sp
 
 __all__ = [
     "u", "v", "k_u", "k_v", "FIELD_SYMBOLS", "ELEMENTARY", "KINK_BAND_HALF_WIDTH", "SEED_POINT", "HeightField",
-    "FIELDS", "BUILTIN", "register", "field", "gradient_scale", "gradient_scale_text", "Univariate", "univariate",
-    "x_var", "step",
+    "FIELDS", "BUILTIN", "register", "field", "gradient_scale", "gradient_scale_text", "check_expression",
     "N_x", "N_y", "N_z", "sin_phi", "hypot", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
     "FOOTPRINT_FALLBACK", "FOOTPRINT_MAX", "FOOTPRINT_LIMIT", "FOOTPRINT_RULE", "FUNCTIONS", "FIELD_FUNCTIONS",
-    "UNIVARIATE_FUNCTIONS", "eps", "H3", "H", "HX", "u_round", "ERROR_MODEL", "EPS_STAR",
+    "eps", "H3", "H", "HX", "u_round", "ERROR_MODEL", "EPS_STAR",
 ]
 
 # ---------------------------------------------------------------- height fields
@@ -79,8 +78,18 @@ STENCIL_POINTS = (
 CENTRAL_DENOMINATORS = (2 * eps_u, sp.Piecewise((v_p - v_m, sp.Or(v + eps_v > 1, v - eps_v < 0)), (2 * eps_v, True)))
 
 
-def _check_expression(name, expr, symbols):
-    """``expr`` if it is a real sympy expression in ``symbols`` built from `ELEMENTARY`, else ValueError."""
+def check_expression(name, expr, symbols):
+    """``expr`` if it is a real sympy expression in ``symbols`` built from `ELEMENTARY`, with a real
+    derivative in closed form in each of its variables (a `HeightField`'s, a `renderer.univariate.Univariate`'s).
+
+    Raises
+    ------
+    TypeError
+        ``expr`` is not a sympy expression.
+    ValueError
+        It uses another symbol, calls another function, holds a non-real or infinite number, or its
+        derivative holds re, im, arg or an unevaluated derivative; the message begins with ``name``.
+    """
     if not isinstance(expr, sp.Expr):
         raise TypeError(f"{name} must be a sympy expression, got {type(expr).__name__}")
     extra = expr.free_symbols - set(symbols)
@@ -146,7 +155,7 @@ class HeightField:
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.strip():
             raise TypeError(f"a height field's name must be a non-empty string, got {self.name!r}")
-        _check_expression(f"height field {self.name!r}", self.expr, FIELD_SYMBOLS)
+        check_expression(f"height field {self.name!r}", self.expr, FIELD_SYMBOLS)
 
     @cached_property
     def gradient(self):
@@ -496,85 +505,3 @@ ERROR_MODEL = sp.Add(sp.Mul(sp.Rational(1, 6), eps**2, H3, evaluate=False),
 #: Its minimiser over eps > 0 where |h'''| > 0, as written: (3 u_round (|h| + |x h'|) / |h'''|)^(1/3).
 EPS_STAR = sp.Pow(sp.Mul(3, u_round, sp.Add(H, HX, evaluate=False), 1 / H3, evaluate=False), sp.Rational(1, 3),
                   evaluate=False)
-
-
-# ------------------------------------------------------- a function of one variable
-#: The variable of a reader's function of one variable, and the step.
-x_var, step = sp.Symbol("x", real=True), sp.Symbol("step", positive=True)
-x_p, x_m = sp.symbols("x_p x_m", real=True)
-
-
-@dataclass(frozen=True, eq=False)
-class Univariate:
-    """A reader's function f(x) of one real variable, for U-curves and the gradient methods
-    at any real point where it is defined (Squire and Trapp 1998's test function, say).
-
-    Parameters
-    ----------
-    name : str
-        Its printed form.
-    expr : sympy expression
-        f in `x_var` alone, built from `ELEMENTARY` functions, real.
-
-    Raises
-    ------
-    TypeError, ValueError
-        An expression outside the above.
-    """
-
-    name: str
-    expr: sp.Expr
-
-    def __post_init__(self):
-        _check_expression(f"function {self.name!r}", self.expr, (x_var,))
-
-    @cached_property
-    def derivative(self):
-        """f' (sympy's derivative)."""
-        return sp.diff(self.expr, x_var)
-
-    @cached_property
-    def analytic(self):
-        """As `HeightField.analytic`."""
-        return not self.expr.has(sp.Abs)
-
-
-#: What the generator prints for a `Univariate`: f, and its central and forward differences
-#: at the float64 abscissae x +- step.
-UNIVARIATE_FUNCTIONS = {
-    "value": ((x_var,), lambda f: (f.expr,)),
-    "central": ((x_var, step), lambda f: ((f.expr.subs(x_var, x_p) - f.expr.subs(x_var, x_m)) / (2 * step),)),
-    "forward": ((x_var, step), lambda f: ((f.expr.subs(x_var, x_p) - f.expr) / step,)),
-}
-UNIVARIATE_PRELUDE = {"central": ((x_p, x_var + step), (x_m, x_var - step)), "forward": ((x_p, x_var + step),)}
-
-
-def univariate(spec, name="function"):
-    """The `Univariate` ``spec`` is: one, a sympy expression of one symbol (renamed `x_var`), or
-    its text in ``x`` (parsed by `renderer.validate.expression`).
-
-    Raises
-    ------
-    renderer.validate.InvalidType, renderer.validate.InvalidValue
-        Naming ``name``.
-    """
-    from .validate import InvalidType, InvalidValue, expression
-    if isinstance(spec, Univariate):
-        return spec
-    if isinstance(spec, str):
-        spec = expression(name, spec, (x_var,), ELEMENTARY)
-    if not isinstance(spec, sp.Expr):
-        raise InvalidType(f"{name} must be a sympy expression of one variable or its text in x, "
-                          f"got {type(spec).__name__}")
-    free = spec.free_symbols
-    if len(free) != 1:
-        raise InvalidValue(f"{name} must depend on exactly one variable, got {len(free)}: {spec}")
-    expr = spec.xreplace({free.pop(): x_var})
-    try:
-        record = Univariate(str(expr), expr)
-    except (TypeError, ValueError) as exc:
-        raise InvalidValue(f"{name}: {exc}") from None
-    return _UNIVARIATES.setdefault(record.name, record)
-
-
-_UNIVARIATES = {}

@@ -42,6 +42,7 @@ import sympy as sp
 from renderer import fieldcode, pointwise, validate
 from renderer.scene import DRAFT_SCENE
 from renderer import formulas as F
+from renderer import univariate as U
 
 __all__ = ["UCurve", "measure", "measure_function", "fit_model", "non_differentiable", "UNIT_ROUNDOFF",
            "DIGITS", "SEED_POINT", "SEED_FREQUENCIES", "DEFAULT_STEPS", "MAX_FUNCTION_STEP"]
@@ -438,7 +439,7 @@ def measure_function(function, x, eps=None):
 
     Parameters
     ----------
-    function : sympy expression of one symbol, its text in ``x``, or `renderer.formulas.Univariate`
+    function : sympy expression of one symbol, its text in ``x``, or `renderer.univariate.Univariate`
         E.g. ``"exp(x) / sqrt(sin(x)**3 + cos(x)**3)"`` (Squire and Trapp 1998).
     x : float
         Any real point where f is defined and differentiable, and f(x +- eps) too.
@@ -453,20 +454,20 @@ def measure_function(function, x, eps=None):
     Raises
     ------
     renderer.validate.InputError
-        Naming the argument: an expression refused by `renderer.formulas.univariate`, a point
+        Naming the argument: an expression refused by `renderer.univariate.univariate`, a point
         or a step that is not a finite float in range, a point where f, f' or f''' is not a real
         number float64 can hold or f has a crease (|g| where g changes sign), a step at which
         f(x +- eps) is not.
     """
-    record = F.univariate(function, "function")
+    record = U.univariate(function, "function")
     x = validate.real("x", x)
     steps = DEFAULT_STEPS if eps is None else validate.steps("eps", eps, low=pointwise.MIN_STEP,
                                                               high=MAX_FUNCTION_STEP)
-    line, point = _line(record.expr, F.x_var), dict(u=x, v=float("nan"), component="x")
+    line, point = _line(record.expr, U.x_var), dict(u=x, v=float("nan"), component="x")
     with mpmath.workdps(DIGITS):
         if any(_real(fn, mpmath.mpf(x)) is None for fn in line[:2]):     # before the crease and float64 checks
             raise _undefined(record.name, point)
-    if _crease(record.expr, F.x_var, {}, x) is not None:
+    if _crease(record.expr, U.x_var, {}, x) is not None:
         raise validate.InvalidValue(f"function {record.name} is not differentiable at x = {x!r}: it has a "
                                     f"crease there (the argument of an abs changes sign)")
     code = fieldcode.univariate_code(record)

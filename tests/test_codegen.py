@@ -48,6 +48,7 @@ import sympy as sp
 
 from renderer import GRADIENTS, Scene, backends, codegen, fieldcode, gbuffer, pointwise, render
 from renderer import formulas as F
+from renderer.univariate import univariate
 from renderer import generated as G
 from renderer import generated_array as GA
 
@@ -698,7 +699,7 @@ def test_no_generated_function_assigns_a_name_it_never_reads():
     the check is shown finding such a line planted into each language."""
     sources = {"python": codegen.python_source(), "array": codegen.array_source(), "js": codegen.js_source(),
                "own field": codegen.field_source(F.field("sin(pi*k_v*v)**3")),
-               "univariate": codegen.univariate_source(F.univariate("exp(x)/sqrt(sin(x)**3 + cos(x)**3)"))}
+               "univariate": codegen.univariate_source(univariate("exp(x)/sqrt(sin(x)**3 + cos(x)**3)"))}
     assert {k: unread_names(s) for k, s in sources.items()} == {k: {} for k in sources}
     assert unread_names(sources["python"].replace("    return (math.sin(v*x0)", "    w_p = u + 1\n    return (math.sin(v*x0)", 1)) \
         == {"rings_central": {"w_p"}}

@@ -21,6 +21,7 @@ import pytest
 import sympy as sp
 
 from renderer import formulas as F
+from renderer import univariate as U
 from renderer import pointwise
 from renderer.ucurve import UNIT_ROUNDOFF, measure, measure_function, non_differentiable
 
@@ -66,7 +67,7 @@ def test_the_u_curve_of_a_readers_function_is_mpmaths(text, f_mp, f_py, x):
             python = (f_py(plus) - f_py(minus)) / (2 * e)
             slack = 8 * UNIT_ROUNDOFF * max(abs(f_py(plus)), abs(f_py(minus))) / e
             assert abs(uc.roundoff[i] - float(mpmath.mpf(python) - exact)) <= slack, (text, e)
-    assert uc.u == x and uc.component == "x" and np.isnan(uc.v) and uc.field == F.univariate(text, "function").name
+    assert uc.u == x and uc.component == "x" and np.isnan(uc.v) and uc.field == U.univariate(text, "function").name
     # The error model E(eps) = T eps^2 + (C + G) / eps, its minimiser and least value, from mpmath's values.
     T, C, G = abs(uc.third_derivative) / 6, UNIT_ROUNDOFF * abs(uc.height), UNIT_ROUNDOFF * abs(x * uc.derivative)
     star = ((C + G) / (2 * T)) ** (1 / 3)
