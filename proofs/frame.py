@@ -195,11 +195,11 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
                    r"$⟦kernel_e_phi⟧$, at $N(\theta, \varphi)$, satisfies "
                    r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
         steps=(
-            *calc(ET_S, (r"At $N(\theta, \varphi)$, where the kernel's $\sin\varphi$ is $\sin\varphi$ by ⟪chart⟫, "
-                         r"$e_\theta = (-N_y, N_x, 0)/\sin\varphi$ is", sp.Matrix([-sp.sin(theta), sp.cos(theta), 0])),
+            *calc(ET_S, (r"Substitute $N(\theta, \varphi)$ into $e_\theta = (-N_y, N_x, 0)/\sin\varphi$ (there the "
+                         r"kernel's $\sin\varphi$ is $\sin\varphi$, by ⟪chart⟫)", sp.Matrix([-sp.sin(theta), sp.cos(theta), 0])),
                   (r"This is $\partial N/\partial\theta = \sin\varphi\,(-\sin\theta, \cos\theta, 0)$ divided by "
                    r"$\sin\varphi$", d_theta)),
-            *calc(EP_S, (r"Likewise $e_\varphi = (N_z N_x, N_z N_y, -\sin^2\varphi)/\sin\varphi$ is",
+            *calc(EP_S, (r"Likewise, substitute it into $e_\varphi = (N_z N_x, N_z N_y, -\sin^2\varphi)/\sin\varphi$",
                          sp.Matrix([sp.cos(phi) * sp.cos(theta), sp.cos(phi) * sp.sin(theta), -sp.sin(phi)])),
                   (r"This is the $\varphi$-derivative of $N$", d_phi)),
             Step(r"Differentiating $N \cdot N = 1$ gives $N \cdot \partial N/\partial\theta = N \cdot \partial N/"

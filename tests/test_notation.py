@@ -23,7 +23,7 @@ from proofs.registry import THEOREMS
 PRINTED = {
     "displaced-normal": "0e810649159f81d2",
     "chart": "806ac8c86dd7e8dc",
-    "frame-orthonormal": "ca796763e8a38dd6",
+    "frame-orthonormal": "14b493411c6f31b5",
     "frame-orientation": "e1293a724b51b121",
     "gradient-sine": "25fc2c5ba570a217",
     "gradient-ridges": "b02fc36b87d6eb4f",
