@@ -569,7 +569,7 @@ class Simulator {
                       (marked ? `; the image-best step: ${best_eps}` : ""));
     plot.dataset.eps = String(here.eps);
     this.root.querySelector("#sim-curve-caption").textContent =
-      `The U-curve of central differences, on ${sample}, at half-decade steps of ε; the dashed line and ` +
+      `The U-curve of central differences, on ${sample}, at half-decade steps of ε; the dotted line and ` +
       `the dots: the current ε; the triangle: the image-best step, the one of these steps with the least RMS. ` +
       `An exact zero lies on the bottom axis. ${RIGHT_ARM[FIELD_CREASES[this.state.height_field] ? "creased" : "smooth"]}`;
   }
