@@ -550,8 +550,8 @@ PHONE = "390 px at load"
 def site(browser, book_html):
     """Every page of the built site, each opened twice: {(page, width): the audit classes (a)-(d), its
     length, figures, tables and formulas} at 1280 px and then narrowed to 390 px, with axe-core's
-    violations at 1280 px; {(page, PHONE): formulas and axe-core's violations} of the page opened at
-    390 px; {(page, "loads"): [{"blocked", "errors"}] of each load}.  Saves the report, and with
+    violations at 1280 px; {(page, PHONE): formulas, what floats over a figure (`FLOATING`) and
+    axe-core's violations} of the page opened at 390 px; {(page, "loads"): [{"blocked", "errors"}] of each load}.  Saves the report, and with
     SYMRENDER_SHOTS=1 a screenshot of each page at each width."""
     shots = ARTIFACTS / "pages"
     shots.mkdir(parents=True, exist_ok=True)
@@ -560,7 +560,8 @@ def site(browser, book_html):
         url, loads = (book_html / f"{name}.html").as_uri(), []
         phone = Page(browser, url, 390)
         try:
-            found[name, PHONE] = {"formulas": phone.formulas(), "axe": phone.axe()}
+            found[name, PHONE] = {"formulas": phone.formulas(), "floating": phone.page.evaluate(FLOATING),
+                                  "axe": phone.axe()}
             loads.append({"blocked": phone.blocked, "errors": phone.errors})
         finally:
             phone.close()
@@ -1287,6 +1288,63 @@ def formula_findings(found):
     (scale under 1), reaching past the column by more than a pixel, or a TeX error; or that a keyboard
     reader must Tab through (in the Tab order: MathJax's default)."""
     return [f for f in found if f["scale"] < 0.999 or f["over"] > 1 or f["error"] or f["tab"]]
+
+
+#: Run in a page: each figure's image brought to the top of the screen, its middle and its bottom, each
+#: time scrolled past a little and back up, as a reader returning to it does (the theme shows its "Back to
+#: top" pill on a scroll up); ["<what> over <figure id>"] for each element outside the article but for the
+#: theme's sticky header, fixed or sticky and shown, whose box meets the image's part on the screen.
+FLOATING = """async () => {
+  // A scroll's event is dispatched in the next frame, before its animation-frame callbacks.
+  const frame = () => new Promise(r => requestAnimationFrame(r));
+  const article = document.querySelector('article.bd-article'), chrome = [];
+  const walk = document.createTreeWalker(document.body, NodeFilter.SHOW_ELEMENT,
+    {acceptNode: n => n === article ? NodeFilter.FILTER_REJECT : NodeFilter.FILTER_ACCEPT});
+  for (let n = walk.nextNode(); n; n = walk.nextNode())
+    if (!n.closest('.bd-header, .bd-header-article')) chrome.push(n);
+  const found = [];
+  for (const img of article.querySelectorAll('figure img')) for (const block of ['start', 'center', 'end']) {
+    const figure = img.closest('figure');
+    img.scrollIntoView({block}); await frame();
+    window.scrollBy(0, 60); await frame();
+    window.scrollBy(0, -60); await frame();
+    const r = img.getBoundingClientRect(), top = Math.max(r.top, 0), bottom = Math.min(r.bottom, innerHeight);
+    for (const el of chrome) {
+      const s = getComputedStyle(el);
+      if (!['fixed', 'sticky'].includes(s.position) || s.display === 'none' || s.visibility === 'hidden' || s.opacity === '0') continue;
+      const b = el.getBoundingClientRect();
+      if (b.width > 0 && b.height > 0 && b.left < r.right && b.right > r.left && b.top < bottom && b.bottom > top)
+        found.push((el.id ? '#' + el.id : el.tagName.toLowerCase() + '.' + [...el.classList].join('.')) + ' over ' + (figure.id || img.src.split('/').pop()));
+    }
+  }
+  return [...new Set(found)];
+}"""
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_nothing_floats_over_a_figure_on_a_phone(site, name):
+    """On a phone (390 px), a reader who scrolls back up to a figure sees all of it: nothing but the
+    theme's sticky header lies over its image (`FLOATING`)."""
+    assert site[name, PHONE]["floating"] == [], site[name, PHONE]["floating"]
+
+
+def test_the_floating_check_catches_the_themes_back_to_top_pill(browser, book_html):
+    """The wrong variant: §1 at 390 px without the site's rule that hides the theme's "Back to top" pill
+    on a phone; the pill, shown as the reader scrolls up, lies over a figure."""
+    rule = "@media (max-width: 720px) { #pst-back-to-top { display: none !important; } }"
+
+    def change(path, text):
+        if path.name == "fit.css":
+            assert text.count(rule) == 1, "the variant no longer applies to fit.css"
+            return text.replace(rule, "")
+        return text
+
+    p = Page(browser, (book_html / "s1_what_changes.html").as_uri(), 390, height=844, change=change)
+    try:
+        found = p.page.evaluate(FLOATING)
+        assert any(f.startswith("#pst-back-to-top over ") for f in found), found
+    finally:
+        p.close()
 
 
 @pytest.mark.parametrize("name", PAGES)
