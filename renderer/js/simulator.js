@@ -604,7 +604,7 @@ class Simulator {
     const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom, s.numeric);
     const a = pr.symbolic, b = pr.numeric;
     const vec = (v, digits = 10) => v ? "(" + v.map((x) => x.toPrecision(digits)).join(", ") + ")" : "—";
-    const rows = [["pixel", `(${i}, ${j}): ${CHAMBER_NAMES[a.chamber]}`], ["sees", vec(a.P, 6)]];
+    const rows = [["pixel", `(${i}, ${j}): ${CHAMBER_NAMES[a.chamber]}`], ["hit point", vec(a.P, 6)]];
     if (a.chamber === SPHERE_A) {
       rows.push(["(u, v)", vec(a.uv, 8)]);
       rows.push(["∇h exact", vec(a.grad)]);
