@@ -18,7 +18,6 @@ What lives here (seed §2, §3 and Cell 1, with the project's corrections):
   derived from it the exact gradient, the central difference, the creases and
   the seed's crease band about them; `field` also makes a record of a reader's
   own expression in u, v, k_u, k_v;
-* (a reader's function of one variable is `renderer.univariate`'s);
 * the chart (u, v) of a unit normal N of sphere A, and sin(phi) (`hypot`);
 * the tangent frame (e_theta, e_phi), a fixed basis only where sin(phi) is 0 or subnormal;
 * the perturbed normal of both bump modes ("chart": the seed's formula;
@@ -27,6 +26,8 @@ What lives here (seed §2, §3 and Cell 1, with the project's corrections):
 * the pixel footprint in (u, v), the step of ``gradient="footprint"``
   (pbrt-v4's bump-mapping rule);
 * the central difference's error model and its optimal step (`ERROR_MODEL`, `EPS_STAR`).
+
+A reader's function of one variable, for U-curves at any real point, is `renderer.univariate`'s.
 """
 
 from __future__ import annotations
