@@ -13,7 +13,7 @@ from collections.abc import Mapping
 #: The theorem modules of proofs/, in the chapter's order.  Each has ``titles()`` ({id: title}, in
 #: order, without building a theorem) and ``build(id)`` (the Theorem, built once, until
 #: ``build.cache_clear()``).
-MODULES = ("surface", "frame", "displacement", "gradients", "kinks", "kink_loci", "no_boundary", "finite_difference",
+MODULES = ("shading", "surface", "frame", "displacement", "gradients", "kinks", "kink_loci", "no_boundary", "finite_difference",
            "normal", "blinn")
 
 
@@ -67,7 +67,7 @@ PINNED = {
     "gradient-{field}": "proved", "{field}-kinks": "proved", "kink-loci-rays": "proved",
     "kink-loci-circles": "proved", "no-boundary": ("verified", 0.0), "normal-beta-derivative": "proved",
     "beta-zero-regression": "proved", "central-difference-truncation": "proved", "optimal-step": "proved",
-    "bump-vs-displacement": "proved", "blinn-perturbation": "proved",
+    "bump-vs-displacement": "proved", "blinn-perturbation": "proved", "shading": "proved",
 }
 
 
@@ -79,7 +79,7 @@ PINNED = {
 RENDERED = {
     "chart": 200, "frame-orthonormal": 2 * 200, "gradient-{field}": 200, "kink-loci-rays": 200,
     "kink-loci-circles": 200, "no-boundary": 100, "beta-zero-regression": 4, "central-difference-truncation": 200,
-    "bump-vs-displacement": 200,
+    "bump-vs-displacement": 200, "shading": 2 * 300,
 }
 #: The entries of `RENDERED` that count per registered field: the theorems about every field, whose
 #: evidence names the fields it compared (`proofs.core.Verdict.covers`; `pinned_failure` holds the two together).

@@ -3,7 +3,8 @@
 This module is the single source of sphere A's mathematics (height fields,
 gradients, stencil, crease band, chart, frame, perturbed normals, footprint);
 the ray-sphere hit, the shadow test and the shading are written by hand in
-renderer/kernel.py and renderer/js/render.js, held together by tests.  Nothing
+renderer/kernel.py and renderer/js/render.js, held together by tests (the
+shading's formula is theorem ``shading``, proofs/shading.py, checked on rendered pixels).  Nothing
 imports it at render time: `renderer.codegen` prints each entry of
 `FUNCTIONS`, and of `FIELD_FUNCTIONS` for each height field, as scalar Python
 functions that numba compiles (renderer/generated.py for the fields defined here,

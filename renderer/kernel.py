@@ -296,7 +296,8 @@ def int_power(base, n):
 @njit(cache=True, error_model="numpy")
 def light_term(s, color, w, axis, wv, Ns, albedo):
     """A light's Lambert and Blinn/Phong terms (r, g, b) at a point it reaches:
-    ``w`` the unit vector to the light, (``axis``, ``wv``) its `specular_axis`."""
+    ``w`` the unit vector to the light, (``axis``, ``wv``) its `specular_axis`
+    (the formula: theorem ``shading``, proofs/shading.py)."""
     mu = Ns[0] * w[0] + Ns[1] * w[1] + Ns[2] * w[2]
     if not mu > 0.0:
         return 0.0, 0.0, 0.0

@@ -21,6 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
+    "shading": "ac38ca5542ad7940",
     "displaced-normal": "0e810649159f81d2",
     "chart": "806ac8c86dd7e8dc",
     "frame-orthonormal": "14b493411c6f31b5",

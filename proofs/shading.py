@@ -1,0 +1,200 @@
+"""How a pixel is shaded: ambient, Lambert and a Blinn or Phong highlight (seed Cell 1, ``shade1``).
+
+The kernel writes its shading by hand (`renderer.kernel.light_term` and `shade_lit`; the
+simulator's renderer/js/render.js the same), as it writes the hit and the shadow test.  This
+theorem states what it computes, proves the two facts its code rests on (the Phong cosine it
+evaluates, 2 (N'.w_i)(N'.w_o) - w_i.w_o, is the cosine of the mirror direction; Blinn's half
+vector bisects w_i and w_o), and earns the statement on the renderer's own pixels: seeded pixels
+of spheres A and B in two scenes (Blinn with the seed's integral shininess, Phong with a
+fractional one), their rendered colour against the statement's formula evaluated by mpmath at
+`proofs.pixels.DIGITS` digits, fed the renderer's hit point P and shading normal N' and the
+lights its reach predicate lets through (`renderer.pointwise.reach`, which theorem
+``no-boundary`` holds to the shadow predicates).
+"""
+
+from functools import partial
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from .core import DIGITS, Dot, Step, Theorem, Verdict, _explicit, catalogue, written
+
+#: The vectors the statement names: the shading normal, the unit vectors to the light and to the eye,
+#: the light's mirror direction in N' (Phong) and the half vector (Blinn).
+NP, WI, WO, WR, HV = (sp.MatrixSymbol(name, 3, 1) for name in ("N'", "omega_i", "omega_o", "omega_r", "H"))
+k_a, k_d, k_s, n, rho, a, c, C = sp.symbols("k_a k_d k_s n rho a c_ell C", nonnegative=True)
+#: The highlight's cosine: real, not nonnegative (sympy would drop the clamp max(0, s)).
+s = sp.Symbol("s", real=True)
+ell, m = sp.symbols("ell m", integer=True, positive=True)
+T = sp.IndexedBase("T")
+NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: "H", rho: r"\rho", c: r"c_\ell", ell: r"\ell"}
+
+#: |w_i + w_o|, a name the statement prints, defined in the theorem's ``where`` (`LENGTH`).
+NORM = sp.Symbol("|omega_i + omega_o|", positive=True)
+NAMES[NORM] = r"\lVert\omega_i + \omega_o\rVert"
+LENGTH = {NORM: sp.sqrt(Dot(WI + WO, WI + WO))}
+MIRROR = 2 * Dot(NP, WI) * NP - WI
+HALF = (WI + WO) / NORM
+#: The Phong cosine as the kernel evaluates it (`renderer.kernel.specular_axis`): no mirror vector formed.
+KERNEL_PHONG = 2 * Dot(NP, WI) * Dot(NP, WO) - Dot(WI, WO)
+#: One light's term where N' . w_i > 0 (nothing elsewhere), and the colour of a channel.
+TERM = c * (k_d * rho * Dot(NP, WI) + k_s * sp.Min(1, sp.Max(0, s)) ** n)
+COLOUR = sp.Min(1, written(sp.Add(sp.Mul(k_a, a, evaluate=False), sp.Sum(T[ell], (ell, 1, m)), evaluate=False)))
+#: The specular cosine s of each model, as the renderer evaluates it.
+COSINE = {"blinn": Dot(NP, HALF), "phong": KERNEL_PHONG}
+
+#: Unit vectors in angles, for the steps that hold for unit vectors only.
+_ANGLES = sp.symbols("alpha_1:4 gamma_1:4", real=True)
+
+
+def _unit(alpha, gamma):
+    return sp.ImmutableMatrix([sp.sin(alpha) * sp.cos(gamma), sp.sin(alpha) * sp.sin(gamma), sp.cos(alpha)])
+
+
+UNIT = {vec: _unit(_ANGLES[k], _ANGLES[3 + k]) for k, vec in enumerate((NP, WI, WO))}
+DOMAIN = {**{x: (0.05, 3.1) for x in _ANGLES[:3]}, **{x: (-3.1, 3.1) for x in _ANGLES[3:]}}
+
+#: The scenes of the evidence: the book's (Blinn at the seed's shininess 32: repeated squaring in the
+#: kernel), and Phong with every shading parameter drawn at random (seeded): coloured lights, ambient and
+#: albedos whose channels all differ, and a fractional shininess (libm's pow).
+def _scenes(seed=0):
+    from renderer.scene import PointLight
+    rng = np.random.default_rng(seed)
+    colour = lambda: tuple(rng.uniform(0.1, 1.0, 3))                      # noqa: E731
+    lights = tuple(PointLight(position, colour()) for position in ((5.0, 5.0, 10.0), (-6.0, 2.0, 8.0)))
+    drawn = dict(ka=rng.uniform(0.1, 0.5), kd=rng.uniform(0.3, 1.0), ks=rng.uniform(0.2, 1.0),
+                 shininess=rng.uniform(2.0, 40.0), ambient=colour(), albedo_a=colour(), albedo_b=colour())
+    return ({}, dict(model="phong", lights=lights, height_field="sine", bump="chart", **drawn))
+
+
+SIZE = 128
+#: Pixels compared per scene, at most: from sphere A, and from sphere B.
+PER_SPHERE = (200, 100)
+#: A pixel whose N' . w_i lies within this of 0 for a light that reaches it is left out: the statement's
+#: term jumps there (the highlight is cut where the light goes behind N'), and rounding decides the side.
+GATE_MARGIN = 1e-9
+#: Absolute tolerance on a colour in [0, 1], about 1000 unit roundoffs: the kernel's unit vectors and
+#: cosines carry a few each, and the power n multiplies the cosine's relative rounding by n (up to 40 here).
+TOLERANCE = 2.0**-43
+
+
+def _formula_colour(scene, term, gate=True):
+    """A function of float64 rows (P, N', rho, V_1..V_m) (k, 9 + m) of ``scene``'s pixels: the colour
+    (k, 3) that ``COLOUR`` with one ``term`` per light gives there, evaluated by mpmath at `DIGITS`
+    digits in two stages (each light's N' . w_i and s from P and N', then the colour from those), so that
+    sympy never builds a min or max of the long expressions."""
+    P = sp.Matrix(sp.symbols("P_x P_y P_z", real=True))
+    Ns = sp.Matrix(sp.symbols("n_x n_y n_z", real=True))
+    eye = sp.Matrix([0, 0, scene.camera_z]) - P
+    geometry = []
+    for light in scene.lights:
+        to_light = sp.Matrix(light.position) - P
+        at = {NP: Ns, WI: to_light / sp.sqrt(to_light.dot(to_light)), WO: eye / sp.sqrt(eye.dot(eye))}
+        geometry += [_explicit(x.xreplace(LENGTH).xreplace(at)) for x in (Dot(NP, WI), COSINE[scene.model])]
+    geometry = sp.lambdify(tuple(P) + tuple(Ns), geometry, modules="mpmath", cse=True)
+    albedo = sp.symbols("rho_r rho_g rho_b", nonnegative=True)
+    cosines = sp.symbols(f"mu_1:{len(scene.lights) + 1}", real=True)
+    highlights = sp.symbols(f"s_1:{len(scene.lights) + 1}", real=True)
+    reach = sp.symbols(f"V_1:{len(scene.lights) + 1}", nonnegative=True)
+    colour = []
+    for ch in range(3):
+        total = scene.ka * scene.ambient[ch]
+        for light, mu, s_l, v in zip(scene.lights, cosines, highlights, reach):
+            lit = term.xreplace({Dot(NP, WI): mu, s: s_l, c: light.color[ch], k_d: scene.kd, k_s: scene.ks,
+                                 n: scene.shininess, rho: albedo[ch]})
+            total += v * (sp.Piecewise((lit, mu > 0), (0, True)) if gate else lit)
+        colour.append(COLOUR.func(1, total))
+    colour = sp.lambdify(sum(zip(cosines, highlights), ()) + albedo + reach, colour, modules="mpmath")
+
+    def evaluate(rows):
+        out = np.empty((rows.shape[0], 3))
+        with mpmath.workdps(DIGITS):
+            for i, row in enumerate(rows):
+                x = [mpmath.mpf(float(value)) for value in row]
+                out[i] = [float(value) for value in colour(*geometry(*x[:6]), *x[6:])]
+        return out
+    return evaluate
+
+
+def _evidence(term=TERM, normal="Ns", gate=True, shadows=True):
+    """The rendered colour at seeded sphere pixels of `_scenes` against the statement (the floor, whose
+    albedo is its checker's, is not compared).  Wrong variants: ``term``; ``normal``, the G-buffer's
+    normal fed as N' ("Ns", or "N" the unbumped one); ``gate`` False, the term kept where N' . w_i <= 0;
+    ``shadows`` False, the lights that reach P decided without sphere B."""
+    from renderer import Scene, gbuffer, pointwise, render
+    from renderer.render import SPHERE_A, SPHERE_B
+    worst, count, rng = 0.0, 0, np.random.default_rng(0)
+    for options in _scenes():
+        scene = Scene(**options)
+        g, image = gbuffer(scene, SIZE, SIZE), render(scene, SIZE, SIZE).image
+        reach = pointwise.reach(scene if shadows else scene.replace(sphere_b=False), g)      # (lights, H, W)
+        fed = getattr(g, normal)
+        to_light = np.stack([np.asarray(l.position) - g.P for l in scene.lights])
+        mu = np.einsum("hwk,lhwk->lhw", g.Ns, to_light) / np.linalg.norm(to_light, axis=-1)
+        clear = ~np.any(reach & (np.abs(mu) < GATE_MARGIN), axis=0)
+        rows, want = [], []
+        for code, albedo, most in zip((SPHERE_A, SPHERE_B), (scene.albedo_a, scene.albedo_b), PER_SPHERE):
+            idx = np.flatnonzero((g.chamber == code) & clear)
+            take = rng.choice(idx, size=min(most, idx.size), replace=False)
+            rows.append(np.hstack([g.P.reshape(-1, 3)[take], fed.reshape(-1, 3)[take],
+                                   np.tile(albedo, (take.size, 1)), reach.reshape(len(scene.lights), -1)[:, take].T]))
+            want.append(image.reshape(-1, 3)[take])
+        rows, want = np.vstack(rows), np.vstack(want)
+        worst = max(worst, float(np.max(np.abs(_formula_colour(scene, term, gate)(rows) - want))))
+        count += rows.shape[0]
+    if worst > TOLERANCE:
+        return Verdict("refuted", f"the rendered colour differs from the shading formula by {worst:.1e} at some of "
+                       f"{count:,} sphere pixels")
+    return Verdict("proved", f"the rendered colour at {count:,} seeded pixels of spheres A and B (the book's scene; "
+                   f"Phong with random lights and materials) within {worst:.1e} of the formula in mpmath, fed the renderer's P, N' and reach",
+                   residual=worst, rendered=count, bound=TOLERANCE)
+
+
+def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
+    """Theorem shading, claiming the kernel's Phong cosine ``phong``, for the mirror direction ``mirror``
+    and half vector ``half``, and `_evidence`'s options (wrong variants)."""
+    reflects = (sp.Tuple(Dot(NP, WR), Dot(WR, WR)), sp.Tuple(Dot(NP, WI), 1))
+    bisects = (sp.Tuple(Dot(HV, WI) - Dot(HV, WO), Dot(HV, HV)), sp.Tuple(0, 1))
+    return Theorem(
+        id="shading", title=TITLES["shading"],
+        statement=(
+            r"At a hit point $P$ on a sphere, with shading normal $N'$, $\omega_o$ the unit vector to the eye, and "
+            r"for each light $\ell$ the unit vector $\omega_i$ to it and its colour $c_\ell$, the renderer's colour "
+            r"(each of red, green, blue) is $$⟦colour⟧$$ with $a$ the ambient light. $T_\ell$ is nothing unless "
+            r"$N' \cdot \omega_i$ is positive and the light reaches $P$, which the unbumped geometry alone decides "
+            r"(⟪no-boundary⟫); then $$⟦term⟧$$ with $\rho$ the sphere's albedo. The highlight's cosine $s$ is "
+            r"Blinn's $N' \cdot H$ (the default), $⟦H⟧$ halfway between $\omega_i$ and $\omega_o$; or Phong's "
+            r"$\omega_r \cdot \omega_o$, $⟦omega_r⟧$ being $\omega_i$ mirrored in $N'$, which the kernel evaluates "
+            r"as $⟦phong⟧$."),
+        steps=(
+            Step(r"The dot product is linear, so with $\omega_r = 2(N' \cdot \omega_i)N' - \omega_i$ the cosine "
+                 r"needs no mirror vector formed", Dot(WR, WO), phong),
+            Step(r"With $N' \cdot N' = \omega_i \cdot \omega_i = 1$: $N' \cdot \omega_r = 2 N' \cdot \omega_i - "
+                 r"N' \cdot \omega_i$, and $\omega_r \cdot \omega_r = 4(N' \cdot \omega_i)^2 - "
+                 r"4(N' \cdot \omega_i)^2 + 1$: the same angle to $N'$, on its other side, and unit", *reflects),
+            Step(r"$H \cdot \omega_i - H \cdot \omega_o$ is $\omega_i \cdot \omega_i - \omega_o \cdot \omega_o$ "
+                 r"over $\lVert\omega_i + \omega_o\rVert$, zero for unit vectors; and $H$ is divided by its "
+                 r"length", *bisects),
+        ),
+        claims={"phong": (Dot(WR, WO), phong)},
+        shown={"colour": sp.Eq(C, COLOUR, evaluate=False), "term": sp.Eq(T[ell], TERM, evaluate=False)},
+        where={WR: mirror, HV: half, **LENGTH, **UNIT}, names=NAMES, domain=DOMAIN, evidence=partial(_evidence, **evidence),
+        wrong_variants=(
+            ("Phong's cosine without its - omega_i . omega_o",
+             lambda: _theorem(phong=2 * Dot(NP, WI) * Dot(NP, WO)).check()),
+            ("the mirror direction 2 (N' . omega_i) N' + omega_i", lambda: _theorem(mirror=2 * Dot(NP, WI) * NP + WI).check()),
+            ("the half vector omega_i + omega_o, not divided by its length", lambda: _theorem(half=WI + WO).check()),
+            ("the unbumped normal N in place of N'", lambda: _theorem(normal="N").check()),
+            ("the highlight kept where N' . omega_i is not positive", lambda: _theorem(gate=False).check()),
+            ("sphere B casting no shadow", lambda: _theorem(shadows=False).check()),
+            ("the albedo on the highlight too",
+             lambda: _theorem(term=c * rho * (k_d * Dot(NP, WI) + k_s * sp.Min(1, sp.Max(0, s)) ** n)).check()),
+        ),
+    )
+
+
+#: This module's theorem: id -> title.
+TITLES = {"shading": "The shading of a pixel"}
+
+titles, build = catalogue(TITLES, {"shading": _theorem})
