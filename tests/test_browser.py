@@ -941,7 +941,8 @@ def spoken_problems(s):
 def _keyboard_walk(s):
     """Use the simulator from the keyboard alone, checking `spoken_problems` after each move: Tab to the
     field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
-    and move the probe with the arrow keys (the readout reads the pixel), then on to the view menu and
+    and move the probe with the arrow keys (the readout reads the pixel), to the shading normal and change
+    it (the hint, a live region, must then say the β slider's new range), then on to the view menu and
     change it.  Returns {move: problems} and the readout's texts."""
     page, found, readouts = s.page, {}, []
 
@@ -967,12 +968,16 @@ def _keyboard_walk(s):
     for key in ("ArrowRight", "ArrowDown"):
         page.keyboard.press(key)
         readouts.append(page.text_content("#sim-readout"))
+    tab_to("sim-bump"); move("normal", "ArrowUp")        # to the draft's chart formula
+    top = page.get_attribute("#sim-beta", "max")
+    if f"β now runs to {top}" not in page.text_content("#sim-hint"):         # the slider's range changed with it
+        found["normal"].append(f"β's range changed to {top} silently: hint {page.text_content('#sim-hint')!r}")
     tab_to("sim-view"); move("view", "ArrowDown")
     return found, readouts
 
 
 def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser, book_html):
-    """From the keyboard alone (Tab, arrow keys, Page Down): the field, ε, β and the view change, and
+    """From the keyboard alone (Tab, arrow keys, Page Down): the field, ε, β, the normal and the view change, and
     the probe walks over the symbolic canvas, the readout (a polite live region) reading each pixel;
     after every move each canvas is an image whose label says what it draws (field, β, normal, view;
     the numeric canvas's ε; the difference's largest |ΔI| and RMS as the ledger prints them), the
@@ -992,6 +997,8 @@ WRONG_SPOKEN = {
     "the canvases' labels written once, not kept current": ("    this.describe(ledger);\n", "", "not in"),
     "sliders named by the value beside them": ('return el("label", { for: input.id }, [el("span"',
                                               'return el("label", {}, [el("span"', "accessible name"),
+    "the β slider's range changed without a word": ("      this.hint.textContent = beta_range_note(value, this.state.beta < before.beta);\n",
+                                                     "", "silently"),
     "a readout that is not announced": ('"aria-live": "polite" });\n    root.append(el("div", { class: "sim-stage" }',
                                         '"aria-live": "off" });\n    root.append(el("div", { class: "sim-stage" }',
                                         "readout: aria-live 'off'"),

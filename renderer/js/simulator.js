@@ -38,6 +38,10 @@ export function curve_stride(resolution) {
 // (scene.py: R + β h must stay positive), on the slider's grid of 0.01.
 const BETA = { min: 0, max: 2, step: 0.01 };
 export const beta_max = (bump) => bump === "surface" ? Math.round(100 * (SIMULATOR_SCENE.radius_a - BETA.step)) / 100 : BETA.max;
+// What the hint says when a change of the shading normal changes the β slider's range.
+export const beta_range_note = (bump, lowered) => `β now runs to ${beta_max(bump)}: ` + (bump === "surface"
+  ? `the displaced sphere's radius R + βh must stay positive${lowered ? ", so β was lowered to it" : ""}.`
+  : "the draft's chart formula has no such limit.");
 
 export const DEFAULT_STATE = {
   numeric: "central", height_field: SIMULATOR_SCENE.height_field, k_u: SIMULATOR_SCENE.k_u,
@@ -353,8 +357,12 @@ class Simulator {
     if (c.kind === "checkbox") value = input.checked;
     else if (c.kind === "range" || typeof c.options[0] === "number") value = Number(input.value);
     else value = input.value;
+    const before = { ...this.state };   // a menu fires both input and change: say the new range once
     this.state[c.name] = value;
     if (c.name === "bump") this.sync_inputs();
+    if (c.name === "bump" && value !== before.bump) {
+      this.hint.textContent = beta_range_note(value, this.state.beta < before.beta);
+    }
     this.show_value(c, value);
     this.schedule();
   }
