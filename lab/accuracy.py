@@ -25,7 +25,7 @@ from ._checks import MAX_COUNT, MAX_SQUARE, STEP, broadcast, seed as _seed
 
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
-           "image_beta_order", "optima", "measure_optimum", "crease_distance", "crease_share", "image_best_step", "OPTIMUM_POINTS",
+           "image_beta_order", "optima", "measure_optimum", "crease_distance", "crease_share", "image_best_step", "footprint_steps", "OPTIMUM_POINTS",
            "DIGITS", "HALF_DECADES"]
 
 DIGITS = 50
@@ -406,6 +406,36 @@ def _crease_share(size, steps, scene=DRAFT_SCENE):
     dist = np.minimum(along_u, along_v)
     return dict(steps=steps, share=[float(np.mean(dist < eps)) for eps in steps],
                 share_u=[float(np.mean(along_u < eps)) for eps in steps], pixels=int(dist.size))
+
+
+def footprint_steps(scene=None, size=256):
+    """The footprint step in u of every sphere-A pixel: the chart distance one pixel covers, which
+    ``gradient="footprint"`` takes as its central-difference step (`renderer.pointwise.footprint`,
+    pbrt-v4's bump-mapping rule), in ``scene`` (default the book's, `renderer.Scene()`) at ``size`` ×
+    ``size`` pixels.  Seed Cell 2's question: which steps does a renderer that sets them from the
+    footprint use?
+
+    Returns
+    -------
+    float64 array (k,)
+        Chart units, one per sphere-A pixel of the frame, in row-major pixel order.
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``scene`` is not a `renderer.Scene` (`renderer.gbuffer`), or ``size`` is not an integer in [1, 4096].
+    """
+    scene = Scene() if scene is None else scene
+    size = positive_int("size", size, high=MAX_SQUARE)
+    geo = gbuffer(scene, size, size)
+    on_a = geo.chamber == SPHERE_A
+    P, N = geo.P[on_a].T, geo.N[on_a].T
+    _, _, sin_phi = pointwise.chart(*N)
+    e_theta, e_phi = pointwise.tangent_frame(*N, sin_phi)
+    X, Y = np.meshgrid(geo.x, geo.y)
+    step_u, _ = pointwise.footprint(X[on_a], Y[on_a], geo.x[1] - geo.x[0], geo.y[0] - geo.y[1], scene.camera_z,
+                                    P, N, e_theta, e_phi, scene.radius_a, sin_phi)
+    return np.asarray(step_u, dtype=np.float64)
 
 
 #: The steps of the simulator's U-curve (`renderer.ledger.CURVE_LOG_EPS`), chart units.

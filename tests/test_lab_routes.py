@@ -245,3 +245,35 @@ def test_optima_measured_with_the_frequencies_exchanged_are_caught(monkeypatch):
     monkeypatch.setattr(ucurve, "measure", lambda *a, k_u, k_v, **kw: real(*a, k_u=k_v, k_v=k_u, **kw))
     got, want = _optima_route(31, monkeypatch)
     assert any(got[name]["h1"] != pytest.approx(want[name]["h1"], rel=1e-7, abs=0) for name in want)
+
+
+def _footprint_against_neighbours(scene, size=64):
+    """Per interior sphere-A pixel of ``scene``: `accuracy.footprint_steps` over pbrt-v4's rule computed
+    another way, half the sum of |u's change| across one pixel in x and in y, read off the G-buffer's chart
+    at the neighbouring pixels (central differences of uv), away from the pole (where u turns fast), the
+    silhouette and the seam u = 0 = 1."""
+    g = gbuffer(scene, size, size)
+    on_a = g.chamber == SPHERE_A
+    u = g.uv[..., 0]
+    du_x, du_y = (u[1:-1, 2:] - u[1:-1, :-2]) / 2, (u[2:, 1:-1] - u[:-2, 1:-1]) / 2
+    inner = on_a[1:-1, 1:-1] & on_a[1:-1, 2:] & on_a[1:-1, :-2] & on_a[2:, 1:-1] & on_a[:-2, 1:-1]
+    inner &= (g.N[1:-1, 1:-1, 2] < 0.9) & (g.N[1:-1, 1:-1, 2] > 0.3) & (np.maximum(abs(du_x), abs(du_y)) < 0.1)
+    steps = np.zeros(on_a.shape)
+    steps[on_a] = accuracy.footprint_steps(scene, size)
+    return steps[1:-1, 1:-1][inner] / (0.5 * (abs(du_x) + abs(du_y)))[inner]
+
+
+@pytest.mark.parametrize("scene", _scenes(2, seed=41), ids=lambda s: f"e{s.camera_z:.2f}")
+def test_the_footprint_step_is_the_chart_distance_one_pixel_covers(scene):
+    """On random scenes (the camera moved): the footprint steps Cell 2 histograms and §3's table takes the
+    median of are, pixel by pixel, the chart's change across a pixel as the neighbouring pixels show it."""
+    ratio = _footprint_against_neighbours(scene)
+    assert ratio.size > 300
+    assert np.median(ratio) == pytest.approx(1.0, abs=0.01) and np.quantile(abs(ratio - 1), 0.9) < 0.03
+
+
+def test_a_footprint_step_without_its_half_is_caught(monkeypatch):
+    """The wrong variant: |du/dx| + |du/dy|, pbrt-v4's rule without its factor 1/2."""
+    footprint = pointwise.footprint
+    monkeypatch.setattr(pointwise, "footprint", lambda *a: tuple(2 * x for x in footprint(*a)))
+    assert np.median(_footprint_against_neighbours(_scenes(1, seed=41)[0])) == pytest.approx(2.0, abs=0.04)
