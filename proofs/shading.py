@@ -5,9 +5,9 @@ simulator's renderer/js/render.js the same), as it writes the hit and the shadow
 theorem states what it computes, proves the two facts its code rests on (the Phong cosine it
 evaluates, 2 (N'.w_i)(N'.w_o) - w_i.w_o, is the cosine of the mirror direction; Blinn's half
 vector bisects w_i and w_o), and earns the statement on the renderer's own pixels: seeded pixels
-of spheres A and B in two scenes (Blinn with the seed's integral shininess, Phong with a
-fractional one), their rendered colour against the statement's formula evaluated by mpmath at
-`proofs.pixels.DIGITS` digits, fed the renderer's hit point P and shading normal N' and the
+of spheres A and B in the book's scene (Blinn, the seed's shininess 32) and a Phong scene whose
+lights and materials are drawn at random, their rendered colour against the statement's formula
+evaluated by mpmath at `proofs.core.DIGITS` digits, fed the renderer's hit point P and shading normal N' and the
 lights its reach predicate lets through (`renderer.pointwise.reach`, which theorem
 ``no-boundary`` holds to the shadow predicates).
 """
