@@ -21,14 +21,23 @@ import sympy as sp
 from .core import DIGITS, Dot, Step, Theorem, Verdict, _explicit, catalogue, written
 
 #: The vectors the statement names: the shading normal, the unit vectors to the light and to the eye,
-#: the light's mirror direction in N' (Phong) and the half vector (Blinn).
-NP, WI, WO, WR, HV = (sp.MatrixSymbol(name, 3, 1) for name in ("N'", "omega_i", "omega_o", "omega_r", "H"))
-k_a, k_d, k_s, n, rho, a, c, C = sp.symbols("k_a k_d k_s n rho a c_ell C", nonnegative=True)
-#: The highlight's cosine: real, not nonnegative (sympy would drop the clamp max(0, s)).
-s = sp.Symbol("s", real=True)
+#: the light's mirror direction in N' (Phong) and the half vector (Blinn), in pbrt-v4's omega notation.
+NP, WI, WO, WR, HV = (sp.MatrixSymbol(name, 3, 1) for name in ("N'", "omega_i", "omega_o", "omega_r", "omega_h"))
+#: The weights, the shininess p, the albedo, the ambient light, a light's colour and the pixel's colour I
+#: (each one channel); the letters the book's other formulas use for other things are avoided.
+k_a, k_d, k_s, p, rho, I_a, I_l, I = sp.symbols("k_a k_d k_s p rho I_a I_ell I", nonnegative=True)
+#: The highlight's cosine: real, not nonnegative (sympy would drop the clamp max(0, s)); and its clamp to
+#: [0, 1], a name the statement prints and defines (`CLAMP`).
+s = sp.Symbol("sigma", real=True)
+S_PLUS = sp.Symbol("sigma_+", nonnegative=True)
+CLAMP = {S_PLUS: sp.Min(1, sp.Max(0, s))}
 ell, m = sp.symbols("ell m", integer=True, positive=True)
 T = sp.IndexedBase("T")
-NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: "H", rho: r"\rho", c: r"c_\ell", ell: r"\ell"}
+NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: r"\omega_h", rho: r"\rho", I_l: r"I_\ell",
+         ell: r"\ell", s: r"\sigma", S_PLUS: r"\sigma_+"}
+#: The scene's parameter (`renderer.Scene`) each symbol stands for, for the book's list of them.
+SCENE_SYMBOLS = {"lights": I_l, "ambient": I_a, "albedo_a": rho, "albedo_b": rho, "ka": k_a, "kd": k_d, "ks": k_s,
+                 "shininess": p}
 
 #: |w_i + w_o|, a name the statement prints, defined in the theorem's ``where`` (`LENGTH`).
 NORM = sp.Symbol("|omega_i + omega_o|", positive=True)
@@ -39,8 +48,8 @@ HALF = (WI + WO) / NORM
 #: The Phong cosine as the kernel evaluates it (`renderer.kernel.specular_axis`): no mirror vector formed.
 KERNEL_PHONG = 2 * Dot(NP, WI) * Dot(NP, WO) - Dot(WI, WO)
 #: One light's term where N' . w_i > 0 (nothing elsewhere), and the colour of a channel.
-TERM = c * (k_d * rho * Dot(NP, WI) + k_s * sp.Min(1, sp.Max(0, s)) ** n)
-COLOUR = sp.Min(1, written(sp.Add(sp.Mul(k_a, a, evaluate=False), sp.Sum(T[ell], (ell, 1, m)), evaluate=False)))
+TERM = I_l * (k_d * rho * Dot(NP, WI) + k_s * S_PLUS ** p)
+COLOUR = sp.Min(1, written(sp.Add(sp.Mul(k_a, I_a, evaluate=False), sp.Sum(T[ell], (ell, 1, m)), evaluate=False)))
 #: The specular cosine s of each model, as the renderer evaluates it.
 COSINE = {"blinn": Dot(NP, HALF), "phong": KERNEL_PHONG}
 
@@ -101,8 +110,8 @@ def _formula_colour(scene, term, gate=True):
     for ch in range(3):
         total = scene.ka * scene.ambient[ch]
         for light, mu, s_l, v in zip(scene.lights, cosines, highlights, reach):
-            lit = term.xreplace({Dot(NP, WI): mu, s: s_l, c: light.color[ch], k_d: scene.kd, k_s: scene.ks,
-                                 n: scene.shininess, rho: albedo[ch]})
+            lit = term.xreplace(CLAMP).xreplace({Dot(NP, WI): mu, s: s_l, I_l: light.color[ch], k_d: scene.kd, k_s: scene.ks,
+                                 p: scene.shininess, rho: albedo[ch]})
             total += v * (sp.Piecewise((lit, mu > 0), (0, True)) if gate else lit)
         colour.append(COLOUR.func(1, total))
     colour = sp.lambdify(sum(zip(cosines, highlights), ()) + albedo + reach, colour, modules="mpmath")
@@ -159,27 +168,31 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
     return Theorem(
         id="shading", title=TITLES["shading"],
         statement=(
-            r"At a hit point $P$ on a sphere, with shading normal $N'$, $\omega_o$ the unit vector to the eye, and "
-            r"for each light $\ell$ the unit vector $\omega_i$ to it and its colour $c_\ell$, the renderer's colour "
-            r"(each of red, green, blue) is $$⟦colour⟧$$ with $a$ the ambient light. $T_\ell$ is nothing unless "
-            r"$N' \cdot \omega_i$ is positive and the light reaches $P$, which the unbumped geometry alone decides "
-            r"(⟪no-boundary⟫); then $$⟦term⟧$$ with $\rho$ the sphere's albedo. The highlight's cosine $s$ is "
-            r"Blinn's $N' \cdot H$ (the default), $⟦H⟧$ halfway between $\omega_i$ and $\omega_o$; or Phong's "
-            r"$\omega_r \cdot \omega_o$, $⟦omega_r⟧$ being $\omega_i$ mirrored in $N'$, which the kernel evaluates "
-            r"as $⟦phong⟧$."),
+            r"At a hit point $P$ on a sphere, with unbumped normal $N$, shading normal $N'$, $\omega_o$ the unit "
+            r"vector to the eye, and for each of the scene's $m$ lights $\omega_i$ the unit vector to it and "
+            r"$I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
+            r"nothing unless the light reaches $P$, where ${N \cdot \omega_i}$ is positive and nothing blocks the "
+            r"way, and ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the ambient "
+            r"light, $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and $⟦sigma_+⟧$ the highlight's cosine "
+            r"clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), with the half vector "
+            r"$$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ mirrored in $N'$), "
+            r"which the kernel evaluates as $⟦phong⟧$. The unbumped geometry alone decides which lights reach $P$: "
+            r"⟪no-boundary⟫. The proof checks the two forms; the formula is checked on rendered pixels."),
         steps=(
-            Step(r"The dot product is linear, so with $\omega_r = 2(N' \cdot \omega_i)N' - \omega_i$ the cosine "
+            Step(r"The dot product is linear, so with ${\omega_r = 2(N' \cdot \omega_i)N' - \omega_i}$ the cosine "
                  r"needs no mirror vector formed", Dot(WR, WO), phong),
-            Step(r"With $N' \cdot N' = \omega_i \cdot \omega_i = 1$: $N' \cdot \omega_r = 2 N' \cdot \omega_i - "
-                 r"N' \cdot \omega_i$, and $\omega_r \cdot \omega_r = 4(N' \cdot \omega_i)^2 - "
-                 r"4(N' \cdot \omega_i)^2 + 1$: the same angle to $N'$, on its other side, and unit", *reflects),
-            Step(r"$H \cdot \omega_i - H \cdot \omega_o$ is $\omega_i \cdot \omega_i - \omega_o \cdot \omega_o$ "
-                 r"over $\lVert\omega_i + \omega_o\rVert$, zero for unit vectors; and $H$ is divided by its "
+            Step(r"With ${N' \cdot N'} = {\omega_i \cdot \omega_i} = 1$: ${N' \cdot \omega_r} = "
+                 r"{2 N' \cdot \omega_i} - {N' \cdot \omega_i}$ and ${\omega_r \cdot \omega_r} = "
+                 r"{4(N' \cdot \omega_i)^2} - {4(N' \cdot \omega_i)^2} + 1$: the same angle to $N'$ as $\omega_i$, "
+                 r"and unit", *reflects),
+            Step(r"For unit $\omega_i$, $\omega_o$ (not opposite), ${\omega_h \cdot \omega_i} - "
+                 r"{\omega_h \cdot \omega_o}$ is ${\omega_i \cdot \omega_i} - {\omega_o \cdot \omega_o} = 0$ "
+                 r"over $\lVert\omega_i + \omega_o\rVert$: equal angles to both; and $\omega_h$ is divided by its "
                  r"length", *bisects),
         ),
         claims={"phong": (Dot(WR, WO), phong)},
-        shown={"colour": sp.Eq(C, COLOUR, evaluate=False), "term": sp.Eq(T[ell], TERM, evaluate=False)},
-        where={WR: mirror, HV: half, **LENGTH, **UNIT}, names=NAMES, domain=DOMAIN, evidence=partial(_evidence, **evidence),
+        shown={"colour": sp.Eq(I, COLOUR, evaluate=False), "term": sp.Eq(T[ell], TERM, evaluate=False)},
+        where={WR: mirror, HV: half, **LENGTH, **CLAMP, **UNIT}, names=NAMES, domain=DOMAIN, evidence=partial(_evidence, **evidence),
         wrong_variants=(
             ("Phong's cosine without its - omega_i . omega_o",
              lambda: _theorem(phong=2 * Dot(NP, WI) * Dot(NP, WO)).check()),
@@ -189,7 +202,7 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             ("the highlight kept where N' . omega_i is not positive", lambda: _theorem(gate=False).check()),
             ("sphere B casting no shadow", lambda: _theorem(shadows=False).check()),
             ("the albedo on the highlight too",
-             lambda: _theorem(term=c * rho * (k_d * Dot(NP, WI) + k_s * sp.Min(1, sp.Max(0, s)) ** n)).check()),
+             lambda: _theorem(term=I_l * rho * (k_d * Dot(NP, WI) + k_s * S_PLUS ** p)).check()),
         ),
     )
 

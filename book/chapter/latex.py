@@ -39,8 +39,10 @@ class _Printer(LatexPrinter):
 
     # --- the proofs' own notation: dot and cross products, Jacobians
     def _print_Dot(self, expr):
-        return r" \cdot ".join(rf"\left({self._print(x)}\right)" if isinstance(x, (Cross, sp.MatAdd, sp.Add))
-                               else self._print(x) for x in expr.args)
+        """``{a \\cdot b}``: a group, which MathJax does not break across lines (a break after the dot
+        reads as a product of what stands on either line)."""
+        return "{" + r" \cdot ".join(rf"\left({self._print(x)}\right)" if isinstance(x, (Cross, sp.MatAdd, sp.Add))
+                                     else self._print(x) for x in expr.args) + "}"
 
     def _print_Cross(self, expr):
         return r" \times ".join(rf"\left({self._print(x)}\right)" if isinstance(x, sp.MatAdd) else self._print(x)
