@@ -943,7 +943,7 @@ def _keyboard_walk(s):
     field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
     and move the probe with the arrow keys (the readout reads the pixel), to the shading normal and change
     it (the hint, a live region, must then say the β slider's new range), then on to the view menu and
-    change it.  Returns {move: problems} and the readout's texts."""
+    change it (the hint must be back).  Returns {move: problems} and the readout's texts."""
     page, found, readouts = s.page, {}, []
 
     def move(name, key):
@@ -973,6 +973,8 @@ def _keyboard_walk(s):
     if f"β now runs to {top}" not in page.text_content("#sim-hint"):         # the slider's range changed with it
         found["normal"].append(f"β's range changed to {top} silently: hint {page.text_content('#sim-hint')!r}")
     tab_to("sim-view"); move("view", "ArrowDown")
+    if "β now runs" in page.text_content("#sim-hint"):                         # the note gives way to the hint
+        found["view"].append(f"the β note outlived the next change: {page.text_content('#sim-hint')!r}")
     return found, readouts
 
 
@@ -999,6 +1001,8 @@ WRONG_SPOKEN = {
                                               'return el("label", {}, [el("span"', "accessible name"),
     "the β slider's range changed without a word": ("      this.hint.textContent = beta_range_note(value, this.state.beta < before.beta);\n",
                                                      "", "silently"),
+    "the β note never giving way": ("      this.hint.textContent = this.hint_kept;                      // the note said its piece\n",
+                                     "", "outlived"),
     "a readout that is not announced": ('"aria-live": "polite" });\n    root.append(el("div", { class: "sim-stage" }',
                                         '"aria-live": "off" });\n    root.append(el("div", { class: "sim-stage" }',
                                         "readout: aria-live 'off'"),

@@ -41,7 +41,7 @@ export const beta_max = (bump) => bump === "surface" ? Math.round(100 * (SIMULAT
 // What the hint says when a change of the shading normal changes the β slider's range.
 export const beta_range_note = (bump, lowered) => `β now runs to ${beta_max(bump)}: ` + (bump === "surface"
   ? `the displaced sphere's radius R + βh must stay positive${lowered ? ", so β was lowered to it" : ""}.`
-  : "the draft's chart formula has no such limit.");
+  : "the draft's chart formula puts no bound on β.");
 
 export const DEFAULT_STATE = {
   numeric: "central", height_field: SIMULATOR_SCENE.height_field, k_u: SIMULATOR_SCENE.k_u,
@@ -117,7 +117,8 @@ export const PRESETS = [
           "difference, where the large differences sit: central differences straddle the crease." },
   { id: "try3", label: "3 · rings: magnify the pole", set: { height_field: "rings", zoom: 4, view: "shaded", bump: "chart" },
     hint: "The pole, magnified: the rings circle it, and the shading flips from one side of it to the other " +
-          "with either normal (the shading-normal control swaps them): the bumped sphere comes to a cone's point." },
+          "with either normal (it opens on the draft's formula, where β runs to 2; the shading-normal control swaps " +
+          "them): the bumped sphere comes to a cone's point." },
   { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta",
     hint: "With β = 0 both renders are the un-bumped sphere: the difference is black, the ledger reads " +
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
@@ -361,13 +362,18 @@ class Simulator {
     this.state[c.name] = value;
     if (c.name === "bump") this.sync_inputs();
     if (c.name === "bump" && value !== before.bump) {
+      this.hint_kept = this.hint_kept ?? this.hint.textContent;   // the hint the note stands in for
       this.hint.textContent = beta_range_note(value, this.state.beta < before.beta);
+    } else if (c.name !== "bump" && this.hint_kept !== undefined) {
+      this.hint.textContent = this.hint_kept;                      // the note said its piece
+      this.hint_kept = undefined;
     }
     this.show_value(c, value);
     this.schedule();
   }
 
   apply_preset(p) {
+    this.hint_kept = undefined;
     this.state = { ...DEFAULT_STATE, ...p.set };
     this.sync_inputs();
     this.hint.textContent = p.hint ?? HINT;
