@@ -161,6 +161,8 @@ QUANTITIES = {
     "sines and cosines per pixel of the sine field's exact gradient": (
         ("c4_exact_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "exact").trig),
     "the benchmark's complex step": (("c4_cs_step",), lambda: _lib("lab.gradient_benchmark").FAST.complex_steps[0]),
+    "the margin by which a method is called the fastest": (("c4_margin",),
+                                                           lambda: _lib("chapter.benchmark").FASTEST_MARGIN - 1),
     "sines and cosines per pixel in XLA's program for the sine field's AD gradient": (
         ("c4_ad_trig",), lambda: _lib("lab.gradient_methods").evaluations("sine", "forward-mode AD").trig),
     "JAX's forward-mode slope of |x| at x = 0": (
