@@ -537,10 +537,11 @@ def control_problems(records):
             kind, key = LANDS[name]
             landed = getattr(scene, key) if kind == "scene" else r["args"][key]
             if name == "log_eps":
-                shown = [r["printed"][name]] + [m for text in r["eps_texts"] for m in EPS_TEXT.findall(text)]
+                printed = r["printed"][name].removesuffix(", unused")      # footprint steps: ε is carried, unused
+                shown = [printed] + [m for text in r["eps_texts"] for m in EPS_TEXT.findall(text)]
                 if any(float(s) != landed for s in shown):
                     bad(f"{at}: ε is printed as {shown} but computed with {landed!r}")
-                if not check_glue._matches(r["printed"][name], 10.0 ** float(value)):
+                if not check_glue._matches(printed, 10.0 ** float(value)):
                     bad(f"{at}: ε printed {r['printed'][name]} is not 10^{value} to the digits it shows")
             elif type(landed)(value) != landed or (name in r["printed"] and float(r["printed"][name]) != landed):
                 bad(f"{at}: {name} is {value!r} (printed {r['printed'].get(name)!r}) but the renderer gets {landed!r}")
@@ -622,6 +623,19 @@ def frame_problems(s):
             out.append(f"{key} ({gradient}): {np.count_nonzero(~(ratio <= 1.0))} values beyond the bound, "
                        f"worst |d| / bound {ratio.max():.3g}")
     return out
+
+
+def test_with_footprint_steps_the_eps_slider_is_disabled_and_says_it_is_unused(session):
+    """Each pixel's footprint as its step leaves ε nothing to do: the slider is disabled and its printed value
+    says "unused" (a reader once moved it and watched nothing change); back on central differences it is live."""
+    s = session
+    try:
+        s.select("numeric", "footprint")
+        assert s.page.is_disabled("#sim-log_eps") and s.page.text_content("#sim-log_eps-value").endswith(", unused")
+        s.select("numeric", "central")
+        assert s.page.is_enabled("#sim-log_eps") and "unused" not in s.page.text_content("#sim-log_eps-value")
+    finally:
+        s.click("sim-reset")
 
 
 def test_the_simulators_frames_are_pythons_at_the_extremes_of_its_controls(browser, book_html):

@@ -331,7 +331,7 @@ class Simulator {
 
   // What a slider's value reads as (its aria-valuetext), and the value printed beside it.
   show_value(c, value) {
-    const text = c.show ? c.show(value) : String(value);
+    const text = (c.show ? c.show(value) : String(value)) + (c.name === "log_eps" && this.eps_unused() ? ", unused" : "");
     if (this.outputs[c.name]) this.outputs[c.name].textContent = text;
     if (c.kind === "range") this.inputs[c.name].setAttribute("aria-valuetext", text);
   }
@@ -343,8 +343,14 @@ class Simulator {
     this.state.beta = Math.min(this.state.beta, top);
   }
 
+  // With each pixel's footprint as its step, ε steps nothing: its slider is disabled and says so.
+  eps_unused() {
+    return this.state.numeric === "footprint";
+  }
+
   sync_inputs() {
     this.clamp_beta();
+    this.inputs.log_eps.disabled = this.eps_unused();
     for (const c of CONTROLS) {
       const input = this.inputs[c.name];
       const value = this.state[c.name];
@@ -360,7 +366,7 @@ class Simulator {
     else value = input.value;
     const before = { ...this.state };   // a menu fires both input and change: say the new range once
     this.state[c.name] = value;
-    if (c.name === "bump") this.sync_inputs();
+    if (c.name === "bump" || c.name === "numeric") this.sync_inputs();
     if (c.name === "bump" && value !== before.bump) {
       this.hint_kept = this.hint_kept ?? this.hint.textContent;   // the hint the note stands in for
       this.hint.textContent = beta_range_note(value, this.state.beta < before.beta);
