@@ -315,8 +315,10 @@ def smallest(values):
 #: once, by about 500 words each, for §3's derivation of the displaced normal on any surface, its torus
 #: exercise and its theorem (its statement in a fold, as every theorem of §3 now is); the reading path's
 #: once more, by 100 words, for Richardson's extrapolation and its exercise (§3), the lesson on
-#: numerical differentiation a learner's review found missing.
-MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_600, 8_500, 13_500
+#: numerical differentiation a learner's review found missing; and by 30, for the standard remedy for the
+#: arguments' rounding (divide by the span actually formed, §3), which the next review found missing (the
+#: shading formula that review also asked for was paid for by cuts).
+MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_630, 8_500, 13_500
 #: The pages outside the reading path: looked up, not read through.
 LOOKUP_PAGES = ("s6_ledger", "glossary")
 LENGTH = r"""() => {
