@@ -88,9 +88,9 @@ GATE_MARGIN = 1e-9
 TOLERANCE = 2.0**-43
 
 
-def _formula_colour(scene, term, gate=True):
+def _formula_colour(scene, term, gate=True, colour_of=COLOUR):
     """A function of float64 rows (P, N', rho, V_1..V_m) (k, 9 + m) of ``scene``'s pixels: the colour
-    (k, 3) that ``COLOUR`` with one ``term`` per light gives there, evaluated by mpmath at `DIGITS`
+    (k, 3) that ``colour_of`` (`COLOUR`) with one ``term`` per light gives there, evaluated by mpmath at `DIGITS`
     digits in two stages (each light's N' . w_i and s from P and N', then the colour from those), so that
     sympy never builds a min or max of the long expressions."""
     P = sp.Matrix(sp.symbols("P_x P_y P_z", real=True))
@@ -108,12 +108,15 @@ def _formula_colour(scene, term, gate=True):
     reach = sp.symbols(f"V_1:{len(scene.lights) + 1}", nonnegative=True)
     colour = []
     for ch in range(3):
-        total = scene.ka * scene.ambient[ch]
+        # The scene's values of the statement's symbols (`SCENE_SYMBOLS`) in this channel; rho is the pixel's.
+        values = {sym: getattr(scene, name)[ch] if isinstance(getattr(scene, name), tuple) else getattr(scene, name)
+                  for name, sym in SCENE_SYMBOLS.items() if sym not in (rho, I_l)}
+        terms = []
         for light, mu, s_l, v in zip(scene.lights, cosines, highlights, reach):
-            lit = term.xreplace(CLAMP).xreplace({Dot(NP, WI): mu, s: s_l, I_l: light.color[ch], k_d: scene.kd, k_s: scene.ks,
-                                 p: scene.shininess, rho: albedo[ch]})
-            total += v * (sp.Piecewise((lit, mu > 0), (0, True)) if gate else lit)
-        colour.append(COLOUR.func(1, total))
+            lit = term.xreplace(CLAMP).xreplace({Dot(NP, WI): mu, s: s_l, I_l: light.color[ch]})
+            terms.append(v * (sp.Piecewise((lit, mu > 0), (0, True)) if gate else lit))
+        total = colour_of.replace(lambda e: isinstance(e, sp.Sum), lambda e: sp.Add(*terms))
+        colour.append(_explicit(total).xreplace({**values, rho: albedo[ch]}))
     colour = sp.lambdify(sum(zip(cosines, highlights), ()) + albedo + reach, colour, modules="mpmath")
 
     def evaluate(rows):
@@ -126,9 +129,9 @@ def _formula_colour(scene, term, gate=True):
     return evaluate
 
 
-def _evidence(term=TERM, normal="Ns", gate=True, shadows=True):
+def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR):
     """The rendered colour at seeded sphere pixels of `_scenes` against the statement (the floor, whose
-    albedo is its checker's, is not compared).  Wrong variants: ``term``; ``normal``, the G-buffer's
+    albedo is its checker's, is not compared).  Wrong variants: ``term``, ``colour_of``; ``normal``, the G-buffer's
     normal fed as N' ("Ns", or "N" the unbumped one); ``gate`` False, the term kept where N' . w_i <= 0;
     ``shadows`` False, the lights that reach P decided without sphere B."""
     from renderer import Scene, gbuffer, pointwise, render
@@ -150,7 +153,7 @@ def _evidence(term=TERM, normal="Ns", gate=True, shadows=True):
                                    np.tile(albedo, (take.size, 1)), reach.reshape(len(scene.lights), -1)[:, take].T]))
             want.append(image.reshape(-1, 3)[take])
         rows, want = np.vstack(rows), np.vstack(want)
-        worst = max(worst, float(np.max(np.abs(_formula_colour(scene, term, gate)(rows) - want))))
+        worst = max(worst, float(np.max(np.abs(_formula_colour(scene, term, gate, colour_of)(rows) - want))))
         count += rows.shape[0]
     if worst > TOLERANCE:
         return Verdict("refuted", f"the rendered colour differs from the shading formula by {worst:.1e} at some of "
@@ -201,6 +204,8 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             ("the unbumped normal N in place of N'", lambda: _theorem(normal="N").check()),
             ("the highlight kept where N' . omega_i is not positive", lambda: _theorem(gate=False).check()),
             ("sphere B casting no shadow", lambda: _theorem(shadows=False).check()),
+            ("the ambient light times the albedo, k_a rho I_a, as many textbooks write it",
+             lambda: _theorem(colour_of=COLOUR.xreplace({I_a: rho * I_a})).check()),
             ("the albedo on the highlight too",
              lambda: _theorem(term=I_l * rho * (k_d * Dot(NP, WI) + k_s * S_PLUS ** p)).check()),
         ),
