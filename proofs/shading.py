@@ -158,8 +158,8 @@ def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR)
     if worst > TOLERANCE:
         return Verdict("refuted", f"the rendered colour differs from the shading formula by {worst:.1e} at some of "
                        f"{count:,} sphere pixels")
-    return Verdict("proved", f"the rendered colour at {count:,} seeded pixels of spheres A and B (the book's scene; "
-                   f"Phong with random lights and materials) within {worst:.1e} of the formula in mpmath, fed the renderer's P, N' and reach",
+    return Verdict("proved", f"{count:,} seeded sphere pixels (the book's scene, Blinn; Phong with random lights and "
+                   f"materials) within {worst:.1e} of the formula in mpmath, from the renderer's P, N' and reach",
                    residual=worst, rendered=count, bound=TOLERANCE)
 
 
@@ -172,15 +172,16 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
         id="shading", title=TITLES["shading"],
         statement=(
             r"At a hit point $P$ on a sphere, with unbumped normal $N$, shading normal $N'$, $\omega_o$ the unit "
-            r"vector to the eye, and for each of the scene's $m$ lights $\omega_i$ the unit vector to it and "
-            r"$I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
-            r"nothing unless the light reaches $P$, where ${N \cdot \omega_i}$ is positive and nothing blocks the "
-            r"way, and ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the ambient "
-            r"light, $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and $⟦sigma_+⟧$ the highlight's cosine "
-            r"clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), with the half vector "
+            r"vector to the eye, and for each of the scene's $m$ lights $\omega_i$ (incident) the unit vector to it "
+            r"and $I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
+            r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
+            r"besides, ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the "
+            r"ambient light, $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and $⟦sigma_+⟧$ the highlight's "
+            r"cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), with the half vector "
             r"$$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ mirrored in $N'$), "
             r"which the kernel evaluates as $⟦phong⟧$. The unbumped geometry alone decides which lights reach $P$: "
-            r"⟪no-boundary⟫. The proof checks the two forms; the formula is checked on rendered pixels."),
+            r"⟪no-boundary⟫. The proof checks Phong's two forms and the half vector; the formula is checked on "
+            r"rendered pixels of both models."),
         steps=(
             Step(r"The dot product is linear, so with ${\omega_r = 2(N' \cdot \omega_i)N' - \omega_i}$ the cosine "
                  r"needs no mirror vector formed", Dot(WR, WO), phong),
