@@ -216,9 +216,9 @@ FASTEST_MARGIN = 1.1
 
 
 def fastest_on(measurement, method="exact", margin=FASTEST_MARGIN):
-    """On how many fields ``method`` is the fastest by ``margin``: every other method's median time at
-    least ``margin`` times its own; in words (`share_in_words`): "two of the three" in "the exact gradient
-    is the fastest method on two of the three fields".
+    """On which fields ``method`` is the fastest by ``margin``: every other method's median time at
+    least ``margin`` times its own; in words, their count (`share_in_words`) and, when some but not
+    all, their names: "two of the three fields (sine and ridges)", "all three fields".
 
     Parameters
     ----------
@@ -232,12 +232,14 @@ def fastest_on(measurement, method="exact", margin=FASTEST_MARGIN):
     str
     """
     fields = list(dict.fromkeys(r.field for r in measurement.results))
-    wins = 0
+    wins = []
     for f in fields:
         own = [r.median for r in measurement.of(f) if r.method == method]
         others = [r.median for r in measurement.of(f) if r.method != method]
-        wins += bool(own) and all(o >= margin * min(own) for o in others)
-    return share_in_words(int(wins), len(fields))
+        if own and all(o >= margin * min(own) for o in others):
+            wins.append(f)
+    words = f"{share_in_words(len(wins), len(fields))} fields"
+    return words + (f" ({_and(wins)})" if 0 < len(wins) < len(fields) else "")
 
 
 def step_text(eps):
