@@ -627,13 +627,17 @@ def frame_problems(s):
 
 def test_with_footprint_steps_the_eps_slider_is_disabled_and_says_it_is_unused(session):
     """Each pixel's footprint as its step leaves ε nothing to do: the slider is disabled and its printed value
-    says "unused" (a reader once moved it and watched nothing change); back on central differences it is live."""
+    says "unused" (a reader once moved it and watched nothing change), and the U-curve marks no current ε,
+    its caption saying why (the frame's error had been drawn at ε); back on central differences all is live."""
     s = session
     try:
         s.select("numeric", "footprint")
         assert s.page.is_disabled("#sim-log_eps") and s.page.text_content("#sim-log_eps-value").endswith(", unused")
+        assert s.page.locator("#sim-curve-marker").count() == 0
+        assert "no ε is marked" in s.page.text_content("#sim-curve-caption")
         s.select("numeric", "central")
         assert s.page.is_enabled("#sim-log_eps") and "unused" not in s.page.text_content("#sim-log_eps-value")
+        assert s.page.locator("#sim-curve-marker").count() == 1
     finally:
         s.click("sim-reset")
 
@@ -956,8 +960,8 @@ def _keyboard_walk(s):
     """Use the simulator from the keyboard alone, checking `spoken_problems` after each move: Tab to the
     field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
     and move the probe with the arrow keys (the readout reads the pixel), to the shading normal and change
-    it (the hint, a live region, must then say the β slider's new range), then on to the view menu and
-    change it (the hint must be back).  Returns {move: problems} and the readout's texts."""
+    it (the note beside it, a live region, must then say the β slider's new range), then on to the view
+    menu and change it (the note must be gone).  Returns {move: problems} and the readout's texts."""
     page, found, readouts = s.page, {}, []
 
     def move(name, key):
@@ -984,11 +988,11 @@ def _keyboard_walk(s):
         readouts.append(page.text_content("#sim-readout"))
     tab_to("sim-bump"); move("normal", "ArrowUp")        # to the draft's chart formula
     top = page.get_attribute("#sim-beta", "max")
-    if f"β now runs to {top}" not in page.text_content("#sim-hint"):         # the slider's range changed with it
-        found["normal"].append(f"β's range changed to {top} silently: hint {page.text_content('#sim-hint')!r}")
+    if f"β now runs to {top}" not in page.text_content("#sim-note"):         # the slider's range changed with it
+        found["normal"].append(f"β's range changed to {top} silently: note {page.text_content('#sim-note')!r}")
     tab_to("sim-view"); move("view", "ArrowDown")
-    if "β now runs" in page.text_content("#sim-hint"):                         # the note gives way to the hint
-        found["view"].append(f"the β note outlived the next change: {page.text_content('#sim-hint')!r}")
+    if page.text_content("#sim-note"):                                       # the note said its piece
+        found["view"].append(f"the β note outlived the next change: {page.text_content('#sim-note')!r}")
     return found, readouts
 
 
@@ -1013,9 +1017,9 @@ WRONG_SPOKEN = {
     "the canvases' labels written once, not kept current": ("    this.describe(ledger);\n", "", "not in"),
     "sliders named by the value beside them": ('return el("label", { for: input.id }, [el("span"',
                                               'return el("label", {}, [el("span"', "accessible name"),
-    "the β slider's range changed without a word": ("      this.hint.textContent = beta_range_note(value, this.state.beta < before.beta);\n",
+    "the β slider's range changed without a word": ("      this.note.textContent = beta_range_note(value, this.state.beta < before.beta);\n",
                                                      "", "silently"),
-    "the β note never giving way": ("      this.hint.textContent = this.hint_kept;                      // the note said its piece\n",
+    "the β note never giving way": ("      this.note.textContent = \"\";                                 // the note said its piece\n",
                                      "", "outlived"),
     "a readout that is not announced": ('"aria-live": "polite" });\n    root.append(el("div", { class: "sim-stage" }',
                                         '"aria-live": "off" });\n    root.append(el("div", { class: "sim-stage" }',

@@ -163,6 +163,8 @@ const STYLE = `
 .symrender-sim .sim-presets { display: flex; flex-wrap: wrap; gap: 0.4rem; margin: 0.4rem 0; align-items: center; }
 .symrender-sim .sim-presets button, .symrender-sim .sim-reset { padding: 0.2rem 0.6rem; }
 .symrender-sim .sim-hint { min-height: 2.6em; margin: 0 0 0.4rem; font-style: italic; }
+.symrender-sim .sim-note { grid-column: 1 / -1; margin: 0; font-style: italic; }
+.symrender-sim .sim-note:empty { display: none; }
 .symrender-sim table { font-variant-numeric: tabular-nums; margin: 0.4rem 0; }
 .symrender-sim td, .symrender-sim th { padding: 0.1rem 0.7rem; }
 .symrender-sim .sim-main { grid-template-columns: repeat(3, minmax(0, 1fr)); margin: 0.4rem 0; }
@@ -314,7 +316,11 @@ class Simulator {
     });
     const main = CONTROLS.map((c, i) => MAIN.includes(c.name) ? controls[i] : null).filter(Boolean);
     this.main_controls.append(...main);
-    root.append(el("div", { class: "sim-controls" }, controls.filter((c) => !main.includes(c))));
+    // What a change of the shading normal did to β's range, said beside the menu that made it.
+    this.note = el("p", { id: "sim-note", class: "sim-note", "aria-live": "polite" });
+    const rest = controls.filter((c) => !main.includes(c));
+    const at = rest.indexOf(controls[CONTROLS.findIndex((c) => c.name === "bump")]) + 1;
+    root.append(el("div", { class: "sim-controls" }, [...rest.slice(0, at), this.note, ...rest.slice(at)]));
     this.sync_inputs();
   }
 
@@ -368,18 +374,16 @@ class Simulator {
     this.state[c.name] = value;
     if (c.name === "bump" || c.name === "numeric") this.sync_inputs();
     if (c.name === "bump" && value !== before.bump) {
-      this.hint_kept = this.hint_kept ?? this.hint.textContent;   // the hint the note stands in for
-      this.hint.textContent = beta_range_note(value, this.state.beta < before.beta);
-    } else if (c.name !== "bump" && this.hint_kept !== undefined) {
-      this.hint.textContent = this.hint_kept;                      // the note said its piece
-      this.hint_kept = undefined;
+      this.note.textContent = beta_range_note(value, this.state.beta < before.beta);
+    } else if (c.name !== "bump") {
+      this.note.textContent = "";                                 // the note said its piece
     }
     this.show_value(c, value);
     this.schedule();
   }
 
   apply_preset(p) {
-    this.hint_kept = undefined;
+    this.note.textContent = "";
     this.state = { ...DEFAULT_STATE, ...p.set };
     this.sync_inputs();
     this.hint.textContent = p.hint ?? HINT;
@@ -568,12 +572,14 @@ class Simulator {
                                fill: CURVE_COLOURS.rms, stroke: "currentColor", "data-eps": String(eps_of(CURVE_LOG_EPS[best])) }));
       nodes.push(svg("text", { id: "sim-curve-best-label", x: xb, y: yb + 21, "text-anchor": "middle" }, `best ε = ${best_eps}`));
     }
-    const here = this.curve.here, x = X(Math.log10(here.eps));
-    nodes.push(svg("line", { id: "sim-curve-marker", x1: x, x2: x, y1: m.top, y2: H - m.bottom, stroke: "currentColor",
-                             "stroke-dasharray": "2 2" }));
-    for (const key of ["rms", "max"]) {
-      nodes.push(svg("circle", { cx: x, cy: Y(key === "rms" ? here.rms : here.max_abs), r: 4.5, fill: CURVE_COLOURS[key],
-                                 stroke: "currentColor" }));
+    const here = this.curve.here, x = X(Math.log10(here.eps)), unused = this.eps_unused();
+    if (!unused) {   // footprint steps: the frame has no one ε to mark
+      nodes.push(svg("line", { id: "sim-curve-marker", x1: x, x2: x, y1: m.top, y2: H - m.bottom, stroke: "currentColor",
+                               "stroke-dasharray": "2 2" }));
+      for (const key of ["rms", "max"]) {
+        nodes.push(svg("circle", { cx: x, cy: Y(key === "rms" ? here.rms : here.max_abs), r: 4.5, fill: CURVE_COLOURS[key],
+                                   stroke: "currentColor" }));
+      }
     }
     [["rms", "RMS |ΔI| on sphere A"], ["max", "max |ΔI| on sphere A"]].forEach(([key, label], i) => {
       const y = m.top - 8, x0 = m.left + i * 160;
@@ -589,8 +595,10 @@ class Simulator {
                       (marked ? `; the image-best step: ${best_eps}` : ""));
     plot.dataset.eps = String(here.eps);
     this.root.querySelector("#sim-curve-caption").textContent =
-      `The U-curve of central differences, on ${sample}, at half-decade steps of ε; the dotted line and ` +
-      `the dots: the current ε; the triangle: the image-best step, the one of these steps with the least RMS. ` +
+      `The U-curve of central differences, on ${sample}, at half-decade steps of ε; ` +
+      (unused ? "no ε is marked: the frame takes each pixel's footprint as its step; "
+              : "the dotted line and the dots: the current ε; ") +
+      `the triangle: the image-best step, the one of these steps with the least RMS. ` +
       `An exact zero lies on the bottom axis. ${RIGHT_ARM[FIELD_CREASES[this.state.height_field] ? "creased" : "smooth"]}`;
   }
 
