@@ -176,7 +176,7 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             r"and $I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
             r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
             r"besides, ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the "
-            r"ambient light, $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and $⟦sigma_+⟧$ the highlight's "
+            r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and $⟦sigma_+⟧$ the highlight's "
             r"cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), with the half vector "
             r"$$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ mirrored in $N'$), "
             r"which the kernel evaluates as $⟦phong⟧$. The unbumped geometry alone decides which lights reach $P$: "
