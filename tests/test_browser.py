@@ -635,6 +635,7 @@ def test_with_footprint_steps_the_eps_slider_is_disabled_and_says_it_is_unused(s
         assert s.page.is_disabled("#sim-log_eps") and s.page.text_content("#sim-log_eps-value").endswith(", unused")
         assert s.page.locator("#sim-curve-marker").count() == 0
         assert "no ε is marked" in s.page.text_content("#sim-curve-caption")
+        assert "footprint as its step" in s.page.get_attribute("#sim-curve", "aria-label")
         s.select("numeric", "central")
         assert s.page.is_enabled("#sim-log_eps") and "unused" not in s.page.text_content("#sim-log_eps-value")
         assert s.page.locator("#sim-curve-marker").count() == 1

@@ -590,8 +590,9 @@ class Simulator {
     plot.innerHTML = nodes.join("");
     const stride = this.curve.stride, s = this.state.resolution;
     const sample = stride === 1 ? `all ${s} × ${s} pixels` : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame`;
-    plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; at ε = ` +
-                      `${here.eps.toExponential(1)} RMS ${fmt(here.rms, 1)}, max ${fmt(here.max_abs, 1)}` +
+    plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; ` +
+                      (unused ? "the frame takes each pixel's footprint as its step, " : `at ε = ${here.eps.toExponential(1)} `) +
+                      `RMS ${fmt(here.rms, 1)}, max ${fmt(here.max_abs, 1)}` +
                       (marked ? `; the image-best step: ${best_eps}` : ""));
     plot.dataset.eps = String(here.eps);
     this.root.querySelector("#sim-curve-caption").textContent =
