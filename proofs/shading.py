@@ -68,10 +68,10 @@ DOMAIN = {**{x: (0.05, 3.1) for x in _ANGLES[:3]}, **{x: (-3.1, 3.1) for x in _A
 #: kernel), and Phong with every shading parameter drawn at random (seeded): coloured lights, ambient and
 #: albedos whose channels all differ, and a fractional shininess (libm's pow).
 def _scenes(seed=0):
-    from renderer.scene import PointLight
+    from renderer.scene import PointLight, Scene
     rng = np.random.default_rng(seed)
     colour = lambda: tuple(rng.uniform(0.1, 1.0, 3))                      # noqa: E731
-    lights = tuple(PointLight(position, colour()) for position in ((5.0, 5.0, 10.0), (-6.0, 2.0, 8.0)))
+    lights = tuple(PointLight(light.position, colour()) for light in Scene().lights)   # the book's, recoloured
     drawn = dict(ka=rng.uniform(0.1, 0.5), kd=rng.uniform(0.3, 1.0), ks=rng.uniform(0.2, 1.0),
                  shininess=rng.uniform(2.0, 40.0), ambient=colour(), albedo_a=colour(), albedo_b=colour())
     return ({}, dict(model="phong", lights=lights, height_field="sine", bump="chart", **drawn))
