@@ -79,7 +79,7 @@ PINNED = {
 RENDERED = {
     "chart": 200, "frame-orthonormal": 2 * 200, "gradient-{field}": 200, "kink-loci-rays": 200,
     "kink-loci-circles": 200, "no-boundary": 100, "beta-zero-regression": 4, "central-difference-truncation": 200,
-    "bump-vs-displacement": 200, "shading": 2 * 300,
+    "bump-vs-displacement": 200, "shading": 2 * 450,
 }
 #: The entries of `RENDERED` that count per registered field: the theorems about every field, whose
 #: evidence names the fields it compared (`proofs.core.Verdict.covers`; `pinned_failure` holds the two together).

@@ -5,7 +5,7 @@ simulator's renderer/js/render.js the same), as it writes the hit and the shadow
 theorem states what it computes, proves the two facts its code rests on (the Phong cosine it
 evaluates, 2 (N'.w_i)(N'.w_o) - w_i.w_o, is the cosine of the mirror direction; Blinn's half
 vector bisects w_i and w_o), and earns the statement on the renderer's own pixels: seeded pixels
-of spheres A and B in the book's scene (Blinn, the seed's shininess 32) and a Phong scene whose
+of spheres A and B and of the floor (its checker and tint included) in the book's scene (Blinn, the seed's shininess 32) and a Phong scene whose
 lights and materials are drawn at random, their rendered colour against the statement's formula
 evaluated by mpmath at `proofs.core.DIGITS` digits, fed the renderer's hit point P and shading normal N' and the
 lights its reach predicate lets through (`renderer.pointwise.reach`, which theorem
@@ -33,11 +33,15 @@ S_PLUS = sp.Symbol("sigma_+", nonnegative=True)
 CLAMP = {S_PLUS: sp.Min(1, sp.Max(0, s))}
 ell, m = sp.symbols("ell m", integer=True, positive=True)
 T = sp.IndexedBase("T")
+#: The floor's albedo: P = (x, y, 0) on it, c the checker's grey at P and alpha the tint (`floor_albedo`).
+X, Y = sp.symbols("x y", real=True)
+alpha, c = sp.symbols("alpha c", nonnegative=True)
+FLOOR = sp.Tuple((1 - alpha) * c, (1 - alpha) * c, c)
 NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: r"\omega_h", rho: r"\rho", I_l: r"I_\ell",
-         ell: r"\ell", s: r"\sigma", S_PLUS: r"\sigma_+"}
+         ell: r"\ell", s: r"\sigma", S_PLUS: r"\sigma_+", alpha: r"\alpha"}
 #: The scene's parameter (`renderer.Scene`) each symbol stands for, for the book's list of them.
 SCENE_SYMBOLS = {"lights": I_l, "ambient": I_a, "albedo_a": rho, "albedo_b": rho, "ka": k_a, "kd": k_d, "ks": k_s,
-                 "shininess": p}
+                 "shininess": p, "floor_tint": alpha}
 
 #: |w_i + w_o|, a name the statement prints, defined in the theorem's ``where`` (`LENGTH`).
 NORM = sp.Symbol("|omega_i + omega_o|", positive=True)
@@ -74,14 +78,30 @@ def _scenes(seed=0):
     lights = tuple(PointLight(light.position, colour()) for light in Scene().lights)   # the book's, recoloured
     drawn = dict(ka=rng.uniform(0.1, 0.5), kd=rng.uniform(0.3, 1.0), ks=rng.uniform(0.2, 1.0),
                  shininess=rng.uniform(2.0, 40.0), ambient=colour(), albedo_a=colour(), albedo_b=colour())
-    return ({}, dict(model="phong", lights=lights, height_field="sine", bump="chart", **drawn))
+    return ({}, dict(model="phong", lights=lights, height_field="sine", bump="chart", floor_tint=rng.uniform(0, 1),
+                     **drawn))
+
+
+def greys():
+    """The renderer's greys of the floor's light and dark squares (`renderer.kernel.FLOOR_LIGHT`, ``FLOOR_DARK``)."""
+    from renderer.kernel import FLOOR_DARK, FLOOR_LIGHT
+    return FLOOR_LIGHT, FLOOR_DARK
+
+
+def checker(light=None, dark=None):
+    """The floor's grey c at P = (x, y, 0): ``light`` where sin(pi x) sin(pi y) >= 0, ``dark`` elsewhere (unit
+    squares; seed Cell 1); by default the renderer's (`greys`)."""
+    if light is None:
+        light, dark = greys()
+    return sp.Piecewise((sp.Float(light, 15), sp.sin(sp.pi * X) * sp.sin(sp.pi * Y) >= 0), (sp.Float(dark, 15), True))
 
 
 SIZE = 128
-#: Pixels compared per scene, at most: from sphere A, and from sphere B.
-PER_SPHERE = (200, 100)
+#: Pixels compared per scene, at most: from sphere A, from sphere B and from the floor.
+PER_CHAMBER = (200, 100, 150)
 #: A pixel whose N' . w_i lies within this of 0 for a light that reaches it is left out: the statement's
-#: term jumps there (the highlight is cut where the light goes behind N'), and rounding decides the side.
+#: term jumps there (the highlight is cut where the light goes behind N'), and rounding decides the side;
+#: so is a floor pixel whose sin(pi x) sin(pi y) does, where the checker changes grey.
 GATE_MARGIN = 1e-9
 #: Absolute tolerance on a colour in [0, 1], about 1000 unit roundoffs: the kernel's unit vectors and
 #: cosines carry a few each, and the power n multiplies the cosine's relative rounding by n (up to 40 here).
@@ -129,13 +149,22 @@ def _formula_colour(scene, term, gate=True, colour_of=COLOUR):
     return evaluate
 
 
-def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR):
-    """The rendered colour at seeded sphere pixels of `_scenes` against the statement (the floor, whose
-    albedo is its checker's, is not compared).  Wrong variants: ``term``, ``colour_of``; ``normal``, the G-buffer's
+def _floor_albedo(floor, grey, tint, P):
+    """The albedo (k, 3) that ``floor`` (`FLOOR`) with c = ``grey`` (`checker`) and alpha = ``tint`` gives at the
+    floor points ``P`` (k, 3), by mpmath at `DIGITS` digits."""
+    at = sp.lambdify((X, Y), floor.xreplace({c: grey, alpha: tint}), modules="mpmath")
+    with mpmath.workdps(DIGITS):
+        return np.array([[float(x) for x in at(mpmath.mpf(float(px)), mpmath.mpf(float(py)))] for px, py, _ in P])
+
+
+def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR, floor=FLOOR, grey=None):
+    """The rendered colour at seeded pixels of `_scenes` (spheres A and B, the floor) against the statement.
+    Wrong variants: ``term``, ``colour_of``, ``floor``, ``grey`` (`checker`'s); ``normal``, the G-buffer's
     normal fed as N' ("Ns", or "N" the unbumped one); ``gate`` False, the term kept where N' . w_i <= 0;
     ``shadows`` False, the lights that reach P decided without sphere B."""
     from renderer import Scene, gbuffer, pointwise, render
-    from renderer.render import SPHERE_A, SPHERE_B
+    from renderer.render import FLOOR as ON_FLOOR, SPHERE_A, SPHERE_B
+    grey = checker() if grey is None else grey
     worst, count, rng = 0.0, 0, np.random.default_rng(0)
     for options in _scenes():
         scene = Scene(**options)
@@ -144,22 +173,26 @@ def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR)
         fed = getattr(g, normal)
         to_light = np.stack([np.asarray(l.position) - g.P for l in scene.lights])
         mu = np.einsum("hwk,lhwk->lhw", g.Ns, to_light) / np.linalg.norm(to_light, axis=-1)
-        clear = ~np.any(reach & (np.abs(mu) < GATE_MARGIN), axis=0)
+        squares = np.sin(np.pi * g.P[..., 0]) * np.sin(np.pi * g.P[..., 1])
+        clear = ~np.any(reach & (np.abs(mu) < GATE_MARGIN), axis=0) & ((g.chamber != ON_FLOOR) | (abs(squares) > GATE_MARGIN))
         rows, want = [], []
-        for code, albedo, most in zip((SPHERE_A, SPHERE_B), (scene.albedo_a, scene.albedo_b), PER_SPHERE):
+        for code, most in zip((SPHERE_A, SPHERE_B, ON_FLOOR), PER_CHAMBER):
             idx = np.flatnonzero((g.chamber == code) & clear)
             take = rng.choice(idx, size=min(most, idx.size), replace=False)
-            rows.append(np.hstack([g.P.reshape(-1, 3)[take], fed.reshape(-1, 3)[take],
-                                   np.tile(albedo, (take.size, 1)), reach.reshape(len(scene.lights), -1)[:, take].T]))
+            P = g.P.reshape(-1, 3)[take]
+            albedo = (_floor_albedo(floor, grey, scene.floor_tint, P) if code == ON_FLOOR else
+                      np.tile(scene.albedo_a if code == SPHERE_A else scene.albedo_b, (take.size, 1)))
+            rows.append(np.hstack([P, fed.reshape(-1, 3)[take], albedo, reach.reshape(len(scene.lights), -1)[:, take].T]))
             want.append(image.reshape(-1, 3)[take])
         rows, want = np.vstack(rows), np.vstack(want)
         worst = max(worst, float(np.max(np.abs(_formula_colour(scene, term, gate, colour_of)(rows) - want))))
         count += rows.shape[0]
     if worst > TOLERANCE:
         return Verdict("refuted", f"the rendered colour differs from the shading formula by {worst:.1e} at some of "
-                       f"{count:,} sphere pixels")
-    return Verdict("proved", f"{count:,} seeded sphere pixels (the book's scene, Blinn; Phong with random lights and "
-                   f"materials) within {worst:.1e} of the formula in mpmath, from the renderer's P, N' and reach",
+                       f"{count:,} pixels of the spheres and the floor")
+    return Verdict("proved", f"{count:,} seeded pixels of the spheres and the floor (the book's scene, Blinn; Phong with "
+                   f"random lights, materials and tint) within {worst:.1e} of the formula in mpmath, from the "
+                   f"renderer's P, N' and reach",
                    residual=worst, rendered=count, bound=TOLERANCE)
 
 
@@ -171,17 +204,20 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
     return Theorem(
         id="shading", title=TITLES["shading"],
         statement=(
-            r"At a hit point $P$ on a sphere, with unbumped normal $N$, shading normal $N'$, $\omega_o$ the unit "
+            r"At a hit point $P$, with unbumped normal $N$, shading normal $N'$, $\omega_o$ the unit "
             r"vector to the eye, and for each of the scene's $m$ lights $\omega_i$ (incident) the unit vector to it "
             r"and $I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
             r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
             r"besides, ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the "
-            r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and $⟦sigma_+⟧$ the highlight's "
-            r"cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), with the half vector "
-            r"$$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ mirrored in $N'$), "
-            r"which the kernel evaluates as $⟦phong⟧$. The unbumped geometry alone decides which lights reach $P$: "
-            r"⟪no-boundary⟫. The proof checks Phong's two forms and the half vector; the formula is checked on "
-            r"rendered pixels of both models."),
+            r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and "
+            r"$⟦sigma_+⟧$ the highlight's cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), "
+            r"with the half vector $$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ "
+            r"mirrored in $N'$), which the kernel evaluates as $⟦phong⟧$. A sphere's albedo is its own. The floor, "
+            r"at $⟦on_floor⟧$, carries no bump: its $N$ and $N'$ are both $⟦up⟧$. Its albedo is a checker of unit "
+            r"squares, its red and green dimmed by the tint $\alpha$: $$⟦floor⟧$$ where the grey $c$ is $⟦light⟧$ on the "
+            r"squares where $⟦square⟧$ and $⟦dark⟧$ on the others. The unbumped geometry alone decides which lights reach $P$: ⟪no-boundary⟫. The proof checks Phong's two "
+            r"forms and the half vector; the formula is checked on rendered pixels of both models, on the spheres "
+            r"and the floor."),
         steps=(
             Step(r"The dot product is linear, so with ${\omega_r = 2(N' \cdot \omega_i)N' - \omega_i}$ the cosine "
                  r"needs no mirror vector formed", Dot(WR, WO), phong),
@@ -195,7 +231,10 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
                  r"length", *bisects),
         ),
         claims={"phong": (Dot(WR, WO), phong)},
-        shown={"colour": sp.Eq(I, COLOUR, evaluate=False), "term": sp.Eq(T[ell], TERM, evaluate=False)},
+        shown={"colour": sp.Eq(I, COLOUR, evaluate=False), "term": sp.Eq(T[ell], TERM, evaluate=False),
+               "floor": sp.Eq(rho, FLOOR, evaluate=False), "up": sp.Tuple(0, 0, 1),
+               "on_floor": sp.Eq(sp.Symbol("P"), sp.Tuple(X, Y, 0), evaluate=False),
+               **dict(zip(("light", "dark"), (sp.Float(g, 15) for g in greys()))), "square": checker().args[0].cond},
         where={WR: mirror, HV: half, **LENGTH, **CLAMP, **UNIT}, names=NAMES, domain=DOMAIN, evidence=partial(_evidence, **evidence),
         wrong_variants=(
             ("Phong's cosine without its - omega_i . omega_o",
@@ -209,6 +248,10 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
              lambda: _theorem(colour_of=COLOUR.xreplace({I_a: rho * I_a})).check()),
             ("the albedo on the highlight too",
              lambda: _theorem(term=I_l * rho * (k_d * Dot(NP, WI) + k_s * S_PLUS ** p)).check()),
+            ("the floor's tint taken from its blue as well", lambda: _theorem(floor=sp.Tuple(*[FLOOR[0]] * 3)).check()),
+            ("the tint alpha kept, not taken away, (alpha c, alpha c, c)",
+             lambda: _theorem(floor=FLOOR.xreplace({1 - alpha: alpha})).check()),
+            ("the checker's light and dark squares swapped", lambda: _theorem(grey=checker(*greys()[::-1])).check()),
         ),
     )
 

@@ -24,7 +24,7 @@ from pathlib import Path
 #: line starts at once and ``python -m renderer.codegen`` runs even when the kernel's
 #: digest guard would refuse the generated file it is about to rewrite.
 _WHERE = {
-    "Scene": "scene", "DRAFT_SCENE": "scene", "PointLight": "scene", "BUMPS": "scene",
+    "Scene": "scene", "DRAFT_SCENE": "scene", "DRAFT_NAMES": "scene", "PointLight": "scene", "BUMPS": "scene",
     "MODELS": "scene",
     "render": "render", "gbuffer": "render", "Frame": "render", "GBuffer": "render",
     "GRADIENTS": "render", "CHAMBER_NAMES": "render",

@@ -13,7 +13,7 @@ from functools import lru_cache
 from . import formulas
 from .validate import InvalidType, InvalidValue, _shown, choice, flag, real, vector3
 
-__all__ = ["PointLight", "Scene", "DRAFT_SCENE", "MODELS", "BUMPS"]
+__all__ = ["PointLight", "Scene", "DRAFT_SCENE", "DRAFT_NAMES", "MODELS", "BUMPS"]
 
 #: Largest accepted magnitude of a length or coordinate (scene units): squares of
 #: lengths are formed everywhere, and 1e6 keeps them far from overflow.
@@ -302,3 +302,8 @@ def _check_on_chart(scene):
 #: a claim or erratum of the draft reads the draft's values from it, never from `Scene`'s defaults
 #: (the book's, which may change).
 DRAFT_SCENE = Scene(height_field="ridges", k_u=8.0, k_v=4.0, beta=0.35, eps=1e-3, bump="chart")
+#: The draft's name (its ``SC9`` keys) of each `Scene` field it has, where the two differ (``bump`` is the
+#: renderer's own; the fields not listed keep the draft's names).
+DRAFT_NAMES = dict(radius_a="R", camera_z="e", center_b="Cb", radius_b="R2", sphere_b="b_on", floor="floor_on",
+                   albedo_a="matA", albedo_b="matB", shininess="shin", floor_tint="alpha", height_field="hf",
+                   k_u="ku", k_v="kv")

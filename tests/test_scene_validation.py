@@ -25,7 +25,7 @@ import sympy as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from renderer import BUMPS, DRAFT_SCENE, GRADIENTS, MODELS, PointLight, Scene, compare, gbuffer, render, sweep
+from renderer import BUMPS, DRAFT_NAMES, DRAFT_SCENE, GRADIENTS, MODELS, PointLight, Scene, compare, gbuffer, render, sweep
 from renderer import formulas as F
 from renderer.validate import InputError, InvalidType, InvalidValue
 
@@ -36,12 +36,8 @@ SC9 = dict(R=1.0, e=4.0, Cb=(0.5, 0.5, 1.3), R2=0.32, b_on=True, floor_on=True,
            ambient=(0.15, 0.15, 0.16), matA=(0.63, 0.19, 0.16), matB=(0.33, 0.44, 0.62),
            ka=0.1, kd=0.7, ks=0.5, shin=32.0, model='blinn',
            alpha=0.25, hf='ridges', ku=8.0, kv=4.0, beta=0.35, eps=1e-3)
-# Scene field <- seed name (the `Scene` docstring gives both).
-SEED_NAMES = dict(radius_a="R", camera_z="e", center_b="Cb", radius_b="R2", sphere_b="b_on",
-                  floor="floor_on", ambient="ambient", albedo_a="matA", albedo_b="matB",
-                  ka="ka", kd="kd", ks="ks", shininess="shin", model="model",
-                  floor_tint="alpha", height_field="hf", k_u="ku", k_v="kv", beta="beta",
-                  eps="eps")
+# Scene field <- seed name: `DRAFT_NAMES`, each other field under its own name (lights are compared apart).
+SEED_NAMES = {f: DRAFT_NAMES.get(f, f) for f in Scene.__dataclass_fields__ if f not in ("lights", "bump")}
 
 
 def refusal(call):
@@ -64,6 +60,7 @@ def seed_mismatches(scene):
 
 
 def test_defaults_are_the_seeds():
+    assert sorted([*SEED_NAMES.values(), "lights"]) == sorted(SC9)       # every draft key named, once
     assert seed_mismatches(Scene()) == []
     assert all(isinstance(light, PointLight) for light in Scene().lights)
     # The project's addition: the default perturbed normal is the displaced sphere's; the
