@@ -55,13 +55,6 @@ class _Printer(LatexPrinter):
         comma = r",\ " if all(x.is_Atom for x in expr) else r",\ \allowbreak "      # (x, y, 0) stays whole
         return "(" + comma.join(f"{{{self._print(x)}}}" for x in expr) + ("," if len(expr) == 1 else "") + ")"
 
-    def _print_Piecewise(self, expr):
-        """Cases as a textbook sets them, ``value, & condition`` and ``\\text{otherwise}`` last: no "for", which
-        on a phone's width pushed the display onto a second line."""
-        lines = [rf"{self._print(e)}, & " + (r"\text{otherwise}" if c == True else self._print(c))   # noqa: E712
-                 for e, c in expr.args]
-        return r"\begin{cases} " + r" \\ ".join(lines) + r" \end{cases}"
-
     def _print_Jacobian(self, expr):
         fs, xs = (", ".join(self._print(a) for a in t) for t in expr.args)
         return rf"\frac{{\partial({fs})}}{{\partial({xs})}}"
