@@ -181,13 +181,14 @@ QUANTITIES = {
     "the sine field's image-best step (the simulator's scene and steps, 256 × 256)": (
         ("s4_best",), lambda: _lib("lab.accuracy").image_best_step("sine", 256)["best"]),
     "the chapter's frequency in u": (("s3_torus_ku",), lambda: _lib("renderer").Scene().k_u),
+    "the crease band's half-width": (("s3_band_half",), lambda: float(_lib("renderer.formulas").KINK_BAND_HALF_WIDTH)),
     "the chapter's frequency in v": (("s3_torus_kv",), lambda: _lib("renderer").Scene().k_v),
     # Counted on two pages from their own renders.
     "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1", "c4_pixels"), None),
 }
 #: Glued names each showing a quantity of its own that its page computes (from its renders, counts
 #: and choices), with no second name and no value in the library to agree with.
-ON_THE_PAGE = ("ix_size", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
+ON_THE_PAGE = ("ix_label", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "ix_proved", "ix_verified", "ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata",
                "tilt_chart", "tilt_surface", "s1_steep", "s1_steep_chart", "s1_steep_surface", "s1_away_chart",
                "s1_away_surface", "s1_flips_chart",
