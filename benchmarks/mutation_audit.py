@@ -269,6 +269,8 @@ SECOND = [
      'stamp.is_file() and stamp.read_text(encoding="utf-8") == source_digest()',
      "stamp.is_file()",
      "the simulator's bundle is not made again when the sources change (stale build output)"),
+    ("floor-checker-swapped", "renderer/kernel.py", "    base = FLOOR_LIGHT if checker >= 0.0 else FLOOR_DARK",
+     "    base = FLOOR_DARK if checker >= 0.0 else FLOOR_LIGHT", "the floor's light and dark squares swapped"),
 ]
 
 #: The lists by name.
