@@ -188,7 +188,7 @@ QUANTITIES = {
 }
 #: Glued names each showing a quantity of its own that its page computes (from its renders, counts
 #: and choices), with no second name and no value in the library to agree with.
-ON_THE_PAGE = ("ix_label", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
+ON_THE_PAGE = ("ix_label", "s2_draft_diff", "s3_band_u", "s3_band_v", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "ix_proved", "ix_verified", "ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata",
                "tilt_chart", "tilt_surface", "s1_steep", "s1_steep_chart", "s1_steep_surface", "s1_away_chart",
                "s1_away_surface", "s1_flips_chart",

@@ -159,11 +159,11 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=None, all_visible=False, ba
     mismatched, per_locus, compared = part_mismatch(kind, scene, SIZE, shift, rho, drho, band_scale)
     if kind == "rays":
         seen = np.ones(len(per_locus), dtype=bool)             # every ray crosses the visible cap
-        what = f"{len(per_locus)} rays at alpha = " + ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
+        what = f"{len(per_locus)} rays at psi = " + ", ".join(f"{a:+.4f}" for a in ray_angles(scene.k_u))
     else:
         phis, rhos, seen = circle_radii(scene.radius_a, scene.camera_z, scene.k_v)
         seen = seen | all_visible
-        what = "circles " + "; ".join(f"phi={p:.4f}: rho={r:.4f} ({'visible' if s else 'hidden'})"
+        what = "circles " + "; ".join(f"phi={p:.4f}: r={r:.4f} ({'visible' if s else 'hidden'})"
                                       for p, r, s in zip(phis, rhos, seen))
     family = "u-creases (rays)" if kind == "rays" else "v-creases (circles)"
     if mismatched > 0:
@@ -181,11 +181,11 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=None, all_visible=False, ba
 #: The quantities the proofs name: the image point (x, y), its radius rho(phi), the ray's angle alpha_m,
 #: the eye E and the normal N.
 X, Y = sp.symbols("x y", real=True)
-ALPHA = sp.Symbol("alpha", real=True)
-rho = sp.Function("rho")
-alpha_m = sp.Symbol("alpha_m")
+ALPHA = sp.Symbol("psi", real=True)
+rho = sp.Function("r")
+alpha_m = sp.Symbol("psi_m")
 E_S, N_S, P_S = (sp.MatrixSymbol(name, 3, 1) for name in "ENP")
-NAMES = {alpha_m: r"\alpha_m"}
+NAMES = {alpha_m: r"\psi_m"}
 #: The ray's angle as written: 2 pi m / k_u - pi.
 ALPHA_SHOWN = written(sp.Add(2 * sp.pi * m_sym / F.k_u, -sp.pi, evaluate=False))
 
@@ -202,15 +202,15 @@ def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
     ray = U_OF_THETA.subs(theta, alpha_m)
     return Theorem(
         id="kink-loci-rays", title=TITLES["kink-loci-rays"],
-        statement=r"In image-plane polar coordinates $(\rho, \alpha)$ about the projection of the $z$-axis, "
-                  r"$⟦polar⟧$ with $⟦rho⟧$: $⟦alpha⟧$, so $⟦u⟧$ depends on the angle "
-                  r"alone, and the crease $⟦line_u⟧$ is the ray $⟦alpha_m⟧$: $⟦ray⟧$.",
+        statement=r"In image-plane polar coordinates $(r, \psi)$ about the projection of the $z$-axis, "
+                  r"$⟦polar⟧$ with $⟦r⟧$: $⟦alpha⟧$, so $⟦u⟧$ depends on the angle "
+                  r"alone, and the crease $⟦line_u⟧$ is the ray $⟦psi_m⟧$: $⟦ray⟧$.",
         steps=(
             Step(r"Project $P = R\,N(\theta, \varphi)$ from the eye $(0, 0, e)$ onto the image plane $z = 0$: its "
                  r"$x$ and $y$ scale by $e/(e - P_z)$, and $P_z = R\cos\varphi$", sp.Tuple(X, Y), polar,
                  defines=(rho(phi),)),
-            Step(r"So the image point's polar angle $\alpha$ is $\theta$, and $u = (\theta + \pi)/2\pi$, by ⟪chart⟫, "
-                 r"is a function of $\alpha$ alone; $u = m/k_u$ on the ray", ray, LINE_U,
+            Step(r"So the image point's polar angle $\psi$ is $\theta$, and $u = (\theta + \pi)/2\pi$, by ⟪chart⟫, "
+                 r"is a function of $\psi$ alone; $u = m/k_u$ on the ray", ray, LINE_U,
                  defines=(alpha_m,)),
         ),
         claims={"polar": (sp.Tuple(X, Y), polar), "ray": (ray, LINE_U)},
@@ -237,12 +237,12 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
                   r"$⟦rising⟧$ on the visible cap, where $⟦facing⟧$ is positive. The crease $⟦line_v⟧$ is the circle of "
                   r"radius $⟦rho_m⟧$, visible when $⟦visible⟧$.",
         steps=(
-            Step(r"By ⟪kink-loci-rays⟫, $x^2 + y^2 = \rho(\varphi)^2 (\cos^2\theta + \sin^2\theta)$", radius,
+            Step(r"By ⟪kink-loci-rays⟫, $x^2 + y^2 = r(\varphi)^2 (\cos^2\theta + \sin^2\theta)$", radius,
                  rho(phi)**2),
-            Step(r"Differentiate $\rho(\varphi) = eR\sin\varphi/(e - R\cos\varphi)$ with the quotient rule", slope,
+            Step(r"Differentiate $r(\varphi) = eR\sin\varphi/(e - R\cos\varphi)$ with the quotient rule", slope,
                  drho),
             Step(r"The point $P = R N$ faces the eye $E = (0, 0, e)$ where $N \cdot (E - P) > 0$, that is "
-                 r"$e\cos\varphi > R$: there $\rho' > 0$, so $\rho$ increases with $\varphi$ and each circle "
+                 r"$e\cos\varphi > R$: there $r' > 0$, so $r$ increases with $\varphi$ and each circle "
                  r"$\varphi = \pi m/k_v$ has one radius", facing, cap),
         ),
         claims={"radius": (radius, rho(phi)**2), "slope": (slope, drho), "facing": (facing, cap)},

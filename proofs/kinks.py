@@ -104,8 +104,8 @@ def _creases(field, jump_u, jump_v, band=None):
                   r"crease returns neither one-sided slope, so the renderer flags the pixels near a crease, and "
                   r"the book reports their error apart. Its crease flag is 1 on every zero line, $⟦lines⟧$, and "
                   r"exactly where $⟦band⟧$: a band about "
-                  rf"${float(SEED_HALF_WIDTH):g}/(\pi k_u)$ wide in $u$ on each side of a line (likewise in $v$), "
-                  r"the half-width the draft chose.",
+                  rf"${float(SEED_HALF_WIDTH):g}/(\pi k_u)$ wide in $u$ on each side of a line (likewise in $v$); "
+                  r"the threshold is the draft's.",
         steps=(
             *calc(sp.Tuple(HU_P, HU_M),
                   (r"On the line $u = m/k_u$ the factor $s_1 = \sin\pi k_u u$ vanishes; with $c \ne 0$ the value of "

@@ -5,7 +5,7 @@ simulator's renderer/js/render.js the same), as it writes the hit and the shadow
 theorem states what it computes, proves the two facts its code rests on (the Phong cosine it
 evaluates, 2 (N'.w_i)(N'.w_o) - w_i.w_o, is the cosine of the mirror direction; Blinn's half
 vector bisects w_i and w_o), and earns the statement on the renderer's own pixels: seeded pixels
-of spheres A and B and of the floor (its checker and tint included) in the book's scene (Blinn, the seed's shininess 32) and a Phong scene whose
+of spheres A and B and of the floor (its checker and tint included) in the chapter's scene (Blinn, the seed's shininess 32) and a Phong scene whose
 lights and materials are drawn at random, their rendered colour against the statement's formula
 evaluated by mpmath at `proofs.core.DIGITS` digits, fed the renderer's hit point P and shading normal N' and the
 lights its reach predicate lets through (`renderer.pointwise.reach`, which theorem
@@ -157,18 +157,26 @@ def _floor_albedo(floor, grey, tint, P):
         return np.array([[float(x) for x in at(mpmath.mpf(float(px)), mpmath.mpf(float(py)))] for px, py, _ in P])
 
 
-def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR, floor=FLOOR, grey=None):
-    """The rendered colour at seeded pixels of `_scenes` (spheres A and B, the floor) against the statement.
-    Wrong variants: ``term``, ``colour_of``, ``floor``, ``grey`` (`checker`'s); ``normal``, the G-buffer's
-    normal fed as N' ("Ns", or "N" the unbumped one); ``gate`` False, the term kept where N' . w_i <= 0;
-    ``shadows`` False, the lights that reach P decided without sphere B."""
-    from renderer import Scene, gbuffer, pointwise, render
+def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR, floor=FLOOR, grey=None,
+              unbumped=("sphere B", "floor")):
+    """The rendered colour at seeded pixels of `_scenes` (spheres A and B, the floor) against the statement,
+    after checking that the chambers ``unbumped`` (`renderer.CHAMBER_NAMES`' names) have N' = N at every
+    pixel, and the floor N = (0, 0, 1).  Wrong variants: ``term``, ``colour_of``, ``floor``, ``grey``
+    (`checker`'s), ``unbumped``; ``normal``, the G-buffer's normal fed as N' ("Ns", or "N" the unbumped one);
+    ``gate`` False, the term kept where N' . w_i <= 0; ``shadows`` False, the lights that reach P decided
+    without sphere B."""
+    from renderer import CHAMBER_NAMES, Scene, gbuffer, pointwise, render
     from renderer.render import FLOOR as ON_FLOOR, SPHERE_A, SPHERE_B
     grey = checker() if grey is None else grey
     worst, count, rng = 0.0, 0, np.random.default_rng(0)
     for options in _scenes():
         scene = Scene(**options)
         g, image = gbuffer(scene, SIZE, SIZE), render(scene, SIZE, SIZE).image
+        flat = np.isin(g.chamber, [code for code, name in CHAMBER_NAMES.items() if name in unbumped])
+        bumped = flat & np.any(g.Ns != g.N, axis=-1) | (g.chamber == ON_FLOOR) & np.any(g.N != (0.0, 0.0, 1.0), axis=-1)
+        if bumped.any():
+            return Verdict("refuted", f"{int(bumped.sum()):,} pixels of {' or '.join(unbumped)} have N' other than N, "
+                           "or a floor N other than (0, 0, 1)")
         reach = pointwise.reach(scene if shadows else scene.replace(sphere_b=False), g)      # (lights, H, W)
         fed = getattr(g, normal)
         to_light = np.stack([np.asarray(l.position) - g.P for l in scene.lights])
@@ -190,7 +198,7 @@ def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR,
     if worst > TOLERANCE:
         return Verdict("refuted", f"the rendered colour differs from the shading formula by {worst:.1e} at some of "
                        f"{count:,} pixels of the spheres and the floor")
-    return Verdict("proved", f"{count:,} seeded pixels of the spheres and the floor (the book's scene, Blinn; Phong with "
+    return Verdict("proved", f"{count:,} seeded pixels of the spheres and the floor (the chapter's scene, Blinn; Phong with "
                    f"random lights, materials and tint) within {worst:.1e} of the formula in mpmath, from the "
                    f"renderer's P, N' and reach",
                    residual=worst, rendered=count, bound=TOLERANCE)
@@ -204,7 +212,8 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
     return Theorem(
         id="shading", title=TITLES["shading"],
         statement=(
-            r"At a hit point $P$, with unbumped normal $N$, shading normal $N'$, $\omega_o$ the unit "
+            r"At a hit point $P$, with unbumped normal $N$ (a sphere's outward unit normal), shading normal $N'$ "
+            r"(on sphere A the perturbed normal that §3 derives, on sphere B its $N$), $\omega_o$ the unit "
             r"vector to the eye, and for each of the scene's $m$ lights $\omega_i$ (incident) the unit vector to it "
             r"and $I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
             r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
@@ -252,6 +261,7 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             ("the tint alpha kept, not taken away, (alpha c, alpha c, c)",
              lambda: _theorem(floor=FLOOR.xreplace({1 - alpha: alpha})).check()),
             ("the checker's light and dark squares swapped", lambda: _theorem(grey=checker(*greys()[::-1])).check()),
+            ("sphere A unbumped too, N' = N", lambda: _theorem(unbumped=("sphere A", "sphere B", "floor")).check()),
         ),
     )
 

@@ -21,7 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "shading": "6ae90f831911d7e6",
+    "shading": "5af0a7f5432b58c2",
     "displaced-normal": "980110f1c7d09f11",
     "chart": "806ac8c86dd7e8dc",
     "frame-orthonormal": "494b22ccf6847951",
@@ -29,9 +29,9 @@ PRINTED = {
     "gradient-sine": "afdd4d313d68b6fe",
     "gradient-ridges": "c7e368c0325ff445",
     "gradient-rings": "ccd11d1bae25eafb",
-    "ridges-kinks": "9604b08e06af8e84",
-    "kink-loci-rays": "882bb00bb9cab6d5",
-    "kink-loci-circles": "46a8e79fbad33c8c",
+    "ridges-kinks": "8d21924109afbdea",
+    "kink-loci-rays": "bf275f9204a126d7",
+    "kink-loci-circles": "31c755b11bbe9e76",
     "no-boundary": "3cdd4fa8159796f1",
     "normal-beta-derivative": "644a026a3f47d53f",
     "beta-zero-regression": "ddf30c60292784fd",

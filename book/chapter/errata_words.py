@@ -54,7 +54,8 @@ WORDS = {
             "{steps_shown[1]} at {fraction_interior[1]:.0%} ({rel_change[1]:.1e}); at {steps_shown[2]} at "
             "{fraction_interior[2]:.0%} ({rel_change[2]:.1e}). Where it fires, the rounded span is "
             "the better divisor (it takes the arguments' rounding out): at {steps_shown[1]} its quotient is nearer the "
-            "exact $h_v$ at {nearer[1]:.0%} of those pixels."
+            "exact $h_v$ at {nearer[1]:.0%} of those pixels. The defect is the mix: rounding, not the border, "
+            "picks each pixel's divisor, so no one error model describes the frame."
         ),
     ),
     "acos-pole": dict(
