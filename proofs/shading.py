@@ -5,11 +5,11 @@ simulator's renderer/js/render.js the same), as it writes the hit and the shadow
 theorem states what it computes, proves the two facts its code rests on (the Phong cosine it
 evaluates, 2 (N'.w_i)(N'.w_o) - w_i.w_o, is the cosine of the mirror direction; Blinn's half
 vector bisects w_i and w_o), and earns the statement on the renderer's own pixels: seeded pixels
-of spheres A and B and of the floor (its checker and tint included) in the chapter's scene (Blinn, the seed's shininess 32) and a Phong scene whose
-lights and materials are drawn at random, their rendered colour against the statement's formula
-evaluated by mpmath at `proofs.core.DIGITS` digits, fed the renderer's hit point P and shading normal N' and the
-lights its reach predicate lets through (`renderer.pointwise.reach`, which theorem
-``no-boundary`` holds to the shadow predicates).
+of spheres A and B and of the floor (its checker and tint included) in the chapter's scene (Blinn,
+the seed's shininess 32) and a Phong scene whose lights and materials are drawn at random, their
+rendered colour against the statement's formula evaluated by mpmath at `proofs.core.DIGITS` digits,
+fed the renderer's hit point P and shading normal N' and the lights its reach predicate lets through
+(`renderer.pointwise.reach`, which theorem ``no-boundary`` holds to the shadow predicates).
 """
 
 from functools import partial
@@ -33,7 +33,7 @@ S_PLUS = sp.Symbol("sigma_+", nonnegative=True)
 CLAMP = {S_PLUS: sp.Min(1, sp.Max(0, s))}
 ell, m = sp.symbols("ell m", integer=True, positive=True)
 T = sp.IndexedBase("T")
-#: The floor's albedo: P = (x, y, 0) on it, c the checker's grey at P and alpha the tint (`floor_albedo`).
+#: The floor's albedo: P = (x, y, 0) on it, c the checker's grey at P (`checker`) and alpha the tint.
 X, Y = sp.symbols("x y", real=True)
 alpha, c = sp.symbols("alpha c", nonnegative=True)
 FLOOR = sp.Tuple((1 - alpha) * c, (1 - alpha) * c, c)
@@ -173,7 +173,8 @@ def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR,
         scene = Scene(**options)
         g, image = gbuffer(scene, SIZE, SIZE), render(scene, SIZE, SIZE).image
         flat = np.isin(g.chamber, [code for code, name in CHAMBER_NAMES.items() if name in unbumped])
-        bumped = flat & np.any(g.Ns != g.N, axis=-1) | (g.chamber == ON_FLOOR) & np.any(g.N != (0.0, 0.0, 1.0), axis=-1)
+        bumped = (flat & np.any(g.Ns != g.N, axis=-1)
+                  | (g.chamber == ON_FLOOR) & np.any(g.N != (0.0, 0.0, 1.0), axis=-1))
         if bumped.any():
             return Verdict("refuted", f"{int(bumped.sum()):,} pixels of {' or '.join(unbumped)} have N' other than N, "
                            "or a floor N other than (0, 0, 1)")
@@ -182,7 +183,8 @@ def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR,
         to_light = np.stack([np.asarray(l.position) - g.P for l in scene.lights])
         mu = np.einsum("hwk,lhwk->lhw", g.Ns, to_light) / np.linalg.norm(to_light, axis=-1)
         squares = np.sin(np.pi * g.P[..., 0]) * np.sin(np.pi * g.P[..., 1])
-        clear = ~np.any(reach & (np.abs(mu) < GATE_MARGIN), axis=0) & ((g.chamber != ON_FLOOR) | (abs(squares) > GATE_MARGIN))
+        clear = (~np.any(reach & (np.abs(mu) < GATE_MARGIN), axis=0)
+                 & ((g.chamber != ON_FLOOR) | (abs(squares) > GATE_MARGIN)))
         rows, want = [], []
         for code, most in zip((SPHERE_A, SPHERE_B, ON_FLOOR), PER_CHAMBER):
             idx = np.flatnonzero((g.chamber == code) & clear)
@@ -223,8 +225,9 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             r"with the half vector $$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ "
             r"mirrored in $N'$), which the kernel evaluates as $⟦phong⟧$. A sphere's albedo is its own. The floor, "
             r"at $⟦on_floor⟧$, carries no bump: its $N$ and $N'$ are both $⟦up⟧$. Its albedo is a checker of unit "
-            r"squares, its red and green dimmed by the tint $\alpha$: $$⟦floor⟧$$ where the grey $c$ is $⟦light⟧$ on the "
-            r"squares where $⟦square⟧$ and $⟦dark⟧$ on the others. The unbumped geometry alone decides which lights reach $P$: ⟪no-boundary⟫. The proof checks Phong's two "
+            r"squares, its red and green dimmed by the tint $\alpha$: $$⟦floor⟧$$ where the grey $c$ is $⟦light⟧$ "
+            r"on the squares where $⟦square⟧$ and $⟦dark⟧$ on the others. The unbumped geometry alone decides which "
+            r"lights reach $P$: ⟪no-boundary⟫. The proof checks Phong's two "
             r"forms and the half vector; the formula is checked on rendered pixels of both models, on the spheres "
             r"and the floor."),
         steps=(
