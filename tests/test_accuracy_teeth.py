@@ -34,6 +34,30 @@ def test_the_crease_distance_is_the_distance_to_the_nearest_zero_line():
     assert np.all(np.isinf(crease_distance(u, v, k_u, k_v, "sine")))
 
 
+def test_below_the_bands_width_every_straddling_stencil_lies_in_the_crease_band():
+    """§3's claim: while eps is below asin(half-width) / (pi k) in each direction, every sphere-A pixel whose
+    stencil reaches across a crease (`crease_distance` below eps) carries the renderer's kink flag; for
+    seeded random frequencies.  The check can fail: at five times the width, straddling pixels lie outside."""
+    import math
+
+    import numpy as np
+
+    from lab.accuracy import crease_distance
+    from renderer import Scene, formulas, gbuffer, render
+    from renderer.render import SPHERE_A
+    rng = np.random.default_rng(5)
+    half = float(formulas.KINK_BAND_HALF_WIDTH)
+    for k_u, k_v in [(8.0, 4.0), *rng.integers(2, 13, size=(3, 2)).astype(float)]:
+        scene = Scene(height_field="ridges", k_u=k_u, k_v=k_v)
+        frame, g = render(scene, 160, 160), gbuffer(scene, 160, 160)
+        on_a = g.chamber == SPHERE_A
+        dist = crease_distance(g.uv[on_a][:, 0], g.uv[on_a][:, 1], k_u, k_v, "ridges")
+        width = math.asin(half) / (math.pi * max(k_u, k_v))
+        outside = lambda eps: int(np.sum((dist < eps) & ~frame.kink[on_a]))       # noqa: E731
+        assert outside(0.999 * width) == 0, (k_u, k_v)
+        assert outside(5 * width) > 0, (k_u, k_v)
+
+
 def test_each_fields_optimum_stays_below_its_crease_distance(monkeypatch):
     """`optima` takes every registered field from its record, and a field with a crease 0.005 from its
     optimum point measures only steps below that distance (the rule that was the ridges field's alone)."""
