@@ -25,7 +25,8 @@ from ._checks import MAX_COUNT, MAX_SQUARE, STEP, broadcast, seed as _seed
 
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
-           "image_beta_order", "optima", "measure_optimum", "crease_distance", "crease_share", "image_best_step", "footprint_steps", "OPTIMUM_POINTS",
+           "image_beta_order", "optima", "measure_optimum", "crease_distance", "crease_share", "image_best_step", "footprint_steps",
+           "footprint_median", "OPTIMUM_POINTS",
            "DIGITS", "HALF_DECADES"]
 
 DIGITS = 50
@@ -436,6 +437,21 @@ def footprint_steps(scene=None, size=256):
     step_u, _ = pointwise.footprint(X[on_a], Y[on_a], geo.x[1] - geo.x[0], geo.y[0] - geo.y[1], scene.camera_z,
                                     P, N, e_theta, e_phi, scene.radius_a, sin_phi)
     return np.asarray(step_u, dtype=np.float64)
+
+
+def footprint_median(size=256):
+    """The median of `footprint_steps` over the book's scene, `renderer.Scene()`, at ``size`` × ``size``
+    pixels: one measurement of the build (`lab.store`), which §3's table of steps and §5's Cell 2 both
+    show.  A float, chart units.
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``size`` is not an integer in [1, 4096].
+    """
+    from .store import measured
+    size = positive_int("size", size, high=MAX_SQUARE)
+    return measured("footprint-median", lambda size: float(np.median(footprint_steps(Scene(), size))), size=size)
 
 
 #: The steps of the simulator's U-curve (`renderer.ledger.CURVE_LOG_EPS`), chart units.

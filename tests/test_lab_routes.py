@@ -277,3 +277,14 @@ def test_a_footprint_step_without_its_half_is_caught(monkeypatch):
     footprint = pointwise.footprint
     monkeypatch.setattr(pointwise, "footprint", lambda *a: tuple(2 * x for x in footprint(*a)))
     assert np.median(_footprint_against_neighbours(_scenes(1, seed=41)[0])) == pytest.approx(2.0, abs=0.04)
+
+
+@pytest.mark.parametrize("size", [16, 37])
+def test_the_stored_footprint_median_is_the_median_of_the_footprint_steps(size, monkeypatch):
+    """§3's table and Cell 2 both show `accuracy.footprint_median`: the median of the book scene's footprint
+    steps at that size, which a store reused across sizes (the wrong variant: one size's value for all) fails."""
+    assert accuracy.footprint_median(size) == np.median(accuracy.footprint_steps(Scene(), size))
+    import lab.store as store
+    monkeypatch.setattr(store, "_MEMORY", {("footprint-median", '{"size": 16}'): accuracy.footprint_median(16)})
+    monkeypatch.setattr(store, "measured", lambda name, compute, **params: store._MEMORY[name, '{"size": 16}'])
+    assert (accuracy.footprint_median(size) == np.median(accuracy.footprint_steps(Scene(), size))) == (size == 16)

@@ -93,6 +93,7 @@ FUNCTIONS = {
                                  dict(field=p("field"), size=p("int", (0, V, "got 0")))),
     "accuracy.footprint_steps": (accuracy.footprint_steps, dict(scene=Scene(), size=8),
                                  dict(scene=p("own", (3, T, "got int")), size=p("int", (0, V, "got 0")))),
+    "accuracy.footprint_median": (accuracy.footprint_median, dict(size=8), dict(size=p("int", (0, V, "got 0")))),
     # lab.gradient_methods
     "gradient_benchmark.Config": (gb.Config, CONFIG, {
         **{k: p("steps", ([1.0], V, "1.0 at flat index 0"), named=f"Config.{k}")
