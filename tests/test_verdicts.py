@@ -78,6 +78,34 @@ def test_a_missing_duplicated_or_unknown_place_is_caught():
     assert place_faults(moved) == {"cell3/flips": "not on the page of cell3"}
 
 
+CELL = re.compile(r"\bCell (\d)")
+
+
+def numbering_faults(places, claims=CLAIMS):
+    """Margin notes that break the numbering the index states (the draft's Cell N is noted in the lab's
+    Cell N; outside the lab only the draft's Cell 2, on the tangent frame, in §3): [(claim id, place)]."""
+    where = {c.id: c.where for c in claims}
+    faults = []
+    for place, ids in places.items():
+        for i in ids:
+            cells = CELL.findall(where[i])
+            lab = re.fullmatch(r"cell(\d)", verdicts.section_of(place))
+            if cells and (cells != [lab.group(1)] if lab else (cells, place.split("-")[0]) != (["2"], "s3")):
+                faults.append((i, place))
+    return faults
+
+
+def test_a_note_on_a_draft_cell_stands_in_the_labs_cell_of_that_number_as_the_index_says():
+    index = " ".join((BOOK / "index.md").read_text(encoding="utf-8").split())
+    assert "Cells 1–7 are numbered as this book's sections and the lab's cells" in index
+    assert "the draft's Cell 2 on the tangent frame is noted in {ref}`§3 <s3>`" in index
+    assert numbering_faults(verdicts.PLACES) == []
+    moved = {**verdicts.PLACES, "cell2": verdicts.PLACES["cell2"] + ("census-flips",), "cell3/flips": ()}
+    assert numbering_faults(moved) == [("census-flips", "cell2")]
+    assert numbering_faults({**verdicts.PLACES, "s7": ("cell1-ripples",), "cell1": ()}) == [("cell1-ripples", "s7")]
+    assert numbering_faults({**verdicts.PLACES, "s4-x": ("frame-aligned",), "s3-frame": ()}) == [("frame-aligned", "s4-x")]
+
+
 MARGIN = re.compile(r"```\{margin\}\n(.*?)\n```", re.S)
 
 
