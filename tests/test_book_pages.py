@@ -209,6 +209,11 @@ AUDIT = r"""async () => {
       broken.push({text: s.slice(0, 60), at: s.slice(Math.max(0, at - 24), at) + '|' + s.slice(at, at + 24),
                    code: isCode(chars[a].n), where: where(chars[a].n.parentElement)});
   }
+  // A code chip holding a tuple of numbers, "(0.5, 0.5, 1.3)", on more than one line.
+  for (const c of root.querySelectorAll('code'))
+    if (/^\(-?\d[\d.]*(?:e[-+]?\d+)?(?:, -?\d[\d.]*(?:e[-+]?\d+)?){1,3}\)$/i.test(c.textContent)
+        && new Set([...c.getClientRects()].filter(r => r.width > 0).map(r => Math.round(r.top))).size > 1)
+      broken.push({text: c.textContent, at: 'a tuple on several lines', code: true, where: where(c)});
 
   // (d) nothing wider than the column, nothing cut off by a box that hides its overflow.  A box that
   // scrolls (overflow auto or scroll) may hold wider content; it must fit itself.
@@ -904,6 +909,13 @@ def test_the_break_check_catches_a_broken_number(browser, book_html, tmp_path):
              '<p style="width:5em">central-difference</p>')
     found = _audit(browser, _synthetic(tmp_path, words))["broken"]
     assert [b["text"] for b in found] == ["verdict"], found
+    # A tuple in a code chip, as Sphinx writes one, in a narrow cell: across lines without fit.js, whole with it.
+    chip = ('<table><tr><td><code class="docutils literal notranslate"><span class="pre">(0.33,</span> '
+            '<span class="pre">0.44,</span> <span class="pre">0.62)</span></code></td>'
+            + '<td>RMS |ΔI| on sphere A at the default step</td>' * 4 + '</tr></table>')
+    old = _audit(browser, _synthetic(tmp_path, chip, css="code span.pre { white-space: normal; }"))["broken"]
+    assert [(b["text"], b["at"]) for b in old] == [("(0.33, 0.44, 0.62)", "a tuple on several lines")], old
+    assert _audit(browser, _synthetic(tmp_path, chip, book_html))["broken"] == []
 
 
 def test_the_width_check_catches_an_overwide_block_in_details(browser, book_html):

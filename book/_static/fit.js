@@ -1,5 +1,6 @@
 // Keeps every page within its column without breaking a word or a number (see fit.css):
 // - a number with a hyphen in it (1e-16, 2-3) is kept on one line: Chromium breaks after that hyphen;
+// - a code chip that is a tuple of two to four numbers ("(0.5, 0.5, 1.3)") is kept on one line;
 // - a long identifier or code line gets <wbr> break points between its parts (after . _ / ( [ , = and
 //   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word;
 // - in a table cell, values joined by slashes ("0.51/0.5/0.5") may break after a slash (a zero-width
@@ -51,7 +52,11 @@
       }
       if (pieces.length) { pieces.push(n.data.slice(last)); splice(n, pieces); }
     });
+    root.querySelectorAll("code").forEach(function (c) {
+      if (TUPLE.test(c.textContent)) c.classList.add("fit-whole");
+    });
   }
+  var NUM = "-?\\d[\\d.]*(?:e[-+]?\\d+)?", TUPLE = new RegExp("^\\(" + NUM + "(?:, " + NUM + "){1,3}\\)$", "i");
 
   // After . _ / = , ( [ between a letter (or closing bracket) and a letter: "renderer.<wbr>formulas".
   var JOINT = /([\p{L}\p{N}\])'"])([._\/=,(\[])(?=[\p{L}'"(\[])/gu;
