@@ -267,7 +267,7 @@ ERRATA = (
     Erratum(
         id="terminator-leak",
         where="Cell 1, `shade1`, used by Cells 1, 3, 5 and 6",
-        seed=r"a light counts wherever $N'\cdot\hat w > 0$; the geometric normal is never asked",
+        seed=r"a light counts wherever $N'\cdot\omega_i > 0$; the geometric normal is never asked",
         exposed_by="tests/test_parity.py (scalar reference with geometric shadow predicate)",
         measure=_terminator_leak,
         criterion="the draft's rule lights a pair beyond the terminator at the default β, by more than one 8-bit level",
@@ -276,10 +276,10 @@ ERRATA = (
     Erratum(
         id="specular-ungated",
         where="Cell 1, `shade1`",
-        seed=r"$k_s \max(0, N'\cdot h)^{n}$ added for every unshadowed light",
-        exposed_by="verify/test_errata.py (lobe where the bumped normal faces away)",
+        seed=r"$k_s \max(0, N'\cdot\omega_h)^{p}$ added for every unshadowed light",
+        exposed_by="verify/test_errata.py (highlight where the bumped normal faces away)",
         measure=_specular_ungated,
-        criterion="some pair facing away from its light receives a nonzero lobe",
+        criterion="some pair facing away from its light receives a nonzero highlight",
         present=lambda m: m["pixels"] > 0 and m["max_specular_added"] > 0,
     ),
     Erratum(

@@ -212,7 +212,8 @@ def _truncation(claimed=CLAIMED, denominator=2, order=ORDER, **stencil):
     series = written(sp.Add(*claimed, sp.O(eps**order), evaluate=False))
     return Theorem(
         id="central-difference-truncation", title=TITLES["central-difference-truncation"],
-        statement=(r"For a smooth $h$, $$⟦series⟧$$ Away from the seam and the poles this quotient is the renderer's "
+        statement=(r"For a smooth $h$, $$⟦series⟧$$ Away from the seam (the meridian where $u$ wraps from 1 to "
+                   r"0) and the poles this quotient is the renderer's "
                    r"central-difference stencil $D_u$, $D_v$, in $u$ and in $v$, for every height field: $$⟦stencil⟧$$ At "
                    r"the borders $u$ wraps and $v$ clamps to $[0, 1]$, the quotient in $v$ then one-sided over the "
                    r"clamped distance.  Here $\varepsilon_u$, $\varepsilon_v$ are the steps in $u$ and $v$: one fixed "

@@ -36,7 +36,7 @@ def test_the_crease_distance_is_the_distance_to_the_nearest_zero_line():
 
 def test_below_the_bands_width_every_straddling_stencil_lies_in_the_crease_band():
     """§3's claim: while eps is below asin(half-width) / (pi k) in each direction, every sphere-A pixel whose
-    stencil reaches across a crease (`crease_distance` below eps) carries the renderer's kink flag; for
+    stencil reaches across a crease (`crease_distance` below eps) carries the renderer's crease flag; for
     seeded random frequencies.  The check can fail: at five times the width, straddling pixels lie outside."""
     import math
 

@@ -22,7 +22,7 @@ from proofs.registry import THEOREMS
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
     "shading": "5af0a7f5432b58c2",
-    "displaced-normal": "980110f1c7d09f11",
+    "displaced-normal": "419133bf167ba010",
     "chart": "806ac8c86dd7e8dc",
     "frame-orthonormal": "494b22ccf6847951",
     "frame-orientation": "159cdc15fdb9b096",
@@ -35,7 +35,7 @@ PRINTED = {
     "no-boundary": "3cdd4fa8159796f1",
     "normal-beta-derivative": "644a026a3f47d53f",
     "beta-zero-regression": "ddf30c60292784fd",
-    "central-difference-truncation": "bae73524f9a92e17",
+    "central-difference-truncation": "1d7a38548a2d22ed",
     "optimal-step": "8ff24d3b64fdf31c",
     "bump-vs-displacement": "8908f50dedeb2cc0",
     "blinn-perturbation": "9955779fe68ebcfa",

@@ -613,7 +613,7 @@ def _nudged(value, by):
 def test_parity_rejects_a_frame_of_any_one_field_changed(other, name, by):
     """The default scene's frame replaced by the frame of the scene with any one field changed (set to
     its value in any accepted scene, or its first number nudged by 1e-10 to 1e-3 relative): wherever
-    the two frames differ (a chamber or a kink flag, a channel by more than 1e-9, a gradient component
+    the two frames differ (a chamber or a crease flag, a channel by more than 1e-9, a gradient component
     by more than 1e-9 relative) at more pixels than the grazing exemption may excuse, parity fails.
     Its allowances hide no change of the scene, however small."""
     scene = Scene()

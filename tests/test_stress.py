@@ -149,7 +149,7 @@ def test_grazing_rays_at_the_silhouette_stay_on_the_surface():
        component=st.sampled_from((0, 1)), which=st.floats(0.0, 1.0), other=st.floats(0.02, 0.98))
 def test_points_exactly_on_a_crease(k, k_other, component, which, other):
     """A point on a crease of ridges (u = m / k_u, or v = m / k_v, as float64 represents them; the
-    other coordinate off its own creases), at any frequencies: the kink flag is set, the exact
+    other coordinate off its own creases), at any frequencies: the crease flag is set, the exact
     gradient's component across the crease is 0 or one side's slope, and the central quotient,
     straddling the kink, averages the two sides to about 0.  The creases inside the chart, and u = 0
     and 1 where k_u is a whole number (u wraps; at another k_u the seam is a jump, not a crease;

@@ -26,7 +26,7 @@ WORDS = {
     ),
     "terminator-leak": dict(
         title="Lights leak past the terminator of the bumped sphere",
-        correction=r"a light reaches $P$ only if $N\cdot w > 0$ (geometric) and no blocker cuts the segment; $N'$ then only weights Lambert and the lobe",
+        correction=r"a light reaches $P$ only if $N\cdot\omega_i > 0$ (geometric) and no blocker cuts the segment; $N'$ then only weights Lambert's term and the highlight",
         finding=(
             "At the default $\\beta$ the draft's rule and normal, on this renderer's geometry (E1 hides "
             "sphere A), light {leak_pixels_default:,} (pixel, light) "
@@ -37,11 +37,11 @@ WORDS = {
         ),
     ),
     "specular-ungated": dict(
-        title="The specular lobe is added where the surface faces away from the light",
-        correction=r"the lobe is zero where $N'\cdot\hat w \le 0$",
+        title="The highlight is added where the surface faces away from the light",
+        correction=r"the highlight is zero where $N'\cdot\omega_i \le 0$",
         finding=(
             "In the default frame {pixels:,} (pixel, light) pairs face away from the light yet "
-            "receive a lobe; the largest is {max_specular_added:.1e}, far below one 8-bit level: "
+            "receive a highlight; the largest is {max_specular_added:.1e}, far below one 8-bit level: "
             "invisible here, wrong in principle."
         ),
     ),

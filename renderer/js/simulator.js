@@ -581,7 +581,9 @@ class Simulator {
                                    stroke: "currentColor" }));
       }
     }
-    [["rms", "RMS |ΔI| on sphere A"], ["max", "max |ΔI| on sphere A"]].forEach(([key, label], i) => {
+    // Sampled, the curve's values differ from the ledger's, which counts every pixel: its legend says so.
+    const over = this.curve.stride === 1 ? " on sphere A" : " (sampled)";
+    [["rms", "RMS |ΔI|" + over], ["max", "max |ΔI|" + over]].forEach(([key, label], i) => {
       const y = m.top - 8, x0 = m.left + i * 160;
       nodes.push(svg("line", { x1: x0, x2: x0 + 22, y1: y - 4, y2: y - 4, stroke: CURVE_COLOURS[key], "stroke-width": 2,
                                "stroke-dasharray": key === "max" ? "6 3" : "none" }));
