@@ -1406,7 +1406,10 @@ MAX_STUCK = 0.25
 #: both "ucurve" positions the plot and its caption, which must also lie wholly on the screen,
 #: and on a phone (under 720 px) the ε slider, wholly on the screen with them; on a phone at
 #: "difference", the ε slider and the difference canvas wholly on the screen, uncovered (dragging ε
-#: shows the difference change).  Besides covering, the check measures what a reader must read:
+#: shows the difference change); on a phone at "together" (the difference canvas just below what sticks at
+#: the top, before a pixel is read out: the readout, one line until then, lies between them), the ε slider,
+#: the difference canvas and the U-curve's plot wholly on the screen, uncovered (dragging ε shows the image
+#: and the curve move together).  Besides covering, the check measures what a reader must read:
 #: at the "ucurve" positions the caption's font at least 12 px and every text of the plot at least
 #: 10 px as drawn (its font size times the plot's scale), and at "ledger" every column of the
 #: ledger inside the ledger's visible box (none cut off, no sideways scrolling).
@@ -1418,11 +1421,15 @@ COVERED_JS = """async (where) => {
   const bar = () => Math.max(header(), sticky(main) ? main.getBoundingClientRect().bottom : 0);
   const settle = () => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
   const [at, block] = {top: ['[data-symrender-sim]', 'start'], canvases: ['#sim-canvas-symbolic', 'center'],
-                        difference: ['#sim-canvas-difference', 'center'], ucurve_bottom: ['.sim-curve', 'end'], ucurve_middle: ['.sim-curve', 'center'],
+                        difference: ['#sim-canvas-difference', 'center'], together: ['#sim-canvas-difference', 'start'],
+                        ucurve_bottom: ['.sim-curve', 'end'], ucurve_middle: ['.sim-curve', 'center'],
                         ledger: ['.sim-ledger', 'center']}[where];
   document.querySelector(at).scrollIntoView({block});
   await settle();
   if (where === 'top') { window.scrollBy(0, -header() - 8); await settle(); }
+  if (where === 'together') {
+    window.scrollBy(0, document.querySelector(at).getBoundingClientRect().top - bar() - 4); await settle();
+  }
   // What covers a point: the theme's header, or the nearest element with an id (the simulator's parts).
   const name = hit => {
     if (!hit) return 'nothing (off the screen)';
@@ -1463,6 +1470,9 @@ COVERED_JS = """async (where) => {
     check(document.getElementById('sim-log_eps'), '#sim-log_eps beside the difference canvas', 0, true);
     check(document.getElementById('sim-canvas-difference'), '#sim-canvas-difference', 0, true);
   }
+  if (where === 'together' && innerWidth < 720)
+    for (const id of ['sim-log_eps', 'sim-canvas-difference', 'sim-curve'])
+      check(document.getElementById(id), '#' + id + ' with the difference canvas and the plot', 0, true);
   if (where === 'ledger') {
     const ledger = document.querySelector('.sim-ledger'), box = ledger.getBoundingClientRect();
     if (ledger.scrollWidth > ledger.clientWidth + 1) found.push('.sim-ledger scrolls sideways');
@@ -1471,13 +1481,13 @@ COVERED_JS = """async (where) => {
   }
   return [...new Set(found)];
 }""".replace("MAX_STUCK", str(MAX_STUCK))
-READING_POSITIONS = ("top", "canvases", "difference", "ucurve_bottom", "ucurve_middle", "ledger")
+READING_POSITIONS = ("together", "top", "canvases", "difference", "ucurve_bottom", "ucurve_middle", "ledger")
 
 
 def _layout(browser, book_html, width, bundle=None, css=None, shots=None):
     """{position: what covers the controls, the readout, the plot or its caption there} at ``width``
     px (844 px tall on a phone, with touch; 900 on a desktop), with a pixel of sphere A read out
-    (tapped on a phone, hovered over at 1280); with ``shots``, a screenshot of each position
+    (tapped on a phone, hovered over at 1280) at every position but "together"; with ``shots``, a screenshot of each position
     to test-artifacts/s4_<width>px_<position><shots>.png."""
     phone = width < 720
     options = dict(viewport={"width": width, "height": 844 if phone else 900})
@@ -1485,6 +1495,10 @@ def _layout(browser, book_html, width, bundle=None, css=None, shots=None):
         options.update(has_touch=True, is_mobile=True, device_scale_factor=2)
     s = Session(browser, _url(book_html), bundle=bundle, css=css, **options)
     try:
+        found = {"together": s.page.evaluate(COVERED_JS, "together")}         # before a pixel is read out
+        if shots is not None:
+            ARTIFACTS.mkdir(parents=True, exist_ok=True)
+            s.page.screenshot(path=str(ARTIFACTS / f"s4_{width}px_together{shots}.png"))
         gb = gbuffer(Scene(), SIZE, SIZE)
         rows, cols = np.nonzero(gb.chamber == 1)
         i, j = int(cols[len(rows) // 2]), int(rows[len(rows) // 2])
@@ -1497,8 +1511,7 @@ def _layout(browser, book_html, width, bundle=None, css=None, shots=None):
         else:
             s.page.hover("#sim-canvas-symbolic", position=point)
         _readout_pixel(s, i, j)
-        found = {}
-        for where in READING_POSITIONS:
+        for where in READING_POSITIONS[1:]:
             found[where] = s.page.evaluate(COVERED_JS, where)
             if shots is not None:
                 ARTIFACTS.mkdir(parents=True, exist_ok=True)
@@ -1548,6 +1561,9 @@ WRONG_LAYOUTS = {
     "the U-curve's caption in small print": ("css",
         "#sim-curve-caption { font-size: 0.875rem;", "#sim-curve-caption { font-size: 0.7rem;",
         "#sim-curve-caption's font 11.2 px (under 12)"),
+    "the theme's margin under the readout, the plot pushed off the screen": ("bundle",
+        ".symrender-sim .sim-stage dl.sim-readout { margin: 0; }", "",
+        "#sim-curve with the difference canvas and the plot covered by nothing (off the screen)"),
     "the ledger's wide cells on a phone": ("css",
         "table.sim-ledger td { padding: 0.1rem 0.25rem; }", "table.sim-ledger td { }", 'ledger column "last update" cut off'),
 }

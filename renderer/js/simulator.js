@@ -149,6 +149,8 @@ const STYLE = `
 .symrender-sim .sim-readout { grid-column: 3; font-size: 0.75rem; line-height: 1.3; margin: 0;
   display: grid; grid-template-columns: max-content minmax(0, 1fr); gap: 0.1rem 0.5rem; align-content: start;
   font-variant-numeric: tabular-nums; background: var(--pst-color-background, #fff); }
+/* The theme gives a classed <dl> a bottom margin of 3rem: none here (on a phone it parted the readout from the U-curve). */
+.symrender-sim .sim-stage dl.sim-readout { margin: 0; }
 .symrender-sim .sim-readout dt { font-weight: 600; }
 .symrender-sim .sim-readout dd { margin: 0; overflow-wrap: break-word; min-width: 0; }
 .symrender-sim .sim-controls { display: grid; grid-template-columns: repeat(auto-fill, minmax(13rem, 1fr)); gap: 0.4rem 1rem; margin: 0.8rem 0; }
@@ -182,6 +184,8 @@ const STYLE = `
   .symrender-sim .sim-stage { grid-template-columns: minmax(0, 1fr); }
   .symrender-sim .sim-curve, .symrender-sim .sim-readout { grid-column: 1; }
   .symrender-sim .sim-curve { order: 1; }
+  /* The plot a little lower, so that the difference canvas, the readout and the plot fit under the controls at once. */
+  .symrender-sim .sim-curve svg { height: 12rem; }
   .symrender-sim .sim-readout { position: sticky; bottom: 0; z-index: 2; padding: 0.3rem 0.4rem;
     border-top: 1px solid currentColor; max-height: 40vh; overflow-y: auto; }
 }
