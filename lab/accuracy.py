@@ -450,8 +450,9 @@ def footprint_median(size=256):
         ``size`` is not an integer in [1, 4096].
     """
     from .store import measured
-    size = positive_int("size", size, high=MAX_SQUARE)
-    return measured("footprint-median", lambda size: float(np.median(footprint_steps(Scene(), size))), size=size)
+    size = positive_int("size", size)           # a Python int, which the store's JSON holds; too large a
+    return measured("footprint-median",         # size is footprint_steps' to refuse
+                    lambda size: float(np.median(footprint_steps(size=size))), size=size)
 
 
 #: The steps of the simulator's U-curve (`renderer.ledger.CURVE_LOG_EPS`), chart units.
