@@ -442,7 +442,7 @@ def footprint_steps(scene=None, size=256):
 def footprint_median(size=256):
     """The median of `footprint_steps` over the book's scene, `renderer.Scene()`, at ``size`` × ``size``
     pixels: one measurement of the build (`lab.store`), which §3's table of steps and §5's Cell 2 both
-    show.  A float, chart units.
+    show (seed Cell 2's question; the footprint rule is pbrt-v4's).  A float, chart units.
 
     Raises
     ------

@@ -97,6 +97,8 @@ def numbering_faults(places, claims=CLAIMS):
 
 def test_a_note_on_a_draft_cell_stands_in_the_labs_cell_of_that_number_as_the_index_says():
     index = " ".join((BOOK / "index.md").read_text(encoding="utf-8").split())
+    lab_cells = re.findall(r"^\(cell(\d)\)=$", (BOOK / "s5_lab.md").read_text(encoding="utf-8"), re.M)
+    assert lab_cells == [str(n) for n in range(1, 8)], lab_cells         # the sentence's "Cells 1–7"
     assert "Cells 1–7 are numbered as this book's sections and the lab's cells" in index
     assert "the draft's Cell 2 on the tangent frame is noted in {ref}`§3 <s3>`" in index
     assert numbering_faults(verdicts.PLACES) == []

@@ -146,10 +146,11 @@ const STYLE = `
 .symrender-sim .sim-curve { grid-column: 1 / span 2; }
 .symrender-sim .sim-curve svg { width: 100%; height: 13rem; display: block; overflow: visible; }
 .symrender-sim .sim-curve text { fill: currentColor; font-size: 11px; }
-.symrender-sim .sim-readout { grid-column: 3; font-size: 0.75rem; line-height: 1.3; margin: 0;
+.symrender-sim .sim-readout { grid-column: 3; font-size: 0.75rem; line-height: 1.3;
   display: grid; grid-template-columns: max-content minmax(0, 1fr); gap: 0.1rem 0.5rem; align-content: start;
   font-variant-numeric: tabular-nums; background: var(--pst-color-background, #fff); }
-/* The theme gives a classed <dl> a bottom margin of 3rem: none here (on a phone it parted the readout from the U-curve). */
+/* No margin: the theme gives a classed <dl> 3rem below it, by a selector that outranks the rule above (on a phone
+   it parted the readout from the U-curve). */
 .symrender-sim .sim-stage dl.sim-readout { margin: 0; }
 .symrender-sim .sim-readout dt { font-weight: 600; }
 .symrender-sim .sim-readout dd { margin: 0; overflow-wrap: break-word; min-width: 0; }
