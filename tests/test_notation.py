@@ -22,7 +22,7 @@ from proofs.registry import THEOREMS
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
     "shading": "5af0a7f5432b58c2",
-    "displaced-normal": "419133bf167ba010",
+    "displaced-normal": "9be8eb368edfbd8e",
     "chart": "806ac8c86dd7e8dc",
     "frame-orthonormal": "494b22ccf6847951",
     "frame-orientation": "159cdc15fdb9b096",
@@ -116,6 +116,19 @@ def test_a_tuple_chain_prints_a_component_a_line():
     t = Theorem("t", "T", "", calc(sp.Tuple(u, v), ("why", sp.Tuple(w, 2 * w)), ("then", sp.Tuple(1, 2))), {})
     assert latex.chain(t, t.steps, [1, 2]) == (r"\begin{aligned}\raise 0em{u} &\overset{(1)}{=} w\\ &\overset{(2)}{=} 1\\ "
                                                r"\raise 0em{v} &\overset{(1)}{=} 2 w\\ &\overset{(2)}{=} 2\end{aligned}")
+
+
+def test_a_column_vector_chain_prints_a_component_a_line_its_expressions_above_their_relations():
+    """A column vector's equation is a block per component, as a tuple's (as one matrix beside another, MathJax
+    broke it at "=" on a phone); a component whose left side is an expression, not a name, has that side on a
+    line of its own and its relation indented below it."""
+    u, v, w = sp.symbols("u v w")
+    from proofs.core import Theorem, calc
+    named = Theorem("t", "T", "", calc(sp.Matrix([u, v]), ("why", sp.Matrix([w, 2 * w]))), {})
+    assert latex.chain(named, named.steps) == r"\begin{aligned}\raise 0em{u} &= w\\ \raise 0em{v} &= 2 w\end{aligned}"
+    formulas = Theorem("t", "T", "", calc(sp.Matrix([u + v, v]), ("why", sp.Matrix([w, 2 * w]))), {})
+    assert latex.chain(formulas, formulas.steps) == (r"\begin{aligned}&\raise 0em{u + v}\\ &\qquad = w\\ "
+                                                     r"&\raise 0em{v}\\ &\qquad = 2 w\end{aligned}")
 
 
 def test_a_link_whose_left_side_is_rewritten_shows_that_side_on_an_unmarked_line():

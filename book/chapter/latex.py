@@ -299,16 +299,24 @@ def chain(t, steps, numbers=None) -> str:
             marks.append(None)
         sides.append(step.rhs)
         marks.append(k)
-    split = all(isinstance(s, sp.Tuple) and len(s) == len(sides[0]) for s in sides)
+    split = all(isinstance(s, sp.Tuple) and len(s) == len(sides[0]) for s in sides) or all(
+        isinstance(s, sp.MatrixBase) and s.shape == sides[0].shape and s.shape[1] == 1 for s in sides)
     blocks = [[s[i] for s in sides] for i in range(len(sides[0]))] if split else [sides]
     if len(blocks) == 1 and len(sides) == 2:
         return f"{printer._print(sides[0])} {_relation(marks[0])} {printer._print(sides[1])}"
     rows = []
+    # A column vector's components whose left sides are expressions, not names: each left side on a line
+    # of its own, its relations indented below it (beside its right side, a row was wider than a phone).
+    apart = split and isinstance(sides[0], sp.MatrixBase) and not all(
+        isinstance(b[0], (sp.Symbol, AppliedUndef, sp.Derivative)) for b in blocks)
+    indent = r"&\qquad "
     for block in blocks:
         # The left side in a box of its own width (an mpadded, which MathJax does not break): in a row
         # too wide for the column MathJax narrows every column, and broke D_u(u, v) before its "(".
         head = rf"\raise 0em{{{printer._print(block[0])}}} &"
+        if apart:
+            rows.append("&" + head[:-2])
         for mark, rhs in zip(marks, block[1:]):
-            rows.append(f"{head}{_relation(mark)} {printer._print(rhs)}")
+            rows.append(f"{indent if apart else head}{_relation(mark)} {printer._print(rhs)}")
             head = "&"
     return r"\begin{aligned}" + r"\\ ".join(rows) + r"\end{aligned}"
