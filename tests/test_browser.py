@@ -1283,6 +1283,10 @@ def _scroll_to_canvases(s):
     return header
 
 
+#: Run in the page: the names of the readout's rows on the screen (not hidden).
+SHOWN_ROWS = "[...document.querySelectorAll('#sim-readout dt')].filter(dt => dt.checkVisibility()).map(dt => dt.textContent)"
+
+
 def _canvases_and_readout_in_view(s, width, height, header):
     """Whether the three canvases, the U-curve and the readout are all within the viewport
     below the header, and the readout beside the plot; and their boxes."""
@@ -1294,7 +1298,7 @@ def _canvases_and_readout_in_view(s, width, height, header):
 
 def test_at_1280_the_readout_and_the_u_curve_sit_beside_the_canvases(browser, book_html):
     """At 1280 x 900, with the canvases in view, the U-curve and the readout (filled in by hovering
-    over a pixel of sphere A) are in view too, the readout beside the plot; the readout moved
+    over a pixel of sphere A, every row shown, no button) are in view too, the readout beside the plot; the readout moved
     under the controls (the wrong variant) is not in view."""
     s = Session(browser, _url(book_html), viewport={"width": 1280, "height": 900})
     try:
@@ -1304,7 +1308,8 @@ def test_at_1280_the_readout_and_the_u_curve_sit_beside_the_canvases(browser, bo
         s.page.mouse.move(canvas["x"] + (i + 0.5) * canvas["width"] / SIZE,
                           canvas["y"] + (j + 0.5) * canvas["height"] / SIZE)
         _readout_pixel(s, i, j)
-        assert "(u, v)" in s.page.text_content("#sim-readout")          # a pixel of sphere A: every row
+        assert "(u, v)" in s.page.evaluate(SHOWN_ROWS) and len(s.page.evaluate(SHOWN_ROWS)) == 10   # every row
+        assert not s.page.is_visible(".sim-more")
         in_view, boxes = _canvases_and_readout_in_view(s, 1280, 900, header)
         assert in_view, boxes
         row = [boxes[f"#sim-canvas-{n}"] for n in ("numeric", "symbolic", "difference")]
@@ -1359,7 +1364,8 @@ def _canvases_stacked(s):
 def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_html):
     """At 390 px, with touch: the canvases stacked, each at least 300 px wide; a tap on a canvas
     shows the pixel tapped in the readout, which stays in view (it sticks to the bottom of the
-    screen while the canvases scroll by).  Without the narrow-screen rule (the wrong variant)
+    screen while the canvases scroll by) with two rows, which pixel and its |ΔI|, until its button asks
+    for all ten.  Without the narrow-screen rule (the wrong variant)
     the canvases sit side by side, too small."""
     s = Session(browser, _url(book_html), viewport={"width": 390, "height": 844}, has_touch=True,
                 is_mobile=True, device_scale_factor=2)
@@ -1378,7 +1384,11 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
             ri, rj = _readout_pixel(s, i, j)
             assert s.page.get_attribute("#sim-readout", "data-chamber") == str(gb.chamber[rj, ri]) == "1"
             assert _inside(_box(s, "#sim-readout"), 390, 844), _box(s, "#sim-readout")
-        assert "(u, v)" in s.page.text_content("#sim-readout")
+        assert s.page.evaluate(SHOWN_ROWS) == ["pixel", "|ΔI|"]             # until the reader asks for all
+        s.page.tap(".sim-more")
+        assert s.page.get_attribute(".sim-more", "aria-expanded") == "true"
+        assert "(u, v)" in s.page.evaluate(SHOWN_ROWS) and len(s.page.evaluate(SHOWN_ROWS)) == 10
+        assert _inside(_box(s, ".sim-readout-box"), 390, 844), _box(s, ".sim-readout-box")
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         s.page.screenshot(path=str(ARTIFACTS / "s4_at_390px.png"))
         s.page.evaluate("(st => st.textContent = st.textContent.replace(/@media[^]*$/, ''))"
@@ -1409,7 +1419,8 @@ MAX_STUCK = 0.25
 #: shows the difference change); on a phone at "together" (the difference canvas just below what sticks at
 #: the top, before a pixel is read out: the readout, one line until then, lies between them), the ε slider,
 #: the difference canvas and the U-curve's plot wholly on the screen, uncovered (dragging ε shows the image
-#: and the curve move together).  Besides covering, the check measures what a reader must read:
+#: and the curve move together); and so again at "together_read", with a pixel read out (the readout's two
+#: rows, which pixel and its |ΔI|, until the reader asks for all).  Besides covering, the check measures what a reader must read:
 #: at the "ucurve" positions the caption's font at least 12 px and every text of the plot at least
 #: 10 px as drawn (its font size times the plot's scale), and at "ledger" every column of the
 #: ledger inside the ledger's visible box (none cut off, no sideways scrolling).
@@ -1422,12 +1433,13 @@ COVERED_JS = """async (where) => {
   const settle = () => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)));
   const [at, block] = {top: ['[data-symrender-sim]', 'start'], canvases: ['#sim-canvas-symbolic', 'center'],
                         difference: ['#sim-canvas-difference', 'center'], together: ['#sim-canvas-difference', 'start'],
+                        together_read: ['#sim-canvas-difference', 'start'],
                         ucurve_bottom: ['.sim-curve', 'end'], ucurve_middle: ['.sim-curve', 'center'],
                         ledger: ['.sim-ledger', 'center']}[where];
   document.querySelector(at).scrollIntoView({block});
   await settle();
   if (where === 'top') { window.scrollBy(0, -header() - 8); await settle(); }
-  if (where === 'together') {
+  if (where.startsWith('together')) {
     window.scrollBy(0, document.querySelector(at).getBoundingClientRect().top - bar() - 4); await settle();
   }
   // What covers a point: the theme's header, or the nearest element with an id (the simulator's parts).
@@ -1470,7 +1482,7 @@ COVERED_JS = """async (where) => {
     check(document.getElementById('sim-log_eps'), '#sim-log_eps beside the difference canvas', 0, true);
     check(document.getElementById('sim-canvas-difference'), '#sim-canvas-difference', 0, true);
   }
-  if (where === 'together' && innerWidth < 720)
+  if (where.startsWith('together') && innerWidth < 720)
     for (const id of ['sim-log_eps', 'sim-canvas-difference', 'sim-curve'])
       check(document.getElementById(id), '#' + id + ' with the difference canvas and the plot', 0, true);
   if (where === 'ledger') {
@@ -1481,13 +1493,14 @@ COVERED_JS = """async (where) => {
   }
   return [...new Set(found)];
 }""".replace("MAX_STUCK", str(MAX_STUCK))
-READING_POSITIONS = ("together", "top", "canvases", "difference", "ucurve_bottom", "ucurve_middle", "ledger")
+READING_POSITIONS = ("together", "together_read", "top", "canvases", "difference", "ucurve_bottom", "ucurve_middle", "ledger")
 
 
 def _layout(browser, book_html, width, bundle=None, css=None, shots=None):
     """{position: what covers the controls, the readout, the plot or its caption there} at ``width``
     px (844 px tall on a phone, with touch; 900 on a desktop), with a pixel of sphere A read out
-    (tapped on a phone, hovered over at 1280) at every position but "together"; with ``shots``, a screenshot of each position
+    (tapped on a phone, hovered over at 1280) at every position but "together", on a phone with all its rows
+    shown after "together_read"; with ``shots``, a screenshot of each position
     to test-artifacts/s4_<width>px_<position><shots>.png."""
     phone = width < 720
     options = dict(viewport={"width": width, "height": 844 if phone else 900})
@@ -1516,6 +1529,8 @@ def _layout(browser, book_html, width, bundle=None, css=None, shots=None):
             if shots is not None:
                 ARTIFACTS.mkdir(parents=True, exist_ok=True)
                 s.page.screenshot(path=str(ARTIFACTS / f"s4_{width}px_{where}{shots}.png"))
+            if where == "together_read" and phone:          # the rest with every row shown, the tallest readout
+                s.page.tap(".sim-more")
         assert s.errors == []
         return found
     finally:
@@ -1561,6 +1576,9 @@ WRONG_LAYOUTS = {
     "the U-curve's caption in small print": ("css",
         "#sim-curve-caption { font-size: 0.875rem;", "#sim-curve-caption { font-size: 0.7rem;",
         "#sim-curve-caption's font 11.2 px (under 12)"),
+    "every row of the readout on a phone, the plot pushed off the screen": ("bundle",
+        ' .sim-readout > :not(.sim-brief) { display: none; }', ' .sim-readout > :not(.sim-brief) { }',
+        "#sim-curve with the difference canvas and the plot covered by nothing (off the screen)"),
     "the theme's margin under the readout, the plot pushed off the screen": ("bundle",
         ".symrender-sim .sim-stage dl.sim-readout { margin: 0; }", "",
         "#sim-curve with the difference canvas and the plot covered by nothing (off the screen)"),

@@ -126,6 +126,8 @@ export const PRESETS = [
 
 const HINT = "Hover over a canvas, tap it, or focus it and use the arrow keys, to read that pixel in the readout; " +
   "on the ε slider, Page Up and Page Down move a whole decade.";
+// The readout's rows a phone shows until the reader asks for all (STYLE).
+const BRIEF_ROWS = ["pixel", "|ΔI|"];
 // The controls shown above the canvases.
 const MAIN = ["height_field", "log_eps", "beta"];
 
@@ -146,9 +148,11 @@ const STYLE = `
 .symrender-sim .sim-curve { grid-column: 1 / span 2; }
 .symrender-sim .sim-curve svg { width: 100%; height: 13rem; display: block; overflow: visible; }
 .symrender-sim .sim-curve text { fill: currentColor; font-size: 11px; }
-.symrender-sim .sim-readout { grid-column: 3; font-size: 0.75rem; line-height: 1.3;
+.symrender-sim .sim-readout-box { grid-column: 3; min-width: 0; background: var(--pst-color-background, #fff); }
+.symrender-sim .sim-more { display: none; }
+.symrender-sim .sim-readout { font-size: 0.75rem; line-height: 1.3;
   display: grid; grid-template-columns: max-content minmax(0, 1fr); gap: 0.1rem 0.5rem; align-content: start;
-  font-variant-numeric: tabular-nums; background: var(--pst-color-background, #fff); }
+  font-variant-numeric: tabular-nums; }
 /* No margin: the theme gives a classed <dl> 3rem below it, by a selector that outranks the rule above (on a phone
    it parted the readout from the U-curve). */
 .symrender-sim .sim-stage dl.sim-readout { margin: 0; }
@@ -183,12 +187,20 @@ const STYLE = `
   .symrender-sim .sim-main label:has(select) { flex-direction: row; align-items: center; gap: 0.5rem; }
   .symrender-sim .sim-main label:has(select) select { flex: 1; min-width: 0; }
   .symrender-sim .sim-stage { grid-template-columns: minmax(0, 1fr); }
-  .symrender-sim .sim-curve, .symrender-sim .sim-readout { grid-column: 1; }
+  .symrender-sim .sim-curve, .symrender-sim .sim-readout-box { grid-column: 1; }
   .symrender-sim .sim-curve { order: 1; }
   /* The plot a little lower, so that the difference canvas, the readout and the plot fit under the controls at once. */
   .symrender-sim .sim-curve svg { height: 12rem; }
-  .symrender-sim .sim-readout { position: sticky; bottom: 0; z-index: 2; padding: 0.3rem 0.4rem;
-    border-top: 1px solid currentColor; max-height: 40vh; overflow-y: auto; }
+  .symrender-sim .sim-readout-box { position: sticky; bottom: 0; z-index: 2; padding: 0.3rem 0.4rem;
+    border-top: 1px solid currentColor; max-height: 40vh; overflow-y: auto; display: flex; align-items: start; gap: 0.5rem; }
+  .symrender-sim .sim-readout { flex: 1; }
+  /* A pixel read out shows two rows, which pixel and its |ΔI|, until the reader asks for all: all ten pushed the
+     U-curve off the screen. */
+  .symrender-sim .sim-readout[data-i] + .sim-more { display: block; padding: 0 0.5rem; }
+  .symrender-sim .sim-readout-box:has(.sim-more[aria-expanded="false"]) .sim-readout > :not(.sim-brief) { display: none; }
+  /* All rows: the button on a line of its own above them, which then take the box's width. */
+  .symrender-sim .sim-readout-box:has(.sim-more[aria-expanded="true"]) { flex-wrap: wrap; justify-content: end; }
+  .symrender-sim .sim-readout-box:has(.sim-more[aria-expanded="true"]) .sim-readout { flex-basis: 100%; order: 1; }
 }
 `;
 
@@ -274,7 +286,15 @@ class Simulator {
     const curve = el("figure", { class: "sim-curve" },
                      [this.plot, el("figcaption", { id: "sim-curve-caption" })]);
     this.readout = el("dl", { id: "sim-readout", class: "sim-readout", "aria-live": "polite" });
-    root.append(el("div", { class: "sim-stage" }, [...figs, curve, this.readout]));
+    // Shown on a phone only (STYLE), once a pixel is read out.
+    const more = el("button", { type: "button", class: "sim-more", "aria-controls": "sim-readout",
+                                "aria-expanded": "false", text: "all rows" });
+    more.addEventListener("click", () => {
+      const open = more.getAttribute("aria-expanded") === "false";
+      more.setAttribute("aria-expanded", String(open));
+      more.textContent = open ? "fewer rows" : "all rows";
+    });
+    root.append(el("div", { class: "sim-stage" }, [...figs, curve, el("div", { class: "sim-readout-box" }, [this.readout, more])]));
     this.show_readout([["pixel", "hover over a canvas, tap it, or focus it and use the arrow keys"]]);
     this.readout.setAttribute("aria-label", "the pixel readout");
     if (typeof ResizeObserver !== "undefined") new ResizeObserver(() => this.draw_curve()).observe(this.plot);
@@ -629,7 +649,8 @@ class Simulator {
   }
 
   show_readout(rows) {
-    this.readout.replaceChildren(...rows.flatMap(([k, v]) => [el("dt", { text: k }), el("dd", { text: v })]));
+    const brief = (k) => (BRIEF_ROWS.includes(k) ? { class: "sim-brief" } : {});
+    this.readout.replaceChildren(...rows.flatMap(([k, v]) => [el("dt", { text: k, ...brief(k) }), el("dd", { text: v, ...brief(k) })]));
   }
 
   show_probe(i, j) {
