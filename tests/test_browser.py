@@ -58,6 +58,8 @@ SIZE = 256
 CONTROLS = ["sim-height_field", "sim-log_eps", "sim-beta", "sim-bump", "sim-view", "sim-scale", "sim-numeric",
             "sim-k_u", "sim-k_v", "sim-model", "sim-resolution", "sim-zoom", "sim-sphere_b"]
 BUTTONS = ["sim-preset-try1", "sim-preset-try2", "sim-preset-try3", "sim-preset-try4", "sim-reset"]
+#: The readout's button (on a phone, once a pixel is read out): it shows rows and changes no scene.
+READOUT_BUTTON = "sim-more"
 SIM = "document.querySelector('[data-symrender-sim]').symrender"
 #: numpy dtypes of the page's typed arrays, by constructor name.
 TYPED = {"Uint8Array": np.uint8, "Uint8ClampedArray": np.uint8, "Int8Array": np.int8, "Uint16Array": "<u2",
@@ -112,6 +114,11 @@ class Session:
 
     def ledger(self, name):
         return float(self.page.get_attribute(f"#sim-{name}", "data-value"))
+
+    def wait_curve(self):
+        """Wait until the U-curve is drawn over every pixel (the simulator's `refine`), and return it."""
+        self.page.wait_for_selector("[data-symrender-sim][data-curve]", state="attached", timeout=30_000)
+        return self.sim("sim.curve")
 
     def fill(self, name, value):
         before = self.updates()
@@ -274,28 +281,30 @@ def test_eps_slider_moves_the_ledger_as_python_predicts(session):
     (ARTIFACTS / "browser_ledger.json").write_text(json.dumps(report, indent=1))
 
 
-def test_the_u_curve_is_the_ledger_of_its_sample_and_follows_the_controls(session):
+def test_the_u_curve_is_the_ledger_over_every_pixel_and_follows_the_controls(session):
     """The plot's points are the ledger (RMS, max |dI| on sphere A) at each step of the slider's
-    range in half decades, over the pixels of the frame's sample grid, within the error model of
-    Python's ledger over the same pixels; a sample one pixel coarser (the wrong variant) is not.
-    An eps move moves the marker only; a beta move recomputes the curve."""
+    range in half decades, over every pixel, within the error model of Python's ledger; the curve of
+    the sample it is first drawn from (the wrong variant: on ridges it misses the pixels that straddle a
+    crease) is not.  Its dots at the current step are the ledger's own numbers.  An eps move moves
+    the marker only; a beta move recomputes the curve."""
     session.select("height_field", "ridges")
     session.fill("beta", SIMULATOR_SCENE.beta)
     session.set_eps(-3)
-    curve = session.sim("sim.curve")
-    stride = curve["stride"]
-    assert stride == session.sim(f"Math.max(1, Math.ceil({SIZE} / 48))") and stride > 1
+    curve = session.wait_curve()
+    sample = session.sim(f"Math.max(1, Math.ceil({SIZE} / 48))")
+    assert curve["stride"] == 1 and sample > 1
     steps = [p["eps"] for p in curve["points"]]
     assert len(steps) == 27 and steps[0] == 1e-14 and steps[-1] == 0.1
     assert curve["here"]["eps"] == 1e-3
+    assert (curve["here"]["rms"], curve["here"]["max_abs"]) == (session.ledger("rms"), session.ledger("max"))
     # Near 1e-3 and 10^-2.5, where the model's bound is far below the differences; each point against
     # Python at its own step (which steps the page computes with is the control tests' business).
     for near in (-3.0, -2.5):
         point = min(curve["points"], key=lambda p: abs(np.log10(p["eps"]) - near))
         eps, got = point["eps"], (point["rms"], point["max_abs"])
         ridges = SIMULATOR_SCENE.replace(height_field="ridges")
-        assert _within(got, _python_ledger(ridges, eps, stride)), eps
-        assert not _within(got, _python_ledger(ridges, eps, stride + 1)), eps
+        assert _within(got, _python_ledger(ridges, eps)), eps
+        assert not _within(got, _python_ledger(ridges, eps, sample)), eps
     plot = session.page.locator("#sim-curve")
     rms_line = plot.locator("#sim-curve-rms").get_attribute("points")
     assert len(rms_line.split()) == 27
@@ -304,8 +313,10 @@ def test_the_u_curve_is_the_ledger_of_its_sample_and_follows_the_controls(sessio
     assert plot.locator("#sim-curve-rms").get_attribute("points") == rms_line          # the curve stays
     assert plot.locator("#sim-curve-marker").get_attribute("x1") != marker            # the marker moves
     session.fill("beta", 0.6)
+    session.wait_curve()
     assert plot.locator("#sim-curve-rms").get_attribute("points") != rms_line          # recomputed
     session.fill("beta", SIMULATOR_SCENE.beta)
+    session.wait_curve()
     assert plot.locator("#sim-curve-rms").get_attribute("points") == rms_line
     assert session.errors == []
 
@@ -318,7 +329,7 @@ def test_the_curve_marks_its_image_best_step_and_names_its_right_arm_per_field(s
     session.select("height_field", "ridges")
     session.fill("beta", SIMULATOR_SCENE.beta)
     session.set_eps(-3)
-    points = session.sim("sim.curve")["points"]
+    points = session.wait_curve()["points"]
     best, worst = min(points, key=lambda p: p["rms"]), max(points, key=lambda p: p["rms"])
     plot = session.page.locator("#sim-curve")
     eps = float(plot.locator("#sim-curve-best").get_attribute("data-eps"))
@@ -564,7 +575,7 @@ def every_position(s):
         moves += [("sim-bump", bump), ("sim-beta", "every")]
     moves += [(i, "every") for i, k in layout if k == "range" and i != "sim-beta"]
     moves += [(i, "every") for i, k in layout if isinstance(k, list) or k == "checkbox"]
-    moves += [("sim-resolution", "min")] + [(i, "every") for i, k in layout if k in ("button", "submit")]
+    moves += [("sim-resolution", "min")] + [(i, "every") for i, k in layout if k in ("button", "submit") and i != READOUT_BUTTON]
     return s.page.evaluate(MOVES_JS, moves)
 
 
@@ -742,8 +753,9 @@ def test_every_control_is_reachable_and_movable_from_the_keyboard(browser, book_
 
 # ---- the simulator for every hand, keyboard and screen reader --------------------------------------
 
-#: Run in the page: each control of the simulator (input, select, button) as [id, width, height] in CSS px.
-CONTROL_BOXES_JS = """() => [...document.querySelectorAll('[data-symrender-sim] :is(input, select, button)')].map(e => {
+#: Run in the page: each control of the simulator (input, select, button) shown as [id, width, height] in CSS px.
+CONTROL_BOXES_JS = """() => [...document.querySelectorAll('[data-symrender-sim] :is(input, select, button)')]
+  .filter(e => e.checkVisibility()).map(e => {
   const r = e.getBoundingClientRect(); return [e.id, +r.width.toFixed(1), +r.height.toFixed(1)]; })"""
 #: The least target, CSS px a side (WCAG 2.2, 2.5.8, AA).
 MIN_TARGET_PX = 24
@@ -767,13 +779,17 @@ def small_targets(s):
 @pytest.mark.parametrize("width", [390, 1280])
 def test_every_control_is_a_target_of_at_least_24_px(browser, book_html, width):
     """Every slider, menu, checkbox and button of the simulator at least 24 x 24 CSS px (the browser's
-    own: sliders 16 px tall, menus 20, the checkbox 13); the boxes go to test-artifacts/s4_targets_<width>.json."""
+    own: sliders 16 px tall, menus 20, the checkbox 13), on a phone with a pixel read out (its readout's button
+    shown); the boxes go to test-artifacts/s4_targets_<width>.json."""
     s = _simulator_at(browser, book_html, width)
     try:
+        phone = width < 720
+        if phone:
+            s.page.tap("#sim-canvas-symbolic")
         small, count = small_targets(s)
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         (ARTIFACTS / f"s4_targets_{width}.json").write_text(json.dumps(s.page.evaluate(CONTROL_BOXES_JS), indent=1))
-        assert count == len(CONTROLS) + len(BUTTONS)
+        assert count == len(CONTROLS) + len(BUTTONS) + phone
         assert not small, small
     finally:
         s.close()
@@ -1022,8 +1038,7 @@ WRONG_SPOKEN = {
                                                      "", "silently"),
     "the β note never giving way": ("      this.note.textContent = \"\";                                 // the note said its piece\n",
                                      "", "outlived"),
-    "a readout that is not announced": ('"aria-live": "polite" });\n    root.append(el("div", { class: "sim-stage" }',
-                                        '"aria-live": "off" });\n    root.append(el("div", { class: "sim-stage" }',
+    "a readout that is not announced": ('class: "sim-readout", "aria-live": "polite" }', 'class: "sim-readout", "aria-live": "off" }',
                                         "readout: aria-live 'off'"),
 }
 
