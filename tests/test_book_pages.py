@@ -378,10 +378,11 @@ class Page:
     """A page opened offline at ``width`` px, once MathJax has typeset it and fit.js is done.  Only file:
     addresses load; any other request is blocked and recorded in ``blocked``, and console errors and
     uncaught exceptions in ``errors``.  ``change(path, text)``, if given, rewrites each HTML and CSS file
-    the page loads from the site (a wrong variant)."""
+    the page loads from the site (a wrong variant); ``options`` go to the browser's context (``has_touch=True``: a
+    phone's)."""
 
-    def __init__(self, browser, url, width, height=900, change=None):
-        self.context = browser.new_context(viewport={"width": width, "height": height})
+    def __init__(self, browser, url, width, height=900, change=None, **options):
+        self.context = browser.new_context(viewport={"width": width, "height": height}, **options)
         self.blocked, self.errors = [], []
 
         def route(r):
@@ -1339,6 +1340,35 @@ FLOATING = """async () => {
   }
   return [...new Set(found)];
 }"""
+
+
+@pytest.mark.parametrize("variant", [None, "each solution titled with a link back to its exercise"])
+def test_a_tap_on_a_solutions_title_opens_it(browser, book_html, variant):
+    """On a phone, a tap on the middle of each solution's title (§1's, §7's) opens it: each follows its exercise
+    and is titled "Solution" (book/_config.yml).  The wrong variant, sphinx-exercise's other title, "Solution to"
+    and a link back to the exercise, is refused: the tap follows the link, and the solution stays shut."""
+    title = '<p class="admonition-title">Solution</p>'
+    linked = '<p class="admonition-title">Solution to<a class="reference internal" href="#top"> Exercise 1 (a title)</a></p>'
+
+    def change(path, text):
+        return text.replace(title, linked) if path.suffix == ".html" else text
+
+    for page in ("s1_what_changes", "s7_pitfalls"):
+        p = Page(browser, (book_html / f"{page}.html").as_uri(), 390, height=844,
+                 change=change if variant else None, has_touch=True, is_mobile=True)
+        try:
+            solutions = p.page.locator("div.solution.dropdown")
+            assert solutions.count() >= 1
+            shown = []
+            for k in range(solutions.count()):
+                head = solutions.nth(k).locator(".admonition-title")
+                head.scroll_into_view_if_needed()
+                head.tap()
+                p.page.wait_for_timeout(300)                # the theme's toggle animates
+                shown.append(solutions.nth(k).locator("section").first.is_visible())
+            assert shown == [variant is None] * len(shown), (page, shown)
+        finally:
+            p.close()
 
 
 @pytest.mark.parametrize("name", PAGES)
