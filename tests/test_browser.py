@@ -795,6 +795,48 @@ def test_every_control_is_a_target_of_at_least_24_px(browser, book_html, width):
         s.close()
 
 
+#: Run in the page: ["<menu id>: <option>"] for each option of each of the simulator's menus whose label, in the
+#: menu's font, is wider than the menu's box less its padding and what Chromium draws beside the text
+#: (`MENU_ARROW_PX`: 4 px before it, the arrow and its margin after it).
+MENU_ARROW_PX = 32
+CLIPPED_OPTIONS_JS = """() => {
+  const ruler = document.createElement('span');
+  ruler.style.cssText = 'position: absolute; visibility: hidden; white-space: pre';
+  document.body.append(ruler);
+  const found = [];
+  for (const menu of document.querySelectorAll('[data-symrender-sim] select')) {
+    const s = getComputedStyle(menu);
+    ruler.style.font = s.font;
+    const room = menu.clientWidth - parseFloat(s.paddingLeft) - parseFloat(s.paddingRight) - ARROW;
+    for (const o of menu.options) {
+      ruler.textContent = o.textContent;
+      if (ruler.getBoundingClientRect().width > room) found.push(menu.id + ': ' + o.textContent);
+    }
+  }
+  ruler.remove();
+  return found;
+}""".replace("ARROW", str(MENU_ARROW_PX))
+
+
+@pytest.mark.parametrize("width", [390, 1280])
+def test_every_menu_shows_each_option_whole(browser, book_html, width):
+    """No option of the simulator's menus is cut off by the menu's box (`CLIPPED_OPTIONS_JS`); with the numeric
+    gradient's old, longer label (the wrong variant) the check finds it cut at 1280 px, three menus a row."""
+    s = _simulator_at(browser, book_html, width)
+    try:
+        assert s.page.evaluate(CLIPPED_OPTIONS_JS) == []
+    finally:
+        s.close()
+    if width == 1280:
+        old = 'central: "central, one step ε"'
+        s = _simulator_at(browser, book_html, width,
+                          bundle=_replaced_once(old, 'central: "central differences, step ε"', "a longer label"))
+        try:
+            assert s.page.evaluate(CLIPPED_OPTIONS_JS) == ["sim-numeric: central differences, step ε"]
+        finally:
+            s.close()
+
+
 def test_the_target_check_catches_the_browsers_20_px_menus(browser, book_html):
     """Wrong variant: the menus at the browser's height (20 px) are caught, every one of them."""
     old = ".symrender-sim select { min-height: 1.75rem; }"

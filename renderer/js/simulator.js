@@ -83,7 +83,7 @@ export const CONTROLS = [
   { name: "scale", label: "difference scale", kind: "select", options: ["log", "linear"],
     labels: { log: LOG_SCALE, linear: LINEAR_SCALE } },
   { name: "numeric", label: "numeric gradient", kind: "select", options: NUMERIC,
-    labels: { central: "central differences, step ε", footprint: "central, step = pixel footprint" } },
+    labels: { central: "central, one step ε", footprint: "central, pixel footprint" } },
   { name: "k_u", label: "kᵤ, frequency in u", kind: "range", min: 1, max: 24, step: 1 },
   { name: "k_v", label: "kᵥ, frequency in v", kind: "range", min: 1, max: 24, step: 1 },
   { name: "model", label: "shading model", kind: "select", options: MODELS },
