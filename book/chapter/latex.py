@@ -156,6 +156,10 @@ class _Printer(LatexPrinter):
         else:
             shown = self._print(numer)
             top = (rf"\left({shown}\right)" if numer.is_Add or isinstance(numer, Dot) else shown) + f" {mats}"
+        if denom != 1 and self.inline and denom.is_Atom:          # in running text over one symbol: M / |M|
+            if len(matrices) == 1 and isinstance(matrices[0], sp.MatAdd):       # no fraction bar groups the sum
+                top = top.replace(mats, rf"\left({mats}\right)", 1)
+            return f"{top} / {self._print(denom)}"
         return top if denom == 1 else (rf"- \frac{{{top[2:]}}}{{{self._print(denom)}}}" if top.startswith("- ")
                                        else rf"\frac{{{top}}}{{{self._print(denom)}}}")
 
@@ -188,8 +192,8 @@ class _Printer(LatexPrinter):
         d = r"\partial" if named or requires_partial(f) else "d"
         below = " ".join(f"{d} {self._print(v)}" + (f"^{{{c}}}" if c > 1 else "") for v, c in counts)
         top = d + ("" if n == 1 else f"^{{{n}}}")
-        if named:
-            return rf"\frac{{{top} {self._print(f)}}}{{{below}}}"
+        if named:                                                  # in running text: dN/dbeta, not stacked
+            return rf"{top} {self._print(f)} / {below}" if self.inline else rf"\frac{{{top} {self._print(f)}}}{{{below}}}"
         return rf"\frac{{{top}}}{{{below}}} \left({self._print(f)}\right)"         # d/du (expression)
 
 
@@ -245,19 +249,19 @@ def statement(t) -> str:
 
     def display(m):
         """A placeholder set apart, ``$$⟦key⟧$$``: a claim laid out as `chain` lays out a proof's display,
-        anything else as `fill` prints it; each fraction at full size (``\\dfrac``: one within another is
+        anything else as `fill` prints it set apart; each fraction at full size (``\\dfrac``: one within another is
         otherwise set at 70 %)."""
-        shown = chain(t, [_Relation(*t.claims[m.group(1)])]) if m.group(1) in t.claims else fill(m)
+        shown = chain(t, [_Relation(*t.claims[m.group(1)])]) if m.group(1) in t.claims else fill(m, inline=False)
         return "\n\n$$\n{}\n$$\n\n".format(shown.replace(r"\frac{", r"\dfrac{"))
 
-    def fill(m):
+    def fill(m, inline=True):
         key = m.group(1)
         if key in t.claims:
-            return " = ".join(tex(x, t.names, inline=True) for x in t.claims[key])
+            return " = ".join(tex(x, t.names, inline=inline) for x in t.claims[key])
         if key in named:
-            return definition(t, named[key], inline=True)
+            return definition(t, named[key], inline=inline)
         if key in t.shown:
-            return tex(t.shown[key], t.names, inline=True)
+            return tex(t.shown[key], t.names, inline=inline)
         raise KeyError(f"theorem {t.id!r}: the statement names ⟦{key}⟧, neither a claim {sorted(t.claims)}, "
                        f"a named symbol {sorted(named)} nor a shown object {sorted(t.shown)}")
     return PLACEHOLDER.sub(fill, re.sub(rf"\$\$\s*{PLACEHOLDER.pattern}\s*\$\$", display, t.statement))
