@@ -30,6 +30,7 @@ far below the float64 quantities measured (>= 1e-17).
 
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass
 from fractions import Fraction
@@ -64,6 +65,29 @@ def _rational(x):
     return sp.Rational(*Fraction(x).as_integer_ratio())
 
 
+def _exact_at(expr, at):
+    """``expr`` with the symbols of ``at`` ({symbol: exact value}) replaced, as ``expr.subs(at)`` gives it, or
+    None where a power of two exact numbers would have more digits than Python prints
+    (``sys.get_int_max_str_digits()``): sympy would spend minutes computing (3 k_u)**(k_u**k_u) at k_u = 8 before
+    any check could refuse it."""
+    limit = sys.get_int_max_str_digits() or 4300
+
+    def walk(e):
+        if e in at:
+            return at[e]
+        if not e.args:
+            return e
+        args = [walk(a) for a in e.args]
+        if any(a is None for a in args):
+            return None
+        if isinstance(e, sp.Pow) and all(a.is_Rational for a in args):
+            base, power = args
+            if abs(power.p) * math.log10(max(abs(base.p), base.q)) >= limit:
+                return None
+        return e.func(*args)
+    return walk(expr)
+
+
 def _crease(expr, var, at, x0):
     """The factor under an ``Abs`` of ``expr`` (of the product there, the one in ``var``) that
     changes sign at x0 as ``var`` moves (the other
@@ -72,8 +96,10 @@ def _crease(expr, var, at, x0):
     F' vanishes too, |F| is flat there: both factors of the ridges vanish, say)."""
     for a in sorted(expr.atoms(sp.Abs), key=sp.default_sort_key):
         inner = a.args[0]
-        f = sp.lambdify(var, inner.subs(at), modules="mpmath")
-        df = sp.lambdify(var, sp.diff(inner, var).subs(at), modules="mpmath")
+        exact = _exact_at(inner, at), _exact_at(sp.diff(inner, var), at)
+        if None in exact:                               # too large to evaluate: `measure` refuses the field
+            continue
+        f, df = (sp.lambdify(var, e, modules="mpmath") for e in exact)
         with mpmath.workdps(DIGITS):
             X = mpmath.mpf(x0)
             value, slope = _real(f, X), _real(df, X)
@@ -407,11 +433,11 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     k = 0 if component == "u" else 1
     var, x = (F.u, u) if k == 0 else (F.v, v)
     at = {F.k_u: _rational(k_u), F.k_v: _rational(k_v), (F.v if k == 0 else F.u): _rational(v if k == 0 else u)}
-    point, g = dict(u=u, v=v, component=component), record.expr.subs(at)
-    if g.has(sp.zoo, sp.nan, sp.oo, -sp.oo):                # no value on the line (tan(pi u), u = 1/2)
+    point, g = dict(u=u, v=v, component=component), _exact_at(record.expr, at)
+    if g is not None and g.has(sp.zoo, sp.nan, sp.oo, -sp.oo):      # no value on the line (tan(pi u), u = 1/2)
         raise _undefined(record.name, point)
-    if sys.get_int_max_str_digits() and any(max(abs(r.p), r.q) >= 10 ** sys.get_int_max_str_digits()
-                                            for r in g.atoms(sp.Rational)):     # which lambdify cannot print
+    if g is None or sys.get_int_max_str_digits() and any(max(abs(r.p), r.q) >= 10 ** sys.get_int_max_str_digits()
+                                                         for r in g.atoms(sp.Rational)):   # which lambdify cannot print
         raise validate.InvalidValue(f"field {record.name} is too large to measure at (u, v) = ({u!r}, {v!r}): "
                                     f"its exact value there has more digits than Python prints")
     line = _line(g, var)

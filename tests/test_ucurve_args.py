@@ -127,6 +127,7 @@ def test_any_field_at_any_chart_point_is_a_u_curve_or_one_input_error(case):
     (lambda: measure("log(v)", 0.5, 0.0, component="v"), "field"),      # log 0 at the pole
     (lambda: measure("sqrt(u - 0.3)", 0.31, eps=[1e-3, 0.02]), "eps"),  # u - eps past the branch point
     (lambda: measure("u*(3*k_u + 1/k_u)**(3**k_u)"), "field"),          # 9,077 digits at k_u = 8
+    (lambda: measure("(3*k_u)**(k_u**k_u)"), "field"),                   # 23 million: refused before computing
     (lambda: measure("abs(log(u - 0.31))"), "field"),                   # the crease check meets the pole
     # float64 rounds u_m**2 up to the constant (h(u_m) = 0); exactly it is below it (h imaginary).
     (lambda: measure("sqrt(u**2 - 0.1417678433433451)", 0.3774972702218265, eps=[2.0**-10]), "eps"),
