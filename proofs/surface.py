@@ -139,7 +139,7 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
                   r"arc lengths, tilting away from rising $h$. Where the chart follows lines of curvature, "
                   r"$⟦n_u⟧$ and $⟦n_v⟧$ (a sphere, a torus, a plane), exactly "
                   r"$$⟦principal⟧$$ On sphere A, for $⟦phi⟧$ ($⟦kappa_u⟧$, $⟦kappa_v⟧$, $⟦L_u⟧$, "
-                  r"$⟦L_v⟧$) these are the renderer's surface bump: $$⟦sphere⟧$$",
+                  r"$⟦L_v⟧$) these are the renderer's surface bump, $t_u$ above and $t_v$ below: $$⟦sphere⟧$$",
         steps=(
             Step(r"Differentiate $p' = p + \beta h\, n$ by the product rule", sp.Tuple(DU_S, DV_S), derivatives,
                  cases=(("any surface", ANY_SURFACE),)),

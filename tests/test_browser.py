@@ -639,14 +639,18 @@ def frame_problems(s):
 def test_with_footprint_steps_the_eps_slider_is_disabled_and_says_it_is_unused(session):
     """Each pixel's footprint as its step leaves ε nothing to do: the slider is disabled and its printed value
     says "unused" (a reader once moved it and watched nothing change), and the U-curve marks no current ε,
-    its caption saying why (the frame's error had been drawn at ε); back on central differences all is live."""
+    its caption saying why (the frame's error had been drawn at ε), and its label speaks the frame's ledger; back on
+    central differences all is live."""
     s = session
     try:
         s.select("numeric", "footprint")
         assert s.page.is_disabled("#sim-log_eps") and s.page.text_content("#sim-log_eps-value").endswith(", unused")
         assert s.page.locator("#sim-curve-marker").count() == 0
         assert "no ε is marked" in s.page.text_content("#sim-curve-caption")
-        assert "footprint as its step" in s.page.get_attribute("#sim-curve", "aria-label")
+        label = s.page.get_attribute("#sim-curve", "aria-label")
+        # The label speaks the frame's own numbers, the ledger's (it had kept those of the last ε).
+        said = [f"{s.ledger(name):.1e}".replace("e-0", "e-") for name in ("rms", "max")]     # as the page prints
+        assert f"footprint as its step: RMS {said[0]}, max {said[1]}" in label, label
         s.select("numeric", "central")
         assert s.page.is_enabled("#sim-log_eps") and "unused" not in s.page.text_content("#sim-log_eps-value")
         assert s.page.locator("#sim-curve-marker").count() == 1

@@ -22,7 +22,7 @@ from proofs.registry import THEOREMS
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
     "shading": "5af0a7f5432b58c2",
-    "displaced-normal": "e9a2db1d025df5ca",
+    "displaced-normal": "6ccdd30f2a657fc4",
     "chart": "806ac8c86dd7e8dc",
     "frame-orthonormal": "0edc97e1e3d7ffe8",
     "frame-orientation": "159cdc15fdb9b096",

@@ -432,6 +432,7 @@ class Simulator {
     const t0 = performance.now();
     const res = this.renderer.update(scene, s.resolution, s.resolution, s.zoom, s.numeric);
     const ledger = compare(res.numeric, res.symbolic);
+    this.frame_ledger = ledger;
     const t_shade = performance.now();
     this.draw(res);
     const t1 = performance.now();
@@ -636,10 +637,12 @@ class Simulator {
     });
     plot.innerHTML = nodes.join("");
     const stride = this.curve.stride, s = this.state.resolution;
-    const sample = stride === 1 ? `all ${s} × ${s} pixels` : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame`;
+    const sample = stride === 1 ? `every pixel of sphere A in the ${s} × ${s} frame`
+                                : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame`;
+    const said = unused ? this.frame_ledger : here;     // with footprint steps, the frame's own ledger
     plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; ` +
-                      (unused ? "the frame takes each pixel's footprint as its step, " : `at ε = ${here.eps.toExponential(1)} `) +
-                      `RMS ${fmt(here.rms, 1)}, max ${fmt(here.max_abs, 1)}` +
+                      (unused ? "the frame takes each pixel's footprint as its step: " : `at ε = ${here.eps.toExponential(1)} `) +
+                      `RMS ${fmt(said.rms, 1)}, max ${fmt(said.max_abs, 1)}` +
                       (marked ? `; the image-best step: ${best_eps}` : ""));
     plot.dataset.eps = String(here.eps);
     this.root.querySelector("#sim-curve-caption").textContent =
