@@ -23,21 +23,21 @@ from proofs.registry import THEOREMS
 PRINTED = {
     "shading": "5af0a7f5432b58c2",
     "displaced-normal": "6ccdd30f2a657fc4",
-    "chart": "806ac8c86dd7e8dc",
-    "frame-orthonormal": "0edc97e1e3d7ffe8",
+    "chart": "6eb485444e8d170a",
+    "frame-orthonormal": "65ef8845398fa0b8",
     "frame-orientation": "159cdc15fdb9b096",
     "gradient-sine": "afdd4d313d68b6fe",
     "gradient-ridges": "c7e368c0325ff445",
     "gradient-rings": "ccd11d1bae25eafb",
-    "ridges-kinks": "8d21924109afbdea",
-    "kink-loci-rays": "bf275f9204a126d7",
+    "ridges-kinks": "e05b59e321093ac4",
+    "kink-loci-rays": "f2e0ac4f5bcc39f7",
     "kink-loci-circles": "31c755b11bbe9e76",
     "no-boundary": "3cdd4fa8159796f1",
     "normal-beta-derivative": "35beda755e35b086",
-    "beta-zero-regression": "3667c6cf243c2f02",
+    "beta-zero-regression": "ce1b49f42a4370ba",
     "central-difference-truncation": "1d7a38548a2d22ed",
     "optimal-step": "8ff24d3b64fdf31c",
-    "bump-vs-displacement": "142e0a325acdaeba",
+    "bump-vs-displacement": "bcfda24e2884f7a1",
     "blinn-perturbation": "9955779fe68ebcfa",
 }
 
@@ -47,7 +47,7 @@ def printed(t):
     each defined symbol."""
     return "\n".join([latex.statement(t)] + [s.why for s in t.steps]
                      + [latex.chain(t, [s for _, s in run], [k for k, _ in run]) for run in _chains(t.steps)]
-                     + [latex.definition(t, d) for s in t.steps for d in s.defines])
+                     + [latex.definition(t, d, inline=True) for s in t.steps for d in s.defines])
 
 
 def _digest(text):
@@ -114,10 +114,17 @@ def test_the_printer_writes_each_form_as_a_person_does(expr, names, latex):
     (M / NORM, r"M / \lVert M\rVert"),
     ((A + B) / NORM, r"\left(A + B\right) / \lVert M\rVert"),
     (-2 * M / NORM, r"-2 M / \lVert M\rVert"),
-], ids=["minus-named", "second-named", "over-a-norm", "sum-over-a-norm", "scaled-over-a-norm"])
-def test_in_running_text_a_derivative_of_a_name_and_a_vector_over_one_symbol_are_quotients(expr, latex):
-    """In a line of text a stacked fraction is set at 70 % (small on a phone): the derivative of a name and a
-    vector over one symbol are written with "/", a sum of vectors in brackets; set apart, they stay stacked."""
+    (x / (2 * sp.pi), r"x / \left(2 \pi\right)"),
+    ((x + 1) / (2 * sp.pi), r"\left(x + 1\right) / \left(2 \pi\right)"),
+    (-x / (x + 1), r"- x / \left(x + 1\right)"),
+    (x / sp.sin(theta), r"x / \sin {\theta}"),
+    (sp.Rational(-3, 100), "- 3 / 100"),
+], ids=["minus-named", "second-named", "over-a-norm", "sum-over-a-norm", "scaled-over-a-norm", "over-a-product",
+        "sum-over-a-product", "over-a-sum", "over-a-function", "rational"])
+def test_in_running_text_a_fraction_is_a_quotient(expr, latex):
+    """In a line of text a stacked fraction is set at 70 % (small on a phone): a fraction, the derivative of a name
+    and a vector over a scalar are written with "/", a denominator that is not one symbol, number or function of
+    one in brackets, and a sum over it too; set apart, they stay stacked."""
     assert tex(expr, inline=True) == latex
     assert r"\frac" in tex(expr) and "/" not in tex(expr)
 

@@ -95,19 +95,40 @@ class _Printer(LatexPrinter):
 
     def _print_Mul(self, expr):
         """A coefficient times the derivative of a name: ``\\frac{1}{\\sin\\varphi} \\frac{\\partial N}{\\partial\\theta}``.
-        In running text (``inline``) a fraction over one symbol or number is written ``a / b`` (``m / k_u``), any
-        other stacked: ``a / 2 \\pi`` could be read as ``(a / 2) \\pi``."""
+        In running text (``inline``) a fraction is written with "/", not stacked (set at 70 %, small on a phone): over
+        one symbol or number ``a / b`` (``m / k_u``), over anything else with its denominator in brackets,
+        ``a / (2 \\pi)`` (``a / 2 \\pi`` could be read as ``(a / 2) \\pi``), a sum over it in brackets too."""
         named = [a for a in expr.args if isinstance(a, sp.Derivative) and isinstance(a.expr, (sp.Symbol, sp.MatrixSymbol))]
         if len(named) == 1 and len(expr.args) > 1:
             rest = sp.Mul(*[a for a in expr.args if a is not named[0]])
             coefficient = "-" if rest == -1 else self.parenthesize(rest, PRECEDENCE["Mul"])
+            if self.inline and sp.fraction(rest)[1] != 1:          # (1 / sin phi) dN/dtheta
+                coefficient = rf"\left({coefficient}\right)"
             return f"{coefficient} {self._print(named[0])}"
+        numer, denom = sp.fraction(expr)
+        if self.inline and denom != 1 and not denom.is_Atom:
+            sign = "- " if numer.could_extract_minus_sign() else ""
+            numer = -numer if sign else numer
+            top = self._print(numer) if isinstance(numer, Dot) else self.parenthesize(numer, PRECEDENCE["Mul"], strict=True)
+            return f"{sign}{top} / {self._over(denom)}"
         fold = self._settings["fold_short_frac"]
-        self._settings["fold_short_frac"] = self.inline and sp.fraction(expr)[1].is_Atom
+        self._settings["fold_short_frac"] = self.inline and denom.is_Atom
         try:
             return super()._print_Mul(expr)
         finally:
             self._settings["fold_short_frac"] = fold
+
+    def _print_Rational(self, expr):
+        """In running text ``3 / 100``, not stacked."""
+        if self.inline and expr.q != 1:
+            return f"{'- ' if expr.p < 0 else ''}{abs(expr.p)} / {expr.q}"
+        return super()._print_Rational(expr)
+
+    def _over(self, denom):
+        """A denominator after "/" in running text: bare if one symbol, number, dot product (a group already) or
+        function of one symbol (sin phi), else in brackets."""
+        whole = denom.is_Atom or isinstance(denom, Dot) or isinstance(denom, sp.Function) and all(a.is_Atom for a in denom.args)
+        return self._print(denom) if whole else rf"\left({self._print(denom)}\right)"
 
     def _print_MatAdd(self, expr):
         """Positive terms first (g - M(M.g)/|M|^3, not -M(M.g)/|M|^3 + g), a vector before a scaled one
@@ -156,10 +177,10 @@ class _Printer(LatexPrinter):
         else:
             shown = self._print(numer)
             top = (rf"\left({shown}\right)" if numer.is_Add or isinstance(numer, Dot) else shown) + f" {mats}"
-        if denom != 1 and self.inline and denom.is_Atom:          # in running text over one symbol: M / |M|
+        if denom != 1 and self.inline:                 # in running text, as `_print_Mul`: M / |M|, g / (pi R)
             if len(matrices) == 1 and isinstance(matrices[0], sp.MatAdd):       # no fraction bar groups the sum
                 top = top.replace(mats, rf"\left({mats}\right)", 1)
-            return f"{top} / {self._print(denom)}"
+            return f"{top} / {self._over(denom)}"
         return top if denom == 1 else (rf"- \frac{{{top[2:]}}}{{{self._print(denom)}}}" if top.startswith("- ")
                                        else rf"\frac{{{top}}}{{{self._print(denom)}}}")
 

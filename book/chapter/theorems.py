@@ -156,7 +156,7 @@ def _proof(t, numeric=(), note=None):
         numbers = [k for k, _ in run]
         for k, step in run:
             why = _prose(_cited(step.why.rstrip(".:")))
-            where = ", ".join(f"${latex.definition(t, s)}$" for s in step.defines)
+            where = ", ".join(f"${latex.definition(t, s, inline=True)}$" for s in step.defines)     # in the sentence
             aside = (f" (Checked numerically: {_prose(_cited(step.why_numeric))}.)" if k in numeric else "")
             out.append(f"**Step {k}.** {why}" + (f", where {where}" if where else "")
                        + ("." if k != run[-1][0] else ":") + aside)
