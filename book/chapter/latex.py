@@ -168,7 +168,7 @@ class _Printer(LatexPrinter):
         numer, denom = sp.fraction(coeff)
         mats = " ".join(self.parenthesize(m, PRECEDENCE["Mul"], strict=False) if not isinstance(m, sp.MatAdd)
                         else rf"\left({self._print(m)}\right)" for m in matrices)
-        if denom != 1 and abs(numer) == 1 and len(matrices) == 1:       # a fraction bar groups a sum already
+        if denom != 1 and abs(numer) == 1 and len(matrices) == 1 and not self.inline:   # a fraction bar groups a sum
             mats = self._print(matrices[0])
         if numer == -1:
             top = f"- {mats}"
@@ -178,8 +178,6 @@ class _Printer(LatexPrinter):
             shown = self._print(numer)
             top = (rf"\left({shown}\right)" if numer.is_Add or isinstance(numer, Dot) else shown) + f" {mats}"
         if denom != 1 and self.inline:                 # in running text, as `_print_Mul`: M / |M|, g / (pi R)
-            if len(matrices) == 1 and isinstance(matrices[0], sp.MatAdd):       # no fraction bar groups the sum
-                top = top.replace(mats, rf"\left({mats}\right)", 1)
             return f"{top} / {self._over(denom)}"
         return top if denom == 1 else (rf"- \frac{{{top[2:]}}}{{{self._print(denom)}}}" if top.startswith("- ")
                                        else rf"\frac{{{top}}}{{{self._print(denom)}}}")

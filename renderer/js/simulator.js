@@ -28,7 +28,7 @@ const LOG_EPS = { min: SLIDER_LOG_EPS[0], max: SLIDER_LOG_EPS[1], step: 0.1, tic
 // draws it first within its update from a grid of at most CURVE_SAMPLE x CURVE_SAMPLE of the frame's
 // pixels (every 6th column and row at 256 x 256, a 36th of sphere A: its steps cost less than
 // re-shading sphere A once), then over every pixel a step at a time, between updates (`refine`; all
-// the steps about 0.4 s at 256 x 256 on a desktop).  The sample alone misses most of the few pixels
+// the steps about 0.2 s at 256 x 256 on a desktop).  The sample alone misses most of the few pixels
 // whose stencils straddle a crease, and its curve then fell far below the ledger's RMS.
 export const CURVE_SAMPLE = 48;
 export function curve_stride(resolution) {
@@ -127,8 +127,6 @@ export const PRESETS = [
 
 const HINT = "Hover over a canvas, tap it, or focus it and use the arrow keys, to read that pixel in the readout; " +
   "on the ε slider, Page Up and Page Down move a whole decade.";
-// The readout's rows a phone shows until the reader asks for all (STYLE).
-const BRIEF_ROWS = ["pixel", "|ΔI|"];
 // The controls shown above the canvases.
 const MAIN = ["height_field", "log_eps", "beta"];
 
@@ -297,7 +295,7 @@ class Simulator {
       more.textContent = open ? "fewer rows" : "all rows";
     });
     root.append(el("div", { class: "sim-stage" }, [...figs, curve, el("div", { class: "sim-readout-box" }, [this.readout, more])]));
-    this.show_readout([["pixel", "hover over a canvas, tap it, or focus it and use the arrow keys"]]);
+    this.show_readout([["pixel", "hover over a canvas, tap it, or focus it and use the arrow keys", true]]);
     this.readout.setAttribute("aria-label", "the pixel readout");
     if (typeof ResizeObserver !== "undefined") new ResizeObserver(() => this.draw_curve()).observe(this.plot);
 
@@ -671,9 +669,12 @@ class Simulator {
     this.show_probe(Math.min(res - 1, Math.max(0, p.i + di)), Math.min(res - 1, Math.max(0, p.j + dj)));
   }
 
+  // rows: [name, value, brief]; a brief row is one a phone shows until the reader asks for all (STYLE).
   show_readout(rows) {
-    const brief = (k) => (BRIEF_ROWS.includes(k) ? { class: "sim-brief" } : {});
-    this.readout.replaceChildren(...rows.flatMap(([k, v]) => [el("dt", { text: k, ...brief(k) }), el("dd", { text: v, ...brief(k) })]));
+    this.readout.replaceChildren(...rows.flatMap(([k, v, brief]) => {
+      const cls = brief ? { class: "sim-brief" } : {};
+      return [el("dt", { text: k, ...cls }), el("dd", { text: v, ...cls })];
+    }));
   }
 
   show_probe(i, j) {
@@ -684,7 +685,7 @@ class Simulator {
     const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom, s.numeric);
     const a = pr.symbolic, b = pr.numeric;
     const vec = (v, digits = 10) => v ? "(" + v.map((x) => x.toPrecision(digits)).join(", ") + ")" : "—";
-    const rows = [["pixel", `(${i}, ${j}): ${CHAMBER_NAMES[a.chamber]}`], ["hit point", vec(a.P, 6)]];
+    const rows = [["pixel", `(${i}, ${j}): ${CHAMBER_NAMES[a.chamber]}`, true], ["hit point", vec(a.P, 6)]];
     if (a.chamber === SPHERE_A) {
       rows.push(["(u, v)", vec(a.uv, 8)]);
       rows.push(["∇h exact", vec(a.grad)]);
@@ -695,7 +696,7 @@ class Simulator {
     }
     rows.push(["RGB exact", vec(a.rgb, 6)]);
     rows.push([`RGB ${b.gradient}`, vec(b.rgb, 6)]);
-    rows.push(["|ΔI|", `${fmt(Math.max(...a.rgb.map((x, c) => Math.abs(x - b.rgb[c]))), 2)}, the largest channel`]);
+    rows.push(["|ΔI|", `${fmt(Math.max(...a.rgb.map((x, c) => Math.abs(x - b.rgb[c]))), 2)}, the largest channel`, true]);
     this.show_readout(rows);
     const d = this.readout.dataset;
     d.i = String(i); d.j = String(j); d.chamber = String(a.chamber);
