@@ -549,6 +549,9 @@ def _noise_below_1e11():
 
 #: The step of the draft's Cell 7b (its crease: ``{**SCr, 'eps': 1e-4}``).
 CELL7B_STEP = 1e-4
+#: How near the exact hᵤ's size at Cell 7b's crease must be to the one-sided slope's to be that slope
+#: (relative): far above float64's rounding of the two, far below any other multiple of the slope.
+SIDE_WHOLE = 1e-9
 #: The draft's pole cut-off (Cell 7c; seed Cell 1, ``tangent_frame``): its fixed basis below this
 #: sin(phi), as the frame's theorems name it (`proofs.frame.SEED_POLE_SIN_PHI`).  The renderer keeps
 #: the chart's frame down to `formulas.POLE_SIN_PHI` (2^-1022).
@@ -556,12 +559,17 @@ CELL7C_POLE_SIN_PHI = SEED_POLE_SIN_PHI
 
 
 def _crease_values():
-    """Cell 7b: the draft's field at u = 1/k_u (its first crease in u) and the U-curve's v."""
+    """Cell 7b: the draft's field (ridges, |sin(πk_u u) sin(πk_v v)|) at u = 1/k_u (its first crease
+    in u) and the U-curve's v; and the size of its one-sided slopes there, πk_u |sin(πk_v v)| (the
+    slope of the product under the bars, whose cos(πk_u u) is ±1 on the crease), which an exact
+    gradient that picks a side returns whole."""
     d = DRAFT_SCENE
     u, v = 1.0 / d.k_u, F.SEED_POINT[1]
     fd = float(pointwise.central_gradient(d.field, u, v, d.k_u, d.k_v, CELL7B_STEP)[0])
     ex = float(pointwise.exact_gradient(d.field, u, v, d.k_u, d.k_v)[0])
-    return {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex), "central": fd, "exact": ex, "step": CELL7B_STEP}
+    side = math.pi * d.k_u * abs(math.sin(math.pi * d.k_v * v))
+    return {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex), "|exact hᵤ| / one-sided slope": abs(ex) / side,
+            "central": fd, "exact": ex, "step": CELL7B_STEP}
 
 
 def _pole_pixels():
@@ -720,7 +728,9 @@ CLAIMS = (
           rule(HOLDS, about("relative error at ε = 1e-11", 1.0, hi=False))),
     Claim("crease-fd-zero", "Cell 7b, Expect", "the crease showing FD≈0 vs exact sign-ambiguity",
           "the central and exact hᵤ at u = 1/kᵤ as float64 represents it", CORRECTED, _crease_values,
-          rule(CORRECTED, (Bound("|central hᵤ|", hi=1e-6, strict=True), Bound("|exact hᵤ|", lo=0, strict=True)), HOLDS, Bound("|central hᵤ|", hi=1e-6, strict=True))),
+          rule(CORRECTED, (Bound("|central hᵤ|", hi=1e-6, strict=True),
+                           Bound("|exact hᵤ| / one-sided slope", lo=1 - SIDE_WHOLE, hi=1 + SIDE_WHOLE)),
+               HOLDS, (Bound("|central hᵤ|", hi=1e-6, strict=True), Bound("|exact hᵤ|", hi=0)))),
     Claim("pole-pixels", "Cell 7c", "fallback engages below 1e-4. Pixels affected at 256²: …",
           "count from the rendered geometry", FAILS, _pole_pixels,
           rule(HOLDS, Bound("fallback pixels", lo=1))),
