@@ -173,8 +173,8 @@ def _limit(tilt=None, **evidence):
             Step(r"By ⟪normal-beta-derivative⟫ at $\beta = 0$, where $N' = N$ and $\lVert M\rVert = 1$, the "
                  r"chart mode tilts by the part of $g$ orthogonal to $N$, which is $g$ itself", slope["chart"],
                  tilt["chart"]),
-            Step(r"The displaced sphere's $M = N - \frac{\beta}{R + \beta h}\bigl(\frac{h_u}{2\pi\sin\varphi} "
-                 r"e_\theta + \frac{h_v}{\pi} e_\varphi\bigr)$ tilts, likewise, by its tangential part's "
+            Step(r"The displaced sphere's $M = N - \beta\bigl(h_u e_\theta / {(2\pi\sin\varphi)} "
+                 r"+ h_v e_\varphi / \pi\bigr) / {(R + \beta h)}$ tilts, likewise, by its tangential part's "
                  r"$\beta$-derivative at 0: the gradient over the arc lengths $2\pi R\sin\varphi$ and $\pi R$",
                  slope["surface"], tilt["surface"]),
         ),

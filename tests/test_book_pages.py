@@ -1296,7 +1296,8 @@ FORMULAS_JS = r"""async () => {
     const rects = [m, ...m.querySelectorAll('mjx-math')].flatMap(e => [...e.getClientRects()]).filter(r => r.width);
     const over = Math.max(0, ...rects.map(r => Math.max(r.right - right, left - r.left)));
     const section = m.closest('section[id]');
-    return {display: m.getAttribute('display') === 'true', scale: +scale.toFixed(3),
+    const display = m.getAttribute('display') === 'true';
+    return {display, scale: +scale.toFixed(3), stacked: !display && !!m.querySelector('mjx-mfrac'),
             px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror') || [...m.querySelectorAll('mjx-mtext')].some((t) => t.textContent.startsWith('\\')),
             tab: m.tabIndex >= 0, text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
             where: section ? '#' + section.id : ''};
@@ -1306,9 +1307,10 @@ FORMULAS_JS = r"""async () => {
 
 def formula_findings(found):
     """The formulas of a FORMULAS_JS list that a reader cannot read whole: set below the text's size
-    (scale under 1), reaching past the column by more than a pixel, or a TeX error; or that a keyboard
-    reader must Tab through (in the Tab order: MathJax's default)."""
-    return [f for f in found if f["scale"] < 0.999 or f["over"] > 1 or f["error"] or f["tab"]]
+    (scale under 1, or in running text a stacked fraction, whose parts MathJax sets at 70 %), reaching
+    past the column by more than a pixel, or a TeX error; or that a keyboard reader must Tab through (in
+    the Tab order: MathJax's default)."""
+    return [f for f in found if f["scale"] < 0.999 or f["stacked"] or f["over"] > 1 or f["error"] or f["tab"]]
 
 
 #: Run in a page: each figure's image brought to the top of the screen, its middle and its bottom, each
@@ -1422,8 +1424,8 @@ def test_every_formula_is_at_full_size_within_the_column(site, name):
 #: every formula the check finds must show), each of which the formula check must catch at 390 px: MathJax
 #: left to let formulas run past the column (its default; §3 has the formulas too long for a phone's
 #: column), formulas set at 62 % of the text (as fit.js once shrank them to fit; any page with formulas
-#: shows it, §1 quickly), formulas left in the Tab order, and a TeX command MathJax does not know (a statement's text mistyped: MathJax
-#: sets it as red text, backslash and all).
+#: shows it, §1 quickly), formulas left in the Tab order, a TeX command MathJax does not know (a statement's text mistyped: MathJax
+#: sets it as red text, backslash and all), and a fraction stacked in a line of text.
 WRONG_FORMULAS = {
     "MathJax breaking no line": ("s3_math", "s3_math.html",
                                  '"displayOverflow": "linebreak", "linebreaks": {"inline": true',
@@ -1436,6 +1438,8 @@ WRONG_FORMULAS = {
                                   '"inTabOrder": true', lambda f: f["tab"]),
     "a TeX command MathJax does not know": ("s1_what_changes", "s1_what_changes.html", r"\(\varepsilon =\)",
                                            r"\(\vAREPSILON =\)", lambda f: f["error"]),
+    "a stacked fraction in running text": ("s1_what_changes", "s1_what_changes.html", r"\(\varepsilon =\)",
+                                           r"\(\frac{\varepsilon}{2} =\)", lambda f: f["stacked"]),
 }
 
 

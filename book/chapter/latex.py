@@ -213,7 +213,9 @@ class _Printer(LatexPrinter):
         top = d + ("" if n == 1 else f"^{{{n}}}")
         if named:                                                  # in running text: dN/dbeta, not stacked
             return rf"{top} {self._print(f)} / {below}" if self.inline else rf"\frac{{{top} {self._print(f)}}}{{{below}}}"
-        return rf"\frac{{{top}}}{{{below}}} \left({self._print(f)}\right)"         # d/du (expression)
+        if self.inline:                                            # d / du (expression)
+            return rf"{top} / {below} \left({self._print(f)}\right)"
+        return rf"\frac{{{top}}}{{{below}}} \left({self._print(f)}\right)"
 
 
 def tex(expr, names=None, inline=False) -> str:
