@@ -1019,10 +1019,30 @@ def spoken_problems(s):
     return found
 
 
+#: Run in the page: for each canvas, the canvas pixel [i, j] under the centre of its ring (the read-out
+#: pixel's mark), or null while the ring is hidden.
+MARKS_JS = """() => [...document.querySelectorAll('.sim-canvas-box')].map(box => {
+  const c = box.querySelector('canvas'), m = box.querySelector('.sim-probe');
+  if (!m || m.hidden || !m.getClientRects().length) return null;
+  const r = c.getBoundingClientRect(), k = m.getBoundingClientRect();
+  return [Math.floor((k.left + k.width / 2 - r.left) * c.width / r.width),
+          Math.floor((k.top + k.height / 2 - r.top) * c.height / r.height)];
+})"""
+
+
+def mark_problems(s):
+    """Where the rings on the three canvases are not centred on the pixel the readout reads."""
+    d = s.page.evaluate("({...document.getElementById('sim-readout').dataset})")
+    marks = s.page.evaluate(MARKS_JS)
+    want = [int(d["i"]), int(d["j"])]
+    return [] if len(marks) == 3 and all(m == want for m in marks) else [f"the rings at {marks}, the readout at {want}"]
+
+
 def _keyboard_walk(s):
     """Use the simulator from the keyboard alone, checking `spoken_problems` after each move: Tab to the
     field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
-    and move the probe with the arrow keys (the readout reads the pixel), to the shading normal and change
+    and move the probe with the arrow keys (the readout reads the pixel, a ring on each canvas marks it), to the
+    shading normal and change
     it (the note beside it, a live region, must then say the β slider's new range), then on to the view
     menu and change it (the note must be gone).  Returns {move: problems} and the readout's texts."""
     page, found, readouts = s.page, {}, []
@@ -1046,9 +1066,11 @@ def _keyboard_walk(s):
     tab_to("sim-log_eps"); move("ε", "PageDown")
     tab_to("sim-beta"); move("β", "ArrowRight")
     tab_to("sim-canvas-symbolic")
+    found["probe"] = [] if page.evaluate(MARKS_JS) == [None] * 3 else ["a ring before any pixel was read"]
     for key in ("ArrowRight", "ArrowDown"):
         page.keyboard.press(key)
         readouts.append(page.text_content("#sim-readout"))
+        found["probe"] += mark_problems(s)
     tab_to("sim-bump"); move("normal", "ArrowUp")        # to the draft's chart formula
     top = page.get_attribute("#sim-beta", "max")
     if f"β now runs to {top}" not in page.text_content("#sim-note"):         # the slider's range changed with it
@@ -1075,7 +1097,8 @@ def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser,
         s.close()
 
 
-#: Wrong variants of what a screen reader is given: (old text of the bundle, new text, a problem it must cause).
+#: Wrong variants of what a screen reader is given, and of the rings marking the read-out pixel: (old text of
+#: the bundle, new text, a problem it must cause).
 WRONG_SPOKEN = {
     "the canvases' labels written once, not kept current": ("    this.describe(ledger);\n", "", "not in"),
     "sliders named by the value beside them": ('return el("label", { for: input.id }, [el("span"',
@@ -1086,6 +1109,10 @@ WRONG_SPOKEN = {
                                      "", "outlived"),
     "a readout that is not announced": ('class: "sim-readout", "aria-live": "polite" }', 'class: "sim-readout", "aria-live": "off" }',
                                         "readout: aria-live 'off'"),
+    "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",
+                                           "mark.style.left = `${(100 * (i + 1.5)) / res}%`;", "the rings at"),
+    "the rings left where the first probe put them": ("mark.hidden = false;", "if (!mark.hidden) continue; mark.hidden = false;",
+                                                      "the rings at"),
 }
 
 
@@ -1426,7 +1453,7 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
     """At 390 px, with touch: the canvases stacked, each at least 300 px wide; a tap on a canvas
     shows the pixel tapped in the readout, which stays in view (it sticks to the bottom of the
     screen while the canvases scroll by) with two rows, which pixel and its |ΔI|, until its button asks
-    for all ten.  Without the narrow-screen rule (the wrong variant)
+    for all ten; a ring on each canvas marks the pixel.  Without the narrow-screen rule (the wrong variant)
     the canvases sit side by side, too small."""
     s = Session(browser, _url(book_html), viewport={"width": 390, "height": 844}, has_touch=True,
                 is_mobile=True, device_scale_factor=2)
@@ -1444,6 +1471,7 @@ def test_on_a_phone_the_canvases_stack_and_a_tap_reads_a_pixel(browser, book_htm
                                                          "y": (j + 0.5) * box["height"] / SIZE})
             ri, rj = _readout_pixel(s, i, j)
             assert s.page.get_attribute("#sim-readout", "data-chamber") == str(gb.chamber[rj, ri]) == "1"
+            assert mark_problems(s) == []
             assert _inside(_box(s, "#sim-readout"), 390, 844), _box(s, "#sim-readout")
         assert s.page.evaluate(SHOWN_ROWS) == ["pixel", "|ΔI|"]             # until the reader asks for all
         s.page.tap(".sim-more")

@@ -143,6 +143,11 @@ const STYLE = `
 .symrender-sim canvas { width: 100%; aspect-ratio: 1; image-rendering: pixelated; background: #000; display: block;
   touch-action: manipulation; }
 .symrender-sim canvas:focus { outline: 3px solid #4a90d9; }
+/* The read-out pixel, ringed on each canvas (over it: the canvases' pixels stay the renderer's). */
+.symrender-sim .sim-canvas-box { position: relative; }
+.symrender-sim .sim-probe { position: absolute; box-sizing: border-box; width: 13px; height: 13px; margin: -6.5px 0 0 -6.5px;
+  border: 2px solid #fff; border-radius: 50%; box-shadow: 0 0 0 1px #000, inset 0 0 0 1px #000; pointer-events: none; }
+.symrender-sim .sim-probe[hidden] { display: none; }
 .symrender-sim figcaption { font-size: 0.8rem; line-height: 1.25; margin-top: 0.25rem; }
 .symrender-sim .sim-curve { grid-column: 1 / span 2; }
 .symrender-sim .sim-curve svg { width: 100%; height: 13rem; display: block; overflow: visible; }
@@ -270,6 +275,7 @@ class Simulator {
     root.append(this.main_controls);
 
     this.canvases = {};
+    this.marks = [];
     const figs = ["numeric", "symbolic", "difference"].map((name) => {
       const canvas = el("canvas", { id: `sim-canvas-${name}`, tabindex: "0", role: "img",
                                     "aria-label": `${name} canvas (arrow keys move the probe)` });
@@ -277,7 +283,10 @@ class Simulator {
       canvas.addEventListener("pointerdown", (ev) => this.pointer(canvas, ev));
       canvas.addEventListener("keydown", (ev) => this.probe_key(ev));
       this.canvases[name] = canvas;
-      return el("figure", {}, [canvas, el("figcaption", { id: `sim-caption-${name}` })]);
+      const mark = el("span", { class: "sim-probe", "aria-hidden": "true", hidden: "" });
+      this.marks.push(mark);
+      return el("figure", {}, [el("div", { class: "sim-canvas-box" }, [canvas, mark]),
+                               el("figcaption", { id: `sim-caption-${name}` })]);
     });
     // An inline <svg>, parsed from markup (no namespace address in the script).
     const holder = el("div");
@@ -682,6 +691,11 @@ class Simulator {
     const res = s.resolution;
     if (i >= res || j >= res) { i = res >> 1; j = res >> 1; }
     this.probe = { i, j };
+    for (const mark of this.marks) {
+      mark.hidden = false;
+      mark.style.left = `${(100 * (i + 0.5)) / res}%`;
+      mark.style.top = `${(100 * (j + 0.5)) / res}%`;
+    }
     const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom, s.numeric);
     const a = pr.symbolic, b = pr.numeric;
     const vec = (v, digits = 10) => v ? "(" + v.map((x) => x.toPrecision(digits)).join(", ") + ")" : "—";
