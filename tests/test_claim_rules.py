@@ -260,12 +260,12 @@ def _readings(claim):
         ratio = (steps[0] / steps[1]) ** _series_power()
         return _edges("max |ΔI| ratio", ratio / ABOUT, ratio * ABOUT)
     if q == "crease-fd-zero":                                           # "FD≈0 vs exact sign-ambiguity"
-        central, exact, side = "|central hᵤ|", "|exact hᵤ|", "|exact hᵤ| / one-sided slope"
-        picked = {exact: 9.0, side: 1.0}                                # the correction: a side's slope, whole
+        central, exact, off = "|central hᵤ|", "|exact hᵤ|", "|exact hᵤ| off the slope"
+        picked = {exact: 9.0, off: 0.0}                                 # the correction: a side's slope, whole
         return (_edges(central, hi=FD_ZERO, inside=CORRECTED, outside=FAILS, **picked)
-                + [({central: 0.0, exact: 0.0, side: 0.0}, HOLDS)]     # the claim: the exact gradient is 0
-                + [({central: 0.0, exact: 9.0, side: 1 + d}, CORRECTED) for d in (-FLOAT_EXACT, FLOAT_EXACT)]
-                + [({central: 0.0, exact: 9.0 * r, side: r}, FAILS)    # neither 0 nor the slope
+                + [({central: 0.0, exact: 0.0, off: 1.0}, HOLDS)]      # the claim: the exact gradient is 0
+                + [({central: 0.0, exact: 9.0, off: FLOAT_EXACT}, CORRECTED)]
+                + [({central: 0.0, exact: 9.0 * r, off: abs(r - 1)}, FAILS)     # neither 0 nor the slope
                    for r in (1e-300 / 9, 0.5, 1 - VISIBLE, 1 + VISIBLE, 2.0)])
     if q == "pole-pixels":                                              # "Pixels affected": at least one
         return [({"fallback pixels": 1}, HOLDS), ({"fallback pixels": 0}, FAILS)]
