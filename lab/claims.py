@@ -562,13 +562,13 @@ def _crease_values():
     """Cell 7b: the draft's field (ridges, |sin(πk_u u) sin(πk_v v)|) at u = 1/k_u (its first crease
     in u) and the U-curve's v; and the size of its one-sided slopes there, πk_u |sin(πk_v v)| (the
     slope of the product under the bars, whose cos(πk_u u) is ±1 on the crease), which an exact
-    gradient that picks a side returns whole: "|exact hᵤ| off the slope" is |exact hᵤ| / slope - 1, in size."""
+    gradient that picks a side returns whole."""
     d = DRAFT_SCENE
     u, v = 1.0 / d.k_u, F.SEED_POINT[1]
     fd = float(pointwise.central_gradient(d.field, u, v, d.k_u, d.k_v, CELL7B_STEP)[0])
     ex = float(pointwise.exact_gradient(d.field, u, v, d.k_u, d.k_v)[0])
     side = math.pi * d.k_u * abs(math.sin(math.pi * d.k_v * v))
-    return {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex), "|exact hᵤ| off the slope": abs(abs(ex) / side - 1),
+    return {"|central hᵤ|": abs(fd), "|exact hᵤ|": abs(ex), "||exact hᵤ| / one-sided slope − 1|": abs(abs(ex) / side - 1),
             "central": fd, "exact": ex, "step": CELL7B_STEP}
 
 
@@ -729,7 +729,7 @@ CLAIMS = (
     Claim("crease-fd-zero", "Cell 7b, Expect", "the crease showing FD≈0 vs exact sign-ambiguity",
           "the central and exact hᵤ at u = 1/kᵤ as float64 represents it", CORRECTED, _crease_values,
           rule(CORRECTED, (Bound("|central hᵤ|", hi=1e-6, strict=True),
-                           Bound("|exact hᵤ| off the slope", hi=SIDE_WHOLE)),
+                           Bound("||exact hᵤ| / one-sided slope − 1|", hi=SIDE_WHOLE)),
                HOLDS, (Bound("|central hᵤ|", hi=1e-6, strict=True), Bound("|exact hᵤ|", lo=0, hi=0)))),
     Claim("pole-pixels", "Cell 7c", "fallback engages below 1e-4. Pixels affected at 256²: …",
           "count from the rendered geometry", FAILS, _pole_pixels,

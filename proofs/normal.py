@@ -174,8 +174,9 @@ def _limit(tilt=None, **evidence):
                  r"chart mode tilts by the part of $g$ orthogonal to $N$, which is $g$ itself", slope["chart"],
                  tilt["chart"]),
             Step(r"The displaced sphere's $M = N - \beta\bigl(h_u e_\theta / {(2\pi\sin\varphi)} "
-                 r"+ h_v e_\varphi / \pi\bigr) / {(R + \beta h)}$ tilts, likewise, by its tangential part's "
-                 r"$\beta$-derivative at 0: the gradient over the arc lengths $2\pi R\sin\varphi$ and $\pi R$",
+                 r"+ h_v e_\varphi / \pi\bigr) / {(R + \beta h)}$ tilts by its tangential part's $\beta$-derivative at 0 "
+                 r"($M$ is not linear in $\beta$, but $\lVert M\rVert = 1$ there): minus the gradient over the arc lengths "
+                 r"$2\pi R\sin\varphi$ and $\pi R$",
                  slope["surface"], tilt["surface"]),
         ),
         claims={"limit": (at_zero, sp.Tuple(N_SPHERE, N_SPHERE)), "chart": (slope["chart"], tilt["chart"]),

@@ -260,7 +260,7 @@ def _readings(claim):
         ratio = (steps[0] / steps[1]) ** _series_power()
         return _edges("max |ΔI| ratio", ratio / ABOUT, ratio * ABOUT)
     if q == "crease-fd-zero":                                           # "FD≈0 vs exact sign-ambiguity"
-        central, exact, off = "|central hᵤ|", "|exact hᵤ|", "|exact hᵤ| off the slope"
+        central, exact, off = "|central hᵤ|", "|exact hᵤ|", "||exact hᵤ| / one-sided slope − 1|"
         picked = {exact: 9.0, off: 0.0}                                 # the correction: a side's slope, whole
         return (_edges(central, hi=FD_ZERO, inside=CORRECTED, outside=FAILS, **picked)
                 + [({central: 0.0, exact: 0.0, off: 1.0}, HOLDS)]      # the claim: the exact gradient is 0

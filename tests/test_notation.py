@@ -34,7 +34,7 @@ PRINTED = {
     "kink-loci-circles": "31c755b11bbe9e76",
     "no-boundary": "3cdd4fa8159796f1",
     "normal-beta-derivative": "35beda755e35b086",
-    "beta-zero-regression": "0a39ef8fd65fdca9",
+    "beta-zero-regression": "3fcdd884c05219d5",
     "central-difference-truncation": "1d7a38548a2d22ed",
     "optimal-step": "8ff24d3b64fdf31c",
     "bump-vs-displacement": "bcfda24e2884f7a1",

@@ -155,7 +155,7 @@ const STYLE = `
 .symrender-sim .sim-readout-box { grid-column: 3; min-width: 0; background: var(--pst-color-background, #fff); }
 .symrender-sim .sim-more { display: none; }
 .symrender-sim .sim-readout { font-size: 0.75rem; line-height: 1.3;
-  display: grid; grid-template-columns: max-content minmax(0, 1fr); gap: 0.1rem 0.5rem; align-content: start;
+  display: grid; grid-template-columns: fit-content(40%) minmax(0, 1fr); gap: 0.1rem 0.5rem; align-content: start;
   font-variant-numeric: tabular-nums; }
 /* No margin: the theme gives a classed <dl> 3rem below it, by a selector that outranks the rule above (on a phone
    it parted the readout from the U-curve). */
@@ -699,7 +699,7 @@ class Simulator {
     const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom, s.numeric);
     const a = pr.symbolic, b = pr.numeric;
     const vec = (v, digits = 10) => v ? "(" + v.map((x) => x.toPrecision(digits)).join(", ") + ")" : "—";
-    const rows = [["pixel", `(${i}, ${j}): ${CHAMBER_NAMES[a.chamber]}`, true], ["hit point", vec(a.P, 6)]];
+    const rows = [["pixel", `x\u00a0=\u00a0${i}, y\u00a0=\u00a0${j}: ${CHAMBER_NAMES[a.chamber].replaceAll(" ", "\u00a0")}`, true], ["hit point", vec(a.P, 6)]];
     if (a.chamber === SPHERE_A) {
       rows.push(["(u, v)", vec(a.uv, 8)]);
       rows.push(["∇h exact", vec(a.grad)]);
