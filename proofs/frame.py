@@ -196,7 +196,7 @@ def _orthonormal(et=REGULAR[:3], ep=REGULAR[3:], **evidence):
                    r"$⟦e_theta⟧$ and $⟦e_phi⟧$; it is tangent, $⟦tangent⟧$, and orthonormal, $⟦unit⟧$."),
         steps=(
             *calc(ET_S, (r"Substitute $N(\theta, \varphi)$ into $e_\theta = (-N_y, N_x, 0)/\sin\varphi$ (there the "
-                         r"kernel's $\sin\varphi$ is $\sin\varphi$, by ⟪chart⟫)", sp.Matrix([-sp.sin(theta), sp.cos(theta), 0])),
+                         r"kernel's $\operatorname{hypot}(N_x, N_y)$ is $\sin\varphi$, by ⟪chart⟫)", sp.Matrix([-sp.sin(theta), sp.cos(theta), 0])),
                   (r"This is $\partial N/\partial\theta = \sin\varphi\,(-\sin\theta, \cos\theta, 0)$ divided by "
                    r"$\sin\varphi$", d_theta)),
             *calc(EP_S, (r"Likewise, substitute it into $e_\varphi = (N_z N_x, N_z N_y, -\sin^2\varphi)/\sin\varphi$",
