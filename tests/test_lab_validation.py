@@ -207,9 +207,9 @@ FUNCTIONS = {
     "claims.about": (claims.about, dict(quantity="q", x=2.0, lo=True, hi=True),
                      dict(quantity=p("own", (3, T, "int 3"), named="Bound.quantity"),
                           x=p("real", (-1.0, V, "got -1.0")), lo=p("flag"), hi=p("flag"))),
-    "claims.Bound": (claims.Bound, dict(quantity="q", lo=1.0, hi=2.0, strict=False),
+    "claims.Bound": (claims.Bound, dict(quantity="q", lo=1.0, hi=1.0, strict=False),     # lo = hi: a point
                      dict(quantity=p("own", (3, T, "int 3"), named="Bound.quantity"),
-                          lo=p("real", (3.0, V, "lo = 3.0, hi = 2.0"), named="Bound.lo"),
+                          lo=p("real", (3.0, V, "lo = 3.0, hi = 1.0"), named="Bound.lo"),
                           hi=p("real", named="Bound.hi"), strict=p("flag", named="Bound.strict"))),
     "claims.Criterion": (claims.Criterion, dict(cases=((claims.HOLDS, (claims.Bound("a"),)),), otherwise=claims.FAILS),
                          dict(cases=p("own", ("c", T, "str 'c'"), (((claims.HOLDS, claims.Bound("a")),), T, "Bound("),
