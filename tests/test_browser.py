@@ -1020,10 +1020,10 @@ def spoken_problems(s):
 
 
 #: Run in the page: for each canvas of the simulator, the canvas pixel [i, j] under the centre of its ring
-#: (the read-out pixel's mark), or null while the ring is hidden or missing.
+#: (the read-out pixel's mark), or null while the ring is not shown.
 MARKS_JS = """() => [...document.querySelectorAll('.symrender-sim canvas')].map(c => {
   const m = c.parentElement.querySelector('.sim-probe');
-  if (!m || m.hidden || !m.getClientRects().length) return null;
+  if (!m || !m.checkVisibility()) return null;
   const r = c.getBoundingClientRect(), k = m.getBoundingClientRect();
   return [Math.floor((k.left + k.width / 2 - r.left) * c.width / r.width),
           Math.floor((k.top + k.height / 2 - r.top) * c.height / r.height)];
@@ -1111,6 +1111,8 @@ WRONG_SPOKEN = {
                                         "readout: aria-live 'off'"),
     "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",
                                            "mark.style.left = `${(100 * (i + 1.5)) / res}%`;", "the rings at"),
+    "a ring shown before any pixel is read": ('"aria-hidden": "true", hidden: "" }', '"aria-hidden": "true" }',
+                                              "a ring before any pixel"),
     "the rings left where the first probe put them": ("mark.hidden = false;", "if (!mark.hidden) continue; mark.hidden = false;",
                                                       "the rings at"),
 }

@@ -147,7 +147,6 @@ const STYLE = `
 .symrender-sim .sim-canvas-box { position: relative; }
 .symrender-sim .sim-probe { position: absolute; box-sizing: border-box; width: 13px; height: 13px; margin: -6.5px 0 0 -6.5px;
   border: 2px solid #fff; border-radius: 50%; box-shadow: 0 0 0 1px #000, inset 0 0 0 1px #000; pointer-events: none; }
-.symrender-sim .sim-probe[hidden] { display: none; }
 .symrender-sim figcaption { font-size: 0.8rem; line-height: 1.25; margin-top: 0.25rem; }
 .symrender-sim .sim-curve { grid-column: 1 / span 2; }
 .symrender-sim .sim-curve svg { width: 100%; height: 13rem; display: block; overflow: visible; }
