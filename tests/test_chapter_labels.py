@@ -2,11 +2,27 @@
 resolution, or which U-curve.  Checked by structure (the size, each changed field's value,
 nothing of an unchanged field), not by wording."""
 
+import re
+
 import numpy as np
 import pytest
 
-from chapter.labels import frame_label, ucurve_label
+from chapter import labels
 from renderer import DRAFT_SCENE, Scene
+
+
+def _unbroken(label):
+    """``label`` with its no-break spaces as spaces, once no line can part an "=" or a "×" from a side."""
+    assert re.search(r"\s[=×]|[=×]\s", label.replace("\u00a0", "")) is None, label
+    return label.replace("\u00a0", " ")
+
+
+def frame_label(*args):
+    return _unbroken(labels.frame_label(*args))
+
+
+def ucurve_label(*args):
+    return _unbroken(labels.ucurve_label(*args))
 
 
 def test_a_frame_label_names_the_size_and_exactly_the_fields_that_differ():

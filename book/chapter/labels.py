@@ -10,11 +10,13 @@ from __future__ import annotations
 from renderer import DRAFT_SCENE, Scene
 from renderer.validate import positive_int
 
-__all__ = ["frame_label", "ucurve_label"]
+__all__ = ["frame_label", "size_label", "ucurve_label"]
 
 #: How `frame_label` words a field of `renderer.Scene` that differs from its reference scene.
-_WORDS = {"height_field": "the {} field", "beta": "β = {:g}", "eps": "ε = {:g}", "k_u": "kᵤ = {:g}",
-          "k_v": "kᵥ = {:g}", "radius_a": "R = {:g}", "model": "{} shading", "shininess": "shininess {:g}"}
+#: An equation and a size keep their spaces unbroken (no-break spaces), so that a phone's line never
+#: parts "β =" from its value or "256 ×" from "256".
+_WORDS = {"height_field": "the {} field", "beta": "β\u00a0=\u00a0{:g}", "eps": "ε\u00a0=\u00a0{:g}",
+          "k_u": "kᵤ\u00a0=\u00a0{:g}", "k_v": "kᵥ\u00a0=\u00a0{:g}", "radius_a": "R\u00a0=\u00a0{:g}", "model": "{} shading", "shininess": "shininess {:g}"}
 
 
 def _field_words(name, value):
@@ -60,12 +62,23 @@ def frame_label(scene, width, height) -> str:
     changed = [_field_words(name, getattr(scene, name)) for name in scene.changes()
                if getattr(scene, name) != getattr(reference, name)]
     return (("the draft's scene" if draft else "the chapter's scene") + (" with " + ", ".join(changed) if changed else "")
-            + f", {width} × {height}")
+            + ", " + size_label(width, height))
+
+
+def size_label(width, height):
+    """A frame's size in pixels as the pages print it, ``"256 × 256"``, its spaces no-break ones.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As `frame_label` does for ``width`` and ``height``.
+    """
+    return f"{positive_int('width', width)}\u00a0×\u00a0{positive_int('height', height)}"
 
 
 def ucurve_label(field, curve) -> str:
     """Where a U-curve of `lab.accuracy.optima` is measured, in words: the field, the
-    component and the point, the frequencies and the steps.
+    component and the point, the frequencies and the steps (each equation's spaces no-break ones).
 
     Parameters
     ----------
@@ -82,6 +95,6 @@ def ucurve_label(field, curve) -> str:
         If ``curve`` lacks one of those keys.
     """
     sub = {"u": "ᵤ", "v": "ᵥ"}[curve["component"]]
-    return (f"{field} field, h{sub} at (u, v) = ({curve['u']}, {curve['v']}), kᵤ = {curve['k_u']:g}, "
-            f"kᵥ = {curve['k_v']:g}, {curve['steps']} steps from {curve['largest_step']:.0e} to "
-            f"{curve['smallest_step']:.0e}")
+    return (f"{field} field, h{sub} at (u,\u00a0v)\u00a0=\u00a0({curve['u']},\u00a0{curve['v']}), "
+            f"kᵤ\u00a0=\u00a0{curve['k_u']:g}, kᵥ\u00a0=\u00a0{curve['k_v']:g}, {curve['steps']} steps from "
+            f"{curve['largest_step']:.0e} to {curve['smallest_step']:.0e}")
