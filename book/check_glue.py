@@ -27,7 +27,8 @@ quantity's words may contain another's.
 A count the prose shows is written as the book writes numbers: 29,919, not 29919
 (`bare_counts`; a four-digit number from 1900 to 2099 is read as a year), and
 a number glued into prose is formatted with ',' (`unseparated_formats`) so that
-a measurement that comes out larger on another machine is written so too.
+a measurement that comes out larger on another machine is written so too.  A
+negative number is written with the minus sign, −0.651, not a hyphen (`hyphen_minus`).
 
 Usage: python book/check_glue.py [CACHE_DIR [HTML_DIR]]
        (defaults: book/_build/.jupyter_cache, and html/ beside it)
@@ -440,6 +441,17 @@ def bare_counts(html_dir) -> list:
     return bad
 
 
+def hyphen_minus(html_dir) -> list:
+    """One line per negative number that a page's prose (outside maths and code) writes with a
+    hyphen-minus, "-0.651", where the book writes the minus sign, "−0.651" (`chapter.page.HYPHEN_MINUS`;
+    book/_ext/a11y_markup.py typesets them)."""
+    from chapter.page import HYPHEN_MINUS
+    return [f"{page.stem}: {m.group()}{sentence[m.end():m.end() + 12]} in “{sentence[:160]}”"
+            for page in sorted(Path(html_dir).glob("*.html"))
+            for sentence in prose_sentences(page.read_text(encoding="utf-8"))
+            for m in HYPHEN_MINUS.finditer(sentence)]
+
+
 def unseparated_formats(names: dict, book_dir=Path(__file__).parent) -> list:
     """One line per number glued into a page's prose (``book_dir/*.md``) by a format without ','
     that could write it as four digits or more (any but an e-format): a time that shows 986 ms on
@@ -496,11 +508,16 @@ def main(argv=None) -> int:
         print("check_glue: a count without thousands separators (write 13,686, or format the glue with ','):\n  "
               + "\n  ".join(bare), file=sys.stderr)
         return 1
+    hyphens = hyphen_minus(html_dir)
+    if hyphens:
+        print("check_glue: a negative number with a hyphen where the book writes the minus sign (−):\n  "
+              + "\n  ".join(hyphens), file=sys.stderr)
+        return 1
     print(f"check_glue: {len(names)} glued names; {shared} shown on several pages, each with one value; "
           f"{len(QUANTITIES)} quantities with one value under all their names, "
           f"{sum(s is not None for _, s in QUANTITIES.values())} of them the library's; "
           f"{len(NAMED)} quantities named in prose, each with one value under its words; every count with its "
-          f"thousands separators")
+          f"thousands separators, every negative number with its minus sign")
     return 0
 
 

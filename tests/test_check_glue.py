@@ -305,3 +305,14 @@ def test_main_fails_on_a_bare_count(tmp_path, monkeypatch, capsys):
     site = _site(tmp_path, s7_pitfalls="<p>It covers 13686 pixels.</p>")
     assert check_glue.main([str(tmp_path / "cache"), str(site)]) == 1
     assert "s7_pitfalls: 13686" in capsys.readouterr().err
+
+
+def test_a_negative_number_with_a_hyphen_is_found_and_exponents_ranges_words_and_maths_are_not(tmp_path):
+    """"-0.651" in the prose fails wherever it stands (a glue, a table cell, a tuple); the minus sign,
+    an exponent's hyphen, a range, a hyphenated word and a hyphen inside maths or code pass."""
+    ok = ("<p>At −0.651 (−0.58, +0.61), 1.3e-12 and 2^-1022, pages 12-15, the k-1 term, a 3-D view; "
+          "<span class='math'>x = -1</span> <code>eps = -1e-3</code>.</p>")
+    assert check_glue.hyphen_minus(_site(tmp_path, s3_math=ok)) == []
+    bad = check_glue.hyphen_minus(_site(tmp_path, s3_math=ok + "<p>h is <span class='pasted-text'>-0.6510</span>."
+                                                        "</p><td>-9.252, +9.252</td><li>(-0.58, +0.61)</li>"))
+    assert [b.split(" in ")[0].split()[1] for b in bad] == ["-0.6510.", "-9.252,", "-0.58,"], bad

@@ -15,6 +15,7 @@ import types
 
 import matplotlib
 import pytest
+from hypothesis import given, settings, strategies as st
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -182,3 +183,17 @@ def test_margin_notes_and_exercises_become_plain_markdown():
 ])
 def test_an_admonition_is_a_quotation_headed_by_its_title(body, shown):
     assert page.plain_markdown(f":::{{note}}\n{body}\n:::") == shown
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.sampled_from(["-", "−", "+", "e", "k", ".", "/", "^", " ", "(", ",", "0", "7", "1.5"]),
+                max_size=12).map("".join))
+def test_minus_signs_types_exactly_the_hyphens_that_begin_a_number(text):
+    """Against a reading character by character: a hyphen becomes the minus sign when a digit follows
+    and neither a letter, a digit, nor one of . - − / ^ precedes it; nothing else changes."""
+    typeset = page.minus_signs(text)
+    assert len(typeset) == len(text)
+    for i, (a, b) in enumerate(zip(text, typeset)):
+        begins = (a == "-" and text[i + 1:i + 2].isdigit()
+                  and not (i and (text[i - 1].isalnum() or text[i - 1] == "_" or text[i - 1] in ".-−/^")))
+        assert b == ("−" if begins else a), (text, typeset, i)

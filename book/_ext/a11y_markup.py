@@ -10,13 +10,20 @@ violation on the built pages: tests/test_browser.py).
 * A folded code cell's toggle.  myst-nb names its ``<summary>`` "Toggle hidden content" while it shows
   "Show code cell source": a speech-input user saying what they see misses it (axe-core's
   ``label-content-name-mismatch``).  Here the summary is named by the words it shows.
+* A negative number.  Python writes it with a hyphen-minus, which a screen reader reads as a dash
+  or skips; in the prose (not in code or maths) it becomes the minus sign, "−0.651"
+  (`chapter.page.minus_signs`; book/check_glue.py fails a page with one left).
 """
 
 from __future__ import annotations
 
 from html import escape
 
+from docutils import nodes
+from sphinx.transforms.post_transforms import SphinxPostTransform
 from sphinx.writers.html5 import HTML5Translator
+
+from chapter.page import minus_signs
 
 
 class Translator(HTML5Translator):
@@ -35,8 +42,26 @@ def visit_hidden_cell(self, node):
                      f'<p class="expanded admonition-title">{escape(node["prompt_hide"])}</p>\n</summary>\n')
 
 
+class MinusSigns(SphinxPostTransform):
+    """Each negative number of the prose with the minus sign: every text node outside code, maths
+    and raw markup (glued numbers included: myst-nb pastes them as text)."""
+
+    default_priority = 900
+    KEEP = (nodes.FixedTextElement, nodes.literal, nodes.math, nodes.raw, nodes.comment)
+
+    def run(self, **kwargs):
+        for text in list(self.document.findall(nodes.Text)):
+            parent = text.parent
+            while parent is not None and not isinstance(parent, self.KEEP):
+                parent = parent.parent
+            typeset = minus_signs(str(text))
+            if parent is None and typeset != str(text):
+                text.parent.replace(text, nodes.Text(typeset))
+
+
 def setup(app):
     from myst_nb.sphinx_ import HideCodeCellNode, depart_HideCellInput
     app.set_translator("html", Translator)
+    app.add_post_transform(MinusSigns)
     app.add_node(HideCodeCellNode, override=True, html=(visit_hidden_cell, depart_HideCellInput))
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

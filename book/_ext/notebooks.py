@@ -49,7 +49,7 @@ from docutils import nodes
 
 from lab.store import source_digest
 from renderer import files
-from chapter.page import (TITLED, escape, fenced, plain_directive, plain_exercise,
+from chapter.page import (TITLED, escape, fenced, minus_signs, plain_directive, plain_exercise,
                           plain_markdown)
 
 #: The site folder that holds the notebooks, and the one that holds the wheel and constraints.txt.
@@ -234,7 +234,7 @@ class PageMarkdown:
             data = self.glued(key, what)
             if "text/plain" not in data:
                 self.fail(what, "the value has no text/plain")
-            return escape(format_plain_text(data["text/plain"], fmt))
+            return escape(minus_signs(format_plain_text(data["text/plain"], fmt)))   # as the page shows it
         if name == "glue:md":                        # name:myst or name:commonmark
             return self.glue_markdown(content.rsplit(":", 1)[0] if ":" in content else content, what)
         if name in ("glue", "glue:any"):

@@ -23,7 +23,7 @@ import os
 import re
 
 __all__ = ["glue", "show", "markdown", "plain_markdown", "plain_role", "plain_directive", "plain_exercise",
-           "EXERCISE_FORMS", "BUILD_ENV",
+           "minus_signs", "HYPHEN_MINUS", "EXERCISE_FORMS", "BUILD_ENV",
            "in_book_build", "FigureLayoutError"]
 
 #: Set (to "1") by the book build (book/_ext/measurement_store.py) for the kernels it starts.
@@ -35,6 +35,20 @@ _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 
 class FigureLayoutError(ValueError):
     """A figure's text artists overlap one another."""
+
+
+#: A hyphen-minus that makes a number negative: before a digit, and not after a letter, a digit, a
+#: point, a slash, a caret or another dash (an exponent's ``1e-12``, ``k-1``, a range ``3-5``, a path).
+HYPHEN_MINUS = re.compile(r"(?<![\w.\-−/^])-(?=\d)")
+
+
+def minus_signs(text: str) -> str:
+    """``text`` with each negative number's hyphen-minus the minus sign U+2212: "−0.651", as
+    typeset (a screen reader says "minus"; the hyphen is read as a dash or not at all).  An
+    exponent keeps its hyphen, "1.3e-12", as the book writes it.  Python formats a negative
+    number with a hyphen; the book build (book/_ext/a11y_markup.py) applies this to the prose
+    of every page, and book/_ext/notebooks.py to the values it writes into the notebooks."""
+    return HYPHEN_MINUS.sub("−", text)
 
 
 def in_book_build() -> bool:

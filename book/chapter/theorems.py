@@ -20,6 +20,7 @@ from lab import store
 from proofs.core import MATH
 
 from . import latex
+from .page import minus_signs
 
 __all__ = ["theorem_block", "ledger_table", "ledger", "findings", "TheoremFailed", "tex_number", "glue_math",
            "badge", "code_words"]
@@ -251,8 +252,10 @@ _CODE_NAME = re.compile(r"(?<![\w>])([A-Za-z][\w.]*_[\w.]*(?:\['\w+'\])?)")
 
 def _folded(label, text):
     """Raw HTML: ``label`` and ``text`` up to its first semicolon, the rest folded
-    into a <details> the reader opens; the code's names in it set as code."""
-    head, _, rest = (_CODE_NAME.sub(r"<code>\1</code>", html.escape(t, quote=False)) for t in text.partition("; "))
+    into a <details> the reader opens; the code's names in it set as code, its negative numbers with
+    the minus sign (`chapter.page.minus_signs`: raw HTML escapes the build's own typesetting)."""
+    head, _, rest = (_CODE_NAME.sub(r"<code>\1</code>", html.escape(minus_signs(t), quote=False))
+                     for t in text.partition("; "))
     return f"<details><summary>{label}: {head}</summary>{rest}</details>" if rest else f"<p>{label}: {head}</p>"
 
 
