@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from chapter.page import HYPHEN_MINUS
 from renderer import DRAFT_SCENE, PointLight, Scene, compare, gbuffer, render
 from renderer.formulas import FIELDS
 from renderer.jsgen import SIMULATOR_SCENE
@@ -1070,7 +1071,8 @@ def _keyboard_walk(s):
     for key in ("ArrowRight", "ArrowDown"):
         page.keyboard.press(key)
         readouts.append(page.text_content("#sim-readout"))
-        found["probe"] += mark_problems(s)
+        found["probe"] += mark_problems(s) + [f"a hyphen for a minus sign in the readout: {m.group()}"
+                                              for m in HYPHEN_MINUS.finditer(readouts[-1])]
     tab_to("sim-bump"); move("normal", "ArrowUp")        # to the draft's chart formula
     top = page.get_attribute("#sim-beta", "max")
     if f"β now runs to {top}" not in page.text_content("#sim-note"):         # the slider's range changed with it
@@ -1113,6 +1115,7 @@ WRONG_SPOKEN = {
                                            "mark.style.left = `${(100 * (i + 1.5)) / res}%`;", "the rings at"),
     "a ring shown before any pixel is read": ('"aria-hidden": "true", hidden: "" }', '"aria-hidden": "true" }',
                                               "a ring before any pixel"),
+    "the readout's negative numbers with a hyphen": ('.replace(/^-/, "\\u2212")', "", "a hyphen for a minus sign"),
     "the rings left where the first probe put them": ("mark.hidden = false;", "if (!mark.hidden) continue; mark.hidden = false;",
                                                       "the rings at"),
 }
