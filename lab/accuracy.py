@@ -245,9 +245,10 @@ def __getattr__(name):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def crease_distance(u, v, k_u, k_v, field=None):
-    """Chart distance from (u, v) to the nearest crease of a height field along u or along v: a
-    central difference with a larger step straddles one (its stencil reaches u +- eps, v +- eps).
+def crease_distance(u, v, k_u, k_v, field=None, along=None):
+    """Chart distance from (u, v) to the nearest crease of a height field along u or along v (or
+    along ``along`` alone): a central difference with a larger step straddles one (its stencil
+    reaches u +- eps, v +- eps; one quotient's, ``along`` +- eps only).
 
     A crease is a sign change of one of the field's crease factors
     (`renderer.formulas.HeightField.crease_factors`).  Along each chart direction a factor depends
@@ -263,6 +264,8 @@ def crease_distance(u, v, k_u, k_v, field=None):
     k_u, k_v : float in (0, 1e3]
     field : height field or None
         As `renderer.formulas.field` takes it; None for the draft's (`renderer.DRAFT_SCENE`).
+    along : "u", "v" or None
+        The one chart direction searched (a single quotient, D_u h or D_v h); None for both.
 
     Returns
     -------
@@ -273,11 +276,14 @@ def crease_distance(u, v, k_u, k_v, field=None):
     ------
     renderer.validate.InvalidType, renderer.validate.InvalidValue
         Naming the argument: ``u``, ``v`` not real numbers in [0, 1] or not broadcasting
-        together; ``k_u``, ``k_v`` not real numbers in (0, 1e3]; ``field`` refused.
+        together; ``k_u``, ``k_v`` not real numbers in (0, 1e3]; ``field`` refused; ``along``
+        not "u", "v" or None.
     """
     record = DRAFT_SCENE.field if field is None else F.field(field, "field")
+    directions = (True, False) if along is None else (choice("along", along, ("u", "v")) == "u",)
     u, v = broadcast(("u", "v"), real_array("u", u, **UNIT), real_array("v", v, **UNIT))
-    return _crease_distance(u, v, real("k_u", k_u, **FREQUENCY), real("k_v", k_v, **FREQUENCY), record)
+    return _crease_distance(u, v, real("k_u", k_u, **FREQUENCY), real("k_v", k_v, **FREQUENCY), record,
+                            along=directions)
 
 
 def _crease_distance(u, v, k_u, k_v, record, along=(True, False)):
@@ -322,7 +328,8 @@ def optima():
 
     For each field at its point (`renderer.formulas.HeightField.optimum_at`), the curve of
     `renderer.ucurve.measure` over its default steps below the point's distance to the field's
-    nearest crease (`crease_distance`: no stencil of the curve straddles one), with the draft's
+    nearest crease along the component's coordinate, the one direction its stencil moves
+    (`crease_distance` along it alone: no stencil of the curve straddles one), with the draft's
     frequencies; a dict of floats (steps in chart units, errors in height per chart unit): ``u``,
     ``v``, ``component``, ``k_u``, ``k_v``, ``steps`` (how many), ``largest_step``,
     ``smallest_step``, ``crease_distance`` (inf for a field without creases); ``h`` = |h|,
@@ -360,7 +367,7 @@ def measure_optimum(field, u, v, component):
     ------
     renderer.validate.InvalidType, renderer.validate.InvalidValue
         Naming the argument: ``field`` refused, ``u`` or ``v`` not a real number in [0, 1],
-        ``component`` not "u" or "v".
+        ``component`` not "u" or "v", or a direction along which h''' is 0 at the point (no optimum).
     RuntimeError
         The point lies so close to a crease that fewer than two default steps are below it.
     """
@@ -370,12 +377,16 @@ def measure_optimum(field, u, v, component):
     component = choice("component", component, ("u", "v"))
     k_u, k_v = DRAFT_SCENE.k_u, DRAFT_SCENE.k_v
     distance = float(_crease_distance(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64),
-                                      k_u, k_v, record))
+                                      k_u, k_v, record, along=(component == "u",)))   # where its stencil moves
     steps = DEFAULT_STEPS[DEFAULT_STEPS < distance]
     if steps.size < 2:
         raise RuntimeError(f"the {record.name} field's point ({u}, {v}) is {distance:g} from a crease: fewer "
                            "than two of the default steps lie below that")
     c = measure(record, u, v, component, eps=steps, k_u=k_u, k_v=k_v)
+    if c.third_derivative == 0:
+        raise InvalidValue(f"component must be a direction along which h has a third derivative at the point, got "
+                           f"{component!r}: the {record.name} field's h''' along {component} is 0 at ({u}, {v}), so "
+                           "its central difference has no truncation error and no optimal step")
     at_fitted = float(measure(record, u, v, component, eps=[c.eps_fitted], k_u=k_u, k_v=k_v).error[0])
     return dict(u=u, v=v, component=component, k_u=k_u, k_v=k_v, steps=int(steps.size),
                 largest_step=float(steps.max()), smallest_step=float(steps.min()),

@@ -18,7 +18,8 @@ def test_gradient_accuracy_detects_a_wrong_pipeline(monkeypatch, factor, ulps):
 
 def test_the_crease_distance_is_the_distance_to_the_nearest_zero_line():
     """Two routes for the ridges field: `crease_distance` (sign changes of its crease factors, located
-    numerically) against the closed form min(|u - m/k_u|, |v - m/k_v|) at random points; and a reader's
+    numerically) against the closed form min(|u - m/k_u|, |v - m/k_v|) at random points (and each
+    term alone, searched along u or v alone); and a reader's
     field with one crease, at u = 2/5, whose distance is |u - 2/5| wherever its other term has none."""
     import numpy as np
 
@@ -28,6 +29,9 @@ def test_the_crease_distance_is_the_distance_to_the_nearest_zero_line():
     k_u, k_v = 8.0, 4.0
     closed = np.minimum(np.abs(u * k_u - np.rint(u * k_u)) / k_u, np.abs(v * k_v - np.rint(v * k_v)) / k_v)
     assert np.allclose(crease_distance(u, v, k_u, k_v, "ridges"), closed, rtol=0, atol=1e-15)
+    along_u, along_v = (np.abs(x * k - np.rint(x * k)) / k for x, k in ((u, k_u), (v, k_v)))
+    assert np.allclose(crease_distance(u, v, k_u, k_v, "ridges", along="u"), along_u, rtol=0, atol=1e-15)
+    assert np.allclose(crease_distance(u, v, k_u, k_v, "ridges", along="v"), along_v, rtol=0, atol=1e-15)
     near = np.abs(u - 0.4) < 0.2
     assert np.allclose(crease_distance(u[near], v[near], k_u, k_v, "abs(u - 2/5) + sin(pi*k_v*v)"),
                        np.abs(u[near] - 0.4), rtol=0, atol=1e-15)

@@ -209,13 +209,15 @@ def _optima_route(seed, monkeypatch):
     monkeypatch.setattr(accuracy, "DRAFT_SCENE", DRAFT_SCENE.replace(k_u=k_u, k_v=k_v))
     points = {}
     for name in F.FIELDS:
-        while True:
+        component = str(rng.choice([c for c, s in (("u", F.u), ("v", F.v))      # one h varies along
+                                     if s in F.FIELDS[name].expr.free_symbols]))
+        while True:              # the nearest crease along the component's coordinate, where the stencil moves
             u, v = (float(x) for x in rng.uniform(0.05, 0.95, 2))
-            distance = min(abs(u * k_u - round(u * k_u)) / k_u, abs(v * k_v - round(v * k_v)) / k_v) \
-                if F.FIELDS[name].crease_factors else np.inf
+            x, k = (u, k_u) if component == "u" else (v, k_v)
+            distance = abs(x * k - round(x * k)) / k if F.FIELDS[name].crease_factors else np.inf
             if distance > 1e-3:
                 break
-        points[name] = (u, v, str(rng.choice(["u", "v"])), distance)
+        points[name] = (u, v, component, distance if distance <= accuracy.CREASE_REACH else np.inf)
     got = _optima({name: [str(F.FIELDS[name].expr), list(p[:3])] for name, p in points.items()})
     want = {}
     for name, (u, v, component, distance) in points.items():

@@ -31,7 +31,8 @@ def test_image_beta_derivative_is_second_order_in_the_median():
 def test_each_fields_optimum_at_its_stated_point():
     """`optima`: every field's entry is its curve's (the same `measure` at the same point and
     steps), at the point and component its record names (`HeightField.optimum_at`: rings in v); a
-    field with creases is measured farther from every crease than the curve's largest step; the fitted
+    field with creases is measured farther from every crease the curve's stencil can reach (along its
+    component's coordinate) than the curve's largest step; the fitted
     optimal step lies below the model-optimal one (measured rounding errors are below their bound) and
     its measured error within a factor 3 of the fitted model's."""
     from lab.accuracy import OPTIMUM_POINTS, crease_distance, optima
@@ -43,7 +44,8 @@ def test_each_fields_optimum_at_its_stated_point():
         assert (o["u"], o["v"], o["component"]) == (u, v, component) == FIELDS[field].optimum_at, field
         if FIELDS[field].crease_factors:
             assert o["largest_step"] < o["crease_distance"], field
-            assert o["crease_distance"] == pytest.approx(float(crease_distance(u, v, o["k_u"], o["k_v"]))), field
+            assert o["crease_distance"] == pytest.approx(      # along the component's coordinate: its stencil's
+                float(crease_distance(u, v, o["k_u"], o["k_v"], field, along=component))), field
         steps = DEFAULT_STEPS[DEFAULT_STEPS <= o["largest_step"]]
         c = measure(field, u, v, component, eps=steps)
         assert (o["steps"], o["eps_model"], o["eps_fitted"]) == (steps.size, c.eps_model, c.eps_fitted), field
