@@ -686,7 +686,7 @@ CLAIMS = (
           "values of h in the kernel's formulas (sympy objects)", CORRECTED, _evals,
           rule(HOLDS, (Bound("values of h, central", 4, 4), Bound("values of h, exact", 1, 1)),
                CORRECTED, (Bound("values of h, central", 4, 4), Bound("values of h, exact", 0, 0)))),
-    Claim("cell4-counter", "Cell 4", "h-evals per numeric gradient … per symbolic gradient",
+    Claim("cell4-counter", "Cell 4, printout", "h-evals per numeric gradient … per symbolic gradient",
           "the draft's counting scheme, run: a counter around h, gradients calling h", FAILS, _cell4_counter,
           rule(HOLDS, (Bound("count printed, numeric", 4, 4), Bound("count printed, exact", 1, 1)))),
     Claim("stacking", "§6, Stacking", "bump composes under Ch. 6's filter … no new integral, ever",

@@ -106,8 +106,8 @@ def _chart(u_claim=U_OF_THETA, v_kernel=F.CHART[1], corrupt=None):
         id="chart", title=TITLES["chart"],
         statement=(r"For $⟦theta⟧$ and $⟦phi⟧$ the renderer's chart "
                    r"at the unit normal $N(\theta, \varphi)$, $⟦N_x⟧$, $⟦N_y⟧$, $⟦N_z⟧$, computes "
-                   r"$u$ as $⟦u⟧$ and $v$ as $⟦v⟧$, with $⟦sin⟧$; so $⟦rates⟧$, the factors that "
-                   r"multiply $h_u$ and $h_v$ to give $h_\theta$ and $h_\varphi$."),
+                   r"$u$ as $⟦u⟧$ and $v$ as $⟦v⟧$, with $⟦sin⟧$; so $⟦rates⟧$, the factors from "
+                   r"$h_u$, $h_v$ to $\partial h/\partial\theta$, $\partial h/\partial\varphi$."),
         steps=(
             Step(r"$\operatorname{hypot}(N_x, N_y) = \sqrt{N_x^2 + N_y^2}$ (evaluated without forming the squares); "
                  r"at $N(\theta, \varphi)$ the radicand is $\sin^2\varphi\,(\cos^2\theta + \sin^2\theta) = "

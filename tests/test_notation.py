@@ -23,7 +23,7 @@ from proofs.registry import THEOREMS
 PRINTED = {
     "shading": "5af0a7f5432b58c2",
     "displaced-normal": "6ccdd30f2a657fc4",
-    "chart": "e45e592340c4ac34",
+    "chart": "b0eb3cf5166d0cb0",
     "frame-orthonormal": "6f2e22487456f433",
     "frame-orientation": "159cdc15fdb9b096",
     "gradient-sine": "afdd4d313d68b6fe",
