@@ -125,7 +125,8 @@ class Config:
 #: Book build (§5, Cell 4, which reports the time it took): a few hundred reference pixels
 #: at 34 digits and one Richardson run per field keep it to about a second.  Nine repeats: with
 #: three, one step's median could be twice its neighbours' while the build ran another page beside
-#: it (the same stencil at three steps read as 2.7, 6.6 and 2.7 ms); with nine they agree within a few percent.
+#: it (the same stencil at three steps read as 2.7, 6.6 and 2.7 ms); with nine, run alone, they agree
+#: within a few percent, and in a build they still spread by about a third (2.3 to 3.3 ms).
 #: Steps: the draft's step, near each quotient's optimum (central 1e-6, forward 1e-8),
 #: and one past the central optimum, where rounding rules.
 FAST = Config("fast", central_steps=(DRAFT_SCENE.eps, 1e-6, 1e-9), forward_steps=(DRAFT_SCENE.eps, 1e-8),
