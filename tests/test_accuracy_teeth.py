@@ -36,6 +36,8 @@ def test_the_crease_distance_is_the_distance_to_the_nearest_zero_line():
     assert np.allclose(crease_distance(u[near], v[near], k_u, k_v, "abs(u - 2/5) + sin(pi*k_v*v)"),
                        np.abs(u[near] - 0.4), rtol=0, atol=1e-15)
     assert np.all(np.isinf(crease_distance(u, v, k_u, k_v, "sine")))
+    from renderer import DRAFT_SCENE
+    assert np.array_equal(crease_distance(u, v, k_u, k_v), crease_distance(u, v, k_u, k_v, DRAFT_SCENE.height_field))
 
 
 def test_below_the_bands_width_every_straddling_stencil_lies_in_the_crease_band():
@@ -123,3 +125,16 @@ def test_a_candidate_point_is_measured_as_optima_measures_a_registered_one():
     tried = measure_optimum("sin(2*pi*k_u*u) * sin(2*pi*k_v*v)", 0.37, 0.47, "u")
     assert (tried["u"], tried["v"], tried["component"]) == (0.37, 0.47, "u")
     assert 1 / 3 < tried["measured_at_fitted"] / tried["error_at_fitted"] < 3
+
+
+def test_an_optimum_keeps_the_steps_its_own_stencil_allows():
+    """A U-curve of h_u moves only in u: a v-crease 0.02 away limits none of its steps, the u-crease
+    0.06 away does; on a u-crease no two steps are left, and that is said in one line."""
+    import pytest
+
+    from lab.accuracy import measure_optimum
+    o = measure_optimum("ridges", 0.31, 0.52, "u")
+    assert o["crease_distance"] == pytest.approx(0.06) and 0.02 < o["largest_step"] < 0.06
+    with pytest.raises(RuntimeError, match=r"^the ridges field's point \(0.25, 0.4\) is [\d.e+-]+ from a crease: "
+                                           r"fewer than two of the default steps lie below that$"):
+        measure_optimum("ridges", 0.25, 0.4, "u")

@@ -56,6 +56,10 @@ def test_each_fields_optimum_at_its_stated_point():
             f"a factor 3) at optimum=({u}, {v}, {component!r}); register the field with another optimum= point "
             f"(lab.accuracy.measure_optimum({field!r}, u, v, component) measures any point first)")
         assert o["h"] + o["x_h1"] == pytest.approx(c.model_argument / o["argument_share"] / UNIT_ROUNDOFF), field
+        # The model's two coefficients from their parts (abs=0: approx's default absolute 1e-12 would pass any
+        # rounding coefficient, about 1e-16).
+        assert o["model_truncation"] == pytest.approx(o["h3"] / 6, rel=1e-12, abs=0), field
+        assert o["model_roundoff"] == pytest.approx(UNIT_ROUNDOFF * (o["h"] + o["x_h1"]), rel=1e-12, abs=0), field
 
 
 def test_the_crease_share_is_the_census_straddling_count():
