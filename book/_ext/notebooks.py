@@ -204,7 +204,7 @@ class PageMarkdown:
             return self(data["text/markdown"])
         if "text/plain" in data:
             from myst_nb.core.variables import format_plain_text
-            return escape(format_plain_text(data["text/plain"], ""))
+            return escape(minus_signs(format_plain_text(data["text/plain"], "")))
         self.fail(what, f"the value glued under {key!r} is not text ({', '.join(data)})")
 
     # references ---------------------------------------------------------------------------------

@@ -13,10 +13,12 @@ from renderer.validate import positive_int
 __all__ = ["frame_label", "size_label", "ucurve_label"]
 
 #: How `frame_label` words a field of `renderer.Scene` that differs from its reference scene.
-#: An equation and a size keep their spaces unbroken (no-break spaces), so that a phone's line never
-#: parts "β =" from its value or "256 ×" from "256".
-_WORDS = {"height_field": "the {} field", "beta": "β\u00a0=\u00a0{:g}", "eps": "ε\u00a0=\u00a0{:g}",
-          "k_u": "kᵤ\u00a0=\u00a0{:g}", "k_v": "kᵥ\u00a0=\u00a0{:g}", "radius_a": "R\u00a0=\u00a0{:g}", "model": "{} shading", "shininess": "shininess {:g}"}
+#: An equation's and a size's spaces are no-break ones, so that a phone's line never parts "β =" from
+#: its value or "256 ×" from "256".
+_EQUALS, _TIMES = "\u00a0=\u00a0", "\u00a0×\u00a0"
+_WORDS = {"height_field": "the {} field", "beta": f"β{_EQUALS}{{:g}}", "eps": f"ε{_EQUALS}{{:g}}",
+          "k_u": f"kᵤ{_EQUALS}{{:g}}", "k_v": f"kᵥ{_EQUALS}{{:g}}", "radius_a": f"R{_EQUALS}{{:g}}",
+          "model": "{} shading", "shininess": "shininess {:g}"}
 
 
 def _field_words(name, value):
@@ -73,7 +75,7 @@ def size_label(width, height):
     TypeError, ValueError
         As `frame_label` does for ``width`` and ``height``.
     """
-    return f"{positive_int('width', width)}\u00a0×\u00a0{positive_int('height', height)}"
+    return f"{positive_int('width', width)}{_TIMES}{positive_int('height', height)}"
 
 
 def ucurve_label(field, curve) -> str:
@@ -95,6 +97,6 @@ def ucurve_label(field, curve) -> str:
         If ``curve`` lacks one of those keys.
     """
     sub = {"u": "ᵤ", "v": "ᵥ"}[curve["component"]]
-    return (f"{field} field, h{sub} at (u,\u00a0v)\u00a0=\u00a0({curve['u']},\u00a0{curve['v']}), "
-            f"kᵤ\u00a0=\u00a0{curve['k_u']:g}, kᵥ\u00a0=\u00a0{curve['k_v']:g}, {curve['steps']} steps from "
+    return (f"{field} field, h{sub} at (u,\u00a0v){_EQUALS}({curve['u']},\u00a0{curve['v']}), "
+            f"kᵤ{_EQUALS}{curve['k_u']:g}, kᵥ{_EQUALS}{curve['k_v']:g}, {curve['steps']} steps from "
             f"{curve['largest_step']:.0e} to {curve['smallest_step']:.0e}")

@@ -698,7 +698,8 @@ class Simulator {
     const pr = probe_pixel(this.frames.scene, res, res, i, j, s.zoom, s.numeric);
     const a = pr.symbolic, b = pr.numeric;
     // A negative component with the minus sign, as the book's prose writes it (a screen reader says "minus").
-    const vec = (v, digits = 10) => v ? "(" + v.map((x) => x.toPrecision(digits).replace(/^-/, "\u2212")).join(", ") + ")" : "—";
+    const signed = (x, digits) => x.toPrecision(digits).replace(/^-/, "\u2212");
+    const vec = (v, digits = 10) => v ? "(" + v.map((x) => signed(x, digits)).join(", ") + ")" : "—";
     const rows = [["pixel", `x\u00a0=\u00a0${i}, y\u00a0=\u00a0${j}: ${CHAMBER_NAMES[a.chamber].replaceAll(" ", "\u00a0")}`, true], ["hit point", vec(a.P, 6)]];
     if (a.chamber === SPHERE_A) {
       rows.push(["(u, v)", vec(a.uv, 8)]);
