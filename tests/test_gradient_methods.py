@@ -110,6 +110,44 @@ def test_exact_and_richardson_against_mpmath():
     assert np.all(err < 1e-11)
 
 
+def _richardson_table(f, x, step, rounds):
+    """Richardson's extrapolation, in mpmath at 40 digits, of the central differences of ``f`` at
+    ``step``, ``step``/2, ..., ``step``/2^rounds: ``rounds`` times (4^k D(s/2) - D(s)) / (4^k - 1)."""
+    with mpmath.workdps(40):
+        x = mpmath.mpf(x)
+        table = [(f(x + s) - f(x - s)) / (2 * s) for s in (mpmath.mpf(step) / 2**k for k in range(rounds + 1))]
+        for k in range(1, rounds + 1):
+            table = [(4**k * b - a) / (4**k - 1) for a, b in zip(table, table[1:])]
+        return table[0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(a=st.floats(1.5, 4.0), b=st.floats(-1.0, 1.0), x=st.floats(-1.0, 1.0), step=st.floats(0.4, 0.8))
+def test_scipys_first_estimate_is_richardsons_extrapolation_over_halved_steps(a, b, x, step):
+    """§3: SciPy's differentiator, at the settings `RICHARDSON` gives it, starts from order/2 - 1
+    rounds of Richardson's extrapolation of central differences at the step halved each time.  At
+    steps this large the truncation error dwarfs float64's rounding, so one round fewer or more
+    gives another number: the count of rounds is checked, not only the method."""
+    from scipy.differentiate import derivative
+
+    def f(t):
+        return np.sin(a * t) * np.exp(b * t)
+
+    def f_mp(t):
+        return mpmath.sin(a * t) * mpmath.exp(b * t)
+
+    settings_ = {**gm.RICHARDSON, "initial_step": step, "maxiter": 1, "tolerances": dict(atol=0.0, rtol=0.0)}
+    rounds = gm.RICHARDSON["order"] // 2 - 1
+    assert gm.RICHARDSON["step_factor"] == 2.0
+    first = float(derivative(f, x, **settings_).df)
+    assert first == pytest.approx(float(_richardson_table(f_mp, x, step, rounds)), rel=0, abs=1e-13)
+    # exp(a t), whose derivatives never vanish, at steps 2.5 times as long: one round fewer or
+    # more gives another number (by 6e-9 or more here).
+    first = float(derivative(lambda t: np.exp(a * t), x, **{**settings_, "initial_step": 2.5 * step}).df)
+    for wrong in (rounds - 1, rounds + 1):
+        assert abs(first - float(_richardson_table(lambda t: mpmath.exp(a * t), x, 2.5 * step, wrong))) > 1e-10
+
+
 def test_reference_gradient_is_the_mpmath_value_as_a_double_double():
     hi, lo = gm.reference_gradient("sine", U0, V0, KU, KV)
     with mpmath.workdps(40):
