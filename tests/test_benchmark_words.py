@@ -27,7 +27,10 @@ def test_fastest_on_counts_the_fields_where_the_method_is_fastest():
     rows = {f: [SimpleNamespace(field=f, method="exact", median=2.0 if f == fields[-1] else 1.0),
                 SimpleNamespace(field=f, method="central", median=1.5)] for f in fields}
     fake = SimpleNamespace(of=rows.__getitem__, results=[r for f in fields for r in rows[f]])
-    named = lambda wins: f" ({' and '.join(wins)})" if len(wins) == 2 else f" ({wins[0]})"   # noqa: E731
+
+    def named(wins):                        # "(sine)", "(sine and ridges)", "(sine, ridges and rings)"
+        return f" ({', '.join(wins[:-1])} and {wins[-1]})" if len(wins) > 1 else f" ({wins[0]})"
+
     assert fastest_on(fake, "exact") == share_in_words(len(fields) - 1, len(fields)) + " fields" + named(fields[:-1])
     assert fastest_on(fake, "central") == share_in_words(1, len(fields)) + " fields" + named(fields[-1:])
 

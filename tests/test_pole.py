@@ -214,7 +214,10 @@ def test_the_pixels_span_the_disc():
 @pytest.mark.parametrize("bump", ["surface", "chart"])
 def test_the_draft_cut_off_is_refused(bump):
     """The check shown failing: the pointwise path fed the draft's fixed pair where sin(phi) <= 1e-4
-    and, for the surface, its floor max(sin phi, 1e-4) (the renderer before this change)."""
+    and, for the surface, its floor max(sin phi, 1e-4) (the renderer before this change).  Every
+    field's frame is refused by far; by how many degrees it errs depends on the field (one flat at
+    the pole, as sin^2 is, errs by less), so the visible size is asserted of the worst field."""
+    worst_degrees = 0.0
     for zoom, side in FRAMES:
         for scene in scenes(bump):
             g = gbuffer(scene, side, side, zoom=zoom)
@@ -223,7 +226,9 @@ def test_the_draft_cut_off_is_refused(bump):
             Ns[inside] = pointwise_normals(scene, g.N[inside], frame=lambda s: s <= DRAFT_POLE_SIN_PHI,
                                            floor=DRAFT_POLE_SIN_PHI if bump == "surface" else 0.0)
             ratio, degrees, _ = worst(scene, zoom, side, Ns)
-            assert ratio > 1e9 and degrees > 1.0, (scene.height_field, zoom, degrees)
+            assert ratio > 1e9, (scene.height_field, zoom, degrees)
+            worst_degrees = max(worst_degrees, degrees)
+    assert worst_degrees > 1.0
 
 
 def test_the_frame_is_the_fixed_pair_only_at_sin_phi_zero_or_subnormal():
