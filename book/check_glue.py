@@ -107,8 +107,7 @@ QUANTITIES = {
                                         lambda: 10.0 ** _lib("renderer.ledger").DIFFERENCE_LOG_FLOOR),
     "the U-curve reference's digits": (("c2_digits", "s7_digits"), lambda: _lib("renderer.ucurve").DIGITS),
     "the accuracy references' digits": (("c5_digits",), lambda: _lib("lab.accuracy").DIGITS),
-    "SciPy's rounds of Richardson's extrapolation": (("s3_scipy_rounds",),
-                                                      lambda: _lib("lab.gradient_methods").RICHARDSON["order"] // 2 - 1),
+    "SciPy's rounds of Richardson's extrapolation": (("s3_scipy_rounds",), lambda: _lib("lab.gradient_methods").RICHARDSON_ROUNDS),
     # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
     "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),

@@ -70,7 +70,7 @@ __all__ = [
     "Style", "Method", "METHODS", "method", "Evaluations", "forward_gradient", "complex_step_gradient",
     "richardson_gradient", "ad_gradient", "reference_gradient", "trig_calls", "stencil_values", "height_work",
     "evaluations", "AD", "ad_trig_calls", "abs_slope_at_zero", "crease_values", "xla_exact_gradient",
-    "same_compiler_times", "RICHARDSON",
+    "same_compiler_times", "RICHARDSON", "RICHARDSON_ROUNDS",
 ]
 
 #: The name of forward-mode automatic differentiation in the results.
@@ -283,6 +283,11 @@ def _complex_step_gradient(field, uu, vv, ku, kv, eps, *, continued=False):
 #: phase at the highest frequency of the draft's scene (pi k_u = 8 pi); atol lets it stop where a
 #: component is exactly 0 (rings: h_u = 0), which its default (the smallest normal float) never does.
 RICHARDSON = dict(initial_step=0.02, order=8, step_factor=2.0, maxiter=10, tolerances=dict(atol=1e-12))
+#: At these settings SciPy's first estimate is Richardson's extrapolation (4^k D(s/2) - D(s)) / (4^k - 1)
+#: of central differences D at the initial step halved this many times: its stencil of order 8 on the
+#: nested steps s / step_factor^j is the unique one there, and step_factor 2 makes them halvings
+#: (§3; tests/test_gradient_methods.py checks it against an mpmath table).
+RICHARDSON_ROUNDS = RICHARDSON["order"] // 2 - 1
 
 
 @_documented
