@@ -377,7 +377,7 @@ FITTED = "!document.querySelector('script[src*=\"fit.js\"]') || document.documen
 class Page:
     """A page opened offline at ``width`` px, once MathJax has typeset it and fit.js is done.  Only file:
     addresses load; any other request is blocked and recorded in ``blocked``, and console errors and
-    uncaught exceptions in ``errors``.  ``change(path, text)``, if given, rewrites each HTML and CSS file
+    uncaught exceptions in ``errors``.  ``change(path, text)``, if given, rewrites each HTML, CSS and script file
     the page loads from the site (a wrong variant); ``options`` go to the browser's context (``has_touch=True``: a
     phone's)."""
 
@@ -389,12 +389,12 @@ class Page:
             if not r.request.url.startswith("file://"):
                 self.blocked.append(r.request.url)
                 return r.abort()
-            if change is None or not r.request.url.split("?")[0].endswith((".html", ".css")):
+            if change is None or not r.request.url.split("?")[0].endswith((".html", ".css", ".js")):
                 return r.continue_()
             from urllib.parse import unquote, urlparse
             path = Path(unquote(urlparse(r.request.url).path))
             r.fulfill(body=change(path, path.read_text(encoding="utf-8")),
-                      content_type="text/css" if path.suffix == ".css" else "text/html")
+                      content_type={".css": "text/css", ".js": "text/javascript"}.get(path.suffix, "text/html"))
 
         self.context.route("**/*", route)
         self.page = self.context.new_page()
@@ -1274,7 +1274,7 @@ def test_the_length_check_catches_a_tall_page_and_a_wordy_book(browser, book_htm
 #: it does not know (its noundefined extension shows it as red text, the backslash included),
 #: "text", "where"}.
 FORMULAS_JS = r"""async () => {
-  const root = document.querySelector('article.bd-article');
+  const root = document.querySelector('article.bd-article'), OPEN = '([{⟨|‖', CLOSE = ')]}⟩|‖';
   const folded = [...root.querySelectorAll('details:not([open])')];
   if (folded.length) {
     // fit.js refits on each toggle event, in its own listener (on the document, capturing): the last
@@ -1297,7 +1297,17 @@ FORMULAS_JS = r"""async () => {
     const over = Math.max(0, ...rects.map(r => Math.max(r.right - right, left - r.left)));
     const section = m.closest('section[id]');
     const display = m.getAttribute('display') === 'true';
-    return {display, scale: +scale.toFixed(3), stacked: !display && !!m.querySelector('mjx-mfrac'),
+    // The operators that begin a line of an in-line formula broken there: after the break MathJax took (the
+    // next part to the left of and below the last), an operator that is neither an opening fence nor a
+    // prefix one (one following another operator), as MathJax sets it before a break.
+    const operand = e => e.tagName !== 'MJX-MO' || CLOSE.includes(e.textContent.trim());
+    const opens = display ? [] : [...m.querySelectorAll('mjx-break')].flatMap(b => {
+      const p = b.previousElementSibling, n = b.nextElementSibling;
+      if (!p || !n || n.tagName !== 'MJX-MO' || OPEN.includes(n.textContent.trim()) || !operand(p)) return [];
+      const pr = p.getBoundingClientRect(), nr = n.getBoundingClientRect();
+      return nr.left < pr.left && nr.top > pr.top ? [n.textContent.trim()] : [];
+    });
+    return {display, opens, scale: +scale.toFixed(3), stacked: !display && !!m.querySelector('mjx-mfrac'),
             px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror') || [...m.querySelectorAll('mjx-mtext')].some((t) => t.textContent.startsWith('\\')),
             tab: m.tabIndex >= 0, text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
             where: section ? '#' + section.id : ''};
@@ -1308,9 +1318,11 @@ FORMULAS_JS = r"""async () => {
 def formula_findings(found):
     """The formulas of a FORMULAS_JS list that a reader cannot read whole: set below the text's size
     (scale under 1, or in running text a stacked fraction, whose parts MathJax sets at 70 %), reaching
-    past the column by more than a pixel, or a TeX error; or that a keyboard reader must Tab through (in
-    the Tab order: MathJax's default)."""
-    return [f for f in found if f["scale"] < 0.999 or f["stacked"] or f["over"] > 1 or f["error"] or f["tab"]]
+    past the column by more than a pixel, or a TeX error; that a keyboard reader must Tab through (in
+    the Tab order: MathJax's default); or in-line and broken before an operator ("x" ending a line, "= v"
+    beginning the next), where TeX breaks after one."""
+    return [f for f in found if f["scale"] < 0.999 or f["stacked"] or f["over"] > 1 or f["error"] or f["tab"]
+            or f["opens"]]
 
 
 #: Run in a page: each figure's image brought to the top of the screen, its middle and its bottom, each
@@ -1425,7 +1437,8 @@ def test_every_formula_is_at_full_size_within_the_column(site, name):
 #: left to let formulas run past the column (its default; §3 has the formulas too long for a phone's
 #: column), formulas set at 62 % of the text (as fit.js once shrank them to fit; any page with formulas
 #: shows it, §1 quickly), formulas left in the Tab order, a TeX command MathJax does not know (a statement's text mistyped: MathJax
-#: sets it as red text, backslash and all), and a fraction stacked in a line of text.
+#: sets it as red text, backslash and all), a fraction stacked in a line of text, and in-line formulas broken before
+#: their operators (MathJax's default; §3's lines at 390 px then begin "= …" or "+ …").
 WRONG_FORMULAS = {
     "MathJax breaking no line": ("s3_math", "s3_math.html",
                                  '"displayOverflow": "linebreak", "linebreaks": {"inline": true',
@@ -1440,6 +1453,8 @@ WRONG_FORMULAS = {
                                            r"\(\vAREPSILON =\)", lambda f: f["error"]),
     "a stacked fraction in running text": ("s1_what_changes", "s1_what_changes.html", r"\(\varepsilon =\)",
                                            r"\(\frac{\varepsilon}{2} =\)", lambda f: f["stacked"]),
+    "in-line formulas broken before an operator": ("s3_math", "fit.js", 'set("linebreakstyle", "after")',
+                                                   'set("linebreakstyle", "before")', lambda f: f["opens"]),
 }
 
 

@@ -10,7 +10,9 @@
 //   (fit.css), with a visible cue above it (p.fit-scroll-cue) that says so, and the box takes the
 //   keyboard's focus (its arrow keys scroll it);
 // - a display formula is broken again when its column's width changes: MathJax 4 breaks a display for
-//   the width its column has when it is typeset (none inside a closed <details>, which has no width).
+//   the width its column has when it is typeset (none inside a closed <details>, which has no width);
+// - an in-line formula breaks after a relation or a binary operator, as TeX breaks one ("x =" ends a
+//   line); MathJax 4 breaks before it, MathML's default, which a display keeps.
 // This is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
@@ -133,6 +135,20 @@
       item.rerender(doc);
     });
   }
+
+  // Before MathJax starts (its script is deferred; this one is not): its TeX input's last step marks each
+  // operator of an in-line formula, but one whose break side is given, to break after itself.
+  var config = window.MathJax;
+  if (config && !config.startup) config.startup = { ready: function () {
+    MathJax.startup.defaultReady();
+    MathJax.startup.document.inputJax[0].postFilters.add(function (args) {
+      if (args.math.display) return;
+      args.data.root.walkTree(function (node) {
+        if (node.isKind("mo") && !node.attributes.hasExplicit("linebreakstyle"))
+          node.attributes.set("linebreakstyle", "after");
+      });
+    });
+  } };
 
   var typeset = false;      // MathJax has typeset the page, and `broken` holds its displays' widths
   function fit() {
