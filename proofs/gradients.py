@@ -144,9 +144,8 @@ def _gradient_evidence(field, closed_form, corrupt=None, compiled=None):
                    "central and "
                    f"footprint gradients at {rendered['exact'][1]:,} seeded sphere-A pixels at "
                    f"{rendered['exact'][0]:.2f}, {rendered['central'][0]:.2f} and {rendered['footprint'][0]:.2f} "
-                   "times their rounding tolerances against "
-                   "the exact gradient, the central difference (stencil included) and the central difference with "
-                   "the footprint's steps at its (u, v)",
+                   "times their rounding tolerances against the exact gradient and the central difference "
+                   "(stencil included) at the kernel's and the footprint's steps",
                    worst, DIGITS, POINTS, rendered=rendered["exact"][1], bound=GENERATED_TOLERANCE)
 
 
