@@ -595,6 +595,7 @@ def site(browser, book_html):
                 found[name, width]["formulas"] = p.formulas()
                 if width == WIDTHS[0]:
                     found[name, width]["axe"] = p.axe()
+                    found[name, width]["told_apart"] = p.page.evaluate(TOLD_APART)
                 if os.environ.get("SYMRENDER_SHOTS") == "1":
                     p.screenshot(shots / f"{name}_{width}.png")
             loads.append({"blocked": p.blocked, "errors": p.errors})
@@ -621,6 +622,27 @@ def site(browser, book_html):
     return found
 
 
+#: Run in a page: what a screen reader's lists of the page's controls and regions cannot tell apart (WCAG 2.4.6,
+#: 4.1.2), as sentences: buttons of the article (fold toggles, copy buttons) sharing a name, as each of
+#: sphinx-togglebutton's "Toggle hidden content" and each proof's "Proof" did; more than one unnamed side
+#: region (an ``<aside>`` is a "complementary" landmark: each margin note was one); a figure's image made a link
+#: (to its PNG: a Tab stop named by the whole alt text).  A name is the aria-label, else the words shown.
+TOLD_APART = r"""() => {
+  const root = document.querySelector('article.bd-article');
+  const words = e => (e.innerText || e.textContent).replace(/\s+/g, ' ').trim();
+  const names = new Map();
+  for (const c of root.querySelectorAll('button, summary, [role=button]')) if (c.getClientRects().length) {
+    const n = c.getAttribute('aria-label') || words(c);
+    names.set(n, (names.get(n) || 0) + 1);
+  }
+  const unnamed = [...root.querySelectorAll('aside:not([role]), [role=complementary]')]
+    .filter(a => !a.hasAttribute('aria-label') && !a.hasAttribute('aria-labelledby')).length;
+  return [...[...names].filter(([, k]) => k > 1).map(([n, k]) => `${k} buttons named '${n}'`),
+          ...(unnamed > 1 ? [`${unnamed} unnamed side regions (asides)`] : []),
+          ...[...root.querySelectorAll('figure a img')].map(i => `a figure's image is a link: ${i.getAttribute('src').slice(-24)}`)];
+}"""
+
+
 def _stretched(audit):
     return [i for i in audit["images"] if i["ratio"] is None or abs(i["ratio"] - 1) > RATIO_TOL]
 
@@ -636,6 +658,42 @@ cases = pytest.mark.parametrize("name, width", [(n, w) for w in WIDTHS for n in 
 def test_every_image_keeps_its_aspect_ratio(site, name, width):
     bad = _stretched(site[name, width])
     assert not bad, f"{name} at {width} px: images shown off their natural aspect ratio:\n{_listing(bad)}"
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
+    """`TOLD_APART` finds nothing on any page (at 1280 px: names and regions do not change with the width)."""
+    bad = site[name, WIDTHS[0]]["told_apart"]
+    assert not bad, f"{name}: " + "; ".join(bad)
+
+
+#: Wrong variants of the site (the page opened, the file changed, its text, its replacement), each of which
+#: `TOLD_APART` must catch: sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
+#: undone), the margin notes as unnamed asides, and a figure's image linked to its PNG.
+WRONG_TOLD_APART = {
+    "the folds' and buttons' own names": ("s5_lab", "fit.js", "nameControls(root);", ""),
+    "margin notes as unnamed asides": ("s5_lab", "s5_lab.html", '<aside class="margin sidebar" role="note">',
+                                       '<aside class="margin sidebar">'),
+    "a figure's image linked to its PNG": ("s3_math", "s3_math.html", '<figure class="align-default" id="fig-frame">\n<img',
+                                           '<figure class="align-default" id="fig-frame">\n<a href="x.png"><img'),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_TOLD_APART))
+def test_the_told_apart_check_catches_shared_names_unnamed_regions_and_linked_figures(browser, book_html, variant):
+    name, file, old, new = WRONG_TOLD_APART[variant]
+
+    def change(path, text):
+        if path.name != file:
+            return text
+        assert old in text, f"variant {variant!r} no longer applies to {file}"
+        return text.replace(old, new)
+
+    s = Page(browser, (book_html / f"{name}.html").as_uri(), 1280, change=change)
+    try:
+        assert s.page.evaluate(TOLD_APART), variant
+    finally:
+        s.close()
 
 
 @cases
@@ -1300,17 +1358,17 @@ FORMULAS_JS = r"""async () => {
     const over = Math.max(0, ...rects.map(r => Math.max(r.right - right, left - r.left)));
     const section = m.closest('section[id]');
     const display = m.getAttribute('display') === 'true';
-    // The operators that begin a line of an in-line formula broken there: after the break MathJax took (the
-    // next part to the left of and below the last), an operator that is neither an opening fence nor a
-    // prefix one (one following another operator), as MathJax sets it before a break.
+    // The breaks MathJax took in an in-line formula (the part after a break to the left of and below the part
+    // before it) before an operator, where TeX breaks after one: the part after the break an operator that
+    // is neither an opening fence nor a prefix one (one after another operator); each as "<before>|<after>".
     const operand = e => e.tagName !== 'MJX-MO' || CLOSE.includes(e.textContent.trim());
-    const opens = display ? [] : [...m.querySelectorAll('mjx-break')].flatMap(b => {
+    const breaks = display ? [] : [...m.querySelectorAll('mjx-break')].flatMap(b => {
       const p = b.previousElementSibling, n = b.nextElementSibling;
       if (!p || !n || n.tagName !== 'MJX-MO' || OPEN.includes(n.textContent.trim()) || !operand(p)) return [];
       const pr = p.getBoundingClientRect(), nr = n.getBoundingClientRect();
-      return nr.left < pr.left && nr.top > pr.top ? [n.textContent.trim()] : [];
+      return nr.left < pr.left && nr.top > pr.top ? [p.textContent.trim() + '|' + n.textContent.trim()] : [];
     });
-    return {display, opens, scale: +scale.toFixed(3), stacked: !display && !!m.querySelector('mjx-mfrac'),
+    return {display, breaks, scale: +scale.toFixed(3), stacked: !display && !!m.querySelector('mjx-mfrac'),
             px: +(scale * px(around)).toFixed(1), over: +over.toFixed(1), error: !!m.querySelector('mjx-merror') || [...m.querySelectorAll('mjx-mtext')].some((t) => t.textContent.startsWith('\\')),
             tab: m.tabIndex >= 0, text: (m.querySelector('mjx-assistive-mml') || m).textContent.replace(/\s+/g, ' ').trim().slice(0, 60),
             where: section ? '#' + section.id : ''};
@@ -1325,7 +1383,7 @@ def formula_findings(found):
     the Tab order: MathJax's default); or in-line and broken before an operator ("x" ending a line, "= v"
     beginning the next), where TeX breaks after one."""
     return [f for f in found if f["scale"] < 0.999 or f["stacked"] or f["over"] > 1 or f["error"] or f["tab"]
-            or f["opens"]]
+            or f["breaks"]]
 
 
 #: Run in a page: each figure's image brought to the top of the screen, its middle and its bottom, each
@@ -1457,7 +1515,7 @@ WRONG_FORMULAS = {
     "a stacked fraction in running text": ("s1_what_changes", "s1_what_changes.html", r"\(\varepsilon =\)",
                                            r"\(\frac{\varepsilon}{2} =\)", lambda f: f["stacked"]),
     "in-line formulas broken before an operator": ("s3_math", "fit.js", 'set("linebreakstyle", "after")',
-                                                   'set("linebreakstyle", "before")', lambda f: f["opens"]),
+                                                   'set("linebreakstyle", "before")', lambda f: f["breaks"]),
 }
 
 

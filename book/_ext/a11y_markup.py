@@ -10,6 +10,9 @@ violation on the built pages: tests/test_browser.py).
 * A folded code cell's toggle.  myst-nb names its ``<summary>`` "Toggle hidden content" while it shows
   "Show code cell source": a speech-input user saying what they see misses it (axe-core's
   ``label-content-name-mismatch``).  Here the summary is named by the words it shows.
+* A margin note.  sphinx-book-theme writes each as an ``<aside>``, which a screen reader lists
+  among the page's landmarks, unnamed: §5 had 17 "complementary" landmarks.  Here each is a
+  ``role="note"``, read where it stands and kept out of that list.
 * A negative number.  Python writes it with a hyphen-minus, which a screen reader reads as a dash
   or skips; in the prose (not in code or maths) it becomes the minus sign, "−0.651"
   (`chapter.page.minus_signs`; book/check_glue.py fails a page with one left).
@@ -27,12 +30,19 @@ from chapter.page import minus_signs
 
 
 class Translator(HTML5Translator):
-    """Sphinx's HTML5 translator with each citation a list item of the list around it."""
+    """Sphinx's HTML5 translator with each citation a list item of the list around it, and each
+    margin note a note."""
 
     def visit_citation(self, node):
         if not isinstance(node.previous_sibling(), type(node)):
             self.body.append('<div role="list" class="citation-list">\n')
         self.body.append(self.starttag(node, "div", classes=[node.tagname], role="listitem"))
+
+    def visit_sidebar(self, node):
+        """A margin note as a note: Sphinx's ``<aside class="sidebar">`` with ``role="note"``."""
+        note = {"role": "note"} if "margin" in node["classes"] else {}
+        self.body.append(self.starttag(node, "aside", CLASS="sidebar", **note))
+        self.in_sidebar = True
 
 
 def visit_hidden_cell(self, node):

@@ -12,7 +12,13 @@
 // - a display formula is broken again when its column's width changes: MathJax 4 breaks a display for
 //   the width its column has when it is typeset (none inside a closed <details>, which has no width);
 // - an in-line formula breaks after a relation or a binary operator, as TeX breaks one ("x =" ends a
-//   line); MathJax 4 breaks before it, MathML's default, which a display keeps.
+//   line); MathJax 4 breaks before it, MathML's default, which a display keeps.  (It also breaks at a
+//   space, where TeX would not: a long product or tuple has no other place to break on a phone.)
+// - every button of the article has a name of its own, so that a screen reader's list of them tells them
+//   apart: a fold's toggle (sphinx-togglebutton names each "Toggle hidden content") is named by its fold's
+//   title, a solution's by its exercise's too ("Solution: Exercise 2 (…)"); a name still shared (each
+//   proof's "Proof", each code cell's "Copy to clipboard") gains where the control stands: the fold around
+//   it, else its section's heading, and then, if need be, its place among the others ("2 of 3").
 // This is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
@@ -169,12 +175,54 @@
     if (typeset) document.documentElement.setAttribute("data-fit", "done");     // for the browser tests
   }
 
-  // Once MathJax has typeset the page (its source text is then out of the way): break points, the
-  // widths the displays were broken for, then the tables.
+  function nameControls(root) {
+    // The words shown (a folded code cell's summary holds "Show …" and "Hide …", one of them shown).
+    function text(el) { return el ? (el.innerText || el.textContent).replace(/\s+/g, " ").replace(/\s*#$/, "").trim() : ""; }
+    function name(c) { return c.getAttribute("aria-label") || text(c); }
+    root.querySelectorAll(".toggle-button").forEach(function (button) {
+      var title = text(button.closest(".admonition-title")), fold = button.closest(".admonition");
+      for (var e = fold; e && fold.classList.contains("solution"); e = e.previousElementSibling)
+        if (e.classList.contains("exercise")) { title += ": " + text(e.querySelector(".admonition-title")); break; }
+      if (title) button.setAttribute("aria-label", title);
+    });
+    function apart(more) {        // each name shared by several controls, extended by more(control, i, n)
+      var by = {};
+      root.querySelectorAll("button, summary").forEach(function (c) { (by[name(c)] = by[name(c)] || []).push(c); });
+      Object.keys(by).forEach(function (n) {
+        if (by[n].length > 1) by[n].forEach(function (c, i) {
+          var extra = more(c, i, by[n].length);
+          if (c.querySelector(":scope > .collapsed")) { c.dataset.context = (c.dataset.context || "") + extra; relabel(c); }
+          else c.setAttribute("aria-label", n + extra);
+        });
+      });
+    }
+    apart(function (c) {
+      // The fold around it (not a folded code cell's, titled "Show code cell source"), else its section.
+      var own = c.matches("summary") || c.closest(".admonition-title") ? c.closest("details, .admonition") : null;
+      var fold = (own ? own.parentElement : c).closest("details:not(.hide), .admonition");
+      if (fold) return ": " + text(fold.querySelector(":scope > summary, :scope > .admonition-title"));
+      var section = c.closest("section");
+      return section ? ": " + text(section.querySelector("h1, h2, h3, h4")) : "";
+    });
+    apart(function (c, i, n) { return " (" + (i + 1) + " of " + n + ")"; });
+  }
+
+  // A folded code cell's summary: its name begins with the words it shows as the fold opens and closes.
+  function relabel(summary) {
+    var shown = summary.querySelector(summary.parentElement.open ? ":scope > .expanded" : ":scope > .collapsed");
+    summary.setAttribute("aria-label", shown.textContent.trim() + summary.dataset.context);
+  }
+  document.addEventListener("toggle", function (e) {
+    var summary = e.target.querySelector && e.target.querySelector(":scope > summary[data-context]");
+    if (summary) relabel(summary);
+  }, true);
+
+  // Once MathJax has typeset the page (its source text is then out of the way): the controls' names, break
+  // points, the widths the displays were broken for, then the tables.
   function whenTypeset() {
     var mj = window.MathJax, root = article();
     function done() {
-      if (root) { keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
+      if (root) { nameControls(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
       typeset = true;
       fit();
     }
