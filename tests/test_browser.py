@@ -964,13 +964,19 @@ def test_the_decade_check_catches_a_slider_without_ticks_or_decade_keys(browser,
 
 
 #: Run in the page: what a screen reader is given for the simulator: each canvas's role and label, the
-#: readout's and the hint's live region, the U-curve's role and label, the ε slider's value text.
+#: readout's and the hint's live region, the status line's role and text, the live regions among the ledger
+#: and the sliders' printed values, the U-curve's role and label, the ε slider's value text.
 SPOKEN_JS = """() => {
   const attr = (sel, a) => document.querySelector(sel).getAttribute(a);
   return {canvases: Object.fromEntries(['numeric', 'symbolic', 'difference'].map(n =>
             [n, [attr('#sim-canvas-' + n, 'role'), attr('#sim-canvas-' + n, 'aria-label')]])),
           readout: [attr('#sim-readout', 'aria-live'), document.getElementById('sim-readout').textContent],
           hint: attr('#sim-hint', 'aria-live'), curve: [attr('#sim-curve', 'role'), attr('#sim-curve', 'aria-label')],
+          status: [attr('#sim-status', 'role'), document.getElementById('sim-status').textContent],
+          live: [...document.querySelectorAll('.symrender-sim :is(table, output, [aria-live])')].filter(e =>
+            e.getAttribute('aria-hidden') !== 'true' && (e.tagName === 'OUTPUT' ? e.getAttribute('aria-live') !== 'off'
+            : e.getAttribute('aria-live') && e.getAttribute('aria-live') !== 'off') && !['sim-readout', 'sim-hint', 'sim-note'].includes(e.id))
+            .map(e => e.id || e.className),
           eps: attr('#sim-log_eps', 'aria-valuetext'),
           labels: [...document.querySelectorAll('.symrender-sim :is(select, input)')].map(
             e => e.closest('label').querySelector('span').firstChild.textContent.trim())};
@@ -981,8 +987,11 @@ def spoken_problems(s):
     """Where what a screen reader is given departs from what the simulator shows (`SPOKEN_JS`): a canvas
     that is not an image with a label naming the field, β, the view and the normal, the numeric canvas's ε
     and the difference's largest |ΔI| and RMS as the ledger prints them; a readout or hint that is no
-    polite live region; the U-curve not an image labelled with the current ε; the ε slider's value text
-    not what it prints; a control whose accessible name does not begin with its label."""
+    polite live region; a status line (role status) that does not give the difference's largest |ΔI| and RMS
+    as the ledger prints them; another live region (the ledger table, a slider's printed value: each said its
+    numbers again, the table's without their headers); the U-curve not an image labelled with the current ε;
+    the ε slider's value text not what it prints; a control whose accessible name does not begin with its
+    label."""
     said, st = s.page.evaluate(SPOKEN_JS), s.sim("sim.state")
     found = []
     eps = s.page.text_content("#sim-log_eps-value")
@@ -1003,6 +1012,10 @@ def spoken_problems(s):
         value = re.sub(r"e([+-])0*(\d)", r"e\1\2", f"{s.ledger(cell):.1e}")       # as JavaScript's toExponential(1)
         if value not in difference:
             found.append(f"difference canvas: the ledger's {cell} {value} not in {difference!r}")
+        if said["status"][0] != "status" or value not in said["status"][1]:
+            found.append(f"status: the ledger's {cell} {value} not said: {said['status']}")
+    if said["live"]:
+        found.append(f"live regions saying numbers again: {said['live']}")
     if said["readout"][0] != "polite":
         found.append(f"readout: aria-live {said['readout'][0]!r}")
     if said["hint"] != "polite":
@@ -1116,6 +1129,10 @@ WRONG_SPOKEN = {
     "a ring shown before any pixel is read": ('"aria-hidden": "true", hidden: "" }', '"aria-hidden": "true" }',
                                               "a ring before any pixel"),
     "the readout's negative numbers with a hyphen": ('.replace(/^-/, "\\u2212")', "", "a hyphen for a minus sign"),
+    "the ledger table a live region": ('el("table", { class: "sim-ledger" }', 'el("table", { class: "sim-ledger", "aria-live": "polite" }',
+                                       "live regions"),
+    "the sliders' printed values live": ('for: `sim-${c.name}`, "aria-hidden": "true" }', 'for: `sim-${c.name}` }', "live regions"),
+    "a status that never changes": ("this.status.textContent = ", "this.status.dataset.said = ", "status:"),
     "the rings left where the first probe put them": ("mark.hidden = false;", "if (!mark.hidden) continue; mark.hidden = false;",
                                                       "the rings at"),
 }

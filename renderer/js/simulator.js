@@ -175,6 +175,7 @@ const STYLE = `
 .symrender-sim .sim-hint { min-height: 2.6em; margin: 0 0 0.4rem; font-style: italic; }
 .symrender-sim .sim-note { grid-column: 1 / -1; margin: 0; font-style: italic; }
 .symrender-sim .sim-note:empty { display: none; }
+.symrender-sim .sim-status { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
 .symrender-sim table { font-variant-numeric: tabular-nums; margin: 0.4rem 0; }
 .symrender-sim td, .symrender-sim th { padding: 0.1rem 0.7rem; }
 .symrender-sim .sim-main { grid-template-columns: repeat(3, minmax(0, 1fr)); margin: 0.4rem 0; }
@@ -308,12 +309,16 @@ class Simulator {
     if (typeof ResizeObserver !== "undefined") new ResizeObserver(() => this.draw_curve()).observe(this.plot);
 
     const cell = (id) => el("td", { id });
-    this.ledger = el("table", { class: "sim-ledger", "aria-live": "polite" }, [
+    // Not a live region (a screen reader would read its changed cells without their headers): the status
+    // below says what a change did, in one sentence.
+    this.ledger = el("table", { class: "sim-ledger" }, [
       el("thead", {}, [el("tr", {}, ["max |ΔI| on A", "RMS |ΔI| on A", "flips", "pixels on A", "last update"]
         .map((h) => el("th", { text: h })))]),
       el("tbody", {}, [el("tr", {}, ["sim-max", "sim-rms", "sim-flips", "sim-pixels", "sim-time"].map(cell))]),
     ]);
     root.append(this.ledger);
+    this.status = el("p", { id: "sim-status", class: "sim-status", role: "status" });
+    root.append(this.status);
 
     this.inputs = {};
     this.outputs = {};
@@ -342,7 +347,9 @@ class Simulator {
         return el("label", { class: "sim-check" }, [input, el("span", { text: c.label })]);
       }
       if (c.kind === "select") return el("label", {}, [el("span", { text: c.label }), input]);
-      const out = el("output", { id: `sim-${c.name}-value`, for: `sim-${c.name}` });
+      // Hidden from a screen reader, which hears the value from the slider itself (an <output> is a live
+      // region: it would say each value twice).
+      const out = el("output", { id: `sim-${c.name}-value`, for: `sim-${c.name}`, "aria-hidden": "true" });
       this.outputs[c.name] = out;
       // `for`: the label's first labelable descendant is the <output>, which it would name instead.
       return el("label", { for: input.id }, [el("span", {}, [c.label + " ", out]), input, ...ticks]);
@@ -373,6 +380,7 @@ class Simulator {
     const text = (c.show ? c.show(value) : String(value)) + (c.name === "log_eps" && this.eps_unused() ? ", unused" : "");
     if (this.outputs[c.name]) this.outputs[c.name].textContent = text;
     if (c.kind === "range") this.inputs[c.name].setAttribute("aria-valuetext", text);
+    return c.kind === "select" ? (c.labels?.[value] ?? String(value)) : text;
   }
 
   // The β slider's range follows the shading normal; β is clamped into it.
@@ -411,7 +419,7 @@ class Simulator {
     } else if (c.name !== "bump") {
       this.note.textContent = "";                                 // the note said its piece
     }
-    this.show_value(c, value);
+    this.changed = `${c.label} ${c.kind === "checkbox" ? (value ? "on" : "off") : this.show_value(c, value)}`;
     this.schedule();
   }
 
@@ -455,6 +463,10 @@ class Simulator {
                         curve_ms: performance.now() - t1, full: res.full, shaded: res.shaded });
     this.frames = { scene, numeric: res.numeric, symbolic: res.symbolic, ledger, ms };
     this.describe(ledger);
+    // What the change did, said once: the control and its value, then the difference on sphere A.
+    this.status.textContent = `${this.changed ? this.changed + ". " : ""}On sphere A max |ΔI| ${fmt(ledger.max_abs, 1)}, ` +
+      `RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips.`;
+    this.changed = null;
     const put = (id, text, value) => {
       const td = this.root.querySelector(`#${id}`);
       td.textContent = text;
