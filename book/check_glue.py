@@ -108,6 +108,7 @@ QUANTITIES = {
     "the U-curve reference's digits": (("c2_digits", "s7_digits"), lambda: _lib("renderer.ucurve").DIGITS),
     "the accuracy references' digits": (("c5_digits",), lambda: _lib("lab.accuracy").DIGITS),
     "SciPy's rounds of Richardson's extrapolation": (("s3_scipy_rounds",), lambda: _lib("lab.gradient_methods").RICHARDSON_ROUNDS),
+    "the amplitude of §1's diagram of normals": (("s1_normals_beta",), lambda: _lib("chapter.figures").NORMALS_BETA),
     # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
     "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),

@@ -626,7 +626,11 @@ def site(browser, book_html):
 #: 4.1.2), as sentences: buttons of the article (fold toggles, copy buttons) sharing a name, as each of
 #: sphinx-togglebutton's "Toggle hidden content" and each proof's "Proof" did; more than one unnamed side
 #: region (an ``<aside>`` is a "complementary" landmark: each margin note was one); a figure's image made a link
-#: (to its PNG: a Tab stop named by the whole alt text).  A name is the aria-label, else the words shown.
+#: (to its PNG: a Tab stop named by the whole alt text); the main navigation's link to the page open not marked
+#: as the current page (the theme marks it by its look); a table whose head row begins with an empty cell (its first
+#: column labels its rows) with a row not headed by a row header; links of one name leading to different places (each
+#: margin note's "why", each "§3").  A name is the aria-label, else the words shown; a link to a page's top leads
+#: where the link to the page leads.
 TOLD_APART = r"""() => {
   const root = document.querySelector('article.bd-article');
   const words = e => (e.innerText || e.textContent).replace(/\s+/g, ' ').trim();
@@ -635,11 +639,22 @@ TOLD_APART = r"""() => {
     const n = c.getAttribute('aria-label') || words(c);
     names.set(n, (names.get(n) || 0) + 1);
   }
+  const links = new Map();
+  for (const a of root.querySelectorAll('a[href]:not(.headerlink)')) {
+    const n = (a.getAttribute('aria-label') || a.textContent).replace(/\s+/g, ' ').trim();
+    links.set(n, (links.get(n) || new Set()).add(a.getAttribute('href').replace(/^([^#_\/]+)((?:_[^#]*)?\.html)#\1$/, '$1$2')));
+  }
   const unnamed = [...root.querySelectorAll('aside:not([role]), [role=complementary]')]
     .filter(a => !a.hasAttribute('aria-label') && !a.hasAttribute('aria-labelledby')).length;
   return [...[...names].filter(([, k]) => k > 1).map(([n, k]) => `${k} buttons named '${n}'`),
+          ...[...links].filter(([, to]) => to.size > 1).map(([n, to]) => `${to.size} links named '${n}' lead to different places`),
           ...(unnamed > 1 ? [`${unnamed} unnamed side regions (asides)`] : []),
-          ...[...root.querySelectorAll('figure a img')].map(i => `a figure's image is a link: ${i.getAttribute('src').slice(-24)}`)];
+          ...[...root.querySelectorAll('figure a img')].map(i => `a figure's image is a link: ${i.getAttribute('src').slice(-24)}`),
+          ...[...document.querySelectorAll('.bd-docs-nav a.current')].filter(a => a.getAttribute('aria-current') !== 'page')
+            .map(a => `the navigation's link to this page, '${words(a)}', not marked current`),
+          ...[...root.querySelectorAll('table')].filter(t => t.tHead && t.tHead.rows[0] && !words(t.tHead.rows[0].cells[0])
+            && [...t.tBodies].some(b => [...b.rows].some(r => r.cells[0].tagName !== 'TH' || r.cells[0].scope !== 'row')))
+            .map(t => `a table's row labels are no row headers: ${words(t).slice(0, 40)}`)];
 }"""
 
 
@@ -669,11 +684,16 @@ def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
 
 #: Wrong variants of the site (the page opened, the file changed, its text, its replacement), each of which
 #: `TOLD_APART` must catch: sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
-#: undone), the margin notes as unnamed asides, and a figure's image linked to its PNG.
+#: undone), the margin notes as unnamed asides, their links all named "why" (a11y_markup's names removed), a
+#: table's row labels as data cells, the page open not marked in the navigation, and a figure's image linked to
+#: its PNG.
 WRONG_TOLD_APART = {
     "the folds' and buttons' own names": ("s5_lab", "fit.js", "nameControls(root);", ""),
     "margin notes as unnamed asides": ("s5_lab", "s5_lab.html", '<aside class="margin sidebar" role="note">',
                                        '<aside class="margin sidebar">'),
+    "the margin notes' links all named 'why'": ("s5_lab", "s5_lab.html", 'aria-label="why: claim ', 'data-was="why: claim '),
+    "a table's row labels as data cells": ("s3_math", "s3_math.html", '<th scope="row" class="stub">', '<td class="stub">'),
+    "the page open not marked in the navigation": ("s3_math", "fit.js", 'a.setAttribute("aria-current", "page")', "a"),
     "a figure's image linked to its PNG": ("s3_math", "s3_math.html", '<figure class="align-default" id="fig-frame">\n<img',
                                            '<figure class="align-default" id="fig-frame">\n<a href="x.png"><img'),
 }

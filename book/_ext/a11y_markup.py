@@ -13,6 +13,17 @@ violation on the built pages: tests/test_browser.py).
 * A margin note.  sphinx-book-theme writes each as an ``<aside>``, which a screen reader lists
   among the page's landmarks, unnamed: §5 had 17 "complementary" landmarks.  Here each is a
   ``role="note"``, read where it stands and kept out of that list.
+* A table's row labels.  A table whose head row begins with an empty cell (§3's table of optima) labels
+  its rows in its first column; docutils writes those labels as data cells, so a screen reader reading
+  across a row hears "0.367, 0.367, 0.685" with no quantity.  Here that column is a stub column, each
+  of its cells a ``<th scope="row">``.
+* Links that say the same and lead to different places.  Each margin note on a claim of the draft links
+  to the claim's entry in §6 by the word "why", and many links to a section say only its number ("§3"):
+  a screen reader's list of links had 17 "why" on §5, each to another claim, and five "§3" on the
+  glossary, each to another part of §3.  Here each link whose words another link of its page shares,
+  leading elsewhere, is named by those words and then where it leads: "why: claim 16" (the entry's
+  number in §6), "§3: The finite-difference U-curve" (the section's title), or the words of its target's
+  label ("§6: ledger gradient sine").
 * A negative number.  Python writes it with a hyphen-minus, which a screen reader reads as a dash
   or skips; in the prose (not in code or maths) it becomes the minus sign, "−0.651"
   (`chapter.page.minus_signs`; book/check_glue.py fails a page with one left).
@@ -20,6 +31,7 @@ violation on the built pages: tests/test_browser.py).
 
 from __future__ import annotations
 
+import re
 from html import escape
 
 from docutils import nodes
@@ -38,6 +50,19 @@ class Translator(HTML5Translator):
             self.body.append('<div role="list" class="citation-list">\n')
         self.body.append(self.starttag(node, "div", classes=[node.tagname], role="listitem"))
 
+    def visit_entry(self, node):
+        """A table cell; in the body, a stub column's cell is the header of its row."""
+        super().visit_entry(node)
+        if not isinstance(node.parent.parent, nodes.thead) and self.body[-1].startswith("<th "):
+            self.body[-1] = self.body[-1].replace("<th ", '<th scope="row" ', 1)
+
+    def visit_reference(self, node):
+        """A link, named by its ``aria-label`` where `LinkNames` gave it one."""
+        super().visit_reference(node)
+        if node.get("aria-label"):
+            i = max(k for k, s in enumerate(self.body) if s.startswith("<a "))
+            self.body[i] = self.body[i].replace("<a ", f'<a aria-label="{escape(node["aria-label"])}" ', 1)
+
     def visit_sidebar(self, node):
         """A margin note as a note: Sphinx's ``<aside class="sidebar">`` with ``role="note"``."""
         note = {"role": "note"} if "margin" in node["classes"] else {}
@@ -50,6 +75,48 @@ def visit_hidden_cell(self, node):
     self.body.append(f'<details class="admonition hide {" ".join(node["classes"])}">\n<summary>\n'
                      f'<p class="collapsed admonition-title">{escape(node["prompt_show"])}</p>\n'
                      f'<p class="expanded admonition-title">{escape(node["prompt_hide"])}</p>\n</summary>\n')
+
+
+class RowHeaders(SphinxPostTransform):
+    """The first column of each table whose head row begins with an empty cell, as a stub column."""
+
+    default_priority = 900
+
+    def run(self, **kwargs):
+        for tgroup in self.document.findall(nodes.tgroup):
+            head = next(tgroup.findall(nodes.thead), None)
+            first = next(head.findall(nodes.entry), None) if head is not None else None
+            if first is not None and not first.astext().strip():
+                next(tgroup.findall(nodes.colspec))["stub"] = 1
+
+
+class LinkNames(SphinxPostTransform):
+    """Each link whose words another link of the page shares, leading elsewhere, named by those words and
+    where it leads: a claim's entry in §6 (``#claim-<id>``) by its number there, a section by its title,
+    another target by the words of its label.  A link to a page's top (``s3_math.html#s3``) leads where
+    the link to the page leads."""
+
+    default_priority = 900
+
+    def run(self, **kwargs):
+        titles = {(doc, anchor): str(title).split(" · ")[-1]
+                  for doc, anchor, title in self.env.domaindata["std"]["labels"].values() if title}
+        places = {}
+        for r in self.document.findall(nodes.reference):
+            page, _, anchor = (r.get("refuri") or "#" + r.get("refid", "")).partition("#")
+            doc = page.removesuffix(".html") or self.env.docname
+            if anchor == doc.split("_")[0]:
+                anchor = ""
+            places.setdefault(r.astext(), {}).setdefault((doc, anchor), []).append(r)
+        number = {}
+        for text, targets in places.items():
+            for (doc, anchor), links in targets.items() if len(targets) > 1 else ():
+                if anchor.startswith("claim-") and not number:
+                    from lab.claims import CLAIMS           # the register's order is §6's numbering
+                    number.update({f"claim-{c.id}": f"claim {n}" for n, c in enumerate(CLAIMS, start=1)})
+                where = number.get(anchor) or titles.get((doc, anchor)) or anchor.replace("-", " ")
+                for r in links:
+                    r["aria-label"] = f"{text}: {where}"
 
 
 class MinusSigns(SphinxPostTransform):
@@ -73,5 +140,7 @@ def setup(app):
     from myst_nb.sphinx_ import HideCodeCellNode, depart_HideCellInput
     app.set_translator("html", Translator)
     app.add_post_transform(MinusSigns)
+    app.add_post_transform(RowHeaders)
+    app.add_post_transform(LinkNames)
     app.add_node(HideCodeCellNode, override=True, html=(visit_hidden_cell, depart_HideCellInput))
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

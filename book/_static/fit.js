@@ -19,6 +19,7 @@
 //   title, a solution's by its exercise's too ("Solution: Exercise 2 (…)"); a name still shared (each
 //   proof's "Proof", each code cell's "Copy to clipboard") gains where the control stands: the fold around
 //   it, else its section's heading, and then, if need be, its place among the others ("2 of 3").
+// - the main navigation's link to the page open says so (aria-current): the theme marks it by its look alone.
 // This is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
@@ -231,6 +232,9 @@
   }
 
   window.addEventListener("load", whenTypeset);
+  window.addEventListener("load", function () {
+    document.querySelectorAll(".bd-docs-nav a.current").forEach(function (a) { a.setAttribute("aria-current", "page"); });
+  });
   // Whenever the article changes size: the window resized, a sidebar slid in or out (the column
   // settles after the resize event), a <details> opened (its maths and tables have a width only now).
   // Refitted in the next frame, not in the observer's callback: a change of size there would be a

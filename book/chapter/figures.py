@@ -247,7 +247,11 @@ def frame_diagram(theta=-0.35, phi=0.8):
     return fig
 
 
-def normal_diagram(field="rings", beta=0.08, theta=0.4, phi0=3 * np.pi / 8, span=0.4, count=9):
+#: The amplitude of Fig. 2's bump (§1), below the book's default so that the displaced curve stays near the arc.
+NORMALS_BETA = 0.08
+
+
+def normal_diagram(field="rings", beta=NORMALS_BETA, theta=0.4, phi0=3 * np.pi / 8, span=0.4, count=9):
     """What a bump does, in one meridian of sphere A (theta fixed): the sphere (solid) keeps its
     shape, while the shading normals drawn on it follow the sphere displaced to (R + beta h) N
     (dashed).  At ``count`` points of the sphere, the displaced sphere's normal (the sympy object
