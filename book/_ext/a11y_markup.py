@@ -31,7 +31,6 @@ violation on the built pages: tests/test_browser.py).
 
 from __future__ import annotations
 
-import re
 from html import escape
 
 from docutils import nodes
