@@ -964,18 +964,17 @@ def test_the_decade_check_catches_a_slider_without_ticks_or_decade_keys(browser,
 
 
 #: Run in the page: what a screen reader is given for the simulator: each canvas's role and label, the
-#: readout's and the hint's live region, the status line's role and text, the live regions among the ledger
-#: and the sliders' printed values, the U-curve's role and label, the ε slider's value text.
+#: hint's live region, the status line's role and text, the other live regions (the readout, the ledger, the
+#: sliders' printed values: none may be one), the U-curve's role and label, the ε slider's value text.
 SPOKEN_JS = """() => {
   const attr = (sel, a) => document.querySelector(sel).getAttribute(a);
   return {canvases: Object.fromEntries(['numeric', 'symbolic', 'difference'].map(n =>
             [n, [attr('#sim-canvas-' + n, 'role'), attr('#sim-canvas-' + n, 'aria-label')]])),
-          readout: [attr('#sim-readout', 'aria-live'), document.getElementById('sim-readout').textContent],
           hint: attr('#sim-hint', 'aria-live'), curve: [attr('#sim-curve', 'role'), attr('#sim-curve', 'aria-label')],
           status: [attr('#sim-status', 'role'), document.getElementById('sim-status').textContent],
           live: [...document.querySelectorAll('.symrender-sim :is(table, output, [aria-live])')].filter(e =>
             e.getAttribute('aria-hidden') !== 'true' && (e.tagName === 'OUTPUT' ? e.getAttribute('aria-live') !== 'off'
-            : e.getAttribute('aria-live') && e.getAttribute('aria-live') !== 'off') && !['sim-readout', 'sim-hint', 'sim-note'].includes(e.id))
+            : e.getAttribute('aria-live') && e.getAttribute('aria-live') !== 'off') && !['sim-hint', 'sim-note'].includes(e.id))
             .map(e => e.id || e.className),
           eps: attr('#sim-log_eps', 'aria-valuetext'),
           labels: [...document.querySelectorAll('.symrender-sim :is(select, input)')].map(
@@ -986,10 +985,11 @@ SPOKEN_JS = """() => {
 def spoken_problems(s):
     """Where what a screen reader is given departs from what the simulator shows (`SPOKEN_JS`): a canvas
     that is not an image with a label naming the field, β, the view and the normal, the numeric canvas's ε
-    and the difference's largest |ΔI| and RMS as the ledger prints them; a readout or hint that is no
-    polite live region; a status line (role status) that does not give the difference's largest |ΔI| and RMS
-    as the ledger prints them; another live region (the ledger table, a slider's printed value: each said its
-    numbers again, the table's without their headers); the U-curve not an image labelled with the current ε;
+    and the difference's largest |ΔI| and RMS as the ledger prints them; a hint that is no polite live
+    region; a status line (role status) that does not give the difference's largest |ΔI| and RMS as the
+    ledger prints them; another live region (the readout, read whole after every change once a pixel was
+    read; the ledger table, its changed cells without their headers; a slider's printed value, said twice);
+    the U-curve not an image labelled with the current ε;
     the ε slider's value text not what it prints; a control whose accessible name does not begin with its
     label."""
     said, st = s.page.evaluate(SPOKEN_JS), s.sim("sim.state")
@@ -1016,8 +1016,6 @@ def spoken_problems(s):
             found.append(f"status: the ledger's {cell} {value} not said: {said['status']}")
     if said["live"]:
         found.append(f"live regions saying numbers again: {said['live']}")
-    if said["readout"][0] != "polite":
-        found.append(f"readout: aria-live {said['readout'][0]!r}")
     if said["hint"] != "polite":
         found.append(f"hint: aria-live {said['hint']!r}")
     if said["curve"][0] != "img" or f"ε = {eps}" not in (said["curve"][1] or ""):
@@ -1084,6 +1082,9 @@ def _keyboard_walk(s):
     for key in ("ArrowRight", "ArrowDown"):
         page.keyboard.press(key)
         readouts.append(page.text_content("#sim-readout"))
+        d, said = s.page.evaluate("({...document.getElementById('sim-readout').dataset})"), page.text_content("#sim-status")
+        if not (said.startswith(f"Pixel x {d['i']}, y {d['j']},") and "|ΔI|" in said):
+            found["probe"].append(f"the probe's pixel not said: status {said!r} at ({d['i']}, {d['j']})")
         found["probe"] += mark_problems(s) + [f"a hyphen for a minus sign in the readout: {m.group()}"
                                               for m in HYPHEN_MINUS.finditer(readouts[-1])]
     tab_to("sim-bump"); move("normal", "ArrowUp")        # to the draft's chart formula
@@ -1098,7 +1099,7 @@ def _keyboard_walk(s):
 
 def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser, book_html):
     """From the keyboard alone (Tab, arrow keys, Page Down): the field, ε, β, the normal and the view change, and
-    the probe walks over the symbolic canvas, the readout (a polite live region) reading each pixel;
+    the probe walks over the symbolic canvas, the readout reading each pixel and the status line saying which, and its |ΔI|;
     after every move each canvas is an image whose label says what it draws (field, β, normal, view;
     the numeric canvas's ε; the difference's largest |ΔI| and RMS as the ledger prints them), the
     U-curve's label the current ε, the ε slider's value text the ε printed (`spoken_problems`)."""
@@ -1122,8 +1123,8 @@ WRONG_SPOKEN = {
                                                      "", "silently"),
     "the β note never giving way": ("      this.note.textContent = \"\";                                 // the note said its piece\n",
                                      "", "outlived"),
-    "a readout that is not announced": ('class: "sim-readout", "aria-live": "polite" }', 'class: "sim-readout", "aria-live": "off" }',
-                                        "readout: aria-live 'off'"),
+    "the readout a live region again": ('class: "sim-readout" }', 'class: "sim-readout", "aria-live": "polite" }', "live regions"),
+    "the probe's pixel not said": ("if (say) this.status.textContent", "if (false) this.status.textContent", "the probe's pixel not said"),
     "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",
                                            "mark.style.left = `${(100 * (i + 1.5)) / res}%`;", "the rings at"),
     "a ring shown before any pixel is read": ('"aria-hidden": "true", hidden: "" }', '"aria-hidden": "true" }',
@@ -1132,7 +1133,7 @@ WRONG_SPOKEN = {
     "the ledger table a live region": ('el("table", { class: "sim-ledger" }', 'el("table", { class: "sim-ledger", "aria-live": "polite" }',
                                        "live regions"),
     "the sliders' printed values live": ('for: `sim-${c.name}`, "aria-hidden": "true" }', 'for: `sim-${c.name}` }', "live regions"),
-    "a status that never changes": ("this.status.textContent = ", "this.status.dataset.said = ", "status:"),
+    "a status that never changes": ("this.status.textContent = `On sphere A", "this.status.dataset.said = `On sphere A", "status:"),
     "the rings left where the first probe put them": ("mark.hidden = false;", "if (!mark.hidden) continue; mark.hidden = false;",
                                                       "the rings at"),
 }

@@ -198,10 +198,15 @@
       });
     }
     apart(function (c) {
-      // The fold around it (not a folded code cell's, titled "Show code cell source"), else its section.
+      // A fold that follows its theorem (a proof): the theorem's title.  Else the fold around it (by its
+      // toggle's name, if it has one; not a folded code cell's, titled "Show code cell source"), else its section.
       var own = c.matches("summary") || c.closest(".admonition-title") ? c.closest("details, .admonition") : null;
-      var fold = (own ? own.parentElement : c).closest("details:not(.hide), .admonition");
-      if (fold) return ": " + text(fold.querySelector(":scope > summary, :scope > .admonition-title"));
+      var item = own && own.previousElementSibling;
+      if (item && item.matches(".theorem")) return ": " + text(item.querySelector(".admonition-title"));
+      var fold = (own ? own.parentElement : c).closest("details:not(.hide), .admonition:not(.hide)");
+      var title = fold && fold.querySelector(":scope > summary, :scope > .admonition-title");
+      var toggle = title && title.querySelector(".toggle-button");
+      if (title) return ": " + ((toggle && toggle.getAttribute("aria-label")) || text(title));
       var section = c.closest("section");
       return section ? ": " + text(section.querySelector("h1, h2, h3, h4")) : "";
     });

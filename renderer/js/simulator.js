@@ -294,7 +294,7 @@ class Simulator {
     this.plot = holder.firstChild;
     const curve = el("figure", { class: "sim-curve" },
                      [this.plot, el("figcaption", { id: "sim-curve-caption" })]);
-    this.readout = el("dl", { id: "sim-readout", class: "sim-readout", "aria-live": "polite" });
+    this.readout = el("dl", { id: "sim-readout", class: "sim-readout" });
     // Shown on a phone only (STYLE), once a pixel is read out.
     const more = el("button", { type: "button", id: "sim-more", class: "sim-more", "aria-controls": "sim-readout",
                                 "aria-expanded": "false", text: "all rows" });
@@ -380,7 +380,6 @@ class Simulator {
     const text = (c.show ? c.show(value) : String(value)) + (c.name === "log_eps" && this.eps_unused() ? ", unused" : "");
     if (this.outputs[c.name]) this.outputs[c.name].textContent = text;
     if (c.kind === "range") this.inputs[c.name].setAttribute("aria-valuetext", text);
-    return c.kind === "select" ? (c.labels?.[value] ?? String(value)) : text;
   }
 
   // The β slider's range follows the shading normal; β is clamped into it.
@@ -419,7 +418,7 @@ class Simulator {
     } else if (c.name !== "bump") {
       this.note.textContent = "";                                 // the note said its piece
     }
-    this.changed = `${c.label} ${c.kind === "checkbox" ? (value ? "on" : "off") : this.show_value(c, value)}`;
+    this.show_value(c, value);
     this.schedule();
   }
 
@@ -463,10 +462,8 @@ class Simulator {
                         curve_ms: performance.now() - t1, full: res.full, shaded: res.shaded });
     this.frames = { scene, numeric: res.numeric, symbolic: res.symbolic, ledger, ms };
     this.describe(ledger);
-    // What the change did, said once: the control and its value, then the difference on sphere A.
-    this.status.textContent = `${this.changed ? this.changed + ". " : ""}On sphere A max |ΔI| ${fmt(ledger.max_abs, 1)}, ` +
-      `RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips.`;
-    this.changed = null;
+    // What the change did, said once (the control says its own new value): the difference on sphere A.
+    this.status.textContent = `On sphere A max |ΔI| ${fmt(ledger.max_abs, 1)}, RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips.`;
     const put = (id, text, value) => {
       const td = this.root.querySelector(`#${id}`);
       td.textContent = text;
@@ -478,7 +475,7 @@ class Simulator {
     put("sim-pixels", String(ledger.pixels_a), ledger.pixels_a);
     put("sim-time", `${ms.toFixed(0)} ms (${res.full ? "new geometry" : "sphere A re-shaded"})`, ms);
     this.root.dataset.updates = String(this.timings.length);
-    if (this.probe) this.show_probe(this.probe.i, this.probe.j);
+    if (this.probe) this.show_probe(this.probe.i, this.probe.j, false);
   }
 
   // The three canvases.  Off sphere A nothing changes while the geometry, the
@@ -697,7 +694,10 @@ class Simulator {
     }));
   }
 
-  show_probe(i, j) {
+  // The readout of pixel (i, j); a probe moved there (say) also says, in the status line, which pixel it
+  // reads and its |ΔI|, first: the readout is no live region (after a change of a control it would be
+  // read whole again).
+  show_probe(i, j, say = true) {
     const s = this.state;
     const res = s.resolution;
     if (i >= res || j >= res) { i = res >> 1; j = res >> 1; }
@@ -723,8 +723,10 @@ class Simulator {
     }
     rows.push(["RGB exact", vec(a.rgb, 6)]);
     rows.push([`RGB ${b.gradient}`, vec(b.rgb, 6)]);
-    rows.push(["|ΔI|", `${fmt(Math.max(...a.rgb.map((x, c) => Math.abs(x - b.rgb[c]))), 2)}, the largest channel`, true]);
+    const delta = fmt(Math.max(...a.rgb.map((x, c) => Math.abs(x - b.rgb[c]))), 2);
+    rows.push(["|ΔI|", `${delta}, the largest channel`, true]);
     this.show_readout(rows);
+    if (say) this.status.textContent = `Pixel x ${i}, y ${j}, ${CHAMBER_NAMES[a.chamber]}: |ΔI| ${delta}.`;
     const d = this.readout.dataset;
     d.i = String(i); d.j = String(j); d.chamber = String(a.chamber);
     d.u = a.uv ? String(a.uv[0]) : ""; d.v = a.uv ? String(a.uv[1]) : "";
