@@ -628,7 +628,8 @@ def site(browser, book_html):
 #: region (an ``<aside>`` is a "complementary" landmark: each margin note was one); a figure's image made a link
 #: (to its PNG: a Tab stop named by the whole alt text); the main navigation's link to the page open not marked
 #: as the current page (the theme marks it by its look); a table whose head row begins with an empty cell (its first
-#: column labels its rows) with a row not headed by a row header; links of one name leading to different places (each
+#: column labels its rows) with a row not headed by a row header; an exercise's title that is no heading (a screen
+#: reader goes from heading to heading); links of one name leading to different places (each
 #: margin note's "why", each "§3").  A name is the aria-label, else the words shown; a link to a page's top leads
 #: where the link to the page leads.
 TOLD_APART = r"""() => {
@@ -652,6 +653,8 @@ TOLD_APART = r"""() => {
           ...[...root.querySelectorAll('figure a img')].map(i => `a figure's image is a link: ${i.getAttribute('src').slice(-24)}`),
           ...[...document.querySelectorAll('.bd-docs-nav a.current')].filter(a => a.getAttribute('aria-current') !== 'page')
             .map(a => `the navigation's link to this page, '${words(a)}', not marked current`),
+          ...[...root.querySelectorAll('.exercise > .admonition-title:not([role=heading][aria-level])')]
+            .map(t => `an exercise's title is no heading: ${words(t)}`),
           ...[...root.querySelectorAll('table')].filter(t => t.tHead && t.tHead.rows[0] && !words(t.tHead.rows[0].cells[0])
             && [...t.tBodies].some(b => [...b.rows].some(r => r.cells[0].tagName !== 'TH' || r.cells[0].scope !== 'row')))
             .map(t => `a table's row labels are no row headers: ${words(t).slice(0, 40)}`)];
@@ -694,6 +697,7 @@ WRONG_TOLD_APART = {
                                        '<aside class="margin sidebar">', "unnamed side regions"),
     "the margin notes' links all named 'why'": ("s5_lab", "s5_lab.html", 'aria-label="why: claim ', 'data-was="why: claim ',
                                                 "links named 'why'"),
+    "the exercises' titles as paragraphs": ("s3_math", "fit.js", "exerciseHeadings(root);", "", "exercise's title is no heading"),
     "a table's row labels as data cells": ("s3_math", "s3_math.html", '<th scope="row" class="stub">', '<td class="stub">',
                                            "row labels are no row headers"),
     "the page open not marked in the navigation": ("s3_math", "fit.js", 'a.setAttribute("aria-current", "page")', "a",

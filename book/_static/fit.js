@@ -19,7 +19,9 @@
 //   title, a solution's by its exercise's too ("Solution: Exercise 2 (…)"); a name still shared (each
 //   proof's "Proof", each code cell's "Copy to clipboard") gains where the control stands: the fold around
 //   it, else its section's heading, and then, if need be, its place among the others ("2 of 3").
-// - the main navigation's link to the page open says so (aria-current): the theme marks it by its look alone.
+// - the main navigation's link to the page open says so (aria-current): the theme marks it by its look alone;
+// - each exercise's title is a heading one level below its section's (sphinx-exercise writes a paragraph), so
+//   that a screen reader can go from exercise to exercise.
 // This is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
@@ -213,6 +215,14 @@
     apart(function (c, i, n) { return " (" + (i + 1) + " of " + n + ")"; });
   }
 
+  function exerciseHeadings(root) {
+    root.querySelectorAll(".exercise > .admonition-title").forEach(function (title) {
+      var section = title.closest("section"), heading = section && section.querySelector("h1, h2, h3, h4, h5");
+      title.setAttribute("role", "heading");
+      title.setAttribute("aria-level", String(heading ? Number(heading.tagName[1]) + 1 : 3));
+    });
+  }
+
   // A folded code cell's summary: its name begins with the words it shows as the fold opens and closes.
   function relabel(summary) {
     var shown = summary.querySelector(summary.parentElement.open ? ":scope > .expanded" : ":scope > .collapsed");
@@ -228,7 +238,7 @@
   function whenTypeset() {
     var mj = window.MathJax, root = article();
     function done() {
-      if (root) { nameControls(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
+      if (root) { nameControls(root); exerciseHeadings(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
       typeset = true;
       fit();
     }
