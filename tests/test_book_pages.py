@@ -629,7 +629,8 @@ def site(browser, book_html):
 #: (to its PNG: a Tab stop named by the whole alt text); the main navigation's link to the page open not marked
 #: as the current page (the theme marks it by its look); a table whose head row begins with an empty cell (its first
 #: column labels its rows) with a row not headed by a row header; an exercise's title that is no heading (a screen
-#: reader goes from heading to heading); links of one name leading to different places (each
+#: reader goes from heading to heading); a table's header cell with maths in it and no name of its own (a browser
+#: names a cell from its words alone, dropping the maths); links of one name leading to different places (each
 #: margin note's "why", each "§3").  A name is the aria-label, else the words shown; a link to a page's top leads
 #: where the link to the page leads.
 TOLD_APART = r"""() => {
@@ -653,6 +654,8 @@ TOLD_APART = r"""() => {
           ...[...root.querySelectorAll('figure a img')].map(i => `a figure's image is a link: ${i.getAttribute('src').slice(-24)}`),
           ...[...document.querySelectorAll('.bd-docs-nav a.current')].filter(a => a.getAttribute('aria-current') !== 'page')
             .map(a => `the navigation's link to this page, '${words(a)}', not marked current`),
+          ...[...root.querySelectorAll('th:not([aria-label])')].filter(th => th.querySelector('mjx-container'))
+            .map(th => `a header cell names no maths: ${words(th).slice(0, 30)}`),
           ...[...root.querySelectorAll('.exercise > .admonition-title:not([role=heading][aria-level])')]
             .map(t => `an exercise's title is no heading: ${words(t)}`),
           ...[...root.querySelectorAll('table')].filter(t => t.tHead && t.tHead.rows[0] && !words(t.tHead.rows[0].cells[0])
@@ -689,16 +692,17 @@ def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
 #: cause), each of which `TOLD_APART` must catch (a page's variants planted together, in one load: each causes a
 #: finding of its own): sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
 #: undone), the margin notes as unnamed asides, their links all named "why" (a11y_markup's names removed), a
-#: table's row labels as data cells, the page open not marked in the navigation, and a figure's image linked to
-#: its PNG.
+#: table's row labels without their scope, its header cells named without their maths, the exercises' titles as
+#: paragraphs, the page open not marked in the navigation, and a figure's image linked to its PNG.
 WRONG_TOLD_APART = {
     "the folds' and buttons' own names": ("s5_lab", "fit.js", "nameControls(root);", "", "buttons named 'Toggle hidden"),
     "margin notes as unnamed asides": ("s5_lab", "s5_lab.html", '<aside class="margin sidebar" role="note">',
                                        '<aside class="margin sidebar">', "unnamed side regions"),
     "the margin notes' links all named 'why'": ("s5_lab", "s5_lab.html", 'aria-label="why: claim ', 'data-was="why: claim ',
                                                 "links named 'why'"),
+    "header cells named without their maths": ("s3_math", "fit.js", "nameHeaderCells(root);", "", "header cell names no maths"),
     "the exercises' titles as paragraphs": ("s3_math", "fit.js", "exerciseHeadings(root);", "", "exercise's title is no heading"),
-    "a table's row labels as data cells": ("s3_math", "s3_math.html", '<th scope="row" class="stub">', '<td class="stub">',
+    "a table's row labels without their scope": ("s3_math", "s3_math.html", '<th scope="row" class="stub">', '<th class="stub">',
                                            "row labels are no row headers"),
     "the page open not marked in the navigation": ("s3_math", "fit.js", 'a.setAttribute("aria-current", "page")', "a",
                                                    "not marked current"),

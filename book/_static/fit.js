@@ -21,7 +21,9 @@
 //   it, else its section's heading, and then, if need be, its place among the others ("2 of 3").
 // - the main navigation's link to the page open says so (aria-current): the theme marks it by its look alone;
 // - each exercise's title is a heading one level below its section's (sphinx-exercise writes a paragraph), so
-//   that a screen reader can go from exercise to exercise.
+//   that a screen reader can go from exercise to exercise;
+// - a table's header cell with maths in it is named by its words and its formulas' MathML text ("|h|"): a
+//   browser names a cell from its words alone, and §3's row headers were read as ", , at" and nothing.
 // This is redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
@@ -223,6 +225,18 @@
     });
   }
 
+  function nameHeaderCells(root) {
+    root.querySelectorAll("th").forEach(function (th) {
+      if (!th.querySelector("mjx-assistive-mml")) return;
+      var copy = th.cloneNode(true);
+      copy.querySelectorAll("mjx-container").forEach(function (m) {
+        var mml = m.querySelector("mjx-assistive-mml");
+        m.replaceWith(mml ? mml.textContent : "");
+      });
+      th.setAttribute("aria-label", copy.textContent.replace(/\s+/g, " ").trim());
+    });
+  }
+
   // A folded code cell's summary: its name begins with the words it shows as the fold opens and closes.
   function relabel(summary) {
     var shown = summary.querySelector(summary.parentElement.open ? ":scope > .expanded" : ":scope > .collapsed");
@@ -238,7 +252,7 @@
   function whenTypeset() {
     var mj = window.MathJax, root = article();
     function done() {
-      if (root) { nameControls(root); exerciseHeadings(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
+      if (root) { nameControls(root); exerciseHeadings(root); nameHeaderCells(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
       typeset = true;
       fit();
     }
