@@ -1116,7 +1116,7 @@ def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser,
 #: Wrong variants of what a screen reader is given, and of the rings marking the read-out pixel: (old text of
 #: the bundle, new text, a problem it must cause).
 WRONG_SPOKEN = {
-    "the canvases' labels written once, not kept current": ("    this.describe(ledger);\n", "", "not in"),
+    "the canvases' labels written once, not kept current": ("${this.describe(ledger)}", "max |ΔI|", "not in"),
     "sliders named by the value beside them": ('return el("label", { for: input.id }, [el("span"',
                                               'return el("label", {}, [el("span"', "accessible name"),
     "the β slider's range changed without a word": ("      this.note.textContent = beta_range_note(value, this.state.beta < before.beta);\n",

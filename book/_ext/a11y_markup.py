@@ -57,9 +57,9 @@ class Translator(HTML5Translator):
 
     def visit_reference(self, node):
         """A link, named by its ``aria-label`` where `LinkNames` gave it one."""
+        i = len(self.body)                      # where Sphinx's <a …> goes
         super().visit_reference(node)
         if node.get("aria-label"):
-            i = max(k for k, s in enumerate(self.body) if s.startswith("<a "))
             self.body[i] = self.body[i].replace("<a ", f'<a aria-label="{escape(node["aria-label"])}" ', 1)
 
     def visit_sidebar(self, node):
@@ -111,8 +111,8 @@ class LinkNames(SphinxPostTransform):
         for text, targets in places.items():
             for (doc, anchor), links in targets.items() if len(targets) > 1 else ():
                 if anchor.startswith("claim-") and not number:
-                    from lab.claims import CLAIMS           # the register's order is §6's numbering
-                    number.update({f"claim-{c.id}": f"claim {n}" for n, c in enumerate(CLAIMS, start=1)})
+                    from chapter.verdicts import NUMBERS    # imports lab.claims: only on a page that needs it
+                    number.update({f"claim-{c}": f"claim {n}" for c, n in NUMBERS.items()})
                 where = number.get(anchor) or titles.get((doc, anchor)) or anchor.replace("-", " ")
                 for r in links:
                     r["aria-label"] = f"{text}: {where}"

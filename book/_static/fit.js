@@ -24,7 +24,8 @@
 //   that a screen reader can go from exercise to exercise;
 // - a table's header cell with maths in it is named by its words and its formulas' MathML text ("|h|"): a
 //   browser names a cell from its words alone, and §3's row headers were read as ", , at" and nothing.
-// This is redone whenever the article changes size (window, sidebars, an opened <details>).
+// The names, headings and break points are set once, when MathJax has typeset the page; the tables' fit and
+// the displays' breaks are redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
   var MIN_TABLE = 0.75, LONG = 16;
   // Not inside maths (MathJax reads its source from these nodes), a piece already kept whole, or the

@@ -16,7 +16,10 @@ from lab.claims import CLAIMS, checked
 
 from .claim_words import WORDS, measured_text, rule_text
 
-__all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of", "section_of"]
+__all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of", "section_of", "NUMBERS"]
+
+#: {claim id: its entry's number in §6's register} (`register`; the "why" links' names, book/_ext/a11y_markup.py).
+NUMBERS = {c.id: n for n, c in enumerate(CLAIMS, start=1)}
 
 #: Place -> the claims noted there, in the order the text meets them.  A place is a section label
 #: of the book (``"cell3"``) or a paragraph within it (``"cell3/flips"``: the section label, a slash,
@@ -118,8 +121,8 @@ def register():
     """
     results = _results()
     entries = []
-    for n, c in enumerate(CLAIMS, start=1):
-        claim, measured, verdict = results[c.id]
+    for c in CLAIMS:
+        n, (claim, measured, verdict) = NUMBERS[c.id], results[c.id]
         place = place_of(c.id)
         noted = f" (noted in {{ref}}`{section_of(place)}`)" if place else ""
         entries.append(

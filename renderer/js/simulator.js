@@ -461,9 +461,8 @@ class Simulator {
     this.timings.push({ resolution: s.resolution, ms, shade_ms: t_shade - t0, draw_ms: t1 - t_shade,
                         curve_ms: performance.now() - t1, full: res.full, shaded: res.shaded });
     this.frames = { scene, numeric: res.numeric, symbolic: res.symbolic, ledger, ms };
-    this.describe(ledger);
     // What the change did, said once (the control says its own new value): the difference on sphere A.
-    this.status.textContent = `On sphere A max |ΔI| ${fmt(ledger.max_abs, 1)}, RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips.`;
+    this.status.textContent = `On sphere A ${this.describe(ledger)}.`;
     const put = (id, text, value) => {
       const td = this.root.querySelector(`#${id}`);
       td.textContent = text;
@@ -554,8 +553,10 @@ class Simulator {
   }
 
   // Each canvas's text alternative (its aria-label, the canvases being role="img"): what it draws, in
-  // words, and the ledger's numbers for the difference; rewritten on every update.
+  // words, and the ledger's numbers for the difference; rewritten on every update.  Returns those numbers
+  // in words, as the status line says them too.
   describe(ledger) {
+    const totals = `max |ΔI| ${fmt(ledger.max_abs, 1)}, RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips`;
     const s = this.state, bump = CONTROLS.find((c) => c.name === "bump").labels[s.bump];
     const view = { shaded: "shaded", bump: "the size of ∇h in grey", kink: "the crease band in white" }[s.view];
     const what = `sphere A with the ${s.height_field} field, β = ${s.beta.toFixed(2)}, kᵤ = ${s.k_u}, kᵥ = ${s.k_v}, ` +
@@ -567,9 +568,10 @@ class Simulator {
       numeric: `Render by ${pipe}: ${what}; ${view}.`,
       symbolic: `Render by the exact gradient: ${what}; ${view}.`,
       difference: `Difference |ΔI| of the two renders (${s.view === "bump" ? "of the sizes of ∇h" : "shaded"}), ${scale}: ` +
-        `on sphere A at most ${fmt(ledger.max_abs, 1)}, RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips.`,
+        `on sphere A ${totals}.`,
     };
     for (const [name, t] of Object.entries(text)) this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe.`);
+    return totals;
   }
 
   // The U-curve over every pixel of sphere A, one step of ε per task, replacing the sample's when all
