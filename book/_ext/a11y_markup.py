@@ -22,8 +22,10 @@ violation on the built pages: tests/test_browser.py).
   a screen reader's list of links had 17 "why" on §5, each to another claim, and five "§3" on the
   glossary, each to another part of §3.  Here each link whose words another link of its page shares,
   leading elsewhere, is named by those words and then where it leads: "why: claim 16" (the entry's
-  number in §6), "§3: The finite-difference U-curve" (the section's title), or the words of its target's
-  label ("§6: ledger gradient sine").
+  number in §6), "§6: the evidence for “The gradient of the sine field”" (a theorem's entry in §6's ledger, by
+  the theorem's title), or "§3: The finite-difference U-curve" (the section's title).  A target
+  with none of these (a label on a paragraph) fails the build, naming it: a label's words ("s3 kinks")
+  are no name.
 * A negative number.  Python writes it with a hyphen-minus, which a screen reader reads as a dash
   or skips; in the prose (not in code or maths) it becomes the minus sign, "−0.651"
   (`chapter.page.minus_signs`; book/check_glue.py fails a page with one left).
@@ -31,6 +33,7 @@ violation on the built pages: tests/test_browser.py).
 
 from __future__ import annotations
 
+from functools import cache
 from html import escape
 
 from docutils import nodes
@@ -89,11 +92,28 @@ class RowHeaders(SphinxPostTransform):
                 next(tgroup.findall(nodes.colspec))["stub"] = 1
 
 
+@cache
+def untitled_targets():
+    """{label: where it leads, in words} of §6's targets that have no title: a claim's entry in the register
+    (``claim-<id>``) by its number there, a theorem's entry in the ledger (``ledger-<id>``) by the theorem's
+    title."""
+    from chapter.verdicts import NUMBERS    # imports lab.claims: only on a page that needs it
+    from proofs.registry import CITABLE
+    return {**{f"claim-{c}": f"claim {n}" for c, n in NUMBERS.items()},
+            **{f"ledger-{t}": f"the evidence for “{title}”" for t, title in CITABLE.items()}}
+
+
 class LinkNames(SphinxPostTransform):
     """Each link whose words another link of the page shares, leading elsewhere, named by those words and
-    where it leads: a claim's entry in §6 (``#claim-<id>``) by its number there, a section by its title,
-    another target by the words of its label.  A link to a page's top (``s3_math.html#s3``) leads where
-    the link to the page leads."""
+    where it leads: a section (or another titled target) by its title, else by `untitled_targets`.  A link
+    to a page's top (``s3_math.html#s3``) leads where the link to the page leads.
+
+    Raises
+    ------
+    ValueError
+        For such a link to a target with neither (a label on a paragraph), naming the page, the link's
+        words and the target: give the target a heading, or the link words of its own.
+    """
 
     default_priority = 900
 
@@ -107,13 +127,13 @@ class LinkNames(SphinxPostTransform):
             if anchor == doc.split("_")[0]:
                 anchor = ""
             places.setdefault(r.astext(), {}).setdefault((doc, anchor), []).append(r)
-        number = {}
         for text, targets in places.items():
             for (doc, anchor), links in targets.items() if len(targets) > 1 else ():
-                if anchor.startswith("claim-") and not number:
-                    from chapter.verdicts import NUMBERS    # imports lab.claims: only on a page that needs it
-                    number.update({f"claim-{c}": f"claim {n}" for c, n in NUMBERS.items()})
-                where = number.get(anchor) or titles.get((doc, anchor)) or anchor.replace("-", " ")
+                where = titles.get((doc, anchor)) or untitled_targets().get(anchor)
+                if where is None:
+                    raise ValueError(f"{self.env.docname}: the links {text!r} lead to different places, and "
+                                     f"{doc}#{anchor} has no title to name its links by: give it a heading, "
+                                     f"or its links words of their own")
                 for r in links:
                     r["aria-label"] = f"{text}: {where}"
 
