@@ -630,8 +630,9 @@ def site(browser, book_html):
 #: as the current page (the theme marks it by its look); a table whose head row begins with an empty cell (its first
 #: column labels its rows) with a row not headed by a row header; an exercise's title that is no heading (a screen
 #: reader goes from heading to heading); a table's header cell with maths in it and no name of its own (a browser
-#: names a cell from its words alone, dropping the maths); links of one name leading to different places (each
-#: margin note's "why", each "§3").  A name is the aria-label, else the words shown; a link to a page's top leads
+#: names a cell from its words alone, dropping the maths); a link, button, heading or header cell named by its
+#: words with a <wbr> in them (a browser names it with a space there: "s1_what_changes. ipynb"); links of one
+#: name leading to different places (each margin note's "why", each "§3").  A name is the aria-label, else the words shown; a link to a page's top leads
 #: where the link to the page leads.
 TOLD_APART = r"""() => {
   const root = document.querySelector('article.bd-article');
@@ -656,6 +657,10 @@ TOLD_APART = r"""() => {
             .map(a => `the navigation's link to this page, '${words(a)}', not marked current`),
           ...[...root.querySelectorAll('th:not([aria-label])')].filter(th => th.querySelector('mjx-container'))
             .map(th => `a header cell names no maths: ${words(th).slice(0, 30)}`),
+          ...[...root.querySelectorAll('a[href], button, summary, [role=button], [role=link], h1, h2, h3, h4, h5, h6, '
+                + '[role=heading], th, [role=tab], [role=menuitem], [role=option]')]
+            .filter(e => e.querySelector('wbr') && !e.hasAttribute('aria-label') && !e.hasAttribute('aria-labelledby'))
+            .map(e => `named with a space at each break point: ${words(e).slice(0, 40)}`),
           ...[...root.querySelectorAll('.exercise > .admonition-title:not([role=heading][aria-level])')]
             .map(t => `an exercise's title is no heading: ${words(t)}`),
           ...[...root.querySelectorAll('table')].filter(t => t.tHead && t.tHead.rows[0] && !words(t.tHead.rows[0].cells[0])
@@ -693,7 +698,8 @@ def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
 #: finding of its own): sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
 #: undone), the margin notes as unnamed asides, their links all named "why" (a11y_markup's names removed), a
 #: table's row labels without their scope, its header cells named without their maths, the exercises' titles as
-#: paragraphs, the page open not marked in the navigation, and a figure's image linked to its PNG.
+#: paragraphs, the names fit.js keeps as a <wbr> goes in left to the browser, the page open not marked in the
+#: navigation, and a figure's image linked to its PNG.
 WRONG_TOLD_APART = {
     "the folds' and buttons' own names": ("s5_lab", "fit.js", "nameControls(root);", "", "buttons named 'Toggle hidden"),
     "margin notes as unnamed asides": ("s5_lab", "s5_lab.html", '<aside class="margin sidebar" role="note">',
@@ -702,6 +708,8 @@ WRONG_TOLD_APART = {
                                                 "links named 'why'"),
     "header cells named without their maths": ("s3_math", "fit.js", "nameHeaderCells(root);", "", "header cell names no maths"),
     "the exercises' titles as paragraphs": ("s3_math", "fit.js", "exerciseHeadings(root);", "", "exercise's title is no heading"),
+    "names read with a space at each break point": ("s3_math", "fit.js", 'named.setAttribute("aria-label", ', 'named.setAttribute("data-was", ',
+                                                    "a space at each break point"),
     "a table's row labels without their scope": ("s3_math", "s3_math.html", '<th scope="row" class="stub">', '<th class="stub">',
                                            "row labels are no row headers"),
     "the page open not marked in the navigation": ("s3_math", "fit.js", 'a.setAttribute("aria-current", "page")', "a",

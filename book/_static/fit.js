@@ -2,7 +2,9 @@
 // - a number with a hyphen in it (1e-16, 2-3) is kept on one line: Chromium breaks after that hyphen;
 // - a code chip that is a tuple of two to four numbers ("(0.5, 0.5, 1.3)") is kept on one line;
 // - a long identifier or code line gets <wbr> break points between its parts (after . _ / ( [ , = and
-//   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word;
+//   between two tokens of highlighted code), so a narrow column breaks it there and not mid-word; a link,
+//   button or heading named by its words keeps them as its name (a browser names it with a space at each
+//   break point: "perturbed_ normal_ surface", "s1_what_changes. ipynb");
 // - in a table cell, values joined by slashes ("0.51/0.5/0.5") may break after a slash (a zero-width
 //   space, which fit.css's nowrap turns off from 721 px; Chromium would break at a <wbr> even there), so
 //   that a phone's narrow column wraps them; tables wider than their column are then scaled down to
@@ -42,8 +44,12 @@
   }
 
   // Replace text node n by its pieces: strings, and [string] for a piece kept whole, with <wbr> where
-  // a piece is null.
+  // a piece is null (the element around it named by its words keeps them as its name).
+  var NAMED = "a, button, summary, [role=button], h1, h2, h3, h4, h5, h6, [role=heading], th";
   function splice(n, pieces) {
+    var named = n.parentElement.closest(NAMED);
+    if (pieces.indexOf(null) >= 0 && named && !named.hasAttribute("aria-label"))
+      named.setAttribute("aria-label", named.textContent.replace(/\s+/g, " ").trim());
     var frag = document.createDocumentFragment();
     pieces.forEach(function (p) {
       if (p === null) frag.appendChild(document.createElement("wbr"));
