@@ -630,7 +630,8 @@ def site(browser, book_html):
 #: as the current page (the theme marks it by its look); a table whose head row begins with an empty cell (its first
 #: column labels its rows) with a row not headed by a row header; an exercise's title that is no heading (a screen
 #: reader goes from heading to heading); a table's header cell with maths in it and no name of its own (a browser
-#: names a cell from its words alone, dropping the maths); a link, button, heading or header cell named by its
+#: names a cell from its words alone, dropping the maths), or one naming it by MathML's characters, a subscript run
+#: into its base ("hx" for h_x) or an accent read as a character ("ε^"); a link, button, heading or header cell named by its
 #: words with a <wbr> in them (a browser names it with a space there: "s1_what_changes. ipynb"); links of one
 #: name leading to different places (each margin note's "why", each "§3").  A name is the aria-label, else the words shown; a link to a page's top leads
 #: where the link to the page leads.
@@ -657,6 +658,12 @@ TOLD_APART = r"""() => {
             .map(a => `the navigation's link to this page, '${words(a)}', not marked current`),
           ...[...root.querySelectorAll('th:not([aria-label])')].filter(th => th.querySelector('mjx-container'))
             .map(th => `a header cell names no maths: ${words(th).slice(0, 30)}`),
+          ...[...root.querySelectorAll('th[aria-label]')].flatMap(th => [...th.querySelectorAll('mjx-assistive-mml :is(msub, mover)')]
+            .filter(m => m.children.length === 2).flatMap(m => {
+              const name = th.getAttribute('aria-label'), [base, script] = [...m.children].map(c => c.textContent.trim());
+              return m.localName === 'msub' ? (name.includes(base + script) ? [`a subscript run into its base: '${name}'`] : [])
+                : /^[\^~\u00af\u02d9\u2192]$/.test(script) && name.includes(base + script) ? [`an accent read as a character: '${name}'`] : [];
+            })),
           ...[...root.querySelectorAll('a[href], button, summary, [role=button], [role=link], h1, h2, h3, h4, h5, h6, '
                 + '[role=heading], th, [role=tab], [role=menuitem], [role=option]')]
             .filter(e => e.querySelector('wbr') && !e.hasAttribute('aria-label') && !e.hasAttribute('aria-labelledby'))
@@ -695,9 +702,10 @@ def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
 
 #: Wrong variants of the site (the page opened, the file changed, its text, its replacement, the finding it must
 #: cause), each of which `TOLD_APART` must catch (a page's variants planted together, in one load: each causes a
-#: finding of its own): sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
+#: finding of its own; "<page> again", a second load, for those another variant would hide): sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
 #: undone), the margin notes as unnamed asides, their links all named "why" (a11y_markup's names removed), a
-#: table's row labels without their scope, its header cells named without their maths, the exercises' titles as
+#: table's row labels without their scope, its header cells named without their maths or with a subscript or an
+#: accent flattened, the exercises' titles as
 #: paragraphs, the names fit.js keeps as a <wbr> goes in left to the browser, the page open not marked in the
 #: navigation, and a figure's image linked to its PNG.
 WRONG_TOLD_APART = {
@@ -708,6 +716,10 @@ WRONG_TOLD_APART = {
                                                 "links named 'why'"),
     "header cells named without their maths": ("s3_math", "fit.js", "nameHeaderCells(root);", "", "header cell names no maths"),
     "the exercises' titles as paragraphs": ("s3_math", "fit.js", "exerciseHeadings(root);", "", "exercise's title is no heading"),
+    "a header cell's subscript run into its base": ("s3_math again", "fit.js", 'return kids[0] + " sub " + kids[1];', "return kids.join('');",
+                                                    "a subscript run into its base"),
+    "a header cell's accent read as a character": ("s3_math again", "fit.js", "return accent ? kids[0] + accent :", "return",
+                                                   "an accent read as a character"),
     "names read with a space at each break point": ("s3_math", "fit.js", 'named.setAttribute("aria-label", ', 'named.setAttribute("data-was", ',
                                                     "a space at each break point"),
     "a table's row labels without their scope": ("s3_math", "s3_math.html", '<th scope="row" class="stub">', '<th class="stub">',
@@ -720,9 +732,9 @@ WRONG_TOLD_APART = {
 }
 
 
-@pytest.mark.parametrize("name", sorted({v[0] for v in WRONG_TOLD_APART.values()}))
-def test_the_told_apart_check_catches_shared_names_unnamed_regions_and_linked_figures(browser, book_html, name):
-    variants = {k: v[1:] for k, v in WRONG_TOLD_APART.items() if v[0] == name}
+@pytest.mark.parametrize("load", sorted({v[0] for v in WRONG_TOLD_APART.values()}))
+def test_the_told_apart_check_catches_shared_names_unnamed_regions_and_linked_figures(browser, book_html, load):
+    variants, name = {k: v[1:] for k, v in WRONG_TOLD_APART.items() if v[0] == load}, load.split()[0]
 
     def change(path, text):
         for variant, (file, old, new, _) in variants.items():

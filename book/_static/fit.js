@@ -24,8 +24,9 @@
 // - the main navigation's link to the page open says so (aria-current): the theme marks it by its look alone;
 // - each exercise's title is a heading one level below its section's (sphinx-exercise writes a paragraph), so
 //   that a screen reader can go from exercise to exercise;
-// - a table's header cell with maths in it is named by its words and its formulas' MathML text ("|h|"): a
-//   browser names a cell from its words alone, and §3's row headers were read as ", , at" and nothing.
+// - a table's header cell with maths in it is named by its words and its formulas' MathML read as written
+//   ("|h|", "h sub x", "ε̂"): a browser names a cell from its words alone, and §3's row headers were read
+//   as ", , at" and nothing.
 // The names, headings and break points are set once, when MathJax has typeset the page; the tables' fit and
 // the displays' breaks are redone whenever the article changes size (window, sidebars, an opened <details>).
 (function () {
@@ -232,13 +233,24 @@
     });
   }
 
+  // A formula's MathML in words a screen reader reads as it is written: a subscript after "sub" ("h sub x",
+  // not "hx"), an accent over a letter as the letter's combining mark ("ε̂", not "ε^"), the rest as its text.
+  var ACCENTS = { "^": "\u0302", "~": "\u0303", "\u00af": "\u0304", "\u02d9": "\u0307", "\u2192": "\u20d7" };
+  function spoken(node) {
+    var kids = Array.prototype.map.call(node.children, spoken);
+    if (!kids.length) return node.textContent;
+    if (node.localName === "msub" && kids.length === 2) return kids[0] + " sub " + kids[1];
+    var accent = node.localName === "mover" && kids.length === 2 && ACCENTS[kids[1].trim()];
+    return accent ? kids[0] + accent : kids.join("");
+  }
+
   function nameHeaderCells(root) {
     root.querySelectorAll("th").forEach(function (th) {
       if (!th.querySelector("mjx-assistive-mml")) return;
       var copy = th.cloneNode(true);
       copy.querySelectorAll("mjx-container").forEach(function (m) {
         var mml = m.querySelector("mjx-assistive-mml");
-        m.replaceWith(mml ? mml.textContent : "");
+        m.replaceWith(mml ? spoken(mml) : "");
       });
       th.setAttribute("aria-label", copy.textContent.replace(/\s+/g, " ").trim());
     });
