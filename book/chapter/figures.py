@@ -103,7 +103,7 @@ def difference_bar(fig, ax, *, gain=None, log_floor=None, location="right"):
     """A grey colour bar for difference images drawn on ``ax`` (one axes or a list of them) of ``fig``:
     each channel's |ΔI| (linear colour units) from black to white, linearly from 0 to 1 / ``gain``
     (an image of ``gain`` |ΔI| clipped at 1: the bar's triangle marks the clipping, its label says that its values
-    are before the gain) or, with
+    are |ΔI| itself, drawn times the gain) or, with
     ``log_floor``, logarithmically from ``log_floor`` to 1 (an image of 1 - log10 |ΔI| / log10
     ``log_floor``, as the simulator draws it).  Pass exactly one of them.  ``location``: matplotlib's
     (beside the axes, "right", or under them, "bottom").  Returns the Colorbar.
@@ -128,7 +128,7 @@ def difference_bar(fig, ax, *, gain=None, log_floor=None, location="right"):
         bar.ax.xaxis.set_major_formatter(PlainLogFormatter())
         bar.ax.yaxis.set_major_formatter(PlainLogFormatter())
         bar.ax.minorticks_off()
-    bar.set_label("|ΔI| per channel" + (f", before the × {gain:g}" if gain else ""))     # the bar's values, not the image's
+    bar.set_label("|ΔI| per channel" + (f" (drawn × {gain:g})" if gain else ""))     # the bar's values, not the image's
     return bar
 
 
