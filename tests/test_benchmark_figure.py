@@ -71,8 +71,8 @@ def test_no_text_of_the_figure_collides_whatever_the_machine_times(monkeypatch, 
     needs; a panel's title (two lines for a field with creases) must not reach the neighbouring tick
     labels at any of them, nor at any errors.  Seeded draws of every run's time from 0.5 ms to 0.5 s
     (the page's methods span about that, the fastest to the slowest) and its error from 1e-16 to 2,
-    in the book's style.  With ``added`` methods appended to `METHODS` (a legend taller than a row),
-    the panels keep the height they have without them, and the legend lists the records' order."""
+    in the book's style.  With ``added`` methods appended to `METHODS` (a taller legend), the panels
+    keep the height they have without them, and the legend lists the records' order."""
     import dataclasses
 
     import numpy as np
@@ -102,5 +102,5 @@ def test_no_text_of_the_figure_collides_whatever_the_machine_times(monkeypatch, 
         assert text_overlaps(fig) == [], [(r.field, r.method, r.times, r.max_error) for r in rows]
     grown = panels(pareto_figure(base))
     assert len(grown) == len(alone) and min(h / a for h, a in zip(grown, alone)) > 0.97, (grown, alone)
-    legend = [t.get_text() for a in fig.axes if a.get_legend() for t in a.get_legend().get_texts()]
+    legend = [t.get_text() for lg in fig.legends for t in lg.get_texts()]
     assert legend == ["Pareto front", *(m.label for m in gm.METHODS if m.name in {r.method for r in rows})]

@@ -22,7 +22,7 @@ _NUMBER_WORDS = ("none", "one", "two", "three", "four", "five", "six", "seven", 
 
 #: The error axis starts this factor below the panel's lowest point.
 _Y_ROOM = 30.0
-#: The height of a row of panels, inches (more if the legend, in a row's spare cell, is taller).
+#: The height of a panel, inches.
 _ROW_IN = 1.9
 
 
@@ -32,8 +32,9 @@ def _floor(e):
 
 
 def pareto_figure(measurement, *, error="max"):
-    """Log-log plot of time per frame against error, one panel per field, stacked for a
-    phone's column (5 in wide, every text at the book's size, `chapter.figures.TEXT_PT`, a shared time axis).
+    """Log-log plot of time per frame against error, one panel per field, each as wide as the figure and
+    stacked for a phone's column (5 in wide, every text at the book's size, `chapter.figures.TEXT_PT`, a
+    shared time axis labelled on every panel), the legend under them.
 
     Each point is a method at its median time, with a horizontal bar from the
     fastest to the slowest run; difference sweeps are joined in order of eps
@@ -63,11 +64,9 @@ def pareto_figure(measurement, *, error="max"):
     if error not in ("max", "rms"):
         raise ValueError(f"error must be 'max' or 'rms', got {error!r}")
     names = list(dict.fromkeys(r.field for r in measurement.results))
-    # Two columns (a phone's column holds two panels of 2.5 in); the legend fills an empty cell.
-    rows = (len(names) + 2) // 2
-    fig = Figure(figsize=(5.0, _ROW_IN * rows), layout="constrained")
-    grid = fig.subplots(rows, 2, sharex=True, squeeze=False).ravel()
-    axes, spare = grid[:len(names)], grid[len(names):]
+    # One column: at two panels a row, a phone showed each 140 px wide.
+    fig = Figure(figsize=(5.0, _ROW_IN * len(names)), layout="constrained")
+    axes = fig.subplots(len(names), 1, sharex=True, squeeze=False).ravel()
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
     t_lo = 0.5e3 * min(r.t_min for r in measurement.results)
     t_hi = 2e3 * max(r.t_max for r in measurement.results)
@@ -91,33 +90,25 @@ def pareto_figure(measurement, *, error="max"):
             handles.setdefault(method, line)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        # Every third decade on the error axis, at most three labelled decades on the time axis (the
-        # times are the machine's: over four decades, four labels of up to four digits touch in a
-        # panel 1.6 in wide); no minor ticks (they cost most of the drawing time).
-        ax.xaxis.set_major_locator(LogLocator(base=10.0, numticks=3))
+        # Every third decade on the error axis, at most five labelled decades on the time axis (the
+        # times are the machine's); no minor ticks (they cost most of the drawing time).
+        ax.xaxis.set_major_locator(LogLocator(base=10.0, numticks=5))
         ax.yaxis.set_major_locator(LogLocator(base=1000.0, numticks=9))
         for axis in (ax.xaxis, ax.yaxis):
             axis.set_minor_locator(NullLocator())
         ax.set_xlim(t_lo, t_hi)
         ax.set_ylim(min(_floor(pick(r)) for r in rs) / _Y_ROOM, None)
-        ax.set_title(name + (", off the\ncrease band" if F.field(name).crease_factors else ""))   # narrower than a panel
-        ax.set_ylabel(f"{error} error" if ax in grid[::2] else "")
+        ax.set_title(name + (", off the crease band" if F.field(name).crease_factors else ""))
+        ax.set_ylabel(f"{error} error")
         ax.grid(alpha=0.3, lw=0.3)
-    for ax in axes[-2:]:                # the lowest panel of each column
-        ax.set_xlabel("time per frame, ms")
-        ax.xaxis.set_tick_params(labelbottom=True)
+        ax.xaxis.set_tick_params(labelbottom=True)          # each panel read alone, scrolled to on a phone
+    axes[-1].set_xlabel("time per frame, ms")
     handles = {m: handles[m] for m in ("Pareto front", *(m.name for m in gm.METHODS)) if m in handles}
     labels = [m if m == "Pareto front" else gm.method(m).label for m in handles]
-    if len(spare):
-        for ax in spare:
-            ax.axis("off")
-        legend = spare[0].legend(list(handles.values()), labels, loc="center", frameon=False)
-        # A legend taller than a row (more methods than it holds) would squeeze the panels: the rows,
-        # of equal height in the constrained layout, grow to the legend's height.
-        tall = legend.get_window_extent(FigureCanvasAgg(fig).get_renderer()).height / fig.dpi
-        fig.set_figheight(rows * max(_ROW_IN, tall))
-    else:
-        fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, frameon=False)
+    legend = fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, frameon=False)
+    # The figure grows by the legend's height, so that more methods do not squeeze the panels.
+    tall = legend.get_window_extent(FigureCanvasAgg(fig).get_renderer()).height / fig.dpi
+    fig.set_figheight(_ROW_IN * len(names) + tall)
     return fig
 
 
