@@ -1422,11 +1422,14 @@ FORMULAS_JS = r"""async () => {
     const display = m.getAttribute('display') === 'true';
     // The breaks MathJax took in an in-line formula (the part after a break to the left of and below the part
     // before it) before an operator, where TeX breaks after one: the part after the break an operator that
-    // is neither an opening fence nor a prefix one (one after another operator); each as "<before>|<after>".
+    // is neither an opening fence nor a prefix one (one after another operator, or first); or after an opening
+    // fence or a prefix operator, parting it from what it opens or signs ("(|x", "−|sin"); each as "<before>|<after>".
     const operand = e => e.tagName !== 'MJX-MO' || CLOSE.includes(e.textContent.trim());
+    const prefix = e => e.tagName === 'MJX-MO' && !CLOSE.includes(e.textContent.trim())
+      && (OPEN.includes(e.textContent.trim()) || !e.previousElementSibling || !operand(e.previousElementSibling));
     const breaks = display ? [] : [...m.querySelectorAll('mjx-break')].flatMap(b => {
       const p = b.previousElementSibling, n = b.nextElementSibling;
-      if (!p || !n || n.tagName !== 'MJX-MO' || OPEN.includes(n.textContent.trim()) || !operand(p)) return [];
+      if (!p || !n || !(prefix(p) || n.tagName === 'MJX-MO' && !OPEN.includes(n.textContent.trim()) && operand(p))) return [];
       const pr = p.getBoundingClientRect(), nr = n.getBoundingClientRect();
       return nr.left < pr.left && nr.top > pr.top ? [p.textContent.trim() + '|' + n.textContent.trim()] : [];
     });
@@ -1578,6 +1581,10 @@ WRONG_FORMULAS = {
                                            r"\(\frac{\varepsilon}{2} =\)", lambda f: f["stacked"]),
     "in-line formulas broken before an operator": ("s3_math", "fit.js", 'set("linebreakstyle", "after")',
                                                    'set("linebreakstyle", "before")', lambda f: f["breaks"]),
+    "a sign marked to break after itself": ("s3_math", "fit.js", 'if (prev && (!prev.isKind("mo")',
+                                            'if (true || prev && (!prev.isKind("mo")', lambda f: f["breaks"]),
+    "a sign left to MathJax's break before it": ("s3_math", "fit.js", 'else node.attributes.set("linebreak", "nobreak");',
+                                                 "", lambda f: f["breaks"]),
 }
 
 

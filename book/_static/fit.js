@@ -14,7 +14,8 @@
 // - a display formula is broken again when its column's width changes: MathJax 4 breaks a display for
 //   the width its column has when it is typeset (none inside a closed <details>, which has no width);
 // - an in-line formula breaks after a relation or a binary operator, as TeX breaks one ("x =" ends a
-//   line); MathJax 4 breaks before it, MathML's default, which a display keeps.  (It also breaks at a
+//   line), and never between a sign and its operand ("(−" ending a line); MathJax 4 breaks before an
+//   operator, MathML's default, which a display keeps.  (It also breaks at a
 //   space, where TeX would not: a long product or tuple has no other place to break on a phone.)
 // - every button of the article has a name of its own, so that a screen reader's list of them tells them
 //   apart: a fold's toggle (sphinx-togglebutton names each "Toggle hidden content") is named by its fold's
@@ -156,15 +157,21 @@
   }
 
   // Before MathJax starts (its script is deferred; this one is not): its TeX input's last step marks each
-  // operator of an in-line formula, but one whose break side is given, to break after itself.
+  // operator of an in-line formula that follows an operand, but one whose break side is given, to break
+  // after itself; a sign (the minus of "(−sin θ", of "= −1") not to break at all, and a fence is left as it is.
   var config = window.MathJax;
   if (config && !config.startup) config.startup = { ready: function () {
     MathJax.startup.defaultReady();
     MathJax.startup.document.inputJax[0].postFilters.add(function (args) {
       if (args.math.display) return;
+      var CLASS = MathJax._.core.MmlTree.MmlNode.TEXCLASS;
       args.data.root.walkTree(function (node) {
-        if (node.isKind("mo") && !node.attributes.hasExplicit("linebreakstyle"))
+        if (!node.isKind("mo") || node.attributes.hasExplicit("linebreakstyle") || node.texClass === CLASS.OPEN
+            || node.texClass === CLASS.CLOSE) return;
+        var siblings = node.parent ? node.parent.childNodes : [], prev = siblings[siblings.indexOf(node) - 1];
+        if (prev && (!prev.isKind("mo") || prev.texClass === CLASS.CLOSE || prev.texClass === CLASS.ORD))
           node.attributes.set("linebreakstyle", "after");
+        else node.attributes.set("linebreak", "nobreak");       // a sign, kept with its operand
       });
     });
   } };
