@@ -66,3 +66,14 @@ def test_a_link_to_a_target_without_a_title_is_refused_where_its_words_are_share
     document, links = _linked(("§3", f"s3_math.html#{anchor}"), ("§3", f"s3_math.html#{anchor}"))
     a11y_markup.LinkNames(document).run()                # one place: the words say where it leads
     assert [link.get("aria-label") for link in links] == [None, None]
+
+
+def test_an_id_given_twice_is_numbered_by_its_place_skipping_one_taken():
+    """sphinx-proof gives every proof's section the id "proof-content": the second and later are numbered, and
+    a number another element has is skipped; every id of the page is then given once."""
+    document = new_document("<test>", get_default_settings(Parser))
+    sections = [nodes.section(ids=["proof-content"]) for _ in range(3)] + [nodes.section(ids=["proof-content-2", "x"])]
+    document += sections
+    a11y_markup.UniqueIds(document).run()
+    assert [s["ids"] for s in sections] == [["proof-content"], ["proof-content-3"], ["proof-content-4"],
+                                            ["proof-content-2", "x"]]

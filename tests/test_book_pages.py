@@ -639,7 +639,8 @@ def site(browser, book_html):
 #: names a cell from its words alone, dropping the maths), or one naming it by MathML's characters, a subscript run
 #: into its base ("hx" for h_x) or an accent read as a character ("ε^"); a link, button, heading or header cell named by its
 #: words with a <wbr> in them (a browser names it with a space there: "s1_what_changes. ipynb"); links of one
-#: name leading to different places (each margin note's "why", each "§3").  A name is the aria-label, else the words shown; a link to a page's top leads
+#: name leading to different places (each margin note's "why", each "§3"); an id given to more than one element (a
+#: reference to it finds the first: sphinx-proof's "proof-content", 14 times on §3).  A name is the aria-label, else the words shown; a link to a page's top leads
 #: where the link to the page leads.
 TOLD_APART = r"""() => {
   const root = document.querySelector('article.bd-article');
@@ -674,6 +675,8 @@ TOLD_APART = r"""() => {
                 + '[role=heading], th, [role=tab], [role=menuitem], [role=option]')]
             .filter(e => e.querySelector('wbr') && !e.hasAttribute('aria-label') && !e.hasAttribute('aria-labelledby'))
             .map(e => `named with a space at each break point: ${words(e).slice(0, 40)}`),
+          ...Object.entries([...document.querySelectorAll('[id]')].reduce((n, e) => (n[e.id] = (n[e.id] || 0) + 1, n), {}))
+            .filter(([, k]) => k > 1).map(([id, k]) => `the id '${id}' given ${k} times`),
           ...[...root.querySelectorAll('.exercise > .admonition-title:not([role=heading][aria-level])')]
             .map(t => `an exercise's title is no heading: ${words(t)}`),
           ...[...root.querySelectorAll('table')].filter(t => t.tHead && t.tHead.rows[0] && !words(t.tHead.rows[0].cells[0])
@@ -710,7 +713,7 @@ def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
 #: cause), each of which `TOLD_APART` must catch (a page's variants planted together, in one load: each causes a
 #: finding of its own; "<page> again", a second load, for those another variant would hide): sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
 #: undone), the margin notes as unnamed asides, their links all named "why" (a11y_markup's names removed), a
-#: table's row labels without their scope, its header cells named without their maths or with a subscript or an
+#: table's row labels without their scope, every proof's body given one id, its header cells named without their maths or with a subscript or an
 #: accent flattened, the exercises' titles as
 #: paragraphs, the names fit.js keeps as a <wbr> goes in left to the browser, the page open not marked in the
 #: navigation, and a figure's image linked to its PNG.
@@ -728,6 +731,8 @@ WRONG_TOLD_APART = {
                                                    "an accent read as a character"),
     "names read with a space at each break point": ("s3_math", "fit.js", 'named.setAttribute("aria-label", ', 'named.setAttribute("data-was", ',
                                                     "a space at each break point"),
+    "an id given to every proof's body": ("s3_math", "s3_math.html", 'id="proof-content-2"', 'id="proof-content"',
+                                          "the id 'proof-content' given"),
     "a table's row labels without their scope": ("s3_math", "s3_math.html", '<th scope="row" class="stub">', '<th class="stub">',
                                            "row labels are no row headers"),
     "the page open not marked in the navigation": ("s3_math", "fit.js", 'a.setAttribute("aria-current", "page")', "a",

@@ -26,6 +26,10 @@ violation on the built pages: tests/test_browser.py).
   the theorem's title), or "§3: The finite-difference U-curve" (the section's title).  A target
   with none of these (a label on a paragraph) fails the build, naming it: a label's words ("s3 kinks")
   are no name.
+* An id given twice.  sphinx-proof and sphinx-exercise give each proof, exercise and solution the same
+  ids ("proof", "proof-content", "exercise-content", "solution-content": 14 of each on §3), and an id
+  names one element of a page (a reference to it, ``aria-labelledby`` or ``#proof``, finds only the
+  first).  Here the second and later get a number ("proof-content-2").
 * A negative number.  Python writes it with a hyphen-minus, which a screen reader reads as a dash
   or skips; in the prose (not in code or maths) it becomes the minus sign, "−0.651"
   (`chapter.page.minus_signs`; book/check_glue.py fails a page with one left).
@@ -138,6 +142,26 @@ class LinkNames(SphinxPostTransform):
                     r["aria-label"] = f"{text}: {where}"
 
 
+class UniqueIds(SphinxPostTransform):
+    """Each id of the page once: an id already given is numbered by its place (``proof-content-2``), skipping
+    a number another element has."""
+
+    default_priority = 900
+
+    def run(self, **kwargs):
+        elements = list(self.document.findall(nodes.Element))
+        taken, seen = {i for e in elements for i in e.get("ids", ())}, {}
+        for element in elements:
+            for k, name in enumerate(element.get("ids", ())):
+                seen[name] = seen.get(name, 0) + 1
+                if seen[name] > 1:
+                    n = seen[name]
+                    while f"{name}-{n}" in taken:
+                        n += 1
+                    element["ids"][k] = f"{name}-{n}"
+                    taken.add(element["ids"][k])
+
+
 class MinusSigns(SphinxPostTransform):
     """Each negative number of the prose with the minus sign: every text node outside code, maths
     and raw markup (glued numbers included: myst-nb pastes them as text)."""
@@ -161,5 +185,6 @@ def setup(app):
     app.add_post_transform(MinusSigns)
     app.add_post_transform(RowHeaders)
     app.add_post_transform(LinkNames)
+    app.add_post_transform(UniqueIds)
     app.add_node(HideCodeCellNode, override=True, html=(visit_hidden_cell, depart_HideCellInput))
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
