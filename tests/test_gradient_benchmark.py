@@ -193,8 +193,7 @@ def test_a_new_method_is_one_record_measured_and_drawn(monkeypatch):
     fig = pareto_figure(m)
     drawn = [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_marker() == "v"]
     assert drawn and drawn[0].get_color() == "#444444"
-    assert "backward difference" in [t.get_text() for ax in fig.axes for lg in [ax.get_legend()] if lg
-                                     for t in lg.get_texts()]
+    assert "backward difference" in [t.get_text() for lg in fig.legends for t in lg.get_texts()]
 
 
 # --- a reader's function of one variable -------------------------------------------------------
