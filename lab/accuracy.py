@@ -25,7 +25,7 @@ from ._checks import MAX_COUNT, MAX_SQUARE, STEP, broadcast, seed as _seed
 
 
 __all__ = ["GradientAccuracy", "gradient_accuracy", "normal_beta_derivative_residual",
-           "image_beta_order", "optima", "measure_optimum", "crease_distance", "crease_share", "image_best_step", "footprint_steps",
+           "image_beta_order", "optima", "measure_optimum", "crease_distance", "crease_share", "image_best_step", "frame_model_step", "footprint_steps",
            "footprint_median", "OPTIMUM_POINTS",
            "DIGITS", "HALF_DECADES"]
 
@@ -497,6 +497,58 @@ def image_best_step(field, size=256):
     SIMULATOR_SCENE.replace(height_field=record)              # the scene's own refusals
     return measured("image-best-step", _image_best_step, field=record.name,
                     size=positive_int("size", size, high=MAX_SQUARE), steps=list(HALF_DECADES))
+
+
+def frame_model_step(field, k_u=None, k_v=None, samples=1201):
+    """The model-optimal step for a whole frame, per chart direction x (u, then v): §3's
+    ε* = (3 u_round C / |h'''|)^{1/3} (`renderer.formulas.EPS_STAR`) with C = |h| + |x h_x| and |h'''|
+    (the third derivative along x) at their largest over the chart, each sampled on a ``samples`` ×
+    ``samples`` grid of [0, 1]², its edges included.  A field's |.| (its creases) is dropped: off them the field
+    is its smooth factor or that factor's negative, with the same |h|, |x h_x| and |h'''|.  The step a
+    renderer without an exact frame can take (§3 compares it with `image_best_step`); the trade-off as in
+    Higham, *Accuracy and Stability of Numerical Algorithms*, bounded over the chart.
+
+    Parameters
+    ----------
+    field : str or renderer.formulas.HeightField
+    k_u, k_v : float in (0, 1e3], optional
+        Frequencies (default: the simulator's scene's, as `image_best_step` renders).
+    samples : int
+        Grid points per direction, in [1, 4096].
+
+    Returns
+    -------
+    dict
+        ``{"u": step, "v": step}`` in chart units (float), ``None`` for a direction along which h is
+        constant (no truncation to balance).
+
+    Raises
+    ------
+    renderer.validate.InvalidType, renderer.validate.InvalidValue
+        ``field`` refused by `renderer.formulas.field`, ``k_u`` or ``k_v`` not a real number in (0, 1e3],
+        or ``samples`` not an integer in [1, 4096].
+    """
+    from renderer.ledger import SIMULATOR_SCENE
+    from renderer.ucurve import UNIT_ROUNDOFF
+    record = F.field(field, "field")
+    k_u = real("k_u", SIMULATOR_SCENE.k_u if k_u is None else k_u, **FREQUENCY)
+    k_v = real("k_v", SIMULATOR_SCENE.k_v if k_v is None else k_v, **FREQUENCY)
+    n = positive_int("samples", samples, high=4096)
+    grid = np.linspace(0.0, 1.0, n)                   # the edges too: C is often largest at u or v = 1
+    at = dict(zip((F.u, F.v), np.meshgrid(grid, grid, indexing="ij")))
+    smooth = record.expr.subs({F.k_u: k_u, F.k_v: k_v}).replace(sp.Abs, lambda a: a)
+    step = sp.lambdify((F.H, F.HX, F.H3, F.u_round), F.EPS_STAR)
+
+    def largest(expr):
+        return float(np.max(np.abs(np.broadcast_to(sp.lambdify((F.u, F.v), expr, "numpy")(at[F.u], at[F.v]),
+                                                   at[F.u].shape))))
+
+    out = {}
+    for x in (F.u, F.v):
+        h3 = largest(sp.diff(smooth, x, 3))
+        c = largest(sp.Abs(smooth) + sp.Abs(x * sp.diff(smooth, x)))     # the largest C itself, not two maxima
+        out[str(x)] = float(step(c, 0.0, h3, UNIT_ROUNDOFF)) if h3 > 0 else None
+    return out
 
 
 def _image_best_step(field, size, steps):

@@ -138,3 +138,25 @@ def test_an_optimum_keeps_the_steps_its_own_stencil_allows():
     with pytest.raises(RuntimeError, match=r"^the ridges field's point \(0.25, 0.4\) is [\d.e+-]+ from a crease: "
                                            r"fewer than two of the default steps lie below that$"):
         measure_optimum("ridges", 0.25, 0.4, "u")
+
+
+def test_the_frame_model_step_is_the_model_at_the_charts_largest_c_and_third_derivative():
+    """`frame_model_step` against a second route: for sin(pi k_u u) sin(pi k_v v) at random frequencies the
+    largest |h'''| along u is (pi k_u)^3, and the largest C = |h| + |u h_u| is the largest, over u alone on
+    a fine grid, of |sin(pi k_u u)| + pi k_u u |cos(pi k_u u)| (where |sin(pi k_v v)| = 1); likewise along v.
+    The ridges field, the same under |.|, has the same steps; a direction along which h is constant has
+    none; and a step a tenth off would be seen (the grid's sampling error is far smaller)."""
+    import numpy as np
+
+    from lab.accuracy import frame_model_step
+    from renderer.ucurve import UNIT_ROUNDOFF
+    x = np.linspace(0.0, 1.0, 400_001)
+    for k_u, k_v in np.random.default_rng(12).uniform(1.0, 12.0, (4, 2)):
+        want = {}
+        for name, k in (("u", k_u), ("v", k_v)):
+            c = np.max(np.abs(np.sin(np.pi * k * x)) + np.pi * k * x * np.abs(np.cos(np.pi * k * x)))
+            want[name] = (3 * UNIT_ROUNDOFF * c / (np.pi * k) ** 3) ** (1 / 3)
+        got = frame_model_step("sine", k_u=k_u, k_v=k_v)
+        assert all(abs(got[d] / want[d] - 1) < 1e-3 for d in "uv"), (k_u, k_v, got, want)
+        assert frame_model_step("ridges", k_u=k_u, k_v=k_v) == got
+    assert frame_model_step("rings")["u"] is None and frame_model_step("rings")["v"] > 0
