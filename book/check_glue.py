@@ -231,7 +231,7 @@ ON_THE_PAGE = ("ix_label", "s2_draft_diff", "s3_band_u", "s3_band_v", "s1_size",
                "s3_torus_point", "s3_torus_dot", "s3_torus_Lu", "s3_torus_Lv", "s3_torus_kappa_u",
                "s3_torus_kappa_v", "s3_torus_h", "s3_torus_hu", "s3_torus_hv", "s3_torus_exact", "s3_torus_first",
                "s3_torus_tilt", "s3_torus_agree", "s3_weingarten", "s3_weingarten_axes", "s3_weingarten_agree",
-               "s3_weingarten_points", "s3_float32_step_ratio", "s3_thumb_over_best", "s7_far_zoom", "s7_far_size", "s7_far_inside")
+               "s3_weingarten_points", "s3_float32_step_ratio", "s3_frame_model_factor", "s7_far_zoom", "s7_far_size", "s7_far_inside")
 
 
 def page_glue(notebook: dict) -> dict:
