@@ -152,8 +152,8 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
                  T_U, first[0], cases=ORTHOGONAL),
             Step(r"Likewise $t_v = c\cdot e_v / c\cdot n$", T_V, first[1], cases=ORTHOGONAL),
             Step(r"With $n_u = \kappa_u p_u$ and $n_v = \kappa_v p_v$ the first product is "
-                 r"$(1 + \beta h\kappa_u)(1 + \beta h\kappa_v)\, p_u \times p_v$, the second carries "
-                 r"$1 + \beta h\kappa_v$ and the third $1 + \beta h\kappa_u$, so exactly", slopes, principal,
+                 r"$(1 + \beta h\kappa_u)(1 + \beta h\kappa_v)\, p_u \times p_v$, the term in $h_u$ carries "
+                 r"$1 + \beta h\kappa_v$ and the term in $h_v$ carries $1 + \beta h\kappa_u$, so exactly", slopes, principal,
                  cases=PRINCIPAL_CHARTS),
             Step(r"On sphere A, $n = p/R$ gives $\kappa_u = \kappa_v = 1/R$, and by ⟪chart⟫ a step in $u$ "
                  r"covers $\lvert p_u\rvert = 2\pi R\sin\varphi$, one in $v$ covers $\lvert p_v\rvert = \pi R$; "
