@@ -183,9 +183,9 @@ QUANTITIES = {
         ("ex_rings_best",), lambda: _lib("lab.accuracy").image_best_step("rings", 256)["best"]),
     "the sine field's image-best step (the simulator's scene and steps, 256 × 256)": (
         ("s4_best",), lambda: _lib("lab.accuracy").image_best_step("sine", 256)["best"]),
-    "the chapter's frequency in u": (("s3_torus_ku",), lambda: _lib("renderer").Scene().k_u),
+    "the chapter's frequency in u": (("s3_torus_ku", "s3_band_ku"), lambda: _lib("renderer").Scene().k_u),
     "the crease band's half-width": (("s3_band_half",), lambda: float(_lib("renderer.formulas").KINK_BAND_HALF_WIDTH)),
-    "the chapter's frequency in v": (("s3_torus_kv",), lambda: _lib("renderer").Scene().k_v),
+    "the chapter's frequency in v": (("s3_torus_kv", "s3_band_kv"), lambda: _lib("renderer").Scene().k_v),
     # Counted on two pages from their own renders.
     "sphere A's pixels at 256 × 256": (("s1_pixels_a", "s2_count_1", "c4_pixels"), None),
 }
