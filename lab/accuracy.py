@@ -503,8 +503,8 @@ def frame_model_step(field, k_u=None, k_v=None, samples=1201):
     """The model-optimal step for a whole frame, per chart direction x (u, then v): §3's
     ε* = (3 u_round C / |h'''|)^{1/3} (`renderer.formulas.EPS_STAR`) with C = |h| + |x h_x| and |h'''|
     (the third derivative along x) at their largest over the chart, each sampled on a ``samples`` ×
-    ``samples`` grid of [0, 1]², its edges included.  A field's |.| (its creases) is dropped: off them the field
-    is its smooth factor or that factor's negative, with the same |h|, |x h_x| and |h'''|.  The step a
+    ``samples`` grid of [0, 1]², its edges included.  |h'''| is taken off the creases: the Dirac deltas that
+    the derivatives of a field's |.| leave on its kink loci are dropped.  The step a
     renderer without an exact frame can take (§3 compares it with `image_best_step`); the trade-off as in
     Higham, *Accuracy and Stability of Numerical Algorithms*, bounded over the chart.
 
@@ -536,7 +536,7 @@ def frame_model_step(field, k_u=None, k_v=None, samples=1201):
     n = positive_int("samples", samples, high=4096)
     grid = np.linspace(0.0, 1.0, n)                   # the edges too: C is often largest at u or v = 1
     at = dict(zip((F.u, F.v), np.meshgrid(grid, grid, indexing="ij")))
-    smooth = record.expr.subs({F.k_u: k_u, F.k_v: k_v}).replace(sp.Abs, lambda a: a)
+    h = record.expr.subs({F.k_u: k_u, F.k_v: k_v})
     step = sp.lambdify((F.H, F.HX, F.H3, F.u_round), F.EPS_STAR)
 
     def largest(expr):
@@ -545,8 +545,8 @@ def frame_model_step(field, k_u=None, k_v=None, samples=1201):
 
     out = {}
     for x in (F.u, F.v):
-        h3 = largest(sp.diff(smooth, x, 3))
-        c = largest(sp.Abs(smooth) + sp.Abs(x * sp.diff(smooth, x)))     # the largest C itself, not two maxima
+        h3 = largest(sp.diff(h, x, 3).replace(sp.DiracDelta, lambda *a: sp.S.Zero))
+        c = largest(sp.Abs(h) + sp.Abs(x * sp.diff(h, x)))     # the largest C itself, not two maxima
         out[str(x)] = float(step(c, 0.0, h3, UNIT_ROUNDOFF)) if h3 > 0 else None
     return out
 

@@ -144,7 +144,7 @@ def test_the_frame_model_step_is_the_model_at_the_charts_largest_c_and_third_der
     """`frame_model_step` against a second route: for sin(pi k_u u) sin(pi k_v v) at random frequencies the
     largest |h'''| along u is (pi k_u)^3, and the largest C = |h| + |u h_u| is the largest, over u alone on
     a fine grid, of |sin(pi k_u u)| + pi k_u u |cos(pi k_u u)| (where |sin(pi k_v v)| = 1); likewise along v.
-    The ridges field, the same under |.|, has the same steps; a direction along which h is constant has
+    The ridges field, |.| of the same product, has the same steps (its deltas on the creases dropped); a direction along which h is constant has
     none; and a step a tenth off would be seen (the grid's sampling error is far smaller)."""
     import numpy as np
 
@@ -158,5 +158,6 @@ def test_the_frame_model_step_is_the_model_at_the_charts_largest_c_and_third_der
             want[name] = (3 * UNIT_ROUNDOFF * c / (np.pi * k) ** 3) ** (1 / 3)
         got = frame_model_step("sine", k_u=k_u, k_v=k_v)
         assert all(abs(got[d] / want[d] - 1) < 1e-3 for d in "uv"), (k_u, k_v, got, want)
-        assert frame_model_step("ridges", k_u=k_u, k_v=k_v) == got
+        ridges = frame_model_step("ridges", k_u=k_u, k_v=k_v)        # sign(0) = 0 on a crease's grid points
+        assert all(abs(ridges[d] / got[d] - 1) < 1e-3 for d in "uv"), (ridges, got)
     assert frame_model_step("rings")["u"] is None and frame_model_step("rings")["v"] > 0

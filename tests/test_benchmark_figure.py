@@ -29,7 +29,7 @@ def _fake():
 
 def test_the_lowest_marker_stands_clear_of_the_bottom_edge():
     fig = pareto_figure(_fake())
-    for ax in [a for a in fig.axes if a.get_title()]:     # the panels (not the legend's cell)
+    for ax in [a for a in fig.axes if a.get_title()]:     # the panels
         lines = [ln for ln in ax.get_lines() if ln.get_marker() not in (None, "None", "") and len(ln.get_ydata())]
         front = [ln for ln in ax.get_lines() if ln.get_drawstyle().startswith("steps")]
         assert len(front) == 1 and lines
