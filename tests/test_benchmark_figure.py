@@ -38,6 +38,32 @@ def test_the_lowest_marker_stands_clear_of_the_bottom_edge():
         assert lowest / bottom >= 10, (ax.get_title(), lowest, bottom)     # a decade or more of room
 
 
+def test_each_step_of_a_difference_is_labelled_at_its_bar_in_its_colour():
+    """The sweeps as the page draws them, at one time per method: every step's label, `step_text`'s
+    words in the method's colour at the right end of its marker's bar; a method without steps has none."""
+    from chapter.benchmark import step_text
+    from chapter.layout import text_overlaps
+    from lab import gradient_methods as gm
+    rows = []
+    for f in F.FIELDS:
+        rows += [_result(f, "exact", 1e-14, 1.0), _result(f, "richardson", 1e-12, 100.0)]
+        rows += [_result(f, "central", err, 2.0, eps) for eps, err in ((1e-3, 3e-3), (1e-6, 3e-11), (1e-9, 3e-7))]
+    fig = pareto_figure(SimpleNamespace(results=tuple(rows), of=lambda f: [r for r in rows if r.field == f]))
+    assert text_overlaps(fig) == []
+    for ax in [a for a in fig.axes if a.get_title()]:
+        labels = {t.get_text(): t for t in ax.texts}
+        assert set(labels) == {step_text(e).replace("-", "\u2212") for e in (1e-3, 1e-6, 1e-9)}
+        for eps, err in ((1e-3, 3e-3), (1e-6, 3e-11), (1e-9, 3e-7)):
+            label = labels[step_text(eps).replace("-", "\u2212")]
+            assert label.xy == pytest.approx((1.5 * 2.0, err)) and label.get_color() == gm.method("central").style.colour
+    # A middle step's label on an end's gives way to it, whichever comes first in the sweep.
+    for order in (1, -1):
+        steps = ((1e-3, 3e-3), (1e-6, 3.1e-3), (1e-9, 3e-7))[::order]
+        rows = [_result("sine", "exact", 1e-14, 1.0)] + [_result("sine", "central", err, 2.0, eps) for eps, err in steps]
+        fig = pareto_figure(SimpleNamespace(results=tuple(rows), of=lambda f: rows))
+        assert sorted(t.get_text() for t in fig.axes[0].texts) == ["1e\u22123", "1e\u22129"]
+
+
 def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
     """`univariate_figure`: one line per method in its record's colour and line style, a method without a
     step drawn across the plot, every text at least 10 pt in a figure at most 5 in wide, nothing overlapping."""

@@ -1205,6 +1205,20 @@ def test_text_overlaps_passes_a_clean_figure_and_catches_two_labels_on_top_of_ea
     assert text_overlaps(fig) == ["'a note' / 'a second note'"]
 
 
+def test_drop_clashing_removes_the_optional_labels_that_collide_the_less_important_of_two_first(figure):
+    from chapter.layout import drop_clashing, text_overlaps
+    fig, ax = figure(figsize=(5, 3.5))
+    _clean(ax)
+    on_note = ax.text(0.2, 0.6, "on the note")              # on a label that is not optional
+    kept = ax.text(0.03, 0.9, "kept")
+    under = ax.text(0.03, 0.9, "under it")                   # on a more important optional label
+    edge = ax.text(0.97, 0.5, "over the edge")               # straddles the frame
+    assert drop_clashing(fig, [on_note, kept, under, edge]) == [kept]
+    assert text_overlaps(fig) == [] and {t.get_text() for t in ax.texts} == {"a note", "kept"}
+    second = ax.text(0.03, 0.9, "first now")                 # the order given decides which stays
+    assert drop_clashing(fig, [second, kept]) == [second]
+
+
 def test_text_overlaps_catches_a_title_on_a_label(figure):
     """The diagram of the central stencil as it was: the crease's label just above the axes, under the title."""
     import matplotlib.pyplot as plt

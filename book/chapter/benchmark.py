@@ -37,8 +37,10 @@ def pareto_figure(measurement, *, error="max"):
     shared time axis labelled on every panel), the legend under them.
 
     Each point is a method at its median time, with a horizontal bar from the
-    fastest to the slowest run; difference sweeps are joined in order of eps
-    (unlabelled: neighbouring steps' labels would collide); the Pareto front is the
+    fastest to the slowest run; difference sweeps are joined in order of eps, each
+    marker labelled with its step (`step_text`) above its bar on the right where the label
+    collides with nothing, a sweep's first and last steps before the others
+    (`chapter.layout.drop_clashing`); the Pareto front is the
     grey staircase; each error axis starts `_Y_ROOM` times below its panel's
     lowest point, so no marker sits on the frame.  An error of exactly 0 would be drawn at 1e-18.
     Colours, markers, line styles and legend labels are the methods' records', and the legend lists
@@ -61,6 +63,7 @@ def pareto_figure(measurement, *, error="max"):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.ticker import LogLocator, NullLocator
+    from .layout import drop_clashing
     if error not in ("max", "rms"):
         raise ValueError(f"error must be 'max' or 'rms', got {error!r}")
     names = list(dict.fromkeys(r.field for r in measurement.results))
@@ -70,7 +73,7 @@ def pareto_figure(measurement, *, error="max"):
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
     t_lo = 0.5e3 * min(r.t_min for r in measurement.results)
     t_hi = 2e3 * max(r.t_max for r in measurement.results)
-    handles = {}
+    handles, ends, middles = {}, [], []
     for ax, name in zip(axes, names):
         rs = measurement.of(name)
         front = gb.pareto_front(rs, error=error)
@@ -88,6 +91,13 @@ def pareto_figure(measurement, *, error="max"):
             line, = ax.plot(t, e, color=style.colour, ls=style.line, lw=0.8 if len(group) > 1 else 0, alpha=0.7,
                             marker=style.marker, ms=style.size)
             handles.setdefault(method, line)
+            for i, r in enumerate(group if len(group) > 1 else ()):
+                # At the right end of the marker's bar, which leads the eye from the marker to it.
+                label = ax.annotate(step_text(r.eps).replace("-", "\u2212"), (1e3 * r.t_max, e[i]),
+                                    xytext=(3, 0), textcoords="offset points", ha="left", va="center",
+                                    color=style.colour)
+                label.set_in_layout(False)
+                (ends if i in (0, len(group) - 1) else middles).append(label)
         ax.set_xscale("log")
         ax.set_yscale("log")
         # Every third decade on the error axis, at most five labelled decades on the time axis (the
@@ -97,7 +107,7 @@ def pareto_figure(measurement, *, error="max"):
         for axis in (ax.xaxis, ax.yaxis):
             axis.set_minor_locator(NullLocator())
         ax.set_xlim(t_lo, t_hi)
-        ax.set_ylim(min(_floor(pick(r)) for r in rs) / _Y_ROOM, None)
+        ax.set_ylim(min(_floor(pick(r)) for r in rs) / _Y_ROOM, max(_floor(pick(r)) for r in rs) * _Y_ROOM)
         ax.set_title(name + (", off the crease band" if F.field(name).crease_factors else ""))
         ax.set_ylabel(f"{error} error")
         ax.grid(alpha=0.3, lw=0.3)
@@ -109,6 +119,7 @@ def pareto_figure(measurement, *, error="max"):
     # The figure grows by the legend's height, so that more methods do not squeeze the panels.
     tall = legend.get_window_extent(FigureCanvasAgg(fig).get_renderer()).height / fig.dpi
     fig.set_figheight(_ROW_IN * len(names) + tall)
+    drop_clashing(fig, ends + middles)
     return fig
 
 

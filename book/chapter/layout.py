@@ -11,7 +11,7 @@ records in the PNG for the browser test of the figures' text on a phone, and
 
 from __future__ import annotations
 
-__all__ = ["drawn_size", "drawn_texts", "text_overlaps"]
+__all__ = ["drawn_size", "drawn_texts", "text_overlaps", "drop_clashing"]
 
 #: The least clear space between a label and a line of the data, in points, beyond the line's half width.
 CLEARANCE = 1.0
@@ -115,6 +115,46 @@ def text_overlaps(fig, gap=0.5):
     ValueError
         ``gap`` is negative or not finite.
     """
+    return [message for _, message in _clashes(fig, gap)]
+
+
+def drop_clashing(fig, labels, gap=0.5):
+    """Remove from ``fig`` those of ``labels`` that `text_overlaps` would report, keeping the more
+    important of two labels that collide with each other; labels that collide with nothing stay.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        Drawn once here (see `text_overlaps`); give the labels ``set_in_layout(False)`` so that removing
+        them moves nothing else.
+    labels : sequence of matplotlib.text.Text
+        Optional labels of ``fig``, the most important first.
+    gap : float >= 0
+        As in `text_overlaps`.
+
+    Returns
+    -------
+    list of matplotlib.text.Text
+        The labels kept, in the order given.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As `text_overlaps`.
+    """
+    rank = {id(t): i for i, t in enumerate(labels)}
+    dropped = set()
+    for texts, _ in _clashes(fig, gap):
+        ours = [t for t in texts if id(t) in rank]
+        if ours and not any(id(t) in dropped for t in ours):
+            last = max(ours, key=lambda t: rank[id(t)])
+            dropped.add(id(last))
+            last.remove()
+    return [t for t in labels if id(t) not in dropped]
+
+
+def _clashes(fig, gap):
+    """`text_overlaps`' findings as (the texts involved, the message)."""
     import math
 
     from matplotlib.figure import Figure
@@ -139,12 +179,12 @@ def text_overlaps(fig, gap=0.5):
             room = gap * min(a.get_fontsize(), b.get_fontsize()) * px
             if (across > 0 and down > 0) or (owner.get(id(a)) is not owner.get(id(b))
                                                  and down > 0.5 * min(ba.height, bb.height) and across > -room):
-                out.append(f"{name(a)} / {name(b)}")
+                out.append(((a, b), f"{name(a)} / {name(b)}"))
     legends = [lg for lg in fig.findobj(Legend) if lg.get_visible() and lg.get_frame_on()]
     for lg in legends:
         own = {id(t) for t in lg.findobj(Text)}
         frame = lg.get_window_extent(renderer)
-        out += [f"{name(t)} / legend" for t, bt in zip(drawn, boxes) if id(t) not in own and frame.overlaps(bt)]
+        out += [((t,), f"{name(t)} / legend") for t, bt in zip(drawn, boxes) if id(t) not in own and frame.overlaps(bt)]
     for ax in axes:
         legend = ax.get_legend()
         own = {id(t) for t in ax.texts + (legend.get_texts() if legend is not None else [])}
@@ -152,22 +192,22 @@ def text_overlaps(fig, gap=0.5):
         for t in (t for t in drawn if id(t) in own):                # its labels and legend entries, as drawn
             bt, box = Text.get_window_extent(t, renderer), t.get_bbox_patch()     # an annotation's text, not its arrow
             masked = box is not None and box.get_visible() and box.get_facecolor()[3] == 1
-            out += list(dict.fromkeys(f"{name(t)} / the data's {_kind(a)}" for a in data if _crosses(a, bt, renderer)
-                                      and not (masked and t.get_zorder() > a.get_zorder())))
+            out += list(dict.fromkeys(((t,), f"{name(t)} / the data's {_kind(a)}") for a in data
+                                      if _crosses(a, bt, renderer) and not (masked and t.get_zorder() > a.get_zorder())))
     for t, bt in zip(drawn, boxes):
         home = owner.get(id(t))
         if home is not None and home.axison and t in home.texts:
             frame = home.get_window_extent(renderer)
             inside = frame.padded(1)
             if bt.padded(-1).overlaps(frame) and not (inside.contains(bt.x0, bt.y0) and inside.contains(bt.x1, bt.y1)):
-                out.append(f"{name(t)} / the frame of its axes")
+                out.append(((t,), f"{name(t)} / the frame of its axes"))
         for ax in axes:
             area = ax.get_window_extent(renderer)
             if ax is home or (home is not None and home.get_window_extent(renderer).overlaps(area)):
                 continue
             if bt.padded(-1).overlaps(area):
                 label = ax.get_title() or f"{fig.axes.index(ax) + 1} of {len(fig.axes)}"
-                out.append(f"{name(t)} / axes {label!r}")
+                out.append(((t,), f"{name(t)} / axes {label!r}"))
     return out
 
 
