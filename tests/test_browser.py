@@ -969,7 +969,8 @@ def test_the_decade_check_catches_a_slider_without_ticks_or_decade_keys(browser,
 SPOKEN_JS = """() => {
   const attr = (sel, a) => document.querySelector(sel).getAttribute(a);
   return {canvases: Object.fromEntries(['numeric', 'symbolic', 'difference'].map(n =>
-            [n, [attr('#sim-canvas-' + n, 'role'), attr('#sim-canvas-' + n, 'aria-label')]])),
+            [n, [attr('#sim-canvas-' + n, 'role') + ' ' + attr('#sim-canvas-' + n, 'aria-roledescription'),
+                 attr('#sim-canvas-' + n, 'aria-label')]])),
           hint: attr('#sim-hint', 'aria-live'), curve: [attr('#sim-curve', 'role'), attr('#sim-curve', 'aria-label')],
           status: [attr('#sim-status', 'role'), document.getElementById('sim-status').textContent],
           live: [...document.querySelectorAll('.symrender-sim :is(table, output, [aria-live])')].filter(e =>
@@ -984,7 +985,9 @@ SPOKEN_JS = """() => {
 
 def spoken_problems(s):
     """Where what a screen reader is given departs from what the simulator shows (`SPOKEN_JS`): a canvas
-    that is not an image with a label naming the field, β, the view and the normal, the numeric canvas's ε
+    that is not an application (a screen reader in browse mode keeps the arrow keys that move the probe from
+    anything else) described as an image with a probe, with a label naming the field, β, the view and the
+    normal, the numeric canvas's ε
     and the difference's largest |ΔI| and RMS as the ledger prints them; a hint that is no polite live
     region; a status line (role status) that does not give the difference's largest |ΔI| and RMS as the
     ledger prints them; another live region (the readout, read whole after every change once a pixel was
@@ -997,7 +1000,7 @@ def spoken_problems(s):
     eps = s.page.text_content("#sim-log_eps-value")
     for name, (role, label) in said["canvases"].items():
         label = label or ""
-        if role != "img":
+        if role != "application image with a probe":
             found.append(f"{name} canvas: role {role!r}")
         if name != "difference":
             for part in (f"the {st['height_field']} field", f"β = {st['beta']:.2f}", {"shaded": "shaded", "bump": "size of ∇h",
@@ -1123,6 +1126,7 @@ WRONG_SPOKEN = {
                                                      "", "silently"),
     "the β note never giving way": ("      this.note.textContent = \"\";                                 // the note said its piece\n",
                                      "", "outlived"),
+    "the canvases images, whose arrow keys browse mode keeps": ('role: "application"', 'role: "img"', "role"),
     "the readout a live region again": ('class: "sim-readout" }', 'class: "sim-readout", "aria-live": "polite" }', "live regions"),
     "the probe's pixel not said": ("if (say) this.status.textContent", "if (false) this.status.textContent", "the probe's pixel not said"),
     "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",

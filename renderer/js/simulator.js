@@ -277,7 +277,10 @@ class Simulator {
     this.canvases = {};
     this.marks = [];
     const figs = ["numeric", "symbolic", "difference"].map((name) => {
-      const canvas = el("canvas", { id: `sim-canvas-${name}`, tabindex: "0", role: "img",
+      // An application, not an image: a screen reader in browse mode passes the arrow keys only to an
+      // application; its role description still calls it an image.
+      const canvas = el("canvas", { id: `sim-canvas-${name}`, tabindex: "0", role: "application",
+                                    "aria-roledescription": "image with a probe",
                                     "aria-label": `${name} canvas (arrow keys move the probe)` });
       canvas.addEventListener("pointermove", (ev) => { if (ev.pointerType === "mouse") this.pointer(canvas, ev); });
       canvas.addEventListener("pointerdown", (ev) => this.pointer(canvas, ev));
@@ -552,7 +555,7 @@ class Simulator {
     });
   }
 
-  // Each canvas's text alternative (its aria-label, the canvases being role="img"): what it draws, in
+  // Each canvas's text alternative (its aria-label): what it draws, in
   // words, and the ledger's numbers for the difference; rewritten on every update.  Returns those numbers
   // in words, as the status line says them too.
   describe(ledger) {
