@@ -114,7 +114,7 @@ class Scene:
     green from the floor's checker squares.
 
     Bump.  ``height_field`` [hf] is the name of a registered field (one of
-    `renderer.formulas.FIELDS`: the seed's "sine", "ridges", "rings" of §2), a
+    `renderer.formulas.FIELDS`, the seed's "sine", "ridges" and "rings" of §2 among them), a
     `renderer.formulas.HeightField`, or a reader's own field: a sympy expression, or its
     text (``"sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2"``), in u, v and the frequencies
     ``k_u`` [ku] and ``k_v`` [kv] (kept as its printed text); a field other than the
@@ -268,7 +268,8 @@ CHART_CHECK_POINTS = 65
 
 @lru_cache(maxsize=64)
 def _on_chart(field, k_u, k_v):
-    """(least h, whether h and its gradient are finite and real) on a grid of the chart, numpy float64."""
+    """(least h, the grid point (u, v) where it is, the first grid point where h or its gradient is not
+    finite and real, or None) on a grid of the chart, numpy float64."""
     import numpy as np
     import sympy as sp
     fn = sp.lambdify(formulas.FIELD_SYMBOLS, [field.expr, *field.gradient], modules="numpy")
@@ -278,23 +279,27 @@ def _on_chart(field, k_u, k_v):
         # numpy's frequencies: a term of them alone overflows to inf, where Python's floats raise.
         # A constant sympy cannot tell is complex, (0.5 - pi)**pi, comes out a Python complex.
         values = [np.broadcast_to(a, uu.shape) for a in fn(uu, vv, np.float64(k_u), np.float64(k_v))]
-    if any(np.iscomplexobj(a) for a in values):
-        return float("nan"), False
-    return float(np.min(values[0])), all(np.all(np.isfinite(a)) for a in values)
+    if any(np.iscomplexobj(a) for a in values):       # a constant: every point alike
+        return float("nan"), None, (0.0, 0.0)
+    bad = np.argwhere(~np.all([np.isfinite(a) for a in values], axis=0))
+    low = np.unravel_index(np.argmin(values[0]), uu.shape)
+    where = lambda ij: (float(uu[tuple(ij)]), float(vv[tuple(ij)]))       # noqa: E731
+    return float(values[0][low]), where(low), (where(bad[0]) if len(bad) else None)
 
 
 def _check_on_chart(scene):
     """A field other than the built-in ones: h and its gradient finite at every point of a
     `CHART_CHECK_POINTS`-square grid of the chart, and with ``bump="surface"`` the displaced
     radius radius_a + beta h positive there."""
-    low, finite = _on_chart(scene.field, scene.k_u, scene.k_v)
-    if not finite:
+    low, at, bad = _on_chart(scene.field, scene.k_u, scene.k_v)
+    if bad is not None:
         raise InvalidValue(f"Scene.height_field {scene.height_field!r} or its gradient is not finite and real at "
-                           f"every point of the chart [0, 1]^2 (k_u = {scene.k_u:g}, k_v = {scene.k_v:g})")
+                           f"(u, v) = ({bad[0]:.6g}, {bad[1]:.6g}) of the chart [0, 1]^2 (k_u = {scene.k_u:g}, "
+                           f"k_v = {scene.k_v:g}); it must be at every point")
     if scene.bump == "surface" and not scene.radius_a + scene.beta * low > 0.0:
         raise InvalidValue(f"Scene.beta = {scene.beta!r} with height_field {scene.height_field!r} (least value "
-                           f"{low:.3g}) puts the displaced radius radius_a + beta h at or below 0; bump='surface' "
-                           f"needs radius_a + beta h > 0")
+                           f"{low:.3g}, at (u, v) = ({at[0]:.6g}, {at[1]:.6g})) puts the displaced radius "
+                           f"radius_a + beta h at or below 0; bump='surface' needs radius_a + beta h > 0")
 
 
 #: The draft's scene (seed Cell 1, ``SC9``): its field, frequencies, amplitude and step spelled

@@ -135,6 +135,16 @@ def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
     for text in ("1/u", "log(v)", "1e400*u", "u*(k_u + k_v)**(k_u**k_v)", "u*(0.5 - pi)**pi", "(0.5 - pi)**pi"):
         _, message = refusal(lambda: Scene(height_field=text))
         assert message.startswith("Scene.height_field ") and "not finite and real" in message, message
+    # The point named is one where the field has no value: on its singular line.
+    for text, on_line in (("1/(v - 0.5)", lambda u, v: v == 0.5), ("log(u)*v", lambda u, v: u == 0),
+                          ("1/(u - v)", lambda u, v: u == v), ("sqrt(0.25 - v)", lambda u, v: v >= 0.25)):
+        _, message = refusal(lambda: Scene(height_field=text))
+        u, v = map(float, re.search(r"at \(u, v\) = \(([^,]+), ([^)]+)\)", message).groups())
+        assert on_line(u, v), message
+    # A displaced radius at or below 0 is named where h is least.
+    for text, least in (("u - 2*v", (0.0, 1.0)), ("2*(u - 0.25)**2 - 6*(v - 0.5)**2", (0.25, 0.0))):
+        _, message = refusal(lambda: Scene(height_field=text, beta=0.9))
+        assert f"at (u, v) = ({least[0]:g}, {least[1]:g})" in message, message
 
 
 def _off_contract(fields, k_u, k_v):
@@ -144,8 +154,8 @@ def _off_contract(fields, k_u, k_v):
     from renderer.scene import _on_chart
     off = []
     for field in fields:
-        low, finite = _on_chart(field, k_u, k_v)
-        if not (finite and low >= -1.0):
+        low, _, bad = _on_chart(field, k_u, k_v)
+        if not (bad is None and low >= -1.0):
             off.append(field.name)
     return off
 
