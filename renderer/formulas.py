@@ -317,8 +317,20 @@ def field(spec, name="height_field"):
     try:
         record = HeightField(str(expr), expr)
     except (TypeError, ValueError) as exc:
-        raise InvalidValue(f"{name}: {exc}") from None
+        raise refusal(name, spec, expr, exc) from None
     return _EXPRESSIONS.setdefault(record.name, record)
+
+
+def refusal(name, spec, expr, exc):
+    """The `renderer.validate.InvalidValue` naming ``name`` for a reader's expression ``expr`` (typed as
+    ``spec``) that its record refused with ``exc``: "height_field 'sqrt(-1)*u' (read as I*u) must be real
+    and finite: it holds I", the text as typed and sympy's reading of it where the two differ."""
+    from .validate import InvalidValue
+    said, shown = str(exc), repr(str(expr))
+    same = lambda a: a.replace(" ", "").replace("^", "**").lower()       # noqa: E731
+    typed = repr(str(spec)) if not isinstance(spec, str) or same(spec) == same(str(expr)) else \
+        f"{spec!r} (read as {expr})"
+    return InvalidValue(f"{name} {typed}{said.split(shown, 1)[1]}" if shown in said else f"{name}: {said}")
 
 
 # ------------------------------------------------------------------------ chart

@@ -16,7 +16,7 @@ from functools import cached_property
 
 import sympy as sp
 
-from .formulas import ELEMENTARY, check_expression
+from .formulas import ELEMENTARY, check_expression, refusal
 
 __all__ = ["x_var", "step", "Univariate", "univariate", "FUNCTIONS", "PRELUDE"]
 
@@ -82,6 +82,7 @@ def univariate(spec, name="function"):
     from .validate import InvalidType, InvalidValue, expression
     if isinstance(spec, Univariate):
         return spec
+    typed = spec
     if isinstance(spec, str):
         spec = expression(name, spec, (x_var,), ELEMENTARY)
     if not isinstance(spec, sp.Expr):
@@ -94,7 +95,7 @@ def univariate(spec, name="function"):
     try:
         record = Univariate(str(expr), expr)
     except (TypeError, ValueError) as exc:
-        raise InvalidValue(f"{name}: {exc}") from None
+        raise refusal(name, typed, expr, exc) from None
     return _UNIVARIATES.setdefault(record.name, record)
 
 

@@ -174,10 +174,13 @@ def test_a_field_whose_derivative_sympy_cannot_write_real_is_refused(text, held)
     """|g| of a g sympy cannot tell is real, and a negative base to a power in v: their derivatives
     hold complex parts, which no printer of the kernels has.  A real abs is a field like any other."""
     _, message = refusal(lambda: Scene(height_field=text))
-    assert message.startswith("Scene.height_field: ") and f"sympy's holds {held}" in message, message
+    assert message.startswith(f"Scene.height_field {text!r} ") and f"sympy's holds {held}" in message, message
     assert Scene(height_field="abs(sin(pi*k_u*u))*v").field.crease_factors
     _, message = refusal(lambda: Scene(height_field="u*atan(tan(pi/2))"))    # sympy: an interval, not a number
-    assert message.startswith("Scene.height_field: ") and "must be real" in message, message
+    assert message.startswith("Scene.height_field 'u*atan(tan(pi/2))' (read as u*AccumBounds(-pi/2, pi/2)) must be "
+                              "real"), message
+    _, message = refusal(lambda: Scene(height_field="sqrt(-1)*u"))           # as typed, and as sympy reads it
+    assert message.startswith("Scene.height_field 'sqrt(-1)*u' (read as I*u) must be real and finite: it holds I")
 
 
 @pytest.mark.parametrize("expr, held", [(sp.I * F.u, "I"), (sp.zoo * F.u, "zoo"), (F.u + sp.oo, "oo"),
@@ -185,8 +188,7 @@ def test_a_field_whose_derivative_sympy_cannot_write_real_is_refused(text, held)
                                         (F.u * sp.AccumBounds(0, 1), "an interval")])
 def test_a_sympy_field_holding_a_constant_that_is_not_a_real_number_is_refused_naming_it(expr, held):
     _, message = refusal(lambda: Scene(height_field=expr))
-    assert message.startswith("Scene.height_field: ") and f"must be real and finite: it holds {held}" in message, \
-        message
+    assert message.startswith(f"Scene.height_field {str(expr)!r} must be real and finite: it holds {held}"), message
 
 
 @pytest.mark.parametrize("kwargs, field, phrase", [
