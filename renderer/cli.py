@@ -376,9 +376,15 @@ def _cmd_ucurve(args):
                    f"|h| = {abs(uc.height):.6g}; |x h'| = {uc.model_argument / UNIT_ROUNDOFF:.6g}",
                    f"{head}  {'model':>10}"]
         report += [f"{e:9.2e}  {t:11.3e}  {r:11.3e}  {x:10.3e}  {m:10.3e}" for e, t, r, x, m in rows]
-        report += [f"model-optimal step eps* {uc.eps_model:.3e}, model error there {uc.error_model:.3e}",
-                   f"fitted optimal step eps^ {uc.eps_fitted:.3e}, fitted error there {uc.error_at_fitted:.3e}",
-                   f"measured minimum {uc.error_at_measured_min:.3e} at eps {uc.eps_measured_min:.3e}"]
+        report += ["truncation: the quotient in exact arithmetic at the float64 abscissae minus the true "
+                   "derivative (so it holds their rounding too); roundoff: the rest"]
+        report.append(f"model-optimal step eps* {uc.eps_model:.3e}, model error there {uc.error_model:.3e}"
+                      if math.isfinite(uc.eps_model) else
+                      "model-optimal step eps*: none, |h'''| = 0 (no truncation term: the model falls as eps grows)")
+        report.append(f"fitted optimal step eps^ {uc.eps_fitted:.3e}, fitted error there {uc.error_at_fitted:.3e}"
+                      if math.isfinite(uc.eps_fitted) else "fitted optimal step eps^: none (the errors fit no "
+                      "A eps^2 + B / eps with A, B > 0)")
+        report.append(f"measured minimum {uc.error_at_measured_min:.3e} at eps {uc.eps_measured_min:.3e}")
     if args.plot is None:
         return report, []
     return [*report, f"wrote {args.plot}"], [(args.plot, _ucurve_png(uc))]

@@ -347,6 +347,10 @@ def test_ucurve_prints_the_measurement_and_plots_it(tmp_path, capsys):
                       "--eps", "1e-2:1e-10:5"], capsys)
     assert rc == 0 and "not differentiable: " in out
     assert not re.search("^(true derivative|model-optimal|fitted optimal|measured minimum)", out, re.M)
+    # A function with no third derivative (a line) has no model optimum, and its errors no U to fit: said so.
+    rc, out, _ = run(["ucurve", "--function", "2*x + 1", "--x", "0.7", "--eps", "1e-3,1e-6"], capsys)
+    assert rc == 0 and "model-optimal step eps*: none, |h'''| = 0" in out and "fitted optimal step eps^: none" in out
+    assert not re.search(r"\b(inf|nan)\b", out), out
 
 
 # ------------------------------------------------------------------ help and entry point
