@@ -191,9 +191,10 @@ def test_a_new_method_is_one_record_measured_and_drawn(monkeypatch):
     assert back.h_evals == 3.0 and 1e-7 < back.max_error < 1e-4 and len(back.times) == TINY.repeats
     assert "backward 1e-08" in markdown_table(m)
     fig = pareto_figure(m)
-    drawn = [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_marker() == "v"]
-    assert drawn and drawn[0].get_color() == "#444444"
-    assert "backward difference" in [t.get_text() for lg in fig.legends for t in lg.get_texts()]
+    style = (BACKWARD.style.colour, BACKWARD.style.marker)
+    assert [ln for ax in fig.axes for ln in ax.get_lines() if (ln.get_color(), ln.get_marker()) == style]
+    legend = {t.get_text(): h for lg in fig.legends for t, h in zip(lg.get_texts(), lg.legend_handles)}
+    assert (legend["backward difference"].get_color(), legend["backward difference"].get_marker()) == style
 
 
 # --- a reader's function of one variable -------------------------------------------------------

@@ -409,3 +409,25 @@ def test_the_reference_is_nan_where_the_gradient_has_no_value_and_mpmaths_elsewh
         h_v = float(1 / (2 * mpmath.sqrt(mpmath.mpf(0.47) - mpmath.mpf("0.4"))))
     assert np.isnan(hi[:, 0]).all() and np.isnan(lo[:, 0]).all() and np.isnan(hi[1, 2]) and np.isnan(lo[1, 2])
     assert np.allclose(hi[0, 1:], h_u, rtol=1e-15, atol=0) and np.isclose(hi[1, 1], h_v, rtol=1e-15, atol=0)
+
+
+def _style_clashes(methods):
+    """Pairs of methods a reader could not tell apart in a figure: the same colour and marker."""
+    seen, clashes = {}, []
+    for m in methods:
+        key = (m.style.colour, m.style.marker)
+        if key in seen:
+            clashes.append(f"{m.name!r} is drawn as {seen[key]!r} is: colour {key[0]}, marker {key[1]!r}")
+        seen.setdefault(key, m.name)
+    return clashes
+
+
+def test_each_method_is_drawn_unlike_every_other():
+    """Every record's colour and marker together are its own (a new method's style is checked here, with the
+    method it copies named); a planted copy of the central difference's style is caught."""
+    import dataclasses
+    assert _style_clashes(gm.METHODS) == []
+    copy = dataclasses.replace(gm.METHODS[-1], name="copy", style=gm.method("central").style)
+    assert _style_clashes([*gm.METHODS, copy]) == ["'copy' is drawn as 'central' is: colour "
+                                                    f"{gm.method('central').style.colour}, marker "
+                                                    f"{gm.method('central').style.marker!r}"]

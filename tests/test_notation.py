@@ -65,12 +65,13 @@ def test_every_theorem_has_a_recorded_print():
 
 
 if __name__ == "__main__":
-    # The text of each theorem whose print is new or changed (to review), then the table.
+    # The text of each theorem whose print is new or changed (to review), then the table to paste over
+    # PRINTED: its order, new theorems last, removed ones gone.
     for theorem_id, t in THEOREMS.items():
         if _digest(printed(t)) != PRINTED.get(theorem_id):
             print(f"--- {theorem_id} now prints:\n{printed(t)}\n")
-    for theorem_id, t in THEOREMS.items():
-        print(f'    "{theorem_id}": "{_digest(printed(t))}",')
+    for theorem_id in [*(k for k in PRINTED if k in THEOREMS), *(k for k in THEOREMS if k not in PRINTED)]:
+        print(f'    "{theorem_id}": "{_digest(printed(THEOREMS[theorem_id]))}",')
 
 
 # The printer's forms that no theorem prints today, as a person writes them.
