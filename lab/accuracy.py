@@ -367,11 +367,12 @@ def measure_optimum(field, u, v, component):
     ------
     renderer.validate.InvalidType, renderer.validate.InvalidValue
         Naming the argument: ``field`` refused, ``u`` or ``v`` not a real number in [0, 1],
-        ``component`` not "u" or "v", or a direction along which h''' is 0 at the point (no optimum).
+        ``component`` not "u" or "v", or a direction along which h''' is 0 at the point, or so small that the
+        model-optimal step lies past the largest step tried (no optimum to measure).
     RuntimeError
         The point lies so close to a crease that fewer than two default steps are below it.
     """
-    from renderer.ucurve import DEFAULT_STEPS, UNIT_ROUNDOFF, measure
+    from renderer.ucurve import DEFAULT_STEPS, DIGITS, UNIT_ROUNDOFF, measure
     record = F.field(field, "field")
     u, v = (real(name, x, low=0.0, high=1.0) for name, x in (("u", u), ("v", v)))
     component = choice("component", component, ("u", "v"))
@@ -383,10 +384,20 @@ def measure_optimum(field, u, v, component):
         raise RuntimeError(f"the {record.name} field's point ({u}, {v}) is {distance:g} from a crease: fewer "
                            "than two of the default steps lie below that")
     c = measure(record, u, v, component, eps=steps, k_u=k_u, k_v=k_v)
-    if c.third_derivative == 0:
+    # h''' = 0, or 0 but for the reference's last digits (sin(pi k_u u)**2 where the sine is 0: below
+    # 1e-30 at 50 digits), or so small that the model's optimum lies past every step tried: a fitted
+    # step would fit noise.
+    zero = abs(c.third_derivative) < 10.0 ** (20 - DIGITS)
+    if zero or not c.eps_model < steps.max():
+        if zero:
+            why = "is 0" + (f" (to the reference's {DIGITS} digits: {abs(c.third_derivative):.3g})"
+                            if c.third_derivative else "") + ", so its central difference has no truncation error"
+        else:
+            why = (f"is {abs(c.third_derivative):.3g}, so small that its model-optimal step ({c.eps_model:.3g}) "
+                   f"lies past every step tried (the largest {steps.max():.3g})")
         raise InvalidValue(f"component must be a direction along which h has a third derivative at the point, got "
-                           f"{component!r}: the {record.name} field's h''' along {component} is 0 at ({u}, {v}), so "
-                           "its central difference has no truncation error and no optimal step")
+                           f"{component!r}: the {record.name} field's h''' along {component} at ({u}, {v}) {why}; "
+                           "there is no optimal step to measure there")
     at_fitted = float(measure(record, u, v, component, eps=[c.eps_fitted], k_u=k_u, k_v=k_v).error[0])
     return dict(u=u, v=v, component=component, k_u=k_u, k_v=k_v, steps=int(steps.size),
                 largest_step=float(steps.max()), smallest_step=float(steps.min()),

@@ -127,6 +127,23 @@ def test_a_candidate_point_is_measured_as_optima_measures_a_registered_one():
     assert 1 / 3 < tried["measured_at_fitted"] / tried["error_at_fitted"] < 3
 
 
+def test_a_point_with_no_optimum_to_measure_is_refused_naming_the_component():
+    """Where h''' is 0 but for the reference's last digits (sin(pi k_u u)**2 where the sine is 0: the
+    fitted step there fitted noise, 37,900 times the error it claimed), and where it is so small that the
+    model's optimum lies past every step: refused, each saying which."""
+    import pytest
+
+    from lab.accuracy import measure_optimum
+    with pytest.raises(ValueError, match=r"^component must be .* at \(0.25, 0.47\) is 0 \(to the reference's 50 "
+                                         r"digits: [\d.e+-]+\), so its central difference has no truncation error"):
+        measure_optimum("sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2", 0.25, 0.47, "u")
+    with pytest.raises(ValueError, match=r"^component must be .* is 6e-15, so small that its model-optimal step "
+                                         r"\(1\.\d+\) lies past every step tried \(the largest 0\.1\)"):
+        measure_optimum("1e-15*u**3 + 100", 0.3, 0.4, "u")
+    near = measure_optimum("sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2", 0.15, 0.47, "u")     # away from it: measured
+    assert 1 / 3 < near["measured_at_fitted"] / near["error_at_fitted"] < 3
+
+
 def test_an_optimum_keeps_the_steps_its_own_stencil_allows():
     """A U-curve of h_u moves only in u: a v-crease 0.02 away limits none of its steps, the u-crease
     0.06 away does; on a u-crease no two steps are left, and that is said in one line."""

@@ -91,7 +91,7 @@ FUNCTIONS = {
     "accuracy.measure_optimum": (accuracy.measure_optimum, dict(field="rings", u=0.31, v=0.47, component="v"),
                                  dict(field=p("field"), u=p("real", (1.5, V, "got 1.5")), v=p("real", (-0.1, V, "got -0.1")),
                                       component=p("own", ("w", V, "'w'"), (1, T, "int 1"),
-                                                  ("u", V, "rings field's h''' along u is 0")))),
+                                                  ("u", V, "rings field's h''' along u at (0.31, 0.47) is 0")))),
     "accuracy.image_best_step": (accuracy.image_best_step, dict(field="sine", size=4),
                                  dict(field=p("field"), size=p("int", (0, V, "got 0")))),
     "accuracy.frame_model_step": (accuracy.frame_model_step, dict(field="sine", k_u=8.0, k_v=4.0, samples=8),
