@@ -255,9 +255,13 @@ def test_the_table_covers_every_public_function_and_parameter():
             if (inspect.isfunction(obj) or inspect.isclass(obj) and name in ("Config", "Bound", "Criterion")) \
                     and inspect.signature(obj).parameters:
                 listed[f"{module.__name__.split('.')[-1]}.{name}"] = set(inspect.signature(obj).parameters)
-    assert set(listed) == set(FUNCTIONS)
+    missing, stale = sorted(set(listed) - set(FUNCTIONS)), sorted(set(FUNCTIONS) - set(listed))
+    assert not missing and not stale, (f"public functions without a row in this file's FUNCTIONS: {missing} (give each "
+                                       f"its call with good arguments and a refused value per parameter); rows of no "
+                                       f"public function: {stale}")
     for name, params in listed.items():
-        assert params == set(FUNCTIONS[name][2]), name
+        assert params == set(FUNCTIONS[name][2]), (f"{name}'s row in FUNCTIONS covers {sorted(FUNCTIONS[name][2])}, "
+                                                   f"its parameters are {sorted(params)}")
 
 
 @pytest.mark.parametrize("function", FUNCTIONS)
