@@ -197,14 +197,16 @@ def footprint_error(half, size=96):
     tangent plane at P (``ComputeDifferentials``), (du/dx, dv/dx) and (du/dy,
     dv/dy) solve the 2x2 least squares against dP/du = 2 pi R sin(phi) e_theta,
     dP/dv = pi R e_phi (the chart's rates, theorem `chart`), and du = ``half``
-    (|du/dx| + |du/dy|) (``BumpMap``), with the fallback and the cap of
-    `formulas.FOOTPRINT`; over the sphere-A pixels of the default frame (size²)
+    (|du/dx| + |du/dy|) (``BumpMap``), 0.0005 where that is 0 (``BumpMap``) or not
+    below 1e8 (``ComputeDifferentials`` clamps to 1e8), and at most 0.25 (the stencil's
+    quarter period): constants written here, not read from `formulas`, so that a changed
+    one there is a difference here; over the sphere-A pixels of the default frame (size²)
     and of a pole zoom, with sphere A's radius 0.8 (not 1, so that a lost factor R
     shows); and the count."""
     from renderer import pointwise
     scene = Scene(radius_a=0.8)
     e, R = scene.camera_z, scene.radius_a
-    fallback, cap, limit = (float(c) for c in (F.FOOTPRINT_FALLBACK, F.FOOTPRINT_MAX, F.FOOTPRINT_LIMIT))
+    fallback, cap, limit = 0.0005, 0.25, 1e8
     worst, count = 0.0, 0
     for zoom in (1.0, 300.0):
         g = gbuffer(scene, size, size, zoom=zoom)
@@ -231,4 +233,10 @@ def footprint_error(half, size=96):
         for want, have in zip(steps, got):
             worst = max(worst, float(np.max(np.abs(have - want) / want)))
         count += int(x.size)
-    return worst, count
+    # At the pole (sin phi = 0) u's footprint is infinite, so its step is the fallback; no pixel centre of
+    # a frame lands there.
+    one, pole = np.zeros(1), np.array([[0.0], [0.0], [R]])
+    du = pointwise.footprint(one, one, 1e-3, -1e-3, e, pole, pole / R, np.array([[1.0], [0.0], [0.0]]),
+                             np.array([[0.0], [1.0], [0.0]]), R, one)[0]
+    worst = max(worst, float(abs(du[0] - fallback) / fallback))
+    return worst, count + 1
