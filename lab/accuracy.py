@@ -198,7 +198,8 @@ def _image_beta_order(size, beta, steps):
     """Convergence order of the image's central beta-derivative, fitted from renders.
 
     For each step db, D(db) = (I(beta + db) - I(beta - db)) / (2 db) on the
-    sine field; the reference is Richardson's (4 D(db_min / 2) - D(db_min)) / 3.
+    sine field; the reference is Richardson's extrapolation of D(db_min) and D(db_min / 2)
+    (`proofs.finite_difference.richardson`: (4 D(db_min / 2) - D(db_min)) / 3).
     Over sphere-A pixels, the median and the RMS of |D - ref| are fitted
     against db on log-log axes.  The image is not smooth in beta everywhere:
     where a max(0, .) of Lambert or the lobe, or the clip to [0, 1], switches
@@ -219,7 +220,8 @@ def _image_beta_order(size, beta, steps):
 
     mask = render(scene, size, size).chamber == SPHERE_A
     h = min(steps)
-    ref = (4 * D(h / 2) - D(h)) / 3
+    from proofs.finite_difference import richardson
+    ref = richardson(coarse=D(h), fine=D(h / 2))
     diffs = [np.abs(D(db) - ref)[mask] for db in steps]
     median = np.array([np.median(d) for d in diffs])
     rms = np.array([np.sqrt(np.mean(d**2)) for d in diffs])

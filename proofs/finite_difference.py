@@ -39,6 +39,15 @@ QUOTIENT = written(sp.Add(f(sp.Add(x, eps, evaluate=False)), -f(sp.Add(x, -eps, 
 #: The claimed series' terms, in the order written: h' + eps^2 h''' / 6 + eps^4 h^(5) / 120.
 CLAIMED = (sp.diff(f(x), x), eps**2 / 6 * sp.diff(f(x), x, 3), eps**4 / 120 * sp.diff(f(x), x, 5))
 
+
+
+def richardson(coarse, fine):
+    """Richardson's extrapolation of two central differences, ``fine`` at half the step of ``coarse``:
+    (4 fine - coarse) / 3, which cancels their eps^2 term (verify/test_ucurve.py expands it by sympy);
+    numbers, numpy arrays or sympy expressions alike.  Its only statement of the weights."""
+    return (4 * fine - coarse) / 3
+
+
 a, b = sp.symbols("a b", real=True)
 #: A concrete analytic h for numerical sampling only (the proof is for any h).
 INSTANCE = {f: sp.Lambda(x, sp.sin(a * x) + sp.exp(b * x))}

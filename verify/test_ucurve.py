@@ -168,3 +168,22 @@ def test_the_model_optimal_step_from_an_independent_derivative(curve):
     assert curve.error_model == pytest.approx(h3 / 6 * star**2 + UNIT_ROUNDOFF * (h0 + 0.31 * h1) / star, rel=1e-9, abs=0)
     assert curve.model == pytest.approx(h3 / 6 * curve.eps**2 + UNIT_ROUNDOFF * (h0 + 0.31 * h1) / curve.eps,
                                         rel=1e-9, abs=0)
+
+
+def _series_after(extrapolate):
+    """The error of ``extrapolate(D_eps, D_eps/2)`` of the central quotient (any h), sympy's series in eps."""
+    from proofs.finite_difference import ORDER, QUOTIENT, eps as e, f, x
+    central = QUOTIENT.doit()
+    return sp.expand(extrapolate(central, central.subs(e, e / 2)).series(e, 0, ORDER).removeO().doit()
+                     - f(x).diff(x)), e
+
+
+def test_richardsons_extrapolation_cancels_the_square_term_and_keeps_the_fourth():
+    """`proofs.finite_difference.richardson`, the weights §3 prints and `lab.accuracy.image_beta_order`'s
+    reference uses: its error has no eps^2 term and an eps^4 term; the weights (2, -1) of a first-order
+    method's extrapolation leave the eps^2 term."""
+    from proofs.finite_difference import richardson
+    rest, e = _series_after(richardson)
+    assert rest.coeff(e, 2) == 0 and rest.coeff(e, 4) != 0, rest
+    wrong, e = _series_after(lambda coarse, fine: 2 * fine - coarse)
+    assert wrong.coeff(e, 2) != 0
