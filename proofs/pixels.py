@@ -54,9 +54,10 @@ TOLERANCE = {"chart": 16 * UNIT, "gradient": 64 * UNIT, "normal": 64 * UNIT}
 
 @lru_cache(maxsize=None)
 def _frames(field, gradient, bump):
-    """G-buffers of the default scene (``field``, a `HeightField`; ``gradient``, ``bump``), one per
-    `SOURCES`: 128², and the pole at zoom 300 and 3e4 (48²)."""
-    scene = Scene(height_field=field.name, bump=bump, beta=0.35 if bump == "chart" else 0.3)
+    """G-buffers of the default scene (``field``, a `HeightField`; ``gradient``, ``bump``) with sphere A's
+    radius 0.8, not 1, so that a factor R lost anywhere shows, one per `SOURCES`: 128², and the pole at
+    zoom 300 and 3e4 (48²)."""
+    scene = Scene(height_field=field.name, bump=bump, beta=0.35 if bump == "chart" else 0.3, radius_a=0.8)
     return scene, [gbuffer(scene, 48 if zoom > 1 else 128, 48 if zoom > 1 else 128, gradient=gradient, zoom=zoom)
                    for _, zoom, _, _ in SOURCES]
 
