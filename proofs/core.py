@@ -63,7 +63,8 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
 8. *Citations.*  A statement or a step's sentence names another theorem only by the marker
    ``⟪id⟫`` (`CITATION`), never by its id in words; the id must be a theorem of the registry
    (`CITABLE`, which reads proofs/registry.py's), or the theorem is refuted.  The book prints the marker as
-   "Theorem n (title)", plain text (`plain`) as its title.
+   "Theorem n (title)", plain text (`plain`) as its title.  The registry's citations form no cycle
+   (`citation_cycle`, which verify/test_theorems.py holds): no theorem rests on itself.
 9. *Claims* (lab/claims.py).  A claim of the draft reaches its registered verdict from
    finite measurements, by its criterion, whose thresholds are the ones its words state.
 10. *Placeholders.*  A statement shows mathematics only through ``⟦key⟧`` (`PLACEHOLDER`): a claim,
@@ -166,6 +167,19 @@ CITABLE = _Registered()
 def citations(text) -> list:
     """The theorem ids ``text`` cites (`CITATION`), in order."""
     return CITATION.findall(text)
+
+
+def citation_cycle(theorems):
+    """A cycle among the citations of ``theorems`` (id -> `Theorem`; a statement's or a step's ``⟪id⟫``)
+    as the ids around it, the first repeated last (["a", "b", "a"]: a cites b, which cites a), or None."""
+    from graphlib import CycleError, TopologicalSorter
+    graph = {tid: {c for text in [t.statement] + [s.why for s in t.steps] for c in citations(text)}
+             for tid, t in theorems.items()}
+    try:
+        TopologicalSorter(graph).prepare()
+    except CycleError as exc:
+        return list(reversed(exc.args[1]))
+    return None
 
 
 def plain(text, titles=None) -> str:

@@ -439,6 +439,25 @@ def test_rule_8_a_theorem_named_by_its_id_in_words_is_refuted(words):
     assert verdict.status == "refuted" and "by its id in words" in verdict.evidence, verdict.evidence
 
 
+def test_rule_8_a_cycle_of_citations_is_found_whatever_its_length():
+    """`citation_cycle`: none among the registry's theorems; frame-orthonormal citing bump-vs-displacement,
+    which cites it through frame-orientation (an adversarial review's plant), and chart citing
+    kink-loci-circles, which cites chart through kink-loci-rays: each a cycle, named in citing order (each
+    id cites the next), through the planted citation."""
+    from proofs.core import citation_cycle, citations
+    theorems = dict(THEOREMS)
+    assert citation_cycle(theorems) is None
+
+    def cites(t):
+        return {c for text in [t.statement] + [s.why for s in t.steps] for c in citations(text)}
+    for planted, k, cited in (("frame-orthonormal", 1, "bump-vs-displacement"), ("chart", 0, "kink-loci-circles")):
+        changed = {**theorems, planted: _cite_in(get(planted), k, f"(⟪{cited}⟫)")}
+        cycle = citation_cycle(changed)
+        assert cycle[0] == cycle[-1] and all(b in cites(changed[a]) for a, b in zip(cycle, cycle[1:])), cycle
+        assert (planted, cited) in set(zip(cycle, cycle[1:])), cycle
+
+
+
 def test_no_text_names_a_theorem_by_its_id_and_every_citation_is_known():
     cited = set()
     for t in THEOREMS.values():

@@ -71,3 +71,9 @@ def test_every_claim_is_stated_and_every_statement_prints():
         for key in t.claims:
             assert f"⟦{key}⟧" in t.statement, (t.id, key)
         assert "⟦" not in latex.statement(t), t.id
+
+
+def test_no_theorem_rests_on_itself_through_its_citations():
+    """Rule 8: the citations among the registry's theorems form no cycle (`proofs.core.citation_cycle`)."""
+    from proofs.core import citation_cycle
+    assert citation_cycle(dict(THEOREMS)) is None
