@@ -143,16 +143,19 @@ SEED_POLE_SIN_PHI = 1e-4
 #: has its 53 bits, so the regular branch is evaluated as written; at or below it sin phi is 0
 #: (the pole itself) or subnormal.
 POLE_CLAIMED = 2.0**-1022
+#: ... and the pole's fallback pair (e_theta, e_phi) it claims the kernel takes, written here: the
+#: branches of `renderer.formulas.TANGENT_FRAME` are held to it, not to `F.FALLBACK_FRAME` itself.
+CLAIMED_FALLBACK = (1, 0, 0, 0, 1, 0)
 
 
 def _branch_structure(frame=F.TANGENT_FRAME, pole=F.POLE_SIN_PHI):
     """Refuted unless every component of ``frame`` (TANGENT_FRAME) is Piecewise((regular,
-    sin_phi > POLE_SIN_PHI), (fallback, True)) with FALLBACK_FRAME's values,
+    sin_phi > POLE_SIN_PHI), (fallback, True)) with `CLAIMED_FALLBACK`'s values,
     and ``pole`` (POLE_SIN_PHI) is `POLE_CLAIMED`."""
     if float(pole) != POLE_CLAIMED:
         return Verdict("refuted", f"POLE_SIN_PHI is {pole}: the regular frame is evaluable in float64 down to "
                        f"its smallest normal number {POLE_CLAIMED:g} (the draft cut it off at {SEED_POLE_SIN_PHI:g})")
-    for k, (c, fallback) in enumerate(zip(frame, F.FALLBACK_FRAME)):
+    for k, (c, fallback) in enumerate(zip(frame, CLAIMED_FALLBACK)):
         if not isinstance(c, sp.Piecewise):
             ok = c.is_number and c - fallback == 0         # both branches equal: folded by sympy
         else:
@@ -240,6 +243,11 @@ CLAIMED_ORIENTATION = -1
 CLAIMED_FALLBACK_CROSS = sp.Matrix([0, 0, 1])
 
 
+def _triple(v):
+    """A vector as the steps write it: (1, 0, 0)."""
+    return "(" + ", ".join(str(c) for c in v) + ")"
+
+
 def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGULAR[:3], ep=REGULAR[3:]):
     """Theorem frame-orientation claiming ``claimed``, for the frame (``et``, ``ep``) and pole ``fallback``."""
     triple = Dot(Cross(ET_S, EP_S), N_S)
@@ -256,8 +264,9 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
                  r"-\cos\varphi)$", Cross(ET_S, EP_S), -N_S),
             *calc(triple, ("Dot both sides of step 1 with $N$", -Dot(N_S, N_S)),
                   ("$N$ is a unit vector", sp.Integer(claimed))),
-            Step(r"At the poles the kernel takes the fixed pair $e_\theta = (1, 0, 0)$, $e_\varphi = (0, 1, 0)$, "
-                 r"whose cross product is $+z$, the outward normal at the north pole", poles, CLAIMED_FALLBACK_CROSS),
+            Step(rf"At the poles the kernel takes the fixed pair $e_\theta = {_triple(fallback[:3])}$, "
+                 rf"$e_\varphi = {_triple(fallback[3:])}$, whose cross product is $+z$, the outward normal at the "
+                 r"north pole", poles, CLAIMED_FALLBACK_CROSS),
         ),
         claims={"orientation": (triple, sp.Integer(claimed)), "fallback": (poles, CLAIMED_FALLBACK_CROSS),
                 "cross": (Cross(ET_S, EP_S), -N_S)},
