@@ -42,6 +42,8 @@ SCENES = {
     "B and floor off": Scene(sphere_b=False, floor=False, height_field="sine"),
     "zero-colour light": Scene(lights=(LIGHT_1, DARK, LIGHT_2)),
     "beta 0": Scene(beta=0.0),
+    # The gradient skipped only at beta = 0 exactly: a skip at beta <= 1e-10 changed 1e-12's image by 2e-11.
+    "beta 1e-12": Scene(beta=1e-12, height_field="sine"),
     "beta 0, sine, phong": Scene(beta=0.0, height_field="sine", model="phong"),
     # Lights behind sphere A and below the floor: attached shadows and the floor plane.
     "lights behind": Scene(lights=(PointLight((0.5, -1.0, -6.0)), PointLight((3.0, -2.0, -4.0), (0.5, 0.6, 0.7)))),
