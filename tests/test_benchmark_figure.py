@@ -52,16 +52,19 @@ def test_each_step_of_a_difference_is_labelled_at_its_bar_in_its_colour():
     assert text_overlaps(fig) == []
     for ax in [a for a in fig.axes if a.get_title()]:
         labels = {t.get_text(): t for t in ax.texts}
-        assert set(labels) == {step_text(e).replace("-", "\u2212") for e in (1e-3, 1e-6, 1e-9)}
+        said = lambda e: "\u03b5 = " + step_text(e).replace("-", "\u2212")       # noqa: E731
+        assert set(labels) == {said(e) for e in (1e-3, 1e-6, 1e-9)}
         for eps, err in ((1e-3, 3e-3), (1e-6, 3e-11), (1e-9, 3e-7)):
-            label = labels[step_text(eps).replace("-", "\u2212")]
+            label = labels[said(eps)]
             assert label.xy == pytest.approx((1.5 * 2.0, err)) and label.get_color() == gm.method("central").style.colour
-    # A middle step's label on an end's gives way to it, whichever comes first in the sweep.
+    # A middle step's label on an end's gives way to it, whichever comes first in the sweep: the end keeps the
+    # right end of its bar, the middle one moves to the left end of its own.
     for order in (1, -1):
         steps = ((1e-3, 3e-3), (1e-6, 3.1e-3), (1e-9, 3e-7))[::order]
         rows = [_result("sine", "exact", 1e-14, 1.0)] + [_result("sine", "central", err, 2.0, eps) for eps, err in steps]
         fig = pareto_figure(SimpleNamespace(results=tuple(rows), of=lambda f: rows))
-        assert sorted(t.get_text() for t in fig.axes[0].texts) == ["1e\u22123", "1e\u22129"]
+        sides = {t.get_text(): t.get_horizontalalignment() for t in fig.axes[0].texts}
+        assert sides == {"\u03b5 = 1e\u22123": "left", "\u03b5 = 1e\u22126": "right", "\u03b5 = 1e\u22129": "left"}
 
 
 def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():

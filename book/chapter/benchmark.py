@@ -92,12 +92,11 @@ def pareto_figure(measurement, *, error="max"):
                             marker=style.marker, ms=style.size)
             handles.setdefault(method, line)
             for i, r in enumerate(group if len(group) > 1 else ()):
-                # At the right end of the marker's bar, which leads the eye from the marker to it.
-                label = ax.annotate(step_text(r.eps).replace("-", "\u2212"), (1e3 * r.t_max, e[i]),
-                                    xytext=(3, 0), textcoords="offset points", ha="left", va="center",
-                                    color=style.colour)
-                label.set_in_layout(False)
-                (ends if i in (0, len(group) - 1) else middles).append(label)
+                # At the right end of the marker's bar, which leads the eye from the marker to it, or,
+                # where that collides, at its left end.
+                (ends if i in (0, len(group) - 1) else middles).append(
+                    [_step_label(ax, r.eps, (1e3 * t, e[i]), style.colour, side)
+                     for side, t in (("right", r.t_max), ("left", r.t_min))])
         ax.set_xscale("log")
         ax.set_yscale("log")
         # Every third decade on the error axis, at most five labelled decades on the time axis (the
@@ -121,6 +120,16 @@ def pareto_figure(measurement, *, error="max"):
     fig.set_figheight(_ROW_IN * len(names) + tall)
     drop_clashing(fig, ends + middles)
     return fig
+
+
+def _step_label(ax, eps, at, colour, side):
+    """The label "ε = 1e−3" of a difference's marker beyond the ``side`` ("right" or "left") end of its bar,
+    ``at`` (time in ms, error)."""
+    label = ax.annotate(f"\u03b5 = {step_text(eps).replace('-', chr(0x2212))}", at,
+                        xytext=(3 if side == "right" else -3, 0), textcoords="offset points",
+                        ha="left" if side == "right" else "right", va="center", color=colour)
+    label.set_in_layout(False)
+    return label
 
 
 def _fmt_ms(r):

@@ -93,8 +93,9 @@ def text_overlaps(fig, gap=0.5):
       boxes overlap (twins, insets) are not each other's "other" axes;
     * a text or annotation placed in an axes with a frame that straddles the
       frame: ``'a' / the frame of its axes``;
-    * a text or legend entry in an axes that a line of that axes' data comes
-      within `CLEARANCE` of, or that one of its patches (a bar, a span) covers,
+    * a text or legend entry in an axes that a line of that axes' data (a Line2D, or a
+      LineCollection's segment: hlines, vlines) comes within `CLEARANCE` of, or that one of its
+      patches (a bar, a span) covers,
       unless an opaque box drawn above the line hides it (`chapter.figures.MASK`):
       ``'a' / the data's line 'b'`` (its label, if it has one; a line drawn as
       markers only counts where a marker falls).
@@ -119,44 +120,73 @@ def text_overlaps(fig, gap=0.5):
 
 
 def drop_clashing(fig, labels, gap=0.5):
-    """Remove from ``fig`` those of ``labels`` that `text_overlaps` would report, keeping the more
-    important of two labels that collide with each other; labels that collide with nothing stay.
+    """Remove from ``fig`` the optional ``labels`` that `text_overlaps` would report: in order of
+    importance, each label keeps its first placement that collides with nothing but labels not kept,
+    or, where only one kept label's placement stands in its way, that label moves to another of its
+    placements if it can, to make room.
 
     Parameters
     ----------
     fig : matplotlib.figure.Figure
-        Drawn once here (see `text_overlaps`); give the labels ``set_in_layout(False)`` so that removing
-        them moves nothing else.
-    labels : sequence of matplotlib.text.Text
-        Optional labels of ``fig``, the most important first.
+        Drawn once here (see `text_overlaps`), every placement shown; give the labels
+        ``set_in_layout(False)`` so that removing them moves nothing else.
+    labels : sequence of matplotlib.text.Text, or of sequences of them
+        Optional labels of ``fig``, the most important first; a sequence holds one label's
+        placements, the preferred first.
     gap : float >= 0
         As in `text_overlaps`.
 
     Returns
     -------
     list of matplotlib.text.Text
-        The labels kept, in the order given.
+        The placements kept, at most one per label, in the order given.
 
     Raises
     ------
     TypeError, ValueError
         As `text_overlaps`.
     """
-    rank = {id(t): i for i, t in enumerate(labels)}
-    dropped = set()
+    from matplotlib.text import Text
+    options = [(item,) if isinstance(item, Text) else tuple(item) for item in labels]
+    ours = {id(t) for placements in options for t in placements}
+    bad, near = set(), {}                          # clashing with what stays; clashing with another label
     for texts, _ in _clashes(fig, gap):
-        ours = [t for t in texts if id(t) in rank]
-        if ours and not any(id(t) in dropped for t in ours):
-            last = max(ours, key=lambda t: rank[id(t)])
-            dropped.add(id(last))
-            last.remove()
-    return [t for t in labels if id(t) not in dropped]
+        mine = [t for t in texts if id(t) in ours]
+        if len(mine) < len(texts) or len(mine) == 1:
+            bad.update(id(t) for t in mine)
+        else:
+            a, b = mine
+            near.setdefault(id(a), set()).add(id(b))
+            near.setdefault(id(b), set()).add(id(a))
+    def free(t, kept):                               # t collides with nothing that stays, nor a kept label
+        return id(t) not in bad and not near.get(id(t), set()) & {id(k) for k in kept if k is not None}
+    kept = []
+    for placements in options:
+        choice = next((t for t in placements if free(t, kept)), None)
+        for t in placements if choice is None else ():
+            blocking = [i for i, k in enumerate(kept) if k is not None and id(k) in near.get(id(t), set())]
+            if id(t) in bad or len(blocking) != 1:
+                continue
+            i = blocking[0]
+            others = kept[:i] + kept[i + 1:] + [t]
+            move = next((m for m in options[i] if m is not kept[i] and free(m, others)), None)
+            if move is not None:
+                kept[i], choice = move, t
+                break
+        kept.append(choice)
+    kept = [t for t in kept if t is not None]
+    for placements in options:
+        for t in placements:
+            if t not in kept:
+                t.remove()
+    return kept
 
 
 def _clashes(fig, gap):
     """`text_overlaps`' findings as (the texts involved, the message)."""
     import math
 
+    from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
     from matplotlib.legend import Legend
     from matplotlib.text import Text
@@ -188,7 +218,8 @@ def _clashes(fig, gap):
     for ax in axes:
         legend = ax.get_legend()
         own = {id(t) for t in ax.texts + (legend.get_texts() if legend is not None else [])}
-        data = [a for a in ax.lines + ax.patches if a.get_visible()]
+        data = [a for a in [*ax.lines, *ax.patches, *(c for c in ax.collections if isinstance(c, LineCollection))]
+                if a.get_visible()]
         for t in (t for t in drawn if id(t) in own):                # its labels and legend entries, as drawn
             bt, box = Text.get_window_extent(t, renderer), t.get_bbox_patch()     # an annotation's text, not its arrow
             masked = box is not None and box.get_visible() and box.get_facecolor()[3] == 1
@@ -212,17 +243,26 @@ def _clashes(fig, gap):
 
 
 def _kind(artist):
-    """'line' or 'patch', and the artist's label if it has one: "line 'fitted'"."""
+    """'line' (a Line2D or a LineCollection) or 'patch', and the artist's label if it has one: "line 'fitted'"."""
+    from matplotlib.collections import LineCollection
     from matplotlib.lines import Line2D
     label = artist.get_label()
-    return ("line" if isinstance(artist, Line2D) else "patch") + ("" if label.startswith("_") or not label
+    return ("line" if isinstance(artist, (Line2D, LineCollection)) else "patch") + ("" if label.startswith("_") or not label
                                                                    else f" {label!r}")
 
 
 def _crosses(artist, box, renderer):
-    """Whether a Line2D as drawn (its path's stroke, or its markers if it draws no line) comes within
-    `CLEARANCE` of ``box`` (display units), or a patch meets it."""
+    """Whether a Line2D as drawn (its path's stroke, or its markers if it draws no line), or a segment of
+    a LineCollection (hlines, vlines), comes within `CLEARANCE` of ``box`` (display units), or a patch
+    meets it."""
+    from matplotlib.collections import LineCollection
     from matplotlib.lines import Line2D
+    if isinstance(artist, LineCollection):
+        to_display = artist.get_transform()
+        widths = artist.get_linewidths()
+        pad = renderer.points_to_pixels((max(widths) if len(widths) else 1.0) / 2 + CLEARANCE)
+        return any(to_display.transform_path(p).intersects_bbox(box.padded(pad), filled=False)
+                   for p in artist.get_paths())
     if not isinstance(artist, Line2D):
         return artist.get_window_extent(renderer).overlaps(box)
     path = artist.get_transform().transform_path(artist.get_path())
