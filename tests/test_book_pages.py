@@ -338,9 +338,12 @@ def smallest(values):
 #: crease band is given), the asides by 200 (the Weingarten equations in a fold of §3, checked on a sheared
 #: ellipsoid chart; a glossary entry for principal curvature and lines of curvature), and the tallest page, §3,
 #: by 200 px.  The reading path grew by 10 for Fig. 13's labels of the steps (where they are, and that a step
-#: left without one had no room).  Glued words vary by build (Cell 4's timings
+#: left without one had no room).  A learner's read of the changed pages added 40 words: Fig. 13's caption says
+#: why the smallest step loses and that a difference's times differ only by noise, §1 says where u and v are
+#: defined and what the difference images' spokes and circle are, §4 gives Shift's ten-pixel probe.  Glued words
+#: vary by build (Cell 4's timings
 #: pick "all three fields" or "two of the three fields (sine and ridges)"): keep some 15 words of margin.
-MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_750, 8_800, 13_700
+MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_790, 8_800, 13_700
 #: The pages outside the reading path: looked up, not read through.
 LOOKUP_PAGES = ("s6_ledger", "glossary")
 LENGTH = r"""() => {
@@ -1218,6 +1221,30 @@ def test_drop_clashing_removes_the_optional_labels_that_collide_the_less_importa
     assert text_overlaps(fig) == [] and {t.get_text() for t in ax.texts} == {"a note", "kept"}
     second = ax.text(0.03, 0.9, "first now")                 # the order given decides which stays
     assert drop_clashing(fig, [second, kept]) == [second]
+
+
+def test_drop_clashing_tries_each_labels_placements_and_moves_a_kept_one_to_make_room(figure):
+    """A label's placements in order of preference: the first free one is kept; where a label's only
+    placement is blocked by one kept label that has another free placement, that one moves."""
+    from chapter.layout import drop_clashing, text_overlaps
+    fig, ax = figure(figsize=(5, 3.5))
+    _clean(ax)
+    first = [ax.text(0.03, 0.9, "first, right"), ax.text(0.03, 0.75, "first, left")]
+    second = ax.text(0.03, 0.9, "second")                               # only where first would go
+    third = [ax.text(0.2, 0.6, "third on the note"), ax.text(0.55, 0.9, "third, free")]
+    assert drop_clashing(fig, [first, second, third]) == [first[1], second, third[1]]
+    assert text_overlaps(fig) == [] and {t.get_text() for t in ax.texts} == {"a note", "first, left", "second",
+                                                                                 "third, free"}
+
+
+def test_text_overlaps_catches_a_label_on_a_bar_drawn_by_hlines(figure):
+    from chapter.layout import text_overlaps
+    fig, ax = figure(figsize=(5, 3.5))
+    _clean(ax)
+    ax.hlines([0.9], 0.02, 0.5, color="k")
+    assert text_overlaps(fig) == []
+    ax.text(0.1, 0.9, "on the bar", va="center")
+    assert text_overlaps(fig) == ["'on the bar' / the data's line"]
 
 
 def test_text_overlaps_catches_a_title_on_a_label(figure):
