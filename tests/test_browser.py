@@ -1082,14 +1082,19 @@ def _keyboard_walk(s):
     tab_to("sim-beta"); move("β", "ArrowRight")
     tab_to("sim-canvas-symbolic")
     found["probe"] = [] if not any(page.evaluate(MARKS_JS)) else ["a ring before any pixel was read"]
-    for key in ("ArrowRight", "ArrowDown"):
+    res, at = s.sim("sim.state.resolution"), []
+    for key in ("ArrowRight", "ArrowDown", "Shift+ArrowRight"):
         page.keyboard.press(key)
         readouts.append(page.text_content("#sim-readout"))
         d, said = s.page.evaluate("({...document.getElementById('sim-readout').dataset})"), page.text_content("#sim-status")
+        at.append((int(d["i"]), int(d["j"])))
         if not (said.startswith(f"Pixel x {d['i']}, y {d['j']},") and "|ΔI|" in said):
             found["probe"].append(f"the probe's pixel not said: status {said!r} at ({d['i']}, {d['j']})")
         found["probe"] += mark_problems(s) + [f"a hyphen for a minus sign in the readout: {m.group()}"
                                               for m in HYPHEN_MINUS.finditer(readouts[-1])]
+    c = res // 2                        # the first press reads the centre, the next a pixel on, with Shift ten
+    if at != [(c, c), (c, c + 1), (c + 10, c + 1)]:
+        found["probe"].append(f"the probe went {at}, not from the centre ({c}, {c}) one pixel down, ten right")
     tab_to("sim-bump"); move("normal", "ArrowUp")        # to the draft's chart formula
     top = page.get_attribute("#sim-beta", "max")
     if f"β now runs to {top}" not in page.text_content("#sim-note"):         # the slider's range changed with it
@@ -1110,7 +1115,7 @@ def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser,
     try:
         found, readouts = _keyboard_walk(s)
         assert found == dict.fromkeys(found, []), found
-        assert len(set(readouts)) == 2 and all(r.startswith("pixel") for r in readouts), readouts
+        assert len(set(readouts)) == 3 and all(r.startswith("pixel") for r in readouts), readouts
         assert s.errors == []
     finally:
         s.close()
@@ -1127,6 +1132,10 @@ WRONG_SPOKEN = {
     "the β note never giving way": ("      this.note.textContent = \"\";                                 // the note said its piece\n",
                                      "", "outlived"),
     "the canvases images, whose arrow keys browse mode keeps": ('role: "application"', 'role: "img"', "role"),
+    "Shift ignored by the probe": ("n = ev.shiftKey ? 10 : 1", "n = 1", "not from the centre"),
+    "the first press a step past the centre": ("if (!this.probe) { this.show_probe(res >> 1, res >> 1); return; }",
+                                               "if (!this.probe) this.probe = { i: res >> 1, j: res >> 1 };",
+                                               "not from the centre"),
     "the readout a live region again": ('class: "sim-readout" }', 'class: "sim-readout", "aria-live": "polite" }', "live regions"),
     "the probe's pixel not said": ("if (say) this.status.textContent", "if (false) this.status.textContent", "the probe's pixel not said"),
     "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",

@@ -573,7 +573,9 @@ class Simulator {
       difference: `Difference |ΔI| of the two renders (${s.view === "bump" ? "of the sizes of ∇h" : "shaded"}), ${scale}: ` +
         `on sphere A ${totals}.`,
     };
-    for (const [name, t] of Object.entries(text)) this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe.`);
+    for (const [name, t] of Object.entries(text)) {
+      this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe, with Shift ten pixels.`);
+    }
     return totals;
   }
 
@@ -686,9 +688,9 @@ class Simulator {
     if (!(ev.key in moves)) return;
     ev.preventDefault();
     const res = this.state.resolution;
-    const p = this.probe || { i: res >> 1, j: res >> 1 };
-    const [di, dj] = moves[ev.key];
-    this.show_probe(Math.min(res - 1, Math.max(0, p.i + di)), Math.min(res - 1, Math.max(0, p.j + dj)));
+    if (!this.probe) { this.show_probe(res >> 1, res >> 1); return; }      // the first press reads the centre
+    const p = this.probe, n = ev.shiftKey ? 10 : 1, [di, dj] = moves[ev.key];
+    this.show_probe(Math.min(res - 1, Math.max(0, p.i + n * di)), Math.min(res - 1, Math.max(0, p.j + n * dj)));
   }
 
   // rows: [name, value, brief]; a brief row is one a phone shows until the reader asks for all (STYLE).
