@@ -77,10 +77,13 @@ PINNED = {
 #: A check that skips its renderer comparison reports fewer (`Verdict.rendered`), and
 #: `pinned_failure` names it.  Keys as in `PINNED`.
 RENDERED = {
-    "chart": 200, "frame-orthonormal": 2 * 200, "gradient-{field}": 200, "kink-loci-rays": 200,
-    "kink-loci-circles": 200, "no-boundary": 100, "beta-zero-regression": 4, "central-difference-truncation": 200,
+    "chart": 200, "frame-orthonormal": 2 * 200, "gradient-{field}": 200, "kink-loci-rays": 20_000,
+    "kink-loci-circles": 20_000, "no-boundary": 100, "beta-zero-regression": 4, "central-difference-truncation": 10_000,
     "bump-vs-displacement": 200, "shading": 2 * 450,
 }
+#: A theorem's evidence compares at most this many times its `RENDERED` minimum: a minimum far below what
+#: the evidence compares would let most of it be cut unseen.
+RENDERED_SHARE = 10
 #: The entries of `RENDERED` that count per registered field: the theorems about every field, whose
 #: evidence names the fields it compared (`proofs.core.Verdict.covers`; `pinned_failure` holds the two together).
 COUNTED_PER_FIELD = ("chart", "frame-orthonormal", "beta-zero-regression", "bump-vs-displacement")
@@ -140,7 +143,7 @@ def pinned_failure(theorem_id, status, residual, rendered, covers):
     `RENDERED`, or None if it does not: the status must be the pin's, a verified one's
     residual a number at most the pin's bound (a missing or NaN residual never passes) and
     the bound within `proofs.core.TIGHT` of it, at least `least_rendered` renderer outputs
-    compared, and for a theorem of `COUNTED_PER_FIELD` outputs of every registered field among
+    compared and at most `RENDERED_SHARE` times that many (a theorem with renderer evidence has a minimum), and for a theorem of `COUNTED_PER_FIELD` outputs of every registered field among
     them (``covers``: the field names the evidence compared, `proofs.core.Verdict.covers`); evidence
     that names the fields it compared belongs to a theorem of `COUNTED_PER_FIELD`.
 
@@ -163,6 +166,9 @@ def pinned_failure(theorem_id, status, residual, rendered, covers):
     least = least_rendered(theorem_id)
     if rendered < least:
         return f"{theorem_id} compared {rendered} renderer outputs, pinned at least {least}"
+    if rendered > RENDERED_SHARE * least:
+        return (f"{theorem_id} compared {rendered} renderer outputs, more than {RENDERED_SHARE} times its pinned "
+                f"minimum {least} (RENDERED): raise the minimum, so that evidence cut is seen")
     if theorem_id in COUNTED_PER_FIELD:
         from renderer.formulas import FIELDS
         missing = [name for name in FIELDS if name not in set(covers)]

@@ -32,6 +32,18 @@ def test_a_check_that_skips_the_renderer_is_named():
     assert pinned_failure("chart", "verified", 1e-30, least, ALL) is None
 
 
+def test_a_minimum_lowered_far_below_what_the_evidence_compares_is_named(monkeypatch):
+    """A `RENDERED` minimum cut to a tenth or less of what the evidence compares (an adversarial review: nothing
+    stopped it), or removed while the theorem compares renderer outputs, is named; the registry's hold."""
+    from proofs import registry
+    least = least_rendered("kink-loci-rays")
+    assert pinned_failure("kink-loci-rays", "proved", None, registry.RENDERED_SHARE * least, ()) is None
+    monkeypatch.setitem(registry.RENDERED, "kink-loci-rays", least // 20)
+    assert "more than 10 times its pinned minimum" in pinned_failure("kink-loci-rays", "proved", None, least, ())
+    monkeypatch.delitem(registry.RENDERED, "kink-loci-rays")
+    assert "pinned minimum 0" in pinned_failure("kink-loci-rays", "proved", None, least, ())
+
+
 @pytest.mark.parametrize("pin, status, residual, why", [
     ("proved", "verified", 1e-30, "is verified, pinned proved"),
     (("verified", 1e-25), "proved", None, "is proved, pinned verified"),
