@@ -59,7 +59,8 @@ they hold (tests/test_core.py and tests/test_checker.py plant a violation of eac
    cannot be evaluated, refutes.
 7. *Pins* (proofs/registry.py).  A verdict passes its pin only as "proved" for a pin
    "proved", or as "verified" with a residual at most ``bound`` for ("verified", bound),
-   bound 0.0 included; with at least its `RENDERED` count of renderer outputs.
+   bound 0.0 included; with at least its `RENDERED` count of renderer outputs, and at most
+   `RENDERED_SHARE` times it (a minimum far below the evidence would let most of it go unseen).
 8. *Citations.*  A statement or a step's sentence names another theorem only by the marker
    ``⟪id⟫`` (`CITATION`), never by its id in words; the id must be a theorem of the registry
    (`CITABLE`, which reads proofs/registry.py's), or the theorem is refuted.  The book prints the marker as
