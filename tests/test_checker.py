@@ -226,19 +226,19 @@ def test_evidence_compared_field_by_field_belongs_to_a_theorem_counted_per_field
     grows with the fields and every field must be among them.  Left out of COUNTED_PER_FIELD, it is
     named; so is a per-field theorem whose evidence reports fields."""
     from proofs import registry
-    assert pinned_failure("beta-zero-regression", "proved", None, 10**9, ALL) is None
+    assert pinned_failure("beta-zero-regression", "proved", None, least_rendered("beta-zero-regression"), ALL) is None
     monkeypatch.setattr(registry, "COUNTED_PER_FIELD", tuple(t for t in registry.COUNTED_PER_FIELD
                                                              if t != "beta-zero-regression"))
-    assert "least count is not per field" in pinned_failure("beta-zero-regression", "proved", None, 10**9, ALL)
-    assert "(sine)" in pinned_failure("gradient-sine", "proved", None, 10**9, ("sine",))
+    assert "least count is not per field" in pinned_failure("beta-zero-regression", "proved", None, least_rendered("beta-zero-regression"), ALL)
+    assert "(sine)" in pinned_failure("gradient-sine", "proved", None, least_rendered("gradient-sine"), ("sine",))
 
 
 @pytest.mark.parametrize("theorem_id, verdict, why", [
-    ("chart", Verdict("verified", "e", 1e-31, 20, 24, 10**9, covers=ALL), "at 20 digits and 24 points"),
-    ("chart", Verdict("verified", "e", 1e-31, 30, 19, 10**9, covers=ALL), "at 30 digits and 19 points"),
-    ("chart", Verdict("verified", "e", 1e-31, 30, 24, 10**9, covers=ALL), None),
-    ("no-boundary", Verdict("verified", "e", 0.0, None, 99, 10**9), "at None digits and 99 points"),
-    ("no-boundary", Verdict("verified", "e", 0.0, None, 100, 10**9), None),
+    ("chart", Verdict("verified", "e", 1e-31, 20, 24, 1000, covers=ALL), "at 20 digits and 24 points"),
+    ("chart", Verdict("verified", "e", 1e-31, 30, 19, 1000, covers=ALL), "at 30 digits and 19 points"),
+    ("chart", Verdict("verified", "e", 1e-31, 30, 24, 1000, covers=ALL), None),
+    ("no-boundary", Verdict("verified", "e", 0.0, None, 99, 1000), "at None digits and 99 points"),
+    ("no-boundary", Verdict("verified", "e", 0.0, None, 100, 1000), None),
     ("chart", Verdict("refuted", "forced"), "chart is refuted: forced"),
 ])
 def test_a_verified_verdict_rests_on_enough_digits_and_points_or_renders(theorem_id, verdict, why):
@@ -613,9 +613,9 @@ def test_the_rendered_rate_is_held_to_its_claimed_order_within_a_tenth(monkeypat
 def test_a_verified_pin_loosened_is_refused_and_the_rule_spares_an_exact_zero(monkeypatch):
     from proofs import core, registry
     residual = registry.get("chart").check().residual
-    assert registry.pinned_failure("chart", "verified", residual, 10**6, ALL) is None
+    assert registry.pinned_failure("chart", "verified", residual, least_rendered("chart"), ALL) is None
     monkeypatch.setitem(registry.PINNED, "chart", ("verified", 1e-20))
-    assert "chart's pin: its threshold 1e-20 is" in registry.pinned_failure("chart", "verified", residual, 10**6, ALL)
+    assert "chart's pin: its threshold 1e-20 is" in registry.pinned_failure("chart", "verified", residual, least_rendered("chart"), ALL)
     assert core.loose(1e-20, 0.0) is None and core.loose(1e-20, 1e-23) is None
     assert "threshold 1e-20 is 4e+03 times the residual it measured (2.5e-24)" in core.loose(1e-20, 2.5e-24)
 
@@ -625,7 +625,7 @@ def test_rule_12_evidence_that_leaves_out_a_field_is_named(monkeypatch):
     is named (rule 12); each of the four per-field theorems, its evidence narrowed to the first field,
     is refused: three by rule 12 alone (their outputs counted enough), β → 0's by its own evidence."""
     from proofs import displacement, normal, pixels
-    assert pinned_failure("chart", "verified", 1e-30, 10**6, ALL[:-1]).endswith(
+    assert pinned_failure("chart", "verified", 1e-30, least_rendered("chart"), ALL[:-1]).endswith(
         f"compared no renderer output of the {ALL[-1]} field, which its statement is about")
     real = pixels.worst_of
     monkeypatch.setattr(pixels, "worst_of", lambda check, cases: real(check, [c for c in cases if c[0] == ALL[0]]))
@@ -637,9 +637,9 @@ def test_rule_12_evidence_that_leaves_out_a_field_is_named(monkeypatch):
     for theorem_id in ("chart", "frame-orthonormal", "bump-vs-displacement"):
         v = get(theorem_id).check()
         assert v.holds and v.covers == ALL[:1], (theorem_id, v)
-        # Outputs enough in number (10^9): only rule 12 is left to refuse it.
+        # Outputs enough in number (its least count): only rule 12 is left to refuse it.
         assert f"compared no renderer output of the {', '.join(ALL[1:])} field" in pinned_failure(
-            theorem_id, v.status, v.residual, 10**9, v.covers), theorem_id
+            theorem_id, v.status, v.residual, least_rendered(theorem_id), v.covers), theorem_id
     v = get("beta-zero-regression").check()          # its own evidence counts the configurations it rendered
     assert v.status == "refuted" and "not every configuration was rendered" in v.evidence, v.evidence
 
