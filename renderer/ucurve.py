@@ -284,23 +284,44 @@ def _stencil():
     return sp.lambdify(args, [points[p] for p in (F.u_p, F.u_m, F.v_p, F.v_m)] + dens, modules="math")
 
 
-def _real(fn, X):
-    """``fn(X)`` (an mpmath function at an mpf, at the current precision) where it is a real number
-    float64 can hold, else None: a pole (ZeroDivisionError), an overflow, a complex value, or one
-    beyond float64's range (which the U-curve would report as inf)."""
+def _value(fn, X):
+    """(``fn(X)``, None) (an mpmath function at an mpf, at the current precision) where it is a real number
+    float64 can hold, else (None, why not): infinite (a pole, a logarithm of 0), an overflow, not real
+    (a complex value: a root or logarithm of a negative number), beyond float64's range (which the U-curve
+    would report as inf), or no value at all."""
     try:
         y = mpmath.mpmathify(fn(X))             # a constant derivative is a Python number
+    except ZeroDivisionError:
+        return None, "is infinite"
+    except OverflowError:
+        return None, "overflows (beyond any number mpmath holds)"
     except (ArithmeticError, ValueError, TypeError):
-        return None
-    return y if isinstance(y, mpmath.mpf) and abs(y) <= np.finfo(float).max else None
+        return None, "has no value"
+    if isinstance(y, mpmath.mpc):
+        return None, f"is not real ({mpmath.nstr(y, 3)}: a root or logarithm of a negative number, say)"
+    if mpmath.isinf(y):
+        return None, "is infinite"
+    if mpmath.isnan(y):
+        return None, "has no value"
+    if abs(y) > np.finfo(float).max:
+        return None, f"is {mpmath.nstr(y, 3)}, beyond float64's largest number"
+    return y, None
 
 
-def _undefined(label, point):
-    """The refusal of a point where the function, or a derivative the measurement needs, has no value."""
-    what, where = (("function", f"x = {point['u']!r}") if point["component"] == "x" else
-                   ("field", f"(u, v) = ({point['u']!r}, {point['v']!r})"))
-    return validate.InvalidValue(f"{what} {label} must be defined and differentiable at {where}, where it or a "
-                                 f"derivative the measurement needs is not a real number float64 can hold")
+def _real(fn, X):
+    """`_value`'s value, or None."""
+    return _value(fn, X)[0]
+
+
+def _undefined(label, point, line, X):
+    """The refusal of a point where the function, or a derivative the measurement needs (``line``: h, h',
+    h''' as mpmath functions, at ``X``), has no value float64 can hold, saying which and why."""
+    what, where, names = (("function", f"x = {point['u']!r}", ("f", "f'", "f'''")) if point["component"] == "x" else
+                          ("field", f"(u, v) = ({point['u']!r}, {point['v']!r})",
+                           ("h", f"h_{point['component']}", f"h_{point['component'] * 3}")))
+    why = next((f"{name} {reason}" for name, fn in zip(names, line) for reason in [_value(fn, X)[1]] if reason),
+               "it has no value")
+    return validate.InvalidValue(f"{what} {label} must be defined and differentiable at {where}: there {why}")
 
 
 @lru_cache(maxsize=None)
@@ -332,7 +353,7 @@ def _curve(label, x, steps, quotient, line, reason, point):
             true = _real(dh_mp, X + mpmath.mpf(10) ** -(DIGITS - 10) * (-1 if x == 1.0 else 1))
         h0, h3 = _real(h_mp, X), (_real(d3h_mp, X) if reason is None else mpmath.nan)
         if true is None or h0 is None or h3 is None:
-            raise _undefined(label, point)
+            raise _undefined(label, point, line if reason is None else line[:2], X)
         error, trunc, roundoff = [], [], []
         for i, e in enumerate(steps):
             fd, plus, minus, den = quotient(float(e))
@@ -435,7 +456,9 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
     at = {F.k_u: _rational(k_u), F.k_v: _rational(k_v), (F.v if k == 0 else F.u): _rational(v if k == 0 else u)}
     point, g = dict(u=u, v=v, component=component), _exact_at(record.expr, at)
     if g is not None and g.has(sp.zoo, sp.nan, sp.oo, -sp.oo):      # no value on the line (tan(pi u), u = 1/2)
-        raise _undefined(record.name, point)
+        fixed, at_value = (F.v, v) if k == 0 else (F.u, u)
+        raise validate.InvalidValue(f"field {record.name} must be defined and differentiable at (u, v) = ({u!r}, "
+                                    f"{v!r}): there it has no value on the line {fixed} = {at_value!r}")
     if g is None or sys.get_int_max_str_digits() and any(max(abs(r.p), r.q) >= 10 ** sys.get_int_max_str_digits()
                                                          for r in g.atoms(sp.Rational)):   # which lambdify cannot print
         raise validate.InvalidValue(f"field {record.name} is too large to measure at (u, v) = ({u!r}, {v!r}): "
@@ -495,7 +518,7 @@ def measure_function(function, x, eps=None):
     line, point = _line(record.expr, U.x_var), dict(u=x, v=float("nan"), component="x")
     with mpmath.workdps(DIGITS):
         if any(_real(fn, mpmath.mpf(x)) is None for fn in line[:2]):     # before the crease and float64 checks
-            raise _undefined(record.name, point)
+            raise _undefined(record.name, point, line[:2], mpmath.mpf(x))
     if _crease(record.expr, U.x_var, {}, x) is not None:
         raise validate.InvalidValue(f"function {record.name} is not differentiable at x = {x!r}: it has a "
                                     f"crease there (the argument of an abs changes sign)")

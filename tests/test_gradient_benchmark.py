@@ -259,7 +259,7 @@ def test_an_abs_function_takes_the_continued_complex_step_and_not_the_plain_one(
     ("exp(x)", 1j, "^x must be a real number"),             # not real
     ("abs(x - 1)", 1.0, "^function .*not differentiable at x = 1.0"),
     ("sqrt(x)", -1.0, "^function .*x = -1.0"),              # not defined there
-    ("exp(x)", 800.0, r"^function exp\(x\) must be defined .* not a real number float64 can hold"),
+    ("exp(x)", 800.0, r"^function exp\(x\) must be defined .*: there f is 2.73e\+347, beyond float64's largest number"),
     ("sinh(x)**2/cosh(x)", 400.0, "^x must be a point where .* at x = 400.0 it overflows"),  # f finite, f64 not
     ("log(x**2)", 0.0, r"^function log\(x\*\*2\) must be defined"),  # f is infinite: not "too large"
     ("1/x", 0.0, "^function 1/x must be defined"),

@@ -75,6 +75,27 @@ def test_measure_functions_arguments_are_refused_by_name(args, kwargs, error, me
     assert isinstance(info.value, error) and str(info.value).startswith(message), str(info.value)
 
 
+@pytest.mark.parametrize("call, said", [
+    (lambda: measure_function("1/(x - 2)", 2.0), "function 1/(x - 2) must be defined and differentiable at x = 2.0: there "
+                                                  "f is infinite"),
+    (lambda: measure_function("sqrt(x - 3)", 1.0), "there f is not real ((0.0 + 1.41j): a root or logarithm of a "
+                                                   "negative number, say)"),
+    (lambda: measure_function("exp(x)", 710.0), "there f is 2.23e+308, beyond float64's largest number"),
+    (lambda: measure_function("sqrt(x)", 0.0), "there f' is infinite"),                  # f = 0, f' infinite
+    (lambda: measure_function("x**2.5", 0.0), "there f''' is infinite"),
+    (lambda: measure("log(u - 0.2)", 0.2), "field log(u - 0.2) must be defined and differentiable at (u, v) = (0.2, "
+                                           "0.47): there h is infinite"),
+    (lambda: measure("u*sqrt(v - 0.47)", 0.3, 0.47, component="v"), "there h_v is infinite"),
+    (lambda: measure("tan(pi*u)", 0.5, component="v"), "there it has no value on the line u = 0.5"),
+])
+def test_a_point_without_a_value_is_refused_saying_which_of_f_and_its_derivatives_fails_and_how(call, said):
+    """A pole, a complex value, a value beyond float64 and an infinite derivative: each named, with the
+    function or derivative that fails, h's derivative by its component."""
+    with pytest.raises(InputError) as info:
+        call()
+    assert said in str(info.value) and "\n" not in str(info.value), str(info.value)
+
+
 def test_measure_function_takes_its_steps_or_the_default_ones():
     assert measure_function("sin(x)", 0.5, eps=[MAX_FUNCTION_STEP, 1e-3]).eps.tolist() == [MAX_FUNCTION_STEP, 1e-3]
     assert np.array_equal(measure_function("sin(x)", 0.5).eps, DEFAULT_STEPS)
