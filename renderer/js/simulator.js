@@ -719,7 +719,10 @@ class Simulator {
     // A negative component with the minus sign, as the book's prose writes it (a screen reader says "minus").
     const signed = (x, digits) => x.toPrecision(digits).replace(/^-/, "\u2212");
     const vec = (v, digits = 10) => v ? "(" + v.map((x) => signed(x, digits)).join(", ") + ")" : "—";
-    const rows = [["pixel", `x\u00a0=\u00a0${i}, y\u00a0=\u00a0${j}: ${CHAMBER_NAMES[a.chamber].replaceAll(" ", "\u00a0")}`, true], ["hit point", vec(a.P, 6)]];
+    // |ΔI| second, the readout's one number that says how the two pipelines differ, in view below the canvases.
+    const delta = fmt(Math.max(...a.rgb.map((x, c) => Math.abs(x - b.rgb[c]))), 2);
+    const rows = [["pixel", `x\u00a0=\u00a0${i}, y\u00a0=\u00a0${j}: ${CHAMBER_NAMES[a.chamber].replaceAll(" ", "\u00a0")}`, true],
+                  ["|ΔI|", `${delta}, the largest channel`, true], ["hit point", vec(a.P, 6)]];
     if (a.chamber === SPHERE_A) {
       rows.push(["(u, v)", vec(a.uv, 8)]);
       rows.push(["∇h exact", vec(a.grad)]);
@@ -730,8 +733,6 @@ class Simulator {
     }
     rows.push(["RGB exact", vec(a.rgb, 6)]);
     rows.push([`RGB ${b.gradient}`, vec(b.rgb, 6)]);
-    const delta = fmt(Math.max(...a.rgb.map((x, c) => Math.abs(x - b.rgb[c]))), 2);
-    rows.push(["|ΔI|", `${delta}, the largest channel`, true]);
     this.show_readout(rows);
     if (say) this.status.textContent = `Pixel x ${i}, y ${j}, ${CHAMBER_NAMES[a.chamber]}: |ΔI| ${delta}.`;
     const d = this.readout.dataset;
