@@ -243,11 +243,6 @@ CLAIMED_ORIENTATION = -1
 CLAIMED_FALLBACK_CROSS = sp.Matrix([0, 0, 1])
 
 
-def _triple(v):
-    """A vector as the steps write it: (1, 0, 0)."""
-    return "(" + ", ".join(str(c) for c in v) + ")"
-
-
 def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGULAR[:3], ep=REGULAR[3:]):
     """Theorem frame-orientation claiming ``claimed``, for the frame (``et``, ``ep``) and pole ``fallback``."""
     triple = Dot(Cross(ET_S, EP_S), N_S)
@@ -264,8 +259,8 @@ def _orientation(claimed=CLAIMED_ORIENTATION, fallback=F.FALLBACK_FRAME, et=REGU
                  r"-\cos\varphi)$", Cross(ET_S, EP_S), -N_S),
             *calc(triple, ("Dot both sides of step 1 with $N$", -Dot(N_S, N_S)),
                   ("$N$ is a unit vector", sp.Integer(claimed))),
-            Step(rf"At the poles the kernel takes the fixed pair $e_\theta = {_triple(fallback[:3])}$, "
-                 rf"$e_\varphi = {_triple(fallback[3:])}$, whose cross product is $+z$, the outward normal at the "
+            Step(rf"At the poles the kernel takes the fixed pair $e_\theta = {tuple(fallback[:3])}$, "
+                 rf"$e_\varphi = {tuple(fallback[3:])}$, whose cross product is $+z$, the outward normal at the "
                  r"north pole", poles, CLAIMED_FALLBACK_CROSS),
         ),
         claims={"orientation": (triple, sp.Integer(claimed)), "fallback": (poles, CLAIMED_FALLBACK_CROSS),
