@@ -96,12 +96,15 @@ def checker(light=None, dark=None):
     return sp.Piecewise((sp.Float(light, 15), sp.sin(sp.pi * X) * sp.sin(sp.pi * Y) >= 0), (sp.Float(dark, 15), True))
 
 
-SIZE = 128
+#: Odd: the middle column's pixel centres have x = 0 exactly, where the checker's sin(pi x) sin(pi y) is 0 and
+#: the statement says light (its >=), so the evidence holds the floor to the statement on that boundary too.
+SIZE = 129
 #: Pixels compared per scene, at most: from sphere A, from sphere B and from the floor.
 PER_CHAMBER = (200, 100, 150)
 #: A pixel whose N' . w_i lies within this of 0 for a light that reaches it is left out: the statement's
 #: term jumps there (the highlight is cut where the light goes behind N'), and rounding decides the side;
-#: so is a floor pixel whose sin(pi x) sin(pi y) does, where the checker changes grey.
+#: so is a floor pixel whose sin(pi x) sin(pi y) does, where the checker changes grey, unless it is exactly 0 (there
+#: the kernel and mpmath both compute 0, and every such pixel is compared).
 GATE_MARGIN = 1e-9
 #: Absolute tolerance on a colour in [0, 1], about 1000 unit roundoffs: the kernel's unit vectors and
 #: cosines carry a few each, and the power n multiplies the cosine's relative rounding by n (up to 40 here).
@@ -184,11 +187,12 @@ def _evidence(term=TERM, normal="Ns", gate=True, shadows=True, colour_of=COLOUR,
         mu = np.einsum("hwk,lhwk->lhw", g.Ns, to_light) / np.linalg.norm(to_light, axis=-1)
         squares = np.sin(np.pi * g.P[..., 0]) * np.sin(np.pi * g.P[..., 1])
         clear = (~np.any(reach & (np.abs(mu) < GATE_MARGIN), axis=0)
-                 & ((g.chamber != ON_FLOOR) | (abs(squares) > GATE_MARGIN)))
+                 & ((g.chamber != ON_FLOOR) | (abs(squares) > GATE_MARGIN) | (squares == 0)))
         rows, want = [], []
         for code, most in zip((SPHERE_A, SPHERE_B, ON_FLOOR), PER_CHAMBER):
-            idx = np.flatnonzero((g.chamber == code) & clear)
-            take = rng.choice(idx, size=min(most, idx.size), replace=False)
+            edge = np.flatnonzero((g.chamber == code) & (squares == 0)) if code == ON_FLOOR else np.zeros(0, int)
+            idx = np.setdiff1d(np.flatnonzero((g.chamber == code) & clear), edge)
+            take = np.concatenate([edge, rng.choice(idx, size=min(most - edge.size, idx.size), replace=False)])
             P = g.P.reshape(-1, 3)[take]
             albedo = (_floor_albedo(floor, grey, scene.floor_tint, P) if code == ON_FLOOR else
                       np.tile(scene.albedo_a if code == SPHERE_A else scene.albedo_b, (take.size, 1)))
@@ -264,6 +268,8 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             ("the tint alpha kept, not taken away, (alpha c, alpha c, c)",
              lambda: _theorem(floor=FLOOR.xreplace({1 - alpha: alpha})).check()),
             ("the checker's light and dark squares swapped", lambda: _theorem(grey=checker(*greys()[::-1])).check()),
+            ("the checker dark where sin(pi x) sin(pi y) is 0",
+             lambda: _theorem(grey=checker().replace(sp.GreaterThan, sp.StrictGreaterThan)).check()),
             ("sphere A unbumped too, N' = N", lambda: _theorem(unbumped=("sphere A", "sphere B", "floor")).check()),
         ),
     )
