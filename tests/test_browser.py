@@ -1053,20 +1053,21 @@ def mark_problems(s):
     return [] if marks and all(m == want for m in marks) else [f"the rings at {marks}, the readout at {want}"]
 
 
-def _keyboard_walk(s):
+def _keyboard_walk(s, readouts):
     """Use the simulator from the keyboard alone, checking `spoken_problems` after each move: Tab to the
     field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
     and move the probe with the arrow keys (the readout reads the pixel, a ring on each canvas marks it), to the
     shading normal and change
     it (the note beside it, a live region, must then say the β slider's new range), then on to the view
-    menu and change it (the note must be gone).  Returns {move: problems} and the readout's texts."""
-    page, found, readouts = s.page, {}, []
+    menu and change it (the note must be gone).  Yields (move, problems) as it goes, so that a wrong variant's
+    walk stops where its problem shows; appends the readout's texts to ``readouts``."""
+    page = s.page
 
-    def move(name, key):
+    def move(key):
         n = s.updates()
         page.keyboard.press(key)
         s.wait_update(n)
-        found[name] = spoken_problems(s)
+        return spoken_problems(s)
 
     def tab_to(target):
         for _ in range(60):
@@ -1076,12 +1077,12 @@ def _keyboard_walk(s):
         raise AssertionError(f"Tab never reached #{target}")
 
     page.focus("#sim-preset-try1")
-    found["opening"] = spoken_problems(s)
-    tab_to("sim-height_field"); move("field", "ArrowDown")
-    tab_to("sim-log_eps"); move("ε", "PageDown")
-    tab_to("sim-beta"); move("β", "ArrowRight")
+    yield "opening", spoken_problems(s)
+    tab_to("sim-height_field"); yield "field", move("ArrowDown")
+    tab_to("sim-log_eps"); yield "ε", move("PageDown")
+    tab_to("sim-beta"); yield "β", move("ArrowRight")
     tab_to("sim-canvas-symbolic")
-    found["probe"] = [] if not any(page.evaluate(MARKS_JS)) else ["a ring before any pixel was read"]
+    probe = [] if not any(page.evaluate(MARKS_JS)) else ["a ring before any pixel was read"]
     res, at = s.sim("sim.state.resolution"), []
     for key in ("ArrowRight", "ArrowDown", "Shift+ArrowRight"):
         page.keyboard.press(key)
@@ -1089,20 +1090,22 @@ def _keyboard_walk(s):
         d, said = s.page.evaluate("({...document.getElementById('sim-readout').dataset})"), page.text_content("#sim-status")
         at.append((int(d["i"]), int(d["j"])))
         if not (said.startswith(f"Pixel x {d['i']}, y {d['j']},") and "|ΔI|" in said):
-            found["probe"].append(f"the probe's pixel not said: status {said!r} at ({d['i']}, {d['j']})")
-        found["probe"] += mark_problems(s) + [f"a hyphen for a minus sign in the readout: {m.group()}"
-                                              for m in HYPHEN_MINUS.finditer(readouts[-1])]
+            probe.append(f"the probe's pixel not said: status {said!r} at ({d['i']}, {d['j']})")
+        probe += mark_problems(s) + [f"a hyphen for a minus sign in the readout: {m.group()}"
+                                     for m in HYPHEN_MINUS.finditer(readouts[-1])]
     c = res // 2                        # the first press reads the centre, the next a pixel on, with Shift ten
     if at != [(c, c), (c, c + 1), (c + 10, c + 1)]:
-        found["probe"].append(f"the probe went {at}, not from the centre ({c}, {c}) one pixel down, ten right")
-    tab_to("sim-bump"); move("normal", "ArrowUp")        # to the draft's chart formula
+        probe.append(f"the probe went {at}, not from the centre ({c}, {c}) one pixel down, ten right")
+    yield "probe", probe
+    tab_to("sim-bump"); normal = move("ArrowUp")        # to the draft's chart formula
     top = page.get_attribute("#sim-beta", "max")
     if f"β now runs to {top}" not in page.text_content("#sim-note"):         # the slider's range changed with it
-        found["normal"].append(f"β's range changed to {top} silently: note {page.text_content('#sim-note')!r}")
-    tab_to("sim-view"); move("view", "ArrowDown")
+        normal.append(f"β's range changed to {top} silently: note {page.text_content('#sim-note')!r}")
+    yield "normal", normal
+    tab_to("sim-view"); view = move("ArrowDown")
     if page.text_content("#sim-note"):                                       # the note said its piece
-        found["view"].append(f"the β note outlived the next change: {page.text_content('#sim-note')!r}")
-    return found, readouts
+        view.append(f"the β note outlived the next change: {page.text_content('#sim-note')!r}")
+    yield "view", view
 
 
 def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser, book_html):
@@ -1113,8 +1116,9 @@ def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser,
     U-curve's label the current ε, the ε slider's value text the ε printed (`spoken_problems`)."""
     s = _simulator_at(browser, book_html, 1280)
     try:
-        found, readouts = _keyboard_walk(s)
-        assert found == dict.fromkeys(found, []), found
+        readouts = []
+        found = dict(_keyboard_walk(s, readouts))
+        assert found == dict.fromkeys(("opening", "field", "ε", "β", "probe", "normal", "view"), []), found
         assert len(set(readouts)) == 3 and all(r.startswith("pixel") for r in readouts), readouts
         assert s.errors == []
     finally:
@@ -1157,8 +1161,13 @@ def test_the_spoken_check_catches_stale_labels_and_a_silent_readout(browser, boo
     old, new, message = WRONG_SPOKEN[variant]
     s = _simulator_at(browser, book_html, 1280, bundle=_replaced_once(old, new, variant))
     try:
-        found, _ = _keyboard_walk(s)
-        assert any(message in p for problems in found.values() for p in problems), found
+        seen = {}
+        for move, problems in _keyboard_walk(s, []):          # stopped at the first move that shows the problem
+            seen[move] = problems
+            if any(message in p for p in problems):
+                break
+        else:
+            pytest.fail(f"{variant!r} not caught: {seen}")
     finally:
         s.close()
 
