@@ -119,7 +119,9 @@ class Scene:
     text (``"sin(pi*k_u*u)**2 * sin(pi*k_v*v)**2"``), in u, v and the frequencies
     ``k_u`` [ku] and ``k_v`` [kv] (kept as its printed text); a field other than the
     built-in ones must be finite, with its gradient, on the chart [0, 1]^2 (checked on a
-    grid, `_check_on_chart`); ``beta`` [beta] >= 0 is
+    grid, `_check_on_chart`).  The chart's edges u = 0 and u = 1 meet on the sphere (the seam): a field is
+    smooth across it only if it and h_u agree there, as sine does for an even ``k_u`` (an odd one creases it
+    there, and a non-integer one breaks it).  ``beta`` [beta] >= 0 is
     the bump amplitude; ``eps`` [eps] > 0 is the central-difference step of the
     numeric pipeline, in chart units (u and v both run over [0, 1]).
     ``bump`` selects the perturbed normal: "surface" (default) is the exact

@@ -688,8 +688,8 @@ WRONG_CONTROLS = {
     "β up to R under the displaced sphere's normal": (
         "Math.round(100 * (SIMULATOR_SCENE.radius_a - BETA.step)) / 100", "SIMULATOR_SCENE.radius_a",
         [("sim-bump", "surface"), ("sim-beta", "max")], "did not update"),
-    "kᵤ from 0": ('name: "k_u", label: "kᵤ, frequency in u", kind: "range", min: 1',
-                 'name: "k_u", label: "kᵤ, frequency in u", kind: "range", min: 0', [("sim-k_u", "every")], "refuses"),
+    "kᵤ from 0": ('name: "k_u", label: "kᵤ, frequency in u (even)", kind: "range", min: 2',
+                 'name: "k_u", label: "kᵤ, frequency in u (even)", kind: "range", min: 0', [("sim-k_u", "every")], "refuses"),
     "the renderer handed a β of its own": (
         "this.renderer.update(scene,", "this.renderer.update({ ...scene, beta: 0.9 * scene.beta },", None,
         "values beyond"),

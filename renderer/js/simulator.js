@@ -84,7 +84,8 @@ export const CONTROLS = [
     labels: { log: LOG_SCALE, linear: LINEAR_SCALE } },
   { name: "numeric", label: "numeric gradient", kind: "select", options: NUMERIC,
     labels: { central: "central, one step ε", footprint: "central, pixel footprint" } },
-  { name: "k_u", label: "kᵤ, frequency in u", kind: "range", min: 1, max: 24, step: 1 },
+  // Even only: an odd kᵤ creases sine along the seam u = 0 ≡ 1, where h_u changes sign (§2 calls sine smooth).
+  { name: "k_u", label: "kᵤ, frequency in u (even)", kind: "range", min: 2, max: 24, step: 2 },
   { name: "k_v", label: "kᵥ, frequency in v", kind: "range", min: 1, max: 24, step: 1 },
   { name: "model", label: "shading model", kind: "select", options: MODELS },
   { name: "resolution", label: "resolution", kind: "select", options: [64, 128, 256, 512],
