@@ -340,10 +340,14 @@ def smallest(values):
 #: by 200 px.  The reading path grew by 10 for Fig. 13's labels of the steps (where they are, and that a step
 #: left without one had no room).  A learner's read of the changed pages added 40 words: Fig. 13's caption says
 #: why the smallest step loses and that a difference's times differ only by noise, §1 says where u and v are
-#: defined and what the difference images' spokes and circle are, §4 gives Shift's ten-pixel probe.  Glued words
+#: defined and what the difference images' spokes and circle are, §4 says that Shift moves the probe further.  A
+#: learner's read of the whole book added 20: §2 says sine is smooth across the seam only for an even k_u and
+#: that Theorem 1 is a claim about the renderer's code, §3 links "ulp" where a step is below half of one, and
+#: its exercise on doubling k_u asks why the factor is not the fixed phase's; the asides grew by 10 with the
+#: algebra of Theorem 2's step 3 written out.  Glued words
 #: vary by build (Cell 4's timings
 #: pick "all three fields" or "two of the three fields (sine and ridges)"): keep some 15 words of margin.
-MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_790, 8_800, 13_700
+MAX_READING_WORDS, MAX_ASIDE_WORDS, MAX_HEIGHT = 12_810, 8_815, 13_700
 #: The pages outside the reading path: looked up, not read through.
 LOOKUP_PAGES = ("s6_ledger", "glossary")
 LENGTH = r"""() => {
