@@ -6,17 +6,22 @@ both states of the checkbox, each applied alone to the opening state) and for ea
 scene `scene_of` hands the renderer.  Each must be a `renderer.Scene` Python accepts; a control
 named like a Scene field moves that field and nothing else (the ε slider moves ``eps``, to the
 printed value); a control of the view (scale, resolution, zoom, numeric pipeline) moves none; the
-menus offer exactly Python's choices; the opening scene is `SIMULATOR_SCENE`.  Wrong variants: a
-`scene_of` that swaps the two frequencies, and one that ignores the bump control.
+menus offer exactly Python's choices; the opening scene is `SIMULATOR_SCENE`; every field the menu offers, at
+every pair of frequencies the sliders offer, is smooth across the seam u = 0 = 1 where the chart's edges meet,
+or creased there with the crease band flagging it (`seam_problems`).  Wrong variants: a `scene_of` that swaps
+the two frequencies, one that ignores the bump control, and a k_u slider of odd values (sine creased at the seam).
 """
 
 import dataclasses
 import json
 import subprocess
 
+import numpy as np
 import pytest
+import sympy as sp
 
 from renderer import Scene
+from renderer import formulas as F
 from renderer.formulas import FIELDS
 from renderer.ledger import SIMULATOR_SCENE
 from renderer.render import GRADIENTS
@@ -47,6 +52,26 @@ def _scene(fields):
             return tuple(Light(tuple(l["position"]), tuple(l["color"])) for l in x)
         return tuple(x) if isinstance(x, list) else x
     return Scene(**{name: value(name, x) for name, x in fields.items()})
+
+
+def seam_problems(field, frequencies, v=np.linspace(0.01, 0.99, 99)):
+    """Where ``field`` (a `renderer.formulas.HeightField`) at one of ``frequencies`` [(k_u, k_v)] is neither
+    smooth across the seam (h and h_u the same at u = 0 and u = 1, to 1e-9 of their scale) nor creased there
+    with its crease band flagging both sides: [sentences].  At a smooth seam the shading is continuous, and the
+    book calls a field without creases smooth; a crease the band does not flag would be truncation error by the
+    captions and crease error on the canvas."""
+    h, h_u, band = sp.lambdify((F.u, F.v, F.k_u, F.k_v), (field.expr, field.gradient[0], field.kink_band), "numpy")(
+        *np.broadcast_arrays(np.array([[0.0], [1.0]]), v, *[np.array(k, float)[:, None, None] for k in zip(*frequencies)]))
+    out = []
+    for at, (k_u, k_v) in enumerate(frequencies):
+        values = [np.broadcast_to(a, (len(frequencies), 2, v.size))[at] for a in (h, h_u, band)]
+        (h0, h1), (d0, d1), flagged = values[0], values[1], values[2].all(axis=0)
+        scale = max(1.0, np.abs(values[1]).max())
+        if np.abs(h0 - h1).max() > 1e-9 * scale:
+            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: h breaks at the seam")
+        elif np.any((np.abs(d0 - d1) > 1e-9 * scale) & ~flagged):
+            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: creased at the seam, and the crease band does not say so")
+    return out
 
 
 def _problems(data):
@@ -84,6 +109,9 @@ def _problems(data):
             bad.append(f"the {control} menu offers {seen.get(control)}, Python {choices}")
     if set(seen) != set(SCENE_CONTROLS) | VIEW_CONTROLS:
         bad.append(f"controls {sorted(set(seen) ^ (set(SCENE_CONTROLS) | VIEW_CONTROLS))} unaccounted for")
+    frequencies = [(k_u, k_v) for k_u in seen.get("k_u", ()) for k_v in seen.get("k_v", ())]
+    for name in seen.get("height_field", ()):
+        bad += seam_problems(FIELDS[name], frequencies)
     for preset in data["presets"]:
         try:
             _scene(preset["scene"])
@@ -100,6 +128,8 @@ def test_every_control_position_is_a_python_scene_moving_its_own_field(tmp_path)
     ("k_u and k_v swapped", lambda name, text: text.replace("k_u: state.k_u, k_v: state.k_v",
                                                             "k_u: state.k_v, k_v: state.k_u")),
     ("the bump control ignored", lambda name, text: text.replace("bump: state.bump,", "")),
+    ("a k_u slider of odd values", lambda name, text: text.replace('kind: "range", min: 2, max: 24, step: 2 }',
+                                                                   'kind: "range", min: 1, max: 24, step: 1 }')),
 ])
 def test_the_controls_check_catches_a_wrong_scene_of(tmp_path, variant, transform):
     data = _positions(tmp_path, lambda name, text: transform(name, text) if name == "simulator" else text)

@@ -2,7 +2,8 @@
 //   node controls_driver.mjs MODULE_DIR
 // Prints one JSON object: { default: scene_of(DEFAULT_STATE), positions: [{ control, value, scene }],
 // presets: [{ id, scene }] }: for a select each option, for a range its ends, its default and each
-// tick (the decades of log eps), for the checkbox both states, each applied alone to the default state;
+// tick (the decades of log eps) and, on an integer slider of at most 100 steps (the frequencies), every value,
+// for the checkbox both states, each applied alone to the default state;
 // the presets, and each shading normal with β at the top of its slider.
 import { resolve } from "node:path";
 import { pathToFileURL } from "node:url";
@@ -18,6 +19,8 @@ function values(c) {
   if (c.kind === "checkbox") return [true, false];
   const out = new Set([c.min, top(c, DEFAULT_STATE), DEFAULT_STATE[c.name]]);
   if (c.ticks) for (let x = Math.ceil(c.min); x <= c.max; x += c.ticks) out.add(x);
+  if (Number.isInteger(c.min) && Number.isInteger(c.step) && (c.max - c.min) / c.step <= 100)
+    for (let x = c.min; x <= c.max; x += c.step) out.add(x);
   return [...out];
 }
 const positions = [];
