@@ -27,6 +27,26 @@ def _fake():
     return SimpleNamespace(results=tuple(rows), of=lambda f: [r for r in rows if r.field == f])
 
 
+def misleading_labels(fig):
+    """The step labels of the drawn ``fig`` (texts "ε = …" with the attribute ``marks``, the marker each names)
+    that stand nearer to another marker of their panel (its plotted lines' points) than to their own:
+    [(label, the nearer marker)]."""
+    import numpy as np
+    out = []
+    for ax in fig.axes:
+        points = np.vstack([ln.get_xydata() for ln in ax.get_lines() if ln.get_marker() not in (None, "None", "")]
+                           or [np.empty((0, 2))])
+        for label in [t for t in ax.texts if hasattr(t, "marks")]:
+            box = label.get_window_extent()
+            at = ax.transData.transform(points)
+            gap = np.hypot(np.clip(np.maximum(box.x0 - at[:, 0], at[:, 0] - box.x1), 0, None),
+                           np.clip(np.maximum(box.y0 - at[:, 1], at[:, 1] - box.y1), 0, None))
+            own = np.all(np.isclose(points, label.marks), axis=1)
+            if own.any() and gap[~own].size and gap[~own].min() < gap[own].min():
+                out.append((label.get_text(), tuple(points[~own][gap[~own].argmin()])))
+    return out
+
+
 def test_the_lowest_marker_stands_clear_of_the_bottom_edge():
     fig = pareto_figure(_fake())
     for ax in [a for a in fig.axes if a.get_title()]:     # the panels
@@ -94,13 +114,39 @@ def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
     assert text_overlaps(fig) == []
 
 
+def _drawn(base, rng):
+    """``base``'s results, each with a time drawn from 0.5 ms to 0.5 s and an error from 1e-16 to 2."""
+    import dataclasses
+    return tuple(dataclasses.replace(r, times=(0.8 * t, t, 1.5 * t), max_error=e, rms_error=e)
+                 for r in base.results for t, e in [10 ** rng.uniform((-3.3, -16), (-0.3, 0.3))])
+
+
+def test_the_label_check_catches_a_step_label_beside_another_marker(monkeypatch):
+    """With `chapter.benchmark.misleading` never true, the first seeded draw of the test below puts a step
+    label nearer another marker than its own, and `misleading_labels` says so."""
+    import dataclasses
+
+    import numpy as np
+
+    from chapter import benchmark, figures
+    from lab import gradient_methods as gm
+
+    from .test_figure_baselines import _measurement
+
+    figures.style()
+    monkeypatch.setattr(benchmark, "misleading", lambda label, markers: False)
+    base = _measurement([m.name for m in gm.METHODS])
+    rows = _drawn(base, np.random.default_rng(20261125))
+    assert misleading_labels(benchmark.pareto_figure(dataclasses.replace(base, results=rows)))
+
+
 @pytest.mark.parametrize("added", [0, 1, 4])
 def test_no_text_of_the_figure_collides_whatever_the_machine_times(monkeypatch, added):
     """The times are the machine's, so the panels' widths move with the tick labels the time axis
     needs; a panel's title (two lines for a field with creases) must not reach the neighbouring tick
     labels at any of them, nor at any errors.  Seeded draws of every run's time from 0.5 ms to 0.5 s
     (the page's methods span about that, the fastest to the slowest) and its error from 1e-16 to 2,
-    in the book's style.  With ``added`` methods appended to `METHODS` (a taller legend), the panels
+    in the book's style; no step label stands nearer another marker than its own (`misleading_labels`).  With ``added`` methods appended to `METHODS` (a taller legend), the panels
     keep the height they have without them, and the legend lists the records' order."""
     import dataclasses
 
@@ -125,10 +171,10 @@ def test_no_text_of_the_figure_collides_whatever_the_machine_times(monkeypatch, 
         for i in range(added))])
     base, rng = _measurement([m.name for m in gm.METHODS]), np.random.default_rng(20261125)
     for _ in range(6):
-        rows = tuple(dataclasses.replace(r, times=(0.8 * t, t, 1.5 * t), max_error=e, rms_error=e)
-                     for r in base.results for t, e in [10 ** rng.uniform((-3.3, -16), (-0.3, 0.3))])
+        rows = _drawn(base, rng)
         fig = pareto_figure(dataclasses.replace(base, results=rows))
         assert text_overlaps(fig) == [], [(r.field, r.method, r.times, r.max_error) for r in rows]
+        assert misleading_labels(fig) == [], [(r.field, r.method, r.times, r.max_error) for r in rows]
     grown = panels(pareto_figure(base))
     assert len(grown) == len(alone) and min(h / a for h, a in zip(grown, alone)) > 0.97, (grown, alone)
     legend = [t.get_text() for lg in fig.legends for t in lg.get_texts()]

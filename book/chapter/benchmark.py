@@ -73,7 +73,7 @@ def pareto_figure(measurement, *, error="max"):
     pick = (lambda r: r.max_error) if error == "max" else (lambda r: r.rms_error)
     t_lo = 0.5e3 * min(r.t_min for r in measurement.results)
     t_hi = 2e3 * max(r.t_max for r in measurement.results)
-    handles, ends, middles = {}, [], []
+    handles, ends, middles, markers = {}, [], [], {}
     for ax, name in zip(axes, names):
         rs = measurement.of(name)
         front = gb.pareto_front(rs, error=error)
@@ -91,12 +91,13 @@ def pareto_figure(measurement, *, error="max"):
             line, = ax.plot(t, e, color=style.colour, ls=style.line, lw=0.8 if len(group) > 1 else 0, alpha=0.7,
                             marker=style.marker, ms=style.size)
             handles.setdefault(method, line)
+            markers.setdefault(ax, []).extend(zip(t, e))
             for i, r in enumerate(group if len(group) > 1 else ()):
                 # At the right end of the marker's bar, which leads the eye from the marker to it, or,
                 # where that collides, at its left end.
                 (ends if i in (0, len(group) - 1) else middles).append(
-                    [_step_label(ax, r.eps, (1e3 * t, e[i]), style.colour, side)
-                     for side, t in (("right", r.t_max), ("left", r.t_min))])
+                    [_step_label(ax, r.eps, (1e3 * end, e[i]), style.colour, side, marks=(t[i], e[i]))
+                     for side, end in (("right", r.t_max), ("left", r.t_min))])
         ax.set_xscale("log")
         ax.set_yscale("log")
         # Every third decade on the error axis, at most five labelled decades on the time axis (the
@@ -118,18 +119,33 @@ def pareto_figure(measurement, *, error="max"):
     # The figure grows by the legend's height, so that more methods do not squeeze the panels.
     tall = legend.get_window_extent(FigureCanvasAgg(fig).get_renderer()).height / fig.dpi
     fig.set_figheight(_ROW_IN * len(names) + tall)
-    drop_clashing(fig, ends + middles)
+    drop_clashing(fig, ends + middles, misplaced=lambda label: misleading(label, markers[label.axes]))
     return fig
 
 
-def _step_label(ax, eps, at, colour, side):
-    """The label "ε = 1e−3" of a difference's marker beyond the ``side`` ("right" or "left") end of its bar,
-    ``at`` (time in ms, error)."""
+def _step_label(ax, eps, at, colour, side, marks):
+    """The label "ε = 1e−3" of a difference's marker ``marks`` (time in ms, error) beyond the ``side``
+    ("right" or "left") end of its bar, ``at``; the label keeps ``marks`` as its attribute ``marks``."""
     label = ax.annotate(f"\u03b5 = {step_text(eps).replace('-', chr(0x2212))}", at,
                         xytext=(3 if side == "right" else -3, 0), textcoords="offset points",
                         ha="left" if side == "right" else "right", va="center", color=colour)
     label.set_in_layout(False)
+    label.marks = marks
     return label
+
+
+def misleading(label, markers):
+    """Whether another of ``markers`` [(time in ms, error)] of the label's panel lies nearer to the drawn
+    ``label`` (a step label of `pareto_figure`, its figure drawn) than the marker it names, ``label.marks``:
+    a reader takes a label for the nearest marker's."""
+    xy = label.axes.transData.transform(np.asarray(markers, float))
+    own = label.axes.transData.transform(np.asarray([label.marks], float))[0]
+    box = label.get_window_extent()
+    def distance(p):
+        return np.hypot(np.maximum(0, np.maximum(box.x0 - p[..., 0], p[..., 0] - box.x1)),
+                        np.maximum(0, np.maximum(box.y0 - p[..., 1], p[..., 1] - box.y1)))
+    others = ~np.all(np.isclose(xy, own), axis=1)
+    return bool(np.any(distance(xy[others]) < distance(own)))
 
 
 def _fmt_ms(r):

@@ -119,11 +119,12 @@ def text_overlaps(fig, gap=0.5):
     return [message for _, message in _clashes(fig, gap)]
 
 
-def drop_clashing(fig, labels, gap=0.5):
+def drop_clashing(fig, labels, gap=0.5, misplaced=None):
     """Remove from ``fig`` the optional ``labels`` that `text_overlaps` would report: in order of
     importance, each label keeps its first placement that collides with nothing but labels not kept,
     or, where only one kept label's placement stands in its way, that label moves to another of its
-    placements if it can, to make room.
+    placements if it can, to make room.  A placement for which ``misplaced`` (a function of the
+    Text, called once the figure is drawn) is true counts as colliding.
 
     Parameters
     ----------
@@ -135,6 +136,8 @@ def drop_clashing(fig, labels, gap=0.5):
         placements, the preferred first.
     gap : float >= 0
         As in `text_overlaps`.
+    misplaced : callable or None
+        Text -> bool: a placement that would mislead where it stands (beside another's marker, say).
 
     Returns
     -------
@@ -158,6 +161,7 @@ def drop_clashing(fig, labels, gap=0.5):
             a, b = mine
             near.setdefault(id(a), set()).add(id(b))
             near.setdefault(id(b), set()).add(id(a))
+    bad.update(id(t) for placements in options for t in placements if misplaced is not None and misplaced(t))
     def free(t, kept):                               # t collides with nothing that stays, nor a kept label
         return id(t) not in bad and not near.get(id(t), set()) & {id(k) for k in kept if k is not None}
     kept = []
