@@ -246,8 +246,8 @@ def _no_boundary(attached=None, **evidence):
     return Theorem(
         id="no-boundary", title=TITLES["no-boundary"],
         statement=r"The chamber of every pixel (the nearest of the hits $t_A$, $t_B$, $t_{\mathrm{floor}}$) and "
-                  r"every shadow predicate (attached, $a$: $⟦attached⟧$; cast, $q$: a root of the segment quadratic "
-                  r"in $(0, 1)$; floor, $f$: the floor plane between $P$ and $L$) are functions of the geometry alone, of none of the bump's parameters: "
+                  r"every shadow predicate (attached, $a$: $⟦attached⟧$; cast, $q$: sphere B's quadratic along the "
+                  r"segment from $P$ to $L$ has a root in $(0, 1)$; floor, $f$: the floor plane between $P$ and $L$) are functions of the geometry alone, of none of the bump's parameters: "
                   r"its strength $\beta$, its frequencies $k_u$, $k_v$ and the central difference's steps "
                   r"$\varepsilon_u$, $\varepsilon_v$ (fixed or footprint): $$⟦chamber⟧$$ and $$⟦shadow⟧$$ "
                   r"Hence no pixel changes chamber, and no shadow boundary moves, when the bump's parameters "

@@ -32,7 +32,7 @@ PRINTED = {
     "ridges-kinks": "e05b59e321093ac4",
     "kink-loci-rays": "f2e0ac4f5bcc39f7",
     "kink-loci-circles": "31c755b11bbe9e76",
-    "no-boundary": "3cdd4fa8159796f1",
+    "no-boundary": "204deb95f3fef11f",
     "normal-beta-derivative": "35beda755e35b086",
     "beta-zero-regression": "3fcdd884c05219d5",
     "central-difference-truncation": "1d7a38548a2d22ed",
