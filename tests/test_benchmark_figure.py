@@ -41,7 +41,7 @@ def misleading_labels(fig):
             at = ax.transData.transform(points)
             gap = np.hypot(np.clip(np.maximum(box.x0 - at[:, 0], at[:, 0] - box.x1), 0, None),
                            np.clip(np.maximum(box.y0 - at[:, 1], at[:, 1] - box.y1), 0, None))
-            own = np.all(np.isclose(points, label.marks), axis=1)
+            own = np.all(points == label.marks, axis=1)                # the very floats plotted
             if own.any() and gap[~own].size and gap[~own].min() < gap[own].min():
                 out.append((label.get_text(), tuple(points[~own][gap[~own].argmin()])))
     return out

@@ -138,13 +138,13 @@ def misleading(label, markers):
     """Whether another of ``markers`` [(time in ms, error)] of the label's panel lies nearer to the drawn
     ``label`` (a step label of `pareto_figure`, its figure drawn) than the marker it names, ``label.marks``:
     a reader takes a label for the nearest marker's."""
-    xy = label.axes.transData.transform(np.asarray(markers, float))
-    own = label.axes.transData.transform(np.asarray([label.marks], float))[0]
+    markers = np.asarray(markers, float)
+    xy, own = label.axes.transData.transform(markers), label.axes.transData.transform([label.marks])[0]
     box = label.get_window_extent()
     def distance(p):
         return np.hypot(np.maximum(0, np.maximum(box.x0 - p[..., 0], p[..., 0] - box.x1)),
                         np.maximum(0, np.maximum(box.y0 - p[..., 1], p[..., 1] - box.y1)))
-    others = ~np.all(np.isclose(xy, own), axis=1)
+    others = ~np.all(markers == label.marks, axis=1)                     # the very floats plotted
     return bool(np.any(distance(xy[others]) < distance(own)))
 
 
