@@ -68,9 +68,12 @@ def seam_problems(field, frequencies, v=np.linspace(0.01, 0.99, 99)):
         (h0, h1), (d0, d1), flagged = values[0], values[1], values[2].all(axis=0)
         scale = max(1.0, np.abs(values[1]).max())
         if np.abs(h0 - h1).max() > 1e-9 * scale:
-            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: h breaks at the seam")
+            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: h breaks at the seam (u = 0 and u = 1 meet on the "
+                       "sphere: h must agree there)")
         elif np.any((np.abs(d0 - d1) > 1e-9 * scale) & ~flagged):
-            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: creased at the seam, and the crease band does not say so")
+            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: creased at the seam, and the crease band does not say "
+                       "so (u = 0 and u = 1 meet on the sphere: h_u must agree there, or the seam be a zero of a crease "
+                       "factor, under an Abs)")
     return out
 
 
