@@ -148,8 +148,9 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
             Step(r"Write $c$ for the right side. In coordinates with $n = (0, 0, 1)$, $e_u = (1, 0, 0)$ and "
                  r"$e_v = (0, \pm 1, 0)$ (a rotation changes no cross product or slope), $p_u$, $p_v$, $n_u$ and "
                  r"$n_v$ are tangent ($n_u \perp n$ since $\lvert n\rvert = 1$), so $c$'s first product is "
-                 r"along $n$ and to first order $c\cdot n = \pm\lvert p_u\rvert\lvert p_v\rvert$; of $c$'s terms only "
-                 r"$\beta h_u\, n \times p_v = \mp\beta h_u\lvert p_v\rvert\, e_u$ lies along $e_u$, so the slope "
+                 r"along $n$ and, with $p_u = \lvert p_u\rvert e_u$ and $p_v = \lvert p_v\rvert e_v$, "
+                 r"$c\cdot n = \pm\lvert p_u\rvert\lvert p_v\rvert + O(\beta)$; of $c$'s terms only "
+                 r"$\beta h_u\, n \times p_v = \mp\beta h_u\lvert p_v\rvert\, e_u$, already $O(\beta)$, lies along $e_u$, so the slope "
                  r"$t_u = c\cdot e_u / c\cdot n$ is, to first order",
                  T_U, first[0], cases=ORTHOGONAL),
             Step(r"Likewise $t_v = c\cdot e_v / c\cdot n$", T_V, first[1], cases=ORTHOGONAL),

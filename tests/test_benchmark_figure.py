@@ -29,8 +29,8 @@ def _fake():
 
 def misleading_labels(fig):
     """The step labels of the drawn ``fig`` (texts "ε = …" with the attribute ``marks``, the marker each names)
-    that stand nearer to another marker of their panel (its plotted lines' points) than to their own:
-    [(label, the nearer marker)]."""
+    that stand outside their panel or nearer to another marker of it (its plotted lines' points) than to
+    their own: [(label, the nearer marker, or "outside")]."""
     import numpy as np
     out = []
     for ax in fig.axes:
@@ -38,6 +38,9 @@ def misleading_labels(fig):
                            or [np.empty((0, 2))])
         for label in [t for t in ax.texts if hasattr(t, "marks")]:
             box = label.get_window_extent()
+            if not (ax.bbox.x0 <= box.x0 and box.x1 <= ax.bbox.x1 and ax.bbox.y0 <= box.y0 and box.y1 <= ax.bbox.y1):
+                out.append((label.get_text(), "outside"))
+                continue
             at = ax.transData.transform(points)
             gap = np.hypot(np.clip(np.maximum(box.x0 - at[:, 0], at[:, 0] - box.x1), 0, None),
                            np.clip(np.maximum(box.y0 - at[:, 1], at[:, 1] - box.y1), 0, None))

@@ -135,12 +135,15 @@ def _step_label(ax, eps, at, colour, side, marks):
 
 
 def misleading(label, markers):
-    """Whether another of ``markers`` [(time in ms, error)] of the label's panel lies nearer to the drawn
-    ``label`` (a step label of `pareto_figure`, its figure drawn) than the marker it names, ``label.marks``:
-    a reader takes a label for the nearest marker's."""
+    """Whether the drawn ``label`` (a step label of `pareto_figure`, its figure drawn) leaves its panel (it
+    would cross the axis line beside the tick labels), or another of ``markers`` [(time in ms, error)] of
+    its panel lies nearer to it than the marker it names, ``label.marks``: a reader takes a label for the
+    nearest marker's."""
     markers = np.asarray(markers, float)
     xy, own = label.axes.transData.transform(markers), label.axes.transData.transform([label.marks])[0]
-    box = label.get_window_extent()
+    box, panel = label.get_window_extent(), label.axes.bbox
+    if box.x0 < panel.x0 or box.x1 > panel.x1 or box.y0 < panel.y0 or box.y1 > panel.y1:
+        return True
     def distance(p):
         return np.hypot(np.maximum(0, np.maximum(box.x0 - p[..., 0], p[..., 0] - box.x1)),
                         np.maximum(0, np.maximum(box.y0 - p[..., 1], p[..., 1] - box.y1)))
