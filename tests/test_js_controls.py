@@ -18,10 +18,8 @@ import subprocess
 
 import numpy as np
 import pytest
-import sympy as sp
 
-from renderer import Scene
-from renderer import formulas as F
+from renderer import Scene, pointwise
 from renderer.formulas import FIELDS
 from renderer.ledger import SIMULATOR_SCENE
 from renderer.render import GRADIENTS
@@ -55,23 +53,22 @@ def _scene(fields):
 
 
 def seam_problems(field, frequencies, v=np.linspace(0.01, 0.99, 99)):
-    """Where ``field`` (a `renderer.formulas.HeightField`) at one of ``frequencies`` [(k_u, k_v)] is neither
-    smooth across the seam (h and h_u the same at u = 0 and u = 1, to 1e-9 of their scale) nor creased there
-    with its crease band flagging both sides: [sentences].  At a smooth seam the shading is continuous, and the
-    book calls a field without creases smooth; a crease the band does not flag would be truncation error by the
-    captions and crease error on the canvas."""
-    h, h_u, band = sp.lambdify((F.u, F.v, F.k_u, F.k_v), (field.expr, field.gradient[0], field.kink_band), "numpy")(
-        *np.broadcast_arrays(np.array([[0.0], [1.0]]), v, *[np.array(k, float)[:, None, None] for k in zip(*frequencies)]))
-    out = []
-    for at, (k_u, k_v) in enumerate(frequencies):
-        values = [np.broadcast_to(a, (len(frequencies), 2, v.size))[at] for a in (h, h_u, band)]
-        (h0, h1), (d0, d1), flagged = values[0], values[1], values[2].all(axis=0)
-        scale = max(1.0, np.abs(values[1]).max())
+    """Where ``field`` (a name of `renderer.formulas.FIELDS`) at one of ``frequencies`` [(k_u, k_v)] is, in the
+    renderer's own compiled code (`renderer.pointwise`), neither smooth across the seam (h and h_u the same at
+    u = 0 and u = 1, to 1e-9 of their scale) nor creased there with its crease band flagging both sides:
+    [sentences].  At a smooth seam the shading is continuous, and the book calls a field without creases
+    smooth; a crease the band does not flag would be truncation error by the captions and crease error on
+    the canvas."""
+    out, k = [], np.array(frequencies, float)[:, :, None, None]              # (frequencies, 2, 1, 1)
+    at = (np.array([[0.0], [1.0]]), v, k[:, 0], k[:, 1])                      # each (frequencies, seam side, v)
+    h, h_u, band = pointwise.height(field, *at), pointwise.exact_gradient(field, *at)[0], pointwise.kink_band(field, *at)
+    for (k_u, k_v), (h0, h1), (d0, d1), flagged in zip(frequencies, h, h_u, band.all(axis=1)):
+        scale = max(1.0, np.abs([d0, d1]).max())
         if np.abs(h0 - h1).max() > 1e-9 * scale:
-            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: h breaks at the seam (u = 0 and u = 1 meet on the "
+            out.append(f"{field} at k_u = {k_u}, k_v = {k_v}: h breaks at the seam (u = 0 and u = 1 meet on the "
                        "sphere: h must agree there)")
         elif np.any((np.abs(d0 - d1) > 1e-9 * scale) & ~flagged):
-            out.append(f"{field.name} at k_u = {k_u}, k_v = {k_v}: creased at the seam, and the crease band does not say "
+            out.append(f"{field} at k_u = {k_u}, k_v = {k_v}: creased at the seam, and the crease band does not say "
                        "so (u = 0 and u = 1 meet on the sphere: h_u must agree there, or the seam be a zero of a crease "
                        "factor, under an Abs)")
     return out
@@ -114,7 +111,7 @@ def _problems(data):
         bad.append(f"controls {sorted(set(seen) ^ (set(SCENE_CONTROLS) | VIEW_CONTROLS))} unaccounted for")
     frequencies = [(k_u, k_v) for k_u in seen.get("k_u", ()) for k_v in seen.get("k_v", ())]
     for name in seen.get("height_field", ()):
-        bad += seam_problems(FIELDS[name], frequencies)
+        bad += seam_problems(name, frequencies)
     for preset in data["presets"]:
         try:
             _scene(preset["scene"])
