@@ -143,6 +143,28 @@ def test_the_label_check_catches_a_step_label_beside_another_marker(monkeypatch)
     assert misleading_labels(benchmark.pareto_figure(dataclasses.replace(base, results=rows)))
 
 
+def test_a_step_label_that_leaves_its_panel_is_misleading():
+    """A label drawn past the panel's left edge (over the axis line, beside the tick labels) is refused by
+    `chapter.benchmark.misleading` and found by `misleading_labels`, though its own marker is the nearest;
+    moved inside, beside that marker, it is neither."""
+    from matplotlib.figure import Figure
+
+    from chapter.benchmark import misleading
+
+    fig = Figure(figsize=(4, 2))
+    ax = fig.subplots()
+    ax.plot([1.0, 10.0], [1.0, 1.0], marker="o")
+    ax.set_xlim(0.5, 20)
+    label = ax.annotate("ε = 1e−3", (1.0, 1.0), xytext=(-3, 0), textcoords="offset points", ha="right")
+    label.marks = (1.0, 1.0)
+    fig.draw_without_rendering()
+    assert misleading(label, [(1.0, 1.0), (10.0, 1.0)]) and misleading_labels(fig) == [("ε = 1e−3", "outside")]
+    label.set_horizontalalignment("left")
+    label.set_position((3, 0))
+    fig.draw_without_rendering()
+    assert not misleading(label, [(1.0, 1.0), (10.0, 1.0)]) and misleading_labels(fig) == []
+
+
 @pytest.mark.parametrize("added", [0, 1, 4])
 def test_no_text_of_the_figure_collides_whatever_the_machine_times(monkeypatch, added):
     """The times are the machine's, so the panels' widths move with the tick labels the time axis
