@@ -27,7 +27,12 @@ its label and style, where it applies, its sources.  `lab.gradient_benchmark`, w
 the methods and measures their errors, and book/chapter/benchmark.py, which draws them, read
 only the records: adding a method is one record appended to `METHODS`, and nothing else
 changes (tests/test_gradient_benchmark.py appends a backward difference and sees it measured
-and drawn).
+and drawn).  §5's tables, legends and the sentence naming the methods are generated from the
+list, and its figures make room for a new one (the baselines in tests/figure_baselines draw a
+fixed list and do not change); the prose that describes the figures (their alt text, §5's
+"What it shows") is the author's to extend.  A public function beside the record (as
+`forward_gradient` is) joins the table of tests/test_lab_validation.py, which names a function
+missing from it.
 
 Beside the methods: their work per pixel (`Evaluations`: values of h, evaluations of the
 generated gradient, and the sines and cosines they cost, counted from the sympy objects the

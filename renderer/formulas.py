@@ -211,6 +211,41 @@ FIELDS = {}
 def register(field):
     """Add ``field`` (a `HeightField` named by an identifier) to `FIELDS`, and return it.
 
+    A new built-in field is one call here, after the three built in and before
+    ``BUILTIN = tuple(FIELDS)`` (a field registered after that, or elsewhere, is printed and
+    compiled when first used)::
+
+        register(HeightField("bumps", _s1**2 * _s2**2, optimum=(0.15, 0.47, "u")))
+
+    then ``python -m renderer.codegen``, which rewrites renderer/generated*.py and the kernel's
+    digest.  Everything else takes the field from `FIELDS`: the kernel, the array backends, the
+    simulator's JavaScript, `renderer.ucurve`, the gradient methods, the proofs (its gradient
+    theorem and, if it has creases, its kinks theorem), the checker's pins, the book's maps,
+    tables and theorem blocks, and the tests.  The scale the gradient checks hold errors to
+    (`gradient_scale`) is the fastest-turning sine argument of any registered field, so a field
+    of sin(2 pi k_u u) widens it for all.  The chart's edges u = 0 and u = 1 meet on the sphere
+    (the seam): at every frequency the simulator offers (k_u even), h and h_u must agree there
+    or the seam be a zero of a crease factor (tests/test_js_controls.py checks it).
+
+    Four things stay the author's:
+
+    * ``optimum=``, where §3 and §6 state the field's optimal step.  Without it the seed point
+      is used; the checker holds a claim about the error there (measured within a factor 3 of
+      the model at the fitted step), which one point's rounding can miss: ``pytest verify``
+      says so, and `lab.accuracy.measure_optimum` measures a candidate point first (for the
+      field above the ratio is 1.3 at the point shown, 0.39 at u = 0.2, and u = 0.25, where
+      h''' = 0, is refused).
+    * The theorems print as reviewed: a new field adds its gradient theorem and changes the one
+      that lists the fields (bump-vs-displacement).  ``python tests/test_notation.py`` prints the
+      text of each new or changed theorem, then the digests: read the text, then record the
+      digests in its ``PRINTED``.
+    * §2's prose (its list of the fields, its figure's alt text) describes them in words.
+    * The book's length limits (tests/test_book_pages.py: words on the reading path and in the
+      asides, each page's height) count what a field adds: about 150 words of asides (its
+      gradient theorem) and some 230 px on each of §3 and §5.  ``make audit`` names each limit
+      passed (on a built book, ``pytest -m audit tests/test_book_pages.py -k short_enough``
+      checks them alone); make room, or raise a limit with the reason in its comment.
+
     Raises
     ------
     TypeError
