@@ -329,7 +329,7 @@ def measure(config=FAST, *, fields_=None, uv=None):
         n_ref[name] = int(pick.size)
         ru, rv = u[pick].copy(), v[pick].copy()
         hi, lo = gradient_methods.reference_gradient(record, ru, rv, ku, kv, digits=config.digits)
-        for m in gradient_methods.METHODS:
+        for m in gradient_methods.methods():
             if not m.applies(record):
                 continue
             for eps in m.steps_in(config):
@@ -558,7 +558,7 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
     rows, evaluations = [], {}
     with mpmath.workdps(ucurve.DIGITS):
         true = true_fn(mpmath.mpf(x))
-        for m in gradient_methods.METHODS:
+        for m in gradient_methods.methods():
             if m.derivative is None or not m.applies(record):
                 continue
             for eps in ((None,) if m.steps is None else steps):

@@ -27,12 +27,18 @@ its label and style, where it applies, its sources.  `lab.gradient_benchmark`, w
 the methods and measures their errors, and book/chapter/benchmark.py, which draws them, read
 only the records: adding a method is one record appended to `METHODS`, and nothing else
 changes (tests/test_gradient_benchmark.py appends a backward difference and sees it measured
-and drawn).  §5's tables, legends and the sentence naming the methods are generated from the
-list, and its figures make room for a new one (the baselines in tests/figure_baselines draw a
-fixed list and do not change); the prose that describes the figures (their alt text, §5's
-"What it shows") is the author's to extend.  A public function beside the record (as
-`forward_gradient` is) joins the table of tests/test_lab_validation.py, which names a function
-missing from it.
+and drawn).  Its place in the list is its place in tables and legends, and its name must be
+its own (`methods` refuses a second record of one name).  Its one-variable form
+(`Method.derivative`) is built, as the differences' are, from
+`renderer.fieldcode.univariate_code(function)`: the function's compiled value and its central
+and forward quotients.  §5's tables, legends and the sentence naming the methods are generated
+from the list, and its figures make room for a new one (the baselines in tests/figure_baselines
+draw a fixed list and do not change).  Three things stay the author's: the prose that describes
+the figures (their alt text, §5's "What it shows", book/s5_lab.md); a public function beside the
+record (as `forward_gradient` is) joins the table of tests/test_lab_validation.py, which names a
+function missing from it; and §5's height, which a row of its figures and tables may push past
+the limit of tests/test_book_pages.py (``make audit`` says so; make room, or raise the limit
+with the reason in its comment).
 
 Beside the methods: their work per pixel (`Evaluations`: values of h, evaluations of the
 generated gradient, and the sines and cosines they cost, counted from the sympy objects the
@@ -72,7 +78,7 @@ from renderer.validate import InvalidType, InvalidValue, choice, flag, positive_
 from ._checks import STEP, chart_points as _chart, digits as _digits, height_fields, instance, optional
 
 __all__ = [
-    "Style", "Method", "METHODS", "method", "Evaluations", "forward_gradient", "complex_step_gradient",
+    "Style", "Method", "METHODS", "methods", "method", "Evaluations", "forward_gradient", "complex_step_gradient",
     "richardson_gradient", "ad_gradient", "reference_gradient", "trig_calls", "stencil_values", "height_work",
     "evaluations", "AD", "ad_trig_calls", "abs_slope_at_zero", "crease_values", "xla_exact_gradient",
     "same_compiler_times", "RICHARDSON", "RICHARDSON_ROUNDS",
@@ -700,11 +706,24 @@ def _measured_h(info):
     return info["h_per_pixel"]
 
 
+def methods():
+    """`METHODS`, as a tuple, once no two of its records share a name: results, tables, legends and
+    `method` find a record by its name, and would take the first of two for both.  Raises
+    ValueError naming the name used twice."""
+    names = [m.name for m in METHODS]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ValueError(f"lab.gradient_methods.METHODS holds more than one record named {twice[0]!r}: "
+                         "each method needs a name of its own")
+    return tuple(METHODS)
+
+
 def method(name):
     """The record of `METHODS` named ``name``.  Raises InvalidValue (InvalidType for a name that is
-    not a string) naming the names."""
-    name = choice("method", name, tuple(m.name for m in METHODS))
-    return next(m for m in METHODS if m.name == name)
+    not a string) naming the names, and ValueError as `methods` does."""
+    records = methods()
+    name = choice("method", name, tuple(m.name for m in records))
+    return next(m for m in records if m.name == name)
 
 
 def evaluations(field, name, info=None):

@@ -239,12 +239,14 @@ def register(field):
       that lists the fields (bump-vs-displacement).  ``python tests/test_notation.py`` prints the
       text of each new or changed theorem, then the digests: read the text, then record the
       digests in its ``PRINTED``.
-    * §2's prose (its list of the fields, its figure's alt text) describes them in words.
+    * §2's prose (book/s2_scene.md: its list of the fields, its figure's alt text) describes
+      them in words.
     * The book's length limits (tests/test_book_pages.py: words on the reading path and in the
       asides, each page's height) count what a field adds: about 150 words of asides (its
-      gradient theorem) and some 230 px on each of §3 and §5.  ``make audit`` names each limit
-      passed (on a built book, ``pytest -m audit tests/test_book_pages.py -k short_enough``
-      checks them alone); make room, or raise a limit with the reason in its comment.
+      gradient theorem), some 230 px on each of §3 and §5, and the words you add to §2.  Only
+      the audit of the built site checks them: ``make audit`` (which builds the book first)
+      names each limit passed, and ``pytest -m audit tests/test_book_pages.py -k short_enough``
+      checks them alone; make room, or raise a limit with the reason in its comment.
 
     Raises
     ------

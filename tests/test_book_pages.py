@@ -915,7 +915,8 @@ def test_the_book_is_short_enough(site):
     """At most `MAX_READING_WORDS` words on the reading path and `MAX_ASIDE_WORDS` in the asides, and no
     page over `MAX_HEIGHT` px at 1280 px, folded material closed."""
     bad = too_long({n: site[n, 1280]["length"] for n in PAGES})
-    assert not bad, "\n".join(bad)
+    assert not bad, "\n".join(bad) + ("\nMake room on the page, or raise the limit (MAX_READING_WORDS, MAX_ASIDE_WORDS, "
+                                     "MAX_HEIGHT in tests/test_book_pages.py) with the reason in its comment")
 
 
 def test_every_figure_records_the_size_of_its_smallest_text(site):

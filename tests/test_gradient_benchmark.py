@@ -158,15 +158,16 @@ def backward_gradient(field, u, v, ku, kv, eps, info):
             (h0 - pointwise.height(field, u, v - eps, ku, kv)) / eps)
 
 
-BACKWARD = gm.Method("backward", backward_gradient, lambda f, info: gm.Evaluations(h=3.0), "backward difference",
-                     gm.Style("#444444", "v", 6, "--"), steps="forward_steps")
+#: Named as no real method would be, so that a real backward difference added to METHODS meets no clash.
+BACKWARD = gm.Method("toy backward", backward_gradient, lambda f, info: gm.Evaluations(h=3.0),
+                     "toy backward difference", gm.Style("#444444", "v", 6, "--"), steps="forward_steps")
 
 
 def test_a_method_with_steps_of_its_own_runs_at_them_in_every_configuration(monkeypatch):
     """A record may give its own steps instead of naming a `Config` list: `measure` runs it at exactly
     those, whatever the configuration.  Steps out of range and a name that is no step list are refused,
     naming ``Method.steps``."""
-    own = dataclasses.replace(BACKWARD, name="backward, own", steps=[3e-5, 1e-4])
+    own = dataclasses.replace(BACKWARD, name="toy backward, own", steps=[3e-5, 1e-4])
     assert own.steps == (3e-5, 1e-4)
     monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, own])
     for config in (TINY, dataclasses.replace(TINY, forward_steps=(1e-2,))):
@@ -187,14 +188,30 @@ def test_a_new_method_is_one_record_measured_and_drawn(monkeypatch):
     from chapter.benchmark import markdown_table, pareto_figure
     monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, BACKWARD])
     m = gb.measure(TINY, uv=small_chart(), fields_=("sine",))
-    back = m.get("sine", "backward 1e-08")
+    back = m.get("sine", "toy backward 1e-08")
     assert back.h_evals == 3.0 and 1e-7 < back.max_error < 1e-4 and len(back.times) == TINY.repeats
-    assert "backward 1e-08" in markdown_table(m)
+    assert "toy backward 1e-08" in markdown_table(m)
     fig = pareto_figure(m)
     style = (BACKWARD.style.colour, BACKWARD.style.marker)
     assert [ln for ax in fig.axes for ln in ax.get_lines() if (ln.get_color(), ln.get_marker()) == style]
     legend = {t.get_text(): h for lg in fig.legends for t, h in zip(lg.get_texts(), lg.legend_handles)}
-    assert (legend["backward difference"].get_color(), legend["backward difference"].get_marker()) == style
+    assert (legend[BACKWARD.label].get_color(), legend[BACKWARD.label].get_marker()) == style
+
+
+def test_a_second_record_of_one_name_is_refused_where_the_methods_are_read(monkeypatch):
+    """Two records of one name (a method added under a name already used): the benchmark, the table's
+    lookup and the figure's legend would find the first for both.  Every reader of the list refuses it,
+    naming the name; a record renamed is measured beside the original."""
+    from chapter.benchmark import methods_sentence
+    twin = dataclasses.replace(BACKWARD, name="forward")
+    monkeypatch.setattr(gm, "METHODS", [*gm.METHODS, twin])
+    refused = "^lab.gradient_methods.METHODS holds more than one record named 'forward'"
+    for read in (lambda: gb.measure(TINY, uv=small_chart(), fields_=("sine",)), lambda: gm.method("exact"),
+                 lambda: gb.univariate_errors("exp(x)", 0.5), lambda: methods_sentence(TINY)):
+        with pytest.raises(ValueError, match=refused):
+            read()
+    monkeypatch.setattr(gm, "METHODS", [*gm.METHODS[:-1], BACKWARD])
+    assert gm.method(BACKWARD.name) is BACKWARD
 
 
 # --- a reader's function of one variable -------------------------------------------------------

@@ -113,7 +113,7 @@ def pareto_figure(measurement, *, error="max"):
         ax.grid(alpha=0.3, lw=0.3)
         ax.xaxis.set_tick_params(labelbottom=True)          # each panel read alone, scrolled to on a phone
     axes[-1].set_xlabel("time per frame, ms")
-    handles = {m: handles[m] for m in ("Pareto front", *(m.name for m in gm.METHODS)) if m in handles}
+    handles = {m: handles[m] for m in ("Pareto front", *(m.name for m in gm.methods())) if m in handles}
     labels = [m if m == "Pareto front" else gm.method(m).label for m in handles]
     legend = fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, frameon=False)
     # The figure grows by the legend's height, so that more methods do not squeeze the panels.
@@ -301,7 +301,7 @@ def methods_sentence(config, fields=None):
     """
     records = [F.field(f) for f in (tuple(F.FIELDS) if fields is None else fields)]
     parts = []
-    for m in gm.METHODS:
+    for m in gm.methods():
         text = m.label + (f" {{cite:p}}`{','.join(m.sources)}`" if m.sources else "")
         steps = m.steps_in(config)
         if steps != (None,):
