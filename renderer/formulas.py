@@ -41,6 +41,7 @@ import sympy as sp
 __all__ = [
     "u", "v", "k_u", "k_v", "FIELD_SYMBOLS", "ELEMENTARY", "KINK_BAND_HALF_WIDTH", "SEED_POINT", "HeightField",
     "FIELDS", "BUILTIN", "register", "field", "gradient_scale", "gradient_scale_text", "check_expression",
+    "BUILDING_BLOCKS", "MAX_DEPTH",
     "N_x", "N_y", "N_z", "sin_phi", "hypot", "CHART", "POLE_SIN_PHI",
     "TANGENT_FRAME", "FALLBACK_FRAME", "beta", "R", "h", "h_u", "h_v", "BUMP", "PERTURBED_NORMAL",
     "eps_u", "eps_v", "u_p", "u_m", "v_p", "v_m", "STENCIL_POINTS", "CENTRAL_DENOMINATORS", "FOOTPRINT",
@@ -80,8 +81,26 @@ STENCIL_POINTS = (
 CENTRAL_DENOMINATORS = (2 * eps_u, sp.Piecewise((v_p - v_m, sp.Or(v + eps_v > 1, v - eps_v < 0)), (2 * eps_v, True)))
 
 
+#: What an expression may be built from: numbers, pi and E, symbols, + * ** and `ELEMENTARY`.
+BUILDING_BLOCKS = (sp.Number, sp.NumberSymbol, sp.Symbol, sp.Add, sp.Mul, sp.Pow, *ELEMENTARY)
+#: The deepest an expression's tree may be: sympy and its printers recurse along it.
+MAX_DEPTH = 100
+#: The largest float64.
+_FLOAT_MAX = sp.Float(1.7976931348623157e308)
+
+
+def _depth(expr):
+    """The depth of ``expr``'s tree, found without recursion."""
+    deepest, stack = 0, [(expr, 1)]
+    while stack:
+        e, d = stack.pop()
+        deepest = max(deepest, d)
+        stack.extend((a, d + 1) for a in e.args)
+    return deepest
+
+
 def check_expression(name, expr, symbols):
-    """``expr`` if it is a real sympy expression in ``symbols`` built from `ELEMENTARY`, with a real
+    """``expr`` if it is a real sympy expression in ``symbols`` built from `BUILDING_BLOCKS`, with a real
     derivative in closed form in each of its variables (a `HeightField`'s, a `renderer.univariate.Univariate`'s).
 
     Raises
@@ -89,11 +108,15 @@ def check_expression(name, expr, symbols):
     TypeError
         ``expr`` is not a sympy expression.
     ValueError
-        It uses another symbol, calls another function, holds a non-real or infinite number, or its
-        derivative holds re, im, arg or an unevaluated derivative; the message begins with ``name``.
+        It is nested more than `MAX_DEPTH` deep, uses another symbol, calls another function or holds
+        another of sympy's objects (Max, Piecewise, Integral, Sum, ...), holds a non-real or infinite
+        number or one beyond float64's range, or its derivative holds re, im, arg or an unevaluated
+        derivative; the message begins with ``name``.
     """
     if not isinstance(expr, sp.Expr):
         raise TypeError(f"{name} must be a sympy expression, got {type(expr).__name__}")
+    if (depth := _depth(expr)) > MAX_DEPTH:
+        raise ValueError(f"{name} must be nested at most {MAX_DEPTH} deep; its tree is {depth} deep")
     extra = expr.free_symbols - set(symbols)
     if extra:
         raise ValueError(f"{name} must use only {', '.join(map(str, symbols))}; it uses "
@@ -108,6 +131,21 @@ def check_expression(name, expr, symbols):
         (["an interval, AccumBounds"] if expr.has(sp.AccumBounds) else [])
     if held:
         raise ValueError(f"{name} must be real and finite: it holds {', '.join(dict.fromkeys(held))}")
+    # sympy's other objects are not functions to atoms(Function), and no printer of renderer.codegen has them.
+    other, stack = set(), [expr]
+    while stack:                        # the outermost objects of another kind (Integral, not its Tuple)
+        e = stack.pop()
+        if isinstance(e, BUILDING_BLOCKS):
+            stack.extend(e.args)
+        else:
+            other.add(type(e).__name__)
+    other = sorted(other)
+    if other:
+        raise ValueError(f"{name} must be built from numbers, its symbols, + - * / ** and "
+                         f"{', '.join(f.__name__ for f in ELEMENTARY)}; it holds {', '.join(other)}")
+    large = sorted((a for a in expr.atoms(sp.Number) if abs(a) > _FLOAT_MAX), key=abs)
+    if large:
+        raise ValueError(f"{name} must hold only numbers float64 can: it holds {sp.Float(large[-1], 3)}")
     for var in sorted(expr.free_symbols - {k_u, k_v}, key=str):      # the variables, not the frequencies
         # |g| of a g sympy cannot tell is real (g = u**u) differentiates into re, im and arg of g; a
         # negative base, c**u, into log(c) = log|c| + i pi.
@@ -365,8 +403,10 @@ def refusal(name, spec, expr, exc):
     from .validate import InvalidValue
     said, shown = str(exc), repr(str(expr))
     same = lambda a: a.replace(" ", "").replace("^", "**").lower()       # noqa: E731
-    typed = repr(str(spec)) if not isinstance(spec, str) or same(spec) == same(str(expr)) else \
-        f"{spec!r} (read as {expr})"
+    def short(text):                                            # 10**400 has 401 digits
+        return text if len(text) <= 80 else text[:77] + "..."
+    typed = repr(short(str(spec))) if not isinstance(spec, str) or same(spec) == same(str(expr)) else \
+        f"{short(spec)!r} (read as {short(str(expr))})"
     return InvalidValue(f"{name} {typed}{said.split(shown, 1)[1]}" if shown in said else f"{name}: {said}")
 
 

@@ -261,16 +261,29 @@ def fit_model(eps, error, start=(1.0, UNIT_ROUNDOFF)):
                      "convergence in 100 Gauss-Newton steps)")
 
 
-def _line(g, var):
+#: The most nodes sympy's tree of h' or h'' may have (`_line`): each derivative multiplies the tree (sin
+#: nested 30 deep: 466 nodes, h'' 15,781, h''' 253,146, minutes to print and compile).
+MAX_DERIVATIVE_NODES = 4_000
+
+
+def _line(g, var, what):
     """h, h' and h''' as mpmath functions of ``g``, an expression in ``var`` alone, the derivative
     of |f| as sign(f) f' (the derivatives of sign, which vanish off the crease, dropped: sympy's
-    DiracDelta, and the derivative it leaves unevaluated where it cannot tell f is real)."""
+    DiracDelta, and the derivative it leaves unevaluated where it cannot tell f is real).  Raises
+    InvalidValue beginning with ``what`` ("function f") where h' or h'' has more than
+    `MAX_DERIVATIVE_NODES` nodes, before the next derivative is taken."""
     def kink(x):
         return isinstance(x, sp.DiracDelta) or isinstance(x, sp.Derivative) and isinstance(x.expr, sp.sign)
 
     def smooth(e):
         return e.replace(kink, lambda x: 0)
-    return tuple(sp.lambdify(var, smooth(sp.diff(g, var, n)), modules="mpmath") for n in (0, 1, 3))
+    d = [g]
+    for n in (1, 2, 3):
+        d.append(sp.diff(d[-1], var))
+        if n < 3 and (nodes := sum(1 for _ in sp.preorder_traversal(d[-1]))) > MAX_DERIVATIVE_NODES:
+            raise validate.InvalidValue(f"{what} is too large to measure: sympy's tree of its derivative of "
+                                        f"order {n} has {nodes:,} nodes (at most {MAX_DERIVATIVE_NODES:,})")
+    return tuple(sp.lambdify(var, smooth(d[n]), modules="mpmath") for n in (0, 1, 3))
 
 
 @lru_cache(maxsize=None)
@@ -313,15 +326,32 @@ def _real(fn, X):
     return _value(fn, X)[0]
 
 
+def _named(point):
+    """("function" or "field", the point as the refusals write it, the names of h, h' and h''')."""
+    return (("function", f"x = {point['u']!r}", ("f", "f'", "f'''")) if point["component"] == "x" else
+            ("field", f"(u, v) = ({point['u']!r}, {point['v']!r})",
+             ("h", f"h_{point['component']}", f"h_{point['component'] * 3}")))
+
+
 def _undefined(label, point, line, X):
     """The refusal of a point where the function, or a derivative the measurement needs (``line``: h, h',
     h''' as mpmath functions, at ``X``), has no value float64 can hold, saying which and why."""
-    what, where, names = (("function", f"x = {point['u']!r}", ("f", "f'", "f'''")) if point["component"] == "x" else
-                          ("field", f"(u, v) = ({point['u']!r}, {point['v']!r})",
-                           ("h", f"h_{point['component']}", f"h_{point['component'] * 3}")))
+    what, where, names = _named(point)
     why = next((f"{name} {reason}" for name, fn in zip(names, line) for reason in [_value(fn, X)[1]] if reason),
                "it has no value")
     return validate.InvalidValue(f"{what} {label} must be defined and differentiable at {where}: there {why}")
+
+
+def _refuse_pole(label, exprs, var, x, point):
+    """Raise `_undefined`'s refusal where h or h' (``exprs``, in ``var``) at the float ``x`` taken exactly is
+    infinite or undefined to sympy: a pole the 50-digit reference misses, since its pi is not pi
+    (1/sin(pi x) at x = 1 is 1e102 there)."""
+    what, where, names = _named(point)
+    for name, e in zip(names, exprs):
+        exact = _exact_at(e, {var: _rational(x)})
+        if exact is not None and exact.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+            raise validate.InvalidValue(f"{what} {label} must be defined and differentiable at {where}: there "
+                                        f"{name} is not finite (a pole, or no value: sympy, exactly)")
 
 
 @lru_cache(maxsize=None)
@@ -336,12 +366,13 @@ def _error_model():
     return tuple(sp.lambdify(args, p, "numpy") for p in parts)
 
 
-def _curve(label, x, steps, quotient, line, reason, point):
+def _curve(label, x, steps, quotient, line, reason, point, exact):
     """The U-curve of the float64 quotients ``quotient(eps) -> (value, x_plus, x_minus, den)`` of the
     function ``line`` = (h, h', h''') of one variable at x: `UCurve`'s fields (``label`` and
     ``point`` fill its field, u, v, component).  Raises `renderer.validate.InvalidValue` where h or
     h' (or h''', which the model needs where there is a derivative) is not a real number float64
-    can hold at x, or, naming ``eps``, where a quotient, or h at one of its abscissae, is not."""
+    can hold at x, or is not finite there exactly (``exact``: h and h' as sympy expressions, and their
+    variable; `_refuse_pole`), or, naming ``eps``, where a quotient, or h at one of its abscissae, is not."""
     h_mp, dh_mp, d3h_mp = line
     with mpmath.workdps(DIGITS):
         X = mpmath.mpf(x)
@@ -354,6 +385,7 @@ def _curve(label, x, steps, quotient, line, reason, point):
         h0, h3 = _real(h_mp, X), (_real(d3h_mp, X) if reason is None else mpmath.nan)
         if true is None or h0 is None or h3 is None:
             raise _undefined(label, point, line if reason is None else line[:2], X)
+        _refuse_pole(label, *exact, x, point)
         error, trunc, roundoff = [], [], []
         for i, e in enumerate(steps):
             fd, plus, minus, den = quotient(float(e))
@@ -463,7 +495,7 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
                                                          for r in g.atoms(sp.Rational)):   # which lambdify cannot print
         raise validate.InvalidValue(f"field {record.name} is too large to measure at (u, v) = ({u!r}, {v!r}): "
                                     f"its exact value there has more digits than Python prints")
-    line = _line(g, var)
+    line = _line(g, var, f"field {record.name}")
     stencil = _stencil()
 
     def quotient(e):
@@ -472,7 +504,7 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
         return fd, points[2 * k], points[2 * k + 1], points[4 + k]
 
     return _curve(record.name, x, steps, quotient, line, non_differentiable(record, u, v, component, k_u, k_v),
-                  point)
+                  point, ((g, sp.diff(g, var)), var))
 
 
 #: The largest step `measure_function` accepts (its smallest is `renderer.pointwise.MIN_STEP`).
@@ -515,7 +547,7 @@ def measure_function(function, x, eps=None):
     x = validate.real("x", x)
     steps = DEFAULT_STEPS if eps is None else validate.steps("eps", eps, low=pointwise.MIN_STEP,
                                                               high=MAX_FUNCTION_STEP)
-    line, point = _line(record.expr, U.x_var), dict(u=x, v=float("nan"), component="x")
+    line, point = _line(record.expr, U.x_var, f"function {record.name}"), dict(u=x, v=float("nan"), component="x")
     with mpmath.workdps(DIGITS):
         if any(_real(fn, mpmath.mpf(x)) is None for fn in line[:2]):     # before the crease and float64 checks
             raise _undefined(record.name, point, line[:2], mpmath.mpf(x))
@@ -530,4 +562,4 @@ def measure_function(function, x, eps=None):
     def quotient(e):
         return code.central(x, e), x + e, x - e, 2 * e
 
-    return _curve(record.name, x, steps, quotient, line, None, point)
+    return _curve(record.name, x, steps, quotient, line, None, point, ((record.expr, record.derivative), U.x_var))

@@ -327,6 +327,17 @@ def thread_count(name, value):
 
 #: Longest expression text accepted (characters): a height field or a function is a formula, not a program.
 MAX_EXPRESSION_CHARS = 500
+#: The largest exponent of a power of numbers `expression` evaluates: 2**1100 is past float64 already.
+MAX_NUMBER_EXPONENT = 1100
+
+
+def _huge_exponent(exponent):
+    """Whether ``exponent`` (a sympy expression of numbers, unevaluated) is beyond `MAX_NUMBER_EXPONENT`
+    in size, evaluating none of its own powers that are (9**9**9's exponent 9**9 is evaluated, its power not)."""
+    import sympy as sp
+    if any(isinstance(p, sp.Pow) and _huge_exponent(p.exp) for p in exponent.args):
+        return True
+    return abs(sp.N(exponent, 5)) > MAX_NUMBER_EXPONENT
 
 
 def expression(name, text, symbols, functions, *, fields=()):
@@ -395,9 +406,20 @@ def expression(name, text, symbols, functions, *, fields=()):
             raise InvalidValue(f"{name} must be real; {tok.string!r} is imaginary")
     glob = {"__builtins__": {}, "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational}
     try:
-        expr = parse_expr(text, local_dict=namespace, global_dict=glob, transformations=(auto_number, convert_xor))
+        # First unevaluated: a power of numbers past float64 (9**9**9) would take sympy hours to evaluate.
+        held = parse_expr(text, local_dict=namespace, global_dict={**glob, "Add": sp.Add, "Mul": sp.Mul, "Pow": sp.Pow},
+                          transformations=(auto_number, convert_xor), evaluate=False)
+        power = next((p for p in sp.preorder_traversal(held) if isinstance(p, sp.Pow) and p.exp.is_number
+                      and not p.exp.free_symbols and _huge_exponent(p.exp)), None)
+        if power is None:
+            expr = parse_expr(text, local_dict=namespace, global_dict=glob, transformations=(auto_number, convert_xor))
+    except RecursionError:
+        raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} is nested too deeply") from None
     except (SyntaxError, TypeError, ValueError, AttributeError, ZeroDivisionError) as exc:
         raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} is not one ({exc})") from None
+    if power is not None:
+        raise InvalidValue(f"{name} must hold only numbers float64 can; {text!r:.80} raises a number to the "
+                           f"power {str(power.exp):.40}")
     if not isinstance(expr, sp.Expr):
         raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} is a {type(expr).__name__}")
     return expr

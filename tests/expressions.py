@@ -54,3 +54,22 @@ def fields_at_points():
     singular = st.tuples(st.sampled_from(SINGULAR), st.sampled_from("uv"), chart, chart,
                          st.sampled_from("uv")).map(at)
     return st.one_of(ordinary, singular)
+
+
+#: Singular where pi x is a multiple of pi (or of pi/2) exactly, which neither float64's pi nor a 50-digit
+#: one is: f at such a point is finite in both (1/sin(pi x) at x = 1: 8e15 and 1e102), infinite exactly.
+#: (template, its singular points as a strategy).
+ROUNDED_PI = (("1/sin(pi*{x})", st.integers(-3, 3)), ("tan(pi*{x})", st.integers(-3, 2).map(lambda n: n + 0.5)),
+              ("1/cos(pi*{x})", st.integers(-3, 2).map(lambda n: n + 0.5)), ("log(sin(pi*{x})**2)", st.integers(-3, 3)))
+
+
+def singular_cases(var, lo, hi):
+    """(text, the point on its singularity in [lo, hi]): a `SINGULAR` template at its ``c``, or a
+    `ROUNDED_PI` one at one of its points, in the variable ``var``.  ``c`` is a multiple of 1/64, whose
+    decimal text is the float exactly (sympy reads a float's repr, 3.73e-54, to more bits than 53: the
+    pole of 1/(u - 3.73e-54) is not at the float 3.73e-54)."""
+    at_c = st.tuples(st.sampled_from(SINGULAR), st.integers(int(lo * 64), int(hi * 64)).map(lambda n: n / 64)).map(
+        lambda t: (t[0].format(x=var, c=repr(t[1])), t[1]))
+    rounded = st.one_of(*(p.filter(lambda c: lo <= c <= hi).map(lambda c, t=t: (t.format(x=var), float(c)))
+                          for t, p in ROUNDED_PI))
+    return st.one_of(at_c, rounded)

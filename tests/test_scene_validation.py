@@ -131,8 +131,9 @@ def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
     assert [Scene(height_field=c).field.gradient for c in (0, 0.5)] == [(0, 0)] * 2
     _, message = refusal(lambda: Scene(height_field=True))
     assert message.startswith("Scene.height_field must be") and message.endswith("got bool"), message
-    # 12**4096 overflows; (0.5 - pi)**pi is a complex number sympy does not evaluate.
-    for text in ("1/u", "log(v)", "1e400*u", "u*(k_u + k_v)**(k_u**k_v)", "u*(0.5 - pi)**pi", "(0.5 - pi)**pi"):
+    # 12**4096 overflows; (0.5 - pi)**pi is a complex number sympy does not evaluate.  (1e400 is refused as a
+    # number beyond float64: test_an_expression_beyond_the_grammar_or_float64_is_refused_in_one_line.)
+    for text in ("1/u", "log(v)", "u*(k_u + k_v)**(k_u**k_v)", "u*(0.5 - pi)**pi", "(0.5 - pi)**pi"):
         _, message = refusal(lambda: Scene(height_field=text))
         assert message.startswith("Scene.height_field ") and "not finite and real" in message, message
     # The point named is one where the field has no value: on its singular line.
@@ -145,6 +146,44 @@ def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
     for text, least in (("u - 2*v", (0.0, 1.0)), ("2*(u - 0.25)**2 - 6*(v - 0.5)**2", (0.25, 0.0))):
         _, message = refusal(lambda: Scene(height_field=text, beta=0.9))
         assert f"at (u, v) = ({least[0]:g}, {least[1]:g})" in message, message
+
+
+def _nested(depth):
+    e = F.u
+    for _ in range(depth - 1):
+        e = sp.sin(e)
+    return e
+
+
+@pytest.mark.parametrize("field, said", [
+    # sympy objects that are not functions to atoms(Function): they passed the check of the functions called.
+    (sp.Max(F.u, 0.5), "it holds Max"), (sp.Integral(sp.sin(F.u), F.u), "it holds Integral"),
+    (sp.Derivative(sp.sin(F.u), F.u), "it holds Derivative"), (F.u + sp.O(F.u**2), "it holds Order"),
+    (sp.Sum(F.u**sp.Symbol("t"), (sp.Symbol("t"), 0, 3)), "it holds Sum"),
+    (sp.Subs(sp.sin(sp.Symbol("t")), sp.Symbol("t"), F.u), "it holds Subs"), (sp.Lambda(F.u, F.u**2), "it holds Lambda"),
+    (sp.MatrixSymbol("A", 1, 1)[0, 0] * F.u, "it uses A"),
+    # Numbers beyond float64: 10**400 raised OverflowError from the chart's check; 9**9**9 took hours to parse.
+    ("10**400*u", "must hold only numbers float64 can: it holds 1.00E+400"),
+    (sp.Rational(10**400, 3) * F.u, "it holds 3.33E+399"), ("1e999*u", "it holds 1.00E+999"),
+    ("9**9**9*u", "raises a number to the power 9**9"), ("u*2**(3**7)", "raises a number to the power 3**7"),
+    (_nested(101), "must be nested at most 100 deep; its tree is 101 deep"),
+    ("u**" * 166 + "u", "its tree is 167 deep"),
+])
+def test_an_expression_beyond_the_grammar_or_float64_is_refused_in_one_line(field, said):
+    """What a field may be built from is a whitelist (`renderer.formulas.BUILDING_BLOCKS`), numbers float64
+    holds, a tree at most `renderer.formulas.MAX_DEPTH` deep: anything else is one InputError naming
+    ``Scene.height_field``, never an exception from inside sympy, numba or the chart's check, nor a hang."""
+    kind, message = refusal(lambda: Scene(height_field=field))
+    assert message.startswith("Scene.height_field") and said in message and "\n" not in message, message
+    assert len(message) < 400, message
+
+
+def test_the_deepest_and_largest_accepted_expressions_render():
+    """The limits' other side: a tree exactly `renderer.formulas.MAX_DEPTH` deep and a power of numbers
+    within float64 are accepted and render finite."""
+    for field in (_nested(100), "u*2**(2**10)*1e-300"):
+        out = render(Scene(height_field=field), 8, 8)
+        assert np.isfinite(out.image).all()
 
 
 def _off_contract(fields, k_u, k_v):

@@ -13,12 +13,13 @@ from fractions import Fraction
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from renderer.pointwise import MIN_STEP
 from renderer.ucurve import DEFAULT_STEPS, MAX_FUNCTION_STEP, measure, measure_function
 from renderer.validate import InputError
 
-from .expressions import fields_at_points, functions_at_points
+from .expressions import CHART, fields_at_points, functions_at_points, singular_cases
 
 
 @pytest.mark.parametrize("kwargs, error, name, phrase", [
@@ -138,6 +139,27 @@ def test_any_field_at_any_chart_point_is_a_u_curve_or_one_input_error(case):
     _u_curve_or_refusal(lambda: measure(text, u, v, component, eps=STEPS), ("field", "eps"))
 
 
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=singular_cases("x", -10.0, 10.0))
+def test_a_function_on_its_singularity_is_refused_never_measured(case):
+    """f at a pole, a branch point, an essential singularity or out of its domain: refused, naming
+    ``function``, also where float64 and a 50-digit pi both give a finite value (1/sin(pi x) at 1)."""
+    text, x = case
+    with pytest.raises(InputError, match=r"^(function|x)\b"):
+        measure_function(text, x, eps=STEPS)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=singular_cases("u", 0.0, 1.0), v=st.sampled_from(CHART))
+def test_a_field_on_its_singularity_is_refused_never_measured(case, v):
+    """The same for a field of u at a chart point on its singularity (tan(pi u) at u = 1/2): refused,
+    naming ``field`` or ``eps`` (a step past a branch point), or measured with the reason it has no
+    derivative there (on the seam, where u**1.5 meets 1)."""
+    text, u = case
+    uc = _u_curve_or_refusal(lambda: measure(text, u, v, "u", eps=STEPS), ("field", "eps"))
+    assert uc is None or uc.reason is not None, uc
+
+
 @pytest.mark.parametrize("call, name", [
     (lambda: measure_function("exp(exp(x))", 1e300), "function"),      # mpmath overflows
     (lambda: measure_function("tanh(x)", 1.0, eps=[1e-3, 100.0]), None),  # measured
@@ -149,6 +171,10 @@ def test_any_field_at_any_chart_point_is_a_u_curve_or_one_input_error(case):
     (lambda: measure("sqrt(u - 0.3)", 0.31, eps=[1e-3, 0.02]), "eps"),  # u - eps past the branch point
     (lambda: measure("u*(3*k_u + 1/k_u)**(3**k_u)"), "field"),          # 9,077 digits at k_u = 8
     (lambda: measure("(3*k_u)**(k_u**k_u)"), "field"),                   # 23 million: refused before computing
+    (lambda: measure_function("9**9**9*x", 0.5), "function"),            # hours to parse: refused unevaluated
+    (lambda: measure_function("sin(" * 30 + "x" + ")" * 30, 0.5), "function"),  # f'' of 15,781 nodes: refused
+    (lambda: measure("sin(" * 99 + "u" + ")" * 99), "field"),            # h' of 5,050 nodes: refused before h''
+    (lambda: measure_function("1/sin(pi*x)", 1.0), "function"),          # a pole only exactly: 1e102 at 50 digits
     (lambda: measure("abs(log(u - 0.31))"), "field"),                   # the crease check meets the pole
     # float64 rounds u_m**2 up to the constant (h(u_m) = 0); exactly it is below it (h imaginary).
     (lambda: measure("sqrt(u**2 - 0.1417678433433451)", 0.3774972702218265, eps=[2.0**-10]), "eps"),
