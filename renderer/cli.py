@@ -4,9 +4,10 @@ An input error (a bad option, a malformed scene file, an output directory that d
 exist, a value the library refuses with `renderer.validate.InputError`) prints ONE line
 ``symrender: error: ...`` and returns 2; anything else is a bug: one line ``symrender:
 internal error: ...`` and 1, never a traceback.  Ctrl-C prints ``symrender: interrupted``
-and returns 130, SIGTERM ``symrender: terminated`` and 143 (whatever exception then ends the command).  The report is printed first,
-then the output is put in place by `renderer.files.write_bytes`: an error or a signal at
-any moment leaves no output and no temporary file.  ``-o -`` (``--plot -``) writes the
+and returns 130, SIGTERM ``symrender: terminated`` and 143 (whatever exception then ends the command).  The output is
+written beside its place, then the report is printed, then the output is renamed into place
+(`renderer.files.write_bytes`): an error or a signal at any moment before the rename leaves no
+output and no temporary file, and a signal after it is ignored (the command has succeeded).  ``-o -`` (``--plot -``) writes the
 PNG to stdout and the report to stderr.  PNGs carry no varying metadata.
 
 Not special-cased, by design (a plain error, or Python's or the library's own behaviour):
@@ -44,6 +45,7 @@ MAX_STEPS = 10_000
 #: The census's columns: the step, then `renderer.ledger.Ledger`'s fields.
 COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink", "mean_abs_off_kink")
 _signal = []                            # the first signal of a `main` run
+_placing = []                           # the output's temporary file (None: a device), once it is written
 
 
 class UsageError(Exception):
@@ -155,13 +157,14 @@ def build_parser():
     what.add_argument("--function", metavar="EXPR",
                       help="instead of a field, a function of x, e.g. 'exp(x)/sqrt(sin(x)**3 + cos(x)**3)' "
                            "(pi, E, + - * / ** and sin cos tan asin acos atan sinh cosh tanh exp log sqrt abs)")
-    u.add_argument("--x", type=float, default=1.5, help="with --function: the point x, any real where f is "
-                                                       "differentiable (default 1.5)")
-    u.add_argument("--u", type=float, default=0.31, help="chart u in [0, 1] (default 0.31)")
-    u.add_argument("--v", type=float, default=0.47, help="chart v in [0, 1] (default 0.47)")
-    u.add_argument("--component", choices=("u", "v"), default="u", help="h_u or h_v (default u)")
-    u.add_argument("--k-u", type=float, default=8.0, help="frequency k_u in (0, 1000] (default 8)")
-    u.add_argument("--k-v", type=float, default=4.0, help="frequency k_v in (0, 1000] (default 4)")
+    # Each option of one kind of measurement only (`UCURVE_ONLY`); None when not given.
+    u.add_argument("--x", type=float, help="with --function: the point x, any real where f is "
+                                           f"differentiable (default {UCURVE_ONLY['function']['x']:g})")
+    u.add_argument("--u", type=float, help="chart u in [0, 1] (default 0.31)")
+    u.add_argument("--v", type=float, help="chart v in [0, 1] (default 0.47)")
+    u.add_argument("--component", choices=("u", "v"), help="h_u or h_v (default u)")
+    u.add_argument("--k-u", type=float, help="frequency k_u in (0, 1000] (default 8)")
+    u.add_argument("--k-v", type=float, help="frequency k_v in (0, 1000] (default 4)")
     u.add_argument("--eps", type=_steps, default=_steps("1e-1:1e-15:15"), metavar="a:b:n|e1,e2,...",
                    help=f"as for sweep; 1 to {MAX_STEPS:,} steps, each in [1e-300, 1) (with --function "
                         "[1e-300, 1000]) (default 1e-1:1e-15:15)")
@@ -238,9 +241,11 @@ def load_scene(path=None, sets=()):
 
 
 def _check_output(path, flag):
-    """Refuse, before any work, an output that is a directory or whose directory does not exist."""
-    if path != "-" and (os.path.isdir(path) or not os.path.isdir(os.path.dirname(os.path.realpath(path)))):
-        raise UsageError(f"{flag} {path}: not a file in an existing directory")
+    """Refuse, before any work, an output that is empty, names a directory (``out/`` too) or whose
+    directory does not exist."""
+    if path != "-" and (not path or path.endswith(os.sep) or os.path.isdir(path)
+                        or not os.path.isdir(os.path.dirname(os.path.realpath(path)))):
+        raise UsageError(f"{flag} {path!r}: not a file in an existing directory")
 
 
 def _png(rgb):
@@ -348,22 +353,34 @@ def _ucurve_png(uc):
     return buf.getvalue()
 
 
+#: ucurve's options of one kind of measurement, and their defaults: the field's are `renderer.ucurve.measure`'s.
+UCURVE_ONLY = {"function": {"x": 1.5}, "field": ("u", "v", "component", "k_u", "k_v")}
+
+
 def _cmd_ucurve(args):
     if args.plot is not None:
         _check_output(args.plot, "--plot")
+    import inspect
+
     from renderer.ucurve import UNIT_ROUNDOFF, measure, measure_function
     from renderer.validate import InputError
+    kind = "function" if args.function is not None else "field"
+    stray = [k for other in UCURVE_ONLY if other != kind for k in UCURVE_ONLY[other] if getattr(args, k) is not None]
+    if stray:
+        raise UsageError(f"--{stray[0].replace('_', '-')} " + ("measures a height field, not --function"
+                                                                 if kind == "function" else "applies only with --function"))
+    given = {k: getattr(args, k) for k in UCURVE_ONLY[kind] if getattr(args, k) is not None}
     try:
-        if args.function is not None:
-            uc = measure_function(args.function, args.x, eps=args.eps)
+        if kind == "function":
+            uc = measure_function(args.function, given.get("x", UCURVE_ONLY["function"]["x"]), eps=args.eps)
         else:
-            uc = measure(field=args.field, u=args.u, v=args.v, component=args.component, eps=args.eps,
-                         k_u=args.k_u, k_v=args.k_v)
+            uc = measure(field=args.field, eps=args.eps, **given)
     except InputError as exc:           # the message starts with the parameter, which names the option
         name, _, rest = str(exc).partition(" ")
         raise UsageError(f"--{name.replace('_', '-')} {rest}") from None
+    k = {n: given.get(n, inspect.signature(measure).parameters[n].default) for n in ("k_u", "k_v")}
     report = [f"U-curve: {uc.field}, {_derivative(uc)} at {_point(uc)}"
-              + ("" if args.function else f", k = ({args.k_u:g}, {args.k_v:g})") + "; reference mpmath 50 digits"]
+              + ("" if args.function else f", k = ({k['k_u']:g}, {k['k_v']:g})") + "; reference mpmath 50 digits"]
     rows = zip(uc.eps, uc.truncation, uc.roundoff, uc.error, uc.model)
     head = f"{'eps':>9}  {'truncation':>11}  {'roundoff':>11}  {'|error|':>10}"
     if uc.reason is not None:           # no derivative: no model and no optimal step
@@ -405,7 +422,13 @@ _COMMANDS = {"render": _cmd_render, "sweep": _cmd_sweep, "ucurve": _cmd_ucurve}
 # ---------------------------------------------------------------- main
 
 
+#: The signals that stop a command (`_on_signal`).
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
 def _on_signal(signum, frame):
+    if _placing and not (_placing[0] and os.path.lexists(_placing[0])):
+        return                          # the output is in place (its temporary file renamed): done
     if not _signal:                     # a second signal does not cut the clean-up short
         _signal.append(signum)
         raise KeyboardInterrupt
@@ -434,16 +457,22 @@ def _run(argv):
     if "NUMBA_NUM_THREADS" in os.environ:          # before numba reads it (0 fails its import)
         from renderer.validate import thread_count
         thread_count("NUMBA_NUM_THREADS", os.environ["NUMBA_NUM_THREADS"])
-    report, outputs = _COMMANDS[args.command](args)
+    report, outputs = _COMMANDS[args.command](args)         # at most one output
     _stop_if_signalled()
     on_stdout = any(path == "-" for path, _ in outputs)      # then the report goes to stderr
-    _emit(sys.stderr if on_stdout else sys.stdout, "\n".join(report) + "\n",
-          "standard error" if on_stdout else "standard output")
+
+    def tell():
+        _emit(sys.stderr if on_stdout else sys.stdout, "\n".join(report) + "\n",
+              "standard error" if on_stdout else "standard output")
+    if not outputs or on_stdout:
+        tell()
     for path, data in outputs:
         if path == "-":
             _emit(sys.stdout.buffer, data, "standard output")
         else:
-            files.write_bytes(path, data)
+            # The report once the image is written beside its place (a full disk fails before it says
+            # "wrote"); from its rename on, the command has succeeded (`_on_signal`).
+            files.write_bytes(path, data, before=lambda tmp: (tell(), _placing.append(tmp)))
     return 0
 
 
@@ -453,7 +482,8 @@ def main(argv=None) -> int:
     error, 130 SIGINT, 143 SIGTERM.  Never raises."""
     say = lambda text: print("symrender: " + " ".join(str(text).split()), file=sys.stderr)  # noqa: E731
     _signal.clear()
-    previous = {sig: signal.signal(sig, _on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    _placing.clear()
+    previous = {sig: signal.signal(sig, _on_signal) for sig in SIGNALS}
     hook = sys.unraisablehook           # a KeyboardInterrupt a C callback dropped is `_signal`'s
     sys.unraisablehook = lambda u: None if isinstance(u.exc_value, KeyboardInterrupt) else hook(u)
     try:
@@ -481,8 +511,8 @@ def main(argv=None) -> int:
         return 1
     finally:
         sys.unraisablehook = hook
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        for sig, handler in previous.items():     # as the program exits (argv None), ignored: it is done
+            signal.signal(sig, handler if argv is not None else signal.SIG_IGN)
 
 
 if __name__ == "__main__":  # pragma: no cover

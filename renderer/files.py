@@ -17,7 +17,7 @@ def umask():
     return mask
 
 
-def write_bytes(path, data):
+def write_bytes(path, data, before=None):
     """Write ``data`` to ``path`` atomically: into a temporary file beside it, then `os.replace`.
 
     Parameters
@@ -28,6 +28,9 @@ def write_bytes(path, data):
         on a pipe) is written through instead, and stays what it was.
     data : bytes-like
         The whole content.
+    before : callable, optional
+        Called with the temporary file's path once ``data`` is in it, just before it takes ``path``'s
+        place: what it raises leaves ``path`` as it was (a device: called with None once written through).
 
     On any exception, KeyboardInterrupt included, the temporary file
     (``.<name>.XXXX.part``) is removed and ``path`` is as it was.  The file gets
@@ -41,8 +44,13 @@ def write_bytes(path, data):
     """
     path = os.fspath(path)
     if os.path.exists(path) and not os.path.isfile(path) and not os.path.isdir(path):
-        with open(path, "wb") as f:                 # a device or a pipe: written through
-            f.write(data)
+        try:
+            with open(path, "wb") as f:             # a device or a pipe: written through
+                f.write(data)
+        except OSError as exc:                      # /dev/full: no space, naming the device
+            raise type(exc)(exc.errno, exc.strerror, path) from None
+        if before is not None:
+            before(None)
         return
     target = os.path.realpath(path)
     try:
@@ -56,6 +64,8 @@ def write_bytes(path, data):
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp, 0o666 & ~umask())
+        if before is not None:
+            before(tmp)
         os.replace(tmp, target)
     except BaseException as exc:
         with contextlib.suppress(FileNotFoundError):

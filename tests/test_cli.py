@@ -9,16 +9,19 @@ tests/test_interrupts.py's, the atomic write tests/test_files.py's.
 from __future__ import annotations
 
 import contextlib
+import errno
 import csv
 import io
 import json
 import math
 import os
 import re
+import signal
 import struct
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -434,7 +437,8 @@ def test_any_input_succeeds_or_is_one_input_error(command, toml, pairs):
 def ucurve_drift(parser, measure):
     """Where ``symrender ucurve``'s parser departs from the library it calls: each option that passes a
     parameter of ``measure`` whose default differs from that parameter's default in the signature, or
-    whose help does not print the default the command runs with."""
+    whose help does not print the default the command runs with (an option given no default passes
+    nothing, and the library's default applies)."""
     import inspect
     parsers = parser._subparsers._group_actions[0].choices
     actions = {a.dest: a for a in parsers["ucurve"]._actions}
@@ -443,8 +447,9 @@ def ucurve_drift(parser, measure):
         if name not in actions or p.default is None:
             continue
         a = actions[name]
-        shown = f"{a.default:g}" if isinstance(a.default, float) else str(a.default)
-        if a.default != p.default or f"(default {shown})" not in a.help:
+        runs = p.default if a.default is None else a.default
+        shown = f"{runs:g}" if isinstance(runs, float) else str(runs)
+        if runs != p.default or f"(default {shown})" not in a.help:
             out.append(f"--{name.replace('_', '-')}: default {a.default!r}, help {a.help!r}; the library's {p.default!r}")
     return out
 
@@ -454,6 +459,8 @@ def test_the_ucurve_commands_defaults_are_the_librarys(monkeypatch):
     held to `renderer.ucurve.measure`'s: the seed's point and frequencies, the field and the component, each
     also as its help prints it.  A library default moved (the seed's point nudged) and a help printing
     another default are caught."""
+    import inspect
+
     import renderer.ucurve
     assert ucurve_drift(cli.build_parser(), renderer.ucurve.measure) == []
     real = renderer.ucurve.measure
@@ -463,5 +470,69 @@ def test_the_ucurve_commands_defaults_are_the_librarys(monkeypatch):
     assert [line.split(":")[0] for line in ucurve_drift(cli.build_parser(), moved)] == ["--u", "--component", "--k-v"]
     parser = cli.build_parser()
     v = next(a for a in parser._subparsers._group_actions[0].choices["ucurve"]._actions if a.dest == "v")
-    v.help = v.help.replace(f"(default {v.default:g})", f"(default {v.default / 2:g})")
+    d = inspect.signature(real).parameters["v"].default
+    v.help = v.help.replace(f"(default {d:g})", f"(default {d / 2:g})")
     assert [line.split(":")[0] for line in ucurve_drift(parser, real)] == ["--v"]
+
+
+@pytest.mark.parametrize("output", ["", "sub/", "{tmp}/"])
+def test_an_output_that_names_no_file_is_refused_before_any_work(tmp_path, monkeypatch, capsys, output):
+    """An empty name and a name ending in a slash (a directory, existing or not) are refused in one line
+    naming ``-o``; before, "sub/" wrote a file named sub and "" failed at the end with "Is a directory"."""
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = run(["render", "--size", "4x4", "-o", output.format(tmp=tmp_path)], capsys)
+    assert one_line(rc, err) and err.startswith("symrender: error: -o ") and out == "", err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_write_that_fails_says_so_without_having_said_wrote(tmp_path, monkeypatch, capsys):
+    """A full disk (the write into the temporary file fails) and a full device (/dev/full, written
+    through) are one line naming the path, and the report, which says "wrote", is not printed."""
+    def full(fd):
+        raise OSError(errno.ENOSPC, "No space left on device")
+    with monkeypatch.context() as m:
+        m.setattr(os, "fsync", full)
+        rc, out, err = run(["render", "--size", "4x4", "-o", tmp_path / "a.png"], capsys)
+    assert one_line(rc, err) and f"{tmp_path / 'a.png'}: No space left" in err and out == "", (out, err)
+    assert list(tmp_path.iterdir()) == []
+    if Path("/dev/full").exists():
+        rc, out, err = run(["render", "--size", "4x4", "-o", "/dev/full"], capsys)
+        assert one_line(rc, err) and "/dev/full: No space left" in err and out == "", (out, err)
+
+
+def test_a_signal_once_the_output_is_in_place_is_held_and_the_command_succeeds(tmp_path, monkeypatch, capsys):
+    """A signal between the output's rename and the command's end: the work is done, so exit 0 with
+    the output and its report, the signal ignored.  Before, a signal there (or after the handlers were
+    restored) ended the command 130, the output in place, without a word.  One just before the rename
+    still stops it: 130, "interrupted", nothing left."""
+    real = os.replace
+
+    def signal_then_replace(after):
+        def replace(src, dst):
+            if not after:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.1)                 # the handler runs at the next bytecode, before the rename
+            real(src, dst)
+            if after:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.1)
+        return replace
+    monkeypatch.setattr(os, "replace", signal_then_replace(after=True))
+    rc, out, err = run(["render", "--size", "4x4", "-o", tmp_path / "a.png"], capsys)
+    assert (rc, err) == (0, "") and out.startswith("wrote ") and (tmp_path / "a.png").is_file()
+    monkeypatch.setattr(os, "replace", signal_then_replace(after=False))
+    rc, out, err = run(["render", "--size", "4x4", "-o", tmp_path / "b.png"], capsys)
+    assert (rc, err) == (130, "symrender: interrupted\n") and sorted(p.name for p in tmp_path.iterdir()) == ["a.png"]
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["--x", "2"], "--x applies only with --function"),
+    (["--function", "x", "--k-u", "0"], "--k-u measures a height field, not --function"),
+    (["--function", "x", "--u", "0.3"], "--u measures a height field, not --function"),
+    (["--function", "x", "--component", "v"], "--component measures a height field, not --function"),
+])
+def test_an_option_of_the_other_measurement_is_refused_not_ignored(capsys, argv, said):
+    """``ucurve``'s options each belong to one kind of measurement, a field's or a function's; given with
+    the other, it was silently ignored (an out-of-range --k-u 0 too)."""
+    rc, out, err = run(["ucurve", *argv], capsys)
+    assert one_line(rc, err) and said in err and out == "", err
