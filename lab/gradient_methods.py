@@ -540,8 +540,11 @@ def crease_values(*, v=None, eps=None, ku=None, kv=None):
         off the creases in v.
     eps : float in [1e-300, 1) or None, keyword-only
         The central difference's step in chart units; None for the draft's step.
-    ku, kv : float in (0, 1e3] or None, keyword-only
-        The frequencies; None for the U-curve's (`renderer.ucurve.SEED_FREQUENCIES`).
+    ku : float in [1, 1e3] or None, keyword-only
+        The frequency in u, at least 1 so that the crease u = 1/k_u is on the chart; None for the
+        U-curve's (`renderer.ucurve.SEED_FREQUENCIES`).
+    kv : float in (0, 1e3] or None, keyword-only
+        The frequency in v; None for the U-curve's.
 
     Returns
     -------
@@ -558,7 +561,8 @@ def crease_values(*, v=None, eps=None, ku=None, kv=None):
     record = DRAFT_SCENE.field
     ku0, kv0 = ucurve.SEED_FREQUENCIES
     v = real("v", ucurve.SEED_POINT[1] if v is None else v, **UNIT)
-    ku, kv = (real(n, k0 if k is None else k, **FREQUENCY) for n, k, k0 in (("ku", ku, ku0), ("kv", kv, kv0)))
+    ku = real("ku", ku0 if ku is None else ku, **{**FREQUENCY, "low": 1.0, "low_open": False})
+    kv = real("kv", kv0 if kv is None else kv, **FREQUENCY)
     eps = real("eps", DRAFT_SCENE.eps if eps is None else eps, **STEP)
     f_u = sp.lambdify(F.FIELD_SYMBOLS, sp.diff(sp.Mul(*record.crease_factors), F.u), modules="mpmath")
     factor_u = sp.lambdify(F.FIELD_SYMBOLS, next(c for c in record.crease_factors if F.u in c.free_symbols))

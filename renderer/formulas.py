@@ -366,7 +366,8 @@ _EXPRESSIONS = {}
 def field(spec, name="height_field"):
     """The `HeightField` ``spec`` names: a registered name, a `HeightField`, a reader's
     sympy expression (or its text, parsed by `renderer.validate.expression`) in u, v, k_u, k_v,
-    or a real number (a constant field, flat: no β moves its normal).
+    or a real number (a constant field, flat: no β moves its normal).  An expression's symbols are
+    taken by their names: ``sympy.symbols("u v")`` are `u` and `v`, whatever their assumptions.
 
     Raises
     ------
@@ -389,6 +390,10 @@ def field(spec, name="height_field"):
         raise InvalidType(f"{name} must be one of {tuple(FIELDS)}, a HeightField, a sympy expression in "
                           f"u, v, k_u, k_v or a real number, got {type(spec).__name__}")
     expr = expression(name, spec, FIELD_SYMBOLS, ELEMENTARY, fields=tuple(FIELDS)) if isinstance(spec, str) else spec
+    by_name = {str(s): s for s in FIELD_SYMBOLS}
+    alike = {s: by_name[s.name] for s in expr.free_symbols if getattr(s, "name", None) in by_name and s != by_name[s.name]}
+    if alike:                           # only then: xreplace evaluates what was built unevaluated
+        expr = expr.xreplace(alike)
     try:
         record = HeightField(str(expr), expr)
     except (TypeError, ValueError) as exc:

@@ -146,7 +146,9 @@ FUNCTIONS = {
                                                                            1.0, 8.0, 4.0)),
                                  dict(measurement=p("own", ("m", T, "str 'm'"), (RESULT, T, "MethodResult")))),
     "gradient_methods.crease_values": (gm.crease_values, dict(v=0.47, eps=1e-3, ku=8.0, kv=4.0),
-                                       dict(v=p("real", (1.5, V, "got 1.5")), eps=EPS, ku=p("real"), kv=p("real"))),
+                                       dict(v=p("real", (1.5, V, "got 1.5")), eps=EPS, kv=p("real"),
+                                            # u = 1/k_u, the second crease, must be on the chart
+                                            ku=p("real", (0.5, V, "ku must be in [1, 1000], got 0.5")))),
     "gradient_methods.same_compiler_times": (gm.same_compiler_times, dict(uu=U8, vv=V8, ku=8.0, kv=4.0, rounds=1,
                                                                           fields_=("rings",)),
                                              dict(uu=p("array"), vv=p("array"), ku=p("real"), kv=p("real"),

@@ -127,6 +127,10 @@ def test_the_field_check_rejects_a_refusal_that_names_another_field():
 def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
     scene = Scene(height_field="sin(pi*k_u*u)^2 * sin(pi*k_v*v)^2", beta=0.5)
     assert scene.field.expr == (F.FIELDS["sine"].expr ** 2) and scene.height_field not in F.FIELDS
+    # Symbols are taken by name: a reader's sympy.symbols("u v k_u k_v") carry no assumptions (the
+    # project's are real), and were refused as "must use only u, v, k_u, k_v; it uses u, v".
+    pu, pv, pk = sp.symbols("u v k_u")
+    assert Scene(height_field=sp.sin(sp.pi * pk * pu) * pv).field.expr == sp.sin(sp.pi * F.k_u * F.u) * F.v
     # A number is a constant field (TOML reads height_field = 0 as one); a bool is not a number here.
     assert [Scene(height_field=c).field.gradient for c in (0, 0.5)] == [(0, 0)] * 2
     _, message = refusal(lambda: Scene(height_field=True))
