@@ -463,7 +463,9 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
         step outside [`renderer.pointwise.MIN_STEP`, 1); naming ``field``, a
         point where h, h' or h''' (the model's, where h' exists) is not a real
         number float64 can hold (a pole of a reader's field, a line where it
-        has no value) or whose exact value has too many digits to print;
+        has no value; also where only its exact value is infinite, 1/sin(pi u)
+        at u = 1) or whose exact value has too many digits to print, or a
+        field whose h' or h'' has more than `MAX_DERIVATIVE_NODES` nodes;
         naming ``eps``, a step at whose abscissae h or the quotient is not.
     TypeError
         Naming the argument, for one of the wrong type (a bool, a string
@@ -537,8 +539,9 @@ def measure_function(function, x, eps=None):
     renderer.validate.InputError
         Naming the argument: an expression refused by `renderer.univariate.univariate`, a point
         or a step that is not a finite float in range, a point where f, f' or f''' is not a real
-        number float64 can hold or f has a crease (|g| where g changes sign), a step at which
-        f(x +- eps) is not.  A stencil that steps over a singularity of f, f finite at both its
+        number float64 can hold (or f or f' is infinite only exactly: 1/sin(pi x) at x = 1) or f has a
+        crease (|g| where g changes sign), an f whose f' or f'' has more than `MAX_DERIVATIVE_NODES`
+        nodes, a step at which f(x +- eps) is not.  A stencil that steps over a singularity of f, f finite at both its
         abscissae (tan(x) at x = 1.5, eps = 0.1), is measured, not refused: its error is of the size
         of f' or larger, and the model-optimal step lies below it.  (sympy's singularity finder,
         which could refuse it, took from 1 s to over 20 s on functions of Squire and Trapp's size.)

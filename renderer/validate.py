@@ -413,8 +413,6 @@ def expression(name, text, symbols, functions, *, fields=()):
                       and not p.exp.free_symbols and _huge_exponent(p.exp)), None)
         if power is None:
             expr = parse_expr(text, local_dict=namespace, global_dict=glob, transformations=(auto_number, convert_xor))
-    except RecursionError:
-        raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} is nested too deeply") from None
     except (SyntaxError, TypeError, ValueError, AttributeError, ZeroDivisionError) as exc:
         raise InvalidValue(f"{name} must be {accepted}; {text!r:.80} is not one ({exc})") from None
     if power is not None:
