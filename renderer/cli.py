@@ -248,6 +248,13 @@ def _check_output(path, flag):
         raise UsageError(f"{flag} {path!r}: not a file in an existing directory")
 
 
+def _frame_size(args):
+    """``--size``'s sides, each held to the library's range, naming ``--size`` (the library names width)."""
+    from renderer.render import MAX_SIDE
+    from renderer.validate import positive_int
+    return tuple(positive_int(f"--size {name}", side, high=MAX_SIDE) for name, side in zip(("width", "height"), args.size))
+
+
 def _png(rgb):
     """PNG bytes of an (H, W, 3) display-encoded image in [0, 1] (Pillow writes no metadata)."""
     import numpy as np
@@ -291,7 +298,7 @@ def _cmd_render(args):
     from renderer.ledger import compare
     from renderer.render import render
     _check_output(args.output, "-o")
-    scene, (width, height), bump = load_scene(args.scene, args.set), args.size, args.view == "bump"
+    scene, (width, height), bump = load_scene(args.scene, args.set), _frame_size(args), args.view == "bump"
     numeric = render(scene, width, height, gradient="central", kink=False, grad=bump, backend=args.backend)
     symbolic = render(scene, width, height, gradient="exact", grad=bump, backend=args.backend)
     led = compare(numeric, symbolic)
@@ -312,7 +319,7 @@ def _cmd_sweep(args):
     from renderer.scene import MAX_EPS, MIN_EPS
     from renderer.sweep import MAX_STEPS as most, sweep
     steps = [float(e) for e in validate.steps("--eps", args.eps, low=MIN_EPS, high=MAX_EPS, max_count=most)]
-    scene, (width, height) = load_scene(args.scene, args.set), args.size
+    scene, (width, height) = load_scene(args.scene, args.set), _frame_size(args)
     census = sweep(scene, steps, width, height).census
     rows = [(e, *(getattr(led, c) for c in COLUMNS[1:])) for e, led in zip(steps, census)]
     if args.format == "json":

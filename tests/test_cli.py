@@ -536,3 +536,12 @@ def test_an_option_of_the_other_measurement_is_refused_not_ignored(capsys, argv,
     the other, it was silently ignored (an out-of-range --k-u 0 too)."""
     rc, out, err = run(["ucurve", *argv], capsys)
     assert one_line(rc, err) and said in err and out == "", err
+
+
+@pytest.mark.parametrize("command, size", [("render", "0x5"), ("sweep", "5x9000")])
+def test_a_size_out_of_range_is_refused_naming_the_option(tmp_path, capsys, command, size):
+    """A side outside the library's range is refused naming ``--size`` and the side (the library's own
+    message named only "width", which the command line has no option for)."""
+    rc, out, err = run([command, "--size", size, *(["-o", tmp_path / "a.png"] if command == "render" else [])], capsys)
+    side = "width" if size.startswith("0") else "height"
+    assert one_line(rc, err) and err.startswith(f"symrender: error: --size {side} must be") and out == "", err
