@@ -466,7 +466,8 @@ class Jacobian(sp.MatrixExpr):
 # ------------------------------------------------------------------------------- written forms
 def written(expr):
     """``expr`` (built with ``evaluate=False``) kept as written: printed in the order written
-    (``3 u |h|``, not sympy's ``3 |h| u``), evaluated when checked."""
+    (``3 u |h|``, not sympy's ``3 |h| u``; but sympy's printer still puts a derivative last: h_u s
+    prints as s h_u), evaluated when checked."""
     return sp.UnevaluatedExpr(expr)
 
 

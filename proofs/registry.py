@@ -5,6 +5,18 @@ each theorem module's ``titles()``, in the chapter's order, and a theorem is bui
 module's ``build(id)`` when it is first asked for (`get`, ``THEOREMS[id]``), then kept by that
 module.  A module's theorems per height field follow `renderer.formulas.FIELDS` as it stands
 when they are asked for: a field registered later has its theorems too.
+
+A new theorem (proofs/finite_difference.py's are a short model to copy):
+
+1. a builder in one of `MODULES`: a function returning a `proofs.core.Theorem` (its steps a
+   ``calc`` chain, each checked by sympy; its statement's relations shown through ⟦key⟧, rule 10
+   of proofs.core), at least one wrong variant (tests/test_checker.py refutes each), and its id and
+   title in the module's ``TITLES`` and ``catalogue``;
+2. its verdict in `PINNED` (``pytest verify`` fails on any other, and on a theorem without a pin);
+3. a place on a book page: its id in a ``theorem_block``, ``theorems`` or ``folded`` call of a
+   page's code cell (book/s*.md; verify/test_theorems.py finds it there);
+4. its printed text reviewed: ``python tests/test_notation.py`` prints it and its digest for
+   ``PRINTED``, and a theorem that renders adds its minimum to `RENDERED`.
 """
 
 import importlib
@@ -102,7 +114,8 @@ def _entry(table, theorem_id):
         for key, value in table.items():
             if any(key.replace("{field}", name) == theorem_id for name in FIELDS):
                 return value
-    raise KeyError(theorem_id)
+    raise KeyError(f"{theorem_id!r} has no entry in proofs.registry's table: a new theorem needs its verdict "
+                   "in PINNED (see the module's docstring)")
 
 
 def least_rendered(theorem_id):

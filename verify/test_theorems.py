@@ -61,7 +61,8 @@ def test_every_theorem_is_titled_and_placed_on_a_page():
     placed = set().union(*(_placed(p.read_text(encoding="utf-8")) for p in BOOK.glob("s[0-9]_*.md")))
     for t in THEOREMS.values():
         assert isinstance(t.title, str) and t.title.strip() == t.title and len(t.title) > 3, t.id
-        assert t.id in placed, f"{t.id} is placed on no page"
+        assert t.id in placed, (f"{t.id} is placed on no page: name it in a theorem_block, theorems or folded call "
+                                "of a page's code cell (book/s*.md)")
 
 
 def test_every_claim_is_stated_and_every_statement_prints():
