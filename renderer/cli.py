@@ -157,9 +157,9 @@ def build_parser():
     what.add_argument("--function", metavar="EXPR",
                       help="instead of a field, a function of x, e.g. 'exp(x)/sqrt(sin(x)**3 + cos(x)**3)' "
                            "(pi, E, + - * / ** and sin cos tan asin acos atan sinh cosh tanh exp log sqrt abs)")
-    # Each option of one kind of measurement only (`UCURVE_ONLY`); None when not given.
+    # Each option of one kind of measurement only (`_cmd_ucurve`); None when not given.
     u.add_argument("--x", type=float, help="with --function: the point x, any real where f is "
-                                           f"differentiable (default {UCURVE_ONLY['function']['x']:g})")
+                                           f"differentiable (default {FUNCTION_X:g})")
     u.add_argument("--u", type=float, help="chart u in [0, 1] (default 0.31)")
     u.add_argument("--v", type=float, help="chart v in [0, 1] (default 0.47)")
     u.add_argument("--component", choices=("u", "v"), help="h_u or h_v (default u)")
@@ -360,8 +360,8 @@ def _ucurve_png(uc):
     return buf.getvalue()
 
 
-#: ucurve's options of one kind of measurement, and their defaults: the field's are `renderer.ucurve.measure`'s.
-UCURVE_ONLY = {"function": {"x": 1.5}, "field": ("u", "v", "component", "k_u", "k_v")}
+#: ``ucurve --x``'s default (`renderer.ucurve.measure_function` has none; `measure`'s are the field options').
+FUNCTION_X = 1.5
 
 
 def _cmd_ucurve(args):
@@ -372,14 +372,17 @@ def _cmd_ucurve(args):
     from renderer.ucurve import UNIT_ROUNDOFF, measure, measure_function
     from renderer.validate import InputError
     kind = "function" if args.function is not None else "field"
-    stray = [k for other in UCURVE_ONLY if other != kind for k in UCURVE_ONLY[other] if getattr(args, k) is not None]
+    # Each kind's own options: its function's parameters that are options, but the expression and the steps.
+    only = {k: [p for p in inspect.signature(fn).parameters if p not in ("field", "function", "eps") and hasattr(args, p)]
+            for k, fn in (("field", measure), ("function", measure_function))}
+    stray = [p for other in only if other != kind for p in only[other] if getattr(args, p) is not None]
     if stray:
         raise UsageError(f"--{stray[0].replace('_', '-')} " + ("measures a height field, not --function"
                                                                  if kind == "function" else "applies only with --function"))
-    given = {k: getattr(args, k) for k in UCURVE_ONLY[kind] if getattr(args, k) is not None}
+    given = {p: getattr(args, p) for p in only[kind] if getattr(args, p) is not None}
     try:
         if kind == "function":
-            uc = measure_function(args.function, given.get("x", UCURVE_ONLY["function"]["x"]), eps=args.eps)
+            uc = measure_function(args.function, given.get("x", FUNCTION_X), eps=args.eps)
         else:
             uc = measure(field=args.field, eps=args.eps, **given)
     except InputError as exc:           # the message starts with the parameter, which names the option
