@@ -271,7 +271,8 @@ def _line(g, var, what):
     of |f| as sign(f) f' (the derivatives of sign, which vanish off the crease, dropped: sympy's
     DiracDelta, and the derivative it leaves unevaluated where it cannot tell f is real).  Raises
     InvalidValue beginning with ``what`` ("function f") where h' or h'' has more than
-    `MAX_DERIVATIVE_NODES` nodes, before the next derivative is taken."""
+    `MAX_DERIVATIVE_NODES` nodes, before the next derivative is taken.  Returns (the three functions,
+    (h, h') as sympy expressions, for `_refuse_pole`)."""
     def kink(x):
         return isinstance(x, sp.DiracDelta) or isinstance(x, sp.Derivative) and isinstance(x.expr, sp.sign)
 
@@ -283,7 +284,7 @@ def _line(g, var, what):
         if n < 3 and (nodes := sum(1 for _ in sp.preorder_traversal(d[-1]))) > MAX_DERIVATIVE_NODES:
             raise validate.InvalidValue(f"{what} is too large to measure: sympy's tree of its derivative of "
                                         f"order {n} has {nodes:,} nodes (at most {MAX_DERIVATIVE_NODES:,})")
-    return tuple(sp.lambdify(var, smooth(d[n]), modules="mpmath") for n in (0, 1, 3))
+    return tuple(sp.lambdify(var, smooth(d[n]), modules="mpmath") for n in (0, 1, 3)), (d[0], d[1])
 
 
 @lru_cache(maxsize=None)
@@ -497,7 +498,7 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
                                                          for r in g.atoms(sp.Rational)):   # which lambdify cannot print
         raise validate.InvalidValue(f"field {record.name} is too large to measure at (u, v) = ({u!r}, {v!r}): "
                                     f"its exact value there has more digits than Python prints")
-    line = _line(g, var, f"field {record.name}")
+    line, exact = _line(g, var, f"field {record.name}")
     stencil = _stencil()
 
     def quotient(e):
@@ -506,7 +507,7 @@ def measure(field="sine", u=SEED_POINT[0], v=SEED_POINT[1], component="u", eps=N
         return fd, points[2 * k], points[2 * k + 1], points[4 + k]
 
     return _curve(record.name, x, steps, quotient, line, non_differentiable(record, u, v, component, k_u, k_v),
-                  point, ((g, sp.diff(g, var)), var))
+                  point, (exact, var))
 
 
 #: The largest step `measure_function` accepts (its smallest is `renderer.pointwise.MIN_STEP`).
@@ -550,7 +551,7 @@ def measure_function(function, x, eps=None):
     x = validate.real("x", x)
     steps = DEFAULT_STEPS if eps is None else validate.steps("eps", eps, low=pointwise.MIN_STEP,
                                                               high=MAX_FUNCTION_STEP)
-    line, point = _line(record.expr, U.x_var, f"function {record.name}"), dict(u=x, v=float("nan"), component="x")
+    (line, exact), point = _line(record.expr, U.x_var, f"function {record.name}"), dict(u=x, v=float("nan"), component="x")
     with mpmath.workdps(DIGITS):
         if any(_real(fn, mpmath.mpf(x)) is None for fn in line[:2]):     # before the crease and float64 checks
             raise _undefined(record.name, point, line[:2], mpmath.mpf(x))
@@ -565,4 +566,4 @@ def measure_function(function, x, eps=None):
     def quotient(e):
         return code.central(x, e), x + e, x - e, 2 * e
 
-    return _curve(record.name, x, steps, quotient, line, None, point, ((record.expr, record.derivative), U.x_var))
+    return _curve(record.name, x, steps, quotient, line, None, point, (exact, U.x_var))
