@@ -12,8 +12,9 @@ PNG to stdout and the report to stderr.  PNGs carry no varying metadata.
 
 Not special-cased, by design (a plain error, or Python's or the library's own behaviour):
 closed standard descriptors; ``/dev/stdout`` as the output (the report is not moved to
-stderr); ``-o -`` on a terminal; option abbreviations, and negative values after a space
-(``--eps=-1e-3`` works); digits of other scripts; huge values repeated in messages; TOML
+stderr); ``-o -`` on a terminal; option abbreviations, and values that begin with a minus sign
+after a space (``--eps=-1e-3`` and ``--function=-x`` work); numbers in Python's syntax (``1_0e-3``
+is 0.01) and digits of other scripts; huge values repeated in messages; TOML
 nested thousands deep (a RecursionError, exit 1); integers beyond a float (the library
 names them); scene files that are FIFOs, devices or huge; unwritable directories (found
 at the write); file names stdout cannot encode; matplotlib's warnings about an unwritable
@@ -40,8 +41,10 @@ from . import files
 __all__ = ["main", "load_scene", "view_image"]
 
 VIEWS = ("shaded", "difference", "bump", "kink")
-#: Most steps ``a:b:n`` expands to (ucurve's limit; sweep's is the library's).
+#: Most steps ucurve's ``--eps`` holds; sweep's are `renderer.sweep.MAX_STEPS`, written out as
+#: SWEEP_STEPS so that ``--help`` starts without numpy (a test holds them equal).
 MAX_STEPS = 10_000
+SWEEP_STEPS = 64
 #: The census's columns: the step, then `renderer.ledger.Ledger`'s fields.
 COLUMNS = ("eps", "max_abs", "rms", "flips", "pixels_a", "mean_abs_kink", "mean_abs_off_kink")
 _signal = []                            # the first signal of a `main` run
@@ -74,23 +77,28 @@ def _size(text):
         raise argparse.ArgumentTypeError(f"expected WxH with integer sides (e.g. 256x256), got {text!r}") from None
 
 
-def _steps(text):
-    """``a:b:n`` (n log-spaced steps from a to b, both ends exact) or ``e1,e2,...``, as floats."""
+def _steps(text, most=MAX_STEPS):
+    """``a:b:n`` (n log-spaced steps from a to b, both ends exact) or ``e1,e2,...``, as floats; at
+    most ``most`` of them (the command's limit, checked before a:b:n is expanded)."""
     try:
-        if ":" not in text:
-            return [float(e) for e in text.split(",")]
-        a, b, n = text.split(":")
-        a, b, n = float(a), float(b), int(n)
-        if not (0 < a < math.inf and 0 < b < math.inf and 1 <= n <= MAX_STEPS):
-            raise ValueError
+        if ":" in text:
+            a, b, n = text.split(":")
+            a, b, n = float(a), float(b), int(n)
+            if not (0 < a < math.inf and 0 < b < math.inf):
+                raise ValueError
+        else:
+            steps = [float(e) for e in text.split(",")]
+            n = len(steps)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a:b:n (a, b > 0, n in [1, {MAX_STEPS}]) or e1,e2,..., "
+        raise argparse.ArgumentTypeError(f"expected a:b:n (a, b > 0, n a whole number) or e1,e2,..., "
                                          f"got {text!r}") from None
-    if n == 1:
-        return [a]
+    if not 1 <= n <= most:
+        raise argparse.ArgumentTypeError(f"must hold 1 to {most:,} steps, got {n:,}")
+    if ":" not in text:
+        return steps
     la, lb = math.log10(a), math.log10(b)
     # 15 digits, so that decades print as 1e-05, not 9.999999999999999e-06.
-    return [a, *(float(f"{10 ** (la + (lb - la) * i / (n - 1)):.15g}") for i in range(1, n - 1)), b]
+    return [a, *(float(f"{10 ** (la + (lb - la) * i / (n - 1)):.15g}") for i in range(1, n - 1)), b][:n]
 
 
 def _version():
@@ -137,8 +145,9 @@ def build_parser():
                                    "and RMS |dI| on sphere A, flips, and mean |dI| on and off the crease band "
                                    "(none: no pixel of A there).")
     scene_options(s)
-    s.add_argument("--eps", type=_steps, default=_steps("1e-1:1e-8:8"), metavar="a:b:n|e1,e2,...",
-                   help="n log-spaced steps from a to b, or a list; 1 to 64 steps, each in [1e-16, 0.25] "
+    s.add_argument("--eps", type=lambda text: _steps(text, SWEEP_STEPS), default=_steps("1e-1:1e-8:8"),
+                   metavar="a:b:n|e1,e2,...",
+                   help=f"n log-spaced steps from a to b, or a list; 1 to {SWEEP_STEPS} steps, each in [1e-16, 0.25] "
                         "(default 1e-1:1e-8:8)")
     s.add_argument("--size", type=_size, default=(256, 256), metavar="WxH",
                    help=f"{size}; (steps + 1) * W * H <= 33,554,432")
@@ -317,8 +326,8 @@ def _cmd_render(args):
 def _cmd_sweep(args):
     from renderer import validate
     from renderer.scene import MAX_EPS, MIN_EPS
-    from renderer.sweep import MAX_STEPS as most, sweep
-    steps = [float(e) for e in validate.steps("--eps", args.eps, low=MIN_EPS, high=MAX_EPS, max_count=most)]
+    from renderer.sweep import sweep
+    steps = [float(e) for e in validate.steps("--eps", args.eps, low=MIN_EPS, high=MAX_EPS)]
     scene, (width, height) = load_scene(args.scene, args.set), _frame_size(args)
     census = sweep(scene, steps, width, height).census
     rows = [(e, *(getattr(led, c) for c in COLUMNS[1:])) for e, led in zip(steps, census)]

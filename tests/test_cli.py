@@ -251,6 +251,22 @@ def test_an_input_error_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, 
     assert one_line(rc, err) and name in err and out == "" and list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("command, most", [("sweep", 64), ("ucurve", 10_000)])
+def test_each_command_refuses_more_steps_than_it_takes_naming_its_own_limit(capsys, command, most):
+    """``--eps`` as a:b:n or as a list: one step more than the command takes (sweep's are the library's
+    `renderer.sweep.MAX_STEPS`), or none, is refused by the parser naming the command's limit; as many
+    as it takes are accepted."""
+    from renderer.sweep import MAX_STEPS
+    assert most == {"sweep": MAX_STEPS, "ucurve": cli.MAX_STEPS}[command]
+    size = ["--size", "2x2"] if command == "sweep" else []
+    for eps in (f"1e-1:1e-8:{most + 1}", ",".join(["1e-3"] * (most + 1)), "1e-1:1e-8:0"):
+        rc, out, err = run([command, "--eps", eps, *size], capsys)
+        got = "0" if eps.endswith(":0") else f"{most + 1:,}"
+        assert one_line(rc, err) and f"--eps: must hold 1 to {most:,} steps, got {got}" in err and out == "", err
+    if command == "sweep":
+        assert run([command, "--eps", f"1e-1:1e-8:{most}", *size], capsys)[0] == 0
+
+
 def test_a_bug_is_one_line_exit_1_and_writes_nothing(tmp_path, capsys, monkeypatch):
     """A ValueError that is not the library's `InputError` is a bug, not an input error."""
     import importlib
