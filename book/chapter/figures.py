@@ -355,8 +355,9 @@ def ucurve_anatomy(curve):
     arithmetic at the rounded u +- eps (dashed) and the rounding of the float64 evaluation
     (dotted), over a wide translucent band, the model A eps^2 + B / eps fitted to the error
     (label ``model ...``: a band, so that it shows on both sides of the measured curve it
-    follows), two vertical lines, at the model-optimal step eps* (dotted, labelled right of
-    it) and the fitted optimal step eps^ (dash-dotted, labelled left of it), and two slope
+    follows), the model E(eps) that charges each rounding a full unit roundoff (``curve.model``,
+    black, dotted, as the line of its minimiser), two vertical lines, at the model-optimal step eps*
+    (dotted, labelled right of it) and the fitted optimal step eps^ (dash-dotted, labelled left of it), and two slope
     guides (labels ``_guide slope +2`` and ``_guide slope -1``, kept out of the legend), each
     parallel to one arm of the fitted model (A eps^2 on steps of 100 eps^ and more, B / eps
     on steps of eps^ / 100 and less) a factor `GUIDE_OFFSET` above it, with its slope written
@@ -369,6 +370,7 @@ def ucurve_anatomy(curve):
     ax.loglog(curve.eps, A * curve.eps**2 + B / curve.eps, color=GREY, lw=7, alpha=0.4, solid_capstyle="butt",
               label="model fitted to the error", zorder=1)
     ax.loglog(curve.eps, curve.error, lw=1.6, color=RED, label="|error| of the float64 quotient", zorder=3)
+    ax.loglog(curve.eps, curve.model, ":", color="k", lw=1.0, label="model E(ε), a full unit roundoff each", zorder=2)
     ax.loglog(curve.eps, np.abs(curve.truncation), "--", color=BLUE, lw=1.2,
               label="exact arithmetic at the rounded $u \\pm \\varepsilon$", zorder=4)
     ax.loglog(curve.eps, np.abs(curve.roundoff), ":", color=GREEN, lw=1.2, label="rounding of the float64 evaluation",
