@@ -28,8 +28,8 @@ NP, WI, WO, WR, HV = (sp.MatrixSymbol(name, 3, 1) for name in ("N'", "omega_i", 
 k_a, k_d, k_s, p, rho, I_a, I_l, I = sp.symbols("k_a k_d k_s p rho I_a I_ell I", nonnegative=True)
 #: The highlight's cosine: real, not nonnegative (sympy would drop the clamp max(0, s)); and its clamp to
 #: [0, 1], a name the statement prints and defines (`CLAMP`).
-s = sp.Symbol("sigma", real=True)
-S_PLUS = sp.Symbol("sigma_+", nonnegative=True)
+s = sp.Symbol("mu", real=True)
+S_PLUS = sp.Symbol("mu_+", nonnegative=True)
 CLAMP = {S_PLUS: sp.Min(1, sp.Max(0, s))}
 ell, m = sp.symbols("ell m", integer=True, positive=True)
 T = sp.IndexedBase("T")
@@ -38,7 +38,7 @@ X, Y = sp.symbols("x y", real=True)
 alpha, c = sp.symbols("alpha c", nonnegative=True)
 FLOOR = sp.Tuple((1 - alpha) * c, (1 - alpha) * c, c)
 NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: r"\omega_h", rho: r"\rho", I_l: r"I_\ell",
-         ell: r"\ell", s: r"\sigma", S_PLUS: r"\sigma_+", alpha: r"\alpha"}
+         ell: r"\ell", s: r"\mu", S_PLUS: r"\mu_+", alpha: r"\alpha"}
 #: The scene's parameter (`renderer.Scene`) each symbol stands for, for the book's list of them.
 SCENE_SYMBOLS = {"lights": I_l, "ambient": I_a, "albedo_a": rho, "albedo_b": rho, "ka": k_a, "kd": k_d, "ks": k_s,
                  "shininess": p, "floor_tint": alpha}
@@ -225,7 +225,7 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
             r"besides, ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the "
             r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and "
-            r"$⟦sigma_+⟧$ the highlight's cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), "
+            r"$⟦mu_+⟧$ the highlight's cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), "
             r"with the half vector $$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ "
             r"mirrored in $N'$), which the kernel evaluates as $⟦phong⟧$. A sphere's albedo is its own. The floor, "
             r"at $⟦on_floor⟧$, carries no bump: its $N$ and $N'$ are both $⟦up⟧$. Its albedo is a checker of unit "

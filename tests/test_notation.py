@@ -21,7 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "shading": "5af0a7f5432b58c2",
+    "shading": "e5d2f63ed7f0cdfd",
     "displaced-normal": "d41ae0ec92d4e7ef",
     "chart": "b0eb3cf5166d0cb0",
     "frame-orthonormal": "6f2e22487456f433",
