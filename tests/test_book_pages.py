@@ -651,8 +651,8 @@ def site(browser, book_html):
 #: region (an ``<aside>`` is a "complementary" landmark: each margin note was one); a figure's image made a link
 #: (to its PNG: a Tab stop named by the whole alt text); the main navigation's link to the page open not marked
 #: as the current page (the theme marks it by its look); a table whose head row begins with an empty cell (its first
-#: column labels its rows) with a row not headed by a row header; an exercise's title that is no heading (a screen
-#: reader goes from heading to heading); a table's header cell with maths in it and no name of its own (a browser
+#: column labels its rows) with a row not headed by a row header; an exercise's or a theorem's title that is no heading (a screen
+#: reader goes from heading to heading), or one whose name holds an icon's private-use character; a table's header cell with maths in it and no name of its own (a browser
 #: names a cell from its words alone, dropping the maths), or one naming it by MathML's characters, a subscript run
 #: into its base ("hx" for h_x) or an accent read as a character ("ε^"); a link, button, heading or header cell named by its
 #: words with a <wbr> in them (a browser names it with a space there: "s1_what_changes. ipynb"); links of one
@@ -694,8 +694,11 @@ TOLD_APART = r"""() => {
             .map(e => `named with a space at each break point: ${words(e).slice(0, 40)}`),
           ...Object.entries([...document.querySelectorAll('[id]')].reduce((n, e) => (n[e.id] = (n[e.id] || 0) + 1, n), {}))
             .filter(([, k]) => k > 1).map(([id, k]) => `the id '${id}' given ${k} times`),
-          ...[...root.querySelectorAll('.exercise > .admonition-title:not([role=heading][aria-level])')]
-            .map(t => `an exercise's title is no heading: ${words(t)}`),
+          ...[...root.querySelectorAll(':is(.exercise, .theorem) > .admonition-title:not([role=heading][aria-level])')]
+            .map(t => `${t.parentElement.matches('.theorem') ? "a theorem's" : "an exercise's"} title is no heading: ${words(t)}`),
+          ...[...root.querySelectorAll(':is(h1, h2, h3, h4, h5, h6, [role=heading])')].filter(h => ['::before', '::after']
+            .some(p => /[\ue000-\uf8ff]/.test(getComputedStyle(h, p).content) && !/\/ *""$/.test(getComputedStyle(h, p).content)))
+            .map(h => `an icon's character in a heading's name: ${words(h)}`),
           ...[...root.querySelectorAll('table')].filter(t => t.tHead && t.tHead.rows[0] && !words(t.tHead.rows[0].cells[0])
             && [...t.tBodies].some(b => [...b.rows].some(r => r.cells[0].tagName !== 'TH' || r.cells[0].scope !== 'row')))
             .map(t => `a table's row labels are no row headers: ${words(t).slice(0, 40)}`)];
@@ -731,8 +734,8 @@ def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
 #: finding of its own; "<page> again", a second load, for those another variant would hide): sphinx-togglebutton's and the proofs' names left as they are (fit.js's naming
 #: undone), the margin notes as unnamed asides, their links all named "why" (a11y_markup's names removed), a
 #: table's row labels without their scope, every proof's body given one id, its header cells named without their maths or with a subscript or an
-#: accent flattened, the exercises' titles as
-#: paragraphs, the names fit.js keeps as a <wbr> goes in left to the browser, the page open not marked in the
+#: accent flattened, the exercises' and the theorems' titles as
+#: paragraphs or named with their icons, the names fit.js keeps as a <wbr> goes in left to the browser, the page open not marked in the
 #: navigation, and a figure's image linked to its PNG.
 WRONG_TOLD_APART = {
     "the folds' and buttons' own names": ("s5_lab", "fit.js", "nameControls(root);", "", "buttons named 'Toggle hidden"),
@@ -741,7 +744,12 @@ WRONG_TOLD_APART = {
     "the margin notes' links all named 'why'": ("s5_lab", "s5_lab.html", 'aria-label="why: claim ', 'data-was="why: claim ',
                                                 "links named 'why'"),
     "header cells named without their maths": ("s3_math", "fit.js", "nameHeaderCells(root);", "", "header cell names no maths"),
-    "the exercises' titles as paragraphs": ("s3_math", "fit.js", "exerciseHeadings(root);", "", "exercise's title is no heading"),
+    "the exercises' titles as paragraphs": ("s3_math", "fit.js", "titleHeadings(root);", "", "exercise's title is no heading"),
+    "the icons read in the titles' names": ("s3_math again", "fit.css", 'article div.exercise > p.admonition-title::after',
+                                            'article div.nothing',
+                                            "an icon's character in a heading's name"),
+    "the theorems' titles as paragraphs": ("s3_math again", "fit.js", ".exercise > .admonition-title, .theorem > .admonition-title",
+                                           ".exercise > .admonition-title", "a theorem's title is no heading"),
     "a header cell's subscript run into its base": ("s3_math again", "fit.js", 'return kids[0] + " sub " + kids[1];', "return kids.join('');",
                                                     "a subscript run into its base"),
     "a header cell's accent read as a character": ("s3_math again", "fit.js", "return accent ? kids[0] + accent :", "return",

@@ -232,8 +232,10 @@
     apart(function (c, i, n) { return " (" + (i + 1) + " of " + n + ")"; });
   }
 
-  function exerciseHeadings(root) {
-    root.querySelectorAll(".exercise > .admonition-title").forEach(function (title) {
+  // An exercise's or a theorem's title, a heading one level below its section's: a screen reader goes from
+  // heading to heading.
+  function titleHeadings(root) {
+    root.querySelectorAll(".exercise > .admonition-title, .theorem > .admonition-title").forEach(function (title) {
       var section = title.closest("section"), heading = section && section.querySelector("h1, h2, h3, h4, h5");
       title.setAttribute("role", "heading");
       title.setAttribute("aria-level", String(heading ? Number(heading.tagName[1]) + 1 : 3));
@@ -278,7 +280,7 @@
   function whenTypeset() {
     var mj = window.MathJax, root = article();
     function done() {
-      if (root) { nameControls(root); exerciseHeadings(root); nameHeaderCells(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
+      if (root) { nameControls(root); titleHeadings(root); nameHeaderCells(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
       typeset = true;
       fit();
     }
