@@ -652,7 +652,7 @@ def site(browser, book_html):
 #: (to its PNG: a Tab stop named by the whole alt text); the main navigation's link to the page open not marked
 #: as the current page (the theme marks it by its look); a table whose head row begins with an empty cell (its first
 #: column labels its rows) with a row not headed by a row header; an exercise's or a theorem's title that is no heading (a screen
-#: reader goes from heading to heading), or one whose name holds an icon's private-use character; a table's header cell with maths in it and no name of its own (a browser
+#: reader goes from heading to heading), or one whose name holds an icon's private-use character; a figure not named by its number ("Fig. 7"); a table's header cell with maths in it and no name of its own (a browser
 #: names a cell from its words alone, dropping the maths), or one naming it by MathML's characters, a subscript run
 #: into its base ("hx" for h_x) or an accent read as a character ("ε^"); a link, button, heading or header cell named by its
 #: words with a <wbr> in them (a browser names it with a space there: "s1_what_changes. ipynb"); links of one
@@ -696,6 +696,8 @@ TOLD_APART = r"""() => {
             .filter(([, k]) => k > 1).map(([id, k]) => `the id '${id}' given ${k} times`),
           ...[...root.querySelectorAll(':is(.exercise, .theorem) > .admonition-title:not([role=heading][aria-level])')]
             .map(t => `${t.parentElement.matches('.theorem') ? "a theorem's" : "an exercise's"} title is no heading: ${words(t)}`),
+          ...[...root.querySelectorAll('figure')].filter(f => !(document.getElementById(f.getAttribute('aria-labelledby'))
+            || '').textContent?.trim()).map(f => `a figure named by nothing: ${f.id}`),
           ...[...root.querySelectorAll(':is(h1, h2, h3, h4, h5, h6, [role=heading])')].filter(h => ['::before', '::after']
             .some(p => /[\ue000-\uf8ff]/.test(getComputedStyle(h, p).content) && !/\/ *""$/.test(getComputedStyle(h, p).content)))
             .map(h => `an icon's character in a heading's name: ${words(h)}`),
@@ -735,7 +737,7 @@ def test_a_screen_reader_tells_every_button_and_region_apart(site, name):
 #: undone), the margin notes as unnamed asides, their links all named "why" (a11y_markup's names removed), a
 #: table's row labels without their scope, every proof's body given one id, its header cells named without their maths or with a subscript or an
 #: accent flattened, the exercises' and the theorems' titles as
-#: paragraphs or named with their icons, the names fit.js keeps as a <wbr> goes in left to the browser, the page open not marked in the
+#: paragraphs or named with their icons, the figures unnamed, the names fit.js keeps as a <wbr> goes in left to the browser, the page open not marked in the
 #: navigation, and a figure's image linked to its PNG.
 WRONG_TOLD_APART = {
     "the folds' and buttons' own names": ("s5_lab", "fit.js", "nameControls(root);", "", "buttons named 'Toggle hidden"),
@@ -745,6 +747,7 @@ WRONG_TOLD_APART = {
                                                 "links named 'why'"),
     "header cells named without their maths": ("s3_math", "fit.js", "nameHeaderCells(root);", "", "header cell names no maths"),
     "the exercises' titles as paragraphs": ("s3_math", "fit.js", "titleHeadings(root);", "", "exercise's title is no heading"),
+    "figures named by nothing": ("s3_math", "fit.js", "figureNames(root);", "", "a figure named by nothing"),
     "the icons read in the titles' names": ("s3_math again", "fit.css", 'article div.exercise > p.admonition-title::after',
                                             'article div.nothing',
                                             "an icon's character in a heading's name"),

@@ -232,6 +232,17 @@
     apart(function (c, i, n) { return " (" + (i + 1) + " of " + n + ")"; });
   }
 
+  // A figure, named by its number ("Fig. 7"): a screen reader says "figure, Fig. 7", then reads the image's
+  // alt text and the caption (Chromium names a <figure> by nothing, not by its <figcaption>).
+  function figureNames(root) {
+    root.querySelectorAll("figure[id]").forEach(function (figure) {
+      var number = figure.querySelector("figcaption .caption-number");
+      if (!number) return;
+      number.id = figure.id + "-number";
+      figure.setAttribute("aria-labelledby", number.id);
+    });
+  }
+
   // An exercise's or a theorem's title, a heading one level below its section's: a screen reader goes from
   // heading to heading.
   function titleHeadings(root) {
@@ -280,7 +291,7 @@
   function whenTypeset() {
     var mj = window.MathJax, root = article();
     function done() {
-      if (root) { nameControls(root); titleHeadings(root); nameHeaderCells(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
+      if (root) { nameControls(root); titleHeadings(root); figureNames(root); nameHeaderCells(root); keepNumbersWhole(root); breakLongWords(root); breakTableCells(root); rebreak(root, true); }
       typeset = true;
       fit();
     }

@@ -289,14 +289,15 @@ class Simulator {
       this.canvases[name] = canvas;
       const mark = el("span", { class: "sim-probe", "aria-hidden": "true", hidden: "" });
       this.marks.push(mark);
-      return el("figure", {}, [el("div", { class: "sim-canvas-box" }, [canvas, mark]),
+      // Named by its caption (Chromium names a <figure> by nothing).
+      return el("figure", { "aria-labelledby": `sim-caption-${name}` }, [el("div", { class: "sim-canvas-box" }, [canvas, mark]),
                                el("figcaption", { id: `sim-caption-${name}` })]);
     });
     // An inline <svg>, parsed from markup (no namespace address in the script).
     const holder = el("div");
     holder.innerHTML = svg("svg", { id: "sim-curve", role: "img" });
     this.plot = holder.firstChild;
-    const curve = el("figure", { class: "sim-curve" },
+    const curve = el("figure", { class: "sim-curve", "aria-labelledby": "sim-curve-caption" },
                      [this.plot, el("figcaption", { id: "sim-curve-caption" })]);
     this.readout = el("dl", { id: "sim-readout", class: "sim-readout" });
     // Shown on a phone only (STYLE), once a pixel is read out.
