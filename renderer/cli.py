@@ -97,7 +97,7 @@ def _steps(text, most=MAX_STEPS):
     if ":" not in text:
         return steps
     la, lb = math.log10(a), math.log10(b)
-    # 15 digits, so that decades print as 1e-05, not 9.999999999999999e-06.
+    # 15 digits, so that decades print as 1e-05, not 9.999999999999999e-06; [:n] leaves a alone for n = 1.
     return [a, *(float(f"{10 ** (la + (lb - la) * i / (n - 1)):.15g}") for i in range(1, n - 1)), b][:n]
 
 
