@@ -34,12 +34,13 @@ from numba import njit
 
 from renderer import GBuffer, formulas, gbuffer, kernel, pointwise, render
 from renderer.render import Frame, check_args, image_plane
+from renderer.scene import search_chart
 from renderer.validate import InvalidValue, positive_int
 
 __all__ = ["Displaced", "render_displaced", "surface_function", "H_MAX", "MAX_SAMPLES"]
 
 #: The bound on |h| the bracketing assumes (the built-in fields are sines, their products and |.| of
-#: one); `render_displaced` refuses a field that exceeds it on a grid of the chart (`_check_bounded`).
+#: one); `render_displaced` refuses a field that exceeds it on the chart (`_check_bounded`).
 H_MAX = 1.0
 #: Points per side of the chart grid on which a field is held to `H_MAX`.
 BOUND_CHECK_POINTS = 257
@@ -294,13 +295,24 @@ def _cast_shadow(lights, chamber, P, N, reach):
 
 def _check_bounded(scene):
     """InvalidValue unless |h| <= `H_MAX` at every point of a `BOUND_CHECK_POINTS`-square grid of the
-    chart: the bracketing shells lie at R +- beta `H_MAX`."""
+    chart and between its points (`renderer.scene.search_chart`): the bracketing shells lie at
+    R +- beta `H_MAX`."""
+    h_of = sp.lambdify(formulas.FIELD_SYMBOLS, scene.field.expr, modules="numpy")   # not numba's: no compilation
+
+    def height(u, v):
+        return np.broadcast_to(h_of(u, v, scene.k_u, scene.k_v), np.shape(u))
     t = np.linspace(0.0, 1.0, BOUND_CHECK_POINTS)
     uu, vv = np.meshgrid(t, t)
-    largest = float(np.max(np.abs(pointwise.height(scene.field, uu, vv, scene.k_u, scene.k_v))))
-    if not largest <= H_MAX:
-        raise InvalidValue(f"Scene.height_field {scene.height_field!r} reaches |h| = {largest:.3g} on the chart; "
-                           f"a displaced sphere brackets its surface for |h| <= {H_MAX:g}")
+    h = np.abs(height(uu, vv))
+    ij = np.unravel_index(np.argmax(h), h.shape)
+    def holds(hs):
+        return hs is not None and max(abs(hs[0].a), abs(hs[0].b)) <= H_MAX
+    at = (float(uu[ij]), float(vv[ij])) if not h[ij] <= H_MAX else search_chart(
+        [scene.field.expr], scene.k_u, scene.k_v, holds, broken=lambda u, v: not abs(height(u, v)) <= H_MAX)
+    if at is not None:
+        raise InvalidValue(f"Scene.height_field {scene.height_field!r} reaches |h| = {abs(float(height(*at)))!r} at "
+                           f"(u, v) = ({at[0]:.6g}, {at[1]:.6g}) of the chart; a displaced sphere brackets its surface "
+                           f"for |h| <= {H_MAX:g}")
 
 
 def render_displaced(scene, width, height, *, samples=64):
@@ -328,7 +340,7 @@ def render_displaced(scene, width, height, *, samples=64):
         A size out of range; ``samples`` outside [1, 4096]; ``beta * max|h|`` not below
         ``radius_a`` (the displaced radius must stay positive); the camera not outside the
         displaced sphere (``camera_z > radius_a + beta``); a height field whose |h| exceeds
-        `H_MAX` on a grid of the chart.
+        `H_MAX` somewhere on the chart.
     """
     scene, width, height, _, _ = check_args(scene, width, height, "exact", 1.0)
     samples = positive_int("samples", samples, high=MAX_SAMPLES)

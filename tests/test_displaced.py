@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from renderer import Scene, gbuffer, generated, kernel, pointwise
 from renderer.render import image_plane
+from lab import displaced as D
 from lab.displaced import H_MAX, render_displaced
 
 SIZE = 48
@@ -107,3 +112,18 @@ def test_bad_input_is_refused(kwargs, words):
     scene, width, height = args.pop("scene"), args.pop("width"), args.pop("height")
     with pytest.raises((TypeError, ValueError), match=words):
         render_displaced(scene, width, height, **args)
+
+
+@settings(max_examples=20, deadline=None)
+@given(p=st.floats(0.01, 0.99), q=st.floats(0.01, 0.99), width=st.floats(1e-8, 1e-6), a=st.floats(0.6, 5.0))
+def test_a_field_past_h_max_anywhere_on_the_chart_is_refused_where_it_is(p, q, width, a):
+    """The bracketing shells hold |h| <= `H_MAX`: a spike of h past it, narrower than the check's grid
+    and wherever it stands, is refused naming a point of the spike where |h| is past it; the same spike
+    under `H_MAX` is accepted."""
+    spike = lambda height: f"0.5 + {height!r}*exp(-((u - {p!r})**2 + (v - {q!r})**2)/{width!r})"   # noqa: E731
+    with pytest.raises(ValueError) as info:
+        D._check_bounded(Scene(height_field=spike(a), bump="chart"))
+    said = re.search(r"reaches \|h\| = (\S+) at \(u, v\) = \(([^,]+), ([^)]+)\)", str(info.value))
+    assert said and float(said[1]) > H_MAX, info.value
+    assert np.hypot(float(said[2]) - p, float(said[3]) - q) <= 3 * np.sqrt(width), (p, q, info.value)
+    D._check_bounded(Scene(height_field=spike(0.4), bump="chart"))      # |h| <= 0.9 everywhere: no error

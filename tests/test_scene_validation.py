@@ -152,6 +152,61 @@ def test_a_readers_expression_is_accepted_and_a_non_finite_one_refused():
         assert f"at (u, v) = ({least[0]:g}, {least[1]:g})" in message, message
 
 
+#: Fields singular between any grid's points: on a line u = P or v = Q, at a point (P, Q), or in their
+#: gradient alone; each is named by the coordinates it is singular in.  Between them a pole or a jump
+#: of tan, log, abs, atan, exp, sinh, tanh and a power.
+SINGULAR = {"1/(u - P)": "u", "tan(pi*(v - Q + 0.5))": "v", "log(abs(u - P))": "u", "sqrt(abs(v - Q))": "v",
+            "abs(u - P)**(1/3)*v": "u", "atan(1/(u - P))": "u", "exp(v)/(v - Q)": "v", "1/sinh(u - P)": "u",
+            "1/tanh(v - Q)": "v", "1/((u - P)**2 + (v - Q)**2)": "uv"}
+#: Fields bounded on the chart with their gradients, however near C puts them to a pole; together
+#: they call every function of `renderer.formulas.ELEMENTARY`.
+BOUNDED = ("1/((u - P)**2 + C)", "log((v - Q)**2 + C)*sqrt((u - P)**2 + C)", "exp(-((u - P)**2 + (v - Q)**2)/C)",
+           "atan(u - P) + sinh(v)*cosh(u) + tanh((v - Q)/C)", "asin(0.9*u) - acos(0.9*v)",
+           "abs(sin(pi*k_u*(u - P)))*tan(v/2) + cos(u)")
+
+
+@settings(max_examples=30, deadline=None)
+@given(p=st.floats(0.001, 0.999), q=st.floats(0.001, 0.999), c=st.floats(1e-6, 1.0),
+       form=st.sampled_from(sorted(SINGULAR)), bounded=st.sampled_from(BOUNDED))
+def test_a_singularity_between_the_grids_points_is_refused_where_it_is_and_a_near_one_accepted(
+        p, q, c, form, bounded):
+    """A reader's field is checked on a grid of the chart and between its points by interval arithmetic
+    (`renderer.scene._unbounded_near`): a pole, a jump or a gradient without bound anywhere in the chart,
+    wherever it falls, is refused naming a point within a millionth of it; a field bounded with its
+    gradient, even a millionth from a pole, is accepted.  (Before the interval check, tan(pi*u) with
+    bump="chart" was accepted: no grid point is a float whose tangent overflows.)"""
+    text = lambda t: t.replace("P", repr(p)).replace("Q", repr(q)).replace("C", repr(c))       # noqa: E731
+    _, message = refusal(lambda: Scene(height_field=text(form), bump="chart"))
+    named = re.search(r"(?:at|near) \(u, v\) = \(([^,]+), ([^)]+)\)", message)
+    assert message.startswith("Scene.height_field ") and "not finite and real" in message and named, message
+    assert all(abs(float(named[i]) - x) <= 1e-6 for i, (x, axis) in enumerate(((p, "u"), (q, "v")), 1)
+               if axis in SINGULAR[form]), (p, q, message)
+    assert Scene(height_field=text(bounded), bump="chart").height_field not in F.FIELDS     # accepted, as typed
+
+
+@settings(max_examples=20, deadline=None)
+@given(p=st.floats(0.01, 0.99), q=st.floats(0.01, 0.99), width=st.floats(1e-8, 1e-6), depth=st.floats(3.5, 50.0))
+def test_a_dip_through_the_displaced_radius_anywhere_is_refused_where_it_is(p, q, width, depth):
+    """bump="surface" needs radius_a + beta h > 0 on the whole chart: a dip of h below -radius_a / beta,
+    narrower than the chart check's grid and wherever it stands, is refused naming a point of it where h
+    is below; the same dip short of it is accepted."""
+    dip = lambda d: f"1 - {d!r}*exp(-((u - {p!r})**2 + (v - {q!r})**2)/{width!r})"     # noqa: E731
+    _, message = refusal(lambda: Scene(height_field=dip(depth), beta=0.5))
+    said = re.search(r"\(h = (\S+) at \(u, v\) = \(([^,]+), ([^)]+)\)\)", message)
+    assert said and 1.0 + 0.5 * float(said[1]) <= 0.0, message
+    assert np.hypot(float(said[2]) - p, float(said[3]) - q) <= 3 * np.sqrt(width), (p, q, message)
+    assert Scene(height_field=dip(2.5), beta=0.5).beta == 0.5           # 1 + 0.5 h >= 0.25: accepted
+
+
+def test_a_bounded_field_the_intervals_overestimate_is_accepted_after_the_searchs_budget():
+    """(u - v)**2 written out holds each variable twice, and interval arithmetic bounds
+    1/(u**2 - 2*u*v + v**2 + 1e-4) about u = v only on boxes of side about 1e-5: the search stops at
+    `renderer.scene.CHART_CHECK_BOXES` boxes and the field, bounded, is accepted on the grid's evidence."""
+    from renderer import scene as S
+    scene = Scene(height_field="1/(u**2 - 2*u*v + v**2 + 1e-4)", bump="chart")
+    assert S._unbounded_near(scene.field, scene.k_u, scene.k_v) is None
+
+
 def _nested(depth):
     e = F.u
     for _ in range(depth - 1):
@@ -192,13 +247,13 @@ def test_the_deepest_and_largest_accepted_expressions_render():
 
 def _off_contract(fields, k_u, k_v):
     """The fields of ``fields`` a built-in may not be (`Scene` skips the chart check for them and
-    checks only beta < radius_a): not finite and real with its gradient on the chart, or with
-    h < -1 there, where R + beta h would reach 0 under beta < R."""
-    from renderer.scene import _on_chart
+    checks only beta < radius_a): not finite and real with its gradient on the chart's grid or
+    between its points, or with h < -1 there, where R + beta h would reach 0 under beta < R."""
+    from renderer.scene import _on_chart, _unbounded_near
     off = []
     for field in fields:
         low, _, bad = _on_chart(field, k_u, k_v)
-        if not (bad is None and low >= -1.0):
+        if not (bad is None and low >= -1.0 and _unbounded_near(field, k_u, k_v) is None):
             off.append(field.name)
     return off
 
