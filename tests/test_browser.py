@@ -1045,6 +1045,11 @@ MARKS_JS = """() => [...document.querySelectorAll('.symrender-sim canvas')].map(
 })"""
 
 
+#: Run in the page: the readout's crease row ("in the band: ..." or "not in the band"), "" off sphere A.
+CREASE_ROW_JS = """() => [...document.querySelectorAll('#sim-readout dt')]
+  .find((dt) => dt.textContent === 'crease')?.nextElementSibling.textContent ?? ''"""
+
+
 def mark_problems(s):
     """Where the ring on a canvas is not centred on the pixel the readout reads."""
     d = s.page.evaluate("({...document.getElementById('sim-readout').dataset})")
@@ -1056,8 +1061,9 @@ def mark_problems(s):
 def _keyboard_walk(s, readouts):
     """Use the simulator from the keyboard alone, checking `spoken_problems` after each move: Tab to the
     field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
-    and move the probe with the arrow keys (the readout reads the pixel, a ring on each canvas marks it), to the
-    shading normal and change
+    and move the probe with the arrow keys (the readout reads the pixel, a ring on each canvas marks it, the status
+    line says the pixel and whether it is in the crease band as the readout does; on by tens to a pixel in it), to
+    the shading normal and change
     it (the note beside it, a live region, must then say the β slider's new range), then on to the view
     menu and change it (the note must be gone).  Yields (move, problems) as it goes, so that a wrong variant's
     walk stops where its problem shows; appends the readout's texts to ``readouts``."""
@@ -1083,19 +1089,33 @@ def _keyboard_walk(s, readouts):
     tab_to("sim-beta"); yield "β", move("ArrowRight")
     tab_to("sim-canvas-symbolic")
     probe = [] if not any(page.evaluate(MARKS_JS)) else ["a ring before any pixel was read"]
-    res, at = s.sim("sim.state.resolution"), []
-    for key in ("ArrowRight", "ArrowDown", "Shift+ArrowRight"):
+    res, at, bands = s.sim("sim.state.resolution"), [], set()
+
+    def press(key):
         page.keyboard.press(key)
         readouts.append(page.text_content("#sim-readout"))
         d, said = s.page.evaluate("({...document.getElementById('sim-readout').dataset})"), page.text_content("#sim-status")
         at.append((int(d["i"]), int(d["j"])))
-        if not (said.startswith(f"Pixel x {d['i']}, y {d['j']},") and "|ΔI|" in said):
-            probe.append(f"the probe's pixel not said: status {said!r} at ({d['i']}, {d['j']})")
-        probe += mark_problems(s) + [f"a hyphen for a minus sign in the readout: {m.group()}"
-                                     for m in HYPHEN_MINUS.finditer(readouts[-1])]
+        found = [] if said.startswith(f"Pixel x {d['i']}, y {d['j']},") and "|ΔI|" in said else [
+            f"the probe's pixel not said: status {said!r} at ({d['i']}, {d['j']})"]
+        band = page.evaluate(CREASE_ROW_JS).startswith("in the band")
+        bands.add(band)
+        if band != ("in the crease band" in said):
+            found.append(f"the crease band {'not said' if band else 'said'} at ({d['i']}, {d['j']}), "
+                         f"{'in' if band else 'out of'} it by the readout: status {said!r}")
+        return found + mark_problems(s) + [f"a hyphen for a minus sign in the readout: {m.group()}"
+                                           for m in HYPHEN_MINUS.finditer(readouts[-1])]
+    for key in ("ArrowRight", "ArrowDown", "Shift+ArrowRight"):
+        probe += press(key)
     c = res // 2                        # the first press reads the centre, the next a pixel on, with Shift ten
     if at != [(c, c), (c, c + 1), (c + 10, c + 1)]:
         probe.append(f"the probe went {at}, not from the centre ({c}, {c}) one pixel down, ten right")
+    for _ in range(res // 10):          # on, ten pixels a press, to a pixel the readout puts in the crease band
+        if True in bands:
+            break
+        probe += press("Shift+ArrowRight")
+    if bands != {True, False}:
+        probe.append(f"the walk read pixels {'in' if True in bands else 'out of'} the crease band only")
     yield "probe", probe
     tab_to("sim-bump"); normal = move("ArrowUp")        # to the draft's chart formula
     top = page.get_attribute("#sim-beta", "max")
@@ -1110,7 +1130,8 @@ def _keyboard_walk(s, readouts):
 
 def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser, book_html):
     """From the keyboard alone (Tab, arrow keys, Page Down): the field, ε, β, the normal and the view change, and
-    the probe walks over the symbolic canvas, the readout reading each pixel and the status line saying which, and its |ΔI|;
+    the probe walks over the symbolic canvas, the readout reading each pixel and the status line saying which, whether
+    it is in the crease band (the walk reads pixels in it and out of it), and its |ΔI|;
     after every move each canvas is an image whose label says what it draws (field, β, normal, view;
     the numeric canvas's ε; the difference's largest |ΔI| and RMS as the ledger prints them), the
     U-curve's label the current ε, the ε slider's value text the ε printed (`spoken_problems`)."""
@@ -1119,7 +1140,7 @@ def test_the_simulator_works_from_the_keyboard_and_speaks_what_it_shows(browser,
         readouts = []
         found = dict(_keyboard_walk(s, readouts))
         assert found == dict.fromkeys(found, []), found
-        assert len(set(readouts)) == 3 and all(r.startswith("pixel") for r in readouts), readouts
+        assert len(set(readouts)) == len(readouts) >= 4 and all(r.startswith("pixel") for r in readouts), readouts
         assert s.errors == []
     finally:
         s.close()
@@ -1142,6 +1163,10 @@ WRONG_SPOKEN = {
                                                "not from the centre"),
     "the readout a live region again": ('class: "sim-readout" }', 'class: "sim-readout", "aria-live": "polite" }', "live regions"),
     "the probe's pixel not said": ("if (say) this.status.textContent", "if (false) this.status.textContent", "the probe's pixel not said"),
+    "the crease band left unsaid": ('const band = a.kink ? ", in the crease band" : "";', 'const band = "";',
+                                    "the crease band not said"),
+    "every pixel of sphere A said in the crease band": ('const band = a.kink ?', 'const band = a.chamber === SPHERE_A ?',
+                                                        "the crease band said"),
     "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",
                                            "mark.style.left = `${(100 * (i + 1.5)) / res}%`;", "the rings at"),
     "a ring shown before any pixel is read": ('"aria-hidden": "true", hidden: "" }', '"aria-hidden": "true" }',

@@ -704,8 +704,8 @@ class Simulator {
   }
 
   // The readout of pixel (i, j); a probe moved there (say) also says, in the status line, which pixel it
-  // reads and its |ΔI|, first: the readout is no live region (after a change of a control it would be
-  // read whole again).
+  // reads, whether it is in the crease band (where the two pipelines part) and its |ΔI|, first: the
+  // readout is no live region (after a change of a control it would be read whole again).
   show_probe(i, j, say = true) {
     const s = this.state;
     const res = s.resolution;
@@ -736,7 +736,8 @@ class Simulator {
     rows.push(["RGB exact", vec(a.rgb, 6)]);
     rows.push([`RGB ${b.gradient}`, vec(b.rgb, 6)]);
     this.show_readout(rows);
-    if (say) this.status.textContent = `Pixel x ${i}, y ${j}, ${CHAMBER_NAMES[a.chamber]}: |ΔI| ${delta}.`;
+    const band = a.kink ? ", in the crease band" : "";
+    if (say) this.status.textContent = `Pixel x ${i}, y ${j}, ${CHAMBER_NAMES[a.chamber]}${band}: |ΔI| ${delta}.`;
     const d = this.readout.dataset;
     d.i = String(i); d.j = String(j); d.chamber = String(a.chamber);
     d.u = a.uv ? String(a.uv[0]) : ""; d.v = a.uv ? String(a.uv[1]) : "";
