@@ -292,6 +292,7 @@ def test_the_u_curve_is_the_ledger_over_every_pixel_and_follows_the_controls(ses
     session.fill("beta", SIMULATOR_SCENE.beta)
     session.set_eps(-3)
     curve = session.wait_curve()
+    assert curve_table_problems(session) == []
     sample = session.sim(f"Math.max(1, Math.ceil({SIZE} / 48))")
     assert curve["stride"] == 1 and sample > 1
     steps = [p["eps"] for p in curve["points"]]
@@ -316,10 +317,58 @@ def test_the_u_curve_is_the_ledger_over_every_pixel_and_follows_the_controls(ses
     session.fill("beta", 0.6)
     session.wait_curve()
     assert plot.locator("#sim-curve-rms").get_attribute("points") != rms_line          # recomputed
+    assert curve_table_problems(session) == []                                         # and its table with it
     session.fill("beta", SIMULATOR_SCENE.beta)
     session.wait_curve()
     assert plot.locator("#sim-curve-rms").get_attribute("points") == rms_line
     assert session.errors == []
+
+
+#: Run in the page: the U-curve's folded table (the simulator's ``draw_curve``), its caption and each row's cells.
+CURVE_TABLE_JS = """() => ({caption: document.getElementById('sim-curve-table-caption').textContent,
+  rows: [...document.querySelectorAll('#sim-curve-rows tr')].map((tr) => [...tr.children].map((c) => c.textContent))})"""
+
+
+def curve_table_problems(s):
+    """Where the U-curve's table departs from the curve it tabulates, once drawn over every pixel
+    (`Session.wait_curve`): a row count other than the points'; a row whose ε, RMS or max |ΔI| is not its
+    point's to the digits it prints; a step marked best other than the triangle's; a caption that does not
+    say every pixel."""
+    curve, table = s.wait_curve(), s.page.evaluate(CURVE_TABLE_JS)
+    found = [] if len(table["rows"]) == len(curve["points"]) else [
+        f"{len(table['rows'])} rows for the curve's {len(curve['points'])} points"]
+    triangle = s.page.locator("#sim-curve-best")
+    best = float(triangle.get_attribute("data-eps")) if triangle.count() else None
+    for (eps, rms, top), p in zip(table["rows"], curve["points"]):
+        cells = {"ε": (float(eps.removesuffix(" (best)")), p["eps"], 0.05), "RMS": (float(rms), p["rms"], 5e-3),
+                 "max": (float(top), p["max_abs"], 5e-3)}
+        found += [f"{name} {shown!r} in the row of the point at ε = {p['eps']:.1e}, {value!r}"
+                  for name, (shown, value, rel) in cells.items() if not abs(shown - value) <= rel * value]
+        if eps.endswith(" (best)") != (p["eps"] == best):
+            found.append(f"the row of ε = {p['eps']:.1e} {'marked' if eps.endswith(' (best)') else 'unmarked'}, "
+                         f"the triangle at {best}")
+    if "every pixel" not in table["caption"]:
+        found.append(f"the table's caption: {table['caption']!r}")
+    return found
+
+
+#: Wrong variants of the U-curve's table: (old text of the bundle, new text).
+WRONG_TABLE = {
+    "filled once, from the sampled curve": ("this.curve_rows.replaceChildren(",
+                                           "if (!this.curve_rows.children.length) this.curve_rows.replaceChildren("),
+    "the best step unmarked": ('(marked && i === best ? " (best)" : "")', '""'),
+    "the RMS under max": ('el("td", { text: fmt(p.max_abs, 2) })', 'el("td", { text: fmt(p.rms, 2) })'),
+    "a caption naming the sample": ("over ${sample}`", "over a sample`"),
+}
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_TABLE))
+def test_the_table_check_catches_a_stale_or_wrong_curve_table(browser, book_html, variant):
+    s = _simulator_at(browser, book_html, 1280, bundle=_replaced_once(*WRONG_TABLE[variant], variant))
+    try:
+        assert curve_table_problems(s), variant
+    finally:
+        s.close()
 
 
 def test_the_curve_marks_its_image_best_step_and_names_its_right_arm_per_field(session):

@@ -152,6 +152,8 @@ const STYLE = `
 .symrender-sim .sim-curve { grid-column: 1 / span 2; }
 .symrender-sim .sim-curve svg { width: 100%; height: 13rem; display: block; overflow: visible; }
 .symrender-sim .sim-curve text { fill: currentColor; font-size: 11px; }
+.symrender-sim .sim-curve-values summary { min-height: 1.75rem; cursor: pointer; }
+.symrender-sim .sim-curve-values caption { caption-side: top; text-align: left; font-size: 0.8rem; }
 .symrender-sim .sim-readout-box { grid-column: 3; min-width: 0; background: var(--pst-color-background, #fff); }
 .symrender-sim .sim-more { display: none; }
 .symrender-sim .sim-readout { font-size: 0.75rem; line-height: 1.3;
@@ -297,8 +299,14 @@ class Simulator {
     const holder = el("div");
     holder.innerHTML = svg("svg", { id: "sim-curve", role: "img" });
     this.plot = holder.firstChild;
+    // The curve's numbers as a table, folded under the plot: what a screen reader (or anyone) reads of it.
+    this.curve_rows = el("tbody", { id: "sim-curve-rows" });
+    const values = el("details", { class: "sim-curve-values" }, [el("summary", { text: "The curve's values" }),
+      el("table", { class: "sim-curve-table" }, [el("caption", { id: "sim-curve-table-caption" }),
+                       el("thead", {}, [el("tr", {}, ["ε", "RMS |ΔI|", "max |ΔI|"].map((h) => el("th", { scope: "col", text: h })))]),
+                       this.curve_rows])]);
     const curve = el("figure", { class: "sim-curve", "aria-labelledby": "sim-curve-caption" },
-                     [this.plot, el("figcaption", { id: "sim-curve-caption" })]);
+                     [this.plot, el("figcaption", { id: "sim-curve-caption" }), values]);
     this.readout = el("dl", { id: "sim-readout", class: "sim-readout" });
     // Shown on a phone only (STYLE), once a pixel is read out.
     const more = el("button", { type: "button", id: "sim-more", class: "sim-more", "aria-controls": "sim-readout",
@@ -660,9 +668,13 @@ class Simulator {
       nodes.push(svg("text", { x: x0 + 27, y }, label));
     });
     plot.innerHTML = nodes.join("");
+    this.curve_rows.replaceChildren(...points.map((p, i) => el("tr", {}, [
+      el("th", { scope: "row", text: eps_of(CURVE_LOG_EPS[i]).toExponential(1) + (marked && i === best ? " (best)" : "") }),
+      el("td", { text: fmt(p.rms, 2) }), el("td", { text: fmt(p.max_abs, 2) })])));
     const stride = this.curve.stride, s = this.state.resolution;
     const sample = stride === 1 ? `every pixel of sphere A in the ${s} × ${s} frame`
                                 : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame`;
+    this.root.querySelector("#sim-curve-table-caption").textContent = `|ΔI| on sphere A at each step ε, over ${sample}`;
     const said = unused ? this.frame_ledger : here;     // with footprint steps, the frame's own ledger
     plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; ` +
                       (unused ? "the frame takes each pixel's footprint as its step: " : `at ε = ${here.eps.toExponential(1)} `) +
