@@ -299,6 +299,11 @@ def test_the_u_curve_is_the_ledger_over_every_pixel_and_follows_the_controls(ses
     assert len(steps) == 27 and steps[0] == 1e-14 and steps[-1] == 0.1
     assert curve["here"]["eps"] == 1e-3
     assert (curve["here"]["rms"], curve["here"]["max_abs"]) == (session.ledger("rms"), session.ledger("max"))
+    # The means on and off the crease band the difference canvas's label says: Python's, within the largest
+    # bound of a pixel's |ΔI| (a mean moves no further than its terms).
+    led, _, _, _, max_bound = _python_ledger(SIMULATOR_SCENE.replace(height_field="ridges"), 1e-3)
+    js = session.sim("sim.frames.ledger")
+    assert all(abs(js[k] - getattr(led, k)) <= max_bound for k in ("mean_abs_kink", "mean_abs_off_kink")), (js, led)
     # Near 1e-3 and 10^-2.5, where the model's bound is far below the differences; each point against
     # Python at its own step (which steps the page computes with is the control tests' business).
     for near in (-3.0, -2.5):
@@ -1032,12 +1037,18 @@ SPOKEN_JS = """() => {
 }"""
 
 
+def _js_exponential(x):
+    """``x`` as JavaScript's ``toExponential(1)`` prints it (1.2e-3, not 1.2e-03)."""
+    return re.sub(r"e([+-])0*(\d)", r"e\1\2", f"{x:.1e}")
+
+
 def spoken_problems(s):
     """Where what a screen reader is given departs from what the simulator shows (`SPOKEN_JS`): a canvas
     that is not an application (a screen reader in browse mode keeps the arrow keys that move the probe from
     anything else) described as an image with a probe, with a label naming the field, β, the view and the
     normal, the numeric canvas's ε
-    and the difference's largest |ΔI| and RMS as the ledger prints them; a hint that is no polite live
+    and the difference's largest |ΔI| and RMS as the ledger prints them, and its means on and off the crease
+    band where the frame has both (none where it has not); a hint that is no polite live
     region; a status line (role status) that does not give the difference's largest |ΔI| and RMS as the
     ledger prints them; another live region (the readout, read whole after every change once a pixel was
     read; the ledger table, its changed cells without their headers; a slider's printed value, said twice);
@@ -1060,8 +1071,15 @@ def spoken_problems(s):
     if st["numeric"] == "central" and f"ε = {eps}" not in said["canvases"]["numeric"][1]:
         found.append(f"numeric canvas: ε = {eps} not in {said['canvases']['numeric'][1]!r}")
     difference = said["canvases"]["difference"][1] or ""
+    led, band = s.sim("sim.frames.ledger"), re.search(r"mean \|ΔI\| (\S+) in the crease band, (\S+) off it", difference)
+    if np.isfinite([led["mean_abs_kink"], led["mean_abs_off_kink"]]).all():
+        want = (_js_exponential(led["mean_abs_kink"]), _js_exponential(led["mean_abs_off_kink"]))
+        if band is None or band.groups() != want:
+            found.append(f"difference canvas: the ledger's means on and off the crease band {want} not in {difference!r}")
+    elif band:
+        found.append(f"difference canvas: means on a crease band the frame has not: {difference!r}")
     for cell in ("max", "rms"):
-        value = re.sub(r"e([+-])0*(\d)", r"e\1\2", f"{s.ledger(cell):.1e}")       # as JavaScript's toExponential(1)
+        value = _js_exponential(s.ledger(cell))
         if value not in difference:
             found.append(f"difference canvas: the ledger's {cell} {value} not in {difference!r}")
         if said["status"][0] != "status" or value not in said["status"][1]:
@@ -1214,6 +1232,8 @@ WRONG_SPOKEN = {
     "the probe's pixel not said": ("if (say) this.status.textContent", "if (false) this.status.textContent", "the probe's pixel not said"),
     "the crease band left unsaid": ('const band = a.kink ? ", in the crease band" : "";', 'const band = "";',
                                     "the crease band not said"),
+    "the difference's band means left unsaid": ("`on sphere A ${totals}${where}.`", "`on sphere A ${totals}.`",
+                                                "means on and off the crease band"),
     "every pixel of sphere A said in the crease band": ('const band = a.kink ?', 'const band = a.chamber === SPHERE_A ?',
                                                         "the crease band said"),
     "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",

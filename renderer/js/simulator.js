@@ -570,6 +570,10 @@ class Simulator {
   // in words, as the status line says them too.
   describe(ledger) {
     const totals = `max |ΔI| ${fmt(ledger.max_abs, 1)}, RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips`;
+    // Where the differences sit, as the difference canvas shows them: on a field with creases, the ledger's mean
+    // |ΔI| on the crease band and off it.
+    const where = Number.isFinite(ledger.mean_abs_kink) && Number.isFinite(ledger.mean_abs_off_kink)
+      ? `; mean |ΔI| ${fmt(ledger.mean_abs_kink, 1)} in the crease band, ${fmt(ledger.mean_abs_off_kink, 1)} off it` : "";
     const s = this.state, bump = CONTROLS.find((c) => c.name === "bump").labels[s.bump];
     const view = { shaded: "shaded", bump: "the size of ∇h in grey", kink: "the crease band in white" }[s.view];
     const what = `sphere A with the ${s.height_field} field, β = ${s.beta.toFixed(2)}, kᵤ = ${s.k_u}, kᵥ = ${s.k_v}, ` +
@@ -581,7 +585,7 @@ class Simulator {
       numeric: `Render by ${pipe}: ${what}; ${view}.`,
       symbolic: `Render by the exact gradient: ${what}; ${view}.`,
       difference: `Difference |ΔI| of the two renders (${s.view === "bump" ? "of the sizes of ∇h" : "shaded"}), ${scale}: ` +
-        `on sphere A ${totals}.`,
+        `on sphere A ${totals}${where}.`,
     };
     for (const [name, t] of Object.entries(text)) {
       this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe, with Shift ten pixels.`);
