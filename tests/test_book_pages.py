@@ -697,8 +697,9 @@ TOLD_APART = r"""() => {
             .filter(([, k]) => k > 1).map(([id, k]) => `the id '${id}' given ${k} times`),
           ...[...root.querySelectorAll(':is(.exercise, .theorem) > .admonition-title:not([role=heading][aria-level])')]
             .map(t => `${t.parentElement.matches('.theorem') ? "a theorem's" : "an exercise's"} title is no heading: ${words(t)}`),
-          ...[...root.querySelectorAll('figure')].filter(f => !(document.getElementById(f.getAttribute('aria-labelledby'))
-            || '').textContent?.trim()).map(f => `a figure named by nothing: ${f.id}`),
+          ...[...root.querySelectorAll('figure')].filter(f => !(f.getAttribute('aria-label')
+            || document.getElementById(f.getAttribute('aria-labelledby'))?.textContent || '').trim())
+            .map(f => `a figure named by nothing: ${f.id}`),
           ...[...root.querySelectorAll(':is(h1, h2, h3, h4, h5, h6, [role=heading])')].filter(h => ['::before', '::after']
             .some(p => /[\ue000-\uf8ff]/.test(getComputedStyle(h, p).content) && !/\/ *""$/.test(getComputedStyle(h, p).content)))
             .map(h => `an icon's character in a heading's name: ${words(h)}`),

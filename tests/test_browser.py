@@ -1050,7 +1050,7 @@ def spoken_problems(s):
     and the difference's largest |ΔI| and RMS as the ledger prints them, and its means on and off the crease
     band where the frame has both (none where it has not); a hint that is no polite live
     region; a status line (role status) that does not give the difference's largest |ΔI| and RMS as the
-    ledger prints them; another live region (the readout, read whole after every change once a pixel was
+    ledger prints them, and the band's means as the label does; another live region (the readout, read whole after every change once a pixel was
     read; the ledger table, its changed cells without their headers; a slider's printed value, said twice);
     the U-curve not an image labelled with the current ε;
     the ε slider's value text not what it prints; a control whose accessible name does not begin with its
@@ -1071,13 +1071,17 @@ def spoken_problems(s):
     if st["numeric"] == "central" and f"ε = {eps}" not in said["canvases"]["numeric"][1]:
         found.append(f"numeric canvas: ε = {eps} not in {said['canvases']['numeric'][1]!r}")
     difference = said["canvases"]["difference"][1] or ""
-    led, band = s.sim("sim.frames.ledger"), re.search(r"mean \|ΔI\| (\S+) in the crease band, (\S+) off it", difference)
-    if np.isfinite([led["mean_abs_kink"], led["mean_abs_off_kink"]]).all():
-        want = (_js_exponential(led["mean_abs_kink"]), _js_exponential(led["mean_abs_off_kink"]))
-        if band is None or band.groups() != want:
-            found.append(f"difference canvas: the ledger's means on and off the crease band {want} not in {difference!r}")
-    elif band:
-        found.append(f"difference canvas: means on a crease band the frame has not: {difference!r}")
+    if st["view"] == "bump" and "the shaded renders' on sphere A" not in difference:    # the ledger is of those
+        found.append(f"difference canvas: the ledger not said to be the shaded renders' in the bump view: {difference!r}")
+    led = s.sim("sim.frames.ledger")
+    for where, text in (("difference canvas", difference), ("status", said["status"][1] or "")):
+        band = re.search(r"mean \|ΔI\| (\S+) in the crease band, (\S+) off it", text)
+        if np.isfinite([led["mean_abs_kink"], led["mean_abs_off_kink"]]).all():
+            want = (_js_exponential(led["mean_abs_kink"]), _js_exponential(led["mean_abs_off_kink"]))
+            if band is None or band.groups() != want:
+                found.append(f"{where}: the ledger's means on and off the crease band {want} not in {text!r}")
+        elif band:
+            found.append(f"{where}: means on a crease band the frame has not: {text!r}")
     for cell in ("max", "rms"):
         value = _js_exponential(s.ledger(cell))
         if value not in difference:
@@ -1234,6 +1238,9 @@ WRONG_SPOKEN = {
                                     "the crease band not said"),
     "the difference's band means left unsaid": ("`on sphere A ${totals}${where}.`", "`on sphere A ${totals}.`",
                                                 "means on and off the crease band"),
+    "the status without the band's means": ("return totals + where;", "return totals;", "status: the ledger's means"),
+    "the bump view's ledger said to be of the sizes of ∇h": ("the two renders, ${scale}; the shaded renders' `",
+                                                              "the two renders, ${scale}; `", "shaded renders'"),
     "every pixel of sphere A said in the crease band": ('const band = a.kink ?', 'const band = a.chamber === SPHERE_A ?',
                                                         "the crease band said"),
     "the rings a pixel off the one read": ("mark.style.left = `${(100 * (i + 0.5)) / res}%`;",
@@ -1241,7 +1248,7 @@ WRONG_SPOKEN = {
     "a ring shown before any pixel is read": ('"aria-hidden": "true", hidden: "" }', '"aria-hidden": "true" }',
                                               "a ring before any pixel"),
     "the readout's negative numbers with a hyphen": ('.replace(/^-/, "\\u2212")', "", "a hyphen for a minus sign"),
-    "the ledger table a live region": ('el("table", { class: "sim-ledger" }', 'el("table", { class: "sim-ledger", "aria-live": "polite" }',
+    "the ledger table a live region": ('el("table", { class: "sim-ledger",', 'el("table", { class: "sim-ledger", "aria-live": "polite",',
                                        "live regions"),
     "the sliders' printed values live": ('for: `sim-${c.name}`, "aria-hidden": "true" }', 'for: `sim-${c.name}` }', "live regions"),
     "a status that never changes": ("this.status.textContent = `On sphere A", "this.status.dataset.said = `On sphere A", "status:"),
@@ -1785,7 +1792,8 @@ WRONG_LAYOUTS = {
     "the sticky controls under the theme's header": ("bundle",
         "position: sticky; top: 3.5rem;", "position: sticky; top: 0;", "#sim-height_field covered by div.bd-header-article"),
     "the sticky readout below the U-curve, over its caption": ("bundle",
-        ".symrender-sim .sim-curve { order: 1; }", "", "#sim-curve-caption covered by dl#sim-readout"),
+        '[...figs, el("div", { class: "sim-readout-box" }, [this.readout, more]), curve]',
+        '[...figs, curve, el("div", { class: "sim-readout-box" }, [this.readout, more])]', "#sim-curve-caption covered by dl#sim-readout"),
     "the controls scrolled away from the U-curve": ("bundle",
         "position: sticky; top: 3.5rem;", "position: static;", "#sim-log_eps beside the plot covered by nothing (off the screen)"),
     "the controls scrolled away from the difference canvas": ("bundle",

@@ -149,12 +149,12 @@ const STYLE = `
 .symrender-sim .sim-probe { position: absolute; box-sizing: border-box; width: 13px; height: 13px; margin: -6.5px 0 0 -6.5px;
   border: 2px solid #fff; border-radius: 50%; box-shadow: 0 0 0 1px #000, inset 0 0 0 1px #000; pointer-events: none; }
 .symrender-sim figcaption { font-size: 0.8rem; line-height: 1.25; margin-top: 0.25rem; }
-.symrender-sim .sim-curve { grid-column: 1 / span 2; }
+.symrender-sim .sim-curve { grid-column: 1 / span 2; grid-row: 2; }
 .symrender-sim .sim-curve svg { width: 100%; height: 13rem; display: block; overflow: visible; }
 .symrender-sim .sim-curve text { fill: currentColor; font-size: 11px; }
 .symrender-sim .sim-curve-values summary { min-height: 1.75rem; cursor: pointer; }
 .symrender-sim .sim-curve-values caption { caption-side: top; text-align: left; font-size: 0.8rem; }
-.symrender-sim .sim-readout-box { grid-column: 3; min-width: 0; background: var(--pst-color-background, #fff); }
+.symrender-sim .sim-readout-box { grid-column: 3; grid-row: 2; min-width: 0; background: var(--pst-color-background, #fff); }
 .symrender-sim .sim-more { display: none; }
 .symrender-sim .sim-readout { font-size: 0.75rem; line-height: 1.3;
   display: grid; grid-template-columns: fit-content(40%) minmax(0, 1fr); gap: 0.1rem 0.5rem; align-content: start;
@@ -177,7 +177,8 @@ const STYLE = `
 .symrender-sim .sim-presets button, .symrender-sim .sim-reset { padding: 0.2rem 0.6rem; }
 .symrender-sim .sim-hint { min-height: 2.6em; margin: 0 0 0.4rem; font-style: italic; }
 .symrender-sim .sim-note { grid-column: 1 / -1; margin: 0; font-style: italic; }
-.symrender-sim .sim-note:empty { display: none; }
+/* Empty, out of sight but not out of the accessibility tree: a live region shown only once it has text is often not read. */
+.symrender-sim .sim-note:empty { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); }
 .symrender-sim .sim-status { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
 .symrender-sim table { font-variant-numeric: tabular-nums; margin: 0.4rem 0; }
 .symrender-sim td, .symrender-sim th { padding: 0.1rem 0.7rem; }
@@ -194,8 +195,7 @@ const STYLE = `
   .symrender-sim .sim-main label:has(select) { flex-direction: row; align-items: center; gap: 0.5rem; }
   .symrender-sim .sim-main label:has(select) select { flex: 1; min-width: 0; }
   .symrender-sim .sim-stage { grid-template-columns: minmax(0, 1fr); }
-  .symrender-sim .sim-curve, .symrender-sim .sim-readout-box { grid-column: 1; }
-  .symrender-sim .sim-curve { order: 1; }
+  .symrender-sim .sim-curve, .symrender-sim .sim-readout-box { grid-column: 1; grid-row: auto; }
   /* The plot a little lower, so that the difference canvas, the readout and the plot fit under the controls at once. */
   .symrender-sim .sim-curve svg { height: 12rem; }
   .symrender-sim .sim-readout-box { position: sticky; bottom: 0; z-index: 2; padding: 0.3rem 0.4rem;
@@ -291,8 +291,8 @@ class Simulator {
       this.canvases[name] = canvas;
       const mark = el("span", { class: "sim-probe", "aria-hidden": "true", hidden: "" });
       this.marks.push(mark);
-      // Named by its caption (Chromium names a <figure> by nothing).
-      return el("figure", { "aria-labelledby": `sim-caption-${name}` }, [el("div", { class: "sim-canvas-box" }, [canvas, mark]),
+      // Named in a few words (Chromium names a <figure> by nothing): its caption, read after them, is long.
+      return el("figure", { "aria-label": name === "difference" ? "the difference" : `the ${name} render` }, [el("div", { class: "sim-canvas-box" }, [canvas, mark]),
                                el("figcaption", { id: `sim-caption-${name}` })]);
     });
     // An inline <svg>, parsed from markup (no namespace address in the script).
@@ -305,7 +305,7 @@ class Simulator {
       el("table", { class: "sim-curve-table" }, [el("caption", { id: "sim-curve-table-caption" }),
                        el("thead", {}, [el("tr", {}, ["ε", "RMS |ΔI|", "max |ΔI|"].map((h) => el("th", { scope: "col", text: h })))]),
                        this.curve_rows])]);
-    const curve = el("figure", { class: "sim-curve", "aria-labelledby": "sim-curve-caption" },
+    const curve = el("figure", { class: "sim-curve", "aria-label": "the U-curve" },
                      [this.plot, el("figcaption", { id: "sim-curve-caption" }), values]);
     this.readout = el("dl", { id: "sim-readout", class: "sim-readout" });
     // Shown on a phone only (STYLE), once a pixel is read out.
@@ -316,7 +316,8 @@ class Simulator {
       more.setAttribute("aria-expanded", String(open));
       more.textContent = open ? "fewer rows" : "all rows";
     });
-    root.append(el("div", { class: "sim-stage" }, [...figs, curve, el("div", { class: "sim-readout-box" }, [this.readout, more])]));
+    // The readout right after the canvases it reads, in reading order; the grid puts it beside the U-curve.
+    root.append(el("div", { class: "sim-stage" }, [...figs, el("div", { class: "sim-readout-box" }, [this.readout, more]), curve]));
     this.show_readout([["pixel", "hover over a canvas, tap it, or focus it and use the arrow keys", true]]);
     this.readout.setAttribute("aria-label", "the pixel readout");
     if (typeof ResizeObserver !== "undefined") new ResizeObserver(() => this.draw_curve()).observe(this.plot);
@@ -324,7 +325,7 @@ class Simulator {
     const cell = (id) => el("td", { id });
     // Not a live region (a screen reader would read its changed cells without their headers): the status
     // below says what a change did, in one sentence.
-    this.ledger = el("table", { class: "sim-ledger" }, [
+    this.ledger = el("table", { class: "sim-ledger", "aria-label": "the ledger of the two renders" }, [
       el("thead", {}, [el("tr", {}, ["max |ΔI| on A", "RMS |ΔI| on A", "flips", "pixels on A", "last update"]
         .map((h) => el("th", { text: h })))]),
       el("tbody", {}, [el("tr", {}, ["sim-max", "sim-rms", "sim-flips", "sim-pixels", "sim-time"].map(cell))]),
@@ -567,7 +568,7 @@ class Simulator {
 
   // Each canvas's text alternative (its aria-label): what it draws, in
   // words, and the ledger's numbers for the difference; rewritten on every update.  Returns those numbers
-  // in words, as the status line says them too.
+  // in words, as the status line says them too (the band's means with them: the chapter's point).
   describe(ledger) {
     const totals = `max |ΔI| ${fmt(ledger.max_abs, 1)}, RMS ${fmt(ledger.rms, 1)}, ${ledger.flips} flips`;
     // Where the differences sit, as the difference canvas shows them: on a field with creases, the ledger's mean
@@ -584,13 +585,15 @@ class Simulator {
     const text = {
       numeric: `Render by ${pipe}: ${what}; ${view}.`,
       symbolic: `Render by the exact gradient: ${what}; ${view}.`,
-      difference: `Difference |ΔI| of the two renders (${s.view === "bump" ? "of the sizes of ∇h" : "shaded"}), ${scale}: ` +
+      // The ledger is of the shaded renders in every view (the bump view draws the sizes of ∇h instead).
+      difference: (s.view === "bump" ? `Difference of the sizes of ∇h of the two renders, ${scale}; the shaded renders' `
+        : `Difference |ΔI| of the two shaded renders, ${scale}${s.view === "kink" ? ", the crease band in blue" : ""}; `) +
         `on sphere A ${totals}${where}.`,
     };
     for (const [name, t] of Object.entries(text)) {
       this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe, with Shift ten pixels.`);
     }
-    return totals;
+    return totals + where;
   }
 
   // The U-curve over every pixel of sphere A, one step of ε per task, replacing the sample's when all
