@@ -112,7 +112,7 @@ QUANTITIES = {
     # The U-curve of Cell 2: the fitted optimal step (of the model fitted to it), the model-optimal step.
     "the fitted optimal step": (("eps_fitted_sine",), lambda: _ucurve().eps_fitted),
     "the model-optimal step": (("eps_model_sine", "s3_ex_eps"), lambda: _ucurve().eps_model),
-    "the U-curve's label": (("ucurve_label", "s3_ex_label", "c4_fm_label"), lambda: _lib("chapter.labels").ucurve_label(
+    "the U-curve's label": (("ucurve_label", "s3_ex_label"), lambda: _lib("chapter.labels").ucurve_label(
         "sine", _lib("lab.accuracy").optima()["sine"])),
     "the unit roundoff": (("s3_unit_roundoff",), lambda: _lib("renderer.ucurve").UNIT_ROUNDOFF),
     "the book's default step": (("s3_eps_default",), lambda: _lib("renderer").Scene().eps),
@@ -173,11 +173,11 @@ QUANTITIES = {
     "the U-curve's chart v": (("c4_crease_v", "s3_torus_v"), lambda: _lib("renderer.ucurve").SEED_POINT[1]),
     "the classic complex-step test function's point": (("c4_classic_x",),
                                                        lambda: _lib("lab.gradient_benchmark").TEST_FUNCTION.x),
-    # The price of fast math (Cell 4): the ulp sample, its quantile, libm's sine.
-    "the fast-math sample per function": (("c4_fm_points",), lambda: _lib("lab.fastmath").SAMPLES),
-    "the fast-math quantile (%)": (("c4_fm_quantile",), lambda: 100 * _lib("lab.fastmath").QUANTILE),
+    # A fast sine (§7): the ulp sample, its quantile, libm's sine.
+    "the fast-math sample per function": (("s7_fm_points",), lambda: _lib("lab.fastmath").SAMPLES),
+    "the fast-math quantile (%)": (("s7_fm_quantile",), lambda: 100 * _lib("lab.fastmath").QUANTILE),
     "libm's largest sine error (ulp)": (
-        ("c4_fm_libm_sin",), lambda: _lib("lab.fastmath").ulp_table()["errors"]["numba"]["sin"]["max"]),
+        ("s7_fm_libm_sin",), lambda: _lib("lab.fastmath").ulp_table()["errors"]["numba"]["sin"]["max"]),
     "the chapter's amplitude": (("c5_fit_beta", "s3_torus_beta"), lambda: _lib("renderer").Scene().beta),
     "the rings field's image-best step (the simulator's scene and steps, 256 × 256)": (
         ("ex_rings_best",), lambda: _lib("lab.accuracy").image_best_step("rings", 256)["best"]),
@@ -198,7 +198,7 @@ ON_THE_PAGE = ("ix_label", "s2_draft_diff", "s3_band_u", "s3_band_v", "s1_size",
                "s1_flips_surface", "s1_ex_factor", "s2_count_0", "s2_count_2", "s2_count_3",
                "s4_label", "s4_field", "s4_max", "s4_rms", "s4_ulp_points", "s4_ulp_shift_e3", "s4_ulp_shift_e10", "s4_ulp_eps_e3",
                "s4_ulp_eps_e10", "c2_fp_u", "c2_fp_ratio", "c4_fastest", "c4_cs_ratio", "c4_ad_ratio", "c4_ad_err_ratio",
-               "c4_ad_compile_ms", "c4_xla_ad_lo", "c4_xla_ad_hi", "c4_xla_numba_lo", "c4_xla_numba_hi", "c4_sine_points", "c4_fm_ulps", "c4_fm_floors", "c4_fm_drjit", "c6_beta",
+               "c4_ad_compile_ms", "c4_xla_ad_lo", "c4_xla_ad_hi", "c4_xla_numba_lo", "c4_xla_numba_hi", "c4_sine_points", "s7_fm_ulps", "s7_fm_floors", "s7_fm_drjit", "s7_fm_worst_ratio", "s7_fm_floor_rise", "c6_beta",
                "c4_methods", "c4_classic_derivative", "c4_classic_table", "c4_classic_published", "c4_classic_cs_from",
                "c4_classic_cs_max", "c4_classic_ad_err", "c4_classic_eps_model", "c4_classic_eps_fitted",
                "c4_classic_central_step", "c4_classic_richardson_f", "c4_classic_fwd_step", "c4_classic_fwd_trunc",

@@ -22,7 +22,7 @@ from __future__ import annotations
 import os
 import re
 
-__all__ = ["glue", "show", "markdown", "plain_markdown", "plain_role", "plain_directive", "plain_exercise",
+__all__ = ["glue", "show", "markdown", "table", "plain_markdown", "plain_role", "plain_directive", "plain_exercise",
            "minus_signs", "HYPHEN_MINUS", "EXERCISE_FORMS", "BUILD_ENV",
            "in_book_build", "FigureLayoutError"]
 
@@ -159,6 +159,13 @@ def markdown(text):
         raise TypeError(f"text must be a str of MyST markdown, got {type(text).__name__}")
     from IPython.display import Markdown
     return Markdown(text if in_book_build() else plain_markdown(text))
+
+
+def table(header, rows):
+    """A Markdown table (`markdown`) of a header and rows of formatted cells, each a sequence of str
+    as long as the header."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    return markdown("\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows]))
 
 
 # --- MyST -> plain Markdown ----------------------------------------------------------------------
