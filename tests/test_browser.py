@@ -1032,6 +1032,14 @@ SPOKEN_JS = """() => {
             : e.getAttribute('aria-live') && e.getAttribute('aria-live') !== 'off') && !['sim-hint', 'sim-note'].includes(e.id))
             .map(e => e.id || e.className),
           eps: attr('#sim-log_eps', 'aria-valuetext'),
+          // What reads after the difference canvas, of the readout and the U-curve, in document order.
+          order: ['#sim-readout', '#sim-curve'].sort((a, b) => document.querySelector(a).compareDocumentPosition(
+            document.querySelector(b)) & Node.DOCUMENT_POSITION_FOLLOWING ? -1 : 1)
+            .filter(sel => document.getElementById('sim-canvas-difference').compareDocumentPosition(
+              document.querySelector(sel)) & Node.DOCUMENT_POSITION_FOLLOWING),
+          note: document.getElementById('sim-note').textContent ? null : getComputedStyle(document.getElementById('sim-note')).display,
+          tables: [...document.querySelectorAll('.symrender-sim table')].map(t => t.getAttribute('aria-label')
+            || (t.caption ? t.caption.textContent : '')),
           labels: [...document.querySelectorAll('.symrender-sim :is(select, input)')].map(
             e => e.closest('label').querySelector('span').firstChild.textContent.trim())};
 }"""
@@ -1052,7 +1060,8 @@ def spoken_problems(s):
     region; a status line (role status) that does not give the difference's largest |ΔI| and RMS as the
     ledger prints them, and the band's means as the label does; another live region (the readout, read whole after every change once a pixel was
     read; the ledger table, its changed cells without their headers; a slider's printed value, said twice);
-    the U-curve not an image labelled with the current ε;
+    the U-curve not an image labelled with the current ε; the readout not read after the canvases and before
+    the U-curve; the β note's live region out of the tree while empty; a table of the simulator without a name;
     the ε slider's value text not what it prints; a control whose accessible name does not begin with its
     label."""
     said, st = s.page.evaluate(SPOKEN_JS), s.sim("sim.state")
@@ -1096,6 +1105,12 @@ def spoken_problems(s):
         found.append(f"U-curve: {said['curve']}")
     if said["eps"] != eps:
         found.append(f"ε slider: aria-valuetext {said['eps']!r}, printed {eps!r}")
+    if said["order"] != ["#sim-readout", "#sim-curve"]:
+        found.append(f"reading order after the canvases: {said['order']}, not the readout and then the U-curve")
+    if said["note"] == "none":
+        found.append("the β note's live region out of the accessibility tree while empty (display: none)")
+    if not all(said["tables"]):
+        found.append(f"a table of the simulator unnamed: {said['tables']}")
     # Each control's name in Chromium's accessibility tree (axe passes a control inside a <label> whose
     # first labelable element, an <output>, takes the label instead: the sliders were once nameless).
     named = re.findall(r'- (?:slider|combobox|checkbox)(?: "([^"]*)")?', s.page.locator(".symrender-sim").aria_snapshot())
@@ -1239,6 +1254,12 @@ WRONG_SPOKEN = {
     "the difference's band means left unsaid": ("`on sphere A ${totals}${where}.`", "`on sphere A ${totals}.`",
                                                 "means on and off the crease band"),
     "the status without the band's means": ("return totals + where;", "return totals;", "status: the ledger's means"),
+    "the readout read after the U-curve": ('[...figs, el("div", { class: "sim-readout-box" }, [this.readout, more]), curve]',
+                                          '[...figs, curve, el("div", { class: "sim-readout-box" }, [this.readout, more])]',
+                                          "reading order"),
+    "the empty note hidden from the tree": (".sim-note:empty { position: absolute;", ".sim-note:empty { display: none;",
+                                            "out of the accessibility tree"),
+    "the ledger table unnamed": ('"aria-label": "the ledger of the two renders" ', "", "table of the simulator unnamed"),
     "the bump view's ledger said to be of the sizes of ∇h": ("the two renders, ${scale}; the shaded renders' `",
                                                               "the two renders, ${scale}; `", "shaded renders'"),
     "every pixel of sphere A said in the crease band": ('const band = a.kink ?', 'const band = a.chamber === SPHERE_A ?',
