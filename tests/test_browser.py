@@ -48,7 +48,7 @@ from chapter.page import HYPHEN_MINUS
 from renderer import DRAFT_SCENE, PointLight, Scene, compare, gbuffer, render
 from renderer.formulas import FIELDS
 from renderer.jsgen import SIMULATOR_SCENE
-from renderer.render import check_args
+from renderer.render import SPHERE_A, check_args
 
 from .jsnode import ARTIFACTS, chromium
 from .test_check_glue import check_glue
@@ -1148,8 +1148,8 @@ def _keyboard_walk(s, readouts):
     """Use the simulator from the keyboard alone, checking `spoken_problems` after each move: Tab to the
     field menu and change it, Tab to ε and move it a decade, to β and move it, on to the symbolic canvas
     and move the probe with the arrow keys (the readout reads the pixel, a ring on each canvas marks it, the status
-    line says the pixel and whether it is in the crease band as the readout does; on by tens to a pixel in it), to
-    the shading normal and change
+    line says the pixel and whether it is in the crease band as the readout does; B to the next pixel in the band,
+    Shift+B back to the one before), to the shading normal and change
     it (the note beside it, a live region, must then say the β slider's new range), then on to the view
     menu and change it (the note must be gone).  Yields (move, problems) as it goes, so that a wrong variant's
     walk stops where its problem shows; appends the readout's texts to ``readouts``."""
@@ -1196,10 +1196,16 @@ def _keyboard_walk(s, readouts):
     c = res // 2                        # the first press reads the centre, the next a pixel on, with Shift ten
     if at != [(c, c), (c, c + 1), (c + 10, c + 1)]:
         probe.append(f"the probe went {at}, not from the centre ({c}, {c}) one pixel down, ten right")
-    for _ in range(res // 10):          # on, ten pixels a press, to a pixel the readout puts in the crease band
-        if True in bands:
-            break
-        probe += press("Shift+ArrowRight")
+    # B to the next pixel of sphere A in the crease band (row by row from the probe's), Shift+B to the one before.
+    kink, chamber = s.page.evaluate("""() => { const f = document.querySelector('[data-symrender-sim]').symrender
+      .frames.symbolic; return [Array.from(f.kink), Array.from(f.chamber)]; }""")
+    band_pixels = [k for k in range(res * res) if kink[k] and chamber[k] == SPHERE_A]
+    for key, pick in (("b", lambda k: min((b for b in band_pixels if b > k), default=band_pixels[0])),
+                      ("Shift+B", lambda k: max((b for b in band_pixels if b < k), default=band_pixels[-1]))):
+        want = pick(at[-1][1] * res + at[-1][0])
+        probe += press(key)
+        if at[-1] != (want % res, want // res):
+            probe.append(f"{key} moved the probe to {at[-1]}, not to the crease band's pixel {(want % res, want // res)}")
     if bands != {True, False}:
         probe.append(f"the walk read pixels {'in' if True in bands else 'out of'} the crease band only")
     yield "probe", probe
@@ -1254,6 +1260,9 @@ WRONG_SPOKEN = {
     "the difference's band means left unsaid": ("`on sphere A ${totals}${where}.`", "`on sphere A ${totals}.`",
                                                 "means on and off the crease band"),
     "the status without the band's means": ("return totals + where;", "return totals;", "status: the ledger's means"),
+    "B to the next pixel of sphere A, in the band or not": ("if (f.kink[k] && f.chamber[k] === SPHERE_A)",
+                                                           "if (f.chamber[k] === SPHERE_A)", "not to the crease band's pixel"),
+    "Shift+B forward too": ("this.probe_band(ev.shiftKey ? -1 : 1)", "this.probe_band(1)", "Shift+B moved the probe"),
     "the readout read after the U-curve": ('[...figs, el("div", { class: "sim-readout-box" }, [this.readout, more]), curve]',
                                           '[...figs, curve, el("div", { class: "sim-readout-box" }, [this.readout, more])]',
                                           "reading order"),

@@ -591,7 +591,8 @@ class Simulator {
         `on sphere A ${totals}${where}.`,
     };
     for (const [name, t] of Object.entries(text)) {
-      this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe, with Shift ten pixels.`);
+      this.canvases[name].setAttribute("aria-label", `${t} Arrow keys move the probe, with Shift ten pixels; ` +
+                                       "B moves it to the next pixel in the crease band, Shift+B to the one before.");
     }
     return totals + where;
   }
@@ -706,12 +707,27 @@ class Simulator {
 
   probe_key(ev) {
     const moves = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
-    if (!(ev.key in moves)) return;
+    const band = ev.key === "b" || ev.key === "B";
+    if (!(ev.key in moves) && !band) return;
     ev.preventDefault();
+    if (band) { this.probe_band(ev.shiftKey ? -1 : 1); return; }
     const res = this.state.resolution;
     if (!this.probe) { this.show_probe(res >> 1, res >> 1); return; }      // the first press reads the centre
     const p = this.probe, n = ev.shiftKey ? 10 : 1, [di, dj] = moves[ev.key];
     this.show_probe(Math.min(res - 1, Math.max(0, p.i + n * di)), Math.min(res - 1, Math.max(0, p.j + n * dj)));
+  }
+
+  // The probe to the next pixel of sphere A in the crease band (dir 1; -1, the one before), row by row from the
+  // probe's pixel and round: the band is a pixel or two wide, and arrow keys step over it.  The status line
+  // says so when the frame has none.
+  probe_band(dir) {
+    const f = this.frames.symbolic, res = this.state.resolution, n = res * res;
+    const from = this.probe ? this.probe.j * res + this.probe.i : (dir > 0 ? -1 : n);
+    for (let step = 1; step <= n; step++) {
+      const k = (((from + dir * step) % n) + n) % n;
+      if (f.kink[k] && f.chamber[k] === SPHERE_A) { this.show_probe(k % res, Math.floor(k / res)); return; }
+    }
+    this.status.textContent = "No pixel of sphere A is in the crease band.";
   }
 
   // rows: [name, value, brief]; a brief row is one a phone shows until the reader asks for all (STYLE).
