@@ -34,7 +34,7 @@ from numba import njit
 
 from renderer import GBuffer, formulas, gbuffer, kernel, pointwise, render
 from renderer.render import Frame, check_args, image_plane
-from renderer.scene import search_chart
+from renderer.intervals import search_chart
 from renderer.validate import InvalidValue, positive_int
 
 __all__ = ["Displaced", "render_displaced", "surface_function", "H_MAX", "MAX_SAMPLES"]
@@ -295,7 +295,7 @@ def _cast_shadow(lights, chamber, P, N, reach):
 
 def _check_bounded(scene):
     """InvalidValue unless |h| <= `H_MAX` at every point of a `BOUND_CHECK_POINTS`-square grid of the
-    chart and between its points (`renderer.scene.search_chart`): the bracketing shells lie at
+    chart and between its points (`renderer.intervals.search_chart`): the bracketing shells lie at
     R +- beta `H_MAX`."""
     h_of = sp.lambdify(formulas.FIELD_SYMBOLS, scene.field.expr, modules="numpy")   # not numba's: no compilation
 

@@ -201,7 +201,7 @@ def test_a_dip_through_the_displaced_radius_anywhere_is_refused_where_it_is(p, q
 def test_a_bounded_field_the_intervals_overestimate_is_accepted_after_the_searchs_budget():
     """(u - v)**2 written out holds each variable twice, and interval arithmetic bounds
     1/(u**2 - 2*u*v + v**2 + 1e-4) about u = v only on boxes of side about 1e-5: the search stops at
-    `renderer.scene.CHART_CHECK_BOXES` boxes and the field, bounded, is accepted on the grid's evidence."""
+    `renderer.intervals.CHART_CHECK_BOXES` boxes and the field, bounded, is accepted on the grid's evidence."""
     from renderer import scene as S
     scene = Scene(height_field="1/(u**2 - 2*u*v + v**2 + 1e-4)", bump="chart")
     assert S._unbounded_near(scene.field, scene.k_u, scene.k_v) is None

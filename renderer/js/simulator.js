@@ -292,8 +292,9 @@ class Simulator {
       const mark = el("span", { class: "sim-probe", "aria-hidden": "true", hidden: "" });
       this.marks.push(mark);
       // Named in a few words (Chromium names a <figure> by nothing): its caption, read after them, is long.
-      return el("figure", { "aria-label": name === "difference" ? "the difference" : `the ${name} render` }, [el("div", { class: "sim-canvas-box" }, [canvas, mark]),
-                               el("figcaption", { id: `sim-caption-${name}` })]);
+      const figure_name = name === "difference" ? "the difference" : `the ${name} render`;
+      return el("figure", { "aria-label": figure_name }, [el("div", { class: "sim-canvas-box" }, [canvas, mark]),
+                                                          el("figcaption", { id: `sim-caption-${name}` })]);
     });
     // An inline <svg>, parsed from markup (no namespace address in the script).
     const holder = el("div");
