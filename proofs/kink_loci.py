@@ -179,19 +179,19 @@ def _loci(kind, shift=0.0, rho=RHO, drho=DRHO, scene=None, all_visible=False, ba
 
 
 #: The quantities the proofs name: the image point (x, y), its radius rho(phi), the ray's angle alpha_m,
-#: the eye E and the normal N.
+#: the eye O and the normal N.
 X, Y = sp.symbols("x y", real=True)
 ALPHA = sp.Symbol("psi", real=True)
 rho = sp.Function("r")
 alpha_m = sp.Symbol("psi_m")
-E_S, N_S, P_S = (sp.MatrixSymbol(name, 3, 1) for name in "ENP")
+O_S, N_S, P_S = (sp.MatrixSymbol(name, 3, 1) for name in "ONP")
 NAMES = {alpha_m: r"\psi_m"}
 #: The ray's angle as written: 2 pi m / k_u - pi.
 ALPHA_SHOWN = written(sp.Add(2 * sp.pi * m_sym / F.k_u, -sp.pi, evaluate=False))
 
 
 def _where(rho_, alpha=ALPHA_SHOWN):
-    return {X: x_img, Y: y_img, rho(phi): rho_, alpha_m: alpha, E_S: sp.ImmutableMatrix([0, 0, e]),
+    return {X: x_img, Y: y_img, rho(phi): rho_, alpha_m: alpha, O_S: sp.ImmutableMatrix([0, 0, e]),
             N_S: P / R, P_S: P}
 
 
@@ -227,9 +227,9 @@ def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
 
 
 def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
-    """Theorem kink-loci-circles claiming rho' = ``drho`` and N . (E - P) = e cos(phi) + ``radius_term``, with
+    """Theorem kink-loci-circles claiming rho' = ``drho`` and N . (O - P) = e cos(phi) + ``radius_term``, with
     the evidence's options (wrong variants)."""
-    radius, slope, facing = X**2 + Y**2, sp.Derivative(rho(phi), phi), Dot(N_S, E_S - P_S)
+    radius, slope, facing = X**2 + Y**2, sp.Derivative(rho(phi), phi), Dot(N_S, O_S - P_S)
     cap = written(sp.Add(e * sp.cos(phi), radius_term, evaluate=False))
     return Theorem(
         id="kink-loci-circles", title=TITLES["kink-loci-circles"],
@@ -241,7 +241,7 @@ def _circles(drho=DRHO_SHOWN, radius_term=-R, **evidence):
                  rho(phi)**2),
             Step(r"Differentiate $r(\varphi) = eR\sin\varphi/(e - R\cos\varphi)$ with the quotient rule", slope,
                  drho),
-            Step(r"The point $P = R N$ faces the eye $E = (0, 0, e)$ where $N \cdot (E - P) > 0$, that is "
+            Step(r"The point $P = R N$ faces the eye $O = (0, 0, e)$ where $N \cdot (O - P) > 0$, that is "
                  r"$e\cos\varphi > R$: there $r' > 0$, so $r$ increases with $\varphi$ and each circle "
                  r"$\varphi = \pi m/k_v$ has one radius", facing, cap),
         ),

@@ -29,14 +29,14 @@ Cb = sp.Matrix(sp.symbols("C_x C_y C_z", real=True))
 r_b = sp.Symbol("r_B", positive=True)
 L = sp.Matrix(sp.symbols("L_x L_y L_z", real=True))
 
-E = sp.Matrix([0, 0, e])
+O = sp.Matrix([0, 0, e])
 d = sp.Matrix([x, y, -e])
-ray = E + t * d
+ray = O + t * d
 
 
 def _sphere_roots(C, r):
-    """(near, far) roots t of |E + t d - C|^2 = r^2: (-b -+ sqrt(b^2 - 4 a c)) / 2a."""
-    a_, b_, c_ = d.dot(d), 2 * d.dot(E - C), (E - C).dot(E - C) - r**2
+    """(near, far) roots t of |O + t d - C|^2 = r^2: (-b -+ sqrt(b^2 - 4 a c)) / 2a."""
+    a_, b_, c_ = d.dot(d), 2 * d.dot(O - C), (O - C).dot(O - C) - r**2
     return tuple((-b_ + sign * sp.sqrt(b_**2 - 4 * a_ * c_)) / (2 * a_) for sign in (-1, 1))
 
 
@@ -253,11 +253,11 @@ def _no_boundary(attached=None, **evidence):
                   r"Hence no pixel changes chamber, and no shadow boundary moves, when the bump's parameters "
                   r"change: the renderer's per-pixel hits and shadow tests come out bit for bit the same.",
         steps=(
-            Step(r"The chamber is the nearest hit: the near roots $t_A$, $t_B$ of $\lvert E + t d - C\rvert^2 = r^2$ "
-                 r"for spheres A and B and the floor plane's $t_{\mathrm{floor}}$, with $E = (0, 0, e)$ the eye and "
+            Step(r"The chamber is the nearest hit: the near roots $t_A$, $t_B$ of $\lvert O + t d - C\rvert^2 = r^2$ "
+                 r"for spheres A and B and the floor plane's $t_{\mathrm{floor}}$, with $O = (0, 0, e)$ the eye and "
                  r"$d = (x, y, -e)$ the pixel's ray; none involves $\beta$, the steps $\varepsilon$ or the frequencies",
                  chamber, sp.ZeroMatrix(3, len(BUMP))),
-            Step(r"The shadow predicates at sphere A's hit $P = E + t_A d$, with $N = P/R$ and $L$ the light, are "
+            Step(r"The shadow predicates at sphere A's hit $P = O + t_A d$, with $N = P/R$ and $L$ the light, are "
                  r"$a = N \cdot (L - P)$, the segment quadratic $q = \lvert P + s(L - P) - C_B\rvert^2 - r_B^2$ and "
                  r"$f = P_z L_z$: built from the same geometry", shadow, sp.ZeroMatrix(3, len(BUMP))),
         ),

@@ -23,9 +23,9 @@ from .core import DIGITS, Dot, Step, Theorem, Verdict, _explicit, catalogue, wri
 #: The vectors the statement names: the shading normal, the unit vectors to the light and to the eye,
 #: the light's mirror direction in N' (Phong) and the half vector (Blinn), in pbrt-v4's omega notation.
 NP, WI, WO, WR, HV = (sp.MatrixSymbol(name, 3, 1) for name in ("N'", "omega_i", "omega_o", "omega_r", "omega_h"))
-#: The weights, the shininess p, the albedo, the ambient light, a light's colour and the pixel's colour I
+#: The weights, the shininess alpha, the albedo, the ambient light, a light's colour and the pixel's colour I
 #: (each one channel); the letters the book's other formulas use for other things are avoided.
-k_a, k_d, k_s, p, rho, I_a, I_l, I = sp.symbols("k_a k_d k_s p rho I_a I_ell I", nonnegative=True)
+k_a, k_d, k_s, alpha, rho, I_a, I_l, I = sp.symbols("k_a k_d k_s alpha rho I_a I_ell I", nonnegative=True)
 #: The highlight's cosine: real, not nonnegative (sympy would drop the clamp max(0, s)); and its clamp to
 #: [0, 1], a name the statement prints and defines (`CLAMP`).
 s = sp.Symbol("mu", real=True)
@@ -33,15 +33,15 @@ S_PLUS = sp.Symbol("mu_+", nonnegative=True)
 CLAMP = {S_PLUS: sp.Min(1, sp.Max(0, s))}
 ell, m = sp.symbols("ell m", integer=True, positive=True)
 T = sp.IndexedBase("T")
-#: The floor's albedo: P = (x, y, 0) on it, c the checker's grey at P (`checker`) and alpha the tint.
+#: The floor's albedo: P = (x, y, 0) on it, c the checker's grey at P (`checker`) and tau the tint.
 X, Y = sp.symbols("x y", real=True)
-alpha, c = sp.symbols("alpha c", nonnegative=True)
-FLOOR = sp.Tuple((1 - alpha) * c, (1 - alpha) * c, c)
+tau, c = sp.symbols("tau c", nonnegative=True)
+FLOOR = sp.Tuple((1 - tau) * c, (1 - tau) * c, c)
 NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: r"\omega_h", rho: r"\rho", I_l: r"I_\ell",
-         ell: r"\ell", s: r"\mu", S_PLUS: r"\mu_+", alpha: r"\alpha"}
+         ell: r"\ell", s: r"\mu", S_PLUS: r"\mu_+", tau: r"\tau"}
 #: The scene's parameter (`renderer.Scene`) each symbol stands for, for the book's list of them.
 SCENE_SYMBOLS = {"lights": I_l, "ambient": I_a, "albedo_a": rho, "albedo_b": rho, "ka": k_a, "kd": k_d, "ks": k_s,
-                 "shininess": p, "floor_tint": alpha}
+                 "shininess": alpha, "floor_tint": tau}
 
 #: |w_i + w_o|, a name the statement prints, defined in the theorem's ``where`` (`LENGTH`).
 NORM = sp.Symbol("|omega_i + omega_o|", positive=True)
@@ -52,7 +52,7 @@ HALF = (WI + WO) / NORM
 #: The Phong cosine as the kernel evaluates it (`renderer.kernel.specular_axis`): no mirror vector formed.
 KERNEL_PHONG = 2 * Dot(NP, WI) * Dot(NP, WO) - Dot(WI, WO)
 #: One light's term where N' . w_i > 0 (nothing elsewhere), and the colour of a channel.
-TERM = I_l * (k_d * rho * Dot(NP, WI) + k_s * S_PLUS ** p)
+TERM = I_l * (k_d * rho * Dot(NP, WI) + k_s * S_PLUS ** alpha)
 COLOUR = sp.Min(1, written(sp.Add(sp.Mul(k_a, I_a, evaluate=False), sp.Sum(T[ell], (ell, 1, m)), evaluate=False)))
 #: The specular cosine s of each model, as the renderer evaluates it.
 COSINE = {"blinn": Dot(NP, HALF), "phong": KERNEL_PHONG}
@@ -153,9 +153,9 @@ def _formula_colour(scene, term, gate=True, colour_of=COLOUR):
 
 
 def _floor_albedo(floor, grey, tint, P):
-    """The albedo (k, 3) that ``floor`` (`FLOOR`) with c = ``grey`` (`checker`) and alpha = ``tint`` gives at the
+    """The albedo (k, 3) that ``floor`` (`FLOOR`) with c = ``grey`` (`checker`) and tau = ``tint`` gives at the
     floor points ``P`` (k, 3), by mpmath at `DIGITS` digits."""
-    at = sp.lambdify((X, Y), floor.xreplace({c: grey, alpha: tint}), modules="mpmath")
+    at = sp.lambdify((X, Y), floor.xreplace({c: grey, tau: tint}), modules="mpmath")
     with mpmath.workdps(DIGITS):
         return np.array([[float(x) for x in at(mpmath.mpf(float(px)), mpmath.mpf(float(py)))] for px, py, _ in P])
 
@@ -224,12 +224,12 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             r"and $I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
             r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
             r"besides, ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the "
-            r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $p$ the shininess and "
+            r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $\alpha$ the shininess and "
             r"$⟦mu_+⟧$ the highlight's cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), "
             r"with the half vector $$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ "
             r"mirrored in $N'$), which the kernel evaluates as $⟦phong⟧$. A sphere's albedo is its own. The floor, "
             r"at $⟦on_floor⟧$, carries no bump: its $N$ and $N'$ are both $⟦up⟧$. Its albedo is a checker of unit "
-            r"squares, its red and green dimmed by the tint $\alpha$: $$⟦floor⟧$$ where the grey $c$ is $⟦light⟧$ "
+            r"squares, its red and green dimmed by the tint $\tau$: $$⟦floor⟧$$ where the grey $c$ is $⟦light⟧$ "
             r"on the squares where $⟦square⟧$ and $⟦dark⟧$ on the others. The unbumped geometry alone decides which "
             r"lights reach $P$: ⟪no-boundary⟫. The proof checks Phong's two "
             r"forms and the half vector; the formula is checked on rendered pixels of both models, on the spheres "
@@ -263,10 +263,10 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             ("the ambient light times the albedo, k_a rho I_a, as many textbooks write it",
              lambda: _theorem(colour_of=COLOUR.xreplace({I_a: rho * I_a})).check()),
             ("the albedo on the highlight too",
-             lambda: _theorem(term=I_l * rho * (k_d * Dot(NP, WI) + k_s * S_PLUS ** p)).check()),
+             lambda: _theorem(term=I_l * rho * (k_d * Dot(NP, WI) + k_s * S_PLUS ** alpha)).check()),
             ("the floor's tint taken from its blue as well", lambda: _theorem(floor=sp.Tuple(*[FLOOR[0]] * 3)).check()),
-            ("the tint alpha kept, not taken away, (alpha c, alpha c, c)",
-             lambda: _theorem(floor=FLOOR.xreplace({1 - alpha: alpha})).check()),
+            ("the tint tau kept, not taken away, (tau c, tau c, c)",
+             lambda: _theorem(floor=FLOOR.xreplace({1 - tau: tau})).check()),
             ("the checker's light and dark squares swapped", lambda: _theorem(grey=checker(*greys()[::-1])).check()),
             ("the checker dark where sin(pi x) sin(pi y) is 0",
              lambda: _theorem(grey=checker().replace(sp.GreaterThan, sp.StrictGreaterThan)).check()),

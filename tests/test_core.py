@@ -343,6 +343,13 @@ def test_printing_as_a_person_writes():
     names = {H: r"\lvert h\rvert", H3: r"\lvert h'''\rvert", u_round: r"u_{\mathrm{round}}"}
     star = written(sp.Pow(sp.Mul(3, u_round, H, 1 / H3, evaluate=False), sp.Rational(1, 3), evaluate=False))
     assert tex(star, names) == r"\left(\frac{3 u_{\mathrm{round}} \lvert h\rvert}{\lvert h'''\rvert}\right)^{1/3}"
+    # In running text too, the numerator in the order written (sympy's R e sin phi read as "Re" sin phi), and a
+    # power over which "/" needs no brackets of its own; evaluated, sympy's order (the wrong variant's).
+    e, R = sp.symbols("e R", positive=True)
+    over = sp.Pow(sp.Add(e, -R * sp.cos(phi), evaluate=False), -2)
+    assert tex(written(sp.Mul(e, R, sp.sin(phi), over, evaluate=False)), inline=True) == \
+        r"e R \sin {\varphi} / \left(e - R \cos {\varphi}\right)^{2}"
+    assert tex(e * R * sp.sin(phi) * over, inline=True).startswith("R e")
     assert tex(sp.Symbol("sin_phi", nonnegative=True)) == r"\sin\varphi"
     assert tex(sp.sin(phi) * sp.cos(sp.pi * phi)) == r"\sin {\varphi} \cos{\left(\pi \varphi \right)}"
     assert tex(sp.Matrix([sp.Float(0.0), 1])) == r"\left(\begin{matrix}0\\1\end{matrix}\right)"

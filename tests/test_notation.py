@@ -21,7 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "shading": "e5d2f63ed7f0cdfd",
+    "shading": "b485ea3dde41526e",
     "displaced-normal": "d41ae0ec92d4e7ef",
     "chart": "b0eb3cf5166d0cb0",
     "frame-orthonormal": "6f2e22487456f433",
@@ -30,9 +30,9 @@ PRINTED = {
     "gradient-ridges": "c7e368c0325ff445",
     "gradient-rings": "ccd11d1bae25eafb",
     "ridges-kinks": "e05b59e321093ac4",
-    "kink-loci-rays": "f2e0ac4f5bcc39f7",
-    "kink-loci-circles": "31c755b11bbe9e76",
-    "no-boundary": "204deb95f3fef11f",
+    "kink-loci-rays": "005512f110d04e4c",
+    "kink-loci-circles": "3fd68e4230bb45e8",
+    "no-boundary": "77207819daf09ad4",
     "normal-beta-derivative": "35beda755e35b086",
     "beta-zero-regression": "3fcdd884c05219d5",
     "central-difference-truncation": "1d7a38548a2d22ed",

@@ -109,6 +109,8 @@ class _Printer(LatexPrinter):
         if self.inline and denom != 1 and not denom.is_Atom:
             sign = "- " if numer.could_extract_minus_sign() else ""
             numer = -numer if sign else numer
+            if self._settings["order"] == "none" and not sign:        # a written form: its factors as written
+                numer = sp.Mul(*[a for a in expr.args if not (a.is_Pow and a.exp.is_negative)], evaluate=False)
             top = self._print(numer) if isinstance(numer, Dot) else self.parenthesize(numer, PRECEDENCE["Mul"], strict=True)
             return f"{sign}{top} / {self._over(denom)}"
         fold = self._settings["fold_short_frac"]
@@ -127,7 +129,8 @@ class _Printer(LatexPrinter):
     def _over(self, denom):
         """A denominator after "/" in running text: bare if one symbol, number, dot product (a group already) or
         function of one symbol (sin phi), else in brackets."""
-        whole = denom.is_Atom or isinstance(denom, Dot) or isinstance(denom, sp.Function) and all(a.is_Atom for a in denom.args)
+        whole = (denom.is_Atom or isinstance(denom, Dot) or isinstance(denom, sp.Function) and all(a.is_Atom for a in denom.args)
+                 or denom.is_Pow and denom.exp.is_Integer)                     # (e - R cos phi)^2
         return self._print(denom) if whole else rf"\left({self._print(denom)}\right)"
 
     def _print_MatAdd(self, expr):
