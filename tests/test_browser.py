@@ -1448,6 +1448,10 @@ def test_preset_three_magnifies_the_pole_where_the_shading_flips(browser, book_h
         state = _preset(s, "try3")
         assert (state["height_field"], state["view"], state["zoom"], state["bump"]) == \
             ("rings", "shaded", "4", "chart")
+        assert s.page.text_content("#sim-note").startswith(f"β now runs to {s.page.get_attribute('#sim-beta', 'max')}:")
+        _preset(s, "try1")                                  # back to the displaced sphere's range, said again
+        assert s.page.text_content("#sim-note").startswith(f"β now runs to {s.page.get_attribute('#sim-beta', 'max')}:")
+        _preset(s, "try3")
         spread = _pole_ring_spread(s)
         assert spread > 60, spread
         s.fill("beta", 0)

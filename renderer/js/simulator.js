@@ -119,7 +119,7 @@ export const PRESETS = [
           "difference, where the large differences sit: central differences straddle the crease." },
   { id: "try3", label: "3 · rings: magnify the pole", set: { height_field: "rings", zoom: 4, view: "shaded", bump: "chart" },
     hint: "The pole, magnified: the rings circle it, and the shading flips from one side of it to the other " +
-          "with either normal (it opens on the draft's formula, where β runs to 2; the shading-normal control swaps " +
+          "with either normal (it opens on the draft's formula; the shading-normal control swaps " +
           "them): the bumped sphere comes to a cone's point." },
   { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta",
     hint: "With β = 0 both renders are the un-bumped sphere: the difference is black, the ledger reads " +
@@ -438,9 +438,11 @@ class Simulator {
   }
 
   apply_preset(p) {
-    this.note.textContent = "";
+    const bump = this.state.bump;
     this.state = { ...DEFAULT_STATE, ...p.set };
     this.sync_inputs();
+    // A preset that swaps the shading normal changes the β slider's range: said as the control says it.
+    this.note.textContent = this.state.bump === bump ? "" : beta_range_note(this.state.bump, false);
     this.hint.textContent = p.hint ?? HINT;
     this.root.dataset.preset = p.id ?? "";
     this.update();
@@ -657,7 +659,8 @@ class Simulator {
       const xb = X(CURVE_LOG_EPS[best]), yb = Math.min(Y(points[best].rms) + 6, H - m.bottom - 22);
       nodes.push(svg("path", { id: "sim-curve-best", d: `M ${xb.toFixed(1)} ${yb.toFixed(1)} l -5 9 l 10 0 z`,
                                fill: CURVE_COLOURS.rms, stroke: "currentColor", "data-eps": String(eps_of(CURVE_LOG_EPS[best])) }));
-      nodes.push(svg("text", { id: "sim-curve-best-label", x: xb, y: yb + 21, "text-anchor": "middle" }, `best ε = ${best_eps}`));
+      nodes.push(svg("text", { id: "sim-curve-best-label", x: xb, y: yb + 21, "text-anchor": "middle" },
+                               `best ε ${this.curve.stride === 1 ? "=" : "≈"} ${best_eps}`));   // ≈: of the sample
     }
     const here = this.curve.here, x = X(Math.log10(here.eps)), unused = this.eps_unused();
     if (!unused) {   // footprint steps: the frame has no one ε to mark
@@ -682,7 +685,8 @@ class Simulator {
       el("td", { text: fmt(p.rms, 2) }), el("td", { text: fmt(p.max_abs, 2) })])));
     const stride = this.curve.stride, s = this.state.resolution;
     const sample = stride === 1 ? `every pixel of sphere A in the ${s} × ${s} frame`
-                                : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame`;
+                                : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame ` +
+                                  "(every pixel's curve follows in a moment)";
     this.root.querySelector("#sim-curve-table-caption").textContent = `|ΔI| on sphere A at each step ε, over ${sample}`;
     const said = unused ? this.frame_ledger : here;     // with footprint steps, the frame's own ledger
     plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; ` +
