@@ -19,22 +19,27 @@ def _placed(places):
 
 
 def placement_faults(places):
-    """What is wrong with a `verdicts.PLACES`: claims placed twice, and ids that are no claim."""
-    placed, ids = _placed(places), {c.id for c in CLAIMS}
-    return sorted({i for i in placed if placed.count(i) > 1}) + sorted(set(placed) - ids)
+    """What is wrong with a `verdicts.PLACES`: claims placed twice, ids that are no claim, and claims
+    placed nowhere (the front page promises a margin note beside each)."""
+    placed, ids = _placed(places), [c.id for c in CLAIMS]
+    return (sorted({i for i in placed if placed.count(i) > 1}) + sorted(set(placed) - set(ids))
+            + [f"{i} nowhere" for i in ids if i not in placed])
 
 
-def test_every_placed_claim_exists_and_is_placed_once():
+def test_every_claim_is_placed_once():
     assert placement_faults(verdicts.PLACES) == []
 
 
-def test_a_claim_placed_twice_or_no_claim_placed_is_caught():
+def test_a_claim_placed_twice_or_nowhere_or_no_claim_placed_is_caught():
     assert placement_faults({**verdicts.PLACES, "s9": ("h3-scale",)}) == ["h3-scale"]
     assert placement_faults({**verdicts.PLACES, "s9": ("no-such-claim",)}) == ["no-such-claim"]
+    assert placement_faults({**verdicts.PLACES, "cell6/truncation": ()}) == ["cell6-truncation nowhere"]
     assert verdicts.place_of("h3-scale") == "s3-ucurve"
-    assert verdicts.place_of("cell6-truncation") is None         # in §6's register only
-    with pytest.raises(KeyError, match="claim_id must be"):
-        verdicts.place_of("no-such-claim")
+    for unplaced in ("no-such-claim", "cell6-truncation"):
+        with pytest.MonkeyPatch.context() as m:
+            m.setitem(verdicts.PLACES, "cell6/truncation", ())
+            with pytest.raises(KeyError, match="claim_id must be"):
+                verdicts.place_of(unplaced)
 
 
 CALL = re.compile(r"margin_notes\([\"']([^\"']+)[\"']\)")
@@ -139,8 +144,7 @@ def test_the_register_gives_each_claim_a_target_its_measurement_its_rule_and_a_l
         _, measured, verdict = results[c.id]
         assert f"{{term}}`{verdicts.WORDS[verdict]}`" in row
         assert measured_text(c.id, measured) in row and rule_text(c.criterion) in row
-        place = verdicts.place_of(c.id)
-        assert (f"{{ref}}`{verdicts.section_of(place)}`" in row) if place else ("noted in" not in row)
+        assert f"(noted in {{ref}}`{verdicts.section_of(verdicts.place_of(c.id))}`)" in row
     in_cell3 = [i for p, ids in verdicts.PLACES.items() if verdicts.section_of(p) == "cell3" for i in ids]
     assert md.count("{ref}`cell3`") == len(in_cell3) == 4
 

@@ -16,7 +16,7 @@ from lab.claims import CLAIMS, checked
 
 from .claim_words import WORDS, measured_text, rule_text
 
-__all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of", "section_of", "NUMBERS"]
+__all__ = ["PLACES", "WORDS", "margin_notes", "register", "place_of", "section_of", "measurement", "NUMBERS"]
 
 #: {claim id: its entry's number in §6's register} (`register`; the "why" links' names, book/_ext/a11y_markup.py).
 NUMBERS = {c.id: n for n, c in enumerate(CLAIMS, start=1)}
@@ -24,8 +24,7 @@ NUMBERS = {c.id: n for n, c in enumerate(CLAIMS, start=1)}
 #: Place -> the claims noted there, in the order the text meets them.  A place is a section label
 #: of the book (``"cell3"``) or a paragraph within it (``"cell3/flips"``: the section label, a slash,
 #: a name), and the page calls ``margin_notes(place)`` once, right before the paragraph that discusses
-#: those claims: the theme floats a margin note beside what follows it.  A claim that no paragraph
-#: of the reading path discusses is placed nowhere: it appears only in §6's register.
+#: those claims: the theme floats a margin note beside what follows it.  Every claim is placed once.
 PLACES = {
     "s3-frame": ("frame-aligned",),
     "s3-boundary": ("flips-zero",),
@@ -46,6 +45,7 @@ PLACES = {
     "cell5": ("dn-verified-1e-12", "cell5-fd-1e-9"),
     "cell5/order": ("beta-quadratic",),
     "cell6": ("beta0-1e-16", "bump-nonzero"),
+    "cell6/truncation": ("cell6-truncation",),
     "cell7": ("noise-below-1e-11",),
     "cell7/crease": ("crease-fd-zero",),
     "cell7/pole": ("pole-pixels",),
@@ -60,17 +60,31 @@ def section_of(place):
 
 
 def place_of(claim_id):
-    """The place (a key of `PLACES`) where ``claim_id``'s margin note is shown, or None if the
-    claim is shown only in §6's register.
+    """The place (a key of `PLACES`) where ``claim_id``'s margin note is shown.
 
     Raises
     ------
     KeyError
-        If ``claim_id`` is not the id of a claim of `lab.claims.CLAIMS`.
+        If ``claim_id`` is not the id of a claim of `lab.claims.CLAIMS` placed in `PLACES`.
     """
-    if claim_id not in {c.id for c in CLAIMS}:
-        raise KeyError(f"claim_id must be the id of a claim of lab.claims.CLAIMS, got {claim_id!r}")
-    return next((place for place, ids in PLACES.items() if claim_id in ids), None)
+    place = next((place for place, ids in PLACES.items() if claim_id in ids), None)
+    if place is None or claim_id not in NUMBERS:
+        raise KeyError(f"claim_id must be the id of a claim of lab.claims.CLAIMS placed in PLACES, got {claim_id!r}")
+    return place
+
+
+def measurement(claim_id):
+    """The measured values of the claim ``claim_id`` (its `lab.claims.Claim.measure` dict), from the
+    evaluation its margin note shows, for a page to glue.
+
+    Raises
+    ------
+    KeyError
+        As `place_of`.
+    lab.claims.ClaimChanged
+        If a computed verdict is not the registered one.
+    """
+    return _results(PLACES[place_of(claim_id)])[claim_id][1]
 
 
 def _results(ids=None):
@@ -111,8 +125,8 @@ def register():
     """MyST markdown: the register of §6, one entry per claim in `lab.claims.CLAIMS`
     order, each with the target ``claim-<id>``, its verdict (a ``{term}`` link), the
     measurement in words (`chapter.claim_words.measured_text`), the rule that decided it
-    (`chapter.claim_words.rule_text`), and, for a claim with a margin note (`margin_notes`),
-    a link to the section that shows it.
+    (`chapter.claim_words.rule_text`), and a link to the section whose margin note shows it
+    (`margin_notes`).
 
     Raises
     ------
@@ -123,11 +137,9 @@ def register():
     entries = []
     for c in CLAIMS:
         n, (claim, measured, verdict) = NUMBERS[c.id], results[c.id]
-        place = place_of(c.id)
-        noted = f" (noted in {{ref}}`{section_of(place)}`)" if place else ""
         entries.append(
             f"(claim-{c.id})=\n"
-            f"**{n}. {claim.where}:** “{claim.quote}”{noted}. "
+            f"**{n}. {claim.where}:** “{claim.quote}” (noted in {{ref}}`{section_of(place_of(c.id))}`). "
             f"**{{term}}`{WORDS[verdict]}`**: {measured_text(c.id, measured)}; rule: "
             f"{rule_text(claim.criterion)}.\n")
     return "\n".join(entries)
