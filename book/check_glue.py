@@ -191,7 +191,7 @@ QUANTITIES = {
 }
 #: Glued names each showing a quantity of its own that its page computes (from its renders, counts
 #: and choices), with no second name and no value in the library to agree with.
-ON_THE_PAGE = ("c6_fine_step", "c6_trunc_ratio", "ix_label", "s2_draft_diff", "s3_band_u", "s3_band_v", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
+ON_THE_PAGE = ("c6_fine_step", "c6_trunc_ratio", "c6_trunc_size", "ix_label", "s2_draft_diff", "s3_band_u", "s3_band_v", "s1_size", "s2_size", "c1_size", "s4_size", "s7_size",
                "ix_proved", "ix_verified", "ix_claims", "ix_holds", "ix_corrected", "ix_fails", "ix_errata",
                "tilt_chart", "tilt_surface", "s1_steep", "s1_steep_chart", "s1_steep_surface", "s1_away_chart",
                "s1_away_surface", "s1_flips_chart",
@@ -202,7 +202,7 @@ ON_THE_PAGE = ("c6_fine_step", "c6_trunc_ratio", "ix_label", "s2_draft_diff", "s
                "c4_methods", "c4_classic_derivative", "c4_classic_table", "c4_classic_published", "c4_classic_cs_from",
                "c4_classic_cs_max", "c4_classic_ad_err", "c4_classic_eps_model", "c4_classic_eps_fitted",
                "c4_classic_central_step", "c4_classic_richardson_f", "c4_classic_fwd_step", "c4_classic_fwd_trunc",
-               "c4_classic_fwd_err", "c4_classic_fwd_numpy", "c4_classic_rtol", "c4_classic_rich_first", "c4_classic_rich_nit", "c4_classic_rich_tight", "c4_classic_rich_tight_f",
+               "c4_classic_fwd_err", "c4_classic_fwd_numpy", "c4_classic_rtol", "c4_classic_rich_first", "c4_classic_rich_nit", "c4_classic_rich_off", "c4_classic_rich_tight", "c4_classic_rich_tight_f",
                "c4_classic_rich_tight_err", "c4_classic_rich_tighter", "c4_classic_rich_tighter_f", "c4_classic_rich_tighter_err", "s2_field_order", "c4_crease_table", "c5_iterates",
                "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err", "ex_fwd_best_eps", "ex_fwd_best_err", "ex_fwd_best_share",
                "ex_fwd_err_1e8", "ex_fwd_small", "ex_fwd_small_bound", "ex_fwd_err_1e3", "ex_cen_err_1e6", "ex_cs_err", "ex_exact_err", "ex_gn_jr0",

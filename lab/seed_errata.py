@@ -276,7 +276,7 @@ ERRATA = (
     Erratum(
         id="specular-ungated",
         where="Cell 1, `shade1`",
-        seed=r"$k_s \max(0, N'\cdot\omega_h)^{p}$ added for every unshadowed light",
+        seed=r"$k_s \max(0, N'\cdot\omega_h)^{\nu}$ added for every unshadowed light",
         exposed_by="verify/test_errata.py (highlight where the bumped normal faces away)",
         measure=_specular_ungated,
         criterion="some pair facing away from its light receives a nonzero highlight",

@@ -23,9 +23,9 @@ from .core import DIGITS, Dot, Step, Theorem, Verdict, _explicit, catalogue, wri
 #: The vectors the statement names: the shading normal, the unit vectors to the light and to the eye,
 #: the light's mirror direction in N' (Phong) and the half vector (Blinn), in pbrt-v4's omega notation.
 NP, WI, WO, WR, HV = (sp.MatrixSymbol(name, 3, 1) for name in ("N'", "omega_i", "omega_o", "omega_r", "omega_h"))
-#: The weights, the shininess alpha, the albedo, the ambient light, a light's colour and the pixel's colour I
+#: The weights, the shininess nu, the albedo, the ambient light, a light's colour and the pixel's colour I
 #: (each one channel); the letters the book's other formulas use for other things are avoided.
-k_a, k_d, k_s, alpha, rho, I_a, I_l, I = sp.symbols("k_a k_d k_s alpha rho I_a I_ell I", nonnegative=True)
+k_a, k_d, k_s, nu, rho, I_a, I_l, I = sp.symbols("k_a k_d k_s nu rho I_a I_ell I", nonnegative=True)
 #: The highlight's cosine: real, not nonnegative (sympy would drop the clamp max(0, s)); and its clamp to
 #: [0, 1], a name the statement prints and defines (`CLAMP`).
 s = sp.Symbol("mu", real=True)
@@ -41,7 +41,7 @@ NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: r"\ome
          ell: r"\ell", s: r"\mu", S_PLUS: r"\mu_+", tau: r"\tau"}
 #: The scene's parameter (`renderer.Scene`) each symbol stands for, for the book's list of them.
 SCENE_SYMBOLS = {"lights": I_l, "ambient": I_a, "albedo_a": rho, "albedo_b": rho, "ka": k_a, "kd": k_d, "ks": k_s,
-                 "shininess": alpha, "floor_tint": tau}
+                 "shininess": nu, "floor_tint": tau}
 
 #: |w_i + w_o|, a name the statement prints, defined in the theorem's ``where`` (`LENGTH`).
 NORM = sp.Symbol("|omega_i + omega_o|", positive=True)
@@ -52,7 +52,7 @@ HALF = (WI + WO) / NORM
 #: The Phong cosine as the kernel evaluates it (`renderer.kernel.specular_axis`): no mirror vector formed.
 KERNEL_PHONG = 2 * Dot(NP, WI) * Dot(NP, WO) - Dot(WI, WO)
 #: One light's term where N' . w_i > 0 (nothing elsewhere), and the colour of a channel.
-TERM = I_l * (k_d * rho * Dot(NP, WI) + k_s * S_PLUS ** alpha)
+TERM = I_l * (k_d * rho * Dot(NP, WI) + k_s * S_PLUS ** nu)
 COLOUR = sp.Min(1, written(sp.Add(sp.Mul(k_a, I_a, evaluate=False), sp.Sum(T[ell], (ell, 1, m)), evaluate=False)))
 #: The specular cosine s of each model, as the renderer evaluates it.
 COSINE = {"blinn": Dot(NP, HALF), "phong": KERNEL_PHONG}
@@ -224,7 +224,7 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             r"and $I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
             r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
             r"besides, ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the "
-            r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $\alpha$ the shininess and "
+            r"ambient light (not tinted by $\rho$), $k_a$, $k_d$, $k_s$ the weights, $\nu$ the shininess and "
             r"$⟦mu_+⟧$ the highlight's cosine clamped. That cosine is Blinn's ${N' \cdot \omega_h}$ (the default), "
             r"with the half vector $$⟦omega_h⟧$$ or Phong's ${\omega_r \cdot \omega_o}$, with $⟦omega_r⟧$ ($\omega_i$ "
             r"mirrored in $N'$), which the kernel evaluates as $⟦phong⟧$. A sphere's albedo is its own. The floor, "
@@ -263,7 +263,7 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
             ("the ambient light times the albedo, k_a rho I_a, as many textbooks write it",
              lambda: _theorem(colour_of=COLOUR.xreplace({I_a: rho * I_a})).check()),
             ("the albedo on the highlight too",
-             lambda: _theorem(term=I_l * rho * (k_d * Dot(NP, WI) + k_s * S_PLUS ** alpha)).check()),
+             lambda: _theorem(term=I_l * rho * (k_d * Dot(NP, WI) + k_s * S_PLUS ** nu)).check()),
             ("the floor's tint taken from its blue as well", lambda: _theorem(floor=sp.Tuple(*[FLOOR[0]] * 3)).check()),
             ("the tint tau kept, not taken away, (tau c, tau c, c)",
              lambda: _theorem(floor=FLOOR.xreplace({1 - tau: tau})).check()),

@@ -21,7 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "shading": "b485ea3dde41526e",
+    "shading": "a677813c1ebab6e3",
     "displaced-normal": "d41ae0ec92d4e7ef",
     "chart": "b0eb3cf5166d0cb0",
     "frame-orthonormal": "6f2e22487456f433",
@@ -30,7 +30,7 @@ PRINTED = {
     "gradient-ridges": "c7e368c0325ff445",
     "gradient-rings": "ccd11d1bae25eafb",
     "ridges-kinks": "e05b59e321093ac4",
-    "kink-loci-rays": "005512f110d04e4c",
+    "kink-loci-rays": "5dffa25d9d5aa024",
     "kink-loci-circles": "3fd68e4230bb45e8",
     "no-boundary": "77207819daf09ad4",
     "normal-beta-derivative": "35beda755e35b086",

@@ -15,7 +15,7 @@ __all__ = ["WORDS", "finding", "errata"]
 WORDS = {
     "sphere-b-quadratic": dict(
         title="Sphere B is intersected from the wrong origin",
-        correction=r"$c = |E - C_B|^2 - r_B^2$ for the ray from the eye $E$, roots by the stable pair $q/a,\ c/q$ with $q = -(b + \operatorname{sign}(b)\sqrt{b^2 - ac})$ for $at^2 + 2bt + c = 0$",
+        correction=r"$c = |O - C_B|^2 - r_B^2$ for the ray from the eye $O$, roots by the stable pair $q/a,\ c/q$ with $q = -(b + \operatorname{sign}(b)\sqrt{b^2 - ac})$ for $at^2 + 2bt + c = 0$",
         finding=(
             "In the default frame of {pixels:,} pixels every ray hits the draft's sphere B: it "
             "covers {seed_pixels_b:,} pixels where the true sphere covers {true_pixels_b:,}, so "

@@ -119,8 +119,9 @@ export const PRESETS = [
           "difference, where the large differences sit: central differences straddle the crease." },
   { id: "try3", label: "3 · rings: magnify the pole", set: { height_field: "rings", zoom: 4, view: "shaded", bump: "chart" },
     hint: "The pole, magnified: the rings circle it, and the shading flips from one side of it to the other " +
-          "with either normal (it opens on the draft's formula; the shading-normal control swaps " +
-          "them): the bumped sphere comes to a cone's point." },
+          "with either normal: the bumped sphere comes to a cone's point. It opens on the draft's formula, whose β " +
+          `slider runs to ${beta_max("chart")} (the displaced sphere's stops below R, as its radius R + βh must stay ` +
+          "positive); the shading-normal control swaps them." },
   { id: "try4", label: "4 · β to 0", set: { beta: 0 }, focus: "beta",
     hint: "With β = 0 both renders are the un-bumped sphere: the difference is black, the ledger reads " +
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
