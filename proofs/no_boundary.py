@@ -253,8 +253,8 @@ def _no_boundary(attached=None, **evidence):
                   r"Hence no pixel changes chamber, and no shadow boundary moves, when the bump's parameters "
                   r"change: the renderer's per-pixel hits and shadow tests come out bit for bit the same.",
         steps=(
-            Step(r"The chamber is the nearest hit: the near roots $t_A$, $t_B$ of $\lvert O + t d - C\rvert^2 = r^2$ "
-                 r"for spheres A and B and the floor plane's $t_{\mathrm{floor}}$, with $O = (0, 0, e)$ the eye and "
+            Step(r"The chamber is the nearest hit: the near roots $t_A$ of $\lvert O + t d\rvert^2 = R^2$ (sphere A) and "
+                 r"$t_B$ of $\lvert O + t d - C_B\rvert^2 = r_B^2$ (sphere B) and the floor plane's $t_{\mathrm{floor}}$, with $O = (0, 0, e)$ the eye and "
                  r"$d = (x, y, -e)$ the pixel's ray; none involves $\beta$, the steps $\varepsilon$ or the frequencies",
                  chamber, sp.ZeroMatrix(3, len(BUMP))),
             Step(r"The shadow predicates at sphere A's hit $P = O + t_A d$, with $N = P/R$ and $L$ the light, are "

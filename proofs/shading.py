@@ -31,14 +31,14 @@ k_a, k_d, k_s, nu, rho, I_a, I_l, I = sp.symbols("k_a k_d k_s nu rho I_a I_ell I
 s = sp.Symbol("mu", real=True)
 S_PLUS = sp.Symbol("mu_+", nonnegative=True)
 CLAMP = {S_PLUS: sp.Min(1, sp.Max(0, s))}
-ell, m = sp.symbols("ell m", integer=True, positive=True)
+ell, m = sp.symbols("ell n_ell", integer=True, positive=True)   # a light, and their count
 T = sp.IndexedBase("T")
 #: The floor's albedo: P = (x, y, 0) on it, c the checker's grey at P (`checker`) and tau the tint.
 X, Y = sp.symbols("x y", real=True)
 tau, c = sp.symbols("tau c", nonnegative=True)
 FLOOR = sp.Tuple((1 - tau) * c, (1 - tau) * c, c)
 NAMES = {NP: "N'", WI: r"\omega_i", WO: r"\omega_o", WR: r"\omega_r", HV: r"\omega_h", rho: r"\rho", I_l: r"I_\ell",
-         ell: r"\ell", s: r"\mu", S_PLUS: r"\mu_+", tau: r"\tau"}
+         ell: r"\ell", m: r"n_\ell", s: r"\mu", S_PLUS: r"\mu_+", tau: r"\tau"}
 #: The scene's parameter (`renderer.Scene`) each symbol stands for, for the book's list of them.
 SCENE_SYMBOLS = {"lights": I_l, "ambient": I_a, "albedo_a": rho, "albedo_b": rho, "ka": k_a, "kd": k_d, "ks": k_s,
                  "shininess": nu, "floor_tint": tau}
@@ -220,7 +220,7 @@ def _theorem(phong=KERNEL_PHONG, mirror=MIRROR, half=HALF, **evidence):
         statement=(
             r"At a hit point $P$, with unbumped normal $N$ (a sphere's outward unit normal), shading normal $N'$ "
             r"(on sphere A the perturbed normal that §3 derives, on sphere B its $N$), $\omega_o$ the unit "
-            r"vector to the eye, and for each of the scene's $m$ lights $\omega_i$ (incident) the unit vector to it "
+            r"vector to the eye, and for each of the scene's $n_\ell$ lights $\omega_i$ (incident) the unit vector to it "
             r"and $I_\ell$ its colour, the renderer's colour (each of red, green, blue) is $$⟦colour⟧$$ $T_\ell$ is "
             r"zero unless the light reaches $P$ (${N \cdot \omega_i}$ is positive and nothing blocks the way) and, "
             r"besides, ${N' \cdot \omega_i}$ is positive; then $$⟦term⟧$$ with $\rho$ the albedo, $I_a$ the "

@@ -21,7 +21,7 @@ from proofs.registry import THEOREMS
 
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
-    "shading": "a677813c1ebab6e3",
+    "shading": "1fce5561cf3d311a",
     "displaced-normal": "d41ae0ec92d4e7ef",
     "chart": "b0eb3cf5166d0cb0",
     "frame-orthonormal": "6f2e22487456f433",
@@ -32,7 +32,7 @@ PRINTED = {
     "ridges-kinks": "e05b59e321093ac4",
     "kink-loci-rays": "5dffa25d9d5aa024",
     "kink-loci-circles": "3fd68e4230bb45e8",
-    "no-boundary": "77207819daf09ad4",
+    "no-boundary": "8bce22910d9e53d8",
     "normal-beta-derivative": "35beda755e35b086",
     "beta-zero-regression": "3fcdd884c05219d5",
     "central-difference-truncation": "1d7a38548a2d22ed",
