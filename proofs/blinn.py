@@ -54,15 +54,15 @@ def exact_normal():
                               .subs(_TO_ANGLES, simultaneous=True))
 
 #: The names the proof uses: N, e_theta, e_phi at N(theta, phi); P_u, P_v; Blinn's N_B = P_u x P_v, its
-#: length and his N'_B; the bump's F_u, F_v; and the slopes t (components along e_theta, e_phi over the
+#: length and his N'_B; the bump's F_u, F_v; and the slopes xi (components along e_theta, e_phi over the
 #: one along N) of Blinn's normal, of the displaced sphere's and of the renderer's two bump modes.
 PU_S, PV_S = sp.MatrixSymbol("P_u", 3, 1), sp.MatrixSymbol("P_v", 3, 1)
 NB_S, NBP_S = sp.MatrixSymbol("N_B", 3, 1), sp.MatrixSymbol("N'_B", 3, 1)
 NORM_NB, F_U, F_V = sp.symbols("|N_B| F_u F_v")
-T = {k: sp.MatrixSymbol(f"t_{k}", 2, 1) for k in ("blinn", "displaced", "surface", "chart")}
+XI = {k: sp.MatrixSymbol(f"xi_{k}", 2, 1) for k in ("blinn", "displaced", "surface", "chart")}
 NAMES = {**VECTOR_NAMES, NB_S: "N_B", NBP_S: "N'_B", NORM_NB: r"\lvert N_B\rvert",
-         T["blinn"]: r"t_{\mathrm{Blinn}}", T["displaced"]: r"t_{P'}", T["surface"]: r"t_{\mathrm{surface}}",
-         T["chart"]: r"t_{\mathrm{chart}}"}
+         XI["blinn"]: r"\xi_{\mathrm{Blinn}}", XI["displaced"]: r"\xi_{P'}", XI["surface"]: r"\xi_{\mathrm{surface}}",
+         XI["chart"]: r"\xi_{\mathrm{chart}}"}
 
 
 def _slopes(n):
@@ -100,14 +100,14 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
     (wrong variants)."""
     frame = sp.Tuple(PU_S, PV_S)
     inward = -2 * sp.pi**2 * R**2 * s * N_S
-    renderer, scaled = sp.Tuple(T["surface"], T["chart"]), sp.Tuple(SURFACE, CHART)
-    draft = sp.ImmutableMatrix(sp.diag(*factors)) * T["blinn"]
+    renderer, scaled = sp.Tuple(XI["surface"], XI["chart"]), sp.Tuple(SURFACE, CHART)
+    draft = sp.ImmutableMatrix(sp.diag(*factors)) * XI["blinn"]
     return Theorem(
         id="blinn-perturbation", title=TITLES["blinn-perturbation"],
         statement=(
             r"Set Blinn's $$⟦N'_B⟧$$ with $⟦N_B⟧$, for sphere A in the renderer's chart, away from the poles ($⟦phi_range⟧$), "
             r"$⟦P⟧$ with $⟦theta⟧$, $⟦phi⟧$. Then $⟦inward⟧$ points inward, so the outward displacement "
-            r"$⟦displacement⟧$ is, in Blinn's terms (along $N_B$), $⟦F_u⟧$ and $⟦F_v⟧$. As slopes $t$ (components along "
+            r"$⟦displacement⟧$ is, in Blinn's terms (along $N_B$), $⟦F_u⟧$ and $⟦F_v⟧$. As slopes $\xi$ (components along "
             r"$e_\theta$, $e_\varphi$ over the one along $N$), Blinn's normal has $$⟦blinn⟧$$ the displaced sphere's "
             r"$$⟦displaced⟧$$ and the renderer's bump modes surface and chart (the draft's) "
             r"$$⟦renderer⟧$$ Blinn's slopes equal the displaced sphere's to first order in $\beta$, not beyond "
@@ -125,20 +125,20 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
                  inward, using=(1,)),
             Step(r"His $N'_B$, with $F_u = -\beta h_u$, $F_v = -\beta h_v$ and steps 1 and 2, is built from $N$, "
                  r"$e_\theta$, $e_\varphi$ by dot and cross products, the same in every left-handed orthonormal "
-                 r"frame; in $e_\theta = x$, $e_\varphi = y$, $N = -z$ its slopes are", T["blinn"], blinn,
+                 r"frame; in $e_\theta = x$, $e_\varphi = y$, $N = -z$ its slopes are", XI["blinn"], blinn,
                  using=(1, 2), cases=(("a left-handed orthonormal basis", {**STANDARD_FRAME, F.sin_phi: s}),)),
             Step(r"The displaced sphere $P' = (R + \beta h)N$ has the normal $P'_u \times P'_v$, whose slopes carry "
                  r"$R + \beta h$ where Blinn's carry $R$: equal to first order in $\beta$, different at the second",
-                 T["displaced"], SURFACE),
-            Step(r"The renderer's normals are $M/\lVert M\rVert$ with $M = N + t_u e_\theta + t_v e_\varphi$, whose "
-                 r"slopes in an orthonormal frame are $(t_u, t_v)$: the displaced sphere's for `bump='surface'`, "
+                 XI["displaced"], SURFACE),
+            Step(r"The renderer's normals are $M/\lVert M\rVert$ with $M = N + \xi_u e_\theta + \xi_v e_\varphi$, whose "
+                 r"slopes in an orthonormal frame are $(\xi_u, \xi_v)$: the displaced sphere's for `bump='surface'`, "
                  r"the draft's $+\beta(h_u, h_v)$ for `bump='chart'`", renderer, scaled,
                  cases=(("a left-handed orthonormal basis", {**STANDARD_FRAME, F.sin_phi: s}),)),
             Step(r"Comparing steps 3 and 5, the draft's slopes are Blinn's scaled by $-2\pi R\sin\varphi$ and "
-                 r"$-\pi R$", T["chart"], draft, using=(3, 5)),
+                 r"$-\pi R$", XI["chart"], draft, using=(3, 5)),
         ),
-        claims={"inward": (NB_S, inward), "blinn": (T["blinn"], blinn), "displaced": (T["displaced"], SURFACE),
-                "renderer": (renderer, scaled), "factors": (T["chart"], draft)},
+        claims={"inward": (NB_S, inward), "blinn": (XI["blinn"], blinn), "displaced": (XI["displaced"], SURFACE),
+                "renderer": (renderer, scaled), "factors": (XI["chart"], draft)},
         shown={"P": sp.Eq(sp.Function("P")(F.u, F.v), R * sp.Function("N")(theta, phi), evaluate=False),
                "theta": sp.Eq(theta, THETA_OF_U, evaluate=False), "phi": sp.Eq(phi, PHI_OF_V, evaluate=False),
                "phi_range": PHI_OFF_POLES,
@@ -150,8 +150,8 @@ def _theorem(normal=None, factors=FACTORS, blinn=BLINN, f=(-beta * h_u, -beta * 
                PV_S: sp.ImmutableMatrix(P_UV.diff(F.v).subs(_TO_ANGLES, simultaneous=True)),
                NB_S: Cross(PU_S, PV_S), NORM_NB: 2 * sp.pi**2 * R**2 * s, F_U: f[0], F_V: f[1],
                NBP_S: blinn_normal() if normal is None else normal,
-               T["blinn"]: _slopes(NBP_S), T["displaced"]: _slopes(exact_normal()),
-               T["surface"]: _slopes(RENDERER["surface"]), T["chart"]: _slopes(RENDERER["chart"]), **_RENDERER_AT},
+               XI["blinn"]: _slopes(NBP_S), XI["displaced"]: _slopes(exact_normal()),
+               XI["surface"]: _slopes(RENDERER["surface"]), XI["chart"]: _slopes(RENDERER["chart"]), **_RENDERER_AT},
         names=NAMES, domain=DOMAIN,
         wrong_variants=(
             ("Blinn's formula with the sign of the F_v term flipped", lambda: _theorem(blinn_normal(sign_v=+1)).check()),

@@ -67,7 +67,7 @@ def away_from_pole(bump):
     Parameters
     ----------
     bump : sequence of two sympy expressions
-        (t_u, t_v), the coefficients of dpdu and dpdv in N' for one bump mode
+        (xi_u, xi_v), the slopes: the coefficients of dpdu and dpdv in N' for one bump mode
         (`renderer.formulas.BUMP`), in the symbols of `renderer.formulas`.
 
     Returns
@@ -100,7 +100,7 @@ def chart_terms(claim):
 
 #: ... and as the statement derives them: the displaced normal's tangential coefficients in chart terms.
 CHART_COEFFS = chart_terms(CLAIM)
-T_U, T_V = sp.symbols("t_u t_v")
+XI_U, XI_V = sp.symbols("xi_u xi_v")
 KERNEL_DOMAIN = {F.beta: (0.0, 2.0), F.R: (0.5, 2.0), F.h: (-1.0, 1.0), F.h_u: (-30.0, 30.0),
                  F.h_v: (-30.0, 30.0), F.sin_phi: (0.001, 1.0)}
 
@@ -228,7 +228,7 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
     and the curl -pi R ``obstruction``, for the renderer's surface-bump coefficients ``kernel``, with the
     evidence's options (wrong variants)."""
     cross = Cross(sp.Derivative(P_S, phi), sp.Derivative(P_S, theta))
-    coeffs = sp.Tuple(T_U, T_V)
+    coeffs = sp.Tuple(XI_U, XI_V)
     curl = written(sp.Add(sp.Derivative(G_T, phi), -sp.Derivative(G_P, theta), evaluate=False))
     exact = integrable()
     others = [name for name in F.FIELDS if name not in exact]
@@ -284,7 +284,7 @@ def _theorem(claim=CLAIM, kernel=KERNEL_COEFFS, chart=CHART_COEFFS, obstruction=
                "H_phi": sp.Eq(H_p, F.h_v * CHART_RATES[1], evaluate=False),
                "G": sp.Eq(sp.Symbol("G"), POTENTIAL, evaluate=False), "phi": PHI_OFF_POLES},
         where={N_S: sp.ImmutableMatrix(N), ET_S: sp.ImmutableMatrix(e_theta), EP_S: sp.ImmutableMatrix(e_phi),
-               P_S: sp.MatMul(R + beta * H_at, N_S), T_U: kernel[0], T_V: kernel[1],
+               P_S: sp.MatMul(R + beta * H_at, N_S), XI_U: kernel[0], XI_V: kernel[1],
                G_T: SEED_DISPLACEMENT[0], G_P: SEED_DISPLACEMENT[1]},
         names={ET_S: r"e_\theta", EP_S: r"e_\varphi", H_at: "H", G_T: r"G_\theta", G_P: r"G_\varphi"},
         domain={**DOMAIN, F.k_u: (0.5, 12.0), F.k_v: (0.5, 12.0)}, functions=INSTANCE,

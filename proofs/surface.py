@@ -45,7 +45,7 @@ NU_S, NV_S = sp.MatrixSymbol("n_u", 3, 1), sp.MatrixSymbol("n_v", 3, 1)
 DU_S, DV_S = sp.MatrixSymbol("p'_u", 3, 1), sp.MatrixSymbol("p'_v", 3, 1)
 EU_S, EV_S = sp.MatrixSymbol("e_u", 3, 1), sp.MatrixSymbol("e_v", 3, 1)
 C_S = sp.MatrixSymbol("c", 3, 1)
-T_U, T_V = sp.symbols("t_u t_v")
+XI_U, XI_V = sp.symbols("xi_u xi_v")
 #: |p_u|, |p_v| and the normal curvatures along the chart's directions.
 L_U, L_V = sp.symbols("L_u L_v", positive=True)
 K_U, K_V = sp.symbols("kappa_u kappa_v", real=True)
@@ -126,20 +126,20 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
                                 sp.MatMul(beta * h, NU_S, evaluate=False)),
                            _sum(PV_S, sp.MatMul(beta * h_v, N_S, evaluate=False),
                                 sp.MatMul(beta * h, NV_S, evaluate=False)))
-    slopes = sp.ImmutableMatrix([T_U, T_V])
+    slopes = sp.ImmutableMatrix([XI_U, XI_V])
     at_sphere = principal.subs(sphere)
     return Theorem(
         id="displaced-normal", title=TITLES["displaced-normal"],
         statement=r"Let $p(u, v)$ be a surface with unit normal $n$, displaced along it by $\beta$ times a "
                   r"height $h(u, v)$: $⟦displaced⟧$. Then exactly $$⟦cross⟧$$ and the first product "
-                  r"lies along $n$. Measure a normal by its slopes $⟦t⟧$: its components along "
+                  r"lies along $n$. Measure a normal by its slopes $⟦xi⟧$: its components along "
                   r"$⟦e_u⟧$ and $⟦e_v⟧$ over its component along $n$. "
                   r"On an orthogonal chart, right- or left-handed, the displaced normal's slopes are, to first "
                   r"order in $\beta$, $⟦first_u⟧$ and $⟦first_v⟧$: the slope of $h$ divided by the chart's "
                   r"arc lengths, tilting away from rising $h$. Where the chart follows lines of curvature, "
                   r"$⟦n_u⟧$ and $⟦n_v⟧$ (a sphere, a torus, a plane), exactly "
                   r"$$⟦principal⟧$$ On sphere A, for $⟦phi⟧$ ($⟦kappa_u⟧$, $⟦kappa_v⟧$, $⟦L_u⟧$, "
-                  r"$⟦L_v⟧$) these are the renderer's surface bump, $t_u$ above and $t_v$ below: $$⟦sphere⟧$$",
+                  r"$⟦L_v⟧$) these are the renderer's surface bump, $\xi_u$ above and $\xi_v$ below: $$⟦sphere⟧$$",
         steps=(
             Step(r"Differentiate $p' = p + \beta h\, n$ by the product rule", sp.Tuple(DU_S, DV_S), derivatives,
                  cases=(("any surface", ANY_SURFACE),)),
@@ -151,9 +151,9 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
                  r"along $n$ and, with $p_u = \lvert p_u\rvert e_u$ and $p_v = \lvert p_v\rvert e_v$, "
                  r"$c\cdot n = \pm\lvert p_u\rvert\lvert p_v\rvert + O(\beta)$; of $c$'s terms only "
                  r"$\beta h_u\, n \times p_v = \mp\beta h_u\lvert p_v\rvert\, e_u$, already $O(\beta)$, lies along $e_u$, so the slope "
-                 r"$t_u = c\cdot e_u / c\cdot n$ is, to first order",
-                 T_U, first[0], cases=ORTHOGONAL),
-            Step(r"Likewise $t_v = c\cdot e_v / c\cdot n$", T_V, first[1], cases=ORTHOGONAL),
+                 r"$\xi_u = c\cdot e_u / c\cdot n$ is, to first order",
+                 XI_U, first[0], cases=ORTHOGONAL),
+            Step(r"Likewise $\xi_v = c\cdot e_v / c\cdot n$", XI_V, first[1], cases=ORTHOGONAL),
             Step(r"With $n_u = \kappa_u p_u$ and $n_v = \kappa_v p_v$ the first product is "
                  r"$(1 + \beta h\kappa_u)(1 + \beta h\kappa_v)\, p_u \times p_v$, the term in $h_u$ carries "
                  r"$1 + \beta h\kappa_v$ and the term in $h_v$ carries $1 + \beta h\kappa_u$, so exactly", slopes, principal,
@@ -161,18 +161,18 @@ def _theorem(cross=CROSS, first=FIRST, principal=PRINCIPAL, sphere=SPHERE, rende
             Step(r"On sphere A, $n = p/R$ gives $\kappa_u = \kappa_v = 1/R$, and by ⟪chart⟫ a step in $u$ "
                  r"covers $\lvert p_u\rvert = 2\pi R\sin\varphi$, one in $v$ covers $\lvert p_v\rvert = \pi R$; "
                  r"in the renderer's left-handed chart (⟪frame-orientation⟫) step 5 gives its surface bump's "
-                 r"coefficients $(t_u, t_v)$", at_sphere, renderer),
+                 r"coefficients $(\xi_u, \xi_v)$", at_sphere, renderer),
         ),
-        claims={"cross": (product, cross), "first_u": (T_U, first[0]), "first_v": (T_V, first[1]),
+        claims={"cross": (product, cross), "first_u": (XI_U, first[0]), "first_v": (XI_V, first[1]),
                 "principal": (slopes, principal), "sphere": (at_sphere, renderer)},
         shown={"displaced": sp.Eq(sp.MatrixSymbol("p'", 3, 1), DISPLACED, evaluate=False),
-               "t": sp.Eq(sp.Symbol("t"), sp.Tuple(T_U, T_V), evaluate=False),
+               "xi": sp.Eq(sp.Symbol("xi"), sp.Tuple(XI_U, XI_V), evaluate=False),
                **{str(e): sp.Eq(e, sp.MatMul(1 / length, p, evaluate=False), evaluate=False)
                   for e, p, length in ((EU_S, PU_S, L_U), (EV_S, PV_S, L_V))},
                **{str(n): sp.Eq(n, sp.MatMul(k, p, evaluate=False), evaluate=False)
                   for n, k, p in ((NU_S, K_U, PU_S), (NV_S, K_V, PV_S))},
                **{str(k): sp.Eq(k, value, evaluate=False) for k, value in sphere.items()}, "phi": PHI_OFF_POLES},
-        where={C_S: cross, T_U: Dot(C_S, EU_S) / Dot(C_S, N_S), T_V: Dot(C_S, EV_S) / Dot(C_S, N_S)},
+        where={C_S: cross, XI_U: Dot(C_S, EU_S) / Dot(C_S, N_S), XI_V: Dot(C_S, EV_S) / Dot(C_S, N_S)},
         names=NAMES, domain=DOMAIN, functions=INSTANCES,
         wrong_variants=(
             ("Blinn's drop of the terms in h itself, claimed exact on a principal chart",

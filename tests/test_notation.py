@@ -22,7 +22,7 @@ from proofs.registry import THEOREMS
 #: sha256 (first 16 hex digits) of `printed`, per theorem.
 PRINTED = {
     "shading": "1fce5561cf3d311a",
-    "displaced-normal": "d41ae0ec92d4e7ef",
+    "displaced-normal": "29ad1e174333cdfb",
     "chart": "b0eb3cf5166d0cb0",
     "frame-orthonormal": "6f2e22487456f433",
     "frame-orientation": "159cdc15fdb9b096",
@@ -37,8 +37,8 @@ PRINTED = {
     "beta-zero-regression": "3fcdd884c05219d5",
     "central-difference-truncation": "1d7a38548a2d22ed",
     "optimal-step": "8ff24d3b64fdf31c",
-    "bump-vs-displacement": "bcfda24e2884f7a1",
-    "blinn-perturbation": "9955779fe68ebcfa",
+    "bump-vs-displacement": "faba007091e2fccc",
+    "blinn-perturbation": "0b31a92250fdbb7d",
 }
 
 
