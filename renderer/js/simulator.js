@@ -127,7 +127,8 @@ export const PRESETS = [
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
 ];
 
-const HINT = "Hover over a canvas, tap it, or focus it and use the arrow keys, to read that pixel in the readout; " +
+const HINT = "Hover over a canvas, tap it, or focus it and use the arrow keys (Shift: ten pixels; B: the next pixel " +
+  "in the crease band), to read that pixel in the readout; " +
   "on the ε slider, Page Up and Page Down move a whole decade.";
 // The controls shown above the canvases.
 const MAIN = ["height_field", "log_eps", "beta"];
