@@ -337,21 +337,25 @@ CURVE_TABLE_JS = """() => ({caption: document.getElementById('sim-curve-table-ca
 def curve_table_problems(s):
     """Where the U-curve's table departs from the curve it tabulates, once drawn over every pixel
     (`Session.wait_curve`): a row count other than the points'; a row whose ε, RMS or max |ΔI| is not its
-    point's to the digits it prints; a step marked best other than the triangle's; a caption that does not
-    say every pixel."""
+    point's to the digits it prints; a step marked best other than the triangle's, or current other than the
+    marker's (none with footprint steps); a caption that does not say every pixel."""
     curve, table = s.wait_curve(), s.page.evaluate(CURVE_TABLE_JS)
     found = [] if len(table["rows"]) == len(curve["points"]) else [
         f"{len(table['rows'])} rows for the curve's {len(curve['points'])} points"]
     triangle = s.page.locator("#sim-curve-best")
     best = float(triangle.get_attribute("data-eps")) if triangle.count() else None
+    current = float(s.page.locator("#sim-curve").get_attribute("data-eps")) \
+        if s.page.locator("#sim-curve-marker").count() else None
     for (eps, rms, top), p in zip(table["rows"], curve["points"]):
-        cells = {"ε": (float(eps.removesuffix(" (best)")), p["eps"], 0.05), "RMS": (float(rms), p["rms"], 5e-3),
+        marks = re.findall(r" \((best|current)\)", eps)
+        cells = {"ε": (float(eps.split(" (")[0]), p["eps"], 0.05), "RMS": (float(rms), p["rms"], 5e-3),
                  "max": (float(top), p["max_abs"], 5e-3)}
         found += [f"{name} {shown!r} in the row of the point at ε = {p['eps']:.1e}, {value!r}"
                   for name, (shown, value, rel) in cells.items() if not abs(shown - value) <= rel * value]
-        if eps.endswith(" (best)") != (p["eps"] == best):
-            found.append(f"the row of ε = {p['eps']:.1e} {'marked' if eps.endswith(' (best)') else 'unmarked'}, "
-                         f"the triangle at {best}")
+        for mark, at in (("best", best), ("current", current)):
+            if (mark in marks) != (p["eps"] == at):
+                found.append(f"the row of ε = {p['eps']:.1e} {'marked' if mark in marks else 'not marked'} {mark}, "
+                             f"the {'triangle' if mark == 'best' else 'marker'} at {at}")
     if "every pixel" not in table["caption"]:
         found.append(f"the table's caption: {table['caption']!r}")
     return found
@@ -361,7 +365,9 @@ def curve_table_problems(s):
 WRONG_TABLE = {
     "filled once, from the sampled curve": ("this.curve_rows.replaceChildren(",
                                            "if (!this.curve_rows.children.length) this.curve_rows.replaceChildren("),
-    "the best step unmarked": ('(marked && i === best ? " (best)" : "")', '""'),
+    "the best step unmarked": ('marked && i === best && "best"', 'false'),
+    "the current step unmarked": ('i === current && "current"', 'false'),
+    "the current step marked with footprint steps too": ("const current = unused ? -1 : ", "const current = "),
     "the RMS under max": ('el("td", { text: fmt(p.max_abs, 2) })', 'el("td", { text: fmt(p.rms, 2) })'),
     "a caption naming the sample": ("over ${sample}`", "over a sample`"),
 }
@@ -371,7 +377,9 @@ WRONG_TABLE = {
 def test_the_table_check_catches_a_stale_or_wrong_curve_table(browser, book_html, variant):
     s = _simulator_at(browser, book_html, 1280, bundle=_replaced_once(*WRONG_TABLE[variant], variant))
     try:
-        assert curve_table_problems(s), variant
+        if not curve_table_problems(s):          # as it opens, else with footprint steps
+            s.select("numeric", "footprint")
+            assert curve_table_problems(s), variant
     finally:
         s.close()
 
@@ -702,6 +710,7 @@ def test_with_footprint_steps_the_eps_slider_is_disabled_and_says_it_is_unused(s
         assert s.page.is_disabled("#sim-log_eps") and s.page.text_content("#sim-log_eps-value").endswith(", unused")
         assert s.page.locator("#sim-curve-marker").count() == 0
         assert "no ε is marked" in s.page.text_content("#sim-curve-caption")
+        assert curve_table_problems(s) == []                # no row marked current
         label = s.page.get_attribute("#sim-curve", "aria-label")
         # The label speaks the frame's own numbers, the ledger's (it had kept those of the last ε).
         said = [f"{s.ledger(name):.1e}".replace("e-0", "e-") for name in ("rms", "max")]     # as the page prints

@@ -490,7 +490,7 @@ class Simulator {
     put("sim-max", fmt(ledger.max_abs), ledger.max_abs);
     put("sim-rms", fmt(ledger.rms), ledger.rms);
     put("sim-flips", String(ledger.flips), ledger.flips);
-    put("sim-pixels", String(ledger.pixels_a), ledger.pixels_a);
+    put("sim-pixels", ledger.pixels_a.toLocaleString("en-US"), ledger.pixels_a);   // with thousands separators, as the book prints counts
     put("sim-time", `${ms.toFixed(0)} ms (${res.full ? "new geometry" : "sphere A re-shaded"})`, ms);
     this.root.dataset.updates = String(this.timings.length);
     if (this.probe) this.show_probe(this.probe.i, this.probe.j, false);
@@ -682,8 +682,11 @@ class Simulator {
       nodes.push(svg("text", { x: x0 + 27, y }, label));
     });
     plot.innerHTML = nodes.join("");
+    // Each row's ε, with "best" at the triangle's and "current" at the slider's (when it is one of the curve's steps).
+    const current = unused ? -1 : CURVE_LOG_EPS.findIndex((l) => eps_of(l) === here.eps);
     this.curve_rows.replaceChildren(...points.map((p, i) => el("tr", {}, [
-      el("th", { scope: "row", text: eps_of(CURVE_LOG_EPS[i]).toExponential(1) + (marked && i === best ? " (best)" : "") }),
+      el("th", { scope: "row", text: eps_of(CURVE_LOG_EPS[i]).toExponential(1) +
+        [marked && i === best && "best", i === current && "current"].filter(Boolean).map((m) => ` (${m})`).join("") }),
       el("td", { text: fmt(p.rms, 2) }), el("td", { text: fmt(p.max_abs, 2) })])));
     const stride = this.curve.stride, s = this.state.resolution;
     const sample = stride === 1 ? `every pixel of sphere A in the ${s} × ${s} frame`
