@@ -203,7 +203,7 @@ ON_THE_PAGE = ("c6_fine_step", "c6_trunc_ratio", "c6_trunc_size", "ix_label", "s
                "c4_classic_cs_max", "c4_classic_ad_err", "c4_classic_eps_model", "c4_classic_eps_fitted",
                "c4_classic_central_step", "c4_classic_richardson_f", "c4_classic_fwd_step", "c4_classic_fwd_trunc",
                "c4_classic_fwd_err", "c4_classic_fwd_numpy", "c4_classic_rtol", "c4_classic_rich_first", "c4_classic_rich_nit", "c4_classic_rich_off", "c4_classic_rich_tight", "c4_classic_rich_tight_f",
-               "c4_classic_rich_tight_err", "c4_classic_rich_tighter", "c4_classic_rich_tighter_f", "c4_classic_rich_tighter_err", "s2_field_order", "c4_crease_table", "c5_iterates",
+               "c4_classic_rich_tight_err", "c4_classic_rich_tighter", "c4_classic_rich_tighter_f", "c4_classic_rich_tighter_err", "s2_field_order", "s4_smooth_fields", "s4_creased_fields", "c4_crease_table", "c5_iterates",
                "c2_label", "c5_fit_label", "c5_fit_pixels", "c5_fit_beta_0", "ex_fwd_h2", "ex_fwd_eps", "ex_fwd_err", "ex_fwd_best_eps", "ex_fwd_best_err", "ex_fwd_best_share",
                "ex_fwd_err_1e8", "ex_fwd_small", "ex_fwd_small_bound", "ex_fwd_err_1e3", "ex_cen_err_1e6", "ex_cs_err", "ex_exact_err", "ex_gn_jr0",
                "ex_gn_jj0", "ex_gn_jr1", "ex_gn_jj1", "ex_gn_b1", "ex_gn_b2", "ex_gn_share", "ex_gn_errors",

@@ -122,6 +122,9 @@ def build_parser():
                         help="TOML file of Scene fields (lights as [[lights]] tables of position and color); "
                              "missing fields keep the defaults: the draft's scene with the displaced sphere's "
                              "normal, bump=surface (the draft's own normal is bump=chart)")
+        sp.add_argument("--field", metavar="NAME|EXPR",
+                        help="the height field, after the file: a registered name (an unknown one is refused with "
+                             "the list) or an expression in u, v, k_u, k_v, as for ucurve")
         sp.add_argument("--set", action="append", default=[], metavar="key=value",
                         help="override a Scene field after the file; the value is TOML, or else a string "
                              "(height_field=sine); repeatable")
@@ -215,9 +218,10 @@ def _replace(scene, table, source):
         raise UsageError(f"{source}: {str(exc).replace('Scene.', '')}") from None
 
 
-def load_scene(path=None, sets=()):
+def load_scene(path=None, sets=(), field=None):
     """The `Scene` of a TOML file (its keys are Scene fields; missing ones keep the defaults),
-    then the ``key=value`` overrides ``sets``.
+    then the height field ``field`` (a name or an expression; None keeps the file's), then the
+    ``key=value`` overrides ``sets``.
 
     Raises
     ------
@@ -237,6 +241,8 @@ def load_scene(path=None, sets=()):
         except ValueError as exc:      # TOMLDecodeError, UnicodeDecodeError
             raise UsageError(f"{path}: {exc}") from None
         scene = _replace(scene, table, path)
+    if field is not None:
+        scene = _replace(scene, {"height_field": field}, "--field")
     overrides = {}
     for item in sets:
         key, eq, text = item.partition("=")
@@ -307,7 +313,7 @@ def _cmd_render(args):
     from renderer.ledger import compare
     from renderer.render import render
     _check_output(args.output, "-o")
-    scene, (width, height), bump = load_scene(args.scene, args.set), _frame_size(args), args.view == "bump"
+    scene, (width, height), bump = load_scene(args.scene, args.set, args.field), _frame_size(args), args.view == "bump"
     numeric = render(scene, width, height, gradient="central", kink=False, grad=bump, backend=args.backend)
     symbolic = render(scene, width, height, gradient="exact", grad=bump, backend=args.backend)
     led = compare(numeric, symbolic)
@@ -328,7 +334,7 @@ def _cmd_sweep(args):
     from renderer.scene import MAX_EPS, MIN_EPS
     from renderer.sweep import sweep
     steps = [float(e) for e in validate.steps("--eps", args.eps, low=MIN_EPS, high=MAX_EPS)]
-    scene, (width, height) = load_scene(args.scene, args.set), _frame_size(args)
+    scene, (width, height) = load_scene(args.scene, args.set, args.field), _frame_size(args)
     census = sweep(scene, steps, width, height).census
     rows = [(e, *(getattr(led, c) for c in COLUMNS[1:])) for e, led in zip(steps, census)]
     if args.format == "json":

@@ -65,6 +65,16 @@ def _builtin(field):
     return field.name in F.BUILTIN and F.FIELDS.get(field.name) is field
 
 
+def _generated(module, field):
+    """A built-in field's functions in the generated ``module``; a field registered in formulas.py since the
+    generator last ran has none there (RuntimeError, naming the command that prints them)."""
+    try:
+        return module.FIELDS[field.name]
+    except KeyError:
+        raise RuntimeError(f"{module.__name__} has no code for the height field {field.name!r} of renderer/formulas.py: "
+                           "run python -m renderer.codegen") from None
+
+
 @lru_cache(maxsize=None)
 def compiled(field):
     """The `FieldCode` of a `formulas.HeightField`: numba cfuncs of `SIGNATURES`.
@@ -79,10 +89,16 @@ def compiled(field):
         ``height(u, v, k_u, k_v) -> h``; ``exact(u, v, k_u, k_v)`` and
         ``central(u, v, k_u, k_v, eps_u, eps_v) -> (h, h_u, h_v, flag)``;
         ``kink(u, v, k_u, k_v) -> flag``.  float64 in and out, the flag a bool.
+
+    Raises
+    ------
+    RuntimeError
+        A built-in field (`formulas.BUILTIN`) renderer/generated.py does not hold: registered in
+        formulas.py since ``python -m renderer.codegen`` last ran.
     """
     if _builtin(field):
         from . import generated
-        functions, cache = generated.FIELDS[field.name], True
+        functions, cache = _generated(generated, field), True
     else:
         from .codegen import field_source
         ns = _execute(field_source(field), f"height field {field.name}")
@@ -97,7 +113,7 @@ def array_code(field):
     arrays of the namespace ``xp``), as a `FieldCode`."""
     if _builtin(field):
         from . import generated_array
-        return FieldCode(*generated_array.FIELDS[field.name])
+        return FieldCode(*_generated(generated_array, field))
     from .codegen import field_source
     ns = _execute(field_source(field, array=True), f"height field {field.name}")
     return FieldCode(*(ns[name] for name in F.FIELD_FUNCTIONS))

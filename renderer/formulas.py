@@ -249,7 +249,7 @@ FIELDS = {}
 def register(field):
     """Add ``field`` (a `HeightField` named by an identifier) to `FIELDS`, and return it.
 
-    A new built-in field is one call here, after the three built in and before
+    A new built-in field is one call here, after the built-in ones and before
     ``BUILTIN = tuple(FIELDS)`` (a field registered after that, or elsewhere, is printed and
     compiled when first used)::
 
@@ -277,8 +277,8 @@ def register(field):
       that lists the fields (bump-vs-displacement).  ``python tests/test_notation.py`` prints the
       text of each new or changed theorem, then the digests: read the text, then record the
       digests in its ``PRINTED``.
-    * §2's prose (book/s2_scene.md: its list of the fields, its figure's alt text) describes
-      them in words.
+    * §2's prose (book/s2_scene.md: its list of the fields, its figure's alt text, its summary)
+      describes them in words; tests/test_book_prose.py finds a field it leaves out.
     * The book's length limits (tests/test_book_pages.py: words on the reading path and in the
       asides, each page's height) count what a field adds: about 150 words of asides (its
       gradient theorem), some 230 px on each of §3 and §5, and the words you add to §2.  Only

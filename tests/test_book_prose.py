@@ -388,3 +388,25 @@ def test_a_page_with_exercises_left_out_of_the_index_is_found(tmp_path):
         (tmp_path / p.name).write_text(p.read_text())
     (tmp_path / "s8_history.md").write_text("::::{exercise} New\n:label: ex-new\n::::\n")
     assert exercises_named_by_the_index((BOOK / "index.md").read_text()) != pages_with_exercises(tmp_path)
+
+
+def fields_left_unsaid(text):
+    """The registered height fields (`renderer.formulas.FIELDS`) §2's words leave out: its list (an item
+    ``* **name**``), its map's alt text and its summary's line on the fields."""
+    from renderer.formulas import FIELDS
+    alt = re.search(r"^:alt: (.*)$", text.split("```{glue:figure} fig-s2-fields", 1)[-1], re.M)
+    summary = re.search(r"^- Sine is .*$", text, re.M)
+    where = {"list": lambda name: f"* **{name}**" in text,
+             "the map's alt text": lambda name: alt is not None and name.lower() in alt.group(1).lower(),
+             "the summary": lambda name: summary is not None and name.lower() in summary.group(0).lower()}
+    return [f"{name} not in {part}" for name in FIELDS for part, said in where.items() if not said(name)]
+
+
+def test_the_scene_page_describes_every_registered_field():
+    """The one part of a new field written by hand, §2's words about it (`renderer.formulas.register` says so),
+    is there for each field; a field unsaid is found (wrong variant: rings dropped from each place)."""
+    text = (BOOK / "s2_scene.md").read_text(encoding="utf-8")
+    assert fields_left_unsaid(text) == []
+    unsaid = text.replace("* **rings**", "* **circles**").replace("rings is a set", "the last is a set")
+    unsaid = unsaid.replace("rings varies in $v$ only", "the last varies in $v$ only")
+    assert fields_left_unsaid(unsaid) == ["rings not in list", "rings not in the map's alt text", "rings not in the summary"]

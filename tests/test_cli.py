@@ -190,6 +190,20 @@ def test_set_takes_toml_values_and_bare_words(text, value):
     assert getattr(cli.load_scene(None, [text]), key) == value
 
 
+def test_field_sets_the_height_field_after_the_file_and_before_set(tmp_path, capsys):
+    """``--field`` of render and sweep, as ucurve's: a name or an expression, over the file's field, under
+    ``--set``'s; a wrong one refused in one line naming --field."""
+    toml = tmp_path / "scene.toml"
+    toml.write_text('height_field = "rings"\n', encoding="utf-8")
+    assert cli.load_scene(toml, (), "ridges").height_field == "ridges"
+    assert cli.load_scene(toml, ("height_field=sine",), "ridges").height_field == "sine"
+    assert cli.load_scene(None, (), "u*v").height_field == "u*v"
+    rc, out, err = run(["sweep", "--field", "ridges", "--size", "8x8", "--eps", "1e-3"], capsys)
+    assert rc == 0 and out.startswith("census: ridges,")
+    rc, _, err = run(["render", "--field", "bumpz", "-o", tmp_path / "o.png"], capsys)
+    assert one_line(rc, err) and "--field" in err and "'bumpz'" in err and not (tmp_path / "o.png").exists()
+
+
 def test_a_value_that_is_not_toml_reaches_the_library_as_a_string(tmp_path, capsys):
     """``height_field`` may be an expression of u and v: the library accepts it, or refuses it by name."""
     assert cli._toml_value("sin(2*pi*u) * v") == "sin(2*pi*u) * v"

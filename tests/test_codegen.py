@@ -568,6 +568,17 @@ def test_check_catches_a_missing_generated_file_and_the_generator_writes_it(copi
     assert codegen.main([]) == 0 and path.read_text(encoding="utf-8") == fresh
 
 
+@pytest.mark.parametrize("code", [fieldcode.compiled, fieldcode.array_code])
+def test_a_built_in_field_the_generator_has_not_printed_sends_the_author_to_it(code, monkeypatch):
+    """A field registered among the built-in ones since the generator last ran (as a line added to
+    formulas.py is) has no generated code: the error names the generator's command, not a KeyError."""
+    late = F.HeightField("late", F.u * F.v)
+    monkeypatch.setattr(F, "FIELDS", {**F.FIELDS, "late": late})
+    monkeypatch.setattr(F, "BUILTIN", (*F.BUILTIN, "late"))
+    with pytest.raises(RuntimeError, match=r"no code for the height field 'late'.*run python -m renderer\.codegen"):
+        code(late)
+
+
 @pytest.mark.parametrize("lines", [0, 2])
 def test_a_kernel_without_exactly_one_digest_line_is_refused(lines):
     text = "x = 1\n" + 'FORMULAS_DIGEST = "abc"  # of generated.py\n' * lines

@@ -42,6 +42,11 @@ PRINTED = {
 }
 
 
+#: What a failure tells the author to do.
+RECORD = ("If the change is intended, review the text, then run .venv/bin/python tests/test_notation.py "
+          "and paste the table it prints over PRINTED in tests/test_notation.py.")
+
+
 def printed(t):
     """The theorem's text as the book prints it: statement, each step's sentence, each calc chain's display,
     each defined symbol."""
@@ -57,11 +62,12 @@ def _digest(text):
 @pytest.mark.parametrize("theorem_id", list(THEOREMS))
 def test_the_theorem_prints_as_reviewed(theorem_id):
     text = printed(THEOREMS[theorem_id])
-    assert _digest(text) == PRINTED.get(theorem_id), f"{theorem_id} now prints:\n{text}"
+    assert _digest(text) == PRINTED.get(theorem_id), f"{theorem_id} now prints:\n{text}\n{RECORD}"
 
 
 def test_every_theorem_has_a_recorded_print():
-    assert set(PRINTED) == set(THEOREMS)
+    assert set(PRINTED) == set(THEOREMS), (f"theorems without a recorded print: {sorted(set(THEOREMS) - set(PRINTED))}; "
+                                           f"recorded, no longer a theorem: {sorted(set(PRINTED) - set(THEOREMS))}. {RECORD}")
 
 
 if __name__ == "__main__":
