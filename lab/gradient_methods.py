@@ -32,13 +32,14 @@ its own (`methods` refuses a second record of one name).  Its one-variable form
 (`Method.derivative`) is built, as the differences' are, from
 `renderer.fieldcode.univariate_code(function)`: the function's compiled value and its central
 and forward quotients.  §5's tables, legends and the sentence naming the methods are generated
-from the list, and its figures make room for a new one (the baselines in tests/figure_baselines
-draw a fixed list and do not change).  Three things stay the author's: the prose that describes
+from the list, and its figures make room for a new one (a legend too wide for two columns takes
+one; the baselines in tests/figure_baselines draw a fixed list and do not change).  Three things stay the author's: the prose that describes
 the figures (their alt text, §5's "What it shows", book/s5_lab.md); a public function beside the
 record (as `forward_gradient` is) joins the table of tests/test_lab_validation.py, which names a
-function missing from it; and §5's height, which a row of its figures and tables may push past
-the limit of tests/test_book_pages.py (``make audit`` says so; make room, or raise the limit
-with the reason in its comment).
+function missing from it; and the book's length: a record adds words to §5's sentence and rows
+to its tables and figures, which may push the reading path's words or §5's height past the limits
+of tests/test_book_pages.py, which only the audit of the built site checks (``make audit`` says
+so; make room, or raise the limit with the reason in its comment).
 
 Beside the methods: their work per pixel (`Evaluations`: values of h, evaluations of the
 generated gradient, and the sines and cosines they cost, counted from the sympy objects the

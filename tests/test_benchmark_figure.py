@@ -117,6 +117,28 @@ def test_the_univariate_figure_draws_each_method_in_its_style_for_a_phone():
     assert text_overlaps(fig) == []
 
 
+@pytest.mark.parametrize("figure", ["univariate", "pareto"])
+def test_a_methods_long_label_stacks_the_legend_and_leaves_the_figure_its_width(figure, monkeypatch):
+    """A legend wider than the figure widens the saved PNG (tight bounding box), and a phone's column then
+    shrinks every text in it below the audit's floor (a newcomer's 31-character label did): with a long
+    label the legend takes one column and the drawn figure stays within its width."""
+    import dataclasses
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from chapter.benchmark import univariate_figure
+    from lab import gradient_benchmark as gb
+    from lab import gradient_methods as gm
+
+    long = dataclasses.replace(gm.method("central"), label="a fourth-order central difference, five points")
+    monkeypatch.setattr(gm, "METHODS", [long if m.name == "central" else m for m in gm.METHODS])
+    if figure == "univariate":
+        rows = [gb.UnivariateRow(m, e, 1.0, 1e-8, 1e-8) for m in ("central", "complex step") for e in (1e-2, 1e-6)]
+        fig = univariate_figure(gb.UnivariateErrors("f", 1.5, 1.0, 50, tuple(rows), None, {}))
+    else:
+        fig = pareto_figure(_fake())
+    drawn = fig.get_tightbbox(FigureCanvasAgg(fig).get_renderer())
+    assert drawn.width <= fig.get_figwidth() + 0.05 and len(fig.legends) == 1 and fig.legends[0]._ncols == 1
+
+
 def _drawn(base, rng):
     """``base``'s results, each with a time drawn from 0.5 ms to 0.5 s and an error from 1e-16 to 2."""
     import dataclasses

@@ -31,6 +31,18 @@ def _floor(e):
     return max(e, 1e-18)
 
 
+def _legend(fig, handles, labels):
+    """The figure's legend under its panels in two columns, or in one where two would be wider than the
+    figure (a method's long label): a legend wider than the figure widens the saved image, and a phone's
+    column then shrinks every text in it."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    for ncols in (2, 1):
+        legend = fig.legend(handles, labels, loc="outside lower center", ncols=ncols, frameon=False)
+        if ncols == 1 or legend.get_window_extent(FigureCanvasAgg(fig).get_renderer()).width <= fig.bbox.width:
+            return legend
+        legend.remove()
+
+
 def pareto_figure(measurement, *, error="max"):
     """Log-log plot of time per frame against error, one panel per field, each as wide as the figure and
     stacked for a phone's column (5 in wide, every text at the book's size, `chapter.figures.TEXT_PT`, a
@@ -115,7 +127,7 @@ def pareto_figure(measurement, *, error="max"):
     axes[-1].set_xlabel("time per frame, ms")
     handles = {m: handles[m] for m in ("Pareto front", *(m.name for m in gm.methods())) if m in handles}
     labels = [m if m == "Pareto front" else gm.method(m).label for m in handles]
-    legend = fig.legend(list(handles.values()), labels, loc="outside lower center", ncols=2, frameon=False)
+    legend = _legend(fig, list(handles.values()), labels)
     # The figure grows by the legend's height, so that more methods do not squeeze the panels.
     tall = legend.get_window_extent(FigureCanvasAgg(fig).get_renderer()).height / fig.dpi
     fig.set_figheight(_ROW_IN * len(names) + tall)
@@ -343,7 +355,7 @@ def univariate_figure(errors):
     ax.set_xlabel("step")
     ax.set_ylabel("relative error of f′(x)")
     ax.grid(alpha=0.3, lw=0.3)
-    fig.legend(loc="outside lower center", ncols=2, frameon=False)
+    _legend(fig, *ax.get_legend_handles_labels())
     return fig
 
 
