@@ -568,7 +568,8 @@ def univariate_errors(function, x, *, steps=UNIVARIATE_STEPS):
                 if not math.isfinite(value):
                     raise validate.InvalidValue(f"function {record.name}: its {m.name} derivative at x = {x!r}"
                                                 + (f" with the step {eps!r}" if eps is not None else "")
-                                                + " is not a finite number (f is not finite where it looks)")
+                                                + " is not a finite number: it evaluates f where f is not finite"
+                                                + " (a smaller step keeps it nearer x)")
                 if "h_per_pixel" in info:
                     evaluations[m.name] = info["h_per_pixel"]
                 error = float(abs(mpmath.mpf(value) - true))
