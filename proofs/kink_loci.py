@@ -202,7 +202,7 @@ def _rays(rho_=RHO_SHOWN, alpha=ALPHA_SHOWN, **evidence):
     ray = U_OF_THETA.subs(theta, alpha_m)
     return Theorem(
         id="kink-loci-rays", title=TITLES["kink-loci-rays"],
-        statement=r"In image-plane polar coordinates $(r, \psi)$ about the projection of the $z$ axis, "
+        statement=r"Seen from the eye $(0, 0, e)$, in image-plane polar coordinates $(r, \psi)$ about the projection of the $z$ axis, "
                   r"$⟦polar⟧$ with $⟦r⟧$: $⟦alpha⟧$, so $⟦u⟧$ depends on the angle "
                   r"alone, and the crease $⟦line_u⟧$ is the ray $⟦psi_m⟧$: $⟦ray⟧$.",
         steps=(

@@ -30,7 +30,7 @@ PRINTED = {
     "gradient-ridges": "c7e368c0325ff445",
     "gradient-rings": "ccd11d1bae25eafb",
     "ridges-kinks": "e05b59e321093ac4",
-    "kink-loci-rays": "5dffa25d9d5aa024",
+    "kink-loci-rays": "3f2bafdfa214747e",
     "kink-loci-circles": "3fd68e4230bb45e8",
     "no-boundary": "8bce22910d9e53d8",
     "normal-beta-derivative": "35beda755e35b086",

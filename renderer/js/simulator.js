@@ -127,8 +127,8 @@ export const PRESETS = [
           "zero and the U-curve lies on its floor. Move β up to bring the bump back." },
 ];
 
-const HINT = "Hover over a canvas, tap it, or focus it and use the arrow keys (Shift: ten pixels; B: the next pixel " +
-  "in the crease band), to read that pixel in the readout; " +
+const HINT = "Hover over a canvas, tap it, or focus it and use the arrow keys (Shift: ten pixels; B, Shift+B: the next, " +
+  "the previous pixel in the crease band), to read that pixel in the readout; " +
   "on the ε slider, Page Up and Page Down move a whole decade.";
 // The controls shown above the canvases.
 const MAIN = ["height_field", "log_eps", "beta"];
@@ -692,7 +692,7 @@ class Simulator {
     const sample = stride === 1 ? `every pixel of sphere A in the ${s} × ${s} frame`
                                 : `one pixel in each ${stride} × ${stride} block of the ${s} × ${s} frame ` +
                                   "(every pixel's curve follows in a moment)";
-    this.root.querySelector("#sim-curve-table-caption").textContent = `|ΔI| on sphere A at each step ε, over ${sample}`;
+    this.root.querySelector("#sim-curve-table-caption").textContent = `|ΔI| on sphere A at each step ε, over ${sample}; (current): the slider's ε, if one of them`;
     const said = unused ? this.frame_ledger : here;     // with footprint steps, the frame's own ledger
     plot.setAttribute("aria-label", `U-curve: RMS and max |ΔI| on sphere A against ε, log-log; ` +
                       (unused ? "the frame takes each pixel's footprint as its step: " : `at ε = ${here.eps.toExponential(1)} `) +
@@ -776,7 +776,7 @@ class Simulator {
       rows.push([`∇h ${b.gradient}`, vec(b.grad)]);
       rows.push(["step", b.steps[0] === b.steps[1] ? `ε = ${b.steps[0].toExponential(1)}`
         : `εᵤ = ${b.steps[0].toExponential(2)}, εᵥ = ${b.steps[1].toExponential(2)}`]);
-      rows.push(["crease", a.kink ? "in the band: the gradient is undefined on the crease" : "not in the band"]);
+      rows.push(["crease", a.kink ? "in the band: the stencil may reach across a crease" : "not in the band"]);
     }
     rows.push(["RGB exact", vec(a.rgb, 6)]);
     rows.push([`RGB ${b.gradient}`, vec(b.rgb, 6)]);
