@@ -369,7 +369,7 @@ WRONG_TABLE = {
     "the current step unmarked": ('i === current && "current"', 'false'),
     "the current step marked with footprint steps too": ("const current = unused ? -1 : ", "const current = "),
     "the RMS under max": ('el("td", { text: fmt(p.max_abs, 2) })', 'el("td", { text: fmt(p.rms, 2) })'),
-    "a caption naming the sample": ("over ${sample}`", "over a sample`"),
+    "a caption naming the sample": ("over ${sample};", "over a sample;"),
 }
 
 
