@@ -126,7 +126,7 @@ def build_parser():
                         help="the height field, after the file: a registered name (an unknown one is refused with "
                              "the list) or an expression in u, v, k_u, k_v, as for ucurve")
         sp.add_argument("--set", action="append", default=[], metavar="key=value",
-                        help="override a Scene field after the file; the value is TOML, or else a string "
+                        help="override a Scene field after the file and --field; the value is TOML, or else a string "
                              "(height_field=sine); repeatable")
 
     r = sub.add_parser("render", help="render a PNG and print the ledger",

@@ -392,13 +392,13 @@ def test_a_page_with_exercises_left_out_of_the_index_is_found(tmp_path):
 
 def fields_left_unsaid(text):
     """The registered height fields (`renderer.formulas.FIELDS`) §2's words leave out: its list (an item
-    ``* **name**``), its map's alt text and its summary's line on the fields."""
+    ``* **name**``), its map's alt text and its summary (the "In short" box)."""
     from renderer.formulas import FIELDS
     alt = re.search(r"^:alt: (.*)$", text.split("```{glue:figure} fig-s2-fields", 1)[-1], re.M)
-    summary = re.search(r"^- Sine is .*$", text, re.M)
+    summary = re.search(r"^:::\{admonition\} In short\n(.*?)^:::$", text, re.M | re.S)
     where = {"list": lambda name: f"* **{name}**" in text,
              "the map's alt text": lambda name: alt is not None and name.lower() in alt.group(1).lower(),
-             "the summary": lambda name: summary is not None and name.lower() in summary.group(0).lower()}
+             "the summary": lambda name: summary is not None and name.lower() in summary.group(1).lower()}
     return [f"{name} not in {part}" for name in FIELDS for part, said in where.items() if not said(name)]
 
 
